@@ -1,0 +1,133 @@
+// Front end: the Voronoi cells of a point set, over flat arrays.
+//
+// This is the compiled, non-templated layer (DESIGN §2.3): the CLI, the Python
+// module and the tests call only this. Everything it returns is ordered by
+// generator id and is byte-identical for any thread count.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <span>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace tessera {
+
+/// Axis-aligned domain box. In 2D only the first two axes are used.
+struct Bounds {
+  std::array<double, 3> lo{0, 0, 0};
+  std::array<double, 3> hi{0, 0, 0};
+  double volume(int dim) const;  ///< area in 2D
+};
+
+/// Invalid input (shape, NaN, bounds, labels...). The message is one line
+/// naming the problem; the CLI prints it and exits non-zero.
+struct InputError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+/// Raised from a progress callback to cancel a run (e.g. Ctrl-C in Python).
+struct Cancelled : std::runtime_error {
+  Cancelled() : std::runtime_error("cancelled") {}
+};
+
+struct VoronoiOptions {
+  int dim = 3;                          ///< 2 or 3
+  std::optional<Bounds> bounds;         ///< explicit domain; default: padded bbox
+  double padding = 0.01;                ///< relative margin of the default domain (fraction of the largest extent)
+  bool ignore_outside_points = false;   ///< with explicit bounds: drop points outside instead of failing
+  int threads = 0;                      ///< 0: TESSERA_NUM_THREADS, else all cores
+  double points_per_bin = 0;            ///< locator bin occupancy; 0 = automatic
+  bool build_mesh = true;               ///< merged vertices + per-cell faces (needed for VTK output)
+  /// Called from the calling thread with the fraction done, in [0,1]; may throw
+  /// Cancelled to stop the run (the engine stops between batches).
+  std::function<void(double)> progress;
+};
+
+/// Spoke classes (DESIGN §2, the classifier): the kind of each cell face.
+enum class SpokeClass : std::uint8_t {
+  same_region = 0,     ///< neighbour is an inside point with the same label
+  region_boundary = 1, ///< neighbour is an inside point with another label
+  domain_boundary = 2, ///< face lies on the domain box
+  outside = 3,         ///< neighbour is an outside point (label < 0)
+};
+
+/// The Voronoi tessellation of the inside points, clipped to the domain box.
+///
+/// Generators: the n input points. A generator "has a cell" when it is inside
+/// (label >= 0 or no labels), within the domain, and not an exact duplicate of
+/// a point that owns the cell. Cells are listed in generator-id order; `cell_of`
+/// maps a generator to its cell index (-1 when it has none).
+struct Cells {
+  int dim = 3;
+  std::size_t n_points = 0;
+  Bounds bounds;
+
+  // ---- per cell (size n_cells, in generator-id order) ----
+  std::vector<std::int32_t> generator;   ///< generator id of each cell
+  std::vector<std::int32_t> region;      ///< its label (0 when no labels were given)
+  std::vector<double> volume;            ///< area in 2D
+  std::vector<double> centroid;          ///< n_cells * dim
+  std::vector<std::int32_t> num_faces;   ///< faces (3D) / edges (2D), box faces included
+  /// Face neighbours of each cell as CSR: the generator ids across its faces,
+  /// ascending; box faces are not listed (they are counted in num_faces).
+  std::vector<std::int64_t> neighbor_offsets;  ///< n_cells + 1
+  std::vector<std::int32_t> neighbors;
+
+  // ---- per generator (size n_points) ----
+  std::vector<std::int32_t> cell_of;     ///< cell index or -1
+
+  // ---- the conformal mesh (only with build_mesh) ----
+  /// Merged vertices: one per topological coordinate.
+  std::vector<double> vertices;          ///< n_vertices * dim
+  /// Topological coordinate of each vertex: dim+1 ids, ascending; domain-box
+  /// planes are negative (-1-axis*2 for lo, -2-axis*2 for hi: x0=-1, x1=-2, y0=-3, ...).
+  std::vector<std::int32_t> vertex_keys; ///< n_vertices * (dim+1)
+  /// 3D: faces of each cell: cell_face_offsets (n_cells+1) into faces; each face
+  /// has face_vertex_offsets (n_faces_total+1) into face_vertices (global vertex
+  /// ids, counter-clockwise seen from outside the cell) and face_neighbor (the
+  /// spoke: generator id, or the negative box-plane id).
+  /// 2D: one face per edge; face_vertices holds the edge's two vertices (the
+  /// polygon's vertices, counter-clockwise, are the first vertex of each edge in order).
+  std::vector<std::int64_t> cell_face_offsets;
+  std::vector<std::int64_t> face_vertex_offsets;
+  std::vector<std::int32_t> face_vertices;
+  std::vector<std::int32_t> face_neighbor;
+  std::vector<SpokeClass> face_class;
+
+  // ---- diagnostics ----
+  /// Pairs (duplicate id, owner id): exactly coincident inputs; the lowest id owns the cell.
+  std::vector<std::pair<std::int32_t, std::int32_t>> duplicates;
+  std::vector<std::int32_t> ignored_outside_bounds;  ///< with ignore_outside_points
+  std::uint64_t exact_predicate_calls = 0;          ///< filter failures resolved exactly
+  int threads_used = 1;
+
+  std::size_t n_cells() const { return generator.size(); }
+  std::size_t n_vertices() const { return vertex_keys.size() / (dim + 1); }
+};
+
+/// Compute the cells. `points` holds n*dim doubles (row-major). `labels` is
+/// empty or n ints (label < 0: outside, clips neighbours, owns no cell).
+/// Throws InputError on bad input.
+Cells voronoi(std::span<const double> points, int dim, std::span<const std::int32_t> labels,
+              const VoronoiOptions& options);
+
+/// Invariant checks on a result (the CLI's --validate).
+struct ValidationReport {
+  bool ok = true;
+  double volume_sum = 0, domain_volume = 0, volume_rel_error = 0;
+  std::size_t asymmetric_spokes = 0;      ///< i lists j but j does not list i (both inside)
+  std::size_t bad_vertex_degree = 0;      ///< merged vertices not shared by exactly the cells of their key
+  std::size_t bad_euler = 0;              ///< cells with V - E + F != 2 (3D)
+  std::vector<std::string> messages;      ///< one line each
+};
+ValidationReport validate(const Cells& cells, std::span<const std::int32_t> labels);
+
+/// Resolved thread count for an option value (0 -> TESSERA_NUM_THREADS or hardware).
+int resolve_threads(int requested);
+
+}  // namespace tessera

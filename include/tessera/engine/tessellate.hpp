@@ -1,0 +1,94 @@
+// The parallel driver: every generator builds its own cell (the meshless
+// method), in fixed batches of generators in bin order, on oneTBB workers.
+#pragma once
+
+#include <algorithm>
+#include <cstdint>
+#include <functional>
+#include <span>
+#include <vector>
+
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include "tessera/engine/concepts.hpp"
+#include "tessera/kernels/cell_builder.hpp"
+#include "tessera/kernels/exact_predicates.hpp"
+#include "tessera/kernels/locator.hpp"
+
+namespace tessera::engine {
+
+/// What the driver needs: input, domain, locator and the generators whose
+/// cells are wanted, listed in the order to process them (bin order).
+template <int D>
+struct Generators {
+  const double* coords = nullptr;                 ///< n * D
+  const kernels::BinLocator<D>* locator = nullptr; ///< holds every point that clips
+  std::array<double, D> lo{}, hi{};               ///< domain box
+  std::span<const std::int32_t> order;            ///< generators to build, bin order
+  const kernels::ExactContext* exact = nullptr;
+};
+
+struct EngineOptions {
+  int threads = 1;
+  std::size_t batch_size = 512;   ///< fixed: results never depend on the thread count
+  std::function<void(double)> progress;
+};
+
+/// Build every cell of `gens.order` and hand each to the compositor; returns
+/// the number of exact predicate evaluations.
+template <class CellT, class Comp>
+  requires Compositor<Comp, CellT>
+std::uint64_t tessellate(const Generators<CellT::dim>& gens, Comp& comp, const EngineOptions& opt) {
+  constexpr int D = CellT::dim;
+  const std::size_t n = gens.order.size();
+  const std::size_t bs = std::max<std::size_t>(1, opt.batch_size);
+  const std::size_t nb = (n + bs - 1) / bs;
+  std::vector<typename Comp::Batch> batches(nb);
+
+  struct Workspace {
+    kernels::CellBuilder<CellT> builder;
+    CellT cell;
+    std::uint64_t exact_calls = 0;
+  };
+  tbb::enumerable_thread_specific<Workspace> workspaces([&] {
+    return Workspace{kernels::CellBuilder<CellT>(*gens.locator, gens.coords, gens.lo.data(),
+                                                 gens.hi.data(), gens.exact),
+                     CellT{}, 0};
+  });
+
+  auto run_batch = [&](std::size_t k) {
+    Workspace& ws = workspaces.local();
+    auto& batch = batches[k];
+    const std::size_t end = std::min(n, (k + 1) * bs);
+    for (std::size_t g = k * bs; g < end; ++g) {
+      std::int32_t gen = gens.order[g];
+      kernels::BuildStatus st = ws.builder.build(gen, ws.cell);
+      ws.exact_calls += ws.cell.exact_calls();
+      comp.add(batch, gen, st, ws.cell);
+    }
+  };
+
+  tbb::task_arena arena(std::max(1, opt.threads));
+  // Progress is reported (and cancellation honoured) between chunks of batches,
+  // from the calling thread.
+  const std::size_t chunk = opt.progress ? std::max<std::size_t>(1, nb / 100) : nb;
+  for (std::size_t first = 0; first < nb; first += chunk) {
+    const std::size_t last = std::min(nb, first + chunk);
+    arena.execute([&] {
+      tbb::parallel_for(tbb::blocked_range<std::size_t>(first, last, 1),
+                        [&](const tbb::blocked_range<std::size_t>& r) {
+                          for (std::size_t k = r.begin(); k != r.end(); ++k) run_batch(k);
+                        });
+    });
+    if (opt.progress) opt.progress(static_cast<double>(last) / static_cast<double>(nb));
+  }
+  std::uint64_t exact_calls = 0;
+  for (auto& ws : workspaces) exact_calls += ws.exact_calls;
+  comp.finish(std::span<typename Comp::Batch>(batches));
+  (void)D;
+  return exact_calls;
+}
+
+}  // namespace tessera::engine

@@ -1,0 +1,123 @@
+// Builds one generator's cell: the meshless method's per-point loop.
+//
+// Start from the domain box; visit the locator's bins in shells of growing
+// Chebyshev radius; in each shell sort the candidates by distance and clip by
+// each bisector in turn. A candidate j can only clip while |p_j - p_i| <= 2R
+// (R: the distance to the farthest cell vertex, so the flower of petals — the
+// balls centred at the vertices through p_i — lies within 2R): bins and whole
+// shells beyond the security radius are skipped, and the loop ends when the
+// next shell's distance lower bound passes it. A candidate inside the radius
+// but in no petal leaves every vertex in place and costs only the sign pass.
+//
+// One builder per thread: its buffers grow to the largest cell seen and are
+// reused, so steady state allocates nothing.
+#pragma once
+
+#include <algorithm>
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "tessera/kernels/locator.hpp"
+
+namespace tessera::kernels {
+
+/// Outcome of building one cell.
+struct BuildStatus {
+  bool has_cell = true;          ///< false: an exact duplicate of `duplicate_of`
+  std::int32_t duplicate_of = -1;
+};
+
+template <class CellT>
+class CellBuilder {
+ public:
+  static constexpr int D = CellT::dim;
+
+  CellBuilder(const BinLocator<D>& locator, const double* coords, const double* lo, const double* hi,
+              const ExactContext* exact)
+      : loc_(locator), coords_(coords), lo_(lo), hi_(hi), exact_(exact) {}
+
+  /// Build the cell of generator i into `cell`.
+  BuildStatus build(std::int32_t i, CellT& cell) {
+    const double* p = coords_ + static_cast<std::size_t>(i) * D;
+    cell.reset(i, p, lo_, hi_, exact_);
+    const auto b = loc_.bin_coords(p);
+    const int last = loc_.max_shell(b);
+    const auto& off = loc_.offsets();
+    BuildStatus status;
+    for (int s = 0; s <= last; ++s) {
+      double sec2 = cell.security_radius2();
+      if (s > 0) {
+        double lb = loc_.shell_lower_bound(p, b, s);
+        if (lb * lb > sec2) break;
+      }
+      cand_.clear();
+      loc_.for_each_shell_bin(b, s, [&](const std::array<std::int32_t, D>& c, std::size_t bin) {
+        if (s > 0 && loc_.bin_distance2(p, c) > sec2) return;
+        for (std::uint32_t k = off[bin]; k < off[bin + 1]; ++k) {
+          std::int32_t j = loc_.id(k);
+          if (j == i) continue;
+          const auto& pj = loc_.point(k);
+          Candidate cd;
+          double r2 = 0;
+          for (int d = 0; d < D; ++d) {
+            cd.q[d] = pj[d] - p[d];
+            r2 += cd.q[d] * cd.q[d];
+          }
+          if (r2 > sec2) continue;
+          cd.r2 = r2;
+          cd.id = j;
+          cand_.push_back(cd);
+        }
+      });
+      std::sort(cand_.begin(), cand_.end(), [](const Candidate& x, const Candidate& y) {
+        return x.r2 < y.r2 || (x.r2 == y.r2 && x.id < y.id);
+      });
+      for (const Candidate& cd : cand_) {
+        if (cd.r2 > sec2) break;
+        if (cd.r2 == 0 && exactly_equal(p, cd.id)) {
+          // Exact duplicates: the lowest id owns the cell. Coincident points
+          // share a bin, which the stable bin sort keeps in id order, so the
+          // first lower id met here is the lowest of the group.
+          if (cd.id < i) {
+            status.has_cell = false;
+            status.duplicate_of = cd.id;
+            return status;
+          }
+          continue;  // a higher-id duplicate of ours never clips
+        }
+        ClipResult r = cell.clip(cd.id, cd.q);
+        if (r == ClipResult::clipped) sec2 = cell.security_radius2();
+        else if (r == ClipResult::emptied) {
+          // Only possible for coincident points, which are handled above.
+          status.has_cell = false;
+          return status;
+        }
+      }
+    }
+    return status;
+  }
+
+ private:
+  struct Candidate {
+    double r2;
+    std::int32_t id;
+    double q[D];
+  };
+
+  bool exactly_equal(const double* p, std::int32_t j) const {
+    const double* pj = coords_ + static_cast<std::size_t>(j) * D;
+    for (int d = 0; d < D; ++d)
+      if (p[d] != pj[d]) return false;
+    return true;
+  }
+
+  const BinLocator<D>& loc_;
+  const double* coords_;
+  const double* lo_;
+  const double* hi_;
+  const ExactContext* exact_;
+  std::vector<Candidate> cand_;
+};
+
+}  // namespace tessera::kernels

@@ -1,0 +1,51 @@
+// The one combinatorial question every clip asks, decided exactly.
+//
+// Cell of generator i, a vertex v of it (the meeting point of `dim` planes:
+// bisectors of i with other generators, or domain-box planes), a candidate j.
+// The clip removes v iff v is closer to p_j than to p_i:
+//
+//     P = pow_j(v) - pow_i(v),   pow_k(x) = |x - p_k|^2 - w_k
+//
+// where w_k are infinitesimal symbolic weights (w_k >> w_l when k < l) that
+// break every exact tie (Edelsbrunner & Mücke, "Simulation of Simplicity",
+// 1990; in the spirit of Devillers & Teillaud 2011 for weighted Delaunay).
+// Because P does not depend on which of v's generators asks (at v all their
+// power distances are equal), every cell sharing v gets the same answer: the
+// merged mesh is conformal and every vertex has exactly dim+1 generators.
+//
+// Formulation: v solves A v = b (dim rows: a bisector row 2(p_k-p_i).x =
+// |p_k|^2-|p_i|^2 - w_k + w_i, or a box row x_axis = c). With the query row
+// (a_j, b_j) appended, det[[A,b],[a_j,b_j]] = det(A) * P (Schur complement), so
+// sign(P) = sign(det M) * sign(det A). det M is linear in the weights; its
+// coefficients are the last-column cofactors, so the perturbed sign costs
+// nothing beyond the determinant. All of it is evaluated on the input doubles
+// scaled to integers (every double is an integer times a power of two) in GMP.
+#pragma once
+
+#include <array>
+#include <cstdint>
+
+namespace tessera::kernels {
+
+/// Domain-box plane ids as they appear in topological coordinates.
+/// Axis a (0..2): lower plane -1-2a, upper plane -2-2a (x0=-1, x1=-2, y0=-3, ...).
+constexpr std::int32_t box_plane_id(int axis, bool upper) { return -1 - 2 * axis - (upper ? 1 : 0); }
+constexpr int box_plane_axis(std::int32_t id) { return (-1 - id) / 2; }
+constexpr bool box_plane_upper(std::int32_t id) { return ((-1 - id) & 1) != 0; }
+
+/// Everything the exact predicate needs to know about the input.
+struct ExactContext {
+  const double* points = nullptr;   ///< n * dim input coordinates
+  int dim = 3;
+  std::array<double, 3> lo{}, hi{}; ///< domain box
+};
+
+/// Exact sign of P (see above) for the vertex of cell `i` defined by
+/// `planes[0..dim)` (generator ids >= 0, box-plane ids < 0), against candidate
+/// `j`. Returns +1 when the vertex stays (strictly closer to p_i in the
+/// perturbed sense), -1 when the clip removes it. Never returns 0.
+/// Precondition: the planes define a vertex (their normals are independent),
+/// and j is not i nor one of the planes.
+int exact_clip_sign(const ExactContext& ctx, std::int32_t i, const std::int32_t* planes, std::int32_t j);
+
+}  // namespace tessera::kernels

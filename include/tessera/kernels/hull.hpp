@@ -1,0 +1,278 @@
+// The 3D cell builder: a convex polyhedron clipped by half-spaces.
+//
+// Representation (dual, after Lévy's ConvexCell and Ray et al., "Meshless
+// Voronoi on the GPU", 2018): the cell is a list of planes (its faces: box
+// planes first, then one bisector per clipping neighbour) and a list of
+// vertices, each the meeting point of three planes stored as a triangle
+// (a, b, c) of local plane indices, ordered counter-clockwise seen from
+// outside (det(n_a, n_b, n_c) > 0). The triangles form a closed, consistently
+// oriented surface: vertex adjacency is the table `edge_tri` that maps a
+// directed plane pair (a -> b) to the triangle holding that edge.
+//
+// Every vertex's topological coordinate is {generator, ids of its 3 planes}.
+// Clip decisions go through the float filter, then the exact predicate, so the
+// combinatorics are those of the exactly computed, symbolically perturbed
+// diagram: every vertex is simple and every cell agrees with its neighbours.
+#pragma once
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <stdexcept>
+#include <vector>
+
+#include "tessera/kernels/exact_predicates.hpp"
+#include "tessera/kernels/filter.hpp"
+
+namespace tessera::kernels {
+
+enum class ClipResult { unchanged, clipped, emptied };
+
+class Hull {
+ public:
+  static constexpr int dim = 3;
+  struct Plane {
+    double n[3];
+    double d;
+    double n1;           // |n|_1, for the error bound
+    std::int32_t id;     // generator id, or box-plane id < 0
+  };
+  struct Vertex {
+    double y[3];         // position relative to the generator
+    double err;          // bound on |y - exact|_inf
+    double ymax;         // |y|_inf
+    std::uint16_t p[3];  // local plane indices, counter-clockwise from outside
+  };
+
+  /// Start the cell of generator `gen` at p as the domain box [lo, hi].
+  void reset(std::int32_t gen, const double* p, const double* lo, const double* hi,
+             const ExactContext* exact) {
+    gen_ = gen;
+    exact_ = exact;
+    exact_calls_ = 0;
+    planes_.clear();
+    verts_.clear();
+    for (int k = 0; k < 6; ++k) {
+      int axis = k / 2;
+      bool upper = k & 1;
+      Plane pl{};
+      pl.n[axis] = upper ? 1.0 : -1.0;
+      pl.d = upper ? hi[axis] - p[axis] : p[axis] - lo[axis];
+      pl.n1 = 1.0;
+      pl.id = box_plane_id(axis, upper);
+      planes_.push_back(pl);
+    }
+    ensure_table(64);
+    for (int c = 0; c < 8; ++c) {
+      int sx = c & 1, sy = (c >> 1) & 1, sz = (c >> 2) & 1;
+      Vertex v{};
+      v.y[0] = sx ? planes_[1].d : -planes_[0].d;
+      v.y[1] = sy ? planes_[3].d : -planes_[2].d;
+      v.y[2] = sz ? planes_[5].d : -planes_[4].d;
+      v.ymax = std::max({std::fabs(v.y[0]), std::fabs(v.y[1]), std::fabs(v.y[2])});
+      v.err = filter::u * v.ymax;  // each coordinate rounded once
+      std::uint16_t a = static_cast<std::uint16_t>(sx), b = static_cast<std::uint16_t>(2 + sy),
+                    cc = static_cast<std::uint16_t>(4 + sz);
+      // det(±e_x, ±e_y, ±e_z) = product of the signs; swap to make it positive.
+      bool positive = ((sx + sy + sz) % 2) == 1;  // signs: upper=+, lower=-
+      if (positive) { v.p[0] = a; v.p[1] = b; v.p[2] = cc; }
+      else { v.p[0] = a; v.p[1] = cc; v.p[2] = b; }
+      verts_.push_back(v);
+    }
+    for (std::size_t t = 0; t < verts_.size(); ++t) link(static_cast<std::uint32_t>(t));
+    update_radius();
+  }
+
+  /// Clip by the bisector with generator j, q = p_j - p_i (computed in double).
+  ClipResult clip(std::int32_t j, const double* q) {
+    Plane pl;
+    pl.n[0] = q[0]; pl.n[1] = q[1]; pl.n[2] = q[2];
+    pl.d = 0.5 * (q[0] * q[0] + q[1] * q[1] + q[2] * q[2]);
+    pl.n1 = std::fabs(q[0]) + std::fabs(q[1]) + std::fabs(q[2]);
+    pl.id = j;
+
+    const std::size_t nv = verts_.size();
+    sign_.resize(nv);
+    std::size_t removed = 0;
+    for (std::size_t t = 0; t < nv; ++t) {
+      const Vertex& v = verts_[t];
+      double P = pl.d - (pl.n[0] * v.y[0] + pl.n[1] * v.y[1] + pl.n[2] * v.y[2]);
+      double e = filter::clip_error(pl.n1, pl.d, v.err, v.ymax);
+      std::int8_t s;
+      if (P > e) s = 1;
+      else if (P < -e) s = -1;
+      else s = static_cast<std::int8_t>(exact_sign(v, j));
+      sign_[t] = s;
+      removed += (s < 0);
+    }
+    if (removed == 0) return ClipResult::unchanged;
+    if (removed == nv) { verts_.clear(); security2_ = 0; return ClipResult::emptied; }
+
+    const std::uint16_t pn = static_cast<std::uint16_t>(planes_.size());
+    if (planes_.size() + 1 >= 0xFFFF)
+      throw std::length_error("tessera: a cell has more than 65534 faces");
+    planes_.push_back(pl);
+    if (planes_.size() > cap_) ensure_table(2 * cap_);
+
+    // Boundary of the removed region: edges (a -> b) of removed triangles whose
+    // twin (b -> a) lies in a kept triangle. Each gets a new triangle (a, b, pn).
+    fresh_.clear();
+    for (std::size_t t = 0; t < nv; ++t) {
+      if (sign_[t] > 0) continue;
+      const Vertex& v = verts_[t];
+      for (int k = 0; k < 3; ++k) {
+        std::uint16_t a = v.p[k], b = v.p[(k + 1) % 3];
+        std::uint32_t twin = edge_tri_[static_cast<std::size_t>(b) * cap_ + a];
+        if (sign_[twin] < 0) continue;
+        Vertex nvtx;
+        nvtx.p[0] = a; nvtx.p[1] = b; nvtx.p[2] = pn;
+        solve(nvtx);
+        fresh_.push_back(nvtx);
+      }
+    }
+    // Put the new triangles into removed slots; append the rest, or, when
+    // fewer were made than removed, fill the remaining holes from the tail.
+    std::size_t f = 0;
+    for (std::size_t t = 0; t < nv && f < fresh_.size(); ++t) {
+      if (sign_[t] < 0) {
+        verts_[t] = fresh_[f++];
+        sign_[t] = 1;
+        link(static_cast<std::uint32_t>(t));
+      }
+    }
+    if (f < fresh_.size()) {
+      for (; f < fresh_.size(); ++f) {
+        verts_.push_back(fresh_[f]);
+        link(static_cast<std::uint32_t>(verts_.size() - 1));
+      }
+    } else {
+      std::size_t end = nv, t = 0;
+      for (;;) {
+        while (t < end && sign_[t] >= 0) ++t;        // next hole
+        if (t >= end) break;
+        while (end > t && sign_[end - 1] < 0) --end;  // drop trailing holes
+        if (end <= t) break;
+        verts_[t] = verts_[end - 1];
+        sign_[t] = 1;
+        --end;
+        link(static_cast<std::uint32_t>(t));
+      }
+      verts_.resize(end);
+    }
+    update_radius();
+    return ClipResult::clipped;
+  }
+
+  /// Upper bound on (2R)^2, R = the largest distance from the generator to a
+  /// vertex: a neighbour farther than 2R cannot clip (security radius).
+  double security_radius2() const { return security2_; }
+
+  std::int32_t generator() const { return gen_; }
+  std::size_t num_vertices() const { return verts_.size(); }
+  const std::vector<Vertex>& vertices() const { return verts_; }
+  const std::vector<Plane>& planes() const { return planes_; }
+  std::uint64_t exact_calls() const { return exact_calls_; }
+
+  /// Visit each face once: f(plane index, vertex indices counter-clockwise
+  /// from outside as a span-like pointer + count). `scratch` buffers are reused.
+  template <class F>
+  void for_each_face(F&& f) {
+    seen_.assign(planes_.size(), 0);
+    loop_.clear();
+    for (std::size_t t = 0; t < verts_.size(); ++t) {
+      for (int k = 0; k < 3; ++k) {
+        std::uint16_t p = verts_[t].p[k];
+        if (seen_[p]) continue;
+        seen_[p] = 1;
+        loop_.clear();
+        // Walk the triangles around plane p: in (p, x, y) the next one holds p -> y.
+        std::uint32_t cur = static_cast<std::uint32_t>(t);
+        do {
+          loop_.push_back(cur);
+          const Vertex& v = verts_[cur];
+          int at = v.p[0] == p ? 0 : (v.p[1] == p ? 1 : 2);
+          std::uint16_t y = v.p[(at + 2) % 3];
+          cur = edge_tri_[static_cast<std::size_t>(p) * cap_ + y];
+        } while (cur != t && loop_.size() <= verts_.size());
+        f(p, loop_.data(), loop_.size());
+      }
+    }
+  }
+
+ private:
+  int exact_sign(const Vertex& v, std::int32_t j) {
+    ++exact_calls_;
+    std::int32_t ids[3] = {planes_[v.p[0]].id, planes_[v.p[1]].id, planes_[v.p[2]].id};
+    return exact_clip_sign(*exact_, gen_, ids, j);
+  }
+
+  void link(std::uint32_t t) {
+    const Vertex& v = verts_[t];
+    for (int k = 0; k < 3; ++k)
+      edge_tri_[static_cast<std::size_t>(v.p[k]) * cap_ + v.p[(k + 1) % 3]] = t;
+  }
+
+  void ensure_table(std::size_t cap) {
+    if (cap <= cap_ && !edge_tri_.empty()) return;
+    cap_ = std::max<std::size_t>(cap, 64);
+    edge_tri_.assign(cap_ * cap_, 0);
+    for (std::size_t t = 0; t < verts_.size(); ++t) link(static_cast<std::uint32_t>(t));
+  }
+
+  // The vertex where planes p[0], p[1], p[2] meet (Cramer's rule) and its error bound.
+  void solve(Vertex& v) const {
+    const Plane& A = planes_[v.p[0]];
+    const Plane& B = planes_[v.p[1]];
+    const Plane& C = planes_[v.p[2]];
+    double c1[3], c2[3], c3[3];
+    cross(B.n, C.n, c1);
+    cross(C.n, A.n, c2);
+    cross(A.n, B.n, c3);
+    double det = A.n[0] * c1[0] + A.n[1] * c1[1] + A.n[2] * c1[2];
+    double inv = 1.0 / det;
+    for (int k = 0; k < 3; ++k) v.y[k] = (A.d * c1[k] + B.d * c2[k] + C.d * c3[k]) * inv;
+    v.ymax = std::max({std::fabs(v.y[0]), std::fabs(v.y[1]), std::fabs(v.y[2])});
+    double s = 0;
+    for (int k = 0; k < 3; ++k) s += std::fabs(c1[k]) + std::fabs(c2[k]) + std::fabs(c3[k]);
+    double inv_norm = s * std::fabs(inv);             // >= |A^-1|_inf
+    double amax = std::max({A.n1, B.n1, C.n1});
+    double bmax = std::max({std::fabs(A.d), std::fabs(B.d), std::fabs(C.d)});
+    double cond = inv_norm * amax;
+    if (!(cond < filter::max_condition) || !std::isfinite(v.ymax))
+      v.err = std::numeric_limits<double>::infinity();
+    else
+      v.err = filter::vertex_eps * inv_norm * (amax * v.ymax + bmax);
+  }
+
+  static void cross(const double* a, const double* b, double* out) {
+    out[0] = a[1] * b[2] - a[2] * b[1];
+    out[1] = a[2] * b[0] - a[0] * b[2];
+    out[2] = a[0] * b[1] - a[1] * b[0];
+  }
+
+  void update_radius() {
+    double r2 = 0;
+    for (const Vertex& v : verts_) {
+      double r = std::sqrt(v.y[0] * v.y[0] + v.y[1] * v.y[1] + v.y[2] * v.y[2]) + 2.0 * v.err;
+      r2 = std::max(r2, r * r);
+    }
+    security2_ = 4.0 * r2 * (1 + 1e-12);
+  }
+
+  std::int32_t gen_ = -1;
+  const ExactContext* exact_ = nullptr;
+  std::uint64_t exact_calls_ = 0;
+  std::vector<Plane> planes_;
+  std::vector<Vertex> verts_;
+  std::vector<Vertex> fresh_;
+  std::vector<std::int8_t> sign_;
+  std::vector<std::uint32_t> edge_tri_;  // cap_ x cap_: directed plane pair -> triangle
+  std::size_t cap_ = 0;
+  double security2_ = 0;
+  std::vector<std::uint8_t> seen_;
+  std::vector<std::uint32_t> loop_;
+};
+
+}  // namespace tessera::kernels

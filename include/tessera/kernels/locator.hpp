@@ -1,0 +1,166 @@
+// Static uniform bin grid over the domain box (VTK's static point locator).
+//
+// Points are sorted by bin (counting sort, stable in point id), with CSR
+// offsets per bin and a copy of the coordinates in bin order so the neighbour
+// search streams through memory. Bins are near-cubic: one target edge length,
+// rounded per axis to divide the box exactly.
+#pragma once
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include <tbb/parallel_for.h>
+
+namespace tessera::kernels {
+
+template <int D>
+class BinLocator {
+ public:
+  using Point = std::array<double, D>;
+
+  /// Bin the points of `coords` (n*D, row-major) whose `use[id]` is true (all
+  /// when `use` is empty) inside the box [lo, hi]; points must lie in the box.
+  /// `points_per_bin` sets the mean occupancy the bin size aims for.
+  BinLocator(std::span<const double> coords, std::span<const std::uint8_t> use, const Point& lo,
+             const Point& hi, double points_per_bin) {
+    const std::size_t n = coords.size() / D;
+    std::size_t used = use.empty() ? n : static_cast<std::size_t>(std::count(use.begin(), use.end(), 1));
+    double vol = 1;
+    for (int d = 0; d < D; ++d) vol *= hi[d] - lo[d];
+    const double target_bins = std::max(1.0, static_cast<double>(used) / std::max(points_per_bin, 0.05));
+    const double h = std::pow(vol / target_bins, 1.0 / D);
+    std::size_t total = 1;
+    for (int d = 0; d < D; ++d) {
+      lo_[d] = lo[d];
+      double extent = hi[d] - lo[d];
+      // Cap each axis so the grid stays proportionate to the point count.
+      double divs = std::clamp(std::round(extent / h), 1.0, 1.0 + 4.0 * static_cast<double>(used));
+      divs_[d] = static_cast<std::int32_t>(std::min(divs, 1e6));
+      size_[d] = extent / divs_[d];
+      inv_size_[d] = 1.0 / size_[d];
+      total *= static_cast<std::size_t>(divs_[d]);
+    }
+    min_size_ = *std::min_element(size_.begin(), size_.end());
+    // Counting sort by bin; stable in id, so the order is deterministic.
+    std::vector<std::uint32_t> bin_of(n);
+    offsets_.assign(total + 1, 0);
+    for (std::size_t id = 0; id < n; ++id) {
+      if (!use.empty() && !use[id]) continue;
+      std::uint32_t b = static_cast<std::uint32_t>(bin_index(bin_coords(&coords[id * D])));
+      bin_of[id] = b;
+      ++offsets_[b + 1];
+    }
+    for (std::size_t b = 0; b < total; ++b) offsets_[b + 1] += offsets_[b];
+    ids_.resize(used);
+    sorted_.resize(used);
+    std::vector<std::uint32_t> fill(offsets_.begin(), offsets_.end() - 1);
+    for (std::size_t id = 0; id < n; ++id) {
+      if (!use.empty() && !use[id]) continue;
+      std::uint32_t k = fill[bin_of[id]]++;
+      ids_[k] = static_cast<std::int32_t>(id);
+      for (int d = 0; d < D; ++d) sorted_[k][d] = coords[id * D + d];
+    }
+  }
+
+  std::array<std::int32_t, D> bin_coords(const double* x) const {
+    std::array<std::int32_t, D> b;
+    for (int d = 0; d < D; ++d) {
+      double f = std::floor((x[d] - lo_[d]) * inv_size_[d]);
+      b[d] = static_cast<std::int32_t>(std::clamp(f, 0.0, static_cast<double>(divs_[d] - 1)));
+    }
+    return b;
+  }
+  std::size_t bin_index(const std::array<std::int32_t, D>& b) const {
+    std::size_t idx = static_cast<std::size_t>(b[D - 1]);
+    for (int d = D - 2; d >= 0; --d) idx = idx * static_cast<std::size_t>(divs_[d]) + static_cast<std::size_t>(b[d]);
+    return idx;
+  }
+  /// Squared distance from x to the box of bin b (0 inside).
+  double bin_distance2(const double* x, const std::array<std::int32_t, D>& b) const {
+    double s = 0;
+    for (int d = 0; d < D; ++d) {
+      double blo = lo_[d] + b[d] * size_[d], bhi = blo + size_[d];
+      double g = std::max({0.0, blo - x[d], x[d] - bhi});
+      s += g * g;
+    }
+    return s;
+  }
+  /// Lower bound on the distance from x (in bin b) to any point in the shell of
+  /// Chebyshev radius s >= 1 around b: it must cross s-1 whole bins plus the gap
+  /// from x to the nearest face of its own bin along some axis.
+  double shell_lower_bound(const double* x, const std::array<std::int32_t, D>& b, int s) const {
+    double gap = INFINITY;
+    for (int d = 0; d < D; ++d) {
+      double blo = lo_[d] + b[d] * size_[d];
+      gap = std::min({gap, x[d] - blo, blo + size_[d] - x[d]});
+    }
+    return std::max(0.0, gap) + (s - 1) * min_size_;
+  }
+  /// The largest shell radius that still touches the grid from bin b.
+  int max_shell(const std::array<std::int32_t, D>& b) const {
+    int m = 0;
+    for (int d = 0; d < D; ++d) m = std::max({m, b[d], divs_[d] - 1 - b[d]});
+    return m;
+  }
+
+  /// Visit the bins of the shell of Chebyshev radius s around b (clipped to the
+  /// grid): f(bin coords, bin index).
+  template <class F>
+  void for_each_shell_bin(const std::array<std::int32_t, D>& b, int s, F&& f) const {
+    if (s == 0) { f(b, bin_index(b)); return; }
+    std::array<std::int32_t, D> c;
+    if constexpr (D == 2) {
+      for (int dy = -s; dy <= s; ++dy) {
+        c[1] = b[1] + dy;
+        if (c[1] < 0 || c[1] >= divs_[1]) continue;
+        const bool edge = (dy == -s || dy == s);
+        const int step = edge ? 1 : 2 * s;
+        for (int dx = -s; dx <= s; dx += step) {
+          c[0] = b[0] + dx;
+          if (c[0] < 0 || c[0] >= divs_[0]) continue;
+          f(c, bin_index(c));
+        }
+      }
+    } else {
+      for (int dz = -s; dz <= s; ++dz) {
+        c[2] = b[2] + dz;
+        if (c[2] < 0 || c[2] >= divs_[2]) continue;
+        const bool zface = (dz == -s || dz == s);
+        for (int dy = -s; dy <= s; ++dy) {
+          c[1] = b[1] + dy;
+          if (c[1] < 0 || c[1] >= divs_[1]) continue;
+          const bool edge = zface || dy == -s || dy == s;
+          const int step = edge ? 1 : 2 * s;
+          for (int dx = -s; dx <= s; dx += step) {
+            c[0] = b[0] + dx;
+            if (c[0] < 0 || c[0] >= divs_[0]) continue;
+            f(c, bin_index(c));
+          }
+        }
+      }
+    }
+  }
+
+  std::size_t num_bins() const { return offsets_.size() - 1; }
+  std::size_t size() const { return ids_.size(); }
+  /// Points of bin k are slots offsets()[k] .. offsets()[k+1]).
+  const std::vector<std::uint32_t>& offsets() const { return offsets_; }
+  std::int32_t id(std::size_t slot) const { return ids_[slot]; }
+  const Point& point(std::size_t slot) const { return sorted_[slot]; }
+  const std::array<std::int32_t, D>& divisions() const { return divs_; }
+
+ private:
+  Point lo_{}, size_{}, inv_size_{};
+  double min_size_ = 0;
+  std::array<std::int32_t, D> divs_{};
+  std::vector<std::uint32_t> offsets_;
+  std::vector<std::int32_t> ids_;   // point id per slot (bin order)
+  std::vector<Point> sorted_;       // coordinates per slot
+};
+
+}  // namespace tessera::kernels

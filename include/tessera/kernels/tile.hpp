@@ -1,0 +1,172 @@
+// The 2D cell builder: a convex polygon clipped by half-planes.
+//
+// The tile is a counter-clockwise cycle of vertices; edge k runs from vertex k
+// to vertex k+1 and lies on plane `next` of vertex k (= plane `prev` of
+// vertex k+1). A vertex is the meeting point of its two planes, so its
+// topological coordinate is {generator, prev plane id, next plane id}. Clip
+// decisions use the float filter and the exact predicate exactly as the 3D
+// hull does (see hull.hpp, filter.hpp).
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <stdexcept>
+#include <vector>
+
+#include "tessera/kernels/exact_predicates.hpp"
+#include "tessera/kernels/filter.hpp"
+#include "tessera/kernels/hull.hpp"  // ClipResult
+
+namespace tessera::kernels {
+
+class Tile {
+ public:
+  static constexpr int dim = 2;
+  struct Plane {
+    double n[2];
+    double d;
+    double n1;
+    std::int32_t id;
+  };
+  struct Vertex {
+    double y[2];
+    double err;
+    double ymax;
+    std::uint16_t p[2];  // [0] = plane of the edge arriving, [1] = of the edge leaving
+  };
+
+  void reset(std::int32_t gen, const double* p, const double* lo, const double* hi,
+             const ExactContext* exact) {
+    gen_ = gen;
+    exact_ = exact;
+    exact_calls_ = 0;
+    planes_.clear();
+    verts_.clear();
+    for (int k = 0; k < 4; ++k) {
+      int axis = k / 2;
+      bool upper = k & 1;
+      Plane pl{};
+      pl.n[axis] = upper ? 1.0 : -1.0;
+      pl.d = upper ? hi[axis] - p[axis] : p[axis] - lo[axis];
+      pl.n1 = 1.0;
+      pl.id = box_plane_id(axis, upper);
+      planes_.push_back(pl);
+    }
+    // Corners counter-clockwise from (lo, lo); local planes x0=0, x1=1, y0=2, y1=3.
+    const std::uint16_t in[4] = {0, 2, 1, 3}, out[4] = {2, 1, 3, 0};
+    const int cx[4] = {0, 1, 1, 0}, cy[4] = {0, 0, 1, 1};
+    for (int c = 0; c < 4; ++c) {
+      Vertex v{};
+      v.y[0] = cx[c] ? planes_[1].d : -planes_[0].d;
+      v.y[1] = cy[c] ? planes_[3].d : -planes_[2].d;
+      v.ymax = std::max(std::fabs(v.y[0]), std::fabs(v.y[1]));
+      v.err = filter::u * v.ymax;
+      v.p[0] = in[c];
+      v.p[1] = out[c];
+      verts_.push_back(v);
+    }
+    update_radius();
+  }
+
+  ClipResult clip(std::int32_t j, const double* q) {
+    Plane pl;
+    pl.n[0] = q[0]; pl.n[1] = q[1];
+    pl.d = 0.5 * (q[0] * q[0] + q[1] * q[1]);
+    pl.n1 = std::fabs(q[0]) + std::fabs(q[1]);
+    pl.id = j;
+    const std::size_t nv = verts_.size();
+    sign_.resize(nv);
+    std::size_t removed = 0;
+    for (std::size_t t = 0; t < nv; ++t) {
+      const Vertex& v = verts_[t];
+      double P = pl.d - (pl.n[0] * v.y[0] + pl.n[1] * v.y[1]);
+      double e = filter::clip_error(pl.n1, pl.d, v.err, v.ymax);
+      std::int8_t s;
+      if (P > e) s = 1;
+      else if (P < -e) s = -1;
+      else s = static_cast<std::int8_t>(exact_sign(v, j));
+      sign_[t] = s;
+      removed += (s < 0);
+    }
+    if (removed == 0) return ClipResult::unchanged;
+    if (removed == nv) { verts_.clear(); security2_ = 0; return ClipResult::emptied; }
+    if (planes_.size() + 1 >= 0xFFFF) throw std::length_error("tessera: a tile has more than 65534 edges");
+    const std::uint16_t pn = static_cast<std::uint16_t>(planes_.size());
+    planes_.push_back(pl);
+    // The removed vertices form one cyclic run; replace it by two new vertices.
+    next_.clear();
+    for (std::size_t t = 0; t < nv; ++t) {
+      const Vertex& v = verts_[t];
+      const Vertex& w = verts_[(t + 1) % nv];
+      const std::int8_t sv = sign_[t], sw = sign_[(t + 1) % nv];
+      if (sv > 0) next_.push_back(v);
+      if (sv > 0 && sw < 0) {          // leaving: edge plane v.p[1], then the new plane
+        Vertex a;
+        a.p[0] = v.p[1]; a.p[1] = pn;
+        solve(a);
+        next_.push_back(a);
+      } else if (sv < 0 && sw > 0) {   // entering: the new plane, then edge plane w.p[0]
+        Vertex b;
+        b.p[0] = pn; b.p[1] = w.p[0];
+        solve(b);
+        next_.push_back(b);
+      }
+    }
+    verts_.swap(next_);
+    update_radius();
+    return ClipResult::clipped;
+  }
+
+  double security_radius2() const { return security2_; }
+  std::int32_t generator() const { return gen_; }
+  std::size_t num_vertices() const { return verts_.size(); }
+  const std::vector<Vertex>& vertices() const { return verts_; }
+  const std::vector<Plane>& planes() const { return planes_; }
+  std::uint64_t exact_calls() const { return exact_calls_; }
+
+ private:
+  int exact_sign(const Vertex& v, std::int32_t j) {
+    ++exact_calls_;
+    std::int32_t ids[2] = {planes_[v.p[0]].id, planes_[v.p[1]].id};
+    return exact_clip_sign(*exact_, gen_, ids, j);
+  }
+
+  void solve(Vertex& v) const {
+    const Plane& A = planes_[v.p[0]];
+    const Plane& B = planes_[v.p[1]];
+    double det = A.n[0] * B.n[1] - A.n[1] * B.n[0];
+    double inv = 1.0 / det;
+    v.y[0] = (B.n[1] * A.d - A.n[1] * B.d) * inv;
+    v.y[1] = (A.n[0] * B.d - B.n[0] * A.d) * inv;
+    v.ymax = std::max(std::fabs(v.y[0]), std::fabs(v.y[1]));
+    double inv_norm = (A.n1 + B.n1) * std::fabs(inv);  // sum of |adj| entries / |det|
+    double amax = std::max(A.n1, B.n1);
+    double bmax = std::max(std::fabs(A.d), std::fabs(B.d));
+    double cond = inv_norm * amax;
+    if (!(cond < filter::max_condition) || !std::isfinite(v.ymax))
+      v.err = std::numeric_limits<double>::infinity();
+    else
+      v.err = filter::vertex_eps * inv_norm * (amax * v.ymax + bmax);
+  }
+
+  void update_radius() {
+    double r2 = 0;
+    for (const Vertex& v : verts_) {
+      double r = std::sqrt(v.y[0] * v.y[0] + v.y[1] * v.y[1]) + 2.0 * v.err;
+      r2 = std::max(r2, r * r);
+    }
+    security2_ = 4.0 * r2 * (1 + 1e-12);
+  }
+
+  std::int32_t gen_ = -1;
+  const ExactContext* exact_ = nullptr;
+  std::uint64_t exact_calls_ = 0;
+  std::vector<Plane> planes_;
+  std::vector<Vertex> verts_, next_;
+  std::vector<std::int8_t> sign_;
+  double security2_ = 0;
+};
+
+}  // namespace tessera::kernels

@@ -1,0 +1,282 @@
+// The compositor behind tessera::voronoi: per-cell measures, neighbour lists
+// and (optionally) the conformal mesh merged by topological coordinate.
+#pragma once
+
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <string>
+#include <cstdint>
+#include <numeric>
+#include <span>
+#include <stdexcept>
+#include <vector>
+
+#include <tbb/parallel_for.h>
+
+#include "cell_geometry.hpp"
+#include "tessera/cells.hpp"
+#include "tessera/engine/classifier.hpp"
+#include "tessera/kernels/cell_builder.hpp"
+
+namespace tessera::front {
+
+template <class CellT>
+class CellsCompositor {
+ public:
+  static constexpr int D = CellT::dim;
+
+  struct Batch {
+    std::vector<std::int32_t> gen;          // every generator of the batch, in order
+    std::vector<std::int32_t> dup_of;       // -1, or the owner it duplicates (no cell)
+    std::vector<double> volume, centroid;
+    std::vector<std::int32_t> num_faces;
+    std::vector<std::uint32_t> nbr_end;     // running end into nbrs, per generator
+    std::vector<std::int32_t> nbrs;
+    // mesh
+    std::vector<std::uint32_t> vert_end;    // running end into keys/pos, per generator
+    std::vector<Key<D>> keys;
+    std::vector<double> pos;                // absolute coordinates
+    std::vector<std::int32_t> vglobal;      // merged vertex id per local vertex
+    std::vector<std::uint32_t> face_end;    // running end into faces, per generator
+    std::vector<std::int32_t> face_nbr;
+    std::vector<std::uint32_t> face_vend;   // running end into fverts, per face
+    std::vector<std::uint32_t> fverts;      // local vertex index (within the cell)
+  };
+
+  CellsCompositor(Cells& out, const double* coords, std::span<const std::int32_t> labels, bool mesh)
+      : out_(out), coords_(coords), labels_(labels), classify_(labels), mesh_(mesh) {}
+
+  void add(Batch& b, std::int32_t gen, const kernels::BuildStatus& st, CellT& cell) {
+    b.gen.push_back(gen);
+    b.dup_of.push_back(st.has_cell ? -1 : st.duplicate_of);
+    if (!st.has_cell) {
+      b.volume.push_back(0);
+      for (int d = 0; d < D; ++d) b.centroid.push_back(0);
+      b.num_faces.push_back(0);
+      b.nbr_end.push_back(static_cast<std::uint32_t>(b.nbrs.size()));
+      if (mesh_) {
+        b.vert_end.push_back(static_cast<std::uint32_t>(b.keys.size()));
+        b.face_end.push_back(static_cast<std::uint32_t>(b.face_nbr.size()));
+      }
+      return;
+    }
+    const double* p = coords_ + static_cast<std::size_t>(gen) * D;
+    double vol;
+    std::array<double, D> c;
+    measure(cell, vol, c);
+    b.volume.push_back(vol);
+    for (int d = 0; d < D; ++d) b.centroid.push_back(c[d] + p[d]);
+    const std::size_t nb0 = b.nbrs.size();
+    std::int32_t nf = 0;
+    const std::size_t fbase = b.face_nbr.size();
+    for_each_face(cell, [&](std::int32_t id, const std::uint32_t* loop, std::size_t m) {
+      ++nf;
+      if (id >= 0) b.nbrs.push_back(id);
+      if (mesh_) {
+        b.face_nbr.push_back(id);
+        b.fverts.insert(b.fverts.end(), loop, loop + m);
+        b.face_vend.push_back(static_cast<std::uint32_t>(b.fverts.size()));
+      }
+    });
+    std::sort(b.nbrs.begin() + static_cast<std::ptrdiff_t>(nb0), b.nbrs.end());
+    b.num_faces.push_back(nf);
+    b.nbr_end.push_back(static_cast<std::uint32_t>(b.nbrs.size()));
+    if (mesh_) {
+      (void)fbase;
+      const auto& v = cell.vertices();
+      for (std::size_t t = 0; t < v.size(); ++t) {
+        b.keys.push_back(vertex_key(cell, t));
+        for (int d = 0; d < D; ++d) b.pos.push_back(v[t].y[d] + p[d]);
+      }
+      b.vert_end.push_back(static_cast<std::uint32_t>(b.keys.size()));
+      b.face_end.push_back(static_cast<std::uint32_t>(b.face_nbr.size()));
+    }
+  }
+
+  void finish(std::span<Batch> batches) {
+    Cells& o = out_;
+    const std::size_t n = o.n_points;
+    // Where each generator's data sits: (batch, index in batch).
+    struct Loc { std::int32_t batch = -1, index = -1; };
+    std::vector<Loc> where(n);
+    for (std::size_t k = 0; k < batches.size(); ++k)
+      for (std::size_t t = 0; t < batches[k].gen.size(); ++t)
+        where[static_cast<std::size_t>(batches[k].gen[t])] = {static_cast<std::int32_t>(k), static_cast<std::int32_t>(t)};
+    // Cells in generator-id order.
+    o.cell_of.assign(n, -1);
+    std::int32_t nc = 0;
+    for (std::size_t g = 0; g < n; ++g) {
+      const Loc& w = where[g];
+      if (w.batch < 0) continue;
+      const Batch& b = batches[static_cast<std::size_t>(w.batch)];
+      std::int32_t dup = b.dup_of[static_cast<std::size_t>(w.index)];
+      if (dup >= 0) { o.duplicates.emplace_back(static_cast<std::int32_t>(g), dup); continue; }
+      o.cell_of[g] = nc++;
+    }
+    const std::size_t ncell = static_cast<std::size_t>(nc);
+    o.generator.resize(ncell);
+    o.region.resize(ncell);
+    o.volume.resize(ncell);
+    o.centroid.resize(ncell * D);
+    o.num_faces.resize(ncell);
+    o.neighbor_offsets.assign(ncell + 1, 0);
+    if (mesh_) o.cell_face_offsets.assign(ncell + 1, 0);
+    std::vector<std::int64_t> face_count_vertices;  // per cell: total face-vertex entries
+    if (mesh_) face_count_vertices.assign(ncell + 1, 0);
+
+    auto range_of = [](const std::vector<std::uint32_t>& ends, std::size_t t) {
+      std::uint32_t lo = t == 0 ? 0 : ends[t - 1];
+      return std::pair<std::uint32_t, std::uint32_t>(lo, ends[t]);
+    };
+
+    // Pass 1: fixed-size fields and counts.
+    tbb::parallel_for(std::size_t(0), batches.size(), [&](std::size_t k) {
+      const Batch& b = batches[k];
+      for (std::size_t t = 0; t < b.gen.size(); ++t) {
+        std::int32_t g = b.gen[t];
+        std::int32_t c = o.cell_of[static_cast<std::size_t>(g)];
+        if (c < 0) continue;
+        std::size_t cu = static_cast<std::size_t>(c);
+        o.generator[cu] = g;
+        o.region[cu] = labels_at(g);
+        o.volume[cu] = b.volume[t];
+        for (int d = 0; d < D; ++d) o.centroid[cu * D + d] = b.centroid[t * D + d];
+        o.num_faces[cu] = b.num_faces[t];
+        auto [n0, n1] = range_of(b.nbr_end, t);
+        o.neighbor_offsets[cu + 1] = n1 - n0;
+        if (mesh_) {
+          auto [f0, f1] = range_of(b.face_end, t);
+          o.cell_face_offsets[cu + 1] = f1 - f0;
+          std::uint32_t v0 = f0 == 0 ? 0 : b.face_vend[f0 - 1];
+          std::uint32_t v1 = f1 == 0 ? 0 : b.face_vend[f1 - 1];
+          face_count_vertices[cu + 1] = v1 - v0;
+        }
+      }
+    });
+    std::partial_sum(o.neighbor_offsets.begin(), o.neighbor_offsets.end(), o.neighbor_offsets.begin());
+    o.neighbors.resize(static_cast<std::size_t>(o.neighbor_offsets.back()));
+    tbb::parallel_for(std::size_t(0), batches.size(), [&](std::size_t k) {
+      const Batch& b = batches[k];
+      for (std::size_t t = 0; t < b.gen.size(); ++t) {
+        std::int32_t c = o.cell_of[static_cast<std::size_t>(b.gen[t])];
+        if (c < 0) continue;
+        auto [n0, n1] = range_of(b.nbr_end, t);
+        std::copy(b.nbrs.begin() + n0, b.nbrs.begin() + n1,
+                  o.neighbors.begin() + o.neighbor_offsets[static_cast<std::size_t>(c)]);
+      }
+    });
+    if (mesh_) build_mesh(batches, where, face_count_vertices);
+  }
+
+ private:
+  std::int32_t labels_at(std::int32_t g) const { return labels_.empty() ? 0 : labels_[static_cast<std::size_t>(g)]; }
+
+  // The lowest generator of the key that owns a cell owns the merged vertex.
+  std::int32_t owner(const Key<D>& key) const {
+    for (std::int32_t id : key)
+      if (id >= 0 && out_.cell_of[static_cast<std::size_t>(id)] >= 0) return id;
+    return -1;
+  }
+
+  template <class Where>
+  void build_mesh(std::span<Batch> batches, const Where& where, std::vector<std::int64_t>& fcv) {
+    Cells& o = out_;
+    const std::size_t ncell = o.n_cells();
+    // Owned vertices per cell -> global numbering in cell order.
+    std::vector<std::int64_t> owned(ncell + 1, 0);
+    tbb::parallel_for(std::size_t(0), batches.size(), [&](std::size_t k) {
+      Batch& b = batches[k];
+      b.vglobal.assign(b.keys.size(), -1);
+      for (std::size_t t = 0; t < b.gen.size(); ++t) {
+        std::int32_t c = o.cell_of[static_cast<std::size_t>(b.gen[t])];
+        if (c < 0) continue;
+        std::uint32_t v0 = t == 0 ? 0 : b.vert_end[t - 1], v1 = b.vert_end[t];
+        std::int64_t cnt = 0;
+        for (std::uint32_t v = v0; v < v1; ++v) cnt += owner(b.keys[v]) == b.gen[t];
+        owned[static_cast<std::size_t>(c) + 1] = cnt;
+      }
+    });
+    std::partial_sum(owned.begin(), owned.end(), owned.begin());
+    const std::size_t nverts = static_cast<std::size_t>(owned.back());
+    o.vertices.resize(nverts * D);
+    o.vertex_keys.resize(nverts * (D + 1));
+    tbb::parallel_for(std::size_t(0), batches.size(), [&](std::size_t k) {
+      Batch& b = batches[k];
+      for (std::size_t t = 0; t < b.gen.size(); ++t) {
+        std::int32_t c = o.cell_of[static_cast<std::size_t>(b.gen[t])];
+        if (c < 0) continue;
+        std::uint32_t v0 = t == 0 ? 0 : b.vert_end[t - 1], v1 = b.vert_end[t];
+        std::int64_t next = owned[static_cast<std::size_t>(c)];
+        for (std::uint32_t v = v0; v < v1; ++v) {
+          if (owner(b.keys[v]) != b.gen[t]) continue;
+          std::size_t gid = static_cast<std::size_t>(next++);
+          b.vglobal[v] = static_cast<std::int32_t>(gid);
+          for (int d = 0; d < D; ++d) o.vertices[gid * D + d] = b.pos[static_cast<std::size_t>(v) * D + d];
+          for (int d = 0; d <= D; ++d) o.vertex_keys[gid * (D + 1) + d] = b.keys[v][static_cast<std::size_t>(d)];
+        }
+      }
+    });
+    // Vertices owned elsewhere: found by key in the owner's cell. A miss means
+    // two cells disagree about a vertex, which exact predicates rule out.
+    std::atomic<std::size_t> misses{0};
+    tbb::parallel_for(std::size_t(0), batches.size(), [&](std::size_t k) {
+      Batch& b = batches[k];
+      for (std::size_t t = 0; t < b.gen.size(); ++t) {
+        if (o.cell_of[static_cast<std::size_t>(b.gen[t])] < 0) continue;
+        std::uint32_t v0 = t == 0 ? 0 : b.vert_end[t - 1], v1 = b.vert_end[t];
+        for (std::uint32_t v = v0; v < v1; ++v) {
+          if (b.vglobal[v] >= 0) continue;
+          std::int32_t own = owner(b.keys[v]);
+          const auto& w = where[static_cast<std::size_t>(own)];
+          const Batch& ob = batches[static_cast<std::size_t>(w.batch)];
+          std::size_t ot = static_cast<std::size_t>(w.index);
+          std::uint32_t o0 = ot == 0 ? 0 : ob.vert_end[ot - 1], o1 = ob.vert_end[ot];
+          std::int32_t found = -1;
+          for (std::uint32_t u = o0; u < o1; ++u)
+            if (ob.keys[u] == b.keys[v]) { found = ob.vglobal[u]; break; }
+          if (found < 0) misses.fetch_add(1, std::memory_order_relaxed);
+          b.vglobal[v] = found;
+        }
+      }
+    });
+    if (misses.load() != 0)
+      throw std::logic_error("tessera: " + std::to_string(misses.load()) +
+                             " cell vertices have no match in their owner cell (inconsistent topology)");
+    // Faces.
+    std::partial_sum(o.cell_face_offsets.begin(), o.cell_face_offsets.end(), o.cell_face_offsets.begin());
+    std::partial_sum(fcv.begin(), fcv.end(), fcv.begin());
+    const std::size_t nfaces = static_cast<std::size_t>(o.cell_face_offsets.back());
+    o.face_vertex_offsets.assign(nfaces + 1, 0);
+    o.face_vertices.resize(static_cast<std::size_t>(fcv.back()));
+    o.face_neighbor.resize(nfaces);
+    o.face_class.resize(nfaces);
+    tbb::parallel_for(std::size_t(0), batches.size(), [&](std::size_t k) {
+      const Batch& b = batches[k];
+      for (std::size_t t = 0; t < b.gen.size(); ++t) {
+        std::int32_t c = o.cell_of[static_cast<std::size_t>(b.gen[t])];
+        if (c < 0) continue;
+        std::size_t cu = static_cast<std::size_t>(c);
+        std::uint32_t f0 = t == 0 ? 0 : b.face_end[t - 1], f1 = b.face_end[t];
+        std::uint32_t vbase = t == 0 ? 0 : b.vert_end[t - 1];
+        std::size_t fo = static_cast<std::size_t>(o.cell_face_offsets[cu]);
+        std::size_t vo = static_cast<std::size_t>(fcv[cu]);
+        for (std::uint32_t f = f0; f < f1; ++f, ++fo) {
+          std::uint32_t a = f == 0 ? 0 : b.face_vend[f - 1], e = b.face_vend[f];
+          o.face_neighbor[fo] = b.face_nbr[f];
+          o.face_class[fo] = classify_(b.gen[t], b.face_nbr[f]);
+          for (std::uint32_t q = a; q < e; ++q) o.face_vertices[vo++] = b.vglobal[vbase + b.fverts[q]];
+          o.face_vertex_offsets[fo + 1] = static_cast<std::int64_t>(vo);
+        }
+      }
+    });
+  }
+
+  Cells& out_;
+  const double* coords_;
+  std::span<const std::int32_t> labels_;
+  engine::RegionClassifier classify_;
+  bool mesh_;
+};
+
+}  // namespace tessera::front

@@ -1,0 +1,110 @@
+// tessera::validate: the invariants a correct tessellation satisfies.
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <sstream>
+#include <unordered_map>
+
+#include "tessera/cells.hpp"
+
+namespace tessera {
+
+ValidationReport validate(const Cells& c, std::span<const std::int32_t> labels) {
+  ValidationReport r;
+  const std::size_t nc = c.n_cells();
+  const int D = c.dim;
+
+  // Volumes: with every point inside, the cells tile the domain exactly.
+  for (double v : c.volume) r.volume_sum += v;
+  r.domain_volume = c.bounds.volume(D);
+  r.volume_rel_error = std::fabs(r.volume_sum - r.domain_volume) / r.domain_volume;
+  const bool all_inside = c.ignored_outside_bounds.empty() &&
+                          std::none_of(labels.begin(), labels.end(), [](std::int32_t l) { return l < 0; });
+  if (all_inside && r.volume_rel_error > 1e-9) {
+    std::ostringstream m;
+    m << "cell volumes sum to " << r.volume_sum << ", domain volume " << r.domain_volume
+      << " (relative error " << r.volume_rel_error << ")";
+    r.messages.push_back(m.str());
+    r.ok = false;
+  }
+  for (std::size_t k = 0; k < nc; ++k)
+    if (!(c.volume[k] > 0)) {
+      r.messages.push_back("cell of point " + std::to_string(c.generator[k]) + " has non-positive volume");
+      r.ok = false;
+      break;
+    }
+
+  // Symmetric spokes between cells.
+  for (std::size_t k = 0; k < nc; ++k) {
+    std::int32_t g = c.generator[k];
+    for (auto e = c.neighbor_offsets[k]; e < c.neighbor_offsets[k + 1]; ++e) {
+      std::int32_t j = c.neighbors[static_cast<std::size_t>(e)];
+      std::int32_t cj = c.cell_of[static_cast<std::size_t>(j)];
+      if (cj < 0) continue;  // outside point: one-sided by design
+      auto b = c.neighbors.begin() + c.neighbor_offsets[static_cast<std::size_t>(cj)];
+      auto en = c.neighbors.begin() + c.neighbor_offsets[static_cast<std::size_t>(cj) + 1];
+      if (!std::binary_search(b, en, g)) ++r.asymmetric_spokes;
+    }
+  }
+  if (r.asymmetric_spokes) {
+    r.messages.push_back(std::to_string(r.asymmetric_spokes) + " one-sided spokes (i lists j, j does not list i)");
+    r.ok = false;
+  }
+
+  if (!c.vertex_keys.empty()) {
+    // Each merged vertex is used by exactly the cells of its key's generators.
+    const std::size_t nv = c.n_vertices();
+    std::vector<std::int32_t> users(nv, 0);
+    std::vector<std::int32_t> last_cell(nv, -1);
+    std::size_t bad_euler = 0;
+    for (std::size_t k = 0; k < nc; ++k) {
+      std::int64_t f0 = c.cell_face_offsets[k], f1 = c.cell_face_offsets[k + 1];
+      std::size_t corners = 0;
+      std::int64_t half_edges = 0;
+      for (auto f = f0; f < f1; ++f) {
+        for (auto q = c.face_vertex_offsets[static_cast<std::size_t>(f)];
+             q < c.face_vertex_offsets[static_cast<std::size_t>(f) + 1]; ++q) {
+          std::int32_t v = c.face_vertices[static_cast<std::size_t>(q)];
+          if (v < 0 || static_cast<std::size_t>(v) >= nv) continue;
+          if (last_cell[static_cast<std::size_t>(v)] != static_cast<std::int32_t>(k)) {
+            last_cell[static_cast<std::size_t>(v)] = static_cast<std::int32_t>(k);
+            ++users[static_cast<std::size_t>(v)];
+            ++corners;
+          }
+          ++half_edges;
+        }
+      }
+      if (D == 3) {
+        std::int64_t F = f1 - f0, E = half_edges / 2, V = static_cast<std::int64_t>(corners);
+        if (V - E + F != 2) ++bad_euler;
+      }
+    }
+    for (std::size_t v = 0; v < nv; ++v) {
+      std::int32_t expect = 0;
+      for (int d = 0; d <= D; ++d) {
+        std::int32_t id = c.vertex_keys[v * static_cast<std::size_t>(D + 1) + static_cast<std::size_t>(d)];
+        if (id >= 0 && c.cell_of[static_cast<std::size_t>(id)] >= 0) ++expect;
+      }
+      if (users[v] != expect) ++r.bad_vertex_degree;
+    }
+    r.bad_euler = bad_euler;
+    if (r.bad_vertex_degree) {
+      r.messages.push_back(std::to_string(r.bad_vertex_degree) +
+                           " merged vertices not shared by exactly the cells of their generators");
+      r.ok = false;
+    }
+    if (bad_euler) {
+      r.messages.push_back(std::to_string(bad_euler) + " cells with Euler characteristic != 2");
+      r.ok = false;
+    }
+    std::size_t unresolved = static_cast<std::size_t>(
+        std::count_if(c.face_vertices.begin(), c.face_vertices.end(), [](std::int32_t v) { return v < 0; }));
+    if (unresolved) {
+      r.messages.push_back(std::to_string(unresolved) + " face corners refer to no merged vertex");
+      r.ok = false;
+    }
+  }
+  return r;
+}
+
+}  // namespace tessera

@@ -1,0 +1,187 @@
+// Exact evaluation of the clip predicate; see exact_predicates.hpp for the math.
+#include "tessera/kernels/exact_predicates.hpp"
+
+#include <gmp.h>
+
+#include <algorithm>
+#include <climits>
+#include <cmath>
+#include <stdexcept>
+
+namespace tessera::kernels {
+namespace {
+
+// Scratch integers reused across calls on one thread: the exact path is rare on
+// random input but common on lattices, and GMP allocation would dominate it.
+struct Scratch {
+  static constexpr int kMaxDim = 3;
+  static constexpr int kRows = kMaxDim + 1;
+  mpz_t coord[kRows + 1][kMaxDim];  // scaled coordinates of i, the plane generators and j
+  mpz_t box[kRows];                 // scaled box constant for box rows
+  mpz_t a[kRows][kMaxDim];          // first dim columns of M
+  mpz_t b[kRows];                   // last column of M without weights
+  mpz_t minor[kRows];               // minors of M without its last column
+  mpz_t t0, t1, t2, acc;
+  Scratch() {
+    for (auto& r : coord) for (auto& c : r) mpz_init(c);
+    for (auto& c : box) mpz_init(c);
+    for (auto& r : a) for (auto& c : r) mpz_init(c);
+    for (auto& c : b) mpz_init(c);
+    for (auto& c : minor) mpz_init(c);
+    mpz_init(t0); mpz_init(t1); mpz_init(t2); mpz_init(acc);
+  }
+  ~Scratch() {
+    for (auto& r : coord) for (auto& c : r) mpz_clear(c);
+    for (auto& c : box) mpz_clear(c);
+    for (auto& r : a) for (auto& c : r) mpz_clear(c);
+    for (auto& c : b) mpz_clear(c);
+    for (auto& c : minor) mpz_clear(c);
+    mpz_clear(t0); mpz_clear(t1); mpz_clear(t2); mpz_clear(acc);
+  }
+};
+
+// Exponent of the least significant bit of x's 53-bit mantissa (x != 0).
+int lsb_exponent(double x) {
+  int e;
+  std::frexp(x, &e);  // x = f * 2^e, 0.5 <= |f| < 1
+  return e - 53;
+}
+
+// out = x * 2^(-shift), exactly an integer because shift <= lsb_exponent(x).
+void set_scaled(mpz_t out, double x, int shift) {
+  if (x == 0) { mpz_set_ui(out, 0); return; }
+  int e;
+  double f = std::frexp(x, &e);
+  // f * 2^53 is an exact integer (|f| < 1 has at most 53 significant bits).
+  mpz_set_d(out, std::ldexp(f, 53));
+  int s = e - 53 - shift;
+  if (s > 0) mpz_mul_2exp(out, out, static_cast<mp_bitcnt_t>(s));
+}
+
+// det of the k x k matrix formed by rows `rows` of a (k = 2 or 3).
+void det_rows(mpz_t out, mpz_t (*a)[Scratch::kMaxDim], const int* rows, int k, Scratch& s) {
+  if (k == 2) {
+    mpz_mul(s.t0, a[rows[0]][0], a[rows[1]][1]);
+    mpz_submul(s.t0, a[rows[0]][1], a[rows[1]][0]);
+    mpz_set(out, s.t0);
+    return;
+  }
+  // 3x3 by cofactors along the first row.
+  auto& r0 = a[rows[0]];
+  auto& r1 = a[rows[1]];
+  auto& r2 = a[rows[2]];
+  mpz_set_ui(s.acc, 0);
+  mpz_mul(s.t0, r1[1], r2[2]); mpz_submul(s.t0, r1[2], r2[1]); mpz_addmul(s.acc, r0[0], s.t0);
+  mpz_mul(s.t0, r1[2], r2[0]); mpz_submul(s.t0, r1[0], r2[2]); mpz_addmul(s.acc, r0[1], s.t0);
+  mpz_mul(s.t0, r1[0], r2[1]); mpz_submul(s.t0, r1[1], r2[0]); mpz_addmul(s.acc, r0[2], s.t0);
+  mpz_set(out, s.acc);
+}
+
+}  // namespace
+
+int exact_clip_sign(const ExactContext& ctx, std::int32_t i, const std::int32_t* planes, std::int32_t j) {
+  thread_local Scratch s;
+  const int dim = ctx.dim;
+  const int rows = dim + 1;  // dim vertex planes + the query row
+
+  // Row r's generator (or box id); the query row is last.
+  std::int32_t gen[Scratch::kRows];
+  for (int r = 0; r < dim; ++r) gen[r] = planes[r];
+  gen[dim] = j;
+
+  // Common scale: the smallest mantissa lsb among all doubles involved.
+  int shift = INT_MAX;
+  auto consider = [&](double x) { if (x != 0) shift = std::min(shift, lsb_exponent(x)); };
+  const double* pi = ctx.points + static_cast<std::size_t>(i) * dim;
+  for (int d = 0; d < dim; ++d) consider(pi[d]);
+  for (int r = 0; r < rows; ++r) {
+    if (gen[r] >= 0) {
+      const double* pk = ctx.points + static_cast<std::size_t>(gen[r]) * dim;
+      for (int d = 0; d < dim; ++d) consider(pk[d]);
+    } else {
+      int axis = box_plane_axis(gen[r]);
+      consider(box_plane_upper(gen[r]) ? ctx.hi[axis] : ctx.lo[axis]);
+    }
+  }
+  if (shift == INT_MAX) shift = 0;
+
+  // Scaled p_i and |p_i|^2.
+  mpz_t* ci = s.coord[Scratch::kRows];
+  for (int d = 0; d < dim; ++d) set_scaled(ci[d], pi[d], shift);
+  mpz_set_ui(s.t1, 0);
+  for (int d = 0; d < dim; ++d) mpz_addmul(s.t1, ci[d], ci[d]);  // t1 = |p_i|^2
+
+  // Build M = [a | b] row by row.
+  for (int r = 0; r < rows; ++r) {
+    if (gen[r] >= 0) {
+      const double* pk = ctx.points + static_cast<std::size_t>(gen[r]) * dim;
+      mpz_set_ui(s.b[r], 0);
+      for (int d = 0; d < dim; ++d) {
+        set_scaled(s.coord[r][d], pk[d], shift);
+        mpz_sub(s.a[r][d], s.coord[r][d], ci[d]);
+        mpz_mul_2exp(s.a[r][d], s.a[r][d], 1);          // 2 (p_k - p_i)
+        mpz_addmul(s.b[r], s.coord[r][d], s.coord[r][d]);
+      }
+      mpz_sub(s.b[r], s.b[r], s.t1);                      // |p_k|^2 - |p_i|^2
+    } else {
+      int axis = box_plane_axis(gen[r]);
+      for (int d = 0; d < dim; ++d) mpz_set_ui(s.a[r][d], d == axis ? 1 : 0);
+      set_scaled(s.b[r], box_plane_upper(gen[r]) ? ctx.hi[axis] : ctx.lo[axis], shift);
+    }
+  }
+
+  // Minors of the rows x dim block without row r; cofactor of (r, last) is
+  // (-1)^(r + dim) * minor[r].
+  for (int r = 0; r < rows; ++r) {
+    int sel[Scratch::kMaxDim] = {0, 0, 0};
+    int k = 0;
+    for (int q = 0; q < rows; ++q) if (q != r) sel[k++] = q;
+    det_rows(s.minor[r], s.a, sel, dim, s);
+  }
+  // det A = minor[dim] (cofactor sign (+1)); it is never zero for a real vertex.
+  const int sign_det_a = mpz_sgn(s.minor[dim]);
+  if (sign_det_a == 0)
+    throw std::logic_error("exact_clip_sign: vertex planes are dependent (corrupt cell)");
+
+  // det M0 = sum_r b[r] * cofactor(r).
+  mpz_set_ui(s.t2, 0);
+  for (int r = 0; r < rows; ++r) {
+    if (((r + dim) & 1) == 0) mpz_addmul(s.t2, s.b[r], s.minor[r]);
+    else mpz_submul(s.t2, s.b[r], s.minor[r]);
+  }
+  int sign_m = mpz_sgn(s.t2);
+
+  if (sign_m == 0) {
+    // Exact tie: the perturbation decides. det M(w) = det M0 + sum over
+    // bisector rows r of (w_i - w_gen[r]) * cofactor(r). Coefficient of
+    // w_gen[r] is -cofactor(r); of w_i it is the sum of those cofactors.
+    // Weights decrease with id, so the smallest id with a non-zero
+    // coefficient decides. The query row alone has coefficient -det A != 0.
+    struct Term { std::int32_t id; int row; };
+    Term terms[Scratch::kRows + 1];
+    int nt = 0;
+    for (int r = 0; r < rows; ++r) if (gen[r] >= 0) terms[nt++] = {gen[r], r};
+    terms[nt++] = {i, -1};
+    for (int a = 1; a < nt; ++a)  // insertion sort by id (at most 5 terms)
+      for (int b = a; b > 0 && terms[b].id < terms[b - 1].id; --b) std::swap(terms[b], terms[b - 1]);
+    for (int t = 0; t < nt && sign_m == 0; ++t) {
+      if (terms[t].row >= 0) {
+        int r = terms[t].row;
+        int cof = (((r + dim) & 1) == 0 ? 1 : -1) * mpz_sgn(s.minor[r]);
+        sign_m = -cof;
+      } else {
+        mpz_set_ui(s.t2, 0);
+        for (int r = 0; r < rows; ++r) {
+          if (gen[r] < 0) continue;
+          if (((r + dim) & 1) == 0) mpz_add(s.t2, s.t2, s.minor[r]);
+          else mpz_sub(s.t2, s.t2, s.minor[r]);
+        }
+        sign_m = mpz_sgn(s.t2);
+      }
+    }
+  }
+  // sign(P) = sign(det M) * sign(det A); P > 0 keeps the vertex.
+  return sign_m * sign_det_a > 0 ? +1 : -1;
+}
+
+}  // namespace tessera::kernels
