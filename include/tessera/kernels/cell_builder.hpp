@@ -15,6 +15,7 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cstdint>
 #include <vector>
 
@@ -52,6 +53,7 @@ class CellBuilder {
         if (lb * lb > sec2) break;
       }
       cand_.clear();
+      keys_.clear();
       loc_.for_each_shell_bin(b, s, [&](const std::array<std::int32_t, D>& c, std::size_t bin) {
         if (s > 0 && loc_.bin_distance2(p, c) > sec2) return;
         for (std::uint32_t k = off[bin]; k < off[bin + 1]; ++k) {
@@ -67,18 +69,22 @@ class CellBuilder {
           if (r2 > sec2) continue;
           cd.r2 = r2;
           cd.id = j;
+          // Sort key: r2 rounded to float (non-negative floats order as their
+          // bits), then gather order, which is deterministic.
+          keys_.push_back((static_cast<std::uint64_t>(std::bit_cast<std::uint32_t>(static_cast<float>(r2))) << 32) |
+                          static_cast<std::uint32_t>(cand_.size()));
           cand_.push_back(cd);
         }
       });
-      std::sort(cand_.begin(), cand_.end(), [](const Candidate& x, const Candidate& y) {
-        return x.r2 < y.r2 || (x.r2 == y.r2 && x.id < y.id);
-      });
-      for (const Candidate& cd : cand_) {
+      std::sort(keys_.begin(), keys_.end());
+      for (std::uint64_t key : keys_) {
+        const Candidate& cd = cand_[static_cast<std::uint32_t>(key)];
         if (cd.r2 > sec2) break;
         if (cd.r2 == 0 && exactly_equal(p, cd.id)) {
           // Exact duplicates: the lowest id owns the cell. Coincident points
-          // share a bin, which the stable bin sort keeps in id order, so the
-          // first lower id met here is the lowest of the group.
+          // share a bin, which the stable bin sort keeps in id order, and ties
+          // in the sort key keep gather order, so the first lower id met here
+          // is the lowest of the group.
           if (cd.id < i) {
             status.has_cell = false;
             status.duplicate_of = cd.id;
@@ -118,6 +124,7 @@ class CellBuilder {
   const double* hi_;
   const ExactContext* exact_;
   std::vector<Candidate> cand_;
+  std::vector<std::uint64_t> keys_;
 };
 
 }  // namespace tessera::kernels

@@ -27,6 +27,8 @@ inline constexpr double vertex_eps = 64 * u;
 inline constexpr double max_condition = 1e12;
 
 /// Error bound of P~ = d - n.y for a vertex with bound `err` and |y|_inf = ymax.
+/// The clippers store e = err + plane_eps * ymax per vertex and evaluate
+/// n1 * e + plane_eps * |d| inline; this is the same bound spelled out.
 inline double clip_error(double n1, double d, double err, double ymax) {
   return n1 * (err + plane_eps * ymax) + plane_eps * std::fabs(d);
 }

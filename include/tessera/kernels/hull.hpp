@@ -41,8 +41,8 @@ class Hull {
   };
   struct Vertex {
     double y[3];         // position relative to the generator
-    double err;          // bound on |y - exact|_inf
-    double ymax;         // |y|_inf
+    double e;            // err + plane_eps * |y|_inf, err bounding |y - exact|_inf (filter.hpp)
+    double r2;           // upper bound on the exact |y|^2
     std::uint16_t p[3];  // local plane indices, counter-clockwise from outside
   };
 
@@ -71,8 +71,10 @@ class Hull {
       v.y[0] = sx ? planes_[1].d : -planes_[0].d;
       v.y[1] = sy ? planes_[3].d : -planes_[2].d;
       v.y[2] = sz ? planes_[5].d : -planes_[4].d;
-      v.ymax = std::max({std::fabs(v.y[0]), std::fabs(v.y[1]), std::fabs(v.y[2])});
-      v.err = filter::u * v.ymax;  // each coordinate rounded once
+      double ymax = std::max({std::fabs(v.y[0]), std::fabs(v.y[1]), std::fabs(v.y[2])});
+      double err = filter::u * ymax;  // each coordinate rounded once
+      v.e = err + filter::plane_eps * ymax;
+      set_radius(v, err);
       std::uint16_t a = static_cast<std::uint16_t>(sx), b = static_cast<std::uint16_t>(2 + sy),
                     cc = static_cast<std::uint16_t>(4 + sz);
       // det(±e_x, ±e_y, ±e_z) = product of the signs; swap to make it positive.
@@ -94,18 +96,42 @@ class Hull {
     pl.id = j;
 
     const std::size_t nv = verts_.size();
-    sign_.resize(nv);
-    std::size_t removed = 0;
+    // A vertex no farther than |q|/2 from the generator cannot be cut:
+    // q.y <= |q||y| <= |q|^2/2 (equality would need y = q/2 exactly, which the
+    // strict margin excludes). Candidates usually fail to clip, and then only
+    // the few far vertices need a plane test.
+    const double q2lo = 2.0 * pl.d * (1.0 - 1e-12);  // <= the exact |p_j - p_i|^2
+    const double de = filter::plane_eps * std::fabs(pl.d);
+    bool may_cut = false;
     for (std::size_t t = 0; t < nv; ++t) {
       const Vertex& v = verts_[t];
+      if (4.0 * v.r2 < q2lo) continue;
       double P = pl.d - (pl.n[0] * v.y[0] + pl.n[1] * v.y[1] + pl.n[2] * v.y[2]);
-      double e = filter::clip_error(pl.n1, pl.d, v.err, v.ymax);
-      std::int8_t s;
-      if (P > e) s = 1;
-      else if (P < -e) s = -1;
-      else s = static_cast<std::int8_t>(exact_sign(v, j));
-      sign_[t] = s;
+      if (!(P > pl.n1 * v.e + de)) { may_cut = true; break; }
+    }
+    if (!may_cut) return ClipResult::unchanged;
+
+    // Full sign pass: +1 keep, -1 remove, 0 uncertain (exact below).
+    sign_.resize(nv);
+    std::size_t removed = 0, uncertain = 0;
+    for (std::size_t t = 0; t < nv; ++t) {
+      const Vertex& v = verts_[t];
+      int s = 1;
+      if (4.0 * v.r2 >= q2lo) {
+        double P = pl.d - (pl.n[0] * v.y[0] + pl.n[1] * v.y[1] + pl.n[2] * v.y[2]);
+        double e = pl.n1 * v.e + de;
+        s = (P > e) - (P < -e);
+      }
+      sign_[t] = static_cast<std::int8_t>(s);
       removed += (s < 0);
+      uncertain += (s == 0);
+    }
+    if (uncertain) {
+      for (std::size_t t = 0; t < nv; ++t) {
+        if (sign_[t] != 0) continue;
+        sign_[t] = static_cast<std::int8_t>(exact_sign(verts_[t], j));
+        removed += (sign_[t] < 0);
+      }
     }
     if (removed == 0) return ClipResult::unchanged;
     if (removed == nv) { verts_.clear(); security2_ = 0; return ClipResult::emptied; }
@@ -233,17 +259,27 @@ class Hull {
     double det = A.n[0] * c1[0] + A.n[1] * c1[1] + A.n[2] * c1[2];
     double inv = 1.0 / det;
     for (int k = 0; k < 3; ++k) v.y[k] = (A.d * c1[k] + B.d * c2[k] + C.d * c3[k]) * inv;
-    v.ymax = std::max({std::fabs(v.y[0]), std::fabs(v.y[1]), std::fabs(v.y[2])});
+    double ymax = std::max({std::fabs(v.y[0]), std::fabs(v.y[1]), std::fabs(v.y[2])});
     double s = 0;
     for (int k = 0; k < 3; ++k) s += std::fabs(c1[k]) + std::fabs(c2[k]) + std::fabs(c3[k]);
     double inv_norm = s * std::fabs(inv);             // >= |A^-1|_inf
     double amax = std::max({A.n1, B.n1, C.n1});
     double bmax = std::max({std::fabs(A.d), std::fabs(B.d), std::fabs(C.d)});
     double cond = inv_norm * amax;
-    if (!(cond < filter::max_condition) || !std::isfinite(v.ymax))
-      v.err = std::numeric_limits<double>::infinity();
-    else
-      v.err = filter::vertex_eps * inv_norm * (amax * v.ymax + bmax);
+    double err = std::numeric_limits<double>::infinity();
+    if (cond < filter::max_condition && std::isfinite(ymax))
+      err = filter::vertex_eps * inv_norm * (amax * ymax + bmax);
+    v.e = err + filter::plane_eps * ymax;
+    set_radius(v, err);
+  }
+
+  // |y_exact| <= |y| + sqrt(3) err, so |y_exact|^2 <= |y|^2 + 4 err |y|_1 + 4 err^2
+  // (|y| <= |y|_1), with a relative margin for the rounding of this sum.
+  static void set_radius(Vertex& v, double err) {
+    double a = v.y[0] * v.y[0] + v.y[1] * v.y[1] + v.y[2] * v.y[2];
+    double l1 = std::fabs(v.y[0]) + std::fabs(v.y[1]) + std::fabs(v.y[2]);
+    v.r2 = (a + 4.0 * err * (l1 + err)) * (1.0 + 1e-12);
+    if (!(v.r2 < std::numeric_limits<double>::infinity())) v.r2 = std::numeric_limits<double>::infinity();  // NaN too
   }
 
   static void cross(const double* a, const double* b, double* out) {
@@ -254,10 +290,7 @@ class Hull {
 
   void update_radius() {
     double r2 = 0;
-    for (const Vertex& v : verts_) {
-      double r = std::sqrt(v.y[0] * v.y[0] + v.y[1] * v.y[1] + v.y[2] * v.y[2]) + 2.0 * v.err;
-      r2 = std::max(r2, r * r);
-    }
+    for (const Vertex& v : verts_) r2 = std::max(r2, v.r2);
     security2_ = 4.0 * r2 * (1 + 1e-12);
   }
 

@@ -32,8 +32,8 @@ class Tile {
   };
   struct Vertex {
     double y[2];
-    double err;
-    double ymax;
+    double e;            // err + plane_eps * |y|_inf (see hull.hpp)
+    double r2;           // upper bound on the exact |y|^2
     std::uint16_t p[2];  // [0] = plane of the edge arriving, [1] = of the edge leaving
   };
 
@@ -61,8 +61,10 @@ class Tile {
       Vertex v{};
       v.y[0] = cx[c] ? planes_[1].d : -planes_[0].d;
       v.y[1] = cy[c] ? planes_[3].d : -planes_[2].d;
-      v.ymax = std::max(std::fabs(v.y[0]), std::fabs(v.y[1]));
-      v.err = filter::u * v.ymax;
+      double ymax = std::max(std::fabs(v.y[0]), std::fabs(v.y[1]));
+      double err = filter::u * ymax;
+      v.e = err + filter::plane_eps * ymax;
+      set_radius(v, err);
       v.p[0] = in[c];
       v.p[1] = out[c];
       verts_.push_back(v);
@@ -77,18 +79,37 @@ class Tile {
     pl.n1 = std::fabs(q[0]) + std::fabs(q[1]);
     pl.id = j;
     const std::size_t nv = verts_.size();
-    sign_.resize(nv);
-    std::size_t removed = 0;
+    // Vertices no farther than |q|/2 cannot be cut (see hull.hpp).
+    const double q2lo = 2.0 * pl.d * (1.0 - 1e-12);
+    const double de = filter::plane_eps * std::fabs(pl.d);
+    bool may_cut = false;
     for (std::size_t t = 0; t < nv; ++t) {
       const Vertex& v = verts_[t];
+      if (4.0 * v.r2 < q2lo) continue;
       double P = pl.d - (pl.n[0] * v.y[0] + pl.n[1] * v.y[1]);
-      double e = filter::clip_error(pl.n1, pl.d, v.err, v.ymax);
-      std::int8_t s;
-      if (P > e) s = 1;
-      else if (P < -e) s = -1;
-      else s = static_cast<std::int8_t>(exact_sign(v, j));
-      sign_[t] = s;
+      if (!(P > pl.n1 * v.e + de)) { may_cut = true; break; }
+    }
+    if (!may_cut) return ClipResult::unchanged;
+    sign_.resize(nv);
+    std::size_t removed = 0, uncertain = 0;
+    for (std::size_t t = 0; t < nv; ++t) {
+      const Vertex& v = verts_[t];
+      int s = 1;
+      if (4.0 * v.r2 >= q2lo) {
+        double P = pl.d - (pl.n[0] * v.y[0] + pl.n[1] * v.y[1]);
+        double e = pl.n1 * v.e + de;
+        s = (P > e) - (P < -e);
+      }
+      sign_[t] = static_cast<std::int8_t>(s);
       removed += (s < 0);
+      uncertain += (s == 0);
+    }
+    if (uncertain) {
+      for (std::size_t t = 0; t < nv; ++t) {
+        if (sign_[t] != 0) continue;
+        sign_[t] = static_cast<std::int8_t>(exact_sign(verts_[t], j));
+        removed += (sign_[t] < 0);
+      }
     }
     if (removed == 0) return ClipResult::unchanged;
     if (removed == nv) { verts_.clear(); security2_ = 0; return ClipResult::emptied; }
@@ -140,23 +161,28 @@ class Tile {
     double inv = 1.0 / det;
     v.y[0] = (B.n[1] * A.d - A.n[1] * B.d) * inv;
     v.y[1] = (A.n[0] * B.d - B.n[0] * A.d) * inv;
-    v.ymax = std::max(std::fabs(v.y[0]), std::fabs(v.y[1]));
+    double ymax = std::max(std::fabs(v.y[0]), std::fabs(v.y[1]));
     double inv_norm = (A.n1 + B.n1) * std::fabs(inv);  // sum of |adj| entries / |det|
     double amax = std::max(A.n1, B.n1);
     double bmax = std::max(std::fabs(A.d), std::fabs(B.d));
     double cond = inv_norm * amax;
-    if (!(cond < filter::max_condition) || !std::isfinite(v.ymax))
-      v.err = std::numeric_limits<double>::infinity();
-    else
-      v.err = filter::vertex_eps * inv_norm * (amax * v.ymax + bmax);
+    double err = std::numeric_limits<double>::infinity();
+    if (cond < filter::max_condition && std::isfinite(ymax))
+      err = filter::vertex_eps * inv_norm * (amax * ymax + bmax);
+    v.e = err + filter::plane_eps * ymax;
+    set_radius(v, err);
+  }
+
+  static void set_radius(Vertex& v, double err) {
+    double a = v.y[0] * v.y[0] + v.y[1] * v.y[1];
+    double l1 = std::fabs(v.y[0]) + std::fabs(v.y[1]);
+    v.r2 = (a + 4.0 * err * (l1 + err)) * (1.0 + 1e-12);
+    if (!(v.r2 < std::numeric_limits<double>::infinity())) v.r2 = std::numeric_limits<double>::infinity();  // NaN too
   }
 
   void update_radius() {
     double r2 = 0;
-    for (const Vertex& v : verts_) {
-      double r = std::sqrt(v.y[0] * v.y[0] + v.y[1] * v.y[1]) + 2.0 * v.err;
-      r2 = std::max(r2, r * r);
-    }
+    for (const Vertex& v : verts_) r2 = std::max(r2, v.r2);
     security2_ = 4.0 * r2 * (1 + 1e-12);
   }
 
