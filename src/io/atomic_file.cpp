@@ -1,0 +1,172 @@
+// Atomic whole-file writes: stream into a fresh temporary next to the target,
+// then rename(2) it over the target. Readers therefore see either the old file
+// or the complete new one, and a failed write leaves nothing behind.
+//
+// No fsync: the guarantee is about failures in this process (errors, full
+// disk, exceptions), not about power loss, and an fsync per output file would
+// cost more than the write itself on some filesystems.
+#include "tessera/io/atomic_file.hpp"
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <cerrno>
+#include <cstring>
+#include <filesystem>
+#include <random>
+#include <streambuf>
+#include <vector>
+
+#include "tessera/cells.hpp"
+
+namespace tessera::io {
+namespace {
+
+namespace fs = std::filesystem;
+
+[[noreturn]] void cannot_write(const std::string& path, const std::string& reason) {
+  throw InputError("cannot write " + path + ": " + reason);
+}
+
+/// An output streambuf over a file descriptor that remembers the errno of the
+/// first failed write (std::ofstream only reports "failed", never why).
+class FdBuf : public std::streambuf {
+ public:
+  explicit FdBuf(int fd) : fd_(fd), buf_(1 << 16) { setp(buf_.data(), buf_.data() + buf_.size()); }
+  int error() const { return err_; }
+
+ protected:
+  int_type overflow(int_type ch) override {
+    if (!drain()) return traits_type::eof();
+    if (!traits_type::eq_int_type(ch, traits_type::eof())) {
+      *pptr() = traits_type::to_char_type(ch);
+      pbump(1);
+    }
+    return traits_type::not_eof(ch);
+  }
+  std::streamsize xsputn(const char* s, std::streamsize n) override {
+    // Large blocks bypass the buffer.
+    if (n >= static_cast<std::streamsize>(buf_.size())) {
+      if (!drain() || !write_all(s, static_cast<std::size_t>(n))) return 0;
+      return n;
+    }
+    return std::streambuf::xsputn(s, n);
+  }
+  int sync() override { return drain() ? 0 : -1; }
+
+ private:
+  bool drain() {
+    const std::size_t n = static_cast<std::size_t>(pptr() - pbase());
+    setp(buf_.data(), buf_.data() + buf_.size());
+    return write_all(buf_.data(), n);
+  }
+  bool write_all(const char* p, std::size_t n) {
+    if (err_) return false;
+    while (n > 0) {
+      const ssize_t w = ::write(fd_, p, n);
+      if (w < 0) {
+        if (errno == EINTR) continue;
+        err_ = errno;
+        return false;
+      }
+      p += w;
+      n -= static_cast<std::size_t>(w);
+    }
+    return true;
+  }
+
+  int fd_;
+  std::vector<char> buf_;
+  int err_ = 0;
+};
+
+/// Create `path.tmp-XXXXXX` exclusively (mode 0666 less the umask, like a
+/// plain new file). Returns its fd and sets `tmp`; throws on failure.
+int create_temp(const std::string& path, std::string& tmp) {
+  static std::atomic<unsigned> counter{0};
+  static const char kAlnum[] = "abcdefghijklmnopqrstuvwxyz0123456789";
+  std::random_device rd;
+  std::mt19937 gen(rd() ^ (static_cast<unsigned>(::getpid()) << 16) ^ counter.fetch_add(1));
+  for (int attempt = 0; attempt < 100; ++attempt) {
+    tmp = path + ".tmp-";
+    for (int k = 0; k < 6; ++k) tmp += kAlnum[gen() % (sizeof kAlnum - 1)];
+    const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+    if (fd >= 0) return fd;
+    if (errno != EEXIST) cannot_write(path, std::strerror(errno));
+  }
+  cannot_write(path, "could not create a unique temporary file");
+}
+
+}  // namespace
+
+void write_file_atomic(const std::string& path, const std::function<void(std::ostream&)>& fill) {
+  if (path.empty()) throw InputError("cannot write an empty path");
+  std::error_code ec;
+  if (fs::is_directory(path, ec)) cannot_write(path, "is a directory");
+
+  std::string tmp;
+  const int fd = create_temp(path, tmp);
+  // From here on every exit path must close fd and remove tmp unless renamed.
+  auto discard = [&](int open_fd) {
+    if (open_fd >= 0) ::close(open_fd);
+    ::unlink(tmp.c_str());
+  };
+  int write_error = 0;
+  bool stream_bad = false;
+  try {
+    FdBuf buf(fd);
+    std::ostream os(&buf);
+    fill(os);
+    os.flush();
+    write_error = buf.error();
+    stream_bad = !os;
+  } catch (const Cancelled&) {
+    discard(fd);
+    throw;  // cancellation is not a write error; let it through as itself
+  } catch (const std::exception& e) {
+    discard(fd);
+    cannot_write(path, e.what());
+  } catch (...) {
+    discard(fd);
+    throw;
+  }
+  if (write_error || stream_bad) {
+    discard(fd);
+    cannot_write(path, write_error ? std::strerror(write_error) : "stream error");
+  }
+  if (::close(fd) != 0) {
+    const int err = errno;
+    discard(-1);
+    cannot_write(path, std::strerror(err));
+  }
+  fs::rename(tmp, path, ec);
+  if (ec) {
+    discard(-1);
+    cannot_write(path, ec.message());
+  }
+}
+
+void write_file_atomic(const std::string& path, std::string_view bytes) {
+  write_file_atomic(path, [bytes](std::ostream& os) {
+    os.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  });
+}
+
+void check_writable(const std::string& path) {
+  if (path.empty()) throw InputError("cannot write an empty path");
+  std::error_code ec;
+  if (fs::is_directory(path, ec)) cannot_write(path, "is a directory");
+  fs::path dir = fs::path(path).parent_path();
+  if (dir.empty()) dir = ".";
+  const auto st = fs::status(dir, ec);
+  if (!fs::exists(st)) cannot_write(path, "directory '" + dir.string() + "' does not exist");
+  if (!fs::is_directory(st)) cannot_write(path, "'" + dir.string() + "' is not a directory");
+  if (::access(dir.c_str(), W_OK) != 0) {
+    const int err = errno;
+    cannot_write(path, "directory '" + dir.string() + "' is not writable (" + std::strerror(err) + ")");
+  }
+}
+
+}  // namespace tessera::io

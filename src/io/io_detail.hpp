@@ -1,0 +1,38 @@
+// Private helpers shared by the IO readers and writers (not installed).
+#pragma once
+
+#include <string>
+#include <string_view>
+
+#include "tessera/cells.hpp"
+#include "tessera/io/points.hpp"
+
+namespace tessera::io::detail {
+
+/// Throw tessera::InputError("PATH: what"). Every reader error goes through
+/// here so that messages are one line and start with the file path.
+[[noreturn]] void fail(const std::string& path, std::string_view what);
+
+/// The whole file as bytes. Throws InputError("cannot open PATH: reason")
+/// (reason from strerror, e.g. "No such file or directory").
+std::string read_file_bytes(const std::string& path);
+
+/// Throws InputError("cannot open PATH: reason") unless `path` names an
+/// existing file that is not a directory. Used before opening a file.
+void check_readable(const std::string& path);
+
+/// The extension of `path`, lowercased, with its dot ("" when there is none).
+std::string lower_extension(const std::string& path);
+
+/// Text point files (.csv/.xyz/.txt). `label_column` is empty, or the header
+/// name of the column holding integer labels. Coordinates are checked finite
+/// (errors name the line). Returns the cloud with labels filled when asked.
+PointCloud read_text_points(const std::string& path, const ReadOptions& options,
+                            const std::string& label_column);
+
+/// .ply files (ascii or binary_little_endian). `label_property` is empty, or
+/// the name of an integer vertex property holding labels.
+PointCloud read_ply_points(const std::string& path, const ReadOptions& options,
+                           const std::string& label_property);
+
+}  // namespace tessera::io::detail

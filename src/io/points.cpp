@@ -1,0 +1,175 @@
+// read_points: dispatch by extension, then the checks common to all formats
+// (non-empty, finite coordinates, labels of the right length).
+#include "tessera/io/points.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <limits>
+#include <memory>
+#include <sstream>
+
+#include "io_detail.hpp"
+#include "tessera/cells.hpp"
+#include "tessera/io/npy.hpp"
+
+namespace tessera::io {
+
+namespace detail {
+
+void fail(const std::string& path, std::string_view what) {
+  std::string msg = path;
+  msg += ": ";
+  msg += what;
+  // Keep messages on one line whatever got spliced into them.
+  std::replace(msg.begin(), msg.end(), '\n', ' ');
+  std::replace(msg.begin(), msg.end(), '\r', ' ');
+  throw InputError(msg);
+}
+
+void check_readable(const std::string& path) {
+  std::error_code ec;
+  const auto st = std::filesystem::status(path, ec);
+  if (ec || !std::filesystem::exists(st)) {
+    const int err = ec ? ec.value() : ENOENT;
+    throw InputError("cannot open " + path + ": " + std::strerror(err));
+  }
+  if (std::filesystem::is_directory(st))
+    throw InputError("cannot open " + path + ": " + std::strerror(EISDIR));
+}
+
+std::string read_file_bytes(const std::string& path) {
+  check_readable(path);
+  struct Closer {
+    void operator()(std::FILE* f) const { std::fclose(f); }
+  };
+  std::unique_ptr<std::FILE, Closer> f(std::fopen(path.c_str(), "rb"));
+  if (!f) throw InputError("cannot open " + path + ": " + std::strerror(errno));
+  std::string bytes;
+  std::error_code ec;
+  const auto size = std::filesystem::file_size(path, ec);
+  if (!ec) bytes.reserve(size);
+  // Read in blocks until EOF: file_size is only a hint (pipes, growing files).
+  char buf[1 << 16];
+  for (;;) {
+    const std::size_t got = std::fread(buf, 1, sizeof buf, f.get());
+    bytes.append(buf, got);
+    if (got < sizeof buf) {
+      if (std::ferror(f.get())) {
+        const int err = errno;
+        throw InputError("cannot read " + path + ": " + std::strerror(err));
+      }
+      break;
+    }
+  }
+  return bytes;
+}
+
+std::string lower_extension(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext;
+}
+
+}  // namespace detail
+
+namespace {
+
+/// Points from an .npy array of shape (N, 2) or (N, 3).
+PointCloud read_npy_points(const std::string& path, const ReadOptions& options) {
+  NpyArray a = read_npy_double(path);
+  const auto& s = a.shape;
+  if (s.size() != 2 || s[1] < 2 || s[1] > 3) {
+    std::ostringstream shape;
+    shape << '(';
+    for (std::size_t k = 0; k < s.size(); ++k) shape << (k ? ", " : "") << s[k];
+    shape << (s.size() == 1 ? ",)" : ")");
+    detail::fail(path, "expected a point array of shape (N, 2) or (N, 3), found shape " + shape.str());
+  }
+  const int cols = static_cast<int>(s[1]);
+  const int dim = options.dim ? options.dim : cols;
+  if (dim > cols)
+    detail::fail(path,
+                 "3D points asked but the array has 2 columns (shape (" + std::to_string(s[0]) + ", 2))");
+  PointCloud pc;
+  pc.dim = dim;
+  pc.n = s[0];
+  pc.coords = std::move(a.as_double);
+  if (dim < cols) {
+    // Keep x,y of each row, compacting in place (write index never passes read index).
+    for (std::size_t i = 0; i < pc.n; ++i) {
+      pc.coords[i * 2] = pc.coords[i * 3];
+      pc.coords[i * 2 + 1] = pc.coords[i * 3 + 1];
+    }
+    pc.coords.resize(pc.n * 2);
+    pc.coords.shrink_to_fit();
+  }
+  return pc;
+}
+
+}  // namespace
+
+std::vector<std::int32_t> read_labels_npy(const std::string& path) {
+  NpyArray a = read_npy_int(path);
+  if (!(a.shape.size() == 1 || (a.shape.size() == 2 && a.shape[1] == 1))) {
+    std::string shape = "(";
+    for (std::size_t k = 0; k < a.shape.size(); ++k) shape += (k ? ", " : "") + std::to_string(a.shape[k]);
+    detail::fail(path, "labels must be a 1-D integer array, found shape " + shape + ")");
+  }
+  std::vector<std::int32_t> labels(a.as_int.size());
+  for (std::size_t i = 0; i < labels.size(); ++i) {
+    const std::int64_t v = a.as_int[i];
+    if (v < std::numeric_limits<std::int32_t>::min() || v > std::numeric_limits<std::int32_t>::max())
+      detail::fail(
+          path, "label " + std::to_string(v) + " at index " + std::to_string(i) + " does not fit in int32");
+    labels[i] = static_cast<std::int32_t>(v);
+  }
+  return labels;
+}
+
+PointCloud read_points(const std::string& path, const ReadOptions& options) {
+  if (options.dim != 0 && options.dim != 2 && options.dim != 3)
+    detail::fail(path, "dimension must be 2 or 3, not " + std::to_string(options.dim));
+
+  // A labels option ending in .npy is a file; anything else names a column/property.
+  const bool labels_file = !options.labels.empty() && detail::lower_extension(options.labels) == ".npy";
+  const std::string label_name = labels_file ? std::string() : options.labels;
+
+  const std::string ext = detail::lower_extension(path);
+  PointCloud pc;
+  if (ext == ".npy") {
+    if (!label_name.empty())
+      detail::fail(path, "labels '" + label_name + "': with .npy points, labels must be a .npy file");
+    pc = read_npy_points(path, options);
+  } else if (ext == ".csv" || ext == ".xyz" || ext == ".txt") {
+    pc = detail::read_text_points(path, options, label_name);
+  } else if (ext == ".ply") {
+    pc = detail::read_ply_points(path, options, label_name);
+  } else {
+    detail::fail(path, "unknown input extension '" + ext + "' (expected .npy, .csv, .xyz, .txt, .ply)");
+  }
+
+  if (pc.n == 0) detail::fail(path, "no points");
+  for (std::size_t k = 0; k < pc.coords.size(); ++k) {
+    if (!std::isfinite(pc.coords[k])) {
+      char buf[64];
+      std::snprintf(buf, sizeof buf, "%g", pc.coords[k]);
+      detail::fail(path, "non-finite coordinate " + std::string(buf) + " in row " +
+                             std::to_string(k / pc.dim) + " (0-based)");
+    }
+  }
+
+  if (labels_file) {
+    pc.labels = read_labels_npy(options.labels);
+    if (pc.labels.size() != pc.n)
+      detail::fail(options.labels, "labels: " + std::to_string(pc.labels.size()) + " values for " +
+                                       std::to_string(pc.n) + " points");
+  }
+  return pc;
+}
+
+}  // namespace tessera::io

@@ -1,0 +1,244 @@
+// Text point files: .csv, .xyz, .txt.
+//
+// Rules (see points.hpp):
+//  - fields are separated by ',' or ';' (picked from the first content line; blanks
+//    around fields are trimmed) or else by runs of spaces/tabs;
+//  - blank lines and lines starting with '#' are skipped; CRLF and a UTF-8 BOM are fine;
+//  - the first content line is a header when one of its fields is not a number;
+//  - the columns (other than a labels column) give the coordinates: 2 -> 2D,
+//    3 or more -> 3D (extras ignored), unless ReadOptions::dim forces it;
+//  - every data line must have the columns needed; errors name the line (1-based).
+// The whole file is read into memory and parsed with std::from_chars.
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "io_detail.hpp"
+#include "tessera/cells.hpp"
+
+namespace tessera::io::detail {
+namespace {
+
+inline bool is_blank(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
+
+std::string_view trim(std::string_view s) {
+  while (!s.empty() && is_blank(s.front())) s.remove_prefix(1);
+  while (!s.empty() && is_blank(s.back())) s.remove_suffix(1);
+  return s;
+}
+
+/// Walks the fields of one line. delim is ',' or ';', or ' ' for whitespace runs.
+class Fields {
+ public:
+  Fields(std::string_view line, char delim)
+      : p_(line.data()), end_(line.data() + line.size()), delim_(delim) {}
+
+  /// Next field into `f`; false when the line has no more fields.
+  bool next(std::string_view& f) {
+    if (delim_ == ' ') {
+      while (p_ < end_ && is_blank(*p_)) ++p_;
+      if (p_ == end_) return false;
+      const char* b = p_;
+      while (p_ < end_ && !is_blank(*p_)) ++p_;
+      f = std::string_view(b, static_cast<std::size_t>(p_ - b));
+      return true;
+    }
+    if (done_) return false;
+    const char* b = p_;
+    while (p_ < end_ && *p_ != delim_) ++p_;
+    f = trim(std::string_view(b, static_cast<std::size_t>(p_ - b)));
+    if (p_ == end_)
+      done_ = true;
+    else
+      ++p_;
+    return true;
+  }
+
+ private:
+  const char* p_;
+  const char* end_;
+  char delim_;
+  bool done_ = false;
+};
+
+/// Parse a whole field as a double (a leading '+' is allowed). "nan"/"inf"
+/// parse; the caller rejects them with the line number.
+inline bool parse_double(std::string_view f, double& v) {
+  const char* b = f.data();
+  const char* e = b + f.size();
+  if (b != e && *b == '+') ++b;
+  if (b == e) return false;
+  auto [p, ec] = std::from_chars(b, e, v);
+  return ec == std::errc() && p == e;
+}
+
+/// Parse a label: an integer, or a decimal with an integral value ("3.0"), in int32 range.
+bool parse_label(std::string_view f, std::int32_t& out) {
+  const char* b = f.data();
+  const char* e = b + f.size();
+  if (b != e && *b == '+') ++b;
+  std::int64_t iv = 0;
+  auto [p, ec] = std::from_chars(b, e, iv);
+  if (!(ec == std::errc() && p == e)) {
+    double d = 0;
+    if (!parse_double(f, d) || !std::isfinite(d) || d != std::floor(d) || std::abs(d) > 4e9) return false;
+    iv = static_cast<std::int64_t>(d);
+  }
+  if (iv < std::numeric_limits<std::int32_t>::min() || iv > std::numeric_limits<std::int32_t>::max())
+    return false;
+  out = static_cast<std::int32_t>(iv);
+  return true;
+}
+
+/// Cursor over the content lines (skips blank and '#' lines, strips '\r').
+class Lines {
+ public:
+  explicit Lines(std::string_view text) : p_(text.data()), end_(text.data() + text.size()) {
+    if (text.substr(0, 3) == "\xEF\xBB\xBF") p_ += 3;
+  }
+  /// Next content line and its 1-based number; false at end of file.
+  bool next(std::string_view& line, std::size_t& number) {
+    while (p_ < end_) {
+      const char* nl = static_cast<const char*>(std::memchr(p_, '\n', static_cast<std::size_t>(end_ - p_)));
+      const char* e = nl ? nl : end_;
+      std::string_view l(p_, static_cast<std::size_t>(e - p_));
+      p_ = nl ? nl + 1 : end_;
+      ++line_no_;
+      if (!l.empty() && l.back() == '\r') l.remove_suffix(1);
+      std::size_t k = 0;
+      while (k < l.size() && is_blank(l[k])) ++k;
+      if (k == l.size() || l[k] == '#') continue;
+      line = l;
+      number = line_no_;
+      return true;
+    }
+    return false;
+  }
+
+ private:
+  const char* p_;
+  const char* end_;
+  std::size_t line_no_ = 0;
+};
+
+std::string quoted_list(const std::vector<std::string>& names) {
+  std::string s;
+  for (std::size_t k = 0; k < names.size(); ++k) s += (k ? ", '" : "'") + names[k] + "'";
+  return s;
+}
+
+}  // namespace
+
+PointCloud read_text_points(const std::string& path, const ReadOptions& options,
+                            const std::string& label_column) {
+  const std::string text = read_file_bytes(path);
+  Lines lines(text);
+  std::string_view line;
+  std::size_t line_no = 0;
+  if (!lines.next(line, line_no)) fail(path, "no points");
+
+  // Layout from the first content line: delimiter, header, column count.
+  const char delim = line.find(',') != std::string_view::npos   ? ','
+                     : line.find(';') != std::string_view::npos ? ';'
+                                                                : ' ';
+  std::vector<std::string_view> first;
+  {
+    Fields fs(line, delim);
+    std::string_view f;
+    while (fs.next(f)) first.push_back(f);
+  }
+  bool header = false;
+  for (std::string_view f : first) {
+    double v;
+    if (!f.empty() && !parse_double(f, v)) header = true;
+  }
+  std::vector<std::string> names;
+  if (header) {
+    for (std::string_view f : first) {
+      if (f.size() >= 2 && (f.front() == '"' || f.front() == '\'') && f.back() == f.front())
+        f = f.substr(1, f.size() - 2);
+      names.emplace_back(f);
+    }
+  }
+  const std::size_t ncols = first.size();
+
+  // Which column holds labels, if any.
+  std::size_t label_col = ncols;  // ncols = none
+  if (!label_column.empty()) {
+    if (!header) fail(path, "labels '" + label_column + "': the file has no header line naming its columns");
+    auto it = std::find(names.begin(), names.end(), label_column);
+    if (it == names.end())
+      fail(path, "no column '" + label_column + "' for labels (columns: " + quoted_list(names) + ")");
+    label_col = static_cast<std::size_t>(it - names.begin());
+  }
+
+  // Coordinate columns: the first `dim` columns other than the labels column.
+  const std::size_t avail = ncols - (label_col < ncols ? 1 : 0);
+  int dim = options.dim;
+  if (dim == 0) {
+    if (avail < 2)
+      fail(path, "line " + std::to_string(line_no) + " has " + std::to_string(avail) +
+                     " coordinate column(s); need 2 (x,y) or 3 (x,y,z)");
+    dim = avail >= 3 ? 3 : 2;
+  } else if (avail < static_cast<std::size_t>(dim)) {
+    fail(path, std::to_string(dim) + "D points asked but line " + std::to_string(line_no) + " has " +
+                   std::to_string(avail) + " coordinate column(s)");
+  }
+  std::size_t coord_col[3] = {0, 0, 0};
+  for (std::size_t c = 0, k = 0; k < static_cast<std::size_t>(dim); ++c)
+    if (c != label_col) coord_col[k++] = c;
+  // Field index -> slot: 0..dim-1 a coordinate, 3 the label, -1 ignored.
+  const std::size_t needed = std::max(coord_col[dim - 1], label_col < ncols ? label_col : 0) + 1;
+  std::vector<int> slot(needed, -1);
+  for (int k = 0; k < dim; ++k) slot[coord_col[k]] = k;
+  if (label_col < ncols) slot[label_col] = 3;
+
+  PointCloud pc;
+  pc.dim = dim;
+  // Rows <= lines: counting newlines is cheap next to parsing and avoids regrowth.
+  const std::size_t max_rows = static_cast<std::size_t>(std::count(text.begin(), text.end(), '\n')) + 1;
+  pc.coords.reserve(max_rows * static_cast<std::size_t>(dim));
+  if (label_col < ncols) pc.labels.reserve(max_rows);
+
+  bool have = !header;  // the first line is data unless it was the header
+  if (!have) have = lines.next(line, line_no);
+  for (; have; have = lines.next(line, line_no)) {
+    Fields fs(line, delim);
+    std::string_view f;
+    double xyz[3] = {0, 0, 0};
+    std::size_t c = 0;
+    for (; c < needed && fs.next(f); ++c) {
+      const int s = slot[c];
+      if (s < 0) continue;
+      if (s == 3) {
+        std::int32_t lab;
+        if (!parse_label(f, lab))
+          fail(path, "line " + std::to_string(line_no) + ": label '" + std::string(f) + "' in column '" +
+                         label_column + "' is not a 32-bit integer");
+        pc.labels.push_back(lab);
+        continue;
+      }
+      if (!parse_double(f, xyz[s])) {
+        if (f.empty())
+          fail(path, "line " + std::to_string(line_no) + ": empty field in column " + std::to_string(c + 1));
+        fail(path, "line " + std::to_string(line_no) + ": cannot parse '" + std::string(f) +
+                       "' as a number (column " + std::to_string(c + 1) + ")");
+      }
+      if (!std::isfinite(xyz[s]))
+        fail(path, "line " + std::to_string(line_no) + ": non-finite coordinate '" + std::string(f) + "'");
+    }
+    if (c < needed)
+      fail(path, "line " + std::to_string(line_no) + " has " + std::to_string(c) +
+                     " column(s), expected at least " + std::to_string(needed));
+    pc.coords.insert(pc.coords.end(), xyz, xyz + dim);
+  }
+  pc.n = pc.coords.size() / static_cast<std::size_t>(dim);
+  return pc;
+}
+
+}  // namespace tessera::io::detail

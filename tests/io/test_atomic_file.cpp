@@ -1,0 +1,101 @@
+// Atomic writes: success, overwrite, and failures that leave nothing behind.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <stdexcept>
+#include <string>
+
+#include "io/io_test_util.hpp"
+#include "tessera/io/atomic_file.hpp"
+
+using namespace tessera_test;
+using tessera::io::check_writable;
+using tessera::io::write_file_atomic;
+
+TEST(AtomicFile, WritesAndOverwrites) {
+  TempDir dir;
+  const std::string p = dir.file("out.txt");
+  write_file_atomic(p, std::string_view("hello"));
+  EXPECT_EQ(read_all(p), "hello");
+  write_file_atomic(p, [](std::ostream& os) { os << "second " << 2; });
+  EXPECT_EQ(read_all(p), "second 2");
+  EXPECT_EQ(dir.entries(), std::vector<std::string>{"out.txt"});  // no temporaries left
+}
+
+TEST(AtomicFile, LargeWrite) {
+  TempDir dir;
+  const std::string p = dir.file("big.bin");
+  std::string big(3 << 20, 'x');
+  big[12345] = 'y';
+  write_file_atomic(p, [&](std::ostream& os) {
+    os << 'a';
+    os.write(big.data(), static_cast<std::streamsize>(big.size()));
+    os << 'b';
+  });
+  EXPECT_EQ(read_all(p), "a" + big + "b");
+}
+
+TEST(AtomicFile, MissingDirectoryFailsAndLeavesNothing) {
+  TempDir dir;
+  const std::string p = (dir.path() / "no_such_dir" / "out.csv").string();
+  auto msg = input_error([&] { write_file_atomic(p, std::string_view("data")); });
+  EXPECT_EQ(msg.rfind("cannot write " + p + ": ", 0), 0u) << msg;
+  EXPECT_FALSE(fs::exists(dir.path() / "no_such_dir"));
+  EXPECT_TRUE(dir.entries().empty());
+  msg = input_error([&] { check_writable(p); });
+  EXPECT_NE(msg.find("does not exist"), std::string::npos) << msg;
+}
+
+TEST(AtomicFile, ExceptionInFillKeepsOldFile) {
+  TempDir dir;
+  const std::string p = dir.file("keep.txt");
+  write_file_atomic(p, std::string_view("original"));
+  auto msg = input_error([&] {
+    write_file_atomic(p, [](std::ostream& os) {
+      os << std::string(200000, 'z');
+      throw std::runtime_error("boom");
+    });
+  });
+  EXPECT_EQ(msg, "cannot write " + p + ": boom");
+  EXPECT_EQ(read_all(p), "original");
+  EXPECT_EQ(dir.entries(), std::vector<std::string>{"keep.txt"});
+}
+
+TEST(AtomicFile, CancelledPassesThrough) {
+  TempDir dir;
+  const std::string p = dir.file("c.txt");
+  EXPECT_THROW(write_file_atomic(p, [](std::ostream&) { throw tessera::Cancelled(); }), tessera::Cancelled);
+  EXPECT_TRUE(dir.entries().empty());
+}
+
+TEST(AtomicFile, DirectoryTargetRejected) {
+  TempDir dir;
+  fs::create_directory(dir.path() / "sub");
+  const std::string p = dir.file("sub");
+  auto msg = input_error([&] { write_file_atomic(p, std::string_view("x")); });
+  EXPECT_NE(msg.find("is a directory"), std::string::npos) << msg;
+  msg = input_error([&] { check_writable(p); });
+  EXPECT_NE(msg.find("is a directory"), std::string::npos) << msg;
+  EXPECT_EQ(dir.entries(), std::vector<std::string>{"sub"});
+}
+
+TEST(AtomicFile, CheckWritable) {
+  TempDir dir;
+  EXPECT_NO_THROW(check_writable(dir.file("fine.csv")));
+  // A regular file used as the directory.
+  write_file_atomic(dir.file("plain"), std::string_view("x"));
+  auto msg = input_error([&] { check_writable(dir.file("plain") + "/out.csv"); });
+  EXPECT_NE(msg.find("not a directory"), std::string::npos) << msg;
+  // A read-only directory (root bypasses permissions, so only check as non-root).
+  if (::geteuid() != 0) {
+    fs::create_directory(dir.path() / "ro");
+    fs::permissions(dir.path() / "ro", fs::perms::owner_read | fs::perms::owner_exec);
+    const std::string p = (dir.path() / "ro" / "out.csv").string();
+    msg = input_error([&] { check_writable(p); });
+    EXPECT_NE(msg.find("not writable"), std::string::npos) << msg;
+    msg = input_error([&] { write_file_atomic(p, std::string_view("x")); });
+    EXPECT_NE(msg.find("Permission denied"), std::string::npos) << msg;
+    fs::permissions(dir.path() / "ro", fs::perms::owner_all);
+    EXPECT_TRUE(fs::is_empty(dir.path() / "ro"));
+  }
+}

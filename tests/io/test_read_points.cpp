@@ -1,0 +1,86 @@
+// read_points dispatch and the checks common to all formats.
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <string>
+
+#include "io/io_test_util.hpp"
+#include "tessera/io/npy.hpp"
+#include "tessera/io/points.hpp"
+
+using namespace tessera_test;
+using tessera::io::read_points;
+using tessera::io::ReadOptions;
+
+TEST(ReadPoints, UnknownExtension) {
+  TempDir dir;
+  const std::string p = dir.write("points.foo", "1,2,3\n");
+  auto msg = input_error([&] { read_points(p); });
+  EXPECT_EQ(msg, p + ": unknown input extension '.foo' (expected .npy, .csv, .xyz, .txt, .ply)");
+}
+
+TEST(ReadPoints, MissingFile) {
+  TempDir dir;
+  for (const char* name : {"nope.csv", "nope.npy", "nope.ply"}) {
+    const std::string p = dir.file(name);
+    auto msg = input_error([&] { read_points(p); });
+    EXPECT_EQ(msg, "cannot open " + p + ": No such file or directory");
+  }
+}
+
+TEST(ReadPoints, DirectoryIsNotAFile) {
+  TempDir dir;
+  fs::create_directory(dir.path() / "d.csv");
+  auto msg = input_error([&] { read_points(dir.file("d.csv")); });
+  EXPECT_NE(msg.find("cannot open"), std::string::npos) << msg;
+}
+
+TEST(ReadPoints, BadDimOption) {
+  TempDir dir;
+  ReadOptions opt;
+  opt.dim = 4;
+  input_error([&] { read_points(dir.write("a.csv", "1,2,3\n"), opt); });
+}
+
+TEST(ReadPoints, LabelsFromNpy) {
+  TempDir dir;
+  const std::string pts = dir.write("p.csv", "1,2,3\n4,5,6\n7,8,9\n");
+  ReadOptions opt;
+  opt.labels = dir.write("l.NPY", make_npy("<i8", "(3,)", raw_bytes(std::vector<std::int64_t>{0, -1, 4})));
+  auto pc = read_points(pts, opt);
+  EXPECT_EQ(pc.labels, (std::vector<std::int32_t>{0, -1, 4}));
+}
+
+TEST(ReadPoints, LabelsLengthMismatch) {
+  TempDir dir;
+  const std::string pts = dir.write("p.csv", "1,2,3\n4,5,6\n7,8,9\n");
+  ReadOptions opt;
+  opt.labels = dir.write("l.npy", make_npy("<i4", "(2,)", raw_bytes(std::vector<std::int32_t>{1, 2})));
+  auto msg = input_error([&] { read_points(pts, opt); });
+  EXPECT_EQ(msg, opt.labels + ": labels: 2 values for 3 points");
+}
+
+TEST(ReadPoints, LabelsFileMissing) {
+  TempDir dir;
+  const std::string pts = dir.write("p.csv", "1,2,3\n");
+  ReadOptions opt;
+  opt.labels = dir.file("missing.npy");
+  auto msg = input_error([&] { read_points(pts, opt); });
+  EXPECT_EQ(msg, "cannot open " + opt.labels + ": No such file or directory");
+}
+
+TEST(ReadPoints, NpyPointsWithNamedLabelsRejected) {
+  TempDir dir;
+  const std::vector<double> d{1, 2, 3};
+  const std::string p = dir.write("p.npy", make_npy("<f8", "(1, 3)", raw_bytes(d)));
+  ReadOptions opt;
+  opt.labels = "region";
+  input_error([&] { read_points(p, opt); });
+}
+
+TEST(ReadPoints, NonFiniteInNpyNamesRow) {
+  TempDir dir;
+  const std::vector<double> d{1, 2, 3, 4, 5, std::numeric_limits<double>::infinity()};
+  auto msg = input_error([&] { read_points(dir.write("p.npy", make_npy("<f8", "(2, 3)", raw_bytes(d)))); });
+  EXPECT_NE(msg.find("row 1"), std::string::npos) << msg;
+}
