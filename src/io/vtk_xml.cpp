@@ -5,8 +5,8 @@
 // byte count followed by the raw values in native (little-endian on x86/ARM)
 // byte order. The XML header needs every array's byte offset, so all sizes are
 // computed first (cheap: they follow from the CSR offsets) and the arrays are then
-// streamed in fixed-size chunks; nothing proportional to the mesh is allocated
-// except the per-cell connectivity offsets in 3D.
+// streamed through a 4 MiB buffer. Besides that buffer, 3D allocates only one
+// int32 per vertex (duplicate-vertex stamps) and one int64 per cell (offsets).
 //
 // 3D (.vtu, UnstructuredGrid, file version 1.0 as written by VTK 9.0-9.3):
 //   connectivity  Int32  unique vertex ids of each cell (first-appearance order)
@@ -71,6 +71,16 @@ class BlockWriter {
     flush();
     if (os_) os_.write(static_cast<const char*>(p), static_cast<std::streamsize>(n));
   }
+  /// Room for `n` <= capacity() bytes, filled through the returned cursor and
+  /// closed with commit(cursor): hot loops then store values without a bounds
+  /// check per element.
+  char* reserve(std::size_t n) {
+    if (used_ + n > kSize) flush();
+    return buf_.data() + used_;
+  }
+  void commit(const char* end) { used_ = static_cast<std::size_t>(end - buf_.data()); }
+  static constexpr std::size_t capacity() { return kSize; }
+
   void flush() {
     if (used_ == 0) return;
     if (os_) os_.write(buf_.data(), static_cast<std::streamsize>(used_));
@@ -83,6 +93,13 @@ class BlockWriter {
   std::vector<char> buf_;
   std::size_t used_ = 0;
 };
+
+/// Stores `v` at `p` (any alignment) and returns the next position.
+template <class T>
+char* store(char* p, T v) {
+  std::memcpy(p, &v, sizeof(T));
+  return p + sizeof(T);
+}
 
 /// One appended DataArray: its XML attributes and its payload size in bytes.
 struct ArraySpec {
@@ -234,25 +251,51 @@ void write_vtu(const std::string& path, const Cells& c) {
     std::fill(stamp.begin(), stamp.end(), -1);
     for (std::size_t ci = 0; ci < nc; ++ci) {
       const auto cell = static_cast<std::int32_t>(ci);
-      for (std::int64_t k = fvo[cfo[ci]]; k < fvo[cfo[ci + 1]]; ++k) {
-        const std::int32_t v = fv[k];
-        if (stamp[v] != cell) {
-          stamp[v] = cell;
-          w.put<std::int32_t>(v);
-        }
+      const std::int64_t k0 = fvo[cfo[ci]], k1 = fvo[cfo[ci + 1]];
+      const std::size_t most = static_cast<std::size_t>(k1 - k0) * 4;  // every face vertex distinct
+      if (most <= BlockWriter::capacity()) {
+        char* p = w.reserve(most);
+        for (std::int64_t k = k0; k < k1; ++k)
+          if (stamp[fv[k]] != cell) {
+            stamp[fv[k]] = cell;
+            p = store<std::int32_t>(p, fv[k]);
+          }
+        w.commit(p);
+      } else {  // a cell larger than the buffer: element by element
+        for (std::int64_t k = k0; k < k1; ++k)
+          if (stamp[fv[k]] != cell) {
+            stamp[fv[k]] = cell;
+            w.put<std::int32_t>(fv[k]);
+          }
       }
     }
     begin_block(w, offs);
     w.put_bytes(conn_end.data(), nc * sizeof(std::int64_t));
     begin_block(w, types);
-    for (std::size_t ci = 0; ci < nc; ++ci) w.put<std::uint8_t>(kVtkPolyhedron);
+    const std::vector<std::uint8_t> type_chunk(std::min<std::size_t>(nc, 1 << 16), kVtkPolyhedron);
+    for (std::size_t done = 0; done < nc; done += type_chunk.size())
+      w.put_bytes(type_chunk.data(), std::min(type_chunk.size(), nc - done));
 
     begin_block(w, faces);
     for (std::size_t ci = 0; ci < nc; ++ci) {
-      w.put<std::int32_t>(static_cast<std::int32_t>(cfo[ci + 1] - cfo[ci]));
-      for (std::int64_t f = cfo[ci]; f < cfo[ci + 1]; ++f) {
-        w.put<std::int32_t>(static_cast<std::int32_t>(fvo[f + 1] - fvo[f]));
-        for (std::int64_t k = fvo[f]; k < fvo[f + 1]; ++k) w.put<std::int32_t>(fv[k]);
+      const std::int64_t f0 = cfo[ci], f1 = cfo[ci + 1];
+      const std::size_t bytes = 4 * static_cast<std::size_t>(1 + (f1 - f0) + (fvo[f1] - fvo[f0]));
+      if (bytes <= BlockWriter::capacity()) {
+        char* p = w.reserve(bytes);
+        p = store<std::int32_t>(p, static_cast<std::int32_t>(f1 - f0));
+        for (std::int64_t f = f0; f < f1; ++f) {
+          const std::int64_t n = fvo[f + 1] - fvo[f];
+          p = store<std::int32_t>(p, static_cast<std::int32_t>(n));
+          std::memcpy(p, fv.data() + fvo[f], static_cast<std::size_t>(n) * 4);  // ids are Int32 already
+          p += n * 4;
+        }
+        w.commit(p);
+      } else {
+        w.put<std::int32_t>(static_cast<std::int32_t>(f1 - f0));
+        for (std::int64_t f = f0; f < f1; ++f) {
+          w.put<std::int32_t>(static_cast<std::int32_t>(fvo[f + 1] - fvo[f]));
+          for (std::int64_t k = fvo[f]; k < fvo[f + 1]; ++k) w.put<std::int32_t>(fv[k]);
+        }
       }
     }
     begin_block(w, faceoffs);

@@ -77,17 +77,11 @@ void det_rows(mpz_t out, mpz_t (*a)[Scratch::kMaxDim], const int* rows, int k, S
   mpz_set(out, s.acc);
 }
 
-}  // namespace
-
-int exact_clip_sign(const ExactContext& ctx, std::int32_t i, const std::int32_t* planes, std::int32_t j) {
-  thread_local Scratch s;
+// Fill s.a / s.b with the rows of gen[0..rows) (see the header) on the input
+// scaled to integers; returns the scale exponent (coordinates = ints * 2^shift)
+// and leaves the scaled p_i in s.coord[kRows].
+int build_rows(const ExactContext& ctx, std::int32_t i, const std::int32_t* gen, int rows, Scratch& s) {
   const int dim = ctx.dim;
-  const int rows = dim + 1;  // dim vertex planes + the query row
-
-  // Row r's generator (or box id); the query row is last.
-  std::int32_t gen[Scratch::kRows];
-  for (int r = 0; r < dim; ++r) gen[r] = planes[r];
-  gen[dim] = j;
 
   // Common scale: the smallest mantissa lsb among all doubles involved.
   int shift = INT_MAX;
@@ -129,6 +123,22 @@ int exact_clip_sign(const ExactContext& ctx, std::int32_t i, const std::int32_t*
       set_scaled(s.b[r], box_plane_upper(gen[r]) ? ctx.hi[axis] : ctx.lo[axis], shift);
     }
   }
+
+  return shift;
+}
+
+}  // namespace
+
+int exact_clip_sign(const ExactContext& ctx, std::int32_t i, const std::int32_t* planes, std::int32_t j) {
+  thread_local Scratch s;
+  const int dim = ctx.dim;
+  const int rows = dim + 1;  // dim vertex planes + the query row
+
+  // Row r's generator (or box id); the query row is last.
+  std::int32_t gen[Scratch::kRows];
+  for (int r = 0; r < dim; ++r) gen[r] = planes[r];
+  gen[dim] = j;
+  build_rows(ctx, i, gen, rows, s);
 
   // Minors of the rows x dim block without row r; cofactor of (r, last) is
   // (-1)^(r + dim) * minor[r].
@@ -182,6 +192,35 @@ int exact_clip_sign(const ExactContext& ctx, std::int32_t i, const std::int32_t*
   }
   // sign(P) = sign(det M) * sign(det A); P > 0 keeps the vertex.
   return sign_m * sign_det_a > 0 ? +1 : -1;
+}
+
+void exact_vertex(const ExactContext& ctx, std::int32_t i, const std::int32_t* planes, double* y) {
+  thread_local Scratch s;
+  thread_local struct Q {
+    mpq_t q;
+    Q() { mpq_init(q); }
+    ~Q() { mpq_clear(q); }
+  } qs;
+  const int dim = ctx.dim;
+  const int shift = build_rows(ctx, i, planes, dim, s);
+  // det A, then Cramer: numerator d = det(A with column d replaced by b).
+  // Weights are infinitesimal and do not move the vertex in the limit.
+  int sel[Scratch::kMaxDim] = {0, 1, 2};
+  det_rows(s.minor[dim], s.a, sel, dim, s);
+  if (mpz_sgn(s.minor[dim]) == 0)
+    throw std::logic_error("exact_vertex: vertex planes are dependent (corrupt cell)");
+  for (int d = 0; d < dim; ++d) {
+    // Swap column d with b, take the determinant, swap back.
+    for (int r = 0; r < dim; ++r) mpz_swap(s.a[r][d], s.b[r]);
+    det_rows(s.minor[d], s.a, sel, dim, s);
+    for (int r = 0; r < dim; ++r) mpz_swap(s.a[r][d], s.b[r]);
+    // y_d = num_d / det - p_i,d = (num_d - det * P_i,d) / det, in units of 2^shift.
+    mpz_submul(s.minor[d], s.minor[dim], s.coord[Scratch::kRows][d]);
+    mpq_set_num(qs.q, s.minor[d]);
+    mpq_set_den(qs.q, s.minor[dim]);
+    mpq_canonicalize(qs.q);
+    y[d] = std::ldexp(mpq_get_d(qs.q), shift);
+  }
 }
 
 }  // namespace tessera::kernels

@@ -79,7 +79,14 @@ class CellBuilder {
       std::sort(keys_.begin(), keys_.end());
       for (std::uint64_t key : keys_) {
         const Candidate& cd = cand_[static_cast<std::uint32_t>(key)];
-        if (cd.r2 > sec2) break;
+        if (cd.r2 > sec2) {
+          // Keys are r2 rounded to float, so a later candidate may still be
+          // slightly nearer; stop only once every later one is surely beyond
+          // (a later key k' >= k has r2 >= k' (1 - 2^-24)).
+          const float k = std::bit_cast<float>(static_cast<std::uint32_t>(key >> 32));
+          if (static_cast<double>(k) * (1.0 - 1e-7) > sec2) break;
+          continue;
+        }
         if (cd.r2 == 0 && exactly_equal(p, cd.id)) {
           // Exact duplicates: the lowest id owns the cell. Coincident points
           // share a bin, which the stable bin sort keeps in id order, and ties

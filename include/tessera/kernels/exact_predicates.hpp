@@ -48,4 +48,10 @@ struct ExactContext {
 /// and j is not i nor one of the planes.
 int exact_clip_sign(const ExactContext& ctx, std::int32_t i, const std::int32_t* planes, std::int32_t j);
 
+/// The vertex of cell `i` where `planes[0..dim)` meet, relative to p_i,
+/// computed exactly and rounded once per coordinate (within 2 ulp). Used when
+/// the float solve is too ill-conditioned to give a trustworthy position (a
+/// near-duplicate pair's two bisectors seen from a third cell, say).
+void exact_vertex(const ExactContext& ctx, std::int32_t i, const std::int32_t* planes, double* y);
+
 }  // namespace tessera::kernels

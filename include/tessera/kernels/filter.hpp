@@ -11,8 +11,8 @@
 // otherwise the exact predicate decides. Vertices are solved by Cramer's rule
 // from three (two) planes; their `err` is u * cond * scale * 64 (Higham,
 // "Accuracy and Stability of Numerical Algorithms", §1 and §9 for the bound
-// shape), and infinite when the system is too ill-conditioned to trust, which
-// sends every test on that vertex to the exact path.
+// shape); beyond a condition number of 1e6 the vertex is instead solved
+// exactly and rounded, so every vertex position is accurate.
 #pragma once
 
 #include <cmath>
@@ -23,8 +23,9 @@ namespace tessera::kernels::filter {
 inline constexpr double u = std::numeric_limits<double>::epsilon() * 0.5;  // unit roundoff
 inline constexpr double plane_eps = 16 * u;
 inline constexpr double vertex_eps = 64 * u;
-/// Beyond this condition number the Cramer solution is not trusted at all.
-inline constexpr double max_condition = 1e12;
+/// Beyond this condition number the float solve's position is too inaccurate
+/// for geometry (volumes, merged coordinates): the vertex is solved exactly.
+inline constexpr double exact_vertex_condition = 1e6;
 
 /// Error bound of P~ = d - n.y for a vertex with bound `err` and |y|_inf = ymax.
 /// The clippers store e = err + plane_eps * ymax per vertex and evaluate

@@ -166,9 +166,17 @@ class Tile {
     double amax = std::max(A.n1, B.n1);
     double bmax = std::max(std::fabs(A.d), std::fabs(B.d));
     double cond = inv_norm * amax;
-    double err = std::numeric_limits<double>::infinity();
-    if (cond < filter::max_condition && std::isfinite(ymax))
+    double err;
+    if (cond < filter::exact_vertex_condition && std::isfinite(ymax)) {
       err = filter::vertex_eps * inv_norm * (amax * ymax + bmax);
+    } else {
+      // Too ill-conditioned for a trustworthy float position (the vertex
+      // exists: the exact predicates created it): solve it exactly.
+      std::int32_t ids[2] = {planes_[v.p[0]].id, planes_[v.p[1]].id};
+      exact_vertex(*exact_, gen_, ids, v.y);
+      ymax = std::max(std::fabs(v.y[0]), std::fabs(v.y[1]));
+      err = 4 * filter::u * ymax;
+    }
     v.e = err + filter::plane_eps * ymax;
     set_radius(v, err);
   }

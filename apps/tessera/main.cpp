@@ -1,0 +1,197 @@
+// tessera: command-line front end (argument parsing, dispatch, error reporting).
+//
+// Contract with the user: every failure prints exactly one line
+// "tessera: error: MESSAGE" on stderr and exits non-zero (2: bad command line
+// or input, 1: anything else or a failed --validate, 130: Ctrl-C). Outputs are
+// written atomically by the IO layer, so a failed run leaves no partial file.
+#include <cerrno>
+#include <cstdio>
+#include <cstdlib>
+#include <exception>
+#include <new>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "commands.hpp"
+#include "tessera/cells.hpp"
+
+namespace {
+
+using namespace tessera::cli;
+
+/// One line, whatever the message contains.
+void print_error(const std::string& msg) {
+  std::string line = msg;
+  for (char& c : line)
+    if (c == '\n' || c == '\r') c = ' ';
+  std::fprintf(stderr, "tessera: error: %s\n", line.c_str());
+}
+
+constexpr const char* kExitCodes =
+    "Exit status: 0 success; 1 failure (internal error, or --validate found a problem);\n"
+    "2 bad command line or bad input; 130 interrupted (Ctrl-C).\n"
+    "Environment: TESSERA_NUM_THREADS sets the thread count when --threads is not given.";
+
+/// Options shared by `voronoi` and `bench voronoi`.
+void add_compute_options(CLI::App* app, ComputeArgs& c, std::vector<std::string>& raw_bounds) {
+  // INPUT is checked after parsing (finish_compute_args), not ->required():
+  // "--bounds 0 1 0 1 pts.npy" hands pts.npy to --bounds, which gives it back.
+  app->add_option("INPUT", c.input,
+                  "Point file (required): .npy (float array, shape (N,2) or (N,3)), .csv/.xyz/.txt (2 or 3 "
+                  "numeric columns), or .ply (vertex x,y,z)");
+  app->add_option("--dim", c.dim,
+                  "Dimension: 2 or 3 (default: the number of columns; .ply is 3D). --dim 2 on 3-column "
+                  "input keeps x,y")
+      ->check(CLI::IsMember({2, 3}));
+  app->add_option("--labels", c.labels,
+                  "Per-point integer labels: FILE.npy (length N), or the name of an integer .ply vertex "
+                  "property / .csv column. Cells get their point's label as Region; points labelled < 0 "
+                  "own no cell and clip their neighbours");
+  // Collected as text: CLI11 cannot know whether 4 (2D) or 6 (3D) numbers
+  // follow, so in 2D it also takes the next word; finish_compute_args sorts it out.
+  app->add_option("--bounds", raw_bounds,
+                  "Domain box: X0 X1 Y0 Y1 in 2D, X0 X1 Y0 Y1 Z0 Z1 in 3D (default: the bounding box of "
+                  "the points grown by --padding); also X0,X1,Y0,Y1[,Z0,Z1]")
+      ->expected(4, 6)
+      ->allow_extra_args(false)  // never more than 6 values
+      ->delimiter(',')
+      ->type_name("X0 X1 Y0 Y1 [Z0 Z1]");
+  app->add_option("--padding", c.padding,
+                  "Margin of the default domain, as a fraction of the largest extent of the points")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  app->add_flag("--ignore-outside", c.ignore_outside,
+                "With --bounds: drop points outside the box (listed in the summary) instead of failing");
+  app->add_option("--threads", c.threads,
+                  "Worker threads (default 0: $TESSERA_NUM_THREADS, else all cores). Results are identical "
+                  "for any thread count")
+      ->check(CLI::NonNegativeNumber);
+  app->add_option("--bin-points", c.bin_points,
+                  "Tuning: mean points per bin of the point locator (default 0: automatic)")
+      ->check(CLI::NonNegativeNumber);
+}
+
+/// Converts the --bounds words to numbers. A fifth word that is not a number
+/// is the INPUT that CLI11 attached to a 2D --bounds (when INPUT is otherwise
+/// missing). Throws InputError for anything else that is not a number.
+void finish_compute_args(ComputeArgs& c, const std::vector<std::string>& raw_bounds) {
+  auto parse = [](const std::string& w, double& v) {
+    char* end = nullptr;
+    errno = 0;
+    v = std::strtod(w.c_str(), &end);
+    return !w.empty() && end == w.c_str() + w.size() && errno != ERANGE;
+  };
+  c.bounds.clear();
+  for (std::size_t i = 0; i < raw_bounds.size(); ++i) {
+    double v = 0;
+    if (parse(raw_bounds[i], v)) {
+      c.bounds.push_back(v);
+      continue;
+    }
+    if (i == 4 && c.input.empty() && raw_bounds.size() == 5) {
+      c.input = raw_bounds[i];
+      break;
+    }
+    throw tessera::InputError("--bounds: '" + raw_bounds[i] + "' is not a number" +
+                              (i >= 4 ? " (put INPUT before --bounds)" : ""));
+  }
+  if (c.input.empty()) throw tessera::InputError("INPUT is required (run with --help for usage)");
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"tessera: Voronoi tessellations of 2D/3D point clouds, clipped to a box, with exact topology.",
+               "tessera"};
+  app.require_subcommand(1);
+  app.footer(kExitCodes);
+
+  VoronoiArgs va;
+  CLI::App* vor = app.add_subcommand("voronoi", "Compute the Voronoi cells of a point cloud and write them");
+  std::vector<std::string> vor_bounds, bench_bounds;
+  add_compute_options(vor, va.compute, vor_bounds);
+  vor->add_option("-o,--output", va.output,
+                  "Cells as VTK XML: .vtu (3D, one polyhedron per cell) or .vtp (2D, one polygon per cell), "
+                  "with cell data GeneratorId, Region, Volume/Area, NumberOfFaces/Edges, NumberOfNeighbors");
+  vor->add_option("--cell-table", va.cell_table,
+                  "Per-cell table, one row per cell in point order: .csv (id,region,volume,cx,cy,cz,faces,"
+                  "neighbors; 2D: id,region,area,cx,cy,edges,neighbors) or .npy (float64, same columns)");
+  vor->add_option("--neighbors", va.neighbors,
+                  "Neighbour lists as one int64 .npy array: [n_cells, offsets (n_cells+1), ids...]; the "
+                  "neighbours of cell c are ids[offsets[c]:offsets[c+1]] (point ids)");
+  vor->add_flag("--validate", va.validate,
+                "Check the result (volume sum, neighbour symmetry, vertex degrees, Euler characteristic), "
+                "print the report, exit 1 if a check fails");
+  vor->add_flag("-q,--quiet", va.quiet, "No summary and no progress bar");
+  vor->footer(
+      "At least one of -o, --cell-table, --neighbors or --validate is required. Output paths are checked\n"
+      "before computing; files are written atomically (never partially).\n"
+      "Examples:\n"
+      "  tessera voronoi points.npy -o cells.vtu --cell-table cells.csv\n"
+      "  tessera voronoi points.csv --dim 2 --bounds 0 1 0 1 -o cells.vtp\n"
+      "  tessera voronoi grains.ply --labels grain --neighbors nb.npy --validate");
+
+  BenchArgs ba;
+  CLI::App* bench = app.add_subcommand("bench", "Benchmarks printing one JSON line per run on stdout");
+  bench->require_subcommand(1);
+  CLI::App* bench_vor = bench->add_subcommand(
+      "voronoi",
+      "Time tessera::voronoi (cells, volumes and neighbour lists; no mesh, no output files) K times. "
+      "Each run prints {\"tool\":\"tessera\",\"op\":\"voronoi3\"|\"voronoi2\",\"n\",\"threads\",\"seconds\","
+      "\"simplices\" (= cells),\"extra\":{cpu_user_s,cpu_sys_s,minflt,peak_rss_bytes,neighbors,exact_calls,"
+      "volume_sum,repeat}}; seconds is wall time of the computation only");
+  add_compute_options(bench_vor, ba.compute, bench_bounds);
+  bench_vor->add_option("--repeat", ba.repeat, "Number of timed runs")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  bench_vor->add_flag("--mesh", ba.mesh,
+                      "Also build the merged mesh (what VTK output needs); op becomes voronoi3_mesh/voronoi2_mesh");
+
+  DemoArgs da;
+  CLI::App* demo = app.add_subcommand(
+      "run-default",
+      "The default job: 1,000,000 uniform random 3D points (fixed seed) in the unit cube, computed in "
+      "memory; writes DIR/cells.vtu and DIR/cells.csv and prints a summary");
+  demo->add_option("-o,--output-dir", da.out_dir, "Output directory (created if missing)")->capture_default_str();
+  demo->add_option("--points", da.n, "Number of points")->check(CLI::PositiveNumber)->capture_default_str();
+  demo->add_option("--seed", da.seed, "Random seed (std::mt19937_64)")->capture_default_str();
+  demo->add_option("--threads", da.threads, "Worker threads (default 0: $TESSERA_NUM_THREADS, else all cores)")
+      ->check(CLI::NonNegativeNumber);
+  demo->add_flag("-q,--quiet", da.quiet, "No summary and no progress bar");
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    if (e.get_exit_code() == 0) return app.exit(e);  // --help
+    print_error(std::string(e.what()) + " (run with --help for usage)");
+    return kExitInputError;
+  }
+
+  try {
+    if (vor->parsed()) {
+      finish_compute_args(va.compute, vor_bounds);
+      return run_voronoi(va);
+    }
+    if (bench_vor->parsed()) {
+      finish_compute_args(ba.compute, bench_bounds);
+      return run_bench_voronoi(ba);
+    }
+    if (demo->parsed()) return run_default(da);
+    print_error("no command given (see tessera --help)");
+    return kExitInputError;
+  } catch (const tessera::InputError& e) {
+    print_error(e.what());
+    return kExitInputError;
+  } catch (const tessera::Cancelled&) {
+    print_error("interrupted; nothing was written");
+    return kExitInterrupted;
+  } catch (const std::bad_alloc&) {
+    print_error("out of memory");
+    return kExitFailure;
+  } catch (const std::exception& e) {
+    print_error(e.what());
+    return kExitFailure;
+  }
+}

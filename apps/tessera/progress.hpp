@@ -1,0 +1,60 @@
+// Terminal progress bar and Ctrl-C handling for the tessera command.
+#pragma once
+
+#include <chrono>
+#include <csignal>
+#include <string>
+
+namespace tessera::cli {
+
+/// True when stderr is a terminal (a progress bar would be seen, not logged).
+bool stderr_is_terminal();
+
+/// A one-line progress bar redrawn in place on stderr.
+///
+/// Contract: update() may be called as often as the engine likes; it redraws at
+/// most every 100 ms, and only once the run has lasted `delay` (short runs show
+/// nothing). finish() (or the destructor) erases the line so later output starts
+/// clean. A disabled bar does nothing at all.
+class ProgressBar {
+ public:
+  ProgressBar(std::string label, bool enabled,
+              std::chrono::milliseconds delay = std::chrono::milliseconds(500));
+  ~ProgressBar();
+  ProgressBar(const ProgressBar&) = delete;
+  ProgressBar& operator=(const ProgressBar&) = delete;
+
+  void update(double fraction);
+  void finish();
+
+ private:
+  using clock = std::chrono::steady_clock;
+  void draw(double fraction, double elapsed);
+
+  std::string label_;
+  bool enabled_;
+  bool drawn_ = false;
+  clock::time_point start_, last_draw_;
+  std::chrono::milliseconds delay_;
+  int last_permille_ = -1;
+};
+
+/// While alive, the first SIGINT (Ctrl-C) only sets a flag, which the progress
+/// callback turns into tessera::Cancelled so the run stops between batches and
+/// no output is written; a second SIGINT kills the process as usual
+/// (SA_RESETHAND). The previous handler is restored on destruction.
+class InterruptGuard {
+ public:
+  InterruptGuard();
+  ~InterruptGuard();
+  InterruptGuard(const InterruptGuard&) = delete;
+  InterruptGuard& operator=(const InterruptGuard&) = delete;
+
+  static bool interrupted();
+
+ private:
+  struct sigaction previous_ {};
+  bool installed_ = false;
+};
+
+}  // namespace tessera::cli

@@ -1,0 +1,495 @@
+// Invariants of the tessellation, on random and on DEGENERATE inputs (no joggle).
+//
+// check_invariants (helpers.hpp) proves, for each result: the cells partition
+// the box (volume sum == domain to 1e-12 relative), adjacency is symmetric,
+// every merged vertex has a key of dim+1 ascending ids, sits where its key
+// says (equidistant from its generators, on its box planes) and is used by
+// exactly the cells of its key, every 3D cell is a closed oriented surface
+// with V-E+F = 2, every 2D cell a closed chain, and the mesh integrates to
+// the reported volume and centroid. On lattices the tests also check the
+// known exact cells (unit cubes/squares).
+#include <gtest/gtest-spi.h>
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <numbers>
+
+#include "helpers.hpp"
+
+namespace {
+
+using namespace cells_test;
+
+// ------------------------------------------------------------------ random
+
+TEST(Invariants, Random10k2D) {
+  const auto pts = random_points(10000, 2, 101);
+  check_invariants(run(pts, 2, unit_box()), pts, {}, "random 10k 2D explicit box");
+  check_invariants(run(pts, 2), pts, {}, "random 10k 2D default box");
+}
+
+TEST(Invariants, Random10k3D) {
+  const auto pts = random_points(10000, 3, 102);
+  check_invariants(run(pts, 3, unit_box()), pts, {}, "random 10k 3D explicit box");
+  const auto far = make_bounds({100, -0.02, 5}, {103, -0.01, 5.5});  // off the origin, thin in y
+  const auto p2 = random_points(10000, 3, 103, far);
+  check_invariants(run(p2, 3, far), p2, {}, "random 10k 3D far thin box");
+}
+
+/// Runs the checker on a corrupted result with failures intercepted; returns
+/// whether some failure message contains `needle`.
+bool checker_reports(const tessera::Cells& c, const std::vector<double>& pts, const std::string& needle) {
+  ::testing::TestPartResultArray results;
+  {
+    ::testing::ScopedFakeTestPartResultReporter rep(::testing::ScopedFakeTestPartResultReporter::INTERCEPT_ONLY_CURRENT_THREAD, &results);
+    check_invariants(c, pts, {}, "corrupted", {true, 1e-12, false});
+  }
+  for (int i = 0; i < results.size(); ++i)
+    if (std::string(results.GetTestPartResult(i).message()).find(needle) != std::string::npos) return true;
+  return false;
+}
+
+// The checker itself is not vacuous: small corruptions of a valid result are caught.
+TEST(Invariants, CheckerCatchesCorruption) {
+  const auto pts = random_points(200, 3, 104);
+  const auto good = run(pts, 3, unit_box());
+  {
+    auto c = good;  // one face turned inside out
+    std::reverse(c.face_vertices.begin() + c.face_vertex_offsets[0], c.face_vertices.begin() + c.face_vertex_offsets[1]);
+    EXPECT_TRUE(checker_reports(c, pts, "no reverse"));
+  }
+  {
+    auto c = good;  // cell 0 forgets its last neighbour
+    c.neighbors.erase(c.neighbors.begin() + c.neighbor_offsets[1] - 1);
+    for (std::size_t k = 1; k < c.neighbor_offsets.size(); ++k) --c.neighbor_offsets[k];
+    EXPECT_TRUE(checker_reports(c, pts, "asymmetric"));
+  }
+  {
+    auto c = good;  // a volume off by 1e-6 relative
+    c.volume[5] *= 1 + 1e-6;
+    EXPECT_TRUE(checker_reports(c, pts, "volume sum"));
+  }
+  {
+    auto c = good;  // a vertex moved by 1e-6
+    c.vertices[3 * 20 + 1] += 1e-6;
+    EXPECT_TRUE(checker_reports(c, pts, "vertex 20"));
+  }
+}
+
+// ------------------------------------------------------------------ lattices
+
+/// Points on a lattice whose cells are all the same known box: checks each
+/// cell's volume, centroid (== its point) and, for each axis neighbour, that
+/// it is listed and the shared face has the full area; the total face measure
+/// is the cell's full surface, so any extra (symbolic) faces have zero area.
+void check_lattice_cells(const tessera::Cells& c, const std::vector<double>& pts, int dim, int k, double h,
+                         const std::string& what) {
+  SCOPED_TRACE(what);
+  const double cell_vol = std::pow(h, dim);
+  const double face = std::pow(h, dim - 1);
+  std::size_t bad = 0;
+  auto id_of = [&](std::array<int, 3> ix) {
+    return dim == 2 ? ix[0] * k + ix[1] : (ix[0] * k + ix[1]) * k + ix[2];
+  };
+  for (std::size_t i = 0; i < pts.size() / dim; ++i) {
+    const auto cell = c.cell_of[i];
+    ASSERT_GE(cell, 0);
+    if (!(std::abs(c.volume[cell] - cell_vol) <= 1e-9 * cell_vol) && ++bad <= 5)
+      ADD_FAILURE() << "point " << i << " volume " << c.volume[cell] << " expected " << cell_vol;
+    for (int a = 0; a < dim; ++a)
+      if (!(std::abs(c.centroid[cell * dim + a] - pts[i * dim + a]) <= 1e-9 * h) && ++bad <= 5)
+        ADD_FAILURE() << "point " << i << " centroid axis " << a << " " << c.centroid[cell * dim + a];
+    std::array<int, 3> ix{0, 0, 0};
+    {
+      std::size_t r = i;
+      for (int a = dim - 1; a >= 0; --a) {
+        ix[a] = int(r % k);
+        r /= k;
+      }
+    }
+    auto nb = neighbours_of(c, cell);
+    auto mm = mesh_face_measures(c, cell);
+    double total = 0;
+    for (auto [s, m] : mm) total += m;
+    if (!(std::abs(total - 2 * dim * face) <= 1e-9 * face) && ++bad <= 5)
+      ADD_FAILURE() << "point " << i << " total face measure " << total << " expected " << 2 * dim * face;
+    for (int a = 0; a < dim; ++a)
+      for (int step : {-1, 1}) {
+        auto jx = ix;
+        jx[a] += step;
+        if (jx[a] < 0 || jx[a] >= k) continue;
+        const int j = id_of(jx);
+        if (!std::binary_search(nb.begin(), nb.end(), j) && ++bad <= 5)
+          ADD_FAILURE() << "point " << i << " does not list its axis neighbour " << j;
+        if (!(std::abs(mm[j] - face) <= 1e-9 * face) && ++bad <= 5)
+          ADD_FAILURE() << "point " << i << " face to axis neighbour " << j << " measure " << mm[j];
+      }
+  }
+  EXPECT_EQ(bad, 0u);
+}
+
+TEST(Invariants, IntegerGrid3D) {
+  for (int k : {8, 10}) {
+    const auto pts = grid_points(k, 3);
+    const auto box = make_bounds({-0.5, -0.5, -0.5}, {k - 0.5, k - 0.5, k - 0.5});
+    const auto c = run(pts, 3, box);
+    check_invariants(c, pts, {}, "integer grid " + std::to_string(k) + "^3");
+    check_lattice_cells(c, pts, 3, k, 1.0, "integer grid " + std::to_string(k) + "^3");
+    check_invariants(run(pts, 3), pts, {}, "integer grid default box " + std::to_string(k) + "^3");
+  }
+}
+
+TEST(Invariants, TenthGrid3D) {
+  // Spacing 0.1 is not representable: the points are a slightly irregular grid
+  // whose co-spherical quadruples are only nearly so.
+  const int k = 10;
+  const auto pts = grid_points(k, 3, 0.1);
+  const auto box = make_bounds({-0.05, -0.05, -0.05}, {0.1 * (k - 1) + 0.05, 0.1 * (k - 1) + 0.05, 0.1 * (k - 1) + 0.05});
+  const auto c = run(pts, 3, box);
+  check_invariants(c, pts, {}, "0.1 grid 10^3");
+  check_lattice_cells(c, pts, 3, k, 0.1, "0.1 grid 10^3");
+  check_invariants(run(pts, 3), pts, {}, "0.1 grid 10^3 default box");
+}
+
+TEST(Invariants, VoxelCentres3D) {
+  const int k = 10;
+  const auto pts = grid_points(k, 3, 1.0, 0.5);
+  const auto box = make_bounds({0, 0, 0}, {double(k), double(k), double(k)});
+  const auto c = run(pts, 3, box);
+  check_invariants(c, pts, {}, "voxel centres 10^3");
+  check_lattice_cells(c, pts, 3, k, 1.0, "voxel centres 10^3");
+}
+
+TEST(Invariants, RotatedLattice3D) {
+  // A unit grid under a generic rotation: every 8 neighbouring points are
+  // co-spherical up to rounding. Cells of interior points far from the box are
+  // unit cubes.
+  const int k = 8;
+  const double A = 0.3, B = 0.7, C = 1.1;
+  const double R[3][3] = {
+      {std::cos(A) * std::cos(B), std::cos(A) * std::sin(B) * std::sin(C) - std::sin(A) * std::cos(C),
+       std::cos(A) * std::sin(B) * std::cos(C) + std::sin(A) * std::sin(C)},
+      {std::sin(A) * std::cos(B), std::sin(A) * std::sin(B) * std::sin(C) + std::cos(A) * std::cos(C),
+       std::sin(A) * std::sin(B) * std::cos(C) - std::cos(A) * std::sin(C)},
+      {-std::sin(B), std::cos(B) * std::sin(C), std::cos(B) * std::cos(C)}};
+  const auto g = grid_points(k, 3);
+  std::vector<double> pts(g.size());
+  for (std::size_t i = 0; i < g.size() / 3; ++i)
+    for (int r = 0; r < 3; ++r) pts[3 * i + r] = R[r][0] * g[3 * i] + R[r][1] * g[3 * i + 1] + R[r][2] * g[3 * i + 2];
+  const auto c = run(pts, 3);
+  check_invariants(c, pts, {}, "rotated lattice 8^3");
+  std::size_t checked = 0;
+  for (std::size_t i = 0; i < g.size() / 3; ++i) {
+    bool interior = true;
+    for (int a = 0; a < 3; ++a) {
+      interior &= g[3 * i + a] >= 1 && g[3 * i + a] <= k - 2;
+      interior &= pts[3 * i + a] - c.bounds.lo[a] > 0.9 && c.bounds.hi[a] - pts[3 * i + a] > 0.9;
+    }
+    if (!interior) continue;
+    ++checked;
+    EXPECT_NEAR(c.volume[c.cell_of[i]], 1.0, 1e-9) << "interior point " << i;
+    for (int a = 0; a < 3; ++a) EXPECT_NEAR(c.centroid[3 * c.cell_of[i] + a], pts[3 * i + a], 1e-9);
+  }
+  EXPECT_GT(checked, 50u);
+}
+
+TEST(Invariants, FibonacciSphere3D) {
+  // 500 points on a sphere (co-spherical up to rounding) plus its centre: the
+  // centre's cell has ~500 faces, all meeting the nearly degenerate outer cells.
+  const int m = 500;
+  std::vector<double> pts;
+  const double golden = std::numbers::pi * (3.0 - std::sqrt(5.0));
+  for (int i = 0; i < m; ++i) {
+    const double z = 1.0 - 2.0 * (i + 0.5) / m;
+    const double r = std::sqrt(1.0 - z * z);
+    pts.insert(pts.end(), {r * std::cos(golden * i), r * std::sin(golden * i), z});
+  }
+  pts.insert(pts.end(), {0.0, 0.0, 0.0});
+  const auto c = run(pts, 3);
+  check_invariants(c, pts, {}, "fibonacci sphere 500 + centre");
+  EXPECT_EQ(c.n_cells(), std::size_t(m + 1));
+  EXPECT_EQ(neighbours_of(c, c.cell_of[m]).size(), std::size_t(m)) << "the centre touches every sphere point";
+}
+
+TEST(Invariants, IntegerSphere3D) {
+  // All 390 integer points with x^2+y^2+z^2 = 33^2: EXACTLY co-spherical (the
+  // whole input is one degenerate configuration), plus the centre.
+  const int r = 33;
+  std::vector<double> pts;
+  for (int x = -r; x <= r; ++x)
+    for (int y = -r; y <= r; ++y)
+      for (int z = -r; z <= r; ++z)
+        if (x * x + y * y + z * z == r * r) pts.insert(pts.end(), {double(x), double(y), double(z)});
+  ASSERT_EQ(pts.size() / 3, 390u);
+  pts.insert(pts.end(), {0.0, 0.0, 0.0});
+  const auto c = run(pts, 3);
+  check_invariants(c, pts, {}, "integer sphere r=33 + centre");
+  EXPECT_EQ(c.n_cells(), pts.size() / 3);
+  EXPECT_EQ(neighbours_of(c, c.cell_of[390]).size(), 390u) << "the centre touches every sphere point";
+}
+
+TEST(Invariants, Grid2D) {
+  const int k = 30;
+  const auto pts = grid_points(k, 2);
+  const auto box = make_bounds({-0.5, -0.5, 0}, {k - 0.5, k - 0.5, 0});
+  const auto c = run(pts, 2, box);
+  check_invariants(c, pts, {}, "integer grid 30^2");
+  check_lattice_cells(c, pts, 2, k, 1.0, "integer grid 30^2");
+  check_invariants(run(pts, 2), pts, {}, "integer grid 30^2 default box");
+
+  const auto vox = grid_points(k, 2, 1.0, 0.5);
+  const auto vb = make_bounds({0, 0, 0}, {double(k), double(k), 0});
+  const auto cv = run(vox, 2, vb);
+  check_invariants(cv, vox, {}, "pixel centres 30^2");
+  check_lattice_cells(cv, vox, 2, k, 1.0, "pixel centres 30^2");
+
+  const auto tenth = grid_points(k, 2, 0.1);
+  check_invariants(run(tenth, 2), tenth, {}, "0.1 grid 30^2 default box");
+}
+
+TEST(Invariants, Circle2D) {
+  // Exactly co-circular: the 324 integer points on x^2+y^2 = 32045^2, plus the centre.
+  const long long r = 32045;
+  std::vector<double> pts;
+  for (long long x = -r; x <= r; ++x) {
+    const long long y2 = r * r - x * x;
+    long long y = (long long)std::llround(std::sqrt(double(y2)));
+    while (y * y > y2) --y;
+    while ((y + 1) * (y + 1) <= y2) ++y;
+    if (y * y != y2) continue;
+    pts.insert(pts.end(), {double(x), double(y)});
+    if (y != 0) pts.insert(pts.end(), {double(x), double(-y)});
+  }
+  ASSERT_EQ(pts.size() / 2, 324u);
+  pts.insert(pts.end(), {0.0, 0.0});
+  const auto c = run(pts, 2);
+  check_invariants(c, pts, {}, "integer circle + centre");
+  EXPECT_EQ(neighbours_of(c, c.cell_of[324]).size(), 324u) << "the centre touches every circle point";
+
+  // Nearly co-circular: cos/sin points, plus the centre.
+  std::vector<double> q;
+  for (int i = 0; i < 400; ++i)
+    q.insert(q.end(), {std::cos(2 * std::numbers::pi * i / 400), std::sin(2 * std::numbers::pi * i / 400)});
+  q.insert(q.end(), {0.0, 0.0});
+  const auto cq = run(q, 2);
+  check_invariants(cq, q, {}, "cos/sin circle + centre");
+  EXPECT_EQ(neighbours_of(cq, cq.cell_of[400]).size(), 400u);
+}
+
+// ------------------------------------------------------------------ near / exact duplicates
+
+/// Each base point i gets a partner at distance `sep` (a random direction, or
+/// along +x when along_x): both must own a cell, list each other, and their
+/// cells together must be the base point's cell without the partner.
+void near_duplicates(int dim, const std::vector<double>& base, std::optional<tessera::Bounds> box, double sep,
+                     bool along_x, std::uint64_t seed, const std::string& what) {
+  SCOPED_TRACE(what);
+  const std::size_t n = base.size() / dim;
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> nd;
+  std::vector<double> pts = base;
+  for (std::size_t i = 0; i < n; ++i) {
+    std::array<double, 3> d{1, 0, 0};
+    if (!along_x) {
+      double s = 0;
+      for (int a = 0; a < dim; ++a) s += (d[a] = nd(rng)) * d[a];
+      for (int a = 0; a < dim; ++a) d[a] /= std::sqrt(s);
+    }
+    for (int a = 0; a < dim; ++a) pts.push_back(base[i * dim + a] + sep * d[a]);
+  }
+  const auto c = run(pts, dim, box);
+  check_invariants(c, pts, {}, what);
+  EXPECT_TRUE(c.duplicates.empty());
+  const auto alone = run(base, dim, c.bounds);
+  std::size_t bad = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto a = c.cell_of[i], b = c.cell_of[n + i];
+    ASSERT_GE(a, 0);
+    ASSERT_GE(b, 0);
+    auto na = neighbours_of(c, a), nb = neighbours_of(c, b);
+    if (!std::binary_search(na.begin(), na.end(), std::int32_t(n + i)) ||
+        !std::binary_search(nb.begin(), nb.end(), std::int32_t(i))) {
+      if (++bad <= 5) ADD_FAILURE() << "near-duplicate pair " << i << "," << n + i << " are not neighbours";
+    }
+    const double v = alone.volume[alone.cell_of[i]];
+    if (!(std::abs(c.volume[a] + c.volume[b] - v) <= 1e-9 * v) && ++bad <= 5)
+      ADD_FAILURE() << "pair " << i << " volumes " << c.volume[a] << "+" << c.volume[b] << " != " << v;
+  }
+  EXPECT_EQ(bad, 0u);
+}
+
+TEST(Invariants, NearDuplicates) {
+  near_duplicates(3, random_points(300, 3, 201), unit_box(), 1e-12, false, 1, "3D random pairs 1e-12");
+  near_duplicates(2, random_points(500, 2, 202), unit_box(), 1e-12, false, 2, "2D random pairs 1e-12");
+  // Pairs on a lattice, split along an axis: the splitting bisectors pass
+  // (nearly) through the lattice's co-spherical vertices.
+  near_duplicates(3, grid_points(5, 3), std::nullopt, 4e-12, true, 3, "3D grid pairs along x");
+  near_duplicates(2, grid_points(10, 2), std::nullopt, 9e-12, true, 4, "2D grid pairs along x");
+}
+
+/// Inserts exact duplicates (including a triple and a copy placed BEFORE its
+/// original) and checks: each duplicate is reported once as (dup, lowest id),
+/// owns no cell, and the cells equal those of the input without duplicates.
+void exact_duplicates(int dim, std::uint64_t seed) {
+  SCOPED_TRACE(::testing::Message() << "dim " << dim);
+  const std::size_t n0 = 200;
+  std::vector<double> pts = random_points(n0, dim, seed);
+  auto copy = [&](std::size_t from) {
+    for (int a = 0; a < dim; ++a) pts.push_back(pts[from * dim + a]);
+  };
+  for (int a = 0; a < dim; ++a) pts[3 * dim + a] = pts[150 * dim + a];  // 3 and 150 coincide: 3 owns
+  copy(5);
+  copy(5);  // 5, 200, 201: a triple
+  copy(17);
+  copy(199);
+  copy(150);  // 3, 150, 204
+  const std::vector<std::pair<std::int32_t, std::int32_t>> want = {{150, 3}, {200, 5}, {201, 5}, {202, 17}, {203, 199}, {204, 3}};
+  const auto c = run(pts, dim, unit_box());
+  check_invariants(c, pts, {}, "exact duplicates");
+  auto got = c.duplicates;
+  std::sort(got.begin(), got.end());
+  EXPECT_EQ(got, want);
+  for (auto [d, o] : want) {
+    EXPECT_EQ(c.cell_of[d], -1) << "duplicate " << d;
+    EXPECT_GE(c.cell_of[o], 0) << "owner " << o;
+  }
+  EXPECT_EQ(c.n_cells(), n0 - 1);
+
+  // Same cells as the deduplicated input (ids mapped back).
+  std::vector<double> uniq;
+  std::vector<std::int32_t> old_id;
+  for (std::size_t i = 0; i < pts.size() / dim; ++i) {
+    if (std::any_of(want.begin(), want.end(), [&](auto p) { return p.first == std::int32_t(i); })) continue;
+    old_id.push_back(std::int32_t(i));
+    for (int a = 0; a < dim; ++a) uniq.push_back(pts[i * dim + a]);
+  }
+  const auto u = run(uniq, dim, unit_box());
+  ASSERT_EQ(u.n_cells(), c.n_cells());
+  for (std::size_t k = 0; k < u.n_cells(); ++k) {
+    const auto g = old_id[u.generator[k]];
+    const auto ck = c.cell_of[g];
+    ASSERT_GE(ck, 0);
+    EXPECT_NEAR(c.volume[ck], u.volume[k], 1e-12 * u.volume[k]) << "generator " << g;
+    std::vector<std::int32_t> mapped;
+    for (auto j : neighbours_of(u, k)) mapped.push_back(old_id[j]);
+    EXPECT_EQ(neighbours_of(c, ck), mapped) << "generator " << g;
+  }
+}
+
+TEST(Invariants, ExactDuplicates) {
+  exact_duplicates(2, 301);
+  exact_duplicates(3, 302);
+}
+
+TEST(Invariants, DuplicatesOnGrid) {
+  // Every point of a degenerate grid given twice: the second copies are all duplicates.
+  for (int dim : {2, 3}) {
+    auto pts = grid_points(dim == 2 ? 12 : 6, dim);
+    const std::size_t n = pts.size() / dim;
+    pts.insert(pts.end(), pts.begin(), pts.end());
+    const auto c = run(pts, dim);
+    check_invariants(c, pts, {}, "doubled grid dim " + std::to_string(dim));
+    EXPECT_EQ(c.n_cells(), n);
+    EXPECT_EQ(c.duplicates.size(), n);
+    for (auto [d, o] : c.duplicates) EXPECT_EQ(std::size_t(d), std::size_t(o) + n);
+  }
+}
+
+// ------------------------------------------------------------------ labels
+
+/// Points labelled -1 clip their neighbours but own no cell: the inside cells
+/// are exactly the cells of the unlabelled run (volume and neighbour list,
+/// outside neighbours included), and the missing volume is the outside cells'.
+void labelled(int dim, const std::vector<double>& pts, std::uint64_t seed, const std::string& what) {
+  SCOPED_TRACE(what);
+  const std::size_t n = pts.size() / dim;
+  std::mt19937_64 rng(seed);
+  std::vector<std::int32_t> labels(n);
+  for (auto& l : labels) l = std::int32_t(rng() % 4) - 1;  // -1, 0, 1, 2
+  const auto c = run(pts, dim, std::nullopt, labels);
+  InvariantOptions io;
+  io.all_inside = false;
+  check_invariants(c, pts, labels, what, io);
+  const auto all = run(pts, dim, c.bounds);
+  double inside = 0, outside = 0;
+  std::size_t n_inside = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double va = all.volume[all.cell_of[i]];
+    if (labels[i] < 0) {
+      EXPECT_EQ(c.cell_of[i], -1);
+      outside += va;
+      continue;
+    }
+    ++n_inside;
+    const auto k = c.cell_of[i];
+    ASSERT_GE(k, 0);
+    inside += c.volume[k];
+    EXPECT_NEAR(c.volume[k], va, 1e-12 * va) << "point " << i;
+    EXPECT_EQ(neighbours_of(c, k), neighbours_of(all, all.cell_of[i])) << "point " << i;
+  }
+  EXPECT_EQ(c.n_cells(), n_inside);
+  const double dom = box_volume(c.bounds, dim);
+  EXPECT_LT(inside, dom);
+  EXPECT_NEAR(inside + outside, dom, 1e-12 * dom);
+}
+
+TEST(Invariants, Labels) {
+  labelled(3, random_points(2000, 3, 401), 1, "3D random labelled");
+  labelled(2, random_points(2000, 2, 402), 2, "2D random labelled");
+  labelled(3, grid_points(8, 3), 3, "3D grid labelled");
+  labelled(2, grid_points(20, 2), 4, "2D grid labelled");
+}
+
+// ------------------------------------------------------------------ threads
+
+/// The result is independent of the thread count: every vector is identical.
+void same_for_threads(int dim, const std::vector<double>& pts, const std::vector<std::int32_t>& labels,
+                      const std::string& what) {
+  SCOPED_TRACE(what);
+  const auto a = run(pts, dim, std::nullopt, labels, 1);
+  const auto b = run(pts, dim, std::nullopt, labels, 2);
+  EXPECT_EQ(a.threads_used, 1);
+  EXPECT_GE(b.threads_used, 1);
+  EXPECT_LE(b.threads_used, 2);
+  EXPECT_EQ(a.dim, b.dim);
+  EXPECT_EQ(a.n_points, b.n_points);
+  EXPECT_EQ(a.bounds.lo, b.bounds.lo);
+  EXPECT_EQ(a.bounds.hi, b.bounds.hi);
+#define SAME(f) EXPECT_TRUE(a.f == b.f) << #f " differs between 1 and 2 threads"
+  SAME(generator);
+  SAME(region);
+  SAME(volume);
+  SAME(centroid);
+  SAME(num_faces);
+  SAME(neighbor_offsets);
+  SAME(neighbors);
+  SAME(cell_of);
+  SAME(vertices);
+  SAME(vertex_keys);
+  SAME(cell_face_offsets);
+  SAME(face_vertex_offsets);
+  SAME(face_vertices);
+  SAME(face_neighbor);
+  SAME(face_class);
+  SAME(duplicates);
+  SAME(ignored_outside_bounds);
+#undef SAME
+  if (a.exact_predicate_calls != b.exact_predicate_calls)
+    std::printf("[ note ] %s: exact_predicate_calls %llu (1 thread) vs %llu (2 threads)\n", what.c_str(),
+                (unsigned long long)a.exact_predicate_calls, (unsigned long long)b.exact_predicate_calls);
+}
+
+TEST(Invariants, ThreadCountDoesNotChangeResult) {
+  same_for_threads(3, random_points(4000, 3, 501), {}, "3D random");
+  same_for_threads(2, random_points(4000, 2, 502), {}, "2D random");
+  same_for_threads(3, grid_points(8, 3), {}, "3D grid");
+  auto pts = random_points(3000, 3, 503);
+  std::mt19937_64 rng(5);
+  std::vector<std::int32_t> labels(3000);
+  for (auto& l : labels) l = std::int32_t(rng() % 3) - 1;
+  pts.insert(pts.end(), pts.begin(), pts.begin() + 300);  // 100 duplicates
+  labels.insert(labels.end(), labels.begin(), labels.begin() + 100);
+  same_for_threads(3, pts, labels, "3D labelled with duplicates");
+}
+
+}  // namespace

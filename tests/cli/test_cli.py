@@ -1,0 +1,624 @@
+#!/usr/bin/python3
+"""End-to-end tests of the `tessera` command.
+
+Usage: /usr/bin/python3 tests/cli/test_cli.py PATH_TO_tessera [unittest args...]
+
+Runs the binary on small generated inputs and checks what it writes by reading
+it back: VTK files through VTK's own XML readers (Debian python3-vtk9), tables
+and neighbour lists through numpy. Also checks that every kind of bad input
+fails cleanly: non-zero exit, one line "tessera: error: ..." on stderr, and no
+output file (not even a temporary) left behind.
+
+Prints "N passed, M failed" last; exits 1 if anything failed.
+"""
+import json
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import unittest
+
+import numpy as np
+
+try:
+    import vtk
+    from vtk.util.numpy_support import vtk_to_numpy
+except ImportError:  # pragma: no cover - reported as failures of the VTK tests
+    vtk = None
+
+TESSERA = None  # set from argv in main()
+BOX3 = ["0", "1", "0", "1", "0", "1"]
+BOX2 = ["0", "1", "0", "1"]
+
+
+def run(args, env=None, timeout=600):
+    full_env = dict(os.environ)
+    full_env.pop("TESSERA_NUM_THREADS", None)
+    if env:
+        full_env.update(env)
+    return subprocess.run([TESSERA] + [str(a) for a in args], capture_output=True, text=True,
+                          env=full_env, timeout=timeout)
+
+
+def read_vtu(path):
+    r = vtk.vtkXMLUnstructuredGridReader()
+    r.SetFileName(path)
+    r.Update()
+    return r.GetOutput()
+
+
+def read_vtp(path):
+    r = vtk.vtkXMLPolyDataReader()
+    r.SetFileName(path)
+    r.Update()
+    return r.GetOutput()
+
+
+def cell_array(data, name):
+    a = data.GetCellData().GetArray(name)
+    if a is None:
+        raise AssertionError("cell data array %r missing" % name)
+    return a
+
+
+def polyhedron_volumes(grid):
+    """Signed volume of every polyhedron from the VTK face stream (divergence
+    theorem over fan triangles): positive iff faces are counter-clockwise seen
+    from outside, as VTK expects."""
+    pts = vtk_to_numpy(grid.GetPoints().GetData())
+    faces = vtk_to_numpy(grid.GetFaces())
+    locs = vtk_to_numpy(grid.GetFaceLocations())
+    vols = np.zeros(grid.GetNumberOfCells())
+    nfaces = np.zeros(grid.GetNumberOfCells(), dtype=np.int64)
+    for c, loc in enumerate(locs):
+        k = int(loc)
+        nf = int(faces[k])
+        k += 1
+        nfaces[c] = nf
+        v = 0.0
+        for _ in range(nf):
+            npts = int(faces[k])
+            ids = faces[k + 1:k + 1 + npts]
+            k += 1 + npts
+            p = pts[ids]
+            v += np.dot(p[0], np.cross(p[1:-1], p[2:]).sum(axis=0))
+        vols[c] = v / 6.0
+    return vols, nfaces
+
+
+def polygon_areas(poly):
+    pts = vtk_to_numpy(poly.GetPoints().GetData())
+    conn = vtk_to_numpy(poly.GetPolys().GetConnectivityArray())
+    offs = vtk_to_numpy(poly.GetPolys().GetOffsetsArray())
+    areas = np.zeros(len(offs) - 1)
+    nverts = np.diff(offs)
+    for c in range(len(offs) - 1):
+        p = pts[conn[offs[c]:offs[c + 1]]]
+        x, y = p[:, 0], p[:, 1]
+        areas[c] = 0.5 * np.sum(x * np.roll(y, -1) - np.roll(x, -1) * y)
+    return areas, nverts
+
+
+def read_bytes(path):
+    with open(path, "rb") as f:
+        return f.read()
+
+
+def load_neighbors(path):
+    a = np.load(path)
+    if a.dtype != np.int64 or a.ndim != 1:
+        raise AssertionError("neighbours array must be 1-D int64, got %s %s" % (a.dtype, a.shape))
+    n = int(a[0])
+    off = a[1:n + 2]
+    ids = a[n + 2:]
+    return n, off, ids
+
+
+class TempDirCase(unittest.TestCase):
+    def setUp(self):
+        self.dir = tempfile.mkdtemp(prefix="tessera-cli-")
+
+    def tearDown(self):
+        shutil.rmtree(self.dir, ignore_errors=True)
+
+    def p(self, name):
+        return os.path.join(self.dir, name)
+
+    def save(self, name, arr):
+        path = self.p(name)
+        np.save(path, arr)
+        return path
+
+    def ok(self, args, **kw):
+        r = run(args, **kw)
+        self.assertEqual(r.returncode, 0, "tessera %s failed:\n%s%s" % (" ".join(map(str, args)), r.stdout, r.stderr))
+        return r
+
+
+class Voronoi3D(TempDirCase):
+    N = 400
+
+    def setUp(self):
+        super().setUp()
+        self.pts = np.random.default_rng(3).random((self.N, 3))
+        self.inp = self.save("pts.npy", self.pts)
+
+    def test_vtu_read_back(self):
+        out = self.p("cells.vtu")
+        r = self.ok(["voronoi", self.inp, "-o", out, "--bounds"] + BOX3)
+        self.assertEqual(r.stderr, "", "no progress bar / messages when stderr is not a terminal")
+        self.assertIn("cells", r.stdout)
+        g = read_vtu(out)
+        self.assertEqual(g.GetNumberOfCells(), self.N)
+        types = {g.GetCellType(i) for i in range(g.GetNumberOfCells())}
+        self.assertEqual(types, {42}, "every cell must be a VTK_POLYHEDRON")
+        for name, cls in [("GeneratorId", "vtkIntArray"), ("Region", "vtkIntArray"), ("Volume", "vtkDoubleArray"),
+                          ("NumberOfFaces", "vtkIntArray"), ("NumberOfNeighbors", "vtkIntArray")]:
+            self.assertEqual(cell_array(g, name).GetClassName(), cls, name)
+        gid = vtk_to_numpy(cell_array(g, "GeneratorId"))
+        np.testing.assert_array_equal(gid, np.arange(self.N))
+        np.testing.assert_array_equal(vtk_to_numpy(cell_array(g, "Region")), 0)
+        vol = vtk_to_numpy(cell_array(g, "Volume"))
+        self.assertTrue(np.all(vol > 0))
+        self.assertAlmostEqual(vol.sum(), 1.0, delta=1e-9)
+        # The face stream describes closed, outward-oriented polyhedra whose
+        # volumes are the reported ones.
+        geo_vol, nfaces = polyhedron_volumes(g)
+        np.testing.assert_allclose(geo_vol, vol, rtol=1e-9, atol=1e-15)
+        np.testing.assert_array_equal(nfaces, vtk_to_numpy(cell_array(g, "NumberOfFaces")))
+        # Points are the merged vertices: every one is used, none repeated.
+        pts = vtk_to_numpy(g.GetPoints().GetData())
+        self.assertEqual(len(np.unique(pts, axis=0)), len(pts))
+        self.assertTrue(np.all(pts >= -1e-12) and np.all(pts <= 1 + 1e-12))
+
+    def test_tables_and_neighbors(self):
+        vtu, csv, tnpy, nb = self.p("c.vtu"), self.p("t.csv"), self.p("t.npy"), self.p("nb.npy")
+        self.ok(["voronoi", self.inp, "-o", vtu, "--cell-table", csv, "--neighbors", nb, "--bounds"] + BOX3)
+        self.ok(["voronoi", self.inp, "--cell-table", tnpy, "--bounds"] + BOX3 + ["-q"])
+        with open(csv) as f:
+            header = f.readline().strip()
+        self.assertEqual(header, "id,region,volume,cx,cy,cz,faces,neighbors")
+        t = np.loadtxt(csv, delimiter=",", skiprows=1)
+        tn = np.load(tnpy)
+        self.assertEqual(tn.dtype, np.float64)
+        self.assertEqual(tn.shape, (self.N, 8))
+        self.assertEqual(t.shape, (self.N, 8))
+        np.testing.assert_array_equal(t, tn)  # csv keeps 17 significant digits
+        np.testing.assert_array_equal(t[:, 0], np.arange(self.N))
+        self.assertAlmostEqual(t[:, 2].sum(), 1.0, delta=1e-9)
+        # centroids lie inside the box and near their generator
+        self.assertTrue(np.all((t[:, 3:6] > 0) & (t[:, 3:6] < 1)))
+
+        g = read_vtu(vtu)
+        np.testing.assert_array_equal(vtk_to_numpy(cell_array(g, "Volume")), t[:, 2])
+        n, off, ids = load_neighbors(nb)
+        self.assertEqual(n, self.N)
+        self.assertEqual(off[0], 0)
+        self.assertEqual(off[-1], len(ids))
+        self.assertTrue(np.all(np.diff(off) >= 0))
+        np.testing.assert_array_equal(np.diff(off), t[:, 7])
+        np.testing.assert_array_equal(np.diff(off), vtk_to_numpy(cell_array(g, "NumberOfNeighbors")))
+        pairs = set()
+        for c in range(n):
+            lst = ids[off[c]:off[c + 1]]
+            self.assertTrue(np.all(np.diff(lst) > 0), "neighbours must be ascending, unique")
+            self.assertNotIn(c, lst)
+            pairs.update((c, int(j)) for j in lst)
+        for (i, j) in pairs:
+            self.assertIn((j, i), pairs, "neighbour relation must be symmetric")
+        # box faces are counted in faces but not listed as neighbours
+        self.assertTrue(np.all(t[:, 6] >= t[:, 7]))
+
+    def test_threads_byte_identical(self):
+        pts = np.random.default_rng(11).random((5000, 3))
+        inp = self.save("big.npy", pts)
+        outs = {}
+        for th in (1, 2):
+            vtu, csv, nb = self.p("t%d.vtu" % th), self.p("t%d.csv" % th), self.p("n%d.npy" % th)
+            self.ok(["voronoi", inp, "-o", vtu, "--cell-table", csv, "--neighbors", nb, "--threads", th, "-q"])
+            outs[th] = [read_bytes(f) for f in (vtu, csv, nb)]
+        for a, b, what in zip(outs[1], outs[2], ("vtu", "csv", "neighbors")):
+            self.assertTrue(a == b, "%s differs between --threads 1 and --threads 2" % what)
+        # the environment variable is honoured the same way
+        vtu = self.p("env.vtu")
+        self.ok(["voronoi", inp, "-o", vtu, "-q"], env={"TESSERA_NUM_THREADS": "2"})
+        self.assertTrue(read_bytes(vtu) == outs[1][0])
+
+    def test_default_bounds_and_validate(self):
+        out = self.p("cells.vtu")
+        r = self.ok(["voronoi", self.inp, "-o", out, "--validate"])
+        self.assertIn("validation: OK", r.stdout)
+        g = read_vtu(out)
+        self.assertEqual(g.GetNumberOfCells(), self.N)
+        # default domain: bounding box padded by 1% of the largest extent
+        lo, hi = self.pts.min(0), self.pts.max(0)
+        pad = 0.01 * (hi - lo).max()
+        expected = np.prod(hi - lo + 2 * pad)
+        vol = vtk_to_numpy(cell_array(g, "Volume"))
+        self.assertAlmostEqual(vol.sum() / expected, 1.0, delta=1e-9)
+
+    def test_duplicates_reported(self):
+        pts = self.pts.copy()
+        pts[17] = pts[3]
+        inp = self.save("dup.npy", pts)
+        out = self.p("d.vtu")
+        r = self.ok(["voronoi", inp, "-o", out, "--bounds"] + BOX3)
+        self.assertIn("point 17 duplicates point 3", r.stdout)
+        g = read_vtu(out)
+        self.assertEqual(g.GetNumberOfCells(), self.N - 1)
+        gid = vtk_to_numpy(cell_array(g, "GeneratorId"))
+        self.assertNotIn(17, gid)
+        self.assertAlmostEqual(vtk_to_numpy(cell_array(g, "Volume")).sum(), 1.0, delta=1e-9)
+
+    def test_labels(self):
+        labels = np.random.default_rng(5).integers(-1, 3, self.N).astype(np.int32)
+        lab = self.save("labels.npy", labels)
+        out = self.p("l.vtu")
+        self.ok(["voronoi", self.inp, "--labels", lab, "-o", out, "--bounds"] + BOX3)
+        g = read_vtu(out)
+        inside = np.flatnonzero(labels >= 0)
+        self.assertEqual(g.GetNumberOfCells(), len(inside))
+        gid = vtk_to_numpy(cell_array(g, "GeneratorId"))
+        np.testing.assert_array_equal(gid, inside)
+        np.testing.assert_array_equal(vtk_to_numpy(cell_array(g, "Region")), labels[inside])
+        vol = vtk_to_numpy(cell_array(g, "Volume")).sum()
+        self.assertLess(vol, 1.0)  # outside points own the rest of the box
+
+    def test_ignore_outside(self):
+        pts = self.pts * 2 - 0.5  # about 7/8 of the points leave the unit box
+        inp = self.save("wide.npy", pts)
+        out = self.p("i.vtu")
+        inside = np.flatnonzero(np.all((pts >= 0) & (pts <= 1), axis=1))
+        r = self.ok(["voronoi", inp, "-o", out, "--ignore-outside", "--bounds"] + BOX3)
+        self.assertIn("ignored", r.stdout)
+        g = read_vtu(out)
+        self.assertEqual(g.GetNumberOfCells(), len(inside))
+        np.testing.assert_array_equal(vtk_to_numpy(cell_array(g, "GeneratorId")), inside)
+        self.assertAlmostEqual(vtk_to_numpy(cell_array(g, "Volume")).sum(), 1.0, delta=1e-9)
+
+    def test_csv_input_and_summary(self):
+        csv_in = self.p("pts.csv")
+        np.savetxt(csv_in, self.pts, delimiter=",", fmt="%.17g")
+        out = self.p("c.vtu")
+        r = self.ok(["voronoi", csv_in, "-o", out, "--bounds"] + BOX3)
+        for word in ("points", "cells", "duplicates", "volume sum", "compute", "thread", out):
+            self.assertIn(word, r.stdout)
+        self.assertEqual(read_vtu(out).GetNumberOfCells(), self.N)
+
+    def test_quiet(self):
+        r = self.ok(["voronoi", self.inp, "-o", self.p("q.vtu"), "--quiet"])
+        self.assertEqual(r.stdout, "")
+        self.assertEqual(r.stderr, "")
+
+
+class Voronoi2D(TempDirCase):
+    N = 500
+
+    def setUp(self):
+        super().setUp()
+        self.pts = np.random.default_rng(7).random((self.N, 2)) * [2.0, 1.0]
+        self.inp = self.save("pts2.npy", self.pts)
+
+    def test_vtp_read_back(self):
+        out = self.p("cells.vtp")
+        self.ok(["voronoi", self.inp, "-o", out, "--bounds", "0", "2", "0", "1"])
+        pd = read_vtp(out)
+        self.assertEqual(pd.GetNumberOfPolys(), self.N)
+        self.assertEqual(pd.GetNumberOfCells(), self.N)
+        for name in ("GeneratorId", "Region", "Area", "NumberOfEdges", "NumberOfNeighbors"):
+            cell_array(pd, name)
+        area = vtk_to_numpy(cell_array(pd, "Area"))
+        self.assertAlmostEqual(area.sum(), 2.0, delta=2e-9)
+        geo, nverts = polygon_areas(pd)
+        self.assertTrue(np.all(geo > 0), "polygons must be counter-clockwise")
+        np.testing.assert_allclose(geo, area, rtol=1e-9, atol=1e-15)
+        np.testing.assert_array_equal(nverts, vtk_to_numpy(cell_array(pd, "NumberOfEdges")))
+        pts = vtk_to_numpy(pd.GetPoints().GetData())
+        self.assertEqual(pts.shape[1], 3)
+        self.assertTrue(np.all(pts[:, 2] == 0))
+
+    def test_2d_tables(self):
+        csv, tnpy, nb = self.p("t.csv"), self.p("t.npy"), self.p("nb.npy")
+        self.ok(["voronoi", self.inp, "--cell-table", csv, "--neighbors", nb, "-q"])
+        self.ok(["voronoi", self.inp, "--cell-table", tnpy, "-q"])
+        with open(csv) as f:
+            self.assertEqual(f.readline().strip(), "id,region,area,cx,cy,edges,neighbors")
+        t = np.loadtxt(csv, delimiter=",", skiprows=1)
+        self.assertEqual(t.shape, (self.N, 7))
+        self.assertEqual(np.load(tnpy).shape, (self.N, 7))
+        n, off, ids = load_neighbors(nb)
+        self.assertEqual(n, self.N)
+        np.testing.assert_array_equal(np.diff(off), t[:, 6])
+
+    def test_dim2_from_3_columns(self):
+        pts3 = np.column_stack([self.pts, np.random.default_rng(1).random(self.N)])
+        inp = self.save("p3.npy", pts3)
+        out = self.p("c.vtp")
+        self.ok(["voronoi", inp, "--dim", "2", "-o", out, "--bounds", "0", "2", "0", "1"])
+        self.assertEqual(read_vtp(out).GetNumberOfPolys(), self.N)
+
+    def test_bounds_before_input(self):
+        # CLI11 hands the input to a 2D --bounds; the command must take it back.
+        out = self.p("c.vtp")
+        self.ok(["voronoi", "--bounds", "0", "2", "0", "1", self.inp, "-o", out, "-q"])
+        self.ok(["voronoi", "--bounds=0,2,0,1", self.inp, "-o", out, "-q"])
+        self.assertEqual(read_vtp(out).GetNumberOfPolys(), self.N)
+
+    def test_threads_byte_identical(self):
+        a, b = self.p("a.vtp"), self.p("b.vtp")
+        self.ok(["voronoi", self.inp, "-o", a, "--threads", "1", "-q"])
+        self.ok(["voronoi", self.inp, "-o", b, "--threads", "2", "-q"])
+        self.assertTrue(read_bytes(a) == read_bytes(b))
+
+
+class Interrupt(TempDirCase):
+    def test_ctrl_c_writes_nothing(self):
+        """SIGINT during the computation: exit 130, one error line, no output."""
+        import pty
+        import signal
+        import time
+        inp = self.save("p.npy", np.random.default_rng(4).random((300000, 3)))
+        out = self.p("c.vtu")
+        pid, fd = pty.fork()  # a terminal, as for an interactive user
+        if pid == 0:
+            os.execv(TESSERA, [TESSERA, "voronoi", inp, "-o", out])
+        time.sleep(0.5)
+        os.kill(pid, signal.SIGINT)
+        text = b""
+        while True:
+            try:
+                chunk = os.read(fd, 65536)
+            except OSError:
+                break
+            if not chunk:
+                break
+            text += chunk
+        os.close(fd)
+        _, status = os.waitpid(pid, 0)
+        code = os.waitstatus_to_exitcode(status)
+        if code == 0:
+            self.skipTest("the run finished before the signal")
+        self.assertEqual(code, 130, text)
+        self.assertIn(b"tessera: error: interrupted", text)
+        self.assertEqual(sorted(os.listdir(self.dir)), ["p.npy"])
+
+
+class Bench(TempDirCase):
+    KEYS = {"tool", "op", "n", "threads", "seconds", "simplices", "extra"}
+    EXTRA = {"cpu_user_s", "cpu_sys_s", "minflt", "peak_rss_bytes", "neighbors", "exact_calls", "volume_sum"}
+
+    def check_lines(self, out, op, n, count):
+        lines = [l for l in out.splitlines() if l.strip()]
+        self.assertEqual(len(lines), count, out)
+        for line in lines:
+            j = json.loads(line)
+            self.assertTrue(self.KEYS <= set(j), j)
+            self.assertTrue(self.EXTRA <= set(j["extra"]), j)
+            self.assertEqual(j["tool"], "tessera")
+            self.assertEqual(j["op"], op)
+            self.assertEqual(j["n"], n)
+            self.assertEqual(j["simplices"], n)
+            self.assertGreaterEqual(j["threads"], 1)
+            self.assertGreater(j["seconds"], 0)
+            self.assertGreater(j["extra"]["neighbors"], 0)
+            self.assertGreater(j["extra"]["peak_rss_bytes"], 0)
+            self.assertAlmostEqual(j["extra"]["volume_sum"], 1.0, delta=1e-9)
+
+    def test_bench_3d(self):
+        inp = self.save("p.npy", np.random.default_rng(2).random((2000, 3)))
+        r = self.ok(["bench", "voronoi", inp, "--repeat", "3", "--threads", "2", "--bounds"] + BOX3)
+        self.check_lines(r.stdout, "voronoi3", 2000, 3)
+        self.assertEqual(json.loads(r.stdout.splitlines()[0])["threads"], 2)
+
+    def test_bench_2d(self):
+        inp = self.save("p.npy", np.random.default_rng(2).random((2000, 2)))
+        r = self.ok(["bench", "voronoi", inp, "--bounds"] + BOX2)
+        self.check_lines(r.stdout, "voronoi2", 2000, 1)
+
+    def test_bench_bad_input(self):
+        r = run(["bench", "voronoi", self.p("missing.npy")])
+        self.assertEqual(r.returncode, 2)
+        self.assertTrue(r.stderr.startswith("tessera: error:"))
+
+
+class RunDefault(TempDirCase):
+    def test_small_run(self):
+        d = self.p("out")  # created by the command
+        r = self.ok(["run-default", "-o", d, "--points", "3000"])
+        g = read_vtu(os.path.join(d, "cells.vtu"))
+        self.assertEqual(g.GetNumberOfCells(), 3000)
+        self.assertAlmostEqual(vtk_to_numpy(cell_array(g, "Volume")).sum(), 1.0, delta=1e-9)
+        t = np.loadtxt(os.path.join(d, "cells.csv"), delimiter=",", skiprows=1)
+        self.assertEqual(t.shape, (3000, 8))
+        for word in ("cells", "faces", "neighbour", "volume sum", "compute", "thread"):
+            self.assertIn(word, r.stdout)
+        # fixed seed: the same points every time
+        d2 = self.p("out2")
+        self.ok(["run-default", "-o", d2, "--points", "3000", "-q"])
+        self.assertTrue(read_bytes(os.path.join(d, "cells.vtu")) == read_bytes(os.path.join(d2, "cells.vtu")))
+
+
+class Help(unittest.TestCase):
+    def test_help_lists_everything(self):
+        r = run(["voronoi", "--help"])
+        self.assertEqual(r.returncode, 0)
+        for opt in ("INPUT", "--output", "--dim", "--labels", "--bounds", "--padding", "--ignore-outside",
+                    "--threads", "--bin-points", "--cell-table", "--neighbors", "--validate", "--quiet"):
+            self.assertIn(opt, r.stdout)
+        r = run(["--help"])
+        self.assertEqual(r.returncode, 0)
+        for sub in ("voronoi", "bench", "run-default"):
+            self.assertIn(sub, r.stdout)
+        r = run(["bench", "voronoi", "--help"])
+        self.assertEqual(r.returncode, 0)
+        self.assertIn("--repeat", r.stdout)
+        self.assertIn("run-default", run(["--help"]).stdout)
+
+
+class BadInput(TempDirCase):
+    """Every failure: exit 2, one stderr line "tessera: error: ...", no output files."""
+
+    def setUp(self):
+        super().setUp()
+        self.good3 = self.save("good3.npy", np.random.default_rng(1).random((50, 3)))
+        self.good2 = self.save("good2.npy", np.random.default_rng(1).random((50, 2)))
+
+    def fails(self, args, fragment=None, code=2, outputs=None):
+        before = set(os.listdir(self.dir))
+        r = run(args)
+        after = set(os.listdir(self.dir))
+        cmd = "tessera " + " ".join(map(str, args))
+        self.assertEqual(r.returncode, code, "%s: exit %d\nstdout: %s\nstderr: %s" %
+                         (cmd, r.returncode, r.stdout, r.stderr))
+        lines = r.stderr.splitlines()
+        self.assertEqual(len(lines), 1, "%s: stderr must be one line, got %r" % (cmd, r.stderr))
+        self.assertTrue(lines[0].startswith("tessera: error: "), "%s: %r" % (cmd, lines[0]))
+        if fragment:
+            self.assertIn(fragment, lines[0], cmd)
+        self.assertEqual(after - before, set(), "%s left files behind" % cmd)
+        for o in outputs or []:
+            self.assertFalse(os.path.exists(o), "%s left %s" % (cmd, o))
+        return lines[0]
+
+    def out(self, name="cells.vtu"):
+        return self.p(name)
+
+    def test_missing_file(self):
+        self.fails(["voronoi", self.p("nope.npy"), "-o", self.out()], "nope.npy")
+
+    def test_unknown_input_extension(self):
+        path = self.p("pts.foo")
+        with open(path, "w") as f:
+            f.write("0 0 0\n1 1 1\n")
+        self.fails(["voronoi", path, "-o", self.out()])
+
+    def test_wrong_dtypes(self):
+        for name, arr in [("complex.npy", np.zeros((10, 3), complex)), ("str.npy", np.array([["a", "b", "c"]] * 10)),
+                          ("obj.npy", None)]:
+            path = self.p(name)
+            if arr is None:
+                np.save(path, np.array([{"a": 1}] * 4, dtype=object), allow_pickle=True)
+            else:
+                np.save(path, arr)
+            self.fails(["voronoi", path, "-o", self.out()], name)
+
+    def test_wrong_shapes(self):
+        for shape in [(20, 1), (20, 5), (20,), (4, 5, 3)]:
+            path = self.save("s%d.npy" % len(shape), np.zeros(shape))
+            self.fails(["voronoi", path, "-o", self.out()], "shape")
+            os.remove(path)
+
+    def test_empty_inputs(self):
+        for name in ("empty.npy", "empty.csv", "empty.ply"):
+            path = self.p(name)
+            open(path, "w").close()
+            self.fails(["voronoi", path, "-o", self.out()], name)
+        self.fails(["voronoi", self.save("zero.npy", np.zeros((0, 3))), "-o", self.out()])
+
+    def test_single_point(self):
+        self.fails(["voronoi", self.save("one.npy", np.array([[0.5, 0.5, 0.5]])), "-o", self.out()], "--bounds")
+
+    def test_nan_inf(self):
+        for name, bad in (("nan.npy", np.nan), ("inf.npy", np.inf)):
+            pts = np.random.default_rng(1).random((20, 3))
+            pts[7, 1] = bad
+            self.fails(["voronoi", self.save(name, pts), "-o", self.out()])
+
+    def test_labels_wrong_length(self):
+        lab = self.save("lab.npy", np.zeros(49, dtype=np.int32))
+        self.fails(["voronoi", self.good3, "--labels", lab, "-o", self.out()], "lab")
+
+    def test_labels_not_integer(self):
+        lab = self.save("labf.npy", np.zeros(50, dtype=np.float64) + 0.5)
+        self.fails(["voronoi", self.good3, "--labels", lab, "-o", self.out()])
+
+    def test_all_points_outside_bounds(self):
+        args = ["voronoi", self.good3, "-o", self.out(), "--bounds", "5", "6", "5", "6", "5", "6"]
+        self.fails(args)
+        self.fails(args + ["--ignore-outside"])
+
+    def test_some_points_outside_bounds_without_ignore(self):
+        self.fails(["voronoi", self.good3, "-o", self.out(), "--bounds", "0", "0.5", "0", "1", "0", "1"])
+
+    def test_bad_bounds(self):
+        for b in (["0", "0", "0", "1", "0", "1"], ["1", "0", "0", "1", "0", "1"], ["0", "1", "0", "1", "0"],
+                  ["0", "nan", "0", "1", "0", "1"], ["0", "1", "0", "1"]):
+            self.fails(["voronoi", self.good3, "-o", self.out(), "--bounds"] + b)
+        self.fails(["voronoi", self.good2, "-o", self.out("c.vtp"), "--bounds"] + BOX3)
+
+    def test_coplanar_3d_suggests_dim2(self):
+        pts = np.random.default_rng(1).random((50, 3))
+        pts[:, 2] = 0.25
+        msg = self.fails(["voronoi", self.save("flat.npy", pts), "-o", self.out()])
+        self.assertIn("--dim 2", msg)
+
+    def test_coincident_points(self):
+        self.fails(["voronoi", self.save("same.npy", np.ones((10, 3))), "-o", self.out()])
+
+    def test_output_dir_missing(self):
+        self.fails(["voronoi", self.good3, "-o", self.p("no/such/dir/c.vtu")], "no/such/dir")
+        self.fails(["voronoi", self.good3, "--cell-table", self.p("no/t.csv")])
+        self.fails(["voronoi", self.good3, "-o", self.out(), "--neighbors", self.p("no/nb.npy")],
+                   outputs=[self.out()])
+        self.fails(["voronoi", self.good3, "-o", os.path.join(self.good3, "c.vtu")])  # parent is a file
+
+    def test_output_dir_not_writable(self):
+        if os.geteuid() == 0:
+            self.skipTest("root can write anywhere")
+        ro = self.p("ro")
+        os.mkdir(ro)
+        os.chmod(ro, 0o555)
+        try:
+            self.fails(["voronoi", self.good3, "-o", os.path.join(ro, "c.vtu")])
+        finally:
+            os.chmod(ro, 0o755)
+
+    def test_output_is_directory(self):
+        os.mkdir(self.p("d.vtu"))
+        r = run(["voronoi", self.good3, "-o", self.p("d.vtu")])
+        self.assertEqual(r.returncode, 2)
+        self.assertTrue(r.stderr.startswith("tessera: error:"))
+
+    def test_output_extensions(self):
+        self.fails(["voronoi", self.good3, "-o", self.out("c.vtp")], ".vtu")
+        self.fails(["voronoi", self.good2, "-o", self.out("c.vtu")], ".vtp")
+        self.fails(["voronoi", self.good3, "-o", self.out("c.vtk")])
+        self.fails(["voronoi", self.good3, "--cell-table", self.out("t.txt")])
+        self.fails(["voronoi", self.good3, "--neighbors", self.out("nb.csv")])
+
+    def test_bad_command_lines(self):
+        self.fails([])
+        self.fails(["voronoi"])
+        self.fails(["voronoi", self.good3])  # nothing to do
+        self.fails(["voronoi", self.good3, "-o", self.out(), "--dim", "4"])
+        self.fails(["voronoi", self.good3, "-o", self.out(), "--threads", "-1"])
+        self.fails(["voronoi", self.good3, "-o", self.out(), "--padding", "-0.1"])
+        self.fails(["voronoi", self.good3, "-o", self.out(), "--no-such-option"])
+        self.fails(["bench", "voronoi", self.good3, "--repeat", "0"])
+        self.fails(["frobnicate"])
+
+
+def main():
+    global TESSERA
+    if len(sys.argv) < 2:
+        print("usage: test_cli.py PATH_TO_tessera [unittest args]", file=sys.stderr)
+        return 2
+    TESSERA = os.path.abspath(sys.argv[1])
+    if not os.access(TESSERA, os.X_OK):
+        print("not an executable: %s" % TESSERA, file=sys.stderr)
+        return 2
+    if vtk is None:
+        print("python3-vtk9 is required (run with /usr/bin/python3)", file=sys.stderr)
+        return 2
+    argv = [sys.argv[0]] + sys.argv[2:]
+    prog = unittest.main(argv=argv, exit=False, verbosity=2)
+    res = prog.result
+    failed = len(res.failures) + len(res.errors) + len(res.unexpectedSuccesses)
+    passed = res.testsRun - failed - len(res.skipped)
+    print("%d passed, %d failed, %d skipped" % (passed, failed, len(res.skipped)))
+    return 0 if failed == 0 else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
