@@ -90,14 +90,42 @@ Bounds make_domain(std::span<const double> pts, int dim, std::size_t n, const Vo
   return b;
 }
 
+/// Power-of-two exponent that brings the largest coordinate near 1 when the
+/// input is so large or small that squared distances could overflow or
+/// underflow in the float filter (0 otherwise). Scaling by 2^k is exact.
+int normalizing_exponent(std::span<const double> points, const Bounds& b, int dim) {
+  double m = 0;
+  for (double x : points) m = std::max(m, std::fabs(x));
+  for (int d = 0; d < dim; ++d)
+    m = std::max({m, std::fabs(b.lo[static_cast<std::size_t>(d)]), std::fabs(b.hi[static_cast<std::size_t>(d)])});
+  if (m == 0 || (m < 0x1p200 && m > 0x1p-200)) return 0;
+  int e;
+  std::frexp(m, &e);
+  return -e;
+}
+
 template <class CellT>
-Cells run(std::span<const double> points, std::span<const std::int32_t> labels, const VoronoiOptions& opt) {
+Cells run(std::span<const double> input, std::span<const std::int32_t> labels, const VoronoiOptions& opt) {
   constexpr int D = CellT::dim;
-  const std::size_t n = points.size() / D;
+  const std::size_t n = input.size() / D;
   Cells out;
   out.dim = D;
   out.n_points = n;
-  out.bounds = make_domain(points, D, n, opt);
+  out.bounds = make_domain(input, D, n, opt);
+  // Extreme magnitudes: compute on an exactly rescaled copy, scale results back.
+  const int k = normalizing_exponent(input, out.bounds, D);
+  std::vector<double> scaled;
+  std::span<const double> points = input;
+  const Bounds user_bounds = out.bounds;
+  if (k != 0) {
+    scaled.resize(input.size());
+    for (std::size_t i = 0; i < input.size(); ++i) scaled[i] = std::ldexp(input[i], k);
+    for (int d = 0; d < D; ++d) {
+      out.bounds.lo[static_cast<std::size_t>(d)] = std::ldexp(out.bounds.lo[static_cast<std::size_t>(d)], k);
+      out.bounds.hi[static_cast<std::size_t>(d)] = std::ldexp(out.bounds.hi[static_cast<std::size_t>(d)], k);
+    }
+    points = scaled;
+  }
   const Bounds& bx = out.bounds;
 
   // Which points take part (inside the box) and which get cells (also label >= 0).
@@ -163,6 +191,12 @@ Cells run(std::span<const double> points, std::span<const std::int32_t> labels, 
   front::CellsCompositor<CellT> comp(out, points.data(), labels, opt.build_mesh);
   out.exact_predicate_calls = engine::tessellate<CellT>(gens, comp, eo);
   std::sort(out.duplicates.begin(), out.duplicates.end());
+  if (k != 0) {
+    for (double& v : out.volume) v = std::ldexp(v, -k * D);
+    for (double& c : out.centroid) c = std::ldexp(c, -k);
+    for (double& c : out.vertices) c = std::ldexp(c, -k);
+    out.bounds = user_bounds;
+  }
   return out;
 }
 

@@ -23,6 +23,11 @@ namespace tessera::kernels::filter {
 inline constexpr double u = std::numeric_limits<double>::epsilon() * 0.5;  // unit roundoff
 inline constexpr double plane_eps = 16 * u;
 inline constexpr double vertex_eps = 64 * u;
+/// Absolute slack for underflow: every rounding below DBL_MIN errs by at most
+/// 2^-1074 in absolute terms, far below this. The front end rescales inputs by
+/// a power of two so coordinates stay within 2^±200 and this never matters on
+/// sane data.
+inline constexpr double abs_eps = 0x1p-900;
 /// Beyond this condition number the float solve's position is too inaccurate
 /// for geometry (volumes, merged coordinates): the vertex is solved exactly.
 inline constexpr double exact_vertex_condition = 1e6;

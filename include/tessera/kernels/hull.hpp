@@ -100,8 +100,8 @@ class Hull {
     // q.y <= |q||y| <= |q|^2/2 (equality would need y = q/2 exactly, which the
     // strict margin excludes). Candidates usually fail to clip, and then only
     // the few far vertices need a plane test.
-    const double q2lo = 2.0 * pl.d * (1.0 - 1e-12);  // <= the exact |p_j - p_i|^2
-    const double de = filter::plane_eps * std::fabs(pl.d);
+    const double q2lo = 2.0 * pl.d * (1.0 - 1e-12) - filter::abs_eps;  // <= the exact |p_j - p_i|^2
+    const double de = filter::plane_eps * std::fabs(pl.d) + filter::abs_eps;
     bool may_cut = false;
     for (std::size_t t = 0; t < nv; ++t) {
       const Vertex& v = verts_[t];
@@ -286,7 +286,7 @@ class Hull {
   static void set_radius(Vertex& v, double err) {
     double a = v.y[0] * v.y[0] + v.y[1] * v.y[1] + v.y[2] * v.y[2];
     double l1 = std::fabs(v.y[0]) + std::fabs(v.y[1]) + std::fabs(v.y[2]);
-    v.r2 = (a + 4.0 * err * (l1 + err)) * (1.0 + 1e-12);
+    v.r2 = (a + 4.0 * err * (l1 + err)) * (1.0 + 1e-12) + filter::abs_eps;
     if (!(v.r2 < std::numeric_limits<double>::infinity())) v.r2 = std::numeric_limits<double>::infinity();  // NaN too
   }
 

@@ -80,8 +80,8 @@ class Tile {
     pl.id = j;
     const std::size_t nv = verts_.size();
     // Vertices no farther than |q|/2 cannot be cut (see hull.hpp).
-    const double q2lo = 2.0 * pl.d * (1.0 - 1e-12);
-    const double de = filter::plane_eps * std::fabs(pl.d);
+    const double q2lo = 2.0 * pl.d * (1.0 - 1e-12) - filter::abs_eps;
+    const double de = filter::plane_eps * std::fabs(pl.d) + filter::abs_eps;
     bool may_cut = false;
     for (std::size_t t = 0; t < nv; ++t) {
       const Vertex& v = verts_[t];
@@ -184,7 +184,7 @@ class Tile {
   static void set_radius(Vertex& v, double err) {
     double a = v.y[0] * v.y[0] + v.y[1] * v.y[1];
     double l1 = std::fabs(v.y[0]) + std::fabs(v.y[1]);
-    v.r2 = (a + 4.0 * err * (l1 + err)) * (1.0 + 1e-12);
+    v.r2 = (a + 4.0 * err * (l1 + err)) * (1.0 + 1e-12) + filter::abs_eps;
     if (!(v.r2 < std::numeric_limits<double>::infinity())) v.r2 = std::numeric_limits<double>::infinity();  // NaN too
   }
 
