@@ -17,42 +17,59 @@ namespace tessera::front {
 template <int D>
 using Key = std::array<std::int32_t, D + 1>;
 
-/// Volume and centroid (relative to the generator) by a fan of simplices from
-/// the generator: faces are counter-clockwise from outside, so every simplex
-/// has positive orientation when the generator is inside.
-inline void measure(kernels::Hull& hull, double& volume, std::array<double, 3>& centroid) {
-  const auto& v = hull.vertices();
-  double vol = 0, c[3] = {0, 0, 0};
-  hull.for_each_face([&](std::uint16_t, const std::uint32_t* loop, std::size_t m) {
-    const double* a = v[loop[0]].y;
-    for (std::size_t k = 1; k + 1 < m; ++k) {
-      const double* b = v[loop[k]].y;
-      const double* d = v[loop[k + 1]].y;
-      double t = (a[0] * (b[1] * d[2] - b[2] * d[1]) + a[1] * (b[2] * d[0] - b[0] * d[2]) +
-                  a[2] * (b[0] * d[1] - b[1] * d[0])) / 6.0;
-      vol += t;
-      for (int i = 0; i < 3; ++i) c[i] += t * (a[i] + b[i] + d[i]) * 0.25;
-    }
-  });
-  volume = vol;
-  for (int i = 0; i < 3; ++i) centroid[i] = vol != 0 ? c[i] / vol : 0.0;
-}
+/// Volume and centroid (relative to the generator), accumulated face by face
+/// while the faces are walked once. 3D: a fan of tetrahedra from the generator
+/// over each face (faces are counter-clockwise from outside, so every tetra is
+/// positive when the generator is inside). 2D: the shoelace formula over edges.
+template <int D>
+class Measure;
 
-inline void measure(kernels::Tile& tile, double& area, std::array<double, 2>& centroid) {
-  const auto& v = tile.vertices();
-  const std::size_t m = v.size();
-  double s = 0, cx = 0, cy = 0;
-  for (std::size_t k = 0; k < m; ++k) {
-    const double* a = v[k].y;
-    const double* b = v[(k + 1) % m].y;
-    double cr = a[0] * b[1] - a[1] * b[0];
-    s += cr;
-    cx += (a[0] + b[0]) * cr;
-    cy += (a[1] + b[1]) * cr;
+template <>
+class Measure<3> {
+ public:
+  explicit Measure(const kernels::Hull& hull) : v_(hull.vertices()) {}
+  void add_face(const std::uint32_t* loop, std::size_t m) {
+    const double* a = v_[loop[0]].y;
+    for (std::size_t k = 1; k + 1 < m; ++k) {
+      const double* b = v_[loop[k]].y;
+      const double* d = v_[loop[k + 1]].y;
+      double t = (a[0] * (b[1] * d[2] - b[2] * d[1]) + a[1] * (b[2] * d[0] - b[0] * d[2]) +
+                  a[2] * (b[0] * d[1] - b[1] * d[0]));
+      vol_ += t;
+      for (int i = 0; i < 3; ++i) c_[i] += t * (a[i] + b[i] + d[i]);
+    }
   }
-  area = 0.5 * s;
-  centroid = {s != 0 ? cx / (3 * s) : 0.0, s != 0 ? cy / (3 * s) : 0.0};
-}
+  void result(double& volume, std::array<double, 3>& centroid) const {
+    volume = vol_ / 6.0;
+    for (int i = 0; i < 3; ++i) centroid[static_cast<std::size_t>(i)] = vol_ != 0 ? c_[i] / (4.0 * vol_) : 0.0;
+  }
+
+ private:
+  const std::vector<kernels::Hull::Vertex>& v_;
+  double vol_ = 0, c_[3] = {0, 0, 0};
+};
+
+template <>
+class Measure<2> {
+ public:
+  explicit Measure(const kernels::Tile& tile) : v_(tile.vertices()) {}
+  void add_face(const std::uint32_t* e, std::size_t) {  // the edge e[0] -> e[1]
+    const double* a = v_[e[0]].y;
+    const double* b = v_[e[1]].y;
+    double cr = a[0] * b[1] - a[1] * b[0];
+    s_ += cr;
+    cx_ += (a[0] + b[0]) * cr;
+    cy_ += (a[1] + b[1]) * cr;
+  }
+  void result(double& area, std::array<double, 2>& centroid) const {
+    area = 0.5 * s_;
+    centroid = {s_ != 0 ? cx_ / (3 * s_) : 0.0, s_ != 0 ? cy_ / (3 * s_) : 0.0};
+  }
+
+ private:
+  const std::vector<kernels::Tile::Vertex>& v_;
+  double s_ = 0, cx_ = 0, cy_ = 0;
+};
 
 inline Key<3> vertex_key(const kernels::Hull& hull, std::size_t t) {
   const auto& v = hull.vertices()[t];

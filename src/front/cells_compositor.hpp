@@ -62,28 +62,29 @@ class CellsCompositor {
       return;
     }
     const double* p = coords_ + static_cast<std::size_t>(gen) * D;
-    double vol;
-    std::array<double, D> c;
-    measure(cell, vol, c);
-    b.volume.push_back(vol);
-    for (int d = 0; d < D; ++d) b.centroid.push_back(c[d] + p[d]);
     const std::size_t nb0 = b.nbrs.size();
     std::int32_t nf = 0;
-    const std::size_t fbase = b.face_nbr.size();
-    for_each_face(cell, [&](std::int32_t id, const std::uint32_t* loop, std::size_t m) {
+    // One walk over the faces: measures, spokes and (optionally) the mesh.
+    Measure<D> m(cell);
+    for_each_face(cell, [&](std::int32_t id, const std::uint32_t* loop, std::size_t count) {
       ++nf;
+      m.add_face(loop, count);
       if (id >= 0) b.nbrs.push_back(id);
       if (mesh_) {
         b.face_nbr.push_back(id);
-        b.fverts.insert(b.fverts.end(), loop, loop + m);
+        b.fverts.insert(b.fverts.end(), loop, loop + count);
         b.face_vend.push_back(static_cast<std::uint32_t>(b.fverts.size()));
       }
     });
+    double vol;
+    std::array<double, D> c;
+    m.result(vol, c);
+    b.volume.push_back(vol);
+    for (int d = 0; d < D; ++d) b.centroid.push_back(c[d] + p[d]);
     std::sort(b.nbrs.begin() + static_cast<std::ptrdiff_t>(nb0), b.nbrs.end());
     b.num_faces.push_back(nf);
     b.nbr_end.push_back(static_cast<std::uint32_t>(b.nbrs.size()));
     if (mesh_) {
-      (void)fbase;
       const auto& v = cell.vertices();
       for (std::size_t t = 0; t < v.size(); ++t) {
         b.keys.push_back(vertex_key(cell, t));

@@ -260,8 +260,8 @@ class Hull {
     double inv = 1.0 / det;
     for (int k = 0; k < 3; ++k) v.y[k] = (A.d * c1[k] + B.d * c2[k] + C.d * c3[k]) * inv;
     double ymax = std::max({std::fabs(v.y[0]), std::fabs(v.y[1]), std::fabs(v.y[2])});
-    double s = 0;
-    for (int k = 0; k < 3; ++k) s += std::fabs(c1[k]) + std::fabs(c2[k]) + std::fabs(c3[k]);
+    // |a x b|_1 <= |a|_1 |b|_1, so the adjugate's entries sum to at most s.
+    double s = B.n1 * C.n1 + C.n1 * A.n1 + A.n1 * B.n1;
     double inv_norm = s * std::fabs(inv);             // >= |A^-1|_inf
     double amax = std::max({A.n1, B.n1, C.n1});
     double bmax = std::max({std::fabs(A.d), std::fabs(B.d), std::fabs(C.d)});
