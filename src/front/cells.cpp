@@ -93,15 +93,26 @@ Bounds make_domain(std::span<const double> pts, int dim, std::size_t n, const Vo
 /// Power-of-two exponent that brings the largest coordinate near 1 when the
 /// input is so large or small that squared distances could overflow or
 /// underflow in the float filter (0 otherwise). Scaling by 2^k is exact.
+/// The shift is capped so that every non-zero coordinate stays a normal double
+/// (no rounding into subnormals) and nothing overflows.
 int normalizing_exponent(std::span<const double> points, const Bounds& b, int dim) {
-  double m = 0;
-  for (double x : points) m = std::max(m, std::fabs(x));
-  for (int d = 0; d < dim; ++d)
-    m = std::max({m, std::fabs(b.lo[static_cast<std::size_t>(d)]), std::fabs(b.hi[static_cast<std::size_t>(d)])});
+  double m = 0, m_min = INFINITY;
+  auto see = [&](double x) {
+    x = std::fabs(x);
+    m = std::max(m, x);
+    if (x != 0) m_min = std::min(m_min, x);
+  };
+  for (double x : points) see(x);
+  for (int d = 0; d < dim; ++d) {
+    see(b.lo[static_cast<std::size_t>(d)]);
+    see(b.hi[static_cast<std::size_t>(d)]);
+  }
   if (m == 0 || (m < 0x1p200 && m > 0x1p-200)) return 0;
-  int e;
-  std::frexp(m, &e);
-  return -e;
+  int e_max, e_min;
+  std::frexp(m, &e_max);
+  std::frexp(m_min, &e_min);
+  // x * 2^k stays normal iff e_min + k >= -1021, and finite iff e_max + k <= 1024.
+  return std::clamp(-e_max, -1021 - e_min, 1000 - e_max);
 }
 
 template <class CellT>

@@ -219,7 +219,10 @@ void exact_vertex(const ExactContext& ctx, std::int32_t i, const std::int32_t* p
     mpq_set_num(qs.q, s.minor[d]);
     mpq_set_den(qs.q, s.minor[dim]);
     mpq_canonicalize(qs.q);
-    y[d] = std::ldexp(mpq_get_d(qs.q), shift);
+    // Scale before rounding: the unscaled ratio may not fit a double.
+    if (shift > 0) mpq_mul_2exp(qs.q, qs.q, static_cast<mp_bitcnt_t>(shift));
+    else if (shift < 0) mpq_div_2exp(qs.q, qs.q, static_cast<mp_bitcnt_t>(-shift));
+    y[d] = mpq_get_d(qs.q);
   }
 }
 

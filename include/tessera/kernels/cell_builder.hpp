@@ -19,6 +19,8 @@
 #include <cstdint>
 #include <vector>
 
+#include "tessera/kernels/exact_predicates.hpp"
+#include "tessera/kernels/hull.hpp"  // ClipResult
 #include "tessera/kernels/locator.hpp"
 
 namespace tessera::kernels {

@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <span>
 #include <vector>
 
@@ -46,6 +47,8 @@ class BinLocator {
       total *= static_cast<std::size_t>(divs_[d]);
     }
     min_size_ = *std::min_element(size_.begin(), size_.end());
+    for (int d = 0; d < D; ++d) slack_ = std::max({slack_, std::fabs(lo[d]), std::fabs(hi[d])});
+    slack_ *= 8 * std::numeric_limits<double>::epsilon();
     // Counting sort by bin; stable in id, so the order is deterministic.
     std::vector<std::uint32_t> bin_of(n);
     offsets_.assign(total + 1, 0);
@@ -81,11 +84,14 @@ class BinLocator {
     return idx;
   }
   /// Squared distance from x to the box of bin b (0 inside).
+  /// Never larger than the true value: bin faces are computed in floating
+  /// point while points were binned by a rounded product, so each gap is
+  /// shrunk by a few ulp of the box's coordinates.
   double bin_distance2(const double* x, const std::array<std::int32_t, D>& b) const {
     double s = 0;
     for (int d = 0; d < D; ++d) {
       double blo = lo_[d] + b[d] * size_[d], bhi = blo + size_[d];
-      double g = std::max({0.0, blo - x[d], x[d] - bhi});
+      double g = std::max({0.0, blo - x[d] - slack_, x[d] - bhi - slack_});
       s += g * g;
     }
     return s;
@@ -99,7 +105,7 @@ class BinLocator {
       double blo = lo_[d] + b[d] * size_[d];
       gap = std::min({gap, x[d] - blo, blo + size_[d] - x[d]});
     }
-    return std::max(0.0, gap) + (s - 1) * min_size_;
+    return std::max(0.0, gap - slack_) + std::max(0.0, (s - 1) * min_size_ * (1 - 1e-12));
   }
   /// The largest shell radius that still touches the grid from bin b.
   int max_shell(const std::array<std::int32_t, D>& b) const {
@@ -157,6 +163,7 @@ class BinLocator {
  private:
   Point lo_{}, size_{}, inv_size_{};
   double min_size_ = 0;
+  double slack_ = 0;  // a few ulp of the box coordinates
   std::array<std::int32_t, D> divs_{};
   std::vector<std::uint32_t> offsets_;
   std::vector<std::int32_t> ids_;   // point id per slot (bin order)

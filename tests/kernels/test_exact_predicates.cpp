@@ -1,0 +1,638 @@
+// exact_clip_sign and exact_vertex against an independent oracle in exact
+// rationals (GMP mpq_class).
+//
+// The oracle does not share the kernel's formulation: it solves the vertex's
+// linear system by Gaussian elimination in rationals (bisector rows
+// pow_k(v) = pow_i(v), box rows v_axis = c) and evaluates the power-distance
+// difference P = pow_j(v) - pow_i(v) directly. The symbolic weights are
+// handled by linearity: P is affine in the weights (v is, and P is affine in
+// v), so the coefficient of w_k is P(w = e_k) - P(0), computed by one more
+// exact solve with w_k = 1. The perturbed sign is then sign(P0) when P0 != 0,
+// else the sign of the first non-zero coefficient in increasing id order
+// (w_k >> w_l for k < l).
+//
+// Checked: the kernel equals the oracle on random input of every magnitude
+// (1e-300 .. 1e300, subnormals, large offsets, near ties built by reflecting
+// p_i through the exact vertex), on exact ties (co-circular / co-spherical
+// lattice points, duplicates, with box planes), where in addition every cell
+// sharing the vertex and every order of its planes gives the same non-zero
+// sign; exact duplicates leave the vertices with the lower id; exact_vertex is
+// within 2 ulp of the rational vertex per coordinate.
+#include <gtest/gtest.h>
+#include <gmpxx.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <optional>
+#include <random>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "tessera/kernels/exact_predicates.hpp"
+
+namespace {
+
+using tessera::kernels::box_plane_axis;
+using tessera::kernels::box_plane_id;
+using tessera::kernels::box_plane_upper;
+using tessera::kernels::exact_clip_sign;
+using tessera::kernels::exact_vertex;
+using tessera::kernels::ExactContext;
+using Q = mpq_class;
+using Ids = std::array<std::int32_t, 3>;
+
+// ------------------------------------------------------------------ oracle
+
+/// A point set with its domain box; `ctx()` views it for the kernel.
+struct Problem {
+  int dim = 3;
+  std::vector<double> pts;
+  std::array<double, 3> lo{}, hi{};
+  ExactContext ctx() const {
+    ExactContext c;
+    c.points = pts.data();
+    c.dim = dim;
+    c.lo = lo;
+    c.hi = hi;
+    return c;
+  }
+  std::int32_t add(std::array<double, 3> p) {
+    for (int d = 0; d < dim; ++d) pts.push_back(p[d]);
+    return static_cast<std::int32_t>(pts.size() / dim - 1);
+  }
+  std::int32_t size() const { return static_cast<std::int32_t>(pts.size() / dim); }
+};
+
+Q coord(const ExactContext& c, std::int32_t id, int d) { return Q(c.points[static_cast<std::size_t>(id) * c.dim + d]); }
+
+Q norm2(const ExactContext& c, std::int32_t id) {
+  Q s = 0;
+  for (int d = 0; d < c.dim; ++d) s += coord(c, id, d) * coord(c, id, d);
+  return s;
+}
+
+/// The (perturbed) vertex of cell i on planes[0..dim), with weight 1 on
+/// generator `wid` and 0 on every other (wid = -1: unperturbed). Empty when
+/// the planes are dependent.
+std::optional<std::array<Q, 3>> solve_vertex(const ExactContext& c, std::int32_t i, const std::int32_t* planes,
+                                             std::int32_t wid = -1) {
+  const int n = c.dim;
+  Q A[3][3], b[3];
+  const Q wi = (i == wid) ? 1 : 0;
+  for (int r = 0; r < n; ++r) {
+    const std::int32_t k = planes[r];
+    if (k >= 0) {  // 2 (p_k - p_i).v = |p_k|^2 - |p_i|^2 - w_k + w_i
+      for (int d = 0; d < n; ++d) A[r][d] = 2 * (coord(c, k, d) - coord(c, i, d));
+      b[r] = norm2(c, k) - norm2(c, i) - (k == wid ? 1 : 0) + wi;
+    } else {  // v_axis = box constant
+      const int axis = box_plane_axis(k);
+      for (int d = 0; d < n; ++d) A[r][d] = (d == axis) ? 1 : 0;
+      b[r] = box_plane_upper(k) ? Q(c.hi[axis]) : Q(c.lo[axis]);
+    }
+  }
+  for (int col = 0; col < n; ++col) {  // Gaussian elimination, any non-zero pivot
+    int piv = col;
+    while (piv < n && A[piv][col] == 0) ++piv;
+    if (piv == n) return std::nullopt;
+    for (int d = 0; d < n; ++d) std::swap(A[piv][d], A[col][d]);
+    std::swap(b[piv], b[col]);
+    for (int r = col + 1; r < n; ++r) {
+      if (A[r][col] == 0) continue;
+      Q f = A[r][col] / A[col][col];
+      for (int d = col; d < n; ++d) A[r][d] -= f * A[col][d];
+      b[r] -= f * b[col];
+    }
+  }
+  std::array<Q, 3> v;
+  for (int r = n - 1; r >= 0; --r) {
+    Q s = b[r];
+    for (int d = r + 1; d < n; ++d) s -= A[r][d] * v[d];
+    v[r] = s / A[r][r];
+  }
+  return v;
+}
+
+/// P = pow_j(v) - pow_i(v) with weight 1 on `wid` (see solve_vertex).
+Q power_diff(const ExactContext& c, std::int32_t i, const std::int32_t* planes, std::int32_t j, std::int32_t wid = -1) {
+  auto v = solve_vertex(c, i, planes, wid);
+  Q dj = 0, di = 0;
+  for (int d = 0; d < c.dim; ++d) {
+    Q a = (*v)[d] - coord(c, j, d), e = (*v)[d] - coord(c, i, d);
+    dj += a * a;
+    di += e * e;
+  }
+  return dj - (j == wid ? 1 : 0) - di + (i == wid ? 1 : 0);
+}
+
+/// The sign of P under the symbolic perturbation, decided independently of
+/// the kernel (see the file comment). 0 only if every coefficient vanishes.
+int oracle_sign(const ExactContext& c, std::int32_t i, const std::int32_t* planes, std::int32_t j) {
+  const Q p0 = power_diff(c, i, planes, j);
+  if (p0 != 0) return sgn(p0);
+  std::vector<std::int32_t> ids{i, j};
+  for (int r = 0; r < c.dim; ++r)
+    if (planes[r] >= 0) ids.push_back(planes[r]);
+  std::sort(ids.begin(), ids.end());
+  ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
+  for (std::int32_t k : ids) {
+    Q coef = power_diff(c, i, planes, j, k) - p0;
+    if (coef != 0) return sgn(coef);
+  }
+  return 0;
+}
+
+bool independent(const ExactContext& c, std::int32_t i, const std::int32_t* planes) {
+  return solve_vertex(c, i, planes).has_value();
+}
+
+std::string describe(const ExactContext& c, std::int32_t i, const std::int32_t* planes, std::int32_t j) {
+  std::ostringstream s;
+  s.precision(17);
+  auto pt = [&](std::int32_t id) {
+    if (id < 0) { s << "box" << id; return; }
+    s << id << "(";
+    for (int d = 0; d < c.dim; ++d) s << (d ? "," : "") << c.points[static_cast<std::size_t>(id) * c.dim + d];
+    s << ")";
+  };
+  s << "cell ";
+  pt(i);
+  s << " planes ";
+  for (int r = 0; r < c.dim; ++r) { pt(planes[r]); s << " "; }
+  if (j != i) {
+    s << "candidate ";
+    pt(j);
+  }
+  return s.str();
+}
+
+/// exact_vertex(i, planes) against the rational vertex minus p_i: within 2 ulp
+/// of the exact value per coordinate.
+void check_exact_vertex(const ExactContext& c, std::int32_t i, const std::int32_t* planes) {
+  auto v = solve_vertex(c, i, planes);
+  ASSERT_TRUE(v.has_value());
+  double y[3] = {0, 0, 0};
+  exact_vertex(c, i, planes, y);
+  for (int d = 0; d < c.dim; ++d) {
+    const Q exact = (*v)[d] - coord(c, i, d);
+    const double r = std::fabs(exact.get_d());  // truncated: within 1 ulp of |exact|
+    if (r > std::numeric_limits<double>::max()) continue;
+    ASSERT_TRUE(std::isfinite(y[d])) << "coordinate " << d << " of " << describe(c, i, planes, i)
+                                     << ": exact value " << exact.get_d() << ", got " << y[d];
+    const double ulp = std::nextafter(r, INFINITY) - r;
+    const Q err = abs(Q(y[d]) - exact);
+    EXPECT_LE(err, Q(2 * ulp)) << "coordinate " << d << " of " << describe(c, i, planes, i) << ": exact "
+                               << exact.get_d() << ", got " << y[d];
+  }
+}
+
+/// Kernel vs oracle for one query; returns the kernel's sign.
+int check_sign(const ExactContext& c, std::int32_t i, const std::int32_t* planes, std::int32_t j) {
+  const int got = exact_clip_sign(c, i, planes, j);
+  const int want = oracle_sign(c, i, planes, j);
+  EXPECT_NE(want, 0) << "oracle: every perturbation coefficient vanished for " << describe(c, i, planes, j);
+  EXPECT_EQ(got, want) << describe(c, i, planes, j) << "  P0 = " << power_diff(c, i, planes, j).get_d();
+  return got;
+}
+
+/// A vertex defined by `defs[0..dim]` (generators and box planes, at least
+/// one generator): from every generator's cell and every order of the other
+/// planes, the kernel's sign against j is the same, non-zero, and the oracle's.
+int check_views(const ExactContext& c, const std::array<std::int32_t, 4>& defs, std::int32_t j) {
+  int first = 0;
+  for (int g = 0; g <= c.dim; ++g) {
+    if (defs[g] < 0) continue;
+    Ids others{};
+    int k = 0;
+    for (int r = 0; r <= c.dim; ++r)
+      if (r != g) others[k++] = defs[r];
+    std::sort(others.begin(), others.begin() + c.dim);
+    const int want = oracle_sign(c, defs[g], others.data(), j);
+    do {
+      const int s = exact_clip_sign(c, defs[g], others.data(), j);
+      EXPECT_TRUE(s == 1 || s == -1) << describe(c, defs[g], others.data(), j);
+      EXPECT_EQ(s, want) << describe(c, defs[g], others.data(), j);
+      if (first == 0) first = s;
+      EXPECT_EQ(s, first) << "cells sharing a vertex disagree: " << describe(c, defs[g], others.data(), j);
+    } while (std::next_permutation(others.begin(), others.begin() + c.dim));
+  }
+  return first;
+}
+
+// ------------------------------------------------------------------ inputs
+
+struct Rng {
+  std::mt19937_64 g;
+  explicit Rng(std::uint64_t seed) : g(seed) {}
+  double uniform(double a, double b) { return std::uniform_real_distribution<double>(a, b)(g); }
+  int index(int n) { return std::uniform_int_distribution<int>(0, n - 1)(g); }
+  bool coin() { return index(2) == 1; }
+};
+
+/// A random double in [-1, 1) with a full 53-bit mantissa (most values from
+/// uniform_real_distribution already have one; this makes sure).
+double full_mantissa(Rng& r) {
+  double x = r.uniform(-1, 1);
+  return x + std::ldexp(r.coin() ? 1.0 : -1.0, -53) * std::fabs(x);
+}
+
+/// n random points offset + scale * [-1,1)^dim; box offset +- 1.5 scale.
+Problem random_problem(int dim, int n, double scale, double offset, Rng& r) {
+  Problem p;
+  p.dim = dim;
+  for (int d = 0; d < 3; ++d) {
+    p.lo[d] = offset - 1.5 * scale;
+    p.hi[d] = offset + 1.5 * scale;
+  }
+  for (int k = 0; k < n; ++k) {
+    std::array<double, 3> x{};
+    for (int d = 0; d < dim; ++d) x[d] = offset + scale * full_mantissa(r);
+    p.add(x);
+  }
+  return p;
+}
+
+/// Random vertex planes for cell i: up to dim-1 box planes on distinct axes,
+/// the rest distinct generators != i; the candidate j is a different
+/// generator. Returns false when the pick is not a vertex (dependent planes).
+bool random_query(const Problem& p, Rng& r, int max_box, std::int32_t& i, Ids& planes, std::int32_t& j) {
+  const int n = p.size();
+  i = r.index(n);
+  const int nbox = r.index(max_box + 1);
+  std::array<int, 3> axes{0, 1, 2};
+  std::shuffle(axes.begin(), axes.begin() + p.dim, r.g);
+  std::vector<std::int32_t> used{i};
+  for (int k = 0; k < p.dim; ++k) {
+    if (k < nbox) {
+      planes[k] = box_plane_id(axes[k], r.coin());
+    } else {
+      std::int32_t g;
+      do g = r.index(n); while (std::find(used.begin(), used.end(), g) != used.end());
+      used.push_back(g);
+      planes[k] = g;
+    }
+  }
+  std::shuffle(planes.begin(), planes.begin() + p.dim, r.g);  // box planes anywhere
+  do j = r.index(n); while (std::find(used.begin(), used.end(), j) != used.end());
+  return independent(p.ctx(), i, planes.data());
+}
+
+// ------------------------------------------------------------------ tests
+
+// The oracle itself on hand-checked cases: cell of (0,0) with neighbours
+// (2,0), (0,2) has the vertex (1,1), at squared distance 2 from p_i.
+TEST(ExactPredicates, HandCheckedCases) {
+  Problem p;
+  p.dim = 2;
+  p.lo = {-4, -4, 0};
+  p.hi = {4, 4, 0};
+  const std::int32_t i = p.add({0, 0}), a = p.add({2, 0}), b = p.add({0, 2});
+  const std::int32_t far = p.add({3, 3}), near = p.add({1, 1}), tie = p.add({2, 2});
+  const auto c = p.ctx();
+  const Ids planes{a, b, 0};
+  EXPECT_EQ(power_diff(c, i, planes.data(), far), 6);    // 8 - 2
+  EXPECT_EQ(power_diff(c, i, planes.data(), near), -2);  // 0 - 2
+  EXPECT_EQ(power_diff(c, i, planes.data(), tie), 0);    // 2 - 2: co-circular
+  EXPECT_EQ(exact_clip_sign(c, i, planes.data(), far), +1);
+  EXPECT_EQ(exact_clip_sign(c, i, planes.data(), near), -1);
+  check_views(c, {i, a, b, 0}, tie);
+  // Box planes: the corner (-4, 2) of cell i on x0 and the bisector with b.
+  const Ids corner{box_plane_id(0, false), b, 0};
+  EXPECT_EQ(power_diff(c, i, corner.data(), far), 53 - 17);  // vertex (-4, 1)
+  EXPECT_EQ(exact_clip_sign(c, i, corner.data(), far), +1);
+  double y[2];
+  exact_vertex(c, i, corner.data(), y);
+  EXPECT_EQ(y[0], -4);
+  EXPECT_EQ(y[1], 1);
+  // The same tie in 3D: cube corners around (1,1,1).
+  Problem q;
+  q.lo = {-1, -1, -1};
+  q.hi = {3, 3, 3};
+  const std::int32_t o = q.add({0, 0, 0}), x = q.add({2, 0, 0}), yy = q.add({0, 2, 0}), z = q.add({0, 0, 2});
+  const std::int32_t opp = q.add({2, 2, 2}), in = q.add({1, 1, 1});
+  const auto c3 = q.ctx();
+  const Ids pl3{x, yy, z};
+  EXPECT_EQ(power_diff(c3, o, pl3.data(), opp), 0);
+  EXPECT_EQ(power_diff(c3, o, pl3.data(), in), -3);
+  EXPECT_EQ(exact_clip_sign(c3, o, pl3.data(), in), -1);
+  check_views(c3, {o, x, yy, z}, opp);
+}
+
+// Random input at every magnitude: the kernel's sign is sign(P0) (ties do not
+// occur), box planes mixed in.
+void random_matches(int dim, std::uint64_t seed) {
+  // Scales include subnormal-producing (1e-300) and near-overflow (1e300)
+  // values and a large offset (cancellation: many mantissa bits of p_k - p_i).
+  const double scales[][2] = {{1, 0},       {1e-300, 0}, {1e300, 0},   {1e-150, 0}, {1e150, 0},
+                              {0x1p-1000, 0}, {3.7e-5, 0}, {1e-6, 1e6}, {1, 1e15},   {1e-12, -0.3}};
+  Rng r(seed);
+  int checked = 0, nonzero = 0;
+  for (const auto& s : scales) {
+    const Problem p = random_problem(dim, 16, s[0], s[1], r);
+    const auto c = p.ctx();
+    for (int t = 0; t < 150; ++t) {
+      std::int32_t i, j;
+      Ids planes;
+      if (!random_query(p, r, dim - 1, i, planes, j)) continue;
+      const Q p0 = power_diff(c, i, planes.data(), j);
+      const int got = exact_clip_sign(c, i, planes.data(), j);
+      if (p0 != 0) {
+        ++nonzero;
+        ASSERT_EQ(got, sgn(p0)) << "scale " << s[0] << " offset " << s[1] << ": " << describe(c, i, planes.data(), j);
+      } else {
+        check_sign(c, i, planes.data(), j);
+      }
+      ++checked;
+    }
+  }
+  EXPECT_GT(checked, 1200);
+  EXPECT_GT(nonzero, 1200);
+}
+
+TEST(ExactPredicates, RandomMatchesRational2D) { random_matches(2, 11); }
+TEST(ExactPredicates, RandomMatchesRational3D) { random_matches(3, 12); }
+
+// Near ties: j is p_i reflected through the exact vertex, rounded to doubles
+// (and nudged by one ulp), so P0 is tiny, of either sign, or exactly 0.
+void near_ties(int dim, std::uint64_t seed) {
+  const double scales[][2] = {{1, 0}, {1e-300, 0}, {1e300, 0}, {1e-3, 1e3}, {0.1, 0}};
+  Rng r(seed);
+  int pos = 0, neg = 0, zero = 0;
+  for (const auto& s : scales) {
+    Problem p = random_problem(dim, 12, s[0], s[1], r);
+    const std::int32_t probe = p.add({0, 0, 0});
+    for (int t = 0; t < 200; ++t) {
+      const auto c = p.ctx();
+      std::int32_t i, j;
+      Ids planes;
+      if (!random_query(p, r, dim - 1, i, planes, j)) continue;
+      if (i == probe || std::find(planes.begin(), planes.begin() + dim, probe) != planes.begin() + dim) continue;
+      auto v = solve_vertex(c, i, planes.data());
+      for (int d = 0; d < dim; ++d) {
+        double x = Q(2 * (*v)[d] - coord(c, i, d)).get_d();
+        if (r.index(3) == 0) x = std::nextafter(x, r.coin() ? INFINITY : -INFINITY);
+        p.pts[static_cast<std::size_t>(probe) * dim + d] = x;
+      }
+      bool finite = true;
+      for (int d = 0; d < dim; ++d) finite &= std::isfinite(p.pts[static_cast<std::size_t>(probe) * dim + d]);
+      if (!finite) continue;
+      const int got = check_sign(p.ctx(), i, planes.data(), probe);
+      const int z = sgn(power_diff(p.ctx(), i, planes.data(), probe));
+      (z > 0 ? pos : z < 0 ? neg : zero) += 1;
+      (void)got;
+    }
+  }
+  // Both signs of tiny P0 occur (the float filter could not decide these).
+  EXPECT_GT(pos, 50);
+  EXPECT_GT(neg, 50);
+  (void)zero;
+}
+
+TEST(ExactPredicates, NearTies2D) { near_ties(2, 21); }
+TEST(ExactPredicates, NearTies3D) { near_ties(3, 22); }
+
+/// Integer points on the sphere |x|^2 = r2 (circle in 2D).
+std::vector<std::array<int, 3>> lattice_sphere(int dim, int r2) {
+  std::vector<std::array<int, 3>> out;
+  const int m = static_cast<int>(std::sqrt(r2)) + 1;
+  for (int x = -m; x <= m; ++x)
+    for (int y = -m; y <= m; ++y)
+      for (int z = (dim == 3 ? -m : 0); z <= (dim == 3 ? m : 0); ++z)
+        if (x * x + y * y + z * z == r2) out.push_back({x, y, z});
+  return out;
+}
+
+/// Exact ties: dim+1 defining generators (or box planes through the centre)
+/// and a candidate j, all on one sphere, so P0 == 0. Lattice coordinates are
+/// scaled by powers of two (exact), from subnormals to 2^1000.
+void lattice_ties(int dim, int r2, int nbox, std::uint64_t seed) {
+  const double scales[] = {1, 0.5, 0x1p-1060, 0x1p1000, 0x1p-40};
+  const auto sphere = lattice_sphere(dim, r2);
+  ASSERT_GE(sphere.size(), 8u);
+  Rng r(seed);
+  int checked = 0;
+  for (double sc : scales) {
+    for (int offset : {0, 7, -1000003}) {
+      // The centre; with nbox box planes, box faces pass through it (lower on
+      // axes 0..nbox-1), and only points on their inner side are kept.
+      std::array<int, 3> ctr{offset, offset + 1, dim == 3 ? offset - 2 : 0};
+      Problem p;
+      p.dim = dim;
+      const int ext = static_cast<int>(std::sqrt(r2)) + 2;
+      for (int d = 0; d < 3; ++d) {
+        p.lo[d] = sc * (d < nbox ? ctr[d] : ctr[d] - ext);
+        p.hi[d] = sc * (ctr[d] + ext);
+      }
+      auto pts = sphere;
+      std::shuffle(pts.begin(), pts.end(), r.g);  // ids unrelated to geometry
+      for (const auto& q : pts) {
+        bool inside = true;
+        for (int d = 0; d < nbox; ++d) inside &= q[d] >= 0;
+        if (!inside) continue;
+        std::array<double, 3> x{};
+        for (int d = 0; d < dim; ++d) x[d] = sc * (ctr[d] + q[d]);
+        p.add(x);
+      }
+      // Exact duplicates of some points as well (ties with a plane generator).
+      for (int k = 0; k < 3; ++k) {
+        std::int32_t src = r.index(p.size());
+        std::array<double, 3> x{};
+        for (int d = 0; d < dim; ++d) x[d] = p.pts[static_cast<std::size_t>(src) * dim + d];
+        p.add(x);
+      }
+      const auto c = p.ctx();
+      const int n = p.size();
+      for (int t = 0; t < 60; ++t) {
+        std::array<std::int32_t, 4> defs{};
+        for (int k = 0; k < nbox; ++k) defs[k] = box_plane_id(k, false);
+        std::vector<std::int32_t> used;
+        for (int k = nbox; k <= dim; ++k) {
+          std::int32_t g;
+          do g = r.index(n); while (std::find(used.begin(), used.end(), g) != used.end());
+          used.push_back(g);
+          defs[k] = g;
+        }
+        std::shuffle(defs.begin(), defs.begin() + dim + 1, r.g);
+        // Cell: the first generator in defs; planes: the others.
+        std::int32_t i = -1;
+        Ids planes{};
+        int k = 0;
+        for (int q = 0; q <= dim; ++q) {
+          if (i < 0 && defs[q] >= 0) i = defs[q];
+          else planes[k++] = defs[q];
+        }
+        if (!independent(c, i, planes.data())) continue;
+        std::int32_t j;
+        do j = r.index(n); while (std::find(used.begin(), used.end(), j) != used.end());
+        ASSERT_EQ(power_diff(c, i, planes.data(), j), 0) << "not a tie: " << describe(c, i, planes.data(), j);
+        check_views(c, defs, j);
+        check_exact_vertex(c, i, planes.data());
+        ++checked;
+      }
+    }
+  }
+  EXPECT_GT(checked, 300);
+}
+
+TEST(ExactPredicates, CocircularTies) { lattice_ties(2, 65, 0, 31); }         // 16 points
+TEST(ExactPredicates, CocircularTiesBox) { lattice_ties(2, 25, 1, 32); }      // on x0
+TEST(ExactPredicates, CosphericalTies) { lattice_ties(3, 27, 0, 33); }        // 32 points
+TEST(ExactPredicates, CosphericalTiesBoxFace) { lattice_ties(3, 50, 1, 34); } // on x0
+TEST(ExactPredicates, CosphericalTiesBoxEdge) { lattice_ties(3, 50, 2, 35); } // on x0 and y0
+
+// Square and cube corners: the classic degenerate grid vertex, seen from all
+// 4 (2D) / 8 (3D) corners with every choice of defining corners.
+TEST(ExactPredicates, GridCornerTies) {
+  for (int dim : {2, 3}) {
+    Problem p;
+    p.dim = dim;
+    p.lo = {-1, -1, -1};
+    p.hi = {2, 2, 2};
+    const int nc = 1 << dim;
+    for (int m = 0; m < nc; ++m) p.add({0.1 * (m & 1), 0.1 * ((m >> 1) & 1), 0.1 * ((m >> 2) & 1)});
+    const auto c = p.ctx();
+    int checked = 0;
+    // Every (dim+1)-subset of corners that defines a vertex, every other corner as j.
+    for (int mask = 0; mask < (1 << nc); ++mask) {
+      if (__builtin_popcount(static_cast<unsigned>(mask)) != dim + 1) continue;
+      std::array<std::int32_t, 4> defs{};
+      int k = 0;
+      for (int b = 0; b < nc; ++b)
+        if (mask >> b & 1) defs[k++] = b;
+      if (!independent(c, defs[0], defs.data() + 1)) continue;
+      for (std::int32_t j = 0; j < nc; ++j) {
+        if (mask >> j & 1) continue;
+        EXPECT_EQ(power_diff(c, defs[0], defs.data() + 1, j), 0);
+        check_views(c, defs, j);
+        ++checked;
+      }
+    }
+    EXPECT_EQ(checked, dim == 2 ? 4 : (70 - 12) * 4) << "dim " << dim;  // 3D: 4-subsets minus the 12 coplanar ones
+  }
+}
+
+// Exact duplicates p_j == p_i: the lower id keeps its vertices (+1 when i < j,
+// -1 when i > j), whatever the planes, at every magnitude.
+TEST(ExactPredicates, DuplicatesLowerIdKeeps) {
+  Rng r(41);
+  int checked = 0;
+  for (int dim : {2, 3}) {
+    for (double sc : {1.0, 1e-300, 1e300, 0x1p-1070}) {
+      Problem p = random_problem(dim, 10, sc, 0, r);
+      for (int k = 0; k < 10; ++k) {  // ten duplicates, interleaved ids
+        std::array<double, 3> x{};
+        for (int d = 0; d < dim; ++d) x[d] = p.pts[static_cast<std::size_t>(k) * dim + d];
+        p.add(x);
+      }
+      const auto c = p.ctx();
+      for (int t = 0; t < 200; ++t) {
+        std::int32_t i, j;
+        Ids planes;
+        if (!random_query(p, r, dim - 1, i, planes, j)) continue;
+        // j := the twin of i (ids k and k + 10), when it is not a plane.
+        const std::int32_t twin = i < 10 ? i + 10 : i - 10;
+        if (std::find(planes.begin(), planes.begin() + dim, twin) != planes.begin() + dim) continue;
+        ASSERT_EQ(power_diff(c, i, planes.data(), twin), 0);
+        const int s = check_sign(c, i, planes.data(), twin);
+        EXPECT_EQ(s, i < twin ? +1 : -1) << describe(c, i, planes.data(), twin);
+        ++checked;
+      }
+    }
+  }
+  EXPECT_GT(checked, 1000);
+}
+
+// exact_vertex within 2 ulp of the rational vertex, on random input (every
+// magnitude) and on ill-conditioned pairs: a generator one ulp from p_i, seen
+// with the other planes (the case the kernels call it for).
+TEST(ExactPredicates, ExactVertexMatchesRational) {
+  Rng r(51);
+  int checked = 0;
+  for (int dim : {2, 3}) {
+    const double scales[][2] = {{1, 0}, {1e-300, 0}, {1e300, 0}, {1e-6, 1e6}, {0x1p-1040, 0}, {1e-9, 0.7}};
+    for (const auto& s : scales) {
+      Problem p = random_problem(dim, 12, s[0], s[1], r);
+      // Near-duplicates: points 0..3 get a partner a few ulp away.
+      for (int k = 0; k < 4; ++k) {
+        std::array<double, 3> x{};
+        for (int d = 0; d < dim; ++d) {
+          x[d] = p.pts[static_cast<std::size_t>(k) * dim + d];
+          for (int u = r.index(3); u >= 0; --u) x[d] = std::nextafter(x[d], r.coin() ? INFINITY : -INFINITY);
+        }
+        p.add(x);
+      }
+      const auto c = p.ctx();
+      for (int t = 0; t < 150; ++t) {
+        std::int32_t i, j;
+        Ids planes;
+        if (!random_query(p, r, dim - 1, i, planes, j)) continue;
+        check_exact_vertex(c, i, planes.data());
+        ++checked;
+      }
+      // Explicitly: cell k with its near twin among the planes.
+      for (std::int32_t k = 0; k < 4; ++k) {
+        Ids planes{k + 12, 5, 6};
+        if (independent(c, k, planes.data())) { check_exact_vertex(c, k, planes.data()); ++checked; }
+        Ids boxed{box_plane_id(1, true), k + 12, 7};
+        if (independent(c, k, boxed.data())) { check_exact_vertex(c, k, boxed.data()); ++checked; }
+      }
+    }
+  }
+  EXPECT_GT(checked, 1500);
+}
+
+// Mixed magnitudes: the input coordinates and the box differ by hundreds of
+// binary orders (a unit cloud in a 1e300 box, a 1e-300 cloud in a unit box),
+// so the common integer scale of the exact computation is far from the
+// vertex's own magnitude.
+Problem mixed_problem(int dim, double point_scale, double box, Rng& r) {
+  Problem p = random_problem(dim, 12, point_scale, 0, r);
+  for (int d = 0; d < 3; ++d) { p.lo[d] = -box; p.hi[d] = box; }
+  return p;
+}
+constexpr double kMixes[][2] = {{1, 1e300}, {1e-300, 1}, {1e-200, 1e200}, {1, 1e200}};
+
+TEST(ExactPredicates, SignMixedMagnitudes) {
+  Rng r(52);
+  int checked = 0;
+  for (int dim : {2, 3})
+    for (const auto& m : kMixes) {
+      const Problem p = mixed_problem(dim, m[0], m[1], r);
+      for (int t = 0; t < 100; ++t) {
+        std::int32_t i, j;
+        Ids planes;
+        if (!random_query(p, r, dim - 1, i, planes, j)) continue;
+        check_sign(p.ctx(), i, planes.data(), j);
+        ++checked;
+      }
+    }
+  EXPECT_GT(checked, 700);
+}
+
+// KNOWN BUG (reported, not fixed here): exact_vertex rounds the rational
+// vertex in units of 2^shift (shift: the smallest mantissa lsb of the inputs)
+// before scaling back with ldexp, so the intermediate overflows to +-inf when
+// the vertex is more than ~2^1024 of those units (a 1e-300 cloud in a unit
+// box). Fix: mpq_mul_2exp / mpq_div_2exp by the shift, then mpq_get_d.
+// Reachable through tessera::voronoi (NaN volumes); enable once fixed.
+TEST(ExactPredicates, ExactVertexMixedMagnitudes) {
+  Rng r(53);
+  int checked = 0;
+  for (int dim : {2, 3})
+    for (const auto& m : kMixes) {
+      const Problem p = mixed_problem(dim, m[0], m[1], r);
+      for (int t = 0; t < 100; ++t) {
+        std::int32_t i, j;
+        Ids planes;
+        if (!random_query(p, r, dim - 1, i, planes, j)) continue;
+        check_exact_vertex(p.ctx(), i, planes.data());
+        ++checked;
+      }
+    }
+  EXPECT_GT(checked, 700);
+}
+
+}  // namespace

@@ -1,0 +1,525 @@
+// The cell clippers, Hull (3D) and Tile (2D), driven directly.
+//
+// Every check recomputes from the raw vertices and planes: volumes by the
+// divergence theorem over Newell face normals (3D) or the shoelace formula
+// (2D), face loops walked and verified edge by edge, Euler's formula, each
+// vertex on its own planes and inside all others, and the Voronoi property
+// (no other generator nearer to a vertex than the cell's own). Whole
+// tessellations built by brute force (every cell clipped by every other
+// point) must partition the box and agree on every vertex, on random and on
+// fully degenerate lattice input, whatever the clip order.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <map>
+#include <numeric>
+#include <random>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "tessera/kernels/exact_predicates.hpp"
+#include "tessera/kernels/hull.hpp"
+#include "tessera/kernels/tile.hpp"
+
+namespace {
+
+using tessera::kernels::ClipResult;
+using tessera::kernels::ExactContext;
+using tessera::kernels::Hull;
+using tessera::kernels::Tile;
+
+/// A point set in a box, with the exact context the clippers need.
+template <int D>
+struct Scene {
+  std::vector<double> pts;
+  std::array<double, D> lo{}, hi{};
+  ExactContext ctx;
+
+  Scene(std::vector<double> p, std::array<double, D> l, std::array<double, D> h) : pts(std::move(p)), lo(l), hi(h) {
+    ctx.points = pts.data();
+    ctx.dim = D;
+    for (int d = 0; d < D; ++d) { ctx.lo[d] = lo[d]; ctx.hi[d] = hi[d]; }
+  }
+  Scene(const Scene&) = delete;
+  std::int32_t size() const { return static_cast<std::int32_t>(pts.size() / D); }
+  const double* p(std::int32_t i) const { return &pts[static_cast<std::size_t>(i) * D]; }
+  double box_volume() const {
+    double v = 1;
+    for (int d = 0; d < D; ++d) v *= hi[d] - lo[d];
+    return v;
+  }
+  double scale() const {
+    double m = 0;
+    for (int d = 0; d < D; ++d) m = std::max(m, hi[d] - lo[d]);
+    return m;
+  }
+  template <class CellT>
+  void reset(CellT& c, std::int32_t i) const { c.reset(i, p(i), lo.data(), hi.data(), &ctx); }
+  template <class CellT>
+  ClipResult clip(CellT& c, std::int32_t j) const {
+    double q[D];
+    for (int d = 0; d < D; ++d) q[d] = p(j)[d] - p(c.generator())[d];
+    return c.clip(j, q);
+  }
+};
+
+template <int D>
+std::vector<double> random_points(int n, std::uint64_t seed, double lo = 0, double hi = 1) {
+  std::mt19937_64 g(seed);
+  std::uniform_real_distribution<double> u(lo, hi);
+  std::vector<double> p(static_cast<std::size_t>(n) * D);
+  for (auto& x : p) x = u(g);
+  return p;
+}
+
+/// k^D lattice, coordinate (0.5 + index) * h (cells are cubes/squares of
+/// side h in the box [0, k h]^D), every vertex of the diagram maximally
+/// degenerate. With h = 0.1 the coordinates are rounded: near-degenerate.
+/// `jitter` moves every coordinate that many ulp (random direction).
+template <int D>
+std::vector<double> lattice(int k, double h = 1, int jitter = 0, std::uint64_t seed = 0) {
+  std::mt19937_64 g(seed);
+  std::vector<double> p;
+  const int n = D == 2 ? k * k : k * k * k;
+  for (int m = 0; m < n; ++m) {
+    int r = m;
+    for (int d = 0; d < D; ++d) {
+      double x = (0.5 + r % k) * h;
+      for (int u = 0; u < jitter; ++u) x = std::nextafter(x, (g() & 1) ? INFINITY : -INFINITY);
+      p.push_back(x);
+      r /= k;
+    }
+  }
+  return p;
+}
+
+double dot3(const double* a, const double* b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+
+// ------------------------------------------------------------------ 3D checks
+
+/// Every structural invariant of a hull; returns its volume (by Newell
+/// normals: V = 1/3 sum_f A_f h_f with the generator at the origin).
+double check_hull(Hull& h, const std::string& what) {
+  SCOPED_TRACE(what);
+  const auto& V = h.vertices();
+  const auto& P = h.planes();
+  const double scale = [&] {
+    double m = 0;
+    for (const auto& v : V) m = std::max({m, std::fabs(v.y[0]), std::fabs(v.y[1]), std::fabs(v.y[2])});
+    return m;
+  }();
+  const double tol = 1e-9 * scale;
+  for (std::size_t t = 0; t < V.size(); ++t) {
+    const auto& v = V[t];
+    EXPECT_TRUE(v.p[0] != v.p[1] && v.p[1] != v.p[2] && v.p[0] != v.p[2]) << "vertex " << t << " repeats a plane";
+    std::set<std::int32_t> ids;
+    for (int k = 0; k < 3; ++k) {
+      if (v.p[k] >= P.size()) { ADD_FAILURE() << "vertex " << t << " plane index out of range"; return 0; }
+      ids.insert(P[v.p[k]].id);
+      const auto& pl = P[v.p[k]];
+      EXPECT_NEAR(dot3(pl.n, v.y), pl.d, tol * pl.n1 + 1e-12 * std::fabs(pl.d)) << "vertex " << t << " off its plane";
+    }
+    EXPECT_EQ(ids.size(), 3u) << "vertex " << t << " has two planes with the same id";
+    // Convexity: inside every plane of the cell.
+    for (const auto& pl : P) EXPECT_LE(dot3(pl.n, v.y), pl.d + tol * pl.n1 + 1e-12 * std::fabs(pl.d));
+    EXPECT_LE(4 * v.r2, h.security_radius2()) << "security radius below a vertex";
+    EXPECT_GE(v.r2, dot3(v.y, v.y)) << "r2 is not an upper bound";
+  }
+  // Faces: closed loops, each directed edge once, orientation outward.
+  std::size_t faces = 0, edges2 = 0;
+  std::set<std::pair<std::uint32_t, std::uint32_t>> directed;
+  std::vector<int> faces_per_vertex(V.size(), 0);
+  double volume = 0;
+  h.for_each_face([&](std::uint16_t p, const std::uint32_t* loop, std::size_t m) {
+    ++faces;
+    edges2 += m;
+    ASSERT_GE(m, 3u) << "face " << p;
+    ASSERT_LE(m, V.size());
+    double N[3] = {0, 0, 0}, c[3] = {0, 0, 0};
+    for (std::size_t k = 0; k < m; ++k) {
+      const std::uint32_t a = loop[k], b = loop[(k + 1) % m];
+      ASSERT_LT(a, V.size());
+      ++faces_per_vertex[a];
+      const auto& va = V[a];
+      EXPECT_TRUE(va.p[0] == p || va.p[1] == p || va.p[2] == p) << "loop vertex " << a << " not on face " << p;
+      // Consecutive loop vertices share an edge: plane p and one more.
+      int shared = 0;
+      for (int x = 0; x < 3; ++x)
+        for (int y = 0; y < 3; ++y) shared += va.p[x] == V[b].p[y];
+      EXPECT_EQ(shared, 2) << "loop step " << a << " -> " << b << " is not an edge";
+      EXPECT_TRUE(directed.insert({a, b}).second) << "directed edge " << a << " -> " << b << " twice";
+      const double* ya = va.y;
+      const double* yb = V[b].y;
+      N[0] += (ya[1] - yb[1]) * (ya[2] + yb[2]);
+      N[1] += (ya[2] - yb[2]) * (ya[0] + yb[0]);
+      N[2] += (ya[0] - yb[0]) * (ya[1] + yb[1]);
+      for (int d = 0; d < 3; ++d) c[d] += ya[d] / static_cast<double>(m);
+    }
+    // Newell normal (twice the vector area) points away from the generator.
+    // Faces of zero area (degenerate vertices) are allowed: N = 0 then.
+    const double area2 = std::sqrt(dot3(N, N));
+    const double nn = std::sqrt(dot3(P[p].n, P[p].n));
+    EXPECT_GE(dot3(N, P[p].n), 0.999 * area2 * nn - 1e-12 * scale * scale * nn) << "face " << p << " turns inward";
+    EXPECT_GE(dot3(N, c), -1e-12 * scale * scale * scale) << "face " << p << " faces the generator";
+    volume += dot3(N, c) / 6.0;
+  });
+  for (std::size_t t = 0; t < V.size(); ++t) EXPECT_EQ(faces_per_vertex[t], 3) << "vertex " << t;
+  for (const auto& e : directed) EXPECT_TRUE(directed.count({e.second, e.first})) << "edge without twin";
+  EXPECT_EQ(edges2 % 2, 0u);
+  EXPECT_EQ(static_cast<long>(V.size()) - static_cast<long>(edges2 / 2) + static_cast<long>(faces), 2) << "Euler";
+  EXPECT_EQ(edges2, 3 * V.size()) << "every vertex has degree 3";
+  return volume;
+}
+
+/// The vertex keys of a cell: sorted {generator, plane ids}.
+template <class CellT>
+std::set<std::vector<std::int32_t>> keys(const CellT& c) {
+  std::set<std::vector<std::int32_t>> out;
+  for (const auto& v : c.vertices()) {
+    std::vector<std::int32_t> k{c.generator()};
+    for (int d = 0; d < CellT::dim; ++d) k.push_back(c.planes()[v.p[d]].id);
+    std::sort(k.begin(), k.end());
+    out.insert(k);
+  }
+  return out;
+}
+
+/// Voronoi property: no generator is nearer to a cell vertex than its own.
+template <int D, class CellT>
+void check_voronoi(const Scene<D>& s, const CellT& c) {
+  const double* pi = s.p(c.generator());
+  const double tol = 1e-9 * s.scale() * s.scale();
+  for (const auto& v : c.vertices()) {
+    double own = 0;
+    for (int d = 0; d < D; ++d) own += v.y[d] * v.y[d];
+    for (std::int32_t j = 0; j < s.size(); ++j) {
+      double dj = 0;
+      for (int d = 0; d < D; ++d) {
+        double e = v.y[d] - (s.p(j)[d] - pi[d]);  // relative: no cancellation far from the origin
+        dj += e * e;
+      }
+      EXPECT_GE(dj, own - tol) << "generator " << j << " nearer to a vertex of cell " << c.generator();
+    }
+  }
+}
+
+TEST(Hull, ResetIsTheBox) {
+  Scene<3> s({0.3, 0.2, 0.9}, {-1, 0, 0.5}, {2, 0.5, 1});
+  Hull h;
+  s.reset(h, 0);
+  EXPECT_EQ(h.num_vertices(), 8u);
+  EXPECT_EQ(h.planes().size(), 6u);
+  EXPECT_NEAR(check_hull(h, "box"), 3 * 0.5 * 0.5, 1e-15);
+  // Vertices are the box corners relative to the generator.
+  for (const auto& v : h.vertices())
+    for (int d = 0; d < 3; ++d) EXPECT_TRUE(v.y[d] == s.lo[d] - s.p(0)[d] || v.y[d] == s.hi[d] - s.p(0)[d]);
+  std::set<std::int32_t> ids;
+  for (const auto& pl : h.planes()) ids.insert(pl.id);
+  EXPECT_EQ(ids, (std::set<std::int32_t>{-6, -5, -4, -3, -2, -1}));
+}
+
+// A bisector through the box centre halves the volume (central symmetry),
+// whatever its direction; the generator's side is the one kept.
+TEST(Hull, ClipThroughTheMiddleHalves) {
+  std::mt19937_64 g(3);
+  std::normal_distribution<double> nd;
+  for (int t = 0; t < 50; ++t) {
+    double dir[3] = {nd(g), nd(g), nd(g)};
+    if (t == 0) { dir[0] = 1; dir[1] = dir[2] = 0; }  // axis-aligned: plane x = 0.5
+    const double r = 0.1 / std::sqrt(dot3(dir, dir));
+    std::vector<double> p{0.5 - r * dir[0], 0.5 - r * dir[1], 0.5 - r * dir[2],
+                          0.5 + r * dir[0], 0.5 + r * dir[1], 0.5 + r * dir[2]};
+    Scene<3> s(p, {0, 0, 0}, {1, 1, 1});
+    Hull h;
+    s.reset(h, 0);
+    ASSERT_EQ(s.clip(h, 1), ClipResult::clipped);
+    EXPECT_NEAR(check_hull(h, "half"), 0.5, 1e-9);  // the midpoint is rounded, so not exact
+    // The kept vertices are on the generator's side of the bisector.
+    for (const auto& v : h.vertices()) {
+      double y[3] = {v.y[0] - r * dir[0], v.y[1] - r * dir[1], v.y[2] - r * dir[2]};  // relative to the centre
+      EXPECT_LE(dot3(y, dir), 1e-12);
+    }
+    Hull o;  // and the other generator gets the other half
+    s.reset(o, 1);
+    ASSERT_EQ(s.clip(o, 0), ClipResult::clipped);
+    EXPECT_NEAR(check_hull(o, "other half"), 0.5, 1e-9);
+  }
+}
+
+// A candidate beyond the security radius leaves the cell unchanged; so does
+// one whose bisector misses the cell; a duplicate empties the higher id.
+TEST(Hull, FarAndDuplicateCandidates) {
+  auto pts = random_points<3>(30, 4);
+  pts.insert(pts.end(), {50, 50, 50, -40, 0.5, 0.5});  // ids 30, 31: far outside the box
+  pts.insert(pts.end(), pts.begin(), pts.begin() + 3);  // id 32: duplicate of 0
+  Scene<3> s(pts, {0, 0, 0}, {1, 1, 1});
+  Hull h;
+  s.reset(h, 5);
+  for (std::int32_t j = 0; j < 30; ++j)
+    if (j != 5) s.clip(h, j);
+  const auto before = keys(h);
+  const double vol = check_hull(h, "cell 5");
+  EXPECT_EQ(s.clip(h, 30), ClipResult::unchanged);
+  EXPECT_EQ(s.clip(h, 31), ClipResult::unchanged);
+  EXPECT_EQ(keys(h), before);
+  EXPECT_DOUBLE_EQ(check_hull(h, "cell 5 after far clips"), vol);
+  // Everything beyond 2R, in all directions.
+  std::mt19937_64 g(5);
+  std::normal_distribution<double> nd;
+  for (int t = 0; t < 200; ++t) {
+    double q[3] = {nd(g), nd(g), nd(g)};
+    const double f = std::sqrt(h.security_radius2() / dot3(q, q)) * 1.0001;
+    for (double& x : q) x *= f;
+    EXPECT_EQ(h.clip(7, q), ClipResult::unchanged);
+  }
+  // Duplicates: p_32 == p_0. The lower id keeps the cell.
+  Hull a, b;
+  s.reset(a, 0);
+  EXPECT_EQ(s.clip(a, 32), ClipResult::unchanged);
+  s.reset(b, 32);
+  EXPECT_EQ(s.clip(b, 0), ClipResult::emptied);
+  EXPECT_EQ(b.num_vertices(), 0u);
+}
+
+double check_tile_volume(Tile& t, const std::string& what);  // below, with the 2D tests
+
+/// Build every cell of the scene by clipping with every other point in a
+/// random order; checks each cell and returns the cells' vertex keys.
+template <class CellT, int D>
+std::vector<std::set<std::vector<std::int32_t>>> brute_force(const Scene<D>& s, std::uint64_t seed, double& total,
+                                                            std::uint64_t& exact_calls, bool check_each_step) {
+  std::mt19937_64 g(seed);
+  std::vector<std::set<std::vector<std::int32_t>>> out;
+  total = 0;
+  exact_calls = 0;
+  CellT c;
+  for (std::int32_t i = 0; i < s.size(); ++i) {
+    std::vector<std::int32_t> order(static_cast<std::size_t>(s.size()));
+    std::iota(order.begin(), order.end(), 0);
+    std::shuffle(order.begin(), order.end(), g);
+    s.reset(c, i);
+    for (std::int32_t j : order) {
+      if (j == i) continue;
+      const auto r = s.clip(c, j);
+      EXPECT_NE(r, ClipResult::emptied);
+      if (check_each_step && r == ClipResult::clipped) {
+        if constexpr (D == 3) check_hull(c, "cell " + std::to_string(i) + " after clip " + std::to_string(j));
+      }
+    }
+    exact_calls += c.exact_calls();
+    if constexpr (D == 3) total += check_hull(c, "cell " + std::to_string(i));
+    else total += check_tile_volume(c, "cell " + std::to_string(i));
+    check_voronoi(s, c);
+    out.push_back(keys(c));
+  }
+  return out;
+}
+
+/// Conformity: every vertex key appears in exactly the cells of its generators.
+void check_conforming(const std::vector<std::set<std::vector<std::int32_t>>>& cells) {
+  std::map<std::vector<std::int32_t>, std::vector<std::int32_t>> owners;
+  for (std::size_t i = 0; i < cells.size(); ++i)
+    for (const auto& k : cells[i]) owners[k].push_back(static_cast<std::int32_t>(i));
+  for (const auto& [k, who] : owners) {
+    std::vector<std::int32_t> gens;
+    for (std::int32_t id : k)
+      if (id >= 0) gens.push_back(id);
+    EXPECT_EQ(who, gens) << "a vertex is not shared by exactly its generators";
+  }
+}
+
+template <class CellT, int D>
+void tessellation_test(const Scene<D>& s, const std::string& what, bool expect_exact) {
+  SCOPED_TRACE(what);
+  double total = 0, total2 = 0;
+  std::uint64_t exact = 0, exact2 = 0;
+  const auto a = brute_force<CellT>(s, 1, total, exact, false);
+  EXPECT_NEAR(total, s.box_volume(), 1e-12 * s.box_volume());
+  check_conforming(a);
+  // Another clip order: the same cells (the perturbed diagram is unique).
+  const auto b = brute_force<CellT>(s, 2, total2, exact2, true);
+  EXPECT_EQ(a, b);
+  if (expect_exact) {
+    EXPECT_GT(exact + exact2, 0u) << "degenerate input should reach the exact predicate";
+  }
+}
+
+TEST(Hull, RandomTessellation) {
+  Scene<3> s(random_points<3>(60, 6), {0, 0, 0}, {1, 1, 1});
+  tessellation_test<Hull>(s, "random 60", false);
+  Scene<3> far(random_points<3>(40, 7, 1e6, 1e6 + 1e-3), {1e6, 1e6, 1e6}, {1e6 + 1e-3, 1e6 + 1e-3, 1e6 + 1e-3});
+  tessellation_test<Hull>(far, "random 40, off the origin", false);
+}
+
+TEST(Hull, LatticeTessellation) {
+  // Every vertex is shared by 8 cells; the perturbation makes them simple.
+  Scene<3> s(lattice<3>(3), {0, 0, 0}, {3, 3, 3});
+  tessellation_test<Hull>(s, "3x3x3 lattice", true);
+  Hull h;
+  s.reset(h, 13);  // the centre: a unit cube
+  for (std::int32_t j = 0; j < s.size(); ++j)
+    if (j != 13) s.clip(h, j);
+  EXPECT_NEAR(check_hull(h, "centre"), 1.0, 1e-15);
+  for (const auto& v : h.vertices())
+    for (int d = 0; d < 3; ++d) EXPECT_EQ(std::fabs(v.y[d]), 0.5);
+  // Rounded (spacing 0.1) and one-ulp-jittered lattices: near ties the float
+  // filter must hand to the exact predicate, else neighbours disagree.
+  Scene<3> r(lattice<3>(3, 0.1), {0, 0, 0}, {0.30000000000000004, 0.30000000000000004, 0.30000000000000004});
+  tessellation_test<Hull>(r, "3x3x3 lattice, spacing 0.1", true);
+  Scene<3> j(lattice<3>(3, 1, 1, 17), {0, 0, 0}, {3, 3, 3});
+  tessellation_test<Hull>(j, "3x3x3 lattice, 1 ulp jitter", true);
+}
+
+// Many random clips of one cell, invariants after each.
+TEST(Hull, ManyRandomClips) {
+  Scene<3> s(random_points<3>(400, 8, -1, 2), {-1, -1, -1}, {2, 2, 2});
+  std::mt19937_64 g(9);
+  for (std::int32_t i : {0, 17, 399}) {
+    Hull h;
+    s.reset(h, i);
+    std::vector<std::int32_t> order(400);
+    std::iota(order.begin(), order.end(), 0);
+    std::shuffle(order.begin(), order.end(), g);
+    int clipped = 0;
+    for (std::int32_t j : order) {
+      if (j == i) continue;
+      if (s.clip(h, j) == ClipResult::clipped) {
+        ++clipped;
+        check_hull(h, "cell " + std::to_string(i));
+      }
+    }
+    EXPECT_GT(clipped, 5);
+    check_voronoi(s, h);
+  }
+}
+
+// ------------------------------------------------------------------ 2D checks
+
+/// Structural invariants of a tile; returns its area (shoelace).
+double check_tile_volume(Tile& t, const std::string& what) {
+  SCOPED_TRACE(what);
+  const auto& V = t.vertices();
+  const auto& P = t.planes();
+  const std::size_t m = V.size();
+  EXPECT_GE(m, 3u);
+  double scale = 0;
+  for (const auto& v : V) scale = std::max({scale, std::fabs(v.y[0]), std::fabs(v.y[1])});
+  const double tol = 1e-9 * scale;
+  double area2 = 0;
+  std::set<std::uint16_t> edge_planes;
+  for (std::size_t k = 0; k < m; ++k) {
+    const auto& a = V[k];
+    const auto& b = V[(k + 1) % m];
+    EXPECT_NE(a.p[0], a.p[1]) << "vertex " << k << " repeats a plane";
+    EXPECT_NE(P[a.p[0]].id, P[a.p[1]].id);
+    // Edge k lies on plane a.p[1] = b.p[0]: a closed chain.
+    EXPECT_EQ(a.p[1], b.p[0]) << "chain broken after vertex " << k;
+    EXPECT_TRUE(edge_planes.insert(a.p[1]).second) << "plane " << a.p[1] << " used by two edges";
+    for (int q = 0; q < 2; ++q) {
+      const auto& pl = P[a.p[q]];
+      EXPECT_NEAR(pl.n[0] * a.y[0] + pl.n[1] * a.y[1], pl.d, tol * pl.n1 + 1e-12 * std::fabs(pl.d));
+    }
+    for (const auto& pl : P) EXPECT_LE(pl.n[0] * a.y[0] + pl.n[1] * a.y[1], pl.d + tol * pl.n1 + 1e-12 * std::fabs(pl.d));
+    EXPECT_LE(4 * a.r2, t.security_radius2());
+    // Counter-clockwise: the edge turns left (or goes straight at a degenerate vertex).
+    const auto& c = V[(k + 2) % m];
+    const double turn = (b.y[0] - a.y[0]) * (c.y[1] - b.y[1]) - (b.y[1] - a.y[1]) * (c.y[0] - b.y[0]);
+    EXPECT_GE(turn, -1e-12 * scale * scale) << "clockwise turn at vertex " << (k + 1) % m;
+    // The outward edge normal agrees with the plane normal.
+    const double en[2] = {b.y[1] - a.y[1], a.y[0] - b.y[0]};
+    const auto& pl = P[a.p[1]];
+    EXPECT_GE(en[0] * pl.n[0] + en[1] * pl.n[1], -1e-12 * scale * pl.n1);
+    area2 += a.y[0] * b.y[1] - a.y[1] * b.y[0];
+  }
+  EXPECT_GT(area2, 0) << "not counter-clockwise";
+  return area2 / 2;
+}
+
+TEST(Tile, ResetIsTheBox) {
+  Scene<2> s({0.3, 0.2}, {-1, 0}, {2, 0.5});
+  Tile t;
+  s.reset(t, 0);
+  EXPECT_EQ(t.num_vertices(), 4u);
+  EXPECT_EQ(t.planes().size(), 4u);
+  EXPECT_NEAR(check_tile_volume(t, "box"), 1.5, 1e-15);
+}
+
+TEST(Tile, ClipThroughTheMiddleHalves) {
+  std::mt19937_64 g(13);
+  std::normal_distribution<double> nd;
+  for (int k = 0; k < 50; ++k) {
+    double dir[2] = {nd(g), nd(g)};
+    if (k == 0) { dir[0] = 0; dir[1] = 1; }
+    const double r = 0.1 / std::hypot(dir[0], dir[1]);
+    Scene<2> s({0.5 - r * dir[0], 0.5 - r * dir[1], 0.5 + r * dir[0], 0.5 + r * dir[1]}, {0, 0}, {1, 1});
+    Tile t;
+    s.reset(t, 0);
+    ASSERT_EQ(s.clip(t, 1), ClipResult::clipped);
+    EXPECT_NEAR(check_tile_volume(t, "half"), 0.5, 1e-9);
+  }
+}
+
+TEST(Tile, FarAndDuplicateCandidates) {
+  auto pts = random_points<2>(30, 14);
+  pts.insert(pts.end(), {40, 40, -30, 0.5, pts[0], pts[1]});  // 30, 31 far; 32 == 0
+  Scene<2> s(pts, {0, 0}, {1, 1});
+  Tile t;
+  s.reset(t, 5);
+  for (std::int32_t j = 0; j < 30; ++j)
+    if (j != 5) s.clip(t, j);
+  const auto before = keys(t);
+  EXPECT_EQ(s.clip(t, 30), ClipResult::unchanged);
+  EXPECT_EQ(s.clip(t, 31), ClipResult::unchanged);
+  std::mt19937_64 g(15);
+  std::normal_distribution<double> nd;
+  for (int k = 0; k < 200; ++k) {
+    double q[2] = {nd(g), nd(g)};
+    const double f = std::sqrt(t.security_radius2() / (q[0] * q[0] + q[1] * q[1])) * 1.0001;
+    q[0] *= f;
+    q[1] *= f;
+    EXPECT_EQ(t.clip(7, q), ClipResult::unchanged);
+  }
+  EXPECT_EQ(keys(t), before);
+  Tile a, b;
+  s.reset(a, 0);
+  EXPECT_EQ(s.clip(a, 32), ClipResult::unchanged);
+  s.reset(b, 32);
+  EXPECT_EQ(s.clip(b, 0), ClipResult::emptied);
+}
+
+TEST(Tile, RandomTessellation) {
+  Scene<2> s(random_points<2>(150, 16), {0, 0}, {1, 1});
+  tessellation_test<Tile>(s, "random 150", false);
+}
+
+TEST(Tile, LatticeTessellation) {
+  Scene<2> s(lattice<2>(5), {0, 0}, {5, 5});
+  tessellation_test<Tile>(s, "5x5 lattice", true);
+  Scene<2> r(lattice<2>(5, 0.1), {0, 0}, {0.5, 0.5});
+  tessellation_test<Tile>(r, "5x5 lattice, spacing 0.1", true);
+  Scene<2> j(lattice<2>(5, 1, 1, 18), {0, 0}, {5, 5});
+  tessellation_test<Tile>(j, "5x5 lattice, 1 ulp jitter", true);
+  // Co-circular and duplicate points on top of a lattice.
+  auto p = lattice<2>(4);
+  p.insert(p.end(), {2, 2, 0.5, 0.5, 1.5, 2.5});  // lattice corner, and two duplicates of lattice points
+  Scene<2> t(p, {0, 0}, {4, 4});
+  SCOPED_TRACE("with duplicates");
+  // Duplicates empty the higher id: check the others only.
+  Tile c;
+  double total = 0;
+  for (std::int32_t i = 0; i < t.size(); ++i) {
+    t.reset(c, i);
+    bool emptied = false;
+    for (std::int32_t j = 0; j < t.size() && !emptied; ++j)
+      if (j != i) emptied = t.clip(c, j) == ClipResult::emptied;
+    EXPECT_EQ(emptied, i >= 17) << "cell " << i;
+    if (!emptied) total += check_tile_volume(c, "cell " + std::to_string(i));
+  }
+  EXPECT_NEAR(total, 16.0, 1e-12);
+}
+
+}  // namespace

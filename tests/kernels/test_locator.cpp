@@ -1,0 +1,297 @@
+// BinLocator<2>/<3> by brute force: the slot order is a stable counting sort
+// by bin; the shells around a bin partition the grid; the distance bounds the
+// cell builder prunes with (bin_distance2, shell_lower_bound) never exceed a
+// true distance. Inputs include points on the box faces and on (and one ulp
+// either side of) interior bin boundaries, where rounding of the bin index
+// and of the bin's box could disagree.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <random>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "tessera/kernels/locator.hpp"
+
+namespace {
+
+using tessera::kernels::BinLocator;
+
+template <int D>
+struct Case {
+  std::string name;
+  std::vector<double> coords;
+  std::vector<std::uint8_t> use;  // empty: all
+  std::array<double, D> lo, hi;
+  double ppb;
+};
+
+/// Random points in [lo, hi], a share of them snapped to a regular lattice
+/// of the box (lo + k * extent / m, as the locator computes bin faces) or
+/// one ulp either side of it, and a few on the box faces and corners.
+template <int D>
+std::vector<double> tricky_points(std::size_t n, const std::array<double, D>& lo, const std::array<double, D>& hi,
+                                  int m, std::mt19937_64& g) {
+  std::uniform_real_distribution<double> u(0, 1);
+  std::uniform_int_distribution<int> k(0, m), mode(0, 5);
+  std::vector<double> p(n * D);
+  for (std::size_t i = 0; i < n; ++i)
+    for (int d = 0; d < D; ++d) {
+      const double ext = hi[d] - lo[d];
+      double x;
+      switch (mode(g)) {
+        case 0: x = lo[d] + k(g) * (ext / m); break;
+        case 1: x = std::nextafter(lo[d] + k(g) * (ext / m), -INFINITY); break;
+        case 2: x = std::nextafter(lo[d] + k(g) * (ext / m), INFINITY); break;
+        case 3: x = (g() & 1) ? lo[d] : hi[d]; break;
+        default: x = lo[d] + u(g) * ext;
+      }
+      p[i * D + d] = std::clamp(x, lo[d], hi[d]);
+    }
+  return p;
+}
+
+template <int D>
+std::vector<Case<D>> cases() {
+  std::vector<Case<D>> out;
+  std::mt19937_64 g(D * 1000 + 7);
+  auto add = [&](std::string name, std::size_t n, std::array<double, D> lo, std::array<double, D> hi, double ppb,
+                 bool mask) {
+    Case<D> c{name, {}, {}, lo, hi, ppb};
+    // m = the locator's likely divisions (or a near miss) so lattice points
+    // fall on its bin faces.
+    for (int m : {3, 5, 7, 10}) {
+      auto p = tricky_points<D>(n / 4, lo, hi, m, g);
+      c.coords.insert(c.coords.end(), p.begin(), p.end());
+    }
+    if (mask) {
+      c.use.resize(c.coords.size() / D);
+      for (auto& b : c.use) b = (g() % 3) != 0;
+    }
+    out.push_back(std::move(c));
+  };
+  std::array<double, D> z{}, one{}, a{}, b{}, t0{}, t1{};
+  for (int d = 0; d < D; ++d) {
+    one[d] = 1;
+    a[d] = 0.1 * (d + 1);   // inexact box faces
+    b[d] = 0.7 + 0.3 * d;
+    t0[d] = d == 1 ? -0.02 : 100;  // thin and off the origin
+    t1[d] = d == 1 ? -0.01 : 103;
+  }
+  add("unit", 400, z, one, 2.0, false);
+  add("unit masked", 400, z, one, 2.0, true);
+  add("inexact box", 600, a, b, 3.0, false);
+  add("thin far box", 800, t0, t1, 1.0, true);
+  add("one bin", 40, z, one, 1000.0, false);
+  add("dense", 200, a, b, 0.1, false);
+  return out;
+}
+
+template <int D>
+std::array<int, D> bin_of(const BinLocator<D>& loc, std::size_t index) {
+  std::array<int, D> c{};
+  for (int d = 0; d < D; ++d) {
+    c[d] = static_cast<int>(index % static_cast<std::size_t>(loc.divisions()[d]));
+    index /= static_cast<std::size_t>(loc.divisions()[d]);
+  }
+  return c;
+}
+
+template <int D>
+double dist2(const double* x, const std::array<double, D>& y) {
+  double s = 0;
+  for (int d = 0; d < D; ++d) s += (x[d] - y[d]) * (x[d] - y[d]);
+  return s;
+}
+
+/// Rounding slack of the bin faces: a point is binned by floor((x - lo) /
+/// size) but bin_distance2 measures to lo + b * size, which can disagree by a
+/// few ulp of the box coordinates (see BinDistanceStrict).
+template <int D>
+double face_slack(const Case<D>& c) {
+  double m = 0;
+  for (int d = 0; d < D; ++d) m = std::max({m, std::fabs(c.lo[d]), std::fabs(c.hi[d])});
+  return 8 * std::numeric_limits<double>::epsilon() * m;
+}
+
+/// bd <= d2, or (with slack) sqrt(bd) <= sqrt(d2) + slack.
+bool within(double bd, double d2, double slack) {
+  if (slack == 0) return bd <= d2;
+  const double r = std::sqrt(d2) + slack;
+  return bd <= r * r;
+}
+
+template <int D>
+void check_sorting(const Case<D>& c) {
+  SCOPED_TRACE(c.name);
+  BinLocator<D> loc(c.coords, c.use, c.lo, c.hi, c.ppb);
+  const std::size_t n = c.coords.size() / D;
+  std::size_t used = 0;
+  for (std::size_t i = 0; i < n; ++i) used += c.use.empty() || c.use[i];
+  ASSERT_EQ(loc.size(), used);
+  std::size_t bins = 1;
+  for (int d = 0; d < D; ++d) {
+    ASSERT_GE(loc.divisions()[d], 1);
+    bins *= static_cast<std::size_t>(loc.divisions()[d]);
+  }
+  ASSERT_EQ(loc.num_bins(), bins);
+  const auto& off = loc.offsets();
+  ASSERT_EQ(off.size(), bins + 1);
+  EXPECT_EQ(off.front(), 0u);
+  EXPECT_EQ(off.back(), used);
+  std::vector<int> seen(n, 0);
+  for (std::size_t k = 0; k < bins; ++k) {
+    ASSERT_LE(off[k], off[k + 1]);
+    for (std::uint32_t s = off[k]; s < off[k + 1]; ++s) {
+      const std::int32_t id = loc.id(s);
+      ASSERT_GE(id, 0);
+      ASSERT_LT(static_cast<std::size_t>(id), n);
+      ++seen[static_cast<std::size_t>(id)];
+      const double* x = &c.coords[static_cast<std::size_t>(id) * D];
+      for (int d = 0; d < D; ++d) EXPECT_EQ(loc.point(s)[d], x[d]);  // bit-identical copy
+      const auto b = loc.bin_coords(x);
+      EXPECT_EQ(loc.bin_index(b), k) << "point " << id << " in the wrong bin's slots";
+      for (int d = 0; d < D; ++d) EXPECT_EQ(b[d], bin_of(loc, k)[d]);
+      if (s > off[k]) {
+        EXPECT_LT(loc.id(s - 1), id) << "not stable by id within bin " << k;
+      }
+    }
+  }
+  for (std::size_t i = 0; i < n; ++i)
+    EXPECT_EQ(seen[i], (c.use.empty() || c.use[i]) ? 1 : 0) << "point " << i;
+}
+
+template <int D>
+void check_shells(const Case<D>& c, std::uint64_t seed) {
+  SCOPED_TRACE(c.name);
+  BinLocator<D> loc(c.coords, c.use, c.lo, c.hi, c.ppb);
+  std::mt19937_64 g(seed);
+  std::uniform_real_distribution<double> u(0, 1);
+  // Queries: the input points themselves (tricky positions), and random points.
+  std::vector<std::array<double, D>> queries;
+  for (std::size_t i = 0; i < c.coords.size() / D; i += 7) {
+    std::array<double, D> x;
+    for (int d = 0; d < D; ++d) x[d] = c.coords[i * D + d];
+    queries.push_back(x);
+  }
+  for (int q = 0; q < 30; ++q) {
+    std::array<double, D> x;
+    for (int d = 0; d < D; ++d) x[d] = c.lo[d] + u(g) * (c.hi[d] - c.lo[d]);
+    queries.push_back(x);
+  }
+  const auto& off = loc.offsets();
+  int lb_checks = 0;
+  for (const auto& x : queries) {
+    const auto b = loc.bin_coords(x.data());
+    const int last = loc.max_shell(b);
+    std::vector<int> visits(loc.num_bins(), 0);
+    for (int s = 0; s <= last; ++s) {
+      const double lb = loc.shell_lower_bound(x.data(), b, s);
+      int in_shell = 0;
+      loc.for_each_shell_bin(b, s, [&](const std::array<std::int32_t, D>& cb, std::size_t bin) {
+        ++in_shell;
+        ASSERT_LT(bin, loc.num_bins());
+        EXPECT_EQ(loc.bin_index(cb), bin);
+        int cheb = 0;
+        for (int d = 0; d < D; ++d) {
+          ASSERT_GE(cb[d], 0);
+          ASSERT_LT(cb[d], loc.divisions()[d]);
+          cheb = std::max(cheb, std::abs(cb[d] - b[d]));
+        }
+        EXPECT_EQ(cheb, s) << "bin outside its shell";
+        ++visits[bin];
+        for (std::uint32_t k = off[bin]; k < off[bin + 1]; ++k) {
+          const double d2 = dist2<D>(x.data(), loc.point(k));
+          // The bounds the cell builder prunes with never exceed the truth.
+          EXPECT_PRED3(within, loc.bin_distance2(x.data(), cb), d2, face_slack(c))
+              << "bin_distance2 above a point's distance";
+          if (s >= 1) {
+            EXPECT_LE(lb, std::sqrt(d2)) << "shell " << s << " lower bound above a point's distance";
+            ++lb_checks;
+          }
+        }
+      });
+      EXPECT_GT(in_shell, 0) << "shell " << s << " <= max_shell is empty";
+    }
+    // Nothing beyond max_shell.
+    loc.for_each_shell_bin(b, last + 1, [&](const std::array<std::int32_t, D>&, std::size_t) {
+      ADD_FAILURE() << "a bin beyond max_shell";
+    });
+    for (std::size_t k = 0; k < visits.size(); ++k) ASSERT_EQ(visits[k], 1) << "bin " << k << " visited " << visits[k] << " times";
+  }
+  if (loc.num_bins() > 1) {
+    EXPECT_GT(lb_checks, 0);
+  }
+}
+
+// bin_distance2 on every bin for every query, not only through the shells
+// (up to `slack`, see face_slack).
+template <int D>
+void check_bin_distance(const Case<D>& c, double slack) {
+  SCOPED_TRACE(c.name);
+  BinLocator<D> loc(c.coords, c.use, c.lo, c.hi, c.ppb);
+  const auto& off = loc.offsets();
+  for (std::size_t i = 0; i < c.coords.size() / D; i += 5) {
+    const double* x = &c.coords[i * D];
+    if (!c.use.empty() && !c.use[i]) continue;
+    for (std::size_t bin = 0; bin < loc.num_bins(); ++bin) {
+      const auto bc = bin_of(loc, bin);
+      std::array<std::int32_t, D> cb;
+      for (int d = 0; d < D; ++d) cb[d] = bc[d];
+      const double bd = loc.bin_distance2(x, cb);
+      for (std::uint32_t k = off[bin]; k < off[bin + 1]; ++k)
+        ASSERT_PRED3(within, bd, dist2<D>(x, loc.point(k)), slack)
+            << "query point " << i << " bin " << bin << " slot " << k;
+    }
+  }
+}
+
+TEST(BinLocator, SortedStable2D) { for (const auto& c : cases<2>()) check_sorting(c); }
+TEST(BinLocator, SortedStable3D) { for (const auto& c : cases<3>()) check_sorting(c); }
+TEST(BinLocator, ShellsPartitionAndBound2D) {
+  std::uint64_t seed = 1;
+  for (const auto& c : cases<2>()) check_shells(c, seed++);
+}
+TEST(BinLocator, ShellsPartitionAndBound3D) {
+  std::uint64_t seed = 100;
+  for (const auto& c : cases<3>()) check_shells(c, seed++);
+}
+TEST(BinLocator, BinDistance2D) { for (const auto& c : cases<2>()) check_bin_distance(c, face_slack(c)); }
+TEST(BinLocator, BinDistance3D) { for (const auto& c : cases<3>()) check_bin_distance(c, face_slack(c)); }
+
+// KNOWN ISSUE (reported): without slack this fails by ~1 ulp for points on
+// bin faces, e.g. in the unit box with 3 divisions a point binned into bin 1
+// lies 1 ulp below lo + 1 * size, so bin_distance2 from the point to its own
+// bin is 1.2e-32 > 0. The cell builder prunes bins with bin_distance2 > sec2,
+// so a candidate within a few ulp of the security radius could be skipped.
+TEST(BinLocator, BinDistanceStrict) {
+  for (const auto& c : cases<2>()) check_bin_distance(c, 0);
+  for (const auto& c : cases<3>()) check_bin_distance(c, 0);
+}
+
+// The grid: near-cubic bins aiming at the requested occupancy, never more
+// than 1 + 4 n divisions on an axis (a thin box stays proportionate).
+TEST(BinLocator, GridShape) {
+  std::mt19937_64 g(5);
+  std::uniform_real_distribution<double> u(0, 1);
+  std::vector<double> p(3000 * 3);
+  for (auto& x : p) x = u(g);
+  BinLocator<3> loc(p, {}, {0, 0, 0}, {1, 1, 1}, 2.0);
+  const double mean = 3000.0 / static_cast<double>(loc.num_bins());
+  EXPECT_GT(mean, 1.0);
+  EXPECT_LT(mean, 4.0);
+  EXPECT_EQ(loc.divisions()[0], loc.divisions()[1]);
+  EXPECT_EQ(loc.divisions()[1], loc.divisions()[2]);
+  std::vector<double> q(10 * 2);
+  for (std::size_t i = 0; i < 10; ++i) { q[2 * i] = u(g); q[2 * i + 1] = 1e-9 * u(g); }
+  BinLocator<2> thin(q, {}, {0, 0}, {1, 1e-9}, 2.0);
+  EXPECT_LE(thin.divisions()[0], 41);
+  EXPECT_EQ(thin.divisions()[1], 1);
+}
+
+}  // namespace
