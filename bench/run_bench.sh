@@ -1,0 +1,193 @@
+#!/usr/bin/env bash
+# Tessera vs the Voronoi peers, in one run; writes docs/performance.md.
+#
+# usage: bench/run_bench.sh            (from anywhere; see bench/README.md)
+#
+#   1. builds the peers harness ($SHARED/peers) into bench/build-peers (voro_cells, cgal_delaunay2)
+#   2. generates the inputs into bench/data/ (fixed seed; existing files are reused)
+#   3. per input: `tessera bench voronoi` at each thread count, then the peers
+#      (3D: Voro++; 2D: CGAL Delaunay_triangulation_2 and scipy.spatial.Voronoi),
+#      each WARMUP untimed runs then REPS timed ones; JSON lines into $OUT/<input>.jsonl
+#   4. bench/report.py $OUT -> docs/performance.md (REPORT=0 skips it)
+#
+# env knobs (defaults in brackets):
+#   SIZES    size classes to run ["1e4 1e5 1e6", plus 1e7 with FULL=1]; lattice3 K=50 is class 1e5, K=100 is 1e6
+#   FULL     1: add the 1e7 class (uniform3 1e7) [0]
+#   REPS     timed runs per configuration [3]        WARMUP  untimed runs before them [1]
+#   THREADS  tessera thread counts ["1 2"]           MESH    1: also time tessera with --mesh [0]
+#   TESSERA  tessera binary [build/tessera, build-cli/tessera, else built in bench/build-tessera];
+#            "none": peers only
+#   SHARED   folder holding peers/ [the repository's parent folder's shared/]
+#   INPUTS   replace the input list, e.g. "uniform3:2e5 lattice3:30 jlattice3:20:1e-9" (KIND:ARG[:ARG], gen_points.py)
+#   OUT      results folder [bench/results/raw/<date-time>]
+#   DOC      report file [docs/performance.md]     REPORT  0: do not write it [1]
+#   JOBS     build parallelism [2]                 TIMEOUT seconds per run [900]
+set -euo pipefail
+
+bench=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
+repo=$(dirname "$bench")
+py=/usr/bin/python3   # Debian's, with numpy/scipy (not a pyenv python3)
+
+# The exact command, with the knobs that were set, for the report.
+quote() {
+  if [[ $1 =~ ^[A-Za-z0-9_./:=+-]+$ ]]; then printf '%s' "$1"
+  elif [[ $1 != *"'"* ]]; then printf "'%s'" "$1"
+  else printf '%q' "$1"; fi
+}
+cmd=""
+for v in FULL SIZES REPS WARMUP THREADS MESH INPUTS TESSERA SHARED OUT DOC; do
+  [[ -n ${!v+x} ]] && cmd+="$v=$(quote "${!v}") "
+done
+cmd+="bench/run_bench.sh"
+
+shared=${SHARED:-$(dirname "$repo")/shared}
+peers=$shared/peers
+full=${FULL:-0}
+default_sizes="1e4 1e5 1e6"; [[ $full == 1 ]] && default_sizes+=" 1e7"
+sizes=${SIZES:-$default_sizes}
+reps=${REPS:-3}
+warmup=${WARMUP:-1}
+threads=${THREADS:-"1 2"}
+jobs=${JOBS:-2}
+timeout=${TIMEOUT:-900}
+out=${OUT:-$bench/results/raw/$(date +%Y%m%d-%H%M%S)}
+doc=${DOC:-$repo/docs/performance.md}
+
+note() { echo "run_bench: $*" >&2; }
+die() { note "error: $*"; exit 1; }
+[[ -f $peers/run_peers.sh && -f $peers/gen_points.py ]] || die "no peers harness in $peers (set SHARED=/path/to/shared)"
+$py -c 'import numpy, scipy' 2>/dev/null || die "$py lacks numpy/scipy (apt-get install python3-numpy python3-scipy)"
+
+# ---- 1. peers -------------------------------------------------------------------------------
+peer_build=$bench/build-peers
+peer_log=$peer_build/run_bench.log
+mkdir -p "$peer_build"
+note "building peer drivers in $peer_build"
+cmake -S "$peers" -B "$peer_build" -DCMAKE_BUILD_TYPE=Release >"$peer_log" 2>&1 \
+  || die "configuring the peers failed, see $peer_log"
+for t in voro_cells cgal_delaunay2; do
+  # A target CMake dropped (library missing) is skipped by run_peers.sh with a note.
+  if grep -q "^$t:" "$peer_build/Makefile" 2>/dev/null || grep -q "build $t:" "$peer_build/build.ninja" 2>/dev/null; then
+    cmake --build "$peer_build" -j"$jobs" --target "$t" >>"$peer_log" 2>&1 || die "building $t failed, see $peer_log"
+  else
+    note "warning: $t not configured (library missing?), see $peer_log"
+  fi
+done
+
+# ---- tessera ----------------------------------------------------------------------------------
+if [[ -z ${TESSERA:-} ]]; then
+  for c in "$repo/build/tessera" "$repo/build-cli/tessera"; do
+    [[ -x $c ]] && { TESSERA=$c; break; }
+  done
+fi
+if [[ -z ${TESSERA:-} ]]; then
+  tb=$bench/build-tessera
+  note "no tessera binary found: building a Release one in $tb"
+  mkdir -p "$tb"
+  cmake -S "$repo" -B "$tb" -DCMAKE_BUILD_TYPE=Release \
+        -DTESSERA_BUILD_TESTS=OFF -DTESSERA_BUILD_BENCH=OFF >"$tb/run_bench.log" 2>&1 \
+    && cmake --build "$tb" -j"$jobs" --target tessera_cli >>"$tb/run_bench.log" 2>&1 \
+    || die "building tessera failed, see $tb/run_bench.log"
+  TESSERA=$tb/tessera
+fi
+build_type=
+if [[ $TESSERA == none ]]; then
+  note "TESSERA=none: peers only"
+else
+  [[ -x $TESSERA ]] || die "TESSERA=$TESSERA is not an executable"
+  "$TESSERA" bench voronoi --help >/dev/null 2>&1 || die "$TESSERA has no 'bench voronoi' subcommand"
+  build_type=$(sed -n 's/^CMAKE_BUILD_TYPE:STRING=//p' "$(dirname "$TESSERA")/CMakeCache.txt" 2>/dev/null || true)
+  [[ -z $build_type || $build_type == Release ]] || note "warning: $TESSERA is a '$build_type' build, not Release"
+fi
+
+# ---- 2. inputs ----------------------------------------------------------------------------------
+# name kind arg size-class
+default_inputs="
+uniform3_1e4 uniform3 1e4 1e4
+uniform3_1e5 uniform3 1e5 1e5
+uniform3_1e6 uniform3 1e6 1e6
+uniform3_1e7 uniform3 1e7 1e7
+clustered3_1e5 clustered3 1e5 1e5
+clustered3_1e6 clustered3 1e6 1e6
+lattice3_K50 lattice3 50 1e5
+lattice3_K100 lattice3 100 1e6
+uniform2_1e6 uniform2 1e6 1e6"
+inputs=()
+if [[ -n ${INPUTS:-} ]]; then
+  for s in $INPUTS; do
+    [[ $s == *:* ]] || die "INPUTS entries are KIND:ARG[:ARG], got '$s'"
+    inputs+=("${s//:/_} ${s%%:*} ${s#*:} any")
+  done
+else
+  while read -r name kind arg class; do
+    [[ -n $name && " $sizes " == *" $class "* ]] && inputs+=("$name $kind $arg $class")
+  done <<<"$default_inputs"
+fi
+((${#inputs[@]})) || die "no inputs selected (SIZES='$sizes')"
+
+mkdir -p "$bench/data" "$out"
+for e in "${inputs[@]}"; do
+  read -r name kind arg _ <<<"$e"
+  f=$bench/data/$name.npy
+  # shellcheck disable=SC2086  # ARG:ARG -> separate arguments
+  [[ -s $f ]] || $py "$peers/gen_points.py" "$kind" ${arg//:/ } "$f" || die "generating $f failed"
+done
+
+$py "$bench/report.py" --write-meta "$out" --command "$cmd" --tessera "$TESSERA" \
+    --build-type "${build_type:-unknown}" --reps "$reps" --warmup "$warmup" --threads "$threads" \
+    --peers "$peers" --inputs "$(for e in "${inputs[@]}"; do echo "${e%% *}"; done)"
+
+# Time one binary throughout, even if the build folder is rebuilt during the sweep.
+if [[ $TESSERA != none ]]; then
+  cp -p "$TESSERA" "$out/tessera"
+  bin=$out/tessera
+fi
+
+# ---- 3. runs --------------------------------------------------------------------------------------
+# repeat CMD...: WARMUP untimed runs (output dropped), then REPS timed runs, stdout -> JSON lines.
+repeat() {
+  local i rc
+  for ((i = 0; i < warmup + reps; i++)); do
+    if ((i < warmup)); then timeout "$timeout" "$@" >/dev/null; else timeout "$timeout" "$bench/maxrss.py" "$@"; fi
+    rc=$?
+    ((rc == 0)) || { note "FAILED (rc=$rc): $*"; return 0; }
+  done
+}
+
+for e in "${inputs[@]}"; do
+  read -r name _ _ _ <<<"$e"
+  f=$bench/data/$name.npy
+  dim=$($py -c 'import sys, numpy; print(numpy.load(sys.argv[1], mmap_mode="r").shape[1])' "$f")
+  jl=$out/$name.jsonl
+  : >"$jl"
+  note "$name ($(cut -d' ' -f1-3 /proc/loadavg) load)"
+  [[ $TESSERA == none ]] || for mesh in "" $([[ ${MESH:-0} == 1 ]] && echo --mesh); do
+    for t in $threads; do
+      # WARMUP untimed processes, then one process timing REPS repeats (--repeat).
+      args=(bench voronoi "$f" --dim "$dim" --threads "$t" $mesh)
+      (
+        set +e
+        for ((i = 0; i < warmup; i++)); do timeout "$timeout" "$bin" "${args[@]}" --repeat 1 >/dev/null; done
+        timeout "$timeout" "$bin" "${args[@]}" --repeat "$reps"
+        rc=$?; ((rc == 0)) || note "FAILED (rc=$rc): tessera ${args[*]}"
+      ) | grep '^{' >>"$jl" || true
+    done
+  done
+  if [[ $dim == 3 ]]; then
+    BUILD=$peer_build ONLY=voro WARMUP=$warmup TIMEOUT=$timeout \
+      $py "$bench/maxrss.py" "$peers/run_peers.sh" "$f" 3 "$reps" | grep '^{' >>"$jl" || true
+  else
+    BUILD=$peer_build ONLY=cgal WARMUP=$warmup TIMEOUT=$timeout \
+      $py "$bench/maxrss.py" "$peers/run_peers.sh" "$f" 2 "$reps" | grep '^{' >>"$jl" || true
+    (set +e; repeat $py "$peers/scipy_bench.py" "$f" --op voronoi) | grep '^{' >>"$jl" || true
+  fi
+done
+
+# ---- 4. report --------------------------------------------------------------------------------------
+$py "$bench/report.py" --finish-meta "$out"
+if [[ ${REPORT:-1} == 1 ]]; then
+  $py "$bench/report.py" "$out" -o "$doc"
+  note "wrote $doc from $out"
+else
+  $py "$bench/report.py" "$out"
+fi
