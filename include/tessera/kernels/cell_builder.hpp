@@ -50,14 +50,15 @@ class CellBuilder {
     BuildStatus status;
     for (int s = 0; s <= last; ++s) {
       double sec2 = cell.security_radius2();
-      if (s > 0) {
+      if (s > 1) {
         double lb = loc_.shell_lower_bound(p, b, s);
         if (lb * lb > sec2) break;
       }
       cand_.clear();
       keys_.clear();
-      loc_.for_each_shell_bin(b, s, [&](const std::array<std::int32_t, D>& c, std::size_t bin) {
-        if (s > 0 && loc_.bin_distance2(p, c) > sec2) return;
+      auto gather = [&](const std::array<std::int32_t, D>& c, std::size_t bin) {
+        // The bins next to the generator's are always near: test only beyond.
+        if (s > 1 && loc_.bin_distance2(p, c) > sec2) return;
         for (std::uint32_t k = off[bin]; k < off[bin + 1]; ++k) {
           std::int32_t j = loc_.id(k);
           if (j == i) continue;
@@ -77,7 +78,14 @@ class CellBuilder {
                           static_cast<std::uint32_t>(cand_.size()));
           cand_.push_back(cd);
         }
-      });
+      };
+      // The generator's own bin and the shell around it are gathered and
+      // sorted together (own bin first, so coincident points keep id order).
+      loc_.for_each_shell_bin(b, s, gather);
+      if (s == 0 && last >= 1) {
+        s = 1;
+        loc_.for_each_shell_bin(b, s, gather);
+      }
       std::sort(keys_.begin(), keys_.end());
       for (std::uint64_t key : keys_) {
         const Candidate& cd = cand_[static_cast<std::uint32_t>(key)];
