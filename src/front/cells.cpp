@@ -82,10 +82,17 @@ Bounds make_domain(std::span<const double> pts, int dim, std::size_t n, const Vo
     }
     ext = std::max(ext, e);
   }
+  // Pad, then round outward to a multiple of a power of two near ext/64: the
+  // box constants become short binary fractions (integer grids get the
+  // half-integer box), so exact predicates on box vertices stay in the fast
+  // 128-bit path. The margin is never smaller than asked.
+  int e;
+  std::frexp(ext, &e);
+  const double step = std::ldexp(1.0, e - 7);
   for (int d = 0; d < dim; ++d) {
     auto du = static_cast<std::size_t>(d);
-    b.lo[du] -= opt.padding * ext;
-    b.hi[du] += opt.padding * ext;
+    b.lo[du] = std::floor((b.lo[du] - opt.padding * ext) / step) * step;
+    b.hi[du] = std::ceil((b.hi[du] + opt.padding * ext) / step) * step;
   }
   return b;
 }

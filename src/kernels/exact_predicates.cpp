@@ -4,6 +4,7 @@
 #include <gmp.h>
 
 #include <algorithm>
+#include <bit>
 #include <climits>
 #include <cmath>
 #include <stdexcept>
@@ -40,11 +41,12 @@ struct Scratch {
   }
 };
 
-// Exponent of the least significant bit of x's 53-bit mantissa (x != 0).
+// Exponent of the lowest set bit of x (x != 0): x is an odd integer times 2^that.
 int lsb_exponent(double x) {
   int e;
-  std::frexp(x, &e);  // x = f * 2^e, 0.5 <= |f| < 1
-  return e - 53;
+  double f = std::frexp(x, &e);  // x = f * 2^e, 0.5 <= |f| < 1
+  auto m = static_cast<std::uint64_t>(std::fabs(std::ldexp(f, 53)));  // exact, < 2^53
+  return e - 53 + std::countr_zero(m);
 }
 
 // out = x * 2^(-shift), exactly an integer because shift <= lsb_exponent(x).
@@ -56,6 +58,7 @@ void set_scaled(mpz_t out, double x, int shift) {
   mpz_set_d(out, std::ldexp(f, 53));
   int s = e - 53 - shift;
   if (s > 0) mpz_mul_2exp(out, out, static_cast<mp_bitcnt_t>(s));
+  else if (s < 0) mpz_tdiv_q_2exp(out, out, static_cast<mp_bitcnt_t>(-s));  // exact: those bits are zero
 }
 
 // det of the k x k matrix formed by rows `rows` of a (k = 2 or 3).
@@ -129,38 +132,153 @@ int build_rows(const ExactContext& ctx, std::int32_t i, const std::int32_t* gen,
 
 }  // namespace
 
-int exact_clip_sign(const ExactContext& ctx, std::int32_t i, const std::int32_t* planes, std::int32_t j) {
+namespace {
+
+// What the decision needs from M = [[A, b], [a_j, b_j]]: the sign of det M0
+// (weights zero), of each minor of the rows x dim block without row r (the
+// last-column cofactor of row r is (-1)^(r+dim) * minor[r]; det A = minor[dim]),
+// and of w_i's coefficient (the sum of the bisector rows' cofactors).
+struct ClipSigns {
+  int det_m0 = 0;
+  int minor[Scratch::kRows] = {0, 0, 0, 0};
+  int weight_i = 0;
+};
+
+int cofactor_sign(int r, int dim) { return ((r + dim) & 1) == 0 ? 1 : -1; }
+
+// Exact signs in GMP integers: any input.
+void signs_gmp(const ExactContext& ctx, std::int32_t i, const std::int32_t* gen, ClipSigns& out) {
   thread_local Scratch s;
-  const int dim = ctx.dim;
-  const int rows = dim + 1;  // dim vertex planes + the query row
-
-  // Row r's generator (or box id); the query row is last.
-  std::int32_t gen[Scratch::kRows];
-  for (int r = 0; r < dim; ++r) gen[r] = planes[r];
-  gen[dim] = j;
+  const int dim = ctx.dim, rows = dim + 1;
   build_rows(ctx, i, gen, rows, s);
-
-  // Minors of the rows x dim block without row r; cofactor of (r, last) is
-  // (-1)^(r + dim) * minor[r].
   for (int r = 0; r < rows; ++r) {
     int sel[Scratch::kMaxDim] = {0, 0, 0};
     int k = 0;
     for (int q = 0; q < rows; ++q) if (q != r) sel[k++] = q;
     det_rows(s.minor[r], s.a, sel, dim, s);
+    out.minor[r] = mpz_sgn(s.minor[r]);
   }
-  // det A = minor[dim] (cofactor sign (+1)); it is never zero for a real vertex.
-  const int sign_det_a = mpz_sgn(s.minor[dim]);
-  if (sign_det_a == 0)
-    throw std::logic_error("exact_clip_sign: vertex planes are dependent (corrupt cell)");
-
-  // det M0 = sum_r b[r] * cofactor(r).
   mpz_set_ui(s.t2, 0);
   for (int r = 0; r < rows; ++r) {
-    if (((r + dim) & 1) == 0) mpz_addmul(s.t2, s.b[r], s.minor[r]);
+    if (cofactor_sign(r, dim) > 0) mpz_addmul(s.t2, s.b[r], s.minor[r]);
     else mpz_submul(s.t2, s.b[r], s.minor[r]);
   }
-  int sign_m = mpz_sgn(s.t2);
+  out.det_m0 = mpz_sgn(s.t2);
+  mpz_set_ui(s.t2, 0);
+  for (int r = 0; r < rows; ++r) {
+    if (gen[r] < 0) continue;
+    if (cofactor_sign(r, dim) > 0) mpz_add(s.t2, s.t2, s.minor[r]);
+    else mpz_sub(s.t2, s.t2, s.minor[r]);
+  }
+  out.weight_i = mpz_sgn(s.t2);
+}
 
+// The same in 128-bit integers when every scaled coordinate has at most 22
+// bits (lattices, voxel centres, integer and dyadic grids: where ties are
+// common). Bounds: |a| < 2^24, |b| < 2^46, 3x3 minors < 2^(3*24+3), det M0 <
+// 2^(46+75+2) < 2^127. Returns false when the input does not fit.
+bool signs_int128(const ExactContext& ctx, std::int32_t i, const std::int32_t* gen, ClipSigns& out) {
+  using I = __int128;
+  const int dim = ctx.dim, rows = dim + 1;
+  if (dim != 2 && dim != 3) return false;
+  constexpr int kBits = 22;
+  const double* pi = ctx.points + static_cast<std::size_t>(i) * dim;
+  // Gather the doubles: p_i, then per row either p_k or the box constant.
+  double v[Scratch::kRows + 1][Scratch::kMaxDim];
+  for (int d = 0; d < dim; ++d) v[rows][d] = pi[d];
+  for (int r = 0; r < rows; ++r) {
+    if (gen[r] >= 0) {
+      const double* pk = ctx.points + static_cast<std::size_t>(gen[r]) * dim;
+      for (int d = 0; d < dim; ++d) v[r][d] = pk[d];
+    } else {
+      int axis = box_plane_axis(gen[r]);
+      v[r][0] = box_plane_upper(gen[r]) ? ctx.hi[axis] : ctx.lo[axis];
+    }
+  }
+  int shift = INT_MAX, top = INT_MIN;
+  auto see = [&](double x) {
+    if (x == 0) return;
+    int e;
+    std::frexp(x, &e);
+    shift = std::min(shift, lsb_exponent(x));
+    top = std::max(top, e);
+  };
+  for (int d = 0; d < dim; ++d) see(v[rows][d]);
+  for (int r = 0; r < rows; ++r) {
+    if (gen[r] >= 0) for (int d = 0; d < dim; ++d) see(v[r][d]);
+    else see(v[r][0]);
+  }
+  if (shift == INT_MAX) shift = 0;
+  if (top != INT_MIN && top - shift > kBits) return false;
+  auto scaled = [&](double x) { return static_cast<std::int64_t>(std::ldexp(x, -shift)); };
+  std::int64_t ci[Scratch::kMaxDim];
+  I ci2 = 0;
+  for (int d = 0; d < dim; ++d) {
+    ci[d] = scaled(v[rows][d]);
+    ci2 += static_cast<I>(ci[d]) * ci[d];
+  }
+  std::int64_t a[Scratch::kRows][Scratch::kMaxDim];
+  I b[Scratch::kRows];
+  for (int r = 0; r < rows; ++r) {
+    if (gen[r] >= 0) {
+      I sq = 0;
+      for (int d = 0; d < dim; ++d) {
+        std::int64_t x = scaled(v[r][d]);
+        a[r][d] = 2 * (x - ci[d]);
+        sq += static_cast<I>(x) * x;
+      }
+      b[r] = sq - ci2;
+    } else {
+      int axis = box_plane_axis(gen[r]);
+      for (int d = 0; d < dim; ++d) a[r][d] = d == axis ? 1 : 0;
+      b[r] = scaled(v[r][0]);
+    }
+  }
+  I minor[Scratch::kRows];
+  for (int r = 0; r < rows; ++r) {
+    int sel[Scratch::kMaxDim] = {0, 0, 0};
+    int k = 0;
+    for (int q = 0; q < rows; ++q) if (q != r) sel[k++] = q;
+    if (dim == 2) {
+      minor[r] = static_cast<I>(a[sel[0]][0]) * a[sel[1]][1] - static_cast<I>(a[sel[0]][1]) * a[sel[1]][0];
+    } else {
+      const std::int64_t* r0 = a[sel[0]];
+      const std::int64_t* r1 = a[sel[1]];
+      const std::int64_t* r2 = a[sel[2]];
+      minor[r] = r0[0] * (static_cast<I>(r1[1]) * r2[2] - static_cast<I>(r1[2]) * r2[1]) +
+                 r0[1] * (static_cast<I>(r1[2]) * r2[0] - static_cast<I>(r1[0]) * r2[2]) +
+                 r0[2] * (static_cast<I>(r1[0]) * r2[1] - static_cast<I>(r1[1]) * r2[0]);
+    }
+    out.minor[r] = (minor[r] > 0) - (minor[r] < 0);
+  }
+  I m0 = 0, wi = 0;
+  for (int r = 0; r < rows; ++r) {
+    I cof = cofactor_sign(r, dim) * minor[r];
+    m0 += b[r] * cof;
+    if (gen[r] >= 0) wi += cof;
+  }
+  out.det_m0 = (m0 > 0) - (m0 < 0);
+  out.weight_i = (wi > 0) - (wi < 0);
+  return true;
+}
+
+}  // namespace
+
+int exact_clip_sign(const ExactContext& ctx, std::int32_t i, const std::int32_t* planes, std::int32_t j) {
+  const int dim = ctx.dim;
+  const int rows = dim + 1;  // dim vertex planes + the query row
+  // Row r's generator (or box id); the query row is last.
+  std::int32_t gen[Scratch::kRows];
+  for (int r = 0; r < dim; ++r) gen[r] = planes[r];
+  gen[dim] = j;
+  ClipSigns sg;
+  if (!signs_int128(ctx, i, gen, sg)) signs_gmp(ctx, i, gen, sg);
+
+  // det A = minor[dim]; it is never zero for a real vertex.
+  const int sign_det_a = sg.minor[dim];
+  if (sign_det_a == 0)
+    throw std::logic_error("exact_clip_sign: vertex planes are dependent (corrupt cell)");
+  int sign_m = sg.det_m0;
   if (sign_m == 0) {
     // Exact tie: the perturbation decides. det M(w) = det M0 + sum over
     // bisector rows r of (w_i - w_gen[r]) * cofactor(r). Coefficient of
@@ -175,19 +293,8 @@ int exact_clip_sign(const ExactContext& ctx, std::int32_t i, const std::int32_t*
     for (int a = 1; a < nt; ++a)  // insertion sort by id (at most 5 terms)
       for (int b = a; b > 0 && terms[b].id < terms[b - 1].id; --b) std::swap(terms[b], terms[b - 1]);
     for (int t = 0; t < nt && sign_m == 0; ++t) {
-      if (terms[t].row >= 0) {
-        int r = terms[t].row;
-        int cof = (((r + dim) & 1) == 0 ? 1 : -1) * mpz_sgn(s.minor[r]);
-        sign_m = -cof;
-      } else {
-        mpz_set_ui(s.t2, 0);
-        for (int r = 0; r < rows; ++r) {
-          if (gen[r] < 0) continue;
-          if (((r + dim) & 1) == 0) mpz_add(s.t2, s.t2, s.minor[r]);
-          else mpz_sub(s.t2, s.t2, s.minor[r]);
-        }
-        sign_m = mpz_sgn(s.t2);
-      }
+      if (terms[t].row >= 0) sign_m = -cofactor_sign(terms[t].row, dim) * sg.minor[terms[t].row];
+      else sign_m = sg.weight_i;
     }
   }
   // sign(P) = sign(det M) * sign(det A); P > 0 keeps the vertex.

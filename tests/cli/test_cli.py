@@ -231,10 +231,15 @@ class Voronoi3D(TempDirCase):
         self.assertIn("validation: OK", r.stdout)
         g = read_vtu(out)
         self.assertEqual(g.GetNumberOfCells(), self.N)
-        # default domain: bounding box padded by 1% of the largest extent
+        # default domain: bounding box padded by 1% of the largest extent, then
+        # rounded outward to a multiple of 2^(e-7), ext = f * 2^e (docs/design.md)
         lo, hi = self.pts.min(0), self.pts.max(0)
-        pad = 0.01 * (hi - lo).max()
-        expected = np.prod(hi - lo + 2 * pad)
+        ext = (hi - lo).max()
+        pad = 0.01 * ext
+        step = 2.0 ** (np.frexp(ext)[1] - 7)
+        blo = np.floor((lo - pad) / step) * step
+        bhi = np.ceil((hi + pad) / step) * step
+        expected = np.prod(bhi - blo)
         vol = vtk_to_numpy(cell_array(g, "Volume"))
         self.assertAlmostEqual(vol.sum() / expected, 1.0, delta=1e-9)
 
