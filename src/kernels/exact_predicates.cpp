@@ -195,26 +195,44 @@ bool signs_int128(const ExactContext& ctx, std::int32_t i, const std::int32_t* g
       v[r][0] = box_plane_upper(gen[r]) ? ctx.hi[axis] : ctx.lo[axis];
     }
   }
-  int shift = INT_MAX, top = INT_MIN;
-  auto see = [&](double x) {
-    if (x == 0) return;
-    int e;
-    std::frexp(x, &e);
-    shift = std::min(shift, lsb_exponent(x));
-    top = std::max(top, e);
+  // Decompose each double by its bits (no libm calls: this path is hot on
+  // lattices): x = sign * mant * 2^e2 with mant < 2^53.
+  struct Parts { std::int64_t mant; int e2; };
+  auto parts = [](double x) {
+    const std::uint64_t bits = std::bit_cast<std::uint64_t>(x);
+    const int biased = static_cast<int>((bits >> 52) & 0x7ff);
+    std::uint64_t m = bits & ((std::uint64_t{1} << 52) - 1);
+    int e2 = -1074;
+    if (biased != 0) { m |= std::uint64_t{1} << 52; e2 = biased - 1075; }
+    const std::int64_t sm = (bits >> 63) ? -static_cast<std::int64_t>(m) : static_cast<std::int64_t>(m);
+    return Parts{sm, e2};
   };
-  for (int d = 0; d < dim; ++d) see(v[rows][d]);
+  Parts pv[Scratch::kRows + 1][Scratch::kMaxDim];
+  int shift = INT_MAX, top = INT_MIN;
+  auto see = [&](Parts& pt, double x) {
+    pt = parts(x);
+    if (pt.mant == 0) return;
+    const auto um = static_cast<std::uint64_t>(pt.mant < 0 ? -pt.mant : pt.mant);
+    shift = std::min(shift, pt.e2 + std::countr_zero(um));
+    top = std::max(top, pt.e2 + 64 - std::countl_zero(um));  // |x| < 2^top
+  };
+  for (int d = 0; d < dim; ++d) see(pv[rows][d], v[rows][d]);
   for (int r = 0; r < rows; ++r) {
-    if (gen[r] >= 0) for (int d = 0; d < dim; ++d) see(v[r][d]);
-    else see(v[r][0]);
+    if (gen[r] >= 0) for (int d = 0; d < dim; ++d) see(pv[r][d], v[r][d]);
+    else see(pv[r][0], v[r][0]);
   }
   if (shift == INT_MAX) shift = 0;
   if (top != INT_MIN && top - shift > kBits) return false;
-  auto scaled = [&](double x) { return static_cast<std::int64_t>(std::ldexp(x, -shift)); };
+  // x / 2^shift: an integer below 2^22 (its low bits below 2^shift are zero).
+  auto scaled_p = [&](const Parts& pt) -> std::int64_t {
+    if (pt.mant == 0) return 0;
+    const int k = pt.e2 - shift;
+    return k >= 0 ? pt.mant * (std::int64_t{1} << k) : pt.mant / (std::int64_t{1} << -k);
+  };
   std::int64_t ci[Scratch::kMaxDim];
   I ci2 = 0;
   for (int d = 0; d < dim; ++d) {
-    ci[d] = scaled(v[rows][d]);
+    ci[d] = scaled_p(pv[rows][d]);
     ci2 += static_cast<I>(ci[d]) * ci[d];
   }
   std::int64_t a[Scratch::kRows][Scratch::kMaxDim];
@@ -223,7 +241,7 @@ bool signs_int128(const ExactContext& ctx, std::int32_t i, const std::int32_t* g
     if (gen[r] >= 0) {
       I sq = 0;
       for (int d = 0; d < dim; ++d) {
-        std::int64_t x = scaled(v[r][d]);
+        std::int64_t x = scaled_p(pv[r][d]);
         a[r][d] = 2 * (x - ci[d]);
         sq += static_cast<I>(x) * x;
       }
@@ -231,7 +249,7 @@ bool signs_int128(const ExactContext& ctx, std::int32_t i, const std::int32_t* g
     } else {
       int axis = box_plane_axis(gen[r]);
       for (int d = 0; d < dim; ++d) a[r][d] = d == axis ? 1 : 0;
-      b[r] = scaled(v[r][0]);
+      b[r] = scaled_p(pv[r][0]);
     }
   }
   I minor[Scratch::kRows];
