@@ -167,8 +167,15 @@ def div(a, b):
     return a / b if a is not None and b not in (None, 0) else None
 
 
+NOISY = 0.10  # spread above which a median is flagged
+
+
 def med(g):
     return g.med if g else None
+
+
+def fm(g):  # a group's median seconds, flagged when its runs disagree
+    return DASH if g is None else fs(g.med) + (" ‡" if g.spread > NOISY else "")
 
 
 def per_core(g):
@@ -206,6 +213,11 @@ def report(meta, data):
       "ratios compare medians of this run only.")
     w("")
 
+    w(f"‡: the timed runs of that configuration differ by more than {NOISY:.0%} of their median (another "
+      "process shared the cores; its CPU seconds in the last table stay put while wall time moves): "
+      "treat its ratios as rough.")
+    w("")
+
     have_tessera = any(k[0] == "tessera" for groups in data.values() for k in groups)
     if not have_tessera:
         w("**No tessera results in this run** (the binary failed or was missing): only the peers are shown.")
@@ -232,7 +244,7 @@ def report(meta, data):
             v, a, b = g(grp, "voro++", "voronoi3"), g(grp, "tessera", "voronoi3", t1), g(grp, "tessera", "voronoi3", t2)
             n = (a or v or b).n
             cells = (a or b or v).simplices
-            w(f"| {name} | {fn(n)} | {fn(cells)} | {fs(med(v))} | {fs(med(a))} | {fs(med(b))} | "
+            w(f"| {name} | {fn(n)} | {fn(cells)} | {fm(v)} | {fm(a)} | {fm(b)} | "
               f"{fr(div(med(v), med(a)))} | {fr(div(med(v), med(b)))} | {fr(div(med(a), med(b)))} |")
         w("")
         w("Throughput and memory. Cells/s/core = cells / (seconds x threads). Peak bytes/point = the "
@@ -262,24 +274,28 @@ def report(meta, data):
             a, b = g(grp, "tessera", "voronoi2", t1), g(grp, "tessera", "voronoi2", t2)
             n = (a or c or s or b).n
             cells = (a or b).simplices if (a or b) else None
-            w(f"| {name} | {fn(n)} | {DASH if cells is None else fn(cells)} | {fs(med(c))} | {fs(med(s))} | "
-              f"{fs(med(a))} | {fs(med(b))} | {fr(div(med(c), med(a)))} | {fr(div(med(s), med(a)))} | "
+            w(f"| {name} | {fn(n)} | {DASH if cells is None else fn(cells)} | {fm(c)} | {fm(s)} | "
+              f"{fm(a)} | {fm(b)} | {fr(div(med(c), med(a)))} | {fr(div(med(s), med(a)))} | "
               f"{fr(div(med(s), med(b)))} | {fr(div(med(a), med(b)))} | {frate(per_core(a))} | {fb(bpp(a))} | {fb(bpp(s))} |")
         w("")
 
     w("## Every configuration")
     w("")
     w("Spread = (max - min) / median over the timed runs. CPU = median user/sys seconds of the timed "
-      "region (user > wall: several threads busy). Voro++ seconds include its container fill.")
+      "region. Busy cores = (user + sys) / wall, medians: about 1 for one busy thread, up to 2 when two "
+      "threads both work; below the thread count means idle or preempted threads. Voro++ seconds "
+      "include its container fill.")
     w("")
-    w("| input | tool | op | threads | runs | median s | min s | max s | spread | CPU user/sys s | simplices | peak B/pt |")
-    w("|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
+    w("| input | tool | op | threads | runs | median s | min s | max s | spread | CPU user/sys s | busy cores | simplices | peak B/pt |")
+    w("|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
     for name, grp in data.items():
         for (tool, op, th), x in sorted(grp.items(), key=lambda kv: (kv[0][0] != "tessera", kv[0])):
             u, s = x.extra_med("cpu_user_s"), x.extra_med("cpu_sys_s")
-            cpu = f"{u:.2f}/{s:.2f}" if u is not None and s is not None else DASH
+            ok = u is not None and s is not None
+            cpu = f"{u:.2f}/{s:.2f}" if ok else DASH
+            busy = f"{(u + s) / x.med:.2f}" if ok and x.med > 0 else DASH
             w(f"| {name} | {tool} | {op} | {th} | {len(x.runs)} | {fs(x.med)} | {fs(min(x.secs))} | {fs(max(x.secs))} | "
-              f"{100 * x.spread:.0f} % | {cpu} | {fn(x.simplices)} | {fb(bpp(x))} |")
+              f"{100 * x.spread:.0f} % | {cpu} | {busy} | {fn(x.simplices)} | {fb(bpp(x))} |")
     w("")
     w("Simplices: cells for Tessera and Voro++, triangles for CGAL, Voronoi ridges for scipy.")
     return "\n".join(L) + "\n"

@@ -84,9 +84,9 @@ if [[ -z ${TESSERA:-} ]]; then
   tb=$bench/build-tessera
   note "no tessera binary found: building a Release one in $tb"
   mkdir -p "$tb"
-  cmake -S "$repo" -B "$tb" -DCMAKE_BUILD_TYPE=Release \
-        -DTESSERA_BUILD_TESTS=OFF -DTESSERA_BUILD_BENCH=OFF >"$tb/run_bench.log" 2>&1 \
-    && cmake --build "$tb" -j"$jobs" --target tessera_cli >>"$tb/run_bench.log" 2>&1 \
+  { cmake -S "$repo" -B "$tb" -DCMAKE_BUILD_TYPE=Release \
+          -DTESSERA_BUILD_TESTS=OFF -DTESSERA_BUILD_BENCH=OFF >"$tb/run_bench.log" 2>&1 &&
+    cmake --build "$tb" -j"$jobs" --target tessera_cli >>"$tb/run_bench.log" 2>&1; } \
     || die "building tessera failed, see $tb/run_bench.log"
   TESSERA=$tb/tessera
 fi
@@ -154,6 +154,8 @@ repeat() {
   done
 }
 
+variants=("")  # tessera runs: plain, and with --mesh when MESH=1
+[[ ${MESH:-0} != 1 ]] || variants+=(--mesh)
 for e in "${inputs[@]}"; do
   read -r name _ _ _ <<<"$e"
   f=$bench/data/$name.npy
@@ -161,10 +163,11 @@ for e in "${inputs[@]}"; do
   jl=$out/$name.jsonl
   : >"$jl"
   note "$name ($(cut -d' ' -f1-3 /proc/loadavg) load)"
-  [[ $TESSERA == none ]] || for mesh in "" $([[ ${MESH:-0} == 1 ]] && echo --mesh); do
+  [[ $TESSERA == none ]] || for mesh in "${variants[@]}"; do
     for t in $threads; do
       # WARMUP untimed processes, then one process timing REPS repeats (--repeat).
-      args=(bench voronoi "$f" --dim "$dim" --threads "$t" $mesh)
+      args=(bench voronoi "$f" --dim "$dim" --threads "$t")
+      [[ -z $mesh ]] || args+=("$mesh")
       (
         set +e
         for ((i = 0; i < warmup; i++)); do timeout "$timeout" "$bin" "${args[@]}" --repeat 1 >/dev/null; done
