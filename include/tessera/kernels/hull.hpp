@@ -202,7 +202,7 @@ class Hull {
   std::uint64_t exact_calls() const { return exact_calls_; }
 
   /// Visit each face once: f(plane index, vertex indices counter-clockwise
-  /// from outside as a span-like pointer + count). `scratch` buffers are reused.
+  /// from outside as pointer + count). The walk buffers are members, reused.
   template <class F>
   void for_each_face(F&& f) {
     seen_.assign(planes_.size(), 0);
