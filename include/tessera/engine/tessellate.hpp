@@ -41,7 +41,6 @@ struct EngineOptions {
 template <class CellT, class Comp>
   requires Compositor<Comp, CellT>
 std::uint64_t tessellate(const Generators<CellT::dim>& gens, Comp& comp, const EngineOptions& opt) {
-  constexpr int D = CellT::dim;
   const std::size_t n = gens.order.size();
   const std::size_t bs = std::max<std::size_t>(1, opt.batch_size);
   const std::size_t nb = (n + bs - 1) / bs;
@@ -87,7 +86,6 @@ std::uint64_t tessellate(const Generators<CellT::dim>& gens, Comp& comp, const E
   std::uint64_t exact_calls = 0;
   for (auto& ws : workspaces) exact_calls += ws.exact_calls;
   comp.finish(std::span<typename Comp::Batch>(batches));
-  (void)D;
   return exact_calls;
 }
 

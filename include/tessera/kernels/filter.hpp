@@ -16,7 +16,10 @@
 #pragma once
 
 #include <cmath>
+#include <cstddef>
+#include <cstdint>
 #include <limits>
+#include <vector>
 
 namespace tessera::kernels::filter {
 
@@ -32,11 +35,55 @@ inline constexpr double abs_eps = 0x1p-900;
 /// for geometry (volumes, merged coordinates): the vertex is solved exactly.
 inline constexpr double exact_vertex_condition = 1e6;
 
-/// Error bound of P~ = d - n.y for a vertex with bound `err` and |y|_inf = ymax.
-/// The clippers store e = err + plane_eps * ymax per vertex and evaluate
-/// n1 * e + plane_eps * |d| inline; this is the same bound spelled out.
-inline double clip_error(double n1, double d, double err, double ymax) {
-  return n1 * (err + plane_eps * ymax) + plane_eps * std::fabs(d);
+/// The sign pass every clip starts with, shared by the 2D tile and the 3D hull.
+///
+/// Vertices carry y[D] (relative to the generator), e = err + plane_eps*|y|_inf
+/// and r2 (an upper bound on the exact |y|^2). The plane is n.y <= d with
+/// |n|_1 = n1, d = |q|^2/2. Fills `sign` with +1 (keep) / -1 (remove), asking
+/// `exact(vertex)` only where the filter cannot decide, and returns the number
+/// removed. A vertex no farther than |q|/2 from the generator cannot be cut:
+/// q.y <= |q||y| <= |q|^2/2 (equality would need y = q/2 exactly, which the
+/// strict margin excludes). Candidates usually fail to clip; a first pass over
+/// the far vertices only proves that, and then `sign` is left untouched.
+template <int D, class Vertex, class Exact>
+std::size_t classify(const std::vector<Vertex>& verts, const double* n, double d, double n1,
+                     std::vector<std::int8_t>& sign, Exact&& exact) {
+  const std::size_t nv = verts.size();
+  const double q2lo = 2.0 * d * (1.0 - 1e-12) - abs_eps;  // <= the exact |p_j - p_i|^2
+  const double de = plane_eps * std::fabs(d) + abs_eps;
+  auto plane_value = [&](const Vertex& v) {
+    double dot = 0;
+    for (int k = 0; k < D; ++k) dot += n[k] * v.y[k];
+    return d - dot;
+  };
+  bool may_cut = false;
+  for (std::size_t t = 0; t < nv && !may_cut; ++t) {
+    const Vertex& v = verts[t];
+    if (4.0 * v.r2 < q2lo) continue;
+    may_cut = !(plane_value(v) > n1 * v.e + de);
+  }
+  if (!may_cut) return 0;
+  sign.resize(nv);
+  std::size_t removed = 0, uncertain = 0;
+  for (std::size_t t = 0; t < nv; ++t) {
+    const Vertex& v = verts[t];
+    int s = 1;
+    if (4.0 * v.r2 >= q2lo) {
+      double P = plane_value(v);
+      double e = n1 * v.e + de;
+      s = (P > e) - (P < -e);
+    }
+    sign[t] = static_cast<std::int8_t>(s);
+    removed += (s < 0);
+    uncertain += (s == 0);
+  }
+  for (std::size_t t = 0; uncertain && t < nv; ++t) {
+    if (sign[t] != 0) continue;
+    sign[t] = static_cast<std::int8_t>(exact(verts[t]));
+    removed += (sign[t] < 0);
+    --uncertain;
+  }
+  return removed;
 }
 
 }  // namespace tessera::kernels::filter

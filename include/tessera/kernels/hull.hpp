@@ -96,43 +96,8 @@ class Hull {
     pl.id = j;
 
     const std::size_t nv = verts_.size();
-    // A vertex no farther than |q|/2 from the generator cannot be cut:
-    // q.y <= |q||y| <= |q|^2/2 (equality would need y = q/2 exactly, which the
-    // strict margin excludes). Candidates usually fail to clip, and then only
-    // the few far vertices need a plane test.
-    const double q2lo = 2.0 * pl.d * (1.0 - 1e-12) - filter::abs_eps;  // <= the exact |p_j - p_i|^2
-    const double de = filter::plane_eps * std::fabs(pl.d) + filter::abs_eps;
-    bool may_cut = false;
-    for (std::size_t t = 0; t < nv; ++t) {
-      const Vertex& v = verts_[t];
-      if (4.0 * v.r2 < q2lo) continue;
-      double P = pl.d - (pl.n[0] * v.y[0] + pl.n[1] * v.y[1] + pl.n[2] * v.y[2]);
-      if (!(P > pl.n1 * v.e + de)) { may_cut = true; break; }
-    }
-    if (!may_cut) return ClipResult::unchanged;
-
-    // Full sign pass: +1 keep, -1 remove, 0 uncertain (exact below).
-    sign_.resize(nv);
-    std::size_t removed = 0, uncertain = 0;
-    for (std::size_t t = 0; t < nv; ++t) {
-      const Vertex& v = verts_[t];
-      int s = 1;
-      if (4.0 * v.r2 >= q2lo) {
-        double P = pl.d - (pl.n[0] * v.y[0] + pl.n[1] * v.y[1] + pl.n[2] * v.y[2]);
-        double e = pl.n1 * v.e + de;
-        s = (P > e) - (P < -e);
-      }
-      sign_[t] = static_cast<std::int8_t>(s);
-      removed += (s < 0);
-      uncertain += (s == 0);
-    }
-    if (uncertain) {
-      for (std::size_t t = 0; t < nv; ++t) {
-        if (sign_[t] != 0) continue;
-        sign_[t] = static_cast<std::int8_t>(exact_sign(verts_[t], j));
-        removed += (sign_[t] < 0);
-      }
-    }
+    const std::size_t removed = filter::classify<3>(verts_, pl.n, pl.d, pl.n1, sign_,
+                                                     [&](const Vertex& v) { return exact_sign(v, j); });
     if (removed == 0) return ClipResult::unchanged;
     if (removed == nv) { verts_.clear(); security2_ = 0; return ClipResult::emptied; }
 
