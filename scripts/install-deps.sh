@@ -8,10 +8,13 @@ set -euo pipefail
 pkgs=(build-essential cmake ninja-build ccache pkg-config
       libtbb-dev libcli11-dev libgtest-dev libgmock-dev libbenchmark-dev libgmp-dev
       voro++-dev libvoro++1
-      python3 python3-numpy python3-vtk9 qhull-bin)
+      python3 python3-numpy python3-vtk9 qhull-bin
+      # test oracles (CGAL's Delaunay, scipy) and the Python module (pybind11, pytest, meshio, matplotlib)
+      libcgal-dev libmpfr-dev libboost-dev python3-scipy
+      python3-dev pybind11-dev python3-pybind11 python3-pytest python3-meshio python3-matplotlib
+      python3-setuptools python3-pip python3-venv)
 if [[ "${1:-}" == "--bench" ]]; then
-  pkgs+=(libcgal-dev libmpfr-dev libboost-dev libeigen3-dev voro++ libqhull-dev
-         python3-scipy libvtk9-dev libgmsh-dev gmsh)
+  pkgs+=(libeigen3-dev voro++ libqhull-dev libvtk9-dev libgmsh-dev gmsh)
 fi
 
 missing=()

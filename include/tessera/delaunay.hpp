@@ -1,0 +1,76 @@
+// Front end: the Delaunay triangulation of a point set, the dual of the cells.
+//
+// Every Voronoi vertex of the (symbolically perturbed) diagram with D+1 inside
+// generators is one Delaunay simplex. The cells pass finds those whose
+// circumcentre lies in the domain box; without labels, hull completion then
+// adds the thin simplices near the convex hull whose circumcentres lie outside
+// it, so the result covers the convex hull of the input exactly (docs/design.md,
+// "Delaunay and hull completion").
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "tessera/cells.hpp"
+
+namespace tessera {
+
+struct DelaunayOptions : VoronoiOptions {
+  /// Without labels: close the triangulation up to the convex hull (simplices
+  /// whose circumcentre lies outside the domain box). Ignored with labels,
+  /// where the result is the simplices whose generators are all inside points.
+  bool complete_hull = true;
+};
+
+/// Simplices of the Delaunay triangulation (triangles in 2D, tetrahedra in 3D).
+struct Delaunay {
+  int dim = 3;
+  std::size_t n_points = 0;
+  Bounds bounds;                           ///< the domain box of the cells pass
+  /// n_simplices * (dim+1) point ids. Row r's first id is its lowest; rows are
+  /// in ascending order of their sorted id tuples. 3D tets are positively
+  /// oriented (det[p1-p0, p2-p0, p3-p0] > 0), 2D triangles counter-clockwise,
+  /// decided by exact predicates.
+  std::vector<std::int32_t> simplices;
+  std::size_t from_cells = 0;              ///< simplices found by the cells pass
+  std::size_t from_hull_completion = 0;    ///< simplices added by hull completion
+  bool hull_completed = false;             ///< hull completion ran (no labels, complete_hull)
+  std::vector<std::pair<std::int32_t, std::int32_t>> duplicates;  ///< (duplicate, owner): not vertices
+  std::vector<std::int32_t> ignored_outside_bounds;
+  std::uint64_t exact_predicate_calls = 0;
+  int threads_used = 1;
+
+  std::size_t n_simplices() const { return simplices.size() / static_cast<std::size_t>(dim + 1); }
+};
+
+/// Compute the Delaunay triangulation. Same input rules as voronoi() (points
+/// n*dim row-major; labels empty or n ints, < 0 = outside). Throws InputError.
+Delaunay delaunay(std::span<const double> points, int dim, std::span<const std::int32_t> labels,
+                  const DelaunayOptions& options);
+
+/// Adjacent simplices, as scipy.spatial.Delaunay.neighbors: entry r*(dim+1)+k is
+/// the simplex sharing the facet opposite vertex k of simplex r, or -1.
+std::vector<std::int32_t> simplex_neighbors(const Delaunay& dt);
+
+/// Checks of a triangulation (the CLI's `delaunay --validate`).
+struct DelaunayReport {
+  bool ok = true;
+  std::size_t simplices = 0;
+  std::size_t flat_or_inverted = 0;        ///< simplices not strictly positively oriented
+  std::size_t nonmanifold_facets = 0;      ///< facets in more than two simplices, or twice with one orientation
+  std::size_t boundary_facets = 0;         ///< facets in exactly one simplex
+  std::size_t open_boundary_ridges = 0;    ///< boundary ridges not shared by exactly two boundary facets
+  std::size_t nonconvex_boundary = 0;      ///< (no labels) boundary ridges where the hull is not convex
+  std::size_t missing_points = 0;          ///< (no labels) non-duplicate points in no simplex
+  std::size_t local_delaunay_violations = 0;  ///< interior facets whose opposite vertex is in the circumsphere
+  double volume_sum = 0;                   ///< sum of simplex volumes (areas in 2D)
+  double enclosed_volume = 0;              ///< volume enclosed by the boundary facets
+  std::vector<std::string> messages;       ///< one line each
+};
+DelaunayReport validate(const Delaunay& dt, std::span<const double> points, std::span<const std::int32_t> labels);
+
+}  // namespace tessera
