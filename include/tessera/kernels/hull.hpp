@@ -165,6 +165,12 @@ class Hull {
   const std::vector<Vertex>& vertices() const { return verts_; }
   const std::vector<Plane>& planes() const { return planes_; }
   std::uint64_t exact_calls() const { return exact_calls_; }
+  /// The triangle (vertex) sharing edge k of triangle t, i.e. the directed
+  /// plane pair (p[k] -> p[k+1]) seen from the other side.
+  std::uint32_t across(std::size_t t, int k) const {
+    const Vertex& v = verts_[t];
+    return edge_tri_[static_cast<std::size_t>(v.p[(k + 1) % 3]) * cap_ + v.p[k]];
+  }
 
   /// Visit each face once: f(plane index, vertex indices counter-clockwise
   /// from outside as pointer + count). The walk buffers are members, reused.

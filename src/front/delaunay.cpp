@@ -1,0 +1,148 @@
+// tessera::delaunay: the cells pass with the Delaunay compositor, hull
+// completion, and orientation of every simplex by the exact predicate.
+#include "tessera/delaunay.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include "delaunay_compositor.hpp"
+#include "hull_completion.hpp"
+#include "pass.hpp"
+#include "simplex_facets.hpp"
+#include "tessera/engine/tessellate.hpp"
+#include "tessera/kernels/delaunay_predicates.hpp"
+#include "tessera/kernels/hull.hpp"
+#include "tessera/kernels/tile.hpp"
+
+namespace tessera {
+namespace {
+
+template <class CellT>
+Delaunay run(std::span<const double> input, std::span<const std::int32_t> labels, const DelaunayOptions& opt,
+             int attempt = 0) {
+  constexpr int D = CellT::dim;
+  const std::size_t n = input.size() / D;
+  const bool complete = opt.complete_hull && labels.empty();
+  front::Pass<D> pass(input, labels, opt);
+  Delaunay out;
+  out.dim = D;
+  out.n_points = n;
+  out.bounds = pass.user_bounds;
+  out.ignored_outside_bounds = pass.ignored_outside;
+  out.threads_used = pass.engine_options.threads;
+
+  front::DelaunayPassResult<D> found;
+  front::DelaunayCompositor<CellT> comp(found, n, labels, complete);
+  out.exact_predicate_calls = engine::tessellate<CellT>(pass.gens, comp, pass.engine_options);
+  out.duplicates = std::move(found.duplicates);
+  out.from_cells = found.simplices.size() / (D + 1);
+
+  if (complete && out.from_cells == 0 && pass.locator->size() - out.duplicates.size() > D && attempt < 2) {
+    // Every circumcentre lies outside the box (a handful of points, or nearly
+    // flat input), so completion has no found simplex to start from. The
+    // triangulation does not depend on the box: run again in a box a thousand
+    // times larger (twice at most), and complete the rest from there. Exactly
+    // flat input has no simplex at all and ends here empty.
+    DelaunayOptions big = opt;
+    big.progress = nullptr;
+    Bounds b = pass.user_bounds;
+    for (int d = 0; d < D; ++d) {
+      auto du = static_cast<std::size_t>(d);
+      double mid = 0.5 * (b.lo[du] + b.hi[du]), half = 0.5 * (b.hi[du] - b.lo[du]);
+      b.lo[du] = mid - 1024 * half;
+      b.hi[du] = mid + 1024 * half;
+    }
+    big.bounds = b;
+    big.ignore_outside_points = true;
+    std::vector<double> kept;
+    if (!pass.ignored_outside.empty()) {
+      // Keep the original domain's selection: points it dropped stay dropped.
+      kept.assign(input.begin(), input.end());
+      for (std::int32_t id : pass.ignored_outside)
+        for (int d = 0; d < D; ++d) kept[static_cast<std::size_t>(id) * D + d] = 2 * b.hi[static_cast<std::size_t>(d)];
+    }
+    Delaunay retry = run<CellT>(kept.empty() ? input : std::span<const double>(kept), labels, big, attempt + 1);
+    retry.bounds = out.bounds;
+    retry.ignored_outside_bounds = out.ignored_outside_bounds;
+    return retry;
+  }
+
+  std::vector<std::array<std::int32_t, D + 1>> added;
+  if (complete) {
+    out.hull_completed = true;
+    const kernels::BinLocator<D> candidates(pass.points, found.touches_box, pass.gens.lo, pass.gens.hi, 8.0);
+    double diam2 = 0;
+    for (int d = 0; d < D; ++d) {
+      double e = pass.gens.hi[static_cast<std::size_t>(d)] - pass.gens.lo[static_cast<std::size_t>(d)];
+      diam2 += e * e;
+    }
+    front::HullCompletion<D> hc(pass.exact, candidates, std::sqrt(diam2));
+    added = hc.run(found.open, pass.engine_options.threads);
+  }
+  out.from_hull_completion = added.size();
+
+  // Merge the two ascending lists, then orient each row in place.
+  const std::size_t m = out.from_cells + added.size();
+  out.simplices.resize(m * (D + 1));
+  {
+    std::size_t i = 0, j = 0, r = 0;
+    const auto& f = found.simplices;
+    auto less_added = [&](std::size_t a, std::size_t b) {
+      return std::lexicographical_compare(added[b].begin(), added[b].end(), f.begin() + static_cast<std::ptrdiff_t>(a * (D + 1)),
+                                          f.begin() + static_cast<std::ptrdiff_t>((a + 1) * (D + 1)));
+    };
+    while (i < out.from_cells || j < added.size()) {
+      const bool take_added = i == out.from_cells || (j < added.size() && less_added(i, j));
+      for (int d = 0; d <= D; ++d)
+        out.simplices[r * (D + 1) + d] = take_added ? added[j][static_cast<std::size_t>(d)] : f[i * (D + 1) + d];
+      take_added ? ++j : ++i;
+      ++r;
+    }
+  }
+  tbb::task_arena arena(pass.engine_options.threads);
+  std::size_t flat = 0;
+  arena.execute([&] {
+    std::vector<std::uint8_t> is_flat(m, 0);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, m, 4096), [&](const tbb::blocked_range<std::size_t>& rg) {
+      for (std::size_t s = rg.begin(); s != rg.end(); ++s) {
+        std::int32_t* row = out.simplices.data() + s * (D + 1);
+        int o = kernels::orientation(pass.exact, row);
+        if (o < 0) std::swap(row[D - 1], row[D]);
+        if (o == 0) is_flat[s] = 1;
+      }
+    });
+    flat = static_cast<std::size_t>(std::count(is_flat.begin(), is_flat.end(), 1));
+  });
+  if (flat != 0)
+    throw std::logic_error("tessera: " + std::to_string(flat) + " Delaunay simplices are flat (inconsistent topology)");
+  std::sort(out.duplicates.begin(), out.duplicates.end());
+  return out;
+}
+
+}  // namespace
+
+Delaunay delaunay(std::span<const double> points, int dim, std::span<const std::int32_t> labels,
+                  const DelaunayOptions& options) {
+  front::check_input(points, dim, labels);
+  return dim == 3 ? run<kernels::Hull>(points, labels, options) : run<kernels::Tile>(points, labels, options);
+}
+
+std::vector<std::int32_t> simplex_neighbors(const Delaunay& dt) {
+  const std::size_t m = dt.n_simplices();
+  const std::size_t w = static_cast<std::size_t>(dt.dim + 1);
+  const std::vector<front::FacetRecord> recs = front::sorted_facets(dt);
+  std::vector<std::int32_t> nb(m * w, -1);
+  for (std::size_t i = 0; i + 1 < recs.size(); ++i) {
+    if (recs[i].facet != recs[i + 1].facet) continue;
+    nb[static_cast<std::size_t>(recs[i].simplex) * w + static_cast<std::size_t>(recs[i].k)] = recs[i + 1].simplex;
+    nb[static_cast<std::size_t>(recs[i + 1].simplex) * w + static_cast<std::size_t>(recs[i + 1].k)] = recs[i].simplex;
+    ++i;
+  }
+  return nb;
+}
+
+}  // namespace tessera

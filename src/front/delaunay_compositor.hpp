@@ -1,0 +1,179 @@
+// The compositor behind tessera::delaunay: reads the Delaunay simplices off
+// the cells' topological coordinates, plus what hull completion needs.
+//
+// Every vertex of cell g whose planes are all bisectors (no box plane) is the
+// circumcentre of the simplex {g, plane ids}. Each such simplex is seen by all
+// D+1 of its cells and emitted by the lowest id only, so no global
+// deduplication is needed. For hull completion the compositor also reports
+// the *open facets* of the found complex: a Voronoi edge (3D; a Voronoi vertex
+// pair in 2D) that runs from a found simplex's circumcentre to the box is a
+// facet whose other simplex was not found, and the generators whose cells
+// reach the box (the only candidates for the missing simplices: a missing
+// circumcentre lies outside the box, inside the cells of all its generators).
+#pragma once
+
+#include <algorithm>
+#include <array>
+#include <climits>
+#include <cstdint>
+#include <numeric>
+#include <span>
+#include <vector>
+
+#include <tbb/parallel_for.h>
+
+#include "tessera/kernels/cell_builder.hpp"
+#include "tessera/kernels/hull.hpp"
+#include "tessera/kernels/tile.hpp"
+
+namespace tessera::front {
+
+template <int D>
+struct OpenFacet {
+  std::array<std::int32_t, D> facet;  ///< ids, ascending
+  std::int32_t apex;                  ///< the found simplex's other vertex
+  auto operator<=>(const OpenFacet&) const = default;
+};
+
+/// What the compositor leaves for the front end.
+template <int D>
+struct DelaunayPassResult {
+  std::vector<std::int32_t> simplices;     ///< rows of D+1 ascending ids, rows ascending
+  std::vector<OpenFacet<D>> open;          ///< ascending
+  std::vector<std::uint8_t> touches_box;   ///< per point (hull info only)
+  std::vector<std::pair<std::int32_t, std::int32_t>> duplicates;
+};
+
+template <class CellT>
+class DelaunayCompositor {
+ public:
+  static constexpr int D = CellT::dim;
+  using Simplex = std::array<std::int32_t, D + 1>;
+
+  struct Batch {
+    std::vector<std::int32_t> gen, dup_of;
+    std::vector<std::uint32_t> simplex_end;  // running end into simplices, per generator
+    std::vector<Simplex> simplices;
+    std::vector<OpenFacet<D>> open;
+    std::vector<std::int32_t> touches_box;
+  };
+
+  /// `hull_info`: also collect open facets and box-touching generators.
+  DelaunayCompositor(DelaunayPassResult<D>& out, std::size_t n_points, std::span<const std::int32_t> labels,
+                     bool hull_info)
+      : out_(out), n_(n_points), labels_(labels), hull_info_(hull_info) {}
+
+  void add(Batch& b, std::int32_t gen, const kernels::BuildStatus& st, CellT& cell) {
+    b.gen.push_back(gen);
+    b.dup_of.push_back(st.has_cell ? -1 : st.duplicate_of);
+    if (st.has_cell) {
+      const std::size_t s0 = b.simplices.size();
+      bool touches = false;
+      const auto& verts = cell.vertices();
+      for (std::size_t t = 0; t < verts.size(); ++t) {
+        std::array<std::int32_t, D> ids;
+        bool box = false, inside = true;
+        for (int k = 0; k < D; ++k) {
+          ids[k] = cell.planes()[verts[t].p[k]].id;
+          if (ids[k] < 0) box = true;
+          else if (!labels_.empty() && labels_[static_cast<std::size_t>(ids[k])] < 0) inside = false;
+        }
+        if (box) { touches = true; continue; }
+        if (inside && gen < *std::min_element(ids.begin(), ids.end())) {
+          Simplex s;
+          s[0] = gen;
+          std::sort(ids.begin(), ids.end());
+          std::copy(ids.begin(), ids.end(), s.begin() + 1);
+          b.simplices.push_back(s);
+        }
+        if (hull_info_) open_facets(b, gen, cell, t);
+      }
+      std::sort(b.simplices.begin() + static_cast<std::ptrdiff_t>(s0), b.simplices.end());
+      if (hull_info_ && touches) b.touches_box.push_back(gen);
+    }
+    b.simplex_end.push_back(static_cast<std::uint32_t>(b.simplices.size()));
+  }
+
+  void finish(std::span<Batch> batches) {
+    struct Loc { std::int32_t batch = -1, index = -1; };
+    std::vector<Loc> where(n_);
+    for (std::size_t k = 0; k < batches.size(); ++k)
+      for (std::size_t t = 0; t < batches[k].gen.size(); ++t)
+        where[static_cast<std::size_t>(batches[k].gen[t])] = {static_cast<std::int32_t>(k), static_cast<std::int32_t>(t)};
+    // Simplices in generator order (each generator's are ascending, and its
+    // lowest id is the generator): the whole list comes out ascending.
+    std::vector<std::int64_t> offset(n_ + 1, 0);
+    for (std::size_t g = 0; g < n_; ++g) {
+      const Loc& w = where[g];
+      std::int64_t cnt = 0;
+      if (w.batch >= 0) {
+        const Batch& b = batches[static_cast<std::size_t>(w.batch)];
+        const auto t = static_cast<std::size_t>(w.index);
+        if (b.dup_of[t] >= 0) out_.duplicates.emplace_back(static_cast<std::int32_t>(g), b.dup_of[t]);
+        cnt = b.simplex_end[t] - (t == 0 ? 0 : b.simplex_end[t - 1]);
+      }
+      offset[g + 1] = offset[g] + cnt;
+    }
+    out_.simplices.resize(static_cast<std::size_t>(offset[n_]) * (D + 1));
+    tbb::parallel_for(std::size_t(0), batches.size(), [&](std::size_t k) {
+      const Batch& b = batches[k];
+      for (std::size_t t = 0; t < b.gen.size(); ++t) {
+        std::uint32_t s0 = t == 0 ? 0 : b.simplex_end[t - 1];
+        std::size_t o = static_cast<std::size_t>(offset[static_cast<std::size_t>(b.gen[t])]) * (D + 1);
+        for (std::uint32_t s = s0; s < b.simplex_end[t]; ++s)
+          for (int d = 0; d <= D; ++d) out_.simplices[o++] = b.simplices[s][d];
+      }
+    });
+    if (hull_info_) {
+      out_.touches_box.assign(n_, 0);
+      for (const Batch& b : batches) {
+        out_.open.insert(out_.open.end(), b.open.begin(), b.open.end());
+        for (std::int32_t g : b.touches_box) out_.touches_box[static_cast<std::size_t>(g)] = 1;
+      }
+      std::sort(out_.open.begin(), out_.open.end());
+    }
+  }
+
+ private:
+  // Facets {gen, shared planes} of the found simplex at vertex t whose Voronoi
+  // edge (3D) / neighbouring vertex (2D) ends on the box; emitted by the lowest id.
+  void open_facets(Batch& b, std::int32_t gen, const CellT& cell, std::size_t t) {
+    const auto& verts = cell.vertices();
+    const auto& planes = cell.planes();
+    auto emit = [&](std::array<std::int32_t, D - 1> shared, std::int32_t apex) {
+      for (std::int32_t id : shared)
+        if (id < gen) return;
+      OpenFacet<D> f;
+      f.facet[0] = gen;
+      std::sort(shared.begin(), shared.end());
+      std::copy(shared.begin(), shared.end(), f.facet.begin() + 1);
+      f.apex = apex;
+      b.open.push_back(f);
+    };
+    if constexpr (D == 3) {
+      const auto& v = verts[t];
+      for (int k = 0; k < 3; ++k) {
+        const auto& w = verts[cell.across(t, k)];
+        bool box = false;
+        for (int m = 0; m < 3; ++m) box |= planes[w.p[m]].id < 0;
+        if (box) emit({planes[v.p[k]].id, planes[v.p[(k + 1) % 3]].id}, planes[v.p[(k + 2) % 3]].id);
+      }
+    } else {
+      // Tile: vertex t sits between the edge on plane p[0] (from t-1) and the
+      // edge on plane p[1] (to t+1).
+      const std::size_t nv = verts.size();
+      const auto& v = verts[t];
+      const auto& next = verts[(t + 1) % nv];
+      const auto& prev = verts[(t + nv - 1) % nv];
+      if (planes[next.p[1]].id < 0) emit({planes[v.p[1]].id}, planes[v.p[0]].id);
+      if (planes[prev.p[0]].id < 0) emit({planes[v.p[0]].id}, planes[v.p[1]].id);
+    }
+  }
+
+  DelaunayPassResult<D>& out_;
+  std::size_t n_;
+  std::span<const std::int32_t> labels_;
+  bool hull_info_;
+};
+
+}  // namespace tessera::front

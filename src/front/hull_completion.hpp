@@ -1,0 +1,254 @@
+// Hull completion: the Delaunay simplices the cells pass cannot see.
+//
+// The cells pass finds exactly the simplices whose circumcentre lies in the
+// domain box. Near the convex hull, thin simplices have circumcentres far
+// outside any padded box (arbitrarily far for nearly coplanar hull points).
+// They are recovered by gift wrapping restricted to the thin hull shell:
+//
+//  * Open facets of the found complex (a facet in one found simplex, whose
+//    Voronoi edge runs to the box) are closed one by one: the simplex on the
+//    far side is {facet, p} for the point p strictly beyond the facet whose
+//    sphere through the facet is empty of every other point beyond it (the
+//    first point swept as the sphere through the facet grows away from the
+//    found simplex). No point beyond the facet: it is a hull facet.
+//  * Every vertex of a missing simplex has a cell that reaches the box (its
+//    circumcentre lies outside the box and inside all those cells), so the
+//    candidates come from a locator over those points only.
+//  * Comparisons use in_sphere(), the clip predicate with its symbolic
+//    perturbation, so the added simplices are those of the same perturbed
+//    triangulation the cells pass computed: together they are one
+//    triangulation of the convex hull, exactly CGAL's on points in general
+//    position.
+// Closing a facet can open new ones; rounds repeat until every open facet is
+// a hull facet. Each round's gift wraps run in parallel.
+#pragma once
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <map>
+#include <stdexcept>
+#include <vector>
+
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include "delaunay_compositor.hpp"
+#include "tessera/kernels/delaunay_predicates.hpp"
+#include "tessera/kernels/locator.hpp"
+
+namespace tessera::front {
+
+template <int D>
+class HullCompletion {
+ public:
+  using Facet = std::array<std::int32_t, D>;
+  using Simplex = std::array<std::int32_t, D + 1>;
+
+  /// `candidates` holds the points whose cells reach the box; `diameter` is
+  /// the domain's diagonal (the scale for float margins).
+  HullCompletion(const kernels::ExactContext& ctx, const kernels::BinLocator<D>& candidates, double diameter)
+      : ctx_(ctx), loc_(candidates), diam_(diameter) {}
+
+  /// The point beyond `f` (away from `apex`) that closes it, or -1 for a hull facet.
+  std::int32_t wrap(const Facet& f, std::int32_t apex) const {
+    std::array<std::int32_t, D + 1> ids;
+    std::copy(f.begin(), f.end(), ids.begin());
+    ids[D] = apex;
+    const int apex_side = kernels::orientation(ctx_, ids.data());
+    if (apex_side == 0) throw std::logic_error("tessera: hull completion met a flat simplex");
+    // g(x) > 0 beyond the facet (float, for pruning bins only).
+    const double* a = pt(f[0]);
+    double n[3] = {0, 0, 0};
+    if constexpr (D == 3) {
+      const double* b = pt(f[1]);
+      const double* c = pt(f[2]);
+      double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+      n[0] = u[1] * v[2] - u[2] * v[1];
+      n[1] = u[2] * v[0] - u[0] * v[2];
+      n[2] = u[0] * v[1] - u[1] * v[0];
+    } else {
+      const double* b = pt(f[1]);
+      n[0] = -(b[1] - a[1]);
+      n[1] = b[0] - a[0];
+    }
+    for (double& x : n) x *= -apex_side;
+    double nn = 0;
+    for (int d = 0; d < D; ++d) nn += n[d] * n[d];
+    const double margin = 1e-9 * std::sqrt(nn) * diam_;
+    auto g = [&](const double* x) {
+      double s = 0;
+      for (int d = 0; d < D; ++d) s += n[d] * (x[d] - a[d]);
+      return s;
+    };
+
+    double c[D];
+    for (int d = 0; d < D; ++d) {
+      c[d] = 0;
+      for (int k = 0; k < D; ++k) c[d] += pt(f[k])[d];
+      c[d] /= D;
+    }
+    const auto b0 = loc_.bin_coords(c);
+    std::int32_t best = -1;
+    double r2 = std::numeric_limits<double>::infinity();  // search radius^2 around c
+    const int smax = loc_.max_shell(b0);
+    for (int s = 0; s <= smax; ++s) {
+      if (s > 0 && best >= 0) {
+        double lb = loc_.shell_lower_bound(c, b0, s);
+        if (lb * lb > r2) break;
+      }
+      loc_.for_each_shell_bin(b0, s, [&](const std::array<std::int32_t, D>& bin, std::size_t index) {
+        const auto& off = loc_.offsets();
+        if (off[index] == off[index + 1]) return;
+        if (best >= 0 && loc_.bin_distance2(c, bin) > r2) return;
+        double lo[D], hi[D];
+        loc_.bin_box(bin, lo, hi);
+        double gmax = -std::numeric_limits<double>::infinity();
+        for (int corner = 0; corner < (1 << D); ++corner) {
+          double x[D];
+          for (int d = 0; d < D; ++d) x[d] = (corner >> d) & 1 ? hi[d] : lo[d];
+          gmax = std::max(gmax, g(x));
+        }
+        if (gmax < -margin) return;  // wholly on the found side
+        for (std::uint32_t slot = off[index]; slot < off[index + 1]; ++slot) {
+          const std::int32_t q = loc_.id(slot);
+          if (q == apex || std::find(f.begin(), f.end(), q) != f.end()) continue;
+          ids[D] = q;
+          if (kernels::orientation(ctx_, ids.data()) != -apex_side) continue;  // not strictly beyond
+          if (best >= 0) {
+            std::array<std::int32_t, D> planes;
+            std::copy(f.begin() + 1, f.end(), planes.begin());
+            planes[D - 1] = best;
+            if (!kernels::in_sphere(ctx_, f[0], planes.data(), q)) continue;
+          }
+          best = q;
+          r2 = search_radius2(f, best, n, c);
+        }
+      });
+    }
+    return best;
+  }
+
+  /// Close the complex whose open facets are `open`; returns the added
+  /// simplices (ascending ids), in ascending order. Terminates: a simplex is
+  /// never added twice (its facets would then be in three simplices, which
+  /// throws), and there are finitely many.
+  std::vector<Simplex> run(const std::vector<OpenFacet<D>>& open, int threads) {
+    struct State { int count; };
+    std::map<Facet, State> facets;  // facets on the current boundary and those closed by completion
+    std::vector<OpenFacet<D>> queue;
+    for (const auto& o : open) {
+      facets[o.facet] = {1};
+      queue.push_back(o);
+    }
+    std::vector<Simplex> added;
+    tbb::task_arena arena(std::max(1, threads));
+    while (!queue.empty()) {
+      std::vector<std::int32_t> hit(queue.size());
+      arena.execute([&] {
+        tbb::parallel_for(std::size_t(0), queue.size(), [&](std::size_t i) { hit[i] = wrap(queue[i].facet, queue[i].apex); });
+      });
+      std::vector<Simplex> fresh;
+      for (std::size_t i = 0; i < queue.size(); ++i) {
+        if (hit[i] < 0) continue;
+        Simplex s;
+        std::copy(queue[i].facet.begin(), queue[i].facet.end(), s.begin());
+        s[D] = hit[i];
+        std::sort(s.begin(), s.end());
+        fresh.push_back(s);
+      }
+      std::sort(fresh.begin(), fresh.end());
+      fresh.erase(std::unique(fresh.begin(), fresh.end()), fresh.end());
+      std::vector<OpenFacet<D>> next;
+      for (const Simplex& s : fresh) {
+        added.push_back(s);
+        for (int k = 0; k <= D; ++k) {
+          OpenFacet<D> o;
+          for (int m = 0, j = 0; m <= D; ++m)
+            if (m != k) o.facet[j++] = s[m];
+          o.apex = s[k];
+          auto [it, inserted] = facets.try_emplace(o.facet, State{1});
+          if (!inserted && ++it->second.count > 2)
+            throw std::logic_error("tessera: hull completion put a facet in three simplices");
+          if (inserted) next.push_back(o);
+        }
+      }
+      queue.clear();
+      for (const auto& o : next)
+        if (facets[o.facet].count == 1) queue.push_back(o);
+    }
+    std::sort(added.begin(), added.end());
+    return added;
+  }
+
+ private:
+  const double* pt(std::int32_t id) const { return ctx_.points + static_cast<std::size_t>(id) * D; }
+
+  // Squared radius around c of a ball holding every point beyond the facet that
+  // could still beat `best`: the part of best's circumsphere beyond the facet
+  // plane. Float, with margins; infinite when the sphere is too ill-conditioned
+  // to trust.
+  double search_radius2(const Facet& f, std::int32_t best, const double* n, const double* c) const {
+    const double* a = pt(f[0]);
+    double r[D][D], s[D];
+    for (int k = 0; k < D; ++k) {
+      const double* p = pt(k + 1 < D ? f[static_cast<std::size_t>(k + 1)] : best);
+      s[k] = 0;
+      for (int d = 0; d < D; ++d) {
+        r[k][d] = p[d] - a[d];
+        s[k] += r[k][d] * r[k][d];
+      }
+    }
+    // Circumcentre y relative to a: 2 r_k . y = s_k (Cramer).
+    double y[D];
+    if constexpr (D == 2) {
+      double det = 2 * (r[0][0] * r[1][1] - r[0][1] * r[1][0]);
+      y[0] = (s[0] * r[1][1] - s[1] * r[0][1]) / det;
+      y[1] = (r[0][0] * s[1] - r[1][0] * s[0]) / det;
+    } else {
+      double c0[3], c1[3], c2[3];
+      auto cross = [](const double* u, const double* v, double* o) {
+        o[0] = u[1] * v[2] - u[2] * v[1];
+        o[1] = u[2] * v[0] - u[0] * v[2];
+        o[2] = u[0] * v[1] - u[1] * v[0];
+      };
+      cross(r[1], r[2], c0);
+      cross(r[2], r[0], c1);
+      cross(r[0], r[1], c2);
+      double det = 2 * (r[0][0] * c0[0] + r[0][1] * c0[1] + r[0][2] * c0[2]);
+      for (int d = 0; d < 3; ++d) y[d] = (s[0] * c0[d] + s[1] * c1[d] + s[2] * c2[d]) / det;
+    }
+    double rad2 = 0, ny = 0, nn = 0;
+    for (int d = 0; d < D; ++d) {
+      rad2 += y[d] * y[d];
+      ny += n[d] * y[d];
+      nn += n[d] * n[d];
+    }
+    const double rad = std::sqrt(rad2);
+    if (!std::isfinite(rad) || rad > 1e6 * diam_) return std::numeric_limits<double>::infinity();
+    double centre[D], radius;
+    if (ny <= 0) {
+      // Centre on the found side: the cap beyond the plane lies within the
+      // base disc's radius of the base centre (the centre's projection).
+      const double t = ny / nn;
+      double rho2 = rad2 - ny * t;
+      for (int d = 0; d < D; ++d) centre[d] = a[d] + y[d] - t * n[d];
+      radius = std::sqrt(std::max(0.0, rho2));
+    } else {
+      for (int d = 0; d < D; ++d) centre[d] = a[d] + y[d];
+      radius = rad;
+    }
+    double dist2 = 0;
+    for (int d = 0; d < D; ++d) dist2 += (centre[d] - c[d]) * (centre[d] - c[d]);
+    const double reach = (std::sqrt(dist2) + radius) * (1 + 1e-6) + 1e-9 * diam_;
+    return reach * reach;
+  }
+
+  const kernels::ExactContext& ctx_;
+  const kernels::BinLocator<D>& loc_;
+  double diam_;
+};
+
+}  // namespace tessera::front

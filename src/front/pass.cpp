@@ -1,0 +1,189 @@
+// The shared set-up of a cells pass; see pass.hpp.
+#include "pass.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <string>
+
+namespace tessera::front {
+namespace {
+const char* axis_name(int d) { return d == 0 ? "x" : (d == 1 ? "y" : "z"); }
+}  // namespace
+
+void check_input(std::span<const double> points, int dim, std::span<const std::int32_t> labels) {
+  if (dim != 2 && dim != 3) throw InputError("dimension must be 2 or 3, got " + std::to_string(dim));
+  if (points.empty()) throw InputError("no input points");
+  if (points.size() % static_cast<std::size_t>(dim) != 0)
+    throw InputError("point array length " + std::to_string(points.size()) + " is not a multiple of dimension " +
+                     std::to_string(dim));
+  const std::size_t n = points.size() / static_cast<std::size_t>(dim);
+  if (n > static_cast<std::size_t>(INT32_MAX - 1)) throw InputError("too many points (ids are 32-bit)");
+  for (std::size_t k = 0; k < points.size(); ++k)
+    if (!std::isfinite(points[k]))
+      throw InputError("point " + std::to_string(k / static_cast<std::size_t>(dim)) + " has a NaN or infinite coordinate");
+  if (!labels.empty() && labels.size() != n)
+    throw InputError("labels: " + std::to_string(labels.size()) + " values for " + std::to_string(n) + " points");
+  if (!labels.empty() && std::none_of(labels.begin(), labels.end(), [](std::int32_t l) { return l >= 0; }))
+    throw InputError("labels: every point is outside (label < 0); nothing to tessellate");
+}
+
+Bounds make_domain(std::span<const double> pts, int dim, const VoronoiOptions& opt) {
+  const std::size_t n = pts.size() / static_cast<std::size_t>(dim);
+  if (opt.bounds) {
+    Bounds b = *opt.bounds;
+    for (int d = 0; d < dim; ++d) {
+      auto du = static_cast<std::size_t>(d);
+      if (!std::isfinite(b.lo[du]) || !std::isfinite(b.hi[du]) || !(b.lo[du] < b.hi[du])) {
+        std::ostringstream m;
+        m << "bounds: " << axis_name(d) << " range [" << b.lo[du] << ", " << b.hi[du] << "] is empty or not finite";
+        throw InputError(m.str());
+      }
+    }
+    return b;
+  }
+  if (!(opt.padding >= 0) || !std::isfinite(opt.padding))
+    throw InputError("padding must be a finite number >= 0");
+  Bounds b;
+  for (int d = 0; d < dim; ++d) {
+    b.lo[static_cast<std::size_t>(d)] = INFINITY;
+    b.hi[static_cast<std::size_t>(d)] = -INFINITY;
+  }
+  for (std::size_t i = 0; i < n; ++i)
+    for (int d = 0; d < dim; ++d) {
+      double x = pts[i * static_cast<std::size_t>(dim) + static_cast<std::size_t>(d)];
+      b.lo[static_cast<std::size_t>(d)] = std::min(b.lo[static_cast<std::size_t>(d)], x);
+      b.hi[static_cast<std::size_t>(d)] = std::max(b.hi[static_cast<std::size_t>(d)], x);
+    }
+  if (n == 1)
+    throw InputError("a single point has no extent to make a domain from; give the domain with --bounds");
+  double ext = 0;
+  for (int d = 0; d < dim; ++d) {
+    auto du = static_cast<std::size_t>(d);
+    double e = b.hi[du] - b.lo[du];
+    if (!(e > 0)) {
+      std::ostringstream m;
+      m << "all points have the same " << axis_name(d) << " coordinate (" << b.lo[du]
+        << "): the bounding box has zero extent";
+      if (dim == 3) m << "; for planar input use --dim 2, or give --bounds";
+      else m << "; give --bounds";
+      throw InputError(m.str());
+    }
+    ext = std::max(ext, e);
+  }
+  // Pad, then round outward to a multiple of a power of two near ext/64: the
+  // box constants become short binary fractions (integer grids get the
+  // half-integer box), so exact predicates on box vertices stay in the fast
+  // 128-bit path. The margin is never smaller than asked.
+  int e;
+  std::frexp(ext, &e);
+  const double step = std::ldexp(1.0, e - 7);
+  for (int d = 0; d < dim; ++d) {
+    auto du = static_cast<std::size_t>(d);
+    b.lo[du] = std::floor((b.lo[du] - opt.padding * ext) / step) * step;
+    b.hi[du] = std::ceil((b.hi[du] + opt.padding * ext) / step) * step;
+  }
+  return b;
+}
+
+// Scaling by 2^k is exact. The shift is capped so that every non-zero
+// coordinate stays a normal double (no rounding into subnormals) and nothing
+// overflows.
+int normalizing_exponent(std::span<const double> points, const Bounds& b, int dim) {
+  double m = 0, m_min = INFINITY;
+  auto see = [&](double x) {
+    x = std::fabs(x);
+    m = std::max(m, x);
+    if (x != 0) m_min = std::min(m_min, x);
+  };
+  for (double x : points) see(x);
+  for (int d = 0; d < dim; ++d) {
+    see(b.lo[static_cast<std::size_t>(d)]);
+    see(b.hi[static_cast<std::size_t>(d)]);
+  }
+  if (m == 0 || (m < 0x1p200 && m > 0x1p-200)) return 0;
+  int e_max, e_min;
+  std::frexp(m, &e_max);
+  std::frexp(m_min, &e_min);
+  // x * 2^k stays normal iff e_min + k >= -1021, and finite iff e_max + k <= 1024.
+  return std::clamp(-e_max, -1021 - e_min, 1000 - e_max);
+}
+
+template <int D>
+Pass<D>::Pass(std::span<const double> input, std::span<const std::int32_t> labels, const VoronoiOptions& opt) {
+  const std::size_t n = input.size() / D;
+  user_bounds = make_domain(input, D, opt);
+  bounds = user_bounds;
+  // Extreme magnitudes: compute on an exactly rescaled copy.
+  k = normalizing_exponent(input, user_bounds, D);
+  points = input;
+  if (k != 0) {
+    scaled.resize(input.size());
+    for (std::size_t i = 0; i < input.size(); ++i) scaled[i] = std::ldexp(input[i], k);
+    for (int d = 0; d < D; ++d) {
+      bounds.lo[static_cast<std::size_t>(d)] = std::ldexp(bounds.lo[static_cast<std::size_t>(d)], k);
+      bounds.hi[static_cast<std::size_t>(d)] = std::ldexp(bounds.hi[static_cast<std::size_t>(d)], k);
+    }
+    points = scaled;
+  }
+
+  // Which points take part (inside the box) and which get cells (also label >= 0).
+  in_box.assign(n, 1);
+  std::size_t n_in = n;
+  for (std::size_t i = 0; i < n; ++i) {
+    for (int d = 0; d < D; ++d) {
+      double x = points[i * D + static_cast<std::size_t>(d)];
+      if (x < bounds.lo[static_cast<std::size_t>(d)] || x > bounds.hi[static_cast<std::size_t>(d)]) {
+        in_box[i] = 0;
+        break;
+      }
+    }
+    if (!in_box[i]) {
+      if (!opt.ignore_outside_points) {
+        std::ostringstream m;
+        m << "point " << i << " lies outside the bounds (use --ignore-outside to drop such points)";
+        throw InputError(m.str());
+      }
+      ignored_outside.push_back(static_cast<std::int32_t>(i));
+      --n_in;
+    }
+  }
+  if (n_in == 0) throw InputError("all points lie outside the bounds");
+
+  std::array<double, D> lo, hi;
+  for (int d = 0; d < D; ++d) {
+    lo[static_cast<std::size_t>(d)] = bounds.lo[static_cast<std::size_t>(d)];
+    hi[static_cast<std::size_t>(d)] = bounds.hi[static_cast<std::size_t>(d)];
+  }
+  const double ppb = opt.points_per_bin > 0 ? opt.points_per_bin : 2.0;
+  locator.emplace(points, n_in == n ? std::span<const std::uint8_t>() : std::span<const std::uint8_t>(in_box), lo, hi,
+                  ppb);
+
+  // Generators with cells, in bin order (neighbouring cells run together).
+  order.reserve(locator->size());
+  for (std::size_t s = 0; s < locator->size(); ++s) {
+    std::int32_t id = locator->id(s);
+    if (labels.empty() || labels[static_cast<std::size_t>(id)] >= 0) order.push_back(id);
+  }
+
+  exact.points = points.data();
+  exact.dim = D;
+  for (int d = 0; d < 3; ++d) {
+    exact.lo[static_cast<std::size_t>(d)] = bounds.lo[static_cast<std::size_t>(d)];
+    exact.hi[static_cast<std::size_t>(d)] = bounds.hi[static_cast<std::size_t>(d)];
+  }
+  gens.coords = points.data();
+  gens.locator = &*locator;
+  gens.lo = lo;
+  gens.hi = hi;
+  gens.order = order;
+  gens.exact = &exact;
+
+  engine_options.threads = resolve_threads(opt.threads);
+  engine_options.progress = opt.progress;
+}
+
+template struct Pass<2>;
+template struct Pass<3>;
+
+}  // namespace tessera::front

@@ -1,0 +1,58 @@
+// What every product's cells pass shares: input checks, the domain box, exact
+// power-of-two rescaling of extreme inputs, the locator and the generator order.
+// tessera::voronoi and tessera::delaunay each run one Pass with their own
+// compositor (DESIGN §2: one engine, many compositors).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <vector>
+
+#include "tessera/cells.hpp"
+#include "tessera/engine/tessellate.hpp"
+#include "tessera/kernels/exact_predicates.hpp"
+#include "tessera/kernels/locator.hpp"
+
+namespace tessera::front {
+
+/// Throws InputError unless points/labels are a valid input of dimension dim.
+void check_input(std::span<const double> points, int dim, std::span<const std::int32_t> labels);
+
+/// The domain: explicit bounds checked, or the bounding box padded and rounded
+/// outward to a short binary fraction (see cells.cpp).
+Bounds make_domain(std::span<const double> points, int dim, const VoronoiOptions& opt);
+
+/// Power-of-two exponent that brings extreme coordinates near 1 (0 for sane input).
+int normalizing_exponent(std::span<const double> points, const Bounds& b, int dim);
+
+/// Everything set up for one engine run over the input. Not movable: the
+/// engine's Generators point into it.
+template <int D>
+struct Pass {
+  Pass(std::span<const double> input, std::span<const std::int32_t> labels, const VoronoiOptions& opt);
+  Pass(const Pass&) = delete;
+  Pass& operator=(const Pass&) = delete;
+
+  /// Coordinates from the computation's frame (scaled by 2^k) back to the user's.
+  double unscale(double x) const { return k == 0 ? x : std::ldexp(x, -k); }
+
+  Bounds user_bounds;                        ///< the domain in the user's frame
+  Bounds bounds;                             ///< the domain in the computation's frame
+  int k = 0;                                 ///< coordinates are scaled by 2^k
+  std::vector<double> scaled;                ///< the scaled copy when k != 0
+  std::span<const double> points;            ///< the computation's coordinates
+  std::vector<std::uint8_t> in_box;          ///< per point: inside the domain
+  std::vector<std::int32_t> ignored_outside; ///< points dropped (ignore_outside_points)
+  std::optional<kernels::BinLocator<D>> locator;
+  std::vector<std::int32_t> order;           ///< generators with cells wanted, bin order
+  kernels::ExactContext exact;
+  engine::Generators<D> gens;
+  engine::EngineOptions engine_options;
+};
+
+extern template struct Pass<2>;
+extern template struct Pass<3>;
+
+}  // namespace tessera::front

@@ -1,0 +1,184 @@
+// tessera::validate for a Delaunay triangulation: orientation, conformity,
+// closed and convex boundary, every point used, local Delaunay, volumes.
+//
+// Local Delaunay on every interior facet of a conforming triangulation implies
+// the triangulation is Delaunay (Delaunay's lemma); with a closed, locally
+// convex boundary and every point a vertex, it is the triangulation of the
+// convex hull. All decisions use the exact predicates, in the same symbolic
+// perturbation the computation used.
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <sstream>
+#include <vector>
+
+#include <tbb/parallel_for.h>
+
+#include "tessera/delaunay.hpp"
+#include "simplex_facets.hpp"
+#include "tessera/kernels/delaunay_predicates.hpp"
+
+namespace tessera {
+namespace {
+
+using front::FacetRecord;
+
+double det_rows(const double (*r)[3], int D) {
+  if (D == 2) return r[0][0] * r[1][1] - r[0][1] * r[1][0];
+  return r[0][0] * (r[1][1] * r[2][2] - r[1][2] * r[2][1]) - r[0][1] * (r[1][0] * r[2][2] - r[1][2] * r[2][0]) +
+         r[0][2] * (r[1][0] * r[2][1] - r[1][1] * r[2][0]);
+}
+
+}  // namespace
+
+DelaunayReport validate(const Delaunay& dt, std::span<const double> points, std::span<const std::int32_t> labels) {
+  DelaunayReport rep;
+  const int D = dt.dim;
+  const std::size_t w = static_cast<std::size_t>(D + 1);
+  const std::size_t m = dt.n_simplices();
+  rep.simplices = m;
+  kernels::ExactContext ctx;
+  ctx.points = points.data();
+  ctx.dim = D;
+  auto pt = [&](std::int32_t id) { return points.data() + static_cast<std::size_t>(id) * static_cast<std::size_t>(D); };
+  const double fact = D == 2 ? 2.0 : 6.0;
+
+  // Orientation and volume of every simplex.
+  std::vector<std::uint8_t> bad(m, 0);
+  std::vector<double> vol(m, 0);
+  tbb::parallel_for(std::size_t(0), m, [&](std::size_t s) {
+    const std::int32_t* row = dt.simplices.data() + s * w;
+    bad[s] = kernels::orientation(ctx, row) != 1;
+    double r[3][3] = {};
+    for (int k = 0; k < D; ++k)
+      for (int d = 0; d < D; ++d) r[k][d] = pt(row[k + 1])[d] - pt(row[0])[d];
+    vol[s] = det_rows(r, D) / fact;
+  });
+  rep.flat_or_inverted = static_cast<std::size_t>(std::count(bad.begin(), bad.end(), 1));
+  for (double v : vol) rep.volume_sum += v;
+
+  // Facets, sorted so the simplices sharing one sit together.
+  const std::vector<FacetRecord> recs = front::sorted_facets(dt);
+
+  // A facet of simplex s (opposite slot k) with the apex, as D+1 ids in the
+  // simplex's own order: the facet's orientation seen from its simplex.
+  auto side_of = [&](const FacetRecord& f, std::int32_t q) {
+    std::array<std::int32_t, 4> ids;
+    const std::int32_t* row = dt.simplices.data() + static_cast<std::size_t>(f.simplex) * w;
+    for (std::size_t j = 0; j < w; ++j) ids[j] = row[j];
+    ids[static_cast<std::size_t>(f.k)] = q;
+    return kernels::orientation(ctx, ids.data());
+  };
+  auto apex = [&](const FacetRecord& f) {
+    return dt.simplices[static_cast<std::size_t>(f.simplex) * w + static_cast<std::size_t>(f.k)];
+  };
+
+  std::vector<const FacetRecord*> boundary;
+  std::vector<std::pair<const FacetRecord*, const FacetRecord*>> interior;
+  for (std::size_t i = 0; i < recs.size();) {
+    std::size_t j = i + 1;
+    while (j < recs.size() && recs[j].facet == recs[i].facet) ++j;
+    if (j - i == 1) boundary.push_back(&recs[i]);
+    else if (j - i == 2) interior.emplace_back(&recs[i], &recs[i + 1]);
+    else rep.nonmanifold_facets += j - i - 2;
+    i = j;
+  }
+  rep.boundary_facets = boundary.size();
+
+  // Interior facets: the two apexes on opposite sides; neither in the other's sphere.
+  std::vector<std::uint8_t> twice(interior.size(), 0), nonlocal(interior.size(), 0);
+  tbb::parallel_for(std::size_t(0), interior.size(), [&](std::size_t i) {
+    auto [a, b] = interior[i];
+    // Replacing a's apex by b's apex must flip a's orientation (+1 -> -1).
+    if (side_of(*a, apex(*b)) != -1) { twice[i] = 1; return; }
+    const std::int32_t* row = dt.simplices.data() + static_cast<std::size_t>(a->simplex) * w;
+    if (kernels::in_sphere(ctx, row[0], row + 1, apex(*b))) nonlocal[i] = 1;
+  });
+  rep.nonmanifold_facets += static_cast<std::size_t>(std::count(twice.begin(), twice.end(), 1));
+  rep.local_delaunay_violations = static_cast<std::size_t>(std::count(nonlocal.begin(), nonlocal.end(), 1));
+
+  // Boundary: the volume it encloses (facets in the simplex's induced
+  // orientation, sign (-1)^k), and its ridges, each in exactly two boundary facets.
+  double o[3] = {0, 0, 0};
+  for (int d = 0; d < D; ++d) o[d] = 0.5 * (dt.bounds.lo[static_cast<std::size_t>(d)] + dt.bounds.hi[static_cast<std::size_t>(d)]);
+  struct RidgeRec {
+    std::array<std::int32_t, 2> ridge;
+    std::int32_t facet;   // index into boundary
+    std::int32_t other;   // the facet's vertex not on the ridge
+    bool operator<(const RidgeRec& r) const { return ridge != r.ridge ? ridge < r.ridge : facet < r.facet; }
+  };
+  std::vector<RidgeRec> ridges;
+  for (std::size_t b = 0; b < boundary.size(); ++b) {
+    const FacetRecord& f = *boundary[b];
+    const std::int32_t* row = dt.simplices.data() + static_cast<std::size_t>(f.simplex) * w;
+    double r[3][3] = {};
+    for (std::size_t j = 0, c = 0; j < w; ++j) {
+      if (static_cast<std::int32_t>(j) == f.k) continue;
+      for (int d = 0; d < D; ++d) r[c][d] = pt(row[j])[d] - o[d];
+      ++c;
+    }
+    rep.enclosed_volume += ((f.k % 2) ? -1.0 : 1.0) * det_rows(r, D) / fact;
+    for (int drop = 0; drop < D; ++drop) {
+      RidgeRec rr{{-1, -1}, static_cast<std::int32_t>(b), f.facet[static_cast<std::size_t>(drop)]};
+      for (int j = 0, c = 0; j < D; ++j)
+        if (j != drop) rr.ridge[static_cast<std::size_t>(c++)] = f.facet[static_cast<std::size_t>(j)];
+      ridges.push_back(rr);
+    }
+  }
+  std::sort(ridges.begin(), ridges.end());
+  for (std::size_t i = 0; i < ridges.size();) {
+    std::size_t j = i + 1;
+    while (j < ridges.size() && ridges[j].ridge == ridges[i].ridge) ++j;
+    if (!labels.empty()) {
+      // Labelled results may be concave and pinched: nothing to check here.
+    } else if (j - i != 2) {
+      ++rep.open_boundary_ridges;
+    } else {
+      // Convex: each facet's far vertex is not strictly beyond the other facet.
+      for (int t = 0; t < 2; ++t) {
+        const RidgeRec& a = ridges[i + static_cast<std::size_t>(t)];
+        const RidgeRec& b = ridges[i + static_cast<std::size_t>(1 - t)];
+        if (side_of(*boundary[static_cast<std::size_t>(a.facet)], b.other) == -1) {
+          ++rep.nonconvex_boundary;
+          break;
+        }
+      }
+    }
+    i = j;
+  }
+
+  // Every point that takes part is a vertex.
+  if (labels.empty()) {
+    std::vector<std::uint8_t> used(dt.n_points, 0);
+    for (std::int32_t id : dt.simplices) used[static_cast<std::size_t>(id)] = 1;
+    for (auto [dup, owner] : dt.duplicates) used[static_cast<std::size_t>(dup)] = 1;
+    for (std::int32_t id : dt.ignored_outside_bounds) used[static_cast<std::size_t>(id)] = 1;
+    rep.missing_points = static_cast<std::size_t>(std::count(used.begin(), used.end(), 0));
+    // Exactly flat input has no simplex and nothing to check.
+    if (m == 0) rep.missing_points = 0;
+  }
+
+  auto fail = [&](std::size_t count, const char* what) {
+    if (count == 0) return;
+    rep.ok = false;
+    std::ostringstream s;
+    s << count << " " << what;
+    rep.messages.push_back(s.str());
+  };
+  fail(rep.flat_or_inverted, "simplices are flat or inverted");
+  fail(rep.nonmanifold_facets, "facets are shared by more than two simplices or overlap");
+  fail(rep.open_boundary_ridges, "boundary ridges are not shared by exactly two boundary facets");
+  fail(rep.nonconvex_boundary, "boundary ridges are not convex (the hull is incomplete)");
+  fail(rep.missing_points, "points are in no simplex");
+  fail(rep.local_delaunay_violations, "interior facets are not locally Delaunay");
+  const double tol = 1e-9 * std::max(std::fabs(rep.volume_sum), std::fabs(rep.enclosed_volume)) + 1e-300;
+  if (std::fabs(rep.volume_sum - rep.enclosed_volume) > tol) {
+    rep.ok = false;
+    std::ostringstream s;
+    s << "simplex volumes sum to " << rep.volume_sum << " but the boundary encloses " << rep.enclosed_volume;
+    rep.messages.push_back(s.str());
+  }
+  return rep;
+}
+
+}  // namespace tessera

@@ -1,0 +1,147 @@
+// Filtered orientation and in-sphere predicates; see delaunay_predicates.hpp.
+#include "tessera/kernels/delaunay_predicates.hpp"
+
+#include <gmp.h>
+
+#include <cmath>
+
+#include "tessera/kernels/filter.hpp"
+
+namespace tessera::kernels {
+namespace {
+
+const double* pt(const ExactContext& ctx, std::int32_t id) {
+  return ctx.points + static_cast<std::size_t>(id) * static_cast<std::size_t>(ctx.dim);
+}
+
+// Rows r_k = p_k - p_0 (rounded) of the orientation matrix.
+struct Rows {
+  double r[3][3];
+};
+
+// det of the D x D matrix of rows and its permanent (for the error bound).
+double det_perm(const double (*r)[3], int dim, double& perm) {
+  if (dim == 2) {
+    double a = r[0][0] * r[1][1], b = r[0][1] * r[1][0];
+    perm = std::fabs(a) + std::fabs(b);
+    return a - b;
+  }
+  double c0 = r[1][1] * r[2][2] - r[1][2] * r[2][1];
+  double c1 = r[1][2] * r[2][0] - r[1][0] * r[2][2];
+  double c2 = r[1][0] * r[2][1] - r[1][1] * r[2][0];
+  double p0 = std::fabs(r[1][1] * r[2][2]) + std::fabs(r[1][2] * r[2][1]);
+  double p1 = std::fabs(r[1][2] * r[2][0]) + std::fabs(r[1][0] * r[2][2]);
+  double p2 = std::fabs(r[1][0] * r[2][1]) + std::fabs(r[1][1] * r[2][0]);
+  perm = std::fabs(r[0][0]) * p0 + std::fabs(r[0][1]) * p1 + std::fabs(r[0][2]) * p2;
+  return r[0][0] * c0 + r[0][1] * c1 + r[0][2] * c2;
+}
+
+// Exact orientation in rationals: every double is exactly representable.
+int orientation_exact(const ExactContext& ctx, const std::int32_t* ids) {
+  const int D = ctx.dim;
+  struct Q {
+    mpq_t m[3][3], t, u, acc;
+    Q() {
+      for (auto& r : m) for (auto& c : r) mpq_init(c);
+      mpq_init(t); mpq_init(u); mpq_init(acc);
+    }
+    ~Q() {
+      for (auto& r : m) for (auto& c : r) mpq_clear(c);
+      mpq_clear(t); mpq_clear(u); mpq_clear(acc);
+    }
+  };
+  thread_local Q q;
+  const double* p0 = pt(ctx, ids[0]);
+  for (int k = 0; k < D; ++k) {
+    const double* p = pt(ctx, ids[k + 1]);
+    for (int d = 0; d < D; ++d) {
+      mpq_set_d(q.t, p[d]);
+      mpq_set_d(q.u, p0[d]);
+      mpq_sub(q.m[k][d], q.t, q.u);
+    }
+  }
+  if (D == 2) {
+    mpq_mul(q.t, q.m[0][0], q.m[1][1]);
+    mpq_mul(q.u, q.m[0][1], q.m[1][0]);
+    mpq_sub(q.acc, q.t, q.u);
+    return mpq_sgn(q.acc);
+  }
+  mpq_set_ui(q.acc, 0, 1);
+  for (int c = 0; c < 3; ++c) {
+    int c1 = (c + 1) % 3, c2 = (c + 2) % 3;
+    mpq_mul(q.t, q.m[1][c1], q.m[2][c2]);
+    mpq_mul(q.u, q.m[1][c2], q.m[2][c1]);
+    mpq_sub(q.t, q.t, q.u);
+    mpq_mul(q.t, q.t, q.m[0][c]);
+    mpq_add(q.acc, q.acc, q.t);
+  }
+  return mpq_sgn(q.acc);
+}
+
+}  // namespace
+
+int orientation(const ExactContext& ctx, const std::int32_t* ids) {
+  const int D = ctx.dim;
+  double r[3][3] = {};
+  const double* p0 = pt(ctx, ids[0]);
+  for (int k = 0; k < D; ++k) {
+    const double* p = pt(ctx, ids[k + 1]);
+    for (int d = 0; d < D; ++d) r[k][d] = p[d] - p0[d];
+  }
+  double perm;
+  const double det = det_perm(r, D, perm);
+  // Shewchuk's bounds are 3u (2D) and 7u (3D) of the permanent including the
+  // rounded differences; 16u leaves room to spare.
+  const double bound = 16 * filter::u * perm + filter::abs_eps;
+  if (det > bound) return 1;
+  if (det < -bound) return -1;
+  return orientation_exact(ctx, ids);
+}
+
+bool in_sphere(const ExactContext& ctx, std::int32_t a, const std::int32_t* planes, std::int32_t q) {
+  // Float filter on the Schur form of the clip predicate: with rows
+  // r_k = p_k - p_a, s_k = |r_k|^2 for the planes and for q (last row),
+  // det[[R, s], [r_q, s_q]] = det R * (pow_q(v) - pow_a(v)) (exact_predicates.hpp),
+  // and q is inside iff that power difference is negative.
+  const int D = ctx.dim;
+  double r[4][3] = {}, s[4];
+  const double* pa = pt(ctx, a);
+  for (int k = 0; k <= D; ++k) {
+    const double* p = pt(ctx, k < D ? planes[k] : q);
+    s[k] = 0;
+    for (int d = 0; d < D; ++d) {
+      r[k][d] = p[d] - pa[d];
+      s[k] += r[k][d] * r[k][d];
+    }
+  }
+  // det R (rows 0..D-1) and the full determinant by expansion along the s column.
+  double perm_r;
+  const double det_r = det_perm(r, D, perm_r);
+  double det_m = 0, perm_m = 0;
+  for (int k = 0; k <= D; ++k) {
+    double minor[3][3] = {};
+    int row = 0;
+    for (int m = 0; m <= D; ++m) {
+      if (m == k) continue;
+      for (int d = 0; d < D; ++d) minor[row][d] = r[m][d];
+      ++row;
+    }
+    double pm;
+    double dm = det_perm(minor, D, pm);
+    // Cofactor sign of (row k, column D) in a (D+1) x (D+1) matrix.
+    double sign = ((k + D) % 2 == 0) ? 1.0 : -1.0;
+    det_m += sign * s[k] * dm;
+    perm_m += s[k] * pm;
+  }
+  const double bound_r = 16 * filter::u * perm_r + filter::abs_eps;
+  // The lifted column is itself rounded (relative 3u per entry): 64u covers the
+  // classic 11u of Shewchuk's insphere bound with a wide margin.
+  const double bound_m = 64 * filter::u * perm_m + filter::abs_eps;
+  if (std::fabs(det_r) > bound_r && std::fabs(det_m) > bound_m) {
+    // P = det M / det R; inside iff P < 0.
+    return (det_m > 0) != (det_r > 0);
+  }
+  return exact_clip_sign(ctx, a, planes, q) < 0;
+}
+
+}  // namespace tessera::kernels

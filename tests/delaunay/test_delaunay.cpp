@@ -1,0 +1,265 @@
+// Delaunay triangulation: simplex sets equal to CGAL's on points in general
+// position (hull included), valid triangulations on degenerate inputs, 1 vs N
+// threads identical, labels and duplicates.
+#include <gtest/gtest.h>
+
+#include <CGAL/Delaunay_triangulation_2.h>
+#include <CGAL/Delaunay_triangulation_3.h>
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Triangulation_vertex_base_with_info_2.h>
+#include <CGAL/Triangulation_vertex_base_with_info_3.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <random>
+#include <set>
+#include <vector>
+
+#include "tessera/delaunay.hpp"
+
+namespace {
+
+using K = CGAL::Exact_predicates_inexact_constructions_kernel;
+using Vb3 = CGAL::Triangulation_vertex_base_with_info_3<std::int32_t, K>;
+using Tds3 = CGAL::Triangulation_data_structure_3<Vb3>;
+using DT3 = CGAL::Delaunay_triangulation_3<K, Tds3>;
+using Vb2 = CGAL::Triangulation_vertex_base_with_info_2<std::int32_t, K>;
+using Tds2 = CGAL::Triangulation_data_structure_2<Vb2>;
+using DT2 = CGAL::Delaunay_triangulation_2<K, Tds2>;
+
+using SimplexSet = std::set<std::vector<std::int32_t>>;
+
+std::vector<double> random_points(std::size_t n, int dim, std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::vector<double> p(n * static_cast<std::size_t>(dim));
+  for (double& x : p) x = u(rng);
+  return p;
+}
+
+SimplexSet cgal_simplices(const std::vector<double>& p, int dim) {
+  SimplexSet out;
+  const std::size_t n = p.size() / static_cast<std::size_t>(dim);
+  if (dim == 3) {
+    std::vector<std::pair<K::Point_3, std::int32_t>> pts;
+    for (std::size_t i = 0; i < n; ++i)
+      pts.emplace_back(K::Point_3(p[3 * i], p[3 * i + 1], p[3 * i + 2]), static_cast<std::int32_t>(i));
+    DT3 dt(pts.begin(), pts.end());
+    for (auto c = dt.finite_cells_begin(); c != dt.finite_cells_end(); ++c) {
+      std::vector<std::int32_t> s;
+      for (int k = 0; k < 4; ++k) s.push_back(c->vertex(k)->info());
+      std::sort(s.begin(), s.end());
+      out.insert(s);
+    }
+  } else {
+    std::vector<std::pair<K::Point_2, std::int32_t>> pts;
+    for (std::size_t i = 0; i < n; ++i) pts.emplace_back(K::Point_2(p[2 * i], p[2 * i + 1]), static_cast<std::int32_t>(i));
+    DT2 dt(pts.begin(), pts.end());
+    for (auto f = dt.finite_faces_begin(); f != dt.finite_faces_end(); ++f) {
+      std::vector<std::int32_t> s;
+      for (int k = 0; k < 3; ++k) s.push_back(f->vertex(k)->info());
+      std::sort(s.begin(), s.end());
+      out.insert(s);
+    }
+  }
+  return out;
+}
+
+SimplexSet as_set(const tessera::Delaunay& dt) {
+  SimplexSet out;
+  const std::size_t w = static_cast<std::size_t>(dt.dim + 1);
+  for (std::size_t s = 0; s < dt.n_simplices(); ++s) {
+    std::vector<std::int32_t> v(dt.simplices.begin() + static_cast<std::ptrdiff_t>(s * w),
+                                dt.simplices.begin() + static_cast<std::ptrdiff_t>((s + 1) * w));
+    std::sort(v.begin(), v.end());
+    out.insert(v);
+  }
+  return out;
+}
+
+tessera::Delaunay run(const std::vector<double>& p, int dim, int threads = 2,
+                      const std::vector<std::int32_t>& labels = {}) {
+  tessera::DelaunayOptions o;
+  o.dim = dim;
+  o.threads = threads;
+  return tessera::delaunay(p, dim, labels, o);
+}
+
+void expect_valid(const tessera::Delaunay& dt, const std::vector<double>& p,
+                  const std::vector<std::int32_t>& labels = {}) {
+  tessera::DelaunayReport r = tessera::validate(dt, p, labels);
+  for (const auto& m : r.messages) ADD_FAILURE() << m;
+  EXPECT_TRUE(r.ok);
+  EXPECT_EQ(as_set(dt).size(), dt.n_simplices()) << "a simplex is listed twice";
+}
+
+class EqualsCgal : public ::testing::TestWithParam<std::tuple<int, int, int>> {};
+
+TEST_P(EqualsCgal, RandomPoints) {
+  auto [dim, n, seed] = GetParam();
+  auto p = random_points(static_cast<std::size_t>(n), dim, static_cast<std::uint64_t>(seed));
+  tessera::Delaunay dt = run(p, dim);
+  SimplexSet ours = as_set(dt), theirs = cgal_simplices(p, dim);
+  EXPECT_EQ(ours.size(), theirs.size());
+  std::size_t missing = 0, extra = 0;
+  for (const auto& s : theirs) missing += !ours.count(s);
+  for (const auto& s : ours) extra += !theirs.count(s);
+  EXPECT_EQ(missing, 0u);
+  EXPECT_EQ(extra, 0u);
+  EXPECT_TRUE(dt.hull_completed);
+  EXPECT_GT(dt.from_hull_completion, 0u) << "the padded box should miss some thin hull simplices";
+  expect_valid(dt, p);
+}
+
+INSTANTIATE_TEST_SUITE_P(Delaunay, EqualsCgal,
+                         ::testing::Values(std::tuple{2, 10, 1}, std::tuple{2, 1000, 2}, std::tuple{2, 20000, 3},
+                                           std::tuple{3, 12, 4}, std::tuple{3, 1000, 5}, std::tuple{3, 20000, 6}));
+
+TEST(Delaunay, RowsAreOrientedAndAscending) {
+  for (int dim : {2, 3}) {
+    auto p = random_points(2000, dim, 7);
+    tessera::Delaunay dt = run(p, dim);
+    const std::size_t w = static_cast<std::size_t>(dim + 1);
+    std::vector<std::vector<std::int32_t>> keys;
+    for (std::size_t s = 0; s < dt.n_simplices(); ++s) {
+      const std::int32_t* row = dt.simplices.data() + s * w;
+      EXPECT_EQ(*std::min_element(row, row + w), row[0]);
+      std::vector<std::int32_t> k(row, row + w);
+      std::sort(k.begin(), k.end());
+      keys.push_back(k);
+    }
+    EXPECT_TRUE(std::is_sorted(keys.begin(), keys.end()));
+    expect_valid(dt, p);
+  }
+}
+
+TEST(Delaunay, ThreadsGiveIdenticalOutput) {
+  for (int dim : {2, 3}) {
+    auto p = random_points(5000, dim, 11);
+    EXPECT_EQ(run(p, dim, 1).simplices, run(p, dim, 2).simplices);
+  }
+}
+
+std::vector<double> grid(int k, int dim) {
+  std::vector<double> p;
+  for (int i = 0; i < k; ++i)
+    for (int j = 0; j < k; ++j) {
+      if (dim == 2) { p.insert(p.end(), {double(i), double(j)}); continue; }
+      for (int l = 0; l < k; ++l) p.insert(p.end(), {double(i), double(j), double(l)});
+    }
+  return p;
+}
+
+double hull_volume_of_grid(int k, int dim) { return std::pow(double(k - 1), dim); }
+
+TEST(Delaunay, LatticesGiveValidTriangulations) {
+  for (int dim : {2, 3}) {
+    const int k = dim == 2 ? 30 : 8;
+    auto p = grid(k, dim);
+    tessera::Delaunay dt = run(p, dim);
+    expect_valid(dt, p);
+    tessera::DelaunayReport r = tessera::validate(dt, p, {});
+    EXPECT_NEAR(r.volume_sum, hull_volume_of_grid(k, dim), 1e-9);
+  }
+}
+
+TEST(Delaunay, RotatedLatticeAndSphere) {
+  // A rotated 7^3 lattice (inexact coordinates) and points on a sphere.
+  std::vector<double> rot;
+  const double c = std::cos(0.3), s = std::sin(0.3);
+  for (int i = 0; i < 7; ++i)
+    for (int j = 0; j < 7; ++j)
+      for (int l = 0; l < 7; ++l) rot.insert(rot.end(), {c * i - s * j, s * i + c * j, double(l)});
+  expect_valid(run(rot, 3), rot);
+
+  std::vector<double> sphere;  // integer points on the sphere of radius 5 (rbox s-like, exactly co-spherical)
+  for (int x = -5; x <= 5; ++x)
+    for (int y = -5; y <= 5; ++y)
+      for (int z = -5; z <= 5; ++z)
+        if (x * x + y * y + z * z == 25) sphere.insert(sphere.end(), {double(x), double(y), double(z)});
+  tessera::Delaunay dt = run(sphere, 3);
+  expect_valid(dt, sphere);
+}
+
+TEST(Delaunay, SpiralAndCircle) {
+  std::vector<double> spiral, circle;
+  for (int i = 0; i < 400; ++i) {
+    double t = 0.05 * i;
+    spiral.insert(spiral.end(), {t * std::cos(t), t * std::sin(t), 0.1 * t});
+  }
+  // Close to the moment curve: a quadratic number of simplices, nearly all of
+  // them thin hull simplices found by completion.
+  tessera::Delaunay sdt = run(spiral, 3);
+  EXPECT_EQ(as_set(sdt), cgal_simplices(spiral, 3));
+  expect_valid(sdt, spiral);
+  // 2D: integer points on a circle (co-circular) plus its centre.
+  for (int x = -25; x <= 25; ++x)
+    for (int y = -25; y <= 25; ++y)
+      if (x * x + y * y == 625) circle.insert(circle.end(), {double(x), double(y)});
+  circle.insert(circle.end(), {0.0, 0.0});
+  expect_valid(run(circle, 2), circle);
+}
+
+TEST(Delaunay, NearDuplicatesAndDuplicates) {
+  auto p = random_points(500, 3, 21);
+  for (int i = 0; i < 20; ++i) {
+    std::size_t a = static_cast<std::size_t>(i) * 3;
+    p.insert(p.end(), {p[a] + 1e-12, p[a + 1], p[a + 2]});  // near duplicate
+    p.insert(p.end(), {p[a + 3], p[a + 4], p[a + 5]});      // exact duplicate
+  }
+  tessera::Delaunay dt = run(p, 3);
+  EXPECT_EQ(dt.duplicates.size(), 20u);
+  expect_valid(dt, p);
+}
+
+TEST(Delaunay, FewPointsAndFlatInput) {
+  // Four points: one tetrahedron, whose circumcentre may lie outside the box.
+  std::vector<double> p = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0.3, 0.3, 0.01};
+  tessera::Delaunay dt = run(p, 3);
+  ASSERT_EQ(dt.n_simplices(), 1u);
+  expect_valid(dt, p);
+  // Three collinear 2D points plus a far one.
+  std::vector<double> q = {0, 0, 1, 0, 2, 0, 1, 1e-3};
+  tessera::Delaunay d2 = run(q, 2);
+  EXPECT_EQ(as_set(d2), cgal_simplices(q, 2));
+  expect_valid(d2, q);
+}
+
+TEST(Delaunay, LabelsKeepInsideSimplicesOnly) {
+  auto p = random_points(3000, 3, 31);
+  std::vector<std::int32_t> labels(3000);
+  for (std::size_t i = 0; i < 3000; ++i) {
+    double x = p[3 * i] - 0.5, y = p[3 * i + 1] - 0.5, z = p[3 * i + 2] - 0.5;
+    labels[i] = x * x + y * y + z * z < 0.16 ? 1 : -1;  // a ball of inside points
+  }
+  tessera::Delaunay dt = run(p, 3, 2, labels);
+  EXPECT_FALSE(dt.hull_completed);
+  SimplexSet all = cgal_simplices(p, 3);
+  SimplexSet expected;
+  for (const auto& s : all)
+    if (std::all_of(s.begin(), s.end(), [&](std::int32_t id) { return labels[static_cast<std::size_t>(id)] >= 0; }))
+      expected.insert(s);
+  // Every all-inside simplex of a ball well inside the box has its circumcentre in the box.
+  EXPECT_EQ(as_set(dt), expected);
+  expect_valid(dt, p, labels);
+}
+
+TEST(Delaunay, NeighborsAreMutual) {
+  auto p = random_points(3000, 3, 41);
+  tessera::Delaunay dt = run(p, 3);
+  auto nb = tessera::simplex_neighbors(dt);
+  std::size_t hull = 0;
+  for (std::size_t s = 0; s < dt.n_simplices(); ++s)
+    for (std::size_t k = 0; k < 4; ++k) {
+      std::int32_t t = nb[s * 4 + k];
+      if (t < 0) { ++hull; continue; }
+      const std::int32_t* row = dt.simplices.data() + static_cast<std::size_t>(t) * 4;
+      EXPECT_EQ(std::count(nb.begin() + t * 4, nb.begin() + t * 4 + 4, static_cast<std::int32_t>(s)), 1);
+      // The opposite vertex of s is not in t.
+      EXPECT_EQ(std::count(row, row + 4, dt.simplices[s * 4 + k]), 0);
+    }
+  EXPECT_EQ(hull, tessera::validate(dt, p, {}).boundary_facets);
+}
+
+}  // namespace
