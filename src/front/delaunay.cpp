@@ -74,7 +74,7 @@ Delaunay run(std::span<const double> input, std::span<const std::int32_t> labels
   std::vector<std::array<std::int32_t, D + 1>> added;
   if (complete) {
     out.hull_completed = true;
-    const kernels::BinLocator<D> candidates(pass.points, found.touches_box, pass.gens.lo, pass.gens.hi, 8.0);
+    const front::CandidateTree<D> candidates(pass.points, found.touches_box);
     double diam2 = 0;
     for (int d = 0; d < D; ++d) {
       double e = pass.gens.hi[static_cast<std::size_t>(d)] - pass.gens.lo[static_cast<std::size_t>(d)];

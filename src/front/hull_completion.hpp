@@ -13,7 +13,11 @@
 //    found simplex). No point beyond the facet: it is a hull facet.
 //  * Every vertex of a missing simplex has a cell that reaches the box (its
 //    circumcentre lies outside the box and inside all those cells), so the
-//    candidates come from a locator over those points only.
+//    candidates are those points only, in a small bounding-volume tree with
+//    tight boxes (candidate_tree.hpp). The region a better point must lie in
+//    (the current best sphere beyond the facet) is a huge, thin lens for the
+//    thin simplices near the hull; tight boxes around a shell of points prune
+//    it far better than a uniform grid, whose bins the lens cuts by hundreds.
 //  * Comparisons use in_sphere(), the clip predicate with its symbolic
 //    perturbation, so the added simplices are those of the same perturbed
 //    triangulation the cells pass computed: together they are one
@@ -37,7 +41,7 @@
 
 #include "delaunay_compositor.hpp"
 #include "tessera/kernels/delaunay_predicates.hpp"
-#include "tessera/kernels/locator.hpp"
+#include "candidate_tree.hpp"
 
 namespace tessera::front {
 
@@ -49,8 +53,8 @@ class HullCompletion {
 
   /// `candidates` holds the points whose cells reach the box; `diameter` is
   /// the domain's diagonal (the scale for float margins).
-  HullCompletion(const kernels::ExactContext& ctx, const kernels::BinLocator<D>& candidates, double diameter)
-      : ctx_(ctx), loc_(candidates), diam_(diameter) {}
+  HullCompletion(const kernels::ExactContext& ctx, const CandidateTree<D>& candidates, double diameter)
+      : ctx_(ctx), tree_(candidates), diam_(diameter) {}
 
   /// The point beyond `f` (away from `apex`) that closes it, or -1 for a hull facet.
   std::int32_t wrap(const Facet& f, std::int32_t apex) const {
@@ -59,9 +63,10 @@ class HullCompletion {
     ids[D] = apex;
     const int apex_side = kernels::orientation(ctx_, ids.data());
     if (apex_side == 0) throw std::logic_error("tessera: hull completion met a flat simplex");
-    // g(x) > 0 beyond the facet (float, for pruning bins only).
+    // Float normal n with n.(x - a) > 0 beyond the facet, for pruning only;
+    // the exact orientation decides for every point.
     const double* a = pt(f[0]);
-    double n[3] = {0, 0, 0};
+    double n[D];
     if constexpr (D == 3) {
       const double* b = pt(f[1]);
       const double* c = pt(f[2]);
@@ -74,60 +79,33 @@ class HullCompletion {
       n[0] = -(b[1] - a[1]);
       n[1] = b[0] - a[0];
     }
-    for (double& x : n) x *= -apex_side;
     double nn = 0;
-    for (int d = 0; d < D; ++d) nn += n[d] * n[d];
-    const double margin = 1e-9 * std::sqrt(nn) * diam_;
-    auto g = [&](const double* x) {
-      double s = 0;
-      for (int d = 0; d < D; ++d) s += n[d] * (x[d] - a[d]);
-      return s;
-    };
-
-    double c[D];
+    for (double& x : n) {
+      x *= -apex_side;
+      nn += x * x;
+    }
+    typename CandidateTree<D>::Query q;
     for (int d = 0; d < D; ++d) {
-      c[d] = 0;
-      for (int k = 0; k < D; ++k) c[d] += pt(f[k])[d];
-      c[d] /= D;
+      q.normal[d] = n[d];
+      q.origin[d] = a[d];
+      q.near[d] = 0;
+      for (int k = 0; k < D; ++k) q.near[d] += pt(f[static_cast<std::size_t>(k)])[d] / D;
     }
-    const auto b0 = loc_.bin_coords(c);
+    q.margin = 1e-9 * std::sqrt(nn) * diam_;
     std::int32_t best = -1;
-    double r2 = std::numeric_limits<double>::infinity();  // search radius^2 around c
-    const int smax = loc_.max_shell(b0);
-    for (int s = 0; s <= smax; ++s) {
-      if (s > 0 && best >= 0) {
-        double lb = loc_.shell_lower_bound(c, b0, s);
-        if (lb * lb > r2) break;
+    tree_.search(q, [&](std::int32_t p) {
+      if (p == apex || std::find(f.begin(), f.end(), p) != f.end()) return;
+      ids[D] = p;
+      if (kernels::orientation(ctx_, ids.data()) != -apex_side) return;  // not strictly beyond
+      if (best >= 0) {
+        std::array<std::int32_t, D> planes;
+        std::copy(f.begin() + 1, f.end(), planes.begin());
+        planes[D - 1] = best;
+        if (!kernels::in_sphere(ctx_, f[0], planes.data(), p)) return;
       }
-      loc_.for_each_shell_bin(b0, s, [&](const std::array<std::int32_t, D>& bin, std::size_t index) {
-        const auto& off = loc_.offsets();
-        if (off[index] == off[index + 1]) return;
-        if (best >= 0 && loc_.bin_distance2(c, bin) > r2) return;
-        double lo[D], hi[D];
-        loc_.bin_box(bin, lo, hi);
-        double gmax = -std::numeric_limits<double>::infinity();
-        for (int corner = 0; corner < (1 << D); ++corner) {
-          double x[D];
-          for (int d = 0; d < D; ++d) x[d] = (corner >> d) & 1 ? hi[d] : lo[d];
-          gmax = std::max(gmax, g(x));
-        }
-        if (gmax < -margin) return;  // wholly on the found side
-        for (std::uint32_t slot = off[index]; slot < off[index + 1]; ++slot) {
-          const std::int32_t q = loc_.id(slot);
-          if (q == apex || std::find(f.begin(), f.end(), q) != f.end()) continue;
-          ids[D] = q;
-          if (kernels::orientation(ctx_, ids.data()) != -apex_side) continue;  // not strictly beyond
-          if (best >= 0) {
-            std::array<std::int32_t, D> planes;
-            std::copy(f.begin() + 1, f.end(), planes.begin());
-            planes[D - 1] = best;
-            if (!kernels::in_sphere(ctx_, f[0], planes.data(), q)) continue;
-          }
-          best = q;
-          r2 = search_radius2(f, best, n, c);
-        }
-      });
-    }
+      best = p;
+      circumball(f, best, q);
+    });
     return best;
   }
 
@@ -186,11 +164,10 @@ class HullCompletion {
  private:
   const double* pt(std::int32_t id) const { return ctx_.points + static_cast<std::size_t>(id) * D; }
 
-  // Squared radius around c of a ball holding every point beyond the facet that
-  // could still beat `best`: the part of best's circumsphere beyond the facet
-  // plane. Float, with margins; infinite when the sphere is too ill-conditioned
-  // to trust.
-  double search_radius2(const Facet& f, std::int32_t best, const double* n, const double* c) const {
+  // The circumball of the facet and `best`, inflated: a better point lies in
+  // it (and beyond the facet). Float, with a relative margin; unbounded when
+  // too ill-conditioned to trust.
+  void circumball(const Facet& f, std::int32_t best, typename CandidateTree<D>::Query& q) const {
     const double* a = pt(f[0]);
     double r[D][D], s[D];
     for (int k = 0; k < D; ++k) {
@@ -201,7 +178,7 @@ class HullCompletion {
         s[k] += r[k][d] * r[k][d];
       }
     }
-    // Circumcentre y relative to a: 2 r_k . y = s_k (Cramer).
+    // Centre y relative to a: 2 r_k . y = s_k (Cramer).
     double y[D];
     if constexpr (D == 2) {
       double det = 2 * (r[0][0] * r[1][1] - r[0][1] * r[1][0]);
@@ -220,34 +197,20 @@ class HullCompletion {
       double det = 2 * (r[0][0] * c0[0] + r[0][1] * c0[1] + r[0][2] * c0[2]);
       for (int d = 0; d < 3; ++d) y[d] = (s[0] * c0[d] + s[1] * c1[d] + s[2] * c2[d]) / det;
     }
-    double rad2 = 0, ny = 0, nn = 0;
-    for (int d = 0; d < D; ++d) {
-      rad2 += y[d] * y[d];
-      ny += n[d] * y[d];
-      nn += n[d] * n[d];
-    }
+    double rad2 = 0;
+    for (int d = 0; d < D; ++d) rad2 += y[d] * y[d];
     const double rad = std::sqrt(rad2);
-    if (!std::isfinite(rad) || rad > 1e6 * diam_) return std::numeric_limits<double>::infinity();
-    double centre[D], radius;
-    if (ny <= 0) {
-      // Centre on the found side: the cap beyond the plane lies within the
-      // base disc's radius of the base centre (the centre's projection).
-      const double t = ny / nn;
-      double rho2 = rad2 - ny * t;
-      for (int d = 0; d < D; ++d) centre[d] = a[d] + y[d] - t * n[d];
-      radius = std::sqrt(std::max(0.0, rho2));
-    } else {
-      for (int d = 0; d < D; ++d) centre[d] = a[d] + y[d];
-      radius = rad;
+    if (!std::isfinite(rad) || rad > 1e6 * diam_) {
+      q.ball_r2 = std::numeric_limits<double>::infinity();
+      return;
     }
-    double dist2 = 0;
-    for (int d = 0; d < D; ++d) dist2 += (centre[d] - c[d]) * (centre[d] - c[d]);
-    const double reach = (std::sqrt(dist2) + radius) * (1 + 1e-6) + 1e-9 * diam_;
-    return reach * reach;
+    for (int d = 0; d < D; ++d) q.ball_centre[d] = a[d] + y[d];
+    const double reach = rad * (1 + 1e-6) + 1e-9 * diam_;
+    q.ball_r2 = reach * reach;
   }
 
   const kernels::ExactContext& ctx_;
-  const kernels::BinLocator<D>& loc_;
+  const CandidateTree<D>& tree_;
   double diam_;
 };
 

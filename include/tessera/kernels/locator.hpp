@@ -96,13 +96,6 @@ class BinLocator {
     }
     return s;
   }
-  /// The box of bin b grown by the binning slack: every point binned to b lies in it.
-  void bin_box(const std::array<std::int32_t, D>& b, double* blo, double* bhi) const {
-    for (int d = 0; d < D; ++d) {
-      blo[d] = lo_[d] + b[d] * size_[d] - slack_;
-      bhi[d] = lo_[d] + (b[d] + 1) * size_[d] + slack_;
-    }
-  }
   /// Lower bound on the distance from x (in bin b) to any point in the shell of
   /// Chebyshev radius s >= 1 around b: it must cross s-1 whole bins plus the gap
   /// from x to the nearest face of its own bin along some axis.

@@ -1,0 +1,159 @@
+// A bounding-volume tree over the candidate points of hull completion, and
+// the one query gift wrapping asks of it: every point that may lie beyond a
+// facet's plane and inside the current best ball.
+//
+// Median splits on the widest axis, leaves of a few points, and each node's
+// box shrunk to its points (not to a grid), so empty space is cut away: the
+// candidates form a thin shell along the domain box, and the lens a query
+// covers is thin too. Written here rather than taken from a library because
+// the pruning test (a ball that shrinks during the search, intersected with a
+// half-space) is the whole point and no Debian-packaged tree (nanoflann, CGAL's
+// Kd_tree) takes a custom, changing predicate cheaply.
+#pragma once
+
+#include <algorithm>
+#include <array>
+#include <cstdint>
+#include <limits>
+#include <numeric>
+#include <span>
+#include <vector>
+
+namespace tessera::front {
+
+template <int D>
+class CandidateTree {
+ public:
+  /// The query: points p with normal.(p - origin) > -margin (beyond the
+  /// plane, with a float margin) and |p - ball_centre|^2 <= ball_r2. Nodes
+  /// nearer `near` are visited first. The visitor may shrink the ball.
+  struct Query {
+    double normal[D], origin[D], near[D];
+    double margin = 0;
+    double ball_centre[D] = {};
+    double ball_r2 = std::numeric_limits<double>::infinity();
+  };
+
+  /// The points of `coords` (n*D) whose `use[id]` is set.
+  CandidateTree(std::span<const double> coords, std::span<const std::uint8_t> use) {
+    const std::size_t n = use.size();
+    for (std::size_t i = 0; i < n; ++i)
+      if (use[i]) ids_.push_back(static_cast<std::int32_t>(i));
+    pts_.resize(ids_.size());
+    for (std::size_t k = 0; k < ids_.size(); ++k)
+      for (int d = 0; d < D; ++d) pts_[k][d] = coords[static_cast<std::size_t>(ids_[k]) * D + d];
+    if (!ids_.empty()) build(0, static_cast<std::uint32_t>(ids_.size()));
+  }
+
+  std::size_t size() const { return ids_.size(); }
+
+  /// Calls visit(id) for every point that may satisfy the query (a superset).
+  template <class Visit>
+  void search(Query& q, Visit&& visit) const {
+    if (nodes_.empty()) return;
+    std::uint32_t stack[128];
+    int top = 0;
+    stack[top++] = 0;
+    while (top > 0) {
+      const Node& nd = nodes_[stack[--top]];
+      if (distance2(q.ball_centre, nd) > q.ball_r2) continue;
+      // Largest value of the plane function over the box: beyond test.
+      double g = 0;
+      for (int d = 0; d < D; ++d)
+        g += std::max(q.normal[d] * (nd.lo[d] - q.origin[d]), q.normal[d] * (nd.hi[d] - q.origin[d]));
+      if (g < -q.margin) continue;
+      if (nd.left == 0) {
+        for (std::uint32_t k = nd.begin; k < nd.end; ++k) {
+          if (q.ball_r2 != std::numeric_limits<double>::infinity()) {
+            double s = 0;
+            for (int d = 0; d < D; ++d) s += (pts_[k][d] - q.ball_centre[d]) * (pts_[k][d] - q.ball_centre[d]);
+            if (s > q.ball_r2) continue;
+          }
+          visit(ids_[k]);
+        }
+        continue;
+      }
+      // Push the farther child first so the nearer one is searched first.
+      const std::uint32_t l = nd.left, r = nd.left + 1;
+      const bool left_first = distance2(q.near, nodes_[l]) <= distance2(q.near, nodes_[r]);
+      stack[top++] = left_first ? r : l;
+      stack[top++] = left_first ? l : r;
+    }
+  }
+
+ private:
+  struct Node {
+    double lo[D], hi[D];
+    std::uint32_t begin, end;
+    std::uint32_t left = 0;  // children at left, left+1; 0 for a leaf
+  };
+  static constexpr std::uint32_t kLeaf = 8;
+
+  static double distance2(const double* x, const Node& nd) {
+    double s = 0;
+    for (int d = 0; d < D; ++d) {
+      double g = std::max({0.0, nd.lo[d] - x[d], x[d] - nd.hi[d]});
+      s += g * g;
+    }
+    return s;
+  }
+
+  // Builds the node for [begin, end) at the end of nodes_, then its children
+  // (pairs, adjacent). Depth is about log2(n / kLeaf): far below the stack size.
+  void build(std::uint32_t begin, std::uint32_t end) {
+    nodes_.push_back({});
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> work{{0, 0}};
+    nodes_[0].begin = begin;
+    nodes_[0].end = end;
+    for (std::size_t w = 0; w < work.size(); ++w) {
+      const std::uint32_t at = work[w].first;
+      Node nd = nodes_[at];
+      for (int d = 0; d < D; ++d) {
+        nd.lo[d] = std::numeric_limits<double>::infinity();
+        nd.hi[d] = -std::numeric_limits<double>::infinity();
+      }
+      for (std::uint32_t k = nd.begin; k < nd.end; ++k)
+        for (int d = 0; d < D; ++d) {
+          nd.lo[d] = std::min(nd.lo[d], pts_[k][d]);
+          nd.hi[d] = std::max(nd.hi[d], pts_[k][d]);
+        }
+      if (nd.end - nd.begin > kLeaf) {
+        int axis = 0;
+        for (int d = 1; d < D; ++d)
+          if (nd.hi[d] - nd.lo[d] > nd.hi[axis] - nd.lo[axis]) axis = d;
+        const std::uint32_t mid = nd.begin + (nd.end - nd.begin) / 2;
+        // Sort a permutation of the range, then apply it to ids and points.
+        std::vector<std::uint32_t> perm(nd.end - nd.begin);
+        std::iota(perm.begin(), perm.end(), nd.begin);
+        std::nth_element(perm.begin(), perm.begin() + (mid - nd.begin), perm.end(), [&](std::uint32_t x, std::uint32_t y) {
+          return pts_[x][axis] != pts_[y][axis] ? pts_[x][axis] < pts_[y][axis] : ids_[x] < ids_[y];
+        });
+        std::vector<std::int32_t> ids(perm.size());
+        std::vector<std::array<double, D>> pts(perm.size());
+        for (std::size_t k = 0; k < perm.size(); ++k) {
+          ids[k] = ids_[perm[k]];
+          pts[k] = pts_[perm[k]];
+        }
+        std::copy(ids.begin(), ids.end(), ids_.begin() + nd.begin);
+        std::copy(pts.begin(), pts.end(), pts_.begin() + nd.begin);
+        nd.left = static_cast<std::uint32_t>(nodes_.size());
+        Node l{}, r{};
+        l.begin = nd.begin;
+        l.end = mid;
+        r.begin = mid;
+        r.end = nd.end;
+        nodes_.push_back(l);
+        nodes_.push_back(r);
+        work.push_back({nd.left, 0});
+        work.push_back({nd.left + 1, 0});
+      }
+      nodes_[at] = nd;
+    }
+  }
+
+  std::vector<std::int32_t> ids_;
+  std::vector<std::array<double, D>> pts_;
+  std::vector<Node> nodes_;
+};
+
+}  // namespace tessera::front
