@@ -83,6 +83,8 @@ def write_meta(a):
         "tessera_build_type": a.build_type, "reps": int(a.reps), "warmup": int(a.warmup),
         "threads": [int(t) for t in a.threads.split()], "peers": a.peers,
         "inputs": a.inputs.split(),
+        "ops": a.ops.split() or ["voronoi"],
+        "peer_threads": [int(t) for t in a.peer_threads.split()] or [1, 2],
     }
     Path(a.run_dir).mkdir(parents=True, exist_ok=True)
     (Path(a.run_dir) / META).write_text(json.dumps(meta, indent=1) + "\n")
@@ -121,6 +123,13 @@ class Group:
         return statistics.median(v) if len(v) == len(self.runs) else None
 
 
+def tool_key(r):
+    """The tool name results are grouped by: gmsh_delaunay's HXT runs apart from its delaunay3d ones."""
+    if r["tool"] == "gmsh" and str(r.get("extra", {}).get("algo", "")).startswith("HXT"):
+        return "gmsh-hxt"
+    return r["tool"]
+
+
 def load(run_dir):
     meta = json.loads((Path(run_dir) / META).read_text())
     names = list(meta.get("inputs", []))
@@ -134,7 +143,7 @@ def load(run_dir):
         for line in p.read_text().splitlines():
             if line.startswith("{"):
                 r = json.loads(line)
-                by[(r["tool"], r["op"], r["threads"])].append(r)
+                by[(tool_key(r), r["op"], r["threads"])].append(r)
         data[name] = {k: Group(v) for k, v in by.items()}
     return meta, data
 
@@ -230,7 +239,8 @@ def report(meta, data):
         return None
 
     d3 = {k: v for k, v in data.items() if any(o == "voronoi3" for (_, o, _) in v)}
-    d2 = {k: v for k, v in data.items() if any(o in ("voronoi2", "delaunay2") for (_, o, _) in v)}
+    d2 = {k: v for k, v in data.items() if any(o == "voronoi2" for (_, o, _) in v)}
+    dd = {k: v for k, v in data.items() if any(tl == "tessera" and o in ("delaunay3", "delaunay2") for (tl, o, _) in v)}
 
     if d3:
         w("## 3D Voronoi cells: Tessera vs Voro++ 0.4.6")
@@ -279,6 +289,9 @@ def report(meta, data):
               f"{fr(div(med(s), med(b)))} | {fr(div(med(a), med(b)))} | {frate(per_core(a))} | {fb(bpp(a))} | {fb(bpp(s))} |")
         w("")
 
+    if dd:
+        delaunay_section(w, meta, dd, g, t1, t2)
+
     w("## Every configuration")
     w("")
     w("Spread = (max - min) / median over the timed runs. CPU = median user/sys seconds of the timed "
@@ -297,8 +310,78 @@ def report(meta, data):
             w(f"| {name} | {tool} | {op} | {th} | {len(x.runs)} | {fs(x.med)} | {fs(min(x.secs))} | {fs(max(x.secs))} | "
               f"{100 * x.spread:.0f} % | {cpu} | {busy} | {fn(x.simplices)} | {fb(bpp(x))} |")
     w("")
-    w("Simplices: cells for Tessera and Voro++, triangles for CGAL, Voronoi ridges for scipy.")
+    w("Simplices: cells for Tessera voronoi and Voro++, Voronoi ridges for scipy, tetrahedra / triangles for "
+      "the delaunay ops (Tessera, CGAL, Gmsh HXT = `gmsh-hxt`).")
     return "\n".join(L) + "\n"
+
+
+def delaunay_section(w, meta, dd, g, t1, t2):
+    pts = meta.get("peer_threads") or [1, 2]
+    p1, p2 = pts[0], pts[-1]
+    NA = "n/a"
+    w("## Delaunay: Tessera vs CGAL 5.5.1 and Gmsh 4.8.4 HXT")
+    w("")
+    w("Tessera: `tessera bench delaunay` (the `tessera::delaunay` call: tetrahedra / triangles from the "
+      "cells, plus hull completion). CGAL: `Delaunay_triangulation_3` range constructor (sequential, and "
+      "`Parallel_tag` with TBB), `Delaunay_triangulation_2` in 2D (sequential only). HXT: Gmsh's "
+      "`tetrahedralize` with `Mesh.Algorithm3D = 10` (OpenMP). All three return the Delaunay "
+      "triangulation of the convex hull. Seconds (wall); ratio = peer seconds / Tessera seconds at the "
+      f"thread counts shown (> 1: Tessera faster). Scaling = Tessera {t1}-thread seconds / {t2}-thread seconds. "
+      "n/a: no such peer configuration (no parallel 2D CGAL, no 2D HXT).")
+    w("")
+    w(f"| input | points | Tessera {t1}T s | Tessera {t2}T s | CGAL {p1}T s | CGAL {p2}T s | HXT {p1}T s | HXT {p2}T s | "
+      f"CGAL {p1}T / Tessera {t1}T | CGAL {p2}T / Tessera {t2}T | HXT {p1}T / Tessera {t1}T | HXT {p2}T / Tessera {t2}T | "
+      f"scaling {t1}→{t2} |")
+    w("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
+    rows = []
+    for name, grp in dd.items():
+        op = "delaunay3" if any(o == "delaunay3" for (_, o, _) in grp) else "delaunay2"
+        a, b = g(grp, "tessera", op, t1), g(grp, "tessera", op, t2)
+        if op == "delaunay3":
+            c1, c2 = g(grp, "cgal", op, p1), g(grp, "cgal", op, p2)
+            h1, h2 = g(grp, "gmsh-hxt", op, p1), g(grp, "gmsh-hxt", op, p2)
+        else:  # CGAL 2D is sequential; Gmsh's 2D triangulate is not HXT
+            c1, c2, h1, h2 = g(grp, "cgal", op, 1), None, None, None
+        rows.append((name, op, a, b, c1, c2, h1, h2))
+        n = (a or b).n
+        d3 = op == "delaunay3"
+        w(f"| {name} | {fn(n)} | {fm(a)} | {fm(b)} | {fm(c1)} | {fm(c2) if d3 else NA} | "
+          f"{fm(h1) if d3 else NA} | {fm(h2) if d3 else NA} | {fr(div(med(c1), med(a)))} | "
+          f"{fr(div(med(c2), med(b))) if d3 else NA} | {fr(div(med(h1), med(a))) if d3 else NA} | "
+          f"{fr(div(med(h2), med(b))) if d3 else NA} | {fr(div(med(a), med(b)))} |")
+    w("")
+    w("Simplex counts and memory. Tessera's count must equal CGAL's (and HXT's) on general-position input "
+      "such as uniform points; on degenerate input (lattices: cospherical points) the Delaunay "
+      "triangulation is not unique and counts may legitimately differ. From cells / from hull completion "
+      "= Tessera's simplices read off the Voronoi cells / added by completing the convex hull; exact calls "
+      "= exact-arithmetic fallbacks. Peak B/pt = the process's peak resident set / points.")
+    w("")
+    w(f"| input | Tessera simplices | CGAL simplices | Tessera − CGAL | HXT simplices | from cells | "
+      f"from hull completion | exact calls | Tessera {t1}T peak B/pt | Tessera {t2}T peak B/pt | "
+      f"CGAL {p1}T peak B/pt | CGAL {p2}T peak B/pt | HXT {p2}T peak B/pt |")
+    w("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
+
+    def cnt(x):
+        return DASH if x is None else fn(x.simplices)
+
+    def fx(x):
+        return DASH if x is None else fn(x)
+
+    for name, op, a, b, c1, c2, h1, h2 in rows:
+        d3 = op == "delaunay3"
+        ta = a or b
+        tcount = cnt(ta)
+        if a and b and int(a.simplices) != int(b.simplices):  # must not depend on the thread count
+            tcount = f"{fn(a.simplices)} ({t1}T) / {fn(b.simplices)} ({t2}T) **differ**"
+        c = c1 or c2
+        d = int(ta.simplices) - int(c.simplices) if ta and c else None
+        diff = DASH if d is None else ("0" if d == 0 else f"{d:+,d}")
+        h = h2 or h1
+        w(f"| {name} | {tcount} | {cnt(c)} | {diff} | {cnt(h) if d3 else NA} | "
+          f"{fx(ta.extra_med('from_cells')) if ta else DASH} | {fx(ta.extra_med('from_hull_completion')) if ta else DASH} | "
+          f"{fx(ta.extra_med('exact_calls')) if ta else DASH} | {fb(bpp(a))} | {fb(bpp(b))} | {fb(bpp(c1))} | "
+          f"{fb(bpp(c2)) if d3 else NA} | {fb(bpp(h2)) if d3 else NA} |")
+    w("")
 
 
 def main():
@@ -307,7 +390,8 @@ def main():
     ap.add_argument("-o", "--output")
     ap.add_argument("--write-meta", metavar="RUN_DIR")
     ap.add_argument("--finish-meta", metavar="RUN_DIR")
-    for k in ("command", "tessera", "build-type", "reps", "warmup", "threads", "peers", "inputs"):
+    for k in ("command", "tessera", "build-type", "reps", "warmup", "threads", "peers", "inputs", "ops",
+              "peer-threads"):
         ap.add_argument(f"--{k}", default="")
     a = ap.parse_args()
     if a.write_meta:

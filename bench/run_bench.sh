@@ -1,16 +1,25 @@
 #!/usr/bin/env bash
-# Tessera vs the Voronoi peers, in one run; writes docs/performance.md.
+# Tessera vs the Voronoi and Delaunay peers, in one run; writes docs/performance.md.
 #
 # usage: bench/run_bench.sh            (from anywhere; see bench/README.md)
 #
-#   1. builds the peers harness ($SHARED/peers) into bench/build-peers (voro_cells, cgal_delaunay2)
+#   1. builds the peers harness ($SHARED/peers) into bench/build-peers (voro_cells, cgal_delaunay2;
+#      with OPS delaunay also cgal_delaunay3, gmsh_delaunay)
 #   2. generates the inputs into bench/data/ (fixed seed; existing files are reused)
-#   3. per input: `tessera bench voronoi` at each thread count, then the peers
-#      (3D: Voro++; 2D: CGAL Delaunay_triangulation_2 and scipy.spatial.Voronoi),
+#   3. per input, for each op in OPS:
+#      voronoi:  `tessera bench voronoi` at each thread count, then the peers
+#                (3D: Voro++; 2D: CGAL Delaunay_triangulation_2 and scipy.spatial.Voronoi)
+#      delaunay: `tessera bench delaunay` at each thread count, then the peers
+#                (3D: CGAL Delaunay_triangulation_3 and Gmsh HXT at each PEER_THREADS count;
+#                 2D: CGAL Delaunay_triangulation_2, shared with voronoi when both run)
 #      each WARMUP untimed runs then REPS timed ones; JSON lines into $OUT/<input>.jsonl
 #   4. bench/report.py $OUT -> docs/performance.md (REPORT=0 skips it)
 #
 # env knobs (defaults in brackets):
+#   OPS      tessera ops to measure, with their peers ["voronoi delaunay"]
+#   DELAUNAY_INPUTS  restrict the delaunay op to these inputs (names as in $OUT, e.g. uniform3_1e6,
+#            or KIND:ARG as in INPUTS) [every selected input]
+#   PEER_THREADS  thread counts of the parallel Delaunay peers (CGAL 3D, Gmsh HXT) ["1 2"]
 #   SIZES    size classes to run ["1e4 1e5 1e6", plus 1e7 with FULL=1]; lattice3 K=50 is class 1e5, K=100 is 1e6
 #   FULL     1: add the 1e7 class (uniform3 1e7) [0]
 #   REPS     timed runs per configuration [3]        WARMUP  untimed runs before them [1]
@@ -35,7 +44,7 @@ quote() {
   else printf '%q' "$1"; fi
 }
 cmd=""
-for v in FULL SIZES REPS WARMUP THREADS MESH INPUTS TESSERA SHARED OUT DOC; do
+for v in OPS FULL SIZES REPS WARMUP THREADS PEER_THREADS MESH INPUTS DELAUNAY_INPUTS TESSERA SHARED OUT DOC; do
   [[ -n ${!v+x} ]] && cmd+="$v=$(quote "${!v}") "
 done
 cmd+="bench/run_bench.sh"
@@ -48,6 +57,8 @@ sizes=${SIZES:-$default_sizes}
 reps=${REPS:-3}
 warmup=${WARMUP:-1}
 threads=${THREADS:-"1 2"}
+peer_threads=${PEER_THREADS:-"1 2"}
+ops=${OPS:-"voronoi delaunay"}
 jobs=${JOBS:-2}
 timeout=${TIMEOUT:-900}
 out=${OUT:-$bench/results/raw/$(date +%Y%m%d-%H%M%S)}
@@ -57,6 +68,11 @@ note() { echo "run_bench: $*" >&2; }
 die() { note "error: $*"; exit 1; }
 [[ -f $peers/run_peers.sh && -f $peers/gen_points.py ]] || die "no peers harness in $peers (set SHARED=/path/to/shared)"
 $py -c 'import numpy, scipy' 2>/dev/null || die "$py lacks numpy/scipy (apt-get install python3-numpy python3-scipy)"
+for op in $ops; do
+  [[ $op == voronoi || $op == delaunay ]] || die "OPS entries are voronoi or delaunay, got '$op'"
+done
+has_op() { [[ " $ops " == *" $1 "* ]]; }
+has_op voronoi || has_op delaunay || die "OPS is empty"
 
 # ---- 1. peers -------------------------------------------------------------------------------
 peer_build=$bench/build-peers
@@ -65,7 +81,10 @@ mkdir -p "$peer_build"
 note "building peer drivers in $peer_build"
 cmake -S "$peers" -B "$peer_build" -DCMAKE_BUILD_TYPE=Release >"$peer_log" 2>&1 \
   || die "configuring the peers failed, see $peer_log"
-for t in voro_cells cgal_delaunay2; do
+peer_targets=(cgal_delaunay2)
+has_op voronoi && peer_targets+=(voro_cells)
+has_op delaunay && peer_targets+=(cgal_delaunay3 gmsh_delaunay)
+for t in "${peer_targets[@]}"; do
   # A target CMake dropped (library missing) is skipped by run_peers.sh with a note.
   if grep -q "^$t:" "$peer_build/Makefile" 2>/dev/null || grep -q "build $t:" "$peer_build/build.ninja" 2>/dev/null; then
     cmake --build "$peer_build" -j"$jobs" --target "$t" >>"$peer_log" 2>&1 || die "building $t failed, see $peer_log"
@@ -95,7 +114,9 @@ if [[ $TESSERA == none ]]; then
   note "TESSERA=none: peers only"
 else
   [[ -x $TESSERA ]] || die "TESSERA=$TESSERA is not an executable"
-  "$TESSERA" bench voronoi --help >/dev/null 2>&1 || die "$TESSERA has no 'bench voronoi' subcommand"
+  for op in $ops; do
+    "$TESSERA" bench "$op" --help >/dev/null 2>&1 || die "$TESSERA has no 'bench $op' subcommand"
+  done
   build_type=$(sed -n 's/^CMAKE_BUILD_TYPE:STRING=//p' "$(dirname "$TESSERA")/CMakeCache.txt" 2>/dev/null || true)
   [[ -z $build_type || $build_type == Release ]] || note "warning: $TESSERA is a '$build_type' build, not Release"
 fi
@@ -135,7 +156,8 @@ done
 
 $py "$bench/report.py" --write-meta "$out" --command "$cmd" --tessera "$TESSERA" \
     --build-type "${build_type:-unknown}" --reps "$reps" --warmup "$warmup" --threads "$threads" \
-    --peers "$peers" --inputs "$(for e in "${inputs[@]}"; do echo "${e%% *}"; done)"
+    --peers "$peers" --inputs "$(for e in "${inputs[@]}"; do echo "${e%% *}"; done)" \
+    --ops "$ops" --peer-threads "$peer_threads"
 
 # Time one binary throughout, even if the build folder is rebuilt during the sweep.
 if [[ $TESSERA != none ]]; then
@@ -154,7 +176,41 @@ repeat() {
   done
 }
 
-variants=("")  # tessera runs: plain, and with --mesh when MESH=1
+# tessera_runs OP EXTRA-ARGS...: for each T in THREADS, WARMUP untimed processes, then one
+# process timing REPS repeats (--repeat); JSON lines -> $jl.
+tessera_runs() {
+  local op=$1 t i rc; shift
+  [[ $TESSERA != none ]] || return 0
+  for t in $threads; do
+    local args=(bench "$op" "$f" --dim "$dim" --threads "$t" "$@")
+    (
+      set +e
+      for ((i = 0; i < warmup; i++)); do timeout "$timeout" "$bin" "${args[@]}" --repeat 1 >/dev/null; done
+      timeout "$timeout" "$bin" "${args[@]}" --repeat "$reps"
+      rc=$?; ((rc == 0)) || note "FAILED (rc=$rc): tessera ${args[*]}"
+    ) | grep '^{' >>"$jl" || true
+  done
+}
+# peer EXE ARGS...: one peer driver from $peer_build, WARMUP untimed + REPS timed runs, each timed
+# run under maxrss.py (its own peak RSS); skipped with a note when the driver was not built.
+peer() {
+  local exe=$peer_build/$1; shift
+  if [[ ! -x $exe ]]; then note "skip: $(basename "$exe") not built (see $peer_log)"; return 0; fi
+  (set +e; repeat "$exe" "$@") | grep '^{' >>"$jl" || true
+}
+
+# DELAUNAY_INPUTS: names (KIND_ARG) or KIND:ARG specs; empty = every input.
+delaunay_inputs=" "
+for s in ${DELAUNAY_INPUTS:-}; do delaunay_inputs+="${s//:/_} "; done
+if [[ -n ${DELAUNAY_INPUTS:-} ]]; then
+  for s in $delaunay_inputs; do
+    found=0
+    for e in "${inputs[@]}"; do [[ ${e%% *} == "$s" ]] && found=1; done
+    ((found)) || note "warning: DELAUNAY_INPUTS names '$s', which is not among the inputs"
+  done
+fi
+
+variants=("")  # tessera voronoi runs: plain, and with --mesh when MESH=1
 [[ ${MESH:-0} != 1 ]] || variants+=(--mesh)
 for e in "${inputs[@]}"; do
   read -r name _ _ _ <<<"$e"
@@ -162,27 +218,31 @@ for e in "${inputs[@]}"; do
   dim=$($py -c 'import sys, numpy; print(numpy.load(sys.argv[1], mmap_mode="r").shape[1])' "$f")
   jl=$out/$name.jsonl
   : >"$jl"
+  do_delaunay=0
+  if has_op delaunay && [[ -z ${DELAUNAY_INPUTS:-} || $delaunay_inputs == *" $name "* ]]; then do_delaunay=1; fi
   note "$name ($(cut -d' ' -f1-3 /proc/loadavg) load)"
-  [[ $TESSERA == none ]] || for mesh in "${variants[@]}"; do
-    for t in $threads; do
-      # WARMUP untimed processes, then one process timing REPS repeats (--repeat).
-      args=(bench voronoi "$f" --dim "$dim" --threads "$t")
-      [[ -z $mesh ]] || args+=("$mesh")
-      (
-        set +e
-        for ((i = 0; i < warmup; i++)); do timeout "$timeout" "$bin" "${args[@]}" --repeat 1 >/dev/null; done
-        timeout "$timeout" "$bin" "${args[@]}" --repeat "$reps"
-        rc=$?; ((rc == 0)) || note "FAILED (rc=$rc): tessera ${args[*]}"
-      ) | grep '^{' >>"$jl" || true
+  if has_op voronoi; then
+    for mesh in "${variants[@]}"; do
+      tessera_runs voronoi ${mesh:+"$mesh"}
     done
-  done
-  if [[ $dim == 3 ]]; then
-    BUILD=$peer_build ONLY=voro WARMUP=$warmup TIMEOUT=$timeout \
-      $py "$bench/maxrss.py" "$peers/run_peers.sh" "$f" 3 "$reps" | grep '^{' >>"$jl" || true
-  else
-    BUILD=$peer_build ONLY=cgal WARMUP=$warmup TIMEOUT=$timeout \
-      $py "$bench/maxrss.py" "$peers/run_peers.sh" "$f" 2 "$reps" | grep '^{' >>"$jl" || true
-    (set +e; repeat $py "$peers/scipy_bench.py" "$f" --op voronoi) | grep '^{' >>"$jl" || true
+    if [[ $dim == 3 ]]; then
+      BUILD=$peer_build ONLY=voro WARMUP=$warmup TIMEOUT=$timeout \
+        $py "$bench/maxrss.py" "$peers/run_peers.sh" "$f" 3 "$reps" | grep '^{' >>"$jl" || true
+    else
+      BUILD=$peer_build ONLY=cgal WARMUP=$warmup TIMEOUT=$timeout \
+        $py "$bench/maxrss.py" "$peers/run_peers.sh" "$f" 2 "$reps" | grep '^{' >>"$jl" || true
+      (set +e; repeat $py "$peers/scipy_bench.py" "$f" --op voronoi) | grep '^{' >>"$jl" || true
+    fi
+  fi
+  if ((do_delaunay)); then
+    note "$name: delaunay"
+    tessera_runs delaunay
+    if [[ $dim == 3 ]]; then
+      for t in $peer_threads; do peer cgal_delaunay3 "$f" --threads "$t"; done
+      for t in $peer_threads; do peer gmsh_delaunay "$f" --algo hxt --threads "$t"; done
+    elif ! has_op voronoi; then
+      peer cgal_delaunay2 "$f"   # otherwise already timed above, for the voronoi comparison
+    fi
   fi
 done
 

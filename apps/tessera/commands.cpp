@@ -44,12 +44,18 @@ double seconds_since(Clock::time_point t0) {
   return s;
 }
 
+}  // namespace
+
+// Shared with the other subcommand files (declared in commands.hpp).
+
 /// Lower-cased extension including the dot ("" when there is none).
 std::string extension(const std::string& path) {
   std::string ext = std::filesystem::path(path).extension().string();
   for (char& ch : ext) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
   return ext;
 }
+
+namespace {
 
 const char* axis_name(int axis) { return axis == 0 ? "x" : axis == 1 ? "y" : "z"; }
 
@@ -75,6 +81,8 @@ void check_output_names(const VoronoiArgs& a) {
     throw InputError("nothing to do: give -o OUTPUT.vtu|.vtp, --cell-table, --neighbors or --validate");
 }
 
+}  // namespace
+
 /// --bounds: 4 or 6 finite numbers with hi > lo on every axis.
 void check_bounds_arg(const std::vector<double>& b) {
   if (b.empty()) return;
@@ -90,6 +98,8 @@ void check_bounds_arg(const std::vector<double>& b) {
                             lo, hi, axis_name(int(axis)), axis_name(int(axis))));
   }
 }
+
+namespace {
 
 /// Checks that need the data: bounds arity vs dimension, and inputs whose
 /// default (padded bounding-box) domain would be degenerate or meaningless.
@@ -127,6 +137,8 @@ void check_against_input(const ComputeArgs& a, const io::PointCloud& pc) {
   throw InputError(where + " (planar input): for a 2D tessellation drop that column and use --dim 2, or give " +
                    box_hint + " for a 3D domain");
 }
+
+}  // namespace
 
 io::PointCloud read_input(const ComputeArgs& a) {
   io::ReadOptions ro;
@@ -172,6 +184,8 @@ Cells compute(const io::PointCloud& pc, VoronoiOptions opt, bool show_progress, 
   if (InterruptGuard::interrupted()) throw Cancelled();
   return cells;
 }
+
+namespace {
 
 /// Sum with Neumaier compensation: the volume check compares against the
 /// domain at ~1e-15, which plain summation of 1e6 terms can miss.
@@ -260,11 +274,7 @@ bool report_validation(const Cells& c, const io::PointCloud& pc, bool quiet) {
   return r.ok;
 }
 
-struct Usage {
-  double user_s, sys_s;
-  long long minflt;
-  long long maxrss_bytes;
-};
+}  // namespace
 
 Usage usage_now() {
   rusage ru{};
@@ -274,8 +284,6 @@ Usage usage_now() {
   return {tv(ru.ru_utime), tv(ru.ru_stime), static_cast<long long>(ru.ru_minflt),
           static_cast<long long>(ru.ru_maxrss) * 1024};
 }
-
-}  // namespace
 
 // ---------------------------------------------------------------- voronoi
 

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "tessera/cells.hpp"
+#include "tessera/io/points.hpp"
 
 namespace tessera::cli {
 
@@ -54,8 +55,64 @@ struct DemoArgs {
   bool quiet = false;
 };
 
+/// `graph`, `faces`, `flower`: products read off the merged cells (cmd_dual.cpp).
+struct GraphArgs {
+  ComputeArgs compute;
+  std::string output;          ///< .vtp lines, or empty
+  std::string csr;             ///< .npy wheels (layout of --neighbors), or empty
+  std::string spoke_classes;   ///< .npy uint8 class per spoke, or empty
+  double prune_tolerance = 0;
+  bool quiet = false;
+};
+
+struct FacesArgs {
+  ComputeArgs compute;
+  std::string output;          ///< .vtp
+  std::string kind;            ///< boundary | complex | surface-net
+  bool capping = false;
+  bool quiet = false;
+};
+
+struct FlowerArgs {
+  ComputeArgs compute;
+  std::string output;          ///< .vtp
+  std::vector<std::int64_t> points;  ///< ids of the cells to show
+  bool glyphs = false;
+  bool quiet = false;
+};
+
+/// `delaunay` (cmd_delaunay.cpp).
+struct DelaunayArgs {
+  ComputeArgs compute;
+  std::string output;          ///< .vtu (VTK_TETRA / VTK_TRIANGLE) or .vtp (2D), or empty
+  std::string simplices;       ///< .npy int64 (M, D+1), or empty
+  bool no_hull_completion = false;
+  bool validate = false;
+  bool quiet = false;
+};
+
 int run_voronoi(const VoronoiArgs& args);
+int run_delaunay(const DelaunayArgs& args);
+int run_bench_delaunay(const BenchArgs& args);
 int run_bench_voronoi(const BenchArgs& args);
 int run_default(const DemoArgs& args);
+int run_graph(const GraphArgs& args);
+int run_faces(const FacesArgs& args);
+int run_flower(const FlowerArgs& args);
+
+// Shared by the subcommand files (defined in commands.cpp).
+/// Resource usage of this process so far (bench JSON lines).
+struct Usage {
+  double user_s, sys_s;
+  long long minflt;
+  long long maxrss_bytes;
+};
+Usage usage_now();
+std::string extension(const std::string& path);  ///< lower-cased, with the dot; "" if none
+void check_bounds_arg(const std::vector<double>& bounds);  ///< InputError unless 4 or 6 valid numbers
+io::PointCloud read_input(const ComputeArgs& args);        ///< read and check INPUT (InputError)
+VoronoiOptions make_options(const ComputeArgs& args, int dim);
+/// tessera::voronoi with a progress bar (when `show_progress`) and Ctrl-C cancellation.
+Cells compute(const io::PointCloud& pc, VoronoiOptions options, bool show_progress, double& seconds);
 
 }  // namespace tessera::cli

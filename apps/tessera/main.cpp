@@ -34,7 +34,7 @@ constexpr const char* kExitCodes =
     "2 bad command line or bad input; 130 interrupted (Ctrl-C).\n"
     "Environment: TESSERA_NUM_THREADS sets the thread count when --threads is not given.";
 
-/// Options shared by `voronoi` and `bench voronoi`.
+/// Options shared by the commands that compute cells (`voronoi`, `bench voronoi`, `graph`, ...).
 void add_compute_options(CLI::App* app, ComputeArgs& c, std::vector<std::string>& raw_bounds) {
   // INPUT is checked after parsing (finish_compute_args), not ->required():
   // "--bounds 0 1 0 1 pts.npy" hands pts.npy to --bounds, which gives it back.
@@ -133,6 +133,78 @@ int main(int argc, char** argv) {
       "  tessera voronoi points.csv --dim 2 --bounds 0 1 0 1 -o cells.vtp\n"
       "  tessera voronoi grains.ply --labels grain --neighbors nb.npy --validate");
 
+  DelaunayArgs dla;
+  std::vector<std::string> del_bounds, bench_del_bounds;
+  CLI::App* del = app.add_subcommand(
+      "delaunay", "The Delaunay triangulation (tetrahedra in 3D, triangles in 2D), dual of the cells");
+  add_compute_options(del, dla.compute, del_bounds);
+  del->add_option("-o,--output", dla.output,
+                  "Triangulation as VTK: .vtu (VTK_TETRA / VTK_TRIANGLE over the input points) or, in 2D, .vtp");
+  del->add_option("--simplices", dla.simplices,
+                  "Simplices as an int64 .npy array of shape (M, D+1), point ids; tetrahedra positively oriented, "
+                  "triangles counter-clockwise");
+  del->add_flag("--no-hull-completion", dla.no_hull_completion,
+                "Keep only the simplices whose circumcentre lies in the domain box (skip closing the triangulation "
+                "up to the convex hull)");
+  del->add_flag("--validate", dla.validate,
+                "Check the triangulation (orientation, conformity, closed convex hull, every point used, local "
+                "Delaunay, volumes), print the report, exit 1 if a check fails");
+  del->add_flag("-q,--quiet", dla.quiet, "No summary and no progress bar");
+  del->footer(
+      "Without labels the triangulation covers the convex hull (CGAL's on points in general position; a valid\n"
+      "one chosen by symbolic perturbation on degenerate input). With --labels: the simplices whose vertices\n"
+      "all have labels >= 0 (concave results allowed).\n"
+      "Examples:\n"
+      "  tessera delaunay points.npy -o tets.vtu --simplices tets.npy\n"
+      "  tessera delaunay points.csv --dim 2 -o triangles.vtp --validate");
+
+  // Products read off the merged cells (cmd_dual.cpp).
+  GraphArgs ga;
+  std::vector<std::string> graph_bounds, faces_bounds, flower_bounds;
+  CLI::App* graph = app.add_subcommand(
+      "graph", "The adjacency graph: each generator's face neighbours (wheels and spokes) with spoke classes");
+  add_compute_options(graph, ga.compute, graph_bounds);
+  graph->add_option("-o,--output", ga.output,
+                    "Graph as VTK PolyData lines (.vtp): points = input points, one line per undirected edge, "
+                    "cell data SpokeClass (0 same region, 1 region boundary, 3 outside) and FaceArea/FaceLength");
+  graph->add_option("--csr", ga.csr,
+                    "Wheels as one int64 .npy array: [n_points, offsets (n_points+1), spokes...]; spokes of point "
+                    "p are ids[offsets[p]:offsets[p+1]], ascending, box planes negative (x0=-1 .. z1=-6)");
+  graph->add_option("--spoke-classes", ga.spoke_classes,
+                    "Class of every spoke of --csr as a uint8 .npy array (0 same region, 1 region boundary, "
+                    "2 domain boundary, 3 outside)");
+  graph->add_option("--prune-tolerance", ga.prune_tolerance,
+                    "Drop spokes whose face area (length in 2D) is below F * (mean cell volume)^((D-1)/D), both "
+                    "directions together (VTK parity; default 0: keep all)")
+      ->check(CLI::NonNegativeNumber);
+  graph->add_flag("-q,--quiet", ga.quiet, "No summary and no progress bar");
+
+  FacesArgs fa;
+  CLI::App* faces = app.add_subcommand(
+      "faces", "Voronoi faces (3D polygons, 2D segments), each once, oriented, with BoundaryLabels per face");
+  add_compute_options(faces, fa.compute, faces_bounds);
+  faces->add_option("-o,--output", fa.output, "Faces as VTK PolyData (.vtp), cell data BoundaryLabels, Sides, "
+                                              "SpokeClass");
+  faces->add_option("--kind", fa.kind,
+                    "boundary: faces on the box or against outside points; complex: every face once; "
+                    "surface-net: faces between different regions")
+      ->required();
+  faces->add_flag("--capping", fa.capping, "surface-net: also the boundary faces, closing every region");
+  faces->add_flag("-q,--quiet", fa.quiet, "No summary and no progress bar");
+
+  FlowerArgs wa;
+  CLI::App* flower = app.add_subcommand(
+      "flower", "A cell with its petals (vertices, radius to the generator), circumflower and clipping neighbours");
+  add_compute_options(flower, wa.compute, flower_bounds);
+  flower->add_option("--point", wa.points, "Point id whose cell to show (repeat for several)")
+      ->required()
+      ->allow_extra_args(false)
+      ->delimiter(',');
+  flower->add_option("-o,--output", wa.output,
+                     "Flower as VTK PolyData (.vtp): point data Radius, Role, GeneratorId, PointId");
+  flower->add_flag("--glyphs", wa.glyphs, "Also draw each petal and the circumflower as a circle (2D) / sphere (3D)");
+  flower->add_flag("-q,--quiet", wa.quiet, "No summary and no progress bar");
+
   BenchArgs ba;
   CLI::App* bench = app.add_subcommand("bench", "Benchmarks printing one JSON line per run on stdout");
   bench->require_subcommand(1);
@@ -148,6 +220,17 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   bench_vor->add_flag("--mesh", ba.mesh,
                       "Also build the merged mesh (what VTK output needs); op becomes voronoi3_mesh/voronoi2_mesh");
+
+  BenchArgs bda;
+  CLI::App* bench_del = bench->add_subcommand(
+      "delaunay",
+      "Time tessera::delaunay (hull completion included; no output files) K times. Each run prints "
+      "{\"tool\":\"tessera\",\"op\":\"delaunay3\"|\"delaunay2\",\"n\",\"threads\",\"seconds\",\"simplices\","
+      "\"extra\":{cpu_user_s,cpu_sys_s,minflt,peak_rss_bytes,from_cells,from_hull_completion,exact_calls,repeat}}");
+  add_compute_options(bench_del, bda.compute, bench_del_bounds);
+  bench_del->add_option("--repeat", bda.repeat, "Number of timed runs")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
 
   DemoArgs da;
   CLI::App* demo = app.add_subcommand(
@@ -177,6 +260,26 @@ int main(int argc, char** argv) {
     if (bench_vor->parsed()) {
       finish_compute_args(ba.compute, bench_bounds);
       return run_bench_voronoi(ba);
+    }
+    if (graph->parsed()) {
+      finish_compute_args(ga.compute, graph_bounds);
+      return run_graph(ga);
+    }
+    if (faces->parsed()) {
+      finish_compute_args(fa.compute, faces_bounds);
+      return run_faces(fa);
+    }
+    if (flower->parsed()) {
+      finish_compute_args(wa.compute, flower_bounds);
+      return run_flower(wa);
+    }
+    if (del->parsed()) {
+      finish_compute_args(dla.compute, del_bounds);
+      return run_delaunay(dla);
+    }
+    if (bench_del->parsed()) {
+      finish_compute_args(bda.compute, bench_del_bounds);
+      return run_bench_delaunay(bda);
     }
     if (demo->parsed()) return run_default(da);
     print_error("no command given (see tessera --help)");

@@ -44,17 +44,20 @@ Delaunay run(std::span<const double> input, std::span<const std::int32_t> labels
   if (complete && out.from_cells == 0 && pass.locator->size() - out.duplicates.size() > D && attempt < 2) {
     // Every circumcentre lies outside the box (a handful of points, or nearly
     // flat input), so completion has no found simplex to start from. The
-    // triangulation does not depend on the box: run again in a box a thousand
-    // times larger (twice at most), and complete the rest from there. Exactly
-    // flat input has no simplex at all and ends here empty.
+    // triangulation does not depend on the box: run again in a box 2^20, then
+    // 2^50 times larger, and complete the rest from there. Exactly flat input
+    // has no simplex at all and ends here empty; input flat to within ~1e-15
+    // of its extent can end here empty too (validate() reports it).
+    // Costly (cells grow with the box) but reached only on such inputs.
     DelaunayOptions big = opt;
     big.progress = nullptr;
     Bounds b = pass.user_bounds;
     for (int d = 0; d < D; ++d) {
       auto du = static_cast<std::size_t>(d);
       double mid = 0.5 * (b.lo[du] + b.hi[du]), half = 0.5 * (b.hi[du] - b.lo[du]);
-      b.lo[du] = mid - 1024 * half;
-      b.hi[du] = mid + 1024 * half;
+      const double grow = attempt == 0 ? 0x1p20 : 0x1p50;
+      b.lo[du] = mid - grow * half;
+      b.hi[du] = mid + grow * half;
     }
     big.bounds = b;
     big.ignore_outside_points = true;

@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <vector>
 
@@ -23,10 +24,62 @@ namespace {
 
 using front::FacetRecord;
 
-double det_rows(const double (*r)[3], int D) {
-  if (D == 2) return r[0][0] * r[1][1] - r[0][1] * r[1][0];
-  return r[0][0] * (r[1][1] * r[2][2] - r[1][2] * r[2][1]) - r[0][1] * (r[1][0] * r[2][2] - r[1][2] * r[2][0]) +
-         r[0][2] * (r[1][0] * r[2][1] - r[1][1] * r[2][0]);
+// Determinant of D rows and its permanent (|terms| summed), which bounds the
+// rounding error of the float determinant.
+double det_rows(const double (*r)[3], int D, double& perm) {
+  if (D == 2) {
+    perm = std::fabs(r[0][0] * r[1][1]) + std::fabs(r[0][1] * r[1][0]);
+    return r[0][0] * r[1][1] - r[0][1] * r[1][0];
+  }
+  double m0 = r[1][1] * r[2][2] - r[1][2] * r[2][1], m1 = r[1][0] * r[2][2] - r[1][2] * r[2][0],
+         m2 = r[1][0] * r[2][1] - r[1][1] * r[2][0];
+  perm = std::fabs(r[0][0]) * (std::fabs(r[1][1] * r[2][2]) + std::fabs(r[1][2] * r[2][1])) +
+         std::fabs(r[0][1]) * (std::fabs(r[1][0] * r[2][2]) + std::fabs(r[1][2] * r[2][0])) +
+         std::fabs(r[0][2]) * (std::fabs(r[1][0] * r[2][1]) + std::fabs(r[1][1] * r[2][0]));
+  return r[0][0] * m0 - r[0][1] * m1 + r[0][2] * m2;
+}
+
+/// True when the points that take part span less than D dimensions (exactly).
+bool is_flat(const kernels::ExactContext& ctx, const Delaunay& dt) {
+  std::vector<std::uint8_t> skip(dt.n_points, 0);
+  for (auto [dup, owner] : dt.duplicates) skip[static_cast<std::size_t>(dup)] = 1;
+  for (std::int32_t id : dt.ignored_outside_bounds) skip[static_cast<std::size_t>(id)] = 1;
+  // Grow an affinely independent set greedily; the input is flat iff it stops short of D+1.
+  std::array<std::int32_t, 4> basis{};
+  int size = 0;
+  const int D = dt.dim;
+  for (std::size_t i = 0; i < dt.n_points && size <= D; ++i) {
+    if (skip[i]) continue;
+    const auto id = static_cast<std::int32_t>(i);
+    if (size == 0) { basis[0] = id; size = 1; continue; }
+    // Is the point affinely independent of the basis (exactly)?
+    bool independent = false;
+    if (size == 1) {
+      for (int d = 0; d < D; ++d)
+        independent |= ctx.points[i * static_cast<std::size_t>(D) + static_cast<std::size_t>(d)] !=
+                       ctx.points[static_cast<std::size_t>(basis[0]) * static_cast<std::size_t>(D) + static_cast<std::size_t>(d)];
+    } else if (size == D) {
+      basis[static_cast<std::size_t>(size)] = id;
+      independent = kernels::orientation(ctx, basis.data()) != 0;
+    } else {
+      // 3D, size 2: the candidate is independent iff it is not on the line of
+      // basis[0], basis[1]: some coordinate-plane projection is non-collinear.
+      const double* a = ctx.points + static_cast<std::size_t>(basis[0]) * 3;
+      const double* b = ctx.points + static_cast<std::size_t>(basis[1]) * 3;
+      const double* c = ctx.points + i * 3;
+      for (int u = 0; u < 3 && !independent; ++u) {
+        int x = u, y = (u + 1) % 3;
+        kernels::ExactContext plane;
+        double pts[6] = {a[x], a[y], b[x], b[y], c[x], c[y]};
+        plane.points = pts;
+        plane.dim = 2;
+        std::int32_t ids[3] = {0, 1, 2};
+        independent = kernels::orientation(plane, ids) != 0;
+      }
+    }
+    if (independent) basis[static_cast<std::size_t>(size++)] = id;
+  }
+  return size <= D;
 }
 
 }  // namespace
@@ -45,17 +98,23 @@ DelaunayReport validate(const Delaunay& dt, std::span<const double> points, std:
 
   // Orientation and volume of every simplex.
   std::vector<std::uint8_t> bad(m, 0);
-  std::vector<double> vol(m, 0);
+  std::vector<double> vol(m, 0), vol_err(m, 0);
   tbb::parallel_for(std::size_t(0), m, [&](std::size_t s) {
     const std::int32_t* row = dt.simplices.data() + s * w;
     bad[s] = kernels::orientation(ctx, row) != 1;
     double r[3][3] = {};
     for (int k = 0; k < D; ++k)
       for (int d = 0; d < D; ++d) r[k][d] = pt(row[k + 1])[d] - pt(row[0])[d];
-    vol[s] = det_rows(r, D) / fact;
+    double perm;
+    vol[s] = det_rows(r, D, perm) / fact;
+    vol_err[s] = 32 * std::numeric_limits<double>::epsilon() * perm / fact;
   });
   rep.flat_or_inverted = static_cast<std::size_t>(std::count(bad.begin(), bad.end(), 1));
-  for (double v : vol) rep.volume_sum += v;
+  double volume_err = 0;
+  for (std::size_t s = 0; s < m; ++s) {
+    rep.volume_sum += vol[s];
+    volume_err += vol_err[s];
+  }
 
   // Facets, sorted so the simplices sharing one sit together.
   const std::vector<FacetRecord> recs = front::sorted_facets(dt);
@@ -117,7 +176,9 @@ DelaunayReport validate(const Delaunay& dt, std::span<const double> points, std:
       for (int d = 0; d < D; ++d) r[c][d] = pt(row[j])[d] - o[d];
       ++c;
     }
-    rep.enclosed_volume += ((f.k % 2) ? -1.0 : 1.0) * det_rows(r, D) / fact;
+    double perm;
+    rep.enclosed_volume += ((f.k % 2) ? -1.0 : 1.0) * det_rows(r, D, perm) / fact;
+    volume_err += 32 * std::numeric_limits<double>::epsilon() * perm / fact;
     for (int drop = 0; drop < D; ++drop) {
       RidgeRec rr{{-1, -1}, static_cast<std::int32_t>(b), f.facet[static_cast<std::size_t>(drop)]};
       for (int j = 0, c = 0; j < D; ++j)
@@ -154,8 +215,8 @@ DelaunayReport validate(const Delaunay& dt, std::span<const double> points, std:
     for (auto [dup, owner] : dt.duplicates) used[static_cast<std::size_t>(dup)] = 1;
     for (std::int32_t id : dt.ignored_outside_bounds) used[static_cast<std::size_t>(id)] = 1;
     rep.missing_points = static_cast<std::size_t>(std::count(used.begin(), used.end(), 0));
-    // Exactly flat input has no simplex and nothing to check.
-    if (m == 0) rep.missing_points = 0;
+    // Exactly flat (coplanar / collinear) input has no simplex: nothing is missing.
+    if (m == 0 && is_flat(ctx, dt)) rep.missing_points = 0;
   }
 
   auto fail = [&](std::size_t count, const char* what) {
@@ -171,7 +232,9 @@ DelaunayReport validate(const Delaunay& dt, std::span<const double> points, std:
   fail(rep.nonconvex_boundary, "boundary ridges are not convex (the hull is incomplete)");
   fail(rep.missing_points, "points are in no simplex");
   fail(rep.local_delaunay_violations, "interior facets are not locally Delaunay");
-  const double tol = 1e-9 * std::max(std::fabs(rep.volume_sum), std::fabs(rep.enclosed_volume)) + 1e-300;
+  // Float volumes: the comparison allows their rounding (a bound from each
+  // determinant's permanent, which matters for nearly flat input) plus 1e-9.
+  const double tol = 1e-9 * std::max(std::fabs(rep.volume_sum), std::fabs(rep.enclosed_volume)) + volume_err;
   if (std::fabs(rep.volume_sum - rep.enclosed_volume) > tol) {
     rep.ok = false;
     std::ostringstream s;

@@ -381,6 +381,9 @@ NpyArray read_npy_int(const std::string& path) {
 std::string npy_bytes(const double* data, const std::vector<std::size_t>& shape) {
   return npy_bytes_impl(data, shape, "<f8");
 }
+std::string npy_bytes(const std::uint8_t* data, const std::vector<std::size_t>& shape) {
+  return npy_bytes_impl(data, shape, "|u1");
+}
 std::string npy_bytes(const std::int32_t* data, const std::vector<std::size_t>& shape) {
   return npy_bytes_impl(data, shape, "<i4");
 }

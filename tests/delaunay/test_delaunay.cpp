@@ -226,6 +226,27 @@ TEST(Delaunay, FewPointsAndFlatInput) {
   expect_valid(d2, q);
 }
 
+TEST(Delaunay, NearlyFlatInput) {
+  // z = x/2 + y/4 rounded: flat to within an ulp, so every circumcentre is
+  // ~1e16 extents away; scipy/Qhull refuses this input. Exactly flat input has
+  // no tetrahedron at all.
+  auto xy = random_points(200, 2, 51);
+  std::vector<double> p, flat;
+  for (std::size_t i = 0; i < 200; ++i) {
+    double x = xy[2 * i], y = xy[2 * i + 1];
+    p.insert(p.end(), {x, y, 0.5 * x + 0.25 * y});
+    flat.insert(flat.end(), {x, y, 0.0 * x + 0.5});
+  }
+  tessera::Delaunay dt = run(p, 3);
+  EXPECT_EQ(as_set(dt), cgal_simplices(p, 3));
+  expect_valid(dt, p);
+  tessera::DelaunayOptions o;
+  o.bounds = tessera::Bounds{{0, 0, 0}, {1, 1, 1}};
+  tessera::Delaunay none = tessera::delaunay(flat, 3, {}, o);
+  EXPECT_EQ(none.n_simplices(), 0u);
+  expect_valid(none, flat);
+}
+
 TEST(Delaunay, LabelsKeepInsideSimplicesOnly) {
   auto p = random_points(3000, 3, 31);
   std::vector<std::int32_t> labels(3000);

@@ -27,6 +27,7 @@ NpyArray read_npy_int(const std::string& path);
 /// Serialise arrays (C order, little-endian) to an .npy byte string; write the
 /// result with write_file_atomic. shape = {n} or {n, m}.
 std::string npy_bytes(const double* data, const std::vector<std::size_t>& shape);
+std::string npy_bytes(const std::uint8_t* data, const std::vector<std::size_t>& shape);
 std::string npy_bytes(const std::int32_t* data, const std::vector<std::size_t>& shape);
 std::string npy_bytes(const std::int64_t* data, const std::vector<std::size_t>& shape);
 

@@ -1,0 +1,147 @@
+// `tessera delaunay` and `tessera bench delaunay` (see commands.hpp).
+#include <chrono>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "commands.hpp"
+#include "progress.hpp"
+#include "tessera/delaunay.hpp"
+#include "tessera/io/atomic_file.hpp"
+#include "tessera/io/npy.hpp"
+#include "tessera/io/vtk_simplices.hpp"
+
+namespace tessera::cli {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+DelaunayOptions delaunay_options(const ComputeArgs& c, int dim, bool complete_hull) {
+  DelaunayOptions o;
+  static_cast<VoronoiOptions&>(o) = make_options(c, dim);
+  o.complete_hull = complete_hull;
+  return o;
+}
+
+/// tessera::delaunay with a progress bar and Ctrl-C cancellation (as compute()).
+Delaunay triangulate(const io::PointCloud& pc, DelaunayOptions opt, bool show_progress, double& seconds) {
+  ProgressBar bar("tessera: computing the triangulation", show_progress);
+  InterruptGuard guard;
+  opt.progress = [&bar](double f) {
+    if (InterruptGuard::interrupted()) throw Cancelled();
+    bar.update(f);
+  };
+  const auto t0 = Clock::now();
+  Delaunay dt = delaunay(pc.coords, pc.dim, pc.labels, opt);
+  seconds = seconds_since(t0);
+  bar.finish();
+  if (InterruptGuard::interrupted()) throw Cancelled();
+  return dt;
+}
+
+void check_delaunay_outputs(const DelaunayArgs& a) {
+  if (!a.output.empty()) {
+    const std::string e = extension(a.output);
+    if (e != ".vtu" && e != ".vtp")
+      throw InputError("output " + a.output + ": unknown extension '" + e + "' (use .vtu, or .vtp for 2D)");
+  }
+  if (!a.simplices.empty() && extension(a.simplices) != ".npy")
+    throw InputError("--simplices " + a.simplices + ": must be a .npy file");
+  if (a.output.empty() && a.simplices.empty() && !a.validate)
+    throw InputError("nothing to do: give -o OUTPUT.vtu|.vtp, --simplices FILE.npy or --validate");
+  for (const std::string* p : {&a.output, &a.simplices})
+    if (!p->empty()) io::check_writable(*p);
+}
+
+}  // namespace
+
+int run_delaunay(const DelaunayArgs& a) {
+  check_delaunay_outputs(a);
+  check_bounds_arg(a.compute.bounds);
+  auto t0 = Clock::now();
+  const io::PointCloud pc = read_input(a.compute);
+  const double read_s = seconds_since(t0);
+  if (!a.output.empty() && pc.dim == 3 && extension(a.output) != ".vtu")
+    throw InputError("output " + a.output + ": a 3D triangulation is written as .vtu");
+
+  double compute_s = 0;
+  const Delaunay dt = triangulate(pc, delaunay_options(a.compute, pc.dim, !a.no_hull_completion),
+                                  !a.quiet && stderr_is_terminal(), compute_s);
+
+  t0 = Clock::now();
+  std::vector<std::string> written;
+  if (!a.output.empty()) {
+    io::write_simplices_vtk(a.output, dt, pc.coords);
+    written.push_back(a.output);
+  }
+  if (!a.simplices.empty()) {
+    // int64 (M, D+1), as scipy.spatial.Delaunay.simplices.
+    std::vector<std::int64_t> s(dt.simplices.begin(), dt.simplices.end());
+    io::write_file_atomic(a.simplices, io::npy_bytes(s.data(), {dt.n_simplices(), std::size_t(pc.dim + 1)}));
+    written.push_back(a.simplices);
+  }
+  const double write_s = seconds_since(t0);
+
+  if (!a.quiet) {
+    std::fprintf(stderr, "tessera: %zu points (%dD) -> %zu %s (%zu from the cells, %zu by hull completion%s)\n",
+                 pc.n, pc.dim, dt.n_simplices(), pc.dim == 3 ? "tetrahedra" : "triangles", dt.from_cells,
+                 dt.from_hull_completion, dt.hull_completed ? "" : ": off");
+    if (dt.n_simplices() == 0)
+      std::fprintf(stderr, "tessera: no simplices: the points are %s%s\n",
+                   pc.dim == 3 ? "coplanar (for a 2D triangulation use --dim 2 on in-plane coordinates)" : "collinear",
+                   pc.labels.empty() ? "" : ", or too few are inside");
+    if (!dt.duplicates.empty())
+      std::fprintf(stderr, "tessera: %zu duplicate points are not vertices (first: %d = %d)\n", dt.duplicates.size(),
+                   dt.duplicates.front().first, dt.duplicates.front().second);
+    if (!dt.ignored_outside_bounds.empty())
+      std::fprintf(stderr, "tessera: %zu points outside --bounds ignored\n", dt.ignored_outside_bounds.size());
+    std::fprintf(stderr, "tessera: read %.3f s, triangulate %.3f s (%d threads), write %.3f s\n", read_s, compute_s,
+                 dt.threads_used, write_s);
+    for (const auto& w : written) std::fprintf(stderr, "tessera: wrote %s\n", w.c_str());
+  }
+  if (a.validate) {
+    const DelaunayReport r = validate(dt, pc.coords, pc.labels);
+    if (!a.quiet || !r.ok) {
+      std::fprintf(stderr,
+                   "tessera: validation %s: %zu simplices, %zu flat/inverted, %zu non-manifold facets, %zu boundary "
+                   "facets, %zu open ridges, %zu non-convex ridges, %zu missing points, %zu non-Delaunay facets, "
+                   "volume %.17g (boundary encloses %.17g)\n",
+                   r.ok ? "passed" : "FAILED", r.simplices, r.flat_or_inverted, r.nonmanifold_facets,
+                   r.boundary_facets, r.open_boundary_ridges, r.nonconvex_boundary, r.missing_points,
+                   r.local_delaunay_violations, r.volume_sum, r.enclosed_volume);
+      for (const auto& m : r.messages) std::fprintf(stderr, "tessera: validation: %s\n", m.c_str());
+    }
+    if (!r.ok) {
+      std::fprintf(stderr, "tessera: error: validation failed: %s\n", r.messages.front().c_str());
+      return kExitFailure;
+    }
+  }
+  return kExitOk;
+}
+
+int run_bench_delaunay(const BenchArgs& a) {
+  check_bounds_arg(a.compute.bounds);
+  if (a.repeat < 1) throw InputError("--repeat must be at least 1");
+  const io::PointCloud pc = read_input(a.compute);
+  const DelaunayOptions opt = delaunay_options(a.compute, pc.dim, true);
+  for (int rep = 0; rep < a.repeat; ++rep) {
+    // Timed region: the library call only (no I/O), as the peers do.
+    const Usage u0 = usage_now();
+    const auto t0 = Clock::now();
+    const Delaunay dt = delaunay(pc.coords, pc.dim, pc.labels, opt);
+    const double secs = seconds_since(t0);
+    const Usage u1 = usage_now();
+    std::printf(
+        "{\"tool\":\"tessera\",\"op\":\"delaunay%d\",\"n\":%zu,\"threads\":%d,\"seconds\":%.6f,\"simplices\":%zu,"
+        "\"extra\":{\"cpu_user_s\":%.6f,\"cpu_sys_s\":%.6f,\"minflt\":%lld,\"peak_rss_bytes\":%lld,"
+        "\"from_cells\":%zu,\"from_hull_completion\":%zu,\"exact_calls\":%llu,\"repeat\":%d}}\n",
+        pc.dim, pc.n, dt.threads_used, secs, dt.n_simplices(), u1.user_s - u0.user_s, u1.sys_s - u0.sys_s,
+        u1.minflt - u0.minflt, u1.maxrss_bytes, dt.from_cells, dt.from_hull_completion,
+        static_cast<unsigned long long>(dt.exact_predicate_calls), rep);
+    std::fflush(stdout);
+  }
+  return kExitOk;
+}
+
+}  // namespace tessera::cli

@@ -1,0 +1,171 @@
+// The `graph`, `faces` and `flower` subcommands: products read off the merged
+// cells (see commands.hpp). Each checks its arguments and output paths before
+// reading or computing anything, computes the cells with the mesh, and writes
+// its files atomically.
+#include <cinttypes>
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "commands.hpp"
+#include "progress.hpp"
+#include "tessera/faces.hpp"
+#include "tessera/flower.hpp"
+#include "tessera/graph.hpp"
+#include "tessera/io/atomic_file.hpp"
+#include "tessera/io/dual.hpp"
+
+namespace tessera::cli {
+namespace {
+
+void require_extension(const std::string& path, const char* ext, const std::string& option, const char* what) {
+  if (extension(path) != ext)
+    throw InputError(option + " " + path + ": " + what + " is written as " + ext + " (got '" + extension(path) + "')");
+}
+
+/// Reads INPUT and computes the cells with the merged mesh; bad input and an
+/// empty result are InputError, as for `voronoi`.
+struct Computed {
+  io::PointCloud pc;
+  Cells cells;
+  double seconds = 0;
+};
+
+Computed read_and_compute(const ComputeArgs& a, bool quiet) {
+  Computed r;
+  r.pc = read_input(a);
+  VoronoiOptions opt = make_options(a, r.pc.dim);
+  opt.build_mesh = true;
+  r.cells = compute(r.pc, opt, !quiet && stderr_is_terminal(), r.seconds);
+  if (r.cells.n_cells() == 0)
+    throw InputError("no cells: none of the " + std::to_string(r.pc.n) + " points is inside the domain" +
+                     (r.pc.labels.empty() ? "" : " with a label >= 0"));
+  return r;
+}
+
+void print_header(const char* command, const ComputeArgs& a, const Computed& r) {
+  std::printf("tessera %s: %zu points (%dD) from %s\n", command, r.pc.n, r.cells.dim, a.input.c_str());
+  std::printf("  %-18s %zu\n", "cells", r.cells.n_cells());
+  std::printf("  %-18s %.3f s on %d thread%s\n", "compute", r.seconds, r.cells.threads_used,
+              r.cells.threads_used == 1 ? "" : "s");
+}
+
+void print_written(const std::vector<std::string>& written) {
+  std::string out;
+  for (const auto& w : written) out += (out.empty() ? "" : ", ") + w;
+  std::printf("  %-18s %s\n", "wrote", out.c_str());
+  std::fflush(stdout);
+}
+
+}  // namespace
+
+// ------------------------------------------------------------------ graph
+
+int run_graph(const GraphArgs& a) {
+  if (a.output.empty() && a.csr.empty() && a.spoke_classes.empty())
+    throw InputError("nothing to do: give -o GRAPH.vtp, --csr FILE.npy or --spoke-classes FILE.npy");
+  if (!a.output.empty()) require_extension(a.output, ".vtp", "output", "the graph (lines)");
+  if (!a.csr.empty()) require_extension(a.csr, ".npy", "--csr", "the wheels");
+  if (!a.spoke_classes.empty()) require_extension(a.spoke_classes, ".npy", "--spoke-classes", "the spoke classes");
+  if (!(a.prune_tolerance >= 0) || !std::isfinite(a.prune_tolerance))
+    throw InputError("--prune-tolerance must be a finite number >= 0");
+  check_bounds_arg(a.compute.bounds);
+  for (const std::string* p : {&a.output, &a.csr, &a.spoke_classes})
+    if (!p->empty()) io::check_writable(*p);
+
+  const Computed r = read_and_compute(a.compute, a.quiet);
+  const AdjacencyGraph g = adjacency_graph(r.cells, {a.prune_tolerance});
+  std::vector<std::string> written;
+  if (!a.output.empty()) {
+    io::write_graph_vtp(a.output, g, r.pc.coords, r.pc.labels);
+    written.push_back(a.output);
+  }
+  if (!a.csr.empty()) {
+    io::write_graph_csr_npy(a.csr, g);
+    written.push_back(a.csr);
+  }
+  if (!a.spoke_classes.empty()) {
+    io::write_spoke_classes_npy(a.spoke_classes, g);
+    written.push_back(a.spoke_classes);
+  }
+
+  if (!a.quiet) {
+    std::size_t by_class[4] = {0, 0, 0, 0};
+    for (SpokeClass s : g.spoke_class) ++by_class[static_cast<int>(s)];
+    print_header("graph", a.compute, r);
+    std::printf("  %-18s %zu (same region %zu, region boundary %zu, domain boundary %zu, outside %zu)\n", "spokes",
+                g.n_spokes(), by_class[0], by_class[1], by_class[2], by_class[3]);
+    std::printf("  %-18s %zu\n", "edges", graph_edges(g).size());
+    if (a.prune_tolerance > 0)
+      std::printf("  %-18s %zu spokes with face %s < %.6g\n", "pruned", g.pruned_spokes,
+                  g.dim == 3 ? "area" : "length", g.prune_threshold);
+    print_written(written);
+  }
+  return kExitOk;
+}
+
+// ------------------------------------------------------------------ faces
+
+int run_faces(const FacesArgs& a) {
+  const auto kind = parse_face_set_kind(a.kind);
+  if (!kind) throw InputError("--kind must be boundary, complex or surface-net, got '" + a.kind + "'");
+  if (a.capping && *kind != FaceSetKind::surface_net)
+    throw InputError("--capping applies to --kind surface-net only");
+  if (a.output.empty()) throw InputError("nothing to do: give -o FACES.vtp");
+  require_extension(a.output, ".vtp", "output", "a face set");
+  check_bounds_arg(a.compute.bounds);
+  io::check_writable(a.output);
+
+  const Computed r = read_and_compute(a.compute, a.quiet);
+  FaceSetOptions fo;
+  fo.kind = *kind;
+  fo.capping = a.capping;
+  const FaceSet fs = extract_faces(r.cells, r.pc.labels, fo);
+  io::write_faces_vtp(a.output, fs);
+
+  if (!a.quiet) {
+    print_header("faces", a.compute, r);
+    std::printf("  %-18s %s%s\n", "kind", face_set_kind_name(fs.kind), a.capping ? " (capped)" : "");
+    std::printf("  %-18s %zu %s\n", "faces", fs.n_faces(), fs.dim == 3 ? "polygons" : "segments");
+    std::printf("  %-18s %zu\n", "vertices", fs.n_vertices());
+    if (fs.kind == FaceSetKind::surface_net && r.pc.labels.empty())
+      std::printf("  %-18s no --labels: every cell is in region 0, so there are no interfaces\n", "note");
+    print_written({a.output});
+  }
+  return kExitOk;
+}
+
+// ------------------------------------------------------------------ flower
+
+int run_flower(const FlowerArgs& a) {
+  if (a.points.empty()) throw InputError("give at least one --point ID");
+  if (a.output.empty()) throw InputError("nothing to do: give -o FLOWER.vtp");
+  require_extension(a.output, ".vtp", "output", "a flower");
+  for (std::int64_t id : a.points)
+    if (id < 0) throw InputError("--point " + std::to_string(id) + ": point ids are >= 0");
+  check_bounds_arg(a.compute.bounds);
+  io::check_writable(a.output);
+
+  const Computed r = read_and_compute(a.compute, a.quiet);
+  std::vector<std::int32_t> ids;
+  for (std::int64_t id : a.points) {
+    if (static_cast<std::uint64_t>(id) >= r.pc.n)
+      throw InputError("--point " + std::to_string(id) + ": there are " + std::to_string(r.pc.n) +
+                       " points (ids 0.." + std::to_string(r.pc.n - 1) + ")");
+    ids.push_back(static_cast<std::int32_t>(id));
+  }
+  const std::vector<Flower> fl = flowers(r.cells, r.pc.coords, ids);
+  io::write_flowers_vtp(a.output, fl, r.pc.coords, a.glyphs);
+
+  if (!a.quiet) {
+    print_header("flower", a.compute, r);
+    for (const Flower& f : fl)
+      std::printf("  point %-12" PRId32 " %zu petals, circumflower radius %.6g, %zu clipping neighbours\n",
+                  f.generator, f.n_petals(), f.circumflower_radius, f.neighbors.size());
+    print_written({a.output});
+  }
+  return kExitOk;
+}
+
+}  // namespace tessera::cli

@@ -1,0 +1,87 @@
+// Front end: face sets of a tessellation — the domain boundary, the
+// polygonal complex and surface nets.
+//
+// A face set is a list of Voronoi faces (3D: convex polygons; 2D: line
+// segments) over the topologically merged vertices of Cells, each face listed
+// once, with the two sides it separates.
+//
+// Sides and orientation. Every face separates side 0, a cell, from side 1, a
+// cell, an outside point or a domain-box plane. Side 0 is
+//   * the cell, when the other side is not a cell (box or outside point);
+//   * otherwise the cell with the smaller (region label, generator id):
+//     across a region interface the lower label, inside a region the lower id.
+// Faces are oriented from side 0 towards side 1: in 3D the polygon is
+// counter-clockwise seen from side 1 (its right-hand normal points into side
+// 1, so boundary faces face outward); in 2D the segment runs with side 0 on
+// its left (counter-clockwise around side 0's tile), so its right-hand normal
+// (dy, -dx) points into side 1.
+//
+// BoundaryLabels (two per face) are the labels of side 0 and side 1. Side 0
+// always holds a cell's label (>= 0). Side 1 holds the neighbour's label: a
+// cell's region, an outside point's own (negative) label, or
+// FaceSetOptions::background_label for a domain-box plane. Without labels
+// every cell's label is 0.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <string_view>
+#include <vector>
+
+#include "tessera/cells.hpp"
+
+namespace tessera {
+
+enum class FaceSetKind : std::uint8_t {
+  /// Faces on the domain box or against outside points: the boundary of the
+  /// union of all cells, outward.
+  boundary = 0,
+  /// Every Voronoi face exactly once: between cells (same region or not), on
+  /// the box and against outside points.
+  complex = 1,
+  /// Faces between cells of different regions; with capping also the
+  /// boundary faces, so that every region is enclosed.
+  surface_net = 2,
+};
+
+/// "boundary", "complex", "surface-net" (also "surface_net").
+std::optional<FaceSetKind> parse_face_set_kind(std::string_view name);
+const char* face_set_kind_name(FaceSetKind kind);
+
+struct FaceSetOptions {
+  FaceSetKind kind = FaceSetKind::boundary;
+  bool capping = false;              ///< surface_net: add the boundary faces
+  std::int32_t background_label = -1;  ///< BoundaryLabels value of a domain-box side (must be < 0)
+};
+
+struct FaceSet {
+  int dim = 3;
+  FaceSetKind kind = FaceSetKind::boundary;
+  /// The merged vertices of Cells that the faces use, in ascending order of
+  /// their Cells vertex id, and their topological coordinates.
+  std::vector<double> vertices;            ///< n_vertices * dim
+  std::vector<std::int32_t> vertex_keys;   ///< n_vertices * (dim + 1)
+  /// Faces as CSR into face_vertices (ids into `vertices`); 2D faces have two.
+  std::vector<std::int64_t> face_offsets;  ///< n_faces + 1
+  std::vector<std::int32_t> face_vertices;
+  /// Per face: side 0's generator, then side 1's generator or negative
+  /// box-plane id (x0=-1, x1=-2, y0=-3, ...).
+  std::vector<std::int32_t> sides;            ///< n_faces * 2
+  std::vector<std::int32_t> boundary_labels;  ///< n_faces * 2, see the header comment
+  std::vector<SpokeClass> face_class;         ///< the spoke from side 0 to side 1
+
+  std::size_t n_faces() const { return face_offsets.empty() ? 0 : face_offsets.size() - 1; }
+  std::size_t n_vertices() const { return vertex_keys.size() / static_cast<std::size_t>(dim + 1); }
+};
+
+/// Extract a face set from cells computed with VoronoiOptions::build_mesh
+/// (std::invalid_argument otherwise). `labels` are the labels the cells were
+/// computed with (empty or one per point); they give outside points' labels.
+/// Faces are listed in cell (generator-id) order, each cell's faces in its
+/// mesh order. Throws InputError for labels of the wrong length or a
+/// background label >= 0.
+FaceSet extract_faces(const Cells& cells, std::span<const std::int32_t> labels, const FaceSetOptions& options);
+
+}  // namespace tessera

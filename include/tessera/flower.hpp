@@ -1,0 +1,49 @@
+// Front end: the flower of a cell, for debugging and teaching.
+//
+// Each vertex v of the cell of generator p is the centre of a petal: the ball
+// (disk in 2D) through p centred at v, of radius |v - p|. A candidate point
+// clips the cell iff it lies inside some petal; the union of the petals is
+// the flower. The circumflower — the ball around p of twice the largest petal
+// radius, the security radius — contains the flower, so the neighbour search
+// stops once it has visited every point within it.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "tessera/cells.hpp"
+
+namespace tessera {
+
+struct Flower {
+  int dim = 3;
+  std::int32_t generator = -1;
+  std::array<double, 3> site{0, 0, 0};      ///< the generator's position (z = 0 in 2D)
+  /// Petals: one per cell vertex. The centres are the cell's merged vertices
+  /// (their ids in Cells in `vertex_ids`), in ascending vertex id.
+  std::vector<std::int32_t> vertex_ids;
+  std::vector<double> petal_centres;        ///< n_petals * dim
+  std::vector<double> petal_radii;          ///< distance from each centre to the generator
+  double circumflower_radius = 0;           ///< 2 * max petal radius: the security radius
+  /// The cell: its faces (3D polygons, 2D edges) as CSR over petal indices,
+  /// oriented as in Cells, with the spoke across each face (neighbour id, or
+  /// negative box-plane id).
+  std::vector<std::int64_t> face_offsets;   ///< n_faces + 1
+  std::vector<std::int32_t> face_vertices;  ///< indices into the petals
+  std::vector<std::int32_t> face_neighbor;
+  /// The neighbours that clipped the cell (generators across its faces), ascending.
+  std::vector<std::int32_t> neighbors;
+
+  std::size_t n_petals() const { return petal_radii.size(); }
+};
+
+/// Flowers of the cells of points `ids`, from cells computed with
+/// VoronoiOptions::build_mesh (std::invalid_argument otherwise) on `points`
+/// (n * dim, the same array). Throws InputError when an id is out of range or
+/// its point owns no cell (outside label, duplicate, outside the bounds).
+std::vector<Flower> flowers(const Cells& cells, std::span<const double> points, std::span<const std::int32_t> ids);
+
+}  // namespace tessera

@@ -1,0 +1,17 @@
+// VTK output of a Delaunay triangulation: the input points and the simplices.
+#pragma once
+
+#include <span>
+#include <string>
+
+#include "tessera/delaunay.hpp"
+
+namespace tessera::io {
+
+/// .vtu: VTK_TETRA (3D) or VTK_TRIANGLE (2D) cells over all input points (2D
+/// written with z = 0); .vtp (2D only): triangles as polygons. Cell data:
+/// SimplexId (Int64). Point data: PointId (Int32). Written atomically. Throws
+/// InputError on another extension, .vtp in 3D, or an unwritable path.
+void write_simplices_vtk(const std::string& path, const Delaunay& dt, std::span<const double> points);
+
+}  // namespace tessera::io

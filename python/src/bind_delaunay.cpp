@@ -1,0 +1,115 @@
+// tessera._core.Delaunay / delaunay() / validate_delaunay(): the Delaunay
+// front end (include/tessera/delaunay.hpp), its arrays viewing its buffers.
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include "arrays.hpp"
+#include "bindings.hpp"
+#include "interrupt.hpp"
+#include "options.hpp"
+#include "tessera/delaunay.hpp"
+
+namespace tessera::python {
+namespace {
+
+using Points = py::array_t<double, py::array::c_style>;
+
+/// The triangulation plus its simplex adjacency, which is computed on first
+/// use (not every caller wants it) and then kept so every view shares it.
+struct DelaunayResult {
+  Delaunay dt;
+  std::optional<std::vector<std::int32_t>> neighbors;
+};
+
+DelaunayResult run_delaunay(const Points& points, const py::object& labels,
+                            const std::optional<std::vector<double>>& bounds, double padding, bool ignore_outside,
+                            int threads, bool complete_hull) {
+  const int dim = checked_dim(points);
+  DelaunayOptions opt;
+  fill_common(opt, dim, bounds, padding, ignore_outside, threads);
+  opt.complete_hull = complete_hull;
+  const auto pts = as_span(points);
+  const auto lab = as_labels(labels);
+  return DelaunayResult{without_gil([&] { return delaunay(pts, dim, lab, opt); }), std::nullopt};
+}
+
+py::array neighbors_view(py::object self) {
+  auto& r = self.cast<DelaunayResult&>();
+  if (!r.neighbors) {
+    // Computed without the GIL into a local; stored once the GIL is back, so
+    // two threads asking at once cannot race on the member.
+    auto nb = without_gil([&] { return simplex_neighbors(r.dt); });
+    if (!r.neighbors) r.neighbors = std::move(nb);
+  }
+  return view_rows(*r.neighbors, static_cast<std::size_t>(r.dt.dim + 1), self);
+}
+
+}  // namespace
+
+void bind_delaunay(py::module_& m) {
+  py::class_<DelaunayReport>(m, "DelaunayReport", "Checks of a triangulation (Delaunay.validate).")
+      .def_readonly("ok", &DelaunayReport::ok)
+      .def_readonly("simplices", &DelaunayReport::simplices)
+      .def_readonly("flat_or_inverted", &DelaunayReport::flat_or_inverted)
+      .def_readonly("nonmanifold_facets", &DelaunayReport::nonmanifold_facets)
+      .def_readonly("boundary_facets", &DelaunayReport::boundary_facets)
+      .def_readonly("open_boundary_ridges", &DelaunayReport::open_boundary_ridges)
+      .def_readonly("nonconvex_boundary", &DelaunayReport::nonconvex_boundary)
+      .def_readonly("missing_points", &DelaunayReport::missing_points)
+      .def_readonly("local_delaunay_violations", &DelaunayReport::local_delaunay_violations)
+      .def_readonly("volume_sum", &DelaunayReport::volume_sum)
+      .def_readonly("enclosed_volume", &DelaunayReport::enclosed_volume)
+      .def_readonly("messages", &DelaunayReport::messages)
+      .def("__bool__", [](const DelaunayReport& r) { return r.ok; })
+      .def("__repr__", [](const DelaunayReport& r) {
+        return py::str("DelaunayReport(ok={}, simplices={}, flat_or_inverted={}, nonmanifold_facets={}, "
+                       "local_delaunay_violations={}, missing_points={})")
+            .format(r.ok, r.simplices, r.flat_or_inverted, r.nonmanifold_facets, r.local_delaunay_violations,
+                    r.missing_points);
+      });
+
+  py::class_<DelaunayResult>(m, "Delaunay", "Result of delaunay(): owns the buffers its array properties view.")
+      .def_property_readonly("dim", [](const DelaunayResult& r) { return r.dt.dim; })
+      .def_property_readonly("n_points", [](const DelaunayResult& r) { return r.dt.n_points; })
+      .def_property_readonly("n_simplices", [](const DelaunayResult& r) { return r.dt.n_simplices(); })
+      .def_property_readonly("bounds", [](const DelaunayResult& r) { return bounds_tuple(r.dt.bounds, r.dt.dim); })
+      .def_property_readonly("simplices",
+                             [](py::object s) {
+                               const Delaunay& dt = s.cast<const DelaunayResult&>().dt;
+                               return view_rows(dt.simplices, static_cast<std::size_t>(dt.dim + 1), s);
+                             })
+      .def_property_readonly("neighbors", &neighbors_view)
+      .def_property_readonly("from_cells", [](const DelaunayResult& r) { return r.dt.from_cells; })
+      .def_property_readonly("from_hull_completion", [](const DelaunayResult& r) { return r.dt.from_hull_completion; })
+      .def_property_readonly("hull_completed", [](const DelaunayResult& r) { return r.dt.hull_completed; })
+      .def_property_readonly("duplicates", [](const DelaunayResult& r) { return pairs_copy(r.dt.duplicates); })
+      .def_property_readonly("ignored_outside_bounds",
+                             [](py::object s) {
+                               return view_flat(s.cast<const DelaunayResult&>().dt.ignored_outside_bounds, s);
+                             })
+      .def_property_readonly("exact_predicate_calls", [](const DelaunayResult& r) { return r.dt.exact_predicate_calls; })
+      .def_property_readonly("threads_used", [](const DelaunayResult& r) { return r.dt.threads_used; });
+
+  m.def("delaunay", &run_delaunay, py::arg("points").noconvert(), py::arg("labels").none(true), py::arg("bounds"),
+        py::arg("padding"), py::arg("ignore_outside"), py::arg("threads"), py::arg("complete_hull"),
+        "Delaunay simplices of float64 C-ordered (N, D) points; labels None or int32 (N,). Runs without the GIL.");
+
+  m.def(
+      "validate_delaunay",
+      [](const DelaunayResult& r, const Points& points, const py::object& labels) {
+        if (checked_dim(points) != r.dt.dim || static_cast<std::size_t>(points.shape(0)) != r.dt.n_points)
+          throw py::value_error("validate_delaunay: points are not the ones triangulated");
+        const auto pts = as_span(points);
+        const auto lab = as_labels(labels);
+        return without_gil([&] { return validate(r.dt, pts, lab); });
+      },
+      py::arg("delaunay"), py::arg("points").noconvert(), py::arg("labels").none(true),
+      "Checks of a triangulation (the CLI's `delaunay --validate`).");
+}
+
+}  // namespace tessera::python

@@ -1,0 +1,137 @@
+// tessera._core.Cells / voronoi() / validate_cells(): the cells front end
+// (include/tessera/cells.hpp) as a Python class whose arrays view its buffers.
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include "arrays.hpp"
+#include "bindings.hpp"
+#include "interrupt.hpp"
+#include "options.hpp"
+#include "tessera/cells.hpp"
+
+namespace tessera::python {
+namespace {
+
+using Points = py::array_t<double, py::array::c_style>;
+
+Cells run_voronoi(const Points& points, const py::object& labels, const std::optional<std::vector<double>>& bounds,
+                  double padding, bool ignore_outside, int threads, bool merge) {
+  const int dim = checked_dim(points);
+  VoronoiOptions opt;
+  fill_common(opt, dim, bounds, padding, ignore_outside, threads);
+  opt.build_mesh = merge;
+  const auto pts = as_span(points);
+  const auto lab = as_labels(labels);
+  return without_gil([&] { return voronoi(pts, dim, lab, opt); });
+}
+
+/// Per-face CSR and vertex arrays exist only when the cells were built with
+/// the merged mesh (build_mesh); without it cell_face_offsets stays empty
+/// (a result always has at least one cell).
+bool has_mesh(const Cells& c) { return !c.cell_face_offsets.empty(); }
+
+const Cells& mesh_of(const py::object& self) {
+  const Cells& c = self.cast<const Cells&>();
+  if (!has_mesh(c)) throw py::value_error("no mesh: these cells were computed with merge=False");
+  return c;
+}
+
+}  // namespace
+
+void bind_voronoi(py::module_& m) {
+  py::class_<ValidationReport>(m, "ValidationReport", "Invariant checks of a Voronoi result (Cells.validate).")
+      .def_readonly("ok", &ValidationReport::ok)
+      .def_readonly("volume_sum", &ValidationReport::volume_sum)
+      .def_readonly("domain_volume", &ValidationReport::domain_volume)
+      .def_readonly("volume_rel_error", &ValidationReport::volume_rel_error)
+      .def_readonly("asymmetric_spokes", &ValidationReport::asymmetric_spokes)
+      .def_readonly("bad_vertex_degree", &ValidationReport::bad_vertex_degree)
+      .def_readonly("bad_euler", &ValidationReport::bad_euler)
+      .def_readonly("messages", &ValidationReport::messages)
+      .def("__bool__", [](const ValidationReport& r) { return r.ok; })
+      .def("__repr__", [](const ValidationReport& r) {
+        return py::str("ValidationReport(ok={}, volume_rel_error={:.3g}, asymmetric_spokes={}, "
+                       "bad_vertex_degree={}, bad_euler={})")
+            .format(r.ok, r.volume_rel_error, r.asymmetric_spokes, r.bad_vertex_degree, r.bad_euler);
+      });
+
+  // Every array property returns a fresh read-only view whose base is the
+  // Cells object itself (arrays.hpp); the Python layer documents each one.
+  py::class_<Cells> cells(m, "Cells", "Result of voronoi(): owns the buffers that its array properties view.");
+  cells.def_readonly("dim", &Cells::dim)
+      .def_readonly("n_points", &Cells::n_points)
+      .def_property_readonly("n_cells", &Cells::n_cells)
+      .def_property_readonly("n_vertices", [](const Cells& c) { return has_mesh(c) ? c.n_vertices() : 0; })
+      .def_property_readonly("has_mesh", &has_mesh)
+      .def_property_readonly("bounds", [](const Cells& c) { return bounds_tuple(c.bounds, c.dim); })
+      .def_readonly("exact_predicate_calls", &Cells::exact_predicate_calls)
+      .def_readonly("threads_used", &Cells::threads_used)
+      // per cell
+      .def_property_readonly("generator", [](py::object s) { return view_flat(s.cast<const Cells&>().generator, s); })
+      .def_property_readonly("region", [](py::object s) { return view_flat(s.cast<const Cells&>().region, s); })
+      .def_property_readonly("volume", [](py::object s) { return view_flat(s.cast<const Cells&>().volume, s); })
+      .def_property_readonly("centroid",
+                             [](py::object s) {
+                               const Cells& c = s.cast<const Cells&>();
+                               return view_rows(c.centroid, static_cast<std::size_t>(c.dim), s);
+                             })
+      .def_property_readonly("num_faces", [](py::object s) { return view_flat(s.cast<const Cells&>().num_faces, s); })
+      .def_property_readonly("neighbor_offsets",
+                             [](py::object s) { return view_flat(s.cast<const Cells&>().neighbor_offsets, s); })
+      .def_property_readonly("neighbors", [](py::object s) { return view_flat(s.cast<const Cells&>().neighbors, s); })
+      // per generator
+      .def_property_readonly("cell_of", [](py::object s) { return view_flat(s.cast<const Cells&>().cell_of, s); })
+      // merged mesh
+      .def_property_readonly("vertices",
+                             [](py::object s) {
+                               const Cells& c = mesh_of(s);
+                               return view_rows(c.vertices, static_cast<std::size_t>(c.dim), s);
+                             })
+      .def_property_readonly("vertex_keys",
+                             [](py::object s) {
+                               const Cells& c = mesh_of(s);
+                               return view_rows(c.vertex_keys, static_cast<std::size_t>(c.dim + 1), s);
+                             })
+      .def_property_readonly("cell_face_offsets",
+                             [](py::object s) { return view_flat(mesh_of(s).cell_face_offsets, s); })
+      .def_property_readonly("face_vertex_offsets",
+                             [](py::object s) { return view_flat(mesh_of(s).face_vertex_offsets, s); })
+      .def_property_readonly("face_vertices", [](py::object s) { return view_flat(mesh_of(s).face_vertices, s); })
+      .def_property_readonly("face_neighbor", [](py::object s) { return view_flat(mesh_of(s).face_neighbor, s); })
+      .def_property_readonly("face_class",
+                             [](py::object s) {
+                               const auto& fc = mesh_of(s).face_class;
+                               static_assert(sizeof(SpokeClass) == sizeof(std::uint8_t));
+                               return view(std::span<const std::uint8_t>(
+                                               reinterpret_cast<const std::uint8_t*>(fc.data()), fc.size()),
+                                           {static_cast<py::ssize_t>(fc.size())}, s);
+                             })
+      // diagnostics
+      .def_property_readonly("duplicates", [](const Cells& c) { return pairs_copy(c.duplicates); })
+      .def_property_readonly("ignored_outside_bounds",
+                             [](py::object s) { return view_flat(s.cast<const Cells&>().ignored_outside_bounds, s); });
+
+  m.attr("SAME_REGION") = static_cast<int>(SpokeClass::same_region);
+  m.attr("REGION_BOUNDARY") = static_cast<int>(SpokeClass::region_boundary);
+  m.attr("DOMAIN_BOUNDARY") = static_cast<int>(SpokeClass::domain_boundary);
+  m.attr("OUTSIDE") = static_cast<int>(SpokeClass::outside);
+
+  m.def("voronoi", &run_voronoi, py::arg("points").noconvert(), py::arg("labels").none(true), py::arg("bounds"),
+        py::arg("padding"), py::arg("ignore_outside"), py::arg("threads"), py::arg("merge"),
+        "Cells of float64 C-ordered (N, D) points; labels None or int32 (N,). Runs without the GIL.");
+
+  m.def(
+      "validate_cells",
+      [](const Cells& c, const py::object& labels) {
+        const auto lab = as_labels(labels);
+        return without_gil([&] { return validate(c, lab); });
+      },
+      py::arg("cells"), py::arg("labels").none(true), "Invariant checks (the CLI's --validate).");
+}
+
+}  // namespace tessera::python

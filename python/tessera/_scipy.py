@@ -1,0 +1,122 @@
+"""A ``scipy.spatial.Voronoi``-compatible view of :class:`tessera.Voronoi`.
+
+For code written against scipy: the attributes have scipy's names, types and
+meanings, with one difference that follows from tessera's bounded domain:
+every region is a closed cell inside the box, so no vertex index is -1, and the
+faces that lie on the box (they have no point across) are not ridges. Regions
+are indexed by cell (``point_region`` maps points to them), not by qhull's order.
+"""
+
+from __future__ import annotations
+
+from functools import cached_property
+from typing import TYPE_CHECKING, Dict, List, Tuple
+
+import numpy as np
+
+if TYPE_CHECKING:  # pragma: no cover
+    from ._voronoi import Voronoi
+
+
+class ScipyVoronoi:
+    """Attributes of ``scipy.spatial.Voronoi`` over tessera cells (see :attr:`tessera.Voronoi.scipy`)."""
+
+    furthest_site = False
+
+    def __init__(self, vor: "Voronoi"):
+        if not vor.has_mesh:
+            raise ValueError("the scipy view needs the mesh: compute with merge=True")
+        self._vor = vor
+
+    @property
+    def points(self) -> np.ndarray:
+        """float64 (N, D): the input points."""
+        return self._vor.points
+
+    @property
+    def vertices(self) -> np.ndarray:
+        """float64 (V, D): Voronoi vertices, box corners and edge crossings included."""
+        return self._vor.vertices
+
+    @property
+    def ndim(self) -> int:
+        return self._vor.ndim
+
+    @property
+    def npoints(self) -> int:
+        return self._vor.points.shape[0]
+
+    @property
+    def min_bound(self) -> np.ndarray:
+        return self._vor.points.min(axis=0)
+
+    @property
+    def max_bound(self) -> np.ndarray:
+        return self._vor.points.max(axis=0)
+
+    @cached_property
+    def _face_generator(self) -> np.ndarray:
+        """The generator whose cell each face belongs to."""
+        v = self._vor
+        return np.repeat(v.generators, np.diff(v.cell_face_offsets))
+
+    @cached_property
+    def _ridge_faces(self) -> np.ndarray:
+        """Indices of the faces that are ridges: one per pair of adjacent cells
+        (seen from the lower id), plus the faces towards outside points
+        (label < 0), which own no cell and so are seen from one side only."""
+        v = self._vor
+        nb = v.face_neighbor
+        across = nb >= 0
+        nb_has_cell = np.zeros(nb.shape, dtype=bool)
+        nb_has_cell[across] = v.cell_of[nb[across]] >= 0
+        keep = across & ((nb > self._face_generator) | ~nb_has_cell)
+        return np.flatnonzero(keep)
+
+    @cached_property
+    def ridge_points(self) -> np.ndarray:
+        """int32 (R, 2): the two points each ridge lies between."""
+        faces = self._ridge_faces
+        return np.column_stack([self._face_generator[faces], self._vor.face_neighbor[faces]]).astype(np.intc)
+
+    @cached_property
+    def ridge_vertices(self) -> List[List[int]]:
+        """Vertex indices of each ridge (in 3D counter-clockwise seen from
+        outside the cell of ``ridge_points[r, 0]``)."""
+        v = self._vor
+        faces = self._ridge_faces
+        fvo, fv = v.face_vertex_offsets, v.face_vertices
+        if v.ndim == 2:  # every face is an edge of two vertices
+            return fv.reshape(-1, 2)[faces].tolist()
+        return [fv[fvo[f]:fvo[f + 1]].tolist() for f in faces]
+
+    @cached_property
+    def regions(self) -> List[List[int]]:
+        """Vertex indices of each cell (region ``c`` is cell ``c``): in 2D the
+        polygon counter-clockwise, in 3D the cell's vertices, ascending."""
+        v = self._vor
+        cfo, fvo, fv = v.cell_face_offsets, v.face_vertex_offsets, v.face_vertices
+        if v.ndim == 2:
+            first = fv[fvo[:-1]]  # first vertex of each edge, in polygon order
+            return [r.tolist() for r in np.split(first, cfo[1:-1])]
+        # 3D: the distinct vertices of each cell's faces, via one sort of (cell, vertex) keys.
+        per_cell = np.diff(fvo[cfo])
+        cell = np.repeat(np.arange(v.n_cells, dtype=np.int64), per_cell)
+        keys = np.unique(cell * max(v.n_vertices, 1) + fv)
+        counts = np.bincount(keys // max(v.n_vertices, 1), minlength=v.n_cells)
+        verts = keys % max(v.n_vertices, 1)
+        return [r.tolist() for r in np.split(verts, np.cumsum(counts)[:-1])]
+
+    @property
+    def point_region(self) -> np.ndarray:
+        """int32 (N,): the region (cell) of each point, -1 for a point without one
+        (outside label, dropped outside the bounds, or a duplicate)."""
+        return self._vor.cell_of
+
+    @cached_property
+    def ridge_dict(self) -> Dict[Tuple[int, int], List[int]]:
+        """{(p, q): ridge vertices}, as scipy's."""
+        return {(int(p), int(q)): rv for (p, q), rv in zip(self.ridge_points, self.ridge_vertices)}
+
+    def __repr__(self) -> str:
+        return f"<tessera scipy view of {self._vor!r}>"

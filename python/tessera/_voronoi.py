@@ -1,0 +1,307 @@
+"""tessera.voronoi() and its result, :class:`Voronoi`."""
+
+from __future__ import annotations
+
+import os
+from functools import cached_property
+from typing import Any, Optional, Sequence, Tuple, Union
+
+import numpy as np
+
+from . import _core, _inputs
+
+PathLike = Union[str, "os.PathLike[str]"]
+
+
+class Voronoi:
+    """The Voronoi cells of a point set, clipped to a domain box.
+
+    Made by :func:`tessera.voronoi`. Every array attribute is a read-only numpy
+    view of a buffer owned by the compiled result (no copy; ``arr.base`` keeps
+    it alive); copy what you want to change. Cells are listed in generator-id
+    order: cell ``c`` belongs to point ``generators[c]`` and point ``i`` owns cell
+    ``cell_of[i]`` (-1 when it owns none: an outside point (label < 0), a point
+    dropped outside the bounds, or an exact duplicate of a lower id, see
+    :attr:`duplicates`).
+
+    Per cell (``n_cells`` rows): :attr:`generators`, :attr:`regions`,
+    :attr:`volumes`, :attr:`centroids`, :attr:`num_faces`, and the face
+    neighbours as CSR (:attr:`neighbor_offsets`, :attr:`neighbors`).
+
+    The merged mesh (``merge=True``): :attr:`vertices` (one per topological
+    coordinate, :attr:`vertex_keys`) and the faces of every cell as CSR:
+    faces of cell ``c`` are ``cell_face_offsets[c]:cell_face_offsets[c+1]``;
+    vertices of face ``f`` are
+    ``face_vertices[face_vertex_offsets[f]:face_vertex_offsets[f+1]]``
+    (counter-clockwise seen from outside the cell); :attr:`face_neighbor` is
+    the point across face ``f``, or the negative box-plane id for a face on the
+    domain box (x0=-1, x1=-2, y0=-3, y1=-4, z0=-5, z1=-6). In 2D a face is an
+    edge of two vertices, and the first vertex of each edge, in order, walks the
+    polygon counter-clockwise.
+
+    :attr:`scipy` is a view with the attributes of ``scipy.spatial.Voronoi``.
+    """
+
+    def __init__(self, cells: _core.Cells, points: np.ndarray, labels: Optional[np.ndarray]):
+        self._cells = cells
+        self._points = points
+        self._labels = labels
+
+    # ---- input and domain -------------------------------------------------
+    @property
+    def points(self) -> np.ndarray:
+        """The input points, float64 (N, D): the caller's array itself when it was one."""
+        return self._points
+
+    @property
+    def labels(self) -> Optional[np.ndarray]:
+        """The region labels given (int32 (N,)), or None."""
+        return self._labels
+
+    @property
+    def ndim(self) -> int:
+        """2 or 3."""
+        return self._cells.dim
+
+    @property
+    def bounds(self) -> Tuple[float, ...]:
+        """The domain box, (x0, x1, y0, y1[, z0, z1]): the given bounds or the padded bounding box."""
+        return self._cells.bounds
+
+    @property
+    def n_cells(self) -> int:
+        return self._cells.n_cells
+
+    @property
+    def n_vertices(self) -> int:
+        """Merged vertices (0 with merge=False)."""
+        return self._cells.n_vertices
+
+    # ---- per cell ---------------------------------------------------------
+    @property
+    def generators(self) -> np.ndarray:
+        """int32 (n_cells,): the point id of each cell, ascending."""
+        return self._cells.generator
+
+    @property
+    def cell_of(self) -> np.ndarray:
+        """int32 (N,): the cell of each point, -1 when it owns none."""
+        return self._cells.cell_of
+
+    @property
+    def regions(self) -> np.ndarray:
+        """int32 (n_cells,): the label of each cell (0 without labels).
+
+        Not scipy's ``regions`` (vertex lists): that one is ``self.scipy.regions``.
+        """
+        return self._cells.region
+
+    @property
+    def volumes(self) -> np.ndarray:
+        """float64 (n_cells,): cell volumes (areas in 2D). They sum to the domain's volume."""
+        return self._cells.volume
+
+    @property
+    def centroids(self) -> np.ndarray:
+        """float64 (n_cells, D): cell centroids."""
+        return self._cells.centroid
+
+    @property
+    def num_faces(self) -> np.ndarray:
+        """int32 (n_cells,): faces (3D) or edges (2D) of each cell, box faces included."""
+        return self._cells.num_faces
+
+    @property
+    def neighbor_offsets(self) -> np.ndarray:
+        """int64 (n_cells + 1,): CSR offsets into :attr:`neighbors`."""
+        return self._cells.neighbor_offsets
+
+    @property
+    def neighbors(self) -> np.ndarray:
+        """int32: the point ids across the faces of each cell, ascending per cell
+        (box faces are not listed). Neighbours of cell ``c``:
+        ``neighbors[neighbor_offsets[c]:neighbor_offsets[c+1]]``."""
+        return self._cells.neighbors
+
+    def cell_neighbors(self, c: int) -> np.ndarray:
+        """The point ids across the faces of cell ``c`` (a view)."""
+        off = self.neighbor_offsets
+        return self.neighbors[off[c]:off[c + 1]]
+
+    # ---- merged mesh ------------------------------------------------------
+    @property
+    def has_mesh(self) -> bool:
+        """False when computed with merge=False: the mesh attributes below then raise ValueError."""
+        return self._cells.has_mesh
+
+    @property
+    def vertices(self) -> np.ndarray:
+        """float64 (n_vertices, D): merged cell vertices, one per topological coordinate."""
+        return self._cells.vertices
+
+    @property
+    def vertex_keys(self) -> np.ndarray:
+        """int32 (n_vertices, D+1): topological coordinate of each vertex: the ids of
+        the D+1 points (or negative box planes) whose bisectors meet there, ascending."""
+        return self._cells.vertex_keys
+
+    @property
+    def cell_face_offsets(self) -> np.ndarray:
+        """int64 (n_cells + 1,): CSR offsets of each cell's faces."""
+        return self._cells.cell_face_offsets
+
+    @property
+    def face_vertex_offsets(self) -> np.ndarray:
+        """int64 (n_faces + 1,): CSR offsets of each face's vertices in :attr:`face_vertices`."""
+        return self._cells.face_vertex_offsets
+
+    @property
+    def face_vertices(self) -> np.ndarray:
+        """int32: vertex ids of every face, counter-clockwise seen from outside its cell."""
+        return self._cells.face_vertices
+
+    @property
+    def face_neighbor(self) -> np.ndarray:
+        """int32 (n_faces,): the point across each face, or the negative box-plane id."""
+        return self._cells.face_neighbor
+
+    @property
+    def face_class(self) -> np.ndarray:
+        """uint8 (n_faces,): kind of each face: SAME_REGION (0), REGION_BOUNDARY (1),
+        DOMAIN_BOUNDARY (2) or OUTSIDE (3, the point across has label < 0)."""
+        return self._cells.face_class
+
+    def cell_faces(self, c: int) -> list:
+        """The faces of cell ``c``, each an int32 array of vertex ids (views)."""
+        cfo, fvo, fv = self.cell_face_offsets, self.face_vertex_offsets, self.face_vertices
+        return [fv[fvo[f]:fvo[f + 1]] for f in range(cfo[c], cfo[c + 1])]
+
+    # ---- diagnostics ------------------------------------------------------
+    @property
+    def duplicates(self) -> np.ndarray:
+        """int32 (k, 2): (duplicate id, owner id) for exactly coincident points."""
+        return self._cells.duplicates
+
+    @property
+    def ignored_outside_bounds(self) -> np.ndarray:
+        """int32: points dropped outside the bounds (ignore_outside=True)."""
+        return self._cells.ignored_outside_bounds
+
+    @property
+    def exact_predicate_calls(self) -> int:
+        """Clip decisions the float filter left to exact arithmetic."""
+        return self._cells.exact_predicate_calls
+
+    @property
+    def threads_used(self) -> int:
+        return self._cells.threads_used
+
+    # ---- checks, views, files ---------------------------------------------
+    def validate(self) -> "_core.ValidationReport":
+        """Invariant checks (the CLI's ``--validate``): volumes sum to the domain,
+        symmetric neighbours, every merged vertex shared by exactly the cells of
+        its key, Euler characteristic (3D). The report is truthy when all pass;
+        ``report.messages`` says what failed."""
+        return _core.validate_cells(self._cells, self._labels)
+
+    @cached_property
+    def scipy(self) -> "ScipyVoronoi":
+        """The same cells with the attributes of ``scipy.spatial.Voronoi``."""
+        from ._scipy import ScipyVoronoi
+
+        return ScipyVoronoi(self)
+
+    def save(self, path: PathLike) -> None:
+        """Write the cells for ParaView: ``.vtu`` (3D, one VTK_POLYHEDRON per cell)
+        or ``.vtp`` (2D, one polygon per cell), binary, written atomically.
+
+        Cell data: GeneratorId, Region, Volume (Area), NumberOfFaces
+        (NumberOfEdges), NumberOfNeighbors. Needs merge=True. ValueError for a
+        wrong extension, OSError when the file cannot be written.
+        """
+        path = os.fspath(path)
+        want = ".vtu" if self.ndim == 3 else ".vtp"
+        if not path.lower().endswith(want):
+            kind = "UnstructuredGrid" if self.ndim == 3 else "PolyData"
+            raise ValueError(f"save: {self.ndim}D cells are written as VTK {kind} ({want}), got {path!r}")
+        _core.write_cells_vtk(path, self._cells)
+
+    def to_vtk(self) -> Any:
+        """The cells as a ``vtkUnstructuredGrid`` of polyhedra (3D) or a
+        ``vtkPolyData`` of polygons (2D), with the cell data of :meth:`save`.
+        Per-cell arrays and the 3D vertex coordinates are shared with VTK
+        without copies. Needs ``vtk`` (Debian python3-vtk9) and merge=True."""
+        from ._vtk import cells_to_vtk
+
+        return cells_to_vtk(self)
+
+    def __repr__(self) -> str:
+        mesh = f", {self.n_vertices} vertices" if self.has_mesh else ", no mesh"
+        return f"<tessera.Voronoi {self.ndim}D: {self._cells.n_points} points, {self.n_cells} cells{mesh}>"
+
+
+def voronoi(
+    points: Any,
+    labels: Any = None,
+    bounds: Optional[Sequence[float]] = None,
+    padding: float = 0.01,
+    threads: Optional[int] = None,
+    merge: bool = True,
+    *,
+    ignore_outside: bool = False,
+) -> Voronoi:
+    """Voronoi cells of 2D or 3D points, clipped to a box, with exact topology.
+
+    Parameters
+    ----------
+    points : array_like, shape (N, 2) or (N, 3)
+        Real numbers (float64 used as is, float32 and integers converted).
+    labels : array_like of int, shape (N,), optional
+        Region label of each point. A label < 0 marks an outside point: it
+        clips its neighbours but owns no cell (carves concave shapes).
+    bounds : sequence of float, optional
+        The domain box (x0, x1, y0, y1[, z0, z1]). Default: the bounding box of
+        the points grown by ``padding``.
+    padding : float
+        Margin of the default box, as a fraction of the largest extent (it is
+        then rounded outward to a short binary fraction).
+    threads : int, optional
+        Worker threads; default ``TESSERA_NUM_THREADS`` if set, else every
+        core. The result is identical for any count.
+    merge : bool
+        Build the merged mesh (vertices and faces; needed by :meth:`Voronoi.save`,
+        :meth:`Voronoi.to_vtk` and the scipy view). False computes only the
+        per-cell measures and neighbours: faster and smaller.
+    ignore_outside : bool
+        With ``bounds``: drop points outside the box (listed in
+        ``ignored_outside_bounds``) instead of raising ValueError.
+
+    Returns
+    -------
+    Voronoi
+
+    Raises
+    ------
+    ValueError
+        Bad input (``tessera.InputError`` for the library's own checks): wrong
+        shape or dtype, NaN or infinite coordinates, label count mismatch,
+        empty bounds, points outside the bounds, no extent to build a box from.
+    KeyboardInterrupt
+        Ctrl-C during the run (it stops between batches of cells).
+
+    The computation runs with the GIL released: other Python threads go on.
+    """
+    pts = _inputs.as_points(points)
+    dim = pts.shape[1]
+    lab = _inputs.as_labels(labels, pts.shape[0])
+    cells = _inputs.call(
+        _core.voronoi,
+        pts,
+        lab,
+        _inputs.as_bounds(bounds, dim),
+        _inputs.as_padding(padding),
+        bool(ignore_outside),
+        _inputs.as_threads(threads),
+        bool(merge),
+    )
+    return Voronoi(cells, pts, lab)

@@ -1,0 +1,24 @@
+"""Shared fixtures of the tessera Python tests.
+
+Run with Debian's /usr/bin/python3 (numpy, scipy, vtk, meshio from apt) and the
+module on PYTHONPATH: ctest does both (test python.pytest); by hand,
+``PYTHONPATH=build/python /usr/bin/python3 -m pytest python/tests``.
+"""
+
+import numpy as np
+import pytest
+
+
+@pytest.fixture(autouse=True)
+def _default_threads_env(monkeypatch):
+    """Tests choose their thread counts; a TESSERA_NUM_THREADS set in the
+    caller's shell must not change them."""
+    monkeypatch.delenv("TESSERA_NUM_THREADS", raising=False)
+
+
+def random_points(n, dim, seed=0):
+    """n uniform points in the unit square/cube (general position)."""
+    return np.random.default_rng(seed).random((n, dim))
+
+
+UNIT_BOX = {2: (0.0, 1.0, 0.0, 1.0), 3: (0.0, 1.0, 0.0, 1.0, 0.0, 1.0)}

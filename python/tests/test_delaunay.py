@@ -1,0 +1,71 @@
+"""tessera.delaunay: the result's own guarantees (comparison with scipy: test_scipy_compat.py)."""
+
+import numpy as np
+import pytest
+
+import tessera
+from conftest import random_points
+
+
+def signed_volumes(points, simplices):
+    p = points[simplices]
+    edges = p[:, 1:] - p[:, :1]
+    return np.linalg.det(edges)  # 2D: twice the area; 3D: six times the volume
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_validate_orientation_and_hull(dim):
+    pts = random_points(3000, dim, seed=8)
+    dt = tessera.delaunay(pts)
+    report = dt.validate()
+    assert report.ok and bool(report), report.messages
+    assert report.simplices == dt.nsimplex
+    assert dt.ndim == dim and dt.npoints == 3000
+    assert dt.simplices.dtype == np.int32 and dt.simplices.shape == (dt.nsimplex, dim + 1)
+    assert (signed_volumes(pts, dt.simplices) > 0).all()  # positively oriented
+    assert (dt.simplices[:, 0] == dt.simplices.min(axis=1)).all()  # lowest id first
+    assert dt.hull_completed and dt.from_cells + dt.from_hull_completion == dt.nsimplex
+    assert set(np.unique(dt.simplices).tolist()) == set(range(3000))  # every point used
+
+
+def test_neighbors_are_symmetric():
+    dt = tessera.delaunay(random_points(1000, 3, seed=1))
+    nb = dt.neighbors
+    assert nb is not None and nb.shape == dt.simplices.shape
+    rows, ks = np.nonzero(nb >= 0)
+    for r, k in list(zip(rows.tolist(), ks.tolist()))[:2000]:
+        j = nb[r, k]
+        assert r in nb[j].tolist()
+        # They share the facet opposite vertex k of r.
+        facet = set(dt.simplices[r].tolist()) - {int(dt.simplices[r, k])}
+        assert facet <= set(dt.simplices[j].tolist())
+
+
+def test_labels_keep_the_simplices_of_inside_points():
+    pts = random_points(2000, 2, seed=9)
+    labels = np.where(np.linalg.norm(pts - 0.5, axis=1) < 0.25, -1, 0)
+    dt = tessera.delaunay(pts, labels=labels)
+    assert not dt.hull_completed
+    assert (labels[dt.simplices] >= 0).all()
+    assert dt.validate().ok, dt.validate().messages
+
+
+def test_duplicates_are_in_no_simplex():
+    pts = random_points(300, 3)
+    pts = np.vstack([pts, pts[:2]])
+    dt = tessera.delaunay(pts)
+    assert dt.duplicates.tolist() == [[300, 0], [301, 1]]
+    assert not np.isin(dt.simplices, [300, 301]).any()
+
+
+def test_lattice_gets_a_valid_triangulation():
+    g = np.arange(6, dtype=np.float64)
+    pts = np.stack(np.meshgrid(g, g, g, indexing="ij"), axis=-1).reshape(-1, 3)
+    dt = tessera.delaunay(pts)
+    assert dt.validate().ok, dt.validate().messages
+    assert np.abs(signed_volumes(pts, dt.simplices)).sum() / 6 == pytest.approx(5.0**3)
+
+
+def test_repr():
+    dt = tessera.delaunay(random_points(20, 2))
+    assert repr(dt).startswith("<tessera.Delaunay 2D: 20 points,")

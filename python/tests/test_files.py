@@ -1,0 +1,161 @@
+"""Files: save() read back by VTK's XML readers and by meshio; to_vtk().
+
+meshio 5.0 (Debian) reads .vtu but not .vtp, and it misgroups the cell data of
+polyhedra of different sizes unless the sizes first appear in ascending order
+(nschloe/meshio#1463, open), so general 3D cell files are read back with VTK
+and meshio reads the files it can: triangulations, and cells that are all
+boxes.
+"""
+
+import gc
+import os
+
+import meshio
+import numpy as np
+import pytest
+from vtkmodules.util.numpy_support import vtk_to_numpy
+from vtkmodules.vtkFiltersVerdict import vtkCellSizeFilter
+from vtkmodules.vtkIOXML import vtkXMLPolyDataReader, vtkXMLUnstructuredGridReader
+
+import tessera
+from conftest import UNIT_BOX, random_points
+
+
+def read_vtk(path):
+    reader = vtkXMLUnstructuredGridReader() if str(path).endswith(".vtu") else vtkXMLPolyDataReader()
+    reader.SetFileName(str(path))
+    reader.Update()
+    return reader.GetOutput()
+
+
+def cell_array(data, name):
+    return vtk_to_numpy(data.GetCellData().GetArray(name))
+
+
+def measured_sizes(data, name):
+    """Cell sizes as VTK computes them (exact for simplices; for polyhedra it
+    tetrahedralizes with a tolerance and is off by up to ~1e-2 on some cells,
+    hence cell_measures below for the Voronoi cells)."""
+    f = vtkCellSizeFilter()
+    f.SetInputData(data)
+    f.Update()
+    return cell_array(f.GetOutput(), name)
+
+
+def cell_measures(data):
+    """Volume (3D, divergence theorem over the faces) or area (2D, shoelace) of
+    every cell, from the points and cells VTK holds."""
+    pts = vtk_to_numpy(data.GetPoints().GetData())
+    out = np.empty(data.GetNumberOfCells())
+    for c in range(data.GetNumberOfCells()):
+        cell = data.GetCell(c)
+        if cell.GetNumberOfFaces() == 0:  # a polygon
+            x, y = pts[[cell.GetPointId(k) for k in range(cell.GetNumberOfPoints())], :2].T
+            out[c] = 0.5 * (x * np.roll(y, -1) - np.roll(x, -1) * y).sum()
+            continue
+        total = 0.0
+        for f in range(cell.GetNumberOfFaces()):
+            face = cell.GetFace(f)
+            p = pts[[face.GetPointId(k) for k in range(face.GetNumberOfPoints())]]
+            total += np.einsum("ij,ij->", np.broadcast_to(p[0], p[1:-1].shape), np.cross(p[1:-1], p[2:]))
+        out[c] = total / 6
+    return out
+
+
+def test_3d_cells_vtu_read_by_vtk(tmp_path):
+    vor = tessera.voronoi(random_points(800, 3), bounds=UNIT_BOX[3])
+    path = tmp_path / "cells.vtu"
+    vor.save(path)
+    data = read_vtk(path)
+    assert data.GetNumberOfCells() == vor.n_cells
+    assert np.array_equal(vtk_to_numpy(data.GetPoints().GetData()), vor.vertices)
+    assert np.array_equal(cell_array(data, "GeneratorId"), vor.generators)
+    assert np.array_equal(cell_array(data, "Volume"), vor.volumes)
+    assert np.array_equal(cell_array(data, "NumberOfFaces"), vor.num_faces)
+    assert np.array_equal(cell_array(data, "NumberOfNeighbors"), np.diff(vor.neighbor_offsets))
+    assert set(vtk_to_numpy(data.GetCellTypesArray()).tolist()) == {42}  # VTK_POLYHEDRON
+    assert np.allclose(cell_measures(data), vor.volumes, rtol=1e-9, atol=1e-15)
+
+
+def test_2d_cells_vtp_read_by_vtk(tmp_path):
+    vor = tessera.voronoi(random_points(800, 2), labels=np.arange(800) % 3)
+    path = tmp_path / "cells.vtp"
+    vor.save(str(path))
+    data = read_vtk(path)
+    assert data.GetNumberOfPolys() == vor.n_cells
+    assert np.array_equal(cell_array(data, "Region"), vor.regions)
+    assert np.array_equal(cell_array(data, "Area"), vor.volumes)
+    assert np.allclose(cell_measures(data), vor.volumes, rtol=1e-9, atol=1e-15)
+
+
+def test_3d_cells_vtu_read_by_meshio(tmp_path):
+    # Points on a line across the box: every cell is a box slab (8 vertices,
+    # 6 faces), a file meshio 5.0 groups correctly (see the module docstring).
+    pts = np.column_stack([np.linspace(0.1, 0.9, 5), np.full(5, 0.5), np.full(5, 0.5)])
+    vor = tessera.voronoi(pts, bounds=UNIT_BOX[3])
+    vor.save(tmp_path / "slabs.vtu")
+    mesh = meshio.read(tmp_path / "slabs.vtu")
+    assert np.array_equal(mesh.points, vor.vertices)
+    [block] = mesh.cells
+    assert block.type == "polyhedron8" and len(block.data) == 5
+    for c, faces in enumerate(block.data):
+        assert [sorted(f.tolist()) for f in faces] == [sorted(f.tolist()) for f in vor.cell_faces(c)]
+    assert np.array_equal(mesh.cell_data["GeneratorId"][0], vor.generators)
+    assert np.allclose(mesh.cell_data["Volume"][0], vor.volumes)
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_delaunay_vtu_read_by_vtk_and_meshio(tmp_path, dim):
+    pts = random_points(600, dim, seed=3)
+    dt = tessera.delaunay(pts)
+    path = tmp_path / "delaunay.vtu"
+    dt.save(path)
+    data = read_vtk(path)
+    assert data.GetNumberOfCells() == dt.nsimplex
+    assert set(vtk_to_numpy(data.GetCellTypesArray()).tolist()) == {10 if dim == 3 else 5}
+    conn = vtk_to_numpy(data.GetCells().GetConnectivityArray())
+    assert np.array_equal(conn.reshape(-1, dim + 1), dt.simplices)
+    mesh = meshio.read(path)
+    [block] = mesh.cells
+    assert block.type == ("tetra" if dim == 3 else "triangle")
+    assert np.array_equal(block.data, dt.simplices)
+    assert np.array_equal(mesh.points[:, :dim], pts)
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_to_vtk_matches_the_cells_and_outlives_the_result(dim):
+    vor = tessera.voronoi(random_points(500, dim))
+    volumes = vor.volumes.copy()
+    data = vor.to_vtk()
+    del vor
+    gc.collect()  # the VTK object keeps what it shares with numpy alive
+    name = "Volume" if dim == 3 else "Area"
+    assert np.array_equal(cell_array(data, name), volumes)
+    assert np.allclose(cell_measures(data), volumes, rtol=1e-9, atol=1e-15)
+
+
+def test_delaunay_to_vtk():
+    dt = tessera.delaunay(random_points(300, 3))
+    data = dt.to_vtk()
+    assert data.GetNumberOfCells() == dt.nsimplex
+    assert measured_sizes(data, "Volume").sum() == pytest.approx(
+        np.abs(np.linalg.det(dt.points[dt.simplices][:, 1:] - dt.points[dt.simplices][:, :1])).sum() / 6)
+
+
+def test_save_errors_leave_nothing_behind(tmp_path):
+    vor3 = tessera.voronoi(random_points(100, 3))
+    vor2 = tessera.voronoi(random_points(100, 2))
+    with pytest.raises(ValueError, match=r"3D cells are written as VTK UnstructuredGrid \(\.vtu\)"):
+        vor3.save(tmp_path / "x.vtp")
+    with pytest.raises(ValueError, match=r"2D cells are written as VTK PolyData \(\.vtp\)"):
+        vor2.save(tmp_path / "x.vtu")
+    with pytest.raises(OSError, match="cannot write"):
+        vor3.save(tmp_path / "missing" / "x.vtu")
+    with pytest.raises(ValueError, match="merge=False"):
+        tessera.voronoi(random_points(100, 3), merge=False).save(tmp_path / "x.vtu")
+    dt = tessera.delaunay(random_points(100, 3))
+    with pytest.raises(ValueError, match=r"\.vtu"):
+        dt.save(tmp_path / "x.vtp")
+    with pytest.raises(OSError, match="cannot write"):
+        dt.save(tmp_path / "missing" / "x.vtu")
+    assert os.listdir(tmp_path) == []

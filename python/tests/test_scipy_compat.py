@@ -1,0 +1,119 @@
+"""The scipy-compatible view and the Delaunay result against scipy.spatial.
+
+On general-position input the bounded cells and scipy's (unbounded) diagram
+agree wherever the box does not cut in: a ridge whose vertices all lie strictly
+inside the box is the same ridge in both. Delaunay simplices agree everywhere
+(without labels tessera closes the triangulation up to the convex hull, as
+qhull does).
+"""
+
+import numpy as np
+import pytest
+from scipy.spatial import Delaunay as ScipyDelaunay
+from scipy.spatial import Voronoi as ScipyVoronoi
+
+import tessera
+from conftest import UNIT_BOX, random_points
+
+
+def sorted_pairs(pairs):
+    return {(min(a, b), max(a, b)) for a, b in np.asarray(pairs).tolist()}
+
+
+def sorted_tuples(rows):
+    return set(map(tuple, np.sort(np.asarray(rows), axis=1).tolist()))
+
+
+@pytest.mark.parametrize("dim,n", [(2, 3000), (3, 1500)])
+def test_ridge_points_match_scipy_inside_the_box(dim, n):
+    pts = random_points(n, dim, seed=11)
+    sp = ScipyVoronoi(pts)
+    # scipy's ridges that are finite and lie strictly inside the unit box.
+    inside = np.all((sp.vertices > 0) & (sp.vertices < 1), axis=1)
+    theirs = {(min(a, b), max(a, b))
+              for (a, b), rv in zip(sp.ridge_points.tolist(), sp.ridge_vertices)
+              if -1 not in rv and inside[rv].all()}
+    # Ours whose vertices are all bisector vertices (no box plane in the key).
+    vor = tessera.voronoi(pts, bounds=UNIT_BOX[dim])
+    view = vor.scipy
+    interior = (vor.vertex_keys >= 0).all(axis=1)
+    ours = {(min(a, b), max(a, b))
+            for (a, b), rv in zip(view.ridge_points.tolist(), view.ridge_vertices)
+            if interior[rv].all()}
+    assert len(theirs) > n  # the comparison is not vacuous
+    assert ours == theirs
+    # The ridge vertices are the same points too.
+    theirs_v = {(min(a, b), max(a, b)): np.sort(sp.vertices[rv], axis=0)
+                for (a, b), rv in zip(sp.ridge_points.tolist(), sp.ridge_vertices)
+                if -1 not in rv and inside[rv].all()}
+    for (a, b), rv in list(zip(view.ridge_points.tolist(), view.ridge_vertices))[:500]:
+        key = (min(a, b), max(a, b))
+        if key in theirs_v:
+            assert np.allclose(np.sort(view.vertices[rv], axis=0), theirs_v[key], atol=1e-9)
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_scipy_view_shapes_and_meanings(dim):
+    pts = random_points(400, dim, seed=2)
+    vor = tessera.voronoi(pts)
+    view = vor.scipy
+    assert view is vor.scipy  # computed once
+    assert view.points is vor.points and view.ndim == dim and view.npoints == 400
+    assert view.ridge_points.shape[1] == 2 and view.ridge_points.dtype == np.intc
+    assert len(view.ridge_vertices) == len(view.ridge_points)
+    assert len(view.regions) == vor.n_cells
+    assert view.point_region.shape == (400,)
+    # Each pair of adjacent cells is one ridge.
+    assert len(view.ridge_points) == len(vor.neighbors) // 2
+    assert sorted_pairs(view.ridge_points) == {
+        (min(i, j), max(i, j)) for c, i in enumerate(vor.generators.tolist()) for j in vor.cell_neighbors(c).tolist()}
+    # No infinite vertices; region of point i contains the vertices of its cell.
+    for i in (0, 10, 399):
+        region = view.regions[view.point_region[i]]
+        assert -1 not in region
+        assert (vor.vertex_keys[region] == i).any(axis=1).all()
+    if dim == 2:  # regions are the polygons, counter-clockwise: shoelace area = cell area
+        x, y = view.vertices[view.regions[5]].T
+        assert 0.5 * (x * np.roll(y, -1) - np.roll(x, -1) * y).sum() == pytest.approx(vor.volumes[5])
+    d = view.ridge_dict
+    (p, q), rv = next(iter(d.items()))
+    assert d[(p, q)] == rv and q in vor.cell_neighbors(vor.cell_of[p]).tolist()
+
+
+def test_ridges_towards_outside_points_are_kept_once():
+    pts = random_points(500, 2, seed=5)
+    labels = np.where(pts[:, 0] < 0.2, -1, 0)
+    vor = tessera.voronoi(pts, labels=labels)
+    rp = vor.scipy.ridge_points
+    assert len(sorted_pairs(rp)) == len(rp)  # no ridge twice
+    outside = set(np.flatnonzero(labels < 0).tolist())
+    to_outside = [(a, b) for a, b in rp.tolist() if b in outside]
+    assert to_outside and all(a not in outside for a, _ in to_outside)
+    assert (vor.scipy.point_region[labels < 0] == -1).all()
+
+
+@pytest.mark.parametrize("dim,n", [(2, 5000), (3, 2000)])
+def test_delaunay_simplices_match_scipy(dim, n):
+    pts = random_points(n, dim, seed=21)
+    dt = tessera.delaunay(pts)
+    sp = ScipyDelaunay(pts)
+    assert dt.simplices.shape == (sp.nsimplex, dim + 1)
+    assert sorted_tuples(dt.simplices) == sorted_tuples(sp.simplices)
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_delaunay_neighbors_match_scipy(dim):
+    pts = random_points(800, dim, seed=4)
+    dt = tessera.delaunay(pts)
+    sp = ScipyDelaunay(pts)
+
+    def adjacency(simplices, neighbors):
+        # {simplex as a sorted tuple: {vertex opposite: neighbour as a sorted tuple or None}}
+        out = {}
+        for s, nb in zip(simplices.tolist(), neighbors.tolist()):
+            out[tuple(sorted(s))] = {v: (tuple(sorted(simplices[j].tolist())) if j >= 0 else None)
+                                     for v, j in zip(s, nb)}
+        return out
+
+    assert dt.neighbors.shape == dt.simplices.shape
+    assert adjacency(dt.simplices, dt.neighbors) == adjacency(sp.simplices, sp.neighbors)

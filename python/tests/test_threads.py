@@ -1,0 +1,131 @@
+"""Threads, the GIL and Ctrl-C."""
+
+import os
+import signal
+import threading
+import time
+
+import numpy as np
+import pytest
+
+import tessera
+from conftest import random_points
+
+
+def arrays_of(result, names):
+    return {n: np.array(getattr(result, n)) for n in names}
+
+
+def test_threads_1_and_2_give_identical_results():
+    pts = random_points(20000, 3, seed=6)
+    labels = (pts[:, 2] > 0.5).astype(int)
+    names = ["generators", "volumes", "centroids", "neighbor_offsets", "neighbors", "vertices", "vertex_keys",
+             "cell_face_offsets", "face_vertex_offsets", "face_vertices", "face_neighbor", "face_class"]
+    one = tessera.voronoi(pts, labels=labels, threads=1)
+    two = tessera.voronoi(pts, labels=labels, threads=2)
+    assert (one.threads_used, two.threads_used) == (1, 2)
+    a, b = arrays_of(one, names), arrays_of(two, names)
+    for n in names:
+        assert a[n].dtype == b[n].dtype and a[n].tobytes() == b[n].tobytes(), n
+    d1 = tessera.delaunay(pts, threads=1)
+    d2 = tessera.delaunay(pts, threads=2)
+    assert d1.simplices.tobytes() == d2.simplices.tobytes()
+
+
+def test_tessera_num_threads_is_respected(monkeypatch):
+    pts = random_points(2000, 2)
+    monkeypatch.setenv("TESSERA_NUM_THREADS", "1")
+    assert tessera.voronoi(pts).threads_used == 1
+    monkeypatch.setenv("TESSERA_NUM_THREADS", "2")
+    assert tessera.voronoi(pts).threads_used == 2
+    assert tessera.delaunay(pts).threads_used == 2
+    assert tessera.voronoi(pts, threads=1).threads_used == 1  # the argument wins
+    monkeypatch.setenv("TESSERA_NUM_THREADS", "lots")
+    with pytest.raises(ValueError, match="TESSERA_NUM_THREADS must be a positive integer, got 'lots'"):
+        tessera.voronoi(pts)
+
+
+def test_the_gil_is_released_during_a_long_call():
+    pts = random_points(300_000, 2, seed=1)
+    stamps = []
+    stop = threading.Event()
+
+    def spin():  # a pure-Python thread: it runs only while nobody holds the GIL
+        while not stop.is_set():
+            stamps.append(time.perf_counter())
+            for _ in range(100):
+                pass
+
+    t = threading.Thread(target=spin)
+    t.start()
+    try:
+        t0 = time.perf_counter()
+        tessera.voronoi(pts, threads=1)
+        t1 = time.perf_counter()
+    finally:
+        stop.set()
+        t.join()
+    assert t1 - t0 > 0.1, "the call must be long enough to tell"
+    # Had the call held the GIL, the other thread could not have run at all
+    # between shortly after the call started and shortly before it returned.
+    margin = 0.2 * (t1 - t0)
+    during = [s for s in stamps if t0 + margin < s < t1 - margin]
+    assert len(during) > 100
+
+
+class Interrupted(Exception):
+    pass
+
+
+@pytest.mark.parametrize("func", [tessera.voronoi, tessera.delaunay])
+def test_ctrl_c_interrupts_a_long_call(func):
+    """SIGINT during a run: the run stops between batches and the exception the
+    signal handler raised comes back (KeyboardInterrupt with Python's default
+    handler; a custom one here, so that a signal arriving late could never
+    stop the whole test session)."""
+    pts = random_points(300_000, 3, seed=2)  # several seconds on one thread
+
+    def handler(signum, frame):
+        raise Interrupted()
+
+    old = signal.signal(signal.SIGINT, handler)
+    timer = threading.Timer(0.3, os.kill, (os.getpid(), signal.SIGINT))
+    try:
+        timer.start()
+        t0 = time.perf_counter()
+        with pytest.raises(Interrupted):
+            func(pts, threads=1)
+        elapsed = time.perf_counter() - t0
+    finally:
+        timer.cancel()
+        signal.signal(signal.SIGINT, old)
+    assert elapsed < 3.0  # stopped soon after the signal, not at the end
+    assert tessera.voronoi(pts[:1000], threads=1).n_cells == 1000  # usable afterwards
+
+
+def test_ctrl_c_with_the_default_handler_raises_keyboard_interrupt():
+    pts = random_points(300_000, 3, seed=3)
+    old = signal.signal(signal.SIGINT, signal.default_int_handler)
+    timer = threading.Timer(0.3, os.kill, (os.getpid(), signal.SIGINT))
+    try:
+        timer.start()
+        with pytest.raises(KeyboardInterrupt):
+            tessera.voronoi(pts, threads=1)
+    finally:
+        timer.cancel()
+        signal.signal(signal.SIGINT, old)
+
+
+def test_calls_from_other_threads_run_concurrently():
+    pts = random_points(20000, 3)
+    results = [None, None]
+
+    def work(k):
+        results[k] = tessera.voronoi(pts, threads=1).volumes.copy()
+
+    threads = [threading.Thread(target=work, args=(k,)) for k in range(2)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert np.array_equal(results[0], results[1])

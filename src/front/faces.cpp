@@ -1,0 +1,157 @@
+// tessera::extract_faces: boundary, polygonal complex and surface-net face
+// sets over the merged mesh (conventions in include/tessera/faces.hpp).
+#include "tessera/faces.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <numeric>
+#include <string>
+#include <utility>
+
+#include "mesh_faces.hpp"
+
+namespace tessera {
+
+std::optional<FaceSetKind> parse_face_set_kind(std::string_view name) {
+  if (name == "boundary") return FaceSetKind::boundary;
+  if (name == "complex") return FaceSetKind::complex;
+  if (name == "surface-net" || name == "surface_net") return FaceSetKind::surface_net;
+  return std::nullopt;
+}
+
+const char* face_set_kind_name(FaceSetKind kind) {
+  switch (kind) {
+    case FaceSetKind::boundary: return "boundary";
+    case FaceSetKind::complex: return "complex";
+    case FaceSetKind::surface_net: return "surface-net";
+  }
+  return "?";
+}
+
+namespace {
+
+/// Which faces of a cell belong to the set. Every face of the tessellation is
+/// seen from each cell on its sides; a face between two cells is taken from
+/// side 0 only, so each face is listed once and already oriented from side 0
+/// to side 1 (cell faces are counter-clockwise seen from outside their cell).
+class FaceSelector {
+ public:
+  FaceSelector(const Cells& c, const FaceSetOptions& o) : c_(c), o_(o) {}
+
+  bool operator()(std::size_t cell, std::size_t face) const {
+    const SpokeClass cls = c_.face_class[face];
+    const bool bounding = cls == SpokeClass::domain_boundary || cls == SpokeClass::outside;
+    switch (o_.kind) {
+      case FaceSetKind::boundary: return bounding;
+      case FaceSetKind::complex: return bounding || is_side0(cell, c_.face_neighbor[face]);
+      case FaceSetKind::surface_net:
+        return (cls == SpokeClass::region_boundary && is_side0(cell, c_.face_neighbor[face])) ||
+               (o_.capping && bounding);
+    }
+    return false;
+  }
+
+ private:
+  /// Between two cells: does `cell` have the smaller (region, generator)?
+  bool is_side0(std::size_t cell, std::int32_t neighbor) const {
+    const auto other = static_cast<std::size_t>(c_.cell_of[static_cast<std::size_t>(neighbor)]);
+    return std::pair(c_.region[cell], c_.generator[cell]) < std::pair(c_.region[other], neighbor);
+  }
+
+  const Cells& c_;
+  const FaceSetOptions& o_;
+};
+
+}  // namespace
+
+FaceSet extract_faces(const Cells& c, std::span<const std::int32_t> labels, const FaceSetOptions& options) {
+  front::require_mesh(c, "extract_faces");
+  if (!labels.empty() && labels.size() != c.n_points)
+    throw InputError("labels: " + std::to_string(labels.size()) + " values for " + std::to_string(c.n_points) +
+                     " points");
+  if (options.background_label >= 0)
+    throw InputError("background label must be negative (labels >= 0 are regions), got " +
+                     std::to_string(options.background_label));
+  if (labels.empty() && std::find(c.face_class.begin(), c.face_class.end(), SpokeClass::outside) != c.face_class.end())
+    throw InputError("labels: these cells have outside points; pass the labels they were computed with");
+  const int D = c.dim;
+  const std::size_t nc = c.n_cells(), nv = c.n_vertices();
+  const auto& cfo = c.cell_face_offsets;
+  const auto& fvo = c.face_vertex_offsets;
+  const FaceSelector selected(c, options);
+
+  FaceSet out;
+  out.dim = D;
+  out.kind = options.kind;
+
+  // Pass 1: per cell, the faces and corners it contributes; mark used vertices.
+  std::vector<std::int64_t> face_start(nc + 1, 0), corner_start(nc + 1, 0);
+  std::vector<std::uint8_t> used(nv, 0);
+  front::for_each_cell(c, [&](std::size_t k) {
+    std::int64_t faces = 0, corners = 0;
+    for (auto f = cfo[k]; f < cfo[k + 1]; ++f) {
+      const auto fu = static_cast<std::size_t>(f);
+      if (!selected(k, fu)) continue;
+      ++faces;
+      corners += fvo[fu + 1] - fvo[fu];
+      for (auto q = fvo[fu]; q < fvo[fu + 1]; ++q)
+        std::atomic_ref<std::uint8_t>(used[static_cast<std::size_t>(c.face_vertices[static_cast<std::size_t>(q)])])
+            .store(1, std::memory_order_relaxed);
+    }
+    face_start[k + 1] = faces;
+    corner_start[k + 1] = corners;
+  });
+  std::partial_sum(face_start.begin(), face_start.end(), face_start.begin());
+  std::partial_sum(corner_start.begin(), corner_start.end(), corner_start.begin());
+
+  // Used vertices keep their relative order.
+  std::vector<std::int32_t> new_id(nv, -1);
+  std::int32_t nu = 0;
+  for (std::size_t v = 0; v < nv; ++v)
+    if (used[v]) new_id[v] = nu++;
+  const std::size_t dn = static_cast<std::size_t>(D), kn = dn + 1;
+  out.vertices.resize(static_cast<std::size_t>(nu) * dn);
+  out.vertex_keys.resize(static_cast<std::size_t>(nu) * kn);
+  for (std::size_t v = 0; v < nv; ++v) {
+    if (new_id[v] < 0) continue;
+    const auto w = static_cast<std::size_t>(new_id[v]);
+    std::copy_n(&c.vertices[v * dn], dn, &out.vertices[w * dn]);
+    std::copy_n(&c.vertex_keys[v * kn], kn, &out.vertex_keys[w * kn]);
+  }
+
+  // Pass 2: fill.
+  const std::size_t nf = static_cast<std::size_t>(face_start[nc]);
+  out.face_offsets.resize(nf + 1);
+  out.face_offsets[0] = 0;
+  out.face_vertices.resize(static_cast<std::size_t>(corner_start[nc]));
+  out.sides.resize(2 * nf);
+  out.boundary_labels.resize(2 * nf);
+  out.face_class.resize(nf);
+  front::for_each_cell(c, [&](std::size_t k) {
+    auto o = static_cast<std::size_t>(face_start[k]);
+    auto q = static_cast<std::size_t>(corner_start[k]);
+    for (auto f = cfo[k]; f < cfo[k + 1]; ++f) {
+      const auto fu = static_cast<std::size_t>(f);
+      if (!selected(k, fu)) continue;
+      for (auto t = fvo[fu]; t < fvo[fu + 1]; ++t)
+        out.face_vertices[q++] = new_id[static_cast<std::size_t>(c.face_vertices[static_cast<std::size_t>(t)])];
+      out.face_offsets[o + 1] = static_cast<std::int64_t>(q);
+      const std::int32_t j = c.face_neighbor[fu];
+      const SpokeClass cls = c.face_class[fu];
+      std::int32_t other_label = options.background_label;
+      if (cls == SpokeClass::outside)
+        other_label = labels[static_cast<std::size_t>(j)];
+      else if (cls == SpokeClass::same_region || cls == SpokeClass::region_boundary)
+        other_label = c.region[static_cast<std::size_t>(c.cell_of[static_cast<std::size_t>(j)])];
+      out.sides[2 * o] = c.generator[k];
+      out.sides[2 * o + 1] = j;
+      out.boundary_labels[2 * o] = c.region[k];
+      out.boundary_labels[2 * o + 1] = other_label;
+      out.face_class[o] = cls;
+      ++o;
+    }
+  });
+  return out;
+}
+
+}  // namespace tessera

@@ -1,0 +1,86 @@
+// tessera::flowers: petals, circumflower and clipping neighbours of chosen cells.
+#include "tessera/flower.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "mesh_faces.hpp"
+
+namespace tessera {
+namespace {
+
+/// Why point `id` owns no cell, in words.
+std::string no_cell_reason(const Cells& c, std::int32_t id) {
+  for (auto [dup, owner] : c.duplicates)
+    if (dup == id) return "it duplicates point " + std::to_string(owner);
+  if (std::find(c.ignored_outside_bounds.begin(), c.ignored_outside_bounds.end(), id) !=
+      c.ignored_outside_bounds.end())
+    return "it lies outside the bounds";
+  return "it is an outside point (label < 0)";
+}
+
+Flower flower_of(const Cells& c, std::span<const double> points, std::int32_t id) {
+  const auto k = static_cast<std::size_t>(c.cell_of[static_cast<std::size_t>(id)]);
+  const auto D = static_cast<std::size_t>(c.dim);
+  Flower fl;
+  fl.dim = c.dim;
+  fl.generator = id;
+  for (std::size_t a = 0; a < D; ++a) fl.site[a] = points[static_cast<std::size_t>(id) * D + a];
+
+  const auto f0 = static_cast<std::size_t>(c.cell_face_offsets[k]);
+  const auto f1 = static_cast<std::size_t>(c.cell_face_offsets[k + 1]);
+  const auto q0 = static_cast<std::size_t>(c.face_vertex_offsets[f0]);
+  const auto q1 = static_cast<std::size_t>(c.face_vertex_offsets[f1]);
+  fl.vertex_ids.assign(c.face_vertices.begin() + static_cast<std::ptrdiff_t>(q0),
+                       c.face_vertices.begin() + static_cast<std::ptrdiff_t>(q1));
+  std::sort(fl.vertex_ids.begin(), fl.vertex_ids.end());
+  fl.vertex_ids.erase(std::unique(fl.vertex_ids.begin(), fl.vertex_ids.end()), fl.vertex_ids.end());
+
+  double r_max = 0;
+  for (std::int32_t v : fl.vertex_ids) {
+    double r2 = 0;
+    for (std::size_t a = 0; a < D; ++a) {
+      const double x = c.vertices[static_cast<std::size_t>(v) * D + a];
+      fl.petal_centres.push_back(x);
+      r2 += (x - fl.site[a]) * (x - fl.site[a]);
+    }
+    fl.petal_radii.push_back(std::sqrt(r2));
+    r_max = std::max(r_max, fl.petal_radii.back());
+  }
+  fl.circumflower_radius = 2 * r_max;
+
+  fl.face_offsets.push_back(0);
+  for (std::size_t f = f0; f < f1; ++f) {
+    for (auto q = c.face_vertex_offsets[f]; q < c.face_vertex_offsets[f + 1]; ++q) {
+      const std::int32_t v = c.face_vertices[static_cast<std::size_t>(q)];
+      fl.face_vertices.push_back(static_cast<std::int32_t>(
+          std::lower_bound(fl.vertex_ids.begin(), fl.vertex_ids.end(), v) - fl.vertex_ids.begin()));
+    }
+    fl.face_offsets.push_back(static_cast<std::int64_t>(fl.face_vertices.size()));
+    fl.face_neighbor.push_back(c.face_neighbor[f]);
+  }
+  fl.neighbors.assign(c.neighbors.begin() + c.neighbor_offsets[k], c.neighbors.begin() + c.neighbor_offsets[k + 1]);
+  return fl;
+}
+
+}  // namespace
+
+std::vector<Flower> flowers(const Cells& c, std::span<const double> points, std::span<const std::int32_t> ids) {
+  front::require_mesh(c, "flowers");
+  if (points.size() != c.n_points * static_cast<std::size_t>(c.dim))
+    throw std::invalid_argument("flowers: points are not the array the cells were computed from");
+  std::vector<Flower> out;
+  out.reserve(ids.size());
+  for (std::int32_t id : ids) {
+    if (id < 0 || static_cast<std::size_t>(id) >= c.n_points)
+      throw InputError("point " + std::to_string(id) + " does not exist (there are " + std::to_string(c.n_points) +
+                       " points, ids 0.." + std::to_string(c.n_points - 1) + ")");
+    if (c.cell_of[static_cast<std::size_t>(id)] < 0)
+      throw InputError("point " + std::to_string(id) + " owns no cell: " + no_cell_reason(c, id));
+    out.push_back(flower_of(c, points, id));
+  }
+  return out;
+}
+
+}  // namespace tessera

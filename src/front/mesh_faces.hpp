@@ -1,0 +1,77 @@
+// Private helpers for the products read off the merged mesh of Cells (the
+// adjacency graph, face sets, flowers): the mesh precondition, face measures
+// and the parallel loop over cells.
+#pragma once
+
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include "tessera/cells.hpp"
+
+namespace tessera::front {
+
+/// The mesh arrays exist and have consistent sizes. A Cells without a mesh is
+/// a programming error of the caller (std::invalid_argument), not bad input.
+inline void require_mesh(const Cells& c, const char* who) {
+  const std::size_t nc = c.n_cells();
+  auto fail = [who](const char* what) { throw std::invalid_argument(std::string(who) + ": " + what); };
+  if (c.dim != 2 && c.dim != 3) fail("dim must be 2 or 3");
+  if (c.cell_face_offsets.size() != nc + 1)
+    fail("cells have no mesh (compute them with VoronoiOptions::build_mesh = true)");
+  const std::size_t nf = static_cast<std::size_t>(c.cell_face_offsets.back());
+  if (c.face_vertex_offsets.size() != nf + 1 || c.face_neighbor.size() != nf || c.face_class.size() != nf ||
+      static_cast<std::size_t>(c.face_vertex_offsets.back()) != c.face_vertices.size())
+    fail("face arrays have inconsistent sizes");
+  if (c.generator.size() != nc || c.region.size() != nc || c.volume.size() != nc ||
+      c.cell_of.size() != c.n_points)
+    fail("per-cell arrays have inconsistent sizes");
+  if (c.vertices.size() != c.n_vertices() * static_cast<std::size_t>(c.dim)) fail("bad vertex array");
+}
+
+/// Area of a 3D face (a planar convex polygon, via the fan from its first
+/// vertex) or length of a 2D face (an edge).
+inline double face_measure(const Cells& c, std::int64_t f) {
+  const std::size_t b = static_cast<std::size_t>(c.face_vertex_offsets[static_cast<std::size_t>(f)]);
+  const std::size_t e = static_cast<std::size_t>(c.face_vertex_offsets[static_cast<std::size_t>(f) + 1]);
+  auto at = [&](std::size_t k) { return &c.vertices[static_cast<std::size_t>(c.face_vertices[k]) * c.dim]; };
+  if (c.dim == 2) {
+    const double* p = at(b);
+    const double* q = at(b + 1);
+    return std::hypot(q[0] - p[0], q[1] - p[1]);
+  }
+  const double* o = at(b);
+  double s[3] = {0, 0, 0};
+  for (std::size_t k = b + 1; k + 1 < e; ++k) {
+    const double* p = at(k);
+    const double* q = at(k + 1);
+    const double u[3] = {p[0] - o[0], p[1] - o[1], p[2] - o[2]};
+    const double v[3] = {q[0] - o[0], q[1] - o[1], q[2] - o[2]};
+    s[0] += u[1] * v[2] - u[2] * v[1];
+    s[1] += u[2] * v[0] - u[0] * v[2];
+    s[2] += u[0] * v[1] - u[1] * v[0];
+  }
+  return 0.5 * std::sqrt(s[0] * s[0] + s[1] * s[1] + s[2] * s[2]);
+}
+
+/// body(cell index) for every cell, on the thread count the cells were
+/// computed with. Bodies write only per-cell slots, so results never depend
+/// on the schedule.
+template <class Body>
+void for_each_cell(const Cells& c, Body&& body) {
+  tbb::task_arena arena(c.threads_used > 0 ? c.threads_used : 1);
+  arena.execute([&] {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, c.n_cells(), 256),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+                        for (std::size_t k = r.begin(); k != r.end(); ++k) body(k);
+                      });
+  });
+}
+
+}  // namespace tessera::front

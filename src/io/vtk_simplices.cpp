@@ -1,0 +1,116 @@
+// VTK output of a Delaunay triangulation (include/tessera/io/vtk_simplices.hpp).
+//
+// The .vtu layout follows the cells writer (src/io/vtk_xml.cpp): one <Piece>,
+// every DataArray appended raw in one <AppendedData> block, each payload a
+// UInt64 byte count and then the values in native (little-endian) order.
+// Simplices are all of one type, so offsets and types are generated on the fly.
+#include "tessera/io/vtk_simplices.hpp"
+
+#include <cstdint>
+#include <numeric>
+#include <ostream>
+#include <vector>
+
+#include "io_detail.hpp"
+#include "tessera/io/atomic_file.hpp"
+#include "tessera/io/vtk_polydata.hpp"
+
+namespace tessera::io {
+namespace {
+
+constexpr std::uint8_t kVtkTriangle = 5, kVtkTetra = 10;
+
+template <class T>
+void put(std::ostream& os, const T& v) {
+  os.write(reinterpret_cast<const char*>(&v), sizeof(T));
+}
+
+void write_vtu(const std::string& path, const Delaunay& dt, std::span<const double> points) {
+  const int D = dt.dim;
+  const std::size_t n = dt.n_points, m = dt.n_simplices(), w = static_cast<std::size_t>(D + 1);
+  struct Array { const char* type; const char* name; int comps; std::uint64_t bytes; };
+  const Array arrays[] = {
+      {"Int32", "PointId", 1, n * 4},
+      {"Int64", "SimplexId", 1, m * 8},
+      {"Float64", "Points", 3, n * 3 * 8},
+      {"Int32", "connectivity", 1, m * w * 4},
+      {"Int64", "offsets", 1, m * 8},
+      {"UInt8", "types", 1, m},
+  };
+  std::uint64_t offsets[6], at = 0;
+  for (int k = 0; k < 6; ++k) {
+    offsets[k] = at;
+    at += 8 + arrays[k].bytes;
+  }
+  auto tag = [&](int k, const char* indent) {
+    std::string s = std::string(indent) + "<DataArray type=\"" + arrays[k].type + "\" Name=\"" + arrays[k].name + "\"";
+    if (arrays[k].comps != 1) s += " NumberOfComponents=\"" + std::to_string(arrays[k].comps) + "\"";
+    return s + " format=\"appended\" offset=\"" + std::to_string(offsets[k]) + "\"/>\n";
+  };
+  std::string xml =
+      "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" "
+      "header_type=\"UInt64\">\n  <UnstructuredGrid>\n    <Piece NumberOfPoints=\"" +
+      std::to_string(n) + "\" NumberOfCells=\"" + std::to_string(m) + "\">\n";
+  xml += "      <PointData>\n" + tag(0, "        ") + "      </PointData>\n";
+  xml += "      <CellData>\n" + tag(1, "        ") + "      </CellData>\n";
+  xml += "      <Points>\n" + tag(2, "        ") + "      </Points>\n";
+  xml += "      <Cells>\n" + tag(3, "        ") + tag(4, "        ") + tag(5, "        ") + "      </Cells>\n";
+  xml += "    </Piece>\n  </UnstructuredGrid>\n  <AppendedData encoding=\"raw\">\n   _";
+
+  write_file_atomic(path, [&](std::ostream& os) {
+    os << xml;
+    std::vector<char> buf;
+    auto flush = [&] { os.write(buf.data(), static_cast<std::streamsize>(buf.size())); buf.clear(); };
+    auto emit = [&](const auto& v) {
+      const char* p = reinterpret_cast<const char*>(&v);
+      buf.insert(buf.end(), p, p + sizeof(v));
+      if (buf.size() > (1u << 20)) flush();
+    };
+    emit(arrays[0].bytes);
+    for (std::size_t i = 0; i < n; ++i) emit(static_cast<std::int32_t>(i));
+    emit(arrays[1].bytes);
+    for (std::size_t s = 0; s < m; ++s) emit(static_cast<std::int64_t>(s));
+    emit(arrays[2].bytes);
+    for (std::size_t i = 0; i < n; ++i)
+      for (int d = 0; d < 3; ++d) emit(d < D ? points[i * static_cast<std::size_t>(D) + static_cast<std::size_t>(d)] : 0.0);
+    flush();
+    put(os, arrays[3].bytes);
+    os.write(reinterpret_cast<const char*>(dt.simplices.data()), static_cast<std::streamsize>(arrays[3].bytes));
+    emit(arrays[4].bytes);
+    for (std::size_t s = 1; s <= m; ++s) emit(static_cast<std::int64_t>(s * w));
+    emit(arrays[5].bytes);
+    for (std::size_t s = 0; s < m; ++s) emit(D == 3 ? kVtkTetra : kVtkTriangle);
+    flush();
+    os << "\n  </AppendedData>\n</VTKFile>\n";
+  });
+}
+
+void write_vtp(const std::string& path, const Delaunay& dt, std::span<const double> points) {
+  const std::size_t m = dt.n_simplices();
+  std::vector<std::int64_t> offsets(m + 1);
+  for (std::size_t s = 0; s <= m; ++s) offsets[s] = static_cast<std::int64_t>(3 * s);
+  std::vector<std::int64_t> ids(m);
+  std::iota(ids.begin(), ids.end(), 0);
+  std::vector<std::int32_t> pids(dt.n_points);
+  std::iota(pids.begin(), pids.end(), 0);
+  PolyData pd;
+  pd.dim = 2;
+  pd.points = points;
+  pd.polys = {offsets, dt.simplices};
+  pd.point_data.push_back({"PointId", std::span<const std::int32_t>(pids), 1});
+  pd.cell_data.push_back({"SimplexId", std::span<const std::int64_t>(ids), 1});
+  write_polydata(path, pd);
+}
+
+}  // namespace
+
+void write_simplices_vtk(const std::string& path, const Delaunay& dt, std::span<const double> points) {
+  const std::string ext = detail::lower_extension(path);
+  if (ext == ".vtu") return write_vtu(path, dt, points);
+  if (ext == ".vtp" && dt.dim == 2) return write_vtp(path, dt, points);
+  if (ext == ".vtp")
+    throw InputError("cannot write " + path + ": 3D Delaunay output is an unstructured grid (.vtu)");
+  throw InputError("cannot write " + path + ": unknown extension '" + ext + "' (use .vtu, or .vtp in 2D)");
+}
+
+}  // namespace tessera::io

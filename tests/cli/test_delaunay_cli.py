@@ -1,0 +1,177 @@
+#!/usr/bin/python3
+"""End-to-end tests of `tessera delaunay` and `tessera bench delaunay`.
+
+Usage: /usr/bin/python3 tests/cli/test_delaunay_cli.py PATH_TO_tessera [unittest args...]
+
+Checks what the command writes by reading it back (VTK's XML readers, numpy)
+and against scipy.spatial.Delaunay (Qhull) on general-position input, and that
+bad input fails cleanly with nothing written. Prints "N passed, M failed" last.
+"""
+import json
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import unittest
+
+import numpy as np
+import vtk
+from scipy.spatial import Delaunay as ScipyDelaunay
+from vtk.util.numpy_support import vtk_to_numpy
+
+TESSERA = None
+
+
+def run(args):
+    env = dict(os.environ)
+    env.pop("TESSERA_NUM_THREADS", None)
+    return subprocess.run([TESSERA] + [str(a) for a in args], capture_output=True, text=True, env=env, timeout=600)
+
+
+def simplex_set(s):
+    return set(map(tuple, np.sort(np.asarray(s), axis=1)))
+
+
+class DelaunayCommand(unittest.TestCase):
+    def setUp(self):
+        self.dir = tempfile.mkdtemp(prefix="tessera-delaunay-")
+        rng = np.random.default_rng(5)
+        self.p3 = rng.random((3000, 3))
+        self.p2 = rng.random((3000, 2))
+        np.save(self.path("p3.npy"), self.p3)
+        np.save(self.path("p2.npy"), self.p2)
+
+    def tearDown(self):
+        shutil.rmtree(self.dir)
+
+    def path(self, name):
+        return os.path.join(self.dir, name)
+
+    def ok(self, args):
+        r = run(args)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        return r
+
+    def test_3d_equals_scipy_and_reads_back(self):
+        r = self.ok(["delaunay", self.path("p3.npy"), "-o", self.path("t.vtu"), "--simplices", self.path("t.npy"),
+                     "--validate"])
+        self.assertIn("validation passed", r.stderr)
+        s = np.load(self.path("t.npy"))
+        self.assertEqual(s.dtype, np.int64)
+        self.assertEqual(s.shape[1], 4)
+        self.assertEqual(simplex_set(s), simplex_set(ScipyDelaunay(self.p3).simplices))
+        # Positively oriented: det[p1-p0, p2-p0, p3-p0] > 0.
+        p = self.p3[s]
+        det = np.linalg.det(np.stack([p[:, 1] - p[:, 0], p[:, 2] - p[:, 0], p[:, 3] - p[:, 0]], axis=1))
+        self.assertTrue((det > 0).all())
+        rd = vtk.vtkXMLUnstructuredGridReader()
+        rd.SetFileName(self.path("t.vtu"))
+        rd.Update()
+        g = rd.GetOutput()
+        self.assertEqual(g.GetNumberOfCells(), len(s))
+        self.assertEqual(g.GetNumberOfPoints(), len(self.p3))
+        self.assertTrue(all(g.GetCellType(i) == vtk.VTK_TETRA for i in range(0, len(s), 97)))
+        conn = vtk_to_numpy(g.GetCells().GetConnectivityArray()).reshape(-1, 4)
+        np.testing.assert_array_equal(conn, s)
+        np.testing.assert_allclose(vtk_to_numpy(g.GetPoints().GetData()), self.p3)
+
+    def test_2d_vtp_and_vtu(self):
+        self.ok(["delaunay", self.path("p2.npy"), "-o", self.path("t.vtp"), "--simplices", self.path("t.npy")])
+        s = np.load(self.path("t.npy"))
+        self.assertEqual(simplex_set(s), simplex_set(ScipyDelaunay(self.p2).simplices))
+        p = self.p2[s]
+        cross = (p[:, 1, 0] - p[:, 0, 0]) * (p[:, 2, 1] - p[:, 0, 1]) - (p[:, 1, 1] - p[:, 0, 1]) * (p[:, 2, 0] - p[:, 0, 0])
+        self.assertTrue((cross > 0).all(), "triangles are counter-clockwise")
+        rd = vtk.vtkXMLPolyDataReader()
+        rd.SetFileName(self.path("t.vtp"))
+        rd.Update()
+        self.assertEqual(rd.GetOutput().GetNumberOfPolys(), len(s))
+        self.ok(["delaunay", self.path("p2.npy"), "-o", self.path("t.vtu")])
+        rd = vtk.vtkXMLUnstructuredGridReader()
+        rd.SetFileName(self.path("t.vtu"))
+        rd.Update()
+        self.assertEqual(rd.GetOutput().GetNumberOfCells(), len(s))
+        self.assertEqual(rd.GetOutput().GetCellType(0), vtk.VTK_TRIANGLE)
+
+    def test_threads_identical(self):
+        self.ok(["delaunay", self.path("p3.npy"), "--simplices", self.path("a.npy"), "--threads", "1"])
+        self.ok(["delaunay", self.path("p3.npy"), "--simplices", self.path("b.npy"), "--threads", "2"])
+        with open(self.path("a.npy"), "rb") as a, open(self.path("b.npy"), "rb") as b:
+            self.assertEqual(a.read(), b.read())
+
+    def test_no_hull_completion_is_a_subset(self):
+        self.ok(["delaunay", self.path("p3.npy"), "--simplices", self.path("a.npy"), "--no-hull-completion"])
+        self.ok(["delaunay", self.path("p3.npy"), "--simplices", self.path("b.npy")])
+        a, b = simplex_set(np.load(self.path("a.npy"))), simplex_set(np.load(self.path("b.npy")))
+        self.assertLess(len(a), len(b))
+        self.assertTrue(a <= b)
+
+    def test_lattice_validates(self):
+        g = np.stack(np.meshgrid(*[np.arange(6.0)] * 3, indexing="ij"), -1).reshape(-1, 3)
+        np.save(self.path("g.npy"), g)
+        r = self.ok(["delaunay", self.path("g.npy"), "--simplices", self.path("t.npy"), "--validate"])
+        self.assertIn("validation passed", r.stderr)
+        s = np.load(self.path("t.npy"))
+        p = g[s]
+        vol = np.linalg.det(np.stack([p[:, 1] - p[:, 0], p[:, 2] - p[:, 0], p[:, 3] - p[:, 0]], axis=1)) / 6
+        self.assertTrue((vol > 0).all())
+        self.assertAlmostEqual(vol.sum(), 125.0, places=9)
+
+    def test_labels(self):
+        labels = np.where(np.linalg.norm(self.p3 - 0.5, axis=1) < 0.3, 1, -1).astype(np.int32)
+        np.save(self.path("l.npy"), labels)
+        self.ok(["delaunay", self.path("p3.npy"), "--labels", self.path("l.npy"), "--simplices", self.path("t.npy"),
+                 "--validate"])
+        s = np.load(self.path("t.npy"))
+        self.assertTrue((labels[s] >= 0).all())
+
+    def test_bench_line(self):
+        r = self.ok(["bench", "delaunay", self.path("p2.npy"), "--repeat", "2", "--threads", "1"])
+        lines = [json.loads(x) for x in r.stdout.splitlines()]
+        self.assertEqual(len(lines), 2)
+        for j in lines:
+            self.assertEqual(j["tool"], "tessera")
+            self.assertEqual(j["op"], "delaunay2")
+            self.assertEqual(j["n"], 3000)
+            self.assertEqual(j["threads"], 1)
+            self.assertEqual(j["simplices"], len(ScipyDelaunay(self.p2).simplices))
+
+    def fails(self, args, outputs=()):
+        r = run(args)
+        self.assertEqual(r.returncode, 2, r.stderr)
+        lines = r.stderr.strip().splitlines()
+        self.assertEqual(len(lines), 1, r.stderr)
+        self.assertTrue(lines[0].startswith("tessera: error: "), r.stderr)
+        for o in outputs:
+            self.assertFalse(os.path.exists(o), o)
+        self.assertEqual([f for f in os.listdir(self.dir) if f.startswith(".")], [])
+
+    def test_bad_input(self):
+        out = self.path("t.vtu")
+        self.fails(["delaunay", self.path("missing.npy"), "-o", out], [out])
+        self.fails(["delaunay", self.path("p3.npy")], [])
+        self.fails(["delaunay", self.path("p3.npy"), "-o", self.path("t.vtk")], [self.path("t.vtk")])
+        self.fails(["delaunay", self.path("p3.npy"), "-o", self.path("t.vtp")], [self.path("t.vtp")])
+        self.fails(["delaunay", self.path("p3.npy"), "--simplices", self.path("t.csv")], [self.path("t.csv")])
+        bad = self.p3.copy()
+        bad[7, 1] = np.nan
+        np.save(self.path("nan.npy"), bad)
+        self.fails(["delaunay", self.path("nan.npy"), "-o", out], [out])
+        self.fails(["delaunay", self.path("p3.npy"), "-o", out, "--bounds", "0", "0.5", "0", "1", "0", "1"], [out])
+        self.fails(["bench", "delaunay", self.path("p3.npy"), "--repeat", "0"])
+
+
+def main():
+    global TESSERA
+    TESSERA = os.path.abspath(sys.argv[1])
+    prog = unittest.main(argv=[sys.argv[0]] + sys.argv[2:], exit=False, verbosity=2)
+    res = prog.result
+    failed = len(res.failures) + len(res.errors) + len(res.unexpectedSuccesses)
+    passed = res.testsRun - failed - len(res.skipped)
+    print("%d passed, %d failed, %d skipped" % (passed, failed, len(res.skipped)))
+    return 0 if failed == 0 else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())

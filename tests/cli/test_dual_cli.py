@@ -1,0 +1,412 @@
+#!/usr/bin/python3
+"""End-to-end tests of `tessera graph`, `tessera faces` and `tessera flower`.
+
+Usage: /usr/bin/python3 tests/cli/test_dual_cli.py PATH_TO_tessera [unittest args...]
+
+Every file written is read back: .vtp through VTK's XML reader, .npy through
+numpy. The graph is checked against scipy's Delaunay triangulation and the
+`voronoi --neighbors` lists, face sets for completeness (counts from the graph),
+closedness, orientation and enclosed volume, flowers against the cells. Bad
+input: exit 2, one error line, nothing written. Shares its helpers with
+test_cli.py.
+
+Prints "N passed, M failed" last; exits 1 if anything failed.
+"""
+import os
+import sys
+import unittest
+from collections import Counter
+
+import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import test_cli as base  # noqa: E402  (helpers only; its test classes are not collected here)
+from test_cli import read_bytes, read_vtp, cell_array  # noqa: E402
+
+try:
+    from scipy.spatial import Delaunay
+except ImportError:  # pragma: no cover
+    Delaunay = None
+
+from vtk.util.numpy_support import vtk_to_numpy  # noqa: E402
+
+run = base.run
+BOX3 = base.BOX3
+BOX2 = base.BOX2
+SAME, REGION, DOMAIN, OUTSIDE = 0, 1, 2, 3
+
+
+def cells_of(cell_array_obj):
+    """Connectivity of a vtkCellArray as a list of id arrays."""
+    conn = vtk_to_numpy(cell_array_obj.GetConnectivityArray())
+    offs = vtk_to_numpy(cell_array_obj.GetOffsetsArray())
+    return [conn[offs[i]:offs[i + 1]] for i in range(len(offs) - 1)]
+
+
+def load_csr(path):
+    a = np.load(path)
+    assert a.dtype == np.int64 and a.ndim == 1, (a.dtype, a.shape)
+    n = int(a[0])
+    return n, a[1:n + 2], a[n + 2:]
+
+
+def surface(loops, pts, dim):
+    """(unbalanced, nonmanifold, enclosed volume) of oriented faces: 3D polygons
+    or 2D segments. Closed and consistently oriented iff unbalanced == 0."""
+    directed = Counter()
+    vol = 0.0
+    o = pts.mean(axis=0)
+    for l in loops:
+        l = [int(x) for x in l]
+        if dim == 2:
+            directed[(l[0], l[1])] += 1
+            a, b = pts[l[0]] - o, pts[l[1]] - o
+            vol += 0.5 * (a[0] * b[1] - a[1] * b[0])
+        else:
+            for t in range(len(l)):
+                directed[(l[t], l[(t + 1) % len(l)])] += 1
+            p = pts[l] - o
+            vol += np.dot(p[0], np.cross(p[1:-1], p[2:]).sum(axis=0)) / 6.0
+    unbalanced = nonmanifold = 0
+    if dim == 3:
+        for (a, b), k in directed.items():
+            if directed.get((b, a), 0) != k:
+                unbalanced += 1
+            if a < b and (k != 1 or directed.get((b, a), 0) != 1):
+                nonmanifold += 1
+    else:
+        inn, out = Counter(), Counter()
+        for (a, b), k in directed.items():
+            out[a] += k
+            inn[b] += k
+        for v in set(inn) | set(out):
+            unbalanced += inn[v] != out[v]
+            nonmanifold += inn[v] != 1 or out[v] != 1
+    return unbalanced, nonmanifold, vol
+
+
+class Graph(base.TempDirCase):
+    def graph(self, pts, extra=(), labels=None):
+        inp = self.save("pts.npy", pts)
+        out, csr, cls = self.p("g.vtp"), self.p("g.npy"), self.p("c.npy")
+        args = ["graph", inp, "-o", out, "--csr", csr, "--spoke-classes", cls, "-q"] + list(extra)
+        if labels is not None:
+            args += ["--labels", self.save("labels.npy", labels)]
+        self.ok(args)
+        return read_vtp(out), load_csr(csr), np.load(cls)
+
+    def check_graph(self, pts, pd, csr, cls, labels=None):
+        n, off, ids = csr
+        self.assertEqual(n, len(pts))
+        self.assertEqual(cls.dtype, np.uint8)
+        self.assertEqual(len(cls), len(ids))
+        self.assertEqual(off[0], 0)
+        self.assertEqual(off[-1], len(ids))
+        # Points are the input points; lines are the undirected edges.
+        np.testing.assert_array_equal(vtk_to_numpy(pd.GetPoints().GetData())[:, :pts.shape[1]], pts)
+        spokes = {}
+        for i in range(n):
+            w = ids[off[i]:off[i + 1]]
+            self.assertTrue(np.all(np.diff(w) > 0), "wheel must be ascending")
+            for j, c in zip(w, cls[off[i]:off[i + 1]]):
+                spokes[(i, int(j))] = int(c)
+        edges = set()
+        for (i, j), c in spokes.items():
+            if j < 0:
+                self.assertEqual(c, DOMAIN)
+            elif c == OUTSIDE:
+                self.assertTrue(labels is not None and labels[j] < 0)
+                edges.add((i, j))
+            else:
+                self.assertEqual(spokes.get((j, i)), c, "spoke %d->%d has no twin of its class" % (i, j))
+                self.assertEqual(c, SAME if labels is None or labels[i] == labels[j] else REGION)
+                if i < j:
+                    edges.add((i, j))
+        lines = cells_of(pd.GetLines())
+        self.assertEqual(len(lines), len(edges))
+        got = {(int(l[0]), int(l[1])) for l in lines}
+        self.assertEqual(got, edges)
+        line_cls = vtk_to_numpy(cell_array(pd, "SpokeClass"))
+        self.assertEqual([int(c) for c in line_cls], [spokes[(int(l[0]), int(l[1]))] for l in lines])
+        name = "FaceArea" if pts.shape[1] == 3 else "FaceLength"
+        self.assertTrue(np.all(vtk_to_numpy(cell_array(pd, name)) > 0))
+        return spokes, edges
+
+    def test_graph_3d_matches_neighbors_and_delaunay(self):
+        pts = np.random.default_rng(21).random((800, 3))
+        pd, csr, cls = self.graph(pts)
+        spokes, edges = self.check_graph(pts, pd, csr, cls)
+        # Same neighbours as `voronoi --neighbors` (which leaves out box faces).
+        nb = self.p("nb.npy")
+        self.ok(["voronoi", self.p("pts.npy"), "--neighbors", nb, "-q"])
+        n, off, ids = base.load_neighbors(nb)
+        want = {(i, int(j)) for i in range(n) for j in ids[off[i]:off[i + 1]]}
+        self.assertEqual({k for k in spokes if k[1] >= 0}, want)
+        # Every edge is a Delaunay edge (general position); nearly all Delaunay
+        # edges are edges (the rest belong to thin hull simplices whose Voronoi
+        # vertices lie outside the padded box).
+        tri = Delaunay(pts)
+        dt = set()
+        for s in tri.simplices:
+            for a in range(4):
+                for b in range(a + 1, 4):
+                    dt.add((min(s[a], s[b]), max(s[a], s[b])))
+        self.assertTrue(edges <= dt, "graph edges that are not Delaunay edges: %s" % sorted(edges - dt)[:5])
+        self.assertGreater(len(edges), 0.85 * len(dt))
+
+    def test_graph_2d_with_labels(self):
+        pts = np.random.default_rng(22).random((1000, 2))
+        labels = np.random.default_rng(23).integers(-1, 3, len(pts)).astype(np.int32)
+        pd, csr, cls = self.graph(pts, labels=labels)
+        spokes, _ = self.check_graph(pts, pd, csr, cls, labels)
+        self.assertEqual(set(spokes.values()), {SAME, REGION, DOMAIN, OUTSIDE})
+        n, off, _ = csr
+        self.assertTrue(np.all(np.diff(off)[labels < 0] == 0), "outside points have empty wheels")
+        np.testing.assert_array_equal(vtk_to_numpy(pd.GetPointData().GetArray("Region")), labels)
+
+    def test_prune_tolerance(self):
+        pts = np.random.default_rng(24).random((800, 3))
+        _, (_, off0, ids0), _ = self.graph(pts)
+        pd, csr, cls = self.graph(pts, ["--prune-tolerance", "0.05"])
+        self.check_graph(pts, pd, csr, cls)  # still symmetric
+        self.assertLess(len(csr[2]), len(ids0))
+
+    def test_threads_byte_identical(self):
+        inp = self.save("big.npy", np.random.default_rng(25).random((5000, 3)))
+        outs = []
+        for th in (1, 2):
+            files = [self.p("g%d.vtp" % th), self.p("g%d.npy" % th), self.p("c%d.npy" % th)]
+            self.ok(["graph", inp, "-o", files[0], "--csr", files[1], "--spoke-classes", files[2],
+                     "--threads", th, "-q"])
+            outs.append([read_bytes(f) for f in files])
+        self.assertTrue(outs[0] == outs[1])
+
+
+class Faces(base.TempDirCase):
+    def faces(self, inp, kind, extra=()):
+        out = self.p("f-%s.vtp" % kind)
+        self.ok(["faces", inp, "-o", out, "--kind", kind, "-q"] + list(extra))
+        pd = read_vtp(out)
+        dim = 3 if pd.GetNumberOfPolys() or not pd.GetNumberOfLines() else 2
+        loops = cells_of(pd.GetPolys() if dim == 3 else pd.GetLines())
+        pts = vtk_to_numpy(pd.GetPoints().GetData())[:, :dim]
+        labels = vtk_to_numpy(cell_array(pd, "BoundaryLabels"))
+        sides = vtk_to_numpy(cell_array(pd, "Sides"))
+        cls = vtk_to_numpy(cell_array(pd, "SpokeClass"))
+        self.assertEqual(labels.shape, (len(loops), 2))
+        self.assertEqual(sides.shape, (len(loops), 2))
+        self.assertEqual(len(np.unique(pts, axis=0)), len(pts), "vertices are merged")
+        used = np.zeros(len(pts), bool)
+        for l in loops:
+            used[l] = True
+        self.assertTrue(used.all(), "every vertex is used")
+        return loops, pts, labels, sides, cls
+
+    def graph_counts(self, inp, extra=()):
+        csr, cls = self.p("g.npy"), self.p("c.npy")
+        self.ok(["graph", inp, "--csr", csr, "--spoke-classes", cls, "-q"] + list(extra))
+        c = np.load(cls)
+        return {k: int(np.sum(c == k)) for k in (SAME, REGION, DOMAIN, OUTSIDE)}
+
+    def test_boundary_is_closed_outward_box(self):
+        for dim, box in ((3, BOX3), (2, BOX2)):
+            inp = self.save("p%d.npy" % dim, np.random.default_rng(30 + dim).random((700, dim)))
+            loops, pts, labels, sides, cls = self.faces(inp, "boundary", ["--bounds"] + box)
+            unbalanced, nonmanifold, vol = surface(loops, pts, dim)
+            self.assertEqual((unbalanced, nonmanifold), (0, 0), "%dD boundary must be a closed manifold" % dim)
+            self.assertAlmostEqual(vol, 1.0, delta=1e-9, msg="outward: enclosed volume = the box")
+            np.testing.assert_array_equal(labels[:, 1], -1)  # background label of the box side
+            self.assertTrue(np.all(sides[:, 1] < 0))
+            self.assertTrue(np.all(cls == DOMAIN))
+
+    def test_complex_has_every_face_once(self):
+        pts = np.random.default_rng(33).random((700, 3))
+        labels = np.random.default_rng(34).integers(-1, 3, len(pts)).astype(np.int32)
+        inp, lab = self.save("p.npy", pts), self.save("l.npy", labels)
+        k = self.graph_counts(inp, ["--labels", lab])
+        loops, _, blabels, sides, cls = self.faces(inp, "complex", ["--labels", lab])
+        self.assertEqual(len(loops), (k[SAME] + k[REGION]) // 2 + k[DOMAIN] + k[OUTSIDE])
+        pairs = {(min(a, b), max(a, b)) for a, b in sides if b >= 0}
+        self.assertEqual(len(pairs), int(np.sum(sides[:, 1] >= 0)), "no face twice")
+        # BoundaryLabels: side 0 is a cell; between cells the lower (label, id) first.
+        self.assertTrue(np.all(blabels[:, 0] >= 0))
+        inner = (cls == SAME) | (cls == REGION)
+        self.assertTrue(np.all((blabels[inner, 0] < blabels[inner, 1]) |
+                               ((blabels[inner, 0] == blabels[inner, 1]) & (sides[inner, 0] < sides[inner, 1]))))
+        np.testing.assert_array_equal(blabels[cls == OUTSIDE, 1], labels[sides[cls == OUTSIDE, 1]])
+        np.testing.assert_array_equal(blabels[cls == DOMAIN, 1], -1)
+
+    def test_surface_net_regions_closed_with_capping(self):
+        for dim in (3, 2):
+            pts = np.random.default_rng(35 + dim).random((1500, dim))
+            labels = np.where(pts[:, 0] < 0.5, 2, 5).astype(np.int32)
+            labels[(pts[:, 0] > 0.8) & (pts[:, 1] > 0.8)] = -1
+            inp, lab = self.save("p.npy", pts), self.save("l.npy", labels)
+            box = BOX3 if dim == 3 else BOX2
+            k = self.graph_counts(inp, ["--labels", lab, "--bounds"] + box)
+            loops, _, blabels, _, cls = self.faces(inp, "surface-net", ["--labels", lab, "--bounds"] + box)
+            self.assertEqual(len(loops), k[REGION] // 2)
+            self.assertTrue(np.all(blabels == [2, 5]), "interfaces run from the lower label to the higher")
+            loops, pts_f, blabels, _, cls = self.faces(inp, "surface-net",
+                                                       ["--labels", lab, "--capping", "--bounds"] + box)
+            self.assertEqual(len(loops), k[REGION] // 2 + k[DOMAIN] + k[OUTSIDE])
+            table = self.p("t.csv")
+            self.ok(["voronoi", inp, "--labels", lab, "--cell-table", table, "--bounds"] + box + ["-q"])
+            t = np.loadtxt(table, delimiter=",", skiprows=1)
+            for region in (2, 5):
+                mine = [l if blabels[f, 0] == region else l[::-1]
+                        for f, l in enumerate(loops) if region in blabels[f]]
+                unbalanced, _, vol = surface(mine, pts_f, dim)
+                self.assertEqual(unbalanced, 0, "%dD region %d must be enclosed" % (dim, region))
+                self.assertAlmostEqual(vol, t[t[:, 1] == region, 2].sum(), delta=1e-9)
+
+    def test_threads_byte_identical(self):
+        inp = self.save("big.npy", np.random.default_rng(38).random((5000, 3)))
+        outs = []
+        for th in (1, 2):
+            out = self.p("f%d.vtp" % th)
+            self.ok(["faces", inp, "-o", out, "--kind", "complex", "--threads", th, "-q"])
+            outs.append(read_bytes(out))
+        self.assertTrue(outs[0] == outs[1])
+
+
+class Flower(base.TempDirCase):
+    def test_flower_3d_and_2d(self):
+        for dim in (3, 2):
+            pts = np.random.default_rng(40 + dim).random((400, dim))
+            inp = self.save("p%d.npy" % dim, pts)
+            nb = self.p("nb.npy")
+            self.ok(["voronoi", inp, "--neighbors", nb, "-q"])
+            n, off, ids = base.load_neighbors(nb)
+            for glyphs in (False, True):
+                out = self.p("fl.vtp")
+                self.ok(["flower", inp, "--point", "5", "--point", "17,33", "-o", out, "-q"] +
+                        (["--glyphs"] if glyphs else []))
+                pd = read_vtp(out)
+                P = vtk_to_numpy(pd.GetPoints().GetData())[:, :dim]
+                radius = vtk_to_numpy(pd.GetPointData().GetArray("Radius"))
+                role = vtk_to_numpy(pd.GetPointData().GetArray("Role"))
+                gen = vtk_to_numpy(pd.GetPointData().GetArray("GeneratorId"))
+                pid = vtk_to_numpy(pd.GetPointData().GetArray("PointId"))
+                cell_role = vtk_to_numpy(cell_array(pd, "Role"))
+                for g in (5, 17, 33):
+                    site = np.flatnonzero((role == 0) & (gen == g))
+                    self.assertEqual(len(site), 1)
+                    np.testing.assert_array_equal(P[site[0]], pts[g])
+                    petals = np.flatnonzero((role == 1) & (gen == g))
+                    d = np.linalg.norm(P[petals] - pts[g], axis=1)
+                    np.testing.assert_allclose(radius[petals], d, rtol=1e-12)
+                    self.assertAlmostEqual(radius[site[0]], 2 * d.max(), delta=1e-12, msg="circumflower")
+                    # Petals are empty: no input point strictly inside any.
+                    for c, r in zip(P[petals], radius[petals]):
+                        self.assertGreaterEqual(np.linalg.norm(pts - c, axis=1).min(), r * (1 - 1e-9))
+                    neigh = pid[(role == 2) & (gen == g)]
+                    np.testing.assert_array_equal(neigh, ids[off[g]:off[g + 1]])
+                self.assertEqual(set(cell_role) >= {5, 6}, glyphs)
+                self.assertEqual(int(np.sum(cell_role == 3)), int(np.sum(role == 2)), "one spoke line per neighbour")
+
+
+class HelpAndSummary(base.TempDirCase):
+    def test_help(self):
+        top = run(["--help"]).stdout
+        for sub in ("graph", "faces", "flower"):
+            self.assertIn(sub, top)
+        options = {"graph": ("--csr", "--spoke-classes", "--prune-tolerance"),
+                   "faces": ("--kind", "--capping"),
+                   "flower": ("--point", "--glyphs")}
+        for sub, own in options.items():
+            r = run([sub, "--help"])
+            self.assertEqual(r.returncode, 0)
+            for opt in ("INPUT", "--output", "--dim", "--labels", "--bounds", "--padding", "--ignore-outside",
+                        "--threads", "--quiet") + own:
+                self.assertIn(opt, r.stdout, "%s --help lacks %s" % (sub, opt))
+
+    def test_summaries_on_stdout(self):
+        inp = self.save("p.npy", np.random.default_rng(50).random((300, 3)))
+        for args, words in ((["graph", inp, "-o", self.p("g.vtp")], ("spokes", "edges", "wrote")),
+                            (["faces", inp, "-o", self.p("f.vtp"), "--kind", "boundary"], ("faces", "vertices")),
+                            (["flower", inp, "--point", "4", "-o", self.p("w.vtp")], ("petals", "circumflower"))):
+            r = self.ok(args)
+            self.assertEqual(r.stderr, "", "no progress bar when stderr is not a terminal")
+            for w in words:
+                self.assertIn(w, r.stdout)
+            self.assertEqual(self.ok(args + ["-q"]).stdout, "")
+
+
+class BadDualInput(base.TempDirCase):
+    """Every failure: exit 2, one line "tessera: error: ...", no files left."""
+
+    fails = base.BadInput.fails
+
+    def setUp(self):
+        super().setUp()
+        self.good3 = self.save("good3.npy", np.random.default_rng(1).random((50, 3)))
+        self.good2 = self.save("good2.npy", np.random.default_rng(1).random((50, 2)))
+        labels = np.zeros(50, np.int32)
+        labels[7] = -1
+        self.labels = self.save("lab.npy", labels)
+
+    def test_graph(self):
+        out = self.p("g.vtp")
+        self.fails(["graph", self.p("nope.npy"), "-o", out], "nope.npy")
+        self.fails(["graph", self.good3], "nothing to do")
+        self.fails(["graph", self.good3, "-o", self.p("g.vtu")], ".vtp")
+        self.fails(["graph", self.good3, "--csr", self.p("g.csv")], ".npy")
+        self.fails(["graph", self.good3, "--spoke-classes", self.p("c.txt")], ".npy")
+        self.fails(["graph", self.good3, "-o", out, "--prune-tolerance", "-1"])
+        self.fails(["graph", self.good3, "-o", out, "--prune-tolerance", "nan"])
+        self.fails(["graph", self.good3, "-o", out, "--csr", self.p("no/dir/g.npy")], "no/dir")
+        self.fails(["graph", self.good3, "-o", out, "--bounds", "0", "0.5", "0", "1", "0", "1"], "outside the bounds")
+        self.fails(["graph", self.good3, "-o", out, "--labels", self.save("short.npy", np.zeros(3, np.int32))])
+
+    def test_faces(self):
+        out = self.p("f.vtp")
+        self.fails(["faces", self.good3, "-o", out], "--kind")
+        self.fails(["faces", self.good3, "-o", out, "--kind", "surface"], "surface-net")
+        self.fails(["faces", self.good3, "-o", out, "--kind", "complex", "--capping"], "--capping")
+        self.fails(["faces", self.good3, "--kind", "complex"], "nothing to do")
+        self.fails(["faces", self.good3, "-o", self.p("f.vtu"), "--kind", "boundary"], ".vtp")
+        self.fails(["faces", self.good2, "-o", out, "--kind", "boundary", "--bounds"] + BOX3)
+        self.fails(["faces", self.save("flat.npy", np.c_[np.random.default_rng(2).random((20, 2)), np.zeros(20)]),
+                    "-o", out, "--kind", "boundary"], "--dim 2")
+
+    def test_flower(self):
+        out = self.p("fl.vtp")
+        self.fails(["flower", self.good3, "-o", out])
+        self.fails(["flower", self.good3, "--point", "50", "-o", out], "50")
+        self.fails(["flower", self.good3, "--point", "-3", "-o", out])
+        self.fails(["flower", self.good3, "--point", "x", "-o", out])
+        self.fails(["flower", self.good3, "--point", "7", "-o", out, "--labels", self.labels], "outside point")
+        self.fails(["flower", self.good3, "--point", "3"], "nothing to do")
+        self.fails(["flower", self.good3, "--point", "3", "-o", self.p("fl.vtu")], ".vtp")
+        dup = np.random.default_rng(3).random((20, 3))
+        dup[9] = dup[4]
+        self.fails(["flower", self.save("dup.npy", dup), "--point", "9", "-o", out], "duplicates point 4")
+
+    def test_point_before_input(self):
+        # --point takes one value per occurrence, so INPUT may follow it.
+        self.ok(["flower", "--point", "3", self.good3, "-o", self.p("fl.vtp"), "-q"])
+
+
+def main():
+    if len(sys.argv) < 2:
+        print("usage: test_dual_cli.py PATH_TO_tessera [unittest args]", file=sys.stderr)
+        return 2
+    base.TESSERA = os.path.abspath(sys.argv[1])
+    if not os.access(base.TESSERA, os.X_OK):
+        print("not an executable: %s" % base.TESSERA, file=sys.stderr)
+        return 2
+    if base.vtk is None or Delaunay is None:
+        print("python3-vtk9 and python3-scipy are required (run with /usr/bin/python3)", file=sys.stderr)
+        return 2
+    argv = [sys.argv[0]] + sys.argv[2:]
+    prog = unittest.main(argv=argv, exit=False, verbosity=2)
+    res = prog.result
+    failed = len(res.failures) + len(res.errors) + len(res.unexpectedSuccesses)
+    passed = res.testsRun - failed - len(res.skipped)
+    print("%d passed, %d failed, %d skipped" % (passed, failed, len(res.skipped)))
+    return 0 if failed == 0 else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
