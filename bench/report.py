@@ -310,8 +310,11 @@ def report(meta, data):
             w(f"| {name} | {tool} | {op} | {th} | {len(x.runs)} | {fs(x.med)} | {fs(min(x.secs))} | {fs(max(x.secs))} | "
               f"{100 * x.spread:.0f} % | {cpu} | {busy} | {fn(x.simplices)} | {fb(bpp(x))} |")
     w("")
-    w("Simplices: cells for Tessera voronoi and Voro++, Voronoi ridges for scipy, tetrahedra / triangles for "
-      "the delaunay ops (Tessera, CGAL, Gmsh HXT = `gmsh-hxt`).")
+    if dd:
+        w("Simplices: cells for Tessera voronoi and Voro++, Voronoi ridges for scipy, tetrahedra / triangles "
+          "for the delaunay ops (Tessera, CGAL, Gmsh HXT = `gmsh-hxt`).")
+    else:
+        w("Simplices: cells for Tessera and Voro++, triangles for CGAL, Voronoi ridges for scipy.")
     return "\n".join(L) + "\n"
 
 

@@ -18,7 +18,9 @@
 # env knobs (defaults in brackets):
 #   OPS      tessera ops to measure, with their peers ["voronoi delaunay"]
 #   DELAUNAY_INPUTS  restrict the delaunay op to these inputs (names as in $OUT, e.g. uniform3_1e6,
-#            or KIND:ARG as in INPUTS) [every selected input]
+#            or KIND:ARG as in INPUTS; "all") [with INPUTS: all of them; without: the default inputs but
+#            clustered3_1e6, lattice3_K100 and uniform3_1e7 (Tessera's Delaunay of a 1e6 lattice
+#            would exceed TIMEOUT)]
 #   PEER_THREADS  thread counts of the parallel Delaunay peers (CGAL 3D, Gmsh HXT) ["1 2"]
 #   SIZES    size classes to run ["1e4 1e5 1e6", plus 1e7 with FULL=1]; lattice3 K=50 is class 1e5, K=100 is 1e6
 #   FULL     1: add the 1e7 class (uniform3 1e7) [0]
@@ -199,10 +201,14 @@ peer() {
   (set +e; repeat "$exe" "$@") | grep '^{' >>"$jl" || true
 }
 
-# DELAUNAY_INPUTS: names (KIND_ARG) or KIND:ARG specs; empty = every input.
+# DELAUNAY_INPUTS: names (KIND_ARG) or KIND:ARG specs; "all" = every input.
+default_delaunay_inputs="uniform3_1e4 uniform3_1e5 uniform3_1e6 clustered3_1e5 lattice3_K50 uniform2_1e6"
+delaunay_sel=${DELAUNAY_INPUTS:-}
+[[ -n $delaunay_sel || -n ${INPUTS:-} ]] || delaunay_sel=$default_delaunay_inputs
+[[ -n $delaunay_sel ]] || delaunay_sel=all
 delaunay_inputs=" "
-for s in ${DELAUNAY_INPUTS:-}; do delaunay_inputs+="${s//:/_} "; done
-if [[ -n ${DELAUNAY_INPUTS:-} ]]; then
+for s in $delaunay_sel; do delaunay_inputs+="${s//:/_} "; done
+if [[ -n ${DELAUNAY_INPUTS:-} && $delaunay_sel != all ]]; then
   for s in $delaunay_inputs; do
     found=0
     for e in "${inputs[@]}"; do [[ ${e%% *} == "$s" ]] && found=1; done
@@ -219,7 +225,7 @@ for e in "${inputs[@]}"; do
   jl=$out/$name.jsonl
   : >"$jl"
   do_delaunay=0
-  if has_op delaunay && [[ -z ${DELAUNAY_INPUTS:-} || $delaunay_inputs == *" $name "* ]]; then do_delaunay=1; fi
+  if has_op delaunay && [[ $delaunay_sel == all || $delaunay_inputs == *" $name "* ]]; then do_delaunay=1; fi
   note "$name ($(cut -d' ' -f1-3 /proc/loadavg) load)"
   if has_op voronoi; then
     for mesh in "${variants[@]}"; do

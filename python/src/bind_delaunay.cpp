@@ -10,6 +10,7 @@
 
 #include "arrays.hpp"
 #include "bindings.hpp"
+#include "delaunay_result.hpp"
 #include "interrupt.hpp"
 #include "options.hpp"
 #include "tessera/delaunay.hpp"
@@ -18,13 +19,6 @@ namespace tessera::python {
 namespace {
 
 using Points = py::array_t<double, py::array::c_style>;
-
-/// The triangulation plus its simplex adjacency, which is computed on first
-/// use (not every caller wants it) and then kept so every view shares it.
-struct DelaunayResult {
-  Delaunay dt;
-  std::optional<std::vector<std::int32_t>> neighbors;
-};
 
 DelaunayResult run_delaunay(const Points& points, const py::object& labels,
                             const std::optional<std::vector<double>>& bounds, double padding, bool ignore_outside,
@@ -92,7 +86,8 @@ void bind_delaunay(py::module_& m) {
                              [](py::object s) {
                                return view_flat(s.cast<const DelaunayResult&>().dt.ignored_outside_bounds, s);
                              })
-      .def_property_readonly("exact_predicate_calls", [](const DelaunayResult& r) { return r.dt.exact_predicate_calls; })
+      .def_property_readonly("exact_predicate_calls",
+                             [](const DelaunayResult& r) { return r.dt.exact_predicate_calls; })
       .def_property_readonly("threads_used", [](const DelaunayResult& r) { return r.dt.threads_used; });
 
   m.def("delaunay", &run_delaunay, py::arg("points").noconvert(), py::arg("labels").none(true), py::arg("bounds"),

@@ -1,17 +1,38 @@
-// tessera._core.write_cells_vtk: the C++ VTK XML writer (include/tessera/io/vtk_xml.hpp).
+// tessera._core.write_*: the library's VTK XML writers (include/tessera/io/).
 //
-// The Delaunay result is saved from Python (through vtk) until a C++ writer
-// for it exists in vtk_xml.hpp; bind it here when it lands.
+// Each writer runs without the GIL and writes atomically. The Python layer
+// checks the file extension before calling, so an InputError from a writer
+// here is a file that could not be written ("cannot write PATH: reason"), and
+// it is raised as OSError.
 #include <string>
+#include <utility>
 
+#include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
+#include "arrays.hpp"
 #include "bindings.hpp"
+#include "delaunay_result.hpp"
 #include "interrupt.hpp"
 #include "tessera/cells.hpp"
+#include "tessera/io/vtk_simplices.hpp"
 #include "tessera/io/vtk_xml.hpp"
 
 namespace tessera::python {
+namespace {
+
+/// Run a writer without the GIL; its InputError becomes OSError (see above).
+template <class Write>
+void write_or_oserror(Write&& write) {
+  try {
+    without_gil(std::forward<Write>(write));
+  } catch (const InputError& e) {
+    PyErr_SetString(PyExc_OSError, e.what());
+    throw py::error_already_set();
+  }
+}
+
+}  // namespace
 
 void bind_io(py::module_& m) {
   m.def(
@@ -19,17 +40,21 @@ void bind_io(py::module_& m) {
       [](const std::string& path, const Cells& cells) {
         if (cells.cell_face_offsets.empty())
           throw py::value_error("cannot save cells computed with merge=False: they have no mesh");
-        try {
-          without_gil([&] { io::write_cells_vtk(path, cells); });
-        } catch (const InputError& e) {
-          // The Python layer checks the extension first, so what is left is a
-          // file that could not be written ("cannot write PATH: reason").
-          PyErr_SetString(PyExc_OSError, e.what());
-          throw py::error_already_set();
-        }
+        write_or_oserror([&] { io::write_cells_vtk(path, cells); });
       },
       py::arg("path"), py::arg("cells"),
-      "Write cells as .vtu (3D polyhedra) or .vtp (2D polygons), atomically, without the GIL. "
+      "Write cells as .vtu (3D polyhedra) or .vtp (2D polygons). OSError if the file cannot be written.");
+
+  m.def(
+      "write_simplices_vtk",
+      [](const std::string& path, const DelaunayResult& r, const py::array_t<double, py::array::c_style>& points) {
+        if (checked_dim(points) != r.dt.dim || static_cast<std::size_t>(points.shape(0)) != r.dt.n_points)
+          throw py::value_error("write_simplices_vtk: points are not the ones triangulated");
+        const auto pts = as_span(points);
+        write_or_oserror([&] { io::write_simplices_vtk(path, r.dt, pts); });
+      },
+      py::arg("path"), py::arg("delaunay"), py::arg("points").noconvert(),
+      "Write simplices as .vtu (VTK_TETRA / VTK_TRIANGLE over all points; 2D also .vtp polygons). "
       "OSError if the file cannot be written.");
 }
 

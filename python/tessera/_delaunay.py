@@ -109,15 +109,16 @@ class Delaunay:
         return _core.validate_delaunay(self._dt, self._points, self._labels)
 
     def save(self, path: PathLike) -> None:
-        """Write the simplices as ``.vtu`` (VTK_TETRA / VTK_TRIANGLE cells over
-        all input points, 2D points with z = 0), binary, written atomically.
-        Needs ``vtk`` for now (Debian python3-vtk9)."""
-        from ._vtk import write_unstructured_grid
-
+        """Write the simplices for ParaView: ``.vtu`` (VTK_TETRA / VTK_TRIANGLE
+        cells over all input points, 2D points with z = 0) or, in 2D, ``.vtp``
+        (triangles as polygons); binary, written atomically. Cell data
+        SimplexId, point data PointId. ValueError for a wrong extension,
+        OSError when the file cannot be written."""
         path = os.fspath(path)
-        if not path.lower().endswith(".vtu"):
-            raise ValueError(f"save: a triangulation is written as VTK UnstructuredGrid (.vtu), got {path!r}")
-        write_unstructured_grid(self.to_vtk(), path)
+        allowed = (".vtu",) if self.ndim == 3 else (".vtu", ".vtp")
+        if not path.lower().endswith(allowed):
+            raise ValueError(f"save: a {self.ndim}D triangulation is written as {' or '.join(allowed)}, got {path!r}")
+        _core.write_simplices_vtk(path, self._dt, self._points)
 
     def to_vtk(self) -> Any:
         """The triangulation as a ``vtkUnstructuredGrid`` (needs ``vtk``)."""

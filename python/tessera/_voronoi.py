@@ -4,11 +4,14 @@ from __future__ import annotations
 
 import os
 from functools import cached_property
-from typing import Any, Optional, Sequence, Tuple, Union
+from typing import TYPE_CHECKING, Any, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
 from . import _core, _inputs
+
+if TYPE_CHECKING:  # pragma: no cover
+    from ._scipy import ScipyVoronoi
 
 PathLike = Union[str, "os.PathLike[str]"]
 

@@ -9,8 +9,6 @@ with numpy, vectorised.
 
 from __future__ import annotations
 
-import os
-import secrets
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -26,9 +24,8 @@ try:
         vtkPolyData,
         vtkUnstructuredGrid,
     )
-    from vtkmodules.vtkIOXML import vtkXMLUnstructuredGridWriter
 except ImportError as e:  # pragma: no cover - depends on the environment
-    raise ImportError(f"tessera: to_vtk() and Delaunay.save() need the vtk package (Debian python3-vtk9): {e}") from e
+    raise ImportError(f"tessera: to_vtk() needs the vtk package (Debian python3-vtk9): {e}") from e
 
 if TYPE_CHECKING:  # pragma: no cover
     from ._delaunay import Delaunay
@@ -119,29 +116,3 @@ def simplices_to_vtk(dt: "Delaunay") -> Any:
     offsets = np.arange(0, k * (dt.nsimplex + 1), k, dtype=np.int64)
     out.SetCells(VTK_TETRA if dt.ndim == 3 else VTK_TRIANGLE, _cell_array(offsets, dt.simplices.ravel()))
     return out
-
-
-def write_unstructured_grid(grid: Any, path: str) -> None:
-    """Binary appended .vtu, written to a temporary in the target's folder and
-    renamed over `path` once complete, so a failed write leaves nothing behind.
-    OSError when the file cannot be written."""
-    folder = os.path.dirname(os.path.abspath(path))
-    if not os.path.isdir(folder):
-        raise OSError(f"cannot write {path}: no such directory {folder}")
-    # VTK creates the temporary itself, so it gets the usual permissions (umask).
-    tmp = f"{os.path.abspath(path)}.tmp-{os.getpid()}-{secrets.token_hex(4)}"
-    try:
-        w = vtkXMLUnstructuredGridWriter()
-        w.SetInputData(grid)
-        w.SetFileName(tmp)
-        w.SetDataModeToAppended()
-        w.EncodeAppendedDataOff()
-        w.SetHeaderTypeToUInt64()
-        w.SetCompressorTypeToNone()
-        if w.Write() != 1:
-            raise OSError(f"cannot write {path}: VTK's writer failed")
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.remove(tmp)
-        raise

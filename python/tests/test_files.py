@@ -115,11 +115,21 @@ def test_delaunay_vtu_read_by_vtk_and_meshio(tmp_path, dim):
     assert set(vtk_to_numpy(data.GetCellTypesArray()).tolist()) == {10 if dim == 3 else 5}
     conn = vtk_to_numpy(data.GetCells().GetConnectivityArray())
     assert np.array_equal(conn.reshape(-1, dim + 1), dt.simplices)
+    assert np.array_equal(cell_array(data, "SimplexId"), np.arange(dt.nsimplex))
     mesh = meshio.read(path)
     [block] = mesh.cells
     assert block.type == ("tetra" if dim == 3 else "triangle")
     assert np.array_equal(block.data, dt.simplices)
     assert np.array_equal(mesh.points[:, :dim], pts)
+
+
+def test_2d_delaunay_vtp_read_by_vtk(tmp_path):
+    dt = tessera.delaunay(random_points(300, 2, seed=4))
+    dt.save(tmp_path / "delaunay.vtp")
+    data = read_vtk(tmp_path / "delaunay.vtp")
+    assert data.GetNumberOfPolys() == dt.nsimplex
+    conn = vtk_to_numpy(data.GetPolys().GetConnectivityArray())
+    assert np.array_equal(conn.reshape(-1, 3), dt.simplices)
 
 
 @pytest.mark.parametrize("dim", [2, 3])

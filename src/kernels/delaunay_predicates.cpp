@@ -3,7 +3,11 @@
 
 #include <gmp.h>
 
+#include <algorithm>
+#include <bit>
+#include <climits>
 #include <cmath>
+#include <cstdint>
 
 #include "tessera/kernels/filter.hpp"
 
@@ -34,6 +38,45 @@ double det_perm(const double (*r)[3], int dim, double& perm) {
   double p2 = std::fabs(r[1][0] * r[2][1]) + std::fabs(r[1][1] * r[2][0]);
   perm = std::fabs(r[0][0]) * p0 + std::fabs(r[0][1]) * p1 + std::fabs(r[0][2]) * p2;
   return r[0][0] * c0 + r[0][1] * c1 + r[0][2] * c2;
+}
+
+// Exponent of the lowest set bit of x != 0: x is an odd integer times 2^that.
+int lsb_exponent(double x) {
+  int e;
+  const double f = std::frexp(x, &e);
+  const auto m = static_cast<std::uint64_t>(std::fabs(std::ldexp(f, 53)));
+  return e - 53 + std::countr_zero(m);
+}
+
+// Exact orientation in 128-bit integers when every coordinate is a 25-bit
+// integer times one common power of two (lattices, voxel centres, integer and
+// dyadic grids — where exact zeros are common and GMP would dominate).
+// Differences need 26 bits, a 3x3 determinant 3*26+3 < 127. False otherwise.
+bool orientation_int128(const ExactContext& ctx, const std::int32_t* ids, int& sign) {
+  const int D = ctx.dim;
+  int shift = INT_MAX;
+  double maxabs = 0;
+  for (int k = 0; k <= D; ++k)
+    for (int d = 0; d < D; ++d) {
+      const double x = pt(ctx, ids[k])[d];
+      if (x == 0) continue;
+      shift = std::min(shift, lsb_exponent(x));
+      maxabs = std::max(maxabs, std::fabs(x));
+    }
+  if (shift == INT_MAX) { sign = 0; return true; }  // every point at the origin
+  if (std::ldexp(maxabs, -shift) >= 0x1p25) return false;
+  __int128 r[3][3] = {};
+  for (int k = 0; k < D; ++k)
+    for (int d = 0; d < D; ++d)
+      r[k][d] = static_cast<__int128>(std::llrint(std::ldexp(pt(ctx, ids[k + 1])[d], -shift))) -
+                static_cast<__int128>(std::llrint(std::ldexp(pt(ctx, ids[0])[d], -shift)));
+  __int128 det;
+  if (D == 2) det = r[0][0] * r[1][1] - r[0][1] * r[1][0];
+  else
+    det = r[0][0] * (r[1][1] * r[2][2] - r[1][2] * r[2][1]) - r[0][1] * (r[1][0] * r[2][2] - r[1][2] * r[2][0]) +
+          r[0][2] * (r[1][0] * r[2][1] - r[1][1] * r[2][0]);
+  sign = det > 0 ? 1 : (det < 0 ? -1 : 0);
+  return true;
 }
 
 // Exact orientation in rationals: every double is exactly representable.
@@ -95,6 +138,8 @@ int orientation(const ExactContext& ctx, const std::int32_t* ids) {
   const double bound = 16 * filter::u * perm + filter::abs_eps;
   if (det > bound) return 1;
   if (det < -bound) return -1;
+  int sign;
+  if (orientation_int128(ctx, ids, sign)) return sign;
   return orientation_exact(ctx, ids);
 }
 
