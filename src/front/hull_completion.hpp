@@ -28,6 +28,8 @@
 #pragma once
 
 #include <algorithm>
+#include <bit>
+#include <climits>
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -92,11 +94,14 @@ class HullCompletion {
       for (int k = 0; k < D; ++k) q.near[d] += pt(f[static_cast<std::size_t>(k)])[d] / D;
     }
     q.margin = 1e-9 * std::sqrt(nn) * diam_;
+    const IntegerPlane plane(f, *this);
     std::int32_t best = -1;
     tree_.search(q, [&](std::int32_t p) {
       if (p == apex || std::find(f.begin(), f.end(), p) != f.end()) return;
       ids[D] = p;
-      if (kernels::orientation(ctx_, ids.data()) != -apex_side) return;  // not strictly beyond
+      int side;
+      if (!plane.side(pt(p), side)) side = kernels::orientation(ctx_, ids.data());
+      if (side != -apex_side) return;  // not strictly beyond
       if (best >= 0) {
         std::array<std::int32_t, D> planes;
         std::copy(f.begin() + 1, f.end(), planes.begin());
@@ -163,6 +168,58 @@ class HullCompletion {
 
  private:
   const double* pt(std::int32_t id) const { return ctx_.points + static_cast<std::size_t>(id) * D; }
+
+  // The facet's plane in exact 128-bit integers when its coordinates are
+  // 25-bit integers times a common power of two (lattices, voxel centres):
+  // there, whole hull faces are coplanar with the facet and every one of their
+  // points would otherwise go through the slow exact orientation path.
+  // side() gives sign(det[f1-f0, (f2-f0,) x-f0]) = orientation(f, x) for a
+  // point on the same grid, and false when the point is not.
+  struct IntegerPlane {
+    bool ok = false;
+    int shift = 0;
+    __int128 n[D] = {}, a[D] = {};
+
+    IntegerPlane(const Facet& f, const HullCompletion& hc) {
+      shift = INT_MAX;
+      double maxabs = 0;
+      for (std::int32_t id : f)
+        for (int d = 0; d < D; ++d) {
+          const double x = hc.pt(id)[d];
+          if (x == 0) continue;
+          int e;
+          const double m = std::frexp(x, &e);
+          shift = std::min(shift, e - 53 + std::countr_zero(static_cast<std::uint64_t>(std::fabs(std::ldexp(m, 53)))));
+          maxabs = std::max(maxabs, std::fabs(x));
+        }
+      if (shift == INT_MAX || std::ldexp(maxabs, -shift) >= 0x1p25) return;
+      __int128 r[D][D];
+      for (int d = 0; d < D; ++d) a[d] = std::llrint(std::ldexp(hc.pt(f[0])[d], -shift));
+      for (int k = 1; k < D; ++k)
+        for (int d = 0; d < D; ++d) r[k][d] = std::llrint(std::ldexp(hc.pt(f[static_cast<std::size_t>(k)])[d], -shift)) - a[d];
+      if constexpr (D == 3) {
+        n[0] = r[1][1] * r[2][2] - r[1][2] * r[2][1];
+        n[1] = r[1][2] * r[2][0] - r[1][0] * r[2][2];
+        n[2] = r[1][0] * r[2][1] - r[1][1] * r[2][0];
+      } else {
+        n[0] = -r[1][1];
+        n[1] = r[1][0];
+      }
+      ok = true;
+    }
+
+    bool side(const double* x, int& out) const {
+      if (!ok) return false;
+      __int128 s = 0;
+      for (int d = 0; d < D; ++d) {
+        const double v = std::ldexp(x[d], -shift);
+        if (v != std::rint(v) || std::fabs(v) >= 0x1p25) return false;
+        s += n[d] * (static_cast<__int128>(std::llrint(v)) - a[d]);
+      }
+      out = s > 0 ? 1 : (s < 0 ? -1 : 0);
+      return true;
+    }
+  };
 
   // The circumball of the facet and `best`, inflated: a better point lies in
   // it (and beyond the facet). Float, with a relative margin; unbounded when
