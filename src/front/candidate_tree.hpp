@@ -102,11 +102,11 @@ class CandidateTree {
   // (pairs, adjacent). Depth is about log2(n / kLeaf): far below the stack size.
   void build(std::uint32_t begin, std::uint32_t end) {
     nodes_.push_back({});
-    std::vector<std::pair<std::uint32_t, std::uint32_t>> work{{0, 0}};
+    std::vector<std::uint32_t> work{0};  // nodes to finish, breadth first
     nodes_[0].begin = begin;
     nodes_[0].end = end;
     for (std::size_t w = 0; w < work.size(); ++w) {
-      const std::uint32_t at = work[w].first;
+      const std::uint32_t at = work[w];
       Node nd = nodes_[at];
       for (int d = 0; d < D; ++d) {
         nd.lo[d] = std::numeric_limits<double>::infinity();
@@ -144,8 +144,8 @@ class CandidateTree {
         r.end = nd.end;
         nodes_.push_back(l);
         nodes_.push_back(r);
-        work.push_back({nd.left, 0});
-        work.push_back({nd.left + 1, 0});
+        work.push_back(nd.left);
+        work.push_back(nd.left + 1);
       }
       nodes_[at] = nd;
     }

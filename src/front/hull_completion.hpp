@@ -28,8 +28,6 @@
 #pragma once
 
 #include <algorithm>
-#include <bit>
-#include <climits>
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -177,26 +175,20 @@ class HullCompletion {
   // point on the same grid, and false when the point is not.
   struct IntegerPlane {
     bool ok = false;
-    int shift = 0;
+    kernels::GridScale grid;
     __int128 n[D] = {}, a[D] = {};
 
     IntegerPlane(const Facet& f, const HullCompletion& hc) {
-      shift = INT_MAX;
-      double maxabs = 0;
       for (std::int32_t id : f)
-        for (int d = 0; d < D; ++d) {
-          const double x = hc.pt(id)[d];
-          if (x == 0) continue;
-          int e;
-          const double m = std::frexp(x, &e);
-          shift = std::min(shift, e - 53 + std::countr_zero(static_cast<std::uint64_t>(std::fabs(std::ldexp(m, 53)))));
-          maxabs = std::max(maxabs, std::fabs(x));
-        }
-      if (shift == INT_MAX || std::ldexp(maxabs, -shift) >= 0x1p25) return;
+        for (int d = 0; d < D; ++d) grid.see(hc.pt(id)[d]);
+      std::int64_t c[D][D];
+      for (int k = 0; k < D; ++k)
+        for (int d = 0; d < D; ++d)
+          if (!grid.scaled(hc.pt(f[static_cast<std::size_t>(k)])[d], 25, c[k][d])) return;
       __int128 r[D][D];
-      for (int d = 0; d < D; ++d) a[d] = std::llrint(std::ldexp(hc.pt(f[0])[d], -shift));
+      for (int d = 0; d < D; ++d) a[d] = c[0][d];
       for (int k = 1; k < D; ++k)
-        for (int d = 0; d < D; ++d) r[k][d] = std::llrint(std::ldexp(hc.pt(f[static_cast<std::size_t>(k)])[d], -shift)) - a[d];
+        for (int d = 0; d < D; ++d) r[k][d] = c[k][d] - a[d];
       if constexpr (D == 3) {
         n[0] = r[1][1] * r[2][2] - r[1][2] * r[2][1];
         n[1] = r[1][2] * r[2][0] - r[1][0] * r[2][2];
@@ -212,9 +204,9 @@ class HullCompletion {
       if (!ok) return false;
       __int128 s = 0;
       for (int d = 0; d < D; ++d) {
-        const double v = std::ldexp(x[d], -shift);
-        if (v != std::rint(v) || std::fabs(v) >= 0x1p25) return false;
-        s += n[d] * (static_cast<__int128>(std::llrint(v)) - a[d]);
+        std::int64_t v;
+        if (!grid.scaled(x[d], 25, v)) return false;
+        s += n[d] * (static_cast<__int128>(v) - a[d]);
       }
       out = s > 0 ? 1 : (s < 0 ? -1 : 0);
       return true;

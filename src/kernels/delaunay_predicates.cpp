@@ -3,9 +3,6 @@
 
 #include <gmp.h>
 
-#include <algorithm>
-#include <bit>
-#include <climits>
 #include <cmath>
 #include <cstdint>
 
@@ -40,36 +37,22 @@ double det_perm(const double (*r)[3], int dim, double& perm) {
   return r[0][0] * c0 + r[0][1] * c1 + r[0][2] * c2;
 }
 
-// Exponent of the lowest set bit of x != 0: x is an odd integer times 2^that.
-int lsb_exponent(double x) {
-  int e;
-  const double f = std::frexp(x, &e);
-  const auto m = static_cast<std::uint64_t>(std::fabs(std::ldexp(f, 53)));
-  return e - 53 + std::countr_zero(m);
-}
-
 // Exact orientation in 128-bit integers when every coordinate is a 25-bit
 // integer times one common power of two (lattices, voxel centres, integer and
 // dyadic grids — where exact zeros are common and GMP would dominate).
 // Differences need 26 bits, a 3x3 determinant 3*26+3 < 127. False otherwise.
 bool orientation_int128(const ExactContext& ctx, const std::int32_t* ids, int& sign) {
   const int D = ctx.dim;
-  int shift = INT_MAX;
-  double maxabs = 0;
+  GridScale g;
   for (int k = 0; k <= D; ++k)
-    for (int d = 0; d < D; ++d) {
-      const double x = pt(ctx, ids[k])[d];
-      if (x == 0) continue;
-      shift = std::min(shift, lsb_exponent(x));
-      maxabs = std::max(maxabs, std::fabs(x));
-    }
-  if (shift == INT_MAX) { sign = 0; return true; }  // every point at the origin
-  if (std::ldexp(maxabs, -shift) >= 0x1p25) return false;
+    for (int d = 0; d < D; ++d) g.see(pt(ctx, ids[k])[d]);
+  if (!g.fits(25)) return false;
+  std::int64_t c[4][3] = {};
+  for (int k = 0; k <= D; ++k)
+    for (int d = 0; d < D; ++d) g.scaled(pt(ctx, ids[k])[d], 25, c[k][d]);
   __int128 r[3][3] = {};
   for (int k = 0; k < D; ++k)
-    for (int d = 0; d < D; ++d)
-      r[k][d] = static_cast<__int128>(std::llrint(std::ldexp(pt(ctx, ids[k + 1])[d], -shift))) -
-                static_cast<__int128>(std::llrint(std::ldexp(pt(ctx, ids[0])[d], -shift)));
+    for (int d = 0; d < D; ++d) r[k][d] = static_cast<__int128>(c[k + 1][d]) - c[0][d];
   __int128 det;
   if (D == 2) det = r[0][0] * r[1][1] - r[0][1] * r[1][0];
   else

@@ -41,15 +41,7 @@ struct Scratch {
   }
 };
 
-// Exponent of the lowest set bit of x (x != 0): x is an odd integer times 2^that.
-int lsb_exponent(double x) {
-  int e;
-  double f = std::frexp(x, &e);  // x = f * 2^e, 0.5 <= |f| < 1
-  auto m = static_cast<std::uint64_t>(std::fabs(std::ldexp(f, 53)));  // exact, < 2^53
-  return e - 53 + std::countr_zero(m);
-}
-
-// out = x * 2^(-shift), exactly an integer because shift <= lsb_exponent(x).
+// out = x * 2^(-shift), exactly an integer because shift <= lowest_bit_exponent(x).
 void set_scaled(mpz_t out, double x, int shift) {
   if (x == 0) { mpz_set_ui(out, 0); return; }
   int e;
@@ -88,7 +80,7 @@ int build_rows(const ExactContext& ctx, std::int32_t i, const std::int32_t* gen,
 
   // Common scale: the smallest mantissa lsb among all doubles involved.
   int shift = INT_MAX;
-  auto consider = [&](double x) { if (x != 0) shift = std::min(shift, lsb_exponent(x)); };
+  auto consider = [&](double x) { if (x != 0) shift = std::min(shift, lowest_bit_exponent(x)); };
   const double* pi = ctx.points + static_cast<std::size_t>(i) * dim;
   for (int d = 0; d < dim; ++d) consider(pi[d]);
   for (int r = 0; r < rows; ++r) {
@@ -349,6 +341,13 @@ void exact_vertex(const ExactContext& ctx, std::int32_t i, const std::int32_t* p
     else if (shift < 0) mpq_div_2exp(qs.q, qs.q, static_cast<mp_bitcnt_t>(-shift));
     y[d] = mpq_get_d(qs.q);
   }
+}
+
+int lowest_bit_exponent(double x) {
+  int e;
+  double f = std::frexp(x, &e);  // x = f * 2^e, 0.5 <= |f| < 1
+  auto m = static_cast<std::uint64_t>(std::fabs(std::ldexp(f, 53)));  // exact, < 2^53
+  return e - 53 + std::countr_zero(m);
 }
 
 }  // namespace tessera::kernels

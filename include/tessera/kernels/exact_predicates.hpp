@@ -23,6 +23,7 @@
 #pragma once
 
 #include <array>
+#include <cmath>
 #include <cstdint>
 
 namespace tessera::kernels {
@@ -32,6 +33,33 @@ namespace tessera::kernels {
 constexpr std::int32_t box_plane_id(int axis, bool upper) { return -1 - 2 * axis - (upper ? 1 : 0); }
 constexpr int box_plane_axis(std::int32_t id) { return (-1 - id) / 2; }
 constexpr bool box_plane_upper(std::int32_t id) { return ((-1 - id) & 1) != 0; }
+
+/// Exponent of the lowest set bit of x != 0: x is an odd integer times 2^that.
+int lowest_bit_exponent(double x);
+
+/// Whether a set of doubles are all small integers times one common power of
+/// two (lattices, voxel centres, integer and dyadic grids), and that scale:
+/// see() each value, then fits(bits) says whether every |x| / 2^shift < 2^bits,
+/// and scaled(x) gives x / 2^shift exactly. The 128-bit exact paths use it.
+struct GridScale {
+  int shift = INT32_MAX;
+  double maxabs = 0;
+  void see(double x) {
+    if (x == 0) return;
+    const int e = lowest_bit_exponent(x);
+    if (e < shift) shift = e;
+    if (std::fabs(x) > maxabs) maxabs = std::fabs(x);
+  }
+  bool all_zero() const { return shift == INT32_MAX; }
+  bool fits(int bits) const { return all_zero() || std::ldexp(maxabs, -shift) < std::ldexp(1.0, bits); }
+  /// x / 2^shift when it is an integer below 2^bits in magnitude (x on the grid).
+  bool scaled(double x, int bits, std::int64_t& out) const {
+    const double v = all_zero() ? x : std::ldexp(x, -shift);
+    if (v != std::rint(v) || std::fabs(v) >= std::ldexp(1.0, bits)) return false;
+    out = static_cast<std::int64_t>(v);
+    return true;
+  }
+};
 
 /// Everything the exact predicate needs to know about the input.
 struct ExactContext {
