@@ -1,0 +1,31 @@
+// Point preparation: probe — sample an image's scalars at arbitrary points by
+// linear interpolation (bilinear in 2D, trilinear in 3D) between voxel
+// centres, so a field given on a grid can be thresholded into labels at
+// scattered points.
+#pragma once
+
+#include <cstdint>
+#include <limits>
+#include <span>
+#include <vector>
+
+#include "tessera/image.hpp"
+
+namespace tessera {
+
+struct ProbeOptions {
+  /// Value for points outside the image's voxel-centre box.
+  double outside_value = std::numeric_limits<double>::quiet_NaN();
+  int threads = 0;
+};
+
+struct ProbeResult {
+  std::vector<double> values;       ///< one per point
+  std::vector<std::uint8_t> valid;  ///< 1 where the point lies in the image box
+};
+
+/// `coords` has n * image.geometry.dim entries. A point exactly on the box's
+/// far face is inside. Throws InputError on NaN coordinates or an empty image.
+ProbeResult probe(const ScalarImage& image, std::span<const double> coords, const ProbeOptions& options = {});
+
+}  // namespace tessera

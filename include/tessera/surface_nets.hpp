@@ -1,0 +1,98 @@
+// Front end: generalized surface nets — smooth, watertight, consistently
+// oriented surfaces between the regions of labelled points (Schroeder,
+// Thompson, Tsalikis, "A Parallel Meshless Voronoi Method for Generalized
+// SurfaceNets", IEEE TVCG 2026).
+//
+// Pipeline: Voronoi cells of the selected regions' points (the others clip as
+// outside points) -> the surface-net face set (faces between different
+// selected regions; with capping also the faces against the domain box and
+// against unselected/outside points) -> optional constrained smoothing ->
+// optional triangulation.
+//
+// Conventions: those of FaceSet (include/tessera/faces.hpp). BoundaryLabels
+// holds (side 0 label, side 1 label): side 0 is always a selected region;
+// between two selected regions side 0 is the lower label, so pairs are
+// (lo, hi); a capping face has side 1 = the outside point's own label, or
+// background_label for the domain box. Faces are oriented from side 0 to
+// side 1 (right-hand normal into side 1): every region's surface (its faces
+// with the region on side 0, plus the reversed faces with it on side 1) is
+// closed and outward-facing.
+//
+// Smoothing. Each merged vertex is classified from its topological
+// coordinate by the number of distinct regions among its D+1 generators —
+// counting the domain box planes each as its own region and every unselected
+// or outside point as the region of its label:
+//   2 regions: surface vertex — moves freely (Laplacian over its polygon-edge
+//              neighbours);
+//   3 regions: junction vertex — on a curve where three regions meet (or an
+//              interface meets the box); it moves only towards junction/corner
+//              neighbours, i.e. along its curve;
+//   4+ regions: corner — fixed.
+// In 2D (faces are segments) a vertex has 3 generators: 2 regions = curve
+// vertex (free), 3 = corner (fixed).
+// Stencils come from the polygon edges (before triangulation: no diagonals).
+// Iteration: x <- x + relaxation * (mean(stencil) - x), then pulled back to
+// within the constraint distance of the vertex's original position. The
+// constraint is `constraint` times the vertex's local spacing (the distance
+// from the vertex to its generators, i.e. its petal radius), or an absolute
+// distance with `constraint_is_absolute`.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "tessera/cells.hpp"
+#include "tessera/faces.hpp"
+
+namespace tessera {
+
+struct SmoothingOptions {
+  int iterations = 20;              ///< 0 = no smoothing
+  double relaxation = 0.5;          ///< in (0, 1]
+  double constraint = 0.5;          ///< fraction of the local spacing (or absolute)
+  bool constraint_is_absolute = false;
+};
+
+struct SurfaceNetsOptions {
+  VoronoiOptions voronoi;           ///< dim 2 or 3; build_mesh is forced on
+  /// Selected (inside) labels; empty = every label >= 0 present. Points with
+  /// other labels are outside points: they clip, and own no cell.
+  std::vector<std::int32_t> select;
+  std::int32_t background_label = -1;  ///< BoundaryLabels value for the domain box (< 0)
+  bool capping = false;
+  SmoothingOptions smoothing;
+  bool triangles = false;           ///< 3D: split each polygon into triangles (both labels copied)
+};
+
+enum class NetVertexKind : std::uint8_t { surface = 0, junction = 1, corner = 2 };
+
+struct SurfaceNet {
+  /// The faces (polygons, or triangles), merged vertices (smoothed) and their
+  /// topological coordinates, sides, BoundaryLabels and classes.
+  FaceSet mesh;
+  std::vector<NetVertexKind> vertex_kind;  ///< per mesh vertex
+  /// Per output face: the index of the Voronoi face (polygon) it came from
+  /// (identity without triangulation).
+  std::vector<std::int64_t> polygon_of_face;
+  std::size_t n_cells = 0;                 ///< cells computed (selected points)
+  double max_displacement = 0;             ///< largest distance a vertex moved
+};
+
+/// Throws InputError on bad points / labels (as voronoi()), labels missing or
+/// of the wrong length, a selected label that no point carries
+/// ("unknown label"), an empty selection, background_label >= 0, or bad
+/// smoothing options. May throw Cancelled from the progress callback.
+SurfaceNet surface_nets(std::span<const double> points, std::span<const std::int32_t> labels,
+                        const SurfaceNetsOptions& options = {});
+
+/// The smoothing step alone, on a surface-net FaceSet whose vertex_keys are
+/// intact (exposed for tests): classifies the vertices as above (`labels` =
+/// the labels of the points the face set was computed from; box planes are
+/// their own regions), smooths `mesh.vertices` in place and returns the kinds.
+/// `points` gives the local spacing. Returns max displacement via `moved`.
+std::vector<NetVertexKind> smooth_surface_net(FaceSet& mesh, std::span<const double> points,
+                                              std::span<const std::int32_t> labels,
+                                              const SmoothingOptions& options, double& moved);
+
+}  // namespace tessera
