@@ -3,8 +3,12 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <span>
 #include <string>
+#include <utility>
 #include <vector>
+
+#include "tessera/labelled_points.hpp"
 
 namespace tessera::io {
 
@@ -33,5 +37,23 @@ PointCloud read_points(const std::string& path, const ReadOptions& options = {})
 
 /// Labels from a .npy integer array (int8..int64, uint8..uint32), as int32.
 std::vector<std::int32_t> read_labels_npy(const std::string& path);
+
+struct WritePointsOptions {
+  /// .npy output only: where the labels go ("" = OUT with "_labels.npy" in
+  /// place of ".npy"); nothing is written when the points have no labels.
+  std::string labels_path;
+  /// Extra per-point double arrays (name, n values): properties of .ply,
+  /// point data of .vtp; for .npy each goes to OUT with "_<name>.npy".
+  std::vector<std::pair<std::string, std::span<const double>>> scalars;
+};
+
+/// Write points with their labels by extension: .npy (float64 (n, dim)),
+/// .ply (binary little-endian, float64 x y z, int32 property "label"),
+/// .vtp (VTK XML PolyData, one vertex per point, int32 point data "label").
+/// Every file is written atomically (all or nothing). Returns the paths
+/// written. Throws InputError on an unknown extension or arrays of the wrong
+/// length.
+std::vector<std::string> write_points(const std::string& path, const LabelledPoints& points,
+                                      const WritePointsOptions& options = {});
 
 }  // namespace tessera::io
