@@ -10,6 +10,10 @@
 #include "tessera/cells.hpp"
 #include "tessera/io/points.hpp"
 
+namespace CLI {
+class App;
+}
+
 namespace tessera::cli {
 
 /// Exit codes (documented in --help).
@@ -91,6 +95,45 @@ struct DelaunayArgs {
   bool quiet = false;
 };
 
+/// Point preparation (cmd_prep.cpp): each reads points (+ labels) and writes
+/// labelled points (.npy + _labels.npy sidecar, .ply, .vtp) via io::write_points.
+struct PrepInput {
+  std::string input;
+  std::string output;          ///< .npy / .ply / .vtp
+  int dim = 0;                 ///< 0: from the file
+  std::string labels;          ///< "" | NAME | FILE.npy
+  bool quiet = false;
+};
+
+struct JoggleArgs {
+  PrepInput io;
+  double radius = 1e-4;        ///< fraction of the bounding-box diagonal, or absolute
+  bool absolute = false;
+  std::string mode = "ball";   ///< ball | xy | xz | yz
+  std::string mask;            ///< .npy, one value per point (nonzero = move), or empty
+  std::uint64_t seed = 0;
+  int threads = 0;
+};
+
+struct FillArgs {
+  PrepInput io;
+  std::string strategy = "uniform";  ///< uniform | adaptive
+  std::int32_t background_label = -1;
+  std::int32_t in_label = 0;
+  double bin_points = 2.0;
+  std::string bounds;          ///< "" or x0,x1,y0,y1[,z0,z1]
+  double joggle = 0.0;         ///< fraction of the bin edge, <= 0.5
+  std::uint64_t seed = 0;
+  int threads = 0;
+};
+
+struct ThresholdArgs {
+  PrepInput io;
+  std::string scalars;                 ///< S.npy, or a .ply property / .csv column name
+  std::vector<std::string> intervals;  ///< "lo,hi,label" each
+  std::int32_t background_label = -1;
+};
+
 int run_voronoi(const VoronoiArgs& args);
 int run_delaunay(const DelaunayArgs& args);
 int run_bench_delaunay(const BenchArgs& args);
@@ -99,6 +142,87 @@ int run_default(const DemoArgs& args);
 int run_graph(const GraphArgs& args);
 int run_faces(const FacesArgs& args);
 int run_flower(const FlowerArgs& args);
+int run_joggle(const JoggleArgs& args);
+int run_fill(const FillArgs& args);
+int run_threshold(const ThresholdArgs& args);
+/// `joggle`, `fill`, `threshold` with their options (cmd_prep.cpp); main.cpp
+/// calls add_prep_commands before parsing and run_prep_command after it
+/// (-1: none of them was given).
+struct PrepCommands {
+  JoggleArgs joggle;
+  FillArgs fill;
+  ThresholdArgs threshold;
+  CLI::App* joggle_app = nullptr;
+  CLI::App* fill_app = nullptr;
+  CLI::App* threshold_app = nullptr;
+};
+void add_prep_commands(CLI::App& app, PrepCommands& commands);
+int run_prep_command(const PrepCommands& commands);
+
+/// Image commands (cmd_image.cpp): `sample-image` and `probe`.
+/// How to read an image: geometry overrides and the .vti array.
+struct ImageReadArgs {
+  std::vector<double> spacing;  ///< empty, or 2/3 numbers (x, y[, z])
+  std::vector<double> origin;   ///< empty, or 2/3 numbers
+  std::string array;            ///< .vti point-data array ("" = active scalars)
+};
+
+/// The sampler's options; also what `surface-nets` takes for an image input
+/// (add_sampler_options registers them on any subcommand).
+struct SamplerArgs {
+  ImageReadArgs read;
+  std::vector<std::int32_t> select;       ///< empty: every label >= 0
+  std::string schedule = "exponential";   ///< exponential | linear
+  int step = 2;
+  bool no_randomize = false;
+  std::vector<double> probability;        ///< empty or lo,hi
+  std::uint64_t seed = 0;
+  std::string output = "all";             ///< all | labelled | background
+  std::string background_label;           ///< "" or an integer < 0
+  double joggle = 0;
+  int threads = 0;
+};
+
+struct SampleImageArgs {
+  std::string image;
+  std::string output;  ///< .npy / .ply / .vtp
+  SamplerArgs sampler;
+  bool quiet = false;
+};
+
+struct ProbeArgs {
+  std::string image;
+  std::string points;
+  std::string output;                 ///< .npy (the values, (n,) float64) / .ply / .vtp
+  ImageReadArgs read;
+  std::string labels;                 ///< carried to .ply/.vtp output: NAME | FILE.npy
+  std::string outside_value = "nan";  ///< a number, nan, inf, -inf
+  int threads = 0;
+  bool quiet = false;
+};
+
+struct ImageCommands {
+  SampleImageArgs sample;
+  ProbeArgs probe;
+  CLI::App* sample_app = nullptr;
+  CLI::App* probe_app = nullptr;
+};
+/// Registers `sample-image` and `probe` (main.cpp, before parsing).
+void add_image_commands(CLI::App& app, ImageCommands& commands);
+/// Runs the one given, or returns -1 when neither was.
+int run_image_command(const ImageCommands& commands);
+int run_sample_image(const SampleImageArgs& args);
+int run_probe(const ProbeArgs& args);
+/// The sampler's own options on `app`: --spacing, --origin, --array,
+/// --schedule, --step, --no-randomize, --probability, --seed,
+/// --background-label, --joggle. Not --select, --threads (a command that
+/// samples an image has its own; fill SamplerArgs::select / threads from
+/// them) nor the output mode (SamplerArgs::output stays "all").
+void add_sampler_options(CLI::App* app, SamplerArgs& s);
+/// True for the image extensions that are never point files (.nrrd, .nhdr, .mha, .mhd, .vti).
+bool is_image_path(const std::string& path);
+/// Reads a label image and samples it with `s` (InputError on bad options or input).
+LabelledPoints sample_image_file(const std::string& image, const SamplerArgs& s);
 
 // Shared by the subcommand files (defined in commands.cpp).
 /// Resource usage of this process so far (bench JSON lines).

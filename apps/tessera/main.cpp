@@ -244,6 +244,11 @@ int main(int argc, char** argv) {
       ->check(CLI::NonNegativeNumber);
   demo->add_flag("-q,--quiet", da.quiet, "No summary and no progress bar");
 
+  PrepCommands prep;  // joggle, fill, threshold (cmd_prep.cpp)
+  add_prep_commands(app, prep);
+  ImageCommands image_cmds;  // sample-image, probe (cmd_image.cpp)
+  add_image_commands(app, image_cmds);
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -282,6 +287,8 @@ int main(int argc, char** argv) {
       return run_bench_delaunay(bda);
     }
     if (demo->parsed()) return run_default(da);
+    if (const int rc = run_prep_command(prep); rc >= 0) return rc;
+    if (const int rc = run_image_command(image_cmds); rc >= 0) return rc;
     print_error("no command given (see tessera --help)");
     return kExitInputError;
   } catch (const tessera::InputError& e) {

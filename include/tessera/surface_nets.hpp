@@ -77,6 +77,11 @@ struct SurfaceNet {
   std::vector<std::int64_t> polygon_of_face;
   std::size_t n_cells = 0;                 ///< cells computed (selected points)
   double max_displacement = 0;             ///< largest distance a vertex moved
+  std::vector<std::int32_t> selected;      ///< the selected labels, ascending
+  /// Wall time of each stage, seconds.
+  struct Timings {
+    double cells = 0, faces = 0, smoothing = 0, triangulation = 0;
+  } seconds;
 };
 
 /// Throws InputError on bad points / labels (as voronoi()), labels missing or

@@ -13,6 +13,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <initializer_list>
+#include <memory>
 #include <span>
 #include <string>
 #include <utility>
@@ -54,6 +55,29 @@ py::array view_rows(const std::vector<T>& data, std::size_t width, py::handle ow
 template <class T>
 py::array view_flat(const std::vector<T>& data, py::handle owner) {
   return view(std::span<const T>(data), {static_cast<py::ssize_t>(data.size())}, owner);
+}
+
+/// A writable array of `shape` that takes over `data` (moved, not copied):
+/// for results that are nothing but arrays (joggled points, sampled labels),
+/// where no C++ object outlives the call. A capsule owns the vector and is the
+/// array's base; the array is the buffer's only user, so it may be written.
+template <class T>
+py::array adopt(std::vector<T>&& data, std::vector<py::ssize_t> shape) {
+  auto heap = std::make_unique<std::vector<T>>(std::move(data));
+  static const T empty_marker{};
+  const T* ptr = heap->empty() ? &empty_marker : heap->data();
+  py::capsule owner(heap.get(), [](void* p) { delete static_cast<std::vector<T>*>(p); });
+  heap.release();  // the capsule owns it now
+  py::array_t<T> a(shape, ptr, owner);
+  // An empty vector points at the shared marker: never let it be written.
+  if (ptr == &empty_marker) a.attr("setflags")(py::arg("write") = false);
+  return a;
+}
+
+template <class T>
+py::array adopt_flat(std::vector<T>&& data) {
+  const auto n = static_cast<py::ssize_t>(data.size());
+  return adopt(std::move(data), {n});
 }
 
 /// (k, 2) int32 array of id pairs (duplicates: (duplicate, owner)). A vector

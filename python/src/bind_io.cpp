@@ -13,8 +13,12 @@
 #include "arrays.hpp"
 #include "bindings.hpp"
 #include "delaunay_result.hpp"
+#include "dual_result.hpp"
 #include "interrupt.hpp"
 #include "tessera/cells.hpp"
+#include "tessera/io/dual.hpp"
+#include "tessera/io/vtk_polydata.hpp"
+#include "tessera/surface_nets.hpp"
 #include "tessera/io/vtk_simplices.hpp"
 #include "tessera/io/vtk_xml.hpp"
 
@@ -56,6 +60,67 @@ void bind_io(py::module_& m) {
       py::arg("path"), py::arg("delaunay"), py::arg("points").noconvert(),
       "Write simplices as .vtu (VTK_TETRA / VTK_TRIANGLE over all points; 2D also .vtp polygons). "
       "OSError if the file cannot be written.");
+
+  m.def(
+      "write_graph_vtp",
+      [](const std::string& path, const GraphResult& r, const py::array_t<double, py::array::c_style>& points,
+         const py::object& labels) {
+        if (checked_dim(points) != r.graph.dim || static_cast<std::size_t>(points.shape(0)) != r.graph.n_points)
+          throw py::value_error("write_graph_vtp: points are not the ones of the graph");
+        const auto pts = as_span(points);
+        const auto lab = as_labels(labels);
+        if (!lab.empty() && lab.size() != r.graph.n_points)
+          throw py::value_error("write_graph_vtp: labels do not match the points");
+        write_or_oserror([&] { io::write_graph_vtp(path, r.graph, pts, lab); });
+      },
+      py::arg("path"), py::arg("graph"), py::arg("points").noconvert(), py::arg("labels").none(true),
+      "Write the graph as .vtp lines over the input points (one per edge). OSError if the file cannot be written.");
+
+  m.def(
+      "write_faces_vtp",
+      [](const std::string& path, const FaceSet& faces) {
+        write_or_oserror([&] { io::write_faces_vtp(path, faces); });
+      },
+      py::arg("path"), py::arg("faces"),
+      "Write a face set as .vtp (3D polygons, 2D lines) with BoundaryLabels, Sides and SpokeClass cell data.");
+
+  m.def(
+      "write_flowers_vtp",
+      [](const std::string& path, const FlowerSet& fs, const py::array_t<double, py::array::c_style>& points,
+         bool glyphs) {
+        if (fs.flowers.empty()) throw py::value_error("write_flowers_vtp: no flowers");
+        if (checked_dim(points) != fs.flowers.front().dim)
+          throw py::value_error("write_flowers_vtp: points are not the ones of the flowers");
+        const auto pts = as_span(points);
+        write_or_oserror([&] { io::write_flowers_vtp(path, fs.flowers, pts, glyphs); });
+      },
+      py::arg("path"), py::arg("flowers"), py::arg("points").noconvert(), py::arg("glyphs"),
+      "Write flowers as one .vtp (sites, petal centres, neighbours, spokes, cell faces; optional glyphs).");
+
+  m.def(
+      "write_surface_net_vtp",
+      [](const std::string& path, const SurfaceNet& net) {
+        // The face set's file (io::write_faces_vtp: BoundaryLabels, Sides,
+        // SpokeClass), plus the vertex kinds and, per face, its polygon.
+        const FaceSet& fs = net.mesh;
+        static_assert(sizeof(SpokeClass) == 1 && sizeof(NetVertexKind) == 1);
+        const std::span<const std::uint8_t> cls(reinterpret_cast<const std::uint8_t*>(fs.face_class.data()),
+                                                fs.face_class.size());
+        const std::span<const std::uint8_t> kind(reinterpret_cast<const std::uint8_t*>(net.vertex_kind.data()),
+                                                 net.vertex_kind.size());
+        io::PolyData pd;
+        pd.dim = fs.dim;
+        pd.points = fs.vertices;
+        (fs.dim == 3 ? pd.polys : pd.lines) = {fs.face_offsets, fs.face_vertices};
+        pd.point_data.push_back({"VertexKind", kind});
+        pd.cell_data.push_back({"BoundaryLabels", std::span<const std::int32_t>(fs.boundary_labels), 2});
+        pd.cell_data.push_back({"Sides", std::span<const std::int32_t>(fs.sides), 2});
+        pd.cell_data.push_back({"SpokeClass", cls});
+        pd.cell_data.push_back({"PolygonId", std::span<const std::int64_t>(net.polygon_of_face)});
+        write_or_oserror([&] { io::write_polydata(path, pd); });
+      },
+      py::arg("path"), py::arg("net"),
+      "Write a surface net as .vtp: the face set's cell data plus VertexKind (point data) and PolygonId.");
 }
 
 }  // namespace tessera::python

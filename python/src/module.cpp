@@ -1,12 +1,14 @@
 // tessera._core: the compiled half of the Python module.
 //
 // Thin bindings over the compiled front end (include/tessera/cells.hpp,
-// delaunay.hpp, io/vtk_xml.hpp); no templates of the kernels or the engine are
-// instantiated here. The pure-Python package (python/tessera/) converts and
-// checks user input, documents everything and builds the derived views; this
-// layer takes float64/int32 C-ordered arrays only, releases the GIL for every
-// computation and hands results back as read-only numpy views of the C++
-// buffers (arrays.hpp).
+// delaunay.hpp, graph.hpp, faces.hpp, flower.hpp, surface_nets.hpp, prep/,
+// io/); no templates of the kernels or the engine are instantiated here. The
+// pure-Python package (python/tessera/) converts and checks user input,
+// documents everything and builds the derived views; this layer takes
+// float64/int32 C-ordered arrays only, releases the GIL for every computation
+// and hands results back as read-only numpy views of the C++ buffers
+// (arrays.hpp; the preparation tools' plain output arrays take over the
+// library's vectors instead).
 #include <pybind11/pybind11.h>
 
 #include "bindings.hpp"
@@ -37,5 +39,8 @@ PYBIND11_MODULE(_core, m) {
 
   tessera::python::bind_voronoi(m);
   tessera::python::bind_delaunay(m);
+  tessera::python::bind_dual(m);
+  tessera::python::bind_surface_nets(m);
+  tessera::python::bind_prep(m);
   tessera::python::bind_io(m);
 }

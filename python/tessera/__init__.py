@@ -8,22 +8,38 @@ numpy in, numpy out::
     vor.volumes.sum()                          # == the box volume
     vor.save("cells.vtu")                      # ParaView: one polyhedron per cell
     dt = tessera.delaunay(pts)                 # simplices / neighbors as scipy's
+    lab = (pts[:, 0] > 0.5).astype(int)        # a region label per point
+    net = tessera.surface_nets(pts, lab)       # the surface between the regions
 
 * :func:`voronoi` -> :class:`Voronoi`: cells clipped to a box, with volumes,
   centroids, neighbours, region labels, the merged mesh, ``save()`` (.vtu/.vtp),
   ``to_vtk()``, ``validate()`` and ``.scipy`` (a ``scipy.spatial.Voronoi``-like view).
 * :func:`delaunay` -> :class:`Delaunay`: the dual triangulation.
+* :func:`adjacency` -> :class:`AdjacencyGraph`: wheels and spokes (CSR), spoke
+  classes and face measures, ``edges()``.
+* :func:`faces` -> :class:`FaceSet`: the boundary, the polygonal complex or the
+  surface net between regions, with ``sides`` and ``boundary_labels``.
+* :func:`flower` -> :class:`Flowers`: petals and circumflower of chosen cells.
+* :func:`surface_nets` -> :class:`SurfaceNet`: smooth, watertight region
+  surfaces of labelled points, with ``vertex_kind``.
+* Point preparation: :func:`sample_image` (label image -> labelled points),
+  :func:`read_image`, :func:`fill`, :func:`joggle`, :func:`threshold`,
+  :func:`probe`.
+
+:func:`adjacency`, :func:`faces` and :func:`flower` take points or a
+:class:`Voronoi` computed with ``merge=True`` (reused, nothing recomputed).
+Every product saves to ParaView (``save()``: .vtu / .vtp) and converts to a
+VTK object (``to_vtk()``).
 
 Arrays returned are read-only views of buffers the compiled result owns (no
-copies). Work runs in parallel with the GIL released (``threads=`` or the
-``TESSERA_NUM_THREADS`` variable; results do not depend on the count), and
-Ctrl-C interrupts a long run. Bad input raises ``ValueError``
+copies); the preparation tools return new, writable arrays that took over the
+library's buffers. Work runs in parallel with the GIL released (``threads=``
+or the ``TESSERA_NUM_THREADS`` variable; results do not depend on the count),
+and Ctrl-C interrupts a long run. Bad input raises ``ValueError``
 (:class:`InputError` for the library's own checks).
 
-Not in the module yet: the other products of the library (adjacency graph,
-face sets, surface nets, flowers) and the point preparation tools (joggle,
-fill, sample_image, threshold, probe). Each gets a function here, over its
-compiled front end, as it lands; see python/README.md.
+Everything the library's front end computes is in the module; see
+python/README.md for the layout.
 """
 
 from . import _core
@@ -37,7 +53,10 @@ from ._core import (
     ValidationReport,
 )
 from ._delaunay import Delaunay, delaunay
+from ._dual import AdjacencyGraph, FaceSet, Flower, Flowers, adjacency, faces, flower
+from ._prep import fill, joggle, probe, read_image, sample_image, threshold
 from ._scipy import ScipyVoronoi
+from ._surface_nets import NET_CORNER, NET_JUNCTION, NET_SURFACE, SurfaceNet, surface_nets
 from ._voronoi import Voronoi, voronoi
 
 __version__: str = _core.__version__
@@ -50,10 +69,28 @@ __all__ = [
     "Delaunay",
     "ValidationReport",
     "DelaunayReport",
+    "adjacency",
+    "AdjacencyGraph",
+    "faces",
+    "FaceSet",
+    "flower",
+    "Flowers",
+    "Flower",
+    "surface_nets",
+    "SurfaceNet",
+    "sample_image",
+    "read_image",
+    "joggle",
+    "fill",
+    "threshold",
+    "probe",
     "InputError",
     "SAME_REGION",
     "REGION_BOUNDARY",
     "DOMAIN_BOUNDARY",
     "OUTSIDE",
+    "NET_SURFACE",
+    "NET_JUNCTION",
+    "NET_CORNER",
     "__version__",
 ]

@@ -126,3 +126,104 @@ def call(fn, *args):
         return fn(*args)
     except _core.InputError as e:
         raise _core.InputError(python_wording(str(e))) from None
+
+
+# ---- helpers of the dual products and the preparation tools ----------------
+
+_INT32 = np.iinfo(np.int32)
+
+
+def as_int(value: Any, name: str, lo: Optional[int] = None, hi: Optional[int] = None, what: str = "an integer") -> int:
+    """A Python int in [lo, hi] (bools rejected: they are almost always a mistake)."""
+    try:
+        v = operator.index(value)
+    except TypeError:
+        v = None
+    if v is None or isinstance(value, (bool, np.bool_)) or (lo is not None and v < lo) or (hi is not None and v > hi):
+        raise ValueError(f"{name}: expected {what}, got {value!r}")
+    return v
+
+
+def as_label_value(value: Any, name: str, negative: bool = False) -> int:
+    """One label (fits int32); ``negative=True``: must be < 0 (a background label)."""
+    if negative:
+        return as_int(value, name, _INT32.min, -1, "a negative integer (labels >= 0 are regions)")
+    return as_int(value, name, _INT32.min, _INT32.max, "an integer that fits in 32 bits")
+
+
+def as_seed(seed: Any) -> int:
+    return as_int(seed, "seed", 0, 2**64 - 1, "an integer in [0, 2**64)")
+
+
+def as_float(value: Any, name: str, what: str = "a number") -> float:
+    try:
+        if isinstance(value, (bool, np.bool_)):
+            raise TypeError
+        return float(value)
+    except (ValueError, TypeError):
+        raise ValueError(f"{name}: expected {what}, got {value!r}") from None
+
+
+def as_label_list(values: Any, name: str) -> list:
+    """A list of labels (ints that fit int32): one int or a sequence of them."""
+    try:
+        a = np.asarray(values)
+    except (ValueError, TypeError) as e:
+        raise ValueError(f"{name}: expected an integer or a sequence of integers ({e})") from None
+    if a.ndim == 0:
+        a = a.reshape(1)
+    if a.ndim != 1 or (a.size and a.dtype.kind not in "iu"):
+        raise ValueError(f"{name}: expected an integer or a sequence of integers, got {values!r}")
+    if a.size and (a.min() < _INT32.min or a.max() > _INT32.max):
+        raise ValueError(f"{name}: labels must fit in 32 bits")
+    return [int(x) for x in a]
+
+
+def as_choice(value: Any, name: str, choices: Sequence[str]) -> str:
+    if not isinstance(value, str) or value not in choices:
+        raise ValueError(f"{name}: expected one of {', '.join(repr(c) for c in choices)}, got {value!r}")
+    return value
+
+
+def as_scalars(values: Any, name: str = "scalars") -> np.ndarray:
+    """A float64 C-contiguous 1-D array (NaN allowed)."""
+    try:
+        a = np.asarray(values)
+    except (ValueError, TypeError) as e:
+        raise ValueError(f"{name}: cannot be read as a 1-D array of numbers ({e})") from None
+    if a.dtype.kind not in _POINT_KINDS:
+        raise ValueError(f"{name}: expected real numbers, got dtype {a.dtype}")
+    if a.ndim != 1:
+        raise ValueError(f"{name}: expected a 1-D array (one value per point), got shape {a.shape}")
+    return np.ascontiguousarray(a, dtype=np.float64)
+
+
+def as_mask(mask: Any, n: int) -> Optional[np.ndarray]:
+    """None or a uint8 (n,) array (nonzero = selected) from booleans or integers."""
+    if mask is None:
+        return None
+    try:
+        a = np.asarray(mask)
+    except (ValueError, TypeError) as e:
+        raise ValueError(f"mask: cannot be read as an array of booleans ({e})") from None
+    if a.dtype.kind not in "biu":
+        raise ValueError(f"mask: expected booleans (or 0/1 integers), got dtype {a.dtype}")
+    if a.ndim != 1 or a.shape[0] != n:
+        raise ValueError(f"mask: expected one value per point, shape ({n},), got {a.shape}")
+    return np.ascontiguousarray(a != 0, dtype=np.uint8)
+
+
+def as_geometry(values: Any, name: str, dim: Optional[int], positive: bool = False) -> Optional[list]:
+    """spacing / origin: None or dim numbers in x, y[, z] order (dim None: 2 or 3)."""
+    if values is None:
+        return None
+    try:
+        a = np.asarray(values, dtype=np.float64)
+    except (ValueError, TypeError):
+        a = None
+    want = f"{dim}" if dim else "2 or 3"
+    if a is None or a.ndim != 1 or (a.shape[0] != dim if dim else a.shape[0] not in (2, 3)):
+        raise ValueError(f"{name}: expected {want} numbers in x, y{', z' if dim != 2 else ''} order, got {values!r}")
+    if not np.all(np.isfinite(a)) or (positive and not np.all(a > 0)):
+        raise ValueError(f"{name}: expected {'positive ' if positive else ''}finite numbers, got {values!r}")
+    return a.tolist()

@@ -9,6 +9,7 @@ with numpy, vectorised.
 
 from __future__ import annotations
 
+import os
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -115,4 +116,78 @@ def simplices_to_vtk(dt: "Delaunay") -> Any:
     k = dt.ndim + 1
     offsets = np.arange(0, k * (dt.nsimplex + 1), k, dtype=np.int64)
     out.SetCells(VTK_TETRA if dt.ndim == 3 else VTK_TRIANGLE, _cell_array(offsets, dt.simplices.ravel()))
+    return out
+
+
+def _add_data(attributes: Any, name: str, values: np.ndarray) -> None:
+    """Point or cell data from a (n,) or (n, k) array (k components), shared without a copy."""
+    arr = numpy_to_vtk(np.ascontiguousarray(values))
+    arr.SetName(name)
+    attributes.AddArray(arr)
+
+
+def _line_offsets(n: int, k: int = 2) -> np.ndarray:
+    return np.arange(0, k * (n + 1), k, dtype=np.int64)
+
+
+def faces_to_vtk(fs: Any) -> Any:
+    """vtkPolyData of a face set (polygons in 3D, lines in 2D) or surface net,
+    with the cell data of the C++ writer (BoundaryLabels, Sides, SpokeClass)."""
+    out = vtkPolyData()
+    out.SetPoints(_points(fs.vertices))
+    cells = _cell_array(fs.face_offsets, fs.face_vertices)
+    if fs.ndim == 3:
+        out.SetPolys(cells)
+    else:
+        out.SetLines(cells)
+    cd = out.GetCellData()
+    _add_data(cd, "BoundaryLabels", fs.boundary_labels)
+    _add_data(cd, "Sides", fs.sides)
+    _add_data(cd, "SpokeClass", fs.face_class)
+    return out
+
+
+def graph_to_vtk(g: Any) -> Any:
+    """vtkPolyData of the graph: the input points, a line per edge; point data
+    Region, cell data SpokeClass and FaceArea / FaceLength."""
+    out = vtkPolyData()
+    out.SetPoints(_points(g.points))
+    ends = g.edges()
+    out.SetLines(_cell_array(_line_offsets(len(ends)), ends.ravel()))
+    labels = g.labels
+    _add_data(out.GetPointData(), "Region",
+              labels if labels is not None else np.zeros(g.n_points, dtype=np.int32))
+    spoke = g.edge_spokes
+    _add_data(out.GetCellData(), "SpokeClass", g.spoke_class[spoke])
+    _add_data(out.GetCellData(), "FaceArea" if g.ndim == 3 else "FaceLength", g.spoke_measure[spoke])
+    return out
+
+
+def read_vtp(path: str) -> Any:
+    """A .vtp file as a vtkPolyData (VTK's XML reader)."""
+    from vtkmodules.vtkIOXML import vtkXMLPolyDataReader
+
+    reader = vtkXMLPolyDataReader()
+    reader.SetFileName(path)
+    reader.Update()
+    return reader.GetOutput()
+
+
+def flowers_to_vtk(flowers: Any, glyphs: bool) -> Any:
+    """The flowers file written by the library, read back (the layout of glyphs,
+    roles and spokes is the writer's; one source of truth)."""
+    import tempfile
+
+    with tempfile.TemporaryDirectory(prefix="tessera-") as tmp:
+        path = os.path.join(tmp, "flowers.vtp")
+        flowers.save(path, glyphs=glyphs)
+        return read_vtp(path)
+
+
+def surface_net_to_vtk(net: Any) -> Any:
+    """vtkPolyData of a surface net: the face set's, plus VertexKind (point
+    data) and PolygonId (cell data), as the C++ writer."""
+    out = faces_to_vtk(net)
+    _add_data(out.GetPointData(), "VertexKind", net.vertex_kind)
+    _add_data(out.GetCellData(), "PolygonId", net.polygon_of_face)
     return out

@@ -3,6 +3,7 @@
 
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "tessera/cells.hpp"
 #include "tessera/io/points.hpp"
@@ -34,5 +35,13 @@ PointCloud read_text_points(const std::string& path, const ReadOptions& options,
 /// the name of an integer vertex property holding labels.
 PointCloud read_ply_points(const std::string& path, const ReadOptions& options,
                            const std::string& label_property);
+
+/// The values of the numeric scalar vertex property `name` of a .ply file, in
+/// vertex order (used for per-point scalars, e.g. `tessera threshold`).
+std::vector<double> read_ply_property(const std::string& path, const std::string& name);
+
+/// The values of the header column `name` of a text point file, one per data
+/// line (NaN and Inf allowed; the caller decides).
+std::vector<double> read_text_column(const std::string& path, const std::string& name);
 
 }  // namespace tessera::io::detail

@@ -356,4 +356,30 @@ PointCloud read_ply_points(const std::string& path, const ReadOptions& options,
   return pc;
 }
 
+std::vector<double> read_ply_property(const std::string& path, const std::string& name) {
+  const std::string bytes = read_file_bytes(path);
+  const Header h = parse_header(path, bytes);
+  auto vit =
+      std::find_if(h.elements.begin(), h.elements.end(), [](const Element& e) { return e.name == "vertex"; });
+  if (vit == h.elements.end()) fail(path, "PLY file has no 'vertex' element");
+  const Element& vertex = *vit;
+  auto it = std::find_if(vertex.props.begin(), vertex.props.end(), [&](const Property& p) { return p.name == name; });
+  if (it == vertex.props.end())
+    fail(path, "no vertex property '" + name + "' (properties: " + property_names(vertex) + ")");
+  if (it->is_list) fail(path, "vertex property '" + name + "' is a list, not a scalar");
+  std::vector<int> slot(vertex.props.size(), -1);
+  slot[static_cast<std::size_t>(it - vertex.props.begin())] = 0;
+
+  DataReader reader(path, h, bytes);
+  for (auto e = h.elements.begin(); e != vit; ++e) reader.skip(*e);
+  std::vector<double> values;
+  values.reserve(std::min(vertex.count, bytes.size()));
+  double v[4] = {0, 0, 0, 0};
+  for (std::size_t r = 0; r < vertex.count; ++r) {
+    reader.row(vertex, r, slot, v);
+    values.push_back(v[0]);
+  }
+  return values;
+}
+
 }  // namespace tessera::io::detail

@@ -241,4 +241,55 @@ PointCloud read_text_points(const std::string& path, const ReadOptions& options,
   return pc;
 }
 
+std::vector<double> read_text_column(const std::string& path, const std::string& name) {
+  const std::string text = read_file_bytes(path);
+  Lines lines(text);
+  std::string_view line;
+  std::size_t line_no = 0;
+  if (!lines.next(line, line_no)) fail(path, "no points");
+  const char delim = line.find(',') != std::string_view::npos   ? ','
+                     : line.find(';') != std::string_view::npos ? ';'
+                                                                : ' ';
+  // The first content line must be a header naming the column.
+  std::vector<std::string> names;
+  bool header = false;
+  {
+    Fields fs(line, delim);
+    std::string_view f;
+    while (fs.next(f)) {
+      double v;
+      if (!f.empty() && !parse_double(f, v)) header = true;
+      if (f.size() >= 2 && (f.front() == '"' || f.front() == '\'') && f.back() == f.front())
+        f = f.substr(1, f.size() - 2);
+      names.emplace_back(f);
+    }
+  }
+  if (!header) fail(path, "column '" + name + "': the file has no header line naming its columns");
+  auto it = std::find(names.begin(), names.end(), name);
+  if (it == names.end()) fail(path, "no column '" + name + "' (columns: " + quoted_list(names) + ")");
+  const auto col = static_cast<std::size_t>(it - names.begin());
+
+  std::vector<double> values;
+  while (lines.next(line, line_no)) {
+    Fields fs(line, delim);
+    std::string_view f;
+    std::size_t c = 0;
+    bool found = false;
+    while (fs.next(f)) {
+      if (c++ == col) {
+        found = true;
+        break;
+      }
+    }
+    if (!found)
+      fail(path, "line " + std::to_string(line_no) + " has no column " + std::to_string(col + 1) + " ('" + name + "')");
+    double v = 0;
+    if (!parse_double(f, v))
+      fail(path, "line " + std::to_string(line_no) + ": cannot parse '" + std::string(f) + "' in column '" + name +
+                     "' as a number");
+    values.push_back(v);
+  }
+  return values;
+}
+
 }  // namespace tessera::io::detail

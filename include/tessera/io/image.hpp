@@ -4,13 +4,17 @@
 // docs/design.md "Image readers"):
 //   .npy          integer or float array, C order, shape (ny, nx) or (nz, ny, nx);
 //                 spacing/origin from ImageReadOptions (default 1 / 0)
-//   .nrrd / .nhdr NRRD 2D/3D, encodings raw and gzip, detached data files,
-//                 axis-aligned space directions or spacings
-//   .mha / .mhd   MetaImage, ElementDataFile LOCAL or a file name, raw or
-//                 compressed (zlib), TransformMatrix identity only
+//   .nrrd / .nhdr NRRD 2D/3D, encodings raw, gzip and ascii, detached data
+//                 files (line skip, byte skip), axis-aligned space directions
+//                 (positive steps) or spacings
+//   .mha / .mhd   MetaImage, ElementDataFile LOCAL or a file name, raw,
+//                 compressed (zlib) or ascii, TransformMatrix identity only
 //   .vti          VTK XML ImageData, ascii / binary (base64) / appended
-//                 (raw or base64), optionally zlib-compressed; one point-data
-//                 array (the named one, else the active scalars, else the first)
+//                 (raw or base64), optionally zlib-compressed, UInt32 or UInt64
+//                 headers, several pieces; one point-data array (the named
+//                 one, else the active scalars, else the first). The origin is
+//                 that of the extent's first voxel (Origin + start * Spacing);
+//                 one slice along z makes a 2D image.
 // Multi-component data and rotated images (a non-diagonal direction) are
 // rejected with InputError.
 #pragma once

@@ -38,6 +38,13 @@ PointCloud read_points(const std::string& path, const ReadOptions& options = {})
 /// Labels from a .npy integer array (int8..int64, uint8..uint32), as int32.
 std::vector<std::int32_t> read_labels_npy(const std::string& path);
 
+/// Per-point scalars for the points of `points_path`: `source` ending in .npy
+/// is a 1-D float or integer array; otherwise it names a numeric .ply vertex
+/// property or a header column of a .csv/.xyz/.txt file (the points' own
+/// file). NaN values are allowed. The length is the caller's to check.
+/// Throws InputError (one line naming the file) on a missing array/column.
+std::vector<double> read_point_scalars(const std::string& points_path, const std::string& source);
+
 struct WritePointsOptions {
   /// .npy output only: where the labels go ("" = OUT with "_labels.npy" in
   /// place of ".npy"); nothing is written when the points have no labels.

@@ -1,0 +1,325 @@
+// The point-preparation subcommands `joggle`, `fill` and `threshold` (see
+// commands.hpp). Each checks its arguments and output path before reading
+// anything, then reads the points, runs the library function, writes labelled
+// points with io::write_points (atomically) and prints a one-line summary.
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <map>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "commands.hpp"
+#include "tessera/io/atomic_file.hpp"
+#include "tessera/io/npy.hpp"
+#include "tessera/io/points.hpp"
+#include "tessera/prep/fill.hpp"
+#include "tessera/prep/joggle.hpp"
+#include "tessera/prep/threshold.hpp"
+
+namespace tessera::cli {
+namespace {
+
+constexpr const char* kOutputHelp =
+    "Output points with labels: .npy (float64 (N, D); labels in OUT_labels.npy, int32), .ply (binary, double x y z, "
+    "int property 'label') or .vtp (VTK vertices, point data 'label'). 2D points get z = 0 in .ply/.vtp";
+
+void add_input_options(CLI::App* app, PrepInput& p, bool labels) {
+  app->add_option("INPUT", p.input, "Point file: .npy, .csv/.xyz/.txt or .ply (as for `voronoi`)")->required();
+  app->add_option("-o,--output", p.output, kOutputHelp)->required();
+  app->add_option("--dim", p.dim, "Dimension: 2 or 3 (default: the number of columns; .ply is 3D)")
+      ->check(CLI::IsMember({2, 3}));
+  if (labels)
+    app->add_option("--labels", p.labels,
+                    "Per-point integer labels, carried to the output: FILE.npy, or the name of an integer .ply "
+                    "vertex property / .csv column");
+  app->add_flag("-q,--quiet", p.quiet, "No summary line");
+}
+
+/// Checks the output path before any work: a points extension and a writable directory.
+void check_output(const std::string& path) {
+  const std::string e = extension(path);
+  if (e != ".npy" && e != ".ply" && e != ".vtp")
+    throw InputError("output " + path + ": points are written as .npy, .ply or .vtp (got '" + e + "')");
+  io::check_writable(path);
+}
+
+io::PointCloud read_prep_input(const PrepInput& p, bool with_labels) {
+  io::ReadOptions ro;
+  ro.dim = p.dim;
+  if (with_labels) ro.labels = p.labels;
+  return io::read_points(p.input, ro);
+}
+
+/// Parses a number the way the user wrote it ("inf", "-inf" allowed when `allow_inf`).
+double parse_number(const std::string& word, const std::string& what, bool allow_inf) {
+  char* end = nullptr;
+  errno = 0;
+  const double v = std::strtod(word.c_str(), &end);
+  if (word.empty() || end != word.c_str() + word.size() || std::isnan(v) || (!allow_inf && !std::isfinite(v)))
+    throw InputError(what + ": '" + word + "' is not a " + (allow_inf ? "number" : "finite number"));
+  return v;
+}
+
+std::int32_t parse_label(const std::string& word, const std::string& what) {
+  char* end = nullptr;
+  errno = 0;
+  const long long v = std::strtoll(word.c_str(), &end, 10);
+  if (word.empty() || end != word.c_str() + word.size() || errno == ERANGE || v < INT32_MIN || v > INT32_MAX)
+    throw InputError(what + ": '" + word + "' is not a 32-bit integer label");
+  return static_cast<std::int32_t>(v);
+}
+
+std::vector<std::string> split_commas(const std::string& s) {
+  std::vector<std::string> out(1);
+  for (char c : s) {
+    if (c == ',')
+      out.emplace_back();
+    else if (c != ' ')
+      out.back() += c;
+  }
+  return out;
+}
+
+std::string written_list(const std::vector<std::string>& written) {
+  std::string s;
+  for (const auto& w : written) s += (s.empty() ? "" : ", ") + w;
+  return s;
+}
+
+}  // namespace
+
+// ------------------------------------------------------------------ registration
+
+void add_prep_commands(CLI::App& app, PrepCommands& c) {
+  c.joggle_app = app.add_subcommand(
+      "joggle", "Move points by a small deterministic random displacement (seeded per point id)");
+  CLI::App* j = c.joggle_app;
+  add_input_options(j, c.joggle.io, true);
+  j->add_option("--radius", c.joggle.radius,
+                "Largest displacement: a fraction of the bounding-box diagonal, or a length with --absolute")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  j->add_flag("--absolute", c.joggle.absolute, "--radius is a length, not a fraction of the diagonal");
+  j->add_option("--mode", c.joggle.mode,
+                "ball: uniform in the ball (disk in 2D); xy, xz, yz: in a disk of that plane (3D), the third "
+                "coordinate kept exactly")
+      ->check(CLI::IsMember({"ball", "xy", "xz", "yz"}))
+      ->capture_default_str();
+  j->add_option("--mask", c.joggle.mask,
+                "MASK.npy: one integer/bool per point; only points with a nonzero value move, the others are "
+                "copied exactly");
+  j->add_option("--seed", c.joggle.seed, "Random seed (each point's displacement depends on seed and id only)")
+      ->capture_default_str();
+  j->add_option("--threads", c.joggle.threads, "Worker threads (default 0: $TESSERA_NUM_THREADS, else all cores)")
+      ->check(CLI::NonNegativeNumber);
+  j->footer("Examples:\n  tessera joggle lattice.npy -o jittered.npy --radius 1e-6\n"
+            "  tessera joggle slab.ply --mode xy --radius 0.01 --absolute -o out.ply");
+
+  c.fill_app = app.add_subcommand(
+      "fill", "Add background points (label < 0) in the empty bins of a point cloud, so outside regions carve "
+              "concave shapes");
+  CLI::App* f = c.fill_app;
+  add_input_options(f, c.fill.io, true);
+  f->add_option("--strategy", c.fill.strategy,
+                "uniform: one point at the centre of every empty bin; adaptive: every empty bin next to the "
+                "data, sparser (exponentially) further away")
+      ->check(CLI::IsMember({"uniform", "adaptive"}))
+      ->capture_default_str();
+  f->add_option("--background-label", c.fill.background_label, "Label of the added points (must be < 0)")
+      ->capture_default_str();
+  f->add_option("--in-label", c.fill.in_label, "Label of the input points when --labels is not given")
+      ->capture_default_str();
+  f->add_option("--bin-points", c.fill.bin_points, "Average input points per bin: sets the bin size")
+      ->capture_default_str();
+  f->add_option("--bounds", c.fill.bounds,
+                "Region to fill, x0,x1,y0,y1[,z0,z1] (default: the bounding box of the points); must contain "
+                "every point");
+  f->add_option("--joggle", c.fill.joggle,
+                "Joggle of the added points, a fraction (<= 0.5) of the smallest bin edge (default 0: exact bin "
+                "centres)")
+      ->capture_default_str();
+  f->add_option("--seed", c.fill.seed, "Random seed (joggle; adaptive sampling)")->capture_default_str();
+  f->add_option("--threads", c.fill.threads, "Worker threads (default 0: $TESSERA_NUM_THREADS, else all cores)")
+      ->check(CLI::NonNegativeNumber);
+  f->footer("The input points come first, unchanged, with their labels (or --in-label); the added points follow.\n"
+            "Examples:\n  tessera fill grains.ply --labels grain --bin-points 4 -o filled.ply\n"
+            "  tessera fill pts.csv --dim 2 --strategy adaptive --bounds 0,1,0,1 -o filled.npy");
+
+  c.threshold_app = app.add_subcommand(
+      "threshold", "Label points by a scalar per point in half-open intervals [lo, hi); the rest get the "
+                   "background label");
+  CLI::App* t = c.threshold_app;
+  add_input_options(t, c.threshold.io, false);
+  t->add_option("--scalars", c.threshold.scalars,
+                "S.npy (one number per point), or the name of a .ply vertex property / .csv column of INPUT "
+                "(with .csv, use --dim so that the column is not taken as a coordinate)")
+      ->required();
+  t->add_option("--interval", c.threshold.intervals,
+                "lo,hi,label: points with lo <= s < hi get label (repeat; lo may be -inf, hi inf; intervals must "
+                "not overlap)")
+      ->required()
+      ->allow_extra_args(false)
+      ->type_name("LO,HI,LABEL");
+  t->add_option("--background-label", c.threshold.background_label,
+                "Label of points in no interval (and NaN scalars)")
+      ->capture_default_str();
+  t->footer("Examples:\n  tessera threshold pts.npy --scalars density.npy --interval 0.5,inf,1 -o labelled.npy\n"
+            "  tessera threshold scan.ply --scalars intensity --interval 0,10,1 --interval 10,20,2 -o out.vtp");
+}
+
+int run_prep_command(const PrepCommands& c) {
+  if (c.joggle_app && c.joggle_app->parsed()) return run_joggle(c.joggle);
+  if (c.fill_app && c.fill_app->parsed()) return run_fill(c.fill);
+  if (c.threshold_app && c.threshold_app->parsed()) return run_threshold(c.threshold);
+  return -1;
+}
+
+// ------------------------------------------------------------------ joggle
+
+int run_joggle(const JoggleArgs& a) {
+  JoggleOptions o;
+  if (!(a.radius >= 0) || !std::isfinite(a.radius)) throw InputError("--radius must be a finite number >= 0");
+  o.radius = a.radius;
+  o.absolute = a.absolute;
+  o.mode = a.mode == "xy"   ? JoggleMode::xy
+           : a.mode == "xz" ? JoggleMode::xz
+           : a.mode == "yz" ? JoggleMode::yz
+                            : JoggleMode::ball;
+  o.seed = a.seed;
+  o.threads = a.threads;
+  check_output(a.io.output);
+
+  const io::PointCloud pc = read_prep_input(a.io, true);
+  if (o.mode != JoggleMode::ball && pc.dim != 3)
+    throw InputError("--mode " + a.mode + " needs 3D points (2D points joggle in their plane: --mode ball)");
+  std::vector<std::uint8_t> mask;
+  std::size_t moving = pc.n;
+  if (!a.mask.empty()) {
+    const io::NpyArray m = io::read_npy_int(a.mask);
+    if (!(m.shape.size() == 1 || (m.shape.size() == 2 && m.shape[1] == 1)) || m.as_int.size() != pc.n)
+      throw InputError(a.mask + ": mask must be a 1-D array of " + std::to_string(pc.n) + " values (one per point), "
+                       "found " + std::to_string(m.as_int.size()));
+    mask.resize(pc.n);
+    moving = 0;
+    for (std::size_t i = 0; i < pc.n; ++i) moving += (mask[i] = m.as_int[i] != 0 ? 1 : 0);
+  }
+
+  LabelledPoints out;
+  out.dim = pc.dim;
+  out.coords = joggle(pc.coords, pc.dim, o, mask);
+  out.labels = pc.labels;
+  double largest = 0;
+  for (std::size_t i = 0; i < pc.n; ++i) {
+    double s = 0;
+    for (int d = 0; d < pc.dim; ++d) {
+      const double dx = out.coords[i * pc.dim + d] - pc.coords[i * pc.dim + d];
+      s += dx * dx;
+    }
+    largest = std::max(largest, std::sqrt(s));
+  }
+  const std::vector<std::string> written = io::write_points(a.io.output, out);
+  if (!a.io.quiet)
+    std::printf("tessera joggle: %zu points (%dD) from %s, %zu moved (%s, radius %g%s), largest displacement %.3g; "
+                "wrote %s\n",
+                pc.n, pc.dim, a.io.input.c_str(), moving, a.mode.c_str(), a.radius,
+                a.absolute ? "" : " of the bounding-box diagonal", largest, written_list(written).c_str());
+  return kExitOk;
+}
+
+// ------------------------------------------------------------------ fill
+
+int run_fill(const FillArgs& a) {
+  FillOptions o;
+  o.strategy = a.strategy == "adaptive" ? FillStrategy::adaptive : FillStrategy::uniform;
+  if (a.background_label >= 0)
+    throw InputError("--background-label must be < 0 (added points are outside points), got " +
+                     std::to_string(a.background_label));
+  o.background_label = a.background_label;
+  o.in_label = a.in_label;
+  if (!(a.bin_points > 0) || !std::isfinite(a.bin_points)) throw InputError("--bin-points must be a number > 0");
+  o.points_per_bin = a.bin_points;
+  if (!(a.joggle >= 0 && a.joggle <= 0.5)) throw InputError("--joggle must be between 0 and 0.5 (of the bin edge)");
+  o.joggle = a.joggle;
+  o.seed = a.seed;
+  o.threads = a.threads;
+  std::vector<double> bounds;
+  if (!a.bounds.empty()) {
+    for (const std::string& w : split_commas(a.bounds)) bounds.push_back(parse_number(w, "--bounds", false));
+    if (bounds.size() != 4 && bounds.size() != 6)
+      throw InputError("--bounds needs x0,x1,y0,y1 (2D) or x0,x1,y0,y1,z0,z1 (3D), got " +
+                       std::to_string(bounds.size()) + " numbers");
+  }
+  check_output(a.io.output);
+
+  const io::PointCloud pc = read_prep_input(a.io, true);
+  if (!bounds.empty()) {
+    if (static_cast<int>(bounds.size()) != 2 * pc.dim)
+      throw InputError("--bounds has " + std::to_string(bounds.size()) + " numbers but the points are " +
+                       std::to_string(pc.dim) + "D" + (pc.dim == 3 ? " (use --dim 2 for 2D)" : ""));
+    Bounds b;
+    for (int d = 0; d < pc.dim; ++d) {
+      b.lo[d] = bounds[2 * d];
+      b.hi[d] = bounds[2 * d + 1];
+    }
+    o.bounds = b;
+  }
+  const LabelledPoints out = fill(pc.coords, pc.dim, pc.labels, o);
+  const std::vector<std::string> written = io::write_points(a.io.output, out);
+  if (!a.io.quiet)
+    std::printf("tessera fill: %zu points (%dD) from %s, %zu background points added (%s, label %d); wrote %s\n",
+                pc.n, pc.dim, a.io.input.c_str(), out.size() - pc.n, a.strategy.c_str(),
+                static_cast<int>(a.background_label), written_list(written).c_str());
+  return kExitOk;
+}
+
+// ------------------------------------------------------------------ threshold
+
+int run_threshold(const ThresholdArgs& a) {
+  ThresholdOptions o;
+  o.background_label = a.background_label;
+  for (const std::string& spec : a.intervals) {
+    const std::vector<std::string> w = split_commas(spec);
+    if (w.size() != 3) throw InputError("--interval '" + spec + "': expected lo,hi,label");
+    ThresholdInterval iv;
+    iv.lo = parse_number(w[0], "--interval '" + spec + "'", true);
+    iv.hi = parse_number(w[1], "--interval '" + spec + "'", true);
+    iv.label = parse_label(w[2], "--interval '" + spec + "'");
+    if (!(iv.lo < iv.hi)) throw InputError("--interval '" + spec + "': needs lo < hi");
+    o.intervals.push_back(iv);
+  }
+  // Overlaps and the rest are checked once more by the library; check them
+  // here too so that bad intervals fail before reading the input.
+  (void)threshold({}, o);
+  check_output(a.io.output);
+
+  const io::PointCloud pc = read_prep_input(a.io, false);
+  const std::vector<double> s = io::read_point_scalars(a.io.input, a.scalars);
+  if (s.size() != pc.n)
+    throw InputError("--scalars " + a.scalars + ": " + std::to_string(s.size()) + " values for " +
+                     std::to_string(pc.n) + " points");
+  LabelledPoints out;
+  out.dim = pc.dim;
+  out.coords = pc.coords;
+  out.labels = threshold(s, o);
+  io::WritePointsOptions wo;
+  // .ply/.vtp carry the scalars along for viewing; .npy would need another file.
+  if (extension(a.io.output) != ".npy") wo.scalars.push_back({"scalars", std::span<const double>(s)});
+  const std::vector<std::string> written = io::write_points(a.io.output, out, wo);
+  if (!a.io.quiet) {
+    std::map<std::int32_t, std::size_t> count;
+    for (std::int32_t l : out.labels) ++count[l];
+    std::string parts;
+    for (const auto& [label, k] : count)
+      parts += (parts.empty() ? "" : ", ") + std::string(label == a.background_label ? "background " : "label ") +
+               std::to_string(label) + ": " + std::to_string(k);
+    std::printf("tessera threshold: %zu points (%dD) from %s (%s); wrote %s\n", pc.n, pc.dim, a.io.input.c_str(),
+                parts.c_str(), written_list(written).c_str());
+  }
+  return kExitOk;
+}
+
+}  // namespace tessera::cli

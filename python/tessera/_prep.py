@@ -1,0 +1,368 @@
+"""Point preparation: images to points, and points to labels.
+
+:func:`sample_image` turns a label image into labelled points concentrated
+near the label boundaries; :func:`fill` adds background points where a cloud
+is empty; :func:`joggle` breaks exact ties; :func:`threshold` turns a scalar
+per point into labels; :func:`probe` samples an image's scalars at points;
+:func:`read_image` reads the image files the library reads.
+
+Images as numpy arrays are C-ordered, shape ``(ny, nx)`` or ``(nz, ny, nx)``:
+``image[k, j, i]`` is voxel ``(i, j, k)``, x varies fastest (as in VTK, NRRD
+and MetaImage), and it sits at ``origin + (i, j, k) * spacing`` (voxel
+centres), with ``spacing`` and ``origin`` in x, y[, z] order.
+
+The outputs are new arrays that take over the library's buffers (no copy) and
+may be written.
+"""
+
+from __future__ import annotations
+
+import os
+from typing import Any, Optional, Sequence, Tuple, Union
+
+import numpy as np
+
+from . import _core, _inputs
+
+PathLike = Union[str, "os.PathLike[str]"]
+ImageLike = Union[np.ndarray, PathLike]
+
+
+def _is_path(x: Any) -> bool:
+    return isinstance(x, (str, bytes, os.PathLike))
+
+
+def _image_array(image: Any, kinds: str, what: str) -> np.ndarray:
+    try:
+        a = np.asarray(image)
+    except (ValueError, TypeError) as e:
+        raise ValueError(f"image: cannot be read as an array ({e})") from None
+    if a.dtype.kind not in kinds:
+        raise ValueError(f"image: expected {what}, got dtype {a.dtype}")
+    if a.ndim not in (2, 3):
+        raise ValueError(f"image: expected shape (ny, nx) or (nz, ny, nx) (C order, x fastest), got {a.shape}")
+    if a.size == 0:
+        raise ValueError(f"image: no voxels (shape {a.shape})")
+    return a
+
+
+def _geometry(spacing: Any, origin: Any, dim: Optional[int]) -> Tuple[Optional[list], Optional[list]]:
+    """spacing / origin as lists for the compiled readers: one value (every
+    axis) or one per axis (x, y[, z]); dim None (a file) checks only 2 or 3."""
+
+    def one(v: Any, name: str, positive: bool) -> Optional[list]:
+        if v is None:
+            return None
+        if np.ndim(v) == 0:
+            x = _inputs.as_float(v, name, "a number or one per axis")
+            if not np.isfinite(x) or (positive and not x > 0):
+                raise ValueError(f"{name}: expected a {'positive ' if positive else ''}finite number, got {v!r}")
+            return [x]
+        return _inputs.as_geometry(v, name, dim, positive=positive)
+
+    return one(spacing, "spacing", True), one(origin, "origin", False)
+
+
+def _label_image(image: Any, spacing: Any, origin: Any) -> Any:
+    if _is_path(image):
+        sp, org = _geometry(spacing, origin, None)
+        return _inputs.call(_core.read_label_image, os.fsdecode(image), sp, org)
+    a = _image_array(image, "iu", "integer labels (a label image); threshold a scalar image first")
+    info = np.iinfo(np.int32)
+    if a.min() < info.min or a.max() > info.max:
+        raise ValueError(f"image: labels must fit in 32 bits ([{info.min}, {info.max}])")
+    sp, org = _geometry(spacing, origin, a.ndim)
+    return _core.label_image(np.ascontiguousarray(a, dtype=np.int32), sp, org)
+
+
+def _scalar_image(image: Any, spacing: Any, origin: Any) -> Any:
+    if _is_path(image):
+        sp, org = _geometry(spacing, origin, None)
+        return _inputs.call(_core.read_scalar_image, os.fsdecode(image), sp, org)
+    a = _image_array(image, "fiu", "real numbers")
+    sp, org = _geometry(spacing, origin, a.ndim)
+    return _core.scalar_image(np.ascontiguousarray(a, dtype=np.float64), sp, org)
+
+
+# ---------------------------------------------------------------- read_image
+
+def read_image(
+    path: PathLike, spacing: Any = None, origin: Any = None
+) -> Tuple[np.ndarray, Tuple[float, ...], Tuple[float, ...]]:
+    """Read an image file: ``.npy``, NRRD (``.nrrd`` / ``.nhdr``, raw or
+    gzip), MetaImage (``.mha`` / ``.mhd``) or VTK XML image data (``.vti``).
+
+    Returns ``(array, spacing, origin)``: the voxels as a C-ordered array of
+    shape (ny, nx) or (nz, ny, nx) — int32 for integer data that fits, else
+    float64 — and the geometry in x, y[, z] order. ``spacing`` / ``origin``
+    override the file's (a ``.npy`` has none: 1 and 0 by default).
+    ValueError (:class:`tessera.InputError`) for a missing or malformed file.
+    """
+    if not _is_path(path):
+        raise ValueError(f"path: expected a file name, got {type(path).__name__}")
+    name = os.fsdecode(path)
+    sp, org = _geometry(spacing, origin, None)
+    try:
+        im = _inputs.call(_core.read_label_image, name, sp, org)
+    except _core.InputError:
+        # Not an integer image (or not readable at all: the scalar reader then
+        # says why, naming the file).
+        im = _inputs.call(_core.read_scalar_image, name, sp, org)
+    geometry = (im.spacing, im.origin)
+    return (im.release_array(),) + geometry
+
+
+# -------------------------------------------------------------- sample_image
+
+_SCHEDULES = ("exponential", "linear")
+_OUTPUTS = ("all", "labelled", "background")
+
+
+def sample_image(
+    image: ImageLike,
+    spacing: Any = None,
+    origin: Any = None,
+    select: Optional[Union[int, Sequence[int]]] = None,
+    schedule: str = "exponential",
+    step: int = 2,
+    randomize: bool = True,
+    probability_range: Sequence[float] = (0.0, 1.0),
+    seed: int = 0,
+    output: str = "all",
+    background_label: Optional[int] = None,
+    joggle: float = 0.0,
+    threads: Optional[int] = None,
+) -> Tuple[np.ndarray, np.ndarray]:
+    """Sample a label image into points concentrated near the label boundaries.
+
+    1. A voxel is a boundary voxel (distance 1) when a face neighbour has
+       another label and one of the two labels is selected; every other voxel
+       gets 1 + its city-block distance in voxels to the nearest boundary voxel.
+    2. A voxel is a candidate when its distance ``d`` is a power of ``step``
+       (``schedule="exponential"``: 1, N, N², ...) or 1 or a multiple of
+       ``step`` (``"linear"``).
+    3. With ``randomize`` a candidate is kept with probability
+       ``clip(1/d, *probability_range)``, seeded by (``seed``, voxel): the
+       output does not depend on the thread count.
+    4. Points at voxel centres, in voxel order, with their labels.
+
+    Parameters
+    ----------
+    image : array_like of int, shape (ny, nx) or (nz, ny, nx), or a path
+        A label image (C order, x fastest; labels < 0 are background), or a
+        file :func:`read_image` reads.
+    spacing, origin : float or sequence of float, optional
+        Voxel size and position of voxel (0, 0[, 0]), x, y[, z] order (default
+        1 and 0; for a file they override its own).
+    select : int or sequence of int, optional
+        The labels to sample around (each must occur); default every label >= 0.
+    output : {'all', 'labelled', 'background'}
+        Points of selected voxels, of the others, or both.
+    background_label : int, optional
+        Label (< 0) for the points of unselected voxels; default: their own.
+    joggle : float
+        Random offset radius as a fraction of the smallest spacing (at most
+        0.5: points stay in their voxel); 0 = exact voxel centres.
+    threads : int, optional
+
+    Returns
+    -------
+    (points, labels) : float64 (M, D) and int32 (M,)
+    """
+    im = _label_image(image, spacing, origin)
+    sel = [] if select is None else _inputs.as_label_list(select, "select")
+    if select is not None and not sel:
+        raise ValueError("select: empty selection (None selects every label >= 0)")
+    sched = _inputs.as_choice(schedule, "schedule", _SCHEDULES)
+    out = _inputs.as_choice(output, "output", _OUTPUTS)
+    st = _inputs.as_int(step, "step", 1, 2**31 - 1, "an integer >= 2 (exponential) or >= 1 (linear)")
+    try:
+        pr = [float(x) for x in probability_range]
+    except (TypeError, ValueError):
+        pr = []
+    if len(pr) != 2 or not (0 <= pr[0] <= pr[1] <= 1):
+        raise ValueError(f"probability_range: expected (lo, hi) with 0 <= lo <= hi <= 1, got {probability_range!r}")
+    bg = None if background_label is None else _inputs.as_label_value(background_label, "background_label",
+                                                                       negative=True)
+    jog = _inputs.as_float(joggle, "joggle", "a number in [0, 0.5]")
+    if not (np.isfinite(jog) and jog >= 0):
+        raise ValueError(f"joggle: expected a number in [0, 0.5], got {joggle!r}")
+    pts, lab = _inputs.call(_core.sample_image, im, sel, sched, st, bool(randomize), pr, _inputs.as_seed(seed), out,
+                            bg, jog, _inputs.as_threads(threads))
+    return pts, lab
+
+
+# -------------------------------------------------------------------- joggle
+
+_JOGGLE_MODES = ("ball", "xy", "xz", "yz")
+
+
+def joggle(
+    points: Any,
+    radius: float = 1e-4,
+    absolute: bool = False,
+    mode: str = "ball",
+    mask: Any = None,
+    seed: int = 0,
+    threads: Optional[int] = None,
+) -> np.ndarray:
+    """A joggled copy of the points: a small deterministic random displacement
+    that breaks the exact ties of lattice-like input (tessera needs none for
+    correctness; this is for users who want general-position output).
+
+    Parameters
+    ----------
+    points : array_like, shape (N, 2) or (N, 3)
+    radius : float
+        Largest displacement, as a fraction of the bounding-box diagonal, or a
+        distance with ``absolute=True``.
+    mode : {'ball', 'xy', 'xz', 'yz'}
+        Uniform in the ball (disk in 2D), or in a disk in a coordinate plane (3D only).
+    mask : array_like of bool, shape (N,), optional
+        Only these points move; the others are copied bit for bit.
+    seed : int
+        Each point's displacement depends only on (seed, point id): the same
+        for any thread count and any mask.
+
+    Returns
+    -------
+    float64 (N, D), a new array.
+    """
+    pts = _inputs.as_points(points)
+    r = _inputs.as_float(radius, "radius", "a finite number >= 0")
+    if not (np.isfinite(r) and r >= 0):
+        raise ValueError(f"radius: expected a finite number >= 0, got {radius!r}")
+    m = _inputs.as_choice(mode, "mode", _JOGGLE_MODES)
+    if m != "ball" and pts.shape[1] == 2:
+        raise ValueError(f"mode: {m!r} needs 3D points; 2D points joggle in their plane (mode='ball')")
+    mk = _inputs.as_mask(mask, pts.shape[0])
+    return _inputs.call(_core.joggle, pts, r, bool(absolute), m, mk, _inputs.as_seed(seed),
+                        _inputs.as_threads(threads))
+
+
+# ---------------------------------------------------------------------- fill
+
+_STRATEGIES = ("uniform", "adaptive")
+
+
+def fill(
+    points: Any,
+    labels: Any = None,
+    strategy: str = "uniform",
+    background_label: int = -1,
+    in_label: int = 0,
+    points_per_bin: float = 2.0,
+    bounds: Optional[Sequence[float]] = None,
+    joggle: float = 0.0,
+    seed: int = 0,
+    threads: Optional[int] = None,
+) -> Tuple[np.ndarray, np.ndarray]:
+    """Fill a point cloud's empty space with background points (label < 0),
+    so the outside carves concave shapes and the cells' searches stay short.
+
+    The region (``bounds``, else the points' bounding box) is cut into bins of
+    about ``points_per_bin`` input points each; ``uniform`` puts one point at
+    the centre of every empty bin, ``adaptive`` samples the empty bins densely
+    next to the data and sparsely far from it.
+
+    Parameters
+    ----------
+    points : array_like, shape (N, 2) or (N, 3)
+    labels : array_like of int, shape (N,), optional
+        Kept for the input points; without them they get ``in_label``.
+    background_label : int
+        Label of the added points (< 0).
+    bounds : sequence of float, optional
+        (x0, x1, y0, y1[, z0, z1]); must contain every point.
+    joggle : float
+        Offset of the added points as a fraction of the bin edge (at most 0.5).
+    seed : int
+
+    Returns
+    -------
+    (points, labels) : float64 (M, D) and int32 (M,)
+        The input points first, unchanged, then the added ones.
+    """
+    pts = _inputs.as_points(points)
+    dim = pts.shape[1]
+    lab = _inputs.as_labels(labels, pts.shape[0])
+    strat = _inputs.as_choice(strategy, "strategy", _STRATEGIES)
+    bg = _inputs.as_label_value(background_label, "background_label", negative=True)
+    inl = _inputs.as_label_value(in_label, "in_label")
+    ppb = _inputs.as_float(points_per_bin, "points_per_bin", "a finite number > 0")
+    if not (np.isfinite(ppb) and ppb > 0):
+        raise ValueError(f"points_per_bin: expected a finite number > 0, got {points_per_bin!r}")
+    jog = _inputs.as_float(joggle, "joggle", "a number in [0, 0.5]")
+    if not 0 <= jog <= 0.5:
+        raise ValueError(f"joggle: expected a number in [0, 0.5] (a fraction of the bin edge), got {joggle!r}")
+    return _inputs.call(_core.fill, pts, lab, strat, bg, inl, ppb, _inputs.as_bounds(bounds, dim), jog,
+                        _inputs.as_seed(seed), _inputs.as_threads(threads))
+
+
+# ----------------------------------------------------------------- threshold
+
+def threshold(scalars: Any, intervals: Sequence[Tuple[float, float, int]], background_label: int = -1) -> np.ndarray:
+    """Labels from a scalar per point by half-open intervals.
+
+    ``intervals`` is a list of ``(lo, hi, label)``: a value ``v`` with
+    ``lo <= v < hi`` gets ``label`` (``lo`` may be ``-inf``, ``hi`` ``+inf``);
+    values in no interval, and NaN, get ``background_label``. Intervals must
+    not overlap. Returns int32 (N,), a new array.
+    """
+    s = _inputs.as_scalars(scalars)
+    try:
+        items = list(intervals)
+    except TypeError:
+        raise ValueError(f"intervals: expected a list of (lo, hi, label), got {intervals!r}") from None
+    if not items:
+        raise ValueError("intervals: no intervals given")
+    clean = []
+    for k, iv in enumerate(items):
+        try:
+            lo, hi, label = iv
+        except (TypeError, ValueError):
+            raise ValueError(f"intervals[{k}]: expected (lo, hi, label), got {iv!r}") from None
+        lo = _inputs.as_float(lo, f"intervals[{k}] lo")
+        hi = _inputs.as_float(hi, f"intervals[{k}] hi")
+        if np.isnan(lo) or np.isnan(hi) or not lo < hi:
+            raise ValueError(f"intervals[{k}]: expected lo < hi, got [{lo}, {hi})")
+        clean.append((lo, hi, _inputs.as_label_value(label, f"intervals[{k}] label")))
+    bg = _inputs.as_label_value(background_label, "background_label")
+    return _inputs.call(_core.threshold, s, clean, bg)
+
+
+# --------------------------------------------------------------------- probe
+
+def probe(
+    image: ImageLike,
+    points: Any,
+    spacing: Any = None,
+    origin: Any = None,
+    outside_value: float = float("nan"),
+    threads: Optional[int] = None,
+) -> Tuple[np.ndarray, np.ndarray]:
+    """Sample an image's scalars at points by linear interpolation between
+    voxel centres (bilinear in 2D, trilinear in 3D).
+
+    Parameters
+    ----------
+    image : array_like, shape (ny, nx) or (nz, ny, nx), or a path
+        Real values (C order, x fastest), or a file :func:`read_image` reads.
+    points : array_like, shape (N, D)
+        D must be the image's dimension.
+    spacing, origin : as in :func:`sample_image`.
+    outside_value : float
+        The value at points outside the box of the voxel centres (a point on
+        its far face is inside).
+
+    Returns
+    -------
+    (values, valid) : float64 (N,) and bool (N,) (True inside the image box)
+    """
+    im = _scalar_image(image, spacing, origin)
+    pts = _inputs.as_points(points)
+    if pts.shape[1] != im.dim:
+        raise ValueError(f"points: {pts.shape[1]}D points for a {im.dim}D image (shape {im.shape})")
+    ov = _inputs.as_float(outside_value, "outside_value")
+    values, valid = _inputs.call(_core.probe, im, pts, ov, _inputs.as_threads(threads))
+    return values, valid.view(np.bool_)

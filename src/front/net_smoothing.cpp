@@ -1,0 +1,329 @@
+// Smoothing of surface nets: vertex classification from topological
+// coordinates, stencils from polygon edges (CSR), and a constrained Laplacian
+// iterated Jacobi-style (two buffers), so the result is the same for any
+// thread count. Conventions and defaults: include/tessera/surface_nets.hpp.
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <cmath>
+#include <cstdlib>
+#include <cstdint>
+#include <limits>
+#include <numeric>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include "net_smoothing.hpp"
+#include "tessera/surface_nets.hpp"
+
+namespace tessera {
+namespace front {
+
+void check_smoothing_options(const SmoothingOptions& o) {
+  if (o.iterations < 0)
+    throw InputError("smoothing: iterations must be >= 0 (0 = no smoothing), got " + std::to_string(o.iterations));
+  if (!(o.relaxation > 0 && o.relaxation <= 1))
+    throw InputError("smoothing: relaxation factor must be in (0, 1], got " + std::to_string(o.relaxation));
+  if (!(o.constraint >= 0) || !std::isfinite(o.constraint))
+    throw InputError("smoothing: constraint must be a finite number >= 0, got " + std::to_string(o.constraint));
+}
+
+namespace {
+
+constexpr std::int64_t kNoRegion = std::numeric_limits<std::int64_t>::min();
+
+/// The region of a generator id of a topological coordinate: a point's label,
+/// or, for a domain-box plane (negative id), a code of its own that no label
+/// can take (labels are int32).
+struct RegionOf {
+  std::span<const std::int32_t> labels;
+  std::int64_t operator()(std::int32_t id) const {
+    if (id < 0) return (std::int64_t{1} << 40) - id;  // one region per box plane
+    return labels.empty() ? 0 : labels[static_cast<std::size_t>(id)];
+  }
+};
+
+/// Number of distinct values among the first n of r (n <= 4).
+int distinct(const std::int64_t* r, int n) {
+  int k = 0;
+  for (int a = 0; a < n; ++a) {
+    bool seen = false;
+    for (int b = 0; b < a; ++b) seen = seen || r[b] == r[a];
+    k += seen ? 0 : 1;
+  }
+  return k;
+}
+
+template <class Body>
+void parallel_range(std::size_t n, std::size_t grain, Body&& body) {
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, grain), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t i = r.begin(); i != r.end(); ++i) body(i);
+  });
+}
+
+}  // namespace
+
+/// Is (u, w) a junction edge: do the D generators the two keys share span
+/// three distinct regions? (3D only; 2D has no junction vertices.)
+bool is_junction_edge(const FaceSet& mesh, std::span<const std::int32_t> labels, std::size_t u, std::size_t w) {
+  const std::size_t kn = static_cast<std::size_t>(mesh.dim) + 1;
+  if (kn != 4) return false;
+  const RegionOf region{labels};
+  const std::int32_t* a = &mesh.vertex_keys[u * kn];
+  const std::int32_t* b = &mesh.vertex_keys[w * kn];
+  std::int64_t r[4];
+  int n = 0;
+  std::size_t i = 0, j = 0;
+  while (i < kn && j < kn) {  // keys are ascending
+    if (a[i] < b[j]) ++i;
+    else if (b[j] < a[i]) ++j;
+    else {
+      r[n++] = region(a[i]);
+      ++i;
+      ++j;
+    }
+  }
+  return n >= 3 && distinct(r, n) >= 3;
+}
+
+NetStencils build_stencils(const FaceSet& mesh, std::span<const std::int32_t> labels) {
+  const int D = mesh.dim;
+  const std::size_t kn = static_cast<std::size_t>(D) + 1;
+  const std::size_t nv = mesh.n_vertices(), nf = mesh.n_faces();
+  const RegionOf region{labels};
+  NetStencils s;
+  s.kind.resize(nv);
+
+  // Classification: distinct regions among the D+1 generators.
+  parallel_range(nv, 4096, [&](std::size_t v) {
+    std::int64_t r[4] = {kNoRegion, kNoRegion, kNoRegion, kNoRegion};
+    for (std::size_t a = 0; a < kn; ++a) r[a] = region(mesh.vertex_keys[v * kn + a]);
+    const int k = distinct(r, static_cast<int>(kn));
+    NetVertexKind kind = NetVertexKind::surface;
+    if (k >= static_cast<int>(kn)) kind = NetVertexKind::corner;
+    else if (k == 3) kind = NetVertexKind::junction;  // 3D only: in 2D k == 3 is a corner
+    s.kind[v] = kind;
+  });
+
+  // Incidence vertex -> (face corner), counting sort in face order (deterministic).
+  std::vector<std::int64_t> inc_off(nv + 1, 0);
+  for (std::int32_t v : mesh.face_vertices) ++inc_off[static_cast<std::size_t>(v) + 1];
+  std::partial_sum(inc_off.begin(), inc_off.end(), inc_off.begin());
+  std::vector<std::int64_t> inc(mesh.face_vertices.size());
+  {
+    std::vector<std::int64_t> fill(inc_off.begin(), inc_off.end() - 1);
+    for (std::size_t q = 0; q < mesh.face_vertices.size(); ++q)
+      inc[static_cast<std::size_t>(fill[static_cast<std::size_t>(mesh.face_vertices[q])]++)] =
+          static_cast<std::int64_t>(q);
+  }
+  // Face of each corner: the corner positions are the CSR of faces.
+  std::vector<std::int32_t> face_of(mesh.face_vertices.size());
+  parallel_range(nf, 1024, [&](std::size_t f) {
+    for (auto q = mesh.face_offsets[f]; q < mesh.face_offsets[f + 1]; ++q)
+      face_of[static_cast<std::size_t>(q)] = static_cast<std::int32_t>(f);
+  });
+
+  auto junction_edge = [&](std::size_t u, std::size_t w) { return is_junction_edge(mesh, labels, u, w); };
+
+  // The stencil of v: its neighbours along polygon edges (previous and next
+  // corner of every incident face), filtered by v's kind, ascending, unique.
+  auto gather = [&](std::size_t v, std::vector<std::int32_t>& out) {
+    out.clear();
+    const NetVertexKind kind = s.kind[v];
+    if (kind == NetVertexKind::corner) return;
+    for (auto t = inc_off[v]; t < inc_off[v + 1]; ++t) {
+      const auto q = inc[static_cast<std::size_t>(t)];
+      const auto f = static_cast<std::size_t>(face_of[static_cast<std::size_t>(q)]);
+      const auto b = mesh.face_offsets[f], e = mesh.face_offsets[f + 1];
+      const auto prev = q == b ? e - 1 : q - 1, next = q + 1 == e ? b : q + 1;
+      for (auto p : {prev, next}) {
+        const std::int32_t w = mesh.face_vertices[static_cast<std::size_t>(p)];
+        if (static_cast<std::size_t>(w) == v) continue;
+        if (kind == NetVertexKind::junction && !junction_edge(v, static_cast<std::size_t>(w))) continue;
+        out.push_back(w);
+      }
+    }
+    std::sort(out.begin(), out.end());
+    out.erase(std::unique(out.begin(), out.end()), out.end());
+  };
+
+  s.offsets.assign(nv + 1, 0);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nv, 2048), [&](const tbb::blocked_range<std::size_t>& r) {
+    std::vector<std::int32_t> tmp;
+    for (std::size_t v = r.begin(); v != r.end(); ++v) {
+      gather(v, tmp);
+      s.offsets[v + 1] = static_cast<std::int64_t>(tmp.size());
+    }
+  });
+  std::partial_sum(s.offsets.begin(), s.offsets.end(), s.offsets.begin());
+  s.neighbors.resize(static_cast<std::size_t>(s.offsets[nv]));
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nv, 2048), [&](const tbb::blocked_range<std::size_t>& r) {
+    std::vector<std::int32_t> tmp;
+    for (std::size_t v = r.begin(); v != r.end(); ++v) {
+      gather(v, tmp);
+      std::copy(tmp.begin(), tmp.end(), s.neighbors.begin() + s.offsets[v]);
+    }
+  });
+  return s;
+}
+
+}  // namespace front
+
+std::vector<NetVertexKind> smooth_surface_net(FaceSet& mesh, std::span<const double> points,
+                                              std::span<const std::int32_t> labels, const SmoothingOptions& options,
+                                              double& moved) {
+  front::check_smoothing_options(options);
+  moved = 0;
+  const int D = mesh.dim;
+  if (D != 2 && D != 3) throw std::invalid_argument("smooth_surface_net: dim must be 2 or 3");
+  const std::size_t dn = static_cast<std::size_t>(D), kn = dn + 1;
+  const std::size_t nv = mesh.n_vertices();
+  if (mesh.vertex_keys.size() != nv * kn || mesh.vertices.size() != nv * dn)
+    throw std::invalid_argument("smooth_surface_net: vertex arrays have inconsistent sizes");
+  if (points.size() % dn != 0) throw std::invalid_argument("smooth_surface_net: bad point array");
+  const std::size_t n_points = points.size() / dn;
+  if (!labels.empty() && labels.size() != n_points)
+    throw InputError("labels: " + std::to_string(labels.size()) + " values for " + std::to_string(n_points) +
+                     " points");
+  for (std::int32_t id : mesh.vertex_keys)
+    if (id >= 0 && static_cast<std::size_t>(id) >= n_points)
+      throw std::invalid_argument("smooth_surface_net: a vertex key names a point beyond the point array");
+  for (std::int32_t v : mesh.face_vertices)
+    if (v < 0 || static_cast<std::size_t>(v) >= nv)
+      throw std::invalid_argument("smooth_surface_net: face vertex out of range");
+
+  const front::NetStencils st = front::build_stencils(mesh, labels);
+  if (options.iterations == 0 || nv == 0) return st.kind;
+
+  // Per vertex: the constraint radius and the axes pinned to a box plane.
+  const std::vector<double> x0 = mesh.vertices;
+  std::vector<double> radius(nv);
+  std::vector<std::uint8_t> pinned(nv, 0);
+  front::parallel_range(nv, 4096, [&](std::size_t v) {
+    const std::int32_t* key = &mesh.vertex_keys[v * kn];
+    std::uint8_t pin = 0;
+    std::int32_t gen = -1;
+    for (std::size_t a = 0; a < kn; ++a) {
+      if (key[a] < 0) pin |= static_cast<std::uint8_t>(1u << ((-key[a] - 1) / 2));
+      else if (gen < 0) gen = key[a];
+    }
+    pinned[v] = pin;
+    double r = options.constraint;
+    if (!options.constraint_is_absolute) {
+      double d2 = 0;
+      for (std::size_t a = 0; a < dn; ++a) {
+        const double d = x0[v * dn + a] - points[static_cast<std::size_t>(gen) * dn + a];
+        d2 += d * d;
+      }
+      r *= std::sqrt(d2);  // the petal radius: distance to each of its generators
+    }
+    radius[v] = r;
+  });
+
+  // The guard: after each Jacobi step every polygon must still have a ladder
+  // triangulation whose triangles all face the polygon's original normal (2D:
+  // every segment keeps its direction). Where a polygon has none, its
+  // vertices keep their current positions for this step; this is decided in
+  // rounds that each read the previous round's frozen set, so the outcome
+  // does not depend on the schedule, and freezing everything is the
+  // current, valid state, so the rounds end.
+  const std::size_t nf = mesh.n_faces();
+  std::vector<double> ref(nf * dn);
+  std::vector<std::uint32_t> rotation(nf, 0);  // last valid ladder rotation
+  front::parallel_range(nf, 1024, [&](std::size_t f) {
+    const auto b = static_cast<std::size_t>(mesh.face_offsets[f]), e = static_cast<std::size_t>(mesh.face_offsets[f + 1]);
+    if (D == 2) {
+      for (std::size_t a = 0; a < 2; ++a)
+        ref[f * 2 + a] = x0[static_cast<std::size_t>(mesh.face_vertices[b + 1]) * 2 + a] -
+                         x0[static_cast<std::size_t>(mesh.face_vertices[b]) * 2 + a];
+      return;
+    }
+    front::newell(x0.data(), &mesh.face_vertices[b], e - b, &ref[3 * f]);
+  });
+
+  std::vector<double> cur = x0, nxt(x0.size());
+  std::vector<std::uint8_t> frozen(nv), freeze(nv);
+  const double lambda = options.relaxation;
+  for (int it = 0; it < options.iterations; ++it) {
+    front::parallel_range(nv, 2048, [&](std::size_t v) {
+      double* out = &nxt[v * dn];
+      const double* x = &cur[v * dn];
+      const auto b = st.offsets[v], e = st.offsets[v + 1];
+      if (b == e) {
+        std::copy_n(x, dn, out);
+        return;
+      }
+      double mean[3] = {0, 0, 0};
+      for (auto t = b; t < e; ++t) {
+        const double* y = &cur[static_cast<std::size_t>(st.neighbors[static_cast<std::size_t>(t)]) * dn];
+        for (std::size_t a = 0; a < dn; ++a) mean[a] += y[a];
+      }
+      const double inv = 1.0 / static_cast<double>(e - b);
+      double d[3] = {0, 0, 0}, d2 = 0;
+      for (std::size_t a = 0; a < dn; ++a) {
+        const double p = x[a] + lambda * (mean[a] * inv - x[a]);
+        d[a] = p - x0[v * dn + a];
+        d2 += d[a] * d[a];
+      }
+      const double r = radius[v];
+      const double scale = d2 > r * r ? r / std::sqrt(d2) : 1.0;
+      for (std::size_t a = 0; a < dn; ++a)
+        out[a] = (pinned[v] >> a) & 1u ? x0[v * dn + a] : x0[v * dn + a] + scale * d[a];
+    });
+
+    std::fill(frozen.begin(), frozen.end(), 0);
+    for (bool grew = true; grew;) {
+      std::copy(frozen.begin(), frozen.end(), freeze.begin());
+      front::parallel_range(nf, 1024, [&](std::size_t f) {
+        const auto b = static_cast<std::size_t>(mesh.face_offsets[f]);
+        const auto n = static_cast<std::size_t>(mesh.face_offsets[f + 1]) - b;
+        const std::int32_t* loop = &mesh.face_vertices[b];
+        auto at = [&](std::int32_t v) {
+          const auto u = static_cast<std::size_t>(v);
+          return frozen[u] ? &cur[u * dn] : &nxt[u * dn];
+        };
+        bool ok = false;
+        if (D == 2) {
+          const double* p = at(loop[0]);
+          const double* q = at(loop[1]);
+          ok = (q[0] - p[0]) * ref[2 * f] + (q[1] - p[1]) * ref[2 * f + 1] > 0 || (ref[2 * f] == 0 && ref[2 * f + 1] == 0);
+        } else {
+          ok = front::ladder_score(at, x0.data(), loop, n, rotation[f], &ref[3 * f]) > 0;
+          for (std::size_t start = 0; start < n && !ok; ++start)
+            if (start != rotation[f] && front::ladder_score(at, x0.data(), loop, n, start, &ref[3 * f]) > 0) {
+              rotation[f] = static_cast<std::uint32_t>(start);
+              ok = true;
+            }
+        }
+        if (ok) return;
+        for (std::size_t q = 0; q < n; ++q)
+          std::atomic_ref<std::uint8_t>(freeze[static_cast<std::size_t>(loop[q])]).store(1, std::memory_order_relaxed);
+      });
+      grew = freeze != frozen;
+      frozen.swap(freeze);
+    }
+    front::parallel_range(nv, 4096, [&](std::size_t v) {
+      if (frozen[v]) std::copy_n(&cur[v * dn], dn, &nxt[v * dn]);
+    });
+    cur.swap(nxt);
+  }
+
+  double m2 = 0;
+  for (std::size_t v = 0; v < nv; ++v) {
+    double d2 = 0;
+    for (std::size_t a = 0; a < dn; ++a) {
+      const double d = cur[v * dn + a] - x0[v * dn + a];
+      d2 += d * d;
+    }
+    m2 = std::max(m2, d2);
+  }
+  moved = std::sqrt(m2);
+  mesh.vertices = std::move(cur);
+  return st.kind;
+}
+
+}  // namespace tessera

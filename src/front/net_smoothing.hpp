@@ -1,0 +1,108 @@
+// Private: the pieces of surface-net smoothing (src/front/net_smoothing.cpp)
+// that surface_nets.cpp also needs.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <cmath>
+#include <algorithm>
+#include <limits>
+#include <span>
+#include <vector>
+
+#include "tessera/faces.hpp"
+#include "tessera/surface_nets.hpp"
+
+namespace tessera::front {
+
+/// InputError unless iterations >= 0, relaxation in (0, 1] and constraint a
+/// finite number >= 0.
+void check_smoothing_options(const SmoothingOptions& options);
+
+/// Vertex kinds and smoothing stencils (CSR over the mesh vertices: the
+/// neighbours each vertex averages over, ascending).
+struct NetStencils {
+  std::vector<NetVertexKind> kind;
+  std::vector<std::int64_t> offsets;  ///< n_vertices + 1
+  std::vector<std::int32_t> neighbors;
+};
+
+/// Classifies the vertices (box planes count as regions of their own) and
+/// builds their stencils from the polygon edges: a surface vertex takes all
+/// its edge neighbours, a junction vertex only those across junction edges
+/// (edges whose D shared generators span three regions: its curve), a
+/// corner none. Runs in the caller's task arena.
+/// Is (u, w) a junction edge: do the D generators the keys of u and w share
+/// span three distinct regions (3D; always false in 2D)?
+bool is_junction_edge(const FaceSet& mesh, std::span<const std::int32_t> labels, std::size_t u, std::size_t w);
+
+NetStencils build_stencils(const FaceSet& mesh, std::span<const std::int32_t> labels);
+
+/// Newell's area vector (twice the area times the unit normal) of the 3D
+/// polygon `loop` (n corners) over coordinates xyz.
+inline void newell(const double* xyz, const std::int32_t* loop, std::size_t n, double* out) {
+  out[0] = out[1] = out[2] = 0;
+  for (std::size_t q = 0; q < n; ++q) {
+    const double* u = &xyz[3 * static_cast<std::size_t>(loop[q])];
+    const double* w = &xyz[3 * static_cast<std::size_t>(loop[q + 1 == n ? 0 : q + 1])];
+    out[0] += (u[1] - w[1]) * (u[2] + w[2]);
+    out[1] += (u[2] - w[2]) * (u[0] + w[0]);
+    out[2] += (u[0] - w[0]) * (u[1] + w[1]);
+  }
+}
+
+/// The "ladder" of a loop of n corners starting at corner `start`: a strip
+/// zig-zagging between the two ends of the loop instead of a fan, so no
+/// vertex collects many thin triangles: (p0,p1,p(n-1)), (p1,p(n-2),p(n-1)),
+/// (p1,p2,p(n-2)), ... (indices relative to `start`). Every triangle keeps
+/// the loop's orientation (its corners are in loop order). emit(i, j, k)
+/// gets loop positions.
+template <class Emit>
+void ladder(std::size_t n, std::size_t start, Emit&& emit) {
+  std::size_t lo = 0, hi = n - 1;
+  auto at = [&](std::size_t i) { return (start + i) % n; };
+  for (bool left = true; hi - lo >= 2; left = !left) {
+    if (left) {
+      emit(at(lo), at(lo + 1), at(hi));
+      ++lo;
+    } else {
+      emit(at(lo), at(hi - 1), at(hi));
+      --hi;
+    }
+  }
+}
+
+/// Score of a ladder rotation of a 3D polygon whose corners are at pos(v)
+/// (a callable returning const double*), against its original normal `ref`
+/// (Newell's vector at the original positions x0): the smallest, over its
+/// triangles, of dot(triangle area vector, ref) / (|ref| * sum of the
+/// triangle's squared edges) — positive iff every triangle faces the
+/// polygon's original way, larger when they are well shaped. Triangles of
+/// (relative) zero area at x0 — coincident corners, as exact lattices make
+/// — have no orientation to keep and are left out; +infinity when all are.
+template <class Pos>
+double ladder_score(Pos&& pos, const double* x0, const std::int32_t* loop, std::size_t n, std::size_t start,
+                    const double* ref) {
+  const double rr = ref[0] * ref[0] + ref[1] * ref[1] + ref[2] * ref[2];
+  double worst = std::numeric_limits<double>::infinity();
+  if (!(rr > 0)) return worst;
+  auto area_dot = [&](const double* a, const double* b, const double* c, double* edges) {
+    const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, w[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+    if (edges)
+      *edges = u[0] * u[0] + u[1] * u[1] + u[2] * u[2] + w[0] * w[0] + w[1] * w[1] + w[2] * w[2] +
+               (w[0] - u[0]) * (w[0] - u[0]) + (w[1] - u[1]) * (w[1] - u[1]) + (w[2] - u[2]) * (w[2] - u[2]);
+    return ref[0] * (u[1] * w[2] - u[2] * w[1]) + ref[1] * (u[2] * w[0] - u[0] * w[2]) +
+           ref[2] * (u[0] * w[1] - u[1] * w[0]);
+  };
+  auto orig = [&](std::size_t i) { return &x0[3 * static_cast<std::size_t>(loop[i])]; };
+  ladder(n, start, [&](std::size_t i, std::size_t j, std::size_t k) {
+    // |ref| is twice the polygon's area: leave out triangles below 1e-10 of it.
+    if (area_dot(orig(i), orig(j), orig(k), nullptr) <= 1e-10 * rr) return;
+    double edges = 0;
+    const double d = area_dot(pos(loop[i]), pos(loop[j]), pos(loop[k]), &edges);
+    worst = std::min(worst, d / (std::sqrt(rr) * (edges > 0 ? edges : 1.0)));
+  });
+  return worst;
+}
+
+}  // namespace tessera::front

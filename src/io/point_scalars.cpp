@@ -1,0 +1,29 @@
+// io::read_point_scalars (include/tessera/io/points.hpp): a .npy array, or a
+// named .ply vertex property / text column of the points' own file.
+#include <string>
+#include <vector>
+
+#include "io_detail.hpp"
+#include "tessera/io/npy.hpp"
+#include "tessera/io/points.hpp"
+
+namespace tessera::io {
+
+std::vector<double> read_point_scalars(const std::string& points_path, const std::string& source) {
+  if (source.empty()) throw InputError("no scalars given (a .npy file or a property/column name)");
+  if (detail::lower_extension(source) == ".npy") {
+    NpyArray a = read_npy_double(source);
+    if (!(a.shape.size() == 1 || (a.shape.size() == 2 && a.shape[1] == 1))) {
+      std::string shape = "(";
+      for (std::size_t k = 0; k < a.shape.size(); ++k) shape += (k ? ", " : "") + std::to_string(a.shape[k]);
+      detail::fail(source, "scalars must be a 1-D array, found shape " + shape + ")");
+    }
+    return std::move(a.as_double);
+  }
+  const std::string ext = detail::lower_extension(points_path);
+  if (ext == ".ply") return detail::read_ply_property(points_path, source);
+  if (ext == ".csv" || ext == ".xyz" || ext == ".txt") return detail::read_text_column(points_path, source);
+  detail::fail(points_path, "scalars '" + source + "': name a .ply property or a .csv column, or give a .npy file");
+}
+
+}  // namespace tessera::io

@@ -1,0 +1,104 @@
+// Joggle (include/tessera/prep/joggle.hpp): each moving point i gets the
+// displacement radius * u, u uniform in the unit ball / disk drawn from the
+// random stream of (seed, i) — so the result is the same for any thread count
+// and for any mask. Points the mask leaves alone are copied through bit for
+// bit (VTK's vtkJogglePoints leaves them uninitialised, notes §6.7).
+#include "tessera/prep/joggle.hpp"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <string>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include "random.hpp"
+#include "tessera/cells.hpp"
+
+namespace tessera {
+namespace {
+
+constexpr std::size_t kGrain = 4096;
+
+/// Shortest text that reads back as `v`.
+std::string num(double v) {
+  char buf[32];
+  const auto r = std::to_chars(buf, buf + sizeof buf, v);
+  return std::string(buf, r.ptr);
+}
+
+/// Length of the diagonal of the bounding box of all points.
+double bbox_diagonal(std::span<const double> coords, int dim) {
+  const std::size_t n = coords.size() / static_cast<std::size_t>(dim);
+  double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
+  for (int d = 0; d < dim; ++d) lo[d] = hi[d] = coords[static_cast<std::size_t>(d)];
+  for (std::size_t i = 1; i < n; ++i)
+    for (int d = 0; d < dim; ++d) {
+      const double v = coords[i * static_cast<std::size_t>(dim) + static_cast<std::size_t>(d)];
+      lo[d] = std::min(lo[d], v);
+      hi[d] = std::max(hi[d], v);
+    }
+  double s = 0;
+  for (int d = 0; d < dim; ++d) s += (hi[d] - lo[d]) * (hi[d] - lo[d]);
+  return std::sqrt(s);
+}
+
+}  // namespace
+
+std::vector<double> joggle(std::span<const double> coords, int dim, const JoggleOptions& options,
+                           std::span<const std::uint8_t> mask) {
+  if (dim != 2 && dim != 3) throw InputError("joggle: dimension must be 2 or 3, not " + std::to_string(dim));
+  if (coords.size() % static_cast<std::size_t>(dim) != 0)
+    throw InputError("joggle: " + std::to_string(coords.size()) + " coordinates are not a whole number of " +
+                     std::to_string(dim) + "D points");
+  const std::size_t n = coords.size() / static_cast<std::size_t>(dim);
+  if (!(options.radius >= 0) || !std::isfinite(options.radius))
+    throw InputError("joggle: radius must be a finite number >= 0, not " + num(options.radius));
+  if (options.mode != JoggleMode::ball && dim != 3)
+    throw InputError("joggle: plane modes (xy, xz, yz) need 3D points; 2D points joggle in their plane (ball)");
+  if (static_cast<unsigned>(options.mode) > static_cast<unsigned>(JoggleMode::yz))
+    throw InputError("joggle: unknown mode");
+  if (!mask.empty() && mask.size() != n)
+    throw InputError("joggle: mask has " + std::to_string(mask.size()) + " values for " + std::to_string(n) +
+                     " points");
+  for (std::size_t k = 0; k < coords.size(); ++k)
+    if (!std::isfinite(coords[k]))
+      throw InputError("joggle: non-finite coordinate " + num(coords[k]) + " in point " +
+                       std::to_string(k / static_cast<std::size_t>(dim)));
+
+  std::vector<double> out(coords.begin(), coords.end());
+  if (n == 0) return out;
+  const double radius = options.absolute ? options.radius : options.radius * bbox_diagonal(coords, dim);
+  if (radius == 0) return out;
+
+  // The axes that move: all of them (ball), or the two of the plane.
+  int axes[3] = {0, 1, 2};
+  int moving = dim;
+  if (options.mode != JoggleMode::ball) {
+    moving = 2;
+    axes[0] = options.mode == JoggleMode::yz ? 1 : 0;
+    axes[1] = options.mode == JoggleMode::xy ? 1 : 2;
+  }
+  const std::size_t stride = static_cast<std::size_t>(dim);
+  auto body = [&](const tbb::blocked_range<std::size_t>& r) {
+    double u[3];
+    for (std::size_t i = r.begin(); i != r.end(); ++i) {
+      if (!mask.empty() && mask[i] == 0) continue;
+      detail::RandomStream rng(options.seed, i, detail::kStreamJoggle);
+      rng.in_unit_ball(moving, u);
+      for (int k = 0; k < moving; ++k) out[i * stride + static_cast<std::size_t>(axes[k])] += radius * u[k];
+    }
+  };
+  const int threads = resolve_threads(options.threads);
+  if (threads == 1 || n <= kGrain) {
+    body(tbb::blocked_range<std::size_t>(0, n));
+  } else {
+    tbb::task_arena arena(threads);
+    arena.execute([&] { tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, kGrain), body); });
+  }
+  return out;
+}
+
+}  // namespace tessera

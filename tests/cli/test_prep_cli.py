@@ -1,0 +1,257 @@
+#!/usr/bin/python3
+"""End-to-end tests of `tessera joggle`, `tessera fill` and `tessera threshold`.
+
+Usage: /usr/bin/python3 tests/cli/test_prep_cli.py PATH_TO_tessera [unittest args...]
+
+Every output is read back: .npy with numpy, .ply with a small numpy parser
+here, .vtp through VTK's XML reader. Results are checked on hand-checkable
+inputs; bad input: exit 2, one error line, nothing written. Shares its
+helpers with test_cli.py.
+
+Prints "N passed, M failed" last; exits 1 if anything failed.
+"""
+import os
+import sys
+import unittest
+
+import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import test_cli as base  # noqa: E402  (helpers only; its test classes are not collected here)
+from test_cli import read_vtp, read_bytes  # noqa: E402
+
+from vtk.util.numpy_support import vtk_to_numpy  # noqa: E402
+
+run = base.run
+
+
+def read_ply(path):
+    """Vertex properties of a binary little-endian .ply as a numpy structured array."""
+    data = read_bytes(path)
+    end = data.index(b"end_header\n") + len(b"end_header\n")
+    header = data[:end].decode().splitlines()
+    assert header[1] == "format binary_little_endian 1.0", header[1]
+    n = None
+    fields = []
+    types = {"double": "<f8", "int": "<i4"}
+    for line in header:
+        w = line.split()
+        if w[0] == "element":
+            assert w[1] == "vertex"
+            n = int(w[2])
+        elif w[0] == "property":
+            fields.append((w[2], types[w[1]]))
+    arr = np.frombuffer(data[end:], dtype=np.dtype(fields))
+    assert len(arr) == n, (len(arr), n)
+    return arr
+
+
+class Case(base.TempDirCase):
+    def fails(self, args, fragment=None):
+        before = set(os.listdir(self.dir))
+        r = run(args)
+        after = set(os.listdir(self.dir))
+        cmd = "tessera " + " ".join(map(str, args))
+        self.assertEqual(r.returncode, 2, "%s: exit %d\nstdout: %s\nstderr: %s" % (cmd, r.returncode, r.stdout, r.stderr))
+        lines = r.stderr.splitlines()
+        self.assertEqual(len(lines), 1, "%s: stderr must be one line, got %r" % (cmd, r.stderr))
+        self.assertTrue(lines[0].startswith("tessera: error: "), "%s: %r" % (cmd, lines[0]))
+        if fragment:
+            self.assertIn(fragment, lines[0], cmd)
+        self.assertEqual(after - before, set(), "%s left files behind" % cmd)
+        self.assertEqual(r.stdout, "")
+        return lines[0]
+
+
+class Joggle(Case):
+    def setUp(self):
+        super().setUp()
+        self.pts = np.random.default_rng(3).random((2000, 3))
+        self.inp = self.save("pts.npy", self.pts)
+
+    def test_within_radius_deterministic_and_labels_carried(self):
+        labels = self.save("lab.npy", np.arange(2000, dtype=np.int32) % 3)
+        r = self.ok(["joggle", self.inp, "--labels", labels, "--radius", "0.01", "--absolute", "--seed", "7",
+                     "-o", self.p("j.npy")])
+        self.assertEqual(len(r.stdout.splitlines()), 1, r.stdout)
+        self.assertIn("tessera joggle: 2000 points (3D)", r.stdout)
+        q = np.load(self.p("j.npy"))
+        self.assertEqual(q.shape, (2000, 3))
+        d = np.linalg.norm(q - self.pts, axis=1)
+        self.assertTrue(np.all(d <= 0.01 * (1 + 1e-12)))
+        self.assertGreater(d.min(), 0)
+        self.assertTrue(np.array_equal(np.load(self.p("j_labels.npy")), np.load(labels)))
+        self.ok(["joggle", self.inp, "--labels", labels, "--radius", "0.01", "--absolute", "--seed", "7",
+                 "--threads", "1", "-o", self.p("k.npy"), "-q"])
+        self.assertEqual(read_bytes(self.p("j.npy")), read_bytes(self.p("k.npy")))
+
+    def test_relative_radius(self):
+        self.ok(["joggle", self.inp, "-o", self.p("j.npy")])
+        q = np.load(self.p("j.npy"))
+        diag = np.linalg.norm(self.pts.max(0) - self.pts.min(0))
+        self.assertTrue(np.all(np.linalg.norm(q - self.pts, axis=1) <= 1e-4 * diag * (1 + 1e-9)))
+
+    def test_mask_and_plane_mode(self):
+        mask = self.save("mask.npy", (np.arange(2000) % 2 == 0))
+        self.ok(["joggle", self.inp, "--mask", mask, "--mode", "xy", "--radius", "0.1", "-o", self.p("j.ply")])
+        v = read_ply(self.p("j.ply"))
+        q = np.stack([v["x"], v["y"], v["z"]], axis=1)
+        moved = np.any(q != self.pts, axis=1)
+        self.assertTrue(np.array_equal(moved, np.arange(2000) % 2 == 0))
+        self.assertTrue(np.array_equal(q[1::2], self.pts[1::2]))  # bit for bit
+        self.assertTrue(np.array_equal(q[:, 2], self.pts[:, 2]))  # xy mode keeps z
+
+    def test_bad_input(self):
+        out = self.p("j.npy")
+        self.fails(["joggle", self.p("nope.npy"), "-o", out], "nope.npy")
+        self.fails(["joggle", self.inp, "-o", self.p("j.txt")], ".npy, .ply or .vtp")
+        self.fails(["joggle", self.inp, "--radius", "-1", "-o", out])
+        self.fails(["joggle", self.inp, "--mode", "zz", "-o", out])
+        self.fails(["joggle", self.inp, "--mask", self.save("m.npy", np.ones(5, np.uint8)), "-o", out], "mask")
+        self.fails(["joggle", self.inp, "--dim", "2", "--mode", "xz", "-o", out], "3D")
+        self.fails(["joggle", self.inp])
+        self.fails(["joggle", self.inp, "-o", self.p("missing/j.npy")], "missing")
+
+
+class Fill(Case):
+    def test_uniform_by_hand_2d(self):
+        inp = self.save("p.npy", np.array([[0.1, 0.1], [0.9, 0.9]]))
+        r = self.ok(["fill", inp, "--bin-points", "0.5", "--bounds", "0,1,0,1", "-o", self.p("f.npy")])
+        self.assertIn("2 background points added", r.stdout)
+        q = np.load(self.p("f.npy"))
+        self.assertTrue(np.array_equal(q, [[0.1, 0.1], [0.9, 0.9], [0.75, 0.25], [0.25, 0.75]]))
+        self.assertTrue(np.array_equal(np.load(self.p("f_labels.npy")), [0, 0, -1, -1]))
+
+    def test_labels_vtp_and_concave_voronoi(self):
+        # An L-shaped cloud: filling the notch with outside points makes the cells concave.
+        g = np.linspace(0.025, 0.975, 20)
+        xx, yy = np.meshgrid(g, g)
+        pts = np.stack([xx.ravel(), yy.ravel()], axis=1)
+        pts = pts[~((pts[:, 0] > 0.5) & (pts[:, 1] > 0.5))]
+        inp = self.save("l.npy", pts)
+        lab = self.save("l_lab.npy", np.full(len(pts), 3, np.int32))
+        self.ok(["fill", inp, "--labels", lab, "--background-label", "-9", "--bin-points", "4",
+                 "--bounds", "0,1,0,1", "-o", self.p("f.vtp")])
+        pd = read_vtp(self.p("f.vtp"))
+        n = pd.GetNumberOfPoints()
+        self.assertGreater(n, len(pts))
+        self.assertEqual(pd.GetNumberOfVerts(), n)
+        xyz = vtk_to_numpy(pd.GetPoints().GetData())
+        self.assertTrue(np.array_equal(xyz[:len(pts), :2], pts))
+        self.assertTrue(np.all(xyz[:, 2] == 0))
+        labels = vtk_to_numpy(pd.GetPointData().GetArray("label"))
+        self.assertTrue(np.all(labels[:len(pts)] == 3) and np.all(labels[len(pts):] == -9))
+        added = xyz[len(pts):, :2]
+        self.assertTrue(np.all((added[:, 0] > 0.5) & (added[:, 1] > 0.5)))  # only in the empty notch
+        # The filled cloud tessellates with the notch carved out.
+        self.ok(["fill", inp, "--labels", lab, "--bin-points", "4", "--bounds", "0,1,0,1", "-o", self.p("f.npy")])
+        self.ok(["voronoi", self.p("f.npy"), "--labels", self.p("f_labels.npy"), "--bounds", "0", "1", "0", "1",
+                 "--cell-table", self.p("cells.csv")])
+        table = np.genfromtxt(self.p("cells.csv"), delimiter=",", names=True)
+        self.assertAlmostEqual(table["area"].sum(), 0.75, delta=0.05)
+
+    def test_adaptive_3d_ply(self):
+        rng = np.random.default_rng(4)
+        pts = rng.normal(0.5, 0.05, (3000, 3)).clip(0.01, 0.99)
+        inp = self.save("b.npy", pts)
+        self.ok(["fill", inp, "--strategy", "adaptive", "--bounds", "0,1,0,1,0,1", "--bin-points", "0.5",
+                 "--seed", "2", "-o", self.p("a.ply")])
+        v = read_ply(self.p("a.ply"))
+        self.assertTrue(np.array_equal(np.stack([v["x"], v["y"], v["z"]], 1)[:3000], pts))
+        self.assertTrue(np.all(v["label"][:3000] == 0) and np.all(v["label"][3000:] == -1))
+        self.assertGreater(len(v), 3000)
+        self.ok(["fill", inp, "--strategy", "adaptive", "--bounds", "0,1,0,1,0,1", "--bin-points", "0.5",
+                 "--seed", "2", "--threads", "1", "-o", self.p("b.ply"), "-q"])
+        self.assertEqual(read_bytes(self.p("a.ply")), read_bytes(self.p("b.ply")))
+
+    def test_bad_input(self):
+        inp = self.save("p.npy", np.array([[0.1, 0.1], [0.9, 0.9]]))
+        out = self.p("f.npy")
+        self.fails(["fill", inp, "--background-label", "0", "-o", out], "background")
+        self.fails(["fill", inp, "--bin-points", "0", "-o", out], "bin-points")
+        self.fails(["fill", inp, "--joggle", "0.7", "-o", out], "joggle")
+        self.fails(["fill", inp, "--bounds", "0,1,0", "-o", out], "bounds")
+        self.fails(["fill", inp, "--bounds", "0,1,0,1,0,1", "-o", out], "2D")
+        self.fails(["fill", inp, "--bounds", "0,0.5,0,1", "-o", out], "outside")
+        self.fails(["fill", inp, "--bounds", "0,a,0,1", "-o", out], "'a'")
+        self.fails(["fill", inp, "--strategy", "random", "-o", out])
+        self.fails(["fill", self.save("flat.npy", np.array([[0.0, 1.0], [1.0, 1.0]])), "-o", out], "y =")
+
+
+class Threshold(Case):
+    def test_npy_scalars_intervals(self):
+        inp = self.save("p.npy", np.arange(12, dtype=float).reshape(6, 2))
+        s = self.save("s.npy", np.array([-1.0, 0.0, 0.5, 1.0, np.nan, 2.0]))
+        r = self.ok(["threshold", inp, "--scalars", s, "--interval", "1,2,20", "--interval", "0,1,10",
+                     "-o", self.p("t.npy")])
+        self.assertIn("background -1: 3", r.stdout)
+        self.assertTrue(np.array_equal(np.load(self.p("t_labels.npy")), [-1, 10, 10, 20, -1, -1]))
+        self.assertTrue(np.array_equal(np.load(self.p("t.npy")), np.load(inp)))
+        self.assertEqual(sorted(os.listdir(self.dir)), ["p.npy", "s.npy", "t.npy", "t_labels.npy"])
+
+    def test_ply_property_and_csv_column(self):
+        # A .ply with a float32 scalar property, as other tools write them.
+        xyz = np.random.default_rng(5).random((50, 3))
+        val = np.linspace(-1, 1, 50)
+        header = ("ply\nformat binary_little_endian 1.0\nelement vertex 50\nproperty double x\nproperty double y\n"
+                  "property double z\nproperty float value\nend_header\n").encode()
+        rec = np.zeros(50, dtype=[("x", "<f8"), ("y", "<f8"), ("z", "<f8"), ("value", "<f4")])
+        rec["x"], rec["y"], rec["z"], rec["value"] = xyz[:, 0], xyz[:, 1], xyz[:, 2], val
+        with open(self.p("v.ply"), "wb") as f:
+            f.write(header + rec.tobytes())
+        self.ok(["threshold", self.p("v.ply"), "--scalars", "value", "--interval", "-inf,0,1", "--interval", "0,inf,2",
+                 "--background-label", "-3", "-o", self.p("t.vtp")])
+        pd = read_vtp(self.p("t.vtp"))
+        labels = vtk_to_numpy(pd.GetPointData().GetArray("label"))
+        v32 = val.astype(np.float32).astype(float)
+        self.assertTrue(np.array_equal(labels, np.where(v32 < 0, 1, 2)))
+        self.assertTrue(np.array_equal(vtk_to_numpy(pd.GetPointData().GetArray("scalars")), v32))
+        with open(self.p("c.csv"), "w") as f:
+            f.write("x,y,t\n")
+            for i in range(10):
+                f.write("%d,%d,%g\n" % (i, i % 3, i / 10))
+        self.ok(["threshold", self.p("c.csv"), "--dim", "2", "--scalars", "t", "--interval", "0.3,0.6,1",
+                 "-o", self.p("c.ply")])
+        v = read_ply(self.p("c.ply"))
+        self.assertTrue(np.array_equal(v["label"], [-1, -1, -1, 1, 1, 1, -1, -1, -1, -1]))
+        self.assertTrue(np.all(v["z"] == 0))
+
+    def test_bad_input(self):
+        inp = self.save("p.npy", np.arange(12, dtype=float).reshape(6, 2))
+        s = self.save("s.npy", np.zeros(6))
+        out = self.p("t.npy")
+        self.fails(["threshold", inp, "--scalars", s, "--interval", "0,2,1", "--interval", "1,3,2", "-o", out],
+                   "overlap")
+        self.fails(["threshold", inp, "--scalars", s, "--interval", "2,1,1", "-o", out], "lo < hi")
+        self.fails(["threshold", inp, "--scalars", s, "--interval", "0,1", "-o", out], "lo,hi,label")
+        self.fails(["threshold", inp, "--scalars", s, "--interval", "0,1,x", "-o", out], "label")
+        self.fails(["threshold", inp, "--scalars", s, "--interval", "nan,1,1", "-o", out])
+        self.fails(["threshold", inp, "--scalars", self.save("s5.npy", np.zeros(5)), "--interval", "0,1,1",
+                    "-o", out], "5 values for 6 points")
+        self.fails(["threshold", inp, "--scalars", "value", "--interval", "0,1,1", "-o", out], "property")
+        self.fails(["threshold", inp, "--interval", "0,1,1", "-o", out], "scalars")
+        self.fails(["threshold", inp, "--scalars", s, "-o", out], "interval")
+
+
+def main():
+    if len(sys.argv) < 2:
+        print("usage: test_prep_cli.py PATH_TO_tessera [unittest args]", file=sys.stderr)
+        return 2
+    base.TESSERA = os.path.abspath(sys.argv[1])
+    if not os.access(base.TESSERA, os.X_OK):
+        print("not an executable: %s" % base.TESSERA, file=sys.stderr)
+        return 2
+    if base.vtk is None:
+        print("python3-vtk9 is required (run with /usr/bin/python3)", file=sys.stderr)
+        return 2
+    argv = [sys.argv[0]] + sys.argv[2:]
+    prog = unittest.main(argv=argv, exit=False, verbosity=2)
+    res = prog.result
+    failed = len(res.failures) + len(res.errors) + len(res.unexpectedSuccesses)
+    passed = res.testsRun - failed - len(res.skipped)
+    print("%d passed, %d failed, %d skipped" % (passed, failed, len(res.skipped)))
+    return 0 if failed == 0 else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,189 @@
+// tessera::joggle: displacement bounds, determinism, masks, plane modes, threads.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <random>
+#include <vector>
+
+#include "tessera/cells.hpp"
+#include "tessera/prep/joggle.hpp"
+
+namespace {
+
+using tessera::JoggleMode;
+using tessera::JoggleOptions;
+
+std::vector<double> random_points(std::size_t n, int dim, unsigned seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::vector<double> c(n * static_cast<std::size_t>(dim));
+  for (double& v : c) v = u(rng);
+  return c;
+}
+
+double displacement(const std::vector<double>& a, const std::vector<double>& b, std::size_t i, int dim) {
+  double s = 0;
+  for (int d = 0; d < dim; ++d) {
+    const double x = a[i * dim + d] - b[i * dim + d];
+    s += x * x;
+  }
+  return std::sqrt(s);
+}
+
+bool bit_equal(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+
+TEST(PrepJoggle, DisplacementWithinAbsoluteRadiusAndUniformInBall) {
+  const std::size_t n = 20000;
+  const auto p = random_points(n, 3, 1);
+  JoggleOptions o;
+  o.radius = 0.01;
+  o.absolute = true;
+  const auto q = tessera::joggle(p, 3, o);
+  ASSERT_EQ(q.size(), p.size());
+  double sum = 0;
+  std::size_t inner = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double d = displacement(p, q, i, 3);
+    EXPECT_LE(d, 0.01 * (1 + 1e-9)) << i;
+    sum += d;
+    inner += d < 0.005;
+  }
+  // Uniform in the ball: E|d| = 3R/4, P(|d| < R/2) = 1/8.
+  EXPECT_NEAR(sum / n, 0.0075, 0.0002);
+  EXPECT_NEAR(static_cast<double>(inner) / n, 0.125, 0.01);
+}
+
+TEST(PrepJoggle, RelativeRadiusIsAFractionOfTheDiagonal) {
+  // Bounding box 3 x 4 x 0 (diagonal 5), radius 0.1 -> 0.5.
+  std::vector<double> p = {0, 0, 0, 3, 4, 0};
+  for (int i = 0; i < 2000; ++i) p.insert(p.end(), {1.5, 2.0, 0.0});
+  JoggleOptions o;
+  o.radius = 0.1;
+  const auto q = tessera::joggle(p, 3, o);
+  double largest = 0;
+  for (std::size_t i = 0; i < p.size() / 3; ++i) largest = std::max(largest, displacement(p, q, i, 3));
+  EXPECT_LE(largest, 0.5 * (1 + 1e-12));
+  EXPECT_GT(largest, 0.45);
+}
+
+TEST(PrepJoggle, TwoDimensionalDisk) {
+  const std::size_t n = 20000;
+  const auto p = random_points(n, 2, 2);
+  JoggleOptions o;
+  o.radius = 0.5;
+  o.absolute = true;
+  const auto q = tessera::joggle(p, 2, o);
+  double sum = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double d = displacement(p, q, i, 2);
+    EXPECT_LE(d, 0.5 * (1 + 1e-12));
+    sum += d;
+  }
+  EXPECT_NEAR(sum / n, 2.0 / 3.0 * 0.5, 0.01);  // E|d| = 2R/3 in a disk
+}
+
+TEST(PrepJoggle, DeterministicAndSeeded) {
+  const auto p = random_points(1000, 3, 3);
+  JoggleOptions o;
+  o.seed = 42;
+  const auto a = tessera::joggle(p, 3, o);
+  const auto b = tessera::joggle(p, 3, o);
+  EXPECT_EQ(std::memcmp(a.data(), b.data(), a.size() * sizeof(double)), 0);
+  o.seed = 43;
+  const auto c = tessera::joggle(p, 3, o);
+  std::size_t same = 0;
+  for (std::size_t k = 0; k < a.size(); ++k) same += a[k] == c[k];
+  EXPECT_LT(same, 10u);
+}
+
+TEST(PrepJoggle, MaskPassesOthersThroughBitForBit) {
+  auto p = random_points(1000, 3, 4);
+  p[5] = -0.0;  // copied as is, sign included
+  std::vector<std::uint8_t> mask(1000);
+  for (std::size_t i = 0; i < mask.size(); ++i) mask[i] = i % 3 == 0 ? 7 : 0;
+  JoggleOptions o;
+  o.radius = 0.05;
+  const auto all = tessera::joggle(p, 3, o);
+  const auto q = tessera::joggle(p, 3, o, mask);
+  for (std::size_t i = 0; i < 1000; ++i)
+    for (int d = 0; d < 3; ++d) {
+      if (mask[i])  // a masked point moves exactly as it does without a mask
+        EXPECT_TRUE(bit_equal(q[i * 3 + d], all[i * 3 + d])) << i;
+      else
+        EXPECT_TRUE(bit_equal(q[i * 3 + d], p[i * 3 + d])) << i;
+    }
+  EXPECT_TRUE(std::signbit(q[5]));
+  EXPECT_NE(q[0], p[0]);
+}
+
+TEST(PrepJoggle, PlaneModesKeepTheThirdCoordinateExactly) {
+  const auto p = random_points(5000, 3, 5);
+  const struct {
+    JoggleMode mode;
+    int fixed;
+  } cases[] = {{JoggleMode::xy, 2}, {JoggleMode::xz, 1}, {JoggleMode::yz, 0}};
+  for (const auto& c : cases) {
+    JoggleOptions o;
+    o.mode = c.mode;
+    o.radius = 0.02;
+    o.absolute = true;
+    const auto q = tessera::joggle(p, 3, o);
+    std::size_t moved = 0;
+    for (std::size_t i = 0; i < 5000; ++i) {
+      EXPECT_TRUE(bit_equal(q[i * 3 + c.fixed], p[i * 3 + c.fixed]));
+      EXPECT_LE(displacement(p, q, i, 3), 0.02 * (1 + 1e-12));
+      moved += displacement(p, q, i, 3) > 0;
+    }
+    EXPECT_EQ(moved, 5000u);
+  }
+}
+
+TEST(PrepJoggle, SameResultForAnyThreadCount) {
+  const auto p = random_points(200000, 3, 6);
+  JoggleOptions o;
+  o.radius = 1e-3;
+  o.threads = 1;
+  const auto a = tessera::joggle(p, 3, o);
+  o.threads = 2;
+  const auto b = tessera::joggle(p, 3, o);
+  o.threads = 5;
+  const auto c = tessera::joggle(p, 3, o);
+  EXPECT_EQ(std::memcmp(a.data(), b.data(), a.size() * sizeof(double)), 0);
+  EXPECT_EQ(std::memcmp(a.data(), c.data(), a.size() * sizeof(double)), 0);
+}
+
+TEST(PrepJoggle, ZeroRadiusAndEmptyInput) {
+  const auto p = random_points(10, 3, 7);
+  JoggleOptions o;
+  o.radius = 0;
+  EXPECT_EQ(tessera::joggle(p, 3, o), p);
+  EXPECT_TRUE(tessera::joggle({}, 3).empty());
+  // A single point: the diagonal is 0, so a relative radius moves nothing.
+  const std::vector<double> one = {1, 2, 3};
+  EXPECT_EQ(tessera::joggle(one, 3), one);
+}
+
+TEST(PrepJoggle, BadInput) {
+  const auto p = random_points(10, 3, 8);
+  JoggleOptions o;
+  o.radius = -1;
+  EXPECT_THROW(tessera::joggle(p, 3, o), tessera::InputError);
+  o.radius = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW(tessera::joggle(p, 3, o), tessera::InputError);
+  o.radius = std::numeric_limits<double>::infinity();
+  EXPECT_THROW(tessera::joggle(p, 3, o), tessera::InputError);
+  o = {};
+  o.mode = JoggleMode::xz;
+  const auto p2 = random_points(10, 2, 8);
+  EXPECT_THROW(tessera::joggle(p2, 2, o), tessera::InputError);
+  EXPECT_THROW(tessera::joggle(p, 3, {}, std::vector<std::uint8_t>(9, 1)), tessera::InputError);
+  auto bad = p;
+  bad[4] = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW(tessera::joggle(bad, 3), tessera::InputError);
+  EXPECT_THROW(tessera::joggle(p, 4), tessera::InputError);
+  EXPECT_THROW(tessera::joggle(std::vector<double>(7, 0.0), 3), tessera::InputError);
+}
+
+}  // namespace
