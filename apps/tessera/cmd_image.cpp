@@ -186,6 +186,17 @@ LabelledPoints sample_image_file(const std::string& image, const SamplerArgs& s)
   return sample_named(image, img, o);
 }
 
+LabelImage read_label_image_file(const std::string& image, const SamplerArgs& s) {
+  (void)sampler_options(s);  // bad options fail before a possibly large read
+  LabelImage img = io::read_label_image(image, read_options(s.read));
+  check_read_dims(s.read, img.geometry, image);
+  return img;
+}
+
+LabelledPoints sample_label_image(const std::string& image, const LabelImage& img, const SamplerArgs& s) {
+  return sample_named(image, img, sampler_options(s));
+}
+
 // ------------------------------------------------------------------ registration
 
 void add_image_commands(CLI::App& app, ImageCommands& c) {

@@ -8,6 +8,8 @@
 #include <vector>
 
 #include "tessera/cells.hpp"
+#include "tessera/image.hpp"
+#include "tessera/surface_nets.hpp"
 #include "tessera/io/points.hpp"
 
 namespace CLI {
@@ -223,6 +225,35 @@ void add_sampler_options(CLI::App* app, SamplerArgs& s);
 bool is_image_path(const std::string& path);
 /// Reads a label image and samples it with `s` (InputError on bad options or input).
 LabelledPoints sample_image_file(const std::string& image, const SamplerArgs& s);
+/// The two halves of sample_image_file (surface-nets needs the geometry and
+/// times the sampling alone): read (options checked first), then sample.
+LabelImage read_label_image_file(const std::string& image, const SamplerArgs& s);
+LabelledPoints sample_label_image(const std::string& image, const LabelImage& img, const SamplerArgs& s);
+
+/// `surface-nets` and `bench surface-nets` (cmd_surface_nets.cpp). INPUT is
+/// labelled points (compute.input, compute.labels) or a label image (by
+/// extension, or .npy with --image), sampled first with `sampler`.
+struct SurfaceNetsArgs {
+  ComputeArgs compute;
+  std::string output;                  ///< .vtp
+  std::vector<std::int32_t> select;    ///< empty: every label >= 0
+  std::int32_t background_label = -1;  ///< BoundaryLabels value of the domain box
+  bool capping = false;
+  int smooth = SmoothingOptions{}.iterations;  ///< smoothing iterations (0 = none)
+  double relax = SmoothingOptions{}.relaxation;
+  double constraint = SmoothingOptions{}.constraint;  ///< x petal radius, or absolute
+  bool absolute_constraint = false;
+  bool triangles = false;
+  bool image = false;                  ///< .npy INPUT is a label image
+  SamplerArgs sampler;                 ///< select / threads come from the fields above
+  bool quiet = false;
+  int repeat = 1;                      ///< bench only
+};
+/// Registers the surface-nets options other than the compute options (main.cpp
+/// adds those) on `app`; `bench` adds --repeat and leaves out -o/--quiet.
+void add_surface_nets_options(CLI::App* app, SurfaceNetsArgs& args, bool bench);
+int run_surface_nets(const SurfaceNetsArgs& args);
+int run_bench_surface_nets(const SurfaceNetsArgs& args);
 
 // Shared by the subcommand files (defined in commands.cpp).
 /// Resource usage of this process so far (bench JSON lines).

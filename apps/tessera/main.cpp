@@ -205,6 +205,16 @@ int main(int argc, char** argv) {
   flower->add_flag("--glyphs", wa.glyphs, "Also draw each petal and the circumflower as a circle (2D) / sphere (3D)");
   flower->add_flag("-q,--quiet", wa.quiet, "No summary and no progress bar");
 
+  // Generalized surface nets (cmd_surface_nets.cpp).
+  SurfaceNetsArgs sna;
+  std::vector<std::string> sn_bounds;
+  CLI::App* snets = app.add_subcommand(
+      "surface-nets",
+      "Smooth, watertight surfaces between labelled regions (generalized surface nets) from labelled points or a "
+      "label image");
+  add_compute_options(snets, sna.compute, sn_bounds);
+  add_surface_nets_options(snets, sna, false);
+
   BenchArgs ba;
   CLI::App* bench = app.add_subcommand("bench", "Benchmarks printing one JSON line per run on stdout");
   bench->require_subcommand(1);
@@ -231,6 +241,18 @@ int main(int argc, char** argv) {
   bench_del->add_option("--repeat", bda.repeat, "Number of timed runs")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
+
+  SurfaceNetsArgs bsna;
+  std::vector<std::string> bench_sn_bounds;
+  CLI::App* bench_sn = bench->add_subcommand(
+      "surface-nets",
+      "Time the surface-nets pipeline (image sampling + cells + faces + smoothing [+ triangles]; no output files) "
+      "K times. Each run prints {\"tool\":\"tessera\",\"op\":\"surface-nets\",\"n\" (points),\"threads\","
+      "\"seconds\",\"simplices\" (= output faces),\"extra\":{...,voxels,points,cells,polygons,triangles,vertices,"
+      "labels,watertight,open_labels,boundary_edges,nonmanifold_edges,sample_s,cells_s,faces_s,smoothing_s,"
+      "triangulation_s,repeat}}");
+  add_compute_options(bench_sn, bsna.compute, bench_sn_bounds);
+  add_surface_nets_options(bench_sn, bsna, true);
 
   DemoArgs da;
   CLI::App* demo = app.add_subcommand(
@@ -281,6 +303,14 @@ int main(int argc, char** argv) {
     if (del->parsed()) {
       finish_compute_args(dla.compute, del_bounds);
       return run_delaunay(dla);
+    }
+    if (snets->parsed()) {
+      finish_compute_args(sna.compute, sn_bounds);
+      return run_surface_nets(sna);
+    }
+    if (bench_sn->parsed()) {
+      finish_compute_args(bsna.compute, bench_sn_bounds);
+      return run_bench_surface_nets(bsna);
     }
     if (bench_del->parsed()) {
       finish_compute_args(bda.compute, bench_del_bounds);

@@ -6,7 +6,7 @@
 #include <array>
 #include <atomic>
 #include <cmath>
-#include <cstdlib>
+#include <cstdio>
 #include <cstdint>
 #include <limits>
 #include <numeric>
@@ -23,13 +23,21 @@
 namespace tessera {
 namespace front {
 
+namespace {
+std::string num(double v) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%g", v);
+  return b;
+}
+}  // namespace
+
 void check_smoothing_options(const SmoothingOptions& o) {
   if (o.iterations < 0)
     throw InputError("smoothing: iterations must be >= 0 (0 = no smoothing), got " + std::to_string(o.iterations));
   if (!(o.relaxation > 0 && o.relaxation <= 1))
-    throw InputError("smoothing: relaxation factor must be in (0, 1], got " + std::to_string(o.relaxation));
+    throw InputError("smoothing: relaxation factor must be in (0, 1], got " + num(o.relaxation));
   if (!(o.constraint >= 0) || !std::isfinite(o.constraint))
-    throw InputError("smoothing: constraint must be a finite number >= 0, got " + std::to_string(o.constraint));
+    throw InputError("smoothing: constraint must be a finite number >= 0, got " + num(o.constraint));
 }
 
 namespace {

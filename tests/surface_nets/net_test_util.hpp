@@ -11,6 +11,7 @@
 #include <numbers>
 #include <random>
 #include <span>
+#include <utility>
 #include <vector>
 
 #include "dual/surface_checks.hpp"
@@ -150,7 +151,8 @@ inline bool segment_hits_triangle(const V3& p, const V3& q, const V3& a, const V
 /// Pairs of triangles (of a triangulated 3D net) that share no vertex and
 /// intersect; pairs sharing exactly one vertex that intersect away from it
 /// are counted too (an edge of one crossing the other's interior).
-inline std::size_t self_intersections(const tessera::FaceSet& m) {
+inline std::size_t self_intersections(const tessera::FaceSet& m,
+                                      std::vector<std::pair<std::size_t, std::size_t>>* pairs = nullptr) {
   const std::size_t nt = m.n_faces();
   std::vector<std::array<V3, 3>> tri(nt);
   std::vector<std::array<double, 6>> box(nt);
@@ -193,6 +195,7 @@ inline std::size_t self_intersections(const tessera::FaceSet& m) {
         hit = segment_hits_triangle(tri[t][k], tri[t][(k + 1) % 3], tri[s][0], tri[s][1], tri[s][2]);
       }
       hits += hit;
+      if (hit && pairs) pairs->emplace_back(s, t);
     }
   }
   return hits;

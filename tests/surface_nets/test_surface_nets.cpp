@@ -1,0 +1,554 @@
+// Generalized surface nets: every region's surface is closed, 2-manifold
+// and outward; BoundaryLabels follow the convention; enclosed volumes equal
+// the cells' exactly before smoothing and stay close after; volumes and
+// areas approach the analytic ones; smoothing keeps topology (no flips, no
+// self-intersections), respects the constraint, keeps junction vertices on
+// their curve, corners fixed and box vertices on the box; the result does
+// not depend on the thread count; bad input gives one-line errors.
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <limits>
+#include <map>
+#include <numbers>
+#include <set>
+#include <string>
+
+#include "net_test_util.hpp"
+#include "tessera/cells.hpp"
+
+namespace {
+
+using namespace net_test;
+using tessera::NetVertexKind;
+using tessera::SurfaceNet;
+using tessera::SurfaceNetsOptions;
+
+constexpr double kPi = std::numbers::pi;
+
+/// Sum of the cell volumes (areas in 2D) per selected region, with every
+/// other label as an outside point — what each region's surface must enclose.
+std::map<std::int32_t, double> region_volumes(const Labelled& in, const std::set<std::int32_t>& selected) {
+  std::vector<std::int32_t> l(in.labels);
+  for (auto& x : l)
+    if (!selected.count(x)) x = -1;
+  tessera::VoronoiOptions o;
+  o.dim = in.dim;
+  tessera::Bounds b;
+  b.hi = {1, 1, in.dim == 3 ? 1.0 : 0.0};
+  o.bounds = b;
+  o.threads = 1;
+  o.build_mesh = false;
+  const tessera::Cells c = tessera::voronoi(in.points, in.dim, l, o);
+  std::map<std::int32_t, double> v;
+  for (std::size_t k = 0; k < c.n_cells(); ++k) v[c.region[k]] += c.volume[k];
+  return v;
+}
+
+/// Number of distinct regions among a vertex's generators (box planes each
+/// their own), recomputed here from the key.
+int regions_of_key(const tessera::FaceSet& m, const std::vector<std::int32_t>& labels, std::size_t v) {
+  const int kn = m.dim + 1;
+  std::set<std::pair<int, std::int64_t>> r;
+  for (int a = 0; a < kn; ++a) {
+    const std::int32_t id = m.vertex_keys[v * kn + a];
+    r.insert(id < 0 ? std::pair<int, std::int64_t>{1, id} : std::pair<int, std::int64_t>{0, labels[id]});
+  }
+  return static_cast<int>(r.size());
+}
+
+/// Distance from a net vertex (original position) to its generators.
+double petal_radius(const tessera::FaceSet& m, const Labelled& in, std::size_t v) {
+  const int kn = m.dim + 1;
+  for (int a = 0; a < kn; ++a) {
+    const std::int32_t id = m.vertex_keys[v * kn + a];
+    if (id < 0) continue;
+    double d2 = 0;
+    for (int q = 0; q < m.dim; ++q) {
+      const double d = m.vertices[v * m.dim + q] - in.points[static_cast<std::size_t>(id) * in.dim + q];
+      d2 += d * d;
+    }
+    return std::sqrt(d2);
+  }
+  return 0;
+}
+
+double displacement(const tessera::FaceSet& a, const tessera::FaceSet& b, std::size_t v) {
+  double d2 = 0;
+  for (int q = 0; q < a.dim; ++q) {
+    const double d = a.vertices[v * a.dim + q] - b.vertices[v * a.dim + q];
+    d2 += d * d;
+  }
+  return std::sqrt(d2);
+}
+
+/// Checks shared by every net: sizes, labels per face against the sides
+/// (side 0 a selected region; between selected regions lo < hi; capping
+/// faces carry the neighbour's own label or the background), closed
+/// outward 2-manifold surfaces for the `closed` labels with the cells'
+/// volume (exactly when unsmoothed), kinds from the keys.
+void check_net(const SurfaceNet& net, const Labelled& in, const std::set<std::int32_t>& selected,
+               const std::set<std::int32_t>& closed, bool smoothed, std::int32_t background = -1,
+               double volume_tol = 1e-9) {
+  const auto& m = net.mesh;
+  const std::size_t nf = m.n_faces(), nv = m.n_vertices();
+  ASSERT_EQ(m.boundary_labels.size(), 2 * nf);
+  ASSERT_EQ(m.sides.size(), 2 * nf);
+  ASSERT_EQ(net.vertex_kind.size(), nv);
+  ASSERT_EQ(net.polygon_of_face.size(), nf);
+  ASSERT_EQ(std::set<std::int32_t>(net.selected.begin(), net.selected.end()), selected);
+  for (std::size_t f = 0; f < nf; ++f) {
+    const std::int32_t l0 = m.boundary_labels[2 * f], l1 = m.boundary_labels[2 * f + 1];
+    const std::int32_t s0 = m.sides[2 * f], s1 = m.sides[2 * f + 1];
+    ASSERT_TRUE(selected.count(l0)) << "face " << f << ": side 0 label " << l0 << " is not selected";
+    ASSERT_EQ(l0, in.labels[s0]) << "face " << f;
+    if (s1 < 0) {
+      ASSERT_EQ(l1, background) << "face " << f;
+    } else {
+      ASSERT_EQ(l1, in.labels[s1]) << "face " << f;
+      ASSERT_NE(l0, l1) << "face " << f << ": a face inside one region";
+      if (selected.count(l1)) ASSERT_LT(l0, l1) << "face " << f << ": interface not (lo, hi)";
+    }
+  }
+  for (std::size_t v = 0; v < nv; ++v) {
+    const int k = regions_of_key(m, in.labels, v);
+    const NetVertexKind want = k >= m.dim + 1 ? NetVertexKind::corner
+                               : k == 3       ? NetVertexKind::junction
+                                              : NetVertexKind::surface;
+    ASSERT_EQ(net.vertex_kind[v], want) << "vertex " << v << " with " << k << " regions";
+  }
+  const auto vol = region_volumes(in, selected);
+  for (std::int32_t label : closed) {
+    const auto r = region_surface(m, label);
+    EXPECT_EQ(r.unbalanced_edges, 0u) << "label " << label << ": surface not closed / not consistently oriented";
+    EXPECT_EQ(r.nonmanifold_edges, 0u) << "label " << label << ": surface not 2-manifold";
+    EXPECT_EQ(r.degenerate_faces, 0u) << "label " << label;
+    const double want = vol.at(label);
+    if (!smoothed)
+      EXPECT_NEAR(r.volume, want, volume_tol * std::max(1.0, want)) << "label " << label << " encloses its cells";
+    else
+      EXPECT_NEAR(r.volume, want, volume_tol * want) << "label " << label << " after smoothing";
+  }
+}
+
+SurfaceNetsOptions opts(int dim, int iterations, bool capping = false, bool triangles = false, int threads = 1) {
+  SurfaceNetsOptions o = net_options(dim, iterations, triangles, threads);
+  o.capping = capping;
+  return o;
+}
+
+double sphere_volume(double r) { return 4.0 / 3.0 * kPi * r * r * r; }
+
+// ------------------------------------------------------------ topology
+
+TEST(SurfaceNets, NestedSpheresClosedOrientedExactVolumes) {
+  const Labelled in = grid_points(16, 3, 0.3, 1, nested(3));
+  // Without capping the net is the two spheres: every label's surface is
+  // closed (label 0's is the outer sphere, reversed).
+  const SurfaceNet a = run(in, opts(3, 0));
+  check_net(a, in, {0, 1, 2}, {1, 2}, false);
+  std::set<std::pair<int, int>> pairs;
+  for (std::size_t f = 0; f < a.mesh.n_faces(); ++f)
+    pairs.insert({a.mesh.boundary_labels[2 * f], a.mesh.boundary_labels[2 * f + 1]});
+  EXPECT_EQ(pairs, (std::set<std::pair<int, int>>{{0, 1}, {1, 2}}));
+  EXPECT_EQ(a.max_displacement, 0.0);
+  // With capping the box closes label 0 too.
+  const SurfaceNet b = run(in, opts(3, 0, true));
+  check_net(b, in, {0, 1, 2}, {0, 1, 2}, false);
+  pairs.clear();
+  for (std::size_t f = 0; f < b.mesh.n_faces(); ++f)
+    pairs.insert({b.mesh.boundary_labels[2 * f], b.mesh.boundary_labels[2 * f + 1]});
+  EXPECT_EQ(pairs, (std::set<std::pair<int, int>>{{0, -1}, {0, 1}, {1, 2}}));
+  // Smoothed: still closed and manifold (same connectivity), volume close.
+  const SurfaceNet c = run(in, opts(3, 20, true));
+  check_net(c, in, {0, 1, 2}, {0, 1, 2}, true, -1, 0.12);
+  EXPECT_EQ(c.mesh.face_vertices, b.mesh.face_vertices);
+  EXPECT_GT(c.max_displacement, 0.0);
+}
+
+TEST(SurfaceNets, TouchingBoxesAndLabelPairs) {
+  const Labelled in = grid_points(20, 3, 0.25, 2, touching_boxes);
+  const SurfaceNet a = run(in, opts(3, 0, true));
+  check_net(a, in, {0, 1, 2}, {0, 1, 2}, false);
+  std::map<std::pair<int, int>, double> area;
+  for (std::size_t f = 0; f < a.mesh.n_faces(); ++f)
+    area[{a.mesh.boundary_labels[2 * f], a.mesh.boundary_labels[2 * f + 1]}] += 0.5 * norm(face_normal(a.mesh, f));
+  EXPECT_EQ(area.size(), 4u);  // (0,-1), (0,1), (0,2), (1,2)
+  EXPECT_TRUE(area.count({1, 2}) && area.count({0, 1}) && area.count({0, 2}) && area.count({0, -1}));
+  const double box_area = area[{0, -1}], interface_area = area[{1, 2}];
+  EXPECT_NEAR(box_area, 6.0, 1e-9);  // the box, exactly
+  const SurfaceNet b = run(in, opts(3, 20, true, true));
+  check_net(b, in, {0, 1, 2}, {0, 1, 2}, true, -1, 0.06);
+  double a12 = 0;
+  for (std::size_t f = 0; f < b.mesh.n_faces(); ++f)
+    if (b.mesh.boundary_labels[2 * f] == 1 && b.mesh.boundary_labels[2 * f + 1] == 2)
+      a12 += 0.5 * norm(face_normal(b.mesh, f));
+  // The plane x = 0.5 between the boxes: 0.5 x 0.5. Rough before, close after.
+  EXPECT_GT(interface_area, 0.25 * 1.1);
+  EXPECT_NEAR(a12, 0.25, 0.25 * 0.06);
+  EXPECT_LT(std::fabs(a12 - 0.25), std::fabs(interface_area - 0.25));
+}
+
+TEST(SurfaceNets, TrianglesKeepLabelsOrientationAndClosure) {
+  const Labelled in = grid_points(14, 3, 0.3, 3, nested(3));
+  const SurfaceNet p = run(in, opts(3, 20, true));
+  const SurfaceNet t = run(in, opts(3, 20, true, true));
+  ASSERT_EQ(p.mesh.vertices, t.mesh.vertices);  // triangulation comes after smoothing
+  std::size_t want = 0;
+  for (std::size_t f = 0; f < p.mesh.n_faces(); ++f) want += p.mesh.face_offsets[f + 1] - p.mesh.face_offsets[f] - 2;
+  ASSERT_EQ(t.mesh.n_faces(), want);
+  for (std::size_t f = 0; f < t.mesh.n_faces(); ++f) {
+    ASSERT_EQ(t.mesh.face_offsets[f + 1] - t.mesh.face_offsets[f], 3);
+    const auto g = static_cast<std::size_t>(t.polygon_of_face[f]);
+    ASSERT_EQ(t.mesh.boundary_labels[2 * f], p.mesh.boundary_labels[2 * g]);
+    ASSERT_EQ(t.mesh.boundary_labels[2 * f + 1], p.mesh.boundary_labels[2 * g + 1]);
+    ASSERT_EQ(t.mesh.sides[2 * f], p.mesh.sides[2 * g]);
+    for (int k = 0; k < 3; ++k) {
+      const auto v = t.mesh.face_vertices[3 * f + k];
+      ASSERT_NE(std::find(p.mesh.face_vertices.begin() + p.mesh.face_offsets[g],
+                          p.mesh.face_vertices.begin() + p.mesh.face_offsets[g + 1], v),
+                p.mesh.face_vertices.begin() + p.mesh.face_offsets[g + 1]);
+    }
+  }
+  check_net(t, in, {0, 1, 2}, {0, 1, 2}, true, -1, 0.15);
+  // Unsmoothed, the triangles cover the planar polygons exactly.
+  const SurfaceNet t0 = run(in, opts(3, 0, true, true));
+  check_net(t0, in, {0, 1, 2}, {0, 1, 2}, false);
+}
+
+// ------------------------------------------------------------ smoothing
+
+TEST(SurfaceNets, SmoothingFlipsNoFaceAndDoesNotSelfIntersect) {
+  const std::function<std::int32_t(const V3&)> shapes[] = {nested(3), touching_boxes, three_sectors};
+  for (int s = 0; s < 3; ++s)
+    for (double jitter : {0.0, 0.25, 0.5}) {
+      const Labelled in = grid_points(12, 3, jitter, 10 + s, shapes[s]);
+      const SurfaceNet before = run(in, opts(3, 0, true, true));
+      const SurfaceNet after = run(in, opts(3, 20, true, true));
+      ASSERT_EQ(before.mesh.n_vertices(), after.mesh.n_vertices());
+      EXPECT_EQ(flipped_faces(before.mesh, after.mesh, 1.0 / 12), 0u) << "shape " << s << " jitter " << jitter;
+      // Coincident vertices of exact lattices touch before smoothing; only
+      // jittered inputs are in general position.
+      if (jitter > 0) {
+        EXPECT_EQ(self_intersections(before.mesh), 0u) << "shape " << s << " jitter " << jitter;
+        EXPECT_EQ(self_intersections(after.mesh), 0u) << "shape " << s << " jitter " << jitter;
+      }
+    }
+  // Random (not grid) points.
+  Labelled in;
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> u(0, 1);
+  const auto label = nested(3);
+  for (int i = 0; i < 2000; ++i) {
+    const V3 p{u(rng), u(rng), u(rng)};
+    in.points.insert(in.points.end(), p.begin(), p.end());
+    in.labels.push_back(label(p));
+  }
+  const SurfaceNet before = run(in, opts(3, 0, true, true));
+  const SurfaceNet after = run(in, opts(3, 20, true, true));
+  EXPECT_EQ(flipped_faces(before.mesh, after.mesh, 1.0 / 12), 0u);
+  EXPECT_EQ(self_intersections(after.mesh), 0u);
+}
+
+TEST(SurfaceNets, SmoothingRespectsConstraintCornersAndBox) {
+  const Labelled in = grid_points(16, 3, 0.3, 4, touching_boxes);
+  const SurfaceNet before = run(in, opts(3, 0, true));
+  for (double c : {0.2, 0.5, 1.0}) {
+    SurfaceNetsOptions o = opts(3, 30, true);
+    o.smoothing.constraint = c;
+    const SurfaceNet after = run(in, o);
+    double worst = 0;
+    std::size_t corners = 0;
+    for (std::size_t v = 0; v < after.mesh.n_vertices(); ++v) {
+      const double d = displacement(before.mesh, after.mesh, v);
+      const double limit = c * petal_radius(before.mesh, in, v);
+      ASSERT_LE(d, limit * (1 + 1e-12) + 1e-15) << "vertex " << v << " constraint " << c;
+      worst = std::max(worst, d);
+      if (after.vertex_kind[v] == NetVertexKind::corner) {
+        ++corners;
+        ASSERT_EQ(d, 0.0) << "corner " << v << " moved";
+      }
+      // Vertices on a box plane keep that coordinate exactly (as computed
+      // by the cells: on the plane up to rounding) and stay on the plane.
+      for (int a = 0; a < 4; ++a) {
+        const std::int32_t id = after.mesh.vertex_keys[4 * v + a];
+        if (id >= 0) continue;
+        const int axis = (-id - 1) / 2;
+        ASSERT_EQ(after.mesh.vertices[3 * v + axis], before.mesh.vertices[3 * v + axis]) << "vertex " << v;
+        ASSERT_NEAR(after.mesh.vertices[3 * v + axis], (-id - 1) % 2 == 0 ? 0.0 : 1.0, 1e-15) << "vertex " << v;
+      }
+    }
+    EXPECT_GT(corners, 0u);  // the domain box's corners (capping)
+    EXPECT_DOUBLE_EQ(after.max_displacement, worst);
+  }
+  // Absolute constraint.
+  SurfaceNetsOptions o = opts(3, 30, true);
+  o.smoothing.constraint = 0.01;
+  o.smoothing.constraint_is_absolute = true;
+  const SurfaceNet after = run(in, o);
+  EXPECT_LE(after.max_displacement, 0.01 * (1 + 1e-12));
+  EXPECT_GT(after.max_displacement, 0.009);
+}
+
+TEST(SurfaceNets, JunctionVerticesStayOnTheirLine) {
+  // Three sectors meeting along x = y = 0.5: the junction vertices (three
+  // labels, no box plane) lie on a zig-zag around that line; smoothing moves
+  // them along their curve only, so they come closer to the line, never
+  // farther than the constraint, and the curve's ends on the box are fixed.
+  const Labelled in = grid_points(16, 3, 0.3, 6, three_sectors);
+  const SurfaceNet before = run(in, opts(3, 0, true));
+  const SurfaceNet after = run(in, opts(3, 20, true));
+  auto dist_to_line = [](const tessera::FaceSet& m, std::size_t v) {
+    return std::hypot(m.vertices[3 * v] - 0.5, m.vertices[3 * v + 1] - 0.5);
+  };
+  double sum0 = 0, sum1 = 0, max0 = 0, max1 = 0;
+  std::size_t n = 0, ends = 0;
+  for (std::size_t v = 0; v < after.mesh.n_vertices(); ++v) {
+    std::set<std::int32_t> labels;
+    bool on_box = false;
+    for (int a = 0; a < 4; ++a) {
+      const auto id = after.mesh.vertex_keys[4 * v + a];
+      if (id < 0) on_box = true;
+      else labels.insert(in.labels[id]);
+    }
+    if (labels.size() != 3) continue;
+    if (on_box) {  // the curve's ends on z = 0 / z = 1: four regions, fixed
+      ++ends;
+      EXPECT_EQ(after.vertex_kind[v], NetVertexKind::corner);
+      EXPECT_EQ(displacement(before.mesh, after.mesh, v), 0.0);
+      continue;
+    }
+    ASSERT_EQ(after.vertex_kind[v], NetVertexKind::junction);
+    ++n;
+    const double d0 = dist_to_line(before.mesh, v), d1 = dist_to_line(after.mesh, v);
+    sum0 += d0, sum1 += d1;
+    max0 = std::max(max0, d0), max1 = std::max(max1, d1);
+    EXPECT_LE(displacement(before.mesh, after.mesh, v), 0.5 * petal_radius(before.mesh, in, v) * (1 + 1e-12));
+  }
+  ASSERT_GT(n, 16u);
+  EXPECT_GE(ends, 2u);
+  EXPECT_LT(max0, 1.0 / 16);           // the Voronoi junction is within a spacing of the line
+  EXPECT_LE(max1, max0);               // and smoothing never pushes a vertex farther out
+  EXPECT_LT(sum1, 0.8 * sum0);         // it straightens the curve
+}
+
+TEST(SurfaceNets, SmoothingMakesSpheresSmoothVolumeAndAreaClose) {
+  // Inner sphere of radius 0.2 in a jittered grid of 24^3 points.
+  const Labelled in = grid_points(24, 3, 0.25, 7, nested(3));
+  const SurfaceNet before = run(in, opts(3, 0));
+  const SurfaceNet after = run(in, opts(3, 20, false, true));
+  auto normal_error = [](const tessera::FaceSet& m) {  // area-weighted angle to the radius, degrees
+    double sw = 0, sa = 0;
+    for (std::size_t f = 0; f < m.n_faces(); ++f) {
+      if (m.boundary_labels[2 * f] != 1 || m.boundary_labels[2 * f + 1] != 2) continue;
+      const V3 n = face_normal(m, f);
+      V3 c{0, 0, 0};
+      const auto b = m.face_offsets[f], e = m.face_offsets[f + 1];
+      for (auto q = b; q < e; ++q)
+        for (int a = 0; a < 3; ++a) c[a] += vertex(m, m.face_vertices[q])[a] / double(e - b);
+      const V3 r{c[0] - 0.5, c[1] - 0.5, c[2] - 0.5};
+      if (norm(n) == 0) continue;
+      // The face points from 1 (outside) into 2 (inside): against the radius.
+      sa += norm(n) * std::acos(std::clamp(-dot(n, r) / norm(n) / norm(r), -1.0, 1.0)) * 180 / kPi;
+      sw += norm(n);
+    }
+    return sa / sw;
+  };
+  const double e0 = normal_error(before.mesh), e1 = normal_error(after.mesh);
+  EXPECT_GT(e0, 35.0);  // Voronoi faces: a rough, staircase-like surface
+  EXPECT_LT(e1, 0.55 * e0);
+  const auto s0 = region_surface(before.mesh, 2), s1 = region_surface(after.mesh, 2);
+  const double va = sphere_volume(0.2), aa = 4 * kPi * 0.04;
+  EXPECT_NEAR(s0.volume, va, 0.03 * va);
+  EXPECT_NEAR(s1.volume, va, 0.06 * va);
+  EXPECT_GT(s0.measure, 1.3 * aa);         // about +50% before smoothing
+  EXPECT_NEAR(s1.measure, aa, 0.08 * aa);  // within a few percent after
+}
+
+TEST(SurfaceNets, VolumeErrorShrinksWithResolution) {
+  // The smoothed spheres' volume errors decrease as the spacing does (the
+  // area error after smoothing settles at a few percent: the residual
+  // roughness is on the scale of the spacing, and so relative to it).
+  double prev_v[3] = {1e9, 1e9, 1e9};
+  for (int k : {12, 20, 32}) {
+    const Labelled in = grid_points(k, 3, 0.25, 8, nested(3));
+    const SurfaceNet net = run(in, opts(3, 20));
+    const double want[3] = {0, sphere_volume(0.35) - sphere_volume(0.2), sphere_volume(0.2)};
+    const double area[3] = {0, 4 * kPi * (0.35 * 0.35 + 0.04), 4 * kPi * 0.04};
+    for (int label : {1, 2}) {
+      const auto r = region_surface(net.mesh, label);
+      const double ev = std::fabs(r.volume - want[label]) / want[label];
+      EXPECT_LT(ev, prev_v[label]) << "label " << label << " k " << k;
+      prev_v[label] = ev;
+      EXPECT_NEAR(r.measure, area[label], 0.1 * area[label]) << "label " << label << " k " << k;
+    }
+  }
+  EXPECT_LT(prev_v[1], 0.01);
+  EXPECT_LT(prev_v[2], 0.04);
+}
+
+TEST(SurfaceNets, ExactLatticeIsClosedAndSmooths) {
+  // Exact voxel centres (what an unjoggled image sample gives): ties are
+  // broken symbolically, so faces and edges of zero size appear, yet every
+  // surface is closed and manifold and encloses exactly its cells.
+  const Labelled in = grid_points(16, 3, 0.0, 0, nested(3));
+  const SurfaceNet before = run(in, opts(3, 0, true, true));
+  check_net(before, in, {0, 1, 2}, {0, 1, 2}, false);
+  const SurfaceNet after = run(in, opts(3, 20, true, true));
+  check_net(after, in, {0, 1, 2}, {0, 1, 2}, true, -1, 0.15);
+  EXPECT_EQ(flipped_faces(before.mesh, after.mesh, 1.0 / 16), 0u);
+}
+
+// ------------------------------------------------------------ selection
+
+TEST(SurfaceNets, SelectionAndOutsideLabels) {
+  Labelled in = grid_points(14, 3, 0.3, 9, nested(3));
+  // Some outside points of their own (negative) label.
+  for (std::size_t i = 0; i < in.labels.size(); i += 97)
+    if (in.labels[i] == 0) in.labels[i] = -5;
+  SurfaceNetsOptions o = opts(3, 0);
+  o.select = {1};
+  // Only label 1: no interface between two selected regions...
+  const SurfaceNet none = run(in, o);
+  EXPECT_EQ(none.mesh.n_faces(), 0u);
+  // ...with capping, its shell against the unselected 0 and 2, and side 0
+  // is always the selected label even where the other is lower (VTK puts
+  // (0, 1) here, notes §6.10).
+  o.capping = true;
+  o.background_label = -9;
+  const SurfaceNet shell = run(in, o);
+  check_net(shell, in, {1}, {1}, false, -9);
+  std::set<std::pair<int, int>> pairs;
+  for (std::size_t f = 0; f < shell.mesh.n_faces(); ++f)
+    pairs.insert({shell.mesh.boundary_labels[2 * f], shell.mesh.boundary_labels[2 * f + 1]});
+  EXPECT_TRUE(pairs.count({1, 0}) && pairs.count({1, 2}));
+  for (auto [a, b] : pairs) EXPECT_EQ(a, 1);
+  // Default selection: every label >= 0; faces against outside points carry -5,
+  // the box -9.
+  o.select = {};
+  const SurfaceNet all = run(in, o);
+  check_net(all, in, {0, 1, 2}, {0, 1, 2}, false, -9);
+  pairs.clear();
+  for (std::size_t f = 0; f < all.mesh.n_faces(); ++f)
+    pairs.insert({all.mesh.boundary_labels[2 * f], all.mesh.boundary_labels[2 * f + 1]});
+  EXPECT_TRUE(pairs.count({0, -5}) && pairs.count({0, -9}));
+  // Smoothing counts unselected and outside labels as regions too.
+  o.select = {0, 2};
+  o.smoothing.iterations = 20;
+  const SurfaceNet two = run(in, o);
+  check_net(two, in, {0, 2}, {0, 2}, true, -9, 0.15);
+}
+
+// ------------------------------------------------------------ 2D
+
+TEST(SurfaceNets, TwoDimensionalCurves) {
+  const Labelled in = grid_points(40, 2, 0.3, 11, nested(2));
+  const SurfaceNet before = run(in, opts(2, 0, true));
+  check_net(before, in, {0, 1, 2}, {0, 1, 2}, false);
+  const SurfaceNet after = run(in, opts(2, 20, true, true));  // triangles: ignored in 2D
+  check_net(after, in, {0, 1, 2}, {0, 1, 2}, true, -1, 0.05);
+  ASSERT_EQ(after.mesh.face_vertices, before.mesh.face_vertices);
+  std::size_t corners = 0;
+  for (std::size_t v = 0; v < after.mesh.n_vertices(); ++v) {
+    ASSERT_NE(after.vertex_kind[v], NetVertexKind::junction);
+    if (after.vertex_kind[v] == NetVertexKind::corner) {
+      ++corners;
+      EXPECT_EQ(displacement(before.mesh, after.mesh, v), 0.0);
+    }
+    EXPECT_LE(displacement(before.mesh, after.mesh, v), 0.5 * petal_radius(before.mesh, in, v) * (1 + 1e-12));
+  }
+  EXPECT_GE(corners, 4u);  // the box corners
+  // Segments keep their direction; lengths approach the circles'.
+  for (std::size_t f = 0; f < after.mesh.n_faces(); ++f) {
+    const auto a = after.mesh.face_vertices[2 * f], b = after.mesh.face_vertices[2 * f + 1];
+    const V3 d0 = sub(vertex(before.mesh, b), vertex(before.mesh, a)), d1 = sub(vertex(after.mesh, b), vertex(after.mesh, a));
+    if (norm(d0) > 0) EXPECT_GT(dot(d0, d1), 0) << "segment " << f;
+  }
+  const auto c0 = region_surface(before.mesh, 2), c1 = region_surface(after.mesh, 2);
+  EXPECT_NEAR(c1.volume, kPi * 0.04, 0.03 * kPi * 0.04);
+  EXPECT_LT(std::fabs(c1.measure - 2 * kPi * 0.2), std::fabs(c0.measure - 2 * kPi * 0.2));
+}
+
+// ------------------------------------------------------------ threads
+
+TEST(SurfaceNets, OneAndTwoThreadsIdentical) {
+  const Labelled in = grid_points(20, 3, 0.3, 12, three_sectors);
+  const SurfaceNet a = run(in, opts(3, 20, true, true, 1));
+  const SurfaceNet b = run(in, opts(3, 20, true, true, 2));
+  ASSERT_EQ(a.mesh.vertices.size(), b.mesh.vertices.size());
+  EXPECT_EQ(std::memcmp(a.mesh.vertices.data(), b.mesh.vertices.data(), a.mesh.vertices.size() * sizeof(double)), 0);
+  EXPECT_EQ(a.mesh.vertex_keys, b.mesh.vertex_keys);
+  EXPECT_EQ(a.mesh.face_offsets, b.mesh.face_offsets);
+  EXPECT_EQ(a.mesh.face_vertices, b.mesh.face_vertices);
+  EXPECT_EQ(a.mesh.boundary_labels, b.mesh.boundary_labels);
+  EXPECT_EQ(a.mesh.sides, b.mesh.sides);
+  EXPECT_EQ(a.vertex_kind, b.vertex_kind);
+  EXPECT_EQ(a.polygon_of_face, b.polygon_of_face);
+  EXPECT_EQ(a.max_displacement, b.max_displacement);
+}
+
+TEST(SurfaceNets, SmoothStepAloneMatchesPipeline) {
+  const Labelled in = grid_points(12, 3, 0.3, 13, touching_boxes);
+  const SurfaceNet net = run(in, opts(3, 20));
+  SurfaceNet raw = run(in, opts(3, 0));
+  double moved = -1;
+  const auto kinds = tessera::smooth_surface_net(raw.mesh, in.points, in.labels, {}, moved);
+  EXPECT_EQ(kinds, net.vertex_kind);
+  EXPECT_EQ(raw.mesh.vertices, net.mesh.vertices);
+  EXPECT_EQ(moved, net.max_displacement);
+}
+
+// ------------------------------------------------------------ bad input
+
+void expect_error(const Labelled& in, const SurfaceNetsOptions& o, const std::string& needle) {
+  try {
+    (void)tessera::surface_nets(in.points, in.labels, o);
+    ADD_FAILURE() << "no error; expected one mentioning '" << needle << "'";
+  } catch (const tessera::InputError& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find(needle), std::string::npos) << msg;
+    EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;
+  }
+}
+
+TEST(SurfaceNets, BadInputGivesOneLineErrors) {
+  const Labelled in = grid_points(6, 3, 0.2, 14, nested(3));
+  SurfaceNetsOptions o = opts(3, 20);
+  Labelled nolabels = in;
+  nolabels.labels.clear();
+  expect_error(nolabels, o, "labels");
+  Labelled short_labels = in;
+  short_labels.labels.pop_back();
+  expect_error(short_labels, o, "labels");
+  o.select = {1, 7};
+  expect_error(in, o, "unknown label 7");
+  o.select = {-1};
+  expect_error(in, o, "negative");
+  o.select = {};
+  Labelled all_outside = in;
+  for (auto& l : all_outside.labels) l = -1;
+  expect_error(all_outside, o, "empty selection");
+  SurfaceNetsOptions b = opts(3, 20);
+  b.background_label = 0;
+  expect_error(in, b, "background label");
+  const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
+  for (int it : {-1}) {
+    SurfaceNetsOptions s = opts(3, it);
+    expect_error(in, s, "iterations");
+  }
+  for (double r : {0.0, -0.5, 1.5, nan}) {
+    SurfaceNetsOptions s = opts(3, 20);
+    s.smoothing.relaxation = r;
+    expect_error(in, s, "relaxation");
+  }
+  for (double c : {-1.0, nan, inf}) {
+    SurfaceNetsOptions s = opts(3, 20);
+    s.smoothing.constraint = c;
+    expect_error(in, s, "constraint");
+  }
+  SurfaceNetsOptions d = opts(3, 20);
+  d.voronoi.dim = 4;
+  expect_error(in, d, "dim");
+}
+
+}  // namespace
