@@ -18,7 +18,7 @@
 #include "commands.hpp"
 #include "progress.hpp"
 #include "tessera/io/atomic_file.hpp"
-#include "tessera/io/vtk_polydata.hpp"
+#include "tessera/io/dual.hpp"
 #include "tessera/surface_nets.hpp"
 
 namespace tessera::cli {
@@ -211,25 +211,6 @@ Watertight check_watertight(const SurfaceNet& net) {
 
 // ------------------------------------------------------------------ output
 
-void write_net_vtp(const std::string& path, const SurfaceNet& net) {
-  const FaceSet& fs = net.mesh;
-  static_assert(sizeof(SpokeClass) == 1 && sizeof(NetVertexKind) == 1);
-  const std::span<const std::uint8_t> cls(reinterpret_cast<const std::uint8_t*>(fs.face_class.data()),
-                                          fs.face_class.size());
-  const std::span<const std::uint8_t> kind(reinterpret_cast<const std::uint8_t*>(net.vertex_kind.data()),
-                                           net.vertex_kind.size());
-  io::PolyData pd;
-  pd.dim = fs.dim;
-  pd.points = fs.vertices;
-  (fs.dim == 3 ? pd.polys : pd.lines) = {fs.face_offsets, fs.face_vertices};
-  pd.point_data.push_back({"VertexKind", kind});
-  pd.cell_data.push_back({"BoundaryLabels", std::span<const std::int32_t>(fs.boundary_labels), 2});
-  pd.cell_data.push_back({"Sides", std::span<const std::int32_t>(fs.sides), 2});
-  pd.cell_data.push_back({"SpokeClass", cls});
-  pd.cell_data.push_back({"PolygonId", std::span<const std::int64_t>(net.polygon_of_face)});
-  io::write_polydata(path, pd);
-}
-
 std::string label_list(const std::vector<std::int32_t>& l, std::size_t max = 12) {
   std::string s;
   for (std::size_t i = 0; i < l.size() && i < max; ++i) s += (i ? "," : "") + std::to_string(l[i]);
@@ -321,7 +302,7 @@ int run_surface_nets(const SurfaceNetsArgs& a) {
   const NetInput in = read_net_input(a);
   const SurfaceNet net = run_pipeline(in, net_options(a, in), !a.quiet && stderr_is_terminal());
   auto t0 = Clock::now();
-  write_net_vtp(a.output, net);
+  io::write_surface_net_vtp(a.output, net);
   const double write_s = seconds_since(t0);
   if (a.quiet) return kExitOk;
 

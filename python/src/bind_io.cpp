@@ -100,24 +100,7 @@ void bind_io(py::module_& m) {
   m.def(
       "write_surface_net_vtp",
       [](const std::string& path, const SurfaceNet& net) {
-        // The face set's file (io::write_faces_vtp: BoundaryLabels, Sides,
-        // SpokeClass), plus the vertex kinds and, per face, its polygon.
-        const FaceSet& fs = net.mesh;
-        static_assert(sizeof(SpokeClass) == 1 && sizeof(NetVertexKind) == 1);
-        const std::span<const std::uint8_t> cls(reinterpret_cast<const std::uint8_t*>(fs.face_class.data()),
-                                                fs.face_class.size());
-        const std::span<const std::uint8_t> kind(reinterpret_cast<const std::uint8_t*>(net.vertex_kind.data()),
-                                                 net.vertex_kind.size());
-        io::PolyData pd;
-        pd.dim = fs.dim;
-        pd.points = fs.vertices;
-        (fs.dim == 3 ? pd.polys : pd.lines) = {fs.face_offsets, fs.face_vertices};
-        pd.point_data.push_back({"VertexKind", kind});
-        pd.cell_data.push_back({"BoundaryLabels", std::span<const std::int32_t>(fs.boundary_labels), 2});
-        pd.cell_data.push_back({"Sides", std::span<const std::int32_t>(fs.sides), 2});
-        pd.cell_data.push_back({"SpokeClass", cls});
-        pd.cell_data.push_back({"PolygonId", std::span<const std::int64_t>(net.polygon_of_face)});
-        write_or_oserror([&] { io::write_polydata(path, pd); });
+        write_or_oserror([&] { io::write_surface_net_vtp(path, net); });
       },
       py::arg("path"), py::arg("net"),
       "Write a surface net as .vtp: the face set's cell data plus VertexKind (point data) and PolygonId.");

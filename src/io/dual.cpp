@@ -83,6 +83,23 @@ void write_faces_vtp(const std::string& path, const FaceSet& fs) {
   write_polydata(path, pd);
 }
 
+void write_surface_net_vtp(const std::string& path, const SurfaceNet& net) {
+  const FaceSet& fs = net.mesh;
+  static_assert(sizeof(NetVertexKind) == 1);
+  PolyData pd;
+  pd.dim = fs.dim;
+  pd.points = fs.vertices;
+  (fs.dim == 3 ? pd.polys : pd.lines) = {fs.face_offsets, fs.face_vertices};
+  pd.point_data.push_back({"VertexKind", std::span<const std::uint8_t>(
+                                             reinterpret_cast<const std::uint8_t*>(net.vertex_kind.data()),
+                                             net.vertex_kind.size())});
+  pd.cell_data.push_back({"BoundaryLabels", std::span<const std::int32_t>(fs.boundary_labels), 2});
+  pd.cell_data.push_back({"Sides", std::span<const std::int32_t>(fs.sides), 2});
+  pd.cell_data.push_back({"SpokeClass", class_bytes(fs.face_class)});
+  pd.cell_data.push_back({"PolygonId", std::span<const std::int64_t>(net.polygon_of_face)});
+  write_polydata(path, pd);
+}
+
 // ------------------------------------------------------------------ flowers
 
 namespace {

@@ -11,6 +11,7 @@
 #include "tessera/faces.hpp"
 #include "tessera/flower.hpp"
 #include "tessera/graph.hpp"
+#include "tessera/surface_nets.hpp"
 
 namespace tessera::io {
 
@@ -34,6 +35,11 @@ void write_spoke_classes_npy(const std::string& path, const AdjacencyGraph& grap
 /// (Int32, 2 components: side 0's generator, side 1's generator or negative
 /// box-plane id) and SpokeClass (UInt8). Conventions: include/tessera/faces.hpp.
 void write_faces_vtp(const std::string& path, const FaceSet& faces);
+
+/// A surface net: the face set's file (above) plus point data VertexKind
+/// (UInt8: 0 surface, 1 junction, 2 corner) and cell data PolygonId (Int64:
+/// the Voronoi face each output face came from).
+void write_surface_net_vtp(const std::string& path, const SurfaceNet& net);
 
 /// Roles of the points and cells in a flower file (point and cell data "Role").
 enum class FlowerRole : std::uint8_t {
