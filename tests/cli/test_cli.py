@@ -114,6 +114,58 @@ def load_neighbors(path):
     ids = a[n + 2:]
     return n, off, ids
 
+def cells_of(cell_array_obj):
+    """Connectivity of a vtkCellArray as a list of id arrays."""
+    conn = vtk_to_numpy(cell_array_obj.GetConnectivityArray())
+    offs = vtk_to_numpy(cell_array_obj.GetOffsetsArray())
+    return [conn[offs[i]:offs[i + 1]] for i in range(len(offs) - 1)]
+
+
+def read_ply(path):
+    """Vertex properties of a binary little-endian .ply as a numpy structured array."""
+    data = read_bytes(path)
+    end = data.index(b"end_header\n") + len(b"end_header\n")
+    header = data[:end].decode().splitlines()
+    assert header[1] == "format binary_little_endian 1.0", header[1]
+    types = {"double": "<f8", "float": "<f4", "int": "<i4", "uchar": "u1"}
+    fields, n = [], None
+    for line in header:
+        w = line.split()
+        if w[:2] == ["element", "vertex"]:
+            n = int(w[2])
+        elif w[0] == "property":
+            fields.append((w[2], types[w[1]]))
+    arr = np.frombuffer(data[end:], dtype=np.dtype(fields))
+    assert len(arr) == n, (len(arr), n)
+    return arr
+
+
+def cli_main(script, requirements=(), bind=None):
+    """The main() of every tests/cli script: argv[1] is the tessera binary, the
+    rest goes to unittest. `requirements` are (available, message) pairs
+    checked first; `bind(path)` hands the binary to a script with its own run().
+    Prints "N passed, M failed, K skipped" last; returns the exit status."""
+    global TESSERA
+    if len(sys.argv) < 2:
+        print("usage: %s PATH_TO_tessera [unittest args]" % script, file=sys.stderr)
+        return 2
+    TESSERA = os.path.abspath(sys.argv[1])
+    if not os.access(TESSERA, os.X_OK):
+        print("not an executable: %s" % TESSERA, file=sys.stderr)
+        return 2
+    for available, message in requirements:
+        if not available:
+            print(message, file=sys.stderr)
+            return 2
+    if bind:
+        bind(TESSERA)
+    argv = [sys.argv[0]] + sys.argv[2:]
+    res = unittest.main(module="__main__", argv=argv, exit=False, verbosity=2).result
+    failed = len(res.failures) + len(res.errors) + len(res.unexpectedSuccesses)
+    passed = res.testsRun - failed - len(res.skipped)
+    print("%d passed, %d failed, %d skipped" % (passed, failed, len(res.skipped)))
+    return 0 if failed == 0 else 1
+
 
 class TempDirCase(unittest.TestCase):
     def setUp(self):
@@ -605,24 +657,7 @@ class BadInput(TempDirCase):
 
 
 def main():
-    global TESSERA
-    if len(sys.argv) < 2:
-        print("usage: test_cli.py PATH_TO_tessera [unittest args]", file=sys.stderr)
-        return 2
-    TESSERA = os.path.abspath(sys.argv[1])
-    if not os.access(TESSERA, os.X_OK):
-        print("not an executable: %s" % TESSERA, file=sys.stderr)
-        return 2
-    if vtk is None:
-        print("python3-vtk9 is required (run with /usr/bin/python3)", file=sys.stderr)
-        return 2
-    argv = [sys.argv[0]] + sys.argv[2:]
-    prog = unittest.main(argv=argv, exit=False, verbosity=2)
-    res = prog.result
-    failed = len(res.failures) + len(res.errors) + len(res.unexpectedSuccesses)
-    passed = res.testsRun - failed - len(res.skipped)
-    print("%d passed, %d failed, %d skipped" % (passed, failed, len(res.skipped)))
-    return 0 if failed == 0 else 1
+    return cli_main("test_cli.py", [(vtk is not None, "python3-vtk9 is required (run with /usr/bin/python3)")])
 
 
 if __name__ == "__main__":

@@ -20,6 +20,9 @@ import vtk
 from scipy.spatial import Delaunay as ScipyDelaunay
 from vtk.util.numpy_support import vtk_to_numpy
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import test_cli  # noqa: E402  (the shared main() only)
+
 TESSERA = None
 
 
@@ -163,14 +166,10 @@ class DelaunayCommand(unittest.TestCase):
 
 
 def main():
-    global TESSERA
-    TESSERA = os.path.abspath(sys.argv[1])
-    prog = unittest.main(argv=[sys.argv[0]] + sys.argv[2:], exit=False, verbosity=2)
-    res = prog.result
-    failed = len(res.failures) + len(res.errors) + len(res.unexpectedSuccesses)
-    passed = res.testsRun - failed - len(res.skipped)
-    print("%d passed, %d failed, %d skipped" % (passed, failed, len(res.skipped)))
-    return 0 if failed == 0 else 1
+    def bind(path):
+        global TESSERA
+        TESSERA = path
+    return test_cli.cli_main("test_delaunay_cli.py", bind=bind)
 
 
 if __name__ == "__main__":

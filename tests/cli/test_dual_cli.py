@@ -14,14 +14,13 @@ Prints "N passed, M failed" last; exits 1 if anything failed.
 """
 import os
 import sys
-import unittest
 from collections import Counter
 
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import test_cli as base  # noqa: E402  (helpers only; its test classes are not collected here)
-from test_cli import read_bytes, read_vtp, cell_array  # noqa: E402
+from test_cli import read_bytes, read_vtp, cell_array, cells_of  # noqa: E402
 
 try:
     from scipy.spatial import Delaunay
@@ -34,13 +33,6 @@ run = base.run
 BOX3 = base.BOX3
 BOX2 = base.BOX2
 SAME, REGION, DOMAIN, OUTSIDE = 0, 1, 2, 3
-
-
-def cells_of(cell_array_obj):
-    """Connectivity of a vtkCellArray as a list of id arrays."""
-    conn = vtk_to_numpy(cell_array_obj.GetConnectivityArray())
-    offs = vtk_to_numpy(cell_array_obj.GetOffsetsArray())
-    return [conn[offs[i]:offs[i + 1]] for i in range(len(offs) - 1)]
 
 
 def load_csr(path):
@@ -389,23 +381,8 @@ class BadDualInput(base.TempDirCase):
 
 
 def main():
-    if len(sys.argv) < 2:
-        print("usage: test_dual_cli.py PATH_TO_tessera [unittest args]", file=sys.stderr)
-        return 2
-    base.TESSERA = os.path.abspath(sys.argv[1])
-    if not os.access(base.TESSERA, os.X_OK):
-        print("not an executable: %s" % base.TESSERA, file=sys.stderr)
-        return 2
-    if base.vtk is None or Delaunay is None:
-        print("python3-vtk9 and python3-scipy are required (run with /usr/bin/python3)", file=sys.stderr)
-        return 2
-    argv = [sys.argv[0]] + sys.argv[2:]
-    prog = unittest.main(argv=argv, exit=False, verbosity=2)
-    res = prog.result
-    failed = len(res.failures) + len(res.errors) + len(res.unexpectedSuccesses)
-    passed = res.testsRun - failed - len(res.skipped)
-    print("%d passed, %d failed, %d skipped" % (passed, failed, len(res.skipped)))
-    return 0 if failed == 0 else 1
+    return base.cli_main("test_dual_cli.py", [(base.vtk is not None and Delaunay is not None,
+                                               "python3-vtk9 and python3-scipy are required (run with /usr/bin/python3)")])
 
 
 if __name__ == "__main__":

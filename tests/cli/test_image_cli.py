@@ -15,13 +15,12 @@ Prints "N passed, M failed" last; exits 1 if anything failed.
 import gzip
 import os
 import sys
-import unittest
 
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import test_cli as base  # noqa: E402  (helpers only)
-from test_cli import read_bytes, read_vtp  # noqa: E402
+from test_cli import read_bytes, read_vtp, read_ply  # noqa: E402
 
 try:
     from scipy.ndimage import distance_transform_cdt
@@ -114,25 +113,6 @@ def write_nrrd(path, arr):
         f.write(head.encode() + gzip.compress(arr.astype("<i2").tobytes()))
 
 
-def read_ply(path):
-    """(points (n, 3), {property: values}) of a binary little-endian .ply."""
-    data = read_bytes(path)
-    end = data.index(b"end_header\n") + len(b"end_header\n")
-    header = data[:end].decode().splitlines()
-    assert header[1] == "format binary_little_endian 1.0", header[1]
-    types = {"double": "<f8", "float": "<f4", "int": "<i4", "uchar": "u1"}
-    fields, n = [], 0
-    for line in header:
-        w = line.split()
-        if w[:2] == ["element", "vertex"]:
-            n = int(w[2])
-        elif w[0] == "property":
-            fields.append((w[2], types[w[1]]))
-    rec = np.frombuffer(data[end:], dtype=np.dtype(fields), count=n)
-    pts = np.stack([rec["x"], rec["y"], rec["z"]], axis=1)
-    return pts, {name: rec[name] for name, _ in fields}
-
-
 class SampleImage(base.TempDirCase):
     def setUp(self):
         super().setUp()
@@ -182,7 +162,8 @@ class SampleImage(base.TempDirCase):
         for out in (npy, ply, vtp):
             self.sample(self.vti, out, "--seed", "3")
         pts, labels = np.load(npy), np.load(self.p("a_labels.npy"))
-        ppts, props = read_ply(ply)
+        props = read_ply(ply)
+        ppts = np.stack([props["x"], props["y"], props["z"]], axis=1)
         np.testing.assert_array_equal(ppts, pts)
         np.testing.assert_array_equal(props["label"], labels)
         poly = read_vtp(vtp)
@@ -328,22 +309,8 @@ class BadImageInput(base.TempDirCase):
 
 
 def main():
-    if len(sys.argv) < 2:
-        print("usage: test_image_cli.py PATH_TO_tessera [unittest args]", file=sys.stderr)
-        return 2
-    base.TESSERA = os.path.abspath(sys.argv[1])
-    if not os.access(base.TESSERA, os.X_OK):
-        print("not an executable: %s" % base.TESSERA, file=sys.stderr)
-        return 2
-    if base.vtk is None or distance_transform_cdt is None:
-        print("python3-vtk9 and python3-scipy are required (run with /usr/bin/python3)", file=sys.stderr)
-        return 2
-    argv = [sys.argv[0]] + sys.argv[2:]
-    res = unittest.main(argv=argv, exit=False, verbosity=2).result
-    failed = len(res.failures) + len(res.errors) + len(res.unexpectedSuccesses)
-    passed = res.testsRun - failed - len(res.skipped)
-    print("%d passed, %d failed, %d skipped" % (passed, failed, len(res.skipped)))
-    return 0 if failed == 0 else 1
+    return base.cli_main("test_image_cli.py", [(base.vtk is not None and distance_transform_cdt is not None,
+                                                "python3-vtk9 and python3-scipy are required (run with /usr/bin/python3)")])
 
 
 if __name__ == "__main__":

@@ -12,38 +12,16 @@ Prints "N passed, M failed" last; exits 1 if anything failed.
 """
 import os
 import sys
-import unittest
 
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import test_cli as base  # noqa: E402  (helpers only; its test classes are not collected here)
-from test_cli import read_vtp, read_bytes  # noqa: E402
+from test_cli import read_vtp, read_bytes, read_ply  # noqa: E402
 
 from vtk.util.numpy_support import vtk_to_numpy  # noqa: E402
 
 run = base.run
-
-
-def read_ply(path):
-    """Vertex properties of a binary little-endian .ply as a numpy structured array."""
-    data = read_bytes(path)
-    end = data.index(b"end_header\n") + len(b"end_header\n")
-    header = data[:end].decode().splitlines()
-    assert header[1] == "format binary_little_endian 1.0", header[1]
-    n = None
-    fields = []
-    types = {"double": "<f8", "int": "<i4"}
-    for line in header:
-        w = line.split()
-        if w[0] == "element":
-            assert w[1] == "vertex"
-            n = int(w[2])
-        elif w[0] == "property":
-            fields.append((w[2], types[w[1]]))
-    arr = np.frombuffer(data[end:], dtype=np.dtype(fields))
-    assert len(arr) == n, (len(arr), n)
-    return arr
 
 
 class Case(base.TempDirCase):
@@ -234,23 +212,7 @@ class Threshold(Case):
 
 
 def main():
-    if len(sys.argv) < 2:
-        print("usage: test_prep_cli.py PATH_TO_tessera [unittest args]", file=sys.stderr)
-        return 2
-    base.TESSERA = os.path.abspath(sys.argv[1])
-    if not os.access(base.TESSERA, os.X_OK):
-        print("not an executable: %s" % base.TESSERA, file=sys.stderr)
-        return 2
-    if base.vtk is None:
-        print("python3-vtk9 is required (run with /usr/bin/python3)", file=sys.stderr)
-        return 2
-    argv = [sys.argv[0]] + sys.argv[2:]
-    prog = unittest.main(argv=argv, exit=False, verbosity=2)
-    res = prog.result
-    failed = len(res.failures) + len(res.errors) + len(res.unexpectedSuccesses)
-    passed = res.testsRun - failed - len(res.skipped)
-    print("%d passed, %d failed, %d skipped" % (passed, failed, len(res.skipped)))
-    return 0 if failed == 0 else 1
+    return base.cli_main("test_prep_cli.py", [(base.vtk is not None, "python3-vtk9 is required (run with /usr/bin/python3)")])
 
 
 if __name__ == "__main__":

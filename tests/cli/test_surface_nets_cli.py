@@ -17,24 +17,17 @@ Prints "N passed, M failed" last; exits 1 if anything failed.
 import json
 import os
 import sys
-import unittest
 from collections import Counter
 
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import test_cli as base  # noqa: E402  (helpers only; its test classes are not collected here)
-from test_cli import read_bytes, read_vtp, cell_array  # noqa: E402
+from test_cli import read_bytes, read_vtp, cell_array, cells_of  # noqa: E402
 
 from vtk.util.numpy_support import vtk_to_numpy, numpy_to_vtk  # noqa: E402
 
 run = base.run
-
-
-def cells_of(cell_array_obj):
-    conn = vtk_to_numpy(cell_array_obj.GetConnectivityArray())
-    offs = vtk_to_numpy(cell_array_obj.GetOffsetsArray())
-    return [conn[offs[i]:offs[i + 1]] for i in range(len(offs) - 1)]
 
 
 def load_net(path):
@@ -293,23 +286,7 @@ class SurfaceNetsBadInput(base.TempDirCase):
 
 
 def main():
-    if len(sys.argv) < 2:
-        print("usage: test_surface_nets_cli.py PATH_TO_tessera [unittest args]", file=sys.stderr)
-        return 2
-    base.TESSERA = os.path.abspath(sys.argv[1])
-    if not os.access(base.TESSERA, os.X_OK):
-        print("not an executable: %s" % base.TESSERA, file=sys.stderr)
-        return 2
-    if base.vtk is None:
-        print("python3-vtk9 is required (run with /usr/bin/python3)", file=sys.stderr)
-        return 2
-    argv = [sys.argv[0]] + sys.argv[2:]
-    prog = unittest.main(argv=argv, exit=False, verbosity=2)
-    res = prog.result
-    failed = len(res.failures) + len(res.errors) + len(res.unexpectedSuccesses)
-    passed = res.testsRun - failed - len(res.skipped)
-    print("%d passed, %d failed, %d skipped" % (passed, failed, len(res.skipped)))
-    return 0 if failed == 0 else 1
+    return base.cli_main("test_surface_nets_cli.py", [(base.vtk is not None, "python3-vtk9 is required (run with /usr/bin/python3)")])
 
 
 if __name__ == "__main__":
