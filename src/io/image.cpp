@@ -253,15 +253,6 @@ namespace {
 using detail::RawImage;
 using detail::ScalarType;
 
-template <class T>
-T load(const char* p, bool swap) {
-  unsigned char b[sizeof(T)];
-  std::memcpy(b, p, sizeof(T));
-  if (swap) std::reverse(b, b + sizeof(T));
-  T v;
-  std::memcpy(&v, b, sizeof(T));
-  return v;
-}
 
 /// Calls f(value) for every voxel of `raw` (decoded bytes), as type T.
 template <class T, class F>
@@ -269,7 +260,7 @@ void each_value(const RawImage& raw, F&& f) {
   const bool swap = sizeof(T) > 1 && raw.big_endian != (std::endian::native == std::endian::big);
   const char* p = raw.bytes.data();
   const std::size_t n = raw.bytes.size() / sizeof(T);
-  for (std::size_t k = 0; k < n; ++k) f(k, load<T>(p + k * sizeof(T), swap));
+  for (std::size_t k = 0; k < n; ++k) f(k, detail::load_item<T>(p + k * sizeof(T), swap));
 }
 
 template <class F>

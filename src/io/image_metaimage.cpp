@@ -32,12 +32,6 @@
 namespace tessera::io::detail {
 namespace {
 
-std::string lower(std::string_view s) {
-  std::string r(s);
-  for (char& c : r) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return r;
-}
-
 bool met_type(const std::string& name, ScalarType& t) {
   static const std::map<std::string, ScalarType> types = {
       {"MET_CHAR", ScalarType::i8},        {"MET_UCHAR", ScalarType::u8},      {"MET_SHORT", ScalarType::i16},

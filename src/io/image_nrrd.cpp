@@ -35,12 +35,6 @@
 namespace tessera::io::detail {
 namespace {
 
-std::string lower(std::string_view s) {
-  std::string r(s);
-  for (char& c : r) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return r;
-}
-
 /// NRRD type names (all the spellings the format allows).
 bool nrrd_type(const std::string& name, ScalarType& t) {
   static const std::map<std::string, ScalarType> types = {

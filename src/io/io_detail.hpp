@@ -1,6 +1,9 @@
 // Private helpers shared by the IO readers and writers (not installed).
 #pragma once
 
+#include <algorithm>
+#include <cctype>
+#include <cstring>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -21,6 +24,25 @@ std::string read_file_bytes(const std::string& path);
 /// Throws InputError("cannot open PATH: reason") unless `path` names an
 /// existing file that is not a directory. Used before opening a file.
 void check_readable(const std::string& path);
+
+/// `s` in lower case (ASCII).
+inline std::string lower(std::string_view s) {
+  std::string r(s);
+  for (char& c : r) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return r;
+}
+
+/// The item of type T stored at `p` (any alignment), byte-swapped when the
+/// file's byte order is not ours.
+template <class T>
+T load_item(const void* p, bool swap) {
+  unsigned char b[sizeof(T)];
+  std::memcpy(b, p, sizeof(T));
+  if (swap) std::reverse(b, b + sizeof(T));
+  T v;
+  std::memcpy(&v, b, sizeof(T));
+  return v;
+}
 
 /// The extension of `path`, lowercased, with its dot ("" when there is none).
 std::string lower_extension(const std::string& path);

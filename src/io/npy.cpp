@@ -225,15 +225,6 @@ File open_npy(const std::string& path, Header& h) {
   return f;
 }
 
-template <class T>
-T load(const unsigned char* p, bool swap) {
-  unsigned char b[sizeof(T)];
-  std::memcpy(b, p, sizeof(T));
-  if (swap) std::reverse(b, b + sizeof(T));
-  T v;
-  std::memcpy(&v, b, sizeof(T));
-  return v;
-}
 
 /// Reverse the bytes of each of `n` items of `size` bytes at `data`.
 void byteswap_in_place(void* data, std::size_t n, std::size_t size) {
@@ -249,7 +240,7 @@ void convert(const std::string& path, const Header& h, const unsigned char* src,
   const int sz = h.item_size;
   auto each = [&](auto tag) {
     using T = decltype(tag);
-    for (std::size_t k = 0; k < n; ++k) dst[k] = static_cast<Out>(load<T>(src + k * sz, swap));
+    for (std::size_t k = 0; k < n; ++k) dst[k] = static_cast<Out>(detail::load_item<T>(src + k * sz, swap));
   };
   switch (h.kind) {
     case 'f':
@@ -277,7 +268,7 @@ void convert(const std::string& path, const Header& h, const unsigned char* src,
         each(std::uint32_t{});
       else {
         for (std::size_t k = 0; k < n; ++k) {
-          auto v = load<std::uint64_t>(src + k * sz, swap);
+          auto v = detail::load_item<std::uint64_t>(src + k * sz, swap);
           if constexpr (std::is_integral_v<Out>) {
             if (v > static_cast<std::uint64_t>(std::numeric_limits<std::int64_t>::max()))
               detail::fail(path, "uint64 value " + std::to_string(v) + " does not fit in int64");

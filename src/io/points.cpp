@@ -70,9 +70,7 @@ std::string read_file_bytes(const std::string& path) {
 }
 
 std::string lower_extension(const std::string& path) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return ext;
+  return lower(std::filesystem::path(path).extension().string());
 }
 
 }  // namespace detail

@@ -132,6 +132,49 @@ std::string quoted_list(const std::vector<std::string>& names) {
   return s;
 }
 
+/// The layout read off a text file's first content line: delimiter (',', ';'
+/// or whitespace), whether it is a header (some field is not a number), the
+/// column names (quotes stripped; empty without a header) and the count.
+struct TextLayout {
+  char delim = ' ';
+  bool header = false;
+  std::vector<std::string> names;
+  std::size_t ncols = 0;
+};
+
+TextLayout text_layout(std::string_view line) {
+  TextLayout t;
+  t.delim = line.find(',') != std::string_view::npos   ? ','
+            : line.find(';') != std::string_view::npos ? ';'
+                                                       : ' ';
+  std::vector<std::string_view> first;
+  Fields fs(line, t.delim);
+  std::string_view f;
+  while (fs.next(f)) first.push_back(f);
+  for (std::string_view g : first) {
+    double v;
+    if (!g.empty() && !parse_double(g, v)) t.header = true;
+  }
+  if (t.header) {
+    for (std::string_view g : first) {
+      if (g.size() >= 2 && (g.front() == '"' || g.front() == '\'') && g.back() == g.front())
+        g = g.substr(1, g.size() - 2);
+      t.names.emplace_back(g);
+    }
+  }
+  t.ncols = first.size();
+  return t;
+}
+
+/// Index of the header column `name`, `what` naming its use in errors.
+std::size_t find_column(const std::string& path, const TextLayout& t, const std::string& name,
+                        const std::string& what) {
+  if (!t.header) fail(path, what + " '" + name + "': the file has no header line naming its columns");
+  auto it = std::find(t.names.begin(), t.names.end(), name);
+  if (it == t.names.end()) fail(path, "no column '" + name + "' for " + what + " (columns: " + quoted_list(t.names) + ")");
+  return static_cast<std::size_t>(it - t.names.begin());
+}
+
 }  // namespace
 
 PointCloud read_text_points(const std::string& path, const ReadOptions& options,
@@ -143,39 +186,14 @@ PointCloud read_text_points(const std::string& path, const ReadOptions& options,
   if (!lines.next(line, line_no)) fail(path, "no points");
 
   // Layout from the first content line: delimiter, header, column count.
-  const char delim = line.find(',') != std::string_view::npos   ? ','
-                     : line.find(';') != std::string_view::npos ? ';'
-                                                                : ' ';
-  std::vector<std::string_view> first;
-  {
-    Fields fs(line, delim);
-    std::string_view f;
-    while (fs.next(f)) first.push_back(f);
-  }
-  bool header = false;
-  for (std::string_view f : first) {
-    double v;
-    if (!f.empty() && !parse_double(f, v)) header = true;
-  }
-  std::vector<std::string> names;
-  if (header) {
-    for (std::string_view f : first) {
-      if (f.size() >= 2 && (f.front() == '"' || f.front() == '\'') && f.back() == f.front())
-        f = f.substr(1, f.size() - 2);
-      names.emplace_back(f);
-    }
-  }
-  const std::size_t ncols = first.size();
+  const TextLayout layout = text_layout(line);
+  const char delim = layout.delim;
+  const bool header = layout.header;
+  const std::size_t ncols = layout.ncols;
 
   // Which column holds labels, if any.
   std::size_t label_col = ncols;  // ncols = none
-  if (!label_column.empty()) {
-    if (!header) fail(path, "labels '" + label_column + "': the file has no header line naming its columns");
-    auto it = std::find(names.begin(), names.end(), label_column);
-    if (it == names.end())
-      fail(path, "no column '" + label_column + "' for labels (columns: " + quoted_list(names) + ")");
-    label_col = static_cast<std::size_t>(it - names.begin());
-  }
+  if (!label_column.empty()) label_col = find_column(path, layout, label_column, "labels");
 
   // Coordinate columns: the first `dim` columns other than the labels column.
   const std::size_t avail = ncols - (label_col < ncols ? 1 : 0);
@@ -247,27 +265,10 @@ std::vector<double> read_text_column(const std::string& path, const std::string&
   std::string_view line;
   std::size_t line_no = 0;
   if (!lines.next(line, line_no)) fail(path, "no points");
-  const char delim = line.find(',') != std::string_view::npos   ? ','
-                     : line.find(';') != std::string_view::npos ? ';'
-                                                                : ' ';
   // The first content line must be a header naming the column.
-  std::vector<std::string> names;
-  bool header = false;
-  {
-    Fields fs(line, delim);
-    std::string_view f;
-    while (fs.next(f)) {
-      double v;
-      if (!f.empty() && !parse_double(f, v)) header = true;
-      if (f.size() >= 2 && (f.front() == '"' || f.front() == '\'') && f.back() == f.front())
-        f = f.substr(1, f.size() - 2);
-      names.emplace_back(f);
-    }
-  }
-  if (!header) fail(path, "column '" + name + "': the file has no header line naming its columns");
-  auto it = std::find(names.begin(), names.end(), name);
-  if (it == names.end()) fail(path, "no column '" + name + "' (columns: " + quoted_list(names) + ")");
-  const auto col = static_cast<std::size_t>(it - names.begin());
+  const TextLayout layout = text_layout(line);
+  const char delim = layout.delim;
+  const std::size_t col = find_column(path, layout, name, "scalars");
 
   std::vector<double> values;
   while (lines.next(line, line_no)) {
