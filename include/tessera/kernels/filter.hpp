@@ -15,9 +15,11 @@
 // exactly and rounded, so every vertex position is accurate.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <limits>
 #include <vector>
 
@@ -35,55 +37,150 @@ inline constexpr double abs_eps = 0x1p-900;
 /// for geometry (volumes, merged coordinates): the vertex is solved exactly.
 inline constexpr double exact_vertex_condition = 1e6;
 
+/// The vertices' filter data (y, e, r2 of each vertex, as in `classify`) kept
+/// as structure-of-arrays beside the cell's own vertex list, so the sign pass
+/// reads contiguous doubles and runs in SIMD lanes. Slots from size() up to
+/// the next multiple of `lanes` always hold padding (r2 = -1), which the
+/// radius test of `classify` never lets through, so the pass needs no tail.
+template <int D>
+class FilterLanes {
+ public:
+  static constexpr std::size_t lanes = 4;
+
+  std::size_t size() const { return n_; }
+  /// size() rounded up to whole lanes: the extent `classify` reads.
+  std::size_t padded() const { return (n_ + lanes - 1) / lanes * lanes; }
+
+  void clear() { resize(0); }
+  template <class Vertex>
+  void push_back(const Vertex& v) {
+    grow(n_ + 1);
+    put(n_++, v);
+    pad();
+  }
+  template <class Vertex>
+  void set(std::size_t t, const Vertex& v) { put(t, v); }
+  /// Replace the contents by the vertices of `vs`.
+  template <class Vertices>
+  void assign(const Vertices& vs) {
+    grow(vs.size());
+    n_ = vs.size();
+    for (std::size_t t = 0; t < n_; ++t) put(t, vs[t]);
+    pad();
+  }
+  /// Keep the first n slots (n <= size()).
+  void resize(std::size_t n) {
+    grow(n);
+    n_ = n;
+    pad();
+  }
+
+  const double* y(int k) const { return y_[k].data(); }
+  const double* e() const { return e_.data(); }
+  const double* r2() const { return r2_.data(); }
+
+ private:
+  template <class Vertex>
+  void put(std::size_t t, const Vertex& v) {
+    for (int k = 0; k < D; ++k) y_[k][t] = v.y[k];
+    e_[t] = v.e;
+    r2_[t] = v.r2;
+  }
+  void grow(std::size_t n) {
+    const std::size_t need = (n + lanes - 1) / lanes * lanes + lanes;
+    if (r2_.size() >= need) return;
+    const std::size_t cap = std::max(need, 2 * r2_.size());
+    for (int k = 0; k < D; ++k) y_[k].resize(cap, 0.0);
+    e_.resize(cap, 0.0);
+    r2_.resize(cap, -1.0);
+  }
+  void pad() {
+    for (std::size_t t = n_; t < padded(); ++t) {
+      for (int k = 0; k < D; ++k) y_[k][t] = 0;
+      e_[t] = 0;
+      r2_[t] = -1;
+    }
+  }
+
+  std::size_t n_ = 0;
+  std::vector<double> y_[D], e_, r2_;
+};
+
+namespace detail {
+// Two lanes of doubles in GCC's vector extension: one SSE2 register, the
+// default x86-64-v2 target's width. Comparisons yield 0 / -1 per lane.
+using Lane = double __attribute__((vector_size(16)));
+using LaneMask = std::int64_t __attribute__((vector_size(16)));
+inline Lane load(const double* p) {
+  Lane v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+}  // namespace detail
+
 /// The sign pass every clip starts with, shared by the 2D tile and the 3D hull.
 ///
 /// Vertices carry y[D] (relative to the generator), e = err + plane_eps*|y|_inf
-/// and r2 (an upper bound on the exact |y|^2). The plane is n.y <= d with
-/// |n|_1 = n1, d = |q|^2/2. Fills `sign` with +1 (keep) / -1 (remove), asking
-/// `exact(vertex)` only where the filter cannot decide, and returns the number
-/// removed. A vertex no farther than |q|/2 from the generator cannot be cut:
-/// q.y <= |q||y| <= |q|^2/2 (equality would need y = q/2 exactly, which the
-/// strict margin excludes). Candidates usually fail to clip; a first pass over
-/// the far vertices only proves that, and then `sign` is left untouched.
-template <int D, class Vertex, class Exact>
-std::size_t classify(const std::vector<Vertex>& verts, const double* n, double d, double n1,
+/// and r2 (an upper bound on the exact |y|^2), read from `f`. The plane is
+/// n.y <= d with |n|_1 = n1, d = |q|^2/2. Fills `sign` (padded() entries) with
+/// +1 (keep) / -1 (remove), asking `exact(vertex index)` only where the filter
+/// cannot decide, and returns the number removed. A vertex no farther than
+/// |q|/2 from the generator cannot be cut: q.y <= |q||y| <= |q|^2/2 (equality
+/// would need y = q/2 exactly, which the strict margin excludes). Candidates
+/// usually fail to clip; a first pass only proves that, a lane group at a
+/// time, and then `sign` is left untouched. Both passes work on four lanes at a
+/// time; the arithmetic is the same, term for term, as a scalar loop's (no
+/// contraction), so the signs do not depend on the vector width.
+
+template <int D, class Exact>
+std::size_t classify(const FilterLanes<D>& f, const double* n, double d, double n1,
                      std::vector<std::int8_t>& sign, Exact&& exact) {
-  const std::size_t nv = verts.size();
+  static_assert(FilterLanes<D>::lanes == 4, "two detail::Lanes per lane group");
+  using detail::Lane;
+  using detail::LaneMask;
+  const std::size_t nv = f.size(), np = f.padded();
   const double q2lo = 2.0 * d * (1.0 - 1e-12) - abs_eps;  // <= the exact |p_j - p_i|^2
   const double de = plane_eps * std::fabs(d) + abs_eps;
-  auto plane_value = [&](const Vertex& v) {
-    double dot = 0;
-    for (int k = 0; k < D; ++k) dot += n[k] * v.y[k];
+  const double* E = f.e();
+  const double* R = f.r2();
+  // P~ = d - n.y (summed in axis order, like a scalar loop) and its bound.
+  auto plane_value = [&](std::size_t t) {
+    Lane dot = n[0] * detail::load(f.y(0) + t);
+    for (int k = 1; k < D; ++k) dot += n[k] * detail::load(f.y(k) + t);
     return d - dot;
   };
-  bool may_cut = false;
-  for (std::size_t t = 0; t < nv && !may_cut; ++t) {
-    const Vertex& v = verts[t];
-    if (4.0 * v.r2 < q2lo) continue;
-    may_cut = !(plane_value(v) > n1 * v.e + de);
-  }
-  if (!may_cut) return 0;
-  sign.resize(nv);
-  std::size_t removed = 0, uncertain = 0;
-  for (std::size_t t = 0; t < nv; ++t) {
-    const Vertex& v = verts[t];
-    int s = 1;
-    if (4.0 * v.r2 >= q2lo) {
-      double P = plane_value(v);
-      double e = n1 * v.e + de;
-      s = (P > e) - (P < -e);
+  std::size_t first = 0;  // the first lane group holding a vertex that may be cut
+  for (; first < np; first += 4) {
+    LaneMask hit{};
+    for (std::size_t h = first; h < first + 4; h += 2) {
+      const LaneMask far = 4.0 * detail::load(R + h) >= q2lo;
+      const LaneMask safe = plane_value(h) > n1 * detail::load(E + h) + de;
+      hit |= far & ~safe;
     }
-    sign[t] = static_cast<std::int8_t>(s);
-    removed += (s < 0);
-    uncertain += (s == 0);
+    if (hit[0] | hit[1]) break;
   }
-  for (std::size_t t = 0; uncertain && t < nv; ++t) {
+  if (first >= np) return 0;
+  sign.resize(np);
+  std::fill(sign.begin(), sign.begin() + static_cast<std::ptrdiff_t>(first), std::int8_t{1});
+  std::int64_t removed = 0, uncertain = 0;
+  for (std::size_t t = first; t < np; t += 2) {
+    const Lane P = plane_value(t);
+    const Lane e = n1 * detail::load(E + t) + de;
+    const LaneMask near = 4.0 * detail::load(R + t) < q2lo;  // never cut
+    const LaneMask s = near ? LaneMask{1, 1} : (P < -e) - (P > e);
+    for (int k = 0; k < 2; ++k) {
+      sign[t + static_cast<std::size_t>(k)] = static_cast<std::int8_t>(s[k]);
+      removed += s[k] < 0;
+      uncertain += s[k] == 0;
+    }
+  }
+  for (std::size_t t = first; uncertain && t < nv; ++t) {
     if (sign[t] != 0) continue;
-    sign[t] = static_cast<std::int8_t>(exact(verts[t]));
+    sign[t] = static_cast<std::int8_t>(exact(t));
     removed += (sign[t] < 0);
     --uncertain;
   }
-  return removed;
+  return static_cast<std::size_t>(removed);
 }
 
 }  // namespace tessera::kernels::filter

@@ -54,6 +54,7 @@ class Hull {
     exact_calls_ = 0;
     planes_.clear();
     verts_.clear();
+    lanes_.clear();
     for (int k = 0; k < 6; ++k) {
       int axis = k / 2;
       bool upper = k & 1;
@@ -82,6 +83,7 @@ class Hull {
       if (positive) { v.p[0] = a; v.p[1] = b; v.p[2] = cc; }
       else { v.p[0] = a; v.p[1] = cc; v.p[2] = b; }
       verts_.push_back(v);
+      lanes_.push_back(v);
     }
     for (std::size_t t = 0; t < verts_.size(); ++t) link(static_cast<std::uint32_t>(t));
     update_radius();
@@ -96,10 +98,15 @@ class Hull {
     pl.id = j;
 
     const std::size_t nv = verts_.size();
-    const std::size_t removed = filter::classify<3>(verts_, pl.n, pl.d, pl.n1, sign_,
-                                                     [&](const Vertex& v) { return exact_sign(v, j); });
+    const std::size_t removed = filter::classify<3>(lanes_, pl.n, pl.d, pl.n1, sign_,
+                                                     [&](std::size_t t) { return exact_sign(verts_[t], j); });
     if (removed == 0) return ClipResult::unchanged;
-    if (removed == nv) { verts_.clear(); security2_ = 0; return ClipResult::emptied; }
+    if (removed == nv) {
+      verts_.clear();
+      lanes_.clear();
+      security2_ = 0;
+      return ClipResult::emptied;
+    }
 
     const std::uint16_t pn = static_cast<std::uint16_t>(planes_.size());
     if (planes_.size() + 1 >= 0xFFFF)
@@ -129,6 +136,7 @@ class Hull {
     for (std::size_t t = 0; t < nv && f < fresh_.size(); ++t) {
       if (sign_[t] < 0) {
         verts_[t] = fresh_[f++];
+        lanes_.set(t, verts_[t]);
         sign_[t] = 1;
         link(static_cast<std::uint32_t>(t));
       }
@@ -136,6 +144,7 @@ class Hull {
     if (f < fresh_.size()) {
       for (; f < fresh_.size(); ++f) {
         verts_.push_back(fresh_[f]);
+        lanes_.push_back(fresh_[f]);
         link(static_cast<std::uint32_t>(verts_.size() - 1));
       }
     } else {
@@ -146,11 +155,13 @@ class Hull {
         while (end > t && sign_[end - 1] < 0) --end;  // drop trailing holes
         if (end <= t) break;
         verts_[t] = verts_[end - 1];
+        lanes_.set(t, verts_[t]);
         sign_[t] = 1;
         --end;
         link(static_cast<std::uint32_t>(t));
       }
       verts_.resize(end);
+      lanes_.resize(end);
     }
     update_radius();
     return ClipResult::clipped;
@@ -268,8 +279,9 @@ class Hull {
   }
 
   void update_radius() {
-    double r2 = 0;
-    for (const Vertex& v : verts_) r2 = std::max(r2, v.r2);
+    double r2 = 0;  // padding is -1
+    const double* R = lanes_.r2();
+    for (std::size_t t = 0; t < lanes_.padded(); ++t) r2 = std::max(r2, R[t]);
     security2_ = 4.0 * r2 * (1 + 1e-12);
   }
 
@@ -278,6 +290,7 @@ class Hull {
   std::uint64_t exact_calls_ = 0;
   std::vector<Plane> planes_;
   std::vector<Vertex> verts_;
+  filter::FilterLanes<3> lanes_;  // verts_' filter data, for the sign pass
   std::vector<Vertex> fresh_;
   std::vector<std::int8_t> sign_;
   std::vector<std::uint32_t> edge_tri_;  // cap_ x cap_: directed plane pair -> triangle

@@ -69,6 +69,7 @@ class Tile {
       v.p[1] = out[c];
       verts_.push_back(v);
     }
+    lanes_.assign(verts_);
     update_radius();
   }
 
@@ -79,10 +80,15 @@ class Tile {
     pl.n1 = std::fabs(q[0]) + std::fabs(q[1]);
     pl.id = j;
     const std::size_t nv = verts_.size();
-    const std::size_t removed = filter::classify<2>(verts_, pl.n, pl.d, pl.n1, sign_,
-                                                     [&](const Vertex& v) { return exact_sign(v, j); });
+    const std::size_t removed = filter::classify<2>(lanes_, pl.n, pl.d, pl.n1, sign_,
+                                                     [&](std::size_t t) { return exact_sign(verts_[t], j); });
     if (removed == 0) return ClipResult::unchanged;
-    if (removed == nv) { verts_.clear(); security2_ = 0; return ClipResult::emptied; }
+    if (removed == nv) {
+      verts_.clear();
+      lanes_.clear();
+      security2_ = 0;
+      return ClipResult::emptied;
+    }
     if (planes_.size() + 1 >= 0xFFFF) throw std::length_error("tessera: a tile has more than 65534 edges");
     const std::uint16_t pn = static_cast<std::uint16_t>(planes_.size());
     planes_.push_back(pl);
@@ -106,6 +112,7 @@ class Tile {
       }
     }
     verts_.swap(next_);
+    lanes_.assign(verts_);
     update_radius();
     return ClipResult::clipped;
   }
@@ -169,6 +176,7 @@ class Tile {
   std::uint64_t exact_calls_ = 0;
   std::vector<Plane> planes_;
   std::vector<Vertex> verts_, next_;
+  filter::FilterLanes<2> lanes_;  // verts_' filter data, for the sign pass
   std::vector<std::int8_t> sign_;
   double security2_ = 0;
 };
