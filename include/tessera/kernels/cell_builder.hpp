@@ -56,9 +56,7 @@ class CellBuilder {
       }
       cand_.clear();
       keys_.clear();
-      auto gather = [&](const std::array<std::int32_t, D>& c, std::size_t bin) {
-        // The bins next to the generator's are always near: test only beyond.
-        if (s > 1 && loc_.bin_distance2(p, c) > sec2) return;
+      auto gather = [&](const std::array<std::int32_t, D>&, std::size_t bin) {
         for (std::uint32_t k = off[bin]; k < off[bin + 1]; ++k) {
           std::int32_t j = loc_.id(k);
           if (j == i) continue;
@@ -81,7 +79,9 @@ class CellBuilder {
       };
       // The generator's own bin and the shell around it are gathered and
       // sorted together (own bin first, so coincident points keep id order).
-      loc_.for_each_shell_bin(b, s, gather);
+      // The bins next to the generator's are always near: prune only beyond.
+      if (s > 1) loc_.for_each_shell_bin_near(p, b, s, sec2, gaps_, gather);
+      else loc_.for_each_shell_bin(b, s, gather);
       if (s == 0 && last >= 1) {
         s = 1;
         loc_.for_each_shell_bin(b, s, gather);
@@ -142,6 +142,7 @@ class CellBuilder {
   const ExactContext* exact_;
   std::vector<Candidate> cand_;
   std::vector<std::uint64_t> keys_;
+  std::vector<double> gaps_;  // for_each_shell_bin_near's scratch
 };
 
 }  // namespace tessera::kernels

@@ -152,6 +152,59 @@ class BinLocator {
     }
   }
 
+  /// Visit the bins of shell s around b whose box lies within squared distance
+  /// r2max of x (bins with bin_distance2(x, c) > r2max are skipped), in the
+  /// order of for_each_shell_bin. The per-axis gaps are computed once per
+  /// shell; a slab or row whose partial sum already exceeds r2max is skipped
+  /// whole, which is exact: rounding is monotone, so the full sum, added in
+  /// bin_distance2's axis order, can only be larger. `gaps` is the caller's
+  /// scratch (one per thread), so the locator stays read-only.
+  template <class F>
+  void for_each_shell_bin_near(const double* x, const std::array<std::int32_t, D>& b, int s, double r2max,
+                               std::vector<double>& gaps, F&& f) const {
+    const std::size_t w = static_cast<std::size_t>(2 * s + 1);
+    gaps.resize(D * w);
+    for (int d = 0; d < D; ++d) {
+      for (int o = -s; o <= s; ++o) {
+        const double blo = lo_[d] + (b[d] + o) * size_[d], bhi = blo + size_[d];
+        const double g = std::max({0.0, blo - x[d] - slack_, x[d] - bhi - slack_});
+        gaps[static_cast<std::size_t>(d) * w + static_cast<std::size_t>(o + s)] = g * g;
+      }
+    }
+    auto gap2 = [&](int d, int o) { return gaps[static_cast<std::size_t>(d) * w + static_cast<std::size_t>(o + s)]; };
+    std::array<std::int32_t, D> c;
+    if constexpr (D == 2) {
+      for (int dy = -s; dy <= s; ++dy) {
+        c[1] = b[1] + dy;
+        if (c[1] < 0 || c[1] >= divs_[1] || gap2(1, dy) > r2max) continue;
+        const bool edge = (dy == -s || dy == s);
+        const int step = edge ? 1 : 2 * s;
+        for (int dx = -s; dx <= s; dx += step) {
+          c[0] = b[0] + dx;
+          if (c[0] < 0 || c[0] >= divs_[0] || (0.0 + gap2(0, dx)) + gap2(1, dy) > r2max) continue;
+          f(c, bin_index(c));
+        }
+      }
+    } else {
+      for (int dz = -s; dz <= s; ++dz) {
+        c[2] = b[2] + dz;
+        if (c[2] < 0 || c[2] >= divs_[2] || gap2(2, dz) > r2max) continue;
+        const bool zface = (dz == -s || dz == s);
+        for (int dy = -s; dy <= s; ++dy) {
+          c[1] = b[1] + dy;
+          if (c[1] < 0 || c[1] >= divs_[1] || gap2(1, dy) + gap2(2, dz) > r2max) continue;
+          const bool edge = zface || dy == -s || dy == s;
+          const int step = edge ? 1 : 2 * s;
+          for (int dx = -s; dx <= s; dx += step) {
+            c[0] = b[0] + dx;
+            if (c[0] < 0 || c[0] >= divs_[0] || ((0.0 + gap2(0, dx)) + gap2(1, dy)) + gap2(2, dz) > r2max) continue;
+            f(c, bin_index(c));
+          }
+        }
+      }
+    }
+  }
+
   std::size_t num_bins() const { return offsets_.size() - 1; }
   std::size_t size() const { return ids_.size(); }
   /// Points of bin k are slots offsets()[k] .. offsets()[k+1]).
