@@ -114,51 +114,53 @@ class Hull {
     planes_.push_back(pl);
     if (planes_.size() > cap_) ensure_table(2 * cap_);
 
+    // The removed slots, ascending.
+    holes_.clear();
+    for (std::size_t t = 0; t < nv; ++t)
+      if (sign_[t] < 0) holes_.push_back(static_cast<std::uint32_t>(t));
     // Boundary of the removed region: edges (a -> b) of removed triangles whose
     // twin (b -> a) lies in a kept triangle. Each gets a new triangle (a, b, pn).
     fresh_.clear();
-    for (std::size_t t = 0; t < nv; ++t) {
-      if (sign_[t] > 0) continue;
+    auto border = [&](std::uint16_t a, std::uint16_t b) {
+      if (sign_[edge_tri_[static_cast<std::size_t>(b) * cap_ + a]] < 0) return;
+      Vertex nvtx;
+      nvtx.p[0] = a; nvtx.p[1] = b; nvtx.p[2] = pn;
+      solve(nvtx);
+      fresh_.push_back(nvtx);
+    };
+    for (std::uint32_t t : holes_) {
       const Vertex& v = verts_[t];
-      for (int k = 0; k < 3; ++k) {
-        std::uint16_t a = v.p[k], b = v.p[(k + 1) % 3];
-        std::uint32_t twin = edge_tri_[static_cast<std::size_t>(b) * cap_ + a];
-        if (sign_[twin] < 0) continue;
-        Vertex nvtx;
-        nvtx.p[0] = a; nvtx.p[1] = b; nvtx.p[2] = pn;
-        solve(nvtx);
-        fresh_.push_back(nvtx);
-      }
+      border(v.p[0], v.p[1]);
+      border(v.p[1], v.p[2]);
+      border(v.p[2], v.p[0]);
     }
     // Put the new triangles into removed slots; append the rest, or, when
     // fewer were made than removed, fill the remaining holes from the tail.
-    std::size_t f = 0;
-    for (std::size_t t = 0; t < nv && f < fresh_.size(); ++t) {
-      if (sign_[t] < 0) {
-        verts_[t] = fresh_[f++];
-        lanes_.set(t, verts_[t]);
-        sign_[t] = 1;
-        link(static_cast<std::uint32_t>(t));
-      }
+    const std::size_t placed = std::min(fresh_.size(), holes_.size());
+    for (std::size_t k = 0; k < placed; ++k) {
+      const std::uint32_t t = holes_[k];
+      verts_[t] = fresh_[k];
+      lanes_.set(t, verts_[t]);
+      sign_[t] = 1;
+      link(t);
     }
-    if (f < fresh_.size()) {
-      for (; f < fresh_.size(); ++f) {
-        verts_.push_back(fresh_[f]);
-        lanes_.push_back(fresh_[f]);
+    if (placed < fresh_.size()) {
+      for (std::size_t k = placed; k < fresh_.size(); ++k) {
+        verts_.push_back(fresh_[k]);
+        lanes_.push_back(fresh_[k]);
         link(static_cast<std::uint32_t>(verts_.size() - 1));
       }
     } else {
-      std::size_t end = nv, t = 0;
-      for (;;) {
-        while (t < end && sign_[t] >= 0) ++t;        // next hole
-        if (t >= end) break;
+      std::size_t end = nv;
+      for (std::size_t k = placed; k < holes_.size(); ++k) {
+        const std::uint32_t t = holes_[k];
         while (end > t && sign_[end - 1] < 0) --end;  // drop trailing holes
-        if (end <= t) break;
+        if (end <= t) break;                          // this hole and the rest lie beyond
         verts_[t] = verts_[end - 1];
         lanes_.set(t, verts_[t]);
         sign_[t] = 1;
         --end;
-        link(static_cast<std::uint32_t>(t));
+        link(t);
       }
       verts_.resize(end);
       lanes_.resize(end);
@@ -292,6 +294,7 @@ class Hull {
   std::vector<Vertex> verts_;
   filter::FilterLanes<3> lanes_;  // verts_' filter data, for the sign pass
   std::vector<Vertex> fresh_;
+  std::vector<std::uint32_t> holes_;
   std::vector<std::int8_t> sign_;
   std::vector<std::uint32_t> edge_tri_;  // cap_ x cap_: directed plane pair -> triangle
   std::size_t cap_ = 0;
