@@ -88,7 +88,9 @@ class FilterLanes {
   }
   void grow(std::size_t n) {
     const std::size_t need = (n + lanes - 1) / lanes * lanes + lanes;
-    if (r2_.size() >= need) return;
+    if (r2_.size() < need) [[unlikely]] reserve_slots(need);
+  }
+  void reserve_slots(std::size_t need) {
     const std::size_t cap = std::max(need, 2 * r2_.size());
     for (int k = 0; k < D; ++k) y_[k].resize(cap, 0.0);
     e_.resize(cap, 0.0);

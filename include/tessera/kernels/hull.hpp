@@ -115,9 +115,13 @@ class Hull {
     if (planes_.size() > cap_) ensure_table(2 * cap_);
 
     // The removed slots, ascending.
-    holes_.clear();
-    for (std::size_t t = 0; t < nv; ++t)
-      if (sign_[t] < 0) holes_.push_back(static_cast<std::uint32_t>(t));
+    holes_.resize(nv);
+    std::size_t nh = 0;
+    for (std::size_t t = 0; t < nv; ++t) {
+      holes_[nh] = static_cast<std::uint32_t>(t);
+      nh += sign_[t] < 0;
+    }
+    holes_.resize(nh);
     // Boundary of the removed region: edges (a -> b) of removed triangles whose
     // twin (b -> a) lies in a kept triangle. Each gets a new triangle (a, b, pn).
     fresh_.clear();
