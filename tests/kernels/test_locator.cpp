@@ -217,6 +217,23 @@ void check_shells(const Case<D>& c, std::uint64_t seed) {
         }
       });
       EXPECT_GT(in_shell, 0) << "shell " << s << " <= max_shell is empty";
+      // The pruned walk the cell builder uses beyond shell 1 visits exactly
+      // the shell's bins with bin_distance2 <= r2max, in the same order.
+      std::vector<double> gaps;
+      for (double r : {0.0, 0.3, 1.0, 1.7, 2.5, 4.0}) {
+        const double h = (c.hi[0] - c.lo[0]) / loc.divisions()[0];  // a bin edge
+        const double r2max = r * r * h * h;
+        std::vector<std::size_t> want, got;
+        loc.for_each_shell_bin(b, s, [&](const std::array<std::int32_t, D>& cb, std::size_t bin) {
+          if (loc.bin_distance2(x.data(), cb) <= r2max) want.push_back(bin);
+        });
+        loc.for_each_shell_bin_near(x.data(), b, s, r2max, gaps,
+                                    [&](const std::array<std::int32_t, D>& cb, std::size_t bin) {
+                                      EXPECT_EQ(loc.bin_index(cb), bin);
+                                      got.push_back(bin);
+                                    });
+        EXPECT_EQ(got, want) << "shell " << s << ", r2max " << r2max;
+      }
     }
     // Nothing beyond max_shell.
     loc.for_each_shell_bin(b, last + 1, [&](const std::array<std::int32_t, D>&, std::size_t) {
