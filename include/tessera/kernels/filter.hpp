@@ -130,10 +130,10 @@ inline Lane load(const double* p) {
 /// |q|/2 from the generator cannot be cut: q.y <= |q||y| <= |q|^2/2 (equality
 /// would need y = q/2 exactly, which the strict margin excludes). Candidates
 /// usually fail to clip; a first pass only proves that, a lane group at a
-/// time, and then `sign` is left untouched. Both passes work on four lanes at a
-/// time; the arithmetic is the same, term for term, as a scalar loop's (no
-/// contraction), so the signs do not depend on the vector width.
-
+/// time, and then `sign` is left untouched. Both passes take a lane group (four
+/// vertices) at a time, branch-free within it; the arithmetic is the same, term
+/// for term, as a scalar loop's (no contraction), so the signs do not depend on
+/// the vector width.
 template <int D, class Exact>
 std::size_t classify(const FilterLanes<D>& f, const double* n, double d, double n1,
                      std::vector<std::int8_t>& sign, Exact&& exact) {
