@@ -86,16 +86,22 @@ class CellBuilder {
         s = 1;
         loc_.for_each_shell_bin(b, s, gather);
       }
-      std::sort(keys_.begin(), keys_.end());
-      for (std::uint64_t key : keys_) {
+      // Clip in key order. The order is sorted lazily: a shell in a dense
+      // region can hold hundreds of candidates of which the cell uses a few
+      // dozen, so the nearest `sort_head` come first (nth_element + sort);
+      // when they are used up, the rest is cut to the candidates within the
+      // security radius as it is by then (it only shrinks, so the others would
+      // be skipped anyway) and the next head is taken. The clips are those of
+      // a full sort, in the same order.
+      enum class Next { go, stop, no_cell };
+      auto visit = [&](std::uint64_t key) {
         const Candidate& cd = cand_[static_cast<std::uint32_t>(key)];
         if (cd.r2 > sec2) {
           // Keys are r2 rounded to float, so a later candidate may still be
           // slightly nearer; stop only once every later one is surely beyond
           // (a later key k' >= k has r2 >= k' (1 - 2^-24)).
           const float k = std::bit_cast<float>(static_cast<std::uint32_t>(key >> 32));
-          if (static_cast<double>(k) * (1.0 - 1e-7) > sec2) break;
-          continue;
+          return static_cast<double>(k) * (1.0 - 1e-7) > sec2 ? Next::stop : Next::go;
         }
         if (cd.r2 == 0 && exactly_equal(p, cd.id)) {
           // Exact duplicates: the lowest id owns the cell. Coincident points
@@ -105,23 +111,44 @@ class CellBuilder {
           if (cd.id < i) {
             status.has_cell = false;
             status.duplicate_of = cd.id;
-            return status;
+            return Next::no_cell;
           }
-          continue;  // a higher-id duplicate of ours never clips
+          return Next::go;  // a higher-id duplicate of ours never clips
         }
         ClipResult r = cell.clip(cd.id, cd.q);
         if (r == ClipResult::clipped) sec2 = cell.security_radius2();
         else if (r == ClipResult::emptied) {
           // Only possible for coincident points, which are handled above.
           status.has_cell = false;
-          return status;
+          return Next::no_cell;
         }
+        return Next::go;
+      };
+      Next next = Next::go;
+      for (std::size_t done = 0; next == Next::go && done < keys_.size();) {
+        const auto first = keys_.begin() + static_cast<std::ptrdiff_t>(done);
+        if (done > 0)
+          keys_.erase(std::remove_if(first, keys_.end(),
+                                     [&](std::uint64_t key) { return cand_[static_cast<std::uint32_t>(key)].r2 > sec2; }),
+                      keys_.end());
+        const std::size_t left = keys_.size() - done;
+        const std::size_t take = left > 2 * sort_head ? sort_head : left;
+        const auto last_taken = first + static_cast<std::ptrdiff_t>(take);
+        if (take < left) std::nth_element(first, last_taken, keys_.end());
+        std::sort(first, last_taken);
+        for (auto it = first; next == Next::go && it != last_taken; ++it) next = visit(*it);
+        done += take;
       }
+      if (next == Next::no_cell) return status;
     }
     return status;
   }
 
  private:
+  /// Candidates sorted per round of the lazy sort (above: a full sort when a
+  /// shell holds at most twice as many). A uniform cell uses about 47.
+  static constexpr std::size_t sort_head = 64;
+
   struct Candidate {
     double r2;
     std::int32_t id;
