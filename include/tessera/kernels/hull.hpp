@@ -53,8 +53,7 @@ class Hull {
     exact_ = exact;
     exact_calls_ = 0;
     planes_.clear();
-    verts_.clear();
-    lanes_.clear();
+    truncate(0);
     for (int k = 0; k < 6; ++k) {
       int axis = k / 2;
       bool upper = k & 1;
@@ -82,10 +81,8 @@ class Hull {
       bool positive = ((sx + sy + sz) % 2) == 1;  // signs: upper=+, lower=-
       if (positive) { v.p[0] = a; v.p[1] = b; v.p[2] = cc; }
       else { v.p[0] = a; v.p[1] = cc; v.p[2] = b; }
-      verts_.push_back(v);
-      lanes_.push_back(v);
+      append(v);
     }
-    for (std::size_t t = 0; t < verts_.size(); ++t) link(static_cast<std::uint32_t>(t));
     update_radius();
   }
 
@@ -102,8 +99,7 @@ class Hull {
                                                      [&](std::size_t t) { return exact_sign(verts_[t], j); });
     if (removed == 0) return ClipResult::unchanged;
     if (removed == nv) {
-      verts_.clear();
-      lanes_.clear();
+      truncate(0);
       security2_ = 0;
       return ClipResult::emptied;
     }
@@ -141,33 +137,19 @@ class Hull {
     // Put the new triangles into removed slots; append the rest, or, when
     // fewer were made than removed, fill the remaining holes from the tail.
     const std::size_t placed = std::min(fresh_.size(), holes_.size());
-    for (std::size_t k = 0; k < placed; ++k) {
-      const std::uint32_t t = holes_[k];
-      verts_[t] = fresh_[k];
-      lanes_.set(t, verts_[t]);
-      sign_[t] = 1;
-      link(t);
-    }
+    for (std::size_t k = 0; k < placed; ++k) place(holes_[k], fresh_[k]);
     if (placed < fresh_.size()) {
-      for (std::size_t k = placed; k < fresh_.size(); ++k) {
-        verts_.push_back(fresh_[k]);
-        lanes_.push_back(fresh_[k]);
-        link(static_cast<std::uint32_t>(verts_.size() - 1));
-      }
+      for (std::size_t k = placed; k < fresh_.size(); ++k) append(fresh_[k]);
     } else {
       std::size_t end = nv;
       for (std::size_t k = placed; k < holes_.size(); ++k) {
         const std::uint32_t t = holes_[k];
         while (end > t && sign_[end - 1] < 0) --end;  // drop trailing holes
         if (end <= t) break;                          // this hole and the rest lie beyond
-        verts_[t] = verts_[end - 1];
-        lanes_.set(t, verts_[t]);
-        sign_[t] = 1;
+        place(t, verts_[end - 1]);
         --end;
-        link(t);
       }
-      verts_.resize(end);
-      lanes_.resize(end);
+      truncate(end);
     }
     update_radius();
     return ClipResult::clipped;
@@ -220,6 +202,24 @@ class Hull {
     ++exact_calls_;
     std::int32_t ids[3] = {planes_[v.p[0]].id, planes_[v.p[1]].id, planes_[v.p[2]].id};
     return exact_clip_sign(*exact_, gen_, ids, j);
+  }
+
+  // Every change to the vertex list goes through these three, which keep the
+  // sign pass's mirror (lanes_) and the edge table in step with verts_.
+  void place(std::uint32_t t, const Vertex& v) {  // into an existing slot, kept from now on
+    verts_[t] = v;
+    lanes_.set(t, v);
+    sign_[t] = 1;
+    link(t);
+  }
+  void append(const Vertex& v) {
+    verts_.push_back(v);
+    lanes_.push_back(v);
+    link(static_cast<std::uint32_t>(verts_.size() - 1));
+  }
+  void truncate(std::size_t n) {
+    verts_.resize(n);
+    lanes_.resize(n);
   }
 
   void link(std::uint32_t t) {

@@ -118,38 +118,8 @@ class BinLocator {
   /// grid): f(bin coords, bin index).
   template <class F>
   void for_each_shell_bin(const std::array<std::int32_t, D>& b, int s, F&& f) const {
-    if (s == 0) { f(b, bin_index(b)); return; }
-    std::array<std::int32_t, D> c;
-    if constexpr (D == 2) {
-      for (int dy = -s; dy <= s; ++dy) {
-        c[1] = b[1] + dy;
-        if (c[1] < 0 || c[1] >= divs_[1]) continue;
-        const bool edge = (dy == -s || dy == s);
-        const int step = edge ? 1 : 2 * s;
-        for (int dx = -s; dx <= s; dx += step) {
-          c[0] = b[0] + dx;
-          if (c[0] < 0 || c[0] >= divs_[0]) continue;
-          f(c, bin_index(c));
-        }
-      }
-    } else {
-      for (int dz = -s; dz <= s; ++dz) {
-        c[2] = b[2] + dz;
-        if (c[2] < 0 || c[2] >= divs_[2]) continue;
-        const bool zface = (dz == -s || dz == s);
-        for (int dy = -s; dy <= s; ++dy) {
-          c[1] = b[1] + dy;
-          if (c[1] < 0 || c[1] >= divs_[1]) continue;
-          const bool edge = zface || dy == -s || dy == s;
-          const int step = edge ? 1 : 2 * s;
-          for (int dx = -s; dx <= s; dx += step) {
-            c[0] = b[0] + dx;
-            if (c[0] < 0 || c[0] >= divs_[0]) continue;
-            f(c, bin_index(c));
-          }
-        }
-      }
-    }
+    auto keep = [](const auto&...) { return true; };
+    walk_shell(b, s, keep, keep, keep, f);
   }
 
   /// Visit the bins of shell s around b whose box lies within squared distance
@@ -172,37 +142,15 @@ class BinLocator {
       }
     }
     auto gap2 = [&](int d, int o) { return gaps[static_cast<std::size_t>(d) * w + static_cast<std::size_t>(o + s)]; };
-    std::array<std::int32_t, D> c;
-    if constexpr (D == 2) {
-      for (int dy = -s; dy <= s; ++dy) {
-        c[1] = b[1] + dy;
-        if (c[1] < 0 || c[1] >= divs_[1] || gap2(1, dy) > r2max) continue;
-        const bool edge = (dy == -s || dy == s);
-        const int step = edge ? 1 : 2 * s;
-        for (int dx = -s; dx <= s; dx += step) {
-          c[0] = b[0] + dx;
-          if (c[0] < 0 || c[0] >= divs_[0] || (0.0 + gap2(0, dx)) + gap2(1, dy) > r2max) continue;
-          f(c, bin_index(c));
-        }
-      }
-    } else {
-      for (int dz = -s; dz <= s; ++dz) {
-        c[2] = b[2] + dz;
-        if (c[2] < 0 || c[2] >= divs_[2] || gap2(2, dz) > r2max) continue;
-        const bool zface = (dz == -s || dz == s);
-        for (int dy = -s; dy <= s; ++dy) {
-          c[1] = b[1] + dy;
-          if (c[1] < 0 || c[1] >= divs_[1] || gap2(1, dy) + gap2(2, dz) > r2max) continue;
-          const bool edge = zface || dy == -s || dy == s;
-          const int step = edge ? 1 : 2 * s;
-          for (int dx = -s; dx <= s; dx += step) {
-            c[0] = b[0] + dx;
-            if (c[0] < 0 || c[0] >= divs_[0] || ((0.0 + gap2(0, dx)) + gap2(1, dy)) + gap2(2, dz) > r2max) continue;
-            f(c, bin_index(c));
-          }
-        }
-      }
-    }
+    walk_shell(
+        b, s, [&](int o_outer) { return gap2(D - 1, o_outer) <= r2max; },
+        [&](int oy, int oz) { return gap2(1, oy) + gap2(2, oz) <= r2max; },
+        [&](const std::array<std::int32_t, D>& o) {
+          double sum = 0.0;
+          for (int d = 0; d < D; ++d) sum += gap2(d, o[d]);
+          return sum <= r2max;
+        },
+        f);
   }
 
   std::size_t num_bins() const { return offsets_.size() - 1; }
@@ -214,6 +162,40 @@ class BinLocator {
   const std::array<std::int32_t, D>& divisions() const { return divs_; }
 
  private:
+  // The one shell walk (bins in z, y, x order; only the shell's surface)
+  // behind both visitors. near_outer(offset along the last axis), near_row
+  // (y and z offsets, 3D only) and near_bin(all offsets) may skip a slab, a
+  // row or a bin; for_each_shell_bin skips nothing.
+  template <class Outer, class Row, class Bin, class F>
+  void walk_shell(const std::array<std::int32_t, D>& b, int s, Outer&& near_outer, Row&& near_row,
+                  Bin&& near_bin, F&& f) const {
+    if (s == 0) { f(b, bin_index(b)); return; }
+    std::array<std::int32_t, D> c, o;
+    auto walk_x = [&](bool surface) {  // surface: every x; else only the two x faces
+      const int step = surface ? 1 : 2 * s;
+      for (o[0] = -s; o[0] <= s; o[0] += step) {
+        c[0] = b[0] + o[0];
+        if (c[0] < 0 || c[0] >= divs_[0] || !near_bin(o)) continue;
+        f(c, bin_index(c));
+      }
+    };
+    const int outer = D - 1;
+    for (o[outer] = -s; o[outer] <= s; ++o[outer]) {
+      c[outer] = b[outer] + o[outer];
+      if (c[outer] < 0 || c[outer] >= divs_[outer] || !near_outer(o[outer])) continue;
+      const bool outer_face = o[outer] == -s || o[outer] == s;
+      if constexpr (D == 2) {
+        walk_x(outer_face);
+      } else {
+        for (o[1] = -s; o[1] <= s; ++o[1]) {
+          c[1] = b[1] + o[1];
+          if (c[1] < 0 || c[1] >= divs_[1] || !near_row(o[1], o[2])) continue;
+          walk_x(outer_face || o[1] == -s || o[1] == s);
+        }
+      }
+    }
+  }
+
   Point lo_{}, size_{}, inv_size_{};
   double min_size_ = 0;
   double slack_ = 0;  // a few ulp of the box coordinates
