@@ -48,8 +48,13 @@ class CandidateTree {
   std::size_t size() const { return ids_.size(); }
 
   /// Calls visit(id) for every point that may satisfy the query (a superset).
-  template <class Visit>
-  void search(Query& q, Visit&& visit) const {
+  /// A node whose box the float plane test puts on the plane, within the
+  /// margin, is offered to `on_plane(lo, hi)`, which returns true when no
+  /// point of the box can lie strictly beyond (decided exactly by the caller):
+  /// whole coplanar hull faces (lattices, points on a box face) would
+  /// otherwise be visited point by point for every facet of that face.
+  template <class Visit, class OnPlane>
+  void search(Query& q, Visit&& visit, OnPlane&& on_plane) const {
     if (nodes_.empty()) return;
     std::uint32_t stack[128];
     int top = 0;
@@ -62,6 +67,7 @@ class CandidateTree {
       for (int d = 0; d < D; ++d)
         g += std::max(q.normal[d] * (nd.lo[d] - q.origin[d]), q.normal[d] * (nd.hi[d] - q.origin[d]));
       if (g < -q.margin) continue;
+      if (g <= q.margin && on_plane(nd.lo, nd.hi)) continue;
       if (nd.left == 0) {
         for (std::uint32_t k = nd.begin; k < nd.end; ++k) {
           if (q.ball_r2 != std::numeric_limits<double>::infinity()) {

@@ -93,6 +93,21 @@ class HullCompletion {
     }
     q.margin = 1e-9 * std::sqrt(nn) * diam_;
     const IntegerPlane plane(f, *this);
+    // True when every corner of the box is on the apex side or on the plane:
+    // the orientation is affine in x, so then no point of the box is beyond.
+    auto box_not_beyond = [&](const double* lo, const double* hi) {
+      const double* pts[D + 1];
+      for (int k = 0; k < D; ++k) pts[k] = pt(f[static_cast<std::size_t>(k)]);
+      double corner[D];
+      pts[D] = corner;
+      for (int c = 0; c < (1 << D); ++c) {
+        for (int d = 0; d < D; ++d) corner[d] = (c >> d) & 1 ? hi[d] : lo[d];
+        int side;
+        if (!plane.side(corner, side)) side = kernels::orientation(D, pts);
+        if (side == -apex_side) return false;
+      }
+      return true;
+    };
     std::int32_t best = -1;
     tree_.search(q, [&](std::int32_t p) {
       if (p == apex || std::find(f.begin(), f.end(), p) != f.end()) return;
@@ -108,7 +123,7 @@ class HullCompletion {
       }
       best = p;
       circumball(f, best, q);
-    });
+    }, box_not_beyond);
     return best;
   }
 

@@ -41,15 +41,14 @@ double det_perm(const double (*r)[3], int dim, double& perm) {
 // integer times one common power of two (lattices, voxel centres, integer and
 // dyadic grids — where exact zeros are common and GMP would dominate).
 // Differences need 26 bits, a 3x3 determinant 3*26+3 < 127. False otherwise.
-bool orientation_int128(const ExactContext& ctx, const std::int32_t* ids, int& sign) {
-  const int D = ctx.dim;
+bool orientation_int128(int D, const double* const* p, int& sign) {
   GridScale g;
   for (int k = 0; k <= D; ++k)
-    for (int d = 0; d < D; ++d) g.see(pt(ctx, ids[k])[d]);
+    for (int d = 0; d < D; ++d) g.see(p[k][d]);
   if (!g.fits(25)) return false;
   std::int64_t c[4][3] = {};
   for (int k = 0; k <= D; ++k)
-    for (int d = 0; d < D; ++d) g.scaled(pt(ctx, ids[k])[d], 25, c[k][d]);
+    for (int d = 0; d < D; ++d) g.scaled(p[k][d], 25, c[k][d]);
   __int128 r[3][3] = {};
   for (int k = 0; k < D; ++k)
     for (int d = 0; d < D; ++d) r[k][d] = static_cast<__int128>(c[k + 1][d]) - c[0][d];
@@ -63,8 +62,7 @@ bool orientation_int128(const ExactContext& ctx, const std::int32_t* ids, int& s
 }
 
 // Exact orientation in rationals: every double is exactly representable.
-int orientation_exact(const ExactContext& ctx, const std::int32_t* ids) {
-  const int D = ctx.dim;
+int orientation_exact(int D, const double* const* pts) {
   struct Q {
     mpq_t m[3][3], t, u, acc;
     Q() {
@@ -77,9 +75,9 @@ int orientation_exact(const ExactContext& ctx, const std::int32_t* ids) {
     }
   };
   thread_local Q q;
-  const double* p0 = pt(ctx, ids[0]);
+  const double* p0 = pts[0];
   for (int k = 0; k < D; ++k) {
-    const double* p = pt(ctx, ids[k + 1]);
+    const double* p = pts[k + 1];
     for (int d = 0; d < D; ++d) {
       mpq_set_d(q.t, p[d]);
       mpq_set_d(q.u, p0[d]);
@@ -106,12 +104,11 @@ int orientation_exact(const ExactContext& ctx, const std::int32_t* ids) {
 
 }  // namespace
 
-int orientation(const ExactContext& ctx, const std::int32_t* ids) {
-  const int D = ctx.dim;
+int orientation(int D, const double* const* pts) {
   double r[3][3] = {};
-  const double* p0 = pt(ctx, ids[0]);
+  const double* p0 = pts[0];
   for (int k = 0; k < D; ++k) {
-    const double* p = pt(ctx, ids[k + 1]);
+    const double* p = pts[k + 1];
     for (int d = 0; d < D; ++d) r[k][d] = p[d] - p0[d];
   }
   double perm;
@@ -122,8 +119,14 @@ int orientation(const ExactContext& ctx, const std::int32_t* ids) {
   if (det > bound) return 1;
   if (det < -bound) return -1;
   int sign;
-  if (orientation_int128(ctx, ids, sign)) return sign;
-  return orientation_exact(ctx, ids);
+  if (orientation_int128(D, pts, sign)) return sign;
+  return orientation_exact(D, pts);
+}
+
+int orientation(const ExactContext& ctx, const std::int32_t* ids) {
+  const double* pts[4] = {};
+  for (int k = 0; k <= ctx.dim; ++k) pts[k] = pt(ctx, ids[k]);
+  return orientation(ctx.dim, pts);
 }
 
 bool in_sphere(const ExactContext& ctx, std::int32_t a, const std::int32_t* planes, std::int32_t q) {

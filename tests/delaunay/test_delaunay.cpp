@@ -201,6 +201,33 @@ TEST(Delaunay, SpiralAndCircle) {
   expect_valid(run(circle, 2), circle);
 }
 
+TEST(Delaunay, CoplanarHullFaces) {
+  // Random (non-grid) points on the six faces of the unit cube, its corners
+  // and random interior points: every hull facet lies in a face with hundreds
+  // of coplanar points, which hull completion must rule out exactly (whole
+  // tree nodes at once, by their box corners) without missing a simplex. No
+  // four face points are co-circular, so the triangulation is unique: CGAL's.
+  // (The hull volume is 1 up to the tiny bumps below.)
+  std::mt19937_64 rng(61);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::vector<double> p;
+  for (int c = 0; c < 8; ++c) p.insert(p.end(), {double(c & 1), double((c >> 1) & 1), double((c >> 2) & 1)});
+  for (int face = 0; face < 6; ++face)
+    for (int i = 0; i < 300; ++i) {
+      double x[3] = {u(rng), u(rng), u(rng)};
+      x[face / 2] = face % 2;
+      p.insert(p.end(), {x[0], x[1], x[2]});
+    }
+  for (int i = 0; i < 1000; ++i) p.insert(p.end(), {u(rng), u(rng), u(rng)});
+  // A few points a hair outside face z = 0, well within the float margin of
+  // its plane: the facets of that face near them are not hull facets.
+  for (int i = 0; i < 5; ++i) p.insert(p.end(), {0.1 + 0.2 * u(rng), 0.1 + 0.2 * u(rng), -1e-13});
+  tessera::Delaunay dt = run(p, 3);
+  EXPECT_EQ(as_set(dt), cgal_simplices(p, 3));
+  expect_valid(dt, p);
+  EXPECT_NEAR(tessera::validate(dt, p, {}).volume_sum, 1.0, 1e-12);
+}
+
 TEST(Delaunay, NearDuplicatesAndDuplicates) {
   auto p = random_points(500, 3, 21);
   for (int i = 0; i < 20; ++i) {

@@ -21,6 +21,10 @@ namespace tessera::kernels {
 /// the points are collinear / coplanar. No perturbation: flat is flat.
 int orientation(const ExactContext& ctx, const std::int32_t* ids);
 
+/// The same for D+1 points given by their coordinates (D = 2 or 3), which
+/// need not be input points (hull completion asks it of box corners).
+int orientation(int D, const double* const* pts);
+
 /// Is q strictly inside the circumsphere of a and planes[0..D) (D = ctx.dim), in
 /// the perturbed sense of the clip predicate? Never undecided. Precondition: a
 /// and the planes are affinely independent, q is none of them.
