@@ -215,11 +215,12 @@ bool signs_int128(const ExactContext& ctx, std::int32_t i, const std::int32_t* g
   }
   if (shift == INT_MAX) shift = 0;
   if (top != INT_MIN && top - shift > kBits) return false;
-  // x / 2^shift: an integer below 2^22 (its low bits below 2^shift are zero).
+  // x / 2^shift: an integer below 2^22 (its low bits below 2^shift are zero,
+  // so the arithmetic right shift is exact, negative or not; C++20 defines it).
   auto scaled_p = [&](const Parts& pt) -> std::int64_t {
     if (pt.mant == 0) return 0;
     const int k = pt.e2 - shift;
-    return k >= 0 ? pt.mant * (std::int64_t{1} << k) : pt.mant / (std::int64_t{1} << -k);
+    return k >= 0 ? pt.mant * (std::int64_t{1} << k) : pt.mant >> -k;
   };
   std::int64_t ci[Scratch::kMaxDim];
   I ci2 = 0;
@@ -244,23 +245,32 @@ bool signs_int128(const ExactContext& ctx, std::int32_t i, const std::int32_t* g
       b[r] = scaled_p(pv[r][0]);
     }
   }
+  // The minors in T: 64-bit when the coordinates have at most 17 bits
+  // (|a| < 2^19, a 3x3 minor < 6 * 2^57 < 2^60: small lattices and voxel
+  // grids, where this path runs for most clips), else 128-bit.
   I minor[Scratch::kRows];
-  for (int r = 0; r < rows; ++r) {
-    int sel[Scratch::kMaxDim] = {0, 0, 0};
-    int k = 0;
-    for (int q = 0; q < rows; ++q) if (q != r) sel[k++] = q;
-    if (dim == 2) {
-      minor[r] = static_cast<I>(a[sel[0]][0]) * a[sel[1]][1] - static_cast<I>(a[sel[0]][1]) * a[sel[1]][0];
-    } else {
+  auto minors = [&]<class T>(T) {
+    for (int r = 0; r < rows; ++r) {
+      int sel[Scratch::kMaxDim] = {0, 0, 0};
+      int k = 0;
+      for (int q = 0; q < rows; ++q) if (q != r) sel[k++] = q;
       const std::int64_t* r0 = a[sel[0]];
       const std::int64_t* r1 = a[sel[1]];
-      const std::int64_t* r2 = a[sel[2]];
-      minor[r] = r0[0] * (static_cast<I>(r1[1]) * r2[2] - static_cast<I>(r1[2]) * r2[1]) +
-                 r0[1] * (static_cast<I>(r1[2]) * r2[0] - static_cast<I>(r1[0]) * r2[2]) +
-                 r0[2] * (static_cast<I>(r1[0]) * r2[1] - static_cast<I>(r1[1]) * r2[0]);
+      T m;
+      if (dim == 2) {
+        m = static_cast<T>(r0[0]) * r1[1] - static_cast<T>(r0[1]) * r1[0];
+      } else {
+        const std::int64_t* r2 = a[sel[2]];
+        m = r0[0] * (static_cast<T>(r1[1]) * r2[2] - static_cast<T>(r1[2]) * r2[1]) +
+            r0[1] * (static_cast<T>(r1[2]) * r2[0] - static_cast<T>(r1[0]) * r2[2]) +
+            r0[2] * (static_cast<T>(r1[0]) * r2[1] - static_cast<T>(r1[1]) * r2[0]);
+      }
+      minor[r] = m;
+      out.minor[r] = (m > 0) - (m < 0);
     }
-    out.minor[r] = (minor[r] > 0) - (minor[r] < 0);
-  }
+  };
+  if (top == INT_MIN || top - shift <= 17) minors(std::int64_t{});
+  else minors(I{});
   I m0 = 0, wi = 0;
   for (int r = 0; r < rows; ++r) {
     I cof = cofactor_sign(r, dim) * minor[r];
@@ -344,10 +354,17 @@ void exact_vertex(const ExactContext& ctx, std::int32_t i, const std::int32_t* p
 }
 
 int lowest_bit_exponent(double x) {
-  int e;
-  double f = std::frexp(x, &e);  // x = f * 2^e, 0.5 <= |f| < 1
-  auto m = static_cast<std::uint64_t>(std::fabs(std::ldexp(f, 53)));  // exact, < 2^53
-  return e - 53 + std::countr_zero(m);
+  // From the bits (x = mant * 2^e2, subnormals included): no libm calls, as
+  // GridScale runs this on every coordinate of the integer-grid paths.
+  const auto bits = std::bit_cast<std::uint64_t>(x);
+  const int biased = static_cast<int>((bits >> 52) & 0x7ff);
+  std::uint64_t mant = bits & ((std::uint64_t{1} << 52) - 1);
+  int e2 = -1074;
+  if (biased != 0) {
+    mant |= std::uint64_t{1} << 52;
+    e2 = biased - 1075;
+  }
+  return e2 + std::countr_zero(mant);
 }
 
 }  // namespace tessera::kernels

@@ -636,3 +636,17 @@ TEST(ExactPredicates, ExactVertexMixedMagnitudes) {
 }
 
 }  // namespace
+
+// x is an odd integer times 2^lowest_bit_exponent(x), for normals and
+// subnormals of either sign.
+TEST(ExactPredicates, LowestBitExponent) {
+  EXPECT_EQ(tessera::kernels::lowest_bit_exponent(1.0), 0);
+  EXPECT_EQ(tessera::kernels::lowest_bit_exponent(3.0), 0);
+  EXPECT_EQ(tessera::kernels::lowest_bit_exponent(0.75), -2);
+  EXPECT_EQ(tessera::kernels::lowest_bit_exponent(-12.0), 2);
+  EXPECT_EQ(tessera::kernels::lowest_bit_exponent(0x1p-1022), -1022);
+  EXPECT_EQ(tessera::kernels::lowest_bit_exponent(0x1p-1074), -1074);
+  EXPECT_EQ(tessera::kernels::lowest_bit_exponent(-3 * 0x1p-1074), -1074);
+  EXPECT_EQ(tessera::kernels::lowest_bit_exponent(0x1p1023 * 1.5), 1022);
+  EXPECT_EQ(tessera::kernels::lowest_bit_exponent(0.1), -55);  // 0.1 = 0x1999999999999a * 2^-56
+}
