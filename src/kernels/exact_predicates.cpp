@@ -12,6 +12,26 @@
 namespace tessera::kernels {
 namespace {
 
+// A finite double by its bits: x = mant * 2^e2 exactly, |mant| < 2^53
+// (subnormals included). No libm calls: the integer-grid paths run this on
+// every coordinate they see.
+struct DoubleParts {
+  std::int64_t mant;
+  int e2;
+};
+DoubleParts double_parts(double x) {
+  const auto bits = std::bit_cast<std::uint64_t>(x);
+  const int biased = static_cast<int>((bits >> 52) & 0x7ff);
+  std::uint64_t m = bits & ((std::uint64_t{1} << 52) - 1);
+  int e2 = -1074;
+  if (biased != 0) {
+    m |= std::uint64_t{1} << 52;
+    e2 = biased - 1075;
+  }
+  const auto sm = static_cast<std::int64_t>(m);
+  return {(bits >> 63) ? -sm : sm, e2};
+}
+
 // Scratch integers reused across calls on one thread: the exact path is rare on
 // random input but common on lattices, and GMP allocation would dominate it.
 struct Scratch {
@@ -187,22 +207,11 @@ bool signs_int128(const ExactContext& ctx, std::int32_t i, const std::int32_t* g
       v[r][0] = box_plane_upper(gen[r]) ? ctx.hi[axis] : ctx.lo[axis];
     }
   }
-  // Decompose each double by its bits (no libm calls: this path is hot on
-  // lattices): x = sign * mant * 2^e2 with mant < 2^53.
-  struct Parts { std::int64_t mant; int e2; };
-  auto parts = [](double x) {
-    const std::uint64_t bits = std::bit_cast<std::uint64_t>(x);
-    const int biased = static_cast<int>((bits >> 52) & 0x7ff);
-    std::uint64_t m = bits & ((std::uint64_t{1} << 52) - 1);
-    int e2 = -1074;
-    if (biased != 0) { m |= std::uint64_t{1} << 52; e2 = biased - 1075; }
-    const std::int64_t sm = (bits >> 63) ? -static_cast<std::int64_t>(m) : static_cast<std::int64_t>(m);
-    return Parts{sm, e2};
-  };
-  Parts pv[Scratch::kRows + 1][Scratch::kMaxDim];
+  // Each double by its bits (double_parts), and the common scale.
+  DoubleParts pv[Scratch::kRows + 1][Scratch::kMaxDim];
   int shift = INT_MAX, top = INT_MIN;
-  auto see = [&](Parts& pt, double x) {
-    pt = parts(x);
+  auto see = [&](DoubleParts& pt, double x) {
+    pt = double_parts(x);
     if (pt.mant == 0) return;
     const auto um = static_cast<std::uint64_t>(pt.mant < 0 ? -pt.mant : pt.mant);
     shift = std::min(shift, pt.e2 + std::countr_zero(um));
@@ -217,7 +226,7 @@ bool signs_int128(const ExactContext& ctx, std::int32_t i, const std::int32_t* g
   if (top != INT_MIN && top - shift > kBits) return false;
   // x / 2^shift: an integer below 2^22 (its low bits below 2^shift are zero,
   // so the arithmetic right shift is exact, negative or not; C++20 defines it).
-  auto scaled_p = [&](const Parts& pt) -> std::int64_t {
+  auto scaled_p = [&](const DoubleParts& pt) -> std::int64_t {
     if (pt.mant == 0) return 0;
     const int k = pt.e2 - shift;
     return k >= 0 ? pt.mant * (std::int64_t{1} << k) : pt.mant >> -k;
@@ -354,17 +363,8 @@ void exact_vertex(const ExactContext& ctx, std::int32_t i, const std::int32_t* p
 }
 
 int lowest_bit_exponent(double x) {
-  // From the bits (x = mant * 2^e2, subnormals included): no libm calls, as
-  // GridScale runs this on every coordinate of the integer-grid paths.
-  const auto bits = std::bit_cast<std::uint64_t>(x);
-  const int biased = static_cast<int>((bits >> 52) & 0x7ff);
-  std::uint64_t mant = bits & ((std::uint64_t{1} << 52) - 1);
-  int e2 = -1074;
-  if (biased != 0) {
-    mant |= std::uint64_t{1} << 52;
-    e2 = biased - 1075;
-  }
-  return e2 + std::countr_zero(mant);
+  const DoubleParts p = double_parts(x);
+  return p.e2 + std::countr_zero(static_cast<std::uint64_t>(p.mant < 0 ? -p.mant : p.mant));
 }
 
 }  // namespace tessera::kernels
