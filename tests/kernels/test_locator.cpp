@@ -217,22 +217,33 @@ void check_shells(const Case<D>& c, std::uint64_t seed) {
         }
       });
       EXPECT_GT(in_shell, 0) << "shell " << s << " <= max_shell is empty";
-      // The pruned walk the cell builder uses beyond shell 1 visits exactly
-      // the shell's bins with bin_distance2 <= r2max, in the same order.
+      // The run walks the cell builder gathers with visit exactly the slots
+      // of the shell's bins (with bin_distance2 <= r2max beyond shell 0), in
+      // bin order, as runs of contiguous slots.
       std::vector<double> gaps;
+      auto slots_of_runs = [](auto&& walk) {
+        std::vector<std::uint32_t> got;
+        walk([&](std::uint32_t a, std::uint32_t e) {
+          EXPECT_LE(a, e);
+          for (std::uint32_t k = a; k < e; ++k) got.push_back(k);
+        });
+        return got;
+      };
+      std::vector<std::uint32_t> all;
+      loc.for_each_shell_bin(b, s, [&](const std::array<std::int32_t, D>&, std::size_t bin) {
+        for (std::uint32_t k = off[bin]; k < off[bin + 1]; ++k) all.push_back(k);
+      });
+      EXPECT_EQ(slots_of_runs([&](auto&& f) { loc.for_each_shell_run(b, s, f); }), all) << "shell " << s;
       for (double r : {0.0, 0.3, 1.0, 1.7, 2.5, 4.0}) {
         const double h = (c.hi[0] - c.lo[0]) / loc.divisions()[0];  // a bin edge
         const double r2max = r * r * h * h;
-        std::vector<std::size_t> want, got;
+        std::vector<std::uint32_t> want;
         loc.for_each_shell_bin(b, s, [&](const std::array<std::int32_t, D>& cb, std::size_t bin) {
-          if (loc.bin_distance2(x.data(), cb) <= r2max) want.push_back(bin);
+          if (s == 0 || loc.bin_distance2(x.data(), cb) <= r2max)
+            for (std::uint32_t k = off[bin]; k < off[bin + 1]; ++k) want.push_back(k);
         });
-        loc.for_each_shell_bin_near(x.data(), b, s, r2max, gaps,
-                                    [&](const std::array<std::int32_t, D>& cb, std::size_t bin) {
-                                      EXPECT_EQ(loc.bin_index(cb), bin);
-                                      got.push_back(bin);
-                                    });
-        EXPECT_EQ(got, want) << "shell " << s << ", r2max " << r2max;
+        EXPECT_EQ(slots_of_runs([&](auto&& f) { loc.for_each_shell_run_near(x.data(), b, s, r2max, gaps, f); }), want)
+            << "shell " << s << ", r2max " << r2max;
       }
     }
     // Nothing beyond max_shell.

@@ -57,11 +57,17 @@ std::uint64_t tessellate(const Generators<CellT::dim>& gens, Comp& comp, const E
                      CellT{}, 0};
   });
 
+  constexpr std::size_t prefetch_ahead = 4;
   auto run_batch = [&](std::size_t k) {
     Workspace& ws = workspaces.local();
     auto& batch = batches[k];
     const std::size_t end = std::min(n, (k + 1) * bs);
     for (std::size_t g = k * bs; g < end; ++g) {
+      // Generators come in bin order, so their coordinates (input order) are
+      // scattered: fetch a few cells ahead (on 1M points a miss per cell
+      // otherwise costs ~7% of a 2D run).
+      if (g + prefetch_ahead < n)
+        __builtin_prefetch(gens.coords + static_cast<std::size_t>(gens.order[g + prefetch_ahead]) * CellT::dim);
       std::int32_t gen = gens.order[g];
       kernels::BuildStatus st = ws.builder.build(gen, ws.cell);
       ws.exact_calls += ws.cell.exact_calls();

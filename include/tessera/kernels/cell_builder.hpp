@@ -46,7 +46,6 @@ class CellBuilder {
     cell.reset(i, p, lo_, hi_, exact_);
     const auto b = loc_.bin_coords(p);
     const int last = loc_.max_shell(b);
-    const auto& off = loc_.offsets();
     BuildStatus status;
     for (int s = 0; s <= last; ++s) {
       double sec2 = cell.security_radius2();
@@ -54,37 +53,45 @@ class CellBuilder {
         double lb = loc_.shell_lower_bound(p, b, s);
         if (lb * lb > sec2) break;
       }
-      cand_.clear();
-      keys_.clear();
-      auto gather = [&](const std::array<std::int32_t, D>&, std::size_t bin) {
-        for (std::uint32_t k = off[bin]; k < off[bin + 1]; ++k) {
-          std::int32_t j = loc_.id(k);
-          if (j == i) continue;
+      // Candidates of slots [a, e) within the security radius, appended to
+      // cand_/keys_ (storage only grows; nc counts what is in use). Each run
+      // is a few bins' worth of contiguous slots: this loop is the search.
+      std::size_t nc = 0;
+      auto gather = [&](std::uint32_t a, std::uint32_t e) {
+        if (cand_.size() < nc + (e - a)) [[unlikely]] {
+          cand_.resize(2 * (nc + (e - a)));
+          keys_.resize(cand_.size());
+        }
+        Candidate* cd = cand_.data() + nc;
+        std::uint64_t* key = keys_.data() + nc;
+        std::uint32_t m = static_cast<std::uint32_t>(nc);
+        for (std::uint32_t k = a; k < e; ++k) {
+          const std::int32_t j = loc_.id(k);
           const auto& pj = loc_.point(k);
-          Candidate cd;
           double r2 = 0;
           for (int d = 0; d < D; ++d) {
-            cd.q[d] = pj[d] - p[d];
-            r2 += cd.q[d] * cd.q[d];
+            cd->q[d] = pj[d] - p[d];
+            r2 += cd->q[d] * cd->q[d];
           }
-          if (r2 > sec2) continue;
-          cd.r2 = r2;
-          cd.id = j;
+          if (r2 > sec2 || j == i) continue;
+          cd->r2 = r2;
+          cd->id = j;
           // Sort key: r2 rounded to float (non-negative floats order as their
           // bits), then gather order, which is deterministic.
-          keys_.push_back((static_cast<std::uint64_t>(std::bit_cast<std::uint32_t>(static_cast<float>(r2))) << 32) |
-                          static_cast<std::uint32_t>(cand_.size()));
-          cand_.push_back(cd);
+          *key++ = (static_cast<std::uint64_t>(std::bit_cast<std::uint32_t>(static_cast<float>(r2))) << 32) | m;
+          ++cd;
+          ++m;
         }
+        nc = m;
       };
       // The generator's own bin and the shell around it are gathered and
       // sorted together (own bin first, so coincident points keep id order).
       // The bins next to the generator's are always near: prune only beyond.
-      if (s > 1) loc_.for_each_shell_bin_near(p, b, s, sec2, gaps_, gather);
-      else loc_.for_each_shell_bin(b, s, gather);
+      if (s > 1) loc_.for_each_shell_run_near(p, b, s, sec2, gaps_, gather);
+      else loc_.for_each_shell_run(b, s, gather);
       if (s == 0 && last >= 1) {
         s = 1;
-        loc_.for_each_shell_bin(b, s, gather);
+        loc_.for_each_shell_run(b, s, gather);
       }
       // Clip in key order. The order is sorted lazily: a shell in a dense
       // region can hold hundreds of candidates of which the cell uses a few
@@ -125,19 +132,16 @@ class CellBuilder {
         return Next::go;
       };
       Next next = Next::go;
-      for (std::size_t done = 0; next == Next::go && done < keys_.size();) {
-        const auto first = keys_.begin() + static_cast<std::ptrdiff_t>(done);
-        if (done > 0)
-          keys_.erase(std::remove_if(first, keys_.end(),
-                                     [&](std::uint64_t key) { return cand_[static_cast<std::uint32_t>(key)].r2 > sec2; }),
-                      keys_.end());
-        const std::size_t left = keys_.size() - done;
-        const std::size_t take = left > 2 * sort_head ? sort_head : left;
-        const auto last_taken = first + static_cast<std::ptrdiff_t>(take);
-        if (take < left) std::nth_element(first, last_taken, keys_.end());
+      std::uint64_t* const keys = keys_.data();
+      std::uint64_t* end = keys + nc;
+      for (std::uint64_t* first = keys; next == Next::go && first != end;) {
+        if (first != keys)
+          end = std::remove_if(first, end, [&](std::uint64_t key) { return cand_[static_cast<std::uint32_t>(key)].r2 > sec2; });
+        const std::size_t left = static_cast<std::size_t>(end - first);
+        std::uint64_t* const last_taken = first + (left > 2 * sort_head ? sort_head : left);
+        if (last_taken != end) std::nth_element(first, last_taken, end);
         std::sort(first, last_taken);
-        for (auto it = first; next == Next::go && it != last_taken; ++it) next = visit(*it);
-        done += take;
+        for (; next == Next::go && first != last_taken; ++first) next = visit(*first);
       }
       if (next == Next::no_cell) return status;
     }

@@ -119,19 +119,46 @@ class BinLocator {
   template <class F>
   void for_each_shell_bin(const std::array<std::int32_t, D>& b, int s, F&& f) const {
     auto keep = [](const auto&...) { return true; };
-    walk_shell(b, s, keep, keep, keep, f);
+    walk_rows(b, s, keep, keep, [&](std::array<std::int32_t, D> c, int xa, int xb) {
+      for (c[0] = xa; c[0] <= xb; ++c[0]) f(c, bin_index(c));
+    });
   }
 
-  /// Visit the bins of shell s around b whose box lies within squared distance
-  /// r2max of x (bins with bin_distance2(x, c) > r2max are skipped), in the
-  /// order of for_each_shell_bin. The per-axis gaps are computed once per
-  /// shell; a slab or row whose partial sum already exceeds r2max is skipped
-  /// whole, which is exact: rounding is monotone, so the full sum, added in
-  /// bin_distance2's axis order, can only be larger. `gaps` is the caller's
-  /// scratch (one per thread), so the locator stays read-only.
+  /// The points of the bins of shell s around b, in the order of
+  /// for_each_shell_bin, as runs of consecutive slots: f(first slot, end slot)
+  /// (see for_each_shell_run_near).
   template <class F>
-  void for_each_shell_bin_near(const double* x, const std::array<std::int32_t, D>& b, int s, double r2max,
+  void for_each_shell_run(const std::array<std::int32_t, D>& b, int s, F&& f) const {
+    auto keep = [](const auto&...) { return true; };
+    walk_rows(b, s, keep, keep, [&](std::array<std::int32_t, D> c, int xa, int xb) {
+      c[0] = xa;
+      const std::size_t k = bin_index(c);
+      f(offsets_[k], offsets_[k + static_cast<std::size_t>(xb - xa) + 1]);
+    });
+  }
+
+  /// The points of the bins of shell s around b whose box lies within squared
+  /// distance r2max of x (bins with bin_distance2(x, c) > r2max are skipped),
+  /// in the order of for_each_shell_bin, as runs of consecutive slots:
+  /// f(first slot, end slot), one call per run of neighbouring bins along x
+  /// (bins are numbered x fastest, so their slots are contiguous). Shell 0 is
+  /// the bin itself, always visited.
+  ///
+  /// The per-axis gaps are computed once per shell; a slab or row whose
+  /// partial sum already exceeds r2max is skipped whole, which is exact:
+  /// rounding is monotone, so the full sum, added in bin_distance2's axis
+  /// order, can only be larger. Along a row the gap grows away from x on both
+  /// sides, so the near bins form one interval, found from its two ends.
+  /// `gaps` is the caller's scratch (one per thread): the locator stays
+  /// read-only.
+  template <class F>
+  void for_each_shell_run_near(const double* x, const std::array<std::int32_t, D>& b, int s, double r2max,
                                std::vector<double>& gaps, F&& f) const {
+    if (s == 0) {
+      const std::size_t k = bin_index(b);
+      f(offsets_[k], offsets_[k + 1]);
+      return;
+    }
     const std::size_t w = static_cast<std::size_t>(2 * s + 1);
     gaps.resize(D * w);
     for (int d = 0; d < D; ++d) {
@@ -142,15 +169,22 @@ class BinLocator {
       }
     }
     auto gap2 = [&](int d, int o) { return gaps[static_cast<std::size_t>(d) * w + static_cast<std::size_t>(o + s)]; };
-    walk_shell(
+    walk_rows(
         b, s, [&](int o_outer) { return gap2(D - 1, o_outer) <= r2max; },
         [&](int oy, int oz) { return gap2(1, oy) + gap2(2, oz) <= r2max; },
-        [&](const std::array<std::int32_t, D>& o) {
-          double sum = 0.0;
-          for (int d = 0; d < D; ++d) sum += gap2(d, o[d]);
-          return sum <= r2max;
-        },
-        f);
+        [&](std::array<std::int32_t, D> c, int xa, int xb) {
+          auto near = [&](int cx) {
+            double sum = gap2(0, cx - b[0]);
+            for (int d = 1; d < D; ++d) sum += gap2(d, c[d] - b[d]);
+            return sum <= r2max;
+          };
+          while (xa <= xb && !near(xa)) ++xa;
+          while (xb >= xa && !near(xb)) --xb;
+          if (xa > xb) return;
+          c[0] = xa;
+          const std::size_t k = bin_index(c);
+          f(offsets_[k], offsets_[k + static_cast<std::size_t>(xb - xa) + 1]);
+        });
   }
 
   std::size_t num_bins() const { return offsets_.size() - 1; }
@@ -162,35 +196,37 @@ class BinLocator {
   const std::array<std::int32_t, D>& divisions() const { return divs_; }
 
  private:
-  // The one shell walk (bins in z, y, x order; only the shell's surface)
-  // behind both visitors. near_outer(offset along the last axis), near_row
-  // (y and z offsets, 3D only) and near_bin(all offsets) may skip a slab, a
-  // row or a bin; for_each_shell_bin skips nothing.
-  template <class Outer, class Row, class Bin, class F>
-  void walk_shell(const std::array<std::int32_t, D>& b, int s, Outer&& near_outer, Row&& near_row,
-                  Bin&& near_bin, F&& f) const {
-    if (s == 0) { f(b, bin_index(b)); return; }
-    std::array<std::int32_t, D> c, o;
-    auto walk_x = [&](bool surface) {  // surface: every x; else only the two x faces
-      const int step = surface ? 1 : 2 * s;
-      for (o[0] = -s; o[0] <= s; o[0] += step) {
-        c[0] = b[0] + o[0];
-        if (c[0] < 0 || c[0] >= divs_[0] || !near_bin(o)) continue;
-        f(c, bin_index(c));
+  // The one shell walk behind both visitors: the shell's surface row by row
+  // (z, then y), each row as intervals of x bin coordinates: the whole row
+  // (clipped to the grid) on the shell's z and y faces, else its two x-face
+  // bins one at a time. f(bin coords with y, z set, first x, last x).
+  // near_outer(offset along the last axis) and near_row (y and z offsets, 3D
+  // only) may skip a slab or a row.
+  template <class Outer, class Row, class F>
+  void walk_rows(const std::array<std::int32_t, D>& b, int s, Outer&& near_outer, Row&& near_row, F&& f) const {
+    if (s == 0) { f(b, b[0], b[0]); return; }
+    std::array<std::int32_t, D> c = b;
+    auto walk_x = [&](bool surface) {
+      if (surface) {
+        const int xa = std::max(b[0] - s, 0), xb = std::min(b[0] + s, divs_[0] - 1);
+        if (xa <= xb) f(c, xa, xb);
+        return;
       }
+      if (b[0] - s >= 0) f(c, b[0] - s, b[0] - s);
+      if (b[0] + s < divs_[0]) f(c, b[0] + s, b[0] + s);
     };
     const int outer = D - 1;
-    for (o[outer] = -s; o[outer] <= s; ++o[outer]) {
-      c[outer] = b[outer] + o[outer];
-      if (c[outer] < 0 || c[outer] >= divs_[outer] || !near_outer(o[outer])) continue;
-      const bool outer_face = o[outer] == -s || o[outer] == s;
+    for (int oo = -s; oo <= s; ++oo) {
+      c[outer] = b[outer] + oo;
+      if (c[outer] < 0 || c[outer] >= divs_[outer] || !near_outer(oo)) continue;
+      const bool outer_face = oo == -s || oo == s;
       if constexpr (D == 2) {
         walk_x(outer_face);
       } else {
-        for (o[1] = -s; o[1] <= s; ++o[1]) {
-          c[1] = b[1] + o[1];
-          if (c[1] < 0 || c[1] >= divs_[1] || !near_row(o[1], o[2])) continue;
-          walk_x(outer_face || o[1] == -s || o[1] == s);
+        for (int oy = -s; oy <= s; ++oy) {
+          c[1] = b[1] + oy;
+          if (c[1] < 0 || c[1] >= divs_[1] || !near_row(oy, oo)) continue;
+          walk_x(outer_face || oy == -s || oy == s);
         }
       }
     }
