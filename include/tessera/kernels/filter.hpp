@@ -68,7 +68,15 @@ class FilterLanes {
     for (std::size_t t = 0; t < n_; ++t) put(t, vs[t]);
     pad();
   }
-  /// Keep the first n slots (n <= size()).
+  /// Move slots [src, src + count) to [dst, dst + count) (the ranges may
+  /// overlap), as the vertex list's own memmove does.
+  void move(std::size_t dst, std::size_t src, std::size_t count) {
+    grow(std::max(dst, src) + count);
+    for (int k = 0; k < D; ++k) std::memmove(y_[k].data() + dst, y_[k].data() + src, count * sizeof(double));
+    std::memmove(e_.data() + dst, e_.data() + src, count * sizeof(double));
+    std::memmove(r2_.data() + dst, r2_.data() + src, count * sizeof(double));
+  }
+  /// Keep (or make room for) the first n slots; new slots are unset until set().
   void resize(std::size_t n) {
     grow(n);
     n_ = n;

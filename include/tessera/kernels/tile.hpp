@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <limits>
 #include <stdexcept>
 #include <vector>
@@ -92,27 +93,48 @@ class Tile {
     if (planes_.size() + 1 >= 0xFFFF) throw std::length_error("tessera: a tile has more than 65534 edges");
     const std::uint16_t pn = static_cast<std::uint16_t>(planes_.size());
     planes_.push_back(pl);
-    // The removed vertices form one cyclic run; replace it by two new vertices.
-    next_.clear();
-    for (std::size_t t = 0; t < nv; ++t) {
-      const Vertex& v = verts_[t];
-      const Vertex& w = verts_[(t + 1) % nv];
-      const std::int8_t sv = sign_[t], sw = sign_[(t + 1) % nv];
-      if (sv > 0) next_.push_back(v);
-      if (sv > 0 && sw < 0) {          // leaving: edge plane v.p[1], then the new plane
-        Vertex a;
-        a.p[0] = v.p[1]; a.p[1] = pn;
-        solve(a);
-        next_.push_back(a);
-      } else if (sv < 0 && sw > 0) {   // entering: the new plane, then edge plane w.p[0]
-        Vertex b;
-        b.p[0] = pn; b.p[1] = w.p[0];
-        solve(b);
-        next_.push_back(b);
+    // The removed vertices form one cyclic run (the polygon is convex). It is
+    // replaced in place by a (leaving: the edge plane of the last kept vertex,
+    // then the new plane) and b (entering: the new plane, then the edge plane
+    // of the first kept vertex), keeping the cycle's start where vertex 0
+    // survives:
+    //   vertex 0 kept:    [0 .. L] a b [E+1 .. nv-1]   (removed run L+1 .. E)
+    //   vertex 0 removed: b [k0 .. k1] a               (kept run k0 .. k1)
+    const std::size_t kept = nv - removed;
+    Vertex a, b;
+    if (sign_[0] > 0) {
+      std::size_t r0 = 1;
+      while (sign_[r0] > 0) ++r0;
+      const std::size_t e1 = r0 + removed;  // first slot after the run (nv: none)
+      a.p[0] = verts_[r0 - 1].p[1]; a.p[1] = pn;
+      b.p[0] = pn; b.p[1] = verts_[e1 % nv].p[0];
+      solve(a);
+      solve(b);
+      const std::size_t tail = nv - e1;
+      if (removed != 2) {
+        if (removed < 2) grow(kept + 2);
+        std::memmove(verts_.data() + r0 + 2, verts_.data() + e1, tail * sizeof(Vertex));
+        lanes_.move(r0 + 2, e1, tail);
       }
+      put(r0, a);
+      put(r0 + 1, b);
+    } else {
+      std::size_t k0 = 1;
+      while (sign_[k0] < 0) ++k0;
+      b.p[0] = pn; b.p[1] = verts_[k0].p[0];
+      a.p[0] = verts_[k0 + kept - 1].p[1]; a.p[1] = pn;
+      solve(a);
+      solve(b);
+      if (removed < 2) grow(kept + 2);
+      if (k0 != 1) {
+        std::memmove(verts_.data() + 1, verts_.data() + k0, kept * sizeof(Vertex));
+        lanes_.move(1, k0, kept);
+      }
+      put(0, b);
+      put(kept + 1, a);
     }
-    verts_.swap(next_);
-    lanes_.assign(verts_);
+    verts_.resize(kept + 2);
+    lanes_.resize(kept + 2);
     update_radius();
     return ClipResult::clipped;
   }
@@ -129,6 +151,18 @@ class Tile {
     ++exact_calls_;
     std::int32_t ids[2] = {planes_[v.p[0]].id, planes_[v.p[1]].id};
     return exact_clip_sign(*exact_, gen_, ids, j);
+  }
+
+  // verts_ and its sign-pass mirror (lanes_) change together.
+  void put(std::size_t t, const Vertex& v) {
+    verts_[t] = v;
+    lanes_.set(t, v);
+  }
+  void grow(std::size_t n) {
+    if (verts_.size() < n) {
+      verts_.resize(n);
+      lanes_.resize(n);
+    }
   }
 
   void solve(Vertex& v) const {
@@ -166,8 +200,9 @@ class Tile {
   }
 
   void update_radius() {
-    double r2 = 0;
-    for (const Vertex& v : verts_) r2 = std::max(r2, v.r2);
+    double r2 = 0;  // padding is -1
+    const double* R = lanes_.r2();
+    for (std::size_t t = 0; t < lanes_.padded(); ++t) r2 = std::max(r2, R[t]);
     security2_ = 4.0 * r2 * (1 + 1e-12);
   }
 
@@ -175,7 +210,7 @@ class Tile {
   const ExactContext* exact_ = nullptr;
   std::uint64_t exact_calls_ = 0;
   std::vector<Plane> planes_;
-  std::vector<Vertex> verts_, next_;
+  std::vector<Vertex> verts_;
   filter::FilterLanes<2> lanes_;  // verts_' filter data, for the sign pass
   std::vector<std::int8_t> sign_;
   double security2_ = 0;
