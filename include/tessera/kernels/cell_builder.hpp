@@ -140,7 +140,7 @@ class CellBuilder {
         const std::size_t left = static_cast<std::size_t>(end - first);
         std::uint64_t* const last_taken = first + (left > 2 * sort_head ? sort_head : left);
         if (last_taken != end) std::nth_element(first, last_taken, end);
-        std::sort(first, last_taken);
+        sort_keys(first, last_taken);
         for (; next == Next::go && first != last_taken; ++first) next = visit(*first);
       }
       if (next == Next::no_cell) return status;
@@ -152,6 +152,25 @@ class CellBuilder {
   /// Candidates sorted per round of the lazy sort (above: a full sort when a
   /// shell holds at most twice as many). A uniform cell uses about 47.
   static constexpr std::size_t sort_head = 64;
+
+  /// Ascending order of distinct keys. Up to 64 (a uniform cell's first
+  /// gather holds ~54 in 3D, ~20 in 2D) by straight insertion, which measured
+  /// faster than std::sort's partitioning at this size; longer runs by std::sort.
+  static void sort_keys(std::uint64_t* first, std::uint64_t* last) {
+    if (last - first > 64) {
+      std::sort(first, last);
+      return;
+    }
+    for (std::uint64_t* it = first + (first != last); it < last; ++it) {
+      const std::uint64_t v = *it;
+      std::uint64_t* hole = it;
+      while (hole != first && hole[-1] > v) {
+        *hole = hole[-1];
+        --hole;
+      }
+      *hole = v;
+    }
+  }
 
   struct Candidate {
     double r2;
