@@ -52,22 +52,26 @@ class Hull {
     gen_ = gen;
     exact_ = exact;
     exact_calls_ = 0;
-    planes_.clear();
-    truncate(0);
+    // Planes and corners are written in place: a local struct copied in
+    // would be read back wider than it was written (a store-forwarding stall).
+    planes_.resize(6);
     for (int k = 0; k < 6; ++k) {
-      int axis = k / 2;
-      bool upper = k & 1;
-      Plane pl{};
+      const int axis = k / 2;
+      const bool upper = k & 1;
+      Plane& pl = planes_[static_cast<std::size_t>(k)];
+      for (int a = 0; a < 3; ++a) pl.n[a] = 0.0;
       pl.n[axis] = upper ? 1.0 : -1.0;
       pl.d = upper ? hi[axis] - p[axis] : p[axis] - lo[axis];
       pl.n1 = 1.0;
       pl.id = box_plane_id(axis, upper);
-      planes_.push_back(pl);
     }
+    truncate(0);
     ensure_table(64);
+    verts_.resize(8);
+    lanes_.resize(8);
     for (int c = 0; c < 8; ++c) {
-      int sx = c & 1, sy = (c >> 1) & 1, sz = (c >> 2) & 1;
-      Vertex v{};
+      const int sx = c & 1, sy = (c >> 1) & 1, sz = (c >> 2) & 1;
+      Vertex& v = verts_[static_cast<std::size_t>(c)];
       v.y[0] = sx ? planes_[1].d : -planes_[0].d;
       v.y[1] = sy ? planes_[3].d : -planes_[2].d;
       v.y[2] = sz ? planes_[5].d : -planes_[4].d;
@@ -75,27 +79,25 @@ class Hull {
       double err = filter::u * ymax;  // each coordinate rounded once
       v.e = err + filter::plane_eps * ymax;
       set_radius(v, err);
-      std::uint16_t a = static_cast<std::uint16_t>(sx), b = static_cast<std::uint16_t>(2 + sy),
-                    cc = static_cast<std::uint16_t>(4 + sz);
+      const std::uint16_t a = static_cast<std::uint16_t>(sx), b = static_cast<std::uint16_t>(2 + sy),
+                          cc = static_cast<std::uint16_t>(4 + sz);
       // det(±e_x, ±e_y, ±e_z) = product of the signs; swap to make it positive.
-      bool positive = ((sx + sy + sz) % 2) == 1;  // signs: upper=+, lower=-
-      if (positive) { v.p[0] = a; v.p[1] = b; v.p[2] = cc; }
-      else { v.p[0] = a; v.p[1] = cc; v.p[2] = b; }
-      append(v);
+      const bool positive = ((sx + sy + sz) % 2) == 1;  // signs: upper=+, lower=-
+      v.p[0] = a;
+      v.p[1] = positive ? b : cc;
+      v.p[2] = positive ? cc : b;
+      lanes_.set(static_cast<std::size_t>(c), v);
+      link(static_cast<std::uint32_t>(c));
     }
     update_radius();
   }
 
   /// Clip by the bisector with generator j, q = p_j - p_i (computed in double).
   ClipResult clip(std::int32_t j, const double* q) {
-    Plane pl;
-    pl.n[0] = q[0]; pl.n[1] = q[1]; pl.n[2] = q[2];
-    pl.d = 0.5 * (q[0] * q[0] + q[1] * q[1] + q[2] * q[2]);
-    pl.n1 = std::fabs(q[0]) + std::fabs(q[1]) + std::fabs(q[2]);
-    pl.id = j;
-
+    const double d = 0.5 * (q[0] * q[0] + q[1] * q[1] + q[2] * q[2]);
+    const double n1 = std::fabs(q[0]) + std::fabs(q[1]) + std::fabs(q[2]);
     const std::size_t nv = verts_.size();
-    const std::size_t removed = filter::classify<3>(lanes_, pl.n, pl.d, pl.n1, sign_,
+    const std::size_t removed = filter::classify<3>(lanes_, q, d, n1, sign_,
                                                      [&](std::size_t t) { return exact_sign(verts_[t], j); });
     if (removed == 0) return ClipResult::unchanged;
     if (removed == nv) {
@@ -107,7 +109,11 @@ class Hull {
     const std::uint16_t pn = static_cast<std::uint16_t>(planes_.size());
     if (planes_.size() + 1 >= 0xFFFF)
       throw std::length_error("tessera: a cell has more than 65534 faces");
-    planes_.push_back(pl);
+    Plane& pl = planes_.emplace_back();  // written in place (see reset)
+    pl.n[0] = q[0]; pl.n[1] = q[1]; pl.n[2] = q[2];
+    pl.d = d;
+    pl.n1 = n1;
+    pl.id = j;
     if (planes_.size() > cap_) ensure_table(2 * cap_);
 
     // The removed slots, ascending.
@@ -123,10 +129,9 @@ class Hull {
     fresh_.clear();
     auto border = [&](std::uint16_t a, std::uint16_t b) {
       if (sign_[edge_tri_[static_cast<std::size_t>(b) * cap_ + a]] < 0) return;
-      Vertex nvtx;
+      Vertex& nvtx = fresh_.emplace_back();  // built in place (see reset)
       nvtx.p[0] = a; nvtx.p[1] = b; nvtx.p[2] = pn;
       solve(nvtx);
-      fresh_.push_back(nvtx);
     };
     for (std::uint32_t t : holes_) {
       const Vertex& v = verts_[t];

@@ -43,23 +43,25 @@ class Tile {
     gen_ = gen;
     exact_ = exact;
     exact_calls_ = 0;
-    planes_.clear();
-    verts_.clear();
+    // Planes and corners are written in place: a local struct copied in
+    // would be read back wider than it was written (a store-forwarding stall).
+    planes_.resize(4);
     for (int k = 0; k < 4; ++k) {
-      int axis = k / 2;
-      bool upper = k & 1;
-      Plane pl{};
+      const int axis = k / 2;
+      const bool upper = k & 1;
+      Plane& pl = planes_[static_cast<std::size_t>(k)];
       pl.n[axis] = upper ? 1.0 : -1.0;
+      pl.n[1 - axis] = 0.0;
       pl.d = upper ? hi[axis] - p[axis] : p[axis] - lo[axis];
       pl.n1 = 1.0;
       pl.id = box_plane_id(axis, upper);
-      planes_.push_back(pl);
     }
     // Corners counter-clockwise from (lo, lo); local planes x0=0, x1=1, y0=2, y1=3.
     const std::uint16_t in[4] = {0, 2, 1, 3}, out[4] = {2, 1, 3, 0};
     const int cx[4] = {0, 1, 1, 0}, cy[4] = {0, 0, 1, 1};
+    verts_.resize(4);
     for (int c = 0; c < 4; ++c) {
-      Vertex v{};
+      Vertex& v = verts_[static_cast<std::size_t>(c)];
       v.y[0] = cx[c] ? planes_[1].d : -planes_[0].d;
       v.y[1] = cy[c] ? planes_[3].d : -planes_[2].d;
       double ymax = std::max(std::fabs(v.y[0]), std::fabs(v.y[1]));
@@ -68,20 +70,16 @@ class Tile {
       set_radius(v, err);
       v.p[0] = in[c];
       v.p[1] = out[c];
-      verts_.push_back(v);
     }
     lanes_.assign(verts_);
     update_radius();
   }
 
   ClipResult clip(std::int32_t j, const double* q) {
-    Plane pl;
-    pl.n[0] = q[0]; pl.n[1] = q[1];
-    pl.d = 0.5 * (q[0] * q[0] + q[1] * q[1]);
-    pl.n1 = std::fabs(q[0]) + std::fabs(q[1]);
-    pl.id = j;
+    const double d = 0.5 * (q[0] * q[0] + q[1] * q[1]);
+    const double n1 = std::fabs(q[0]) + std::fabs(q[1]);
     const std::size_t nv = verts_.size();
-    const std::size_t removed = filter::classify<2>(lanes_, pl.n, pl.d, pl.n1, sign_,
+    const std::size_t removed = filter::classify<2>(lanes_, q, d, n1, sign_,
                                                      [&](std::size_t t) { return exact_sign(verts_[t], j); });
     if (removed == 0) return ClipResult::unchanged;
     if (removed == nv) {
@@ -92,7 +90,11 @@ class Tile {
     }
     if (planes_.size() + 1 >= 0xFFFF) throw std::length_error("tessera: a tile has more than 65534 edges");
     const std::uint16_t pn = static_cast<std::uint16_t>(planes_.size());
-    planes_.push_back(pl);
+    Plane& pl = planes_.emplace_back();  // written in place (see reset)
+    pl.n[0] = q[0]; pl.n[1] = q[1];
+    pl.d = d;
+    pl.n1 = n1;
+    pl.id = j;
     // The removed vertices form one cyclic run (the polygon is convex). It is
     // replaced in place by a (leaving: the edge plane of the last kept vertex,
     // then the new plane) and b (entering: the new plane, then the edge plane
@@ -101,37 +103,38 @@ class Tile {
     //   vertex 0 kept:    [0 .. L] a b [E+1 .. nv-1]   (removed run L+1 .. E)
     //   vertex 0 removed: b [k0 .. k1] a               (kept run k0 .. k1)
     const std::size_t kept = nv - removed;
-    Vertex a, b;
+    // The new vertices are built in their slots (see reset on why not copied in).
+    auto make = [&](std::size_t t, std::uint16_t p0, std::uint16_t p1) {
+      Vertex& v = verts_[t];
+      v.p[0] = p0;
+      v.p[1] = p1;
+      solve(v);
+      lanes_.set(t, v);
+    };
     if (sign_[0] > 0) {
       std::size_t r0 = 1;
       while (sign_[r0] > 0) ++r0;
       const std::size_t e1 = r0 + removed;  // first slot after the run (nv: none)
-      a.p[0] = verts_[r0 - 1].p[1]; a.p[1] = pn;
-      b.p[0] = pn; b.p[1] = verts_[e1 % nv].p[0];
-      solve(a);
-      solve(b);
+      const std::uint16_t a0 = verts_[r0 - 1].p[1], b1 = verts_[e1 % nv].p[0];
       const std::size_t tail = nv - e1;
+      if (removed < 2) grow(kept + 2);
       if (removed != 2) {
-        if (removed < 2) grow(kept + 2);
         std::memmove(verts_.data() + r0 + 2, verts_.data() + e1, tail * sizeof(Vertex));
         lanes_.move(r0 + 2, e1, tail);
       }
-      put(r0, a);
-      put(r0 + 1, b);
+      make(r0, a0, pn);
+      make(r0 + 1, pn, b1);
     } else {
       std::size_t k0 = 1;
       while (sign_[k0] < 0) ++k0;
-      b.p[0] = pn; b.p[1] = verts_[k0].p[0];
-      a.p[0] = verts_[k0 + kept - 1].p[1]; a.p[1] = pn;
-      solve(a);
-      solve(b);
+      const std::uint16_t b1 = verts_[k0].p[0], a0 = verts_[k0 + kept - 1].p[1];
       if (removed < 2) grow(kept + 2);
       if (k0 != 1) {
         std::memmove(verts_.data() + 1, verts_.data() + k0, kept * sizeof(Vertex));
         lanes_.move(1, k0, kept);
       }
-      put(0, b);
-      put(kept + 1, a);
+      make(0, pn, b1);
+      make(kept + 1, a0, pn);
     }
     verts_.resize(kept + 2);
     lanes_.resize(kept + 2);
@@ -154,10 +157,6 @@ class Tile {
   }
 
   // verts_ and its sign-pass mirror (lanes_) change together.
-  void put(std::size_t t, const Vertex& v) {
-    verts_[t] = v;
-    lanes_.set(t, v);
-  }
   void grow(std::size_t n) {
     if (verts_.size() < n) {
       verts_.resize(n);
