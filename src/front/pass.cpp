@@ -6,6 +6,8 @@
 #include <sstream>
 #include <string>
 
+#include <tbb/task_arena.h>
+
 namespace tessera::front {
 namespace {
 const char* axis_name(int d) { return d == 0 ? "x" : (d == 1 ? "y" : "z"); }
@@ -156,8 +158,11 @@ Pass<D>::Pass(std::span<const double> input, std::span<const std::int32_t> label
     hi[static_cast<std::size_t>(d)] = bounds.hi[static_cast<std::size_t>(d)];
   }
   const double ppb = opt.points_per_bin > 0 ? opt.points_per_bin : 2.0;
-  locator.emplace(points, n_in == n ? std::span<const std::uint8_t>() : std::span<const std::uint8_t>(in_box), lo, hi,
-                  ppb);
+  engine_options.threads = resolve_threads(opt.threads);
+  tbb::task_arena(engine_options.threads).execute([&] {
+    locator.emplace(points, n_in == n ? std::span<const std::uint8_t>() : std::span<const std::uint8_t>(in_box), lo,
+                    hi, ppb);
+  });
 
   // Generators with cells, in bin order (neighbouring cells run together).
   order.reserve(locator->size());
@@ -179,7 +184,6 @@ Pass<D>::Pass(std::span<const double> input, std::span<const std::int32_t> label
   gens.order = order;
   gens.exact = &exact;
 
-  engine_options.threads = resolve_threads(opt.threads);
   engine_options.progress = opt.progress;
 }
 

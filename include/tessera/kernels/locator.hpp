@@ -49,15 +49,19 @@ class BinLocator {
     min_size_ = *std::min_element(size_.begin(), size_.end());
     for (int d = 0; d < D; ++d) slack_ = std::max({slack_, std::fabs(lo[d]), std::fabs(hi[d])});
     slack_ *= 8 * std::numeric_limits<double>::epsilon();
-    // Counting sort by bin; stable in id, so the order is deterministic.
+    // Counting sort by bin; stable in id, so the order is deterministic. The
+    // bin of each point (the arithmetic) in parallel, in the caller's arena;
+    // counting and scattering (memory traffic) serially.
     std::vector<std::uint32_t> bin_of(n);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, std::size_t{1} << 14),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+                        for (std::size_t id = r.begin(); id != r.end(); ++id)
+                          if (use.empty() || use[id])
+                            bin_of[id] = static_cast<std::uint32_t>(bin_index(bin_coords(&coords[id * D])));
+                      });
     offsets_.assign(total + 1, 0);
-    for (std::size_t id = 0; id < n; ++id) {
-      if (!use.empty() && !use[id]) continue;
-      std::uint32_t b = static_cast<std::uint32_t>(bin_index(bin_coords(&coords[id * D])));
-      bin_of[id] = b;
-      ++offsets_[b + 1];
-    }
+    for (std::size_t id = 0; id < n; ++id)
+      if (use.empty() || use[id]) ++offsets_[bin_of[id] + 1];
     for (std::size_t b = 0; b < total; ++b) offsets_[b + 1] += offsets_[b];
     ids_.resize(used);
     sorted_.resize(used);
@@ -164,7 +168,7 @@ class BinLocator {
     for (int d = 0; d < D; ++d) {
       for (int o = -s; o <= s; ++o) {
         const double blo = lo_[d] + (b[d] + o) * size_[d], bhi = blo + size_[d];
-        const double g = std::max({0.0, blo - x[d] - slack_, x[d] - bhi - slack_});
+        const double g = std::max(std::max(0.0, blo - x[d] - slack_), x[d] - bhi - slack_);
         gaps[static_cast<std::size_t>(d) * w + static_cast<std::size_t>(o + s)] = g * g;
       }
     }
