@@ -65,10 +65,9 @@ class Hull {
       pl.n1 = 1.0;
       pl.id = box_plane_id(axis, upper);
     }
-    truncate(0);
+    resize_vertices(0);  // nothing stale for ensure_table to link
     ensure_table(64);
-    verts_.resize(8);
-    lanes_.resize(8);
+    resize_vertices(8);
     for (int c = 0; c < 8; ++c) {
       const int sx = c & 1, sy = (c >> 1) & 1, sz = (c >> 2) & 1;
       Vertex& v = verts_[static_cast<std::size_t>(c)];
@@ -86,8 +85,7 @@ class Hull {
       v.p[0] = a;
       v.p[1] = positive ? b : cc;
       v.p[2] = positive ? cc : b;
-      lanes_.set(static_cast<std::size_t>(c), v);
-      link(static_cast<std::uint32_t>(c));
+      settle(static_cast<std::uint32_t>(c));
     }
     update_radius();
   }
@@ -101,7 +99,7 @@ class Hull {
                                                      [&](std::size_t t) { return exact_sign(verts_[t], j); });
     if (removed == 0) return ClipResult::unchanged;
     if (removed == nv) {
-      truncate(0);
+      resize_vertices(0);
       security2_ = 0;
       return ClipResult::emptied;
     }
@@ -154,7 +152,7 @@ class Hull {
         place(t, verts_[end - 1]);
         --end;
       }
-      truncate(end);
+      resize_vertices(end);
     }
     update_radius();
     return ClipResult::clipped;
@@ -209,22 +207,27 @@ class Hull {
     return exact_clip_sign(*exact_, gen_, ids, j);
   }
 
-  // Every change to the vertex list goes through these three, which keep the
-  // sign pass's mirror (lanes_) and the edge table in step with verts_.
+  // Every change to the vertex list goes through these, which keep the sign
+  // pass's mirror (lanes_) and the edge table in step with verts_.
   void place(std::uint32_t t, const Vertex& v) {  // into an existing slot, kept from now on
     verts_[t] = v;
-    lanes_.set(t, v);
     sign_[t] = 1;
-    link(t);
+    settle(t);
   }
   void append(const Vertex& v) {
     verts_.push_back(v);
     lanes_.push_back(v);
     link(static_cast<std::uint32_t>(verts_.size() - 1));
   }
-  void truncate(std::size_t n) {
+  /// Keep the first n vertices, or make room for slots to be written in place
+  /// and then settled.
+  void resize_vertices(std::size_t n) {
     verts_.resize(n);
     lanes_.resize(n);
+  }
+  void settle(std::uint32_t t) {  // slot t was written in place
+    lanes_.set(t, verts_[t]);
+    link(t);
   }
 
   void link(std::uint32_t t) {

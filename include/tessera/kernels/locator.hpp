@@ -134,11 +134,7 @@ class BinLocator {
   template <class F>
   void for_each_shell_run(const std::array<std::int32_t, D>& b, int s, F&& f) const {
     auto keep = [](const auto&...) { return true; };
-    walk_rows(b, s, keep, keep, [&](std::array<std::int32_t, D> c, int xa, int xb) {
-      c[0] = xa;
-      const std::size_t k = bin_index(c);
-      f(offsets_[k], offsets_[k + static_cast<std::size_t>(xb - xa) + 1]);
-    });
+    walk_rows(b, s, keep, keep, [&](std::array<std::int32_t, D> c, int xa, int xb) { emit_run(c, xa, xb, f); });
   }
 
   /// The points of the bins of shell s around b whose box lies within squared
@@ -158,11 +154,7 @@ class BinLocator {
   template <class F>
   void for_each_shell_run_near(const double* x, const std::array<std::int32_t, D>& b, int s, double r2max,
                                std::vector<double>& gaps, F&& f) const {
-    if (s == 0) {
-      const std::size_t k = bin_index(b);
-      f(offsets_[k], offsets_[k + 1]);
-      return;
-    }
+    if (s == 0) return for_each_shell_run(b, 0, f);
     const std::size_t w = static_cast<std::size_t>(2 * s + 1);
     gaps.resize(D * w);
     for (int d = 0; d < D; ++d) {
@@ -184,10 +176,7 @@ class BinLocator {
           };
           while (xa <= xb && !near(xa)) ++xa;
           while (xb >= xa && !near(xb)) --xb;
-          if (xa > xb) return;
-          c[0] = xa;
-          const std::size_t k = bin_index(c);
-          f(offsets_[k], offsets_[k + static_cast<std::size_t>(xb - xa) + 1]);
+          if (xa <= xb) emit_run(c, xa, xb, f);
         });
   }
 
@@ -200,7 +189,15 @@ class BinLocator {
   const std::array<std::int32_t, D>& divisions() const { return divs_; }
 
  private:
-  // The one shell walk behind both visitors: the shell's surface row by row
+  // The slots of bins xa..xb of the row of c: contiguous, as bins are numbered x fastest.
+  template <class F>
+  void emit_run(std::array<std::int32_t, D> c, int xa, int xb, F&& f) const {
+    c[0] = xa;
+    const std::size_t k = bin_index(c);
+    f(offsets_[k], offsets_[k + static_cast<std::size_t>(xb - xa) + 1]);
+  }
+
+  // The one shell walk behind the visitors: the shell's surface row by row
   // (z, then y), each row as intervals of x bin coordinates: the whole row
   // (clipped to the grid) on the shell's z and y faces, else its two x-face
   // bins one at a time. f(bin coords with y, z set, first x, last x).

@@ -111,13 +111,13 @@ class Tile {
       solve(v);
       lanes_.set(t, v);
     };
+    if (removed == 1) grow(kept + 2);  // one vertex out, two in
     if (sign_[0] > 0) {
       std::size_t r0 = 1;
       while (sign_[r0] > 0) ++r0;
       const std::size_t e1 = r0 + removed;  // first slot after the run (nv: none)
       const std::uint16_t a0 = verts_[r0 - 1].p[1], b1 = verts_[e1 % nv].p[0];
       const std::size_t tail = nv - e1;
-      if (removed < 2) grow(kept + 2);
       if (removed != 2) {
         std::memmove(verts_.data() + r0 + 2, verts_.data() + e1, tail * sizeof(Vertex));
         lanes_.move(r0 + 2, e1, tail);
@@ -128,7 +128,6 @@ class Tile {
       std::size_t k0 = 1;
       while (sign_[k0] < 0) ++k0;
       const std::uint16_t b1 = verts_[k0].p[0], a0 = verts_[k0 + kept - 1].p[1];
-      if (removed < 2) grow(kept + 2);
       if (k0 != 1) {
         std::memmove(verts_.data() + 1, verts_.data() + k0, kept * sizeof(Vertex));
         lanes_.move(1, k0, kept);
