@@ -4,10 +4,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <stdexcept>
 
-#include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
 
 #include "delaunay_compositor.hpp"
 #include "hull_completion.hpp"
@@ -36,7 +35,7 @@ Delaunay run(std::span<const double> input, std::span<const std::int32_t> labels
   out.threads_used = pass.engine_options.threads;
 
   front::DelaunayPassResult<D> found;
-  front::DelaunayCompositor<CellT> comp(found, n, labels, complete);
+  front::DelaunayCompositor<CellT> comp(found, n, labels, complete, pass.exact);
   out.exact_predicate_calls = engine::tessellate<CellT>(pass.gens, comp, pass.engine_options);
   out.duplicates = std::move(found.duplicates);
   out.from_cells = found.simplices.size() / (D + 1);
@@ -88,40 +87,44 @@ Delaunay run(std::span<const double> input, std::span<const std::int32_t> labels
   }
   out.from_hull_completion = added.size();
 
-  // Merge the two ascending lists, then orient each row in place.
-  const std::size_t m = out.from_cells + added.size();
-  out.simplices.resize(m * (D + 1));
-  {
-    std::size_t i = 0, j = 0, r = 0;
-    const auto& f = found.simplices;
-    auto less_added = [&](std::size_t a, std::size_t b) {
-      return std::lexicographical_compare(added[b].begin(), added[b].end(), f.begin() + static_cast<std::ptrdiff_t>(a * (D + 1)),
-                                          f.begin() + static_cast<std::ptrdiff_t>((a + 1) * (D + 1)));
-    };
-    while (i < out.from_cells || j < added.size()) {
-      const bool take_added = i == out.from_cells || (j < added.size() && less_added(i, j));
-      for (int d = 0; d <= D; ++d)
-        out.simplices[r * (D + 1) + d] = take_added ? added[j][static_cast<std::size_t>(d)] : f[i * (D + 1) + d];
-      take_added ? ++j : ++i;
-      ++r;
-    }
+  // Orient the completion's simplices as the compositor oriented the found
+  // ones, then merge the two lists, both ascending by key. The completion
+  // adds few rows (the thin shell at the hull): each finds its place by
+  // binary search, and the found rows move up in blocks, from the back.
+  std::size_t flat = found.flat;
+  for (auto& row : added) {
+    const int o = kernels::orientation(pass.exact, row.data());
+    if (o < 0) std::swap(row[D - 1], row[D]);
+    flat += o == 0;
   }
-  tbb::task_arena arena(pass.engine_options.threads);
-  std::size_t flat = 0;
-  arena.execute([&] {
-    std::vector<std::uint8_t> is_flat(m, 0);
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, m, 4096), [&](const tbb::blocked_range<std::size_t>& rg) {
-      for (std::size_t s = rg.begin(); s != rg.end(); ++s) {
-        std::int32_t* row = out.simplices.data() + s * (D + 1);
-        int o = kernels::orientation(pass.exact, row);
-        if (o < 0) std::swap(row[D - 1], row[D]);
-        if (o == 0) is_flat[s] = 1;
-      }
-    });
-    flat = static_cast<std::size_t>(std::count(is_flat.begin(), is_flat.end(), 1));
-  });
   if (flat != 0)
     throw std::logic_error("tessera: " + std::to_string(flat) + " Delaunay simplices are flat (inconsistent topology)");
+  {
+    constexpr std::size_t W = D + 1;
+    const std::size_t nf = out.from_cells;
+    std::vector<std::size_t> before(added.size());  // found rows preceding each added row
+    for (std::size_t j = 0; j < added.size(); ++j) {
+      const auto key = front::simplex_key<D>(added[j].data());
+      std::size_t lo = 0, hi = nf;
+      while (lo < hi) {
+        const std::size_t mid = lo + (hi - lo) / 2;
+        if (front::simplex_key<D>(found.simplices.data() + mid * W) < key) lo = mid + 1;
+        else hi = mid;
+      }
+      before[j] = lo;
+    }
+    out.simplices = std::move(found.simplices);
+    out.simplices.resize((nf + added.size()) * W);
+    std::int32_t* rows = out.simplices.data();
+    std::size_t src_end = nf, dst_end = nf + added.size();
+    for (std::size_t j = added.size(); j-- > 0;) {
+      const std::size_t count = src_end - before[j];
+      std::memmove(rows + (dst_end - count) * W, rows + before[j] * W, count * W * sizeof(std::int32_t));
+      dst_end -= count + 1;
+      src_end = before[j];
+      std::copy(added[j].begin(), added[j].end(), rows + dst_end * W);
+    }
+  }
   std::sort(out.duplicates.begin(), out.duplicates.end());
   return out;
 }

@@ -10,6 +10,12 @@
 // facet whose other simplex was not found, and the generators whose cells
 // reach the box (the only candidates for the missing simplices: a missing
 // circumcentre lies outside the box, inside the cells of all its generators).
+//
+// Each simplex is oriented as it is emitted: the cell's bisector normals are
+// the rounded differences the orientation filter works on, so the exact
+// predicate's coordinates are read only when the filter cannot decide.
+// Done afterwards over the whole list, the same test missed the cache on
+// nearly every point.
 #pragma once
 
 #include <algorithm>
@@ -23,6 +29,8 @@
 #include <tbb/parallel_for.h>
 
 #include "tessera/kernels/cell_builder.hpp"
+#include "tessera/kernels/delaunay_predicates.hpp"
+#include "tessera/kernels/exact_predicates.hpp"
 #include "tessera/kernels/hull.hpp"
 #include "tessera/kernels/tile.hpp"
 
@@ -35,10 +43,23 @@ struct OpenFacet {
   auto operator<=>(const OpenFacet&) const = default;
 };
 
+/// A row's sort key: its first id (the lowest), then the others ascending; the
+/// key of an oriented row is its ascending form.
+template <int D>
+std::array<std::int32_t, D + 1> simplex_key(const std::int32_t* row) {
+  std::array<std::int32_t, D + 1> k;
+  std::copy(row, row + D + 1, k.begin());
+  std::sort(k.begin() + 1, k.end());
+  return k;
+}
+
 /// What the compositor leaves for the front end.
 template <int D>
 struct DelaunayPassResult {
-  std::vector<std::int32_t> simplices;     ///< rows of D+1 ascending ids, rows ascending
+  /// Rows of D+1 ids, positively oriented (the last two swapped where the
+  /// ascending order is negative); rows ascending by key (simplex_key).
+  std::vector<std::int32_t> simplices;
+  std::size_t flat = 0;                    ///< simplices of orientation 0 (must stay 0)
   std::vector<OpenFacet<D>> open;          ///< ascending
   std::vector<std::uint8_t> touches_box;   ///< per point (hull info only)
   std::vector<std::pair<std::int32_t, std::int32_t>> duplicates;
@@ -50,69 +71,93 @@ class DelaunayCompositor {
   static constexpr int D = CellT::dim;
   using Simplex = std::array<std::int32_t, D + 1>;
 
+  struct Pending {  // a simplex in ascending order and its orientation
+    Simplex row;
+    int sign;
+  };
   struct Batch {
     std::vector<std::int32_t> gen, dup_of;
     std::vector<std::uint32_t> simplex_end;  // running end into simplices, per generator
     std::vector<Simplex> simplices;
     std::vector<OpenFacet<D>> open;
     std::vector<std::int32_t> touches_box;
+    std::size_t flat = 0;
+    std::vector<Pending> pending;  // scratch of add()
   };
 
   /// `hull_info`: also collect open facets and box-touching generators.
   DelaunayCompositor(DelaunayPassResult<D>& out, std::size_t n_points, std::span<const std::int32_t> labels,
-                     bool hull_info)
-      : out_(out), n_(n_points), labels_(labels), hull_info_(hull_info) {}
+                     bool hull_info, const kernels::ExactContext& exact)
+      : out_(out), n_(n_points), labels_(labels), hull_info_(hull_info), exact_(exact) {}
 
   void add(Batch& b, std::int32_t gen, const kernels::BuildStatus& st, CellT& cell) {
     b.gen.push_back(gen);
     b.dup_of.push_back(st.has_cell ? -1 : st.duplicate_of);
     if (st.has_cell) {
-      const std::size_t s0 = b.simplices.size();
       bool touches = false;
       const auto& verts = cell.vertices();
+      const auto& planes = cell.planes();
+      b.pending.clear();
       for (std::size_t t = 0; t < verts.size(); ++t) {
         std::array<std::int32_t, D> ids;
+        std::array<const double*, D> normals;
         bool box = false, inside = true;
         for (int k = 0; k < D; ++k) {
-          ids[k] = cell.planes()[verts[t].p[k]].id;
+          const auto& pl = planes[verts[t].p[k]];
+          ids[k] = pl.id;
+          normals[k] = pl.n;  // = p_id - p_gen, rounded as orientation() rounds it
           if (ids[k] < 0) box = true;
           else if (!labels_.empty() && labels_[static_cast<std::size_t>(ids[k])] < 0) inside = false;
         }
         if (box) { touches = true; continue; }
         if (inside && gen < *std::min_element(ids.begin(), ids.end())) {
-          Simplex s;
-          s[0] = gen;
-          std::sort(ids.begin(), ids.end());
-          std::copy(ids.begin(), ids.end(), s.begin() + 1);
-          b.simplices.push_back(s);
+          // Ascending ids, their normals alongside (a sorting network).
+          auto order = [&](int a, int c) {
+            if (ids[c] < ids[a]) {
+              std::swap(ids[a], ids[c]);
+              std::swap(normals[a], normals[c]);
+            }
+          };
+          order(0, 1);
+          if constexpr (D == 3) {
+            order(1, 2);
+            order(0, 1);
+          }
+          Pending& e = b.pending.emplace_back();
+          e.row[0] = gen;
+          std::copy(ids.begin(), ids.end(), e.row.begin() + 1);
+          e.sign = kernels::orientation_filter(D, normals.data());
+          if (e.sign == 0) e.sign = kernels::orientation(exact_, e.row.data());
         }
         if (hull_info_) open_facets(b, gen, cell, t);
       }
-      std::sort(b.simplices.begin() + static_cast<std::ptrdiff_t>(s0), b.simplices.end());
+      std::sort(b.pending.begin(), b.pending.end(), [](const Pending& x, const Pending& y) { return x.row < y.row; });
+      for (Pending& e : b.pending) {
+        if (e.sign < 0) std::swap(e.row[D - 1], e.row[D]);
+        b.flat += e.sign == 0;
+        b.simplices.push_back(e.row);
+      }
       if (hull_info_ && touches) b.touches_box.push_back(gen);
     }
     b.simplex_end.push_back(static_cast<std::uint32_t>(b.simplices.size()));
   }
 
   void finish(std::span<Batch> batches) {
-    struct Loc { std::int32_t batch = -1, index = -1; };
-    std::vector<Loc> where(n_);
-    for (std::size_t k = 0; k < batches.size(); ++k)
-      for (std::size_t t = 0; t < batches[k].gen.size(); ++t)
-        where[static_cast<std::size_t>(batches[k].gen[t])] = {static_cast<std::int32_t>(k), static_cast<std::int32_t>(t)};
-    // Simplices in generator order (each generator's are ascending, and its
-    // lowest id is the generator): the whole list comes out ascending.
+    // Simplices in generator order (each generator's come ascending by key
+    // and hold it as their lowest id): the whole list comes out ascending.
+    // Every generator lies in exactly one batch, so the counts are written
+    // from all batches at once without conflict.
     std::vector<std::int64_t> offset(n_ + 1, 0);
-    for (std::size_t g = 0; g < n_; ++g) {
-      const Loc& w = where[g];
-      std::int64_t cnt = 0;
-      if (w.batch >= 0) {
-        const Batch& b = batches[static_cast<std::size_t>(w.batch)];
-        const auto t = static_cast<std::size_t>(w.index);
-        if (b.dup_of[t] >= 0) out_.duplicates.emplace_back(static_cast<std::int32_t>(g), b.dup_of[t]);
-        cnt = b.simplex_end[t] - (t == 0 ? 0 : b.simplex_end[t - 1]);
-      }
-      offset[g + 1] = offset[g] + cnt;
+    tbb::parallel_for(std::size_t(0), batches.size(), [&](std::size_t k) {
+      const Batch& b = batches[k];
+      for (std::size_t t = 0; t < b.gen.size(); ++t)
+        offset[static_cast<std::size_t>(b.gen[t]) + 1] = b.simplex_end[t] - (t == 0 ? 0 : b.simplex_end[t - 1]);
+    });
+    std::partial_sum(offset.begin(), offset.end(), offset.begin());
+    for (const Batch& b : batches) {
+      out_.flat += b.flat;
+      for (std::size_t t = 0; t < b.gen.size(); ++t)
+        if (b.dup_of[t] >= 0) out_.duplicates.emplace_back(b.gen[t], b.dup_of[t]);
     }
     out_.simplices.resize(static_cast<std::size_t>(offset[n_]) * (D + 1));
     tbb::parallel_for(std::size_t(0), batches.size(), [&](std::size_t k) {
@@ -174,6 +219,7 @@ class DelaunayCompositor {
   std::size_t n_;
   std::span<const std::int32_t> labels_;
   bool hull_info_;
+  const kernels::ExactContext& exact_;
 };
 
 }  // namespace tessera::front

@@ -20,22 +20,7 @@ struct Rows {
   double r[3][3];
 };
 
-// det of the D x D matrix of rows and its permanent (for the error bound).
-double det_perm(const double (*r)[3], int dim, double& perm) {
-  if (dim == 2) {
-    double a = r[0][0] * r[1][1], b = r[0][1] * r[1][0];
-    perm = std::fabs(a) + std::fabs(b);
-    return a - b;
-  }
-  double c0 = r[1][1] * r[2][2] - r[1][2] * r[2][1];
-  double c1 = r[1][2] * r[2][0] - r[1][0] * r[2][2];
-  double c2 = r[1][0] * r[2][1] - r[1][1] * r[2][0];
-  double p0 = std::fabs(r[1][1] * r[2][2]) + std::fabs(r[1][2] * r[2][1]);
-  double p1 = std::fabs(r[1][2] * r[2][0]) + std::fabs(r[1][0] * r[2][2]);
-  double p2 = std::fabs(r[1][0] * r[2][1]) + std::fabs(r[1][1] * r[2][0]);
-  perm = std::fabs(r[0][0]) * p0 + std::fabs(r[0][1]) * p1 + std::fabs(r[0][2]) * p2;
-  return r[0][0] * c0 + r[0][1] * c1 + r[0][2] * c2;
-}
+using detail::det_perm;
 
 // Exact orientation in 128-bit integers when every coordinate is a 25-bit
 // integer times one common power of two (lattices, voxel centres, integer and
@@ -105,19 +90,15 @@ int orientation_exact(int D, const double* const* pts) {
 }  // namespace
 
 int orientation(int D, const double* const* pts) {
+  const double* rows[3] = {};
   double r[3][3] = {};
   const double* p0 = pts[0];
   for (int k = 0; k < D; ++k) {
     const double* p = pts[k + 1];
     for (int d = 0; d < D; ++d) r[k][d] = p[d] - p0[d];
+    rows[k] = r[k];
   }
-  double perm;
-  const double det = det_perm(r, D, perm);
-  // Shewchuk's bounds are 3u (2D) and 7u (3D) of the permanent including the
-  // rounded differences; 16u leaves room to spare.
-  const double bound = 16 * filter::u * perm + filter::abs_eps;
-  if (det > bound) return 1;
-  if (det < -bound) return -1;
+  if (const int sign = orientation_filter(D, rows)) return sign;
   int sign;
   if (orientation_int128(D, pts, sign)) return sign;
   return orientation_exact(D, pts);

@@ -91,7 +91,8 @@ std::uint64_t tessellate(const Generators<CellT::dim>& gens, Comp& comp, const E
   }
   std::uint64_t exact_calls = 0;
   for (auto& ws : workspaces) exact_calls += ws.exact_calls;
-  comp.finish(std::span<typename Comp::Batch>(batches));
+  // In the arena too: the compositor's own parallel loops honour --threads.
+  arena.execute([&] { comp.finish(std::span<typename Comp::Batch>(batches)); });
   return exact_calls;
 }
 

@@ -10,11 +10,48 @@
 // perturbation and agrees with every decision the cells pass made.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 
 #include "tessera/kernels/exact_predicates.hpp"
+#include "tessera/kernels/filter.hpp"
 
 namespace tessera::kernels {
+
+namespace detail {
+/// det of the D x D matrix of rows and its permanent (for the error bound).
+inline double det_perm(const double (*r)[3], int dim, double& perm) {
+  if (dim == 2) {
+    double a = r[0][0] * r[1][1], b = r[0][1] * r[1][0];
+    perm = std::fabs(a) + std::fabs(b);
+    return a - b;
+  }
+  double c0 = r[1][1] * r[2][2] - r[1][2] * r[2][1];
+  double c1 = r[1][2] * r[2][0] - r[1][0] * r[2][2];
+  double c2 = r[1][0] * r[2][1] - r[1][1] * r[2][0];
+  double p0 = std::fabs(r[1][1] * r[2][2]) + std::fabs(r[1][2] * r[2][1]);
+  double p1 = std::fabs(r[1][2] * r[2][0]) + std::fabs(r[1][0] * r[2][2]);
+  double p2 = std::fabs(r[1][0] * r[2][1]) + std::fabs(r[1][1] * r[2][0]);
+  perm = std::fabs(r[0][0]) * p0 + std::fabs(r[0][1]) * p1 + std::fabs(r[0][2]) * p2;
+  return r[0][0] * c0 + r[0][1] * c1 + r[0][2] * c2;
+}
+}  // namespace detail
+
+/// The float filter of `orientation`: rows[k] = p_{k+1} - p_0, each
+/// coordinate the rounded difference of the input coordinates (a cell's
+/// bisector normals are exactly these). +1 / -1 when the sign of the
+/// determinant is certain, 0 when only the exact evaluation can tell.
+inline int orientation_filter(int D, const double* const* rows) {
+  double r[3][3] = {};
+  for (int k = 0; k < D; ++k)
+    for (int d = 0; d < D; ++d) r[k][d] = rows[k][d];
+  double perm;
+  const double det = detail::det_perm(r, D, perm);
+  // Shewchuk's bounds are 3u (2D) and 7u (3D) of the permanent including the
+  // rounded differences; 16u leaves room to spare.
+  const double bound = 16 * filter::u * perm + filter::abs_eps;
+  return det > bound ? 1 : (det < -bound ? -1 : 0);
+}
 
 /// Exact sign of det[p1-p0, ..., pD-p0] for D+1 points given by id (D = ctx.dim):
 /// +1 counter-clockwise (2D) / positively oriented (3D), -1 the reverse, 0 when
