@@ -16,6 +16,7 @@
 #include <vector>
 
 #include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 namespace tessera::kernels {
 
@@ -49,9 +50,10 @@ class BinLocator {
     min_size_ = *std::min_element(size_.begin(), size_.end());
     for (int d = 0; d < D; ++d) slack_ = std::max({slack_, std::fabs(lo[d]), std::fabs(hi[d])});
     slack_ *= 8 * std::numeric_limits<double>::epsilon();
-    // Counting sort by bin; stable in id, so the order is deterministic. The
-    // bin of each point (the arithmetic) in parallel, in the caller's arena;
-    // counting and scattering (memory traffic) serially.
+    // Counting sort by bin, stable in id, so the order is deterministic and
+    // independent of the thread count. In parallel, in the caller's arena:
+    // the ids are cut into contiguous chunks, each chunk counts its bins,
+    // and chunk c's points of bin b go after those of bin b in chunks < c.
     std::vector<std::uint32_t> bin_of(n);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, std::size_t{1} << 14),
                       [&](const tbb::blocked_range<std::size_t>& r) {
@@ -59,19 +61,40 @@ class BinLocator {
                           if (use.empty() || use[id])
                             bin_of[id] = static_cast<std::uint32_t>(bin_index(bin_coords(&coords[id * D])));
                       });
+    const std::size_t chunks = std::clamp<std::size_t>(
+        static_cast<std::size_t>(tbb::this_task_arena::max_concurrency()), 1, std::max<std::size_t>(1, n >> 16));
+    std::vector<std::vector<std::uint32_t>> count(chunks);
+    auto chunk_range = [&](std::size_t c) { return std::pair{n * c / chunks, n * (c + 1) / chunks}; };
+    tbb::parallel_for(std::size_t{0}, chunks, [&](std::size_t c) {
+      auto [first, last] = chunk_range(c);
+      count[c].assign(total, 0);
+      for (std::size_t id = first; id < last; ++id)
+        if (use.empty() || use[id]) ++count[c][bin_of[id]];
+    });
+    // count[c][b] becomes chunk c's first slot in bin b.
     offsets_.assign(total + 1, 0);
-    for (std::size_t id = 0; id < n; ++id)
-      if (use.empty() || use[id]) ++offsets_[bin_of[id] + 1];
-    for (std::size_t b = 0; b < total; ++b) offsets_[b + 1] += offsets_[b];
+    std::uint32_t run = 0;
+    for (std::size_t b = 0; b < total; ++b) {
+      offsets_[b] = run;
+      for (std::size_t c = 0; c < chunks; ++c) {
+        const std::uint32_t k = count[c][b];
+        count[c][b] = run;
+        run += k;
+      }
+    }
+    offsets_[total] = run;
     ids_.resize(used);
     sorted_.resize(used);
-    std::vector<std::uint32_t> fill(offsets_.begin(), offsets_.end() - 1);
-    for (std::size_t id = 0; id < n; ++id) {
-      if (!use.empty() && !use[id]) continue;
-      std::uint32_t k = fill[bin_of[id]]++;
-      ids_[k] = static_cast<std::int32_t>(id);
-      for (int d = 0; d < D; ++d) sorted_[k][d] = coords[id * D + d];
-    }
+    tbb::parallel_for(std::size_t{0}, chunks, [&](std::size_t c) {
+      auto [first, last] = chunk_range(c);
+      std::uint32_t* fill = count[c].data();
+      for (std::size_t id = first; id < last; ++id) {
+        if (!use.empty() && !use[id]) continue;
+        std::uint32_t k = fill[bin_of[id]]++;
+        ids_[k] = static_cast<std::int32_t>(id);
+        for (int d = 0; d < D; ++d) sorted_[k][d] = coords[id * D + d];
+      }
+    });
   }
 
   std::array<std::int32_t, D> bin_coords(const double* x) const {
