@@ -42,6 +42,25 @@ inline constexpr double exact_vertex_condition = 1e6;
 /// reads contiguous doubles and runs in SIMD lanes. Slots from size() up to
 /// the next multiple of `lanes` always hold padding (r2 = -1), which the
 /// radius test of `classify` never lets through, so the pass needs no tail.
+/// memmove of `count` elements from base[src] to base[dst] (the ranges may
+/// overlap) as a plain loop: the moves are a few elements long, where a
+/// library call costs more than the copy. The empty asm statement keeps GCC
+/// from turning the loop back into that call (it emits no instruction).
+template <class T>
+void shift(T* base, std::size_t dst, std::size_t src, std::size_t count) {
+  if (dst < src) {
+    for (std::size_t k = 0; k < count; ++k) {
+      base[dst + k] = base[src + k];
+      __asm__ volatile("");
+    }
+  } else {
+    for (std::size_t k = count; k-- > 0;) {
+      base[dst + k] = base[src + k];
+      __asm__ volatile("");
+    }
+  }
+}
+
 template <int D>
 class FilterLanes {
  public:
@@ -72,9 +91,9 @@ class FilterLanes {
   /// overlap), as the vertex list's own memmove does.
   void move(std::size_t dst, std::size_t src, std::size_t count) {
     grow(std::max(dst, src) + count);
-    for (int k = 0; k < D; ++k) std::memmove(y_[k].data() + dst, y_[k].data() + src, count * sizeof(double));
-    std::memmove(e_.data() + dst, e_.data() + src, count * sizeof(double));
-    std::memmove(r2_.data() + dst, r2_.data() + src, count * sizeof(double));
+    for (int k = 0; k < D; ++k) shift(y_[k].data(), dst, src, count);
+    shift(e_.data(), dst, src, count);
+    shift(r2_.data(), dst, src, count);
   }
   /// Keep (or make room for) the first n slots; new slots are unset until set().
   void resize(std::size_t n) {

@@ -119,7 +119,7 @@ class Tile {
       const std::uint16_t a0 = verts_[r0 - 1].p[1], b1 = verts_[e1 % nv].p[0];
       const std::size_t tail = nv - e1;
       if (removed != 2) {
-        std::memmove(verts_.data() + r0 + 2, verts_.data() + e1, tail * sizeof(Vertex));
+        filter::shift(verts_.data(), r0 + 2, e1, tail);
         lanes_.move(r0 + 2, e1, tail);
       }
       make(r0, a0, pn);
@@ -129,7 +129,7 @@ class Tile {
       while (sign_[k0] < 0) ++k0;
       const std::uint16_t b1 = verts_[k0].p[0], a0 = verts_[k0 + kept - 1].p[1];
       if (k0 != 1) {
-        std::memmove(verts_.data() + 1, verts_.data() + k0, kept * sizeof(Vertex));
+        filter::shift(verts_.data(), 1, k0, kept);
         lanes_.move(1, k0, kept);
       }
       make(0, pn, b1);
