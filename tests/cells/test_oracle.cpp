@@ -43,15 +43,32 @@ struct Case {
   std::size_t n;
   std::uint64_t seed;
   bool explicit_bounds;  // false: tessera's default padded box is used (and checked)
+  bool clustered = false;  // 3/4 of the points in one tight cluster
 };
+
+/// Uniform points in b, then the first 3/4 pulled into a cluster of 1/100 of
+/// the box around its centre (inside the box). The bins are sized for the
+/// mean density, so the cluster's shells hold hundreds of candidates: the
+/// builder's split head, unsorted rest and support bound all run, and the
+/// cells at the cluster's edge reach far into the empty box.
+std::vector<double> clustered_points(std::size_t n, int dim, std::uint64_t seed, const tessera::Bounds& b) {
+  auto p = random_points(n, dim, seed, b);
+  for (std::size_t i = 0; i < 3 * n / 4; ++i)
+    for (int a = 0; a < dim; ++a) {
+      const double mid = 0.5 * (b.lo[a] + b.hi[a]), w = b.hi[a] - b.lo[a];
+      p[i * dim + a] = mid + 0.01 * (p[i * dim + a] - mid) * (1.0 + 0.37 * a) + 1e-3 * w * std::sin(double(i));
+    }
+  return p;
+}
 
 void compare_with_oracle(const Case& cs) {
   SCOPED_TRACE(::testing::Message() << "dim " << cs.dim << " n " << cs.n << " seed " << cs.seed
-                                    << (cs.explicit_bounds ? " explicit bounds" : " default bounds"));
+                                    << (cs.explicit_bounds ? " explicit bounds" : " default bounds")
+                                    << (cs.clustered ? " clustered" : ""));
   const int dim = cs.dim;
   // An anisotropic, off-origin box so no axis or scale is special.
   const auto b = make_bounds({-3, 2, 10}, {7, 2.5, 11});
-  const auto pts = random_points(cs.n, dim, cs.seed, b);
+  const auto pts = cs.clustered ? clustered_points(cs.n, dim, cs.seed, b) : random_points(cs.n, dim, cs.seed, b);
   const tessera::Cells c = cs.explicit_bounds ? run(pts, dim, b) : run(pts, dim);
   ASSERT_EQ(c.n_cells(), cs.n);
 
@@ -159,6 +176,12 @@ TEST(Oracle, Random2D) {
 TEST(Oracle, Random3D) {
   for (Case cs : {Case{3, 50, 11, true}, Case{3, 50, 12, false}, Case{3, 150, 13, true}, Case{3, 400, 14, true},
                   Case{3, 400, 15, false}})
+    compare_with_oracle(cs);
+}
+
+TEST(Oracle, Clustered) {
+  for (Case cs : {Case{2, 600, 21, true, true}, Case{2, 600, 22, false, true}, Case{3, 500, 23, true, true},
+                  Case{3, 500, 24, false, true}})
     compare_with_oracle(cs);
 }
 

@@ -24,6 +24,7 @@
 #include "tessera/kernels/exact_predicates.hpp"
 #include "tessera/kernels/hull.hpp"  // ClipResult
 #include "tessera/kernels/locator.hpp"
+#include "tessera/kernels/support_bound.hpp"
 
 namespace tessera::kernels {
 
@@ -95,13 +96,14 @@ class CellBuilder {
         s = 1;
         loc_.for_each_shell_run(b, s, gather);
       }
-      // Clip in key order. The order is sorted lazily: a shell in a dense
-      // region can hold hundreds of candidates of which the cell uses a few
-      // dozen, so the nearest `sort_head` come first (nth_element + sort);
-      // when they are used up, the rest is cut to the candidates within the
-      // security radius as it is by then (it only shrinks, so the others would
-      // be skipped anyway) and the next head is taken. The clips are those of
-      // a full sort, in the same order.
+      // Clip in key order, the nearest first: a shell of ordinary size
+      // (at most 2 sort_head candidates) is sorted whole. A larger one (a
+      // dense region, or a cell whose security radius holds a cluster) has
+      // its head sorted: the candidates at or below a sampled threshold, some
+      // sort_head of them. Those make the cell nearly final; the rest are
+      // taken in gather order, each first checked against the security
+      // radius and the support bound, as nearly all of them leave the cell
+      // unchanged: ordering them cost more than their sign passes.
       enum class Next { go, stop, no_cell };
       auto visit = [&](std::uint64_t key) {
         const Candidate& cd = cand_[static_cast<std::uint32_t>(key)];
@@ -135,15 +137,19 @@ class CellBuilder {
       };
       Next next = Next::go;
       std::uint64_t* const keys = keys_.data();
-      std::uint64_t* end = keys + nc;
-      for (std::uint64_t* first = keys; next == Next::go && first != end;) {
-        if (first != keys)
-          end = std::remove_if(first, end, [&](std::uint64_t key) { return cand_[static_cast<std::uint32_t>(key)].r2 > sec2; });
-        const std::size_t left = static_cast<std::size_t>(end - first);
-        std::uint64_t* const last_taken = first + (left > 2 * sort_head ? sort_head : left);
-        if (last_taken != end) std::nth_element(first, last_taken, end);
-        sort_keys(first, last_taken);
-        for (; next == Next::go && first != last_taken; ++first) next = visit(*first);
+      std::uint64_t* const end = keys + nc;
+      std::uint64_t* const head_end = nc > 2 * sort_head ? split_head(keys, end) : end;
+      sort_keys(keys, head_end);
+      for (std::uint64_t* it = keys; next == Next::go && it != head_end; ++it) next = visit(*it);
+      if (next == Next::go && head_end != end) {
+        support_.measure(cell.vertices());
+        for (std::uint64_t* it = head_end; next != Next::no_cell && it != end; ++it) {
+          const Candidate& cd = cand_[static_cast<std::uint32_t>(*it)];
+          if (cd.r2 > sec2 || support_.excludes(cd.q)) continue;
+          const double before = sec2;
+          next = visit(*it);
+          if (sec2 != before) support_.measure(cell.vertices());  // it clipped
+        }
       }
       if (next == Next::no_cell) return status;
     }
@@ -151,19 +157,24 @@ class CellBuilder {
   }
 
  private:
-  /// Candidates sorted per round of the lazy sort (above: a full sort when a
-  /// shell holds at most twice as many). A uniform cell uses about 47.
+  /// The size of the sorted head of an oversized shell (above: a shell of at
+  /// most twice as many is sorted whole). A uniform cell uses about 47.
   static constexpr std::size_t sort_head = 64;
 
-  /// Ascending order of at most 2 * sort_head distinct keys, by rank: each
-  /// key's place is the number of keys below it. That is n^2 comparisons, but
-  /// branch-free, two per SSE4.2 instruction, four keys ranked per sweep; at
-  /// these sizes (a uniform cell's first gather holds ~54 keys in 3D, ~20 in
-  /// 2D) it measured 11% (2D) and 7% (3D) faster overall than straight
-  /// insertion, whose mispredicted exits dominated.
+  /// Ascending order of distinct keys: up to 2 * sort_head by rank, each
+  /// key's place being the number of keys below it. That is n^2
+  /// comparisons, but branch-free, two per SSE4.2 instruction, four keys
+  /// ranked per sweep; at these sizes (a uniform cell's first gather holds
+  /// ~54 keys in 3D, ~20 in 2D) it measured 11% (2D) and 7% (3D) faster
+  /// overall than straight insertion, whose mispredicted exits dominated.
+  /// Longer runs (a rare oversized head) by std::sort.
   static void sort_keys(std::uint64_t* first, std::uint64_t* last) {
     using Pair = std::int64_t __attribute__((vector_size(16)));
     const std::size_t n = static_cast<std::size_t>(last - first);
+    if (n > 2 * sort_head) {
+      std::sort(first, last);
+      return;
+    }
     // Keys are below 2^63 (r2 >= 0 has a clear float sign bit), so they
     // compare alike as signed; the padding is above them all.
     alignas(16) std::int64_t k[2 * sort_head + 4];
@@ -180,6 +191,32 @@ class CellBuilder {
       for (std::size_t a = 0; a < 4 && i + a < n; ++a)
         first[-(below[a][0] + below[a][1])] = static_cast<std::uint64_t>(k[i + a]);
     }
+  }
+
+  /// Reorder [first, last) (more than 2 * sort_head keys) so that the keys
+  /// at or below a threshold come first, and return the end of that head.
+  /// The threshold is the sample key whose expected rank is about
+  /// sort_head; the split is branch-free (a partition around an unknown
+  /// pivot mispredicts half its branches, and nth_element needs several).
+  /// The head is only a prefix of the sorted order, of no fixed size.
+  std::uint64_t* split_head(std::uint64_t* first, std::uint64_t* last) {
+    constexpr std::size_t samples = 64;
+    const std::size_t n = static_cast<std::size_t>(last - first);
+    std::uint64_t sample[samples];
+    for (std::size_t k = 0; k < samples; ++k) sample[k] = first[k * n / samples];
+    sort_keys(sample, sample + samples);
+    const std::uint64_t tau = sample[samples * sort_head / n];  // n > 2 sort_head: index < samples / 2
+    spill_.assign(first, last);
+    std::size_t head = 0, rest = n;
+    for (const std::uint64_t key : spill_) {
+      // Written at both ends; the end that does not advance is overwritten later.
+      first[head] = key;
+      first[rest - 1] = key;
+      const bool in = key <= tau;
+      head += in;
+      rest -= !in;
+    }
+    return first + head;
   }
 
   struct Candidate {
@@ -202,7 +239,9 @@ class CellBuilder {
   const ExactContext* exact_;
   std::vector<Candidate> cand_;
   std::vector<std::uint64_t> keys_;
-  std::vector<double> gaps_;  // for_each_shell_bin_near's scratch
+  std::vector<double> gaps_;  // for_each_shell_run_near's scratch
+  std::vector<std::uint64_t> spill_;  // split_head's scratch
+  SupportBound<D> support_;
 };
 
 }  // namespace tessera::kernels
