@@ -98,23 +98,27 @@ class CellsCompositor {
   void finish(std::span<Batch> batches) {
     Cells& o = out_;
     const std::size_t n = o.n_points;
-    // Where each generator's data sits: (batch, index in batch).
+    // Where each generator's data sits: (batch, index in batch). Every
+    // generator lies in exactly one batch, so all batches write at once;
+    // cell_of first holds 1 for a generator with a cell.
     struct Loc { std::int32_t batch = -1, index = -1; };
     std::vector<Loc> where(n);
-    for (std::size_t k = 0; k < batches.size(); ++k)
-      for (std::size_t t = 0; t < batches[k].gen.size(); ++t)
-        where[static_cast<std::size_t>(batches[k].gen[t])] = {static_cast<std::int32_t>(k), static_cast<std::int32_t>(t)};
+    o.cell_of.assign(n, 0);
+    tbb::parallel_for(std::size_t(0), batches.size(), [&](std::size_t k) {
+      const Batch& b = batches[k];
+      for (std::size_t t = 0; t < b.gen.size(); ++t) {
+        const auto g = static_cast<std::size_t>(b.gen[t]);
+        where[g] = {static_cast<std::int32_t>(k), static_cast<std::int32_t>(t)};
+        o.cell_of[g] = b.dup_of[t] < 0;
+      }
+    });
+    for (const Batch& b : batches)
+      for (std::size_t t = 0; t < b.gen.size(); ++t)
+        if (b.dup_of[t] >= 0) o.duplicates.emplace_back(b.gen[t], b.dup_of[t]);
+    std::sort(o.duplicates.begin(), o.duplicates.end());
     // Cells in generator-id order.
-    o.cell_of.assign(n, -1);
     std::int32_t nc = 0;
-    for (std::size_t g = 0; g < n; ++g) {
-      const Loc& w = where[g];
-      if (w.batch < 0) continue;
-      const Batch& b = batches[static_cast<std::size_t>(w.batch)];
-      std::int32_t dup = b.dup_of[static_cast<std::size_t>(w.index)];
-      if (dup >= 0) { o.duplicates.emplace_back(static_cast<std::int32_t>(g), dup); continue; }
-      o.cell_of[g] = nc++;
-    }
+    for (std::size_t g = 0; g < n; ++g) o.cell_of[g] = o.cell_of[g] ? nc++ : -1;
     const std::size_t ncell = static_cast<std::size_t>(nc);
     o.generator.resize(ncell);
     o.region.resize(ncell);
