@@ -157,7 +157,9 @@ inline Lane load(const double* p) {
 /// |q|/2 from the generator cannot be cut: q.y <= |q||y| <= |q|^2/2 (equality
 /// would need y = q/2 exactly, which the strict margin excludes). Candidates
 /// usually fail to clip; a first pass only proves that, a lane group at a
-/// time, and then `sign` is left untouched. Both passes take a lane group (four
+/// time, by the float filter alone (a near vertex passes it but where it
+/// touches the plane, so the radius test is left to the second pass, which
+/// measured cheaper), and then `sign` is left untouched. Both passes take a lane group (four
 /// vertices) at a time, branch-free within it; the arithmetic is the same, term
 /// for term, as a scalar loop's (no contraction), so the signs do not depend on
 /// the vector width.
@@ -181,11 +183,7 @@ std::size_t classify(const FilterLanes<D>& f, const double* n, double d, double 
   std::size_t first = 0;  // the first lane group holding a vertex that may be cut
   for (; first < np; first += 4) {
     LaneMask hit{};
-    for (std::size_t h = first; h < first + 4; h += 2) {
-      const LaneMask far = 4.0 * detail::load(R + h) >= q2lo;
-      const LaneMask safe = plane_value(h) > n1 * detail::load(E + h) + de;
-      hit |= far & ~safe;
-    }
+    for (std::size_t h = first; h < first + 4; h += 2) hit |= ~(plane_value(h) > n1 * detail::load(E + h) + de);
     if (hit[0] | hit[1]) break;
   }
   if (first >= np) return 0;
