@@ -135,6 +135,12 @@ class FilterLanes {
   std::vector<double> y_[D], e_, r2_;
 };
 
+/// A vertex's side of a clipping plane: +1 keep, -1 remove, 0 undecided.
+/// Deliberately not a char type: a store through a char type may alias any
+/// object, so after each one the compiler reloaded every vector's data
+/// pointer in the clip loops.
+using Sign = std::int16_t;
+
 namespace detail {
 // Two lanes of doubles in GCC's vector extension: one SSE2 register, the
 // default x86-64-v2 target's width. Comparisons yield 0 / -1 per lane.
@@ -165,7 +171,7 @@ inline Lane load(const double* p) {
 /// the vector width.
 template <int D, class Exact>
 std::size_t classify(const FilterLanes<D>& f, const double* n, double d, double n1,
-                     std::vector<std::int8_t>& sign, Exact&& exact) {
+                     std::vector<Sign>& sign, Exact&& exact) {
   static_assert(FilterLanes<D>::lanes == 4, "two detail::Lanes per lane group");
   using detail::Lane;
   using detail::LaneMask;
@@ -188,7 +194,7 @@ std::size_t classify(const FilterLanes<D>& f, const double* n, double d, double 
   }
   if (first >= np) return 0;
   sign.resize(np);
-  std::fill(sign.begin(), sign.begin() + static_cast<std::ptrdiff_t>(first), std::int8_t{1});
+  std::fill(sign.begin(), sign.begin() + static_cast<std::ptrdiff_t>(first), Sign{1});
   std::int64_t removed = 0, uncertain = 0;
   for (std::size_t t = first; t < np; t += 2) {
     const Lane P = plane_value(t);
@@ -196,14 +202,14 @@ std::size_t classify(const FilterLanes<D>& f, const double* n, double d, double 
     const LaneMask near = 4.0 * detail::load(R + t) < q2lo;  // never cut
     const LaneMask s = near ? LaneMask{1, 1} : (P < -e) - (P > e);
     for (int k = 0; k < 2; ++k) {
-      sign[t + static_cast<std::size_t>(k)] = static_cast<std::int8_t>(s[k]);
+      sign[t + static_cast<std::size_t>(k)] = static_cast<Sign>(s[k]);
       removed += s[k] < 0;
       uncertain += s[k] == 0;
     }
   }
   for (std::size_t t = first; uncertain && t < nv; ++t) {
     if (sign[t] != 0) continue;
-    sign[t] = static_cast<std::int8_t>(exact(t));
+    sign[t] = static_cast<Sign>(exact(t));
     removed += (sign[t] < 0);
     --uncertain;
   }

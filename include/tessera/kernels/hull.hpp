@@ -307,7 +307,7 @@ class Hull {
   filter::FilterLanes<3> lanes_;  // verts_' filter data, for the sign pass
   std::vector<Vertex> fresh_;
   std::vector<std::uint32_t> holes_;
-  std::vector<std::int8_t> sign_;
+  std::vector<filter::Sign> sign_;
   std::vector<std::uint32_t> edge_tri_;  // cap_ x cap_: directed plane pair -> triangle
   std::size_t cap_ = 0;
   double security2_ = 0;

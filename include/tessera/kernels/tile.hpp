@@ -210,7 +210,7 @@ class Tile {
   std::vector<Plane> planes_;
   std::vector<Vertex> verts_;
   filter::FilterLanes<2> lanes_;  // verts_' filter data, for the sign pass
-  std::vector<std::int8_t> sign_;
+  std::vector<filter::Sign> sign_;
   double security2_ = 0;
 };
 
