@@ -102,6 +102,17 @@ class FilterLanes {
     pad();
   }
 
+  /// The largest r2 (0 when empty; padding is -1). One accumulator per lane:
+  /// the max of doubles is exact in any order, and a single serial chain of
+  /// maxima dominated the tail of every clip.
+  double max_r2() const {
+    double m[lanes] = {0.0, 0.0, 0.0, 0.0};
+    const double* r = r2_.data();
+    for (std::size_t t = 0; t < padded(); t += lanes)
+      for (std::size_t a = 0; a < lanes; ++a) m[a] = std::max(m[a], r[t + a]);
+    return std::max(std::max(m[0], m[1]), std::max(m[2], m[3]));
+  }
+
   const double* y(int k) const { return y_[k].data(); }
   const double* e() const { return e_.data(); }
   const double* r2() const { return r2_.data(); }

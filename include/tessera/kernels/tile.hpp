@@ -198,10 +198,7 @@ class Tile {
   }
 
   void update_radius() {
-    double r2 = 0;  // padding is -1
-    const double* R = lanes_.r2();
-    for (std::size_t t = 0; t < lanes_.padded(); ++t) r2 = std::max(r2, R[t]);
-    security2_ = 4.0 * r2 * (1 + 1e-12);
+    security2_ = 4.0 * lanes_.max_r2() * (1 + 1e-12);
   }
 
   std::int32_t gen_ = -1;
