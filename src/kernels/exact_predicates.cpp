@@ -293,16 +293,13 @@ bool signs_int128(const ExactContext& ctx, std::int32_t i, const std::int32_t* g
 
 }  // namespace
 
-int exact_clip_sign(const ExactContext& ctx, std::int32_t i, const std::int32_t* planes, std::int32_t j) {
-  const int dim = ctx.dim;
-  const int rows = dim + 1;  // dim vertex planes + the query row
-  // Row r's generator (or box id); the query row is last.
-  std::int32_t gen[Scratch::kRows];
-  for (int r = 0; r < dim; ++r) gen[r] = planes[r];
-  gen[dim] = j;
-  ClipSigns sg;
-  if (!signs_int128(ctx, i, gen, sg)) signs_gmp(ctx, i, gen, sg);
+namespace {
 
+// sign(P) from the signs of det M0, the minors and w_i's coefficient, with
+// the symbolic perturbation deciding exact ties. gen[0..dim] are the rows'
+// generators (the query row last).
+int decide(const ClipSigns& sg, std::int32_t i, const std::int32_t* gen, int dim) {
+  const int rows = dim + 1;
   // det A = minor[dim]; it is never zero for a real vertex.
   const int sign_det_a = sg.minor[dim];
   if (sign_det_a == 0)
@@ -328,6 +325,145 @@ int exact_clip_sign(const ExactContext& ctx, std::int32_t i, const std::int32_t*
   }
   // sign(P) = sign(det M) * sign(det A); P > 0 keeps the vertex.
   return sign_m * sign_det_a > 0 ? +1 : -1;
+}
+
+template <class T>
+int sign_of(T x) { return (x > 0) - (x < 0); }
+
+}  // namespace
+
+int exact_clip_sign(const ExactContext& ctx, std::int32_t i, const std::int32_t* planes, std::int32_t j) {
+  const int dim = ctx.dim;
+  // Row r's generator (or box id); the query row is last.
+  std::int32_t gen[Scratch::kRows];
+  for (int r = 0; r < dim; ++r) gen[r] = planes[r];
+  gen[dim] = j;
+  ClipSigns sg;
+  if (!signs_int128(ctx, i, gen, sg)) signs_gmp(ctx, i, gen, sg);
+  return decide(sg, i, gen, dim);
+}
+
+// The prepared form (see VertexPredicate in the header). With the query row
+// q = (a_j, b_j) below A, the minor without row r < dim is A with row r
+// replaced by a_j, moved to the bottom: (-1)^(dim-1-r) a_j . C_r, C_r being
+// row r of A's cofactor matrix. Then det M0 = b_j det A - sum_r b_r (a_j . C_r)
+// and w_i's coefficient is det A - sum over bisector rows of a_j . C_r.
+// Bounds as in signs_int128: |a| < 2^24, |C| < 2^49, |a_j . C_r| < 2^76,
+// |b| < 2^46, so every sum stays below 2^124.
+bool VertexPredicate::prepare(const ExactContext& ctx, std::int32_t i, const std::int32_t* planes) {
+  using I = __int128;
+  constexpr int kBits = 22;
+  dim_ = ctx.dim;
+  i_ = i;
+  if (dim_ != 2 && dim_ != 3) return false;
+  for (int r = 0; r < dim_; ++r) gen_[r] = planes[r];
+  // The vertex's doubles by their bits, and their common grid.
+  DoubleParts pv[Scratch::kRows][Scratch::kMaxDim];
+  int nd[Scratch::kRows];
+  const double* pi = ctx.points + static_cast<std::size_t>(i) * dim_;
+  int shift = INT_MAX, top = INT_MIN;
+  auto see = [&](DoubleParts& pt, double x) {
+    pt = double_parts(x);
+    if (pt.mant == 0) return;
+    const auto um = static_cast<std::uint64_t>(pt.mant < 0 ? -pt.mant : pt.mant);
+    shift = std::min(shift, pt.e2 + std::countr_zero(um));
+    top = std::max(top, pt.e2 + 64 - std::countl_zero(um));
+  };
+  for (int d = 0; d < dim_; ++d) see(pv[dim_][d], pi[d]);
+  for (int r = 0; r < dim_; ++r) {
+    if (gen_[r] >= 0) {
+      const double* pk = ctx.points + static_cast<std::size_t>(gen_[r]) * dim_;
+      for (int d = 0; d < dim_; ++d) see(pv[r][d], pk[d]);
+      nd[r] = dim_;
+    } else {
+      const int axis = box_plane_axis(gen_[r]);
+      see(pv[r][0], box_plane_upper(gen_[r]) ? ctx.hi[axis] : ctx.lo[axis]);
+      nd[r] = 1;
+    }
+  }
+  if (shift == INT_MAX) shift = 0;
+  if (top != INT_MIN && top - shift > kBits) return false;
+  shift_ = shift;
+  auto scaled = [&](const DoubleParts& pt) -> std::int64_t {
+    if (pt.mant == 0) return 0;
+    const int k = pt.e2 - shift;
+    return k >= 0 ? pt.mant * (std::int64_t{1} << k) : pt.mant >> -k;
+  };
+  ci2_ = 0;
+  for (int d = 0; d < dim_; ++d) {
+    ci_[d] = scaled(pv[dim_][d]);
+    ci2_ += static_cast<I>(ci_[d]) * ci_[d];
+  }
+  std::int64_t a[Scratch::kMaxDim][Scratch::kMaxDim] = {};
+  for (int r = 0; r < dim_; ++r) {
+    if (nd[r] == dim_) {
+      I sq = 0;
+      for (int d = 0; d < dim_; ++d) {
+        const std::int64_t x = scaled(pv[r][d]);
+        a[r][d] = 2 * (x - ci_[d]);
+        sq += static_cast<I>(x) * x;
+      }
+      b_[r] = sq - ci2_;
+    } else {
+      a[r][box_plane_axis(gen_[r])] = 1;
+      b_[r] = scaled(pv[r][0]);
+    }
+  }
+  if (dim_ == 2) {
+    cof_[0][0] = a[1][1]; cof_[0][1] = -a[1][0];
+    cof_[1][0] = -a[0][1]; cof_[1][1] = a[0][0];
+    det_a_ = static_cast<I>(a[0][0]) * cof_[0][0] + static_cast<I>(a[0][1]) * cof_[0][1];
+  } else {
+    for (int r = 0; r < 3; ++r) {
+      const std::int64_t* u = a[(r + 1) % 3];
+      const std::int64_t* w = a[(r + 2) % 3];
+      cof_[r][0] = u[1] * w[2] - u[2] * w[1];
+      cof_[r][1] = u[2] * w[0] - u[0] * w[2];
+      cof_[r][2] = u[0] * w[1] - u[1] * w[0];
+    }
+    det_a_ = static_cast<I>(a[0][0]) * cof_[0][0] + static_cast<I>(a[0][1]) * cof_[0][1] +
+             static_cast<I>(a[0][2]) * cof_[0][2];
+  }
+  return true;
+}
+
+int VertexPredicate::sign(const ExactContext& ctx, std::int32_t j) const {
+  using I = __int128;
+  constexpr int kBits = 22;
+  // p_j on the vertex's grid, within the bounds; else the general path.
+  const double* pj = ctx.points + static_cast<std::size_t>(j) * dim_;
+  std::int64_t xj[Scratch::kMaxDim];
+  for (int d = 0; d < dim_; ++d) {
+    const DoubleParts pt = double_parts(pj[d]);
+    if (pt.mant == 0) { xj[d] = 0; continue; }
+    const auto um = static_cast<std::uint64_t>(pt.mant < 0 ? -pt.mant : pt.mant);
+    if (pt.e2 + std::countr_zero(um) < shift_ || pt.e2 + 64 - std::countl_zero(um) - shift_ > kBits)
+      return exact_clip_sign(ctx, i_, gen_, j);
+    const int k = pt.e2 - shift_;
+    xj[d] = k >= 0 ? pt.mant * (std::int64_t{1} << k) : pt.mant >> -k;
+  }
+  std::int64_t aj[Scratch::kMaxDim];
+  I bj = -ci2_;
+  for (int d = 0; d < dim_; ++d) {
+    aj[d] = 2 * (xj[d] - ci_[d]);
+    bj += static_cast<I>(xj[d]) * xj[d];
+  }
+  ClipSigns sg;
+  I m0 = bj * det_a_, wi = det_a_;
+  for (int r = 0; r < dim_; ++r) {
+    I dr = 0;  // det A with row r replaced by a_j
+    for (int d = 0; d < dim_; ++d) dr += static_cast<I>(aj[d]) * cof_[r][d];
+    sg.minor[r] = ((dim_ - 1 - r) & 1) ? -sign_of(dr) : sign_of(dr);
+    m0 -= b_[r] * dr;
+    if (gen_[r] >= 0) wi -= dr;
+  }
+  sg.minor[dim_] = sign_of(det_a_);
+  sg.det_m0 = sign_of(m0);
+  sg.weight_i = sign_of(wi);
+  std::int32_t gen[Scratch::kRows];
+  for (int r = 0; r < dim_; ++r) gen[r] = gen_[r];
+  gen[dim_] = j;
+  return decide(sg, i_, gen, dim_);
 }
 
 void exact_vertex(const ExactContext& ctx, std::int32_t i, const std::int32_t* planes, double* y) {

@@ -189,9 +189,23 @@ void check_exact_vertex(const ExactContext& c, std::int32_t i, const std::int32_
   }
 }
 
+/// How many queries went through the prepared form (VertexPredicate) when
+/// it was usable, over the whole test binary.
+int prepared_used = 0;
+
+/// The prepared form of the same query: it must agree with exact_clip_sign
+/// wherever it applies (and is exact_clip_sign elsewhere).
+int prepared_sign(const ExactContext& c, std::int32_t i, const std::int32_t* planes, std::int32_t j) {
+  tessera::kernels::VertexPredicate vp;
+  if (!vp.prepare(c, i, planes)) return exact_clip_sign(c, i, planes, j);
+  ++prepared_used;
+  return vp.sign(c, j);
+}
+
 /// Kernel vs oracle for one query; returns the kernel's sign.
 int check_sign(const ExactContext& c, std::int32_t i, const std::int32_t* planes, std::int32_t j) {
   const int got = exact_clip_sign(c, i, planes, j);
+  EXPECT_EQ(prepared_sign(c, i, planes, j), got) << "prepared: " << describe(c, i, planes, j);
   const int want = oracle_sign(c, i, planes, j);
   EXPECT_NE(want, 0) << "oracle: every perturbation coefficient vanished for " << describe(c, i, planes, j);
   EXPECT_EQ(got, want) << describe(c, i, planes, j) << "  P0 = " << power_diff(c, i, planes, j).get_d();
@@ -213,6 +227,7 @@ int check_views(const ExactContext& c, const std::array<std::int32_t, 4>& defs, 
     const int want = oracle_sign(c, defs[g], others.data(), j);
     do {
       const int s = exact_clip_sign(c, defs[g], others.data(), j);
+      EXPECT_EQ(prepared_sign(c, defs[g], others.data(), j), s) << "prepared: " << describe(c, defs[g], others.data(), j);
       EXPECT_TRUE(s == 1 || s == -1) << describe(c, defs[g], others.data(), j);
       EXPECT_EQ(s, want) << describe(c, defs[g], others.data(), j);
       if (first == 0) first = s;
@@ -339,6 +354,7 @@ void random_matches(int dim, std::uint64_t seed) {
       if (!random_query(p, r, dim - 1, i, planes, j)) continue;
       const Q p0 = power_diff(c, i, planes.data(), j);
       const int got = exact_clip_sign(c, i, planes.data(), j);
+      EXPECT_EQ(prepared_sign(c, i, planes.data(), j), got) << "prepared: " << describe(c, i, planes.data(), j);
       if (p0 != 0) {
         ++nonzero;
         ASSERT_EQ(got, sgn(p0)) << "scale " << s[0] << " offset " << s[1] << ": " << describe(c, i, planes.data(), j);
@@ -650,3 +666,55 @@ TEST(ExactPredicates, LowestBitExponent) {
   EXPECT_EQ(tessera::kernels::lowest_bit_exponent(0x1p1023 * 1.5), 1022);
   EXPECT_EQ(tessera::kernels::lowest_bit_exponent(0.1), -55);  // 0.1 = 0x1999999999999a * 2^-56
 }
+
+namespace {
+
+// The prepared form (VertexPredicate) on grid input: vertices on a small
+// integer grid (with box planes), queried by points on the grid (prepared
+// path), on a finer grid and off any grid (fallback), and beyond 22 bits
+// (fallback). Every answer equals exact_clip_sign's and the oracle's.
+TEST(ExactPredicates, PreparedVertexOnAndOffGrid) {
+  for (int dim : {2, 3}) {
+    Rng r(61 + static_cast<std::uint64_t>(dim));
+    Problem p;
+    p.dim = dim;
+    for (int d = 0; d < 3; ++d) { p.lo[d] = -8; p.hi[d] = 8; }
+    for (int k = 0; k < 40; ++k) {
+      std::array<double, 3> x{};
+      for (int d = 0; d < dim; ++d) x[d] = static_cast<double>(static_cast<int>(r.index(15)) - 7);
+      p.add(x);
+    }
+    const std::int32_t on_grid = p.size();
+    for (double off : {0.5, 1.0 / 1024, 0.1, 3.0 * 0x1p20}) {
+      std::array<double, 3> x{};
+      for (int d = 0; d < dim; ++d) x[d] = static_cast<double>(static_cast<int>(r.index(9)) - 4) + (d == 0 ? off : 0.0);
+      p.add(x);
+    }
+    const auto c = p.ctx();
+    const int before = prepared_used;
+    int checked = 0;
+    for (int t = 0; t < 400; ++t) {
+      Ids planes{};
+      const std::int32_t i = r.index(on_grid);
+      for (int k = 0; k < dim; ++k) {
+        if (r.index(4) == 0) planes[k] = box_plane_id(static_cast<int>(r.index(dim)), r.index(2) == 1);
+        else planes[k] = r.index(on_grid);
+      }
+      bool distinct = true;
+      for (int k = 0; k < dim; ++k) {
+        distinct &= planes[k] != i;
+        for (int m = 0; m < k; ++m) distinct &= planes[k] != planes[m];
+      }
+      if (!distinct || !independent(c, i, planes.data())) continue;
+      for (std::int32_t j = 0; j < p.size(); ++j) {
+        if (j == i || std::find(planes.begin(), planes.begin() + dim, j) != planes.begin() + dim) continue;
+        check_sign(c, i, planes.data(), j);
+        ++checked;
+      }
+    }
+    EXPECT_GT(checked, 5000) << "dim " << dim;
+    EXPECT_GT(prepared_used - before, 5000) << "dim " << dim << ": the prepared path hardly ran";
+  }
+}
+
+}  // namespace

@@ -76,6 +76,29 @@ struct ExactContext {
 /// and j is not i nor one of the planes.
 int exact_clip_sign(const ExactContext& ctx, std::int32_t i, const std::int32_t* planes, std::int32_t j);
 
+/// exact_clip_sign for one vertex asked against many candidates. What
+/// depends only on the vertex (its rows, det A and A's cofactors) is computed
+/// once, in 64/128-bit integers, when its points lie on a common grid of at
+/// most 22 bits: lattices, voxel centres and integer grids, where nearly
+/// every vertex ties with several candidates and the exact predicate
+/// dominated the run. Each candidate then costs a few dot products. A
+/// candidate off the vertex's grid goes through exact_clip_sign.
+class VertexPredicate {
+ public:
+  /// Prepare for the vertex of cell i where planes[0..dim) meet; false (and
+  /// unusable) when the vertex's points are off the integer path.
+  bool prepare(const ExactContext& ctx, std::int32_t i, const std::int32_t* planes);
+  /// Equal to exact_clip_sign(ctx, i, planes, j).
+  int sign(const ExactContext& ctx, std::int32_t j) const;
+
+ private:
+  int dim_ = 3, shift_ = 0;
+  std::int32_t i_ = -1, gen_[3] = {0, 0, 0};
+  std::int64_t ci_[3] = {0, 0, 0};   // p_i on the grid
+  std::int64_t cof_[3][3] = {};      // row r: A's cofactors along row r
+  __int128 ci2_ = 0, det_a_ = 0, b_[3] = {0, 0, 0};
+};
+
 /// The vertex of cell `i` where `planes[0..dim)` meet, relative to p_i,
 /// computed exactly and rounded once per coordinate (within 2 ulp). Used when
 /// the float solve is too ill-conditioned to give a trustworthy position (a

@@ -52,6 +52,7 @@ class Hull {
     gen_ = gen;
     exact_ = exact;
     exact_calls_ = 0;
+    ++cells_;
     // Planes and corners are written in place: a local struct copied in
     // would be read back wider than it was written (a store-forwarding stall).
     planes_.resize(6);
@@ -96,7 +97,7 @@ class Hull {
     const double n1 = std::fabs(q[0]) + std::fabs(q[1]) + std::fabs(q[2]);
     const std::size_t nv = verts_.size();
     const std::size_t removed = filter::classify<3>(lanes_, q, d, n1, sign_,
-                                                     [&](std::size_t t) { return exact_sign(verts_[t], j); });
+                                                     [&](std::size_t t) { return exact_sign(t, j); });
     if (removed == 0) return ClipResult::unchanged;
     if (removed == nv) {
       resize_vertices(0);
@@ -201,10 +202,20 @@ class Hull {
   }
 
  private:
-  int exact_sign(const Vertex& v, std::int32_t j) {
+  // The exact predicate of vertex slot t, prepared once per vertex: on grid
+  // input a vertex ties with several candidates (VertexPredicate).
+  int exact_sign(std::size_t t, std::int32_t j) {
     ++exact_calls_;
+    const Vertex& v = verts_[t];
+    if (prepared_.size() < verts_.size()) prepared_.resize(verts_.size());
+    Prepared& pr = prepared_[t];
     std::int32_t ids[3] = {planes_[v.p[0]].id, planes_[v.p[1]].id, planes_[v.p[2]].id};
-    return exact_clip_sign(*exact_, gen_, ids, j);
+    if (pr.cell != cells_ || pr.p[0] != v.p[0] || pr.p[1] != v.p[1] || pr.p[2] != v.p[2]) {
+      pr.cell = cells_;
+      for (int k = 0; k < 3; ++k) pr.p[k] = v.p[k];
+      pr.usable = pr.pred.prepare(*exact_, gen_, ids);
+    }
+    return pr.usable ? pr.pred.sign(*exact_, j) : exact_clip_sign(*exact_, gen_, ids, j);
   }
 
   // Every change to the vertex list goes through these, which keep the sign
@@ -310,6 +321,17 @@ class Hull {
   double security2_ = 0;
   std::vector<std::uint8_t> seen_;
   std::vector<std::uint32_t> loop_;
+  // Per vertex slot: its prepared exact predicate, valid while the slot holds
+  // the same planes in the same cell (a cell's local plane indices only grow,
+  // and a removed vertex never returns).
+  struct Prepared {
+    std::uint64_t cell = 0;
+    std::uint16_t p[3] = {0, 0, 0};
+    bool usable = false;
+    VertexPredicate pred;
+  };
+  std::vector<Prepared> prepared_;
+  std::uint64_t cells_ = 0;  // cells started by reset (prepared_'s epoch)
 };
 
 }  // namespace tessera::kernels

@@ -43,6 +43,7 @@ class Tile {
     gen_ = gen;
     exact_ = exact;
     exact_calls_ = 0;
+    ++cells_;
     // Planes and corners are written in place: a local struct copied in
     // would be read back wider than it was written (a store-forwarding stall).
     planes_.resize(4);
@@ -80,7 +81,7 @@ class Tile {
     const double n1 = std::fabs(q[0]) + std::fabs(q[1]);
     const std::size_t nv = verts_.size();
     const std::size_t removed = filter::classify<2>(lanes_, q, d, n1, sign_,
-                                                     [&](std::size_t t) { return exact_sign(verts_[t], j); });
+                                                     [&](std::size_t t) { return exact_sign(t, j); });
     if (removed == 0) return ClipResult::unchanged;
     if (removed == nv) {
       verts_.clear();
@@ -149,10 +150,20 @@ class Tile {
   std::uint64_t exact_calls() const { return exact_calls_; }
 
  private:
-  int exact_sign(const Vertex& v, std::int32_t j) {
+  // As Hull::exact_sign: prepared once per vertex (VertexPredicate).
+  int exact_sign(std::size_t t, std::int32_t j) {
     ++exact_calls_;
+    const Vertex& v = verts_[t];
+    if (prepared_.size() < verts_.size()) prepared_.resize(verts_.size());
+    Prepared& pr = prepared_[t];
     std::int32_t ids[2] = {planes_[v.p[0]].id, planes_[v.p[1]].id};
-    return exact_clip_sign(*exact_, gen_, ids, j);
+    if (pr.cell != cells_ || pr.p[0] != v.p[0] || pr.p[1] != v.p[1]) {
+      pr.cell = cells_;
+      pr.p[0] = v.p[0];
+      pr.p[1] = v.p[1];
+      pr.usable = pr.pred.prepare(*exact_, gen_, ids);
+    }
+    return pr.usable ? pr.pred.sign(*exact_, j) : exact_clip_sign(*exact_, gen_, ids, j);
   }
 
   // verts_ and its sign-pass mirror (lanes_) change together.
@@ -209,6 +220,14 @@ class Tile {
   filter::FilterLanes<2> lanes_;  // verts_' filter data, for the sign pass
   std::vector<filter::Sign> sign_;
   double security2_ = 0;
+  struct Prepared {  // see Hull::Prepared
+    std::uint64_t cell = 0;
+    std::uint16_t p[2] = {0, 0};
+    bool usable = false;
+    VertexPredicate pred;
+  };
+  std::vector<Prepared> prepared_;
+  std::uint64_t cells_ = 0;
 };
 
 }  // namespace tessera::kernels
