@@ -177,6 +177,7 @@ Pass<D>::Pass(std::span<const double> input, std::span<const std::int32_t> label
     exact.lo[static_cast<std::size_t>(d)] = bounds.lo[static_cast<std::size_t>(d)];
     exact.hi[static_cast<std::size_t>(d)] = bounds.hi[static_cast<std::size_t>(d)];
   }
+  kernels::make_grid(exact, n, grid);  // lattices and voxel grids: integer exact predicates
   gens.coords = points.data();
   gens.locator = &*locator;
   gens.lo = lo;

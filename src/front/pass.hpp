@@ -48,6 +48,7 @@ struct Pass {
   std::optional<kernels::BinLocator<D>> locator;
   std::vector<std::int32_t> order;           ///< generators with cells wanted, bin order
   kernels::ExactContext exact;
+  std::vector<std::int32_t> grid;            ///< exact.grid's storage, when the input has one
   engine::Generators<D> gens;
   engine::EngineOptions engine_options;
 };

@@ -350,13 +350,84 @@ int exact_clip_sign(const ExactContext& ctx, std::int32_t i, const std::int32_t*
 // and w_i's coefficient is det A - sum over bisector rows of a_j . C_r.
 // Bounds as in signs_int128: |a| < 2^24, |C| < 2^49, |a_j . C_r| < 2^76,
 // |b| < 2^46, so every sum stays below 2^124.
+namespace {
+constexpr int kGridBits = 22;  // the int128 paths' bound on grid coordinates
+}  // namespace
+
+bool make_grid(ExactContext& ctx, std::size_t n, std::vector<std::int32_t>& grid) {
+  const int dim = ctx.dim;
+  if (dim != 2 && dim != 3) return false;
+  const std::size_t m = n * static_cast<std::size_t>(dim);
+  // The common scale (smallest lowest set bit) and the top bit; stop as soon
+  // as they are too far apart (both only move apart): on general input, at
+  // once.
+  int shift = INT_MAX, top = INT_MIN;
+  auto see = [&](double x) {
+    const DoubleParts pt = double_parts(x);
+    if (pt.mant == 0) return true;
+    const auto um = static_cast<std::uint64_t>(pt.mant < 0 ? -pt.mant : pt.mant);
+    shift = std::min(shift, pt.e2 + std::countr_zero(um));
+    top = std::max(top, pt.e2 + 64 - std::countl_zero(um));
+    return top - shift <= kGridBits;
+  };
+  for (int d = 0; d < dim; ++d)
+    if (!see(ctx.lo[static_cast<std::size_t>(d)]) || !see(ctx.hi[static_cast<std::size_t>(d)])) return false;
+  for (std::size_t k = 0; k < m; ++k)
+    if (!see(ctx.points[k])) return false;
+  if (shift == INT_MAX) shift = 0;
+  auto scaled = [&](double x) -> std::int32_t {
+    const DoubleParts pt = double_parts(x);
+    if (pt.mant == 0) return 0;
+    const int k = pt.e2 - shift;  // exact: the bits below 2^shift are zero
+    return static_cast<std::int32_t>(k >= 0 ? pt.mant * (std::int64_t{1} << k) : pt.mant >> -k);
+  };
+  grid.resize(m);
+  for (std::size_t k = 0; k < m; ++k) grid[k] = scaled(ctx.points[k]);
+  for (int d = 0; d < dim; ++d) {
+    ctx.grid_lo[static_cast<std::size_t>(d)] = scaled(ctx.lo[static_cast<std::size_t>(d)]);
+    ctx.grid_hi[static_cast<std::size_t>(d)] = scaled(ctx.hi[static_cast<std::size_t>(d)]);
+  }
+  ctx.grid = grid.data();
+  ctx.grid_shift = shift;
+  return true;
+}
+
 bool VertexPredicate::prepare(const ExactContext& ctx, std::int32_t i, const std::int32_t* planes) {
   using I = __int128;
-  constexpr int kBits = 22;
+  constexpr int kBits = kGridBits;
   dim_ = ctx.dim;
   i_ = i;
   if (dim_ != 2 && dim_ != 3) return false;
   for (int r = 0; r < dim_; ++r) gen_[r] = planes[r];
+  if (ctx.grid != nullptr) {
+    // The whole input is on one grid: read it.
+    shift_ = ctx.grid_shift;
+    const std::int32_t* gi = ctx.grid + static_cast<std::size_t>(i) * dim_;
+    ci2_ = 0;
+    for (int d = 0; d < dim_; ++d) {
+      ci_[d] = gi[d];
+      ci2_ += static_cast<I>(ci_[d]) * ci_[d];
+    }
+    std::int64_t a[Scratch::kMaxDim][Scratch::kMaxDim] = {};
+    for (int r = 0; r < dim_; ++r) {
+      if (gen_[r] >= 0) {
+        const std::int32_t* gk = ctx.grid + static_cast<std::size_t>(gen_[r]) * dim_;
+        I sq = 0;
+        for (int d = 0; d < dim_; ++d) {
+          a[r][d] = 2 * (std::int64_t{gk[d]} - ci_[d]);
+          sq += static_cast<I>(gk[d]) * gk[d];
+        }
+        b_[r] = sq - ci2_;
+      } else {
+        const int axis = box_plane_axis(gen_[r]);
+        a[r][axis] = 1;
+        b_[r] = box_plane_upper(gen_[r]) ? ctx.grid_hi[static_cast<std::size_t>(axis)]
+                                         : ctx.grid_lo[static_cast<std::size_t>(axis)];
+      }
+    }
+    set_cofactors(a);
+    return true;
+  }
   // The vertex's doubles by their bits, and their common grid.
   DoubleParts pv[Scratch::kRows][Scratch::kMaxDim];
   int nd[Scratch::kRows];
@@ -409,6 +480,12 @@ bool VertexPredicate::prepare(const ExactContext& ctx, std::int32_t i, const std
       b_[r] = scaled(pv[r][0]);
     }
   }
+  set_cofactors(a);
+  return true;
+}
+
+void VertexPredicate::set_cofactors(const std::int64_t (*a)[3]) {
+  using I = __int128;
   if (dim_ == 2) {
     cof_[0][0] = a[1][1]; cof_[0][1] = -a[1][0];
     cof_[1][0] = -a[0][1]; cof_[1][1] = a[0][0];
@@ -424,16 +501,19 @@ bool VertexPredicate::prepare(const ExactContext& ctx, std::int32_t i, const std
     det_a_ = static_cast<I>(a[0][0]) * cof_[0][0] + static_cast<I>(a[0][1]) * cof_[0][1] +
              static_cast<I>(a[0][2]) * cof_[0][2];
   }
-  return true;
 }
 
 int VertexPredicate::sign(const ExactContext& ctx, std::int32_t j) const {
   using I = __int128;
-  constexpr int kBits = 22;
+  constexpr int kBits = kGridBits;
   // p_j on the vertex's grid, within the bounds; else the general path.
   const double* pj = ctx.points + static_cast<std::size_t>(j) * dim_;
   std::int64_t xj[Scratch::kMaxDim];
   for (int d = 0; d < dim_; ++d) {
+    if (ctx.grid != nullptr) {  // the whole input is on the grid
+      xj[d] = ctx.grid[static_cast<std::size_t>(j) * dim_ + d];
+      continue;
+    }
     const DoubleParts pt = double_parts(pj[d]);
     if (pt.mant == 0) { xj[d] = 0; continue; }
     const auto um = static_cast<std::uint64_t>(pt.mant < 0 ? -pt.mant : pt.mant);

@@ -718,3 +718,66 @@ TEST(ExactPredicates, PreparedVertexOnAndOffGrid) {
 }
 
 }  // namespace
+
+namespace {
+
+// make_grid: the input and box on one grid of at most 22 bits, or nothing.
+// With the grid in the context, prepared predicates read integers; their
+// answers equal exact_clip_sign's on the plain context and the oracle's.
+TEST(ExactPredicates, GridContext) {
+  using tessera::kernels::make_grid;
+  for (int dim : {2, 3}) {
+    Rng r(71 + static_cast<std::uint64_t>(dim));
+    Problem p;
+    p.dim = dim;
+    for (int d = 0; d < 3; ++d) { p.lo[d] = -8.5; p.hi[d] = 8.5; }  // half-integer box: shift -1
+    for (int k = 0; k < 40; ++k) {
+      std::array<double, 3> x{};
+      for (int d = 0; d < dim; ++d) x[d] = 0.25 * (static_cast<double>(r.index(61)) - 30);  // quarter grid
+      p.add(x);
+    }
+    const ExactContext plain = p.ctx();
+    ExactContext gc = plain;
+    std::vector<std::int32_t> grid;
+    ASSERT_TRUE(make_grid(gc, static_cast<std::size_t>(p.size()), grid));
+    EXPECT_EQ(gc.grid_shift, -2);
+    EXPECT_EQ(gc.grid_lo[0], -34);
+    EXPECT_EQ(gc.grid_hi[0], 34);
+    int checked = 0;
+    for (int t = 0; t < 300; ++t) {
+      Ids planes{};
+      const std::int32_t i = r.index(p.size());
+      for (int k = 0; k < dim; ++k)
+        planes[k] = r.index(5) == 0 ? box_plane_id(static_cast<int>(r.index(dim)), r.index(2) == 1) : r.index(p.size());
+      bool distinct = true;
+      for (int k = 0; k < dim; ++k) {
+        distinct &= planes[k] != i;
+        for (int m = 0; m < k; ++m) distinct &= planes[k] != planes[m];
+      }
+      if (!distinct || !independent(plain, i, planes.data())) continue;
+      tessera::kernels::VertexPredicate vp;
+      ASSERT_TRUE(vp.prepare(gc, i, planes.data()));
+      for (std::int32_t j = 0; j < p.size(); ++j) {
+        if (j == i || std::find(planes.begin(), planes.begin() + dim, j) != planes.begin() + dim) continue;
+        const int want = check_sign(plain, i, planes.data(), j);
+        EXPECT_EQ(vp.sign(gc, j), want) << "grid: " << describe(plain, i, planes.data(), j);
+        ++checked;
+      }
+    }
+    EXPECT_GT(checked, 3000) << "dim " << dim;
+
+    // No grid: a coordinate off every short grid, a span beyond 22 bits, a box bound off the grid.
+    for (int bad = 0; bad < 3; ++bad) {
+      Problem q = p;
+      if (bad == 0) q.pts[5] = 0.1;
+      if (bad == 1) q.pts[5] = 0x1p21;
+      if (bad == 2) q.hi[1] = 8.3;
+      ExactContext c = q.ctx();
+      std::vector<std::int32_t> g;
+      EXPECT_FALSE(make_grid(c, static_cast<std::size_t>(q.size()), g)) << "case " << bad;
+      EXPECT_EQ(c.grid, nullptr);
+    }
+  }
+}
+
+}  // namespace

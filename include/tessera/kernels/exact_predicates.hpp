@@ -24,7 +24,9 @@
 
 #include <array>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
+#include <vector>
 
 namespace tessera::kernels {
 
@@ -66,7 +68,20 @@ struct ExactContext {
   const double* points = nullptr;   ///< n * dim input coordinates
   int dim = 3;
   std::array<double, 3> lo{}, hi{}; ///< domain box
+  /// Optional (see make_grid): the same coordinates and box as integers on
+  /// one grid of step 2^grid_shift, each below 2^22 in magnitude. Null when
+  /// the input has no such grid; the exact paths then read `points`.
+  const std::int32_t* grid = nullptr;
+  int grid_shift = 0;
+  std::array<std::int32_t, 3> grid_lo{}, grid_hi{};
 };
+
+/// Put n points (n * dim doubles) and the box [lo, hi] on their common grid
+/// when it has at most 22 bits (lattices, voxel centres, integer and dyadic
+/// grids), so prepared exact predicates read integers instead of decomposing
+/// doubles on every call. Fills `grid` (n * dim) and returns true with
+/// `ctx.grid` pointing at it; false (ctx unchanged) otherwise.
+bool make_grid(ExactContext& ctx, std::size_t n, std::vector<std::int32_t>& grid);
 
 /// Exact sign of P (see above) for the vertex of cell `i` defined by
 /// `planes[0..dim)` (generator ids >= 0, box-plane ids < 0), against candidate
@@ -92,6 +107,7 @@ class VertexPredicate {
   int sign(const ExactContext& ctx, std::int32_t j) const;
 
  private:
+  void set_cofactors(const std::int64_t (*a)[3]);  // cof_ and det_a_ from A's rows
   int dim_ = 3, shift_ = 0;
   std::int32_t i_ = -1, gen_[3] = {0, 0, 0};
   std::int64_t ci_[3] = {0, 0, 0};   // p_i on the grid
