@@ -426,7 +426,7 @@ bool VertexPredicate::prepare(const ExactContext& ctx, std::int32_t i, const std
       }
     }
     set_cofactors(a);
-    return true;
+    return det_a_sign_ != 0;  // dependent planes: exact_clip_sign reports it
   }
   // The vertex's doubles by their bits, and their common grid.
   DoubleParts pv[Scratch::kRows][Scratch::kMaxDim];
@@ -481,7 +481,7 @@ bool VertexPredicate::prepare(const ExactContext& ctx, std::int32_t i, const std
     }
   }
   set_cofactors(a);
-  return true;
+  return det_a_sign_ != 0;
 }
 
 void VertexPredicate::set_cofactors(const std::int64_t (*a)[3]) {
@@ -501,6 +501,14 @@ void VertexPredicate::set_cofactors(const std::int64_t (*a)[3]) {
     det_a_ = static_cast<I>(a[0][0]) * cof_[0][0] + static_cast<I>(a[0][1]) * cof_[0][1] +
              static_cast<I>(a[0][2]) * cof_[0][2];
   }
+  det_a_sign_ = sign_of(det_a_);
+  // The perturbation's terms other than j's: i, and each bisector row, by id.
+  nterms_ = 0;
+  terms_[nterms_++] = {i_, -1};
+  for (int r = 0; r < dim_; ++r)
+    if (gen_[r] >= 0) terms_[nterms_++] = {gen_[r], r};
+  for (int a1 = 1; a1 < nterms_; ++a1)
+    for (int b1 = a1; b1 > 0 && terms_[b1].id < terms_[b1 - 1].id; --b1) std::swap(terms_[b1], terms_[b1 - 1]);
 }
 
 int VertexPredicate::sign(const ExactContext& ctx, std::int32_t j) const {
@@ -528,22 +536,30 @@ int VertexPredicate::sign(const ExactContext& ctx, std::int32_t j) const {
     aj[d] = 2 * (xj[d] - ci_[d]);
     bj += static_cast<I>(xj[d]) * xj[d];
   }
-  ClipSigns sg;
-  I m0 = bj * det_a_, wi = det_a_;
+  I m0 = bj * det_a_, wi = det_a_, dr[Scratch::kMaxDim];
   for (int r = 0; r < dim_; ++r) {
-    I dr = 0;  // det A with row r replaced by a_j
-    for (int d = 0; d < dim_; ++d) dr += static_cast<I>(aj[d]) * cof_[r][d];
-    sg.minor[r] = ((dim_ - 1 - r) & 1) ? -sign_of(dr) : sign_of(dr);
-    m0 -= b_[r] * dr;
-    if (gen_[r] >= 0) wi -= dr;
+    dr[r] = 0;  // det A with row r replaced by a_j
+    for (int d = 0; d < dim_; ++d) dr[r] += static_cast<I>(aj[d]) * cof_[r][d];
+    m0 -= b_[r] * dr[r];
+    if (gen_[r] >= 0) wi -= dr[r];
   }
-  sg.minor[dim_] = sign_of(det_a_);
-  sg.det_m0 = sign_of(m0);
-  sg.weight_i = sign_of(wi);
-  std::int32_t gen[Scratch::kRows];
-  for (int r = 0; r < dim_; ++r) gen[r] = gen_[r];
-  gen[dim_] = j;
-  return decide(sg, i_, gen, dim_);
+  int sign_m = sign_of(m0);
+  if (sign_m == 0) {
+    // decide()'s tie-break with the terms pre-sorted: the coefficient of
+    // w_gen[r] has the sign of dr[r] (-cofactor(r) * minor[r], see above),
+    // of w_i that of wi, of w_j that of -det A (never zero), so j decides
+    // unless a lower id does first.
+    sign_m = -det_a_sign_;
+    for (int t = 0; t < nterms_; ++t) {
+      if (terms_[t].id > j) break;
+      const int c = terms_[t].row < 0 ? sign_of(wi) : sign_of(dr[terms_[t].row]);
+      if (c != 0) {
+        sign_m = c;
+        break;
+      }
+    }
+  }
+  return sign_m * det_a_sign_ > 0 ? +1 : -1;
 }
 
 void exact_vertex(const ExactContext& ctx, std::int32_t i, const std::int32_t* planes, double* y) {

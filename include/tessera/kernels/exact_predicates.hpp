@@ -113,6 +113,13 @@ class VertexPredicate {
   std::int64_t ci_[3] = {0, 0, 0};   // p_i on the grid
   std::int64_t cof_[3][3] = {};      // row r: A's cofactors along row r
   __int128 ci2_ = 0, det_a_ = 0, b_[3] = {0, 0, 0};
+  int det_a_sign_ = 0;
+  struct Term {  // a symbolic weight of the tie-break: i (row -1) or a bisector row
+    std::int32_t id;
+    int row;
+  };
+  Term terms_[4] = {};  // by ascending id
+  int nterms_ = 0;
 };
 
 /// The vertex of cell `i` where `planes[0..dim)` meet, relative to p_i,
