@@ -32,6 +32,34 @@ DoubleParts double_parts(double x) {
   return {(bits >> 63) ? -sm : sm, e2};
 }
 
+// The common grid of the doubles seen: the smallest exponent of a lowest
+// set bit (every value is an integer times 2^shift) and the top bit (every
+// |x| < 2^top). The integer paths take a set of values whose span
+// top - shift is small.
+struct GridSpan {
+  int shift = INT_MAX, top = INT_MIN;
+  DoubleParts see(double x) {
+    const DoubleParts pt = double_parts(x);
+    if (pt.mant != 0) {
+      const auto um = static_cast<std::uint64_t>(pt.mant < 0 ? -pt.mant : pt.mant);
+      shift = std::min(shift, pt.e2 + std::countr_zero(um));
+      top = std::max(top, pt.e2 + 64 - std::countl_zero(um));
+    }
+    return pt;
+  }
+  bool fits(int bits) const { return top == INT_MIN || top - shift <= bits; }
+  int scale() const { return shift == INT_MAX ? 0 : shift; }
+};
+
+// x / 2^shift for x = pt on a grid of step 2^shift (its bits below 2^shift
+// are zero, so the arithmetic right shift is exact, negative or not; C++20
+// defines it).
+std::int64_t on_grid(const DoubleParts& pt, int shift) {
+  if (pt.mant == 0) return 0;
+  const int k = pt.e2 - shift;
+  return k >= 0 ? pt.mant * (std::int64_t{1} << k) : pt.mant >> -k;
+}
+
 // Scratch integers reused across calls on one thread: the exact path is rare on
 // random input but common on lattices, and GMP allocation would dominate it.
 struct Scratch {
@@ -209,28 +237,15 @@ bool signs_int128(const ExactContext& ctx, std::int32_t i, const std::int32_t* g
   }
   // Each double by its bits (double_parts), and the common scale.
   DoubleParts pv[Scratch::kRows + 1][Scratch::kMaxDim];
-  int shift = INT_MAX, top = INT_MIN;
-  auto see = [&](DoubleParts& pt, double x) {
-    pt = double_parts(x);
-    if (pt.mant == 0) return;
-    const auto um = static_cast<std::uint64_t>(pt.mant < 0 ? -pt.mant : pt.mant);
-    shift = std::min(shift, pt.e2 + std::countr_zero(um));
-    top = std::max(top, pt.e2 + 64 - std::countl_zero(um));  // |x| < 2^top
-  };
-  for (int d = 0; d < dim; ++d) see(pv[rows][d], v[rows][d]);
+  GridSpan span;
+  for (int d = 0; d < dim; ++d) pv[rows][d] = span.see(v[rows][d]);
   for (int r = 0; r < rows; ++r) {
-    if (gen[r] >= 0) for (int d = 0; d < dim; ++d) see(pv[r][d], v[r][d]);
-    else see(pv[r][0], v[r][0]);
+    if (gen[r] >= 0) for (int d = 0; d < dim; ++d) pv[r][d] = span.see(v[r][d]);
+    else pv[r][0] = span.see(v[r][0]);
   }
-  if (shift == INT_MAX) shift = 0;
-  if (top != INT_MIN && top - shift > kBits) return false;
-  // x / 2^shift: an integer below 2^22 (its low bits below 2^shift are zero,
-  // so the arithmetic right shift is exact, negative or not; C++20 defines it).
-  auto scaled_p = [&](const DoubleParts& pt) -> std::int64_t {
-    if (pt.mant == 0) return 0;
-    const int k = pt.e2 - shift;
-    return k >= 0 ? pt.mant * (std::int64_t{1} << k) : pt.mant >> -k;
-  };
+  if (!span.fits(kBits)) return false;
+  const int shift = span.scale();
+  auto scaled_p = [&](const DoubleParts& pt) { return on_grid(pt, shift); };
   std::int64_t ci[Scratch::kMaxDim];
   I ci2 = 0;
   for (int d = 0; d < dim; ++d) {
@@ -278,7 +293,7 @@ bool signs_int128(const ExactContext& ctx, std::int32_t i, const std::int32_t* g
       out.minor[r] = (m > 0) - (m < 0);
     }
   };
-  if (top == INT_MIN || top - shift <= 17) minors(std::int64_t{});
+  if (span.fits(17)) minors(std::int64_t{});
   else minors(I{});
   I m0 = 0, wi = 0;
   for (int r = 0; r < rows; ++r) {
@@ -358,29 +373,17 @@ bool make_grid(ExactContext& ctx, std::size_t n, std::vector<std::int32_t>& grid
   const int dim = ctx.dim;
   if (dim != 2 && dim != 3) return false;
   const std::size_t m = n * static_cast<std::size_t>(dim);
-  // The common scale (smallest lowest set bit) and the top bit; stop as soon
-  // as they are too far apart (both only move apart): on general input, at
-  // once.
-  int shift = INT_MAX, top = INT_MIN;
-  auto see = [&](double x) {
-    const DoubleParts pt = double_parts(x);
-    if (pt.mant == 0) return true;
-    const auto um = static_cast<std::uint64_t>(pt.mant < 0 ? -pt.mant : pt.mant);
-    shift = std::min(shift, pt.e2 + std::countr_zero(um));
-    top = std::max(top, pt.e2 + 64 - std::countl_zero(um));
-    return top - shift <= kGridBits;
-  };
-  for (int d = 0; d < dim; ++d)
-    if (!see(ctx.lo[static_cast<std::size_t>(d)]) || !see(ctx.hi[static_cast<std::size_t>(d)])) return false;
-  for (std::size_t k = 0; k < m; ++k)
-    if (!see(ctx.points[k])) return false;
-  if (shift == INT_MAX) shift = 0;
-  auto scaled = [&](double x) -> std::int32_t {
-    const DoubleParts pt = double_parts(x);
-    if (pt.mant == 0) return 0;
-    const int k = pt.e2 - shift;  // exact: the bits below 2^shift are zero
-    return static_cast<std::int32_t>(k >= 0 ? pt.mant * (std::int64_t{1} << k) : pt.mant >> -k);
-  };
+  // The common grid; stop as soon as its span is too wide (it only widens):
+  // on general input, at once.
+  GridSpan span;
+  for (int d = 0; d < dim; ++d) {
+    span.see(ctx.lo[static_cast<std::size_t>(d)]);
+    span.see(ctx.hi[static_cast<std::size_t>(d)]);
+  }
+  for (std::size_t k = 0; k < m && span.fits(kGridBits); ++k) span.see(ctx.points[k]);
+  if (!span.fits(kGridBits)) return false;
+  const int shift = span.scale();
+  auto scaled = [&](double x) { return static_cast<std::int32_t>(on_grid(double_parts(x), shift)); };
   grid.resize(m);
   for (std::size_t k = 0; k < m; ++k) grid[k] = scaled(ctx.points[k]);
   for (int d = 0; d < dim; ++d) {
@@ -432,34 +435,22 @@ bool VertexPredicate::prepare(const ExactContext& ctx, std::int32_t i, const std
   DoubleParts pv[Scratch::kRows][Scratch::kMaxDim];
   int nd[Scratch::kRows];
   const double* pi = ctx.points + static_cast<std::size_t>(i) * dim_;
-  int shift = INT_MAX, top = INT_MIN;
-  auto see = [&](DoubleParts& pt, double x) {
-    pt = double_parts(x);
-    if (pt.mant == 0) return;
-    const auto um = static_cast<std::uint64_t>(pt.mant < 0 ? -pt.mant : pt.mant);
-    shift = std::min(shift, pt.e2 + std::countr_zero(um));
-    top = std::max(top, pt.e2 + 64 - std::countl_zero(um));
-  };
-  for (int d = 0; d < dim_; ++d) see(pv[dim_][d], pi[d]);
+  GridSpan span;
+  for (int d = 0; d < dim_; ++d) pv[dim_][d] = span.see(pi[d]);
   for (int r = 0; r < dim_; ++r) {
     if (gen_[r] >= 0) {
       const double* pk = ctx.points + static_cast<std::size_t>(gen_[r]) * dim_;
-      for (int d = 0; d < dim_; ++d) see(pv[r][d], pk[d]);
+      for (int d = 0; d < dim_; ++d) pv[r][d] = span.see(pk[d]);
       nd[r] = dim_;
     } else {
       const int axis = box_plane_axis(gen_[r]);
-      see(pv[r][0], box_plane_upper(gen_[r]) ? ctx.hi[axis] : ctx.lo[axis]);
+      pv[r][0] = span.see(box_plane_upper(gen_[r]) ? ctx.hi[axis] : ctx.lo[axis]);
       nd[r] = 1;
     }
   }
-  if (shift == INT_MAX) shift = 0;
-  if (top != INT_MIN && top - shift > kBits) return false;
-  shift_ = shift;
-  auto scaled = [&](const DoubleParts& pt) -> std::int64_t {
-    if (pt.mant == 0) return 0;
-    const int k = pt.e2 - shift;
-    return k >= 0 ? pt.mant * (std::int64_t{1} << k) : pt.mant >> -k;
-  };
+  if (!span.fits(kBits)) return false;
+  shift_ = span.scale();
+  auto scaled = [&](const DoubleParts& pt) { return on_grid(pt, shift_); };
   ci2_ = 0;
   for (int d = 0; d < dim_; ++d) {
     ci_[d] = scaled(pv[dim_][d]);
@@ -522,13 +513,10 @@ int VertexPredicate::sign(const ExactContext& ctx, std::int32_t j) const {
       xj[d] = ctx.grid[static_cast<std::size_t>(j) * dim_ + d];
       continue;
     }
-    const DoubleParts pt = double_parts(pj[d]);
-    if (pt.mant == 0) { xj[d] = 0; continue; }
-    const auto um = static_cast<std::uint64_t>(pt.mant < 0 ? -pt.mant : pt.mant);
-    if (pt.e2 + std::countr_zero(um) < shift_ || pt.e2 + 64 - std::countl_zero(um) - shift_ > kBits)
-      return exact_clip_sign(ctx, i_, gen_, j);
-    const int k = pt.e2 - shift_;
-    xj[d] = k >= 0 ? pt.mant * (std::int64_t{1} << k) : pt.mant >> -k;
+    GridSpan span;  // p_j's coordinate: on the vertex's grid, within its bounds?
+    const DoubleParts pt = span.see(pj[d]);
+    if (pt.mant != 0 && (span.shift < shift_ || span.top - shift_ > kBits)) return exact_clip_sign(ctx, i_, gen_, j);
+    xj[d] = on_grid(pt, shift_);
   }
   std::int64_t aj[Scratch::kMaxDim];
   I bj = -ci2_;
