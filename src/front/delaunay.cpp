@@ -7,7 +7,6 @@
 #include <cstring>
 #include <stdexcept>
 
-
 #include "delaunay_compositor.hpp"
 #include "hull_completion.hpp"
 #include "pass.hpp"

@@ -16,9 +16,9 @@
 #include <algorithm>
 #include <array>
 #include <bit>
+#include <cstdint>
 #include <cstring>
 #include <limits>
-#include <cstdint>
 #include <vector>
 
 #include "tessera/kernels/exact_predicates.hpp"

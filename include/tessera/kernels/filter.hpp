@@ -37,11 +37,6 @@ inline constexpr double abs_eps = 0x1p-900;
 /// for geometry (volumes, merged coordinates): the vertex is solved exactly.
 inline constexpr double exact_vertex_condition = 1e6;
 
-/// The vertices' filter data (y, e, r2 of each vertex, as in `classify`) kept
-/// as structure-of-arrays beside the cell's own vertex list, so the sign pass
-/// reads contiguous doubles and runs in SIMD lanes. Slots from size() up to
-/// the next multiple of `lanes` always hold padding (r2 = -1), which the
-/// radius test of `classify` never lets through, so the pass needs no tail.
 /// memmove of `count` elements from base[src] to base[dst] (the ranges may
 /// overlap) as a plain loop: the moves are a few elements long, where a
 /// library call costs more than the copy. The empty asm statement keeps GCC
@@ -61,6 +56,12 @@ void shift(T* base, std::size_t dst, std::size_t src, std::size_t count) {
   }
 }
 
+/// The vertices' filter data (y, e, r2 of each vertex, as in `classify`) kept
+/// as structure-of-arrays beside the cell's own vertex list, so the sign pass
+/// reads contiguous doubles and runs in SIMD lanes. Slots from size() up to
+/// the next multiple of `lanes` always hold padding (y = 0, e = 0, r2 = -1),
+/// which `classify` never marks for removal (its plane value is d, its radius
+/// fails the radius test), so the pass needs no tail.
 template <int D>
 class FilterLanes {
  public:
@@ -174,9 +175,10 @@ inline Lane load(const double* p) {
 /// |q|/2 from the generator cannot be cut: q.y <= |q||y| <= |q|^2/2 (equality
 /// would need y = q/2 exactly, which the strict margin excludes). Candidates
 /// usually fail to clip; a first pass only proves that, a lane group at a
-/// time, by the float filter alone (a near vertex passes it but where it
-/// touches the plane, so the radius test is left to the second pass, which
-/// measured cheaper), and then `sign` is left untouched. Both passes take a lane group (four
+/// time, and then `sign` is left untouched. It uses the float filter alone:
+/// a near vertex fails the filter only where it (nearly) touches the plane,
+/// rare enough that leaving the radius test to the second pass measured
+/// cheaper. Both passes take a lane group (four
 /// vertices) at a time, branch-free within it; the arithmetic is the same, term
 /// for term, as a scalar loop's (no contraction), so the signs do not depend on
 /// the vector width.
