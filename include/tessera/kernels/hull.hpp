@@ -179,24 +179,32 @@ class Hull {
   /// from outside as pointer + count). The walk buffers are members, reused.
   template <class F>
   void for_each_face(F&& f) {
+    const std::size_t nv = verts_.size();
     seen_.assign(planes_.size(), 0);
-    loop_.clear();
-    for (std::size_t t = 0; t < verts_.size(); ++t) {
+    loop_.resize(nv + 1);
+    // Raw pointers held in locals: the stores below (the loop, the seen
+    // flags) would otherwise make the compiler reload every member vector's
+    // data pointer at each step of the walk.
+    const Vertex* const verts = verts_.data();
+    const std::uint32_t* const table = edge_tri_.data();
+    const std::size_t cap = cap_;
+    std::uint8_t* const seen = seen_.data();
+    std::uint32_t* const loop = loop_.data();
+    for (std::size_t t = 0; t < nv; ++t) {
       for (int k = 0; k < 3; ++k) {
-        std::uint16_t p = verts_[t].p[k];
-        if (seen_[p]) continue;
-        seen_[p] = 1;
-        loop_.clear();
+        const std::uint16_t p = verts[t].p[k];
+        if (seen[p]) continue;
+        seen[p] = 1;
         // Walk the triangles around plane p: in (p, x, y) the next one holds p -> y.
+        std::size_t m = 0;
         std::uint32_t cur = static_cast<std::uint32_t>(t);
         do {
-          loop_.push_back(cur);
-          const Vertex& v = verts_[cur];
-          int at = v.p[0] == p ? 0 : (v.p[1] == p ? 1 : 2);
-          std::uint16_t y = v.p[(at + 2) % 3];
-          cur = edge_tri_[static_cast<std::size_t>(p) * cap_ + y];
-        } while (cur != t && loop_.size() <= verts_.size());
-        f(p, loop_.data(), loop_.size());
+          loop[m++] = cur;
+          const Vertex& v = verts[cur];
+          const int at = v.p[0] == p ? 0 : (v.p[1] == p ? 1 : 2);
+          cur = table[static_cast<std::size_t>(p) * cap + v.p[(at + 2) % 3]];
+        } while (cur != t && m <= nv);
+        f(p, static_cast<const std::uint32_t*>(loop), m);
       }
     }
   }
