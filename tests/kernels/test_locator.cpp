@@ -11,10 +11,13 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <optional>
 #include <random>
 #include <span>
 #include <string>
 #include <vector>
+
+#include <tbb/task_arena.h>
 
 #include "tessera/kernels/locator.hpp"
 
@@ -281,6 +284,42 @@ void check_bin_distance(const Case<D>& c, double slack) {
 
 TEST(BinLocator, SortedStable2D) { for (const auto& c : cases<2>()) check_sorting(c); }
 TEST(BinLocator, SortedStable3D) { for (const auto& c : cases<3>()) check_sorting(c); }
+// The counting sort splits large inputs into chunks, one per thread of the
+// arena it runs in: the result is the serial one (stable in id) for 1, 2 and
+// 3 threads, masked or not.
+template <int D>
+void chunked_sort_is_serial() {
+  std::mt19937_64 g(D * 77 + 1);
+  std::array<double, D> lo{}, hi{};
+  for (int d = 0; d < D; ++d) hi[d] = 1;
+  for (bool mask : {false, true}) {
+    Case<D> c{mask ? "large masked" : "large", tricky_points<D>(300000, lo, hi, 7, g), {}, lo, hi, 2.0};
+    if (mask) {
+      c.use.resize(c.coords.size() / D);
+      for (auto& b : c.use) b = (g() % 3) != 0;
+    }
+    auto build = [&](int threads) {
+      std::optional<BinLocator<D>> loc;
+      tbb::task_arena(threads).execute([&] { loc.emplace(c.coords, c.use, c.lo, c.hi, c.ppb); });
+      return std::move(*loc);
+    };
+    const BinLocator<D> one = build(1);
+    check_sorting(c);  // the default arena: all cores
+    for (int threads : {2, 3}) {
+      const BinLocator<D> many = build(threads);
+      ASSERT_EQ(many.offsets(), one.offsets()) << threads << " threads";
+      ASSERT_EQ(many.size(), one.size());
+      for (std::size_t s = 0; s < one.size(); ++s) {
+        ASSERT_EQ(many.id(s), one.id(s)) << "slot " << s << ", " << threads << " threads";
+        ASSERT_EQ(many.point(s), one.point(s));
+      }
+    }
+  }
+}
+
+TEST(BinLocator, ChunkedSortIsSerial2D) { chunked_sort_is_serial<2>(); }
+TEST(BinLocator, ChunkedSortIsSerial3D) { chunked_sort_is_serial<3>(); }
+
 TEST(BinLocator, ShellsPartitionAndBound2D) {
   std::uint64_t seed = 1;
   for (const auto& c : cases<2>()) check_shells(c, seed++);
