@@ -164,6 +164,17 @@ Pass<D>::Pass(std::span<const double> input, std::span<const std::int32_t> label
                     hi, ppb);
   });
 
+  // A bin far fuller than the grid was sized for (a cluster much smaller
+  // than a bin): its cells search a k-d tree of all the located points.
+  std::uint32_t fullest = 0;
+  for (std::size_t k = 0; k < locator->num_bins(); ++k)
+    fullest = std::max(fullest, locator->offsets()[k + 1] - locator->offsets()[k]);
+  if (fullest > kernels::overfull_bin) {
+    std::vector<std::int32_t> ids(locator->size());
+    for (std::size_t s = 0; s < ids.size(); ++s) ids[s] = locator->id(s);
+    tree.emplace(points, std::move(ids));
+  }
+
   // Generators with cells, in bin order (neighbouring cells run together).
   order.reserve(locator->size());
   for (std::size_t s = 0; s < locator->size(); ++s) {
@@ -184,6 +195,7 @@ Pass<D>::Pass(std::span<const double> input, std::span<const std::int32_t> label
   gens.hi = hi;
   gens.order = order;
   gens.exact = &exact;
+  gens.tree = tree ? &*tree : nullptr;
 
   engine_options.progress = opt.progress;
 }

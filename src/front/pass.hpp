@@ -46,6 +46,7 @@ struct Pass {
   std::vector<std::uint8_t> in_box;          ///< per point: inside the domain
   std::vector<std::int32_t> ignored_outside; ///< points dropped (ignore_outside_points)
   std::optional<kernels::BinLocator<D>> locator;
+  std::optional<kernels::KdTree<D>> tree;    ///< built when a bin is overfull (CellBuilder)
   std::vector<std::int32_t> order;           ///< generators with cells wanted, bin order
   kernels::ExactContext exact;
   std::vector<std::int32_t> grid;            ///< exact.grid's storage, when the input has one

@@ -28,6 +28,7 @@ struct Generators {
   std::array<double, D> lo{}, hi{};               ///< domain box
   std::span<const std::int32_t> order;            ///< generators to build, bin order
   const kernels::ExactContext* exact = nullptr;
+  const kernels::KdTree<D>* tree = nullptr;        ///< for overfull bins, when built
 };
 
 struct EngineOptions {
@@ -53,7 +54,7 @@ std::uint64_t tessellate(const Generators<CellT::dim>& gens, Comp& comp, const E
   };
   tbb::enumerable_thread_specific<Workspace> workspaces([&] {
     return Workspace{kernels::CellBuilder<CellT>(*gens.locator, gens.coords, gens.lo.data(),
-                                                 gens.hi.data(), gens.exact),
+                                                 gens.hi.data(), gens.exact, gens.tree),
                      CellT{}, 0};
   });
 

@@ -23,10 +23,16 @@
 
 #include "tessera/kernels/exact_predicates.hpp"
 #include "tessera/kernels/hull.hpp"  // ClipResult
+#include "tessera/kernels/kd_tree.hpp"
 #include "tessera/kernels/locator.hpp"
 #include "tessera/kernels/support_bound.hpp"
 
 namespace tessera::kernels {
+
+/// A bin holding more points than this sends its cells to the k-d tree (the
+/// pass builds one when some bin does): scanning the bin would cost each of
+/// them that much. The grid aims at two points per bin.
+inline constexpr std::uint32_t overfull_bin = 1024;
 
 /// Outcome of building one cell.
 struct BuildStatus {
@@ -39,15 +45,21 @@ class CellBuilder {
  public:
   static constexpr int D = CellT::dim;
 
+  /// `tree`, when given, serves the cells of overfull bins (see KdTree).
   CellBuilder(const BinLocator<D>& locator, const double* coords, const double* lo, const double* hi,
-              const ExactContext* exact)
-      : loc_(locator), coords_(coords), lo_(lo), hi_(hi), exact_(exact) {}
+              const ExactContext* exact, const KdTree<D>* tree = nullptr)
+      : loc_(locator), coords_(coords), lo_(lo), hi_(hi), exact_(exact), tree_(tree) {}
+
 
   /// Build the cell of generator i into `cell`.
   BuildStatus build(std::int32_t i, CellT& cell) {
     const double* p = coords_ + static_cast<std::size_t>(i) * D;
     cell.reset(i, p, lo_, hi_, exact_);
     const auto b = loc_.bin_coords(p);
+    if (tree_ != nullptr) {
+      const std::size_t own = loc_.bin_index(b);
+      if (loc_.offsets()[own + 1] - loc_.offsets()[own] > overfull_bin) return build_nearest_first(i, p, cell);
+    }
     const int last = loc_.max_shell(b);
     BuildStatus status;
     for (int s = 0; s <= last; ++s) {
@@ -157,6 +169,35 @@ class CellBuilder {
   }
 
  private:
+  /// build() by the k-d tree: candidates nearest first, until the next one
+  /// lies beyond the security radius. The same clips as the shell walk's,
+  /// from the same differences; exact ties come in id order, so the
+  /// duplicate rule holds as there.
+  BuildStatus build_nearest_first(std::int32_t i, const double* p, CellT& cell) {
+    BuildStatus status;
+    double sec2 = cell.security_radius2();
+    tree_->nearest_first(p, i, heap_, [&] { return sec2; }, [&](std::int32_t j, double r2) {
+      if (r2 == 0 && exactly_equal(p, j)) {
+        if (j < i) {  // the first duplicate met is the lowest id
+          status.has_cell = false;
+          status.duplicate_of = j;
+          return false;
+        }
+        return true;
+      }
+      double q[D];
+      for (int d = 0; d < D; ++d) q[d] = coords_[static_cast<std::size_t>(j) * D + d] - p[d];
+      const ClipResult r = cell.clip(j, q);
+      if (r == ClipResult::clipped) sec2 = cell.security_radius2();
+      else if (r == ClipResult::emptied) {
+        status.has_cell = false;
+        return false;
+      }
+      return true;
+    });
+    return status;
+  }
+
   /// The size of the sorted head of an oversized shell (above: a shell of at
   /// most twice as many is sorted whole). A uniform cell uses about 47.
   static constexpr std::size_t sort_head = 64;
@@ -237,6 +278,8 @@ class CellBuilder {
   const double* lo_;
   const double* hi_;
   const ExactContext* exact_;
+  const KdTree<D>* tree_;
+  std::vector<typename KdTree<D>::Entry> heap_;  // build_nearest_first's scratch
   std::vector<Candidate> cand_;
   std::vector<std::uint64_t> keys_;
   std::vector<double> gaps_;  // for_each_shell_run_near's scratch

@@ -1,0 +1,155 @@
+// A k-d tree over the points, visited nearest first: the candidate search for
+// cells whose bin holds far more points than the grid was sized for.
+//
+// The bin grid is sized for the mean density. A cluster much smaller than a
+// bin (a tight blob plus a few outliers that set the box) falls into one bin,
+// and every one of its cells would scan all of it: quadratic in the cluster's
+// size. For those cells the builder asks this tree instead, which yields the
+// points in increasing distance (best-first search over node boxes, Hjaltason
+// & Samet, "Distance browsing in spatial databases", 1999), so the security
+// radius ends the search after the few dozen candidates a cell needs.
+//
+// Order: by (squared distance, id) — exact ties in id order, as the cell
+// builder's duplicate rule requires — with a node expanded before any point
+// at its lower bound, so no point inside it can be passed over.
+#pragma once
+
+#include <algorithm>
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <span>
+#include <vector>
+
+namespace tessera::kernels {
+
+template <int D>
+class KdTree {
+ public:
+  /// The points `ids` of `coords` (n * D, row-major).
+  KdTree(std::span<const double> coords, std::vector<std::int32_t> ids) : coords_(coords), ids_(std::move(ids)) {
+    if (ids_.empty()) return;
+    nodes_.reserve(2 * (ids_.size() / leaf_size + 1));
+    build(0, static_cast<std::uint32_t>(ids_.size()));
+  }
+
+  /// One entry of the search's queue: a node (lower bound of its box's
+  /// squared distance) or a point (its squared distance).
+  struct Entry {
+    double key;
+    std::int32_t id;     // point id, or -1 - node index
+    bool operator>(const Entry& o) const {
+      if (key != o.key) return key > o.key;
+      const bool node = id < 0, onode = o.id < 0;
+      if (node != onode) return !node;  // nodes first at equal keys
+      return id > o.id;
+    }
+  };
+
+  /// Visit points other than `self` nearest first from x: f(id, r2) with
+  /// r2 = |p_id - x|^2 computed as sum of squared coordinate differences;
+  /// continues while the next key is at most r2max() (re-read each step, it
+  /// may shrink) and f returns true. `heap` is the caller's scratch.
+  template <class Radius, class F>
+  void nearest_first(const double* x, std::int32_t self, std::vector<Entry>& heap, Radius&& r2max, F&& f) const {
+    heap.clear();
+    if (nodes_.empty()) return;
+    auto push = [&](Entry e) {
+      heap.push_back(e);
+      std::push_heap(heap.begin(), heap.end(), std::greater<>{});
+    };
+    push({box_distance2(0, x), -1});
+    while (!heap.empty()) {
+      const Entry e = heap.front();
+      if (e.key > r2max()) return;
+      std::pop_heap(heap.begin(), heap.end(), std::greater<>{});
+      heap.pop_back();
+      if (e.id >= 0) {
+        if (!f(e.id, e.key)) return;
+        continue;
+      }
+      const Node& nd = nodes_[static_cast<std::size_t>(-1 - e.id)];
+      if (nd.left < 0) {
+        for (std::uint32_t k = nd.begin; k < nd.end; ++k) {
+          const std::int32_t j = ids_[k];
+          if (j == self) continue;
+          const double* pj = coords_.data() + static_cast<std::size_t>(j) * D;
+          double r2 = 0;
+          for (int d = 0; d < D; ++d) {
+            const double q = pj[d] - x[d];
+            r2 += q * q;
+          }
+          push({r2, j});
+        }
+      } else {
+        push({box_distance2(static_cast<std::size_t>(nd.left), x), -1 - nd.left});
+        push({box_distance2(static_cast<std::size_t>(nd.right), x), -1 - nd.right});
+      }
+    }
+  }
+
+ private:
+  static constexpr std::uint32_t leaf_size = 16;
+
+  struct Node {
+    std::array<double, D> lo, hi;  // bounding box of its points
+    std::uint32_t begin, end;      // its points: ids_[begin, end)
+    std::int32_t left = -1, right = -1;  // children; -1 for a leaf
+  };
+
+  // Squared distance from x to node k's box, never above the true distance
+  // of any of its points: each axis gap is computed from coordinates the
+  // box holds exactly, by the rounding monotone differences and sums that
+  // the point distances use, so it is at most any point's term.
+  double box_distance2(std::size_t k, const double* x) const {
+    const Node& nd = nodes_[k];
+    double s = 0;
+    for (int d = 0; d < D; ++d) {
+      double g = 0;
+      if (x[d] < nd.lo[d]) g = nd.lo[d] - x[d];
+      else if (x[d] > nd.hi[d]) g = x[d] - nd.hi[d];
+      s += g * g;
+    }
+    return s;
+  }
+
+  const double* at(std::int32_t id) const { return coords_.data() + static_cast<std::size_t>(id) * D; }
+
+  // Node over ids_[begin, end): its box, then a median split on the widest axis.
+  std::int32_t build(std::uint32_t begin, std::uint32_t end) {
+    const auto index = static_cast<std::int32_t>(nodes_.size());
+    nodes_.push_back({});
+    Node nd;
+    nd.begin = begin;
+    nd.end = end;
+    for (int d = 0; d < D; ++d) {
+      nd.lo[d] = nd.hi[d] = at(ids_[begin])[d];
+      for (std::uint32_t k = begin + 1; k < end; ++k) {
+        nd.lo[d] = std::min(nd.lo[d], at(ids_[k])[d]);
+        nd.hi[d] = std::max(nd.hi[d], at(ids_[k])[d]);
+      }
+    }
+    if (end - begin > leaf_size) {
+      int axis = 0;
+      for (int d = 1; d < D; ++d)
+        if (nd.hi[d] - nd.lo[d] > nd.hi[axis] - nd.lo[axis]) axis = d;
+      const std::uint32_t mid = begin + (end - begin) / 2;
+      // (coordinate, id): a strict order, so the tree does not depend on the
+      // library's nth_element.
+      std::nth_element(ids_.begin() + begin, ids_.begin() + mid, ids_.begin() + end, [&](std::int32_t a, std::int32_t b) {
+        const double xa = at(a)[axis], xb = at(b)[axis];
+        return xa < xb || (xa == xb && a < b);
+      });
+      nd.left = build(begin, mid);
+      nd.right = build(mid, end);
+    }
+    nodes_[static_cast<std::size_t>(index)] = nd;
+    return index;
+  }
+
+  std::span<const double> coords_;
+  std::vector<std::int32_t> ids_;
+  std::vector<Node> nodes_;
+};
+
+}  // namespace tessera::kernels
