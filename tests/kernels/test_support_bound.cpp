@@ -8,8 +8,10 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <numeric>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -129,6 +131,11 @@ void lattice_scene() {
     for (int d = 0; d < D; ++d) cheb = std::max(cheb, std::fabs(q[d]));
     if (cheb <= 1) EXPECT_FALSE(bound.excludes(q)) << "touching neighbour " << j << " excluded";
     else EXPECT_TRUE(bound.excludes(q)) << "point " << j << " at Chebyshev distance " << cheb << " kept";
+    // The petal cover, on the point alone as a box: a touching neighbour lies
+    // on a petal's sphere and must not be ruled out.
+    tessera::kernels::PetalCover<D> cover;
+    cover.measure(cell.vertices());
+    if (cheb <= 1) EXPECT_FALSE(cover.excludes_box(s.p(j), s.p(j), s.p(centre))) << "touching neighbour " << j;
   }
 }
 
@@ -153,5 +160,62 @@ void cluster_edge(std::uint64_t seed) {
 
 TEST(SupportBound, ClusterEdgeHull) { cluster_edge<Hull>(43); }
 TEST(SupportBound, ClusterEdgeTile) { cluster_edge<Tile>(44); }
+
+}  // namespace
+
+namespace {
+
+using tessera::kernels::PetalCover;
+
+/// PetalCover: boxes around groups of nearby points. When a box is ruled
+/// out, clipping by each of its points leaves the cell unchanged; at a
+/// cluster's edge, boxes behind the generator are ruled out.
+template <class CellT>
+void petal_boxes(std::uint64_t seed) {
+  constexpr int D = dim_of<CellT>;
+  auto pts = random_points<D>(400, seed, 0.45, 0.55);
+  for (int d = 0; d < D; ++d) pts[static_cast<std::size_t>(d)] = d == 0 ? 0.56 : 0.5;  // point 0: the edge
+  std::array<double, D> lo, hi;
+  lo.fill(0);
+  hi.fill(1);
+  Scene<D> s(std::move(pts), lo, hi);
+  std::mt19937_64 g(seed);
+  int excluded = 0, boxes = 0;
+  for (std::size_t head : {16, 64, 200}) {
+    const auto order = by_distance(s, 0);
+    CellT cell;
+    s.reset(cell, 0);
+    for (std::size_t k = 0; k < head; ++k) s.clip(cell, order[k]);
+    PetalCover<D> cover;
+    cover.measure(cell.vertices());
+    for (int t = 0; t < 200; ++t) {
+      // A group: the 8 points nearest to a random member, and their box.
+      const std::int32_t c = 1 + static_cast<std::int32_t>(g() % static_cast<std::uint64_t>(s.size() - 1));
+      auto near = by_distance(s, c);
+      near.resize(7);
+      near.push_back(c);
+      std::array<double, D> blo, bhi;
+      blo.fill(INFINITY);
+      bhi.fill(-INFINITY);
+      for (std::int32_t j : near)
+        for (int d = 0; d < D; ++d) {
+          blo[d] = std::min(blo[d], s.p(j)[d]);
+          bhi[d] = std::max(bhi[d], s.p(j)[d]);
+        }
+      ++boxes;
+      if (!cover.excludes_box(blo.data(), bhi.data(), s.p(0))) continue;
+      ++excluded;
+      for (std::int32_t j : near) {
+        if (j == 0) continue;
+        CellT copy = cell;
+        EXPECT_EQ(s.clip(copy, j), ClipResult::unchanged) << "point " << j << " of a ruled-out box clips";
+      }
+    }
+  }
+  EXPECT_GT(excluded, boxes / 4) << "the cover hardly rules anything out";
+}
+
+TEST(PetalCover, BoxesAtClusterEdgeHull) { petal_boxes<Hull>(45); }
+TEST(PetalCover, BoxesAtClusterEdgeTile) { petal_boxes<Tile>(46); }
 
 }  // namespace

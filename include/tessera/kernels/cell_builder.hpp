@@ -176,7 +176,21 @@ class CellBuilder {
   BuildStatus build_nearest_first(std::int32_t i, const double* p, CellT& cell) {
     BuildStatus status;
     double sec2 = cell.security_radius2();
+    // Once the cell is nearly final (a few dozen candidates in), whole tree
+    // nodes that meet none of its petals are skipped: behind a cell that
+    // reaches across empty space lies a cluster none of them reaches.
+    std::size_t visited = 0;
+    bool stale = true;
+    auto prune = [&](const double* lo, const double* hi) {
+      if (visited < 32) return false;
+      if (stale) {
+        petals_.measure(cell.vertices());
+        stale = false;
+      }
+      return petals_.excludes_box(lo, hi, p);
+    };
     tree_->nearest_first(p, i, heap_, [&] { return sec2; }, [&](std::int32_t j, double r2) {
+      ++visited;
       if (r2 == 0 && exactly_equal(p, j)) {
         if (j < i) {  // the first duplicate met is the lowest id
           status.has_cell = false;
@@ -188,13 +202,15 @@ class CellBuilder {
       double q[D];
       for (int d = 0; d < D; ++d) q[d] = coords_[static_cast<std::size_t>(j) * D + d] - p[d];
       const ClipResult r = cell.clip(j, q);
-      if (r == ClipResult::clipped) sec2 = cell.security_radius2();
-      else if (r == ClipResult::emptied) {
+      if (r == ClipResult::clipped) {
+        sec2 = cell.security_radius2();
+        stale = true;
+      } else if (r == ClipResult::emptied) {
         status.has_cell = false;
         return false;
       }
       return true;
-    });
+    }, prune);
     return status;
   }
 
@@ -280,6 +296,7 @@ class CellBuilder {
   const ExactContext* exact_;
   const KdTree<D>* tree_;
   std::vector<typename KdTree<D>::Entry> heap_;  // build_nearest_first's scratch
+  PetalCover<D> petals_;  // likewise
   std::vector<Candidate> cand_;
   std::vector<std::uint64_t> keys_;
   std::vector<double> gaps_;  // for_each_shell_run_near's scratch

@@ -49,9 +49,11 @@ class KdTree {
   /// Visit points other than `self` nearest first from x: f(id, r2) with
   /// r2 = |p_id - x|^2 computed as sum of squared coordinate differences;
   /// continues while the next key is at most r2max() (re-read each step, it
-  /// may shrink) and f returns true. `heap` is the caller's scratch.
-  template <class Radius, class F>
-  void nearest_first(const double* x, std::int32_t self, std::vector<Entry>& heap, Radius&& r2max, F&& f) const {
+  /// may shrink) and f returns true. A node for which prune(lo, hi) (its
+  /// box, absolute) holds is skipped with all its points. `heap` is the
+  /// caller's scratch.
+  template <class Radius, class F, class Prune>
+  void nearest_first(const double* x, std::int32_t self, std::vector<Entry>& heap, Radius&& r2max, F&& f, Prune&& prune) const {
     heap.clear();
     if (nodes_.empty()) return;
     auto push = [&](Entry e) {
@@ -68,6 +70,9 @@ class KdTree {
         if (!f(e.id, e.key)) return;
         continue;
       }
+      // Entries beyond the radius as it is now are never visited (it only
+      // shrinks): they are not queued.
+      const double bound = r2max();
       const Node& nd = nodes_[static_cast<std::size_t>(-1 - e.id)];
       if (nd.left < 0) {
         for (std::uint32_t k = nd.begin; k < nd.end; ++k) {
@@ -79,11 +84,14 @@ class KdTree {
             const double q = pj[d] - x[d];
             r2 += q * q;
           }
-          push({r2, j});
+          if (r2 <= bound) push({r2, j});
         }
       } else {
-        push({box_distance2(static_cast<std::size_t>(nd.left), x), -1 - nd.left});
-        push({box_distance2(static_cast<std::size_t>(nd.right), x), -1 - nd.right});
+        for (const std::int32_t c : {nd.left, nd.right}) {
+          const double b2 = box_distance2(static_cast<std::size_t>(c), x);
+          const Node& child = nodes_[static_cast<std::size_t>(c)];
+          if (b2 <= bound && !prune(child.lo.data(), child.hi.data())) push({b2, -1 - c});
+        }
       }
     }
   }

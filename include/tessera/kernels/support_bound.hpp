@@ -1,5 +1,8 @@
-// A cheap test that a candidate cannot clip a cell: a bound on the cell's
-// support function from its extents along a fixed set of directions.
+// Cheap tests that candidates cannot clip a cell, ahead of the sign pass:
+// SupportBound for one candidate, PetalCover for a whole box of them.
+//
+// SupportBound: a bound on the cell's support function from its extents
+// along a fixed set of directions.
 //
 // A bisector with q = p_j - p_i cuts vertex v iff q.v > |q|^2 / 2. The cell
 // measures, once, the largest and smallest value over its vertices of the
@@ -15,11 +18,12 @@
 // the candidate leaves the cell unchanged, and its sign pass is skipped.
 //
 // Clipping only shrinks a cell, so extents measured earlier remain valid
-// bounds; a stale measure is looser, never wrong.
+// bounds; a stale measure is looser, never wrong. (Likewise for PetalCover.)
 //
-// Where it pays: a cell reaching into empty space (the edge of a cluster) has
-// a security radius that holds a whole cluster of candidates, nearly all of
-// them behind its generator. Their sign passes dominated such cells.
+// Where they pay: a cell reaching into empty space (the edge of a cluster)
+// has a security radius that holds a whole cluster of candidates, nearly all
+// of them behind its generator. Their sign passes, and on the k-d tree path
+// their queueing, dominated such cells.
 #pragma once
 
 #include <algorithm>
@@ -27,6 +31,7 @@
 #include <cstddef>
 #include <limits>
 #include <utility>
+#include <vector>
 
 #include "tessera/kernels/filter.hpp"
 
@@ -125,6 +130,62 @@ class SupportBound {
  private:
   double hi_[forms], lo_[forms];
   double emax_ = 0, rinf_ = 0;
+};
+
+/// A cheap test that no point of a box can clip a cell: the box meets none
+/// of the cell's petals. A candidate x (relative to the generator) cuts
+/// vertex v iff |x - v| < |v| (q.v > |q|^2 / 2 rearranged): x lies in the
+/// petal, the ball centred at v through the generator. The k-d tree path
+/// skips whole nodes this way: behind a cell that reaches across empty
+/// space lies a cluster no petal reaches.
+///
+/// Exactness: v* (the exact vertex) is within sqrt(D) e of the stored y and
+/// |v*| <= sqrt(r2); the box is widened past the rounding of its corners
+/// relative to the generator. A box is ruled out only when its distance to
+/// y exceeds sqrt(r2) + 2e, with a relative margin far above the rounding of
+/// these sums, so every point in it is strictly outside every exact petal.
+template <int D>
+class PetalCover {
+ public:
+  template <class Vertices>
+  void measure(const Vertices& vertices) {
+    petals_.clear();
+    for (const auto& v : vertices) {
+      Petal pe;
+      for (int d = 0; d < D; ++d) pe.y[d] = v.y[d];
+      const double r = (std::sqrt(v.r2) + 2.0 * v.e) * (1.0 + 1e-9);  // 2 > sqrt(3)
+      pe.r2 = r * r;
+      petals_.push_back(pe);
+    }
+  }
+
+  /// True when no point of the box [lo, hi] (absolute coordinates) can clip
+  /// the measured cell of the generator at p.
+  bool excludes_box(const double* lo, const double* hi, const double* p) const {
+    double blo[D], bhi[D];
+    for (int d = 0; d < D; ++d) {
+      // Widened by far more than the rounding of the differences.
+      const double slack = 1e-15 * (std::fabs(lo[d]) + std::fabs(hi[d]) + 2.0 * std::fabs(p[d]));
+      blo[d] = (lo[d] - p[d]) - slack;
+      bhi[d] = (hi[d] - p[d]) + slack;
+    }
+    for (const Petal& pe : petals_) {
+      double s2 = 0;
+      for (int d = 0; d < D; ++d) {
+        const double g = std::max(std::max(blo[d] - pe.y[d], 0.0), pe.y[d] - bhi[d]);
+        s2 += g * g;
+      }
+      if (!(s2 > pe.r2)) return false;  // NaN or infinity: not ruled out
+    }
+    return true;
+  }
+
+ private:
+  struct Petal {
+    double y[D];
+    double r2;  // squared radius, widened
+  };
+  std::vector<Petal> petals_;
 };
 
 }  // namespace tessera::kernels
