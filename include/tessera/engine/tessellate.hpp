@@ -70,7 +70,9 @@ std::uint64_t tessellate(const Generators<CellT::dim>& gens, Comp& comp, const E
       if (g + prefetch_ahead < n)
         __builtin_prefetch(gens.coords + static_cast<std::size_t>(gens.order[g + prefetch_ahead]) * CellT::dim);
       std::int32_t gen = gens.order[g];
-      kernels::BuildStatus st = ws.builder.build(gen, ws.cell);
+      kernels::BuildStatus st = gens.tree != nullptr && ws.builder.in_overfull_bin(gen)
+                                    ? ws.builder.build_nearest_first(gen, ws.cell)
+                                    : ws.builder.build(gen, ws.cell);
       ws.exact_calls += ws.cell.exact_calls();
       comp.add(batch, gen, st, ws.cell);
     }

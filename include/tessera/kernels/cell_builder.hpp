@@ -50,25 +50,9 @@ class CellBuilder {
               const ExactContext* exact, const KdTree<D>* tree = nullptr)
       : loc_(locator), coords_(coords), lo_(lo), hi_(hi), exact_(exact), tree_(tree) {}
 
-
   /// Build the cell of generator i into `cell`.
   BuildStatus build(std::int32_t i, CellT& cell) {
     const double* p = coords_ + static_cast<std::size_t>(i) * D;
-    if (tree_ != nullptr) {
-      const std::size_t own = loc_.bin_index(loc_.bin_coords(p));
-      if (loc_.offsets()[own + 1] - loc_.offsets()[own] > overfull_bin) {
-        cell.reset(i, p, lo_, hi_, exact_);
-        return build_nearest_first(i, p, cell);
-      }
-    }
-    return build_by_shells(i, p, cell);
-  }
-
- private:
-  // The shell walk over the bin grid (the usual path). Kept out of line and
-  // apart from the tree path: with both in one function the compiler laid
-  // out the hot loops worse (2D 2 threads 5% slower).
-  [[gnu::noinline]] BuildStatus build_by_shells(std::int32_t i, const double* p, CellT& cell) {
     cell.reset(i, p, lo_, hi_, exact_);
     const auto b = loc_.bin_coords(p);
     const int last = loc_.max_shell(b);
@@ -179,11 +163,23 @@ class CellBuilder {
     return status;
   }
 
+  /// Whether generator i lies in an overfull bin of a pass that built a k-d
+  /// tree: then build_nearest_first() is its cell's build (the engine asks).
+  bool in_overfull_bin(std::int32_t i) const {
+    if (tree_ == nullptr) return false;
+    const std::size_t own = loc_.bin_index(loc_.bin_coords(coords_ + static_cast<std::size_t>(i) * D));
+    return loc_.offsets()[own + 1] - loc_.offsets()[own] > overfull_bin;
+  }
+
   /// build() by the k-d tree: candidates nearest first, until the next one
   /// lies beyond the security radius. The same clips as the shell walk's,
   /// from the same differences; exact ties come in id order, so the
-  /// duplicate rule holds as there.
-  [[gnu::noinline]] BuildStatus build_nearest_first(std::int32_t i, const double* p, CellT& cell) {
+  /// duplicate rule holds as there. A separate function, chosen by the
+  /// engine: with both paths in build() the compiler laid out the hot loops
+  /// worse (2D on 2 threads ~5% slower).
+  [[gnu::noinline]] BuildStatus build_nearest_first(std::int32_t i, CellT& cell) {
+    const double* p = coords_ + static_cast<std::size_t>(i) * D;
+    cell.reset(i, p, lo_, hi_, exact_);
     BuildStatus status;
     double sec2 = cell.security_radius2();
     // Once the cell is nearly final (a few dozen candidates in), whole tree
@@ -224,6 +220,7 @@ class CellBuilder {
     return status;
   }
 
+ private:
   /// The size of the sorted head of an oversized shell (above: a shell of at
   /// most twice as many is sorted whole). A uniform cell uses about 47.
   static constexpr std::size_t sort_head = 64;
