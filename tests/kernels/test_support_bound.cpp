@@ -142,18 +142,22 @@ void lattice_scene() {
 TEST(SupportBound, LatticeTiesKeptHull) { lattice_scene<Hull>(); }
 TEST(SupportBound, LatticeTiesKeptTile) { lattice_scene<Tile>(); }
 
-/// A point at the edge of a dense cluster: its cell reaches across the empty
-/// box, so the security radius holds the whole cluster, nearly all of which
-/// lies behind it.
-template <class CellT>
-void cluster_edge(std::uint64_t seed) {
-  constexpr int D = dim_of<CellT>;
+/// 400 points in a dense cluster in the unit box, point 0 at its edge: its
+/// cell reaches across the empty box, so the security radius holds the whole
+/// cluster, nearly all of which lies behind it.
+template <int D>
+Scene<D> cluster_edge_scene(std::uint64_t seed) {
   auto pts = random_points<D>(400, seed, 0.45, 0.55);
-  for (int d = 0; d < D; ++d) pts[static_cast<std::size_t>(d)] = d == 0 ? 0.56 : 0.5;  // point 0: the edge
+  for (int d = 0; d < D; ++d) pts[static_cast<std::size_t>(d)] = d == 0 ? 0.56 : 0.5;
   std::array<double, D> lo, hi;
   lo.fill(0);
   hi.fill(1);
-  Scene<D> s(std::move(pts), lo, hi);
+  return Scene<D>(std::move(pts), lo, hi);
+}
+
+template <class CellT>
+void cluster_edge(std::uint64_t seed) {
+  const auto s = cluster_edge_scene<dim_of<CellT>>(seed);
   const Tally t = check_cell<CellT>(s, 0, 64, 16);
   EXPECT_GT(t.excluded, t.tested * 3 / 4);
 }
@@ -173,12 +177,7 @@ using tessera::kernels::PetalCover;
 template <class CellT>
 void petal_boxes(std::uint64_t seed) {
   constexpr int D = dim_of<CellT>;
-  auto pts = random_points<D>(400, seed, 0.45, 0.55);
-  for (int d = 0; d < D; ++d) pts[static_cast<std::size_t>(d)] = d == 0 ? 0.56 : 0.5;  // point 0: the edge
-  std::array<double, D> lo, hi;
-  lo.fill(0);
-  hi.fill(1);
-  Scene<D> s(std::move(pts), lo, hi);
+  const auto s = cluster_edge_scene<D>(seed);
   std::mt19937_64 g(seed);
   int excluded = 0, boxes = 0;
   for (std::size_t head : {16, 64, 200}) {
