@@ -17,59 +17,55 @@ namespace tessera::front {
 template <int D>
 using Key = std::array<std::int32_t, D + 1>;
 
-/// Volume and centroid (relative to the generator), accumulated face by face
-/// while the faces are walked once. 3D: a fan of tetrahedra from the generator
-/// over each face (faces are counter-clockwise from outside, so every tetra is
-/// positive when the generator is inside). 2D: the shoelace formula over edges.
-template <int D>
-class Measure;
-
-template <>
-class Measure<3> {
- public:
-  explicit Measure(const kernels::Hull& hull) : v_(hull.vertices()) {}
-  void add_face(const std::uint32_t* loop, std::size_t m) {
-    const double* a = v_[loop[0]].y;
-    for (std::size_t k = 1; k + 1 < m; ++k) {
-      const double* b = v_[loop[k]].y;
-      const double* d = v_[loop[k + 1]].y;
-      double t = (a[0] * (b[1] * d[2] - b[2] * d[1]) + a[1] * (b[2] * d[0] - b[0] * d[2]) +
-                  a[2] * (b[0] * d[1] - b[1] * d[0]));
-      vol_ += t;
-      for (int i = 0; i < 3; ++i) c_[i] += t * (a[i] + b[i] + d[i]);
+/// Volume and centroid (relative to the generator) of a finished cell.
+///
+/// 3D, without walking the faces: the cell is the union of the tetrahedra
+/// (generator, c_f, y_a, y_b) over every edge a -> b of every face f's loop
+/// (counter-clockwise from outside), c_f being the foot of the perpendicular
+/// from the generator to f's plane: q/2 for a bisector, n d for a box plane.
+/// Each tetrahedron's signed volume is det(c_f, y_a, y_b) / 6, and those of
+/// one face sum to its cone's volume whatever the polygon's shape. The edge
+/// leaving triangle t within face p[k+1] is t's edge k, whose twin triangle is
+/// across(t, k) (hull.hpp), so every term comes straight from a triangle and
+/// its edge table: no face walk, no chain of dependent loads.
+/// 2D: the shoelace formula over the polygon's edges.
+inline void measure(const kernels::Hull& hull, double& volume, std::array<double, 3>& centroid) {
+  const auto& verts = hull.vertices();
+  const auto& planes = hull.planes();
+  double vol = 0, c[3] = {0, 0, 0};
+  for (std::size_t t = 0; t < verts.size(); ++t) {
+    const auto& v = verts[t];
+    const double* a = v.y;
+    for (int k = 0; k < 3; ++k) {
+      const auto& pl = planes[v.p[(k + 1) % 3]];
+      const double w = pl.id >= 0 ? 0.5 : pl.d;  // |n|^2 d / |n|^2: n is unit on box planes
+      const double f[3] = {pl.n[0] * w, pl.n[1] * w, pl.n[2] * w};
+      const double* b = verts[hull.across(t, k)].y;
+      const double s = f[0] * (a[1] * b[2] - a[2] * b[1]) + f[1] * (a[2] * b[0] - a[0] * b[2]) +
+                       f[2] * (a[0] * b[1] - a[1] * b[0]);
+      vol += s;
+      for (int i = 0; i < 3; ++i) c[i] += s * (f[i] + a[i] + b[i]);
     }
   }
-  void result(double& volume, std::array<double, 3>& centroid) const {
-    volume = vol_ / 6.0;
-    for (int i = 0; i < 3; ++i) centroid[static_cast<std::size_t>(i)] = vol_ != 0 ? c_[i] / (4.0 * vol_) : 0.0;
-  }
+  volume = vol / 6.0;
+  for (int i = 0; i < 3; ++i) centroid[static_cast<std::size_t>(i)] = vol != 0 ? c[i] / (4.0 * vol) : 0.0;
+}
 
- private:
-  const std::vector<kernels::Hull::Vertex>& v_;
-  double vol_ = 0, c_[3] = {0, 0, 0};
-};
-
-template <>
-class Measure<2> {
- public:
-  explicit Measure(const kernels::Tile& tile) : v_(tile.vertices()) {}
-  void add_face(const std::uint32_t* e, std::size_t) {  // the edge e[0] -> e[1]
-    const double* a = v_[e[0]].y;
-    const double* b = v_[e[1]].y;
-    double cr = a[0] * b[1] - a[1] * b[0];
-    s_ += cr;
-    cx_ += (a[0] + b[0]) * cr;
-    cy_ += (a[1] + b[1]) * cr;
+inline void measure(const kernels::Tile& tile, double& area, std::array<double, 2>& centroid) {
+  const auto& v = tile.vertices();
+  const std::size_t m = v.size();
+  double s = 0, cx = 0, cy = 0;
+  for (std::size_t k = 0; k < m; ++k) {
+    const double* a = v[k].y;
+    const double* b = v[k + 1 == m ? 0 : k + 1].y;
+    const double cr = a[0] * b[1] - a[1] * b[0];
+    s += cr;
+    cx += (a[0] + b[0]) * cr;
+    cy += (a[1] + b[1]) * cr;
   }
-  void result(double& area, std::array<double, 2>& centroid) const {
-    area = 0.5 * s_;
-    centroid = {s_ != 0 ? cx_ / (3 * s_) : 0.0, s_ != 0 ? cy_ / (3 * s_) : 0.0};
-  }
-
- private:
-  const std::vector<kernels::Tile::Vertex>& v_;
-  double s_ = 0, cx_ = 0, cy_ = 0;
-};
+  area = 0.5 * s;
+  centroid = {s != 0 ? cx / (3 * s) : 0.0, s != 0 ? cy / (3 * s) : 0.0};
+}
 
 inline Key<3> vertex_key(const kernels::Hull& hull, std::size_t t) {
   const auto& v = hull.vertices()[t];
@@ -93,6 +89,21 @@ template <class F>
 void for_each_face(kernels::Hull& hull, F&& f) {
   const auto& pl = hull.planes();
   hull.for_each_face([&](std::uint16_t p, const std::uint32_t* loop, std::size_t m) { f(pl[p].id, loop, m); });
+}
+
+/// Visit each face's neighbour id once, f(id) (box planes negative), without
+/// the vertex loops: what a cell's spokes need.
+template <class F>
+void for_each_spoke(kernels::Hull& hull, F&& f) {
+  const auto& pl = hull.planes();
+  hull.for_each_face_plane([&](std::uint16_t p) { f(pl[p].id); });
+}
+
+template <class F>
+void for_each_spoke(kernels::Tile& tile, F&& f) {
+  const auto& v = tile.vertices();
+  const auto& pl = tile.planes();
+  for (std::size_t k = 0; k < v.size(); ++k) f(pl[v[k].p[1]].id);
 }
 
 template <class F>

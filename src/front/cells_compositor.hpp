@@ -64,21 +64,24 @@ class CellsCompositor {
     const double* p = coords_ + static_cast<std::size_t>(gen) * D;
     const std::size_t nb0 = b.nbrs.size();
     std::int32_t nf = 0;
-    // One walk over the faces: measures, spokes and (optionally) the mesh.
-    Measure<D> m(cell);
-    for_each_face(cell, [&](std::int32_t id, const std::uint32_t* loop, std::size_t count) {
-      ++nf;
-      m.add_face(loop, count);
-      if (id >= 0) b.nbrs.push_back(id);
-      if (mesh_) {
+    // Spokes from the face planes; the face loops are walked only for the mesh.
+    if (mesh_) {
+      for_each_face(cell, [&](std::int32_t id, const std::uint32_t* loop, std::size_t count) {
+        ++nf;
+        if (id >= 0) b.nbrs.push_back(id);
         b.face_nbr.push_back(id);
         b.fverts.insert(b.fverts.end(), loop, loop + count);
         b.face_vend.push_back(static_cast<std::uint32_t>(b.fverts.size()));
-      }
-    });
+      });
+    } else {
+      for_each_spoke(cell, [&](std::int32_t id) {
+        ++nf;
+        if (id >= 0) b.nbrs.push_back(id);
+      });
+    }
     double vol;
     std::array<double, D> c;
-    m.result(vol, c);
+    measure(cell, vol, c);
     b.volume.push_back(vol);
     for (int d = 0; d < D; ++d) b.centroid.push_back(c[d] + p[d]);
     std::sort(b.nbrs.begin() + static_cast<std::ptrdiff_t>(nb0), b.nbrs.end());

@@ -175,6 +175,17 @@ class Hull {
     return edge_tri_[static_cast<std::size_t>(v.p[(k + 1) % 3]) * cap_ + v.p[k]];
   }
 
+  /// Visit each face's plane index once, ascending: the planes that still
+  /// carry a vertex (a later clip may have cut a face away whole).
+  template <class F>
+  void for_each_face_plane(F&& f) {
+    seen_.assign(planes_.size(), 0);
+    std::uint8_t* const seen = seen_.data();
+    for (const Vertex& v : verts_) seen[v.p[0]] = seen[v.p[1]] = seen[v.p[2]] = 1;
+    for (std::size_t p = 0; p < planes_.size(); ++p)
+      if (seen[p]) f(static_cast<std::uint16_t>(p));
+  }
+
   /// Visit each face once: f(plane index, vertex indices counter-clockwise
   /// from outside as pointer + count). The walk buffers are members, reused.
   template <class F>
