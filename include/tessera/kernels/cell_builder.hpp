@@ -115,11 +115,11 @@ class CellBuilder {
       auto visit = [&](std::uint64_t key) {
         const Candidate& cd = cand_[static_cast<std::uint32_t>(key)];
         if (cd.r2 > sec2) {
-          // Keys are r2 rounded to float, so a later candidate may still be
-          // slightly nearer; stop only once every later one is surely beyond
-          // (a later key k' >= k has r2 >= k' (1 - 2^-24)).
-          const float k = std::bit_cast<float>(static_cast<std::uint32_t>(key >> 32));
-          return static_cast<double>(k) * (1.0 - 1e-7) > sec2 ? Next::stop : Next::go;
+          // Keys order r2 rounded to float and truncated (sort_keys), so a
+          // later candidate may still be slightly nearer; stop only once every
+          // later one is surely beyond: a later key's r2 is at least this
+          // key's truncated r2 times (1 - 2^-24), the float rounding.
+          return truncated_r2(key) * (1.0 - 1e-7) > sec2 ? Next::stop : Next::go;
         }
         if (cd.r2 == 0 && exactly_equal(p, cd.id)) {
           // Exact duplicates: the lowest id owns the cell. Coincident points
@@ -225,36 +225,54 @@ class CellBuilder {
   /// most twice as many is sorted whole). A uniform cell uses about 47.
   static constexpr std::size_t sort_head = 64;
 
-  /// Ascending order of distinct keys: up to 2 * sort_head by rank, each
-  /// key's place being the number of keys below it. That is n^2
-  /// comparisons, but branch-free, two per SSE4.2 instruction, four keys
-  /// ranked per sweep; at these sizes (a uniform cell's first gather holds
-  /// ~54 keys in 3D, ~20 in 2D) it measured 11% (2D) and 7% (3D) faster
-  /// overall than straight insertion, whose mispredicted exits dominated.
-  /// Longer runs (a rare oversized head) by std::sort.
+  /// Candidate keys in visiting order, nearest first. Up to 2 * sort_head
+  /// keys are ranked, each one's place being the number of keys below it:
+  /// n^2 comparisons, but branch-free, which at these sizes (a uniform
+  /// cell's first gather holds ~54 keys in 3D, ~20 in 2D) beat straight
+  /// insertion, whose mispredicted exits dominated. The ranking compares
+  /// compact 32-bit keys, four per SSE instruction: the float r2's top 24
+  /// bits (8 of mantissa), then the key's position, below 2^8, which breaks
+  /// ties in gather order and makes the keys distinct. Candidates within
+  /// 2^-15 of each other in r2 so keep gather order rather than distance
+  /// order: any order gives the same cell, and this one is as deterministic.
+  /// Longer runs (a rare oversized head) by std::sort on the whole keys.
+  /// Either way a later key's truncated r2 (truncated_r2) is no smaller.
   static void sort_keys(std::uint64_t* first, std::uint64_t* last) {
-    using Pair = std::int64_t __attribute__((vector_size(16)));
+    using Quad = std::int32_t __attribute__((vector_size(16)));
     const std::size_t n = static_cast<std::size_t>(last - first);
     if (n > 2 * sort_head) {
       std::sort(first, last);
       return;
     }
-    // Keys are below 2^63 (r2 >= 0 has a clear float sign bit), so they
-    // compare alike as signed; the padding is above them all.
-    alignas(16) std::int64_t k[2 * sort_head + 4];
-    std::memcpy(k, first, n * sizeof *k);
-    for (std::size_t t = n; t < n + 4; ++t) k[t] = std::numeric_limits<std::int64_t>::max();
-    const std::size_t m = (n + 1) & ~std::size_t{1};  // whole pairs
+    static_assert(2 * sort_head <= 0x100, "positions fit the compact key's low 8 bits");
+    // The compact keys are below 2^31 (r2 >= 0 has a clear float sign bit),
+    // so they compare alike as signed; the padding is above them all.
+    alignas(16) std::int32_t k[2 * sort_head + 8];
+    std::uint64_t whole[2 * sort_head];
+    std::memcpy(whole, first, n * sizeof *whole);
+    for (std::size_t t = 0; t < n; ++t)
+      k[t] = static_cast<std::int32_t>(truncated_bits(whole[t]) | static_cast<std::uint32_t>(t));
+    for (std::size_t t = n; t < n + 8; ++t) k[t] = std::numeric_limits<std::int32_t>::max();
+    const std::size_t m = (n + 3) & ~std::size_t{3};  // whole quads
     for (std::size_t i = 0; i < n; i += 4) {
-      Pair below[4] = {};
-      for (std::size_t j = 0; j < m; j += 2) {
-        Pair kj;
+      Quad below[4] = {};
+      for (std::size_t j = 0; j < m; j += 4) {
+        Quad kj;
         std::memcpy(&kj, k + j, sizeof kj);
-        for (std::size_t a = 0; a < 4; ++a) below[a] += kj < Pair{k[i + a], k[i + a]};  // -1 per key below
+        for (std::size_t a = 0; a < 4; ++a) below[a] += kj < Quad{k[i + a], k[i + a], k[i + a], k[i + a]};  // -1 per key below
       }
       for (std::size_t a = 0; a < 4 && i + a < n; ++a)
-        first[-(below[a][0] + below[a][1])] = static_cast<std::uint64_t>(k[i + a]);
+        first[-(below[a][0] + below[a][1] + below[a][2] + below[a][3])] = whole[i + a];
     }
+  }
+
+  /// A key's float r2 bits without their low 8 (the compact key's order).
+  static std::uint32_t truncated_bits(std::uint64_t key) {
+    return static_cast<std::uint32_t>(key >> 32) & ~std::uint32_t{0xFF};
+  }
+  /// A lower bound on the r2 of this key's candidate and of every later one.
+  static double truncated_r2(std::uint64_t key) {
+    return static_cast<double>(std::bit_cast<float>(truncated_bits(key)));
   }
 
   /// Reorder [first, last) (more than 2 * sort_head keys) so that the keys
