@@ -125,25 +125,36 @@ class Hull {
     holes_.resize(nh);
     // Boundary of the removed region: edges (a -> b) of removed triangles whose
     // twin (b -> a) lies in a kept triangle. Each gets a new triangle (a, b, pn).
-    fresh_.clear();
-    auto border = [&](std::uint16_t a, std::uint16_t b) {
-      if (sign_[edge_tri_[static_cast<std::size_t>(b) * cap_ + a]] < 0) return;
-      Vertex& nvtx = fresh_.emplace_back();  // built in place (see reset)
-      nvtx.p[0] = a; nvtx.p[1] = b; nvtx.p[2] = pn;
+    // The edges are collected first, branch-free (whether a twin was kept is
+    // a coin flip the branch predictor loses), then solved in a plain loop.
+    if (border_.size() < 3 * nh) border_.resize(3 * nh);
+    std::size_t nb = 0;
+    {
+      Edge* const edges = border_.data();
+      const std::uint32_t* const table = edge_tri_.data();
+      const filter::Sign* const sign = sign_.data();
+      const std::size_t cap = cap_;
+      for (std::uint32_t t : holes_) {
+        const Vertex& v = verts_[t];
+        for (int k = 0; k < 3; ++k) {
+          const std::uint16_t a = v.p[k], b = v.p[k == 2 ? 0 : k + 1];
+          edges[nb] = {a, b};
+          nb += sign[table[static_cast<std::size_t>(b) * cap + a]] >= 0;
+        }
+      }
+    }
+    if (fresh_.size() < nb) fresh_.resize(nb);  // never shrunk: slots [0, nb) are rewritten
+    for (std::size_t k = 0; k < nb; ++k) {
+      Vertex& nvtx = fresh_[k];  // built in place (see reset)
+      nvtx.p[0] = border_[k].a; nvtx.p[1] = border_[k].b; nvtx.p[2] = pn;
       solve(nvtx);
-    };
-    for (std::uint32_t t : holes_) {
-      const Vertex& v = verts_[t];
-      border(v.p[0], v.p[1]);
-      border(v.p[1], v.p[2]);
-      border(v.p[2], v.p[0]);
     }
     // Put the new triangles into removed slots; append the rest, or, when
     // fewer were made than removed, fill the remaining holes from the tail.
-    const std::size_t placed = std::min(fresh_.size(), holes_.size());
+    const std::size_t placed = std::min(nb, holes_.size());
     for (std::size_t k = 0; k < placed; ++k) place(holes_[k], fresh_[k]);
-    if (placed < fresh_.size()) {
-      for (std::size_t k = placed; k < fresh_.size(); ++k) append(fresh_[k]);
+    if (placed < nb) {
+      for (std::size_t k = placed; k < nb; ++k) append(fresh_[k]);
     } else {
       std::size_t end = nv;
       for (std::size_t k = placed; k < holes_.size(); ++k) {
@@ -332,7 +343,9 @@ class Hull {
   std::vector<Plane> planes_;
   std::vector<Vertex> verts_;
   filter::FilterLanes<3> lanes_;  // verts_' filter data, for the sign pass
-  std::vector<Vertex> fresh_;
+  std::vector<Vertex> fresh_;  // a clip's new vertices (its first slots)
+  struct Edge { std::uint16_t a, b; };
+  std::vector<Edge> border_;   // a clip's boundary edges (its first slots)
   std::vector<std::uint32_t> holes_;
   std::vector<filter::Sign> sign_;
   std::vector<std::uint32_t> edge_tri_;  // cap_ x cap_: directed plane pair -> triangle
