@@ -115,14 +115,14 @@ class Hull {
     pl.id = j;
     if (planes_.size() > cap_) ensure_table(2 * cap_);
 
-    // The removed slots, ascending.
-    holes_.resize(nv);
+    // The removed slots, ascending: holes_[0, nh) (never shrunk, so growing
+    // it value-initializes nothing per clip).
+    if (holes_.size() < nv) holes_.resize(nv);
     std::size_t nh = 0;
     for (std::size_t t = 0; t < nv; ++t) {
       holes_[nh] = static_cast<std::uint32_t>(t);
       nh += sign_[t] < 0;
     }
-    holes_.resize(nh);
     // Boundary of the removed region: edges (a -> b) of removed triangles whose
     // twin (b -> a) lies in a kept triangle. Each gets a new triangle (a, b, pn).
     // The edges are collected first, branch-free (whether a twin was kept is
@@ -134,8 +134,8 @@ class Hull {
       const std::uint32_t* const table = edge_tri_.data();
       const filter::Sign* const sign = sign_.data();
       const std::size_t cap = cap_;
-      for (std::uint32_t t : holes_) {
-        const Vertex& v = verts_[t];
+      for (std::size_t h = 0; h < nh; ++h) {
+        const Vertex& v = verts_[holes_[h]];
         for (int k = 0; k < 3; ++k) {
           const std::uint16_t a = v.p[k], b = v.p[k == 2 ? 0 : k + 1];
           edges[nb] = {a, b};
@@ -143,21 +143,22 @@ class Hull {
         }
       }
     }
-    if (fresh_.size() < nb) fresh_.resize(nb);  // never shrunk: slots [0, nb) are rewritten
+    // The new triangles go straight into the removed slots (the border is
+    // collected, so those may be overwritten), the rest after the last slot;
+    // when fewer were made than removed, the remaining holes are filled from
+    // the tail.
+    if (nb > nh) resize_vertices(nv + nb - nh);
     for (std::size_t k = 0; k < nb; ++k) {
-      Vertex& nvtx = fresh_[k];  // built in place (see reset)
-      nvtx.p[0] = border_[k].a; nvtx.p[1] = border_[k].b; nvtx.p[2] = pn;
-      solve(nvtx);
+      const std::uint32_t t = k < nh ? holes_[k] : static_cast<std::uint32_t>(nv + k - nh);
+      Vertex& v = verts_[t];  // built in place (see reset)
+      v.p[0] = border_[k].a; v.p[1] = border_[k].b; v.p[2] = pn;
+      solve(v);
+      if (k < nh) sign_[t] = 1;  // kept from now on
+      settle(t);
     }
-    // Put the new triangles into removed slots; append the rest, or, when
-    // fewer were made than removed, fill the remaining holes from the tail.
-    const std::size_t placed = std::min(nb, holes_.size());
-    for (std::size_t k = 0; k < placed; ++k) place(holes_[k], fresh_[k]);
-    if (placed < nb) {
-      for (std::size_t k = placed; k < nb; ++k) append(fresh_[k]);
-    } else {
+    if (nb < nh) {
       std::size_t end = nv;
-      for (std::size_t k = placed; k < holes_.size(); ++k) {
+      for (std::size_t k = nb; k < nh; ++k) {
         const std::uint32_t t = holes_[k];
         while (end > t && sign_[end - 1] < 0) --end;  // drop trailing holes
         if (end <= t) break;                          // this hole and the rest lie beyond
@@ -343,7 +344,6 @@ class Hull {
   std::vector<Plane> planes_;
   std::vector<Vertex> verts_;
   filter::FilterLanes<3> lanes_;  // verts_' filter data, for the sign pass
-  std::vector<Vertex> fresh_;  // a clip's new vertices (its first slots)
   struct Edge { std::uint16_t a, b; };
   std::vector<Edge> border_;   // a clip's boundary edges (its first slots)
   std::vector<std::uint32_t> holes_;
