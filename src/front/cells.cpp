@@ -47,7 +47,7 @@ Cells run(std::span<const double> input, std::span<const std::int32_t> labels, c
   out.ignored_outside_bounds = pass.ignored_outside;
   out.threads_used = pass.engine_options.threads;
 
-  front::CellsCompositor<CellT> comp(out, pass.points.data(), labels, opt.build_mesh);
+  front::CellsCompositor<CellT> comp(out, labels, opt.build_mesh);
   out.exact_predicate_calls = engine::tessellate<CellT>(pass.gens, comp, pass.engine_options);
   std::sort(out.duplicates.begin(), out.duplicates.end());
   if (pass.k != 0) {

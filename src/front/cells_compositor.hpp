@@ -44,8 +44,8 @@ class CellsCompositor {
     std::vector<std::uint32_t> fverts;      // local vertex index (within the cell)
   };
 
-  CellsCompositor(Cells& out, const double* coords, std::span<const std::int32_t> labels, bool mesh)
-      : out_(out), coords_(coords), labels_(labels), classify_(labels), mesh_(mesh) {}
+  CellsCompositor(Cells& out, std::span<const std::int32_t> labels, bool mesh)
+      : out_(out), labels_(labels), classify_(labels), mesh_(mesh) {}
 
   void add(Batch& b, std::int32_t gen, const kernels::BuildStatus& st, CellT& cell) {
     b.gen.push_back(gen);
@@ -61,7 +61,7 @@ class CellsCompositor {
       }
       return;
     }
-    const double* p = coords_ + static_cast<std::size_t>(gen) * D;
+    const double* p = cell.site();
     const std::size_t nb0 = b.nbrs.size();
     std::int32_t nf = 0;
     // Spokes from the face planes; the face loops are walked only for the mesh.
@@ -281,7 +281,6 @@ class CellsCompositor {
   }
 
   Cells& out_;
-  const double* coords_;
   std::span<const std::int32_t> labels_;
   engine::RegionClassifier classify_;
   bool mesh_;

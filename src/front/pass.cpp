@@ -177,9 +177,13 @@ Pass<D>::Pass(std::span<const double> input, std::span<const std::int32_t> label
 
   // Generators with cells, in bin order (neighbouring cells run together).
   order.reserve(locator->size());
+  slots.reserve(locator->size());
   for (std::size_t s = 0; s < locator->size(); ++s) {
     std::int32_t id = locator->id(s);
-    if (labels.empty() || labels[static_cast<std::size_t>(id)] >= 0) order.push_back(id);
+    if (labels.empty() || labels[static_cast<std::size_t>(id)] >= 0) {
+      order.push_back(id);
+      slots.push_back(static_cast<std::uint32_t>(s));
+    }
   }
 
   exact.points = points.data();
@@ -194,6 +198,7 @@ Pass<D>::Pass(std::span<const double> input, std::span<const std::int32_t> label
   gens.lo = lo;
   gens.hi = hi;
   gens.order = order;
+  gens.slots = slots;
   gens.exact = &exact;
   gens.tree = tree ? &*tree : nullptr;
 

@@ -48,6 +48,7 @@ struct Pass {
   std::optional<kernels::BinLocator<D>> locator;
   std::optional<kernels::KdTree<D>> tree;    ///< built when a bin is overfull (CellBuilder)
   std::vector<std::int32_t> order;           ///< generators with cells wanted, bin order
+  std::vector<std::uint32_t> slots;          ///< their slots in the locator
   kernels::ExactContext exact;
   std::vector<std::int32_t> grid;            ///< exact.grid's storage, when the input has one
   engine::Generators<D> gens;

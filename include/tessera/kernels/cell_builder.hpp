@@ -51,9 +51,9 @@ class CellBuilder {
               const ExactContext* exact, const KdTree<D>* tree = nullptr)
       : loc_(locator), coords_(coords), lo_(lo), hi_(hi), exact_(exact), tree_(tree) {}
 
-  /// Build the cell of generator i into `cell`.
-  BuildStatus build(std::int32_t i, CellT& cell) {
-    const double* p = coords_ + static_cast<std::size_t>(i) * D;
+  /// Build the cell of generator i, whose coordinates p holds (the same
+  /// doubles as the input's: the locator's copy), into `cell`.
+  BuildStatus build(std::int32_t i, const double* p, CellT& cell) {
     cell.reset(i, p, lo_, hi_, exact_);
     const auto b = loc_.bin_coords(p);
     const int last = loc_.max_shell(b);
@@ -180,11 +180,11 @@ class CellBuilder {
     return status;
   }
 
-  /// Whether generator i lies in an overfull bin of a pass that built a k-d
-  /// tree: then build_nearest_first() is its cell's build (the engine asks).
-  bool in_overfull_bin(std::int32_t i) const {
+  /// Whether a generator at p lies in an overfull bin of a pass that built a
+  /// k-d tree: then build_nearest_first() is its cell's build (the engine asks).
+  bool in_overfull_bin(const double* p) const {
     if (tree_ == nullptr) return false;
-    const std::size_t own = loc_.bin_index(loc_.bin_coords(coords_ + static_cast<std::size_t>(i) * D));
+    const std::size_t own = loc_.bin_index(loc_.bin_coords(p));
     return loc_.offsets()[own + 1] - loc_.offsets()[own] > overfull_bin;
   }
 
@@ -194,8 +194,7 @@ class CellBuilder {
   /// duplicate rule holds as there. A separate function, chosen by the
   /// engine: with both paths in build() the compiler laid out the hot loops
   /// worse (2D on 2 threads ~5% slower).
-  [[gnu::noinline]] BuildStatus build_nearest_first(std::int32_t i, CellT& cell) {
-    const double* p = coords_ + static_cast<std::size_t>(i) * D;
+  [[gnu::noinline]] BuildStatus build_nearest_first(std::int32_t i, const double* p, CellT& cell) {
     cell.reset(i, p, lo_, hi_, exact_);
     BuildStatus status;
     double sec2 = cell.security_radius2();

@@ -41,6 +41,7 @@ class Tile {
   void reset(std::int32_t gen, const double* p, const double* lo, const double* hi,
              const ExactContext* exact) {
     gen_ = gen;
+    for (int a = 0; a < 2; ++a) site_[a] = p[a];
     exact_ = exact;
     exact_calls_ = 0;
     ++cells_;
@@ -144,6 +145,8 @@ class Tile {
 
   double security_radius2() const { return security2_; }
   std::int32_t generator() const { return gen_; }
+  /// The generator's coordinates: vertices are relative to them.
+  const double* site() const { return site_; }
   std::size_t num_vertices() const { return verts_.size(); }
   const std::vector<Vertex>& vertices() const { return verts_; }
   const std::vector<Plane>& planes() const { return planes_; }
@@ -213,6 +216,7 @@ class Tile {
   }
 
   std::int32_t gen_ = -1;
+  double site_[2] = {};  // the generator's coordinates
   const ExactContext* exact_ = nullptr;
   std::uint64_t exact_calls_ = 0;
   std::vector<Plane> planes_;
