@@ -32,24 +32,12 @@ DoubleParts double_parts(double x) {
   return {(bits >> 63) ? -sm : sm, e2};
 }
 
-// The common grid of the doubles seen: the smallest exponent of a lowest
-// set bit (every value is an integer times 2^shift) and the top bit (every
-// |x| < 2^top). The integer paths take a set of values whose span
-// top - shift is small.
-struct GridSpan {
-  int shift = INT_MAX, top = INT_MIN;
-  DoubleParts see(double x) {
-    const DoubleParts pt = double_parts(x);
-    if (pt.mant != 0) {
-      const auto um = static_cast<std::uint64_t>(pt.mant < 0 ? -pt.mant : pt.mant);
-      shift = std::min(shift, pt.e2 + std::countr_zero(um));
-      top = std::max(top, pt.e2 + 64 - std::countl_zero(um));
-    }
-    return pt;
-  }
-  bool fits(int bits) const { return top == INT_MIN || top - shift <= bits; }
-  int scale() const { return shift == INT_MAX ? 0 : shift; }
-};
+// x's parts, after showing it to the grid.
+DoubleParts see(GridScale& grid, double x) {
+  const DoubleParts pt = double_parts(x);
+  grid.see(pt.mant, pt.e2);
+  return pt;
+}
 
 // x / 2^shift for x = pt on a grid of step 2^shift (its bits below 2^shift
 // are zero, so the arithmetic right shift is exact, negative or not; C++20
@@ -127,20 +115,19 @@ int build_rows(const ExactContext& ctx, std::int32_t i, const std::int32_t* gen,
   const int dim = ctx.dim;
 
   // Common scale: the smallest mantissa lsb among all doubles involved.
-  int shift = INT_MAX;
-  auto consider = [&](double x) { if (x != 0) shift = std::min(shift, lowest_bit_exponent(x)); };
+  GridScale grid;
   const double* pi = ctx.points + static_cast<std::size_t>(i) * dim;
-  for (int d = 0; d < dim; ++d) consider(pi[d]);
+  for (int d = 0; d < dim; ++d) grid.see(pi[d]);
   for (int r = 0; r < rows; ++r) {
     if (gen[r] >= 0) {
       const double* pk = ctx.points + static_cast<std::size_t>(gen[r]) * dim;
-      for (int d = 0; d < dim; ++d) consider(pk[d]);
+      for (int d = 0; d < dim; ++d) grid.see(pk[d]);
     } else {
       int axis = box_plane_axis(gen[r]);
-      consider(box_plane_upper(gen[r]) ? ctx.hi[axis] : ctx.lo[axis]);
+      grid.see(box_plane_upper(gen[r]) ? ctx.hi[axis] : ctx.lo[axis]);
     }
   }
-  if (shift == INT_MAX) shift = 0;
+  const int shift = grid.scale();
 
   // Scaled p_i and |p_i|^2.
   mpz_t* ci = s.coord[Scratch::kRows];
@@ -237,11 +224,11 @@ bool signs_int128(const ExactContext& ctx, std::int32_t i, const std::int32_t* g
   }
   // Each double by its bits (double_parts), and the common scale.
   DoubleParts pv[Scratch::kRows + 1][Scratch::kMaxDim];
-  GridSpan span;
-  for (int d = 0; d < dim; ++d) pv[rows][d] = span.see(v[rows][d]);
+  GridScale span;
+  for (int d = 0; d < dim; ++d) pv[rows][d] = see(span, v[rows][d]);
   for (int r = 0; r < rows; ++r) {
-    if (gen[r] >= 0) for (int d = 0; d < dim; ++d) pv[r][d] = span.see(v[r][d]);
-    else pv[r][0] = span.see(v[r][0]);
+    if (gen[r] >= 0) for (int d = 0; d < dim; ++d) pv[r][d] = see(span, v[r][d]);
+    else pv[r][0] = see(span, v[r][0]);
   }
   if (!span.fits(kBits)) return false;
   const int shift = span.scale();
@@ -375,7 +362,7 @@ bool make_grid(ExactContext& ctx, std::size_t n, std::vector<std::int32_t>& grid
   const std::size_t m = n * static_cast<std::size_t>(dim);
   // The common grid; stop as soon as its span is too wide (it only widens):
   // on general input, at once.
-  GridSpan span;
+  GridScale span;
   for (int d = 0; d < dim; ++d) {
     span.see(ctx.lo[static_cast<std::size_t>(d)]);
     span.see(ctx.hi[static_cast<std::size_t>(d)]);
@@ -435,16 +422,16 @@ bool VertexPredicate::prepare(const ExactContext& ctx, std::int32_t i, const std
   DoubleParts pv[Scratch::kRows][Scratch::kMaxDim];
   int nd[Scratch::kRows];
   const double* pi = ctx.points + static_cast<std::size_t>(i) * dim_;
-  GridSpan span;
-  for (int d = 0; d < dim_; ++d) pv[dim_][d] = span.see(pi[d]);
+  GridScale span;
+  for (int d = 0; d < dim_; ++d) pv[dim_][d] = see(span, pi[d]);
   for (int r = 0; r < dim_; ++r) {
     if (gen_[r] >= 0) {
       const double* pk = ctx.points + static_cast<std::size_t>(gen_[r]) * dim_;
-      for (int d = 0; d < dim_; ++d) pv[r][d] = span.see(pk[d]);
+      for (int d = 0; d < dim_; ++d) pv[r][d] = see(span, pk[d]);
       nd[r] = dim_;
     } else {
       const int axis = box_plane_axis(gen_[r]);
-      pv[r][0] = span.see(box_plane_upper(gen_[r]) ? ctx.hi[axis] : ctx.lo[axis]);
+      pv[r][0] = see(span, box_plane_upper(gen_[r]) ? ctx.hi[axis] : ctx.lo[axis]);
       nd[r] = 1;
     }
   }
@@ -513,8 +500,8 @@ int VertexPredicate::sign(const ExactContext& ctx, std::int32_t j) const {
       xj[d] = ctx.grid[static_cast<std::size_t>(j) * dim_ + d];
       continue;
     }
-    GridSpan span;  // p_j's coordinate: on the vertex's grid, within its bounds?
-    const DoubleParts pt = span.see(pj[d]);
+    GridScale span;  // p_j's coordinate: on the vertex's grid, within its bounds?
+    const DoubleParts pt = see(span, pj[d]);
     if (pt.mant != 0 && (span.shift < shift_ || span.top - shift_ > kBits)) return exact_clip_sign(ctx, i_, gen_, j);
     xj[d] = on_grid(pt, shift_);
   }

@@ -667,6 +667,40 @@ TEST(ExactPredicates, LowestBitExponent) {
   EXPECT_EQ(tessera::kernels::lowest_bit_exponent(0.1), -55);  // 0.1 = 0x1999999999999a * 2^-56
 }
 
+// The common grid of a set of doubles: its step, the integers' bit width,
+// and the exact integer of each value on it.
+TEST(ExactPredicates, GridScale) {
+  using tessera::kernels::GridScale;
+  GridScale g;
+  EXPECT_TRUE(g.all_zero());
+  EXPECT_TRUE(g.fits(0));
+  EXPECT_EQ(g.scale(), 0);
+  g.see(0.0);
+  EXPECT_TRUE(g.all_zero());
+  for (double x : {0.75, -12.0, 5.5, 0.0}) g.see(x);  // 3 * 2^-2, -48 * 2^-2, 22 * 2^-2
+  EXPECT_FALSE(g.all_zero());
+  EXPECT_EQ(g.scale(), -2);
+  EXPECT_TRUE(g.fits(6));   // |-48| < 2^6
+  EXPECT_FALSE(g.fits(5));
+  std::int64_t v = 0;
+  EXPECT_TRUE(g.scaled(-12.0, 6, v));
+  EXPECT_EQ(v, -48);
+  EXPECT_FALSE(g.scaled(0.125, 6, v));  // off the grid
+  EXPECT_FALSE(g.scaled(16.0, 6, v));   // 64: too wide
+  // Subnormals and the largest doubles keep their exact exponents.
+  GridScale t;
+  t.see(3 * 0x1p-1074);
+  t.see(0x1p-1073);
+  EXPECT_EQ(t.scale(), -1074);
+  EXPECT_TRUE(t.fits(2));
+  GridScale w;
+  w.see(0x1p1023 * 1.5);
+  w.see(0.1);
+  EXPECT_EQ(w.scale(), -55);
+  EXPECT_FALSE(w.fits(1000));
+  EXPECT_TRUE(w.fits(1079));  // 2^1024 / 2^-55
+}
+
 namespace {
 
 // The prepared form (VertexPredicate) on grid input: vertices on a small

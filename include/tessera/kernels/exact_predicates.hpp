@@ -22,7 +22,9 @@
 // scaled to integers (every double is an integer times a power of two) in GMP.
 #pragma once
 
+#include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -39,24 +41,33 @@ constexpr bool box_plane_upper(std::int32_t id) { return ((-1 - id) & 1) != 0; }
 /// Exponent of the lowest set bit of x != 0: x is an odd integer times 2^that.
 int lowest_bit_exponent(double x);
 
-/// Whether a set of doubles are all small integers times one common power of
-/// two (lattices, voxel centres, integer and dyadic grids), and that scale:
-/// see() each value, then fits(bits) says whether every |x| / 2^shift < 2^bits,
-/// and scaled(x) gives x / 2^shift exactly. The 128-bit exact paths use it.
+/// The common grid of a set of doubles (lattices, voxel centres, integer and
+/// dyadic grids): see() each value; then every one is an integer times
+/// 2^shift, below 2^top in magnitude, so fits(bits) says whether those
+/// integers all have at most `bits` bits, and scaled(x) gives x / 2^shift.
+/// The integer exact paths use it.
 struct GridScale {
-  int shift = INT32_MAX;
-  double maxabs = 0;
-  void see(double x) {
-    if (x == 0) return;
-    const int e = lowest_bit_exponent(x);
-    if (e < shift) shift = e;
-    if (std::fabs(x) > maxabs) maxabs = std::fabs(x);
+  int shift = INT32_MAX, top = INT32_MIN;
+  /// See x = mant * 2^e2, as the exact code splits a double (mant == 0: nothing).
+  void see(std::int64_t mant, int e2) {
+    if (mant == 0) return;
+    const auto m = static_cast<std::uint64_t>(mant < 0 ? -mant : mant);
+    shift = std::min(shift, e2 + std::countr_zero(m));
+    top = std::max(top, e2 + 64 - std::countl_zero(m));
   }
-  bool all_zero() const { return shift == INT32_MAX; }
-  bool fits(int bits) const { return all_zero() || std::ldexp(maxabs, -shift) < std::ldexp(1.0, bits); }
-  /// x / 2^shift when it is an integer below 2^bits in magnitude (x on the grid).
+  void see(double x) {
+    const auto bits = std::bit_cast<std::uint64_t>(x);
+    const int biased = static_cast<int>((bits >> 52) & 0x7ff);
+    const std::uint64_t m = (bits & ((std::uint64_t{1} << 52) - 1)) | (biased != 0 ? std::uint64_t{1} << 52 : 0);
+    see(static_cast<std::int64_t>(m), biased != 0 ? biased - 1075 : -1074);
+  }
+  bool all_zero() const { return top == INT32_MIN; }
+  bool fits(int bits) const { return all_zero() || top - shift <= bits; }
+  /// The grid's exponent (0 when every value seen was zero).
+  int scale() const { return all_zero() ? 0 : shift; }
+  /// x / 2^scale() when it is an integer below 2^bits in magnitude (x on the grid).
   bool scaled(double x, int bits, std::int64_t& out) const {
-    const double v = all_zero() ? x : std::ldexp(x, -shift);
+    const double v = std::ldexp(x, -scale());
     if (v != std::rint(v) || std::fabs(v) >= std::ldexp(1.0, bits)) return false;
     out = static_cast<std::int64_t>(v);
     return true;
