@@ -301,7 +301,6 @@ namespace {
 // the symbolic perturbation deciding exact ties. gen[0..dim] are the rows'
 // generators (the query row last).
 int decide(const ClipSigns& sg, std::int32_t i, const std::int32_t* gen, int dim) {
-  const int rows = dim + 1;
   // det A = minor[dim]; it is never zero for a real vertex.
   const int sign_det_a = sg.minor[dim];
   if (sign_det_a == 0)
@@ -310,20 +309,13 @@ int decide(const ClipSigns& sg, std::int32_t i, const std::int32_t* gen, int dim
   if (sign_m == 0) {
     // Exact tie: the perturbation decides. det M(w) = det M0 + sum over
     // bisector rows r of (w_i - w_gen[r]) * cofactor(r). Coefficient of
-    // w_gen[r] is -cofactor(r); of w_i it is the sum of those cofactors.
-    // Weights decrease with id, so the smallest id with a non-zero
-    // coefficient decides. The query row alone has coefficient -det A != 0.
-    struct Term { std::int32_t id; int row; };
-    Term terms[Scratch::kRows + 1];
-    int nt = 0;
-    for (int r = 0; r < rows; ++r) if (gen[r] >= 0) terms[nt++] = {gen[r], r};
-    terms[nt++] = {i, -1};
-    for (int a = 1; a < nt; ++a)  // insertion sort by id (at most 5 terms)
-      for (int b = a; b > 0 && terms[b].id < terms[b - 1].id; --b) std::swap(terms[b], terms[b - 1]);
-    for (int t = 0; t < nt && sign_m == 0; ++t) {
-      if (terms[t].row >= 0) sign_m = -cofactor_sign(terms[t].row, dim) * sg.minor[terms[t].row];
-      else sign_m = sg.weight_i;
-    }
+    // w_gen[r] is -cofactor(r); of w_i it is the sum of those cofactors;
+    // of w_j (the query row, last) -det A.
+    PerturbationTerms terms;
+    terms.set(i, gen, dim);
+    sign_m = terms.decide(gen[dim], -sign_det_a, [&](int row) {
+      return row < 0 ? sg.weight_i : -cofactor_sign(row, dim) * sg.minor[row];
+    });
   }
   // sign(P) = sign(det M) * sign(det A); P > 0 keeps the vertex.
   return sign_m * sign_det_a > 0 ? +1 : -1;
@@ -480,13 +472,7 @@ void VertexPredicate::set_cofactors(const std::int64_t (*a)[3]) {
              static_cast<I>(a[0][2]) * cof_[0][2];
   }
   det_a_sign_ = sign_of(det_a_);
-  // The perturbation's terms other than j's: i, and each bisector row, by id.
-  nterms_ = 0;
-  terms_[nterms_++] = {i_, -1};
-  for (int r = 0; r < dim_; ++r)
-    if (gen_[r] >= 0) terms_[nterms_++] = {gen_[r], r};
-  for (int a1 = 1; a1 < nterms_; ++a1)
-    for (int b1 = a1; b1 > 0 && terms_[b1].id < terms_[b1 - 1].id; --b1) std::swap(terms_[b1], terms_[b1 - 1]);
+  terms_.set(i_, gen_, dim_);  // the perturbation's terms other than j's
 }
 
 int VertexPredicate::sign(const ExactContext& ctx, std::int32_t j) const {
@@ -522,17 +508,8 @@ int VertexPredicate::sign(const ExactContext& ctx, std::int32_t j) const {
   if (sign_m == 0) {
     // decide()'s tie-break with the terms pre-sorted: the coefficient of
     // w_gen[r] has the sign of dr[r] (-cofactor(r) * minor[r], see above),
-    // of w_i that of wi, of w_j that of -det A (never zero), so j decides
-    // unless a lower id does first.
-    sign_m = -det_a_sign_;
-    for (int t = 0; t < nterms_; ++t) {
-      if (terms_[t].id > j) break;
-      const int c = terms_[t].row < 0 ? sign_of(wi) : sign_of(dr[terms_[t].row]);
-      if (c != 0) {
-        sign_m = c;
-        break;
-      }
-    }
+    // of w_i that of wi, of w_j that of -det A.
+    sign_m = terms_.decide(j, -det_a_sign_, [&](int row) { return row < 0 ? sign_of(wi) : sign_of(dr[row]); });
   }
   return sign_m * det_a_sign_ > 0 ? +1 : -1;
 }

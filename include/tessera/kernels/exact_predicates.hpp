@@ -28,6 +28,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 namespace tessera::kernels {
@@ -102,6 +103,40 @@ bool make_grid(ExactContext& ctx, std::size_t n, std::vector<std::int32_t>& grid
 /// and j is not i nor one of the planes.
 int exact_clip_sign(const ExactContext& ctx, std::int32_t i, const std::int32_t* planes, std::int32_t j);
 
+/// The symbolic perturbation's tie-break (exact_clip_sign): when det M0 is
+/// exactly zero, the weights w_k (decreasing with id) decide, through the
+/// first term in ascending id whose coefficient is non-zero. The terms are
+/// the generator i (row -1) and the vertex's bisector rows; the query j's
+/// coefficient, -sign(det A), is never zero and is passed apart.
+class PerturbationTerms {
+ public:
+  /// The terms of generator i and the rows' generators gen[0, dim) (box ids < 0 carry no weight).
+  void set(std::int32_t i, const std::int32_t* gen, int dim) {
+    n_ = 0;
+    terms_[n_++] = {i, -1};
+    for (int r = 0; r < dim; ++r)
+      if (gen[r] >= 0) terms_[n_++] = {gen[r], r};
+    for (int a = 1; a < n_; ++a)  // insertion sort by id (at most 4 terms)
+      for (int b = a; b > 0 && terms_[b].id < terms_[b - 1].id; --b) std::swap(terms_[b], terms_[b - 1]);
+  }
+  /// sign(det M) on a tie: coef(row) gives each term's coefficient sign
+  /// (row -1: w_i's), j_coef the query's.
+  template <class Coef>
+  int decide(std::int32_t j, int j_coef, Coef&& coef) const {
+    for (int t = 0; t < n_ && terms_[t].id < j; ++t)
+      if (const int c = coef(terms_[t].row); c != 0) return c;
+    return j_coef;
+  }
+
+ private:
+  struct Term {
+    std::int32_t id;
+    int row;
+  };
+  Term terms_[4] = {};  // by ascending id
+  int n_ = 0;
+};
+
 /// exact_clip_sign for one vertex asked against many candidates. What
 /// depends only on the vertex (its rows, det A and A's cofactors) is computed
 /// once, in 64/128-bit integers, when its points lie on a common grid of at
@@ -125,12 +160,7 @@ class VertexPredicate {
   std::int64_t cof_[3][3] = {};      // row r: A's cofactors along row r
   __int128 ci2_ = 0, det_a_ = 0, b_[3] = {0, 0, 0};
   int det_a_sign_ = 0;
-  struct Term {  // a symbolic weight of the tie-break: i (row -1) or a bisector row
-    std::int32_t id;
-    int row;
-  };
-  Term terms_[4] = {};  // by ascending id
-  int nterms_ = 0;
+  PerturbationTerms terms_;
 };
 
 /// The vertex of cell `i` where `planes[0..dim)` meet, relative to p_i,
