@@ -73,12 +73,6 @@ class FilterLanes {
 
   void clear() { resize(0); }
   template <class Vertex>
-  void push_back(const Vertex& v) {
-    grow(n_ + 1);
-    put(n_++, v);
-    pad();
-  }
-  template <class Vertex>
   void set(std::size_t t, const Vertex& v) { put(t, v); }
   /// Replace the contents by the vertices of `vs`.
   template <class Vertices>

@@ -259,11 +259,6 @@ class Hull {
     sign_[t] = 1;
     settle(t);
   }
-  void append(const Vertex& v) {
-    verts_.push_back(v);
-    lanes_.push_back(v);
-    link(static_cast<std::uint32_t>(verts_.size() - 1));
-  }
   /// Keep the first n vertices, or make room for slots to be written in place
   /// and then settled.
   void resize_vertices(std::size_t n) {
