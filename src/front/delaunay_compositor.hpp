@@ -94,9 +94,15 @@ class DelaunayCompositor {
     b.gen.push_back(gen);
     b.dup_of.push_back(st.has_cell ? -1 : st.duplicate_of);
     if (st.has_cell) {
-      bool touches = false;
       const auto& verts = cell.vertices();
       const auto& planes = cell.planes();
+      // The box planes are the cell's first 2D planes (reset() makes them).
+      // Only a cell with a vertex on the box can hold an open facet: nearly
+      // every cell of a large input has none and skips that search.
+      constexpr std::uint16_t box_planes = 2 * D;
+      bool touches = false;
+      for (const auto& v : verts)
+        for (int k = 0; k < D; ++k) touches |= v.p[k] < box_planes;
       b.pending.clear();
       for (std::size_t t = 0; t < verts.size(); ++t) {
         std::array<std::int32_t, D> ids;
@@ -109,7 +115,7 @@ class DelaunayCompositor {
           if (ids[k] < 0) box = true;
           else if (!labels_.empty() && labels_[static_cast<std::size_t>(ids[k])] < 0) inside = false;
         }
-        if (box) { touches = true; continue; }
+        if (box) continue;
         if (inside && gen < *std::min_element(ids.begin(), ids.end())) {
           // Ascending ids, their normals alongside (a sorting network).
           auto order = [&](int a, int c) {
@@ -129,7 +135,7 @@ class DelaunayCompositor {
           e.sign = kernels::orientation_filter(D, normals.data());
           if (e.sign == 0) e.sign = kernels::orientation(exact_, e.row.data());
         }
-        if (hull_info_) open_facets(b, gen, cell, t);
+        if (hull_info_ && touches) open_facets(b, gen, cell, t);
       }
       std::sort(b.pending.begin(), b.pending.end(), [](const Pending& x, const Pending& y) { return x.row < y.row; });
       for (Pending& e : b.pending) {
