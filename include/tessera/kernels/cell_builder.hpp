@@ -150,9 +150,9 @@ class CellBuilder {
           }
           return Next::go;  // a higher-id duplicate of ours never clips
         }
-        ClipResult r = cell.clip(cd.id, cd.q);
-        if (r == ClipResult::clipped) sec2 = cell.security_radius2();
-        else if (r == ClipResult::emptied) {
+        const ClipResult r = cell.clip(cd.id, cd.q);
+        sec2 = cell.security_radius2();  // unchanged unless it clipped: a load, not a branch
+        if (r == ClipResult::emptied) [[unlikely]] {
           // Only possible for coincident points, which are handled above.
           status.has_cell = false;
           return Next::no_cell;
