@@ -38,7 +38,8 @@ inline void measure(const kernels::Hull& hull, double& volume, std::array<double
     const double* a = v.y;
     for (int k = 0; k < 3; ++k) {
       const auto& pl = planes[v.p[(k + 1) % 3]];
-      const double w = pl.id >= 0 ? 0.5 : pl.d;  // |n|^2 d / |n|^2: n is unit on box planes
+      // The foot n d / |n|^2: d = |n|^2 / 2 on a bisector, |n| = 1 on a box plane.
+      const double w = pl.id >= 0 ? 0.5 : pl.d;
       const double f[3] = {pl.n[0] * w, pl.n[1] * w, pl.n[2] * w};
       const double* b = verts[hull.across(t, k)].y;
       const double s = f[0] * (a[1] * b[2] - a[2] * b[1]) + f[1] * (a[2] * b[0] - a[0] * b[2]) +
