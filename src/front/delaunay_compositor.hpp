@@ -96,13 +96,11 @@ class DelaunayCompositor {
     if (st.has_cell) {
       const auto& verts = cell.vertices();
       const auto& planes = cell.planes();
-      // The box planes are the cell's first 2D planes (reset() makes them).
       // Only a cell with a vertex on the box can hold an open facet: nearly
       // every cell of a large input has none and skips that search.
-      constexpr std::uint16_t box_planes = 2 * D;
       bool touches = false;
       for (const auto& v : verts)
-        for (int k = 0; k < D; ++k) touches |= v.p[k] < box_planes;
+        for (int k = 0; k < D; ++k) touches |= v.p[k] < CellT::box_planes;
       b.pending.clear();
       for (std::size_t t = 0; t < verts.size(); ++t) {
         std::array<std::int32_t, D> ids;

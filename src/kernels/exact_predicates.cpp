@@ -12,33 +12,6 @@
 namespace tessera::kernels {
 namespace {
 
-// A finite double by its bits: x = mant * 2^e2 exactly, |mant| < 2^53
-// (subnormals included). No libm calls: the integer-grid paths run this on
-// every coordinate they see.
-struct DoubleParts {
-  std::int64_t mant;
-  int e2;
-};
-DoubleParts double_parts(double x) {
-  const auto bits = std::bit_cast<std::uint64_t>(x);
-  const int biased = static_cast<int>((bits >> 52) & 0x7ff);
-  std::uint64_t m = bits & ((std::uint64_t{1} << 52) - 1);
-  int e2 = -1074;
-  if (biased != 0) {
-    m |= std::uint64_t{1} << 52;
-    e2 = biased - 1075;
-  }
-  const auto sm = static_cast<std::int64_t>(m);
-  return {(bits >> 63) ? -sm : sm, e2};
-}
-
-// x's parts, after showing it to the grid.
-DoubleParts see(GridScale& grid, double x) {
-  const DoubleParts pt = double_parts(x);
-  grid.see(pt.mant, pt.e2);
-  return pt;
-}
-
 // x / 2^shift for x = pt on a grid of step 2^shift (its bits below 2^shift
 // are zero, so the arithmetic right shift is exact, negative or not; C++20
 // defines it).
@@ -225,10 +198,10 @@ bool signs_int128(const ExactContext& ctx, std::int32_t i, const std::int32_t* g
   // Each double by its bits (double_parts), and the common scale.
   DoubleParts pv[Scratch::kRows + 1][Scratch::kMaxDim];
   GridScale span;
-  for (int d = 0; d < dim; ++d) pv[rows][d] = see(span, v[rows][d]);
+  for (int d = 0; d < dim; ++d) pv[rows][d] = span.see(v[rows][d]);
   for (int r = 0; r < rows; ++r) {
-    if (gen[r] >= 0) for (int d = 0; d < dim; ++d) pv[r][d] = see(span, v[r][d]);
-    else pv[r][0] = see(span, v[r][0]);
+    if (gen[r] >= 0) for (int d = 0; d < dim; ++d) pv[r][d] = span.see(v[r][d]);
+    else pv[r][0] = span.see(v[r][0]);
   }
   if (!span.fits(kBits)) return false;
   const int shift = span.scale();
@@ -415,15 +388,15 @@ bool VertexPredicate::prepare(const ExactContext& ctx, std::int32_t i, const std
   int nd[Scratch::kRows];
   const double* pi = ctx.points + static_cast<std::size_t>(i) * dim_;
   GridScale span;
-  for (int d = 0; d < dim_; ++d) pv[dim_][d] = see(span, pi[d]);
+  for (int d = 0; d < dim_; ++d) pv[dim_][d] = span.see(pi[d]);
   for (int r = 0; r < dim_; ++r) {
     if (gen_[r] >= 0) {
       const double* pk = ctx.points + static_cast<std::size_t>(gen_[r]) * dim_;
-      for (int d = 0; d < dim_; ++d) pv[r][d] = see(span, pk[d]);
+      for (int d = 0; d < dim_; ++d) pv[r][d] = span.see(pk[d]);
       nd[r] = dim_;
     } else {
       const int axis = box_plane_axis(gen_[r]);
-      pv[r][0] = see(span, box_plane_upper(gen_[r]) ? ctx.hi[axis] : ctx.lo[axis]);
+      pv[r][0] = span.see(box_plane_upper(gen_[r]) ? ctx.hi[axis] : ctx.lo[axis]);
       nd[r] = 1;
     }
   }
@@ -487,7 +460,7 @@ int VertexPredicate::sign(const ExactContext& ctx, std::int32_t j) const {
       continue;
     }
     GridScale span;  // p_j's coordinate: on the vertex's grid, within its bounds?
-    const DoubleParts pt = see(span, pj[d]);
+    const DoubleParts pt = span.see(pj[d]);
     if (pt.mant != 0 && (span.shift < shift_ || span.top - shift_ > kBits)) return exact_clip_sign(ctx, i_, gen_, j);
     xj[d] = on_grid(pt, shift_);
   }

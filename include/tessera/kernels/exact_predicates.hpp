@@ -42,6 +42,26 @@ constexpr bool box_plane_upper(std::int32_t id) { return ((-1 - id) & 1) != 0; }
 /// Exponent of the lowest set bit of x != 0: x is an odd integer times 2^that.
 int lowest_bit_exponent(double x);
 
+/// A finite double by its bits: x = mant * 2^e2 exactly, |mant| < 2^53
+/// (subnormals included). No libm calls: the integer-grid paths run this on
+/// every coordinate they see.
+struct DoubleParts {
+  std::int64_t mant;
+  int e2;
+};
+inline DoubleParts double_parts(double x) {
+  const auto bits = std::bit_cast<std::uint64_t>(x);
+  const int biased = static_cast<int>((bits >> 52) & 0x7ff);
+  std::uint64_t m = bits & ((std::uint64_t{1} << 52) - 1);
+  int e2 = -1074;
+  if (biased != 0) {
+    m |= std::uint64_t{1} << 52;
+    e2 = biased - 1075;
+  }
+  const auto sm = static_cast<std::int64_t>(m);
+  return {(bits >> 63) ? -sm : sm, e2};
+}
+
 /// The common grid of a set of doubles (lattices, voxel centres, integer and
 /// dyadic grids): see() each value; then every one is an integer times
 /// 2^shift, below 2^top in magnitude, so fits(bits) says whether those
@@ -49,18 +69,15 @@ int lowest_bit_exponent(double x);
 /// The integer exact paths use it.
 struct GridScale {
   int shift = INT32_MAX, top = INT32_MIN;
-  /// See x = mant * 2^e2, as the exact code splits a double (mant == 0: nothing).
-  void see(std::int64_t mant, int e2) {
-    if (mant == 0) return;
-    const auto m = static_cast<std::uint64_t>(mant < 0 ? -mant : mant);
-    shift = std::min(shift, e2 + std::countr_zero(m));
-    top = std::max(top, e2 + 64 - std::countl_zero(m));
-  }
-  void see(double x) {
-    const auto bits = std::bit_cast<std::uint64_t>(x);
-    const int biased = static_cast<int>((bits >> 52) & 0x7ff);
-    const std::uint64_t m = (bits & ((std::uint64_t{1} << 52) - 1)) | (biased != 0 ? std::uint64_t{1} << 52 : 0);
-    see(static_cast<std::int64_t>(m), biased != 0 ? biased - 1075 : -1074);
+  /// See x; returns its parts, which the integer paths go on to use.
+  DoubleParts see(double x) {
+    const DoubleParts pt = double_parts(x);
+    if (pt.mant != 0) {
+      const auto m = static_cast<std::uint64_t>(pt.mant < 0 ? -pt.mant : pt.mant);
+      shift = std::min(shift, pt.e2 + std::countr_zero(m));
+      top = std::max(top, pt.e2 + 64 - std::countl_zero(m));
+    }
+    return pt;
   }
   bool all_zero() const { return top == INT32_MIN; }
   bool fits(int bits) const { return all_zero() || top - shift <= bits; }

@@ -33,6 +33,8 @@ enum class ClipResult { unchanged, clipped, emptied };
 class Hull {
  public:
   static constexpr int dim = 3;
+  /// The domain box's planes are always the cell's first local planes.
+  static constexpr std::uint16_t box_planes = 6;
   struct Plane {
     double n[3];
     double d;
@@ -56,8 +58,8 @@ class Hull {
     ++cells_;
     // Planes and corners are written in place: a local struct copied in
     // would be read back wider than it was written (a store-forwarding stall).
-    planes_.resize(6);
-    for (int k = 0; k < 6; ++k) {
+    planes_.resize(box_planes);
+    for (int k = 0; k < box_planes; ++k) {
       const int axis = k / 2;
       const bool upper = k & 1;
       Plane& pl = planes_[static_cast<std::size_t>(k)];

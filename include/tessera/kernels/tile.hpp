@@ -25,6 +25,8 @@ namespace tessera::kernels {
 class Tile {
  public:
   static constexpr int dim = 2;
+  /// The domain box's planes are always the tile's first local planes.
+  static constexpr std::uint16_t box_planes = 4;
   struct Plane {
     double n[2];
     double d;
@@ -47,8 +49,8 @@ class Tile {
     ++cells_;
     // Planes and corners are written in place: a local struct copied in
     // would be read back wider than it was written (a store-forwarding stall).
-    planes_.resize(4);
-    for (int k = 0; k < 4; ++k) {
+    planes_.resize(box_planes);
+    for (int k = 0; k < box_planes; ++k) {
       const int axis = k / 2;
       const bool upper = k & 1;
       Plane& pl = planes_[static_cast<std::size_t>(k)];
