@@ -99,41 +99,23 @@ class DelaunayCompositor {
       // Only a cell with a vertex on the box can hold an open facet: nearly
       // every cell of a large input has none and skips that search.
       bool touches = false;
-      for (const auto& v : verts)
-        for (int k = 0; k < D; ++k) touches |= v.p[k] < CellT::box_planes;
+      if (hull_info_)
+        for (const auto& v : verts)
+          for (int k = 0; k < D; ++k) touches |= v.p[k] < CellT::box_planes;
       b.pending.clear();
       for (std::size_t t = 0; t < verts.size(); ++t) {
         std::array<std::int32_t, D> ids;
-        std::array<const double*, D> normals;
-        bool box = false, inside = true;
-        for (int k = 0; k < D; ++k) {
-          const auto& pl = planes[verts[t].p[k]];
-          ids[k] = pl.id;
-          normals[k] = pl.n;  // = p_id - p_gen, rounded as orientation() rounds it
-          if (ids[k] < 0) box = true;
-          else if (!labels_.empty() && labels_[static_cast<std::size_t>(ids[k])] < 0) inside = false;
+        for (int k = 0; k < D; ++k) ids[k] = planes[verts[t].p[k]].id;
+        // Ours to emit when every other generator has a higher id; box
+        // planes have negative ids, so this also skips vertices on the box.
+        // Three of a uniform cell's four vertices fail here.
+        if (*std::min_element(ids.begin(), ids.end()) > gen) {
+          bool inside = true;
+          if (!labels_.empty())
+            for (int k = 0; k < D; ++k) inside &= labels_[static_cast<std::size_t>(ids[k])] >= 0;
+          if (inside) emit(b, gen, ids, verts[t], planes);
         }
-        if (box) continue;
-        if (inside && gen < *std::min_element(ids.begin(), ids.end())) {
-          // Ascending ids, their normals alongside (a sorting network).
-          auto order = [&](int a, int c) {
-            if (ids[c] < ids[a]) {
-              std::swap(ids[a], ids[c]);
-              std::swap(normals[a], normals[c]);
-            }
-          };
-          order(0, 1);
-          if constexpr (D == 3) {
-            order(1, 2);
-            order(0, 1);
-          }
-          Pending& e = b.pending.emplace_back();
-          e.row[0] = gen;
-          std::copy(ids.begin(), ids.end(), e.row.begin() + 1);
-          e.sign = kernels::orientation_filter(D, normals.data());
-          if (e.sign == 0) e.sign = kernels::orientation(exact_, e.row.data());
-        }
-        if (hull_info_ && touches) open_facets(b, gen, cell, t);
+        if (hull_info_ && touches && *std::min_element(ids.begin(), ids.end()) >= 0) open_facets(b, gen, cell, t);
       }
       std::sort(b.pending.begin(), b.pending.end(), [](const Pending& x, const Pending& y) { return x.row < y.row; });
       for (Pending& e : b.pending) {
@@ -184,6 +166,30 @@ class DelaunayCompositor {
   }
 
  private:
+  // Queue the simplex {gen, ids} of vertex v, oriented: ascending ids, their
+  // bisector normals alongside (a sorting network).
+  template <class Vertex, class Planes>
+  void emit(Batch& b, std::int32_t gen, std::array<std::int32_t, D> ids, const Vertex& v, const Planes& planes) {
+    std::array<const double*, D> normals;
+    for (int k = 0; k < D; ++k) normals[k] = planes[v.p[k]].n;  // = p_id - p_gen, rounded as orientation() rounds it
+    auto order = [&](int a, int c) {
+      if (ids[c] < ids[a]) {
+        std::swap(ids[a], ids[c]);
+        std::swap(normals[a], normals[c]);
+      }
+    };
+    order(0, 1);
+    if constexpr (D == 3) {
+      order(1, 2);
+      order(0, 1);
+    }
+    Pending& e = b.pending.emplace_back();
+    e.row[0] = gen;
+    std::copy(ids.begin(), ids.end(), e.row.begin() + 1);
+    e.sign = kernels::orientation_filter(D, normals.data());
+    if (e.sign == 0) e.sign = kernels::orientation(exact_, e.row.data());
+  }
+
   // Facets {gen, shared planes} of the found simplex at vertex t whose Voronoi
   // edge (3D) / neighbouring vertex (2D) ends on the box; emitted by the lowest id.
   void open_facets(Batch& b, std::int32_t gen, const CellT& cell, std::size_t t) {

@@ -32,7 +32,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
-#include <map>
+#include <optional>
 #include <stdexcept>
 #include <vector>
 
@@ -42,6 +42,7 @@
 #include "delaunay_compositor.hpp"
 #include "tessera/kernels/delaunay_predicates.hpp"
 #include "candidate_tree.hpp"
+#include "facet_table.hpp"
 
 namespace tessera::front {
 
@@ -63,26 +64,52 @@ class HullCompletion {
     ids[D] = apex;
     const int apex_side = kernels::orientation(ctx_, ids.data());
     if (apex_side == 0) throw std::logic_error("tessera: hull completion met a flat simplex");
-    // Float normal n with n.(x - a) > 0 beyond the facet, for pruning only;
-    // the exact orientation decides for every point.
+    // The facet's fixed rows of orientation(f, x): its value is the dot of
+    // x - a with their cofactors c, the filter's error bound the dot of |x - a|
+    // with the cofactors' absolute products cp. The same terms as
+    // orientation()'s own filter, so a certain sign here is its sign.
     const double* a = pt(f[0]);
-    double n[D];
+    double c[D], cp[D];
     if constexpr (D == 3) {
       const double* b = pt(f[1]);
-      const double* c = pt(f[2]);
-      double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
-      n[0] = u[1] * v[2] - u[2] * v[1];
-      n[1] = u[2] * v[0] - u[0] * v[2];
-      n[2] = u[0] * v[1] - u[1] * v[0];
+      const double* e = pt(f[2]);
+      double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, v[3] = {e[0] - a[0], e[1] - a[1], e[2] - a[2]};
+      for (int d = 0; d < 3; ++d) {
+        const int d1 = (d + 1) % 3, d2 = (d + 2) % 3;
+        c[d] = u[d1] * v[d2] - u[d2] * v[d1];
+        cp[d] = std::fabs(u[d1] * v[d2]) + std::fabs(u[d2] * v[d1]);
+      }
     } else {
       const double* b = pt(f[1]);
-      n[0] = -(b[1] - a[1]);
-      n[1] = b[0] - a[0];
+      c[0] = -(b[1] - a[1]);
+      c[1] = b[0] - a[0];
+      cp[0] = std::fabs(c[0]);
+      cp[1] = std::fabs(c[1]);
     }
+    // The side of x (an input point or a box corner): the float filter, then
+    // the facet's integer plane (grids, where coplanar points are common),
+    // built on first need, then `exact`.
+    std::optional<IntegerPlane> plane;
+    auto side_of = [&](const double* x, auto&& exact) {
+      double det = 0, perm = 0;
+      for (int d = 0; d < D; ++d) {
+        const double r = x[d] - a[d];
+        det += r * c[d];
+        perm += std::fabs(r) * cp[d];
+      }
+      const double bound = 16 * kernels::filter::u * perm + kernels::filter::abs_eps;
+      if (det > bound) return 1;
+      if (det < -bound) return -1;
+      if (!plane) plane.emplace(f, *this);
+      int side;
+      return plane->side(x, side) ? side : exact();
+    };
+    // Float normal n with n.(x - a) > 0 beyond the facet, for pruning only.
+    double n[D];
     double nn = 0;
-    for (double& x : n) {
-      x *= -apex_side;
-      nn += x * x;
+    for (int d = 0; d < D; ++d) {
+      n[d] = -apex_side * c[d];
+      nn += n[d] * n[d];
     }
     typename CandidateTree<D>::Query q;
     for (int d = 0; d < D; ++d) {
@@ -92,7 +119,6 @@ class HullCompletion {
       for (int k = 0; k < D; ++k) q.near[d] += pt(f[static_cast<std::size_t>(k)])[d] / D;
     }
     q.margin = 1e-9 * std::sqrt(nn) * diam_;
-    const IntegerPlane plane(f, *this);
     // True when every corner of the box is on the apex side or on the plane:
     // the orientation is affine in x, so then no point of the box is beyond.
     auto box_not_beyond = [&](const double* lo, const double* hi) {
@@ -100,11 +126,9 @@ class HullCompletion {
       for (int k = 0; k < D; ++k) pts[k] = pt(f[static_cast<std::size_t>(k)]);
       double corner[D];
       pts[D] = corner;
-      for (int c = 0; c < (1 << D); ++c) {
-        for (int d = 0; d < D; ++d) corner[d] = (c >> d) & 1 ? hi[d] : lo[d];
-        int side;
-        if (!plane.side(corner, side)) side = kernels::orientation(D, pts);
-        if (side == -apex_side) return false;
+      for (int k = 0; k < (1 << D); ++k) {
+        for (int d = 0; d < D; ++d) corner[d] = (k >> d) & 1 ? hi[d] : lo[d];
+        if (side_of(corner, [&] { return kernels::orientation(D, pts); }) == -apex_side) return false;
       }
       return true;
     };
@@ -112,9 +136,7 @@ class HullCompletion {
     tree_.search(q, [&](std::int32_t p) {
       if (p == apex || std::find(f.begin(), f.end(), p) != f.end()) return;
       ids[D] = p;
-      int side;
-      if (!plane.side(pt(p), side)) side = kernels::orientation(ctx_, ids.data());
-      if (side != -apex_side) return;  // not strictly beyond
+      if (side_of(pt(p), [&] { return kernels::orientation(ctx_, ids.data()); }) != -apex_side) return;  // not strictly beyond
       if (best >= 0) {
         std::array<std::int32_t, D> planes;
         std::copy(f.begin() + 1, f.end(), planes.begin());
@@ -132,11 +154,13 @@ class HullCompletion {
   /// never added twice (its facets would then be in three simplices, which
   /// throws), and there are finitely many.
   std::vector<Simplex> run(const std::vector<OpenFacet<D>>& open, int threads) {
-    struct State { int count; };
-    std::map<Facet, State> facets;  // facets on the current boundary and those closed by completion
+    // Facets on the current boundary and those closed by completion, with
+    // the number of simplices holding each (found ones count once: the
+    // other side of an open facet is what completion looks for).
+    FacetTable<D> facets(8 * open.size());
     std::vector<OpenFacet<D>> queue;
     for (const auto& o : open) {
-      facets[o.facet] = {1};
+      facets.bump(o.facet);
       queue.push_back(o);
     }
     std::vector<Simplex> added;
@@ -165,15 +189,14 @@ class HullCompletion {
           for (int m = 0, j = 0; m <= D; ++m)
             if (m != k) o.facet[j++] = s[m];
           o.apex = s[k];
-          auto [it, inserted] = facets.try_emplace(o.facet, State{1});
-          if (!inserted && ++it->second.count > 2)
-            throw std::logic_error("tessera: hull completion put a facet in three simplices");
-          if (inserted) next.push_back(o);
+          const int held = facets.bump(o.facet);
+          if (held > 2) throw std::logic_error("tessera: hull completion put a facet in three simplices");
+          if (held == 1) next.push_back(o);
         }
       }
       queue.clear();
       for (const auto& o : next)
-        if (facets[o.facet].count == 1) queue.push_back(o);
+        if (facets.count(o.facet) == 1) queue.push_back(o);
     }
     std::sort(added.begin(), added.end());
     return added;
