@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 #include <stdexcept>
 
 #include "delaunay_compositor.hpp"
@@ -37,7 +36,7 @@ Delaunay run(std::span<const double> input, std::span<const std::int32_t> labels
   front::DelaunayCompositor<CellT> comp(found, n, labels, complete, pass.exact);
   out.exact_predicate_calls = engine::tessellate<CellT>(pass.gens, comp, pass.engine_options);
   out.duplicates = std::move(found.duplicates);
-  out.from_cells = found.simplices.size() / (D + 1);
+  out.from_cells = found.found;
 
   if (complete && out.from_cells == 0 && pass.locator->size() - out.duplicates.size() > D && attempt < 2) {
     // Every circumcentre lies outside the box (a handful of points, or nearly
@@ -87,9 +86,8 @@ Delaunay run(std::span<const double> input, std::span<const std::int32_t> labels
   out.from_hull_completion = added.size();
 
   // Orient the completion's simplices as the compositor oriented the found
-  // ones, then merge the two lists, both ascending by key. The completion
-  // adds few rows (the thin shell at the hull): each finds its place by
-  // binary search, and the found rows move up in blocks, from the back.
+  // ones (they stay in key order: a row's key is its ascending form), then
+  // lay out both lists in one pass.
   std::size_t flat = found.flat;
   for (auto& row : added) {
     const int o = kernels::orientation(pass.exact, row.data());
@@ -98,32 +96,7 @@ Delaunay run(std::span<const double> input, std::span<const std::int32_t> labels
   }
   if (flat != 0)
     throw std::logic_error("tessera: " + std::to_string(flat) + " Delaunay simplices are flat (inconsistent topology)");
-  {
-    constexpr std::size_t W = D + 1;
-    const std::size_t nf = out.from_cells;
-    std::vector<std::size_t> before(added.size());  // found rows preceding each added row
-    for (std::size_t j = 0; j < added.size(); ++j) {
-      const auto key = front::simplex_key<D>(added[j].data());
-      std::size_t lo = 0, hi = nf;
-      while (lo < hi) {
-        const std::size_t mid = lo + (hi - lo) / 2;
-        if (front::simplex_key<D>(found.simplices.data() + mid * W) < key) lo = mid + 1;
-        else hi = mid;
-      }
-      before[j] = lo;
-    }
-    out.simplices = std::move(found.simplices);
-    out.simplices.resize((nf + added.size()) * W);
-    std::int32_t* rows = out.simplices.data();
-    std::size_t src_end = nf, dst_end = nf + added.size();
-    for (std::size_t j = added.size(); j-- > 0;) {
-      const std::size_t count = src_end - before[j];
-      std::memmove(rows + (dst_end - count) * W, rows + before[j] * W, count * W * sizeof(std::int32_t));
-      dst_end -= count + 1;
-      src_end = before[j];
-      std::copy(added[j].begin(), added[j].end(), rows + dst_end * W);
-    }
-  }
+  comp.write(added, out.simplices);
   std::sort(out.duplicates.begin(), out.duplicates.end());
   return out;
 }

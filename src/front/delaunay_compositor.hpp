@@ -53,12 +53,11 @@ std::array<std::int32_t, D + 1> simplex_key(const std::int32_t* row) {
   return k;
 }
 
-/// What the compositor leaves for the front end.
+/// What the compositor leaves for the front end after the pass (finish);
+/// the simplices themselves stay in the compositor until write().
 template <int D>
 struct DelaunayPassResult {
-  /// Rows of D+1 ids, positively oriented (the last two swapped where the
-  /// ascending order is negative); rows ascending by key (simplex_key).
-  std::vector<std::int32_t> simplices;
+  std::size_t found = 0;                   ///< simplices the cells found
   std::size_t flat = 0;                    ///< simplices of orientation 0 (must stay 0)
   std::vector<OpenFacet<D>> open;          ///< ascending
   std::vector<std::uint8_t> touches_box;   ///< per point (hull info only)
@@ -117,44 +116,33 @@ class DelaunayCompositor {
         }
         if (hull_info_ && touches && *std::min_element(ids.begin(), ids.end()) >= 0) open_facets(b, gen, cell, t);
       }
-      std::sort(b.pending.begin(), b.pending.end(), [](const Pending& x, const Pending& y) { return x.row < y.row; });
-      for (Pending& e : b.pending) {
-        if (e.sign < 0) std::swap(e.row[D - 1], e.row[D]);
-        b.flat += e.sign == 0;
-        b.simplices.push_back(e.row);
-      }
+      place_in_order(b);
       if (hull_info_ && touches) b.touches_box.push_back(gen);
     }
     b.simplex_end.push_back(static_cast<std::uint32_t>(b.simplices.size()));
   }
 
   void finish(std::span<Batch> batches) {
-    // Simplices in generator order (each generator's come ascending by key
-    // and hold it as their lowest id): the whole list comes out ascending.
-    // Every generator lies in exactly one batch, so the counts are written
-    // from all batches at once without conflict.
-    std::vector<std::int64_t> offset(n_ + 1, 0);
+    // Each generator's simplex count, at its id: every generator lies in
+    // exactly one batch, so all batches write at once without conflict. The
+    // batches' rows are kept (moved, not copied) for write().
+    count_.assign(n_, 0);
     tbb::parallel_for(std::size_t(0), batches.size(), [&](std::size_t k) {
       const Batch& b = batches[k];
       for (std::size_t t = 0; t < b.gen.size(); ++t)
-        offset[static_cast<std::size_t>(b.gen[t]) + 1] = b.simplex_end[t] - (t == 0 ? 0 : b.simplex_end[t - 1]);
+        count_[static_cast<std::size_t>(b.gen[t])] = b.simplex_end[t] - (t == 0 ? 0 : b.simplex_end[t - 1]);
     });
-    std::partial_sum(offset.begin(), offset.end(), offset.begin());
-    for (const Batch& b : batches) {
+    kept_.resize(batches.size());
+    for (std::size_t k = 0; k < batches.size(); ++k) {
+      Batch& b = batches[k];
+      out_.found += b.simplices.size();
       out_.flat += b.flat;
       for (std::size_t t = 0; t < b.gen.size(); ++t)
         if (b.dup_of[t] >= 0) out_.duplicates.emplace_back(b.gen[t], b.dup_of[t]);
+      kept_[k].gen = std::move(b.gen);
+      kept_[k].simplex_end = std::move(b.simplex_end);
+      kept_[k].simplices = std::move(b.simplices);
     }
-    out_.simplices.resize(static_cast<std::size_t>(offset[n_]) * (D + 1));
-    tbb::parallel_for(std::size_t(0), batches.size(), [&](std::size_t k) {
-      const Batch& b = batches[k];
-      for (std::size_t t = 0; t < b.gen.size(); ++t) {
-        std::uint32_t s0 = t == 0 ? 0 : b.simplex_end[t - 1];
-        std::size_t o = static_cast<std::size_t>(offset[static_cast<std::size_t>(b.gen[t])]) * (D + 1);
-        for (std::uint32_t s = s0; s < b.simplex_end[t]; ++s)
-          for (int d = 0; d <= D; ++d) out_.simplices[o++] = b.simplices[s][d];
-      }
-    });
     if (hull_info_) {
       out_.touches_box.assign(n_, 0);
       for (const Batch& b : batches) {
@@ -165,7 +153,68 @@ class DelaunayCompositor {
     }
   }
 
+  /// Every simplex as rows of D+1 ids into `rows`, ascending by key
+  /// (simplex_key): the found ones with `extra` (oriented rows, ascending by
+  /// key: hull completion's) merged in. Each generator's rows, found and
+  /// extra, hold it as their lowest id and come ascending, so laying them out
+  /// in generator order sorts the whole list; generators are written in
+  /// parallel, straight into their final place.
+  void write(const std::vector<Simplex>& extra, std::vector<std::int32_t>& rows) {
+    std::vector<std::int64_t> offset(n_ + 1, 0);
+    std::vector<std::uint32_t> extra_begin(n_ + 1, 0);
+    for (const Simplex& s : extra) ++extra_begin[static_cast<std::size_t>(*std::min_element(s.begin(), s.end())) + 1];
+    for (std::size_t g = 0; g < n_; ++g) {
+      extra_begin[g + 1] += extra_begin[g];
+      offset[g + 1] = offset[g] + count_[g] + (extra_begin[g + 1] - extra_begin[g]);
+    }
+    rows.resize(static_cast<std::size_t>(offset[n_]) * (D + 1));
+    tbb::parallel_for(std::size_t(0), kept_.size(), [&](std::size_t k) {
+      const Kept& b = kept_[k];
+      for (std::size_t t = 0; t < b.gen.size(); ++t) {
+        const auto g = static_cast<std::size_t>(b.gen[t]);
+        std::int32_t* o = rows.data() + static_cast<std::size_t>(offset[g]) * (D + 1);
+        const Simplex* s = b.simplices.data() + (t == 0 ? 0 : b.simplex_end[t - 1]);
+        const Simplex* s_end = b.simplices.data() + b.simplex_end[t];
+        const Simplex* x = extra.data() + extra_begin[g];
+        const Simplex* x_end = extra.data() + extra_begin[g + 1];
+        while (s != s_end || x != x_end) {
+          const bool take_extra = s == s_end || (x != x_end && simplex_key<D>(x->data()) < simplex_key<D>(s->data()));
+          const Simplex& r = take_extra ? *x++ : *s++;
+          o = std::copy(r.begin(), r.end(), o);
+        }
+      }
+    });
+    kept_.clear();
+  }
+
  private:
+  // Append the pending rows to b.simplices ascending by key, oriented. All
+  // share row[0] (the generator), so the key is (row[1], row[2]) packed in
+  // 62 bits, then row[D]. A cell emits a handful (~7 in 3D), so each row's
+  // place is the count of rows below it: n^2 branch-free comparisons, which
+  // beat a sort's mispredicted branches at this size.
+  void place_in_order(Batch& b) {
+    const std::size_t m = b.pending.size();
+    const std::size_t base = b.simplices.size();
+    b.simplices.resize(base + m);
+    auto pack = [](const Simplex& r) {
+      return D == 3 ? (static_cast<std::uint64_t>(r[1]) << 31) | static_cast<std::uint64_t>(r[2])
+                    : static_cast<std::uint64_t>(r[1]);
+    };
+    for (std::size_t i = 0; i < m; ++i) {
+      const Pending& e = b.pending[i];
+      const std::uint64_t ki = pack(e.row);
+      std::size_t below = 0;
+      for (std::size_t j = 0; j < m; ++j) {
+        const std::uint64_t kj = pack(b.pending[j].row);
+        below += (kj < ki) | ((kj == ki) & (b.pending[j].row[D] < e.row[D]));
+      }
+      Simplex& r = b.simplices[base + below] = e.row;
+      if (e.sign < 0) std::swap(r[D - 1], r[D]);
+      b.flat += e.sign == 0;
+    }
+  }
+
   // Queue the simplex {gen, ids} of vertex v, oriented: ascending ids, their
   // bisector normals alongside (a sorting network).
   template <class Vertex, class Planes>
@@ -225,7 +274,15 @@ class DelaunayCompositor {
     }
   }
 
+  struct Kept {  // a batch's rows, from finish() to write()
+    std::vector<std::int32_t> gen;
+    std::vector<std::uint32_t> simplex_end;
+    std::vector<Simplex> simplices;
+  };
+
   DelaunayPassResult<D>& out_;
+  std::vector<std::uint32_t> count_;  // per generator: its found simplices
+  std::vector<Kept> kept_;
   std::size_t n_;
   std::span<const std::int32_t> labels_;
   bool hull_info_;
