@@ -45,7 +45,22 @@ struct Case {
   bool explicit_bounds;  // false: tessera's default padded box is used (and checked)
   bool clustered = false;  // 3/4 of the points in one tight cluster
   bool blob = false;       // all but 60 points in a blob far smaller than a bin
+  bool wide = false;       // the points fill only the box's middle third on each axis
 };
+
+/// Uniform points in the middle third of b on each axis: the cells of the
+/// outer points reach far out to the box, so their security spheres hold
+/// many bins of points while their flowers reach little inwards (the
+/// builder bounds them by a box of bins, flower_bins).
+std::vector<double> middle_points(std::size_t n, int dim, std::uint64_t seed, const tessera::Bounds& b) {
+  tessera::Bounds mid = b;
+  for (int a = 0; a < dim; ++a) {
+    const double w = b.hi[a] - b.lo[a];
+    mid.lo[a] = b.lo[a] + w / 3;
+    mid.hi[a] = b.hi[a] - w / 3;
+  }
+  return random_points(n, dim, seed, mid);
+}
 
 /// Uniform points in b, all but the last 60 then squeezed into a blob of
 /// 1e-4 of the box around its centre: the blob lies in one bin of the grid,
@@ -78,12 +93,14 @@ std::vector<double> clustered_points(std::size_t n, int dim, std::uint64_t seed,
 void compare_with_oracle(const Case& cs) {
   SCOPED_TRACE(::testing::Message() << "dim " << cs.dim << " n " << cs.n << " seed " << cs.seed
                                     << (cs.explicit_bounds ? " explicit bounds" : " default bounds")
-                                    << (cs.clustered ? " clustered" : "") << (cs.blob ? " blob" : ""));
+                                    << (cs.clustered ? " clustered" : "") << (cs.blob ? " blob" : "")
+                                    << (cs.wide ? " wide box" : ""));
   const int dim = cs.dim;
   // An anisotropic, off-origin box so no axis or scale is special.
   const auto b = make_bounds({-3, 2, 10}, {7, 2.5, 11});
   const auto pts = cs.blob        ? blob_points(cs.n, dim, cs.seed, b)
                    : cs.clustered ? clustered_points(cs.n, dim, cs.seed, b)
+                   : cs.wide      ? middle_points(cs.n, dim, cs.seed, b)
                                   : random_points(cs.n, dim, cs.seed, b);
   const tessera::Cells c = cs.explicit_bounds ? run(pts, dim, b) : run(pts, dim);
   ASSERT_EQ(c.n_cells(), cs.n);
@@ -228,6 +245,13 @@ TEST(Oracle, BlobDuplicatesLowestIdOwns) {
     EXPECT_EQ(c2.neighbors, c.neighbors);
     EXPECT_EQ(c2.neighbor_offsets, c.neighbor_offsets);
   }
+}
+
+// Points in the middle of a box three times their extent: the outer cells
+// reach the box, far beyond the points.
+TEST(Oracle, PointsInTheMiddleOfAWideBox) {
+  for (Case cs : {Case{2, 800, 41, true, false, false, true}, Case{3, 800, 42, true, false, false, true}})
+    compare_with_oracle(cs);
 }
 
 TEST(Oracle, Clustered) {

@@ -58,11 +58,21 @@ class CellBuilder {
     const auto b = loc_.bin_coords(p);
     const int last = loc_.max_shell(b);
     BuildStatus status;
+    const std::array<std::int32_t, D>* range = nullptr;  // the flower's bins, once measured
     for (int s = 0; s <= last; ++s) {
       double sec2 = cell.security_radius2();
       if (s > 1) {
         double lb = loc_.shell_lower_bound(p, b, s);
         if (lb * lb > sec2) break;
+        if (sec2 > flower_min2_) {
+          // The security sphere is far wider than a bin: bound the flower
+          // by a box instead (flower_bins), and stop once the shell lies
+          // wholly outside it.
+          range = flower_bins(cell, p);
+          int reach = 0;
+          for (int d = 0; d < D; ++d) reach = std::max({reach, b[d] - range[0][d], range[1][d] - b[d]});
+          if (reach < s) break;
+        }
       }
       // Candidates of slots [a, e) within the security radius, appended to
       // cand_/keys_ (storage only grows; nc counts what is in use). Each run
@@ -99,7 +109,7 @@ class CellBuilder {
       // sorted together (own bin first, so coincident points keep id order).
       // The bins next to the generator's are always near: prune only beyond.
       auto walk = [&](auto&& visit_run) {
-        if (s > 1) loc_.for_each_shell_run_near(p, b, s, sec2, gaps_, visit_run);
+        if (s > 1) loc_.for_each_shell_run_near(p, b, s, sec2, gaps_, visit_run, range);
         else loc_.for_each_shell_run(b, s, visit_run);
         if (s == 0 && last >= 1) {
           s = 1;
@@ -159,6 +169,7 @@ class CellBuilder {
         }
         return Next::go;
       };
+      if (s >= screen_from && nc > screen_min) nc = screen(cell, nc, sec2);
       Next next = Next::go;
       std::uint64_t* const keys = keys_.data();
       std::uint64_t* const end = keys + nc;
@@ -237,6 +248,72 @@ class CellBuilder {
   }
 
  private:
+  /// The bins that can hold a point of the cell's flower (the union of its
+  /// petals, the balls centred at its vertices through the generator): a
+  /// candidate x (relative to the generator) cuts vertex v only if
+  /// |x - v| <= |v|, so x[d] lies within |v| of v[d]. With the exact vertex
+  /// within e of the stored y (per axis) and no farther than sqrt(r2) from
+  /// the generator, the box y[d] -+ (sqrt(r2) + e), widened far past the
+  /// rounding of these sums, holds every candidate that can clip. The
+  /// flower only shrinks as the cell does (it is the union of the balls of
+  /// all the cell's points, by convexity), so a box measured earlier stays
+  /// valid. A cell reaching the domain box has its far vertices outside
+  /// the points' extent: its flower reaches little beyond its generator
+  /// inwards, where its security sphere reaches twice its size.
+  const std::array<std::int32_t, D>* flower_bins(const CellT& cell, const double* p) {
+    double lo[D], hi[D];
+    for (int d = 0; d < D; ++d) {
+      lo[d] = std::numeric_limits<double>::infinity();
+      hi[d] = -std::numeric_limits<double>::infinity();
+    }
+    bool finite = true;
+    for (const auto& v : cell.vertices()) {
+      const double r = (std::sqrt(v.r2) + v.e) * (1.0 + 1e-9);
+      for (int d = 0; d < D; ++d) {
+        lo[d] = std::min(lo[d], v.y[d] - r);
+        hi[d] = std::max(hi[d], v.y[d] + r);
+        finite &= std::fabs(v.y[d]) + r < std::numeric_limits<double>::infinity();  // false on NaN
+      }
+    }
+    if (!finite)
+      for (int d = 0; d < D; ++d) {
+        lo[d] = -std::numeric_limits<double>::infinity();
+        hi[d] = std::numeric_limits<double>::infinity();
+      }
+    for (int d = 0; d < D; ++d) {
+      lo[d] = p[d] + lo[d] - 1e-9 * (std::fabs(p[d]) + std::fabs(lo[d]));
+      hi[d] = p[d] + hi[d] + 1e-9 * (std::fabs(p[d]) + std::fabs(hi[d]));
+    }
+    loc_.bin_range(lo, hi, flower_range_[0], flower_range_[1]);
+    return flower_range_;
+  }
+
+  /// The shell from which gathered candidates are screened by the support
+  /// bound before they are sorted (see screen). A uniform cell is final after
+  /// its second gather (shells 0-1, then 2) and never pays for it.
+  static constexpr int screen_from = 2;
+  static constexpr std::size_t screen_min = 48;
+
+  /// Drop the candidates of this gather that surely leave the cell unchanged:
+  /// beyond the security radius, or excluded by the support bound measured
+  /// now. Returns how many remain (their keys first, in gather order). A cell
+  /// that is still being gathered this far out reaches the domain box or
+  /// empty space: its security radius holds hundreds of candidates, nearly
+  /// all behind its generator, and each would cost a sign pass over a cell
+  /// of many vertices. The clips that follow are exactly those without the
+  /// screen, in the same order: a dropped candidate could not have clipped.
+  std::size_t screen(const CellT& cell, std::size_t nc, double sec2) {
+    support_.measure(cell.vertices());
+    std::uint64_t* const keys = keys_.data();
+    std::size_t kept = 0;
+    for (std::size_t k = 0; k < nc; ++k) {
+      const Candidate& cd = cand_[static_cast<std::uint32_t>(keys[k])];
+      keys[kept] = keys[k];
+      kept += cd.r2 <= sec2 && !support_.excludes(cd.q);
+    }
+    return kept;
+  }
+
   /// The size of the sorted head of an oversized shell (above: a shell of at
   /// most twice as many is sorted whole). A uniform cell uses about 47.
   static constexpr std::size_t sort_head = 64;
@@ -344,6 +421,11 @@ class CellBuilder {
   std::vector<std::pair<std::uint32_t, std::uint32_t>> runs_;  // a shell's slot runs
   std::vector<std::uint64_t> spill_;  // split_head's scratch
   SupportBound<D> support_;
+  std::array<std::int32_t, D> flower_range_[2];  // flower_bins' result
+  /// Above this squared security radius (nine squared smallest bin sizes)
+  /// a cell bounds its flower before walking a shell (flower_bins): a
+  /// uniform cell's is about one bin size and never pays for it.
+  double flower_min2_ = 9 * loc_.min_bin_size() * loc_.min_bin_size();
 };
 
 }  // namespace tessera::kernels

@@ -105,6 +105,14 @@ class BinLocator {
     }
     return b;
   }
+  /// Per axis, the bin coordinates that can hold a point whose coordinate
+  /// lies in [lo[d], hi[d]]: [first[d], last[d]]. Exact: binning rounds
+  /// monotonically, so a point at or above lo[d] falls in no lower bin.
+  void bin_range(const double* lo, const double* hi, std::array<std::int32_t, D>& first,
+                 std::array<std::int32_t, D>& last) const {
+    first = bin_coords(lo);
+    last = bin_coords(hi);
+  }
   std::size_t bin_index(const std::array<std::int32_t, D>& b) const {
     std::size_t idx = static_cast<std::size_t>(b[D - 1]);
     for (int d = D - 2; d >= 0; --d) idx = idx * static_cast<std::size_t>(divs_[d]) + static_cast<std::size_t>(b[d]);
@@ -174,9 +182,14 @@ class BinLocator {
   /// sides, so the near bins form one interval, found from its two ends.
   /// `gaps` is the caller's scratch (one per thread): the locator stays
   /// read-only.
+  ///
+  /// `range`, when given, also limits the walk to the bins with coordinates
+  /// range[0][d] <= c[d] <= range[1][d] (see bin_range): their gaps count as
+  /// infinite.
   template <class F>
   void for_each_shell_run_near(const double* x, const std::array<std::int32_t, D>& b, int s, double r2max,
-                               std::vector<double>& gaps, F&& f) const {
+                               std::vector<double>& gaps, F&& f,
+                               const std::array<std::int32_t, D>* range = nullptr) const {
     if (s == 0) return for_each_shell_run(b, 0, f);
     const std::size_t w = static_cast<std::size_t>(2 * s + 1);
     gaps.resize(D * w);
@@ -184,7 +197,9 @@ class BinLocator {
       for (int o = -s; o <= s; ++o) {
         const double blo = lo_[d] + (b[d] + o) * size_[d], bhi = blo + size_[d];
         const double g = std::max(std::max(0.0, blo - x[d] - slack_), x[d] - bhi - slack_);
-        gaps[static_cast<std::size_t>(d) * w + static_cast<std::size_t>(o + s)] = g * g;
+        const bool out = range != nullptr && (b[d] + o < range[0][d] || b[d] + o > range[1][d]);
+        gaps[static_cast<std::size_t>(d) * w + static_cast<std::size_t>(o + s)] =
+            out ? std::numeric_limits<double>::infinity() : g * g;
       }
     }
     auto gap2 = [&](int d, int o) { return gaps[static_cast<std::size_t>(d) * w + static_cast<std::size_t>(o + s)]; };
@@ -204,6 +219,7 @@ class BinLocator {
   }
 
   std::size_t num_bins() const { return offsets_.size() - 1; }
+  double min_bin_size() const { return min_size_; }
   std::size_t size() const { return ids_.size(); }
   /// Points of bin k are slots offsets()[k] .. offsets()[k+1]).
   const std::vector<std::uint32_t>& offsets() const { return offsets_; }
