@@ -104,25 +104,44 @@ class CellsCompositor {
     // Where each generator's data sits: (batch, index in batch). Every
     // generator lies in exactly one batch, so all batches write at once;
     // cell_of first holds 1 for a generator with a cell.
+    // (`where` only for the mesh.)
     struct Loc { std::int32_t batch = -1, index = -1; };
-    std::vector<Loc> where(n);
-    o.cell_of.assign(n, 0);
-    tbb::parallel_for(std::size_t(0), batches.size(), [&](std::size_t k) {
-      const Batch& b = batches[k];
-      for (std::size_t t = 0; t < b.gen.size(); ++t) {
-        const auto g = static_cast<std::size_t>(b.gen[t]);
-        where[g] = {static_cast<std::int32_t>(k), static_cast<std::int32_t>(t)};
-        o.cell_of[g] = b.dup_of[t] < 0;
-      }
-    });
+    std::vector<Loc> where(mesh_ ? n : 0);
     for (const Batch& b : batches)
       for (std::size_t t = 0; t < b.gen.size(); ++t)
         if (b.dup_of[t] >= 0) o.duplicates.emplace_back(b.gen[t], b.dup_of[t]);
     std::sort(o.duplicates.begin(), o.duplicates.end());
-    // Cells in generator-id order.
+    // Cells in generator-id order: when every point is a generator (no
+    // outside labels, none ignored) and none is a duplicate, cell g is
+    // generator g.
+    std::size_t generators = 0;
+    for (const Batch& b : batches) generators += b.gen.size();
+    const bool dense = o.duplicates.empty() && generators == n;
+    o.cell_of.assign(n, dense ? 1 : 0);
+    if (mesh_ || !dense)
+      tbb::parallel_for(std::size_t(0), batches.size(), [&](std::size_t k) {
+        const Batch& b = batches[k];
+        for (std::size_t t = 0; t < b.gen.size(); ++t) {
+          const auto g = static_cast<std::size_t>(b.gen[t]);
+          if (mesh_) where[g] = {static_cast<std::int32_t>(k), static_cast<std::int32_t>(t)};
+          o.cell_of[g] = b.dup_of[t] < 0;
+        }
+      });
     std::int32_t nc = 0;
     for (std::size_t g = 0; g < n; ++g) o.cell_of[g] = o.cell_of[g] ? nc++ : -1;
     const std::size_t ncell = static_cast<std::size_t>(nc);
+    // Generators come in bin order, so their cells' fields land all over
+    // the output: the loops below fetch a cell's destinations some
+    // generators ahead (and, with duplicates, its cell index before that).
+    auto cell_at = [&](std::int32_t g) { return dense ? g : o.cell_of[static_cast<std::size_t>(g)]; };
+    auto ahead = [&](const Batch& b, std::size_t t, auto&& fetch) {
+      if (!dense && t + 2 * prefetch_ahead < b.gen.size())
+        __builtin_prefetch(&o.cell_of[static_cast<std::size_t>(b.gen[t + 2 * prefetch_ahead])]);
+      if (t + prefetch_ahead < b.gen.size()) {
+        const std::int32_t c = cell_at(b.gen[t + prefetch_ahead]);
+        if (c >= 0) fetch(static_cast<std::size_t>(c));
+      }
+    };
     o.generator.resize(ncell);
     o.region.resize(ncell);
     o.volume.resize(ncell);
@@ -138,16 +157,32 @@ class CellsCompositor {
       return std::pair<std::uint32_t, std::uint32_t>(lo, ends[t]);
     };
 
-    // Pass 1: fixed-size fields and counts.
+    // Pass 1: fixed-size fields and counts. Without duplicates the
+    // generator and region columns are the identity and the labels, in order.
+    if (dense)
+      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, ncell), [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t c = r.begin(); c != r.end(); ++c) {
+          o.generator[c] = static_cast<std::int32_t>(c);
+          o.region[c] = labels_at(static_cast<std::int32_t>(c));
+        }
+      });
     tbb::parallel_for(std::size_t(0), batches.size(), [&](std::size_t k) {
       const Batch& b = batches[k];
       for (std::size_t t = 0; t < b.gen.size(); ++t) {
+        ahead(b, t, [&](std::size_t c) {
+          __builtin_prefetch(&o.volume[c], 1);
+          __builtin_prefetch(&o.centroid[c * D], 1);
+          __builtin_prefetch(&o.num_faces[c], 1);
+          __builtin_prefetch(&o.neighbor_offsets[c + 1], 1);
+        });
         std::int32_t g = b.gen[t];
-        std::int32_t c = o.cell_of[static_cast<std::size_t>(g)];
+        std::int32_t c = cell_at(g);
         if (c < 0) continue;
         std::size_t cu = static_cast<std::size_t>(c);
-        o.generator[cu] = g;
-        o.region[cu] = labels_at(g);
+        if (!dense) {
+          o.generator[cu] = g;
+          o.region[cu] = labels_at(g);
+        }
         o.volume[cu] = b.volume[t];
         for (int d = 0; d < D; ++d) o.centroid[cu * D + d] = b.centroid[t * D + d];
         o.num_faces[cu] = b.num_faces[t];
@@ -167,8 +202,13 @@ class CellsCompositor {
     tbb::parallel_for(std::size_t(0), batches.size(), [&](std::size_t k) {
       const Batch& b = batches[k];
       for (std::size_t t = 0; t < b.gen.size(); ++t) {
-        std::int32_t c = o.cell_of[static_cast<std::size_t>(b.gen[t])];
+        ahead(b, t, [&](std::size_t c) { __builtin_prefetch(&o.neighbor_offsets[c]); });
+        std::int32_t c = cell_at(b.gen[t]);
         if (c < 0) continue;
+        if (t + prefetch_ahead / 2 < b.gen.size()) {
+          const std::int32_t c2 = cell_at(b.gen[t + prefetch_ahead / 2]);
+          if (c2 >= 0) __builtin_prefetch(o.neighbors.data() + o.neighbor_offsets[static_cast<std::size_t>(c2)], 1);
+        }
         auto [n0, n1] = range_of(b.nbr_end, t);
         std::copy(b.nbrs.begin() + n0, b.nbrs.begin() + n1,
                   o.neighbors.begin() + o.neighbor_offsets[static_cast<std::size_t>(c)]);
@@ -178,6 +218,8 @@ class CellsCompositor {
   }
 
  private:
+  static constexpr std::size_t prefetch_ahead = 8;  // generators (finish)
+
   std::int32_t labels_at(std::int32_t g) const { return labels_.empty() ? 0 : labels_[static_cast<std::size_t>(g)]; }
 
   // The lowest generator of the key that owns a cell owns the merged vertex.

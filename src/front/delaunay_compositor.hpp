@@ -170,7 +170,14 @@ class DelaunayCompositor {
     rows.resize(static_cast<std::size_t>(offset[n_]) * (D + 1));
     tbb::parallel_for(std::size_t(0), kept_.size(), [&](std::size_t k) {
       const Kept& b = kept_[k];
-      for (std::size_t t = 0; t < b.gen.size(); ++t) {
+      const std::size_t m = b.gen.size();
+      for (std::size_t t = 0; t < m; ++t) {
+        // Generators come in bin order, so their rows land all over the
+        // output (and their offsets all over the table): fetch both ahead,
+        // the offset first, the rows once their offset has arrived.
+        if (t + 2 * prefetch_ahead < m) __builtin_prefetch(&offset[static_cast<std::size_t>(b.gen[t + 2 * prefetch_ahead])]);
+        if (t + prefetch_ahead < m)
+          __builtin_prefetch(rows.data() + static_cast<std::size_t>(offset[static_cast<std::size_t>(b.gen[t + prefetch_ahead])]) * (D + 1), 1);
         const auto g = static_cast<std::size_t>(b.gen[t]);
         std::int32_t* o = rows.data() + static_cast<std::size_t>(offset[g]) * (D + 1);
         const Simplex* s = b.simplices.data() + (t == 0 ? 0 : b.simplex_end[t - 1]);
@@ -188,6 +195,8 @@ class DelaunayCompositor {
   }
 
  private:
+  static constexpr std::size_t prefetch_ahead = 8;  // generators (write)
+
   // Append the pending rows to b.simplices ascending by key, oriented. All
   // share row[0] (the generator), so the key is (row[1], row[2]) packed in
   // 62 bits, then row[D]. A cell emits a handful (~7 in 3D), so each row's
