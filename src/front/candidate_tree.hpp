@@ -79,9 +79,10 @@ class CandidateTree {
         }
         continue;
       }
-      // Push the farther child first so the nearer one is searched first.
+      // Push the farther child first so the nearer one is searched first:
+      // the one on q.near's side of the split.
       const std::uint32_t l = nd.left, r = nd.left + 1;
-      const bool left_first = distance2(q.near, nodes_[l]) <= distance2(q.near, nodes_[r]);
+      const bool left_first = q.near[nd.axis] <= nd.split;
       stack[top++] = left_first ? r : l;
       stack[top++] = left_first ? l : r;
     }
@@ -92,6 +93,8 @@ class CandidateTree {
     double lo[D], hi[D];
     std::uint32_t begin, end;
     std::uint32_t left = 0;  // children at left, left+1; 0 for a leaf
+    std::uint32_t axis = 0;  // inner nodes: the left child holds the points at or below `split` on `axis`
+    double split = 0;
   };
   static constexpr std::uint32_t kLeaf = 8;
 
@@ -142,6 +145,8 @@ class CandidateTree {
         }
         std::copy(ids.begin(), ids.end(), ids_.begin() + nd.begin);
         std::copy(pts.begin(), pts.end(), pts_.begin() + nd.begin);
+        nd.axis = static_cast<std::uint32_t>(axis);
+        nd.split = pts_[mid][axis];  // the median: an order for the search, nothing more
         nd.left = static_cast<std::uint32_t>(nodes_.size());
         Node l{}, r{};
         l.begin = nd.begin;

@@ -128,7 +128,13 @@ class HullCompletion {
       pts[D] = corner;
       for (int k = 0; k < (1 << D); ++k) {
         for (int d = 0; d < D; ++d) corner[d] = (k >> d) & 1 ? hi[d] : lo[d];
-        if (side_of(corner, [&] { return kernels::orientation(D, pts); }) == -apex_side) return false;
+        // A corner at a facet vertex (a tight box holding it) is on the plane.
+        auto exact = [&] {
+          for (int v = 0; v < D; ++v)
+            if (std::equal(corner, corner + D, pts[v])) return 0;
+          return kernels::orientation(D, pts);
+        };
+        if (side_of(corner, exact) == -apex_side) return false;
       }
       return true;
     };
