@@ -199,29 +199,38 @@ class DelaunayCompositor {
 
   // Append the pending rows to b.simplices ascending by key, oriented. All
   // share row[0] (the generator), so the key is (row[1], row[2]) packed in
-  // 62 bits, then row[D]. A cell emits a handful (~7 in 3D), so each row's
+  // 64 bits, then row[D]. A cell emits a handful (~7 in 3D), so each row's
   // place is the count of rows below it: n^2 branch-free comparisons, which
-  // beat a sort's mispredicted branches at this size.
+  // beat a sort's mispredicted branches at this size (a rare larger set is
+  // sorted).
   void place_in_order(Batch& b) {
     const std::size_t m = b.pending.size();
     const std::size_t base = b.simplices.size();
     b.simplices.resize(base + m);
-    auto pack = [](const Simplex& r) {
-      return D == 3 ? (static_cast<std::uint64_t>(r[1]) << 31) | static_cast<std::uint64_t>(r[2])
-                    : static_cast<std::uint64_t>(r[1]);
-    };
-    for (std::size_t i = 0; i < m; ++i) {
-      const Pending& e = b.pending[i];
-      const std::uint64_t ki = pack(e.row);
-      std::size_t below = 0;
-      for (std::size_t j = 0; j < m; ++j) {
-        const std::uint64_t kj = pack(b.pending[j].row);
-        below += (kj < ki) | ((kj == ki) & (b.pending[j].row[D] < e.row[D]));
-      }
-      Simplex& r = b.simplices[base + below] = e.row;
-      if (e.sign < 0) std::swap(r[D - 1], r[D]);
-      b.flat += e.sign == 0;
+    if (m > max_ranked) {
+      std::sort(b.pending.begin(), b.pending.end(), [](const Pending& x, const Pending& y) { return x.row < y.row; });
+      for (std::size_t i = 0; i < m; ++i) place(b, base + i, b.pending[i]);
+      return;
     }
+    std::int64_t key[max_ranked];
+    std::int32_t last[max_ranked];
+    for (std::size_t j = 0; j < m; ++j) {
+      const Simplex& r = b.pending[j].row;
+      key[j] = D == 3 ? (static_cast<std::int64_t>(r[1]) << 32) | r[2] : r[1];
+      last[j] = r[D];
+    }
+    for (std::size_t i = 0; i < m; ++i) {
+      std::size_t below = 0;
+      for (std::size_t j = 0; j < m; ++j) below += (key[j] < key[i]) | ((key[j] == key[i]) & (last[j] < last[i]));
+      place(b, base + below, b.pending[i]);
+    }
+  }
+  static constexpr std::size_t max_ranked = 64;
+
+  void place(Batch& b, std::size_t at, const Pending& e) {
+    Simplex& r = b.simplices[at] = e.row;
+    if (e.sign < 0) std::swap(r[D - 1], r[D]);
+    b.flat += e.sign == 0;
   }
 
   // Queue the simplex {gen, ids} of vertex v, oriented: ascending ids, their
