@@ -134,6 +134,35 @@ TEST(Delaunay, RowsAreOrientedAndAscending) {
   }
 }
 
+// Point 0 at the centre of 300 points near a sphere: it is a vertex of
+// every simplex (about 600) and, as the lowest id, emits them all from one
+// cell, more than the compositor ranks (it sorts them).
+TEST(Delaunay, HubPointEmitsManySimplices) {
+  std::mt19937_64 rng(17);
+  std::normal_distribution<double> g(0.0, 1.0);
+  std::uniform_real_distribution<double> u(0.99, 1.01);
+  std::vector<double> p = {0.01, -0.02, 0.015};
+  for (int i = 0; i < 300; ++i) {
+    double x = g(rng), y = g(rng), z = g(rng);
+    const double r = u(rng) / std::sqrt(x * x + y * y + z * z);
+    p.insert(p.end(), {x * r, y * r, z * r});
+  }
+  tessera::Delaunay dt = run(p, 3);
+  EXPECT_EQ(as_set(dt), cgal_simplices(p, 3));
+  std::size_t hub = 0;
+  std::vector<std::vector<std::int32_t>> keys;
+  for (std::size_t s = 0; s < dt.n_simplices(); ++s) {
+    const std::int32_t* row = dt.simplices.data() + s * 4;
+    hub += row[0] == 0;
+    std::vector<std::int32_t> k(row, row + 4);
+    std::sort(k.begin(), k.end());
+    keys.push_back(k);
+  }
+  EXPECT_GT(hub, 500u);
+  EXPECT_TRUE(std::is_sorted(keys.begin(), keys.end()));
+  expect_valid(dt, p);
+}
+
 TEST(Delaunay, ThreadsGiveIdenticalOutput) {
   for (int dim : {2, 3}) {
     auto p = random_points(5000, dim, 11);
