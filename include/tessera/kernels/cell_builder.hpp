@@ -288,9 +288,11 @@ class CellBuilder {
     return flower_range_;
   }
 
-  /// The shell from which gathered candidates are screened by the support
-  /// bound before they are sorted (see screen). A uniform cell is final after
-  /// its second gather (shells 0-1, then 2) and never pays for it.
+  /// The shell from which a gather of more than screen_min candidates is
+  /// screened by the support bound before it is sorted (see screen). A
+  /// uniform cell is final after its second gather (shells 0-1, then 2),
+  /// which rarely holds that many: 24 cost 1.2% on uniform input, 96 no
+  /// better than 48.
   static constexpr int screen_from = 2;
   static constexpr std::size_t screen_min = 48;
 
