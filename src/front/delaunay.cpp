@@ -1,5 +1,6 @@
-// tessera::delaunay: the cells pass with the Delaunay compositor, hull
-// completion, and orientation of every simplex by the exact predicate.
+// tessera::delaunay: the cells pass with the Delaunay compositor (simplices
+// oriented by the cells' topology), hull completion (oriented by the exact
+// predicate), and one layout of both.
 #include "tessera/delaunay.hpp"
 
 #include <algorithm>
@@ -33,7 +34,7 @@ Delaunay run(std::span<const double> input, std::span<const std::int32_t> labels
   out.threads_used = pass.engine_options.threads;
 
   front::DelaunayPassResult<D> found;
-  front::DelaunayCompositor<CellT> comp(found, n, labels, complete, pass.exact);
+  front::DelaunayCompositor<CellT> comp(found, n, labels, complete);
   out.exact_predicate_calls = engine::tessellate<CellT>(pass.gens, comp, pass.engine_options);
   out.duplicates = std::move(found.duplicates);
   out.from_cells = found.found;
@@ -85,10 +86,10 @@ Delaunay run(std::span<const double> input, std::span<const std::int32_t> labels
   }
   out.from_hull_completion = added.size();
 
-  // Orient the completion's simplices as the compositor oriented the found
-  // ones (they stay in key order: a row's key is its ascending form), then
-  // lay out both lists in one pass.
-  std::size_t flat = found.flat;
+  // Orient the completion's simplices (they have no cell to read it from)
+  // by the exact predicate; they stay in key order, a row's key being its
+  // ascending form. Then lay out both lists in one pass.
+  std::size_t flat = 0;
   for (auto& row : added) {
     const int o = kernels::orientation(pass.exact, row.data());
     if (o < 0) std::swap(row[D - 1], row[D]);

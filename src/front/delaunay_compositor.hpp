@@ -11,11 +11,8 @@
 // reach the box (the only candidates for the missing simplices: a missing
 // circumcentre lies outside the box, inside the cells of all its generators).
 //
-// Each simplex is oriented as it is emitted: the cell's bisector normals are
-// the rounded differences the orientation filter works on, so the exact
-// predicate's coordinates are read only when the filter cannot decide.
-// Done afterwards over the whole list, the same test missed the cache on
-// nearly every point.
+// Each simplex is oriented as it is emitted, from the cell's topology alone
+// (emit): no predicate, no coordinates.
 #pragma once
 
 #include <algorithm>
@@ -29,7 +26,6 @@
 #include <tbb/parallel_for.h>
 
 #include "tessera/kernels/cell_builder.hpp"
-#include "tessera/kernels/delaunay_predicates.hpp"
 #include "tessera/kernels/exact_predicates.hpp"
 #include "tessera/kernels/hull.hpp"
 #include "tessera/kernels/tile.hpp"
@@ -58,7 +54,6 @@ std::array<std::int32_t, D + 1> simplex_key(const std::int32_t* row) {
 template <int D>
 struct DelaunayPassResult {
   std::size_t found = 0;                   ///< simplices the cells found
-  std::size_t flat = 0;                    ///< simplices of orientation 0 (must stay 0)
   std::vector<OpenFacet<D>> open;          ///< ascending
   std::vector<std::uint8_t> touches_box;   ///< per point (hull info only)
   std::vector<std::pair<std::int32_t, std::int32_t>> duplicates;
@@ -80,14 +75,13 @@ class DelaunayCompositor {
     std::vector<Simplex> simplices;
     std::vector<OpenFacet<D>> open;
     std::vector<std::int32_t> touches_box;
-    std::size_t flat = 0;
     std::vector<Pending> pending;  // scratch of add()
   };
 
   /// `hull_info`: also collect open facets and box-touching generators.
   DelaunayCompositor(DelaunayPassResult<D>& out, std::size_t n_points, std::span<const std::int32_t> labels,
-                     bool hull_info, const kernels::ExactContext& exact)
-      : out_(out), n_(n_points), labels_(labels), hull_info_(hull_info), exact_(exact) {}
+                     bool hull_info)
+      : out_(out), n_(n_points), labels_(labels), hull_info_(hull_info) {}
 
   void add(Batch& b, std::int32_t gen, const kernels::BuildStatus& st, CellT& cell) {
     b.gen.push_back(gen);
@@ -112,7 +106,7 @@ class DelaunayCompositor {
           bool inside = true;
           if (!labels_.empty())
             for (int k = 0; k < D; ++k) inside &= labels_[static_cast<std::size_t>(ids[k])] >= 0;
-          if (inside) emit(b, gen, ids, verts[t], planes);
+          if (inside) emit(b, gen, ids);
         }
         if (hull_info_ && touches && *std::min_element(ids.begin(), ids.end()) >= 0) open_facets(b, gen, cell, t);
       }
@@ -136,7 +130,6 @@ class DelaunayCompositor {
     for (std::size_t k = 0; k < batches.size(); ++k) {
       Batch& b = batches[k];
       out_.found += b.simplices.size();
-      out_.flat += b.flat;
       for (std::size_t t = 0; t < b.gen.size(); ++t)
         if (b.dup_of[t] >= 0) out_.duplicates.emplace_back(b.gen[t], b.dup_of[t]);
       kept_[k].gen = std::move(b.gen);
@@ -230,20 +223,24 @@ class DelaunayCompositor {
   void place(Batch& b, std::size_t at, const Pending& e) {
     Simplex& r = b.simplices[at] = e.row;
     if (e.sign < 0) std::swap(r[D - 1], r[D]);
-    b.flat += e.sign == 0;
   }
 
-  // Queue the simplex {gen, ids} of vertex v, oriented: ascending ids, their
-  // bisector normals alongside (a sorting network).
-  template <class Vertex, class Planes>
-  void emit(Batch& b, std::int32_t gen, std::array<std::int32_t, D> ids, const Vertex& v, const Planes& planes) {
-    std::array<const double*, D> normals;
-    for (int k = 0; k < D; ++k) normals[k] = planes[v.p[k]].n;  // = p_id - p_gen, rounded as orientation() rounds it
+  // Queue the simplex {gen, ids} of vertex v (ids in v's plane order),
+  // oriented. The cell keeps every vertex's planes counter-clockwise seen
+  // from outside (3D; in 2D the arriving edge's plane, then the leaving
+  // one's, around a counter-clockwise polygon), so their outward normals
+  // p_id - p_gen have a positive determinant: {gen, ids} in that order is
+  // positively oriented, exactly, by the cell's exact topology. The ids are
+  // sorted ascending and each swap flips the orientation. (A flat simplex
+  // cannot arise: its three bisectors would not meet in a vertex.)
+  void emit(Batch& b, std::int32_t gen, std::array<std::int32_t, D> ids) {
+    int sign = 1;
     auto order = [&](int a, int c) {
-      if (ids[c] < ids[a]) {
-        std::swap(ids[a], ids[c]);
-        std::swap(normals[a], normals[c]);
-      }
+      const bool swap = ids[c] < ids[a];
+      const std::int32_t lo = swap ? ids[c] : ids[a], hi = swap ? ids[a] : ids[c];
+      ids[a] = lo;
+      ids[c] = hi;
+      sign = swap ? -sign : sign;
     };
     order(0, 1);
     if constexpr (D == 3) {
@@ -253,8 +250,7 @@ class DelaunayCompositor {
     Pending& e = b.pending.emplace_back();
     e.row[0] = gen;
     std::copy(ids.begin(), ids.end(), e.row.begin() + 1);
-    e.sign = kernels::orientation_filter(D, normals.data());
-    if (e.sign == 0) e.sign = kernels::orientation(exact_, e.row.data());
+    e.sign = sign;
   }
 
   // Facets {gen, shared planes} of the found simplex at vertex t whose Voronoi
@@ -304,7 +300,6 @@ class DelaunayCompositor {
   std::size_t n_;
   std::span<const std::int32_t> labels_;
   bool hull_info_;
-  const kernels::ExactContext& exact_;
 };
 
 }  // namespace tessera::front
