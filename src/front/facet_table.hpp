@@ -27,7 +27,7 @@ class FacetTable {
   /// Add one simplex's hold on f; returns f's count after it.
   int bump(const Facet& f) {
     if (2 * (size_ + 1) > slots_.size()) rehash(2 * slots_.size());
-    Slot& s = find(f);
+    Slot& s = slots_[slot_of(f)];
     if (s.count == 0) {
       s.key = f;
       ++size_;
@@ -36,7 +36,7 @@ class FacetTable {
   }
 
   /// f's count (0: never added).
-  int count(const Facet& f) const { return const_cast<FacetTable*>(this)->find(f).count; }
+  int count(const Facet& f) const { return slots_[slot_of(f)].count; }
 
  private:
   struct Slot {
@@ -61,12 +61,13 @@ class FacetTable {
     return h;
   }
 
-  // The slot holding f, or the empty slot where it would go.
-  Slot& find(const Facet& f) {
+  // The slot holding f, or the empty slot where it would go (the table is
+  // never full, so there is one).
+  std::size_t slot_of(const Facet& f) const {
     const std::size_t mask = slots_.size() - 1;
     for (std::size_t k = hash(f) & mask;; k = (k + 1) & mask) {
-      Slot& s = slots_[k];
-      if (s.count == 0 || s.key == f) return s;
+      const Slot& s = slots_[k];
+      if (s.count == 0 || s.key == f) return k;
     }
   }
 
@@ -74,7 +75,7 @@ class FacetTable {
     std::vector<Slot> old(capacity);
     old.swap(slots_);
     for (const Slot& s : old)
-      if (s.count != 0) find(s.key) = s;
+      if (s.count != 0) slots_[slot_of(s.key)] = s;
   }
 
   std::vector<Slot> slots_;
