@@ -101,10 +101,9 @@ class CellsCompositor {
   void finish(std::span<Batch> batches) {
     Cells& o = out_;
     const std::size_t n = o.n_points;
-    // Where each generator's data sits: (batch, index in batch). Every
-    // generator lies in exactly one batch, so all batches write at once;
-    // cell_of first holds 1 for a generator with a cell.
-    // (`where` only for the mesh.)
+    // Where each generator's data sits (batch, index in batch), for the
+    // mesh only. Every generator lies in exactly one batch, so all batches
+    // write at once; cell_of first holds 1 for a generator with a cell.
     struct Loc { std::int32_t batch = -1, index = -1; };
     std::vector<Loc> where(mesh_ ? n : 0);
     for (const Batch& b : batches)

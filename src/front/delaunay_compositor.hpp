@@ -17,16 +17,13 @@
 
 #include <algorithm>
 #include <array>
-#include <climits>
 #include <cstdint>
-#include <numeric>
 #include <span>
 #include <vector>
 
 #include <tbb/parallel_for.h>
 
 #include "tessera/kernels/cell_builder.hpp"
-#include "tessera/kernels/exact_predicates.hpp"
 #include "tessera/kernels/hull.hpp"
 #include "tessera/kernels/tile.hpp"
 
@@ -99,16 +96,17 @@ class DelaunayCompositor {
       for (std::size_t t = 0; t < verts.size(); ++t) {
         std::array<std::int32_t, D> ids;
         for (int k = 0; k < D; ++k) ids[k] = planes[verts[t].p[k]].id;
+        const std::int32_t lowest = *std::min_element(ids.begin(), ids.end());
         // Ours to emit when every other generator has a higher id; box
         // planes have negative ids, so this also skips vertices on the box.
         // Three of a uniform cell's four vertices fail here.
-        if (*std::min_element(ids.begin(), ids.end()) > gen) {
+        if (lowest > gen) {
           bool inside = true;
           if (!labels_.empty())
             for (int k = 0; k < D; ++k) inside &= labels_[static_cast<std::size_t>(ids[k])] >= 0;
           if (inside) emit(b, gen, ids);
         }
-        if (hull_info_ && touches && *std::min_element(ids.begin(), ids.end()) >= 0) open_facets(b, gen, cell, t);
+        if (hull_info_ && touches && lowest >= 0) open_facets(b, gen, cell, t);
       }
       place_in_order(b);
       if (hull_info_ && touches) b.touches_box.push_back(gen);
