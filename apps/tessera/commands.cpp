@@ -189,7 +189,7 @@ namespace {
 
 /// Sum with Neumaier compensation: the volume check compares against the
 /// domain at ~1e-15, which plain summation of 1e6 terms can miss.
-double accurate_sum(const std::vector<double>& v) {
+double accurate_sum(std::span<const double> v) {
   double s = 0, c = 0;
   for (double x : v) {
     const double t = s + x;

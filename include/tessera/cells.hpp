@@ -15,6 +15,8 @@
 #include <string>
 #include <vector>
 
+#include "tessera/buffer.hpp"
+
 namespace tessera {
 
 /// Axis-aligned domain box. In 2D only the first two axes are used.
@@ -68,36 +70,36 @@ struct Cells {
   Bounds bounds;
 
   // ---- per cell (size n_cells, in generator-id order) ----
-  std::vector<std::int32_t> generator;   ///< generator id of each cell
-  std::vector<std::int32_t> region;      ///< its label (0 when no labels were given)
-  std::vector<double> volume;            ///< area in 2D
-  std::vector<double> centroid;          ///< n_cells * dim
-  std::vector<std::int32_t> num_faces;   ///< faces (3D) / edges (2D), box faces included
+  Buffer<std::int32_t> generator;   ///< generator id of each cell
+  Buffer<std::int32_t> region;      ///< its label (0 when no labels were given)
+  Buffer<double> volume;            ///< area in 2D
+  Buffer<double> centroid;          ///< n_cells * dim
+  Buffer<std::int32_t> num_faces;   ///< faces (3D) / edges (2D), box faces included
   /// Face neighbours of each cell as CSR: the generator ids across its faces,
   /// ascending; box faces are not listed (they are counted in num_faces).
-  std::vector<std::int64_t> neighbor_offsets;  ///< n_cells + 1
-  std::vector<std::int32_t> neighbors;
+  Buffer<std::int64_t> neighbor_offsets;  ///< n_cells + 1
+  Buffer<std::int32_t> neighbors;
 
   // ---- per generator (size n_points) ----
   std::vector<std::int32_t> cell_of;     ///< cell index or -1
 
   // ---- the conformal mesh (only with build_mesh) ----
   /// Merged vertices: one per topological coordinate.
-  std::vector<double> vertices;          ///< n_vertices * dim
+  Buffer<double> vertices;          ///< n_vertices * dim
   /// Topological coordinate of each vertex: dim+1 ids, ascending; domain-box
   /// planes are negative (-1-axis*2 for lo, -2-axis*2 for hi: x0=-1, x1=-2, y0=-3, ...).
-  std::vector<std::int32_t> vertex_keys; ///< n_vertices * (dim+1)
+  Buffer<std::int32_t> vertex_keys; ///< n_vertices * (dim+1)
   /// 3D: faces of each cell: cell_face_offsets (n_cells+1) into faces; each face
   /// has face_vertex_offsets (n_faces_total+1) into face_vertices (global vertex
   /// ids, counter-clockwise seen from outside the cell) and face_neighbor (the
   /// spoke: generator id, or the negative box-plane id).
   /// 2D: one face per edge; face_vertices holds the edge's two vertices (the
   /// polygon's vertices, counter-clockwise, are the first vertex of each edge in order).
-  std::vector<std::int64_t> cell_face_offsets;
-  std::vector<std::int64_t> face_vertex_offsets;
-  std::vector<std::int32_t> face_vertices;
-  std::vector<std::int32_t> face_neighbor;
-  std::vector<SpokeClass> face_class;
+  Buffer<std::int64_t> cell_face_offsets;
+  Buffer<std::int64_t> face_vertex_offsets;
+  Buffer<std::int32_t> face_vertices;
+  Buffer<std::int32_t> face_neighbor;
+  Buffer<SpokeClass> face_class;
 
   // ---- diagnostics ----
   /// Pairs (duplicate id, owner id): exactly coincident inputs; the lowest id owns the cell.

@@ -35,7 +35,7 @@ struct Delaunay {
   /// in ascending order of their sorted id tuples. 3D tets are positively
   /// oriented (det[p1-p0, p2-p0, p3-p0] > 0), 2D triangles counter-clockwise,
   /// decided by exact predicates.
-  std::vector<std::int32_t> simplices;
+  Buffer<std::int32_t> simplices;
   std::size_t from_cells = 0;              ///< simplices found by the cells pass
   std::size_t from_hull_completion = 0;    ///< simplices added by hull completion
   bool hull_completed = false;             ///< hull completion ran (no labels, complete_hull)

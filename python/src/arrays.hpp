@@ -39,21 +39,22 @@ py::array view(std::span<const T> data, std::initializer_list<py::ssize_t> shape
   return a;
 }
 
-template <class T>
-py::array view(const std::vector<T>& data, std::initializer_list<py::ssize_t> shape, py::handle owner) {
+template <class T, class A>
+py::array view(const std::vector<T, A>& data, std::initializer_list<py::ssize_t> shape, py::handle owner) {
   return view(std::span<const T>(data), shape, owner);
 }
 
+/// (Any allocator: the results' large arrays are tessera::Buffer.)
 /// Rows of `width` values: shape (size / width, width).
-template <class T>
-py::array view_rows(const std::vector<T>& data, std::size_t width, py::handle owner) {
+template <class T, class A>
+py::array view_rows(const std::vector<T, A>& data, std::size_t width, py::handle owner) {
   return view(std::span<const T>(data),
               {static_cast<py::ssize_t>(data.size() / width), static_cast<py::ssize_t>(width)}, owner);
 }
 
 /// One-dimensional view.
-template <class T>
-py::array view_flat(const std::vector<T>& data, py::handle owner) {
+template <class T, class A>
+py::array view_flat(const std::vector<T, A>& data, py::handle owner) {
   return view(std::span<const T>(data), {static_cast<py::ssize_t>(data.size())}, owner);
 }
 

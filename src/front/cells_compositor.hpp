@@ -7,6 +7,7 @@
 #include <atomic>
 #include <string>
 #include <cstdint>
+#include <cstring>
 #include <numeric>
 #include <span>
 #include <stdexcept>
@@ -35,9 +36,9 @@ class CellsCompositor {
     std::vector<std::int32_t> nbrs;
     // mesh
     std::vector<std::uint32_t> vert_end;    // running end into keys/pos, per generator
-    std::vector<Key<D>> keys;
-    std::vector<double> pos;                // absolute coordinates
-    std::vector<std::int32_t> vglobal;      // merged vertex id per local vertex
+    Buffer<Key<D>> keys;                    // (Buffers: resized, then written)
+    Buffer<double> pos;                     // absolute coordinates
+    Buffer<std::int32_t> vglobal;           // merged vertex id per local vertex
     std::vector<std::uint32_t> face_end;    // running end into faces, per generator
     std::vector<std::int32_t> face_nbr;
     std::vector<std::uint32_t> face_vend;   // running end into fverts, per face
@@ -89,9 +90,14 @@ class CellsCompositor {
     b.nbr_end.push_back(static_cast<std::uint32_t>(b.nbrs.size()));
     if (mesh_) {
       const auto& v = cell.vertices();
-      for (std::size_t t = 0; t < v.size(); ++t) {
-        b.keys.push_back(vertex_key(cell, t));
-        for (int d = 0; d < D; ++d) b.pos.push_back(v[t].y[d] + p[d]);
+      const std::size_t nv = v.size(), k0 = b.keys.size();
+      b.keys.resize(k0 + nv);
+      b.pos.resize((k0 + nv) * D);
+      Key<D>* key = b.keys.data() + k0;
+      double* pos = b.pos.data() + k0 * D;
+      for (std::size_t t = 0; t < nv; ++t) {
+        key[t] = vertex_key(cell, t);
+        for (int d = 0; d < D; ++d) pos[t * D + d] = v[t].y[d] + p[d];
       }
       b.vert_end.push_back(static_cast<std::uint32_t>(b.keys.size()));
       b.face_end.push_back(static_cast<std::uint32_t>(b.face_nbr.size()));
@@ -116,6 +122,7 @@ class CellsCompositor {
     std::size_t generators = 0;
     for (const Batch& b : batches) generators += b.gen.size();
     const bool dense = o.duplicates.empty() && generators == n;
+    dense_ = dense;
     o.cell_of.assign(n, dense ? 1 : 0);
     if (mesh_ || !dense)
       tbb::parallel_for(std::size_t(0), batches.size(), [&](std::size_t k) {
@@ -141,6 +148,8 @@ class CellsCompositor {
         if (c >= 0) fetch(static_cast<std::size_t>(c));
       }
     };
+    // Output Buffers are sized, not zeroed: pass 1 writes every cell's
+    // fields, the neighbour copy every entry.
     o.generator.resize(ncell);
     o.region.resize(ncell);
     o.volume.resize(ncell);
@@ -221,11 +230,27 @@ class CellsCompositor {
 
   std::int32_t labels_at(std::int32_t g) const { return labels_.empty() ? 0 : labels_[static_cast<std::size_t>(g)]; }
 
-  // The lowest generator of the key that owns a cell owns the merged vertex.
+  // The lowest generator of the key that owns a cell owns the merged vertex;
+  // when every generator owns one (dense_), that is the lowest of the key's
+  // generators (keys ascend, box planes first), read without a lookup.
   std::int32_t owner(const Key<D>& key) const {
     for (std::int32_t id : key)
-      if (id >= 0 && out_.cell_of[static_cast<std::size_t>(id)] >= 0) return id;
+      if (id >= 0 && (dense_ || out_.cell_of[static_cast<std::size_t>(id)] >= 0)) return id;
     return -1;
+  }
+
+  // Key equality as two or three wide compares: std::array's == calls memcmp.
+  static bool same_key(const Key<D>& a, const Key<D>& b) {
+    if constexpr (D == 3) {
+      std::uint64_t a0, a1, b0, b1;
+      std::memcpy(&a0, a.data(), 8);
+      std::memcpy(&a1, a.data() + 2, 8);
+      std::memcpy(&b0, b.data(), 8);
+      std::memcpy(&b1, b.data() + 2, 8);
+      return ((a0 ^ b0) | (a1 ^ b1)) == 0;
+    } else {
+      return ((a[0] ^ b[0]) | (a[1] ^ b[1]) | (a[2] ^ b[2])) == 0;
+    }
   }
 
   template <class Where>
@@ -283,7 +308,7 @@ class CellsCompositor {
           std::uint32_t o0 = ot == 0 ? 0 : ob.vert_end[ot - 1], o1 = ob.vert_end[ot];
           std::int32_t found = -1;
           for (std::uint32_t u = o0; u < o1; ++u)
-            if (ob.keys[u] == b.keys[v]) { found = ob.vglobal[u]; break; }
+            if (same_key(ob.keys[u], b.keys[v])) { found = ob.vglobal[u]; break; }
           if (found < 0) misses.fetch_add(1, std::memory_order_relaxed);
           b.vglobal[v] = found;
         }
@@ -296,7 +321,11 @@ class CellsCompositor {
     std::partial_sum(o.cell_face_offsets.begin(), o.cell_face_offsets.end(), o.cell_face_offsets.begin());
     std::partial_sum(fcv.begin(), fcv.end(), fcv.begin());
     const std::size_t nfaces = static_cast<std::size_t>(o.cell_face_offsets.back());
-    o.face_vertex_offsets.assign(nfaces + 1, 0);
+    // Buffers: sized, not zeroed; the loop below writes every element
+    // (each face its entries and its end offset), first-touching the pages
+    // on both threads.
+    o.face_vertex_offsets.resize(nfaces + 1);
+    o.face_vertex_offsets[0] = 0;
     o.face_vertices.resize(static_cast<std::size_t>(fcv.back()));
     o.face_neighbor.resize(nfaces);
     o.face_class.resize(nfaces);
@@ -325,6 +354,7 @@ class CellsCompositor {
   std::span<const std::int32_t> labels_;
   engine::RegionClassifier classify_;
   bool mesh_;
+  bool dense_ = false;  // set by finish: every generator owns a cell, cell g = generator g
 };
 
 }  // namespace tessera::front

@@ -150,7 +150,7 @@ class DelaunayCompositor {
   /// extra, hold it as their lowest id and come ascending, so laying them out
   /// in generator order sorts the whole list; generators are written in
   /// parallel, straight into their final place.
-  void write(const std::vector<Simplex>& extra, std::vector<std::int32_t>& rows) {
+  void write(const std::vector<Simplex>& extra, Buffer<std::int32_t>& rows) {
     std::vector<std::int64_t> offset(n_ + 1, 0);
     std::vector<std::uint32_t> extra_begin(n_ + 1, 0);
     for (const Simplex& s : extra) ++extra_begin[static_cast<std::size_t>(*std::min_element(s.begin(), s.end())) + 1];
@@ -158,7 +158,7 @@ class DelaunayCompositor {
       extra_begin[g + 1] += extra_begin[g];
       offset[g + 1] = offset[g] + count_[g] + (extra_begin[g + 1] - extra_begin[g]);
     }
-    rows.resize(static_cast<std::size_t>(offset[n_]) * (D + 1));
+    rows.resize(static_cast<std::size_t>(offset[n_]) * (D + 1));  // every row is written below
     tbb::parallel_for(std::size_t(0), kept_.size(), [&](std::size_t k) {
       const Kept& b = kept_[k];
       const std::size_t m = b.gen.size();

@@ -140,7 +140,7 @@ void check_mesh(const Cells& c) {
   if (c.region.size() != nc || c.volume.size() != nc || c.num_faces.size() != nc ||
       c.neighbor_offsets.size() != nc + 1)
     fail("per-cell arrays have inconsistent sizes");
-  auto monotone = [](const std::vector<std::int64_t>& o) {
+  auto monotone = [](std::span<const std::int64_t> o) {
     if (o.empty() || o.front() != 0) return false;
     for (std::size_t i = 1; i < o.size(); ++i)
       if (o[i] < o[i - 1]) return false;
