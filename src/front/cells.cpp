@@ -47,7 +47,10 @@ Cells run(std::span<const double> input, std::span<const std::int32_t> labels, c
   out.ignored_outside_bounds = pass.ignored_outside;
   out.threads_used = pass.engine_options.threads;
 
-  front::CellsCompositor<CellT> comp(out, labels, opt.build_mesh);
+  // Without coincident points, a merged vertex's owner is known while its
+  // cell is added, and only owners keep its position (CellsCompositor).
+  const bool owners_known = opt.build_mesh && !pass.locator->may_have_coincident();
+  front::CellsCompositor<CellT> comp(out, labels, opt.build_mesh, owners_known);
   out.exact_predicate_calls = engine::tessellate<CellT>(pass.gens, comp, pass.engine_options);
   std::sort(out.duplicates.begin(), out.duplicates.end());
   if (pass.k != 0) {

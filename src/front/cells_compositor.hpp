@@ -37,7 +37,8 @@ class CellsCompositor {
     // mesh
     std::vector<std::uint32_t> vert_end;    // running end into keys/pos, per generator
     Buffer<Key<D>> keys;                    // (Buffers: resized, then written)
-    Buffer<double> pos;                     // absolute coordinates
+    Buffer<double> pos;                     // absolute coordinates: every vertex's, or the owned ones'
+    std::vector<std::uint32_t> pos_end;     // running end into pos (in vertices), per generator
     Buffer<std::int32_t> vglobal;           // merged vertex id per local vertex
     std::vector<std::uint32_t> face_end;    // running end into faces, per generator
     std::vector<std::int32_t> face_nbr;
@@ -45,8 +46,13 @@ class CellsCompositor {
     std::vector<std::uint32_t> fverts;      // local vertex index (within the cell)
   };
 
-  CellsCompositor(Cells& out, std::span<const std::int32_t> labels, bool mesh)
-      : out_(out), labels_(labels), classify_(labels), mesh_(mesh) {}
+  /// `owners_known`: no two generators coincide, so a merged vertex's owner
+  /// (the lowest generator of its key that owns a cell) is the lowest inside
+  /// generator of its key, known when the cell is added; only the owner then
+  /// keeps the vertex's position (a quarter of them: 3D vertices are shared
+  /// by four cells). Otherwise every cell keeps all its positions.
+  CellsCompositor(Cells& out, std::span<const std::int32_t> labels, bool mesh, bool owners_known = false)
+      : out_(out), labels_(labels), classify_(labels), mesh_(mesh), owners_known_(owners_known) {}
 
   void add(Batch& b, std::int32_t gen, const kernels::BuildStatus& st, CellT& cell) {
     b.gen.push_back(gen);
@@ -58,6 +64,7 @@ class CellsCompositor {
       b.nbr_end.push_back(static_cast<std::uint32_t>(b.nbrs.size()));
       if (mesh_) {
         b.vert_end.push_back(static_cast<std::uint32_t>(b.keys.size()));
+        b.pos_end.push_back(static_cast<std::uint32_t>(b.pos.size() / D));
         b.face_end.push_back(static_cast<std::uint32_t>(b.face_nbr.size()));
       }
       return;
@@ -90,16 +97,20 @@ class CellsCompositor {
     b.nbr_end.push_back(static_cast<std::uint32_t>(b.nbrs.size()));
     if (mesh_) {
       const auto& v = cell.vertices();
-      const std::size_t nv = v.size(), k0 = b.keys.size();
+      const std::size_t nv = v.size(), k0 = b.keys.size(), p0 = b.pos.size() / D;
       b.keys.resize(k0 + nv);
-      b.pos.resize((k0 + nv) * D);
+      b.pos.resize((p0 + nv) * D);  // at most; trimmed below
       Key<D>* key = b.keys.data() + k0;
-      double* pos = b.pos.data() + k0 * D;
+      double* pos = b.pos.data() + p0 * D;
+      std::size_t kept = 0;
       for (std::size_t t = 0; t < nv; ++t) {
         key[t] = vertex_key(cell, t);
-        for (int d = 0; d < D; ++d) pos[t * D + d] = v[t].y[d] + p[d];
+        for (int d = 0; d < D; ++d) pos[kept * D + d] = v[t].y[d] + p[d];
+        kept += !owners_known_ || first_inside(key[t]) == gen;
       }
+      b.pos.resize((p0 + kept) * D);
       b.vert_end.push_back(static_cast<std::uint32_t>(b.keys.size()));
+      b.pos_end.push_back(static_cast<std::uint32_t>(p0 + kept));
       b.face_end.push_back(static_cast<std::uint32_t>(b.face_nbr.size()));
     }
   }
@@ -239,6 +250,14 @@ class CellsCompositor {
     return -1;
   }
 
+  // The key's lowest inside generator (label >= 0): its owner when no
+  // generators coincide.
+  std::int32_t first_inside(const Key<D>& key) const {
+    for (std::int32_t id : key)
+      if (id >= 0 && labels_at(id) >= 0) return id;
+    return -1;
+  }
+
   // Key equality as two or three wide compares: std::array's == calls memcmp.
   static bool same_key(const Key<D>& a, const Key<D>& b) {
     if constexpr (D == 3) {
@@ -272,25 +291,34 @@ class CellsCompositor {
       }
     });
     std::partial_sum(owned.begin(), owned.end(), owned.begin());
+    if (owners_known_ && !o.duplicates.empty())
+      throw std::logic_error("tessera: coincident generators were missed before the cells pass");
     const std::size_t nverts = static_cast<std::size_t>(owned.back());
     o.vertices.resize(nverts * D);
     o.vertex_keys.resize(nverts * (D + 1));
+    std::atomic<bool> unowned{false};  // owners_known_ was wrong about a vertex
     tbb::parallel_for(std::size_t(0), batches.size(), [&](std::size_t k) {
       Batch& b = batches[k];
       for (std::size_t t = 0; t < b.gen.size(); ++t) {
         std::int32_t c = o.cell_of[static_cast<std::size_t>(b.gen[t])];
         if (c < 0) continue;
         std::uint32_t v0 = t == 0 ? 0 : b.vert_end[t - 1], v1 = b.vert_end[t];
+        std::uint32_t pv = t == 0 ? 0 : b.pos_end[t - 1];  // the owned positions, in vertex order
         std::int64_t next = owned[static_cast<std::size_t>(c)];
         for (std::uint32_t v = v0; v < v1; ++v) {
           if (owner(b.keys[v]) != b.gen[t]) continue;
           std::size_t gid = static_cast<std::size_t>(next++);
           b.vglobal[v] = static_cast<std::int32_t>(gid);
-          for (int d = 0; d < D; ++d) o.vertices[gid * D + d] = b.pos[static_cast<std::size_t>(v) * D + d];
+          const std::size_t src = owners_known_ ? pv++ : v;
+          if (src >= b.pos.size() / D) break;  // (reported below)
+          for (int d = 0; d < D; ++d) o.vertices[gid * D + d] = b.pos[src * D + d];
           for (int d = 0; d <= D; ++d) o.vertex_keys[gid * (D + 1) + d] = b.keys[v][static_cast<std::size_t>(d)];
         }
+        if (owners_known_ && pv != b.pos_end[t]) unowned.store(true, std::memory_order_relaxed);
       }
     });
+    if (unowned.load())
+      throw std::logic_error("tessera: a cell kept positions for other than its owned vertices");
     // Vertices owned elsewhere: found by key in the owner's cell. A miss means
     // two cells disagree about a vertex, which exact predicates rule out.
     std::atomic<std::size_t> misses{0};
@@ -354,6 +382,7 @@ class CellsCompositor {
   std::span<const std::int32_t> labels_;
   engine::RegionClassifier classify_;
   bool mesh_;
+  bool owners_known_;
   bool dense_ = false;  // set by finish: every generator owns a cell, cell g = generator g
 };
 

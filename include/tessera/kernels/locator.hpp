@@ -218,6 +218,20 @@ class BinLocator {
         });
   }
 
+  /// Whether two located points may coincide exactly. Coincident points
+  /// share a bin, so each bin's points are compared pairwise; a bin of more
+  /// than `crowded` points answers true unchecked (a conservative "may").
+  bool may_have_coincident(std::uint32_t crowded = 64) const {
+    for (std::size_t k = 0; k + 1 < offsets_.size(); ++k) {
+      const std::uint32_t a = offsets_[k], e = offsets_[k + 1];
+      if (e - a > crowded) return true;
+      for (std::uint32_t i = a; i < e; ++i)
+        for (std::uint32_t j = i + 1; j < e; ++j)
+          if (sorted_[i] == sorted_[j]) return true;
+    }
+    return false;
+  }
+
   std::size_t num_bins() const { return offsets_.size() - 1; }
   double min_bin_size() const { return min_size_; }
   std::size_t size() const { return ids_.size(); }
