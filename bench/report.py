@@ -290,6 +290,30 @@ def report(meta, data):
               f"{fr(div(med(s), med(b)))} | {fr(div(med(a), med(b)))} | {frate(per_core(a))} | {fb(bpp(a))} | {fb(bpp(s))} |")
         w("")
 
+    dm = {k: v for k, v in data.items() if any(o in ("voronoi3_mesh", "voronoi2_mesh") for (_, o, _) in v)}
+    if dm:
+        w("## Cells with the merged mesh (`--mesh`, MESH=1)")
+        w("")
+        w("What VTK output computes (`tessera voronoi INPUT -o FILE.vtu`, the README's main job): the cells "
+          "above plus their conformal mesh, vertices merged by topological coordinate (timed without writing "
+          "the file). Mesh / cells = seconds with the mesh / seconds without, same thread count. Voro++ / "
+          "Tessera = Voro++ seconds (3D: its cells, each with its own vertex list, no merged mesh) / Tessera "
+          "seconds with the mesh.")
+        w("")
+        w(f"| input | points | Tessera {t1}T s | Tessera {t2}T s | mesh / cells {t1}T | mesh / cells {t2}T | "
+          f"Voro++ / Tessera {t2}T | Tessera {t1}T peak B/pt | Tessera {t2}T peak B/pt |")
+        w("|---|---:|---:|---:|---:|---:|---:|---:|---:|")
+        for name, grp in dm.items():
+            op = "voronoi3_mesh" if g(grp, "tessera", "voronoi3_mesh") else "voronoi2_mesh"
+            cells = op[:-len("_mesh")]
+            a, b = g(grp, "tessera", op, t1), g(grp, "tessera", op, t2)
+            ca, cb = g(grp, "tessera", cells, t1), g(grp, "tessera", cells, t2)
+            v = g(grp, "voro++", "voronoi3") if op == "voronoi3_mesh" else None
+            n = (a or b).n
+            w(f"| {name} | {fn(n)} | {fm(a)} | {fm(b)} | {fr(div(med(a), med(ca)))} | {fr(div(med(b), med(cb)))} | "
+              f"{fr(div(med(v), med(b)))} | {fb(bpp(a))} | {fb(bpp(b))} |")
+        w("")
+
     if dd:
         delaunay_section(w, meta, dd, g, t1, t2)
 
