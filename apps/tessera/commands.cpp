@@ -249,7 +249,14 @@ void print_summary(const VoronoiArgs& a, const io::PointCloud& pc, const Cells& 
   print_volume_line(c, d3 ? "volume sum" : "area sum");
   std::printf("  %-18s %.3f s on %d thread%s (read %.3f s, write %.3f s)\n", "compute", compute_s,
               c.threads_used, c.threads_used == 1 ? "" : "s", read_s, write_s);
-  std::printf("  %-18s %llu\n", "exact predicates", static_cast<unsigned long long>(c.exact_predicate_calls));
+  // Lattices tie often but cheaply (tens of exact calls per cell, on the
+  // integer path); thousands per cell mean a many-fold near-degenerate vertex
+  // (points on one sphere: docs/design.md, known limits), each call costly.
+  const bool tie_heavy = c.exact_predicate_calls > 1000 * static_cast<std::uint64_t>(c.n_cells());
+  std::printf("  %-18s %llu%s\n", "exact predicates", static_cast<unsigned long long>(c.exact_predicate_calls),
+              tie_heavy ? " (over 1000 per cell: near-degenerate input, e.g. points on one sphere; "
+                          "`tessera joggle` removes such ties)"
+                        : "");
   std::string out;
   for (const auto& w : written) out += (out.empty() ? "" : ", ") + w;
   std::printf("  %-18s %s\n", "wrote", out.empty() ? "(nothing)" : out.c_str());

@@ -308,6 +308,18 @@ class Voronoi3D(TempDirCase):
         self.assertNotIn(17, gid)
         self.assertAlmostEqual(vtk_to_numpy(cell_array(g, "Volume")).sum(), 1.0, delta=1e-9)
 
+    def test_tie_heavy_input_hint(self):
+        # Points normalized onto one sphere tie (to rounding) at its centre:
+        # thousands of exact calls per cell, which the summary points out
+        # along with the remedy; ordinary input gets no such remark.
+        v = np.random.default_rng(5).normal(size=(200, 3))
+        v /= np.linalg.norm(v, axis=1)[:, None]
+        r = self.ok(["voronoi", self.save("sphere.npy", v), "-o", self.p("s.vtu")])
+        self.assertIn("over 1000 per cell", r.stdout)
+        self.assertIn("tessera joggle", r.stdout)
+        r = self.ok(["voronoi", self.inp, "-o", self.p("u.vtu")])
+        self.assertNotIn("over 1000 per cell", r.stdout)
+
     def test_labels(self):
         labels = np.random.default_rng(5).integers(-1, 3, self.N).astype(np.int32)
         lab = self.save("labels.npy", labels)
