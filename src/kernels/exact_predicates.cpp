@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <bit>
 #include <climits>
+#include <limits>
 #include <cmath>
 #include <stdexcept>
 
@@ -522,6 +523,72 @@ void exact_vertex(const ExactContext& ctx, std::int32_t i, const std::int32_t* p
 int lowest_bit_exponent(double x) {
   const DoubleParts p = double_parts(x);
   return p.e2 + std::countr_zero(static_cast<std::uint64_t>(p.mant < 0 ? -p.mant : p.mant));
+}
+
+// ---- ExtendedPredicate (see the header for the bound) ----
+
+namespace {
+using Ext = long double;
+static_assert(std::numeric_limits<Ext>::digits == 64, "ExtendedPredicate assumes x87 extended precision");
+// gamma_24 = 24 u / (1 - 24 u), u = 2^-64, doubled to spare (and to cover the
+// rounding of the absolute-value sums themselves).
+constexpr Ext kExtBound = 2 * (24 * 0x1p-64L) / (1 - 24 * 0x1p-64L);
+
+// a x b, and the same on absolute values (each product's magnitude summed).
+void cross_ext(const Ext* a, const Ext* b, Ext* out, Ext* out_abs) {
+  out[0] = a[1] * b[2] - a[2] * b[1];
+  out[1] = a[2] * b[0] - a[0] * b[2];
+  out[2] = a[0] * b[1] - a[1] * b[0];
+  out_abs[0] = fabsl(a[1] * b[2]) + fabsl(a[2] * b[1]);
+  out_abs[1] = fabsl(a[2] * b[0]) + fabsl(a[0] * b[2]);
+  out_abs[2] = fabsl(a[0] * b[1]) + fabsl(a[1] * b[0]);
+}
+}  // namespace
+
+bool ExtendedPredicate::prepare(const ExactContext& ctx, std::int32_t i, const std::int32_t* planes) {
+  if (ctx.dim != 3) return false;
+  for (int r = 0; r < 3; ++r)
+    if (planes[r] < 0) return false;
+  const double* pi = ctx.points + static_cast<std::size_t>(i) * 3;
+  for (int d = 0; d < 3; ++d) pi_[d] = pi[d];
+  Ext q[3][3], s[3];
+  for (int r = 0; r < 3; ++r) {
+    const double* pk = ctx.points + static_cast<std::size_t>(planes[r]) * 3;
+    for (int d = 0; d < 3; ++d) q[r][d] = static_cast<Ext>(pk[d]) - pi_[d];
+    s[r] = q[r][0] * q[r][0] + q[r][1] * q[r][1] + q[r][2] * q[r][2];
+  }
+  Ext x12[3], x02[3], x01[3], a12[3], a02[3], a01[3];
+  cross_ext(q[1], q[2], x12, a12);
+  cross_ext(q[0], q[2], x02, a02);
+  cross_ext(q[0], q[1], x01, a01);
+  Ext d3 = 0;
+  d3_abs_ = 0;
+  for (int d = 0; d < 3; ++d) {
+    w_[d] = -s[0] * x12[d] + s[1] * x02[d] - s[2] * x01[d];
+    w_abs_[d] = s[0] * a12[d] + s[1] * a02[d] + s[2] * a01[d];
+    d3 += q[0][d] * x12[d];
+    d3_abs_ += fabsl(q[0][d]) * a12[d];
+  }
+  if (!(fabsl(d3) > kExtBound * d3_abs_)) return false;  // D3's sign uncertain (or NaN)
+  d3_ = d3;
+  d3_positive_ = d3 > 0;
+  return true;
+}
+
+int ExtendedPredicate::sign(const ExactContext& ctx, std::int32_t j) const {
+  const double* pj = ctx.points + static_cast<std::size_t>(j) * 3;
+  Ext dot = 0, perm = 0, sj = 0;
+  for (int d = 0; d < 3; ++d) {
+    const Ext qj = static_cast<Ext>(pj[d]) - pi_[d];
+    sj += qj * qj;
+    dot += w_[d] * qj;
+    perm += w_abs_[d] * fabsl(qj);
+  }
+  const Ext d4 = dot + d3_ * sj;
+  perm += d3_abs_ * sj;
+  if (!(fabsl(d4) > kExtBound * perm)) return 0;
+  // sign(P) = sign(D4) sign(D3); P > 0 keeps the vertex.
+  return (d4 > 0) == d3_positive_ ? +1 : -1;
 }
 
 }  // namespace tessera::kernels

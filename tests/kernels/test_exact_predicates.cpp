@@ -202,10 +202,23 @@ int prepared_sign(const ExactContext& c, std::int32_t i, const std::int32_t* pla
   return vp.sign(c, j);
 }
 
-/// Kernel vs oracle for one query; returns the kernel's sign.
+/// The extended-precision stage's sign, 0 when it is unusable or undecided
+/// (counted in extended_decided when it answers).
+int extended_decided = 0;
+int extended_sign(const ExactContext& c, std::int32_t i, const std::int32_t* planes, std::int32_t j) {
+  tessera::kernels::ExtendedPredicate ep;
+  if (!ep.prepare(c, i, planes)) return 0;
+  const int s = ep.sign(c, j);
+  extended_decided += s != 0;
+  return s;
+}
+
+/// Kernel vs oracle for one query; returns the kernel's sign. The extended
+/// stage, where it answers, must answer the same.
 int check_sign(const ExactContext& c, std::int32_t i, const std::int32_t* planes, std::int32_t j) {
   const int got = exact_clip_sign(c, i, planes, j);
   EXPECT_EQ(prepared_sign(c, i, planes, j), got) << "prepared: " << describe(c, i, planes, j);
+  if (const int e = extended_sign(c, i, planes, j); e != 0) EXPECT_EQ(e, got) << "extended: " << describe(c, i, planes, j);
   const int want = oracle_sign(c, i, planes, j);
   EXPECT_NE(want, 0) << "oracle: every perturbation coefficient vanished for " << describe(c, i, planes, j);
   EXPECT_EQ(got, want) << describe(c, i, planes, j) << "  P0 = " << power_diff(c, i, planes, j).get_d();
@@ -228,6 +241,8 @@ int check_views(const ExactContext& c, const std::array<std::int32_t, 4>& defs, 
     do {
       const int s = exact_clip_sign(c, defs[g], others.data(), j);
       EXPECT_EQ(prepared_sign(c, defs[g], others.data(), j), s) << "prepared: " << describe(c, defs[g], others.data(), j);
+      if (const int e = extended_sign(c, defs[g], others.data(), j); e != 0)
+        EXPECT_EQ(e, s) << "extended: " << describe(c, defs[g], others.data(), j);
       EXPECT_TRUE(s == 1 || s == -1) << describe(c, defs[g], others.data(), j);
       EXPECT_EQ(s, want) << describe(c, defs[g], others.data(), j);
       if (first == 0) first = s;
@@ -405,6 +420,64 @@ void near_ties(int dim, std::uint64_t seed) {
   EXPECT_GT(pos, 50);
   EXPECT_GT(neg, 50);
   (void)zero;
+}
+
+// Points normalized onto the unit sphere (cospherical up to rounding), at
+// two scales and offsets: every query is a near-tie the float filter cannot
+// decide. The extended stage must agree with the rational oracle whenever it
+// answers, and answer nearly always (it is what makes such input fast); on
+// exactly cospherical integer points (the lattice tests) it must defer.
+TEST(ExactPredicates, ExtendedStageOnSpherePoints) {
+  Rng r(41);
+  const double setups[][2] = {{1, 0}, {1e-3, 1e3}, {1e5, -3e5}};
+  int asked = 0, decided_before = extended_decided;
+  for (const auto& st : setups) {
+    Problem p;
+    p.dim = 3;
+    for (int d = 0; d < 3; ++d) {
+      p.lo[d] = st[1] - 2 * st[0];
+      p.hi[d] = st[1] + 2 * st[0];
+    }
+    std::normal_distribution<double> gauss;
+    for (int k = 0; k < 60; ++k) {
+      double v[3] = {gauss(r.g), gauss(r.g), gauss(r.g)};
+      const double len = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+      p.add({st[1] + st[0] * (v[0] / len), st[1] + st[0] * (v[1] / len), st[1] + st[0] * (v[2] / len)});
+    }
+    const auto c = p.ctx();
+    for (int t = 0; t < 400; ++t) {
+      std::int32_t ids[5];
+      for (int k = 0; k < 5; ++k) {
+        bool fresh;
+        do {
+          ids[k] = r.index(p.size());
+          fresh = std::find(ids, ids + k, ids[k]) == ids + k;
+        } while (!fresh);
+      }
+      const Ids planes{ids[1], ids[2], ids[3]};
+      if (!independent(c, ids[0], planes.data())) continue;
+      ++asked;
+      check_sign(c, ids[0], planes.data(), ids[4]);
+    }
+  }
+  const int decided = extended_decided - decided_before;
+  EXPECT_GT(asked, 1000);
+  EXPECT_GT(decided, asked * 9 / 10) << "the extended stage decided " << decided << " of " << asked;
+}
+
+TEST(ExactPredicates, ExtendedStageDefersOnExactTies) {
+  // Exactly cospherical: (0,0,0), e_x, e_y, e_z and (1,1,1) lie on one sphere.
+  Problem p;
+  p.dim = 3;
+  p.lo = {-1, -1, -1};
+  p.hi = {2, 2, 2};
+  for (const auto& x : {std::array<double, 3>{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {1, 1, 1}}) p.add(x);
+  const Ids planes{1, 2, 3};
+  tessera::kernels::ExtendedPredicate ep;
+  ASSERT_TRUE(ep.prepare(p.ctx(), 0, planes.data()));
+  EXPECT_EQ(ep.sign(p.ctx(), 4), 0);
+  EXPECT_EQ(power_diff(p.ctx(), 0, planes.data(), 4), 0);
+  check_sign(p.ctx(), 0, planes.data(), 4);
 }
 
 TEST(ExactPredicates, NearTies2D) { near_ties(2, 21); }

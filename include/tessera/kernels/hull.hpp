@@ -268,8 +268,12 @@ class Hull {
       pr.cell = cells_;
       for (int k = 0; k < 3; ++k) pr.p[k] = v.p[k];
       pr.usable = pr.pred.prepare(*exact_, gen_, ids);
+      pr.extended = !pr.usable && pr.ext.prepare(*exact_, gen_, ids);
     }
-    return pr.usable ? pr.pred.sign(*exact_, j) : exact_clip_sign(*exact_, gen_, ids, j);
+    if (pr.usable) return pr.pred.sign(*exact_, j);
+    if (pr.extended)
+      if (const int s = pr.ext.sign(*exact_, j); s != 0) return s;
+    return exact_clip_sign(*exact_, gen_, ids, j);
   }
 
   // Every change to the vertex list goes through these, which keep the sign
@@ -376,11 +380,15 @@ class Hull {
   // Per vertex slot: its prepared exact predicate, valid while the slot holds
   // the same planes in the same cell (a cell's local plane indices only grow,
   // and a removed vertex never returns).
+  // Off the integer grid, the extended-precision stage comes first
+  // (ExtendedPredicate) and GMP decides what it cannot.
   struct Prepared {
     std::uint64_t cell = 0;
     std::uint16_t p[3] = {0, 0, 0};
-    bool usable = false;
+    bool usable = false;    // pred: the integer-grid path
+    bool extended = false;  // ext
     VertexPredicate pred;
+    ExtendedPredicate ext;
   };
   std::vector<Prepared> prepared_;
   std::uint64_t cells_ = 0;  // cells started by reset (prepared_'s epoch)
