@@ -546,7 +546,9 @@ void cross_ext(const Ext* a, const Ext* b, Ext* out, Ext* out_abs) {
 }  // namespace
 
 bool ExtendedPredicate::prepare(const ExactContext& ctx, std::int32_t i, const std::int32_t* planes) {
-  if (ctx.dim != 3) return false;
+  dim_ = ctx.dim;
+  if (dim_ == 2) return prepare2(ctx, i, planes);
+  if (dim_ != 3) return false;
   for (int r = 0; r < 3; ++r)
     if (planes[r] < 0) return false;
   const double* pi = ctx.points + static_cast<std::size_t>(i) * 3;
@@ -575,10 +577,36 @@ bool ExtendedPredicate::prepare(const ExactContext& ctx, std::int32_t i, const s
   return true;
 }
 
+// 2D: D2 = q_0 x q_1 and W = (s_1 q_0y - s_0 q_1y, s_0 q_1x - s_1 q_0x), from
+// the expansion of det[[q_0, s_0], [q_1, s_1], [q_j, s_j]] along its last
+// column; degree-4 monomials, well within the same bound.
+bool ExtendedPredicate::prepare2(const ExactContext& ctx, std::int32_t i, const std::int32_t* planes) {
+  for (int r = 0; r < 2; ++r)
+    if (planes[r] < 0) return false;
+  const double* pi = ctx.points + static_cast<std::size_t>(i) * 2;
+  for (int d = 0; d < 2; ++d) pi_[d] = pi[d];
+  Ext q[2][2], s[2];
+  for (int r = 0; r < 2; ++r) {
+    const double* pk = ctx.points + static_cast<std::size_t>(planes[r]) * 2;
+    for (int d = 0; d < 2; ++d) q[r][d] = static_cast<Ext>(pk[d]) - pi_[d];
+    s[r] = q[r][0] * q[r][0] + q[r][1] * q[r][1];
+  }
+  w_[0] = s[1] * q[0][1] - s[0] * q[1][1];
+  w_[1] = s[0] * q[1][0] - s[1] * q[0][0];
+  w_abs_[0] = s[1] * fabsl(q[0][1]) + s[0] * fabsl(q[1][1]);
+  w_abs_[1] = s[0] * fabsl(q[1][0]) + s[1] * fabsl(q[0][0]);
+  const Ext d2 = q[0][0] * q[1][1] - q[0][1] * q[1][0];
+  d3_abs_ = fabsl(q[0][0] * q[1][1]) + fabsl(q[0][1] * q[1][0]);
+  if (!(fabsl(d2) > kExtBound * d3_abs_)) return false;
+  d3_ = d2;
+  d3_positive_ = d2 > 0;
+  return true;
+}
+
 int ExtendedPredicate::sign(const ExactContext& ctx, std::int32_t j) const {
-  const double* pj = ctx.points + static_cast<std::size_t>(j) * 3;
+  const double* pj = ctx.points + static_cast<std::size_t>(j) * dim_;
   Ext dot = 0, perm = 0, sj = 0;
-  for (int d = 0; d < 3; ++d) {
+  for (int d = 0; d < dim_; ++d) {
     const Ext qj = static_cast<Ext>(pj[d]) - pi_[d];
     sj += qj * qj;
     dot += w_[d] * qj;

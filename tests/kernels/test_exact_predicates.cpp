@@ -427,43 +427,47 @@ void near_ties(int dim, std::uint64_t seed) {
 // decide. The extended stage must agree with the rational oracle whenever it
 // answers, and answer nearly always (it is what makes such input fast); on
 // exactly cospherical integer points (the lattice tests) it must defer.
-TEST(ExactPredicates, ExtendedStageOnSpherePoints) {
-  Rng r(41);
+void extended_on_sphere_points(int dim, std::uint64_t seed) {
+  Rng r(seed);
   const double setups[][2] = {{1, 0}, {1e-3, 1e3}, {1e5, -3e5}};
   int asked = 0, decided_before = extended_decided;
   for (const auto& st : setups) {
     Problem p;
-    p.dim = 3;
+    p.dim = dim;
     for (int d = 0; d < 3; ++d) {
       p.lo[d] = st[1] - 2 * st[0];
       p.hi[d] = st[1] + 2 * st[0];
     }
     std::normal_distribution<double> gauss;
     for (int k = 0; k < 60; ++k) {
-      double v[3] = {gauss(r.g), gauss(r.g), gauss(r.g)};
+      double v[3] = {gauss(r.g), gauss(r.g), dim == 3 ? gauss(r.g) : 0.0};
       const double len = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
       p.add({st[1] + st[0] * (v[0] / len), st[1] + st[0] * (v[1] / len), st[1] + st[0] * (v[2] / len)});
     }
     const auto c = p.ctx();
     for (int t = 0; t < 400; ++t) {
       std::int32_t ids[5];
-      for (int k = 0; k < 5; ++k) {
+      for (int k = 0; k < dim + 2; ++k) {
         bool fresh;
         do {
           ids[k] = r.index(p.size());
           fresh = std::find(ids, ids + k, ids[k]) == ids + k;
         } while (!fresh);
       }
-      const Ids planes{ids[1], ids[2], ids[3]};
+      Ids planes{};
+      for (int k = 0; k < dim; ++k) planes[k] = ids[1 + k];
       if (!independent(c, ids[0], planes.data())) continue;
       ++asked;
-      check_sign(c, ids[0], planes.data(), ids[4]);
+      check_sign(c, ids[0], planes.data(), ids[dim + 1]);
     }
   }
   const int decided = extended_decided - decided_before;
   EXPECT_GT(asked, 1000);
   EXPECT_GT(decided, asked * 9 / 10) << "the extended stage decided " << decided << " of " << asked;
 }
+
+TEST(ExactPredicates, ExtendedStageOnSpherePoints) { extended_on_sphere_points(3, 41); }
+TEST(ExactPredicates, ExtendedStageOnCirclePoints) { extended_on_sphere_points(2, 42); }
 
 TEST(ExactPredicates, ExtendedStageDefersOnExactTies) {
   // Exactly cospherical: (0,0,0), e_x, e_y, e_z and (1,1,1) lie on one sphere.

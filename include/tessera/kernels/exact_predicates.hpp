@@ -202,18 +202,21 @@ class VertexPredicate {
 /// the ~1.5 µs of the GMP path.
 class ExtendedPredicate {
  public:
-  /// Prepare for the vertex of cell i where the bisectors with planes[0..3)
-  /// meet; false (unusable) in 2D, with a box plane, or when D3's sign is
-  /// not certain.
+  /// Prepare for the vertex of cell i where the bisectors with planes[0..dim)
+  /// meet; false (unusable) with a box plane, or when D3's sign is not
+  /// certain. 2D likewise: D2 = q_0 x q_1, W = (s_1 q_0y - s_0 q_1y,
+  /// s_0 q_1x - s_1 q_0x), D = W . q_j + D2 s_j.
   bool prepare(const ExactContext& ctx, std::int32_t i, const std::int32_t* planes);
   /// exact_clip_sign(ctx, i, planes, j) when certain, else 0.
   int sign(const ExactContext& ctx, std::int32_t j) const;
 
  private:
+  bool prepare2(const ExactContext& ctx, std::int32_t i, const std::int32_t* planes);
   using L = long double;
+  int dim_ = 3;
   L pi_[3] = {0, 0, 0};
   L w_[3] = {0, 0, 0}, w_abs_[3] = {0, 0, 0};  // W, and W on absolute values
-  L d3_ = 0, d3_abs_ = 0;                     // D3, and on absolute values
+  L d3_ = 0, d3_abs_ = 0;                     // D3 (2D: D2), and on absolute values
   bool d3_positive_ = false;
 };
 

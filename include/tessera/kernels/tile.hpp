@@ -167,8 +167,12 @@ class Tile {
       pr.p[0] = v.p[0];
       pr.p[1] = v.p[1];
       pr.usable = pr.pred.prepare(*exact_, gen_, ids);
+      pr.extended = !pr.usable && pr.ext.prepare(*exact_, gen_, ids);
     }
-    return pr.usable ? pr.pred.sign(*exact_, j) : exact_clip_sign(*exact_, gen_, ids, j);
+    if (pr.usable) return pr.pred.sign(*exact_, j);
+    if (pr.extended)
+      if (const int s = pr.ext.sign(*exact_, j); s != 0) return s;
+    return exact_clip_sign(*exact_, gen_, ids, j);
   }
 
   // verts_ and its sign-pass mirror (lanes_) change together.
@@ -230,7 +234,9 @@ class Tile {
     std::uint64_t cell = 0;
     std::uint16_t p[2] = {0, 0};
     bool usable = false;
+    bool extended = false;
     VertexPredicate pred;
+    ExtendedPredicate ext;
   };
   std::vector<Prepared> prepared_;
   std::uint64_t cells_ = 0;
