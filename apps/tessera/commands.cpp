@@ -251,7 +251,7 @@ void print_summary(const VoronoiArgs& a, const io::PointCloud& pc, const Cells& 
               c.threads_used, c.threads_used == 1 ? "" : "s", read_s, write_s);
   // Lattices tie often but cheaply (tens of exact calls per cell, on the
   // integer path); thousands per cell mean a many-fold near-degenerate vertex
-  // (points on one sphere: docs/design.md, known limits), each call costly.
+  // (points on one sphere: docs/design.md, known limits): quadratic work.
   const bool tie_heavy = c.exact_predicate_calls > 1000 * static_cast<std::uint64_t>(c.n_cells());
   std::printf("  %-18s %llu%s\n", "exact predicates", static_cast<unsigned long long>(c.exact_predicate_calls),
               tie_heavy ? " (over 1000 per cell: near-degenerate input, e.g. points on one sphere; "
