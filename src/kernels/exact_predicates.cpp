@@ -529,7 +529,10 @@ int lowest_bit_exponent(double x) {
 
 namespace {
 using Ext = long double;
-static_assert(std::numeric_limits<Ext>::digits == 64, "ExtendedPredicate assumes x87 extended precision");
+// The bound below takes each operation's relative error as at most 2^-64:
+// true of x87 extended (64-bit mantissa, Linux's default precision control)
+// and of IEEE quad. Where long double is narrower, the stage stays unused.
+constexpr bool kExtUsable = std::numeric_limits<Ext>::digits >= 64;
 // gamma_24 = 24 u / (1 - 24 u), u = 2^-64, doubled to spare (and to cover the
 // rounding of the absolute-value sums themselves).
 constexpr Ext kExtBound = 2 * (24 * 0x1p-64L) / (1 - 24 * 0x1p-64L);
@@ -547,6 +550,7 @@ void cross_ext(const Ext* a, const Ext* b, Ext* out, Ext* out_abs) {
 
 bool ExtendedPredicate::prepare(const ExactContext& ctx, std::int32_t i, const std::int32_t* planes) {
   dim_ = ctx.dim;
+  if (!kExtUsable) return false;
   if (dim_ == 2) return prepare2(ctx, i, planes);
   if (dim_ != 3) return false;
   for (int r = 0; r < 3; ++r)
