@@ -546,23 +546,31 @@ void cross_ext(const Ext* a, const Ext* b, Ext* out, Ext* out_abs) {
   out_abs[1] = fabsl(a[2] * b[0]) + fabsl(a[0] * b[2]);
   out_abs[2] = fabsl(a[0] * b[1]) + fabsl(a[1] * b[0]);
 }
+// The rows of a vertex of D bisectors: p_i into pi, q_r = p_{planes[r]} - p_i
+// and s_r = |q_r|^2. False when a plane is a box plane.
+template <int D>
+bool bisector_rows(const ExactContext& ctx, std::int32_t i, const std::int32_t* planes, Ext* pi, Ext (*q)[3], Ext* s) {
+  for (int r = 0; r < D; ++r)
+    if (planes[r] < 0) return false;
+  for (int d = 0; d < D; ++d) pi[d] = ctx.points[static_cast<std::size_t>(i) * D + d];
+  for (int r = 0; r < D; ++r) {
+    const double* pk = ctx.points + static_cast<std::size_t>(planes[r]) * D;
+    s[r] = 0;
+    for (int d = 0; d < D; ++d) {
+      q[r][d] = static_cast<Ext>(pk[d]) - pi[d];
+      s[r] += q[r][d] * q[r][d];
+    }
+  }
+  return true;
+}
 }  // namespace
 
 bool ExtendedPredicate::prepare(const ExactContext& ctx, std::int32_t i, const std::int32_t* planes) {
   dim_ = ctx.dim;
   if (!kExtUsable) return false;
   if (dim_ == 2) return prepare2(ctx, i, planes);
-  if (dim_ != 3) return false;
-  for (int r = 0; r < 3; ++r)
-    if (planes[r] < 0) return false;
-  const double* pi = ctx.points + static_cast<std::size_t>(i) * 3;
-  for (int d = 0; d < 3; ++d) pi_[d] = pi[d];
   Ext q[3][3], s[3];
-  for (int r = 0; r < 3; ++r) {
-    const double* pk = ctx.points + static_cast<std::size_t>(planes[r]) * 3;
-    for (int d = 0; d < 3; ++d) q[r][d] = static_cast<Ext>(pk[d]) - pi_[d];
-    s[r] = q[r][0] * q[r][0] + q[r][1] * q[r][1] + q[r][2] * q[r][2];
-  }
+  if (dim_ != 3 || !bisector_rows<3>(ctx, i, planes, pi_, q, s)) return false;
   Ext x12[3], x02[3], x01[3], a12[3], a02[3], a01[3];
   cross_ext(q[1], q[2], x12, a12);
   cross_ext(q[0], q[2], x02, a02);
@@ -585,16 +593,8 @@ bool ExtendedPredicate::prepare(const ExactContext& ctx, std::int32_t i, const s
 // the expansion of det[[q_0, s_0], [q_1, s_1], [q_j, s_j]] along its last
 // column; degree-4 monomials, well within the same bound.
 bool ExtendedPredicate::prepare2(const ExactContext& ctx, std::int32_t i, const std::int32_t* planes) {
-  for (int r = 0; r < 2; ++r)
-    if (planes[r] < 0) return false;
-  const double* pi = ctx.points + static_cast<std::size_t>(i) * 2;
-  for (int d = 0; d < 2; ++d) pi_[d] = pi[d];
-  Ext q[2][2], s[2];
-  for (int r = 0; r < 2; ++r) {
-    const double* pk = ctx.points + static_cast<std::size_t>(planes[r]) * 2;
-    for (int d = 0; d < 2; ++d) q[r][d] = static_cast<Ext>(pk[d]) - pi_[d];
-    s[r] = q[r][0] * q[r][0] + q[r][1] * q[r][1];
-  }
+  Ext q[3][3], s[3];
+  if (!bisector_rows<2>(ctx, i, planes, pi_, q, s)) return false;
   w_[0] = s[1] * q[0][1] - s[0] * q[1][1];
   w_[1] = s[0] * q[1][0] - s[1] * q[0][0];
   w_abs_[0] = s[1] * fabsl(q[0][1]) + s[0] * fabsl(q[1][1]);
