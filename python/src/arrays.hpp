@@ -39,12 +39,13 @@ py::array view(std::span<const T> data, std::initializer_list<py::ssize_t> shape
   return a;
 }
 
+/// Over any std::vector, whatever its allocator: the results' large arrays
+/// are tessera::Buffer.
 template <class T, class A>
 py::array view(const std::vector<T, A>& data, std::initializer_list<py::ssize_t> shape, py::handle owner) {
   return view(std::span<const T>(data), shape, owner);
 }
 
-/// (Any allocator: the results' large arrays are tessera::Buffer.)
 /// Rows of `width` values: shape (size / width, width).
 template <class T, class A>
 py::array view_rows(const std::vector<T, A>& data, std::size_t width, py::handle owner) {

@@ -132,8 +132,8 @@ class CellsCompositor {
     // generator g.
     std::size_t generators = 0;
     for (const Batch& b : batches) generators += b.gen.size();
-    const bool dense = o.duplicates.empty() && generators == n;
-    dense_ = dense;
+    dense_ = o.duplicates.empty() && generators == n;
+    const bool dense = dense_;
     o.cell_of.assign(n, dense ? 1 : 0);
     if (mesh_ || !dense)
       tbb::parallel_for(std::size_t(0), batches.size(), [&](std::size_t k) {
@@ -245,16 +245,21 @@ class CellsCompositor {
   // when every generator owns one (dense_), that is the lowest of the key's
   // generators (keys ascend, box planes first), read without a lookup.
   std::int32_t owner(const Key<D>& key) const {
-    for (std::int32_t id : key)
-      if (id >= 0 && (dense_ || out_.cell_of[static_cast<std::size_t>(id)] >= 0)) return id;
-    return -1;
+    return lowest_generator(key, [&](std::int32_t id) { return dense_ || out_.cell_of[static_cast<std::size_t>(id)] >= 0; });
   }
 
   // The key's lowest inside generator (label >= 0): its owner when no
   // generators coincide.
   std::int32_t first_inside(const Key<D>& key) const {
+    return lowest_generator(key, [&](std::int32_t id) { return labels_at(id) >= 0; });
+  }
+
+  // The key's lowest generator (ids ascend, box planes first) that passes
+  // `take`; -1 when none does.
+  template <class Take>
+  static std::int32_t lowest_generator(const Key<D>& key, Take&& take) {
     for (std::int32_t id : key)
-      if (id >= 0 && labels_at(id) >= 0) return id;
+      if (id >= 0 && take(id)) return id;
     return -1;
   }
 
