@@ -1,0 +1,64 @@
+#!/usr/bin/python3
+"""Strongly clustered 3D point sets, harder than gen_points.py's clustered3.
+
+Usage: gen_clustered.py KIND N OUT.npy [--seed S]
+
+Kinds (float64, shape (N, 3); about the unit cube, a few blob and hierarchy
+points a little outside it):
+  blobs  90% of the points in sqrt(N)/4 Gaussian blobs of sigma 1e-3..5e-3,
+         10% uniform background (cosmology-like halos in a void).
+  sheet  80% in a thin sheet z = 0.5 + N(0, 1e-3), 20% uniform background
+         (a wall or a fracture surface).
+  hier   a Soneira-Peebles hierarchy: 6 levels, 6 children per point, each
+         level's radius 1/1.9 of the one above (fractal clustering; the
+         surplus points are dropped, a shortfall filled uniformly).
+"""
+import argparse
+
+import numpy as np
+
+
+def blobs(rng, n):
+    c = max(1, int(np.sqrt(n) / 4))
+    centres = rng.random((c, 3))
+    sigma = rng.uniform(1e-3, 5e-3, c)
+    m = int(0.9 * n)
+    lab = rng.integers(0, c, m)
+    return np.vstack([centres[lab] + rng.normal(size=(m, 3)) * sigma[lab, None], rng.random((n - m, 3))])
+
+
+def sheet(rng, n):
+    m = int(0.8 * n)
+    q = rng.random((m, 3))
+    q[:, 2] = 0.5 + rng.normal(size=m) * 1e-3
+    return np.vstack([q, rng.random((n - m, 3))])
+
+
+def hier(rng, n, levels=6, children=6, ratio=1.9):
+    pts = np.array([[0.5, 0.5, 0.5]])
+    r = 0.5
+    for _ in range(levels):
+        r /= ratio
+        d = rng.normal(size=(len(pts) * children, 3))
+        d /= np.linalg.norm(d, axis=1)[:, None]
+        d *= (rng.random(len(d)) ** (1 / 3) * r)[:, None]
+        pts = np.repeat(pts, children, axis=0) + d
+    pts = pts[rng.permutation(len(pts))][:n]
+    return np.vstack([pts, rng.random((max(0, n - len(pts)), 3))])
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("kind", choices=["blobs", "sheet", "hier"])
+    ap.add_argument("n", type=float)
+    ap.add_argument("out")
+    ap.add_argument("--seed", type=int, default=7)
+    a = ap.parse_args()
+    rng = np.random.default_rng(a.seed)
+    n = int(a.n)
+    p = {"blobs": blobs, "sheet": sheet, "hier": hier}[a.kind](rng, n)
+    np.save(a.out, np.ascontiguousarray(p, dtype="<f8"))
+
+
+if __name__ == "__main__":
+    main()

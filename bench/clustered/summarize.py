@@ -1,0 +1,54 @@
+#!/usr/bin/python3
+"""Markdown tables (medians over repeats) of bench/clustered/run.sh's .jsonl.
+
+Usage: summarize.py RESULTS.jsonl
+"""
+import json
+import statistics
+import sys
+from collections import defaultdict
+
+
+def main():
+    runs = defaultdict(list)
+    inputs = []
+    with open(sys.argv[1]) as f:
+        for line in f:
+            if line.strip():
+                d = json.loads(line)
+                runs[(d["input"], d["tool"], d["op"])].append(d)
+                if d["input"] not in inputs:
+                    inputs.append(d["input"])
+
+    def med(key):
+        rs = runs.get(key)
+        return statistics.median(r["seconds"] for r in rs) if rs else None
+
+    def fmt(x):
+        return "-" if x is None else "%.3f" % x
+
+    def ratio(peer, ours):
+        return "-" if peer is None or ours is None else "%.2fx" % (peer / ours)
+
+    print("Seconds (wall, median). Ratio = peer seconds / Tessera seconds (> 1: Tessera faster).\n")
+    print("| input | points | Tessera cells | Voro++ cells (1 thread) | Voro++ / Tessera | Tessera Delaunay | "
+          "CGAL | HXT | CGAL / Tessera | HXT / Tessera | simplices (Tessera / CGAL / HXT) |")
+    print("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|")
+    for i in inputs:
+        cells = med((i, "tessera", "voronoi3"))
+        voro = med((i, "voro++", "voronoi3"))
+        dt = med((i, "tessera", "delaunay3"))
+        cgal = med((i, "cgal", "delaunay3"))
+        hxt = next((med(k) for k in runs if k[0] == i and k[1].startswith("gmsh")), None)
+        n = next(r["n"] for k, rs in runs.items() if k[0] == i for r in rs)
+        simp = []
+        for tool in ("tessera", "cgal", "gmsh"):
+            rs = [r for k, v in runs.items() if k[0] == i and k[1].startswith(tool) and k[2] == "delaunay3" for r in v]
+            simp.append(format(rs[0]["simplices"], ",") if rs else "-")
+        print("| %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s |" % (
+            i, format(n, ","), fmt(cells), fmt(voro), ratio(voro, cells), fmt(dt), fmt(cgal), fmt(hxt),
+            ratio(cgal, dt), ratio(hxt, dt), " / ".join(simp)))
+
+
+if __name__ == "__main__":
+    main()
