@@ -122,6 +122,12 @@ Cells voronoi(std::span<const double> points, int dim, std::span<const std::int3
 struct ValidationReport {
   bool ok = true;
   double volume_sum = 0, domain_volume = 0, volume_rel_error = 0;
+  /// False when the volumes are outside double's range at this scale (the
+  /// domain's volume, or a cell's share of it, overflows or underflows, as
+  /// with coordinates near 1e-120 or 1e120): the volume checks are skipped.
+  /// The cells were computed in a rescaled frame; only their volumes in the
+  /// input's units cannot be represented.
+  bool volumes_checked = true;
   std::size_t asymmetric_spokes = 0;      ///< i lists j but j does not list i (both inside)
   std::size_t bad_vertex_degree = 0;      ///< merged vertices not shared by exactly the cells of their key
   std::size_t bad_euler = 0;              ///< cells with V - E + F != 2 (3D)

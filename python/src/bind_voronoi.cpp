@@ -49,6 +49,7 @@ void bind_voronoi(py::module_& m) {
       .def_readonly("volume_sum", &ValidationReport::volume_sum)
       .def_readonly("domain_volume", &ValidationReport::domain_volume)
       .def_readonly("volume_rel_error", &ValidationReport::volume_rel_error)
+      .def_readonly("volumes_checked", &ValidationReport::volumes_checked)
       .def_readonly("asymmetric_spokes", &ValidationReport::asymmetric_spokes)
       .def_readonly("bad_vertex_degree", &ValidationReport::bad_vertex_degree)
       .def_readonly("bad_euler", &ValidationReport::bad_euler)

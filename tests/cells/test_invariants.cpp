@@ -492,4 +492,55 @@ TEST(Invariants, ThreadCountDoesNotChangeResult) {
   same_for_threads(3, pts, labels, "3D labelled with duplicates");
 }
 
+// Coordinates near 2^±410 (1e∓124) and 2^±500: the pass computes in a frame
+// rescaled by a power of two, so the cells are those of the unit-scale
+// points exactly, while their volumes in the input's units fall outside
+// double's range. The validator then skips the volume checks (and says so)
+// rather than failing on volumes a double cannot hold, and still checks the
+// topology; at unit scale it checks the volumes as before.
+TEST(Invariants, ExtremeScalesKeepTopologyAndSkipUnrepresentableVolumes) {
+  for (int dim : {2, 3}) {
+    const auto unit = random_points(400, dim, 611);
+    const tessera::Cells u = run(unit, dim);
+    const tessera::ValidationReport ru = tessera::validate(u, {});
+    EXPECT_TRUE(ru.ok);
+    EXPECT_TRUE(ru.volumes_checked);
+    for (int e : {-410, 410, -500, 500}) {
+      std::vector<double> p(unit);
+      for (double& x : p) x = std::ldexp(x, e);
+      const tessera::Cells c = run(p, dim);
+      const tessera::ValidationReport r = tessera::validate(c, {});
+      for (const auto& m : r.messages) ADD_FAILURE() << "dim " << dim << " 2^" << e << ": " << m;
+      EXPECT_TRUE(r.ok) << "dim " << dim << " 2^" << e;
+      // 2^(±410 dim) is within double's range in 2D (±820) but not in 3D (±1230).
+      EXPECT_EQ(r.volumes_checked, dim == 2 && (e == -410 || e == 410)) << "dim " << dim << " 2^" << e;
+      EXPECT_EQ(c.neighbors, u.neighbors) << "dim " << dim << " 2^" << e;
+      EXPECT_EQ(c.neighbor_offsets, u.neighbor_offsets) << "dim " << dim << " 2^" << e;
+      EXPECT_EQ(c.num_faces, u.num_faces) << "dim " << dim << " 2^" << e;
+    }
+  }
+}
+
+// Across the range computed without rescaling (|x| within 2^±200), the
+// cells are those of the unit-scale points, bit for bit in their topology:
+// every decision is exact and scaling by a power of two changes none. The
+// candidates' sort keys once held r2 as a float, which overflowed past
+// coordinates of 2^64 and underflowed below 2^-63: the stop rule then
+// skipped nearer candidates (wrong cells, caught only by the mesh merge).
+TEST(Invariants, PowerOfTwoScalesGiveTheSameCells) {
+  for (int dim : {2, 3}) {
+    const auto unit = random_points(300, dim, 612);
+    const tessera::Cells u = run(unit, dim);
+    for (int e : {-199, -150, -90, -70, -40, 40, 66, 70, 90, 150, 199}) {
+      std::vector<double> p(unit);
+      for (double& x : p) x = std::ldexp(x, e);
+      const tessera::Cells c = run(p, dim);
+      EXPECT_TRUE(tessera::validate(c, {}).ok) << "dim " << dim << " 2^" << e;
+      EXPECT_EQ(c.neighbors, u.neighbors) << "dim " << dim << " 2^" << e;
+      EXPECT_EQ(c.neighbor_offsets, u.neighbor_offsets) << "dim " << dim << " 2^" << e;
+      EXPECT_EQ(c.face_vertices, u.face_vertices) << "dim " << dim << " 2^" << e;
+    }
+  }
+}
+
 }  // namespace

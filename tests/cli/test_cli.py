@@ -320,6 +320,18 @@ class Voronoi3D(TempDirCase):
         r = self.ok(["voronoi", self.inp, "-o", self.p("u.vtu")])
         self.assertNotIn("over 1000 per cell", r.stdout)
 
+    def test_extreme_scale_validates(self):
+        # Coordinates near 1e-124: the cells are exact, but their volumes
+        # (~1e-375) underflow. --validate checks the topology, says the
+        # volumes cannot be compared, and passes; the summary says so too.
+        tiny = np.ldexp(self.pts, -410)
+        r = self.ok(["voronoi", self.save("tiny.npy", tiny), "-o", self.p("t.vtu"), "--validate"])
+        self.assertIn("validation: OK", r.stdout)
+        self.assertIn("outside double's range", r.stdout)
+        self.assertIn("volume sum         not checked", r.stdout)
+        r = self.ok(["voronoi", self.inp, "-o", self.p("u.vtu"), "--validate"])
+        self.assertNotIn("outside double's range", r.stdout)
+
     def test_labels(self):
         labels = np.random.default_rng(5).integers(-1, 3, self.N).astype(np.int32)
         lab = self.save("labels.npy", labels)

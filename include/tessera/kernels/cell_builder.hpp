@@ -18,6 +18,7 @@
 #include <bit>
 #include <cstdint>
 #include <cstring>
+#include <cmath>
 #include <limits>
 #include <utility>
 #include <vector>
@@ -97,9 +98,11 @@ class CellBuilder {
           if (r2 > sec2 || j == i) continue;
           cd->r2 = r2;
           cd->id = j;
-          // Sort key: r2 rounded to float (non-negative floats order as their
-          // bits), then gather order, which is deterministic.
-          *key++ = (static_cast<std::uint64_t>(std::bit_cast<std::uint32_t>(static_cast<float>(r2))) << 32) | m;
+          // Sort key: r2 in key units (key_scale_) rounded to float
+          // (non-negative floats order as their bits), then gather order,
+          // which is deterministic.
+          *key++ = (static_cast<std::uint64_t>(std::bit_cast<std::uint32_t>(static_cast<float>(r2 * key_scale_)))
+                    << 32) | m;
           ++cd;
           ++m;
         }
@@ -146,7 +149,7 @@ class CellBuilder {
           // later candidate may still be slightly nearer; stop only once every
           // later one is surely beyond: a later key's r2 is at least this
           // key's truncated r2 times (1 - 2^-24), the float rounding.
-          return truncated_r2(key) * (1.0 - 1e-7) > sec2 ? Next::stop : Next::go;
+          return truncated_r2(key) * (1.0 - 1e-7) > sec2 ? Next::stop : Next::go;  // never on 0 (no bound)
         }
         if (cd.r2 == 0 && exactly_equal(p, cd.id)) {
           // Exact duplicates: the lowest id owns the cell. Coincident points
@@ -325,7 +328,7 @@ class CellBuilder {
   /// n^2 comparisons, but branch-free, which at these sizes (a uniform
   /// cell's first gather holds ~54 keys in 3D, ~20 in 2D) beat straight
   /// insertion, whose mispredicted exits dominated. The ranking compares
-  /// compact 32-bit keys, four per SSE instruction: the float r2's top 24
+  /// compact 32-bit keys, four per SSE instruction: the float key's top 24
   /// bits (8 of mantissa), then the key's position, below 2^8, which breaks
   /// ties in gather order and makes the keys distinct. Candidates within
   /// 2^-15 of each other in r2 so keep gather order rather than distance
@@ -365,9 +368,14 @@ class CellBuilder {
   static std::uint32_t truncated_bits(std::uint64_t key) {
     return static_cast<std::uint32_t>(key >> 32) & ~std::uint32_t{0xFF};
   }
-  /// A lower bound on the r2 of this key's candidate and of every later one.
-  static double truncated_r2(std::uint64_t key) {
-    return static_cast<double>(std::bit_cast<float>(truncated_bits(key)));
+  /// A lower bound on the r2 of this key's candidate and of every later one,
+  /// or 0 where the key gives none: a float key that overflowed (infinite:
+  /// its candidates then only follow every finite key, in gather order) or
+  /// lies below the normal floats, where rounding is not relative.
+  double truncated_r2(std::uint64_t key) const {
+    const float f = std::bit_cast<float>(truncated_bits(key));
+    if (!(f >= std::numeric_limits<float>::min() && f <= std::numeric_limits<float>::max())) return 0;
+    return static_cast<double>(f) * key_unscale_;
   }
 
   /// Reorder [first, last) (more than 2 * sort_head keys) so that the keys
@@ -428,6 +436,13 @@ class CellBuilder {
   /// a cell bounds its flower before walking a shell (flower_bins): a
   /// uniform cell's is about one bin size and never pays for it.
   double flower_min2_ = 9 * loc_.min_bin_size() * loc_.min_bin_size();
+  /// Sort keys hold r2 * key_scale_, a power of two that brings a squared
+  /// bin size near 1, so that a cell's candidates stay within float's
+  /// normal range whatever the input's units. Unscaled, r2 above 2^128
+  /// (coordinates past about 1e19) overflowed to the same infinite key, and
+  /// the stop rule then dropped nearer candidates: wrong cells.
+  double key_scale_ = std::ldexp(1.0, -2 * std::ilogb(loc_.min_bin_size()));
+  double key_unscale_ = 1.0 / key_scale_;
 };
 
 }  // namespace tessera::kernels
