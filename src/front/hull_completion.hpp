@@ -319,8 +319,16 @@ class HullCompletion {
       q.ball_r2 = std::numeric_limits<double>::infinity();  // NaN included
       return;
     }
-    for (int d = 0; d < D; ++d) q.ball_centre[d] = a[d] + y[d];
-    const double reach = rad * (1 + 1e-6) + 1e-6 * diam_;
+    // The centre is stored in absolute coordinates: a[d] + y[d] rounds to
+    // the ulp of the larger, which on points far from the origin (a cloud of
+    // extent 1e-10 around 1000, where an ulp is 1e-13) dwarfs the relative
+    // margins; the tree's point distances round likewise.
+    double big = 0;
+    for (int d = 0; d < D; ++d) {
+      q.ball_centre[d] = a[d] + y[d];
+      big = std::max({big, std::fabs(a[d]), std::fabs(q.ball_centre[d])});
+    }
+    const double reach = rad * (1 + 1e-6) + 1e-6 * diam_ + 64 * kernels::filter::u * big;
     q.ball_r2 = reach * reach;
   }
 

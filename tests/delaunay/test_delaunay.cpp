@@ -239,6 +239,22 @@ TEST(Delaunay, RandomlyRotatedSmallLatticesEqualCgal) {
   }
 }
 
+TEST(Delaunay, CloudFarFromTheOriginEqualsCgal) {
+  // A cloud of extent 1e-10 around (1000, ..): an ulp of its coordinates is
+  // 1e-13, so hull completion's float ball centre, stored in absolute
+  // coordinates, is off by a thousandth of the radius. The ball's margin was
+  // relative to the radius alone and pruned the true next point (a facet
+  // then sat in three simplices).
+  for (int dim : {2, 3})
+    for (std::uint64_t seed : {71u, 72u, 73u}) {
+      auto p = random_points(dim == 2 ? 80 : 300, dim, seed);
+      for (double& x : p) x = 1000.0 + 1e-10 * x;
+      tessera::Delaunay dt = run(p, dim);
+      EXPECT_EQ(as_set(dt), cgal_simplices(p, dim)) << "dim " << dim << " seed " << seed;
+      expect_valid(dt, p);
+    }
+}
+
 TEST(Delaunay, SpiralAndCircle) {
   std::vector<double> spiral, circle;
   for (int i = 0; i < 400; ++i) {
