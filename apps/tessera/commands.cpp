@@ -214,11 +214,9 @@ std::string domain_string(const Cells& c) {
 
 void print_volume_line(const Cells& c, const char* name) {
   const double sum = accurate_sum(c.volume), dom = c.bounds.volume(c.dim);
-  // The validator's rule (validate.cpp): beyond it the volumes in the
-  // input's units over- or underflow, and comparing them says nothing.
-  const bool representable = std::isnormal(dom) && dom <= 1e300 &&
-                             dom / static_cast<double>(std::max<std::size_t>(c.n_cells(), 1)) >= 1e-290;
-  if (!representable)
+  // Beyond the validator's rule the volumes in the input's units over- or
+  // underflow, and comparing them says nothing.
+  if (!volumes_representable(dom, c.n_cells()))
     std::printf("  %-18s %.17g (domain %.17g: outside double's range at this scale, not compared)\n", name, sum, dom);
   else
     std::printf("  %-18s %.17g (domain %.17g, relative difference %.2g)\n", name, sum, dom, std::fabs(sum - dom) / dom);

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <array>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <functional>
@@ -134,6 +135,16 @@ struct ValidationReport {
   std::vector<std::string> messages;      ///< one line each
 };
 ValidationReport validate(const Cells& cells, std::span<const std::int32_t> labels);
+
+/// Whether the cell volumes of a domain of volume `domain_volume` cut into
+/// `cells` cells are normal doubles (the rule behind volumes_checked): the
+/// domain's at most 1e300, so their sum cannot overflow, and the mean
+/// cell's at least 1e-290, above the subnormals by a factor that leaves room
+/// for cells far smaller than the mean.
+inline bool volumes_representable(double domain_volume, std::size_t cells) {
+  return std::isnormal(domain_volume) && domain_volume <= 1e300 &&
+         domain_volume / static_cast<double>(cells > 0 ? cells : 1) >= 1e-290;
+}
 
 /// Resolved thread count for an option value (0 -> TESSERA_NUM_THREADS or hardware).
 int resolve_threads(int requested);

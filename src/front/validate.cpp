@@ -15,16 +15,13 @@ ValidationReport validate(const Cells& c, std::span<const std::int32_t> labels) 
   const int D = c.dim;
 
   // Volumes: with every point inside, the cells tile the domain exactly.
-  // Checked only where the volumes are normal doubles: the domain's at most
-  // 1e300 (its cells' sum cannot overflow) and the mean cell's at least
-  // 1e-290 (above the subnormals, by a factor that leaves room for cells far
-  // smaller than the mean). Outside that the input's scale, not the
-  // tessellation, decides what a double can hold.
+  // Checked only where the volumes are normal doubles (volumes_representable):
+  // outside that the input's scale, not the tessellation, decides what a
+  // double can hold.
   for (double v : c.volume) r.volume_sum += v;
   r.domain_volume = c.bounds.volume(D);
   r.volume_rel_error = std::fabs(r.volume_sum - r.domain_volume) / r.domain_volume;
-  r.volumes_checked = std::isnormal(r.domain_volume) && r.domain_volume <= 1e300 &&
-                      r.domain_volume / static_cast<double>(std::max<std::size_t>(nc, 1)) >= 1e-290;
+  r.volumes_checked = volumes_representable(r.domain_volume, nc);
   const bool all_inside = c.ignored_outside_bounds.empty() &&
                           std::none_of(labels.begin(), labels.end(), [](std::int32_t l) { return l < 0; });
   if (r.volumes_checked && all_inside && r.volume_rel_error > 1e-9) {
