@@ -1,0 +1,124 @@
+#!/usr/bin/python3
+"""Hostile inputs, generated at random from a seed, through every product's
+own validation: `voronoi --validate`, `delaunay --validate`, and graph, faces
+and flower (which must succeed).
+
+Usage: /usr/bin/python3 tests/cli/test_hostile_cli.py PATH_TO_tessera [unittest args...]
+  env: TESSERA_HOSTILE_CASES (default 150), TESSERA_HOSTILE_SEED (default 1),
+       TESSERA_HOSTILE_SCALE (default 1: 5 to 400 points; 10: up to 4000)
+
+The default run is the regression test (under ten seconds); raise the
+cases, change the seed or the scale to fuzz. A failing input is kept in a
+folder named in the failure message, with the command that failed.
+
+Each kind reproduces an input that once broke Tessera or could: rotated
+lattices (coplanar hull faces up to rounding), near-duplicates, powers of ten
+from 1e-200 to 1e200 (float sort keys overflowed past 1e19; volumes
+underflow), clouds far from the origin (few significant bits), a tiny
+cluster in a huge cloud, nearly collinear and nearly coplanar points, points
+on a sphere with its centre, small integer grids, with random labels on a
+third of the cases. The only accepted failure is the input error for a zero
+extent (all points on an axis plane, or one point).
+
+Prints "N passed, M failed" last; exits 1 if anything failed.
+"""
+import os
+import shutil
+import sys
+import tempfile
+
+import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import test_cli as base  # noqa: E402  (helpers only; its test classes are not collected here)
+
+run = base.run
+
+
+def lattice(m, d):
+    return np.stack(np.meshgrid(*[np.arange(m)] * d), -1).reshape(-1, d).astype(float)
+
+
+def rotation(rng, d):
+    q, _ = np.linalg.qr(rng.normal(size=(d, d)))
+    return q
+
+
+KINDS = {
+    "uniform": lambda rng, n, d: rng.random((n, d)),
+    "lattice": lambda rng, n, d: lattice(int(rng.integers(2, 8)), d),
+    "rotated_lattice": lambda rng, n, d: lattice(int(rng.integers(2, 7)), d) @ rotation(rng, d).T,
+    "rotated_lattice_scaled": lambda rng, n, d: lattice(int(rng.integers(2, 10)), d) @ rotation(rng, d).T
+    * 10.0 ** int(rng.integers(-3, 4)),
+    "duplicates": lambda rng, n, d: (lambda p: np.vstack([p, p[rng.integers(0, n, n // 3)]]))(rng.random((n, d))),
+    "near_duplicates": lambda rng, n, d: (lambda p, i: np.vstack([p, p[i] + rng.normal(size=(len(i), d)) * 1e-13]))(
+        rng.random((n, d)), rng.integers(0, n, n // 3)),
+    "power_of_ten": lambda rng, n, d: (lambda s: rng.random((n, d)) * s + 10.0 ** int(rng.integers(-5, 12))
+                                       * rng.normal(size=d) * s)(10.0 ** int(rng.integers(-200, 200))),
+    "far_from_origin": lambda rng, n, d: (lambda off: off + rng.random((n, d)) * 10.0 ** int(rng.integers(-6, 0))
+                                          * off * 1e-9)(10.0 ** int(rng.integers(3, 15))),
+    "cluster_in_cloud": lambda rng, n, d: np.vstack([rng.random((n, d)) * 1e6,
+                                                     0.5e6 + rng.random((n // 2, d)) * 1e-6]),
+    "nearly_collinear": lambda rng, n, d: (lambda p: np.vstack([p[4:], p[:4] + rng.random((4, d))]))(
+        np.outer(rng.random(n), rng.normal(size=d)) + rng.normal(size=(n, d)) * 1e-12),
+    "nearly_flat": lambda rng, n, d: (lambda p: np.hstack([p[:, :-1], p[:, -1:] * 1e-9]))(rng.random((n, d))),
+    "sphere_and_centre": lambda rng, n, d: (lambda v: np.vstack([v / np.linalg.norm(v, axis=1)[:, None],
+                                                                 np.zeros((1, d))]))(rng.normal(size=(min(n, 120), d))),
+    "grid_jitter": lambda rng, n, d: (lambda g: g + rng.normal(size=g.shape) * 1e-15)(lattice(int(rng.integers(2, 7)), d)),
+    "small_integers": lambda rng, n, d: rng.integers(0, 4, size=(n, d)).astype(float),
+}
+
+ZERO_EXTENT = ("zero extent", "coplanar", "collinear", "--dim 2", "single point", "one point")
+
+
+class Hostile(base.TempDirCase):
+    def check(self, args, inp, labels, kind, d, case):
+        r = run(args)
+        if r.returncode == 2 and any(w in r.stderr for w in ZERO_EXTENT):
+            return False
+        if r.returncode != 0:
+            keep = tempfile.mkdtemp(prefix="tessera-hostile-")
+            shutil.copy(inp, keep)
+            if labels:
+                shutil.copy(labels, keep)
+            self.fail("case %d (%s, %dD): tessera %s -> exit %d\n%s%s\ninput kept in %s" % (
+                case, kind, d, " ".join(map(str, args)), r.returncode, r.stdout[-2000:], r.stderr[-2000:], keep))
+        return True
+
+    def test_hostile_inputs(self):
+        cases = int(os.environ.get("TESSERA_HOSTILE_CASES", "150"))
+        rng = np.random.default_rng(int(os.environ.get("TESSERA_HOSTILE_SEED", "1")))
+        scale = int(os.environ.get("TESSERA_HOSTILE_SCALE", "1"))
+        names = sorted(KINDS)
+        for case in range(cases):
+            kind = names[case % len(names)]
+            d = 2 + int(rng.integers(0, 2))
+            n = int(rng.integers(5, 400)) * scale
+            pts = np.ascontiguousarray(KINDS[kind](rng, n, d), dtype="<f8")
+            inp = self.save("case%d.npy" % case, pts)
+            args_labels = []
+            labels = None
+            if case % 3 == 2:
+                lab = rng.integers(-1, 3, len(pts)).astype(np.int32)
+                lab[0] = 0
+                labels = self.save("case%d_labels.npy" % case, lab)
+                args_labels = ["--labels", labels]
+            threads = str(int(rng.integers(1, 3)))
+            common = [inp, "--threads", threads, "--quiet"] + args_labels
+            out = self.p("c.vtu" if d == 3 else "c.vtp")
+            if not self.check(["voronoi"] + common + ["-o", out, "--validate"], inp, labels, kind, d, case):
+                continue  # a zero extent: every product refuses it alike
+            self.check(["delaunay"] + common + ["-o", self.p("t.vtu"), "--validate"], inp, labels, kind, d, case)
+            if case % 4 == 0:
+                self.check(["graph"] + common + ["-o", self.p("g.vtp")], inp, labels, kind, d, case)
+                for k in ("complex", "boundary", "surface-net"):
+                    self.check(["faces"] + common + ["-o", self.p("f.vtp"), "--kind", k], inp, labels, kind, d, case)
+                self.check(["flower"] + common + ["--point", "0", "-o", self.p("fl.vtp")], inp, labels, kind, d, case)
+
+
+def main():
+    return base.cli_main("test_hostile_cli.py", [(base.vtk is not None, "python3-vtk9 is required (run with /usr/bin/python3)")])
+
+
+if __name__ == "__main__":
+    sys.exit(main())
