@@ -95,6 +95,16 @@ DelaunayReport validate(const Delaunay& dt, std::span<const double> points, std:
   ctx.dim = D;
   auto pt = [&](std::int32_t id) { return points.data() + static_cast<std::size_t>(id) * static_cast<std::size_t>(D); };
   const double fact = D == 2 ? 2.0 : 6.0;
+  // Volumes are computed in units of a power of two near the domain's
+  // extent (an exact scaling of the coordinate differences), so points near
+  // 1e-150 or 1e150 neither under- nor overflow them; the report gives them
+  // back in the input's units, where they may not be representable.
+  double extent = 0;
+  for (int d = 0; d < D; ++d)
+    extent = std::max(extent, dt.bounds.hi[static_cast<std::size_t>(d)] - dt.bounds.lo[static_cast<std::size_t>(d)]);
+  const int unit_exp = extent > 0 && std::isfinite(extent) ? std::clamp(std::ilogb(extent), -1000, 1000) : 0;
+  const double unit = std::ldexp(1.0, -unit_exp);
+  double volume_sum = 0, enclosed_volume = 0;  // in those units
 
   // Orientation and volume of every simplex.
   std::vector<std::uint8_t> bad(m, 0);
@@ -104,7 +114,7 @@ DelaunayReport validate(const Delaunay& dt, std::span<const double> points, std:
     bad[s] = kernels::orientation(ctx, row) != 1;
     double r[3][3] = {};
     for (int k = 0; k < D; ++k)
-      for (int d = 0; d < D; ++d) r[k][d] = pt(row[k + 1])[d] - pt(row[0])[d];
+      for (int d = 0; d < D; ++d) r[k][d] = (pt(row[k + 1])[d] - pt(row[0])[d]) * unit;
     double perm;
     vol[s] = det_rows(r, D, perm) / fact;
     vol_err[s] = 32 * std::numeric_limits<double>::epsilon() * perm / fact;
@@ -112,7 +122,7 @@ DelaunayReport validate(const Delaunay& dt, std::span<const double> points, std:
   rep.flat_or_inverted = static_cast<std::size_t>(std::count(bad.begin(), bad.end(), 1));
   double volume_err = 0;
   for (std::size_t s = 0; s < m; ++s) {
-    rep.volume_sum += vol[s];
+    volume_sum += vol[s];
     volume_err += vol_err[s];
   }
 
@@ -173,11 +183,11 @@ DelaunayReport validate(const Delaunay& dt, std::span<const double> points, std:
     double r[3][3] = {};
     for (std::size_t j = 0, c = 0; j < w; ++j) {
       if (static_cast<std::int32_t>(j) == f.k) continue;
-      for (int d = 0; d < D; ++d) r[c][d] = pt(row[j])[d] - o[d];
+      for (int d = 0; d < D; ++d) r[c][d] = (pt(row[j])[d] - o[d]) * unit;
       ++c;
     }
     double perm;
-    rep.enclosed_volume += ((f.k % 2) ? -1.0 : 1.0) * det_rows(r, D, perm) / fact;
+    enclosed_volume += ((f.k % 2) ? -1.0 : 1.0) * det_rows(r, D, perm) / fact;
     volume_err += 32 * std::numeric_limits<double>::epsilon() * perm / fact;
     for (int drop = 0; drop < D; ++drop) {
       RidgeRec rr{{-1, -1}, static_cast<std::int32_t>(b), f.facet[static_cast<std::size_t>(drop)]};
@@ -234,8 +244,10 @@ DelaunayReport validate(const Delaunay& dt, std::span<const double> points, std:
   fail(rep.local_delaunay_violations, "interior facets are not locally Delaunay");
   // Float volumes: the comparison allows their rounding (a bound from each
   // determinant's permanent, which matters for nearly flat input) plus 1e-9.
-  const double tol = 1e-9 * std::max(std::fabs(rep.volume_sum), std::fabs(rep.enclosed_volume)) + volume_err;
-  if (std::fabs(rep.volume_sum - rep.enclosed_volume) > tol) {
+  rep.volume_sum = std::ldexp(volume_sum, D * unit_exp);
+  rep.enclosed_volume = std::ldexp(enclosed_volume, D * unit_exp);
+  const double tol = 1e-9 * std::max(std::fabs(volume_sum), std::fabs(enclosed_volume)) + volume_err;
+  if (std::fabs(volume_sum - enclosed_volume) > tol) {
     rep.ok = false;
     std::ostringstream s;
     s << "simplex volumes sum to " << rep.volume_sum << " but the boundary encloses " << rep.enclosed_volume;
