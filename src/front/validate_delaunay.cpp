@@ -250,7 +250,9 @@ DelaunayReport validate(const Delaunay& dt, std::span<const double> points, std:
   if (std::fabs(volume_sum - enclosed_volume) > tol) {
     rep.ok = false;
     std::ostringstream s;
-    s << "simplex volumes sum to " << rep.volume_sum << " but the boundary encloses " << rep.enclosed_volume;
+    s << "simplex volumes sum to " << rep.volume_sum << " but the boundary encloses " << rep.enclosed_volume
+      << " (relative difference "
+      << std::fabs(volume_sum - enclosed_volume) / std::max(std::fabs(volume_sum), std::fabs(enclosed_volume)) << ")";
     rep.messages.push_back(s.str());
   }
   return rep;

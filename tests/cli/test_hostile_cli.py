@@ -44,29 +44,54 @@ def rotation(rng, d):
     return q
 
 
-KINDS = {
-    "uniform": lambda rng, n, d: rng.random((n, d)),
-    "lattice": lambda rng, n, d: lattice(int(rng.integers(2, 8)), d),
-    "rotated_lattice": lambda rng, n, d: lattice(int(rng.integers(2, 7)), d) @ rotation(rng, d).T,
-    "rotated_lattice_scaled": lambda rng, n, d: lattice(int(rng.integers(2, 10)), d) @ rotation(rng, d).T
-    * 10.0 ** int(rng.integers(-3, 4)),
-    "duplicates": lambda rng, n, d: (lambda p: np.vstack([p, p[rng.integers(0, n, n // 3)]]))(rng.random((n, d))),
-    "near_duplicates": lambda rng, n, d: (lambda p, i: np.vstack([p, p[i] + rng.normal(size=(len(i), d)) * 1e-13]))(
-        rng.random((n, d)), rng.integers(0, n, n // 3)),
-    "power_of_ten": lambda rng, n, d: (lambda s: rng.random((n, d)) * s + 10.0 ** int(rng.integers(-5, 12))
-                                       * rng.normal(size=d) * s)(10.0 ** int(rng.integers(-200, 200))),
-    "far_from_origin": lambda rng, n, d: (lambda off: off + rng.random((n, d)) * 10.0 ** int(rng.integers(-6, 0))
-                                          * off * 1e-9)(10.0 ** int(rng.integers(3, 15))),
-    "cluster_in_cloud": lambda rng, n, d: np.vstack([rng.random((n, d)) * 1e6,
-                                                     0.5e6 + rng.random((n // 2, d)) * 1e-6]),
-    "nearly_collinear": lambda rng, n, d: (lambda p: np.vstack([p[4:], p[:4] + rng.random((4, d))]))(
-        np.outer(rng.random(n), rng.normal(size=d)) + rng.normal(size=(n, d)) * 1e-12),
-    "nearly_flat": lambda rng, n, d: (lambda p: np.hstack([p[:, :-1], p[:, -1:] * 1e-9]))(rng.random((n, d))),
-    "sphere_and_centre": lambda rng, n, d: (lambda v: np.vstack([v / np.linalg.norm(v, axis=1)[:, None],
-                                                                 np.zeros((1, d))]))(rng.normal(size=(min(n, 120), d))),
-    "grid_jitter": lambda rng, n, d: (lambda g: g + rng.normal(size=g.shape) * 1e-15)(lattice(int(rng.integers(2, 7)), d)),
-    "small_integers": lambda rng, n, d: rng.integers(0, 4, size=(n, d)).astype(float),
-}
+KINDS = ["uniform", "lattice", "rotated_lattice", "rotated_lattice_scaled", "duplicates", "near_duplicates",
+         "power_of_ten", "far_from_origin", "cluster_in_cloud", "nearly_collinear", "nearly_flat",
+         "sphere_and_centre", "grid_jitter", "small_integers"]
+
+
+def generate(kind, rng, n, d):
+    """n (about) points of the given kind in d dimensions."""
+    if kind == "uniform":
+        return rng.random((n, d))
+    if kind == "lattice":
+        return lattice(int(rng.integers(2, 8)), d)
+    if kind == "rotated_lattice":
+        return lattice(int(rng.integers(2, 7)), d) @ rotation(rng, d).T
+    if kind == "rotated_lattice_scaled":
+        return lattice(int(rng.integers(2, 10)), d) @ rotation(rng, d).T * 10.0 ** int(rng.integers(-3, 4))
+    if kind == "duplicates":
+        p = rng.random((n, d))
+        return np.vstack([p, p[rng.integers(0, n, n // 3)]])
+    if kind == "near_duplicates":
+        p = rng.random((n, d))
+        q = p[rng.integers(0, n, n // 3)]
+        return np.vstack([p, q + rng.normal(size=q.shape) * 1e-13])
+    if kind == "power_of_ten":
+        s = 10.0 ** int(rng.integers(-200, 200))
+        return (rng.random((n, d)) + 10.0 ** int(rng.integers(-5, 12)) * rng.normal(size=d)) * s
+    if kind == "far_from_origin":
+        off = 10.0 ** int(rng.integers(3, 15))
+        return off + rng.random((n, d)) * off * 1e-9 * 10.0 ** int(rng.integers(-6, 0))
+    if kind == "cluster_in_cloud":
+        return np.vstack([rng.random((n, d)) * 1e6, 0.5e6 + rng.random((n // 2, d)) * 1e-6])
+    if kind == "nearly_collinear":
+        p = np.outer(rng.random(n), rng.normal(size=d)) + rng.normal(size=(n, d)) * 1e-12
+        p[:4] += rng.random((4, d))
+        return p
+    if kind == "nearly_flat":
+        p = rng.random((n, d))
+        p[:, -1] *= 1e-9
+        return p
+    if kind == "sphere_and_centre":
+        v = rng.normal(size=(min(n, 120), d))
+        return np.vstack([v / np.linalg.norm(v, axis=1)[:, None], np.zeros((1, d))])
+    if kind == "grid_jitter":
+        g = lattice(int(rng.integers(2, 7)), d)
+        return g + rng.normal(size=g.shape) * 1e-15
+    if kind == "small_integers":
+        return rng.integers(0, 4, size=(n, d)).astype(float)
+    raise ValueError(kind)
+
 
 ZERO_EXTENT = ("zero extent", "coplanar", "collinear", "--dim 2", "single point", "one point")
 
@@ -94,7 +119,7 @@ class Hostile(base.TempDirCase):
             kind = names[case % len(names)]
             d = 2 + int(rng.integers(0, 2))
             n = int(rng.integers(5, 400)) * scale
-            pts = np.ascontiguousarray(KINDS[kind](rng, n, d), dtype="<f8")
+            pts = np.ascontiguousarray(generate(kind, rng, n, d), dtype="<f8")
             inp = self.save("case%d.npy" % case, pts)
             args_labels = []
             labels = None
