@@ -118,11 +118,6 @@ class CellsCompositor {
   void finish(std::span<Batch> batches) {
     Cells& o = out_;
     const std::size_t n = o.n_points;
-    // Where each generator's data sits (batch, index in batch), for the
-    // mesh only. Every generator lies in exactly one batch, so all batches
-    // write at once; cell_of first holds 1 for a generator with a cell.
-    struct Loc { std::int32_t batch = -1, index = -1; };
-    std::vector<Loc> where(mesh_ ? n : 0);
     for (const Batch& b : batches)
       for (std::size_t t = 0; t < b.gen.size(); ++t)
         if (b.dup_of[t] >= 0) o.duplicates.emplace_back(b.gen[t], b.dup_of[t]);
@@ -135,14 +130,12 @@ class CellsCompositor {
     dense_ = o.duplicates.empty() && generators == n;
     const bool dense = dense_;
     o.cell_of.assign(n, dense ? 1 : 0);
-    if (mesh_ || !dense)
+    // cell_of first holds 1 for a generator with a cell. Every generator
+    // lies in exactly one batch, so all batches write at once.
+    if (!dense)
       tbb::parallel_for(std::size_t(0), batches.size(), [&](std::size_t k) {
         const Batch& b = batches[k];
-        for (std::size_t t = 0; t < b.gen.size(); ++t) {
-          const auto g = static_cast<std::size_t>(b.gen[t]);
-          if (mesh_) where[g] = {static_cast<std::int32_t>(k), static_cast<std::int32_t>(t)};
-          o.cell_of[g] = b.dup_of[t] < 0;
-        }
+        for (std::size_t t = 0; t < b.gen.size(); ++t) o.cell_of[static_cast<std::size_t>(b.gen[t])] = b.dup_of[t] < 0;
       });
     std::int32_t nc = 0;
     for (std::size_t g = 0; g < n; ++g) o.cell_of[g] = o.cell_of[g] ? nc++ : -1;
@@ -150,7 +143,6 @@ class CellsCompositor {
     // Generators come in bin order, so their cells' fields land all over
     // the output: the loops below fetch a cell's destinations some
     // generators ahead (and, with duplicates, its cell index before that).
-    auto cell_at = [&](std::int32_t g) { return dense ? g : o.cell_of[static_cast<std::size_t>(g)]; };
     auto ahead = [&](const Batch& b, std::size_t t, auto&& fetch) {
       if (!dense && t + 2 * prefetch_ahead < b.gen.size())
         __builtin_prefetch(&o.cell_of[static_cast<std::size_t>(b.gen[t + 2 * prefetch_ahead])]);
@@ -233,11 +225,14 @@ class CellsCompositor {
                   o.neighbors.begin() + o.neighbor_offsets[static_cast<std::size_t>(c)]);
       }
     });
-    if (mesh_) build_mesh(batches, where, face_count_vertices);
+    if (mesh_) build_mesh(batches, face_count_vertices);
   }
 
  private:
   static constexpr std::size_t prefetch_ahead = 8;  // generators (finish)
+
+  // Generator g's cell index (-1: none); read without a lookup when dense_.
+  std::int32_t cell_at(std::int32_t g) const { return dense_ ? g : out_.cell_of[static_cast<std::size_t>(g)]; }
 
   std::int32_t labels_at(std::int32_t g) const { return labels_.empty() ? 0 : labels_[static_cast<std::size_t>(g)]; }
 
@@ -277,8 +272,7 @@ class CellsCompositor {
     }
   }
 
-  template <class Where>
-  void build_mesh(std::span<Batch> batches, const Where& where, std::vector<std::int64_t>& fcv) {
+  void build_mesh(std::span<Batch> batches, std::vector<std::int64_t>& fcv) {
     Cells& o = out_;
     const std::size_t ncell = o.n_cells();
     // Owned vertices per cell -> global numbering in cell order.
@@ -287,7 +281,7 @@ class CellsCompositor {
       Batch& b = batches[k];
       b.vglobal.assign(b.keys.size(), -1);
       for (std::size_t t = 0; t < b.gen.size(); ++t) {
-        std::int32_t c = o.cell_of[static_cast<std::size_t>(b.gen[t])];
+        std::int32_t c = cell_at(b.gen[t]);
         if (c < 0) continue;
         std::uint32_t v0 = t == 0 ? 0 : b.vert_end[t - 1], v1 = b.vert_end[t];
         std::int64_t cnt = 0;
@@ -305,7 +299,7 @@ class CellsCompositor {
     tbb::parallel_for(std::size_t(0), batches.size(), [&](std::size_t k) {
       Batch& b = batches[k];
       for (std::size_t t = 0; t < b.gen.size(); ++t) {
-        std::int32_t c = o.cell_of[static_cast<std::size_t>(b.gen[t])];
+        std::int32_t c = cell_at(b.gen[t]);
         if (c < 0) continue;
         std::uint32_t v0 = t == 0 ? 0 : b.vert_end[t - 1], v1 = b.vert_end[t];
         std::uint32_t pv = t == 0 ? 0 : b.pos_end[t - 1];  // the owned positions, in vertex order
@@ -324,24 +318,47 @@ class CellsCompositor {
     });
     if (unowned.load())
       throw std::logic_error("tessera: a cell kept positions for other than its owned vertices");
-    // Vertices owned elsewhere: found by key in the owner's cell. A miss means
-    // two cells disagree about a vertex, which exact predicates rule out.
+    // Vertices owned elsewhere: found by key among the owner's owned
+    // vertices, which the loop above wrote contiguously (global ids
+    // owned[c] .. owned[c + 1] of the owner's cell c, keys in vertex_keys):
+    // a quarter of the owner's vertices, found from its cell index alone. A
+    // miss means two cells disagree about a vertex, which exact predicates
+    // rule out.
     std::atomic<std::size_t> misses{0};
     tbb::parallel_for(std::size_t(0), batches.size(), [&](std::size_t k) {
       Batch& b = batches[k];
+      const std::int32_t* const keys = o.vertex_keys.data();
+      // A cell's lookups are independent, and each is two dependent cache
+      // misses (the owner's range, then its keys): they run in three
+      // sweeps, so that the misses of one sweep overlap.
+      std::vector<std::uint32_t> slot;
+      std::vector<std::size_t> at;
       for (std::size_t t = 0; t < b.gen.size(); ++t) {
-        if (o.cell_of[static_cast<std::size_t>(b.gen[t])] < 0) continue;
+        if (cell_at(b.gen[t]) < 0) continue;
         std::uint32_t v0 = t == 0 ? 0 : b.vert_end[t - 1], v1 = b.vert_end[t];
+        slot.clear();
+        at.clear();
         for (std::uint32_t v = v0; v < v1; ++v) {
           if (b.vglobal[v] >= 0) continue;
-          std::int32_t own = owner(b.keys[v]);
-          const auto& w = where[static_cast<std::size_t>(own)];
-          const Batch& ob = batches[static_cast<std::size_t>(w.batch)];
-          std::size_t ot = static_cast<std::size_t>(w.index);
-          std::uint32_t o0 = ot == 0 ? 0 : ob.vert_end[ot - 1], o1 = ob.vert_end[ot];
+          const std::int32_t own = owner(b.keys[v]);
+          const std::size_t oc = static_cast<std::size_t>(cell_at(own));
+          __builtin_prefetch(&owned[oc]);
+          slot.push_back(v);
+          at.push_back(oc);
+        }
+        for (std::size_t& oc : at) {
+          __builtin_prefetch(keys + static_cast<std::size_t>(owned[oc]) * (D + 1));
+        }
+        for (std::size_t m = 0; m < slot.size(); ++m) {
+          const std::uint32_t v = slot[m];
+          const std::size_t oc = at[m];
+          const std::int64_t g1 = owned[oc + 1];
           std::int32_t found = -1;
-          for (std::uint32_t u = o0; u < o1; ++u)
-            if (same_key(ob.keys[u], b.keys[v])) { found = ob.vglobal[u]; break; }
+          for (std::int64_t g = owned[oc]; g < g1; ++g) {
+            Key<D> kg;
+            std::memcpy(kg.data(), keys + static_cast<std::size_t>(g) * (D + 1), sizeof kg);
+            if (same_key(kg, b.keys[v])) { found = static_cast<std::int32_t>(g); break; }
+          }
           if (found < 0) misses.fetch_add(1, std::memory_order_relaxed);
           b.vglobal[v] = found;
         }
@@ -365,7 +382,7 @@ class CellsCompositor {
     tbb::parallel_for(std::size_t(0), batches.size(), [&](std::size_t k) {
       const Batch& b = batches[k];
       for (std::size_t t = 0; t < b.gen.size(); ++t) {
-        std::int32_t c = o.cell_of[static_cast<std::size_t>(b.gen[t])];
+        std::int32_t c = cell_at(b.gen[t]);
         if (c < 0) continue;
         std::size_t cu = static_cast<std::size_t>(c);
         std::uint32_t f0 = t == 0 ? 0 : b.face_end[t - 1], f1 = b.face_end[t];
