@@ -4,11 +4,13 @@
 
 #include <charconv>
 #include <cstdint>
+#include <cstring>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "io_detail.hpp"
+#include "ordered_chunks.hpp"
 #include "tessera/io/atomic_file.hpp"
 #include "tessera/io/npy.hpp"
 
@@ -36,46 +38,34 @@ std::int64_t neighbor_count(const Cells& c, std::size_t i) {
 /// Columns of the table, in order: id, region, volume/area, centroid (dim), faces/edges, neighbors.
 std::size_t table_columns(const Cells& c) { return c.dim == 2 ? 7 : 8; }
 
-void append_int(std::string& s, std::int64_t v) {
-  char buf[24];
-  auto r = std::to_chars(buf, buf + sizeof buf, v);
-  s.append(buf, r.ptr);
-}
-
-/// Shortest representation that round-trips (at most 17 significant digits).
-void append_double(std::string& s, double v) {
-  char buf[32];
-  auto r = std::to_chars(buf, buf + sizeof buf, v);
-  s.append(buf, r.ptr);
-}
-
 void write_csv(const std::string& path, const Cells& c) {
   write_file_atomic(path, [&c](std::ostream& os) {
     const std::size_t d = static_cast<std::size_t>(c.dim);
-    std::string out =
+    const char* header =
         c.dim == 2 ? "id,region,area,cx,cy,edges,neighbors\n" : "id,region,volume,cx,cy,cz,faces,neighbors\n";
-    constexpr std::size_t kFlushAt = 1 << 20;  // write in ~1 MiB pieces
-    for (std::size_t i = 0; i < c.n_cells(); ++i) {
-      append_int(out, c.generator[i]);
-      out += ',';
-      append_int(out, c.region[i]);
-      out += ',';
-      append_double(out, c.volume[i]);
-      for (std::size_t k = 0; k < d; ++k) {
-        out += ',';
-        append_double(out, c.centroid[i * d + k]);
+    os.write(header, static_cast<std::streamsize>(std::strlen(header)));
+    // Rows are formatted by chunks on the worker threads (doubles in their
+    // shortest form that round-trips, which dominates) and written in order.
+    constexpr std::size_t kRowsPerChunk = 8192;
+    constexpr std::size_t kRowBytes = 8 * 24 + 8;  // every field at its longest, and the separators
+    detail::write_ordered_chunks(c.n_cells(), kRowsPerChunk, [&](std::size_t i0, std::size_t i1, std::vector<char>& out) {
+      out.resize((i1 - i0) * kRowBytes);
+      char* p = out.data();
+      char* const end = p + out.size();
+      auto field = [&](auto v, char sep) {
+        p = std::to_chars(p, end, v).ptr;
+        *p++ = sep;
+      };
+      for (std::size_t i = i0; i < i1; ++i) {
+        field(c.generator[i], ',');
+        field(c.region[i], ',');
+        field(c.volume[i], ',');
+        for (std::size_t k = 0; k < d; ++k) field(c.centroid[i * d + k], ',');
+        field(c.num_faces[i], ',');
+        field(neighbor_count(c, i), '\n');
       }
-      out += ',';
-      append_int(out, c.num_faces[i]);
-      out += ',';
-      append_int(out, neighbor_count(c, i));
-      out += '\n';
-      if (out.size() >= kFlushAt) {
-        os.write(out.data(), static_cast<std::streamsize>(out.size()));
-        out.clear();
-      }
-    }
-    os.write(out.data(), static_cast<std::streamsize>(out.size()));
+      out.resize(static_cast<std::size_t>(p - out.data()));
+    }, [&](const char* data, std::size_t size) { os.write(data, static_cast<std::streamsize>(size)); });
   });
 }
 

@@ -277,6 +277,39 @@ class Voronoi3D(TempDirCase):
         self.ok(["voronoi", inp, "-o", vtu, "-q"], env={"TESSERA_NUM_THREADS": "2"})
         self.assertTrue(read_bytes(vtu) == outs[1][0])
 
+    def test_chunked_writers_read_back(self):
+        # The .vtu's connectivity and faces, and the .csv's rows, are written
+        # in chunks of 4096 cells and 8192 rows formatted in parallel: the
+        # cells on both sides of each seam must read back whole.
+        n = 9000
+        pts = np.random.default_rng(12).random((n, 3))
+        vtu, csv, tnpy = self.p("k.vtu"), self.p("k.csv"), self.p("k.npy")
+        self.ok(["voronoi", self.save("k_in.npy", pts), "-o", vtu, "--cell-table", csv, "--threads", "2", "-q"])
+        self.ok(["voronoi", self.p("k_in.npy"), "--cell-table", tnpy, "--threads", "2", "-q"])
+        np.testing.assert_array_equal(np.loadtxt(csv, delimiter=",", skiprows=1), np.load(tnpy))
+        g = read_vtu(vtu)
+        self.assertEqual(g.GetNumberOfCells(), n)
+        pts_out = vtk_to_numpy(g.GetPoints().GetData())
+        faces = vtk_to_numpy(g.GetFaces())
+        locs = vtk_to_numpy(g.GetFaceLocations())
+        vol = vtk_to_numpy(cell_array(g, "Volume"))
+        for c in [0, 1, 4094, 4095, 4096, 4097, 8190, 8191, 8192, 8193, n - 1]:
+            k = int(locs[c])
+            nf = int(faces[k])
+            k += 1
+            v, order = 0.0, []
+            for _ in range(nf):
+                m = int(faces[k])
+                ids = faces[k + 1:k + 1 + m]
+                k += 1 + m
+                p = pts_out[ids]
+                v += np.dot(p[0], np.cross(p[1:-1], p[2:]).sum(axis=0))
+                order.extend(int(i) for i in ids if int(i) not in order)
+            self.assertAlmostEqual(v / 6.0, vol[c], delta=1e-12, msg="cell %d" % c)
+            cell_ids = g.GetCell(c).GetPointIds()
+            self.assertEqual([cell_ids.GetId(i) for i in range(cell_ids.GetNumberOfIds())], order,
+                             "cell %d: its points are its face vertices in first-appearance order" % c)
+
     def test_default_bounds_and_validate(self):
         out = self.p("cells.vtu")
         r = self.ok(["voronoi", self.inp, "-o", out, "--validate"])
