@@ -15,9 +15,8 @@
 
 #include <tbb/parallel_for.h>
 
-#include "release_memory.hpp"
-
 #include "cell_geometry.hpp"
+#include "release_memory.hpp"
 #include "tessera/cells.hpp"
 #include "tessera/engine/classifier.hpp"
 #include "tessera/kernels/cell_builder.hpp"
@@ -349,9 +348,7 @@ class CellsCompositor {
           slot.push_back(v);
           at.push_back(oc);
         }
-        for (std::size_t& oc : at) {
-          __builtin_prefetch(keys + static_cast<std::size_t>(owned[oc]) * (D + 1));
-        }
+        for (const std::size_t oc : at) __builtin_prefetch(keys + static_cast<std::size_t>(owned[oc]) * (D + 1));
         for (std::size_t m = 0; m < slot.size(); ++m) {
           const std::uint32_t v = slot[m];
           const std::size_t oc = at[m];
