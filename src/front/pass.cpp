@@ -59,10 +59,12 @@ Bounds make_domain(std::span<const double> pts, int dim, const VoronoiOptions& o
     }
   if (n == 1)
     throw InputError("a single point has no extent to make a domain from; give the domain with --bounds");
-  double ext = 0;
+  // Half the largest extent: points spanning most of double's range have an
+  // extent that overflows, and their domain is still representable.
+  double half = 0;
   for (int d = 0; d < dim; ++d) {
     auto du = static_cast<std::size_t>(d);
-    double e = b.hi[du] - b.lo[du];
+    double e = 0.5 * b.hi[du] - 0.5 * b.lo[du];
     if (!(e > 0)) {
       std::ostringstream m;
       m << "all points have the same " << axis_name(d) << " coordinate (" << b.lo[du]
@@ -71,19 +73,26 @@ Bounds make_domain(std::span<const double> pts, int dim, const VoronoiOptions& o
       else m << "; give --bounds";
       throw InputError(m.str());
     }
-    ext = std::max(ext, e);
+    half = std::max(half, e);
   }
   // Pad, then round outward to a multiple of a power of two near ext/64: the
   // box constants become short binary fractions (integer grids get the
   // half-integer box), so exact predicates on box vertices stay in the fast
   // 128-bit path. The margin is never smaller than asked.
   int e;
-  std::frexp(ext, &e);
-  const double step = std::ldexp(1.0, e - 7);
+  std::frexp(half, &e);
+  const double step = std::ldexp(1.0, e - 6);  // ext / 64 < step <= ext / 32
+  const double pad = 2.0 * opt.padding * half;
   for (int d = 0; d < dim; ++d) {
     auto du = static_cast<std::size_t>(d);
-    b.lo[du] = std::floor((b.lo[du] - opt.padding * ext) / step) * step;
-    b.hi[du] = std::ceil((b.hi[du] + opt.padding * ext) / step) * step;
+    b.lo[du] = std::floor((b.lo[du] - pad) / step) * step;
+    b.hi[du] = std::ceil((b.hi[du] + pad) / step) * step;
+    if (!std::isfinite(b.lo[du]) || !std::isfinite(b.hi[du])) {
+      std::ostringstream m;
+      m << "the padded domain's " << axis_name(d) << " range overflows double (padding " << opt.padding
+        << " of the points' extent); give a smaller --padding, or --bounds";
+      throw InputError(m.str());
+    }
   }
   return b;
 }

@@ -99,11 +99,17 @@ DelaunayReport validate(const Delaunay& dt, std::span<const double> points, std:
   // extent (an exact scaling of the coordinate differences), so points near
   // 1e-150 or 1e150 neither under- nor overflow them; the report gives them
   // back in the input's units, where they may not be representable.
-  double extent = 0;
+  // Half extents: a domain spanning most of double's range has an extent
+  // that overflows, and a coordinate difference that does too (diff).
+  double half = 0;
   for (int d = 0; d < D; ++d)
-    extent = std::max(extent, dt.bounds.hi[static_cast<std::size_t>(d)] - dt.bounds.lo[static_cast<std::size_t>(d)]);
-  const int unit_exp = extent > 0 && std::isfinite(extent) ? std::clamp(std::ilogb(extent), -1000, 1000) : 0;
+    half = std::max(half, 0.5 * dt.bounds.hi[static_cast<std::size_t>(d)] - 0.5 * dt.bounds.lo[static_cast<std::size_t>(d)]);
+  const int unit_exp = half > 0 && std::isfinite(half) ? std::clamp(std::ilogb(half) + 1, -1000, 1000) : 0;
   const double unit = std::ldexp(1.0, -unit_exp);
+  auto diff = [unit](double a, double b) {
+    const double d = a - b;
+    return std::isfinite(d) ? d * unit : a * unit - b * unit;
+  };
   double volume_sum = 0, enclosed_volume = 0;  // in those units
 
   // Orientation and volume of every simplex.
@@ -114,7 +120,7 @@ DelaunayReport validate(const Delaunay& dt, std::span<const double> points, std:
     bad[s] = kernels::orientation(ctx, row) != 1;
     double r[3][3] = {};
     for (int k = 0; k < D; ++k)
-      for (int d = 0; d < D; ++d) r[k][d] = (pt(row[k + 1])[d] - pt(row[0])[d]) * unit;
+      for (int d = 0; d < D; ++d) r[k][d] = diff(pt(row[k + 1])[d], pt(row[0])[d]);
     double perm;
     vol[s] = det_rows(r, D, perm) / fact;
     vol_err[s] = 32 * std::numeric_limits<double>::epsilon() * perm / fact;
@@ -183,7 +189,7 @@ DelaunayReport validate(const Delaunay& dt, std::span<const double> points, std:
     double r[3][3] = {};
     for (std::size_t j = 0, c = 0; j < w; ++j) {
       if (static_cast<std::int32_t>(j) == f.k) continue;
-      for (int d = 0; d < D; ++d) r[c][d] = (pt(row[j])[d] - o[d]) * unit;
+      for (int d = 0; d < D; ++d) r[c][d] = diff(pt(row[j])[d], o[d]);
       ++c;
     }
     double perm;
@@ -247,7 +253,7 @@ DelaunayReport validate(const Delaunay& dt, std::span<const double> points, std:
   rep.volume_sum = std::ldexp(volume_sum, D * unit_exp);
   rep.enclosed_volume = std::ldexp(enclosed_volume, D * unit_exp);
   const double tol = 1e-9 * std::max(std::fabs(volume_sum), std::fabs(enclosed_volume)) + volume_err;
-  if (std::fabs(volume_sum - enclosed_volume) > tol) {
+  if (!(std::fabs(volume_sum - enclosed_volume) <= tol)) {  // NaN fails too
     rep.ok = false;
     std::ostringstream s;
     s << "simplex volumes sum to " << rep.volume_sum << " but the boundary encloses " << rep.enclosed_volume

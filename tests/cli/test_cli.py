@@ -365,6 +365,18 @@ class Voronoi3D(TempDirCase):
         r = self.ok(["voronoi", self.inp, "-o", self.p("u.vtu"), "--validate"])
         self.assertNotIn("outside double's range", r.stdout)
 
+    def test_extent_beyond_double_validates(self):
+        # Points spanning -1e308..1e308: their extent overflows double, but
+        # their domain (padded by 1%) does not. Cells and Delaunay are
+        # computed and validated (until stop 17: a segfault, and a Delaunay
+        # volume check that compared NaNs and passed).
+        huge = self.save("huge.npy", (self.pts * 2 - 1) * 1e308)
+        r = self.ok(["voronoi", huge, "-o", self.p("h.vtu"), "--validate"])
+        self.assertIn("validation: OK", r.stdout)
+        r = self.ok(["delaunay", huge, "-o", self.p("hd.vtu"), "--validate"])
+        self.assertIn("validation passed", r.stdout + r.stderr)
+        self.assertNotIn("nan", (r.stdout + r.stderr).lower())
+
     def test_labels(self):
         labels = np.random.default_rng(5).integers(-1, 3, self.N).astype(np.int32)
         lab = self.save("labels.npy", labels)
@@ -708,6 +720,15 @@ class BadInput(TempDirCase):
         self.fails(["voronoi", self.good3, "-o", self.out(), "--dim", "4"])
         self.fails(["voronoi", self.good3, "-o", self.out(), "--threads", "-1"])
         self.fails(["voronoi", self.good3, "-o", self.out(), "--padding", "-0.1"])
+        # A padding that makes the domain overflow double (a segfault until
+        # stop 17), in 3D and 2D, for cells and for surface nets.
+        labels = self.save("lab50.npy", np.arange(50, dtype=np.int32) % 2)
+        for good in (self.good3, self.good2):
+            for pad in ("1e307", "1e308"):
+                self.fails(["voronoi", good, "-o", self.out("p.vtu" if good == self.good3 else "p.vtp"),
+                            "--padding", pad], "overflows double")
+                self.fails(["surface-nets", good, "--labels", labels, "-o", self.out("s.vtp"), "--padding", pad],
+                           "overflows double")
         self.fails(["voronoi", self.good3, "-o", self.out(), "--no-such-option"])
         self.fails(["bench", "voronoi", self.good3, "--repeat", "0"])
         self.fails(["frobnicate"])
