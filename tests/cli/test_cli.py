@@ -365,6 +365,19 @@ class Voronoi3D(TempDirCase):
         r = self.ok(["voronoi", self.inp, "-o", self.p("u.vtu"), "--validate"])
         self.assertNotIn("outside double's range", r.stdout)
 
+    def test_anisotropic_lattice_validates(self):
+        # A lattice 1e-8 apart across and 1 apart along (voxel centres of an
+        # image with anisotropic spacing): every vertex is an exact tie, the
+        # planes' magnitudes differ by 1e8. Until stop 17 its bins were sized
+        # for the volume density and the run took 49 s.
+        g = np.stack(np.meshgrid(*[np.arange(8.0)] * 3, indexing="ij"), -1).reshape(-1, 3)
+        g[:, 0] *= 1e-8
+        r = self.ok(["voronoi", self.save("slab.npy", g), "-o", self.p("slab.vtu"), "--validate",
+                     "--bounds", "-0.5e-8", "7.5e-8", "-0.5", "7.5", "-0.5", "7.5"])
+        self.assertIn("validation: OK", r.stdout)
+        vol = vtk_to_numpy(cell_array(read_vtu(self.p("slab.vtu")), "Volume"))
+        np.testing.assert_allclose(vol, 1e-8, rtol=1e-9)
+
     def test_extent_beyond_double_validates(self):
         # Points spanning -1e308..1e308: their extent overflows double, but
         # their domain (padded by 1%) does not. Cells and Delaunay are

@@ -359,6 +359,22 @@ TEST(BinLocator, GridShape) {
   BinLocator<2> thin(q, {}, {0, 0}, {1, 1e-9}, 2.0);
   EXPECT_LE(thin.divisions()[0], 41);
   EXPECT_EQ(thin.divisions()[1], 1);
+  // A slab and a needle far thinner than a bin: the thin axes get one
+  // division and the bins are sized for the density over the others, a few
+  // points each (until stop 17 they were sized by the volume density: a
+  // 1e-8-thick slab of 512 lattice points got 2000 bins across each wide
+  // axis, and its cells took 49 s).
+  for (int thin_axes = 1; thin_axes <= 2; ++thin_axes) {
+    std::vector<double> r(3000 * 3);
+    for (std::size_t i = 0; i < 3000; ++i)
+      for (int d = 0; d < 3; ++d) r[3 * i + static_cast<std::size_t>(d)] = (d < thin_axes ? 1e-8 : 1.0) * u(g);
+    const std::array<double, 3> hi = {1e-8, thin_axes == 2 ? 1e-8 : 1.0, 1.0};
+    BinLocator<3> slab(r, {}, {0, 0, 0}, hi, 2.0);
+    for (int d = 0; d < thin_axes; ++d) EXPECT_EQ(slab.divisions()[static_cast<std::size_t>(d)], 1) << thin_axes;
+    const double per_bin = 3000.0 / static_cast<double>(slab.num_bins());
+    EXPECT_GT(per_bin, 1.0) << thin_axes;
+    EXPECT_LT(per_bin, 4.0) << thin_axes;
+  }
 }
 
 // may_have_coincident: false on distinct points (including ones one ulp

@@ -16,6 +16,7 @@
 #pragma once
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -36,6 +37,16 @@ inline constexpr double abs_eps = 0x1p-900;
 /// Beyond this condition number the float solve's position is too inaccurate
 /// for geometry (volumes, merged coordinates): the vertex is solved exactly.
 inline constexpr double exact_vertex_condition = 1e6;
+
+/// floor(log2(x)) for a finite x > 0, clamped to [-1022, 1022] (subnormals
+/// give -1022), read from the bits.
+inline std::int32_t binary_exponent(double x) {
+  const auto biased = static_cast<std::int32_t>((std::bit_cast<std::uint64_t>(x) >> 52) & 0x7FF);
+  return std::clamp(biased - 1023, -1022, 1022);
+}
+
+/// 2^e for e in [-1022, 1023], built from the bits (no libm call).
+inline double pow2(std::int32_t e) { return std::bit_cast<double>(static_cast<std::uint64_t>(e + 1023) << 52); }
 
 /// memmove of `count` elements from base[src] to base[dst] (the ranges may
 /// overlap) as a plain loop: the moves are a few elements long, where a

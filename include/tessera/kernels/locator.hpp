@@ -32,16 +32,35 @@ class BinLocator {
              const Point& hi, double points_per_bin) {
     const std::size_t n = coords.size() / D;
     std::size_t used = use.empty() ? n : static_cast<std::size_t>(std::count(use.begin(), use.end(), 1));
-    double vol = 1;
-    for (int d = 0; d < D; ++d) vol *= hi[d] - lo[d];
     const double target_bins = std::max(1.0, static_cast<double>(used) / std::max(points_per_bin, 0.05));
-    const double h = std::pow(vol / target_bins, 1.0 / D);
+    // Cubic bins of the size that gives target_bins over the box. An axis
+    // thinner than half that size gets one division, and the size is chosen
+    // again over the other axes: a slab 1e-8 thick would otherwise get bins
+    // sized for a volume density, hundreds across its wide axes per point,
+    // and every cell would walk thousands of empty bins.
+    std::array<bool, D> thin{};
+    double h = 0;
+    for (int round = 0; round < D; ++round) {
+      double vol = 1;
+      int wide = 0;
+      for (int d = 0; d < D; ++d)
+        if (!thin[d]) {
+          vol *= hi[d] - lo[d];
+          ++wide;
+        }
+      if (wide == 0) break;
+      h = std::pow(vol / target_bins, 1.0 / wide);
+      bool again = false;
+      for (int d = 0; d < D; ++d)
+        if (!thin[d] && std::round((hi[d] - lo[d]) / h) < 1) thin[d] = again = true;
+      if (!again) break;
+    }
     std::size_t total = 1;
     for (int d = 0; d < D; ++d) {
       lo_[d] = lo[d];
       double extent = hi[d] - lo[d];
       // Cap each axis so the grid stays proportionate to the point count.
-      double divs = std::clamp(std::round(extent / h), 1.0, 1.0 + 4.0 * static_cast<double>(used));
+      double divs = thin[d] ? 1.0 : std::clamp(std::round(extent / h), 1.0, 1.0 + 4.0 * static_cast<double>(used));
       divs_[d] = static_cast<std::int32_t>(std::min(divs, 1e6));
       size_[d] = extent / divs_[d];
       inv_size_[d] = 1.0 / size_[d];

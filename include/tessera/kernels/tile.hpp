@@ -14,6 +14,8 @@
 #include <cstring>
 #include <limits>
 #include <stdexcept>
+#include <tuple>
+#include <utility>
 #include <vector>
 
 #include "tessera/kernels/exact_predicates.hpp"
@@ -196,18 +198,32 @@ class Tile {
     double bmax = std::max(std::fabs(A.d), std::fabs(B.d));
     double cond = inv_norm * amax;
     double err;
-    if (cond < filter::exact_vertex_condition && std::isfinite(ymax)) {
+    if (cond < filter::exact_vertex_condition && std::isfinite(ymax))
       err = filter::vertex_eps * inv_norm * (amax * ymax + bmax);
-    } else {
-      // Too ill-conditioned for a trustworthy float position (the vertex
-      // exists: the exact predicates created it): solve it exactly.
-      std::int32_t ids[2] = {planes_[v.p[0]].id, planes_[v.p[1]].id};
-      exact_vertex(*exact_, gen_, ids, v.y);
-      ymax = std::max(std::fabs(v.y[0]), std::fabs(v.y[1]));
-      err = 4 * filter::u * ymax;
-    }
+    else
+      std::tie(err, ymax) = ill_conditioned(v, inv, ymax);
     v.e = err + filter::plane_eps * ymax;
     set_radius(v, err);
+  }
+
+  // As Hull::ill_conditioned: the bound on the rows scaled to |n|_1 in
+  // [1, 2) (the same y, a bound blind to the rows' magnitudes), else the
+  // exact solve. Returns err and ymax.
+  [[gnu::noinline, gnu::cold]] std::pair<double, double> ill_conditioned(Vertex& v, double inv, double ymax) const {
+    const Plane& A = planes_[v.p[0]];
+    const Plane& B = planes_[v.p[1]];
+    const std::int32_t ea = filter::binary_exponent(A.n1), eb = filter::binary_exponent(B.n1);
+    const double sa = filter::pow2(-ea), sb = filter::pow2(-eb);
+    const double na = A.n1 * sa, nb = B.n1 * sb;
+    const double inv_norm = (na + nb) * (std::fabs(inv) * filter::pow2(ea) * filter::pow2(eb));
+    const double amax = std::max(na, nb);
+    const double bmax = std::max(std::fabs(A.d) * sa, std::fabs(B.d) * sb);
+    if (inv_norm * amax < filter::exact_vertex_condition && std::isfinite(ymax))  // false on NaN
+      return {filter::vertex_eps * inv_norm * (amax * ymax + bmax), ymax};
+    std::int32_t ids[2] = {A.id, B.id};
+    exact_vertex(*exact_, gen_, ids, v.y);
+    ymax = std::max(std::fabs(v.y[0]), std::fabs(v.y[1]));
+    return {4 * filter::u * ymax, ymax};
   }
 
   static void set_radius(Vertex& v, double err) {
