@@ -6,6 +6,8 @@
 // padded with spaces and ended by '\n', then the raw array data.
 #include "tessera/io/npy.hpp"
 
+#include <sys/stat.h>
+
 #include <algorithm>
 #include <bit>
 #include <cerrno>
@@ -287,12 +289,21 @@ void convert(const std::string& path, const Header& h, const unsigned char* src,
 /// straight into `out`; other dtypes go through a bounded conversion buffer.
 template <class Out>
 void read_data(const std::string& path, std::FILE* f, const Header& h, std::vector<Out>& out) {
-  out.resize(h.count);
   const std::size_t total_bytes = h.count * static_cast<std::size_t>(h.item_size);
   auto truncated = [&](std::size_t got) {
     detail::fail(path, "truncated data: expected " + std::to_string(total_bytes) + " bytes for shape " +
                            shape_string(h.shape) + " " + h.descr + ", found " + std::to_string(got));
   };
+  // A header may claim any shape: check that the file holds the data before
+  // allocating for it (a claim of 2^31 x 2 items otherwise ended in "out of
+  // memory").
+  struct stat st;
+  const long pos = std::ftell(f);
+  if (pos >= 0 && ::fstat(::fileno(f), &st) == 0 && S_ISREG(st.st_mode)) {
+    const std::size_t avail = st.st_size > pos ? static_cast<std::size_t>(st.st_size - pos) : 0;
+    if (avail < total_bytes) truncated(avail);
+  }
+  out.resize(h.count);
   const bool same_type = sizeof(Out) == static_cast<std::size_t>(h.item_size) &&
                          ((std::is_floating_point_v<Out> && h.kind == 'f') ||
                           (std::is_signed_v<Out> && std::is_integral_v<Out> && h.kind == 'i'));

@@ -213,6 +213,13 @@ TEST(Npy, TruncatedData) {
   std::string full = make_npy("<f8", "(2, 3)", raw_bytes(d));
   msg = input_error([&] { read_points(dir.write("th.npy", full.substr(0, 30))); });
   EXPECT_NE(msg.find("truncated"), std::string::npos) << msg;
+  // A header claiming far more data than the file holds (here 48 GiB) is
+  // truncated data, reported before anything is allocated for it (it was
+  // "out of memory", exit 1).
+  msg = input_error([&] { read_points(dir.write("big.npy", make_npy("<f8", "(2147483648, 3)", raw_bytes(d)))); });
+  EXPECT_NE(msg.find("truncated data: expected 51539607552 bytes"), std::string::npos) << msg;
+  msg = input_error([&] { tessera::io::read_labels_npy(dir.write("bigl.npy", make_npy("<i4", "(4294967296,)", raw_bytes(d)))); });
+  EXPECT_NE(msg.find("truncated"), std::string::npos) << msg;
 }
 
 TEST(Npy, BadMagicAndDtype) {
