@@ -29,8 +29,8 @@ std::string num(double v) {
   return std::string(buf, r.ptr);
 }
 
-/// Length of the diagonal of the bounding box of all points.
-double bbox_diagonal(std::span<const double> coords, int dim) {
+/// `r` times the length of the diagonal of the bounding box of all points.
+double times_diagonal(double r, std::span<const double> coords, int dim) {
   const std::size_t n = coords.size() / static_cast<std::size_t>(dim);
   double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
   for (int d = 0; d < dim; ++d) lo[d] = hi[d] = coords[static_cast<std::size_t>(d)];
@@ -42,7 +42,16 @@ double bbox_diagonal(std::span<const double> coords, int dim) {
     }
   double s = 0;
   for (int d = 0; d < dim; ++d) s += (hi[d] - lo[d]) * (hi[d] - lo[d]);
-  return std::sqrt(s);
+  if (std::isfinite(s) && s > 1e-290) return r * std::sqrt(s);
+  // Extents past ~1e154 overflow the sum of squares (and past ~1e308 the
+  // extents themselves), below ~1e-154 they underflow it: scale by the
+  // largest half extent m instead, and apply r to m first.
+  double half[3] = {0, 0, 0}, m = 0;
+  for (int d = 0; d < dim; ++d) m = std::max(m, half[d] = 0.5 * hi[d] - 0.5 * lo[d]);
+  if (m == 0) return 0;
+  double t = 0;
+  for (int d = 0; d < dim; ++d) t += (half[d] / m) * (half[d] / m);
+  return (r * m) * (2 * std::sqrt(t));  // may overflow: joggle() reports it
 }
 
 }  // namespace
@@ -70,8 +79,11 @@ std::vector<double> joggle(std::span<const double> coords, int dim, const Joggle
 
   std::vector<double> out(coords.begin(), coords.end());
   if (n == 0) return out;
-  const double radius = options.absolute ? options.radius : options.radius * bbox_diagonal(coords, dim);
+  const double radius = options.absolute ? options.radius : times_diagonal(options.radius, coords, dim);
   if (radius == 0) return out;
+  if (!std::isfinite(radius))
+    throw InputError("joggle: the displacement radius (" + num(options.radius) +
+                     " of the bounding box's diagonal) overflows double; give a smaller radius");
 
   // The axes that move: all of them (ball), or the two of the plane.
   int axes[3] = {0, 1, 2};
@@ -98,6 +110,10 @@ std::vector<double> joggle(std::span<const double> coords, int dim, const Joggle
     tbb::task_arena arena(threads);
     arena.execute([&] { tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, kGrain), body); });
   }
+  for (std::size_t k = 0; k < out.size(); ++k)
+    if (!std::isfinite(out[k]))
+      throw InputError("joggle: point " + std::to_string(k / stride) + " moved past double's range (radius " +
+                       num(radius) + "); give a smaller radius");
   return out;
 }
 

@@ -68,6 +68,35 @@ TEST(PrepJoggle, RelativeRadiusIsAFractionOfTheDiagonal) {
   EXPECT_GT(largest, 0.45);
 }
 
+// Extents whose squares overflow or underflow double: the relative radius is
+// still the asked fraction of the diagonal (until stop 17, extents past
+// ~1.3e154 gave infinite points with exit 0, and below ~1e-154 nothing moved).
+TEST(PrepJoggle, RelativeRadiusAtExtremeExtents) {
+  for (const double scale : {2e154, 1e300, 1e-170, 1e-300}) {
+    std::vector<double> p = {0, 0, 0, 3 * scale, 4 * scale, 0};  // diagonal 5 scale
+    for (int i = 0; i < 200; ++i) p.insert(p.end(), {1.5 * scale, 2.0 * scale, 0.0});
+    JoggleOptions o;
+    o.radius = 0.1;
+    const auto q = tessera::joggle(p, 3, o);
+    double largest = 0;
+    for (std::size_t i = 0; i < p.size() / 3; ++i) {
+      double m = 0;
+      for (int d = 0; d < 3; ++d) m = std::max(m, std::fabs(q[3 * i + static_cast<std::size_t>(d)] - p[3 * i + static_cast<std::size_t>(d)]));
+      largest = std::max(largest, m / scale);  // the largest component, in units of scale
+    }
+    for (double x : q) EXPECT_TRUE(std::isfinite(x)) << scale;
+    EXPECT_LE(largest, 0.5 * (1 + 1e-9)) << scale;
+    EXPECT_GT(largest, 0.2) << scale;
+  }
+  // A radius that moves points past double's range is an input error.
+  std::vector<double> h = {-1.7e308, 0, 1.7e308, 0};
+  JoggleOptions big;
+  big.radius = 0.3;
+  EXPECT_THROW(tessera::joggle(h, 2, big), tessera::InputError);
+  big.radius = 1e-4;
+  for (double x : tessera::joggle(h, 2, big)) EXPECT_TRUE(std::isfinite(x));
+}
+
 TEST(PrepJoggle, TwoDimensionalDisk) {
   const std::size_t n = 20000;
   const auto p = random_points(n, 2, 2);
