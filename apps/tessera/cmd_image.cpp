@@ -29,18 +29,29 @@ constexpr const char* kImageHelp =
     ".mha/.mhd (MetaImage, raw or compressed) or .vti (VTK XML ImageData, any data mode)";
 
 void add_read_options(CLI::App* app, ImageReadArgs& r) {
-  app->add_option("--spacing", r.spacing,
-                  "Voxel spacing sx,sy[,sz] (default: from the image file; 1 for .npy)")
-      ->expected(2, 3)
-      ->type_name("SX,SY[,SZ]")
-      ->delimiter(',')
-      ->allow_extra_args(false);
-  app->add_option("--origin", r.origin,
-                  "Position ox,oy[,oz] of the centre of voxel (0,0,0) (default: from the image file; 0 for .npy)")
-      ->expected(2, 3)
-      ->type_name("OX,OY[,OZ]")
-      ->delimiter(',')
-      ->allow_extra_args(false);
+  // One comma-separated word each: with 2 or 3 values expected, CLI11 also
+  // took the next word when a 2D image got two ("--spacing 1,1 IMAGE"
+  // swallowed IMAGE).
+  auto numbers = [](std::vector<double>& out, const char* what) {
+    return [&out, what](const std::string& text) {
+      // Thrown as CLI11's own error: the parse reports it like any bad option.
+      out.clear();
+      try {
+        for (const std::string& w : split_commas(text)) out.push_back(parse_number(w, what, false));
+      } catch (const InputError& e) {
+        throw CLI::ValidationError(e.what());
+      }
+      if (out.size() != 2 && out.size() != 3)
+        throw CLI::ValidationError(std::string(what) + ": expected 2 or 3 comma-separated numbers, got '" + text + "'");
+    };
+  };
+  app->add_option_function<std::string>("--spacing", numbers(r.spacing, "--spacing"),
+                                         "Voxel spacing sx,sy[,sz] (default: from the image file; 1 for .npy)")
+      ->type_name("SX,SY[,SZ]");
+  app->add_option_function<std::string>(
+         "--origin", numbers(r.origin, "--origin"),
+         "Position ox,oy[,oz] of the centre of voxel (0,0,0) (default: from the image file; 0 for .npy)")
+      ->type_name("OX,OY[,OZ]");
   app->add_option("--array", r.array, ".vti: the point-data array to read (default: the active scalars, else the first)");
 }
 
@@ -70,10 +81,12 @@ io::ImageReadOptions read_options(const ImageReadArgs& r) {
   return o;
 }
 
-/// A 2-number --spacing/--origin cannot describe a 3D image.
+/// --spacing/--origin must have as many values as the image has axes.
 void check_read_dims(const ImageReadArgs& r, const ImageGeometry& g, const std::string& path) {
   if (g.dim == 3 && (r.spacing.size() == 2 || r.origin.size() == 2))
     throw InputError(path + ": a 3D image needs 3 values for --spacing / --origin");
+  if (g.dim == 2 && (r.spacing.size() == 3 || r.origin.size() == 3))
+    throw InputError(path + ": a 2D image takes 2 values for --spacing / --origin, not 3");
 }
 
 std::string size_string(const ImageGeometry& g) {

@@ -54,16 +54,6 @@ io::PointCloud read_prep_input(const PrepInput& p, bool with_labels) {
   return io::read_points(p.input, ro);
 }
 
-/// Parses a number the way the user wrote it ("inf", "-inf" allowed when `allow_inf`).
-double parse_number(const std::string& word, const std::string& what, bool allow_inf) {
-  char* end = nullptr;
-  errno = 0;
-  const double v = std::strtod(word.c_str(), &end);
-  if (word.empty() || end != word.c_str() + word.size() || std::isnan(v) || (!allow_inf && !std::isfinite(v)))
-    throw InputError(what + ": '" + word + "' is not a " + (allow_inf ? "number" : "finite number"));
-  return v;
-}
-
 std::int32_t parse_label(const std::string& word, const std::string& what) {
   char* end = nullptr;
   errno = 0;
@@ -71,17 +61,6 @@ std::int32_t parse_label(const std::string& word, const std::string& what) {
   if (word.empty() || end != word.c_str() + word.size() || errno == ERANGE || v < INT32_MIN || v > INT32_MAX)
     throw InputError(what + ": '" + word + "' is not a 32-bit integer label");
   return static_cast<std::int32_t>(v);
-}
-
-std::vector<std::string> split_commas(const std::string& s) {
-  std::vector<std::string> out(1);
-  for (char c : s) {
-    if (c == ',')
-      out.emplace_back();
-    else if (c != ' ')
-      out.back() += c;
-  }
-  return out;
 }
 
 std::string written_list(const std::vector<std::string>& written) {

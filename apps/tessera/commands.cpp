@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cctype>
 #include <chrono>
+#include <cerrno>
 #include <cmath>
 #include <cstdarg>
 #include <cstdio>
@@ -430,6 +431,26 @@ int run_default(const DemoArgs& a) {
     std::fflush(stdout);
   }
   return kExitOk;
+}
+
+double parse_number(const std::string& word, const std::string& what, bool allow_inf) {
+  char* end = nullptr;
+  errno = 0;
+  const double v = std::strtod(word.c_str(), &end);
+  if (word.empty() || end != word.c_str() + word.size() || std::isnan(v) || (!allow_inf && !std::isfinite(v)))
+    throw InputError(what + ": '" + word + "' is not a " + (allow_inf ? "number" : "finite number"));
+  return v;
+}
+
+std::vector<std::string> split_commas(const std::string& s) {
+  std::vector<std::string> out(1);
+  for (char c : s) {
+    if (c == ',')
+      out.emplace_back();
+    else if (c != ' ')
+      out.back() += c;
+  }
+  return out;
 }
 
 }  // namespace tessera::cli

@@ -264,6 +264,11 @@ struct Usage {
 };
 Usage usage_now();
 std::string extension(const std::string& path);  ///< lower-cased, with the dot; "" if none
+/// A number as the user wrote it ("inf", "-inf" allowed when `allow_inf`);
+/// InputError("WHAT: 'WORD' is not a ...") otherwise.
+double parse_number(const std::string& word, const std::string& what, bool allow_inf);
+/// The comma-separated words of `s`, spaces dropped ("" gives one empty word).
+std::vector<std::string> split_commas(const std::string& s);
 void check_bounds_arg(const std::vector<double>& bounds);  ///< InputError unless 4 or 6 valid numbers
 io::PointCloud read_input(const ComputeArgs& args);        ///< read and check INPUT (InputError)
 VoronoiOptions make_options(const ComputeArgs& args, int dim);

@@ -279,6 +279,16 @@ class BadImageInput(base.TempDirCase):
         self.fails(["sample-image", self.vti, "-o", out, "--output", "nope"], "--output")
         lab = self.save("lab_in.npy", self.lab.astype(np.int32))
         self.fails(["sample-image", lab, "-o", out, "--spacing", "1,2"], "3 values")
+        # --spacing / --origin take one comma-separated word: two values no
+        # longer swallow the next positional (stop 17), and a wrong count or
+        # word is a one-line error.
+        im2 = self.save("im2.npy", np.array([[0, 1], [1, 1]], dtype=np.int32))
+        pts2 = self.save("p2.npy", np.array([[0.5, 0.5]]))
+        self.ok(["sample-image", "--spacing", "1,1", im2, "-o", self.p("ok.npy"), "-q"])
+        self.ok(["probe", im2, "--origin", "0,0", pts2, "-o", self.p("pr.npy"), "-q"])
+        for bad, what in (("1", "2 or 3"), ("1,2,3,4", "2 or 3"), ("1,x", "'x'"), ("1,nan", "'nan'")):
+            self.fails(["sample-image", "--spacing", bad, im2, "-o", out], what, outputs=[out])
+        self.fails(["sample-image", im2, "--origin", "1,1,1", "-o", out], "2D image takes 2 values", outputs=[out])
         fl = self.save("float.npy", np.zeros((3, 4, 5)))
         self.fails(["sample-image", fl, "-o", out], "float")
 
