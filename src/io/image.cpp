@@ -62,6 +62,11 @@ void check_geometry(const std::string& path, const ImageGeometry& g) {
     if (!(s > 0) || !std::isfinite(s))
       fail(path, "spacing along axis " + std::to_string(a) + " must be a finite number > 0");
     if (!std::isfinite(o)) fail(path, "origin along axis " + std::to_string(a) + " must be finite");
+    // The last voxel centre (and the half voxel beyond it that bounds the
+    // image's domain) must be representable: samples there were infinite.
+    const double last = static_cast<double>(g.size[static_cast<std::size_t>(a)] - 1);
+    if (!std::isfinite(o + (last + 0.5) * s) || !std::isfinite(o - 0.5 * s))
+      fail(path, "voxel centres along axis " + std::to_string(a) + " (origin + index x spacing) pass double's range");
   }
 }
 

@@ -289,6 +289,9 @@ class BadImageInput(base.TempDirCase):
         for bad, what in (("1", "2 or 3"), ("1,2,3,4", "2 or 3"), ("1,x", "'x'"), ("1,nan", "'nan'")):
             self.fails(["sample-image", "--spacing", bad, im2, "-o", out], what, outputs=[out])
         self.fails(["sample-image", im2, "--origin", "1,1,1", "-o", out], "2D image takes 2 values", outputs=[out])
+        # Voxel centres past double's range (they were written as inf, exit 0).
+        for cmd in (["sample-image", im2, "-o", out], ["surface-nets", "--image", im2, "-o", self.p("s.vtp")]):
+            self.fails(cmd + ["--spacing", "1e308,1", "--origin", "1e308,0"], "pass double's range", outputs=[out])
         fl = self.save("float.npy", np.zeros((3, 4, 5)))
         self.fails(["sample-image", fl, "-o", out], "float")
 
