@@ -62,29 +62,32 @@ def cell_array(data, name):
     return a
 
 
+def cell_faces(faces, loc):
+    """The faces (arrays of point ids) of the polyhedron whose record starts at
+    `loc` in a VTK face stream."""
+    k = int(loc)
+    out = []
+    for _ in range(int(faces[k])):
+        m = int(faces[k + 1])
+        out.append(faces[k + 2:k + 2 + m])
+        k += 1 + m
+    return out
+
+
+def faces_volume(pts, cell):
+    """Signed volume enclosed by a cell's faces (divergence theorem over fan
+    triangles): positive iff they are counter-clockwise seen from outside."""
+    return sum(np.dot(p[0], np.cross(p[1:-1], p[2:]).sum(axis=0)) for p in (pts[ids] for ids in cell)) / 6.0
+
+
 def polyhedron_volumes(grid):
-    """Signed volume of every polyhedron from the VTK face stream (divergence
-    theorem over fan triangles): positive iff faces are counter-clockwise seen
-    from outside, as VTK expects."""
+    """Signed volume of every polyhedron from the VTK face stream, as VTK
+    expects it (see faces_volume), and its number of faces."""
     pts = vtk_to_numpy(grid.GetPoints().GetData())
     faces = vtk_to_numpy(grid.GetFaces())
-    locs = vtk_to_numpy(grid.GetFaceLocations())
-    vols = np.zeros(grid.GetNumberOfCells())
-    nfaces = np.zeros(grid.GetNumberOfCells(), dtype=np.int64)
-    for c, loc in enumerate(locs):
-        k = int(loc)
-        nf = int(faces[k])
-        k += 1
-        nfaces[c] = nf
-        v = 0.0
-        for _ in range(nf):
-            npts = int(faces[k])
-            ids = faces[k + 1:k + 1 + npts]
-            k += 1 + npts
-            p = pts[ids]
-            v += np.dot(p[0], np.cross(p[1:-1], p[2:]).sum(axis=0))
-        vols[c] = v / 6.0
-    return vols, nfaces
+    cells = [cell_faces(faces, loc) for loc in vtk_to_numpy(grid.GetFaceLocations())]
+    return (np.array([faces_volume(pts, c) for c in cells]),
+            np.array([len(c) for c in cells], dtype=np.int64))
 
 
 def polygon_areas(poly):
@@ -294,18 +297,11 @@ class Voronoi3D(TempDirCase):
         locs = vtk_to_numpy(g.GetFaceLocations())
         vol = vtk_to_numpy(cell_array(g, "Volume"))
         for c in [0, 1, 4094, 4095, 4096, 4097, 8190, 8191, 8192, 8193, n - 1]:
-            k = int(locs[c])
-            nf = int(faces[k])
-            k += 1
-            v, order = 0.0, []
-            for _ in range(nf):
-                m = int(faces[k])
-                ids = faces[k + 1:k + 1 + m]
-                k += 1 + m
-                p = pts_out[ids]
-                v += np.dot(p[0], np.cross(p[1:-1], p[2:]).sum(axis=0))
+            cell = cell_faces(faces, locs[c])
+            order = []
+            for ids in cell:
                 order.extend(int(i) for i in ids if int(i) not in order)
-            self.assertAlmostEqual(v / 6.0, vol[c], delta=1e-12, msg="cell %d" % c)
+            self.assertAlmostEqual(faces_volume(pts_out, cell), vol[c], delta=1e-12, msg="cell %d" % c)
             cell_ids = g.GetCell(c).GetPointIds()
             self.assertEqual([cell_ids.GetId(i) for i in range(cell_ids.GetNumberOfIds())], order,
                              "cell %d: its points are its face vertices in first-appearance order" % c)
