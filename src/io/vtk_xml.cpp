@@ -82,16 +82,6 @@ class BlockWriter {
     flush();
     if (os_) os_.write(static_cast<const char*>(p), static_cast<std::streamsize>(n));
   }
-  /// Room for `n` <= capacity() bytes, filled through the returned cursor and
-  /// closed with commit(cursor): hot loops then store values without a bounds
-  /// check per element.
-  char* reserve(std::size_t n) {
-    if (used_ + n > kSize) flush();
-    return buf_.data() + used_;
-  }
-  void commit(const char* end) { used_ = static_cast<std::size_t>(end - buf_.data()); }
-  static constexpr std::size_t capacity() { return kSize; }
-
   void flush() {
     if (used_ == 0) return;
     if (os_) os_.write(buf_.data(), static_cast<std::streamsize>(used_));
