@@ -288,7 +288,9 @@ int run_sample_image(const SampleImageArgs& a) {
   const LabelImage img = io::read_label_image(a.image, read_options(s.read));
   check_read_dims(s.read, img.geometry, a.image);
   const LabelledPoints pts = sample_named(a.image, img, o);
-  const auto written = io::write_points(a.output, pts);
+  io::WritePointsOptions wo;
+  wo.labelled = true;  // every sample is labelled, even when none was drawn
+  const auto written = io::write_points(a.output, pts, wo);
   if (!a.quiet) {
     std::printf("tessera sample-image: %zu points (%dD) from %s (%s voxels, %s output) in %.3f s; wrote %s\n",
                 pts.size(), pts.dim, a.image.c_str(), size_string(img.geometry).c_str(), s.output.c_str(),

@@ -54,7 +54,7 @@ void put_le(char*& p, T v) {
 void write_ply(const std::string& path, const LabelledPoints& pts, const WritePointsOptions& opt) {
   const std::size_t n = pts.size();
   const auto dim = static_cast<std::size_t>(pts.dim);
-  const bool labelled = !pts.labels.empty();
+  const bool labelled = !pts.labels.empty() || opt.labelled;
   std::string header = "ply\nformat binary_little_endian 1.0\ncomment written by tessera";
   if (pts.dim == 2) header += " (2D points, z = 0)";
   header += "\nelement vertex " + std::to_string(n) + "\nproperty double x\nproperty double y\nproperty double z\n";
@@ -92,7 +92,8 @@ void write_vtp(const std::string& path, const LabelledPoints& pts, const WritePo
   pd.dim = pts.dim;
   pd.points = pts.coords;
   pd.verts = CellArray{offsets, connectivity};
-  if (!pts.labels.empty()) pd.point_data.push_back({"label", std::span<const std::int32_t>(pts.labels), 1});
+  if (!pts.labels.empty() || opt.labelled)
+    pd.point_data.push_back({"label", std::span<const std::int32_t>(pts.labels), 1});
   for (const auto& [name, values] : opt.scalars) pd.point_data.push_back({name, values, 1});
   write_polydata(path, pd);
 }
@@ -107,7 +108,7 @@ std::vector<std::string> write_points(const std::string& path, const LabelledPoi
     throw InputError("cannot write " + path + ": " + std::to_string(points.coords.size()) +
                      " coordinates are not a whole number of " + std::to_string(points.dim) + "D points");
   const std::size_t n = points.size();
-  if (!points.labels.empty() && points.labels.size() != n)
+  if ((!points.labels.empty() || options.labelled) && points.labels.size() != n)
     throw InputError("cannot write " + path + ": " + std::to_string(points.labels.size()) + " labels for " +
                      std::to_string(n) + " points");
   for (std::size_t k = 0; k < options.scalars.size(); ++k) {
@@ -126,8 +127,8 @@ std::vector<std::string> write_points(const std::string& path, const LabelledPoi
   if (ext == ".npy") {
     // All paths first, so that a bad sidecar path stops the run before any write.
     std::vector<std::string> paths{path};
-    if (!points.labels.empty())
-      paths.push_back(options.labels_path.empty() ? sidecar(path, "_labels.npy") : options.labels_path);
+    const bool labelled = !points.labels.empty() || options.labelled;
+    if (labelled) paths.push_back(options.labels_path.empty() ? sidecar(path, "_labels.npy") : options.labels_path);
     for (const auto& s : options.scalars) paths.push_back(sidecar(path, "_" + s.first + ".npy"));
     for (std::size_t a = 0; a < paths.size(); ++a) {
       for (std::size_t b = 0; b < a; ++b)
@@ -136,7 +137,7 @@ std::vector<std::string> write_points(const std::string& path, const LabelledPoi
     }
     std::size_t k = 0;
     write_file_atomic(paths[k++], npy_bytes(points.coords.data(), {n, static_cast<std::size_t>(points.dim)}));
-    if (!points.labels.empty()) write_file_atomic(paths[k++], npy_bytes(points.labels.data(), {n}));
+    if (labelled) write_file_atomic(paths[k++], npy_bytes(points.labels.data(), {n}));
     for (const auto& s : options.scalars) write_file_atomic(paths[k++], npy_bytes(s.second.data(), {n}));
     return paths;
   }

@@ -4,6 +4,7 @@
 
 #include <cstdlib>
 #include <fstream>
+#include <iterator>
 #include <random>
 #include <string>
 #include <vector>
@@ -152,6 +153,27 @@ print("ok")
     const std::string cmd = std::string(py) + " " + script + " " + vtp + " " + ref + " " + std::to_string(dim);
     EXPECT_EQ(std::system(cmd.c_str()), 0) << cmd;
   }
+}
+
+// A labelled output with zero points keeps its labels (an empty sidecar, the
+// "label" property): an empty label array alone reads as "unlabelled", and
+// sample-image's output of an image with nothing to sample lost them.
+TEST(PrepWritePoints, ZeroLabelledPointsKeepTheirLabels) {
+  TempDir dir;
+  tessera::LabelledPoints none;
+  none.dim = 3;
+  tessera::io::WritePointsOptions wo;
+  wo.labelled = true;
+  EXPECT_EQ(tessera::io::write_points(dir.file("z.npy"), none, wo),
+            (std::vector<std::string>{dir.file("z.npy"), dir.file("z_labels.npy")}));
+  EXPECT_TRUE(tessera::io::read_labels_npy(dir.file("z_labels.npy")).empty());
+  tessera::io::write_points(dir.file("z.ply"), none, wo);
+  std::ifstream ply(dir.file("z.ply"), std::ios::binary);
+  const std::string header((std::istreambuf_iterator<char>(ply)), std::istreambuf_iterator<char>());
+  EXPECT_NE(header.find("property int label"), std::string::npos) << header;
+  EXPECT_EQ(tessera::io::write_points(dir.file("u.npy"), none).size(), 1u);  // unlabelled: no sidecar
+  // Asking for labels on points that have none is a caller's error.
+  EXPECT_THROW(tessera::io::write_points(dir.file("x.ply"), sample(3, 3, false), wo), tessera::InputError);
 }
 
 TEST(PrepWritePoints, BadArgumentsWriteNothing) {

@@ -49,6 +49,11 @@ struct WritePointsOptions {
   /// .npy output only: where the labels go ("" = OUT with "_labels.npy" in
   /// place of ".npy"); nothing is written when the points have no labels.
   std::string labels_path;
+  /// Write the labels (the .npy sidecar, the "label" property or array) even
+  /// when there are none because there are no points: an empty `labels`
+  /// otherwise means "unlabelled", and a labelled output of zero points lost
+  /// its labels file.
+  bool labelled = false;
   /// Extra per-point double arrays (name, n values): properties of .ply,
   /// point data of .vtp; for .npy each goes to OUT with "_<name>.npy".
   std::vector<std::pair<std::string, std::span<const double>>> scalars;
