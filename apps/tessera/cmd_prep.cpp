@@ -193,15 +193,11 @@ int run_joggle(const JoggleArgs& a) {
   out.labels = pc.labels;
   double largest = 0;
   for (std::size_t i = 0; i < pc.n; ++i) {
-    // Scaled by the largest component: squares of displacements below
-    // ~1e-154 underflow (and the summary said 0 for points that moved).
-    double dx[3] = {0, 0, 0}, m = 0;
-    for (int d = 0; d < pc.dim; ++d)
-      m = std::max(m, dx[d] = std::fabs(out.coords[i * pc.dim + d] - pc.coords[i * pc.dim + d]));
-    if (m == 0) continue;
-    double s = 0;
-    for (int d = 0; d < pc.dim; ++d) s += (dx[d] / m) * (dx[d] / m);
-    largest = std::max(largest, m * std::sqrt(s));
+    // std::hypot: squares of displacements below ~1e-154 underflow (the
+    // summary said 0 for points that moved).
+    double dx[3] = {0, 0, 0};
+    for (int d = 0; d < pc.dim; ++d) dx[d] = out.coords[i * pc.dim + d] - pc.coords[i * pc.dim + d];
+    largest = std::max(largest, std::hypot(dx[0], dx[1], dx[2]));
   }
   const std::vector<std::string> written = io::write_points(a.io.output, out);
   if (!a.io.quiet)

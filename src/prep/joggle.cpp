@@ -44,14 +44,11 @@ double times_diagonal(double r, std::span<const double> coords, int dim) {
   for (int d = 0; d < dim; ++d) s += (hi[d] - lo[d]) * (hi[d] - lo[d]);
   if (std::isfinite(s) && s > 1e-290) return r * std::sqrt(s);
   // Extents past ~1e154 overflow the sum of squares (and past ~1e308 the
-  // extents themselves), below ~1e-154 they underflow it: scale by the
-  // largest half extent m instead, and apply r to m first.
-  double half[3] = {0, 0, 0}, m = 0;
-  for (int d = 0; d < dim; ++d) m = std::max(m, half[d] = 0.5 * hi[d] - 0.5 * lo[d]);
-  if (m == 0) return 0;
-  double t = 0;
-  for (int d = 0; d < dim; ++d) t += (half[d] / m) * (half[d] / m);
-  return (r * m) * (2 * std::sqrt(t));  // may overflow: joggle() reports it
+  // extents themselves), below ~1e-154 they underflow it: std::hypot of the
+  // half extents does neither.
+  double half[3] = {0, 0, 0};
+  for (int d = 0; d < dim; ++d) half[d] = 0.5 * hi[d] - 0.5 * lo[d];
+  return (2 * r) * std::hypot(half[0], half[1], half[2]);  // may overflow: joggle() reports it
 }
 
 }  // namespace
