@@ -14,6 +14,7 @@
 #include <CLI/CLI.hpp>
 
 #include "commands.hpp"
+#include "option_checks.hpp"
 #include "tessera/io/atomic_file.hpp"
 #include "tessera/io/image.hpp"
 #include "tessera/io/npy.hpp"
@@ -230,7 +231,7 @@ void add_image_commands(CLI::App& app, ImageCommands& c) {
   s->add_option("--threads", c.sample.sampler.threads,
                 "Worker threads (default 0: $TESSERA_NUM_THREADS, else all cores). Results are identical for any "
                 "thread count")
-      ->check(CLI::NonNegativeNumber);
+      ->check(NonNegative);
   s->add_option("--output", c.sample.sampler.output,
                 "Which points: all, labelled (voxels of selected labels) or background (the others)")
       ->check(CLI::IsMember({"all", "labelled", "background"}))
@@ -262,7 +263,7 @@ void add_image_commands(CLI::App& app, ImageCommands& c) {
                 "Value for points outside the box of voxel centres (a number, nan, inf or -inf)")
       ->capture_default_str();
   p->add_option("--threads", c.probe.threads, "Worker threads (default 0: $TESSERA_NUM_THREADS, else all cores)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(NonNegative);
   p->add_flag("-q,--quiet", c.probe.quiet, "No summary line");
   p->footer(
       "A point is inside when it lies in the box spanned by the voxel centres, far faces included.\n"

@@ -13,6 +13,7 @@
 #include <CLI/CLI.hpp>
 
 #include "commands.hpp"
+#include "option_checks.hpp"
 #include "tessera/io/atomic_file.hpp"
 #include "tessera/io/npy.hpp"
 #include "tessera/io/points.hpp"
@@ -80,7 +81,7 @@ void add_prep_commands(CLI::App& app, PrepCommands& c) {
   add_input_options(j, c.joggle.io, true);
   j->add_option("--radius", c.joggle.radius,
                 "Largest displacement: a fraction of the bounding-box diagonal, or a length with --absolute")
-      ->check(CLI::NonNegativeNumber)
+      ->check(NonNegative)
       ->capture_default_str();
   j->add_flag("--absolute", c.joggle.absolute, "--radius is a length, not a fraction of the diagonal");
   j->add_option("--mode", c.joggle.mode,
@@ -94,7 +95,7 @@ void add_prep_commands(CLI::App& app, PrepCommands& c) {
   j->add_option("--seed", c.joggle.seed, "Random seed (each point's displacement depends on seed and id only)")
       ->capture_default_str();
   j->add_option("--threads", c.joggle.threads, "Worker threads (default 0: $TESSERA_NUM_THREADS, else all cores)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(NonNegative);
   j->footer("Examples:\n  tessera joggle lattice.npy -o jittered.npy --radius 1e-6\n"
             "  tessera joggle slab.ply --mode xy --radius 0.01 --absolute -o out.ply");
 
@@ -123,7 +124,7 @@ void add_prep_commands(CLI::App& app, PrepCommands& c) {
       ->capture_default_str();
   f->add_option("--seed", c.fill.seed, "Random seed (joggle; adaptive sampling)")->capture_default_str();
   f->add_option("--threads", c.fill.threads, "Worker threads (default 0: $TESSERA_NUM_THREADS, else all cores)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(NonNegative);
   f->footer("The input points come first, unchanged, with their labels (or --in-label); the added points follow.\n"
             "Examples:\n  tessera fill grains.ply --labels grain --bin-points 4 -o filled.ply\n"
             "  tessera fill pts.csv --dim 2 --strategy adaptive --bounds 0,1,0,1 -o filled.npy");

@@ -16,6 +16,7 @@
 #include <CLI/CLI.hpp>
 
 #include "commands.hpp"
+#include "option_checks.hpp"
 #include "progress.hpp"
 #include "tessera/io/atomic_file.hpp"
 #include "tessera/io/dual.hpp"
@@ -255,7 +256,7 @@ void add_surface_nets_options(CLI::App* app, SurfaceNetsArgs& a, bool bench) {
                     "VertexKind (0 surface, 1 junction, 2 corner)");
     app->add_flag("-q,--quiet", a.quiet, "No summary and no progress bar");
   } else {
-    app->add_option("--repeat", a.repeat, "Number of timed runs")->check(CLI::PositiveNumber)->capture_default_str();
+    app->add_option("--repeat", a.repeat, "Number of timed runs")->check(Positive)->capture_default_str();
   }
   app->add_option("--select", a.select,
                   "Labels L1,L2,... to wrap (default: every label >= 0); points of other labels act as outside "

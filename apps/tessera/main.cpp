@@ -15,17 +15,19 @@
 #include <CLI/CLI.hpp>
 
 #include "commands.hpp"
+#include "option_checks.hpp"
 #include "tessera/cells.hpp"
 
 namespace {
 
 using namespace tessera::cli;
 
-/// One line, whatever the message contains.
+/// One line, whatever the message contains: control characters (a newline,
+/// or a form feed quoted from a file's header) become spaces.
 void print_error(const std::string& msg) {
   std::string line = msg;
   for (char& c : line)
-    if (c == '\n' || c == '\r') c = ' ';
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = ' ';
   std::fprintf(stderr, "tessera: error: %s\n", line.c_str());
 }
 
@@ -60,17 +62,17 @@ void add_compute_options(CLI::App* app, ComputeArgs& c, std::vector<std::string>
       ->type_name("X0 X1 Y0 Y1 [Z0 Z1]");
   app->add_option("--padding", c.padding,
                   "Margin of the default domain, as a fraction of the largest extent of the points")
-      ->check(CLI::NonNegativeNumber)
+      ->check(NonNegative)
       ->capture_default_str();
   app->add_flag("--ignore-outside", c.ignore_outside,
                 "With --bounds: drop points outside the box (listed in the summary) instead of failing");
   app->add_option("--threads", c.threads,
                   "Worker threads (default 0: $TESSERA_NUM_THREADS, else all cores). Results are identical "
                   "for any thread count")
-      ->check(CLI::NonNegativeNumber);
+      ->check(NonNegative);
   app->add_option("--bin-points", c.bin_points,
                   "Tuning: mean points per bin of the point locator (default 0: automatic)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(NonNegative);
 }
 
 /// Converts the --bounds words to numbers. A fifth word that is not a number
@@ -176,7 +178,7 @@ int main(int argc, char** argv) {
   graph->add_option("--prune-tolerance", ga.prune_tolerance,
                     "Drop spokes whose face area (length in 2D) is below F * (mean cell volume)^((D-1)/D), both "
                     "directions together (VTK parity; default 0: keep all)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(NonNegative);
   graph->add_flag("-q,--quiet", ga.quiet, "No summary and no progress bar");
 
   FacesArgs fa;
@@ -226,7 +228,7 @@ int main(int argc, char** argv) {
       "volume_sum,repeat}}; seconds is wall time of the computation only");
   add_compute_options(bench_vor, ba.compute, bench_bounds);
   bench_vor->add_option("--repeat", ba.repeat, "Number of timed runs")
-      ->check(CLI::PositiveNumber)
+      ->check(Positive)
       ->capture_default_str();
   bench_vor->add_flag("--mesh", ba.mesh,
                       "Also build the merged mesh (what VTK output needs); op becomes voronoi3_mesh/voronoi2_mesh");
@@ -239,7 +241,7 @@ int main(int argc, char** argv) {
       "\"extra\":{cpu_user_s,cpu_sys_s,minflt,peak_rss_bytes,from_cells,from_hull_completion,exact_calls,repeat}}");
   add_compute_options(bench_del, bda.compute, bench_del_bounds);
   bench_del->add_option("--repeat", bda.repeat, "Number of timed runs")
-      ->check(CLI::PositiveNumber)
+      ->check(Positive)
       ->capture_default_str();
 
   SurfaceNetsArgs bsna;
@@ -260,16 +262,17 @@ int main(int argc, char** argv) {
       "The default job: 1,000,000 uniform random 3D points (fixed seed) in the unit cube, computed in "
       "memory; writes DIR/cells.vtu and DIR/cells.csv and prints a summary");
   demo->add_option("-o,--output-dir", da.out_dir, "Output directory (created if missing)")->capture_default_str();
-  demo->add_option("--points", da.n, "Number of points")->check(CLI::PositiveNumber)->capture_default_str();
+  demo->add_option("--points", da.n, "Number of points")->check(Positive)->capture_default_str();
   demo->add_option("--seed", da.seed, "Random seed (std::mt19937_64)")->capture_default_str();
   demo->add_option("--threads", da.threads, "Worker threads (default 0: $TESSERA_NUM_THREADS, else all cores)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(NonNegative);
   demo->add_flag("-q,--quiet", da.quiet, "No summary and no progress bar");
 
   PrepCommands prep;  // joggle, fill, threshold (cmd_prep.cpp)
   add_prep_commands(app, prep);
   ImageCommands image_cmds;  // sample-image, probe (cmd_image.cpp)
   add_image_commands(app, image_cmds);
+  require_number_syntax(app);
 
   try {
     app.parse(argc, argv);
