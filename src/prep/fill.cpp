@@ -128,6 +128,16 @@ Grid make_grid(int dim, const double* lo, const double* hi, std::size_t n, doubl
     g.count[d] = static_cast<std::int64_t>(c);
     g.edge[d] = extent[d] / c;
     g.inv_edge[d] = c / extent[d];
+    // A bin centre lies half an edge inside its bin, so it cannot round onto
+    // an input point of another bin while the edge is far above the
+    // coordinates' last place; at a few ulps it can, and fill would add
+    // points coinciding with the input's.
+    const double magnitude = std::max(std::fabs(lo[d]), std::fabs(hi[d]));
+    const double ulp = std::nextafter(magnitude, INFINITY) - magnitude;
+    if (c > 1 && g.edge[d] < 1024 * ulp)
+      throw InputError(std::string("fill: bins along ") + axis_name(d) + " would be " + num(g.edge[d]) +
+                       " wide, within 1024 steps of double's resolution at " + num(magnitude) +
+                       ": raise the points per bin, or give larger bounds");
   }
   return g;
 }

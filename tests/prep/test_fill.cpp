@@ -7,6 +7,7 @@
 #include <limits>
 #include <random>
 #include <set>
+#include <string>
 #include <vector>
 
 #include "tessera/cells.hpp"
@@ -212,6 +213,29 @@ TEST(PrepFill, AdaptiveIsDenseNextToTheDataAndSparseFarAway) {
   EXPECT_EQ(near_added, near);
   EXPECT_LT(static_cast<double>(far_added) / far, 0.1);
   EXPECT_LT(out.size() - n, 32768u / 4);  // far fewer than uniform would add
+}
+
+TEST(PrepFill, BinsAtDoubleResolutionAreAnError) {
+  // Four points a few ulps apart (found by stop 17's fuzz): the bins were
+  // ~1 ulp wide, and fill added a bin centre that rounded onto an input point.
+  const double u = std::numeric_limits<double>::epsilon();
+  const std::vector<double> tiny = {1 + 3 * u, 1 + 2 * u, 1 + 2 * u, 1 + 3 * u, 1 + 3 * u, 1, 1 + 2 * u, 1};
+  FillOptions o;
+  o.points_per_bin = 0.5;
+  try {
+    tessera::fill(tiny, 2, {}, o);
+    FAIL() << "bins below double's resolution were accepted";
+  } catch (const tessera::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("resolution"), std::string::npos) << e.what();
+  }
+  // The same layout 4096 times wider fills, and no added point meets an input one.
+  std::vector<double> wide = tiny;
+  for (double& x : wide) x = 1 + (x - 1) * 4096;
+  const auto out = tessera::fill(wide, 2, {}, o);
+  ASSERT_GT(out.coords.size(), wide.size());
+  for (std::size_t a = wide.size(); a < out.coords.size(); a += 2)
+    for (std::size_t b = 0; b < wide.size(); b += 2)
+      EXPECT_FALSE(out.coords[a] == wide[b] && out.coords[a + 1] == wide[b + 1]) << "added point " << a / 2;
 }
 
 TEST(PrepFill, BadInput) {
