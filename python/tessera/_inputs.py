@@ -95,6 +95,8 @@ def as_threads(threads: Optional[int]) -> int:
         raise ValueError(f"threads: expected a positive integer or None, got {threads!r}") from None
     if isinstance(threads, bool) or t < 1:
         raise ValueError(f"threads: expected a positive integer or None, got {threads!r}")
+    if t > _INT32.max:
+        raise ValueError(f"threads: at most {_INT32.max}, got {threads!r}")
     return t
 
 
@@ -111,6 +113,7 @@ _CLI_WORDING = (
     ("--bounds", "bounds="),
     ("--dim 2", "(N, 2) points"),
     ("--ignore-outside", "ignore_outside=True"),
+    ("--padding", "padding="),
 )
 
 

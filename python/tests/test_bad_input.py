@@ -47,6 +47,10 @@ CASES = {
     "threads text": (dict(points=P2, threads="2"), r"threads: expected a positive integer"),
     "padding negative": (dict(points=P2, padding=-0.1), r"padding must be a finite number >= 0"),
     "padding text": (dict(points=P2, padding="wide"), r"padding: expected a number >= 0"),
+    # Beyond a C int: pybind11 raised a TypeError listing the whole signature.
+    "threads huge": (dict(points=P2, threads=10**12), r"threads: at most 2147483647, got 1000000000000"),
+    # The front end names its command-line flag; Python says the keyword.
+    "padding overflow": (dict(points=P2, padding=1e308), r"overflows double \(padding 1e\+308 of the points' extent\); give a smaller padding=, or bounds="),
 }
 
 
