@@ -1,5 +1,6 @@
 #include "option_checks.hpp"
 
+#include <cctype>
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
