@@ -306,12 +306,8 @@ int run_sample_image(const SampleImageArgs& a) {
 int run_probe(const ProbeArgs& a) {
   check_points_output(a.output);
   double outside = 0;
-  {
-    char* end = nullptr;
-    outside = std::strtod(a.outside_value.c_str(), &end);
-    if (a.outside_value.empty() || end != a.outside_value.c_str() + a.outside_value.size())
-      throw InputError("--outside-value: '" + a.outside_value + "' is not a number");
-  }
+  if (!whole_number(a.outside_value, outside))  // nan and inf allowed
+    throw InputError("--outside-value: '" + a.outside_value + "' is not a number");
   const auto t0 = std::chrono::steady_clock::now();
   const ScalarImage img = io::read_scalar_image(a.image, read_options(a.read));
   check_read_dims(a.read, img.geometry, a.image);

@@ -433,11 +433,16 @@ int run_default(const DemoArgs& a) {
   return kExitOk;
 }
 
-double parse_number(const std::string& word, const std::string& what, bool allow_inf) {
+bool whole_number(const std::string& word, double& value) {
+  if (word.empty() || std::isspace(static_cast<unsigned char>(word.front()))) return false;
   char* end = nullptr;
-  errno = 0;
-  const double v = std::strtod(word.c_str(), &end);
-  if (word.empty() || end != word.c_str() + word.size() || std::isnan(v) || (!allow_inf && !std::isfinite(v)))
+  value = std::strtod(word.c_str(), &end);
+  return end == word.c_str() + word.size();
+}
+
+double parse_number(const std::string& word, const std::string& what, bool allow_inf) {
+  double v = 0;
+  if (!whole_number(word, v) || std::isnan(v) || (!allow_inf && !std::isfinite(v)))
     throw InputError(what + ": '" + word + "' is not a " + (allow_inf ? "number" : "finite number"));
   return v;
 }

@@ -264,6 +264,10 @@ struct Usage {
 };
 Usage usage_now();
 std::string extension(const std::string& path);  ///< lower-cased, with the dot; "" if none
+/// Whether `word` is one whole number in strtod's syntax (no leading space,
+/// nothing after it; "inf" and "nan" included), and its value. Every reader
+/// of a number from the command line goes through this.
+bool whole_number(const std::string& word, double& value);
 /// A number as the user wrote it ("inf", "-inf" allowed when `allow_inf`);
 /// InputError("WHAT: 'WORD' is not a ...") otherwise.
 double parse_number(const std::string& word, const std::string& what, bool allow_inf);

@@ -80,10 +80,8 @@ void add_compute_options(CLI::App* app, ComputeArgs& c, std::vector<std::string>
 /// missing). Throws InputError for anything else that is not a number.
 void finish_compute_args(ComputeArgs& c, const std::vector<std::string>& raw_bounds) {
   auto parse = [](const std::string& w, double& v) {
-    char* end = nullptr;
     errno = 0;
-    v = std::strtod(w.c_str(), &end);
-    return !w.empty() && end == w.c_str() + w.size() && errno != ERANGE;
+    return whole_number(w, v) && errno != ERANGE;
   };
   c.bounds.clear();
   for (std::size_t i = 0; i < raw_bounds.size(); ++i) {

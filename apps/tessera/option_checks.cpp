@@ -1,10 +1,11 @@
 #include "option_checks.hpp"
 
-#include <cctype>
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
 #include <string>
+
+#include "commands.hpp"  // whole_number
 
 namespace tessera::cli {
 namespace {
@@ -12,15 +13,6 @@ namespace {
 /// The word as quoted in a message: at most 40 characters.
 std::string shown(const std::string& word) {
   return "'" + (word.size() > 40 ? word.substr(0, 37) + "..." : word) + "'";
-}
-
-/// Whether `word` is one whole number in strtod's syntax (leading spaces
-/// excluded), and its value.
-bool whole_number(const std::string& word, double& value) {
-  if (word.empty() || std::isspace(static_cast<unsigned char>(word.front()))) return false;
-  char* end = nullptr;
-  value = std::strtod(word.c_str(), &end);
-  return end == word.c_str() + word.size();
 }
 
 CLI::Validator range_check(bool strict, const char* name) {
@@ -36,17 +28,15 @@ CLI::Validator range_check(bool strict, const char* name) {
 }
 
 /// Digits after an optional sign ('+' or '-' for INT, '+' only for UINT).
-/// The value must fit the widest type CLI11 converts to
-/// (64 bits); a narrower target's overflow is CLI11's conversion error.
+/// The value must fit the widest type CLI11 converts to (64 bits); a
+/// narrower target's overflow is CLI11's own conversion error.
 std::string integer_syntax(const std::string& word, bool is_signed) {
   const std::string kind = is_signed ? "an integer" : "an integer >= 0";
-  std::size_t k = 0;
-  const bool negative = !word.empty() && word[0] == '-';
-  if (!word.empty() && (word[0] == '+' || word[0] == '-')) k = 1;
-  if (k == word.size()) return "expected " + kind + ", got " + shown(word);
-  for (std::size_t i = k; i < word.size(); ++i)
-    if (word[i] < '0' || word[i] > '9') return "expected " + kind + ", got " + shown(word);
-  if (negative && !is_signed) return "expected " + kind + ", got " + shown(word);
+  const bool sign = !word.empty() && (word[0] == '+' || (is_signed && word[0] == '-'));
+  const std::size_t k = sign ? 1 : 0;
+  bool digits = word.size() > k;
+  for (std::size_t i = k; i < word.size(); ++i) digits &= word[i] >= '0' && word[i] <= '9';
+  if (!digits) return "expected " + kind + ", got " + shown(word);
   errno = 0;
   if (is_signed)
     (void)std::strtoll(word.c_str(), nullptr, 10);

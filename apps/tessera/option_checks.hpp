@@ -4,7 +4,8 @@
 // word as 0, wraps "-1" into an unsigned seed, accepts a seed past 2^64 as
 // some other number, and its NonNegativeNumber check prints DBL_MAX in full
 // when it fails. These validators run before CLI11's conversion and reject
-// such words with one short line: "--threads: expected a number >= 0, got '-2'".
+// such words with one short line: "--threads: expected a finite number >= 0,
+// got '-2'".
 #pragma once
 
 #include <CLI/CLI.hpp>
@@ -18,10 +19,10 @@ extern const CLI::Validator NonNegative;
 extern const CLI::Validator Positive;
 
 /// Give every option of `app` and its subcommands whose value is a number
-/// (CLI11 type INT, UINT or FLOAT) a syntax check: FLOAT a whole decimal
-/// number (strtod's syntax; "inf" and "nan" are left to the range checks and
-/// the library), INT an optional sign and digits, UINT digits only, and the
-/// value within the type's range. Call once, after every option is declared.
+/// (CLI11 type INT, UINT or FLOAT) a syntax check: FLOAT one whole number
+/// (whole_number; "inf" and "nan" are left to the range checks and the
+/// library), INT an optional sign and digits, UINT digits without a minus,
+/// both within 64 bits. Call once, after every option is declared.
 void require_number_syntax(CLI::App& app);
 
 }  // namespace tessera::cli
