@@ -56,6 +56,15 @@ Delaunay delaunay(std::span<const double> points, int dim, std::span<const std::
 /// the simplex sharing the facet opposite vertex k of simplex r, or -1.
 std::vector<std::int32_t> simplex_neighbors(const Delaunay& dt);
 
+/// The Delaunay edges as CSR, as scipy.spatial.Delaunay.vertex_neighbor_vertices:
+/// the points sharing a simplex with point v are ids[offsets[v] .. offsets[v+1]),
+/// ascending (none for a point in no simplex: a duplicate, an outside point).
+struct VertexNeighbors {
+  std::vector<std::int64_t> offsets;  ///< n_points + 1
+  std::vector<std::int32_t> ids;
+};
+VertexNeighbors vertex_neighbors(const Delaunay& dt);
+
 /// Checks of a triangulation (the CLI's `delaunay --validate`).
 struct DelaunayReport {
   bool ok = true;

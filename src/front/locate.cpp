@@ -1,0 +1,196 @@
+// tessera::SimplexLocator: a grid of simplices, queried with exact
+// orientation tests (see locate.hpp).
+#include "tessera/locate.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <numeric>
+#include <string>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
+#include <tbb/task_arena.h>
+
+#include "tessera/kernels/delaunay_predicates.hpp"
+
+namespace tessera {
+namespace {
+
+void check_points(const Delaunay& dt, std::span<const double> points, const char* what) {
+  if (points.size() != dt.n_points * static_cast<std::size_t>(dt.dim))
+    throw InputError(std::string(what) + ": " + std::to_string(points.size()) + " coordinates for a triangulation of " +
+                     std::to_string(dt.n_points) + " points in " + std::to_string(dt.dim) + "D");
+}
+
+/// The grid aims at this many simplices per bin (a uniform 3D simplex then
+/// meets about three or four bins, so a query tests a few dozen at most), and
+/// the index at most `max_entries_per_simplex` entries per simplex: long thin
+/// simplices (points on a circle or sphere) would otherwise meet whole rows
+/// of bins, and the grid is made coarser until they do not.
+constexpr double simplices_per_bin = 8;
+constexpr std::uint64_t max_entries_per_simplex = 16;
+
+}  // namespace
+
+std::int64_t SimplexLocator::bin_of(int d, double x) const {
+  const double t = (x - lo_[d]) * scale_[d];
+  if (!(t > 0)) return 0;
+  const double top = static_cast<double>(bins_[d]);
+  return t < top ? static_cast<std::int64_t>(t) : bins_[d] - 1;
+}
+
+SimplexLocator::SimplexLocator(const Delaunay& dt, std::span<const double> points, int threads)
+    : dim_(dt.dim), n_simplices_(dt.n_simplices()), n_points_(dt.n_points) {
+  check_points(dt, points, "locate");
+  const int D = dim_;
+  const std::size_t w = static_cast<std::size_t>(D + 1);
+  const std::size_t m = n_simplices_;
+  offsets_.assign(2, 0);
+  if (m == 0) return;
+
+  // The box of every simplex vertex, and bins near cubes of the volume that
+  // holds simplices_per_bin simplices each.
+  double* hi = hi_;
+  for (int d = 0; d < D; ++d) {
+    lo_[d] = INFINITY;
+    hi[d] = -INFINITY;
+  }
+  for (std::int32_t id : dt.simplices)
+    for (int d = 0; d < D; ++d) {
+      const double x = points[static_cast<std::size_t>(id) * static_cast<std::size_t>(D) + static_cast<std::size_t>(d)];
+      lo_[d] = std::min(lo_[d], x);
+      hi[d] = std::max(hi[d], x);
+    }
+  double volume = 1;
+  for (int d = 0; d < D; ++d) volume *= hi[d] - lo_[d];  // > 0: the simplices are not flat
+  const double target = std::max(1.0, static_cast<double>(m) / simplices_per_bin);
+  const double side = std::pow(volume / target, 1.0 / D);
+  for (int d = 0; d < D; ++d) {
+    const double g = std::ceil((hi[d] - lo_[d]) / side);
+    bins_[d] = g >= 1 ? static_cast<std::int64_t>(std::min(g, 1048576.0)) : 1;  // also NaN, infinite
+  }
+  auto total_bins = [&] { return bins_[0] * bins_[1] * bins_[2]; };
+  while (static_cast<double>(total_bins()) > 4 * target + 64) *std::max_element(bins_, bins_ + D) = (*std::max_element(bins_, bins_ + D) + 1) / 2;
+
+  tbb::task_arena arena(resolve_threads(threads));
+  auto bin_range = [&](std::size_t s, std::int64_t* b0, std::int64_t* b1) {
+    const std::int32_t* row = dt.simplices.data() + s * w;
+    for (int d = 0; d < D; ++d) {
+      double a = INFINITY, b = -INFINITY;
+      for (std::size_t k = 0; k < w; ++k) {
+        const double x = points[static_cast<std::size_t>(row[k]) * static_cast<std::size_t>(D) + static_cast<std::size_t>(d)];
+        a = std::min(a, x);
+        b = std::max(b, x);
+      }
+      b0[d] = bin_of(d, a);
+      b1[d] = bin_of(d, b);
+    }
+    for (int d = D; d < 3; ++d) b0[d] = b1[d] = 0;
+  };
+  arena.execute([&] {
+    // Coarsen until the index fits its budget (see max_entries_per_simplex).
+    for (;;) {
+      for (int d = 0; d < D; ++d) scale_[d] = static_cast<double>(bins_[d]) / (hi[d] - lo_[d]);
+      const std::uint64_t entries = tbb::parallel_reduce(
+          tbb::blocked_range<std::size_t>(0, m, 4096), std::uint64_t{0},
+          [&](const tbb::blocked_range<std::size_t>& r, std::uint64_t sum) {
+            std::int64_t b0[3], b1[3];
+            for (std::size_t s = r.begin(); s != r.end(); ++s) {
+              bin_range(s, b0, b1);
+              sum += static_cast<std::uint64_t>((b1[0] - b0[0] + 1) * (b1[1] - b0[1] + 1) * (b1[2] - b0[2] + 1));
+            }
+            return sum;
+          },
+          std::plus<>());
+      if (entries <= max_entries_per_simplex * m + 4096 || total_bins() == 1) break;
+      for (int d = 0; d < D; ++d) bins_[d] = (bins_[d] + 1) / 2;
+    }
+
+    // Two passes, counts then slots; then each bin's list sorted, so the
+    // index does not depend on the order the threads filled it in.
+    const auto nb = static_cast<std::size_t>(total_bins());
+    auto bin_index = [&](std::int64_t x, std::int64_t y, std::int64_t z) {
+      return static_cast<std::size_t>((z * bins_[1] + y) * bins_[0] + x);
+    };
+    auto for_each_entry = [&](auto&& body) {
+      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, m, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
+        std::int64_t b0[3], b1[3];
+        for (std::size_t s = r.begin(); s != r.end(); ++s) {
+          bin_range(s, b0, b1);
+          for (std::int64_t z = b0[2]; z <= b1[2]; ++z)
+            for (std::int64_t y = b0[1]; y <= b1[1]; ++y)
+              for (std::int64_t x = b0[0]; x <= b1[0]; ++x) body(bin_index(x, y, z), s);
+        }
+      });
+    };
+    offsets_.assign(nb + 1, 0);
+    for_each_entry([&](std::size_t b, std::size_t) { std::atomic_ref<std::uint64_t>(offsets_[b + 1]).fetch_add(1, std::memory_order_relaxed); });
+    std::partial_sum(offsets_.begin(), offsets_.end(), offsets_.begin());
+    ids_.resize(offsets_.back());
+    std::vector<std::uint64_t> cursor(offsets_.begin(), offsets_.end() - 1);
+    for_each_entry([&](std::size_t b, std::size_t s) {
+      const std::uint64_t at = std::atomic_ref<std::uint64_t>(cursor[b]).fetch_add(1, std::memory_order_relaxed);
+      ids_[at] = static_cast<std::int32_t>(s);
+    });
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nb, 1024), [&](const tbb::blocked_range<std::size_t>& r) {
+      for (std::size_t b = r.begin(); b != r.end(); ++b)
+        std::sort(ids_.begin() + static_cast<std::ptrdiff_t>(offsets_[b]), ids_.begin() + static_cast<std::ptrdiff_t>(offsets_[b + 1]));
+    });
+  });
+}
+
+std::vector<std::int32_t> SimplexLocator::locate(const Delaunay& dt, std::span<const double> points,
+                                                 std::span<const double> queries, int threads) const {
+  check_points(dt, points, "locate");
+  if (dt.dim != dim_ || dt.n_simplices() != n_simplices_ || dt.n_points != n_points_)
+    throw InputError("locate: the triangulation is not the one this locator was built for");
+  const int D = dim_;
+  const auto du = static_cast<std::size_t>(D);
+  if (queries.size() % du != 0)
+    throw InputError("locate: query array length " + std::to_string(queries.size()) + " is not a multiple of dimension " +
+                     std::to_string(D));
+  const std::size_t nq = queries.size() / du;
+  std::vector<std::int32_t> found(nq, -1);
+  if (n_simplices_ == 0) return found;
+  auto contains = [&](std::size_t s, const double* x) {
+    const std::int32_t* row = dt.simplices.data() + s * (du + 1);
+    const double* v[4];
+    for (std::size_t k = 0; k <= du; ++k) v[k] = points.data() + static_cast<std::size_t>(row[k]) * du;
+    // x lies in the closed, positively oriented simplex iff putting it in
+    // place of each vertex in turn never makes the simplex negative (its
+    // barycentric coordinates, as signs).
+    for (std::size_t k = 0; k <= du; ++k) {
+      const double* keep = v[k];
+      v[k] = x;
+      const int o = kernels::orientation(D, v);
+      v[k] = keep;
+      if (o < 0) return false;
+    }
+    return true;
+  };
+  tbb::task_arena(resolve_threads(threads)).execute([&] {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nq, 1024), [&](const tbb::blocked_range<std::size_t>& r) {
+      for (std::size_t q = r.begin(); q != r.end(); ++q) {
+        const double* x = queries.data() + q * du;
+        bool inside = true;  // in the vertices' box (false on NaN)
+        std::int64_t b[3] = {0, 0, 0};
+        for (int d = 0; d < D; ++d) {
+          inside &= x[d] >= lo_[d] && x[d] <= hi_[d];
+          b[d] = bin_of(d, x[d]);
+        }
+        if (!inside) continue;
+        const std::size_t bin = static_cast<std::size_t>((b[2] * bins_[1] + b[1]) * bins_[0] + b[0]);
+        for (std::uint64_t e = offsets_[bin]; e != offsets_[bin + 1]; ++e)
+          if (contains(static_cast<std::size_t>(ids_[e]), x)) {
+            found[q] = ids_[e];
+            break;
+          }
+      }
+    });
+  });
+  return found;
+}
+
+}  // namespace tessera
