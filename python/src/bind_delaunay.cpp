@@ -1,7 +1,9 @@
 // tessera._core.Delaunay / delaunay() / validate_delaunay(): the Delaunay
 // front end (include/tessera/delaunay.hpp), its arrays viewing its buffers.
 #include <cstdint>
+#include <memory>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include <pybind11/numpy.h>
@@ -43,6 +45,33 @@ py::array neighbors_view(py::object self) {
   return view_rows(*r.neighbors, static_cast<std::size_t>(r.dt.dim + 1), self);
 }
 
+py::tuple vertex_neighbors_view(py::object self) {
+  auto& r = self.cast<DelaunayResult&>();
+  if (!r.vertex_neighbors) {
+    auto vn = without_gil([&] { return vertex_neighbors(r.dt); });
+    if (!r.vertex_neighbors) r.vertex_neighbors = std::move(vn);
+  }
+  return py::make_tuple(view_flat(r.vertex_neighbors->offsets, self), view_flat(r.vertex_neighbors->ids, self));
+}
+
+// The simplex holding each query point (-1: none). The locator is built on
+// the first call (without the GIL) and kept for the next ones.
+py::array locate_points(DelaunayResult& r, const Points& points, const Points& queries, int threads) {
+  if (threads < 0) throw py::value_error("threads must be >= 1, or 0/None for the default");
+  if (checked_dim(points) != r.dt.dim || static_cast<std::size_t>(points.shape(0)) != r.dt.n_points)
+    throw py::value_error("locate: points are not the ones triangulated");
+  if (queries.ndim() != 2 || queries.shape(1) != r.dt.dim)
+    throw py::value_error("locate: queries must have shape (M, " + std::to_string(r.dt.dim) + ")");
+  const auto pts = as_span(points);
+  const auto q = as_span(queries);
+  std::shared_ptr<const SimplexLocator> loc = r.locator;
+  if (!loc) {
+    loc = without_gil([&] { return std::make_shared<const SimplexLocator>(r.dt, pts, threads); });
+    if (!r.locator) r.locator = loc;
+  }
+  return adopt_flat(without_gil([&] { return loc->locate(r.dt, pts, q, threads); }));
+}
+
 }  // namespace
 
 void bind_delaunay(py::module_& m) {
@@ -78,6 +107,7 @@ void bind_delaunay(py::module_& m) {
                                return view_rows(dt.simplices, static_cast<std::size_t>(dt.dim + 1), s);
                              })
       .def_property_readonly("neighbors", &neighbors_view)
+      .def_property_readonly("vertex_neighbors", &vertex_neighbors_view)
       .def_property_readonly("from_cells", [](const DelaunayResult& r) { return r.dt.from_cells; })
       .def_property_readonly("from_hull_completion", [](const DelaunayResult& r) { return r.dt.from_hull_completion; })
       .def_property_readonly("hull_completed", [](const DelaunayResult& r) { return r.dt.hull_completed; })
@@ -93,6 +123,10 @@ void bind_delaunay(py::module_& m) {
   m.def("delaunay", &run_delaunay, py::arg("points").noconvert(), py::arg("labels").none(true), py::arg("bounds"),
         py::arg("padding"), py::arg("ignore_outside"), py::arg("threads"), py::arg("complete_hull"),
         "Delaunay simplices of float64 C-ordered (N, D) points; labels None or int32 (N,). Runs without the GIL.");
+
+  m.def("locate", &locate_points, py::arg("delaunay"), py::arg("points").noconvert(), py::arg("queries").noconvert(),
+        py::arg("threads"),
+        "Per float64 C-ordered (M, D) query: the lowest simplex holding it, or -1. Runs without the GIL.");
 
   m.def(
       "validate_delaunay",

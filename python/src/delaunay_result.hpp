@@ -2,19 +2,25 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <vector>
 
 #include "tessera/delaunay.hpp"
+#include "tessera/locate.hpp"
 
 namespace tessera::python {
 
-/// The triangulation plus its simplex adjacency, which is computed on first
-/// use (not every caller wants it) and then kept, so every view shares it.
-/// Neither is resized once set: numpy views point into both (arrays.hpp).
+/// The triangulation plus what is derived from it on first use (not every
+/// caller wants it) and then kept: the simplex adjacency and the Delaunay
+/// edges, which every view shares, and the point locator, which every
+/// find_simplex call reuses. None is resized once set: numpy views point into
+/// them (arrays.hpp).
 struct DelaunayResult {
   Delaunay dt;
   std::optional<std::vector<std::int32_t>> neighbors;
+  std::optional<VertexNeighbors> vertex_neighbors;
+  std::shared_ptr<const SimplexLocator> locator;
 };
 
 }  // namespace tessera::python

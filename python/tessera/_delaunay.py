@@ -18,8 +18,11 @@ class Delaunay:
     Made by :func:`tessera.delaunay`. The attributes a ``scipy.spatial.Delaunay``
     user expects are here with the same meanings: :attr:`points`,
     :attr:`simplices`, :attr:`neighbors`, :attr:`ndim`, :attr:`npoints`,
-    :attr:`nsimplex`. Arrays are read-only views of buffers the compiled result
-    owns (no copy).
+    :attr:`nsimplex`, :attr:`convex_hull`, :attr:`coplanar`,
+    :attr:`vertex_to_simplex`, :attr:`vertex_neighbor_vertices`,
+    :attr:`transform` and :meth:`find_simplex`. Arrays are read-only views of
+    buffers the compiled result owns (no copy) or, for the derived ones, arrays
+    computed on first use and kept.
 
     Without labels the simplices cover the convex hull of the points exactly
     (hull completion); with labels they are the simplices whose points are all
@@ -30,6 +33,9 @@ class Delaunay:
         self._dt = dt
         self._points = points
         self._labels = labels
+        self._hull: Optional[np.ndarray] = None
+        self._vertex_to_simplex: Optional[np.ndarray] = None
+        self._transform: Optional[np.ndarray] = None
 
     @property
     def points(self) -> np.ndarray:
@@ -70,6 +76,108 @@ class Delaunay:
         facet opposite vertex ``k`` of simplex ``r``, -1 on the boundary (as scipy).
         Computed on first use."""
         return self._dt.neighbors
+
+    @property
+    def convex_hull(self) -> np.ndarray:
+        """int32 (nfacets, D): the boundary facets (facets of one simplex only),
+        each ordered so that its normal points out of the triangulation (3D:
+        counter-clockwise seen from outside; 2D: the interior on the left).
+        Without labels this is the convex hull, as scipy's; with labels, the
+        boundary of the labelled regions. Computed on first use."""
+        if self._hull is None:
+            nb = self.neighbors
+            s, k = np.nonzero(nb < 0)
+            rows = self.simplices[s]
+            d = self.ndim
+            # The facet opposite vertex k, its vertices in cyclic order from
+            # k + 1. In 2D that is the counter-clockwise edge, interior on its
+            # left. In 3D it faces out of the positively oriented simplex for
+            # even k (the cycle (k+1, k+2, k+3, k) is odd) and in for odd k,
+            # which one swap turns out.
+            idx = (k[:, None] + np.arange(1, d + 1)[None, :]) % (d + 1)
+            facets = np.take_along_axis(rows, idx, axis=1)
+            if d == 3:
+                odd = (k % 2) == 1
+                facets[odd] = facets[odd][:, [1, 0, 2]]
+            facets.setflags(write=False)
+            self._hull = facets
+        return self._hull
+
+    @property
+    def coplanar(self) -> np.ndarray:
+        """int32 (k, 3): the input points left out of the triangulation, as
+        scipy's ``coplanar``: ``[point, a simplex of its twin, twin]``. In
+        tessera these are exact duplicates: the lowest id of a group of
+        coincident points is the vertex, the others are listed here."""
+        dup = np.asarray(self.duplicates, dtype=np.int32).reshape(-1, 2)
+        out = np.empty((len(dup), 3), dtype=np.int32)
+        out[:, 0] = dup[:, 0]
+        out[:, 1] = self.vertex_to_simplex[dup[:, 1]] if len(dup) else 0
+        out[:, 2] = dup[:, 1]
+        out.setflags(write=False)
+        return out
+
+    @property
+    def vertex_to_simplex(self) -> np.ndarray:
+        """int32 (npoints,): a simplex holding each point as a vertex (the
+        lowest-indexed one), -1 for a point in none (a duplicate, an outside
+        point). Computed on first use."""
+        if self._vertex_to_simplex is None:
+            s = self.simplices
+            v2s = np.full(self.npoints, -1, dtype=np.int32)
+            # Written from the last simplex to the first: the lowest one stays.
+            ids = np.repeat(np.arange(len(s), dtype=np.int32), self.ndim + 1)[::-1]
+            v2s[s.ravel()[::-1]] = ids
+            v2s.setflags(write=False)
+            self._vertex_to_simplex = v2s
+        return self._vertex_to_simplex
+
+    @property
+    def vertex_neighbor_vertices(self) -> Tuple[np.ndarray, np.ndarray]:
+        """``(indptr, indices)``: the Delaunay edges as CSR, as scipy's; the
+        neighbours of point ``v`` are ``indices[indptr[v]:indptr[v + 1]]``,
+        ascending. Computed on first use (in parallel)."""
+        return self._dt.vertex_neighbors
+
+    @property
+    def transform(self) -> np.ndarray:
+        """float64 (nsimplex, D+1, D): affine maps to barycentric coordinates,
+        as scipy's: for a point ``x`` in simplex ``s``,
+        ``c = transform[s, :D] @ (x - transform[s, D])`` gives the first D
+        coordinates and ``1 - c.sum()`` the last. Computed on first use."""
+        if self._transform is None:
+            d = self.ndim
+            v = self.points[self.simplices]  # (m, D+1, D)
+            t = np.empty((len(v), d + 1, d))
+            t[:, d, :] = v[:, d, :]
+            # Columns v_k - v_D; a positively oriented simplex is never flat.
+            t[:, :d, :] = np.linalg.inv(np.transpose(v[:, :d, :] - v[:, d:, :], (0, 2, 1)))
+            t.setflags(write=False)
+            self._transform = t
+        return self._transform
+
+    def find_simplex(self, xi: Any, bruteforce: bool = False, tol: Optional[float] = None) -> np.ndarray:
+        """The simplex holding each point of ``xi`` (shape (..., D)), -1 where
+        none does (outside the hull; with labels, outside the regions), as
+        scipy's. Decided exactly: a point on a shared facet, edge or vertex
+        gets the lowest-indexed simplex holding it, whatever the thread count.
+        ``bruteforce`` is accepted for scipy compatibility and changes nothing;
+        ``tol`` is not supported (there is no tolerance to set). The index is
+        built on the first call (a grid of the simplices) and reused."""
+        if tol is not None:
+            raise ValueError("find_simplex: tol is not supported; containment is decided exactly")
+        try:
+            x = np.asarray(xi)
+        except (ValueError, TypeError) as e:
+            raise ValueError(f"xi: cannot be read as an array of numbers ({e})") from None
+        if x.dtype.kind not in "fiu":
+            raise ValueError(f"xi: expected real numbers, got dtype {x.dtype}")
+        if x.ndim == 0 or x.shape[-1] != self.ndim:
+            raise ValueError(f"xi: expected shape (..., {self.ndim}), got {x.shape}")
+        shape = x.shape[:-1]
+        q = np.ascontiguousarray(x.reshape(-1, self.ndim), dtype=np.float64)
+        found = _inputs.call(_core.locate, self._dt, self._points, q, 0)
+        return found.reshape(shape)
 
     @property
     def from_cells(self) -> int:

@@ -117,3 +117,81 @@ def test_delaunay_neighbors_match_scipy(dim):
 
     assert dt.neighbors.shape == dt.simplices.shape
     assert adjacency(dt.simplices, dt.neighbors) == adjacency(sp.simplices, sp.neighbors)
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_delaunay_derived_attributes_match_scipy(dim):
+    pts = random_points(1500, dim, seed=70 + dim)
+    dt = tessera.delaunay(pts)
+    sp = ScipyDelaunay(pts)
+    assert sorted_tuples(np.sort(dt.convex_hull, axis=1)) == sorted_tuples(np.sort(sp.convex_hull, axis=1))
+    # Hull facets face out: their normals point away from the points' centroid.
+    f = pts[dt.convex_hull]
+    if dim == 3:
+        normal = np.cross(f[:, 1] - f[:, 0], f[:, 2] - f[:, 0])
+    else:
+        e = f[:, 1] - f[:, 0]
+        normal = np.stack([e[:, 1], -e[:, 0]], axis=1)  # right of the edge: interior on the left
+    assert (np.einsum("ij,ij->i", normal, f.mean(axis=1) - pts.mean(axis=0)) > 0).all()
+    indptr, indices = dt.vertex_neighbor_vertices
+    sindptr, sindices = sp.vertex_neighbor_vertices
+    for v in range(len(pts)):
+        ours = indices[indptr[v] : indptr[v + 1]]
+        assert (np.diff(ours) > 0).all()
+        assert set(ours.tolist()) == set(sindices[sindptr[v] : sindptr[v + 1]].tolist())
+    v2s = dt.vertex_to_simplex
+    assert all(v in dt.simplices[v2s[v]] for v in range(len(pts)))
+    assert (v2s == [np.nonzero((dt.simplices == v).any(axis=1))[0].min() for v in range(len(pts))]).all()
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_find_simplex_and_transform_match_scipy(dim):
+    rng = np.random.default_rng(80 + dim)
+    pts = rng.random((1500, dim))
+    dt = tessera.delaunay(pts)
+    sp = ScipyDelaunay(pts)
+    q = rng.random((4000, dim)) * 1.2 - 0.1  # about a third outside the hull
+    ours, theirs = dt.find_simplex(q), sp.find_simplex(q)
+    assert ours.dtype == np.int32 and ours.shape == (4000,)
+    assert ((ours >= 0) == (theirs >= 0)).all()
+    assert 0 < (ours < 0).sum() < 4000
+    inside = ours >= 0
+    # Random queries lie strictly inside one simplex: the same points as scipy's.
+    assert (np.sort(dt.simplices[ours[inside]], axis=1) == np.sort(sp.simplices[theirs[inside]], axis=1)).all()
+    # scipy's barycentric recipe works on ours: coordinates in [0, 1], summing to 1.
+    t = dt.transform
+    assert t.shape == (dt.nsimplex, dim + 1, dim)
+    s, x = ours[inside], q[inside]
+    c = np.einsum("ijk,ik->ij", t[s, :dim], x - t[s, dim])
+    c = np.c_[c, 1 - c.sum(axis=1)]
+    assert (c > -1e-12).all() and (c < 1 + 1e-12).all()
+    np.testing.assert_allclose(np.einsum("ij,ijk->ik", c, pts[dt.simplices[s]]), x, atol=1e-12)
+    # Any leading shape, as scipy's; input points lie in their lowest simplex.
+    assert dt.find_simplex(q.reshape(40, 100, dim)).shape == (40, 100)
+    assert (dt.find_simplex(pts) == dt.vertex_to_simplex).all()
+
+
+def test_find_simplex_with_labels_holes_and_bad_queries():
+    pts = random_points(3000, 3, seed=90)
+    r2 = ((pts - 0.5) ** 2).sum(axis=1)
+    labels = np.where((r2 > 0.04) & (r2 < 0.16), 0, -1)  # a shell: not convex
+    dt = tessera.delaunay(pts, labels)
+    assert dt.find_simplex([[0.5, 0.5, 0.5]])[0] == -1  # in the hole
+    shell = pts[labels == 0][:50]
+    assert (dt.find_simplex(shell) >= 0).all()
+    assert (dt.find_simplex([[np.nan, 0.5, 0.5], [0.5, np.inf, 0.5]]) == -1).all()
+    with pytest.raises(ValueError, match="tol"):
+        dt.find_simplex(shell, tol=1e-6)
+    with pytest.raises(ValueError, match=r"shape \(\.\.\., 3\)"):
+        dt.find_simplex(np.zeros((4, 2)))
+    with pytest.raises(ValueError, match="real numbers"):
+        dt.find_simplex(np.array([["a", "b", "c"]]))
+
+
+def test_coplanar_lists_duplicates_as_scipy():
+    pts = np.vstack([random_points(200, 3, seed=91), [[0.25, 0.5, 0.75]] * 3])
+    dt = tessera.delaunay(pts)
+    cop = dt.coplanar
+    assert cop.shape == (2, 3) and cop.dtype == np.int32
+    assert sorted(cop[:, 0].tolist()) == [201, 202] and (cop[:, 2] == 200).all()
+    assert all(200 in dt.simplices[s] for s in cop[:, 1])

@@ -52,17 +52,36 @@ SimplexLocator::SimplexLocator(const Delaunay& dt, std::span<const double> point
 
   // The box of every simplex vertex, and bins near cubes of the volume that
   // holds simplices_per_bin simplices each.
+  tbb::task_arena arena(resolve_threads(threads));
+  struct Box {
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+  };
+  const Box box = arena.execute([&] {
+    return tbb::parallel_reduce(
+        tbb::blocked_range<std::size_t>(0, dt.simplices.size(), 16384), Box{},
+        [&](const tbb::blocked_range<std::size_t>& r, Box b) {
+          for (std::size_t e = r.begin(); e != r.end(); ++e) {
+            const double* x = points.data() + static_cast<std::size_t>(dt.simplices[e]) * static_cast<std::size_t>(D);
+            for (int d = 0; d < D; ++d) {
+              b.lo[d] = std::min(b.lo[d], x[d]);
+              b.hi[d] = std::max(b.hi[d], x[d]);
+            }
+          }
+          return b;
+        },
+        [&](Box a, const Box& b) {
+          for (int d = 0; d < D; ++d) {
+            a.lo[d] = std::min(a.lo[d], b.lo[d]);
+            a.hi[d] = std::max(a.hi[d], b.hi[d]);
+          }
+          return a;
+        });
+  });
   double* hi = hi_;
   for (int d = 0; d < D; ++d) {
-    lo_[d] = INFINITY;
-    hi[d] = -INFINITY;
+    lo_[d] = box.lo[d];
+    hi[d] = box.hi[d];
   }
-  for (std::int32_t id : dt.simplices)
-    for (int d = 0; d < D; ++d) {
-      const double x = points[static_cast<std::size_t>(id) * static_cast<std::size_t>(D) + static_cast<std::size_t>(d)];
-      lo_[d] = std::min(lo_[d], x);
-      hi[d] = std::max(hi[d], x);
-    }
   double volume = 1;
   for (int d = 0; d < D; ++d) volume *= hi[d] - lo_[d];  // > 0: the simplices are not flat
   const double target = std::max(1.0, static_cast<double>(m) / simplices_per_bin);
@@ -74,7 +93,6 @@ SimplexLocator::SimplexLocator(const Delaunay& dt, std::span<const double> point
   auto total_bins = [&] { return bins_[0] * bins_[1] * bins_[2]; };
   while (static_cast<double>(total_bins()) > 4 * target + 64) *std::max_element(bins_, bins_ + D) = (*std::max_element(bins_, bins_ + D) + 1) / 2;
 
-  tbb::task_arena arena(resolve_threads(threads));
   auto bin_range = [&](std::size_t s, std::int64_t* b0, std::int64_t* b1) {
     const std::int32_t* row = dt.simplices.data() + s * w;
     for (int d = 0; d < D; ++d) {
