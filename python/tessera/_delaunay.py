@@ -176,7 +176,7 @@ class Delaunay:
             raise ValueError(f"xi: expected shape (..., {self.ndim}), got {x.shape}")
         shape = x.shape[:-1]
         q = np.ascontiguousarray(x.reshape(-1, self.ndim), dtype=np.float64)
-        found = _inputs.call(_core.locate, self._dt, self._points, q, 0)
+        found = _inputs.call(_core.locate, self._dt, self._points, q, self._dt.threads_used)
         return found.reshape(shape)
 
     @property
