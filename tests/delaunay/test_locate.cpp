@@ -213,6 +213,24 @@ TEST(Locate, ThreadsAndBadQueries) {
   EXPECT_EQ(tessera::SimplexLocator(flat, line).locate(flat, line, line), (std::vector<std::int32_t>{-1, -1, -1}));
 }
 
+TEST(Locate, PowerOfTwoScalesLocateAlike) {
+  // Scaling by 2^e is exact: the same triangulation and the same answers, with
+  // coordinates near double's smallest and largest normal exponents.
+  auto p = uniform(400, 3, 71);
+  auto q = uniform(400, 3, 72, -0.1, 1.1);
+  tessera::Delaunay dt = triangulate(p, 3);
+  const auto want = tessera::SimplexLocator(dt, p).locate(dt, p, q);
+  for (int e : {-900, 900}) {
+    SCOPED_TRACE(e);
+    auto ps = p, qs = q;
+    for (double& x : ps) x = std::ldexp(x, e);
+    for (double& x : qs) x = std::ldexp(x, e);
+    tessera::Delaunay dts = triangulate(ps, 3);
+    ASSERT_EQ(dts.n_simplices(), dt.n_simplices());
+    EXPECT_EQ(tessera::SimplexLocator(dts, ps).locate(dts, ps, qs), want);
+  }
+}
+
 TEST(VertexNeighbors, AreTheSimplicesEdges) {
   for (int dim : {2, 3}) {
     SCOPED_TRACE(dim);
