@@ -166,16 +166,7 @@ class Delaunay:
         built on the first call (a grid of the simplices) and reused."""
         if tol is not None:
             raise ValueError("find_simplex: tol is not supported; containment is decided exactly")
-        try:
-            x = np.asarray(xi)
-        except (ValueError, TypeError) as e:
-            raise ValueError(f"xi: cannot be read as an array of numbers ({e})") from None
-        if x.dtype.kind not in "fiu":
-            raise ValueError(f"xi: expected real numbers, got dtype {x.dtype}")
-        if x.ndim == 0 or x.shape[-1] != self.ndim:
-            raise ValueError(f"xi: expected shape (..., {self.ndim}), got {x.shape}")
-        shape = x.shape[:-1]
-        q = np.ascontiguousarray(x.reshape(-1, self.ndim), dtype=np.float64)
+        q, shape = _inputs.as_queries(xi, self.ndim)
         found = _inputs.call(_core.locate, self._dt, self._points, q, self._dt.threads_used)
         return found.reshape(shape)
 

@@ -11,7 +11,7 @@ end (NaN, bounds ranges, points outside the bounds, padding), and raised as
 from __future__ import annotations
 
 import operator
-from typing import Any, Optional, Sequence
+from typing import Any, Optional, Sequence, Tuple
 
 import numpy as np
 
@@ -22,16 +22,22 @@ from . import _core
 _POINT_KINDS = "fiu"
 
 
+def read_array(value: Any, name: str, what: str) -> np.ndarray:
+    """``np.asarray(value)``, with a ValueError naming the argument when numpy
+    cannot make an array of it (ragged nested lists and the like)."""
+    try:
+        return np.asarray(value)
+    except (ValueError, TypeError) as e:
+        raise ValueError(f"{name}: cannot be read as {what} ({e})") from None
+
+
 def as_points(points: Any) -> np.ndarray:
     """Points as a float64 C-contiguous (N, 2) or (N, 3) array.
 
     No copy when ``points`` already is one: the result is then the caller's
     array itself, which keeps ``result.points`` zero-copy too.
     """
-    try:
-        a = np.asarray(points)
-    except (ValueError, TypeError) as e:  # ragged nested lists and the like
-        raise ValueError(f"points: cannot be read as an (N, 2) or (N, 3) array of numbers ({e})") from None
+    a = read_array(points, "points", "an (N, 2) or (N, 3) array of numbers")
     if a.dtype.kind not in _POINT_KINDS:
         raise ValueError(f"points: expected real numbers (float or int), got dtype {a.dtype}")
     if a.ndim != 2 or a.shape[1] not in (2, 3):
@@ -53,10 +59,7 @@ def as_labels(labels: Any, n: int) -> Optional[np.ndarray]:
     """
     if labels is None:
         return None
-    try:
-        a = np.asarray(labels)
-    except (ValueError, TypeError) as e:
-        raise ValueError(f"labels: cannot be read as an array of integers ({e})") from None
+    a = read_array(labels, "labels", "an array of integers")
     if a.dtype.kind not in "iu":
         raise ValueError(
             f"labels: expected integers (label < 0 marks an outside point), got dtype {a.dtype}"
@@ -190,10 +193,7 @@ def as_choice(value: Any, name: str, choices: Sequence[str]) -> str:
 
 def as_scalars(values: Any, name: str = "scalars") -> np.ndarray:
     """A float64 C-contiguous 1-D array (NaN allowed)."""
-    try:
-        a = np.asarray(values)
-    except (ValueError, TypeError) as e:
-        raise ValueError(f"{name}: cannot be read as a 1-D array of numbers ({e})") from None
+    a = read_array(values, name, "a 1-D array of numbers")
     if a.dtype.kind not in _POINT_KINDS:
         raise ValueError(f"{name}: expected real numbers, got dtype {a.dtype}")
     if a.ndim != 1:
@@ -201,14 +201,22 @@ def as_scalars(values: Any, name: str = "scalars") -> np.ndarray:
     return np.ascontiguousarray(a, dtype=np.float64)
 
 
+def as_queries(xi: Any, dim: int) -> Tuple[np.ndarray, Tuple[int, ...]]:
+    """Query points of shape (..., dim) as a float64 C-contiguous (M, dim)
+    array, and their leading shape (...) for the answers."""
+    x = read_array(xi, "xi", "an array of numbers")
+    if x.dtype.kind not in "fiu":
+        raise ValueError(f"xi: expected real numbers, got dtype {x.dtype}")
+    if x.ndim == 0 or x.shape[-1] != dim:
+        raise ValueError(f"xi: expected shape (..., {dim}), got {x.shape}")
+    return np.ascontiguousarray(x.reshape(-1, dim), dtype=np.float64), x.shape[:-1]
+
+
 def as_mask(mask: Any, n: int) -> Optional[np.ndarray]:
     """None or a uint8 (n,) array (nonzero = selected) from booleans or integers."""
     if mask is None:
         return None
-    try:
-        a = np.asarray(mask)
-    except (ValueError, TypeError) as e:
-        raise ValueError(f"mask: cannot be read as an array of booleans ({e})") from None
+    a = read_array(mask, "mask", "an array of booleans")
     if a.dtype.kind not in "biu":
         raise ValueError(f"mask: expected booleans (or 0/1 integers), got dtype {a.dtype}")
     if a.ndim != 1 or a.shape[0] != n:

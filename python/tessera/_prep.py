@@ -33,10 +33,7 @@ def _is_path(x: Any) -> bool:
 
 
 def _image_array(image: Any, kinds: str, what: str) -> np.ndarray:
-    try:
-        a = np.asarray(image)
-    except (ValueError, TypeError) as e:
-        raise ValueError(f"image: cannot be read as an array ({e})") from None
+    a = _inputs.read_array(image, "image", "an array")
     if a.dtype.kind not in kinds:
         raise ValueError(f"image: expected {what}, got dtype {a.dtype}")
     if a.ndim not in (2, 3):
