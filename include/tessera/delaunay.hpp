@@ -56,6 +56,10 @@ Delaunay delaunay(std::span<const double> points, int dim, std::span<const std::
 /// the simplex sharing the facet opposite vertex k of simplex r, or -1.
 std::vector<std::int32_t> simplex_neighbors(const Delaunay& dt);
 
+/// For each point the lowest index of a simplex having it as a vertex, or -1
+/// (a duplicate, an outside point), as scipy.spatial.Delaunay.vertex_to_simplex.
+std::vector<std::int32_t> vertex_to_simplex(const Delaunay& dt);
+
 /// The Delaunay edges as CSR, as scipy.spatial.Delaunay.vertex_neighbor_vertices:
 /// the points sharing a simplex with point v are ids[offsets[v] .. offsets[v+1]),
 /// ascending (none for a point in no simplex: a duplicate, an outside point).

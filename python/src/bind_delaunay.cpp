@@ -108,6 +108,7 @@ void bind_delaunay(py::module_& m) {
                              })
       .def_property_readonly("neighbors", &neighbors_view)
       .def_property_readonly("vertex_neighbors", &vertex_neighbors_view)
+      .def("vertex_to_simplex", [](const DelaunayResult& r) { return adopt_flat(vertex_to_simplex(r.dt)); })
       .def_property_readonly("from_cells", [](const DelaunayResult& r) { return r.dt.from_cells; })
       .def_property_readonly("from_hull_completion", [](const DelaunayResult& r) { return r.dt.from_hull_completion; })
       .def_property_readonly("hull_completed", [](const DelaunayResult& r) { return r.dt.hull_completed; })

@@ -123,11 +123,7 @@ class Delaunay:
         lowest-indexed one), -1 for a point in none (a duplicate, an outside
         point). Computed on first use."""
         if self._vertex_to_simplex is None:
-            s = self.simplices
-            v2s = np.full(self.npoints, -1, dtype=np.int32)
-            # Written from the last simplex to the first: the lowest one stays.
-            ids = np.repeat(np.arange(len(s), dtype=np.int32), self.ndim + 1)[::-1]
-            v2s[s.ravel()[::-1]] = ids
+            v2s = self._dt.vertex_to_simplex()
             v2s.setflags(write=False)
             self._vertex_to_simplex = v2s
         return self._vertex_to_simplex

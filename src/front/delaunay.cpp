@@ -130,6 +130,14 @@ std::vector<std::int32_t> simplex_neighbors(const Delaunay& dt) {
   return nb;
 }
 
+std::vector<std::int32_t> vertex_to_simplex(const Delaunay& dt) {
+  std::vector<std::int32_t> out(dt.n_points, -1);
+  const std::size_t w = static_cast<std::size_t>(dt.dim + 1);
+  for (std::size_t s = dt.n_simplices(); s-- > 0;)  // the lowest index is written last
+    for (std::size_t k = 0; k < w; ++k) out[static_cast<std::size_t>(dt.simplices[s * w + k])] = static_cast<std::int32_t>(s);
+  return out;
+}
+
 VertexNeighbors vertex_neighbors(const Delaunay& dt) {
   const std::size_t n = dt.n_points, m = dt.n_simplices();
   const std::size_t w = static_cast<std::size_t>(dt.dim + 1);

@@ -231,7 +231,7 @@ TEST(Locate, PowerOfTwoScalesLocateAlike) {
   }
 }
 
-TEST(VertexNeighbors, AreTheSimplicesEdges) {
+TEST(VertexNeighbors, AreTheSimplicesEdgesAndVertexToSimplexTheLowest) {
   for (int dim : {2, 3}) {
     SCOPED_TRACE(dim);
     auto p = uniform(1500, dim, 61);
@@ -251,6 +251,15 @@ TEST(VertexNeighbors, AreTheSimplicesEdges) {
     }
     EXPECT_EQ(nb.offsets[n], static_cast<std::int64_t>(nb.ids.size()));
     EXPECT_EQ(nb.offsets[n - 1], nb.offsets[n]) << "the duplicate has no neighbours";
+    const std::vector<std::int32_t> v2s = tessera::vertex_to_simplex(dt);
+    std::vector<std::int32_t> lowest(n, -1);
+    for (std::size_t s = 0; s < dt.n_simplices(); ++s)
+      for (std::size_t k = 0; k < w; ++k) {
+        std::int32_t& l = lowest[static_cast<std::size_t>(dt.simplices[s * w + k])];
+        if (l < 0) l = static_cast<std::int32_t>(s);
+      }
+    EXPECT_EQ(v2s, lowest);
+    EXPECT_EQ(v2s[n - 1], -1);
   }
 }
 
