@@ -40,6 +40,8 @@ class SimplexLocator {
  private:
   // The bin of coordinate x on axis d, clamped to the grid (monotone in x).
   std::int64_t bin_of(int d, double x) const;
+  // The bin at grid coordinates (x, y, z): x fastest.
+  std::size_t bin_index(std::int64_t x, std::int64_t y, std::int64_t z) const;
 
   int dim_ = 3;
   std::size_t n_simplices_ = 0, n_points_ = 0;

@@ -31,7 +31,7 @@ DelaunayResult run_delaunay(const Points& points, const py::object& labels,
   opt.complete_hull = complete_hull;
   const auto pts = as_span(points);
   const auto lab = as_labels(labels);
-  return DelaunayResult{without_gil([&] { return delaunay(pts, dim, lab, opt); }), std::nullopt};
+  return DelaunayResult{without_gil([&] { return delaunay(pts, dim, lab, opt); }), {}, {}, {}};
 }
 
 py::array neighbors_view(py::object self) {
@@ -55,9 +55,9 @@ py::tuple vertex_neighbors_view(py::object self) {
 }
 
 // The simplex holding each query point (-1: none). The locator is built on
-// the first call (without the GIL) and kept for the next ones.
+// the first call (without the GIL) and kept for the next ones. threads: the
+// triangulation's own count (0 or less: the default).
 py::array locate_points(DelaunayResult& r, const Points& points, const Points& queries, int threads) {
-  if (threads < 0) throw py::value_error("threads must be >= 1, or 0/None for the default");
   if (checked_dim(points) != r.dt.dim || static_cast<std::size_t>(points.shape(0)) != r.dt.n_points)
     throw py::value_error("locate: points are not the ones triangulated");
   if (queries.ndim() != 2 || queries.shape(1) != r.dt.dim)

@@ -8,8 +8,6 @@
 #include <numeric>
 #include <stdexcept>
 
-#include <tbb/blocked_range.h>
-#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
@@ -142,8 +140,7 @@ VertexNeighbors vertex_neighbors(const Delaunay& dt) {
   const std::size_t n = dt.n_points, m = dt.n_simplices();
   const std::size_t w = static_cast<std::size_t>(dt.dim + 1);
   // The simplices of each point (CSR, ascending), then per point the other
-  // vertices of its simplices, sorted and deduplicated: counted in a first
-  // parallel pass, written in a second.
+  // vertices of its simplices, sorted and deduplicated.
   std::vector<std::int64_t> star(n + 1, 0);
   for (std::int32_t id : dt.simplices) ++star[static_cast<std::size_t>(id) + 1];
   std::partial_sum(star.begin(), star.end(), star.begin());
@@ -154,36 +151,34 @@ VertexNeighbors vertex_neighbors(const Delaunay& dt) {
       for (std::size_t k = 0; k < w; ++k)
         star_ids[static_cast<std::size_t>(at[static_cast<std::size_t>(dt.simplices[s * w + k])]++)] = static_cast<std::int32_t>(s);
   }
+  // Each chunk of points gathers its lists into its own buffer (once per
+  // point); the buffers are then copied into place.
   VertexNeighbors out;
   out.offsets.assign(n + 1, 0);
-  tbb::enumerable_thread_specific<std::vector<std::int32_t>> scratch;
-  auto around = [&](std::size_t v, std::vector<std::int32_t>& nb) {
-    nb.clear();
-    for (auto e = star[v]; e != star[v + 1]; ++e) {
-      const std::int32_t* row = dt.simplices.data() + static_cast<std::size_t>(star_ids[static_cast<std::size_t>(e)]) * w;
-      for (std::size_t k = 0; k < w; ++k)
-        if (static_cast<std::size_t>(row[k]) != v) nb.push_back(row[k]);
-    }
-    std::sort(nb.begin(), nb.end());
-    nb.erase(std::unique(nb.begin(), nb.end()), nb.end());
-  };
+  constexpr std::size_t chunk = 4096;
+  std::vector<std::vector<std::int32_t>> part((n + chunk - 1) / chunk);
   tbb::task_arena arena(dt.threads_used > 0 ? dt.threads_used : 1);
   arena.execute([&] {
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1024), [&](const tbb::blocked_range<std::size_t>& r) {
-      auto& nb = scratch.local();
-      for (std::size_t v = r.begin(); v != r.end(); ++v) {
-        around(v, nb);
+    tbb::parallel_for(std::size_t(0), part.size(), [&](std::size_t c) {
+      std::vector<std::int32_t> nb;
+      for (std::size_t v = c * chunk; v < std::min(n, (c + 1) * chunk); ++v) {
+        nb.clear();
+        for (auto e = star[v]; e != star[v + 1]; ++e) {
+          const std::int32_t* row = dt.simplices.data() + static_cast<std::size_t>(star_ids[static_cast<std::size_t>(e)]) * w;
+          for (std::size_t k = 0; k < w; ++k)
+            if (static_cast<std::size_t>(row[k]) != v) nb.push_back(row[k]);
+        }
+        std::sort(nb.begin(), nb.end());
+        nb.erase(std::unique(nb.begin(), nb.end()), nb.end());
         out.offsets[v + 1] = static_cast<std::int64_t>(nb.size());
+        part[c].insert(part[c].end(), nb.begin(), nb.end());
       }
     });
     std::partial_sum(out.offsets.begin(), out.offsets.end(), out.offsets.begin());
     out.ids.resize(static_cast<std::size_t>(out.offsets[n]));
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1024), [&](const tbb::blocked_range<std::size_t>& r) {
-      auto& nb = scratch.local();
-      for (std::size_t v = r.begin(); v != r.end(); ++v) {
-        around(v, nb);
-        std::copy(nb.begin(), nb.end(), out.ids.begin() + out.offsets[v]);
-      }
+    tbb::parallel_for(std::size_t(0), part.size(), [&](std::size_t c) {
+      std::copy(part[c].begin(), part[c].end(), out.ids.begin() + out.offsets[c * chunk]);
+      std::vector<std::int32_t>().swap(part[c]);
     });
   });
   return out;

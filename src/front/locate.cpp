@@ -34,6 +34,10 @@ constexpr std::uint64_t max_entries_per_simplex = 16;
 
 }  // namespace
 
+std::size_t SimplexLocator::bin_index(std::int64_t x, std::int64_t y, std::int64_t z) const {
+  return static_cast<std::size_t>((z * bins_[1] + y) * bins_[0] + x);
+}
+
 std::int64_t SimplexLocator::bin_of(int d, double x) const {
   const double t = (x - lo_[d]) * scale_[d];
   if (!(t > 0)) return 0;
@@ -77,21 +81,24 @@ SimplexLocator::SimplexLocator(const Delaunay& dt, std::span<const double> point
           return a;
         });
   });
-  double* hi = hi_;
   for (int d = 0; d < D; ++d) {
     lo_[d] = box.lo[d];
-    hi[d] = box.hi[d];
+    hi_[d] = box.hi[d];
   }
   double volume = 1;
-  for (int d = 0; d < D; ++d) volume *= hi[d] - lo_[d];  // > 0: the simplices are not flat
+  for (int d = 0; d < D; ++d) volume *= hi_[d] - lo_[d];  // > 0: the simplices are not flat
   const double target = std::max(1.0, static_cast<double>(m) / simplices_per_bin);
   const double side = std::pow(volume / target, 1.0 / D);
   for (int d = 0; d < D; ++d) {
-    const double g = std::ceil((hi[d] - lo_[d]) / side);
+    const double g = std::ceil((hi_[d] - lo_[d]) / side);
     bins_[d] = g >= 1 ? static_cast<std::int64_t>(std::min(g, 1048576.0)) : 1;  // also NaN, infinite
   }
   auto total_bins = [&] { return bins_[0] * bins_[1] * bins_[2]; };
-  while (static_cast<double>(total_bins()) > 4 * target + 64) *std::max_element(bins_, bins_ + D) = (*std::max_element(bins_, bins_ + D) + 1) / 2;
+  // A slab (one thin axis) would get very many bins across the wide ones.
+  while (static_cast<double>(total_bins()) > 4 * target + 64) {
+    std::int64_t* widest = std::max_element(bins_, bins_ + D);
+    *widest = (*widest + 1) / 2;
+  }
 
   auto bin_range = [&](std::size_t s, std::int64_t* b0, std::int64_t* b1) {
     const std::int32_t* row = dt.simplices.data() + s * w;
@@ -107,10 +114,23 @@ SimplexLocator::SimplexLocator(const Delaunay& dt, std::span<const double> point
     }
     for (int d = D; d < 3; ++d) b0[d] = b1[d] = 0;
   };
+  auto for_each_entry = [&](auto&& body) {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, m, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
+      std::int64_t b0[3], b1[3];
+      for (std::size_t s = r.begin(); s != r.end(); ++s) {
+        bin_range(s, b0, b1);
+        for (std::int64_t z = b0[2]; z <= b1[2]; ++z)
+          for (std::int64_t y = b0[1]; y <= b1[1]; ++y)
+            for (std::int64_t x = b0[0]; x <= b1[0]; ++x) body(bin_index(x, y, z), s);
+      }
+    });
+  };
   arena.execute([&] {
-    // Coarsen until the index fits its budget (see max_entries_per_simplex).
+    // Coarsen until the index fits its budget (see max_entries_per_simplex),
+    // counting its entries from each simplex's bin ranges (a product, not a
+    // walk over the bins: over budget, that walk could be quadratic).
     for (;;) {
-      for (int d = 0; d < D; ++d) scale_[d] = static_cast<double>(bins_[d]) / (hi[d] - lo_[d]);
+      for (int d = 0; d < D; ++d) scale_[d] = static_cast<double>(bins_[d]) / (hi_[d] - lo_[d]);
       const std::uint64_t entries = tbb::parallel_reduce(
           tbb::blocked_range<std::size_t>(0, m, 4096), std::uint64_t{0},
           [&](const tbb::blocked_range<std::size_t>& r, std::uint64_t sum) {
@@ -125,26 +145,12 @@ SimplexLocator::SimplexLocator(const Delaunay& dt, std::span<const double> point
       if (entries <= max_entries_per_simplex * m + 4096 || total_bins() == 1) break;
       for (int d = 0; d < D; ++d) bins_[d] = (bins_[d] + 1) / 2;
     }
-
-    // Two passes, counts then slots; then each bin's list sorted, so the
+    // Counts per bin, then the slots; then each bin's list sorted, so the
     // index does not depend on the order the threads filled it in.
-    const auto nb = static_cast<std::size_t>(total_bins());
-    auto bin_index = [&](std::int64_t x, std::int64_t y, std::int64_t z) {
-      return static_cast<std::size_t>((z * bins_[1] + y) * bins_[0] + x);
-    };
-    auto for_each_entry = [&](auto&& body) {
-      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, m, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
-        std::int64_t b0[3], b1[3];
-        for (std::size_t s = r.begin(); s != r.end(); ++s) {
-          bin_range(s, b0, b1);
-          for (std::int64_t z = b0[2]; z <= b1[2]; ++z)
-            for (std::int64_t y = b0[1]; y <= b1[1]; ++y)
-              for (std::int64_t x = b0[0]; x <= b1[0]; ++x) body(bin_index(x, y, z), s);
-        }
-      });
-    };
-    offsets_.assign(nb + 1, 0);
-    for_each_entry([&](std::size_t b, std::size_t) { std::atomic_ref<std::uint64_t>(offsets_[b + 1]).fetch_add(1, std::memory_order_relaxed); });
+    offsets_.assign(static_cast<std::size_t>(total_bins()) + 1, 0);
+    for_each_entry([&](std::size_t b, std::size_t) {
+      std::atomic_ref<std::uint64_t>(offsets_[b + 1]).fetch_add(1, std::memory_order_relaxed);
+    });
     std::partial_sum(offsets_.begin(), offsets_.end(), offsets_.begin());
     ids_.resize(offsets_.back());
     std::vector<std::uint64_t> cursor(offsets_.begin(), offsets_.end() - 1);
@@ -152,7 +158,7 @@ SimplexLocator::SimplexLocator(const Delaunay& dt, std::span<const double> point
       const std::uint64_t at = std::atomic_ref<std::uint64_t>(cursor[b]).fetch_add(1, std::memory_order_relaxed);
       ids_[at] = static_cast<std::int32_t>(s);
     });
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nb, 1024), [&](const tbb::blocked_range<std::size_t>& r) {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, offsets_.size() - 1, 1024), [&](const tbb::blocked_range<std::size_t>& r) {
       for (std::size_t b = r.begin(); b != r.end(); ++b)
         std::sort(ids_.begin() + static_cast<std::ptrdiff_t>(offsets_[b]), ids_.begin() + static_cast<std::ptrdiff_t>(offsets_[b + 1]));
     });
@@ -199,7 +205,7 @@ std::vector<std::int32_t> SimplexLocator::locate(const Delaunay& dt, std::span<c
           b[d] = bin_of(d, x[d]);
         }
         if (!inside) continue;
-        const std::size_t bin = static_cast<std::size_t>((b[2] * bins_[1] + b[1]) * bins_[0] + b[0]);
+        const std::size_t bin = bin_index(b[0], b[1], b[2]);
         for (std::uint64_t e = offsets_[bin]; e != offsets_[bin + 1]; ++e)
           if (contains(static_cast<std::size_t>(ids_[e]), x)) {
             found[q] = ids_[e];

@@ -133,11 +133,8 @@ TEST(Locate, InputPointsFindTheirLowestSimplex) {
   // position): the answer is the lowest of them.
   auto p = uniform(2000, 3, 21);
   tessera::Delaunay dt = triangulate(p, 3);
-  const auto found = tessera::SimplexLocator(dt, p).locate(dt, p, p);
-  std::vector<std::int32_t> lowest(2000, -1);
-  for (std::size_t s = dt.n_simplices(); s-- > 0;)
-    for (std::size_t k = 0; k < 4; ++k) lowest[static_cast<std::size_t>(dt.simplices[4 * s + k])] = static_cast<std::int32_t>(s);
-  EXPECT_EQ(found, lowest);
+  // vertex_to_simplex (checked against its own oracle below) is that lowest.
+  EXPECT_EQ(tessera::SimplexLocator(dt, p).locate(dt, p, p), tessera::vertex_to_simplex(dt));
 }
 
 TEST(Locate, DegenerateTriangulationsCoarsenTheGrid) {
