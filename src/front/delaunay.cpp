@@ -15,6 +15,7 @@
 #include "hull_completion.hpp"
 #include "pass.hpp"
 #include "simplex_facets.hpp"
+#include "simplex_star.hpp"
 #include "tessera/engine/tessellate.hpp"
 #include "tessera/kernels/delaunay_predicates.hpp"
 #include "tessera/kernels/hull.hpp"
@@ -115,20 +116,32 @@ Delaunay delaunay(std::span<const double> points, int dim, std::span<const std::
 }
 
 std::vector<std::int32_t> simplex_neighbors(const Delaunay& dt) {
-  const std::size_t m = dt.n_simplices();
   const std::size_t w = static_cast<std::size_t>(dt.dim + 1);
-  const std::vector<front::FacetRecord> recs = front::sorted_facets(dt);
-  std::vector<std::int32_t> nb(m * w, -1);
-  for (std::size_t i = 0; i + 1 < recs.size(); ++i) {
-    if (recs[i].facet != recs[i + 1].facet) continue;
-    nb[static_cast<std::size_t>(recs[i].simplex) * w + static_cast<std::size_t>(recs[i].k)] = recs[i + 1].simplex;
-    nb[static_cast<std::size_t>(recs[i + 1].simplex) * w + static_cast<std::size_t>(recs[i + 1].k)] = recs[i].simplex;
-    ++i;
-  }
+  std::vector<std::int32_t> nb(dt.n_simplices() * w, -1);
+  // Each point pairs the facets it is lowest in (simplex_facets.hpp): every
+  // entry of nb is written by one point, so points run at once. Records of
+  // one facet pair up in ascending simplex order; a third (a non-conforming
+  // triangulation) stays -1.
+  tbb::task_arena(dt.threads_used > 0 ? dt.threads_used : 1).execute([&] {
+    const front::FacetBuckets buckets(dt);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, dt.n_points, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
+      std::vector<front::FacetRecord> recs;
+      for (std::size_t a = r.begin(); a != r.end(); ++a) {
+        buckets.records(a, recs);
+        for (std::size_t i = 0; i + 1 < recs.size(); ++i) {
+          if (!recs[i].same_facet(recs[i + 1])) continue;
+          nb[static_cast<std::size_t>(recs[i].simplex) * w + static_cast<std::size_t>(recs[i].k)] = recs[i + 1].simplex;
+          nb[static_cast<std::size_t>(recs[i + 1].simplex) * w + static_cast<std::size_t>(recs[i + 1].k)] = recs[i].simplex;
+          ++i;
+        }
+      }
+    });
+  });
   return nb;
 }
 
 std::vector<std::int32_t> vertex_to_simplex(const Delaunay& dt) {
+  front::check_simplex_ids(dt);
   std::vector<std::int32_t> out(dt.n_points, -1);
   const std::size_t w = static_cast<std::size_t>(dt.dim + 1);
   for (std::size_t s = dt.n_simplices(); s-- > 0;)  // the lowest index is written last
@@ -137,20 +150,8 @@ std::vector<std::int32_t> vertex_to_simplex(const Delaunay& dt) {
 }
 
 VertexNeighbors vertex_neighbors(const Delaunay& dt) {
-  const std::size_t n = dt.n_points, m = dt.n_simplices();
+  const std::size_t n = dt.n_points;
   const std::size_t w = static_cast<std::size_t>(dt.dim + 1);
-  // The simplices of each point (CSR, ascending), then per point the other
-  // vertices of its simplices, sorted and deduplicated.
-  std::vector<std::int64_t> star(n + 1, 0);
-  for (std::int32_t id : dt.simplices) ++star[static_cast<std::size_t>(id) + 1];
-  std::partial_sum(star.begin(), star.end(), star.begin());
-  std::vector<std::int32_t> star_ids(static_cast<std::size_t>(star[n]));
-  {
-    std::vector<std::int64_t> at(star.begin(), star.end() - 1);
-    for (std::size_t s = 0; s < m; ++s)
-      for (std::size_t k = 0; k < w; ++k)
-        star_ids[static_cast<std::size_t>(at[static_cast<std::size_t>(dt.simplices[s * w + k])]++)] = static_cast<std::int32_t>(s);
-  }
   // Each chunk of points gathers its lists into its own buffer (once per
   // point); the buffers are then copied into place.
   VertexNeighbors out;
@@ -159,12 +160,15 @@ VertexNeighbors vertex_neighbors(const Delaunay& dt) {
   std::vector<std::vector<std::int32_t>> part((n + chunk - 1) / chunk);
   tbb::task_arena arena(dt.threads_used > 0 ? dt.threads_used : 1);
   arena.execute([&] {
+    // Per point the other vertices of its simplices (its star), sorted and
+    // deduplicated.
+    const front::SimplexStar star = front::simplex_star(dt);
     tbb::parallel_for(std::size_t(0), part.size(), [&](std::size_t c) {
       std::vector<std::int32_t> nb;
       for (std::size_t v = c * chunk; v < std::min(n, (c + 1) * chunk); ++v) {
         nb.clear();
-        for (auto e = star[v]; e != star[v + 1]; ++e) {
-          const std::int32_t* row = dt.simplices.data() + static_cast<std::size_t>(star_ids[static_cast<std::size_t>(e)]) * w;
+        for (const std::int32_t* e = star.begin(v); e != star.end(v); ++e) {
+          const std::int32_t* row = dt.simplices.data() + static_cast<std::size_t>(*e) * w;
           for (std::size_t k = 0; k < w; ++k)
             if (static_cast<std::size_t>(row[k]) != v) nb.push_back(row[k]);
         }

@@ -11,12 +11,14 @@
 #include <cmath>
 #include <limits>
 #include <sstream>
+#include <string>
 #include <vector>
 
 #include <tbb/parallel_for.h>
 
 #include "tessera/delaunay.hpp"
 #include "simplex_facets.hpp"
+#include "simplex_star.hpp"
 #include "tessera/kernels/delaunay_predicates.hpp"
 
 namespace tessera {
@@ -85,6 +87,12 @@ bool is_flat(const kernels::ExactContext& ctx, const Delaunay& dt) {
 }  // namespace
 
 DelaunayReport validate(const Delaunay& dt, std::span<const double> points, std::span<const std::int32_t> labels) {
+  front::check_simplex_ids(dt);
+  if (points.size() != dt.n_points * static_cast<std::size_t>(dt.dim))
+    throw InputError("validate: " + std::to_string(points.size()) + " coordinates for a triangulation of " +
+                     std::to_string(dt.n_points) + " points in " + std::to_string(dt.dim) + "D");
+  if (!labels.empty() && labels.size() != dt.n_points)
+    throw InputError("validate: " + std::to_string(labels.size()) + " labels for " + std::to_string(dt.n_points) + " points");
   DelaunayReport rep;
   const int D = dt.dim;
   const std::size_t w = static_cast<std::size_t>(D + 1);
@@ -152,7 +160,7 @@ DelaunayReport validate(const Delaunay& dt, std::span<const double> points, std:
   std::vector<std::pair<const FacetRecord*, const FacetRecord*>> interior;
   for (std::size_t i = 0; i < recs.size();) {
     std::size_t j = i + 1;
-    while (j < recs.size() && recs[j].facet == recs[i].facet) ++j;
+    while (j < recs.size() && recs[j].same_facet(recs[i])) ++j;
     if (j - i == 1) boundary.push_back(&recs[i]);
     else if (j - i == 2) interior.emplace_back(&recs[i], &recs[i + 1]);
     else rep.nonmanifold_facets += j - i - 2;
