@@ -1,12 +1,17 @@
 // Point location in a Delaunay triangulation: which simplex holds a query
 // point (scipy.spatial.Delaunay.find_simplex).
 //
-// A uniform grid over the simplices' bounding box lists, per bin, every
-// simplex whose bounding box meets it. A query tests the simplices of its
-// bin with the exact orientation predicate and answers the lowest index whose
-// closed simplex holds it: the same answer for any thread count, and for
-// points on shared facets, edges or vertices. Unlike a walk, the grid needs
-// no convexity, so triangulations of labelled (concave) regions work too.
+// Two methods, one answer: the lowest index of a simplex whose closed region
+// holds the point (so the same for any thread count, and for points on
+// shared facets, edges or vertices), decided by exact orientation tests.
+// * walk: from a simplex of a point near the query (a grid of seeds), step
+//   across a facet the query lies beyond until none is left; then gather
+//   the simplices that share the query's face (those across facets through
+//   it) and answer the lowest. Needs a convex triangulation: without labels
+//   and with hull completion, a step out of the hull proves the query outside.
+// * grid: a uniform grid over the simplices' bounding box lists, per bin,
+//   every simplex whose bounding box meets it; a query tests its bin's
+//   simplices. Needs no convexity, so it serves labelled (concave) regions.
 #pragma once
 
 #include <cstddef>
@@ -18,12 +23,19 @@
 
 namespace tessera {
 
+enum class LocateMethod {
+  automatic,  ///< walk on a hull-complete triangulation, else grid
+  walk,       ///< InputError unless dt.hull_completed
+  grid,
+};
+
 class SimplexLocator {
  public:
   /// Index the simplices of `dt`, whose vertex coordinates are `points`
   /// (dt.n_points * dt.dim, row-major: the triangulated points). Throws
   /// InputError when `points` does not match `dt`.
-  SimplexLocator(const Delaunay& dt, std::span<const double> points, int threads = 0);
+  SimplexLocator(const Delaunay& dt, std::span<const double> points, int threads = 0,
+                 LocateMethod method = LocateMethod::automatic);
 
   /// For each query point (row-major, dt.dim coordinates each): the lowest
   /// index of a simplex whose closed region holds it, or -1 (outside every
@@ -32,12 +44,22 @@ class SimplexLocator {
   std::vector<std::int32_t> locate(const Delaunay& dt, std::span<const double> points,
                                    std::span<const double> queries, int threads = 0) const;
 
-  /// Grid bins per axis (1 on the unused z axis in 2D), and the total number of
-  /// (bin, simplex) entries: the index's size.
+  /// The method chosen (never automatic).
+  LocateMethod method() const { return method_; }
+  /// Grid bins per axis (1 on the unused z axis in 2D): the grid's, or the
+  /// walk's seed grid. entries(): the grid's (bin, simplex) entries, its
+  /// index's size (0 for a walk).
   const std::int64_t* bins() const { return bins_; }
   std::size_t entries() const { return ids_.size(); }
 
  private:
+  // Bins near cubes holding `items_per_bin` of `items` (spread over the box), then scale_.
+  void size_bins(double items_per_bin, double items);
+  void build_grid(const Delaunay& dt, std::span<const double> points, int threads);
+  void build_walk(const Delaunay& dt, std::span<const double> points, int threads);
+  std::int32_t walk(const Delaunay& dt, std::span<const double> points, const double* x, std::uint64_t salt) const;
+  std::int32_t scan_bin(const Delaunay& dt, std::span<const double> points, const double* x) const;
+
   // The bin of coordinate x on axis d, clamped to the grid (monotone in x).
   std::int64_t bin_of(int d, double x) const;
   // The bin at grid coordinates (x, y, z): x fastest.
@@ -47,8 +69,13 @@ class SimplexLocator {
   std::size_t n_simplices_ = 0, n_points_ = 0;
   double lo_[3] = {}, hi_[3] = {}, scale_[3] = {};  // the vertices' box; bin = floor((x - lo) * scale)
   std::int64_t bins_[3] = {1, 1, 1};
+  LocateMethod method_ = LocateMethod::grid;
+  // grid
   std::vector<std::uint64_t> offsets_;  // per bin, CSR into ids_
   std::vector<std::int32_t> ids_;       // simplices per bin, ascending
+  // walk
+  std::vector<std::int32_t> neighbors_;  // simplex_neighbors(dt)
+  std::vector<std::int32_t> seed_;       // per bin: a simplex to start from
 };
 
 }  // namespace tessera

@@ -158,8 +158,10 @@ class Delaunay:
         scipy's. Decided exactly: a point on a shared facet, edge or vertex
         gets the lowest-indexed simplex holding it, whatever the thread count.
         ``bruteforce`` is accepted for scipy compatibility and changes nothing;
-        ``tol`` is not supported (there is no tolerance to set). The index is
-        built on the first call (a grid of the simplices) and reused."""
+        ``tol`` is not supported (there is no tolerance to set). The locator is
+        built on the first call and reused: a walk from seeds near each query
+        when the triangulation covers its hull, else (labels, or no hull
+        completion) a grid of the simplices."""
         if tol is not None:
             raise ValueError("find_simplex: tol is not supported; containment is decided exactly")
         q, shape = _inputs.as_queries(xi, self.ndim)

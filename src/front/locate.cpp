@@ -1,5 +1,5 @@
-// tessera::SimplexLocator: a grid of simplices, queried with exact
-// orientation tests (see locate.hpp).
+// tessera::SimplexLocator: a walk from seeded simplices, or a grid of
+// simplices, queried with exact orientation tests (see locate.hpp).
 #include "tessera/locate.hpp"
 
 #include <algorithm>
@@ -45,17 +45,17 @@ std::int64_t SimplexLocator::bin_of(int d, double x) const {
   return t < top ? static_cast<std::int64_t>(t) : bins_[d] - 1;
 }
 
-SimplexLocator::SimplexLocator(const Delaunay& dt, std::span<const double> points, int threads)
+SimplexLocator::SimplexLocator(const Delaunay& dt, std::span<const double> points, int threads, LocateMethod method)
     : dim_(dt.dim), n_simplices_(dt.n_simplices()), n_points_(dt.n_points) {
   check_points(dt, points, "locate");
+  if (method == LocateMethod::walk && !dt.hull_completed)
+    throw InputError("locate: a walk needs a triangulation of the whole convex hull (no labels, hull completion on)");
+  method_ = method == LocateMethod::grid || !dt.hull_completed ? LocateMethod::grid : LocateMethod::walk;
   const int D = dim_;
-  const std::size_t w = static_cast<std::size_t>(D + 1);
-  const std::size_t m = n_simplices_;
   offsets_.assign(2, 0);
-  if (m == 0) return;
+  if (n_simplices_ == 0) return;
 
-  // The box of every simplex vertex, and bins near cubes of the volume that
-  // holds simplices_per_bin simplices each.
+  // The box of every simplex vertex: both methods bin it.
   tbb::task_arena arena(resolve_threads(threads));
   struct Box {
     double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
@@ -85,21 +85,36 @@ SimplexLocator::SimplexLocator(const Delaunay& dt, std::span<const double> point
     lo_[d] = box.lo[d];
     hi_[d] = box.hi[d];
   }
+  if (method_ == LocateMethod::walk) build_walk(dt, points, threads);
+  else build_grid(dt, points, threads);
+}
+
+void SimplexLocator::size_bins(double items_per_bin, double items) {
+  const int D = dim_;
   double volume = 1;
   for (int d = 0; d < D; ++d) volume *= hi_[d] - lo_[d];  // > 0: the simplices are not flat
-  const double target = std::max(1.0, static_cast<double>(m) / simplices_per_bin);
+  const double target = std::max(1.0, items / items_per_bin);
   const double side = std::pow(volume / target, 1.0 / D);
   for (int d = 0; d < D; ++d) {
     const double g = std::ceil((hi_[d] - lo_[d]) / side);
     bins_[d] = g >= 1 ? static_cast<std::int64_t>(std::min(g, 1048576.0)) : 1;  // also NaN, infinite
   }
-  auto total_bins = [&] { return bins_[0] * bins_[1] * bins_[2]; };
   // A slab (one thin axis) would get very many bins across the wide ones.
-  while (static_cast<double>(total_bins()) > 4 * target + 64) {
+  while (static_cast<double>(bins_[0] * bins_[1] * bins_[2]) > 4 * target + 64) {
     std::int64_t* widest = std::max_element(bins_, bins_ + D);
     *widest = (*widest + 1) / 2;
   }
+  for (int d = 0; d < D; ++d) scale_[d] = static_cast<double>(bins_[d]) / (hi_[d] - lo_[d]);
+}
 
+void SimplexLocator::build_grid(const Delaunay& dt, std::span<const double> points, int threads) {
+  const int D = dim_;
+  const std::size_t w = static_cast<std::size_t>(D + 1);
+  const std::size_t m = n_simplices_;
+  tbb::task_arena arena(resolve_threads(threads));
+  // Bins near cubes of the volume that holds simplices_per_bin simplices each.
+  size_bins(simplices_per_bin, static_cast<double>(m));
+  auto total_bins = [&] { return bins_[0] * bins_[1] * bins_[2]; };
   auto bin_range = [&](std::size_t s, std::int64_t* b0, std::int64_t* b1) {
     const std::int32_t* row = dt.simplices.data() + s * w;
     for (int d = 0; d < D; ++d) {
@@ -165,6 +180,139 @@ SimplexLocator::SimplexLocator(const Delaunay& dt, std::span<const double> point
   });
 }
 
+void SimplexLocator::build_walk(const Delaunay& dt, std::span<const double> points, int threads) {
+  const int D = dim_;
+  const std::vector<std::int32_t> start = vertex_to_simplex(dt);
+  const std::size_t used = static_cast<std::size_t>(std::count_if(start.begin(), start.end(), [](std::int32_t s) { return s >= 0; }));
+  // Seeds: bins of about two vertices, each holding a simplex of its
+  // lowest-id vertex; empty bins take the seed of a nearest filled bin
+  // (breadth-first over the grid), so a walk starts a few simplices away.
+  size_bins(2, static_cast<double>(used));
+  seed_.assign(static_cast<std::size_t>(bins_[0] * bins_[1] * bins_[2]), -1);
+  for (std::size_t v = n_points_; v-- > 0;) {
+    if (start[v] < 0) continue;
+    const double* x = points.data() + v * static_cast<std::size_t>(D);
+    std::int64_t b[3] = {0, 0, 0};
+    for (int d = 0; d < D; ++d) b[d] = bin_of(d, x[d]);
+    seed_[bin_index(b[0], b[1], b[2])] = start[v];
+  }
+  std::vector<std::size_t> queue;
+  for (std::size_t b = 0; b < seed_.size(); ++b)
+    if (seed_[b] >= 0) queue.push_back(b);
+  for (std::size_t head = 0; head < queue.size(); ++head) {
+    const std::size_t b = queue[head];
+    std::int64_t c[3] = {static_cast<std::int64_t>(b) % bins_[0], static_cast<std::int64_t>(b) / bins_[0] % bins_[1],
+                         static_cast<std::int64_t>(b) / (bins_[0] * bins_[1])};
+    for (int d = 0; d < D; ++d)
+      for (std::int64_t step : {-1, 1}) {
+        c[d] += step;
+        if (c[d] >= 0 && c[d] < bins_[d]) {
+          const std::size_t nb = bin_index(c[0], c[1], c[2]);
+          if (seed_[nb] < 0) {
+            seed_[nb] = seed_[b];
+            queue.push_back(nb);
+          }
+        }
+        c[d] -= step;
+      }
+  }
+  tbb::task_arena(resolve_threads(threads)).execute([&] { neighbors_ = simplex_neighbors(dt); });
+}
+
+namespace {
+
+// Orientation of simplex row with vertex k replaced by x: its sign says on
+// which side of the facet opposite k the query lies (> 0: the simplex's).
+int side(const Delaunay& dt, std::span<const double> points, std::size_t s, std::size_t k, const double* x) {
+  const std::size_t du = static_cast<std::size_t>(dt.dim);
+  const std::int32_t* row = dt.simplices.data() + s * (du + 1);
+  const double* v[4];
+  for (std::size_t j = 0; j <= du; ++j) v[j] = points.data() + static_cast<std::size_t>(row[j]) * du;
+  v[k] = x;
+  return kernels::orientation(dt.dim, v);
+}
+
+// A closed, positively oriented simplex holds x iff putting x in place of
+// each vertex in turn never makes it negative (its barycentric signs).
+bool holds(const Delaunay& dt, std::span<const double> points, std::size_t s, const double* x) {
+  for (std::size_t k = 0; k <= static_cast<std::size_t>(dt.dim); ++k)
+    if (side(dt, points, s, k, x) < 0) return false;
+  return true;
+}
+
+}  // namespace
+
+std::int32_t SimplexLocator::scan_bin(const Delaunay& dt, std::span<const double> points, const double* x) const {
+  std::int64_t b[3] = {0, 0, 0};
+  for (int d = 0; d < dim_; ++d) b[d] = bin_of(d, x[d]);
+  const std::size_t bin = bin_index(b[0], b[1], b[2]);
+  for (std::uint64_t e = offsets_[bin]; e != offsets_[bin + 1]; ++e)
+    if (holds(dt, points, static_cast<std::size_t>(ids_[e]), x)) return ids_[e];
+  return -1;
+}
+
+// The remembering stochastic walk (Devillers, Pion and Teillaud, "Walking in
+// a triangulation", 2002): from the seed, leave by a facet the query lies
+// strictly beyond, testing the facets in an order that varies by step and
+// never the one just entered by; it ends, with probability one on any
+// triangulation, in a simplex holding the query, or steps out of the hull
+// (which, the triangulation being convex, the query then lies outside). The
+// order comes from a hash of the query and the step, so runs repeat. A walk
+// past its step budget (which no test reaches) falls back to a scan.
+std::int32_t SimplexLocator::walk(const Delaunay& dt, std::span<const double> points, const double* x,
+                                  std::uint64_t salt) const {
+  const int D = dim_;
+  const std::size_t w = static_cast<std::size_t>(D + 1);
+  std::int64_t b[3] = {0, 0, 0};
+  for (int d = 0; d < D; ++d) b[d] = bin_of(d, x[d]);
+  std::size_t s = static_cast<std::size_t>(seed_[bin_index(b[0], b[1], b[2])]);
+  std::int32_t came_from = -1;
+  const std::uint64_t budget = 4 * static_cast<std::uint64_t>(n_simplices_) + 1024;
+  for (std::uint64_t step = 0;; ++step) {
+    if (step == budget) {
+      for (std::size_t t = 0; t < n_simplices_; ++t)
+        if (holds(dt, points, t, x)) return static_cast<std::int32_t>(t);
+      return -1;
+    }
+    std::uint64_t h = (salt + step) * 0x9E3779B97F4A7C15ull;
+    h ^= h >> 29;
+    const std::size_t first = static_cast<std::size_t>(h % w);
+    std::int32_t next = -2;  // -2: none found; -1: beyond the hull
+    for (std::size_t i = 0; i < w && next == -2; ++i) {
+      const std::size_t k = (first + i) % w;
+      const std::int32_t t = neighbors_[s * w + k];
+      if (t >= 0 && t == came_from) continue;  // the query lies on this side of it
+      if (side(dt, points, s, k, x) < 0) next = t;
+    }
+    if (next == -1) return -1;
+    if (next == -2) break;
+    came_from = static_cast<std::int32_t>(s);
+    s = static_cast<std::size_t>(next);
+  }
+  // s holds x. Every simplex holding x holds the face of s that x lies
+  // inside (x's face: its vertices are those whose facet-opposite sign is
+  // not 0), and those simplices are joined across facets through that face,
+  // on each of which x lies (sign 0): gather them and answer the lowest.
+  std::int32_t best = static_cast<std::int32_t>(s);
+  std::vector<std::int32_t> seen{best}, stack{best};
+  bool strictly_inside = true;
+  while (!stack.empty()) {
+    const std::size_t t = static_cast<std::size_t>(stack.back());
+    stack.pop_back();
+    for (std::size_t k = 0; k < w; ++k) {
+      if (side(dt, points, t, k, x) != 0) continue;
+      strictly_inside = false;
+      const std::int32_t u = neighbors_[t * w + k];
+      if (u < 0 || std::find(seen.begin(), seen.end(), u) != seen.end()) continue;
+      seen.push_back(u);
+      stack.push_back(u);
+      best = std::min(best, u);
+    }
+    if (strictly_inside) break;
+  }
+  return best;
+}
+
 std::vector<std::int32_t> SimplexLocator::locate(const Delaunay& dt, std::span<const double> points,
                                                  std::span<const double> queries, int threads) const {
   check_points(dt, points, "locate");
@@ -178,39 +326,14 @@ std::vector<std::int32_t> SimplexLocator::locate(const Delaunay& dt, std::span<c
   const std::size_t nq = queries.size() / du;
   std::vector<std::int32_t> found(nq, -1);
   if (n_simplices_ == 0) return found;
-  auto contains = [&](std::size_t s, const double* x) {
-    const std::int32_t* row = dt.simplices.data() + s * (du + 1);
-    const double* v[4];
-    for (std::size_t k = 0; k <= du; ++k) v[k] = points.data() + static_cast<std::size_t>(row[k]) * du;
-    // x lies in the closed, positively oriented simplex iff putting it in
-    // place of each vertex in turn never makes the simplex negative (its
-    // barycentric coordinates, as signs).
-    for (std::size_t k = 0; k <= du; ++k) {
-      const double* keep = v[k];
-      v[k] = x;
-      const int o = kernels::orientation(D, v);
-      v[k] = keep;
-      if (o < 0) return false;
-    }
-    return true;
-  };
   tbb::task_arena(resolve_threads(threads)).execute([&] {
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nq, 1024), [&](const tbb::blocked_range<std::size_t>& r) {
       for (std::size_t q = r.begin(); q != r.end(); ++q) {
         const double* x = queries.data() + q * du;
-        bool inside = true;  // in the vertices' box (false on NaN)
-        std::int64_t b[3] = {0, 0, 0};
-        for (int d = 0; d < D; ++d) {
-          inside &= x[d] >= lo_[d] && x[d] <= hi_[d];
-          b[d] = bin_of(d, x[d]);
-        }
+        bool inside = true;  // in the vertices' box (false on NaN): else outside every simplex
+        for (int d = 0; d < D; ++d) inside &= x[d] >= lo_[d] && x[d] <= hi_[d];
         if (!inside) continue;
-        const std::size_t bin = bin_index(b[0], b[1], b[2]);
-        for (std::uint64_t e = offsets_[bin]; e != offsets_[bin + 1]; ++e)
-          if (contains(static_cast<std::size_t>(ids_[e]), x)) {
-            found[q] = ids_[e];
-            break;
-          }
+        found[q] = method_ == LocateMethod::walk ? walk(dt, points, x, q) : scan_bin(dt, points, x);
       }
     });
   });

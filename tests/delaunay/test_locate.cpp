@@ -73,20 +73,25 @@ std::int32_t brute_force(const tessera::Delaunay& dt, const std::vector<double>&
   return -1;
 }
 
+// Both methods where both apply (the walk needs a hull-complete triangulation).
 void expect_brute_force(const tessera::Delaunay& dt, const std::vector<double>& p, const std::vector<double>& q) {
-  tessera::SimplexLocator loc(dt, p);
-  const auto found = loc.locate(dt, p, q);
+  std::vector<tessera::LocateMethod> methods{tessera::LocateMethod::grid};
+  if (dt.hull_completed) methods.push_back(tessera::LocateMethod::walk);
   const std::size_t D = static_cast<std::size_t>(dt.dim);
-  ASSERT_EQ(found.size(), q.size() / D);
-  std::size_t wrong = 0, inside = 0;
-  for (std::size_t i = 0; i < found.size(); ++i) {
-    const std::int32_t want = brute_force(dt, p, q.data() + i * D);
-    wrong += found[i] != want;
-    inside += want >= 0;
+  std::vector<std::int32_t> want(q.size() / D);
+  for (std::size_t i = 0; i < want.size(); ++i) want[i] = brute_force(dt, p, q.data() + i * D);
+  EXPECT_GT(std::count_if(want.begin(), want.end(), [](std::int32_t s) { return s >= 0; }), 0);
+  for (const auto method : methods) {
+    SCOPED_TRACE(method == tessera::LocateMethod::walk ? "walk" : "grid");
+    tessera::SimplexLocator loc(dt, p, 0, method);
+    EXPECT_EQ(loc.method(), method);
+    const auto found = loc.locate(dt, p, q);
+    ASSERT_EQ(found.size(), want.size());
+    std::size_t wrong = 0;
+    for (std::size_t i = 0; i < found.size(); ++i) wrong += found[i] != want[i];
+    EXPECT_EQ(wrong, 0u) << "of " << found.size() << " queries";
+    EXPECT_LE(loc.entries(), 16 * dt.n_simplices() + 4096);
   }
-  EXPECT_EQ(wrong, 0u) << "of " << found.size() << " queries";
-  EXPECT_GT(inside, 0u);
-  EXPECT_LE(loc.entries(), 16 * dt.n_simplices() + 4096);
 }
 
 TEST(Locate, RandomQueriesEqualBruteForce) {
@@ -102,7 +107,8 @@ TEST(Locate, EqualsCgalLocateInsideAndOutsideTheHull) {
   auto p = uniform(3000, 3, 11);
   auto q = uniform(3000, 3, 12, -0.05, 1.05);
   tessera::Delaunay dt = triangulate(p, 3);
-  const auto found = tessera::SimplexLocator(dt, p).locate(dt, p, q);
+  const auto found = tessera::SimplexLocator(dt, p, 0, tessera::LocateMethod::walk).locate(dt, p, q);
+  EXPECT_EQ(tessera::SimplexLocator(dt, p, 0, tessera::LocateMethod::grid).locate(dt, p, q), found);
   std::vector<std::pair<K::Point_3, std::int32_t>> pts;
   for (std::size_t i = 0; i < 3000; ++i)
     pts.emplace_back(K::Point_3(p[3 * i], p[3 * i + 1], p[3 * i + 2]), static_cast<std::int32_t>(i));
@@ -134,7 +140,8 @@ TEST(Locate, InputPointsFindTheirLowestSimplex) {
   auto p = uniform(2000, 3, 21);
   tessera::Delaunay dt = triangulate(p, 3);
   // vertex_to_simplex (checked against its own oracle below) is that lowest.
-  EXPECT_EQ(tessera::SimplexLocator(dt, p).locate(dt, p, p), tessera::vertex_to_simplex(dt));
+  for (const auto method : {tessera::LocateMethod::grid, tessera::LocateMethod::walk})
+    EXPECT_EQ(tessera::SimplexLocator(dt, p, 0, method).locate(dt, p, p), tessera::vertex_to_simplex(dt));
 }
 
 TEST(Locate, DegenerateTriangulationsCoarsenTheGrid) {
@@ -157,7 +164,7 @@ TEST(Locate, DegenerateTriangulationsCoarsenTheGrid) {
     spiral.insert(spiral.end(), {t * std::cos(t), t * std::sin(t), 0.1 * t});
   }
   tessera::Delaunay sdt = triangulate(spiral, 3);
-  const tessera::SimplexLocator sloc(sdt, spiral);
+  const tessera::SimplexLocator sloc(sdt, spiral, 0, tessera::LocateMethod::grid);
   EXPECT_LT(sloc.bins()[0] * sloc.bins()[1] * sloc.bins()[2], static_cast<std::int64_t>(sdt.n_simplices() / 8))
       << "the grid was not coarsened";
   auto q = uniform(150, 3, 32, -20, 20);
@@ -189,7 +196,10 @@ TEST(Locate, LabelledRegionsAndHoles) {
   auto q = uniform(500, 3, 42);
   q.insert(q.end(), {0.5, 0.5, 0.5});
   expect_brute_force(dt, p, q);
-  EXPECT_EQ(tessera::SimplexLocator(dt, p).locate(dt, p, {q.end() - 3, q.end()})[0], -1);
+  const tessera::SimplexLocator loc(dt, p);
+  EXPECT_EQ(loc.method(), tessera::LocateMethod::grid) << "a labelled triangulation is not convex";
+  EXPECT_EQ(loc.locate(dt, p, {q.end() - 3, q.end()})[0], -1);
+  EXPECT_THROW(tessera::SimplexLocator(dt, p, 0, tessera::LocateMethod::walk), tessera::InputError);
 }
 
 TEST(Locate, ThreadsAndBadQueries) {
@@ -197,7 +207,9 @@ TEST(Locate, ThreadsAndBadQueries) {
   auto q = uniform(20000, 2, 52, -0.1, 1.1);
   tessera::Delaunay dt = triangulate(p, 2);
   tessera::SimplexLocator loc(dt, p, 1);
+  EXPECT_EQ(loc.method(), tessera::LocateMethod::walk);
   EXPECT_EQ(loc.locate(dt, p, q, 1), tessera::SimplexLocator(dt, p, 2).locate(dt, p, q, 2));
+  EXPECT_EQ(loc.locate(dt, p, q, 2), tessera::SimplexLocator(dt, p, 2, tessera::LocateMethod::grid).locate(dt, p, q, 1));
   const double bad[] = {NAN, 0.5, 0.5, INFINITY};
   EXPECT_EQ(loc.locate(dt, p, bad), (std::vector<std::int32_t>{-1, -1}));
   EXPECT_THROW(loc.locate(dt, p, {q.begin(), q.begin() + 3}), tessera::InputError);
@@ -216,7 +228,7 @@ TEST(Locate, PowerOfTwoScalesLocateAlike) {
   auto p = uniform(400, 3, 71);
   auto q = uniform(400, 3, 72, -0.1, 1.1);
   tessera::Delaunay dt = triangulate(p, 3);
-  const auto want = tessera::SimplexLocator(dt, p).locate(dt, p, q);
+  const auto want = tessera::SimplexLocator(dt, p, 0, tessera::LocateMethod::grid).locate(dt, p, q);
   for (int e : {-900, 900}) {
     SCOPED_TRACE(e);
     auto ps = p, qs = q;
