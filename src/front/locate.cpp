@@ -254,11 +254,14 @@ std::int32_t SimplexLocator::scan_bin(const Delaunay& dt, std::span<const double
 // The remembering stochastic walk (Devillers, Pion and Teillaud, "Walking in
 // a triangulation", 2002): from the seed, leave by a facet the query lies
 // strictly beyond, testing the facets in an order that varies by step and
-// never the one just entered by; it ends, with probability one on any
-// triangulation, in a simplex holding the query, or steps out of the hull
-// (which, the triangulation being convex, the query then lies outside). The
-// order comes from a hash of the query and the step, so runs repeat. A walk
-// past its step budget (which no test reaches) falls back to a scan.
+// never the one just entered by, until a simplex holds the query or a step
+// leaves the hull (the triangulation being convex, the query then lies
+// outside). On a Delaunay triangulation (ours are, under the symbolic
+// perturbation: regular triangulations) every such walk ends, as the
+// "in front of" relation between its simplices is acyclic (Edelsbrunner
+// 1990); the varying order keeps walks short on degenerate ones. The order
+// comes from a hash of the query and the step, so runs repeat. A walk past
+// its step budget (a guard no test reaches) falls back to a scan.
 std::int32_t SimplexLocator::walk(const Delaunay& dt, std::span<const double> points, const double* x,
                                   std::uint64_t salt) const {
   const int D = dim_;
