@@ -14,8 +14,8 @@
 #include "delaunay_compositor.hpp"
 #include "hull_completion.hpp"
 #include "pass.hpp"
+#include "point_buckets.hpp"
 #include "simplex_facets.hpp"
-#include "simplex_star.hpp"
 #include "tessera/engine/tessellate.hpp"
 #include "tessera/kernels/delaunay_predicates.hpp"
 #include "tessera/kernels/hull.hpp"
@@ -150,39 +150,53 @@ std::vector<std::int32_t> vertex_to_simplex(const Delaunay& dt) {
 }
 
 VertexNeighbors vertex_neighbors(const Delaunay& dt) {
-  const std::size_t n = dt.n_points;
-  const std::size_t w = static_cast<std::size_t>(dt.dim + 1);
-  // Each chunk of points gathers its lists into its own buffer (once per
-  // point); the buffers are then copied into place.
+  front::check_simplex_ids(dt);
+  const std::size_t n = dt.n_points, w = static_cast<std::size_t>(dt.dim + 1);
+  // A simplex's edges as slot pairs (i < j): 3 in 2D, 6 in 3D.
+  std::array<std::array<std::size_t, 2>, 6> edge{};
+  std::size_t edges = 0;
+  for (std::size_t i = 0; i < w; ++i)
+    for (std::size_t j = i + 1; j < w; ++j) edge[edges++] = {i, j};
+  const std::int32_t* const rows = dt.simplices.data();
   VertexNeighbors out;
-  out.offsets.assign(n + 1, 0);
-  constexpr std::size_t chunk = 4096;
-  std::vector<std::vector<std::int32_t>> part((n + chunk - 1) / chunk);
-  tbb::task_arena arena(dt.threads_used > 0 ? dt.threads_used : 1);
-  arena.execute([&] {
-    // Per point the other vertices of its simplices (its star), sorted and
-    // deduplicated.
-    const front::SimplexStar star = front::simplex_star(dt);
-    tbb::parallel_for(std::size_t(0), part.size(), [&](std::size_t c) {
-      std::vector<std::int32_t> nb;
-      for (std::size_t v = c * chunk; v < std::min(n, (c + 1) * chunk); ++v) {
-        nb.clear();
-        for (const std::int32_t* e = star.begin(v); e != star.end(v); ++e) {
-          const std::int32_t* row = dt.simplices.data() + static_cast<std::size_t>(*e) * w;
-          for (std::size_t k = 0; k < w; ++k)
-            if (static_cast<std::size_t>(row[k]) != v) nb.push_back(row[k]);
-        }
-        std::sort(nb.begin(), nb.end());
-        nb.erase(std::unique(nb.begin(), nb.end()), nb.end());
-        out.offsets[v + 1] = static_cast<std::int64_t>(nb.size());
-        part[c].insert(part[c].end(), nb.begin(), nb.end());
+  tbb::task_arena(dt.threads_used > 0 ? dt.threads_used : 1).execute([&] {
+    // Every simplex edge {u, v} goes to its lower end as the higher one
+    // (bucket_by_point); each point sorts and deduplicates its bucket in
+    // place: its higher neighbours H, ascending.
+    std::vector<std::int64_t> at;
+    std::vector<std::int32_t> higher;
+    auto end_of = [&](std::size_t s, std::size_t e, bool high) {
+      const std::int32_t a = rows[s * w + edge[e][0]], b = rows[s * w + edge[e][1]];
+      return (a < b) == high ? b : a;
+    };
+    front::bucket_by_point(
+        dt, edges, [&](std::size_t s, std::size_t e) { return end_of(s, e, false); },
+        [&](std::size_t s, std::size_t e) { return end_of(s, e, true); }, at, higher);
+    std::vector<std::int64_t> h_count(n);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
+      for (std::size_t v = r.begin(); v != r.end(); ++v) {
+        const auto first = higher.begin() + at[v], last = higher.begin() + at[v + 1];
+        std::sort(first, last);
+        h_count[v] = std::unique(first, last) - first;
       }
     });
-    std::partial_sum(out.offsets.begin(), out.offsets.end(), out.offsets.begin());
+    // Point v's list is its lower neighbours L (the points u < v with v in
+    // H(u)), then H(v): ascending as it stands. L is H transposed: each v
+    // counts and places its entries from the points u below it, which the
+    // chunks take in ascending order.
+    std::vector<std::int64_t> l_count(n, 0);
+    for (std::size_t u = 0; u < n; ++u)
+      for (std::int64_t e = at[u]; e != at[u] + h_count[u]; ++e) ++l_count[static_cast<std::size_t>(higher[static_cast<std::size_t>(e)])];
+    out.offsets.assign(n + 1, 0);
+    for (std::size_t v = 0; v < n; ++v) out.offsets[v + 1] = out.offsets[v] + l_count[v] + h_count[v];
     out.ids.resize(static_cast<std::size_t>(out.offsets[n]));
-    tbb::parallel_for(std::size_t(0), part.size(), [&](std::size_t c) {
-      std::copy(part[c].begin(), part[c].end(), out.ids.begin() + out.offsets[c * chunk]);
-      std::vector<std::int32_t>().swap(part[c]);
+    std::vector<std::int64_t> next(out.offsets.begin(), out.offsets.end() - 1);  // L's next slot per point
+    for (std::size_t u = 0; u < n; ++u)
+      for (std::int64_t e = at[u]; e != at[u] + h_count[u]; ++e)
+        out.ids[static_cast<std::size_t>(next[static_cast<std::size_t>(higher[static_cast<std::size_t>(e)])]++)] = static_cast<std::int32_t>(u);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
+      for (std::size_t v = r.begin(); v != r.end(); ++v)
+        std::copy(higher.begin() + at[v], higher.begin() + at[v] + h_count[v], out.ids.begin() + out.offsets[v] + l_count[v]);
     });
   });
   return out;

@@ -6,10 +6,11 @@
 // by the facet's lowest id, by a counting sort over the rows
 // (bucket_by_point): the facets opposite the slots other than s's lowest
 // vertex all hold that vertex, so they go to it; the facet opposite it goes
-// to s's second-lowest id. Each point then sorts its few records (~27 in 3D). Laid out point after
-// point, that is the global order by (facet, simplex): at 1M uniform 3D
-// points, the 27M records took ~3 s through a parallel sort, and a search of
-// each point's star (every simplex holding it) ~2 s.
+// to s's second-lowest id. Each point then sorts its few records (~27 in
+// 3D). Laid out point after point, that is the global order by (facet,
+// simplex): at 1M uniform 3D points, the 27M records took ~3 s through a
+// parallel sort, and a search of each point's star (every simplex holding
+// it) ~2 s.
 #pragma once
 
 #include <algorithm>
@@ -21,7 +22,7 @@
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
-#include "simplex_star.hpp"
+#include "point_buckets.hpp"
 #include "tessera/delaunay.hpp"
 
 namespace tessera::front {
@@ -51,7 +52,7 @@ class FacetBuckets {
     // The facet opposite slot k holds the row's lowest id unless k is that
     // id's slot; then its lowest is the row's second-lowest id.
     bucket_by_point(
-        dt,
+        dt, w_,
         [&](std::size_t s, std::size_t k) {
           const Lowest l = lowest(s);
           return k == l.slot ? l.second : l.id;

@@ -18,7 +18,7 @@
 
 #include "tessera/delaunay.hpp"
 #include "simplex_facets.hpp"
-#include "simplex_star.hpp"
+#include "point_buckets.hpp"
 #include "tessera/kernels/delaunay_predicates.hpp"
 
 namespace tessera {

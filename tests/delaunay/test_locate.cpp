@@ -260,6 +260,9 @@ TEST(VertexNeighbors, AreTheSimplicesEdgesAndVertexToSimplexTheLowest) {
     }
     EXPECT_EQ(nb.offsets[n], static_cast<std::int64_t>(nb.ids.size()));
     EXPECT_EQ(nb.offsets[n - 1], nb.offsets[n]) << "the duplicate has no neighbours";
+    const tessera::VertexNeighbors one = tessera::vertex_neighbors(triangulate(p, dim, {}, 1));
+    EXPECT_EQ(one.offsets, nb.offsets) << "1 vs 2 threads";
+    EXPECT_EQ(one.ids, nb.ids) << "1 vs 2 threads";
     const std::vector<std::int32_t> v2s = tessera::vertex_to_simplex(dt);
     std::vector<std::int32_t> lowest(n, -1);
     for (std::size_t s = 0; s < dt.n_simplices(); ++s)

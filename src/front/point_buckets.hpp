@@ -1,9 +1,9 @@
-// The star of every point of a triangulation: the simplices having it as a
-// vertex, as CSR. Everything that pairs simplices by a shared facet or edge
-// (simplex_neighbors, the validator's facets, vertex_neighbors) looks there:
-// two simplices sharing a facet both lie in the star of its lowest vertex, so
-// each point's facets are matched among its own ~24 simplices (3D uniform)
-// instead of by a global sort of every facet.
+// Per-point buckets of a triangulation's simplex entries: a counting sort
+// that everything pairing simplices by a shared facet or edge starts from
+// (simplex_neighbors and the validator's facets, simplex_facets.hpp; the
+// Delaunay edges, vertex_neighbors). Two simplices sharing a facet both list
+// it under its lowest vertex, so each point matches a few entries of its own
+// instead of a global sort of all of them.
 #pragma once
 
 #include <algorithm>
@@ -17,15 +17,6 @@
 #include "tessera/delaunay.hpp"
 
 namespace tessera::front {
-
-struct SimplexStar {
-  std::vector<std::int64_t> offsets;  ///< n_points + 1
-  std::vector<std::int32_t> simplices; ///< per point, ascending
-
-  std::size_t size(std::size_t v) const { return static_cast<std::size_t>(offsets[v + 1] - offsets[v]); }
-  const std::int32_t* begin(std::size_t v) const { return simplices.data() + offsets[v]; }
-  const std::int32_t* end(std::size_t v) const { return simplices.data() + offsets[v + 1]; }
-};
 
 /// Throws InputError unless every id in dt's rows names one of its points
 /// (a Delaunay put together by hand may not), and when the simplices
@@ -41,21 +32,21 @@ inline void check_simplex_ids(const Delaunay& dt) {
                        ", outside [0, " + std::to_string(n) + ")");
 }
 
-/// A counting sort of the (dim + 1) entries (s, k) of each simplex s into
+/// A counting sort of `per_simplex` entries (s, k) of each simplex s into
 /// per-point buckets: entry (s, k) goes to point route(s, k) as
 /// value(s, k). Built in the calling arena, with one histogram per chunk of
-/// simplices (as many chunks as the arena has threads), so no two threads
-/// touch one counter; chunks scatter in simplex order, so each bucket lists
+/// simplices (as many chunks as the arena has threads, at most 8: each costs
+/// 8 bytes per point), so no two threads touch one counter; chunks scatter in simplex order, so each bucket lists
 /// its entries by ascending (s, k) whatever the thread count. (One atomic
 /// counter per point instead was several times slower: locked increments on
 /// random cache lines do not overlap their misses.) `offsets` gets n + 1
 /// entries, `out` one value per entry.
 template <class T, class Route, class Value>
-void bucket_by_point(const Delaunay& dt, Route&& route, Value&& value, std::vector<std::int64_t>& offsets,
-                     std::vector<T>& out) {
-  const std::size_t n = dt.n_points, w = static_cast<std::size_t>(dt.dim + 1), m = dt.n_simplices();
+void bucket_by_point(const Delaunay& dt, std::size_t per_simplex, Route&& route, Value&& value,
+                     std::vector<std::int64_t>& offsets, std::vector<T>& out) {
+  const std::size_t n = dt.n_points, w = per_simplex, m = dt.n_simplices();
   const std::size_t chunks = std::clamp<std::size_t>(static_cast<std::size_t>(tbb::this_task_arena::max_concurrency()), 1,
-                                                     std::max<std::size_t>(1, m / 4096));
+                                                     std::clamp<std::size_t>(m / 4096, 1, 8));
   auto first = [&](std::size_t c) { return c * m / chunks; };
   // count[c][v]: point v's entries in chunk c; then the slot of chunk c's first.
   std::vector<std::vector<std::int64_t>> count(chunks);
@@ -81,19 +72,6 @@ void bucket_by_point(const Delaunay& dt, Route&& route, Value&& value, std::vect
     for (std::size_t s = first(c); s < first(c + 1); ++s)
       for (std::size_t k = 0; k < w; ++k) out[static_cast<std::size_t>(slot[route(s, k)]++)] = value(s, k);
   });
-}
-
-/// The star of every point of `dt`, built in the calling arena; each list
-/// ascending. Throws as check_simplex_ids.
-inline SimplexStar simplex_star(const Delaunay& dt) {
-  check_simplex_ids(dt);
-  const std::size_t w = static_cast<std::size_t>(dt.dim + 1);
-  const std::int32_t* const rows = dt.simplices.data();
-  SimplexStar star;
-  bucket_by_point(
-      dt, [&](std::size_t s, std::size_t k) { return rows[s * w + k]; },
-      [](std::size_t s, std::size_t) { return static_cast<std::int32_t>(s); }, star.offsets, star.simplices);
-  return star;
 }
 
 }  // namespace tessera::front
