@@ -16,6 +16,7 @@
 #include <set>
 #include <vector>
 
+#include "random_points.hpp"
 #include "tessera/delaunay.hpp"
 
 namespace {
@@ -30,13 +31,7 @@ using DT2 = CGAL::Delaunay_triangulation_2<K, Tds2>;
 
 using SimplexSet = std::set<std::vector<std::int32_t>>;
 
-std::vector<double> random_points(std::size_t n, int dim, std::uint64_t seed) {
-  std::mt19937_64 rng(seed);
-  std::uniform_real_distribution<double> u(0.0, 1.0);
-  std::vector<double> p(n * static_cast<std::size_t>(dim));
-  for (double& x : p) x = u(rng);
-  return p;
-}
+std::vector<double> random_points(std::size_t n, int dim, std::uint64_t seed) { return uniform_points(n, dim, seed); }
 
 SimplexSet cgal_simplices(const std::vector<double>& p, int dim) {
   SimplexSet out;

@@ -12,19 +12,14 @@
 #include <random>
 #include <vector>
 
+#include "random_points.hpp"
 #include "tessera/delaunay.hpp"
 
 namespace {
 
 using K = CGAL::Exact_predicates_inexact_constructions_kernel;
 
-std::vector<double> random_points(std::size_t n, int dim, std::uint64_t seed) {
-  std::mt19937_64 rng(seed);
-  std::uniform_real_distribution<double> u(0.0, 1.0);
-  std::vector<double> p(n * static_cast<std::size_t>(dim));
-  for (double& x : p) x = u(rng);
-  return p;
-}
+std::vector<double> random_points(std::size_t n, int dim, std::uint64_t seed) { return uniform_points(n, dim, seed); }
 
 tessera::Delaunay triangulate(const std::vector<double>& p, int dim, int threads = 2) {
   tessera::DelaunayOptions o;

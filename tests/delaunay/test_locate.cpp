@@ -14,6 +14,7 @@
 #include <utility>
 #include <vector>
 
+#include "random_points.hpp"
 #include "tessera/delaunay.hpp"
 #include "tessera/locate.hpp"
 
@@ -22,11 +23,7 @@ namespace {
 using K = CGAL::Exact_predicates_inexact_constructions_kernel;
 
 std::vector<double> uniform(std::size_t n, int dim, std::uint64_t seed, double lo = 0, double hi = 1) {
-  std::mt19937_64 rng(seed);
-  std::uniform_real_distribution<double> u(lo, hi);
-  std::vector<double> p(n * static_cast<std::size_t>(dim));
-  for (double& x : p) x = u(rng);
-  return p;
+  return uniform_points(n, dim, seed, lo, hi);
 }
 
 tessera::Delaunay triangulate(const std::vector<double>& p, int dim, const std::vector<std::int32_t>& labels = {},
