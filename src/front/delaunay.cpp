@@ -177,7 +177,10 @@ VertexNeighbors vertex_neighbors(const Delaunay& dt) {
       for (std::size_t v = r.begin(); v != r.end(); ++v) {
         const auto first = higher.begin() + at[v], last = higher.begin() + at[v + 1];
         std::sort(first, last);
-        h_count[v] = std::unique(first, last) - first;
+        auto end = std::unique(first, last);
+        if (first != end && static_cast<std::size_t>(*first) == v)  // a row naming v twice (hand-made)
+          end = std::copy(first + 1, end, first);
+        h_count[v] = end - first;
       }
     });
     // Point v's list is its lower neighbours L (the points u < v with v in

@@ -216,7 +216,8 @@ void SimplexLocator::build_walk(const Delaunay& dt, std::span<const double> poin
         c[d] -= step;
       }
   }
-  tbb::task_arena(resolve_threads(threads)).execute([&] { neighbors_ = simplex_neighbors(dt); });
+  (void)threads;  // the seeds are a sequential pass; the neighbours run on dt.threads_used
+  neighbors_ = simplex_neighbors(dt);
 }
 
 namespace {
