@@ -168,6 +168,11 @@ TEST(ValidateDelaunay, ReportsEachKindOfCorruption) {
     const tessera::Delaunay bad = with_rows(dt, wrong);
     EXPECT_THROW(tessera::simplex_neighbors(bad), tessera::InputError);
     EXPECT_THROW(tessera::validate(bad, p, {}), tessera::InputError);
+    // Coordinates or labels that do not match the triangulation's points.
+    const std::vector<double> fewer(p.begin(), p.end() - 3);
+    EXPECT_THROW(tessera::validate(dt, fewer, {}), tessera::InputError);
+    const std::vector<std::int32_t> labels(dt.n_points - 1, 0);
+    EXPECT_THROW(tessera::validate(dt, p, labels), tessera::InputError);
   }
 }
 
