@@ -282,37 +282,41 @@ std::int32_t SimplexLocator::walk(const Delaunay& dt, std::span<const double> po
     h ^= h >> 29;
     const std::size_t first = static_cast<std::size_t>(h % w);
     std::int32_t next = -2;  // -2: none found; -1: beyond the hull
+    bool on_facet = false;   // x lies on a facet of s (sign 0)
     for (std::size_t i = 0; i < w && next == -2; ++i) {
       const std::size_t k = (first + i) % w;
       const std::int32_t t = neighbors_[s * w + k];
-      if (t >= 0 && t == came_from) continue;  // the query lies on this side of it
-      if (side(dt, points, s, k, x) < 0) next = t;
+      if (t >= 0 && t == came_from) continue;  // the query lies strictly on this side of it
+      const int o = side(dt, points, s, k, x);
+      if (o < 0) next = t;
+      on_facet |= o == 0;
     }
     if (next == -1) return -1;
-    if (next == -2) break;
+    if (next == -2) {
+      if (!on_facet) return static_cast<std::int32_t>(s);  // strictly inside: the only simplex holding x
+      break;
+    }
     came_from = static_cast<std::int32_t>(s);
     s = static_cast<std::size_t>(next);
   }
-  // s holds x. Every simplex holding x holds the face of s that x lies
+  // s holds x, on one of its facets (rare, so the allocations below stay off
+  // the common path). Every simplex holding x holds the face of s that x lies
   // inside (x's face: its vertices are those whose facet-opposite sign is
   // not 0), and those simplices are joined across facets through that face,
   // on each of which x lies (sign 0): gather them and answer the lowest.
   std::int32_t best = static_cast<std::int32_t>(s);
   std::vector<std::int32_t> seen{best}, stack{best};
-  bool strictly_inside = true;
   while (!stack.empty()) {
     const std::size_t t = static_cast<std::size_t>(stack.back());
     stack.pop_back();
     for (std::size_t k = 0; k < w; ++k) {
       if (side(dt, points, t, k, x) != 0) continue;
-      strictly_inside = false;
       const std::int32_t u = neighbors_[t * w + k];
       if (u < 0 || std::find(seen.begin(), seen.end(), u) != seen.end()) continue;
       seen.push_back(u);
       stack.push_back(u);
       best = std::min(best, u);
     }
-    if (strictly_inside) break;
   }
   return best;
 }

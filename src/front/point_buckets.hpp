@@ -36,11 +36,12 @@ inline void check_simplex_ids(const Delaunay& dt) {
 /// per-point buckets: entry (s, k) goes to point route(s, k) as
 /// value(s, k). Built in the calling arena, with one histogram per chunk of
 /// simplices (as many chunks as the arena has threads, at most 8: each costs
-/// 8 bytes per point), so no two threads touch one counter; chunks scatter in simplex order, so each bucket lists
-/// its entries by ascending (s, k) whatever the thread count. (One atomic
-/// counter per point instead was several times slower: locked increments on
-/// random cache lines do not overlap their misses.) `offsets` gets n + 1
-/// entries, `out` one value per entry.
+/// 8 bytes per point), so no two threads touch one counter; chunks scatter
+/// in simplex order, so each bucket lists its entries by ascending (s, k)
+/// whatever the thread count. (One atomic counter per point instead was
+/// several times slower: locked increments on random cache lines do not
+/// overlap their misses.) `offsets` gets n + 1 entries, `out` one value per
+/// entry.
 template <class T, class Route, class Value>
 void bucket_by_point(const Delaunay& dt, std::size_t per_simplex, Route&& route, Value&& value,
                      std::vector<std::int64_t>& offsets, std::vector<T>& out) {

@@ -64,7 +64,8 @@ class FacetBuckets {
   /// `out` (cleared), ascending by (facet, simplex).
   void records(std::size_t a, std::vector<FacetRecord>& out) const;
 
-  std::size_t size(std::size_t a) const { return static_cast<std::size_t>(offsets_[a + 1] - offsets_[a]); }
+  /// Where point a's records start in the global (facet, simplex) order.
+  std::size_t first_record(std::size_t a) const { return static_cast<std::size_t>(offsets_[a]); }
   std::size_t total() const { return slots_.size(); }
 
  private:
@@ -120,13 +121,11 @@ inline void FacetBuckets::records(std::size_t a, std::vector<FacetRecord>& out) 
 inline std::vector<FacetRecord> sorted_facets(const Delaunay& dt) {
   const FacetBuckets buckets(dt);
   std::vector<FacetRecord> recs(buckets.total());
-  std::vector<std::int64_t> at(dt.n_points + 1, 0);
-  for (std::size_t a = 0; a < dt.n_points; ++a) at[a + 1] = at[a] + static_cast<std::int64_t>(buckets.size(a));
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, dt.n_points, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
     std::vector<FacetRecord> local;
     for (std::size_t a = r.begin(); a != r.end(); ++a) {
       buckets.records(a, local);
-      std::copy(local.begin(), local.end(), recs.begin() + at[a]);
+      std::copy(local.begin(), local.end(), recs.begin() + static_cast<std::ptrdiff_t>(buckets.first_record(a)));
     }
   });
   return recs;
