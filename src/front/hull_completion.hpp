@@ -28,6 +28,7 @@
 #pragma once
 
 #include <algorithm>
+#include <atomic>
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -37,6 +38,7 @@
 #include <vector>
 
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_sort.h>
 #include <tbb/task_arena.h>
 
 #include "delaunay_compositor.hpp"
@@ -180,9 +182,34 @@ class HullCompletion {
     std::vector<Simplex> added;
     tbb::task_arena arena(std::max(1, threads));
     while (!queue.empty()) {
-      std::vector<std::int32_t> hit(queue.size());
+      // A thin hull simplex usually closes two open facets of the same
+      // round. The simplex beyond a facet is unique (the perturbed
+      // triangulation is), so once a wrap finds one, the round's other
+      // facets of it are closed by it and skip their own wrap (about half
+      // of all wraps). Which wrap finds it depends on timing; the simplices
+      // found do not. The queue is sorted by facet for the lookup.
+      std::vector<std::int32_t> hit(queue.size(), -1);
+      std::vector<std::atomic<std::uint8_t>> closed(queue.size());
       arena.execute([&] {
-        tbb::parallel_for(std::size_t(0), queue.size(), [&](std::size_t i) { hit[i] = wrap(queue[i].facet, queue[i].apex); });
+        tbb::parallel_sort(queue.begin(), queue.end());
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, queue.size()), [&](const tbb::blocked_range<std::size_t>& r) {
+          for (std::size_t i = r.begin(); i != r.end(); ++i) {
+            if (closed[i].load(std::memory_order_relaxed)) continue;
+            const Facet& f = queue[i].facet;
+            const std::int32_t p = hit[i] = wrap(f, queue[i].apex);
+            if (p < 0) continue;
+            for (int k = 0; k < D; ++k) {  // the new simplex's other facets: f with f[k] replaced by p
+              OpenFacet<D> g;
+              g.facet = f;
+              g.facet[static_cast<std::size_t>(k)] = p;
+              std::sort(g.facet.begin(), g.facet.end());
+              g.apex = std::numeric_limits<std::int32_t>::min();  // below every apex: the first entry of g
+              const auto at = std::lower_bound(queue.begin(), queue.end(), g);
+              if (at != queue.end() && at->facet == g.facet)
+                closed[static_cast<std::size_t>(at - queue.begin())].store(1, std::memory_order_relaxed);
+            }
+          }
+        });
       });
       std::vector<Simplex> fresh;
       for (std::size_t i = 0; i < queue.size(); ++i) {
@@ -193,7 +220,7 @@ class HullCompletion {
         std::sort(s.begin(), s.end());
         fresh.push_back(s);
       }
-      std::sort(fresh.begin(), fresh.end());
+      arena.execute([&] { tbb::parallel_sort(fresh.begin(), fresh.end()); });
       fresh.erase(std::unique(fresh.begin(), fresh.end()), fresh.end());
       std::vector<OpenFacet<D>> next;
       for (const Simplex& s : fresh) {
@@ -212,7 +239,7 @@ class HullCompletion {
       for (const auto& o : next)
         if (facets.count(o.facet) == 1) queue.push_back(o);
     }
-    std::sort(added.begin(), added.end());
+    arena.execute([&] { tbb::parallel_sort(added.begin(), added.end()); });
     return added;
   }
 
