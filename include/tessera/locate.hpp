@@ -16,6 +16,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <vector>
 
@@ -31,11 +32,18 @@ enum class LocateMethod {
 
 class SimplexLocator {
  public:
+  /// The simplex adjacency a walk steps through: simplex_neighbors(dt).
+  using Adjacency = std::shared_ptr<const std::vector<std::int32_t>>;
+
   /// Index the simplices of `dt`, whose vertex coordinates are `points`
   /// (dt.n_points * dt.dim, row-major: the triangulated points). Throws
-  /// InputError when `points` does not match `dt`.
+  /// InputError when `points` does not match `dt`. A walk needs
+  /// simplex_neighbors(dt): pass it as `neighbors` when the caller already
+  /// has it (it is shared, not copied), else the walk computes it. An
+  /// adjacency of the wrong size, or naming a simplex that does not exist,
+  /// is an InputError; the grid ignores it.
   SimplexLocator(const Delaunay& dt, std::span<const double> points, int threads = 0,
-                 LocateMethod method = LocateMethod::automatic);
+                 LocateMethod method = LocateMethod::automatic, Adjacency neighbors = nullptr);
 
   /// For each query point (row-major, dt.dim coordinates each): the lowest
   /// index of a simplex whose closed region holds it, or -1 (outside every
@@ -50,6 +58,9 @@ class SimplexLocator {
   /// walk's seed grid. entries(): the grid's (bin, simplex) entries, its
   /// index's size (0 for a walk).
   const std::int64_t* bins() const { return bins_; }
+  /// The walk's simplex adjacency (the one passed in, or computed); null
+  /// for the grid.
+  const Adjacency& neighbors() const { return neighbors_; }
   std::size_t entries() const { return ids_.size(); }
 
  private:
@@ -74,7 +85,7 @@ class SimplexLocator {
   std::vector<std::uint64_t> offsets_;  // per bin, CSR into ids_
   std::vector<std::int32_t> ids_;       // simplices per bin, ascending
   // walk
-  std::vector<std::int32_t> neighbors_;  // simplex_neighbors(dt)
+  Adjacency neighbors_;                  // simplex_neighbors(dt)
   std::vector<std::int32_t> seed_;       // per bin: a simplex to start from
 };
 

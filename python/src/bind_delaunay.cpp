@@ -36,10 +36,11 @@ DelaunayResult run_delaunay(const Points& points, const py::object& labels,
 
 py::array neighbors_view(py::object self) {
   auto& r = self.cast<DelaunayResult&>();
+  if (!r.neighbors && r.locator) r.neighbors = r.locator->neighbors();  // a walk's (null for a grid)
   if (!r.neighbors) {
     // Computed without the GIL into a local; stored once the GIL is back, so
     // two threads asking at once cannot race on the member.
-    auto nb = without_gil([&] { return simplex_neighbors(r.dt); });
+    auto nb = without_gil([&] { return std::make_shared<const std::vector<std::int32_t>>(simplex_neighbors(r.dt)); });
     if (!r.neighbors) r.neighbors = std::move(nb);
   }
   return view_rows(*r.neighbors, static_cast<std::size_t>(r.dt.dim + 1), self);
@@ -66,8 +67,10 @@ py::array locate_points(DelaunayResult& r, const Points& points, const Points& q
   const auto q = as_span(queries);
   std::shared_ptr<const SimplexLocator> loc = r.locator;
   if (!loc) {
-    loc = without_gil([&] { return std::make_shared<const SimplexLocator>(r.dt, pts, threads); });
+    SimplexLocator::Adjacency nb = r.neighbors;  // shared with .neighbors, whichever comes first
+    loc = without_gil([&] { return std::make_shared<const SimplexLocator>(r.dt, pts, threads, LocateMethod::automatic, nb); });
     if (!r.locator) r.locator = loc;
+    if (!r.neighbors) r.neighbors = loc->neighbors();
   }
   return adopt_flat(without_gil([&] { return loc->locate(r.dt, pts, q, threads); }));
 }

@@ -15,10 +15,11 @@ namespace tessera::python {
 /// caller wants it) and then kept: the simplex adjacency and the Delaunay
 /// edges, which every view shares, and the point locator, which every
 /// find_simplex call reuses. None is resized once set: numpy views point into
-/// them (arrays.hpp).
+/// them (arrays.hpp). The simplex adjacency is shared with a walking
+/// locator, which steps through it: whichever needs it first computes it.
 struct DelaunayResult {
   Delaunay dt;
-  std::optional<std::vector<std::int32_t>> neighbors;
+  SimplexLocator::Adjacency neighbors;
   std::optional<VertexNeighbors> vertex_neighbors;
   std::shared_ptr<const SimplexLocator> locator;
 };

@@ -161,7 +161,8 @@ class Delaunay:
         ``tol`` is not supported (there is no tolerance to set). The locator is
         built on the first call and reused: a walk from seeds near each query
         when the triangulation covers its hull, else (labels, or no hull
-        completion) a grid of the simplices."""
+        completion) a grid of the simplices. The walk steps through
+        :attr:`neighbors`, computed once for both."""
         if tol is not None:
             raise ValueError("find_simplex: tol is not supported; containment is decided exactly")
         q, shape = _inputs.as_queries(xi, self.ndim)

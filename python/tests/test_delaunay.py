@@ -41,6 +41,24 @@ def test_neighbors_are_symmetric():
         assert facet <= set(dt.simplices[j].tolist())
 
 
+@pytest.mark.parametrize("labelled", [False, True])
+def test_neighbors_and_find_simplex_share_one_adjacency(labelled):
+    # The walking locator steps through the simplex adjacency that .neighbors
+    # shows: whichever is asked first computes it for both. Either order
+    # gives the same arrays and answers; a labelled triangulation's grid
+    # locator keeps none, and .neighbors computes its own.
+    pts = random_points(2000, 3, seed=12)
+    labels = np.where(pts[:, 0] < 0.2, -1, 0) if labelled else None
+    q = random_points(500, 3, seed=13)
+    first_nb = tessera.delaunay(pts, labels=labels)
+    nb = first_nb.neighbors
+    found = first_nb.find_simplex(q)
+    first_find = tessera.delaunay(pts, labels=labels)
+    assert (first_find.find_simplex(q) == found).all()
+    assert (first_find.neighbors == nb).all()
+    assert np.shares_memory(first_find.neighbors, first_find.neighbors)  # kept, not recomputed
+
+
 def test_labels_keep_the_simplices_of_inside_points():
     pts = random_points(2000, 2, seed=9)
     labels = np.where(np.linalg.norm(pts - 0.5, axis=1) < 0.25, -1, 0)

@@ -45,12 +45,25 @@ std::int64_t SimplexLocator::bin_of(int d, double x) const {
   return t < top ? static_cast<std::int64_t>(t) : bins_[d] - 1;
 }
 
-SimplexLocator::SimplexLocator(const Delaunay& dt, std::span<const double> points, int threads, LocateMethod method)
-    : dim_(dt.dim), n_simplices_(dt.n_simplices()), n_points_(dt.n_points) {
+SimplexLocator::SimplexLocator(const Delaunay& dt, std::span<const double> points, int threads, LocateMethod method,
+                               Adjacency neighbors)
+    : dim_(dt.dim), n_simplices_(dt.n_simplices()), n_points_(dt.n_points), neighbors_(std::move(neighbors)) {
   check_points(dt, points, "locate");
   if (method == LocateMethod::walk && !dt.hull_completed)
     throw InputError("locate: a walk needs a triangulation of the whole convex hull (no labels, hull completion on)");
   method_ = method == LocateMethod::grid || !dt.hull_completed ? LocateMethod::grid : LocateMethod::walk;
+  if (method_ == LocateMethod::grid) neighbors_.reset();
+  if (neighbors_) {
+    // Trusted to be simplex_neighbors(dt) once it could not send the walk
+    // out of bounds: the right size, every entry a simplex or -1.
+    const std::size_t w = static_cast<std::size_t>(dt.dim + 1);
+    const std::int64_t m = static_cast<std::int64_t>(n_simplices_);
+    if (neighbors_->size() != n_simplices_ * w)
+      throw InputError("locate: the simplex adjacency has " + std::to_string(neighbors_->size()) + " entries for " +
+                       std::to_string(n_simplices_) + " simplices of " + std::to_string(w) + " facets");
+    if (!std::all_of(neighbors_->begin(), neighbors_->end(), [m](std::int32_t t) { return t >= -1 && t < m; }))
+      throw InputError("locate: the simplex adjacency names a simplex that does not exist");
+  }
   const int D = dim_;
   offsets_.assign(2, 0);
   if (n_simplices_ == 0) return;
@@ -217,7 +230,7 @@ void SimplexLocator::build_walk(const Delaunay& dt, std::span<const double> poin
       }
   }
   (void)threads;  // the seeds are a sequential pass; the neighbours run on dt.threads_used
-  neighbors_ = simplex_neighbors(dt);
+  if (!neighbors_) neighbors_ = std::make_shared<const std::vector<std::int32_t>>(simplex_neighbors(dt));
 }
 
 namespace {
@@ -285,7 +298,7 @@ std::int32_t SimplexLocator::walk(const Delaunay& dt, std::span<const double> po
     bool on_facet = false;   // x lies on a facet of s (sign 0)
     for (std::size_t i = 0; i < w && next == -2; ++i) {
       const std::size_t k = (first + i) % w;
-      const std::int32_t t = neighbors_[s * w + k];
+      const std::int32_t t = (*neighbors_)[s * w + k];
       if (t >= 0 && t == came_from) continue;  // the query lies strictly on this side of it
       const int o = side(dt, points, s, k, x);
       if (o < 0) next = t;
@@ -311,7 +324,7 @@ std::int32_t SimplexLocator::walk(const Delaunay& dt, std::span<const double> po
     stack.pop_back();
     for (std::size_t k = 0; k < w; ++k) {
       if (side(dt, points, t, k, x) != 0) continue;
-      const std::int32_t u = neighbors_[t * w + k];
+      const std::int32_t u = (*neighbors_)[t * w + k];
       if (u < 0 || std::find(seen.begin(), seen.end(), u) != seen.end()) continue;
       seen.push_back(u);
       stack.push_back(u);

@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <random>
 #include <set>
 #include <utility>
@@ -217,6 +218,33 @@ TEST(Locate, ThreadsAndBadQueries) {
   tessera::Delaunay flat = triangulate(line, 2);
   ASSERT_EQ(flat.n_simplices(), 0u);
   EXPECT_EQ(tessera::SimplexLocator(flat, line).locate(flat, line, line), (std::vector<std::int32_t>{-1, -1, -1}));
+}
+
+TEST(Locate, SharedAdjacency) {
+  // A walk given simplex_neighbors(dt) uses that very array (no copy) and
+  // answers as one that computed its own; the grid keeps none. An adjacency
+  // of the wrong size, or naming a simplex that does not exist, could send
+  // the walk out of bounds: refused.
+  auto p = uniform(3000, 3, 81);
+  auto q = uniform(5000, 3, 82, -0.1, 1.1);
+  tessera::Delaunay dt = triangulate(p, 3);
+  const tessera::SimplexLocator own(dt, p);
+  ASSERT_EQ(own.method(), tessera::LocateMethod::walk);
+  ASSERT_TRUE(own.neighbors());
+  EXPECT_EQ(*own.neighbors(), tessera::simplex_neighbors(dt));
+  auto nb = std::make_shared<const std::vector<std::int32_t>>(tessera::simplex_neighbors(dt));
+  const tessera::SimplexLocator shared(dt, p, 0, tessera::LocateMethod::automatic, nb);
+  EXPECT_EQ(shared.neighbors().get(), nb.get());
+  EXPECT_EQ(shared.locate(dt, p, q), own.locate(dt, p, q));
+  EXPECT_FALSE(tessera::SimplexLocator(dt, p, 0, tessera::LocateMethod::grid, nb).neighbors());
+
+  auto shorter = std::make_shared<const std::vector<std::int32_t>>(nb->begin(), nb->end() - 1);
+  EXPECT_THROW(tessera::SimplexLocator(dt, p, 0, tessera::LocateMethod::walk, shorter), tessera::InputError);
+  for (std::int32_t wrong : {-2, static_cast<std::int32_t>(dt.n_simplices())}) {
+    auto bad = std::make_shared<std::vector<std::int32_t>>(*nb);
+    (*bad)[bad->size() / 2] = wrong;
+    EXPECT_THROW(tessera::SimplexLocator(dt, p, 0, tessera::LocateMethod::walk, bad), tessera::InputError) << wrong;
+  }
 }
 
 TEST(Locate, PowerOfTwoScalesLocateAlike) {
