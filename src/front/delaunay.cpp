@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <numeric>
 #include <stdexcept>
 
@@ -107,6 +108,42 @@ Delaunay run(std::span<const double> input, std::span<const std::int32_t> labels
   return out;
 }
 
+/// The distinct values of [first, last) ascending, in place; returns their
+/// end. A point's bucket of Delaunay edges lists each edge once per simplex
+/// around it (~40 entries for ~8 distinct in 3D): sorting them all cost most
+/// of vertex_neighbors. Repeats are dropped first, each entry compared with
+/// the values kept so far four at a time, branch-free; then the few kept are
+/// sorted. Short and long buckets (2D; a point of very high degree) are
+/// sorted whole.
+std::int32_t* distinct_ascending(std::int32_t* first, std::int32_t* last) {
+  constexpr std::size_t cap = 256;
+  const std::size_t n = static_cast<std::size_t>(last - first);
+  if (n <= 12 || n > cap) {  // 2D buckets (~6 entries) sort faster whole
+    std::sort(first, last);
+    return std::unique(first, last);
+  }
+  using Quad = std::int32_t __attribute__((vector_size(16)));
+  // Kept values, then padding that no id equals; slot m may also hold an
+  // entry found to repeat, which only ever matches that same kept value.
+  alignas(16) std::int32_t kept[cap + 4];
+  std::fill(kept, kept + n + 4, -1);
+  std::size_t m = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::int32_t x = first[i];
+    const Quad vx = {x, x, x, x};
+    Quad seen = {};
+    for (std::size_t j = 0; j < m; j += 4) {
+      Quad k;
+      std::memcpy(&k, kept + j, sizeof k);
+      seen |= k == vx;
+    }
+    kept[m] = x;
+    m += (seen[0] | seen[1] | seen[2] | seen[3]) == 0;
+  }
+  std::sort(kept, kept + m);
+  return std::copy(kept, kept + m, first);
+}
+
 }  // namespace
 
 Delaunay delaunay(std::span<const double> points, int dim, std::span<const std::int32_t> labels,
@@ -161,8 +198,8 @@ VertexNeighbors vertex_neighbors(const Delaunay& dt) {
   VertexNeighbors out;
   tbb::task_arena(dt.threads_used > 0 ? dt.threads_used : 1).execute([&] {
     // Every simplex edge {u, v} goes to its lower end as the higher one
-    // (bucket_by_point); each point sorts and deduplicates its bucket in
-    // place: its higher neighbours H, ascending.
+    // (bucket_by_point); each point keeps the distinct values of its bucket
+    // in place (distinct_ascending): its higher neighbours H, ascending.
     std::vector<std::int64_t> at;
     std::vector<std::int32_t> higher;
     auto end_of = [&](std::size_t s, std::size_t e, bool high) {
@@ -175,31 +212,30 @@ VertexNeighbors vertex_neighbors(const Delaunay& dt) {
     std::vector<std::int64_t> h_count(n);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
       for (std::size_t v = r.begin(); v != r.end(); ++v) {
-        const auto first = higher.begin() + at[v], last = higher.begin() + at[v + 1];
-        std::sort(first, last);
-        auto end = std::unique(first, last);
+        std::int32_t* const first = higher.data() + at[v];
+        std::int32_t* end = distinct_ascending(first, higher.data() + at[v + 1]);
         if (first != end && static_cast<std::size_t>(*first) == v)  // a row naming v twice (hand-made)
           end = std::copy(first + 1, end, first);
         h_count[v] = end - first;
       }
     });
     // Point v's list is its lower neighbours L (the points u < v with v in
-    // H(u)), then H(v): ascending as it stands. L is H transposed: each v
-    // counts and places its entries from the points u below it, which the
-    // chunks take in ascending order.
-    std::vector<std::int64_t> l_count(n, 0);
-    for (std::size_t u = 0; u < n; ++u)
-      for (std::int64_t e = at[u]; e != at[u] + h_count[u]; ++e) ++l_count[static_cast<std::size_t>(higher[static_cast<std::size_t>(e)])];
+    // H(u)), then H(v): ascending as it stands. L is H transposed, by the same
+    // counting sort over the points u, which lists each bucket in ascending u.
+    std::vector<std::int64_t> l_at;
+    std::vector<std::int32_t> lower;
+    front::bucket_rows(
+        n, n, [&](std::size_t u) { return h_count[u]; },
+        [&](std::size_t u, std::size_t k) { return higher[static_cast<std::size_t>(at[u]) + k]; },
+        [](std::size_t u, std::size_t) { return static_cast<std::int32_t>(u); }, l_at, lower);
     out.offsets.assign(n + 1, 0);
-    for (std::size_t v = 0; v < n; ++v) out.offsets[v + 1] = out.offsets[v] + l_count[v] + h_count[v];
+    for (std::size_t v = 0; v < n; ++v) out.offsets[v + 1] = out.offsets[v] + (l_at[v + 1] - l_at[v]) + h_count[v];
     out.ids.resize(static_cast<std::size_t>(out.offsets[n]));
-    std::vector<std::int64_t> next(out.offsets.begin(), out.offsets.end() - 1);  // L's next slot per point
-    for (std::size_t u = 0; u < n; ++u)
-      for (std::int64_t e = at[u]; e != at[u] + h_count[u]; ++e)
-        out.ids[static_cast<std::size_t>(next[static_cast<std::size_t>(higher[static_cast<std::size_t>(e)])]++)] = static_cast<std::int32_t>(u);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
-      for (std::size_t v = r.begin(); v != r.end(); ++v)
-        std::copy(higher.begin() + at[v], higher.begin() + at[v] + h_count[v], out.ids.begin() + out.offsets[v] + l_count[v]);
+      for (std::size_t v = r.begin(); v != r.end(); ++v) {
+        const auto o = std::copy(lower.begin() + l_at[v], lower.begin() + l_at[v + 1], out.ids.begin() + out.offsets[v]);
+        std::copy(higher.begin() + at[v], higher.begin() + at[v] + h_count[v], o);
+      }
     });
   });
   return out;

@@ -32,29 +32,29 @@ inline void check_simplex_ids(const Delaunay& dt) {
                        ", outside [0, " + std::to_string(n) + ")");
 }
 
-/// A counting sort of `per_simplex` entries (s, k) of each simplex s into
-/// per-point buckets: entry (s, k) goes to point route(s, k) as
-/// value(s, k). Built in the calling arena, with one histogram per chunk of
-/// simplices (as many chunks as the arena has threads, at most 8: each costs
-/// 8 bytes per point), so no two threads touch one counter; chunks scatter
-/// in simplex order, so each bucket lists its entries by ascending (s, k)
-/// whatever the thread count. (One atomic counter per point instead was
+/// A counting sort of the entries (r, k), k < length(r), of rows r < rows
+/// into `targets` buckets: entry (r, k) goes to bucket route(r, k) as
+/// value(r, k). Built in the calling arena, with one histogram per chunk of
+/// rows (as many chunks as the arena has threads, at most 8: each costs 8
+/// bytes per target), so no two threads touch one counter; chunks scatter
+/// in row order, so each bucket lists its entries by ascending (r, k)
+/// whatever the thread count. (One atomic counter per target instead was
 /// several times slower: locked increments on random cache lines do not
-/// overlap their misses.) `offsets` gets n + 1 entries, `out` one value per
-/// entry.
-template <class T, class Route, class Value>
-void bucket_by_point(const Delaunay& dt, std::size_t per_simplex, Route&& route, Value&& value,
-                     std::vector<std::int64_t>& offsets, std::vector<T>& out) {
-  const std::size_t n = dt.n_points, w = per_simplex, m = dt.n_simplices();
+/// overlap their misses.) `offsets` gets targets + 1 entries, `out` one
+/// value per entry.
+template <class T, class Length, class Route, class Value>
+void bucket_rows(std::size_t targets, std::size_t rows, Length&& length, Route&& route, Value&& value,
+                 std::vector<std::int64_t>& offsets, std::vector<T>& out) {
+  const std::size_t n = targets, m = rows;
   const std::size_t chunks = std::clamp<std::size_t>(static_cast<std::size_t>(tbb::this_task_arena::max_concurrency()), 1,
                                                      std::clamp<std::size_t>(m / 4096, 1, 8));
   auto first = [&](std::size_t c) { return c * m / chunks; };
-  // count[c][v]: point v's entries in chunk c; then the slot of chunk c's first.
+  // count[c][v]: bucket v's entries in chunk c; then the slot of chunk c's first.
   std::vector<std::vector<std::int64_t>> count(chunks);
   tbb::parallel_for(std::size_t(0), chunks, [&](std::size_t c) {
     count[c].assign(n, 0);
-    for (std::size_t s = first(c); s < first(c + 1); ++s)
-      for (std::size_t k = 0; k < w; ++k) ++count[c][static_cast<std::size_t>(route(s, k))];
+    for (std::size_t r = first(c); r < first(c + 1); ++r)
+      for (std::size_t k = 0, e = static_cast<std::size_t>(length(r)); k < e; ++k) ++count[c][static_cast<std::size_t>(route(r, k))];
   });
   offsets.resize(n + 1);
   std::int64_t at = 0;
@@ -70,9 +70,18 @@ void bucket_by_point(const Delaunay& dt, std::size_t per_simplex, Route&& route,
   out.resize(static_cast<std::size_t>(at));
   tbb::parallel_for(std::size_t(0), chunks, [&](std::size_t c) {
     std::int64_t* const slot = count[c].data();
-    for (std::size_t s = first(c); s < first(c + 1); ++s)
-      for (std::size_t k = 0; k < w; ++k) out[static_cast<std::size_t>(slot[route(s, k)]++)] = value(s, k);
+    for (std::size_t r = first(c); r < first(c + 1); ++r)
+      for (std::size_t k = 0, e = static_cast<std::size_t>(length(r)); k < e; ++k)
+        out[static_cast<std::size_t>(slot[route(r, k)]++)] = value(r, k);
   });
+}
+
+/// bucket_rows over a triangulation: `per_simplex` entries (s, k) of each
+/// simplex s go to point route(s, k) as value(s, k).
+template <class T, class Route, class Value>
+void bucket_by_point(const Delaunay& dt, std::size_t per_simplex, Route&& route, Value&& value,
+                     std::vector<std::int64_t>& offsets, std::vector<T>& out) {
+  bucket_rows(dt.n_points, dt.n_simplices(), [per_simplex](std::size_t) { return per_simplex; }, route, value, offsets, out);
 }
 
 }  // namespace tessera::front

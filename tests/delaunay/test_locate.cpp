@@ -265,6 +265,33 @@ TEST(Locate, PowerOfTwoScalesLocateAlike) {
   }
 }
 
+TEST(VertexNeighbors, HubOfHighDegree) {
+  // Point 0 at the centre of points on a sphere: every hull point is its
+  // neighbour, and its bucket (each edge once per tetrahedron around it)
+  // holds thousands of entries, past the branch-free deduplication's cap;
+  // the others hold tens. Both must give the simplices' edges.
+  std::mt19937_64 rng(91);
+  std::normal_distribution<double> g;
+  std::vector<double> p = {0, 0, 0};
+  for (int i = 0; i < 500; ++i) {
+    double x = g(rng), y = g(rng), z = g(rng), r = std::sqrt(x * x + y * y + z * z);
+    p.insert(p.end(), {x / r, y / r, z / r});
+  }
+  tessera::Delaunay dt = triangulate(p, 3);
+  const std::size_t n = dt.n_points, w = 4;
+  std::vector<std::set<std::int32_t>> want(n);
+  for (std::size_t s = 0; s < dt.n_simplices(); ++s)
+    for (std::size_t a = 0; a < w; ++a)
+      for (std::size_t b = 0; b < w; ++b)
+        if (a != b) want[static_cast<std::size_t>(dt.simplices[s * w + a])].insert(dt.simplices[s * w + b]);
+  ASSERT_EQ(want[0].size(), n - 1) << "the centre sees every point";
+  const tessera::VertexNeighbors nb = tessera::vertex_neighbors(dt);
+  for (std::size_t v = 0; v < n; ++v) {
+    std::vector<std::int32_t> got(nb.ids.begin() + nb.offsets[v], nb.ids.begin() + nb.offsets[v + 1]);
+    EXPECT_EQ(got, std::vector<std::int32_t>(want[v].begin(), want[v].end())) << "point " << v;
+  }
+}
+
 TEST(VertexNeighbors, AreTheSimplicesEdgesAndVertexToSimplexTheLowest) {
   for (int dim : {2, 3}) {
     SCOPED_TRACE(dim);
