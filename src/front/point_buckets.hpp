@@ -1,7 +1,8 @@
 // Per-point buckets of a triangulation's simplex entries: a counting sort
 // that everything pairing simplices by a shared facet or edge starts from
 // (simplex_neighbors and the validator's facets, simplex_facets.hpp; the
-// Delaunay edges, vertex_neighbors). Two simplices sharing a facet both list
+// Delaunay edges, vertex_neighbors, and its transpose of them, by
+// bucket_rows directly). Two simplices sharing a facet both list
 // it under its lowest vertex, so each point matches a few entries of its own
 // instead of a global sort of all of them.
 #pragma once
