@@ -97,10 +97,33 @@ Bounds make_domain(std::span<const double> pts, int dim, const VoronoiOptions& o
   return b;
 }
 
-// Scaling by 2^k is exact. The shift is capped so that every non-zero
-// coordinate stays a normal double (no rounding into subnormals) and nothing
-// overflows.
-int normalizing_exponent(std::span<const double> points, const Bounds& b, int dim) {
+// The float filters bound rounding relative to the magnitudes involved. A
+// product that lands below DBL_MIN errs in absolute terms instead (up to
+// 2^-1075), which no relative bound covers: a vertex's Cramer numerator whose
+// terms all underflow computes as 0 where the true value is 1e-85, and its
+// error bound is a thousand times smaller than that (found by fuzzing, with
+// coordinates near 1e-65 a few ulps apart). So the computation's frame keeps
+// products of coordinate differences normal:
+//  * A nonzero difference of two doubles is at least an ulp of the smaller
+//    nonzero one in magnitude (or the other one itself when one is zero): at
+//    least mu 2^-53, mu the smallest nonzero |coordinate|.
+//  * The kernels' float terms are products of at most four such differences
+//    (a 3D numerator: half a squared length times a cross product's entry),
+//    or a cancelled difference of two products (an ulp of them, 2^-53) times
+//    two more. With every difference at least 2^-200, each lies above
+//    2^-853: normal, with room to spare. Hence mu >= 2^-147.
+//  * At the top, coordinates up to 2^200 keep the in-sphere filter's degree-5
+//    terms finite.
+// Input within those limits is computed as given (k = 0). Otherwise it is
+// scaled by 2^k, exact, bringing its largest coordinate near 1; the shift is
+// capped so that no nonzero coordinate turns subnormal (bits lost) and
+// nothing overflows. When even then mu 2^k < 2^-147 (the nonzero coordinates
+// span more than ~2^147: subnormal inputs, or 1e-60 beside 1), the kernels
+// add an absolute underflow term to their vertex error bounds
+// (ExactContext::may_underflow): still exact, only more often on the exact path.
+constexpr double kSmallestSafe = 0x1p-147, kLargestSafe = 0x1p200;
+
+Scaling choose_scaling(std::span<const double> points, const Bounds& b, int dim) {
   double m = 0, m_min = INFINITY;
   auto see = [&](double x) {
     x = std::fabs(x);
@@ -112,12 +135,15 @@ int normalizing_exponent(std::span<const double> points, const Bounds& b, int di
     see(b.lo[static_cast<std::size_t>(d)]);
     see(b.hi[static_cast<std::size_t>(d)]);
   }
-  if (m == 0 || (m < 0x1p200 && m > 0x1p-200)) return 0;
+  Scaling s;
+  if (m == 0 || (m < kLargestSafe && m_min >= kSmallestSafe)) return s;
   int e_max, e_min;
   std::frexp(m, &e_max);
   std::frexp(m_min, &e_min);
   // x * 2^k stays normal iff e_min + k >= -1021, and finite iff e_max + k <= 1024.
-  return std::clamp(-e_max, -1021 - e_min, 1000 - e_max);
+  s.k = std::clamp(-e_max, -1021 - e_min, 1000 - e_max);
+  s.may_underflow = std::ldexp(m_min, s.k) < kSmallestSafe;
+  return s;
 }
 
 template <int D>
@@ -126,7 +152,8 @@ Pass<D>::Pass(std::span<const double> input, std::span<const std::int32_t> label
   user_bounds = make_domain(input, D, opt);
   bounds = user_bounds;
   // Extreme magnitudes: compute on an exactly rescaled copy.
-  k = normalizing_exponent(input, user_bounds, D);
+  const Scaling scaling = choose_scaling(input, user_bounds, D);
+  k = scaling.k;
   points = input;
   if (k != 0) {
     scaled.resize(input.size());
@@ -197,6 +224,7 @@ Pass<D>::Pass(std::span<const double> input, std::span<const std::int32_t> label
 
   exact.points = points.data();
   exact.dim = D;
+  exact.may_underflow = scaling.may_underflow;
   for (int d = 0; d < 3; ++d) {
     exact.lo[static_cast<std::size_t>(d)] = bounds.lo[static_cast<std::size_t>(d)];
     exact.hi[static_cast<std::size_t>(d)] = bounds.hi[static_cast<std::size_t>(d)];

@@ -24,8 +24,17 @@ void check_input(std::span<const double> points, int dim, std::span<const std::i
 /// outward to a short binary fraction (see cells.cpp).
 Bounds make_domain(std::span<const double> points, int dim, const VoronoiOptions& opt);
 
-/// Power-of-two exponent that brings extreme coordinates near 1 (0 for sane input).
-int normalizing_exponent(std::span<const double> points, const Bounds& b, int dim);
+/// How the computation's frame relates to the user's: coordinates are
+/// scaled by 2^k (exact), and `may_underflow` says whether, even so, the
+/// nonzero coordinates span so wide a range that float products of their
+/// differences can round into the subnormal range (see Scaling's definition).
+struct Scaling {
+  int k = 0;
+  bool may_underflow = false;
+};
+
+/// The scaling of the points and the box: k = 0 for input of ordinary range.
+Scaling choose_scaling(std::span<const double> points, const Bounds& b, int dim);
 
 /// Everything set up for one engine run over the input. Not movable: the
 /// engine's Generators point into it.
@@ -40,7 +49,7 @@ struct Pass {
 
   Bounds user_bounds;                        ///< the domain in the user's frame
   Bounds bounds;                             ///< the domain in the computation's frame
-  int k = 0;                                 ///< coordinates are scaled by 2^k
+  int k = 0;                                 ///< coordinates are scaled by 2^k (choose_scaling)
   std::vector<double> scaled;                ///< the scaled copy when k != 0
   std::span<const double> points;            ///< the computation's coordinates
   std::vector<std::uint8_t> in_box;          ///< per point: inside the domain

@@ -83,11 +83,22 @@ struct GridScale {
   bool fits(int bits) const { return all_zero() || top - shift <= bits; }
   /// The grid's exponent (0 when every value seen was zero).
   int scale() const { return all_zero() ? 0 : shift; }
-  /// x / 2^scale() when it is an integer below 2^bits in magnitude (x on the grid).
+  /// x / 2^scale() when it is an integer below 2^bits in magnitude (x on the
+  /// grid). Read from the bits, not computed in floating point: x * 2^-scale()
+  /// can round (a subnormal x halved rounds to a neighbour, or to zero), and a
+  /// rounded value would pass for a grid point.
   bool scaled(double x, int bits, std::int64_t& out) const {
-    const double v = std::ldexp(x, -scale());
-    if (v != std::rint(v) || std::fabs(v) >= std::ldexp(1.0, bits)) return false;
-    out = static_cast<std::int64_t>(v);
+    const DoubleParts pt = double_parts(x);
+    if (pt.mant == 0) {
+      out = 0;
+      return true;
+    }
+    const auto m = static_cast<std::uint64_t>(pt.mant < 0 ? -pt.mant : pt.mant);
+    const int low = pt.e2 + std::countr_zero(m), high = pt.e2 + 64 - std::countl_zero(m);
+    const int s = scale();
+    if (low < s || high - s > bits) return false;  // off the grid, or |x| / 2^s >= 2^bits
+    const int k = pt.e2 - s;
+    out = k >= 0 ? pt.mant * (std::int64_t{1} << k) : pt.mant >> -k;  // exact: the bits shifted out are zero
     return true;
   }
 };
@@ -103,6 +114,10 @@ struct ExactContext {
   const std::int32_t* grid = nullptr;
   int grid_shift = 0;
   std::array<std::int32_t, 3> grid_lo{}, grid_hi{};
+  /// The coordinates span so wide a range that float products in the
+  /// kernels may round into the subnormal range (front/pass.cpp,
+  /// choose_scaling): their vertex bounds then add filter::underflow_slack.
+  bool may_underflow = false;
 };
 
 /// Put n points (n * dim doubles) and the box [lo, hi] on their common grid

@@ -29,11 +29,25 @@ namespace tessera::kernels::filter {
 inline constexpr double u = std::numeric_limits<double>::epsilon() * 0.5;  // unit roundoff
 inline constexpr double plane_eps = 16 * u;
 inline constexpr double vertex_eps = 64 * u;
-/// Absolute slack for underflow: every rounding below DBL_MIN errs by at most
-/// 2^-1074 in absolute terms, far below this. The front end rescales inputs by
-/// a power of two so coordinates stay within 2^±200 and this never matters on
-/// sane data.
+/// Absolute slack for underflow in sums of a few products (a plane value, a
+/// squared length): each rounding below DBL_MIN errs by at most 2^-1075 in
+/// absolute terms, far below this. The front end rescales inputs by a power
+/// of two so coordinates stay within 2^±200 and this never matters on sane
+/// data. Vertex solves, which divide, need more: underflow_slack.
 inline constexpr double abs_eps = 0x1p-900;
+/// The absolute error that underflow adds to a vertex solved by Cramer's
+/// rule (3D, or 2D with its smaller sums), beyond the relative bound. Each
+/// product that rounds below DBL_MIN errs by eta <= 2^-1075 (sums of
+/// subnormals are exact). A numerator sum_r d_r c_r errs by at most
+/// 3 eta + 6 eta max|d| + 4 eta s (s bounds the cofactors' entries) from its
+/// own products, the rounded d and cofactors included; the determinant by
+/// 3 eta + 2 eta max|n|_1, which moves y by |y| |inv| times that; the final
+/// product by eta. 2^-1070 = 32 eta covers every factor. Only asked for when
+/// ExactContext::may_underflow: in ordinary input it is negligible, and
+/// products of it are themselves subnormal (slow on x86).
+inline double underflow_slack(double inv, double amax, double bmax, double s, double ymax) {
+  return 0x1p-1070 * (1 + std::fabs(inv) * (1 + bmax + s + ymax * (1 + amax)));
+}
 /// Beyond this condition number the float solve's position is too inaccurate
 /// for geometry (volumes, merged coordinates): the vertex is solved exactly.
 inline constexpr double exact_vertex_condition = 1e6;

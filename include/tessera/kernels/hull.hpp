@@ -56,6 +56,7 @@ class Hull {
     gen_ = gen;
     for (int a = 0; a < 3; ++a) site_[a] = p[a];
     exact_ = exact;
+    may_underflow_ = exact != nullptr && exact->may_underflow;
     exact_calls_ = 0;
     ++cells_;
     // Planes and corners are written in place: a local struct copied in
@@ -328,17 +329,20 @@ class Hull {
     double amax = std::max({A.n1, B.n1, C.n1});
     double bmax = std::max({std::fabs(A.d), std::fabs(B.d), std::fabs(C.d)});
     double cond = inv_norm * amax;
+    // Extreme input only (front/pass.cpp): products that may have underflowed.
+    const double slack = may_underflow_ ? filter::underflow_slack(inv, amax, bmax, s, ymax) : 0.0;
     double err;
     if (cond < filter::exact_vertex_condition && std::isfinite(ymax))
-      err = filter::vertex_eps * inv_norm * (amax * ymax + bmax);
+      err = filter::vertex_eps * inv_norm * (amax * ymax + bmax) + slack;
     else
-      std::tie(err, ymax) = ill_conditioned(v, inv, ymax);
+      std::tie(err, ymax) = ill_conditioned(v, inv, ymax, slack);
     v.e = err + filter::plane_eps * ymax;
     set_radius(v, err);
   }
 
   // solve() for a vertex whose plain bound failed (cond >= 1e6, or not
   // finite); returns err and ymax, and may replace y. First the same bound
+  // (plus `slack`, solve()'s underflow term)
   // on the equilibrated system: each row (plane) scaled by a power of two
   // that brings |n|_1 into [1, 2). Those scalings are exact, so Cramer's rule
   // on the scaled rows computes the same y bit for bit, and the bound for
@@ -349,7 +353,7 @@ class Hull {
   // vertex is too ill-conditioned for a trustworthy float position (it
   // exists: the exact predicates created it) and is solved exactly. Out of
   // line: inline, the extra code cost ordinary input 2%.
-  [[gnu::noinline, gnu::cold]] std::pair<double, double> ill_conditioned(Vertex& v, double inv, double ymax) const {
+  [[gnu::noinline, gnu::cold]] std::pair<double, double> ill_conditioned(Vertex& v, double inv, double ymax, double slack) const {
     const Plane& A = planes_[v.p[0]];
     const Plane& B = planes_[v.p[1]];
     const Plane& C = planes_[v.p[2]];
@@ -362,7 +366,7 @@ class Hull {
     const double amax = std::max({na, nb, nc});
     const double bmax = std::max({std::fabs(A.d) * sa, std::fabs(B.d) * sb, std::fabs(C.d) * sc});
     if (inv_norm * amax < filter::exact_vertex_condition && std::isfinite(ymax))  // false on NaN
-      return {filter::vertex_eps * inv_norm * (amax * ymax + bmax), ymax};
+      return {filter::vertex_eps * inv_norm * (amax * ymax + bmax) + slack, ymax};
     std::int32_t ids[3] = {A.id, B.id, C.id};
     exact_vertex(*exact_, gen_, ids, v.y);
     ymax = std::max({std::fabs(v.y[0]), std::fabs(v.y[1]), std::fabs(v.y[2])});
@@ -391,6 +395,7 @@ class Hull {
   std::int32_t gen_ = -1;
   double site_[3] = {};  // the generator's coordinates
   const ExactContext* exact_ = nullptr;
+  bool may_underflow_ = false;  // exact_->may_underflow: solve() adds filter::underflow_slack
   std::uint64_t exact_calls_ = 0;
   std::vector<Plane> planes_;
   std::vector<Vertex> verts_;

@@ -47,6 +47,7 @@ class Tile {
     gen_ = gen;
     for (int a = 0; a < 2; ++a) site_[a] = p[a];
     exact_ = exact;
+    may_underflow_ = exact != nullptr && exact->may_underflow;
     exact_calls_ = 0;
     ++cells_;
     // Planes and corners are written in place: a local struct copied in
@@ -197,11 +198,13 @@ class Tile {
     double amax = std::max(A.n1, B.n1);
     double bmax = std::max(std::fabs(A.d), std::fabs(B.d));
     double cond = inv_norm * amax;
+    // Extreme input only (front/pass.cpp): products that may have underflowed.
+    const double slack = may_underflow_ ? filter::underflow_slack(inv, amax, bmax, A.n1 + B.n1, ymax) : 0.0;
     double err;
     if (cond < filter::exact_vertex_condition && std::isfinite(ymax))
-      err = filter::vertex_eps * inv_norm * (amax * ymax + bmax);
+      err = filter::vertex_eps * inv_norm * (amax * ymax + bmax) + slack;
     else
-      std::tie(err, ymax) = ill_conditioned(v, inv, ymax);
+      std::tie(err, ymax) = ill_conditioned(v, inv, ymax, slack);
     v.e = err + filter::plane_eps * ymax;
     set_radius(v, err);
   }
@@ -209,7 +212,7 @@ class Tile {
   // As Hull::ill_conditioned: the bound on the rows scaled to |n|_1 in
   // [1, 2) (the same y, a bound blind to the rows' magnitudes), else the
   // exact solve. Returns err and ymax.
-  [[gnu::noinline, gnu::cold]] std::pair<double, double> ill_conditioned(Vertex& v, double inv, double ymax) const {
+  [[gnu::noinline, gnu::cold]] std::pair<double, double> ill_conditioned(Vertex& v, double inv, double ymax, double slack) const {
     const Plane& A = planes_[v.p[0]];
     const Plane& B = planes_[v.p[1]];
     const std::int32_t ea = filter::binary_exponent(A.n1), eb = filter::binary_exponent(B.n1);
@@ -219,7 +222,7 @@ class Tile {
     const double amax = std::max(na, nb);
     const double bmax = std::max(std::fabs(A.d) * sa, std::fabs(B.d) * sb);
     if (inv_norm * amax < filter::exact_vertex_condition && std::isfinite(ymax))  // false on NaN
-      return {filter::vertex_eps * inv_norm * (amax * ymax + bmax), ymax};
+      return {filter::vertex_eps * inv_norm * (amax * ymax + bmax) + slack, ymax};
     std::int32_t ids[2] = {A.id, B.id};
     exact_vertex(*exact_, gen_, ids, v.y);
     ymax = std::max(std::fabs(v.y[0]), std::fabs(v.y[1]));
@@ -240,6 +243,7 @@ class Tile {
   std::int32_t gen_ = -1;
   double site_[2] = {};  // the generator's coordinates
   const ExactContext* exact_ = nullptr;
+  bool may_underflow_ = false;  // exact_->may_underflow: solve() adds filter::underflow_slack
   std::uint64_t exact_calls_ = 0;
   std::vector<Plane> planes_;
   std::vector<Vertex> verts_;
