@@ -13,8 +13,10 @@
 
 #include <cstdio>
 #include <numbers>
+#include <string>
 
 #include "helpers.hpp"
+#include "tessera/io/points.hpp"
 
 namespace {
 
@@ -521,9 +523,10 @@ TEST(Invariants, ExtremeScalesKeepTopologyAndSkipUnrepresentableVolumes) {
   }
 }
 
-// Across the range computed without rescaling (|x| within 2^±200), the
-// cells are those of the unit-scale points, bit for bit in their topology:
-// every decision is exact and scaling by a power of two changes none. The
+// Across scales computed with and without rescaling (front/pass.cpp,
+// choose_scaling), the cells are those of the unit-scale points, bit for bit
+// in their topology: every decision is exact and scaling by a power of two
+// changes none. The
 // candidates' sort keys once held r2 as a float, which overflowed past
 // coordinates of 2^64 and underflowed below 2^-63: the stop rule then
 // skipped nearer candidates (wrong cells, caught only by the mesh merge).
@@ -541,6 +544,57 @@ TEST(Invariants, PowerOfTwoScalesGiveTheSameCells) {
       EXPECT_EQ(c.face_vertices, u.face_vertices) << "dim " << dim << " 2^" << e;
     }
   }
+}
+
+// Five points near 1e-65, a few ulps apart (from the fuzz). Just above the
+// old rescaling threshold (2^-200) they were computed unscaled, a vertex's
+// Cramer numerator underflowed to 0 where it is 1e-85, and the cells
+// disagreed ("cell vertices have no match"). Scaled by 2^k around that
+// threshold; then beside points of size 1, where no rescaling can help (the
+// nonzero coordinates span 1e-71 to 1) and the vertex bounds carry the
+// underflow term instead.
+TEST(Invariants, CoordinatesNearUnderflowKeepExactTopology) {
+  const auto tiny = tessera::io::read_points(std::string(TESSERA_TEST_DATA_DIR) +
+                                             "/tiny_coordinates_near_rescale_threshold_3d.npy").coords;
+  for (int k = -6; k <= 8; ++k) {
+    std::vector<double> p(tiny);
+    for (double& x : p) x = std::ldexp(x, k);
+    const tessera::Cells c = run(p, 3);
+    const tessera::ValidationReport r = tessera::validate(c, {});
+    for (const auto& m : r.messages) ADD_FAILURE() << "2^" << k << ": " << m;
+  }
+  std::vector<double> wide(tiny);
+  wide.insert(wide.end(), {1.0, 1.0, 1.0, -1.0, 0.5, -1.0, 0.25, -1.0, 0.5});
+  const tessera::Cells c = run(wide, 3);
+  const tessera::ValidationReport r = tessera::validate(c, {});
+  for (const auto& m : r.messages) ADD_FAILURE() << "beside unit points: " << m;
+  same_for_threads(3, wide, {}, "tiny cluster beside unit points");
+}
+
+// Small-integer coordinates with some replaced by zero or by a few multiples
+// of the smallest subnormal (the fuzz's Delaunay failures were of this kind):
+// exact topology (symmetric spokes, every merged vertex shared by exactly its
+// generators' cells, Euler characteristic) and 1 vs 2 threads identical. The
+// volumes are not checked: cells a subnormal thick have no float volume
+// (docs/known-failures).
+TEST(Invariants, SubnormalOffsetsKeepExactTopology) {
+  for (int dim : {2, 3})
+    for (std::uint64_t seed = 1; seed <= 8; ++seed) {
+      std::mt19937_64 rng(seed + 100);
+      std::vector<double> p(static_cast<std::size_t>(dim) * 60);
+      for (double& x : p) {
+        const unsigned r = static_cast<unsigned>(rng() % 10);
+        if (r < 2) x = 0;
+        else if (r < 4) x = (rng() % 2 ? 1.0 : -1.0) * static_cast<double>(1 + rng() % 4) * 0x1p-1074;
+        else x = 16.0 * static_cast<double>(rng() % 29);
+      }
+      const tessera::Cells c = run(p, dim);
+      const tessera::ValidationReport r = tessera::validate(c, {});
+      EXPECT_EQ(r.asymmetric_spokes, 0u) << "dim " << dim << " seed " << seed;
+      EXPECT_EQ(r.bad_vertex_degree, 0u) << "dim " << dim << " seed " << seed;
+      EXPECT_EQ(r.bad_euler, 0u) << "dim " << dim << " seed " << seed;
+      same_for_threads(dim, p, {}, "subnormal offsets, dim " + std::to_string(dim) + " seed " + std::to_string(seed));
+    }
 }
 
 }  // namespace

@@ -14,10 +14,12 @@
 #include <cmath>
 #include <random>
 #include <set>
+#include <string>
 #include <vector>
 
 #include "random_points.hpp"
 #include "tessera/delaunay.hpp"
+#include "tessera/io/points.hpp"
 
 namespace {
 
@@ -266,6 +268,55 @@ TEST(Delaunay, PowerOfTwoScalesGiveTheSameSimplicesAndValidate) {
       expect_valid(dt, p);
     }
   }
+}
+
+// Inputs a differential fuzz found (stop 21), minimized, each in general
+// position (CGAL's triangulation is unique). Subnormal coordinates beside
+// ordinary ones: hull completion's integer-plane test scaled coordinates
+// with ldexp, which rounded a halved 5e-324 to zero, so a point just beyond
+// a facet's plane passed for one on it: a wrong triangulation with no error
+// (7 points), "a facet in three simplices" (65 points), or either depending
+// on the thread count and the run (30 points). And coordinates near 1e-65 a
+// few ulps apart (no subnormals), below the old rescaling threshold: vertex
+// numerators underflowed to zero. Each must equal CGAL's, validate, and
+// come out the same on 1 and 2 threads, run after run.
+TEST(Delaunay, ExtremeCoordinatesFromTheFuzzEqualCgal) {
+  for (const char* name : {"delaunay_wrong_subnormal_3d", "delaunay_subnormal_coordinates_3d",
+                           "delaunay_thread_dependent_subnormal_3d", "tiny_coordinates_near_rescale_threshold_3d"}) {
+    const auto cloud = tessera::io::read_points(std::string(TESSERA_TEST_DATA_DIR) + "/" + name + ".npy");
+    const std::vector<double>& p = cloud.coords;
+    const SimplexSet want = cgal_simplices(p, 3);
+    for (int threads : {1, 2})
+      for (int repeat = 0; repeat < 4; ++repeat) {
+        tessera::Delaunay dt = run(p, 3, threads);
+        EXPECT_EQ(as_set(dt), want) << name << ", " << threads << " threads, run " << repeat;
+        if (repeat == 0) expect_valid(dt, p);
+      }
+  }
+}
+
+// Small-integer coordinates (many exact ties, as in the fuzz's failing
+// inputs) with some replaced by zero or by a few multiples of the smallest
+// subnormal, so points sit a subnormal distance off the planes their
+// neighbours span. Ties make CGAL's triangulation one of several, so the
+// checks are the validator's (exact local Delaunay, conformity, volume) and
+// 1 vs 2 threads identical.
+TEST(Delaunay, SubnormalOffsetsGiveValidTriangulations) {
+  for (int dim : {2, 3})
+    for (std::uint64_t seed = 1; seed <= 12; ++seed) {
+      std::mt19937_64 rng(seed);
+      std::vector<double> p(static_cast<std::size_t>(dim) * 40);
+      for (double& x : p) {
+        const unsigned r = static_cast<unsigned>(rng() % 10);
+        if (r < 2) x = 0;
+        else if (r < 4) x = (rng() % 2 ? 1.0 : -1.0) * static_cast<double>(1 + rng() % 4) * 0x1p-1074;
+        else x = 16.0 * static_cast<double>(rng() % 29);
+      }
+      tessera::Delaunay one = run(p, dim, 1), two = run(p, dim, 2);
+      EXPECT_TRUE(std::equal(one.simplices.begin(), one.simplices.end(), two.simplices.begin(), two.simplices.end()))
+          << "dim " << dim << " seed " << seed;
+      expect_valid(two, p);
+    }
 }
 
 TEST(Delaunay, SpiralAndCircle) {

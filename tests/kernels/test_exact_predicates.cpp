@@ -776,6 +776,24 @@ TEST(ExactPredicates, GridScale) {
   EXPECT_EQ(w.scale(), -55);
   EXPECT_FALSE(w.fits(1000));
   EXPECT_TRUE(w.fits(1079));  // 2^1024 / 2^-55
+  // A subnormal is off a coarser grid even where scaling it in floating
+  // point rounds onto one: 2^-1074 / 2 rounds to 0 (ties to even), and
+  // 3 * 2^-1074 / 2 to 2 * 2^-1074. Hull completion's integer plane once
+  // took such points for points on the facet's plane (a wrong triangulation).
+  GridScale c;
+  for (double x : {16.0, 192.0, 2.0}) c.see(x);
+  EXPECT_EQ(c.scale(), 1);
+  EXPECT_FALSE(c.scaled(0x1p-1074, 25, v));
+  EXPECT_FALSE(c.scaled(-0x1p-1074, 25, v));
+  EXPECT_FALSE(c.scaled(3 * 0x1p-1074, 25, v));
+  EXPECT_FALSE(c.scaled(0x1p-1022, 25, v));
+  EXPECT_TRUE(c.scaled(-0.0, 25, v));
+  EXPECT_EQ(v, 0);
+  EXPECT_TRUE(c.scaled(-208.0, 25, v));
+  EXPECT_EQ(v, -104);
+  EXPECT_TRUE(c.scaled(0x1p25, 25, v));  // 2^24 < 2^25
+  EXPECT_EQ(v, std::int64_t{1} << 24);
+  EXPECT_FALSE(c.scaled(0x1p26, 25, v));  // 2^25: too wide
 }
 
 namespace {
