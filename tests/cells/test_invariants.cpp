@@ -16,6 +16,7 @@
 #include <string>
 
 #include "helpers.hpp"
+#include "common/hostile_points.hpp"
 #include "tessera/io/points.hpp"
 
 namespace {
@@ -571,8 +572,8 @@ TEST(Invariants, CoordinatesNearUnderflowKeepExactTopology) {
   same_for_threads(3, wide, {}, "tiny cluster beside unit points");
 }
 
-// Small-integer coordinates with some replaced by zero or by a few multiples
-// of the smallest subnormal (the fuzz's Delaunay failures were of this kind):
+// Points a subnormal distance off the planes their neighbours span
+// (subnormal_offset_points; the fuzz's Delaunay failures were of this kind):
 // exact topology (symmetric spokes, every merged vertex shared by exactly its
 // generators' cells, Euler characteristic) and 1 vs 2 threads identical. The
 // volumes are not checked: cells a subnormal thick have no float volume
@@ -580,14 +581,7 @@ TEST(Invariants, CoordinatesNearUnderflowKeepExactTopology) {
 TEST(Invariants, SubnormalOffsetsKeepExactTopology) {
   for (int dim : {2, 3})
     for (std::uint64_t seed = 1; seed <= 8; ++seed) {
-      std::mt19937_64 rng(seed + 100);
-      std::vector<double> p(static_cast<std::size_t>(dim) * 60);
-      for (double& x : p) {
-        const unsigned r = static_cast<unsigned>(rng() % 10);
-        if (r < 2) x = 0;
-        else if (r < 4) x = (rng() % 2 ? 1.0 : -1.0) * static_cast<double>(1 + rng() % 4) * 0x1p-1074;
-        else x = 16.0 * static_cast<double>(rng() % 29);
-      }
+      const std::vector<double> p = subnormal_offset_points(60, dim, seed + 100);
       const tessera::Cells c = run(p, dim);
       const tessera::ValidationReport r = tessera::validate(c, {});
       EXPECT_EQ(r.asymmetric_spokes, 0u) << "dim " << dim << " seed " << seed;

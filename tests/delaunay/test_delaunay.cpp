@@ -19,6 +19,7 @@
 
 #include "random_points.hpp"
 #include "tessera/delaunay.hpp"
+#include "common/hostile_points.hpp"
 #include "tessera/io/points.hpp"
 
 namespace {
@@ -295,23 +296,14 @@ TEST(Delaunay, ExtremeCoordinatesFromTheFuzzEqualCgal) {
   }
 }
 
-// Small-integer coordinates (many exact ties, as in the fuzz's failing
-// inputs) with some replaced by zero or by a few multiples of the smallest
-// subnormal, so points sit a subnormal distance off the planes their
-// neighbours span. Ties make CGAL's triangulation one of several, so the
-// checks are the validator's (exact local Delaunay, conformity, volume) and
-// 1 vs 2 threads identical.
+// Points a subnormal distance off the planes their neighbours span
+// (subnormal_offset_points). Ties make CGAL's triangulation one of several,
+// so the checks are the validator's (exact local Delaunay, conformity,
+// volume) and 1 vs 2 threads identical.
 TEST(Delaunay, SubnormalOffsetsGiveValidTriangulations) {
   for (int dim : {2, 3})
     for (std::uint64_t seed = 1; seed <= 12; ++seed) {
-      std::mt19937_64 rng(seed);
-      std::vector<double> p(static_cast<std::size_t>(dim) * 40);
-      for (double& x : p) {
-        const unsigned r = static_cast<unsigned>(rng() % 10);
-        if (r < 2) x = 0;
-        else if (r < 4) x = (rng() % 2 ? 1.0 : -1.0) * static_cast<double>(1 + rng() % 4) * 0x1p-1074;
-        else x = 16.0 * static_cast<double>(rng() % 29);
-      }
+      const std::vector<double> p = subnormal_offset_points(40, dim, seed);
       tessera::Delaunay one = run(p, dim, 1), two = run(p, dim, 2);
       EXPECT_TRUE(std::equal(one.simplices.begin(), one.simplices.end(), two.simplices.begin(), two.simplices.end()))
           << "dim " << dim << " seed " << seed;
