@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -17,6 +18,27 @@ namespace tessera::front {
 template <int D>
 using Key = std::array<std::int32_t, D + 1>;
 
+/// Where a float measure keeps fewer than ~20 correct bits: its terms cancel
+/// to less than 2^-20 of their magnitudes (or to a non-positive sum). That
+/// happens for slivers thinner than the rounding of their own vertices (points
+/// a few ulps apart), whose float volume can come out zero or negative; such
+/// cells are measured exactly instead (exact_cell_measure). Ordinary cells
+/// keep a sum within a small factor of the magnitudes.
+inline bool measure_cancelled(double sum, double magnitude) { return !(sum > 0x1p-20 * magnitude); }
+
+/// The exact fallback: the cell's vertices by their planes and the same
+/// terms as the float measure, in rationals.
+template <class Cell>
+void measure_exactly(const Cell& cell, const std::vector<kernels::MeasureTerm>& terms, double& volume,
+                     double* centroid) {
+  constexpr int D = Cell::dim;
+  thread_local std::vector<std::int32_t> vertex_planes;
+  vertex_planes.clear();
+  for (const auto& v : cell.vertices())
+    for (int k = 0; k < D; ++k) vertex_planes.push_back(cell.planes()[v.p[k]].id);
+  volume = kernels::exact_cell_measure(*cell.exact_context(), cell.generator(), vertex_planes, terms, centroid);
+}
+
 /// Volume and centroid (relative to the generator) of a finished cell.
 ///
 /// 3D, without walking the faces: the cell is the union of the tetrahedra
@@ -29,10 +51,11 @@ using Key = std::array<std::int32_t, D + 1>;
 /// across(t, k) (hull.hpp), so every term comes straight from a triangle and
 /// its edge table: no face walk, no chain of dependent loads.
 /// 2D: the shoelace formula over the polygon's edges.
+/// Either falls back to exact arithmetic where the terms cancel (above).
 inline void measure(const kernels::Hull& hull, double& volume, std::array<double, 3>& centroid) {
   const auto& verts = hull.vertices();
   const auto& planes = hull.planes();
-  double vol = 0, c[3] = {0, 0, 0};
+  double vol = 0, mag = 0, c[3] = {0, 0, 0};
   for (std::size_t t = 0; t < verts.size(); ++t) {
     const auto& v = verts[t];
     const double* a = v.y;
@@ -45,8 +68,18 @@ inline void measure(const kernels::Hull& hull, double& volume, std::array<double
       const double s = f[0] * (a[1] * b[2] - a[2] * b[1]) + f[1] * (a[2] * b[0] - a[0] * b[2]) +
                        f[2] * (a[0] * b[1] - a[1] * b[0]);
       vol += s;
+      mag += std::fabs(s);
       for (int i = 0; i < 3; ++i) c[i] += s * (f[i] + a[i] + b[i]);
     }
+  }
+  if (measure_cancelled(vol, mag) && hull.exact_context() != nullptr && !verts.empty()) [[unlikely]] {
+    thread_local std::vector<kernels::MeasureTerm> terms;
+    terms.clear();
+    for (std::size_t t = 0; t < verts.size(); ++t)
+      for (int k = 0; k < 3; ++k)
+        terms.push_back({planes[verts[t].p[(k + 1) % 3]].id, static_cast<std::uint32_t>(t), hull.across(t, k)});
+    measure_exactly(hull, terms, volume, centroid.data());
+    return;
   }
   volume = vol / 6.0;
   for (int i = 0; i < 3; ++i) centroid[static_cast<std::size_t>(i)] = vol != 0 ? c[i] / (4.0 * vol) : 0.0;
@@ -55,14 +88,23 @@ inline void measure(const kernels::Hull& hull, double& volume, std::array<double
 inline void measure(const kernels::Tile& tile, double& area, std::array<double, 2>& centroid) {
   const auto& v = tile.vertices();
   const std::size_t m = v.size();
-  double s = 0, cx = 0, cy = 0;
+  double s = 0, mag = 0, cx = 0, cy = 0;
   for (std::size_t k = 0; k < m; ++k) {
     const double* a = v[k].y;
     const double* b = v[k + 1 == m ? 0 : k + 1].y;
     const double cr = a[0] * b[1] - a[1] * b[0];
     s += cr;
+    mag += std::fabs(cr);
     cx += (a[0] + b[0]) * cr;
     cy += (a[1] + b[1]) * cr;
+  }
+  if (measure_cancelled(s, mag) && tile.exact_context() != nullptr && m != 0) [[unlikely]] {
+    thread_local std::vector<kernels::MeasureTerm> terms;
+    terms.clear();
+    for (std::size_t k = 0; k < m; ++k)
+      terms.push_back({0, static_cast<std::uint32_t>(k), static_cast<std::uint32_t>(k + 1 == m ? 0 : k + 1)});
+    measure_exactly(tile, terms, area, centroid.data());
+    return;
   }
   area = 0.5 * s;
   centroid = {s != 0 ? cx / (3 * s) : 0.0, s != 0 ? cy / (3 * s) : 0.0};

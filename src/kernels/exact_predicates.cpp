@@ -8,7 +8,9 @@
 #include <climits>
 #include <limits>
 #include <cmath>
+#include <span>
 #include <stdexcept>
+#include <vector>
 
 namespace tessera::kernels {
 namespace {
@@ -518,6 +520,111 @@ void exact_vertex(const ExactContext& ctx, std::int32_t i, const std::int32_t* p
     else if (shift < 0) mpq_div_2exp(qs.q, qs.q, static_cast<mp_bitcnt_t>(-shift));
     y[d] = mpq_get_d(qs.q);
   }
+}
+
+double exact_cell_measure(const ExactContext& ctx, std::int32_t i, std::span<const std::int32_t> vertex_planes,
+                          std::span<const MeasureTerm> terms, double* centroid) {
+  thread_local Scratch s;
+  const int dim = ctx.dim;
+  const auto du = static_cast<std::size_t>(dim);
+  const std::size_t nv = vertex_planes.size() / du;
+  // Rationals with RAII: this path is rare (a few cells of hostile input).
+  struct Rationals {
+    std::vector<__mpq_struct> q;
+    explicit Rationals(std::size_t n) : q(n) {
+      for (auto& x : q) mpq_init(&x);
+    }
+    ~Rationals() {
+      for (auto& x : q) mpq_clear(&x);
+    }
+  };
+  // The vertices (dim each), then a foot, the weight sum, the moments and
+  // three temporaries.
+  const std::size_t base = nv * du;
+  Rationals r(base + 10);
+  auto y = [&](std::size_t v, int d) { return &r.q[v * du + static_cast<std::size_t>(d)]; };
+  mpq_ptr foot[3] = {&r.q[base], &r.q[base + 1], &r.q[base + 2]};
+  mpq_ptr moment[3] = {&r.q[base + 3], &r.q[base + 4], &r.q[base + 5]};
+  mpq_ptr sum = &r.q[base + 6], w = &r.q[base + 7], t0 = &r.q[base + 8], t1 = &r.q[base + 9];
+  int sel[Scratch::kMaxDim] = {0, 1, 2};
+  for (std::size_t v = 0; v < nv; ++v) {  // as exact_vertex, without the rounding
+    const int shift = build_rows(ctx, i, vertex_planes.data() + v * du, dim, s);
+    det_rows(s.minor[dim], s.a, sel, dim, s);
+    if (mpz_sgn(s.minor[dim]) == 0) throw std::logic_error("exact_cell_measure: vertex planes are dependent");
+    for (int d = 0; d < dim; ++d) {
+      for (int row = 0; row < dim; ++row) mpz_swap(s.a[row][d], s.b[row]);
+      det_rows(s.minor[d], s.a, sel, dim, s);
+      for (int row = 0; row < dim; ++row) mpz_swap(s.a[row][d], s.b[row]);
+      mpz_submul(s.minor[d], s.minor[dim], s.coord[Scratch::kRows][d]);
+      mpq_set_num(y(v, d), s.minor[d]);
+      mpq_set_den(y(v, d), s.minor[dim]);
+      mpq_canonicalize(y(v, d));
+      if (shift > 0) mpq_mul_2exp(y(v, d), y(v, d), static_cast<mp_bitcnt_t>(shift));
+      else if (shift < 0) mpq_div_2exp(y(v, d), y(v, d), static_cast<mp_bitcnt_t>(-shift));
+    }
+  }
+  const double* pi = ctx.points + static_cast<std::size_t>(i) * du;
+  // As measure() in front/cell_geometry.hpp: each term's weight w, summed,
+  // and w times the sum of its points (foot and both vertices in 3D, both
+  // vertices in 2D) for the centroid.
+  mpq_set_ui(sum, 0, 1);
+  for (int d = 0; d < dim; ++d) mpq_set_ui(moment[d], 0, 1);
+  for (const MeasureTerm& term : terms) {
+    for (int d = 0; d < 3; ++d) mpq_set_ui(foot[d], 0, 1);
+    if (dim == 2) {  // w = det(y_a, y_b)
+      mpq_mul(w, y(term.a, 0), y(term.b, 1));
+      mpq_mul(t0, y(term.a, 1), y(term.b, 0));
+      mpq_sub(w, w, t0);
+    } else {
+      // The foot of the plane from p_i: (p_j - p_i) / 2 on a bisector,
+      // (bound - p_i) along the axis on a box plane.
+      if (term.plane >= 0) {
+        const double* pj = ctx.points + static_cast<std::size_t>(term.plane) * 3;
+        for (int d = 0; d < 3; ++d) {
+          mpq_set_d(foot[d], pj[d]);
+          mpq_set_d(t0, pi[d]);
+          mpq_sub(foot[d], foot[d], t0);
+          mpq_div_2exp(foot[d], foot[d], 1);
+        }
+      } else {
+        const auto axis = static_cast<std::size_t>(box_plane_axis(term.plane));
+        mpq_set_d(foot[axis], box_plane_upper(term.plane) ? ctx.hi[axis] : ctx.lo[axis]);
+        mpq_set_d(t0, pi[axis]);
+        mpq_sub(foot[axis], foot[axis], t0);
+      }
+      mpq_set_ui(w, 0, 1);  // w = foot . (y_a x y_b)
+      for (int d = 0; d < 3; ++d) {
+        const int d1 = (d + 1) % 3, d2 = (d + 2) % 3;
+        mpq_mul(t0, y(term.a, d1), y(term.b, d2));
+        mpq_mul(t1, y(term.a, d2), y(term.b, d1));
+        mpq_sub(t0, t0, t1);
+        mpq_mul(t0, t0, foot[d]);
+        mpq_add(w, w, t0);
+      }
+    }
+    mpq_add(sum, sum, w);
+    for (int d = 0; d < dim; ++d) {
+      mpq_add(t0, y(term.a, d), y(term.b, d));
+      mpq_add(t0, t0, foot[d]);  // zero in 2D
+      mpq_mul(t0, t0, w);
+      mpq_add(moment[d], moment[d], t0);
+    }
+  }
+  // Centroid: moment / (4 sum) in 3D (a tetrahedron's is the mean of its
+  // corners, one at the origin), moment / (3 sum) in 2D.
+  for (int d = 0; d < dim; ++d) {
+    if (mpq_sgn(sum) == 0) {
+      centroid[d] = 0;
+      continue;
+    }
+    mpq_div(t0, moment[d], sum);
+    mpq_set_ui(t1, dim == 2 ? 3 : 4, 1);
+    mpq_div(t0, t0, t1);
+    centroid[d] = mpq_get_d(t0);
+  }
+  mpq_set_ui(t0, dim == 2 ? 2 : 6, 1);
+  mpq_div(sum, sum, t0);
+  return mpq_get_d(sum);
 }
 
 int lowest_bit_exponent(double x) {

@@ -591,4 +591,23 @@ TEST(Invariants, SubnormalOffsetsKeepExactTopology) {
     }
 }
 
+// Slivers thinner than the rounding of their own vertices (from the fuzz):
+// five points within a few ulps of each other near 4e7, and 2D points at
+// 4.7e80 whose y differ by 3e-244. Their float volumes cancelled to zero or
+// below; measure() now detects the cancellation and measures such cells
+// exactly, so every volume is positive and they sum to the domain's.
+TEST(Invariants, SliverCellsGetExactPositiveVolumes) {
+  for (const auto& [name, dim] : {std::pair{"cells_ulp_near_duplicates_3d", 3}, std::pair{"cells_underflowing_separation_2d", 2}}) {
+    tessera::io::ReadOptions ro;
+    ro.dim = dim;
+    const auto p = tessera::io::read_points(std::string(TESSERA_TEST_DATA_DIR) + "/" + name + ".npy", ro).coords;
+    for (int threads : {1, 2}) {
+      const tessera::Cells c = run(p, dim, std::nullopt, {}, threads);
+      const tessera::ValidationReport r = tessera::validate(c, {});
+      for (const auto& m : r.messages) ADD_FAILURE() << name << ": " << m;
+      for (double v : c.volume) EXPECT_GT(v, 0) << name;
+    }
+  }
+}
+
 }  // namespace

@@ -457,4 +457,57 @@ TEST(Tile, LatticeTessellation) {
   EXPECT_NEAR(total, 16.0, 1e-12);
 }
 
+// exact_cell_measure (the fallback of front/cell_geometry.hpp's measure for
+// slivers) on whole tessellations: the exact volumes of all cells sum to the
+// box's volume, and their first moments to the box's, to rounding (each cell's
+// is exact, rounded once). Terms as measure() forms them: 3D, the cone from
+// the generator over each triangle edge (t, k) with its face's foot; 2D, the
+// shoelace over the polygon.
+template <class CellT>
+void exact_measure_test(const Scene<CellT::dim>& s) {
+  constexpr int D = CellT::dim;
+  double volume = 0, moment[D] = {}, box_moment[D];
+  for (std::int32_t i = 0; i < s.size(); ++i) {
+    CellT c;
+    s.reset(c, i);
+    for (std::int32_t j = 0; j < s.size(); ++j)
+      if (j != i) s.clip(c, j);
+    const auto& v = c.vertices();
+    std::vector<std::int32_t> vp;
+    for (const auto& x : v)
+      for (int k = 0; k < D; ++k) vp.push_back(c.planes()[x.p[k]].id);
+    std::vector<tessera::kernels::MeasureTerm> terms;
+    for (std::size_t t = 0; t < v.size(); ++t) {
+      if constexpr (D == 3) {
+        for (int k = 0; k < 3; ++k)
+          terms.push_back({c.planes()[v[t].p[(k + 1) % 3]].id, static_cast<std::uint32_t>(t), c.across(t, k)});
+      } else {
+        terms.push_back({0, static_cast<std::uint32_t>(t), static_cast<std::uint32_t>(t + 1 == v.size() ? 0 : t + 1)});
+      }
+    }
+    double centroid[D];
+    const double vol = tessera::kernels::exact_cell_measure(s.ctx, i, vp, terms, centroid);
+    EXPECT_GT(vol, 0) << "cell " << i;
+    volume += vol;
+    for (int d = 0; d < D; ++d) moment[d] += vol * (s.p(i)[d] + centroid[d]);
+  }
+  EXPECT_NEAR(volume, s.box_volume(), 1e-13 * s.box_volume());
+  for (int d = 0; d < D; ++d) {
+    box_moment[d] = s.box_volume() * 0.5 * (s.lo[d] + s.hi[d]);
+    EXPECT_NEAR(moment[d], box_moment[d], 1e-13 * s.box_volume() * s.scale()) << "axis " << d;
+  }
+}
+
+TEST(Hull, ExactMeasureSumsToTheBox) {
+  Scene<3> s(random_points<3>(40, 8), {0, 0, 0}, {1, 1, 1});
+  exact_measure_test<Hull>(s);
+  Scene<3> l(lattice<3>(3), {0, 0, 0}, {3, 3, 3});
+  exact_measure_test<Hull>(l);
+}
+
+TEST(Tile, ExactMeasureSumsToTheBox) {
+  Scene<2> s(random_points<2>(60, 17), {0, 0}, {1, 1});
+  exact_measure_test<Tile>(s);
+}
+
 }  // namespace

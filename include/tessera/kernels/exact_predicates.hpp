@@ -28,6 +28,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <span>
 #include <utility>
 #include <vector>
 
@@ -240,5 +241,22 @@ class ExtendedPredicate {
 /// the float solve is too ill-conditioned to give a trustworthy position (a
 /// near-duplicate pair's two bisectors seen from a third cell, say).
 void exact_vertex(const ExactContext& ctx, std::int32_t i, const std::int32_t* planes, double* y);
+
+/// One term of a cell's measure: det(foot of `plane`, y_a, y_b) in 3D (the
+/// cone over a triangle of a face, measure() in front/cell_geometry.hpp), or
+/// det(y_a, y_b) in 2D (the shoelace; `plane` unused).
+struct MeasureTerm {
+  std::int32_t plane;
+  std::uint32_t a, b;
+};
+
+/// The exact volume (area in 2D) of cell `i`, rounded once, and its centroid
+/// relative to p_i (dim doubles into `centroid`). The vertices are given by
+/// their planes (dim ids each, `vertex_planes`) and solved in rationals; the
+/// terms are summed exactly (divided by 6, or 2 in 2D). For cells whose float
+/// measure cancels to no correct digits (slivers thinner than the rounding of
+/// their vertices: near-duplicate points). Slow (GMP rationals).
+double exact_cell_measure(const ExactContext& ctx, std::int32_t i, std::span<const std::int32_t> vertex_planes,
+                          std::span<const MeasureTerm> terms, double* centroid);
 
 }  // namespace tessera::kernels

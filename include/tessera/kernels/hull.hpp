@@ -188,6 +188,8 @@ class Hull {
   const std::vector<Vertex>& vertices() const { return verts_; }
   const std::vector<Plane>& planes() const { return planes_; }
   std::uint64_t exact_calls() const { return exact_calls_; }
+  /// The input's exact context (null in bare kernel tests).
+  const ExactContext* exact_context() const { return exact_; }
   /// The triangle (vertex) sharing edge k of triangle t, i.e. the directed
   /// plane pair (p[k] -> p[k+1]) seen from the other side.
   std::uint32_t across(std::size_t t, int k) const {

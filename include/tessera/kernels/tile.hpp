@@ -156,6 +156,8 @@ class Tile {
   const std::vector<Vertex>& vertices() const { return verts_; }
   const std::vector<Plane>& planes() const { return planes_; }
   std::uint64_t exact_calls() const { return exact_calls_; }
+  /// The input's exact context (null in bare kernel tests).
+  const ExactContext* exact_context() const { return exact_; }
 
  private:
   // As Hull::exact_sign: prepared once per vertex (VertexPredicate).
