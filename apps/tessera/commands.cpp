@@ -281,6 +281,8 @@ bool report_validation(const Cells& c, const io::PointCloud& pc, bool quiet) {
     std::printf("  %-18s %zu\n", "asymmetric spokes", r.asymmetric_spokes);
     std::printf("  %-18s %zu\n", "bad vertex degree", r.bad_vertex_degree);
     if (c.dim == 3) std::printf("  %-18s %zu\n", "bad Euler", r.bad_euler);
+    if (r.underflowed_volumes)
+      std::printf("  %-18s %zu (below the smallest double, reported as 0)\n", "tiny cells", r.underflowed_volumes);
     for (const auto& m : r.messages) std::printf("  %s\n", m.c_str());
     std::fflush(stdout);
   }

@@ -132,6 +132,9 @@ struct ValidationReport {
   std::size_t asymmetric_spokes = 0;      ///< i lists j but j does not list i (both inside)
   std::size_t bad_vertex_degree = 0;      ///< merged vertices not shared by exactly the cells of their key
   std::size_t bad_euler = 0;              ///< cells with V - E + F != 2 (3D)
+  /// Cells whose exact volume is below the smallest double, reported as 0
+  /// (points within ~1e-160 of each other): not a failure.
+  std::size_t underflowed_volumes = 0;
   std::vector<std::string> messages;      ///< one line each
 };
 ValidationReport validate(const Cells& cells, std::span<const std::int32_t> labels);

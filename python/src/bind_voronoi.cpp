@@ -53,6 +53,8 @@ void bind_voronoi(py::module_& m) {
       .def_readonly("asymmetric_spokes", &ValidationReport::asymmetric_spokes)
       .def_readonly("bad_vertex_degree", &ValidationReport::bad_vertex_degree)
       .def_readonly("bad_euler", &ValidationReport::bad_euler)
+      .def_readonly("underflowed_volumes", &ValidationReport::underflowed_volumes,
+                    "cells whose exact volume is below the smallest double (reported as 0; not a failure)")
       .def_readonly("messages", &ValidationReport::messages)
       .def("__bool__", [](const ValidationReport& r) { return r.ok; })
       .def("__repr__", [](const ValidationReport& r) {

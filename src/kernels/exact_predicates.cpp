@@ -522,6 +522,19 @@ void exact_vertex(const ExactContext& ctx, std::int32_t i, const std::int32_t* p
   }
 }
 
+namespace {
+// q as a double, keeping values below DBL_MIN: mpq_get_d returns 0 for them
+// (GMP leaves it system dependent), while a sliver's exact volume can be a
+// subnormal (a cell 5e-324 wide). Scaled up by 2^1100 first, then down by
+// ldexp, which rounds into the subnormals. Modifies q.
+double rational_to_double(mpq_ptr q) {
+  const long e = static_cast<long>(mpz_sizeinbase(mpq_numref(q), 2)) - static_cast<long>(mpz_sizeinbase(mpq_denref(q), 2));
+  if (mpq_sgn(q) == 0 || e > -1000) return mpq_get_d(q);
+  mpq_mul_2exp(q, q, 1100);
+  return std::ldexp(mpq_get_d(q), -1100);
+}
+}  // namespace
+
 double exact_cell_measure(const ExactContext& ctx, std::int32_t i, std::span<const std::int32_t> vertex_planes,
                           std::span<const MeasureTerm> terms, double* centroid) {
   thread_local Scratch s;
@@ -620,11 +633,11 @@ double exact_cell_measure(const ExactContext& ctx, std::int32_t i, std::span<con
     mpq_div(t0, moment[d], sum);
     mpq_set_ui(t1, dim == 2 ? 3 : 4, 1);
     mpq_div(t0, t0, t1);
-    centroid[d] = mpq_get_d(t0);
+    centroid[d] = rational_to_double(t0);
   }
   mpq_set_ui(t0, dim == 2 ? 2 : 6, 1);
   mpq_div(sum, sum, t0);
-  return mpq_get_d(sum);
+  return rational_to_double(sum);
 }
 
 int lowest_bit_exponent(double x) {
