@@ -318,6 +318,16 @@ class HullCompletion {
         s[k] += r[k][d] * r[k][d];
       }
       lengths *= std::sqrt(s[k]);
+      // An edge shorter than 2^-300 (input whose coordinates span more than
+      // 2^147, ExactContext::may_underflow): its squared length, and the
+      // products below, may have underflowed, which the bound above does
+      // not cover. Found by fuzzing: two points 2^-1022 apart made s = 0,
+      // lengths = 0, and a garbage ball pruned the true next point (a facet
+      // then sat in three simplices). No ball: the search is exhaustive.
+      if (!(s[k] >= 0x1p-600)) {
+        q.ball_r2 = std::numeric_limits<double>::infinity();
+        return;
+      }
     }
     // Centre y relative to a: 2 r_k . y = s_k (Cramer).
     double y[D];

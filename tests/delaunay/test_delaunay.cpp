@@ -279,11 +279,15 @@ TEST(Delaunay, PowerOfTwoScalesGiveTheSameSimplicesAndValidate) {
 // (7 points), "a facet in three simplices" (65 points), or either depending
 // on the thread count and the run (30 points). And coordinates near 1e-65 a
 // few ulps apart (no subnormals), below the old rescaling threshold: vertex
-// numerators underflowed to zero. Each must equal CGAL's, validate, and
-// come out the same on 1 and 2 threads, run after run.
+// numerators underflowed to zero. Two points 2^-1022 apart (after the
+// front end's rescaling; stop 22's second fuzz): hull completion's float
+// circumball squared their distance to zero and pruned the true next point.
+// Each must equal CGAL's, validate, and come out the same on 1 and 2
+// threads, run after run.
 TEST(Delaunay, ExtremeCoordinatesFromTheFuzzEqualCgal) {
   for (const char* name : {"delaunay_wrong_subnormal_3d", "delaunay_subnormal_coordinates_3d",
-                           "delaunay_thread_dependent_subnormal_3d", "tiny_coordinates_near_rescale_threshold_3d"}) {
+                           "delaunay_thread_dependent_subnormal_3d", "tiny_coordinates_near_rescale_threshold_3d",
+                           "delaunay_subnormal_near_duplicates_3d"}) {
     const auto cloud = tessera::io::read_points(std::string(TESSERA_TEST_DATA_DIR) + "/" + name + ".npy");
     const std::vector<double>& p = cloud.coords;
     const SimplexSet want = cgal_simplices(p, 3);
