@@ -94,12 +94,21 @@ Delaunay run(std::span<const double> input, std::span<const std::int32_t> labels
     std::sort(out.duplicates.begin(), out.duplicates.end());
     return out;
   }
+  if (complete && out.from_cells == 0 && pass.locator->size() - out.duplicates.size() > D && attempt == 2) {
+    // Not flat, yet no circumcentre within 2^50 extents of the input: flat
+    // to within ~1e-15 of its extent (points 1e-300 off a line). Hull
+    // completion needs a found simplex to start from, and returning none
+    // would be a wrong, empty answer (stop 22's fuzz found such inputs).
+    throw InputError(
+        "the points are flat to within rounding: no Delaunay simplex has its circumcentre within 2^50 times the "
+        "input's extent, which this triangulation cannot start from; remove the near-degenerate offsets or joggle");
+  }
   if (complete && out.from_cells == 0 && pass.locator->size() - out.duplicates.size() > D && attempt < 2) {
     // Every circumcentre lies outside the box (a handful of points, or nearly
     // flat input), so completion has no found simplex to start from. The
     // triangulation does not depend on the box: run again in a box 2^20, then
-    // 2^50 times larger, and complete the rest from there. Input flat to
-    // within ~1e-15 of its extent can end here empty (validate() reports it).
+    // 2^50 times larger, and complete the rest from there (input flatter than
+    // that is refused, above).
     // Costly (cells grow with the box) but reached only on such inputs.
     DelaunayOptions big = opt;
     big.progress = nullptr;

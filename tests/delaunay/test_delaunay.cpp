@@ -435,6 +435,16 @@ TEST(Delaunay, ExactlyFlatTiltedInputHasNoSimplex) {
   tessera::Delaunay none2 = run(line, 2);
   EXPECT_EQ(none2.n_simplices(), 0u);
   expect_valid(none2, line);
+  // Off the line by 1e-300, off the plane by a subnormal: every circumcentre
+  // lies beyond any box the retry can afford, and hull completion has no
+  // simplex to start from. The empty answer this gave was wrong (stop 22's
+  // fuzz); it is refused instead.
+  std::vector<double> nearly_line;
+  for (int k = -7; k <= 7; ++k) nearly_line.insert(nearly_line.end(), {0.0, 2.0 * k});
+  nearly_line.insert(nearly_line.end(), {1e-300, 5.0});
+  EXPECT_THROW(run(nearly_line, 2), tessera::InputError);
+  std::vector<double> sliver = {0, 0, 0, 16, 0, 0, 0, 16, 0, 4, 4, 0x1p-1074};
+  EXPECT_THROW(run(sliver, 3), tessera::InputError);
   // One point off the plane by 2^-30: a solid (if thin) set, with simplices.
   std::vector<double> solid(plane.begin(), plane.begin() + 3 * 200);
   solid.insert(solid.end(), {0.5, 0.5, 0.375 + 0x1p-30});
