@@ -112,16 +112,19 @@ Bounds make_domain(std::span<const double> pts, int dim, const VoronoiOptions& o
 //    or a cancelled difference of two products (an ulp of them, 2^-53) times
 //    two more. With every difference at least 2^-200, each lies above
 //    2^-853: normal, with room to spare. Hence mu >= 2^-147.
-//  * At the top, coordinates up to 2^200 keep the in-sphere filter's degree-5
+//  * At the top, coordinates below 2^200 keep the in-sphere filter's degree-5
 //    terms finite.
-// Input within those limits is computed as given (k = 0). Otherwise it is
-// scaled by 2^k, exact, bringing its largest coordinate near 1; the shift is
-// capped so that no nonzero coordinate turns subnormal (bits lost) and
-// nothing overflows. When even then mu 2^k < 2^-147 (the nonzero coordinates
-// span more than ~2^147: subnormal inputs, or 1e-60 beside 1), the kernels
-// add an absolute underflow term to their vertex error bounds
-// (ExactContext::may_underflow): still exact, only more often on the exact path.
-constexpr double kSmallestSafe = 0x1p-147, kLargestSafe = 0x1p200;
+// Scaling by 2^k is exact, so any k keeping every nonzero coordinate normal
+// and finite computes the same cells. Input within both limits is computed as
+// given (k = 0); otherwise k is the nearest shift that brings it within them.
+// When none does (the nonzero coordinates span more than ~2^347: subnormals
+// beside ordinary values, or 1e-160 beside 1e200), the kernels add an
+// absolute underflow term to their vertex error bounds
+// (ExactContext::may_underflow): still exact, only more often on the exact
+// path. The frame then keeps the largest coordinates near 2^200 (the smallest
+// as large as the top allows), or, where even that would turn a nonzero
+// coordinate subnormal (bits lost), as close to it as normality allows.
+constexpr int kSmallestSafeExp = -147, kLargestSafeExp = 200;
 
 Scaling choose_scaling(std::span<const double> points, const Bounds& b, int dim) {
   double m = 0, m_min = INFINITY;
@@ -136,13 +139,20 @@ Scaling choose_scaling(std::span<const double> points, const Bounds& b, int dim)
     see(b.hi[static_cast<std::size_t>(d)]);
   }
   Scaling s;
-  if (m == 0 || (m < kLargestSafe && m_min >= kSmallestSafe)) return s;
-  int e_max, e_min;
+  if (m == 0) return s;
+  int e_max, e_min;  // m in [2^(e_max-1), 2^e_max), m_min in [2^(e_min-1), 2^e_min)
   std::frexp(m, &e_max);
   std::frexp(m_min, &e_min);
-  // x * 2^k stays normal iff e_min + k >= -1021, and finite iff e_max + k <= 1024.
-  s.k = std::clamp(-e_max, -1021 - e_min, 1000 - e_max);
-  s.may_underflow = std::ldexp(m_min, s.k) < kSmallestSafe;
+  // Safe: m_min 2^k >= 2^-147 and m 2^k < 2^200.
+  const int lo = kSmallestSafeExp + 1 - e_min, hi = kLargestSafeExp - e_max;
+  if (lo <= hi) {
+    s.k = std::clamp(0, lo, hi);
+    return s;
+  }
+  s.may_underflow = true;
+  // Normal iff e_min + k >= -1021; finite iff e_max + k <= 1024 (1000: room).
+  const int keep_normal = -1021 - e_min, keep_finite = 1000 - e_max;
+  s.k = keep_normal <= keep_finite ? std::clamp(hi, keep_normal, keep_finite) : 0;
   return s;
 }
 
