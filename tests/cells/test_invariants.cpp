@@ -551,9 +551,9 @@ TEST(Invariants, PowerOfTwoScalesGiveTheSameCells) {
 // old rescaling threshold (2^-200) they were computed unscaled, a vertex's
 // Cramer numerator underflowed to 0 where it is 1e-85, and the cells
 // disagreed ("cell vertices have no match"). Scaled by 2^k around that
-// threshold; then beside points of size 1, where no rescaling can help (the
-// nonzero coordinates span 1e-71 to 1) and the vertex bounds carry the
-// underflow term instead.
+// threshold; then beside points of size 1 (the pass shifts the whole range,
+// 1e-71 to 1, up by 2^87). Input that no shift fixes, where the vertex
+// bounds carry the underflow term instead, is SubnormalOffsetsKeepExactTopology's.
 TEST(Invariants, CoordinatesNearUnderflowKeepExactTopology) {
   const auto tiny = tessera::io::read_points(std::string(TESSERA_TEST_DATA_DIR) +
                                              "/tiny_coordinates_near_rescale_threshold_3d.npy").coords;
