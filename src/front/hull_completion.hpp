@@ -319,7 +319,7 @@ class HullCompletion {
       }
       lengths *= std::sqrt(s[k]);
       // An edge shorter than 2^-300 (input whose coordinates span more than
-      // 2^147, ExactContext::may_underflow): its squared length, and the
+      // 2^347, ExactContext::may_underflow): its squared length, and the
       // products below, may have underflowed, which the bound above does
       // not cover. Found by fuzzing: two points 2^-1022 apart made s = 0,
       // lengths = 0, and a garbage ball pruned the true next point (a facet

@@ -490,17 +490,26 @@ int VertexPredicate::sign(const ExactContext& ctx, std::int32_t j) const {
   return sign_m * det_a_sign_ > 0 ? +1 : -1;
 }
 
-void exact_vertex(const ExactContext& ctx, std::int32_t i, const std::int32_t* planes, double* y) {
-  thread_local Scratch s;
-  thread_local struct Q {
-    mpq_t q;
-    Q() { mpq_init(q); }
-    ~Q() { mpq_clear(q); }
-  } qs;
+namespace {
+// q as a double, keeping values below DBL_MIN: mpq_get_d returns 0 for them
+// (GMP leaves it system dependent), while a sliver's exact volume, or a
+// vertex coordinate, can be a subnormal. Scaled up by 2^1100 first, then
+// down by ldexp, which rounds into the subnormals. Modifies q.
+double rational_to_double(mpq_ptr q) {
+  const long e = static_cast<long>(mpz_sizeinbase(mpq_numref(q), 2)) - static_cast<long>(mpz_sizeinbase(mpq_denref(q), 2));
+  if (mpq_sgn(q) == 0 || e > -1000) return mpq_get_d(q);
+  mpq_mul_2exp(q, q, 1100);
+  return std::ldexp(mpq_get_d(q), -1100);
+}
+
+// The vertex of cell i where planes[0..dim) meet, relative to p_i, exactly:
+// y[d] for d < dim. Cramer's rule on the integer rows (build_rows): det A,
+// then numerator d = det(A with column d replaced by b). Weights are
+// infinitesimal and do not move the vertex in the limit.
+void solve_vertex_exactly(const ExactContext& ctx, std::int32_t i, const std::int32_t* planes, Scratch& s,
+                          mpq_ptr* y) {
   const int dim = ctx.dim;
   const int shift = build_rows(ctx, i, planes, dim, s);
-  // det A, then Cramer: numerator d = det(A with column d replaced by b).
-  // Weights are infinitesimal and do not move the vertex in the limit.
   int sel[Scratch::kMaxDim] = {0, 1, 2};
   det_rows(s.minor[dim], s.a, sel, dim, s);
   if (mpz_sgn(s.minor[dim]) == 0)
@@ -512,28 +521,26 @@ void exact_vertex(const ExactContext& ctx, std::int32_t i, const std::int32_t* p
     for (int r = 0; r < dim; ++r) mpz_swap(s.a[r][d], s.b[r]);
     // y_d = num_d / det - p_i,d = (num_d - det * P_i,d) / det, in units of 2^shift.
     mpz_submul(s.minor[d], s.minor[dim], s.coord[Scratch::kRows][d]);
-    mpq_set_num(qs.q, s.minor[d]);
-    mpq_set_den(qs.q, s.minor[dim]);
-    mpq_canonicalize(qs.q);
-    // Scale before rounding: the unscaled ratio may not fit a double.
-    if (shift > 0) mpq_mul_2exp(qs.q, qs.q, static_cast<mp_bitcnt_t>(shift));
-    else if (shift < 0) mpq_div_2exp(qs.q, qs.q, static_cast<mp_bitcnt_t>(-shift));
-    y[d] = mpq_get_d(qs.q);
+    mpq_set_num(y[d], s.minor[d]);
+    mpq_set_den(y[d], s.minor[dim]);
+    mpq_canonicalize(y[d]);
+    if (shift > 0) mpq_mul_2exp(y[d], y[d], static_cast<mp_bitcnt_t>(shift));
+    else if (shift < 0) mpq_div_2exp(y[d], y[d], static_cast<mp_bitcnt_t>(-shift));
   }
 }
-
-namespace {
-// q as a double, keeping values below DBL_MIN: mpq_get_d returns 0 for them
-// (GMP leaves it system dependent), while a sliver's exact volume can be a
-// subnormal (a cell 5e-324 wide). Scaled up by 2^1100 first, then down by
-// ldexp, which rounds into the subnormals. Modifies q.
-double rational_to_double(mpq_ptr q) {
-  const long e = static_cast<long>(mpz_sizeinbase(mpq_numref(q), 2)) - static_cast<long>(mpz_sizeinbase(mpq_denref(q), 2));
-  if (mpq_sgn(q) == 0 || e > -1000) return mpq_get_d(q);
-  mpq_mul_2exp(q, q, 1100);
-  return std::ldexp(mpq_get_d(q), -1100);
-}
 }  // namespace
+
+void exact_vertex(const ExactContext& ctx, std::int32_t i, const std::int32_t* planes, double* y) {
+  thread_local Scratch s;
+  thread_local struct Q {
+    mpq_t q[Scratch::kMaxDim];
+    Q() { for (auto& x : q) mpq_init(x); }
+    ~Q() { for (auto& x : q) mpq_clear(x); }
+  } qs;
+  mpq_ptr yq[Scratch::kMaxDim] = {qs.q[0], qs.q[1], qs.q[2]};
+  solve_vertex_exactly(ctx, i, planes, s, yq);
+  for (int d = 0; d < ctx.dim; ++d) y[d] = rational_to_double(yq[d]);
+}
 
 double exact_cell_measure(const ExactContext& ctx, std::int32_t i, std::span<const std::int32_t> vertex_planes,
                           std::span<const MeasureTerm> terms, double* centroid) {
@@ -559,22 +566,9 @@ double exact_cell_measure(const ExactContext& ctx, std::int32_t i, std::span<con
   mpq_ptr foot[3] = {&r.q[base], &r.q[base + 1], &r.q[base + 2]};
   mpq_ptr moment[3] = {&r.q[base + 3], &r.q[base + 4], &r.q[base + 5]};
   mpq_ptr sum = &r.q[base + 6], w = &r.q[base + 7], t0 = &r.q[base + 8], t1 = &r.q[base + 9];
-  int sel[Scratch::kMaxDim] = {0, 1, 2};
-  for (std::size_t v = 0; v < nv; ++v) {  // as exact_vertex, without the rounding
-    const int shift = build_rows(ctx, i, vertex_planes.data() + v * du, dim, s);
-    det_rows(s.minor[dim], s.a, sel, dim, s);
-    if (mpz_sgn(s.minor[dim]) == 0) throw std::logic_error("exact_cell_measure: vertex planes are dependent");
-    for (int d = 0; d < dim; ++d) {
-      for (int row = 0; row < dim; ++row) mpz_swap(s.a[row][d], s.b[row]);
-      det_rows(s.minor[d], s.a, sel, dim, s);
-      for (int row = 0; row < dim; ++row) mpz_swap(s.a[row][d], s.b[row]);
-      mpz_submul(s.minor[d], s.minor[dim], s.coord[Scratch::kRows][d]);
-      mpq_set_num(y(v, d), s.minor[d]);
-      mpq_set_den(y(v, d), s.minor[dim]);
-      mpq_canonicalize(y(v, d));
-      if (shift > 0) mpq_mul_2exp(y(v, d), y(v, d), static_cast<mp_bitcnt_t>(shift));
-      else if (shift < 0) mpq_div_2exp(y(v, d), y(v, d), static_cast<mp_bitcnt_t>(-shift));
-    }
+  for (std::size_t v = 0; v < nv; ++v) {
+    mpq_ptr yv[Scratch::kMaxDim] = {y(v, 0), y(v, 1), dim == 3 ? y(v, 2) : nullptr};
+    solve_vertex_exactly(ctx, i, vertex_planes.data() + v * du, s, yv);
   }
   const double* pi = ctx.points + static_cast<std::size_t>(i) * du;
   // As measure() in front/cell_geometry.hpp: each term's weight w, summed,

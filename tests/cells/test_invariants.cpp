@@ -552,8 +552,10 @@ TEST(Invariants, PowerOfTwoScalesGiveTheSameCells) {
 // Cramer numerator underflowed to 0 where it is 1e-85, and the cells
 // disagreed ("cell vertices have no match"). Scaled by 2^k around that
 // threshold; then beside points of size 1 (the pass shifts the whole range,
-// 1e-71 to 1, up by 2^87). Input that no shift fixes, where the vertex
-// bounds carry the underflow term instead, is SubnormalOffsetsKeepExactTopology's.
+// 1e-71 to 1, up by 2^87); then, shifted by 2^-33, beside points of size
+// 2^166: a range of more than 2^347 that no shift brings within the safe
+// limits, so the vertex bounds carry filter::underflow_slack (without it this
+// input fails: "cell vertices have no match").
 TEST(Invariants, CoordinatesNearUnderflowKeepExactTopology) {
   const auto tiny = tessera::io::read_points(std::string(TESSERA_TEST_DATA_DIR) +
                                              "/tiny_coordinates_near_rescale_threshold_3d.npy").coords;
@@ -570,6 +572,14 @@ TEST(Invariants, CoordinatesNearUnderflowKeepExactTopology) {
   const tessera::ValidationReport r = tessera::validate(c, {});
   for (const auto& m : r.messages) ADD_FAILURE() << "beside unit points: " << m;
   same_for_threads(3, wide, {}, "tiny cluster beside unit points");
+  std::vector<double> wider(tiny);
+  for (double& x : wider) x = std::ldexp(x, -33);
+  const double h = 0x1p166;
+  wider.insert(wider.end(), {h, h, h, -h, h / 2, -h, h / 4, -h, h / 2});
+  const tessera::Cells cw = run(wider, 3);
+  const tessera::ValidationReport rw = tessera::validate(cw, {});
+  for (const auto& m : rw.messages) ADD_FAILURE() << "beside points of 2^166: " << m;
+  same_for_threads(3, wider, {}, "tiny cluster beside points of 2^166");
 }
 
 // Points a subnormal distance off the planes their neighbours span

@@ -31,9 +31,10 @@ inline constexpr double plane_eps = 16 * u;
 inline constexpr double vertex_eps = 64 * u;
 /// Absolute slack for underflow in sums of a few products (a plane value, a
 /// squared length): each rounding below DBL_MIN errs by at most 2^-1075 in
-/// absolute terms, far below this. The front end rescales inputs by a power
-/// of two so coordinates stay within 2^±200 and this never matters on sane
-/// data. Vertex solves, which divide, need more: underflow_slack.
+/// absolute terms, far below this. The front end shifts inputs by a power of
+/// two so nonzero coordinates lie within [2^-147, 2^200) where it can
+/// (front/pass.cpp, choose_scaling), and this never matters on sane data.
+/// Vertex solves, which divide, need more: underflow_slack.
 inline constexpr double abs_eps = 0x1p-900;
 /// The absolute error that underflow adds to a vertex solved by Cramer's
 /// rule (3D, or 2D with its smaller sums), beyond the relative bound. Each

@@ -343,9 +343,8 @@ class Hull {
   }
 
   // solve() for a vertex whose plain bound failed (cond >= 1e6, or not
-  // finite); returns err and ymax, and may replace y. First the same bound
-  // (plus `slack`, solve()'s underflow term)
-  // on the equilibrated system: each row (plane) scaled by a power of two
+  // finite); returns err and ymax, and may replace y. First the same bound,
+  // plus solve()'s underflow `slack`, on the equilibrated system: each row (plane) scaled by a power of two
   // that brings |n|_1 into [1, 2). Those scalings are exact, so Cramer's rule
   // on the scaled rows computes the same y bit for bit, and the bound for
   // that computation holds for this one; but its condition ignores the rows'
