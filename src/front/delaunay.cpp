@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstring>
 #include <numeric>
+#include <optional>
 #include <span>
 #include <stdexcept>
 
@@ -66,6 +67,60 @@ bool exactly_flat(std::span<const double> points, std::span<const std::uint8_t> 
   return true;
 }
 
+// A simplex to start hull completion from when the cells pass found none:
+// every circumcentre lies outside the box (nearly flat input). The cells
+// still hold facets of the triangulation: a cell vertex on D - 1 bisectors
+// and one box plane lies on the (perturbed) Voronoi edge of its generator and
+// those neighbours (3D; in 2D on the Voronoi edge of the generator and one
+// neighbour), which therefore exists, so its dual {generator, neighbours} is a
+// facet of the perturbed triangulation. A facet of a triangulation of a solid
+// set lies in a simplex on at least one side, and gift wrapping finds it
+// (HullCompletion::wrap_toward, the same perturbed choice as every other
+// wrap). The cells of a few generators spread over the bin order are rebuilt
+// and searched; none may have such a vertex where the bisectors are all but
+// parallel (3D points within rounding of a line): then nullopt.
+template <class CellT>
+std::optional<std::array<std::int32_t, CellT::dim + 1>> seed_simplex(const front::Pass<CellT::dim>& pass,
+                                                                     const front::HullCompletion<CellT::dim>& hc) {
+  constexpr int D = CellT::dim;
+  const auto& gens = pass.gens;
+  kernels::CellBuilder<CellT> builder(*gens.locator, gens.coords, gens.lo.data(), gens.hi.data(), gens.exact,
+                                      gens.tree);
+  CellT cell;
+  constexpr std::size_t tries = 32;
+  const std::size_t n = gens.order.size();
+  for (std::size_t t = 0; t < std::min(n, tries); ++t) {
+    const std::int32_t gen = gens.order[t * n / std::min(n, tries)];
+    const double* p = gens.coords + static_cast<std::size_t>(gen) * D;
+    const kernels::BuildStatus st = gens.tree != nullptr && builder.in_overfull_bin(p)
+                                        ? builder.build_nearest_first(gen, p, cell)
+                                        : builder.build(gen, p, cell);
+    if (!st.has_cell) continue;
+    for (const auto& v : cell.vertices()) {
+      std::array<std::int32_t, D> facet;
+      facet[0] = gen;
+      int boxes = 0;
+      for (int k = 0, m = 1; k < D; ++k) {
+        const std::int32_t id = cell.planes()[v.p[k]].id;
+        if (id < 0) ++boxes;
+        else if (m < D) facet[static_cast<std::size_t>(m++)] = id;
+      }
+      if (boxes != 1) continue;
+      std::sort(facet.begin(), facet.end());
+      for (const int side : {1, -1}) {
+        const std::int32_t apex = hc.wrap_toward(facet, side);
+        if (apex < 0) continue;
+        std::array<std::int32_t, D + 1> simplex;
+        std::copy(facet.begin(), facet.end(), simplex.begin());
+        simplex[D] = apex;
+        std::sort(simplex.begin(), simplex.end());
+        return simplex;
+      }
+    }
+  }
+  return std::nullopt;
+}
+
 template <class CellT>
 Delaunay run(std::span<const double> input, std::span<const std::int32_t> labels, const DelaunayOptions& opt,
              int attempt = 0) {
@@ -94,22 +149,16 @@ Delaunay run(std::span<const double> input, std::span<const std::int32_t> labels
     std::sort(out.duplicates.begin(), out.duplicates.end());
     return out;
   }
-  if (complete && out.from_cells == 0 && pass.locator->size() - out.duplicates.size() > D && attempt == 2) {
-    // Not flat, yet no circumcentre within 2^50 extents of the input: flat
-    // to within ~1e-15 of its extent (points 1e-300 off a line). Hull
-    // completion needs a found simplex to start from, and returning none
-    // would be a wrong, empty answer (stop 22's fuzz found such inputs).
-    throw InputError(
-        "the points are flat to within rounding: no Delaunay simplex has its circumcentre within 2^50 times the "
-        "input's extent, which this triangulation cannot start from; remove the near-degenerate offsets or joggle");
-  }
-  if (complete && out.from_cells == 0 && pass.locator->size() - out.duplicates.size() > D && attempt < 2) {
+  const bool none_found = complete && out.from_cells == 0 && pass.locator->size() - out.duplicates.size() > D;
+  if (none_found && attempt < 2) {
     // Every circumcentre lies outside the box (a handful of points, or nearly
     // flat input), so completion has no found simplex to start from. The
     // triangulation does not depend on the box: run again in a box 2^20, then
-    // 2^50 times larger, and complete the rest from there (input flatter than
-    // that is refused, above).
-    // Costly (cells grow with the box) but reached only on such inputs.
+    // 2^50 times larger, and complete the rest from there. Costly (every cell
+    // then reaches across the set: 2,000 points flat to an ulp take ~6 s)
+    // but reached only on such inputs, and cheaper there than wrapping the
+    // whole triangulation from one seed (below: ~36 s on those points,
+    // whose slivers' balls are too ill-conditioned to prune the search).
     DelaunayOptions big = opt;
     big.progress = nullptr;
     Bounds b = pass.user_bounds;
@@ -145,7 +194,33 @@ Delaunay run(std::span<const double> input, std::span<const std::int32_t> labels
       diam2 += e * e;
     }
     front::HullCompletion<D> hc(pass.exact, candidates, std::sqrt(diam2));
-    added = hc.run(found.open, pass.engine_options.threads);
+    std::optional<std::array<std::int32_t, D + 1>> seed;
+    std::vector<front::OpenFacet<D>> seed_facets;
+    if (none_found) {
+      // Not flat, yet no circumcentre within 2^50 extents of the input: flat
+      // to within ~1e-15 of its extent (points 1e-300 off a plane or a
+      // line). Completion starts from one simplex found by gift wrapping a
+      // facet the cells hold (seed_simplex) and wraps the whole
+      // triangulation from there; every cell reaches the box, so every point
+      // is a candidate.
+      seed = seed_simplex<CellT>(pass, hc);
+      if (!seed)
+        // 3D points within rounding of a line: their bisectors are all but
+        // parallel, and no cell has a vertex on a single box plane either.
+        // Returning no simplex would be a wrong, empty answer.
+        throw InputError(
+            "the points lie on a line to within rounding: no Delaunay simplex or facet could be found within 2^50 "
+            "times the input's extent; remove the near-degenerate offsets or joggle");
+      for (int k = 0; k <= D; ++k) {
+        front::OpenFacet<D> o;
+        for (int m = 0, j = 0; m <= D; ++m)
+          if (m != k) o.facet[static_cast<std::size_t>(j++)] = (*seed)[static_cast<std::size_t>(m)];
+        o.apex = (*seed)[static_cast<std::size_t>(k)];
+        seed_facets.push_back(o);
+      }
+    }
+    added = hc.run(seed ? seed_facets : found.open, pass.engine_options.threads);
+    if (seed) added.insert(std::lower_bound(added.begin(), added.end(), *seed), *seed);
   }
   out.from_hull_completion = added.size();
 

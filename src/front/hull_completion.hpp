@@ -66,6 +66,16 @@ class HullCompletion {
     ids[D] = apex;
     const int apex_side = kernels::orientation(ctx_, ids.data());
     if (apex_side == 0) throw std::logic_error("tessera: hull completion met a flat simplex");
+    return wrap_toward(f, -apex_side, apex);
+  }
+
+  /// The point on `side` of `f` (the sign of orientation(f, x)) whose
+  /// simplex with f is Delaunay, or -1 when no point lies strictly there.
+  /// `skip` (an apex already known) is not considered. Precondition: f is a
+  /// facet of the (perturbed) triangulation.
+  std::int32_t wrap_toward(const Facet& f, int side, std::int32_t skip = -1) const {
+    std::array<std::int32_t, D + 1> ids;
+    std::copy(f.begin(), f.end(), ids.begin());
     // The facet's fixed rows of orientation(f, x): its value is the dot of
     // x - a with their cofactors c, the filter's error bound the dot of |x - a|
     // with the cofactors' absolute products cp. The same terms as
@@ -110,7 +120,7 @@ class HullCompletion {
     double n[D];
     double nn = 0;
     for (int d = 0; d < D; ++d) {
-      n[d] = -apex_side * c[d];
+      n[d] = side * c[d];
       nn += n[d] * n[d];
     }
     typename CandidateTree<D>::Query q;
@@ -129,8 +139,8 @@ class HullCompletion {
     double cp_sum = 0;
     for (int d = 0; d < D; ++d) cp_sum += cp[d];
     q.margin = 1e-9 * (std::sqrt(nn) + cp_sum) * diam_;
-    // True when every corner of the box is on the apex side or on the plane:
-    // the orientation is affine in x, so then no point of the box is beyond.
+    // True when no corner of the box is strictly on `side`: the orientation
+    // is affine in x, so then no point of the box is beyond.
     auto box_not_beyond = [&](const double* lo, const double* hi) {
       const double* pts[D + 1];
       for (int k = 0; k < D; ++k) pts[k] = pt(f[static_cast<std::size_t>(k)]);
@@ -144,15 +154,15 @@ class HullCompletion {
             if (std::equal(corner, corner + D, pts[v])) return 0;
           return kernels::orientation(D, pts);
         };
-        if (side_of(corner, exact) == -apex_side) return false;
+        if (side_of(corner, exact) == side) return false;
       }
       return true;
     };
     std::int32_t best = -1;
     tree_.search(q, [&](std::int32_t p) {
-      if (p == apex || std::find(f.begin(), f.end(), p) != f.end()) return;
+      if (p == skip || std::find(f.begin(), f.end(), p) != f.end()) return;
       ids[D] = p;
-      if (side_of(pt(p), [&] { return kernels::orientation(ctx_, ids.data()); }) != -apex_side) return;  // not strictly beyond
+      if (side_of(pt(p), [&] { return kernels::orientation(ctx_, ids.data()); }) != side) return;  // not strictly beyond
       if (best >= 0) {
         std::array<std::int32_t, D> planes;
         std::copy(f.begin() + 1, f.end(), planes.begin());

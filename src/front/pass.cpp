@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <string>
 
@@ -64,8 +65,9 @@ Bounds make_domain(std::span<const double> pts, int dim, const VoronoiOptions& o
   double half = 0;
   for (int d = 0; d < dim; ++d) {
     auto du = static_cast<std::size_t>(d);
+    // (Decided on hi > lo: an extent of one subnormal ulp halves to 0.)
     double e = 0.5 * b.hi[du] - 0.5 * b.lo[du];
-    if (!(e > 0)) {
+    if (!(b.hi[du] > b.lo[du])) {
       std::ostringstream m;
       m << "all points have the same " << axis_name(d) << " coordinate (" << b.lo[du]
         << "): the bounding box has zero extent";
@@ -73,7 +75,7 @@ Bounds make_domain(std::span<const double> pts, int dim, const VoronoiOptions& o
       else m << "; give --bounds";
       throw InputError(m.str());
     }
-    half = std::max(half, e);
+    half = std::max({half, e, std::numeric_limits<double>::denorm_min()});
   }
   // Pad, then round outward to a multiple of a power of two near ext/64: the
   // box constants become short binary fractions (integer grids get the
@@ -81,7 +83,8 @@ Bounds make_domain(std::span<const double> pts, int dim, const VoronoiOptions& o
   // 128-bit path. The margin is never smaller than asked.
   int e;
   std::frexp(half, &e);
-  const double step = std::ldexp(1.0, e - 6);  // ext / 64 < step <= ext / 32
+  // ext / 64 < step <= ext / 32 (no smaller than the least subnormal, which divides every double)
+  const double step = std::max(std::ldexp(1.0, e - 6), std::numeric_limits<double>::denorm_min());
   const double pad = 2.0 * opt.padding * half;
   for (int d = 0; d < dim; ++d) {
     auto du = static_cast<std::size_t>(d);

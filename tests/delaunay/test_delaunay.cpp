@@ -435,22 +435,66 @@ TEST(Delaunay, ExactlyFlatTiltedInputHasNoSimplex) {
   tessera::Delaunay none2 = run(line, 2);
   EXPECT_EQ(none2.n_simplices(), 0u);
   expect_valid(none2, line);
-  // Off the line by 1e-300, off the plane by a subnormal: every circumcentre
-  // lies beyond any box the retry can afford, and hull completion has no
-  // simplex to start from. The empty answer this gave was wrong (stop 22's
-  // fuzz); it is refused instead.
+  // One point off the line by 1e-300, or a subnormal off the plane: every
+  // circumcentre lies beyond any box the retry can afford, so hull completion
+  // has no found simplex to start from. Stop 22 refused these (the empty
+  // answer before that was wrong); completion now starts from a simplex it
+  // wraps from a facet the cells hold, and the results are CGAL's.
   std::vector<double> nearly_line;
   for (int k = -7; k <= 7; ++k) nearly_line.insert(nearly_line.end(), {0.0, 2.0 * k});
   nearly_line.insert(nearly_line.end(), {1e-300, 5.0});
-  EXPECT_THROW(run(nearly_line, 2), tessera::InputError);
   std::vector<double> sliver = {0, 0, 0, 16, 0, 0, 0, 16, 0, 4, 4, 0x1p-1074};
-  EXPECT_THROW(run(sliver, 3), tessera::InputError);
+  for (int threads : {1, 2}) {
+    tessera::Delaunay fan = run(nearly_line, 2, threads);
+    EXPECT_EQ(fan.n_simplices(), 14u);
+    EXPECT_EQ(as_set(fan), cgal_simplices(nearly_line, 2));
+    expect_valid(fan, nearly_line);
+    tessera::Delaunay tet = run(sliver, 3, threads);
+    EXPECT_EQ(tet.n_simplices(), 1u);
+    EXPECT_EQ(as_set(tet), cgal_simplices(sliver, 3));
+    expect_valid(tet, sliver);
+  }
   // One point off the plane by 2^-30: a solid (if thin) set, with simplices.
   std::vector<double> solid(plane.begin(), plane.begin() + 3 * 200);
   solid.insert(solid.end(), {0.5, 0.5, 0.375 + 0x1p-30});
   tessera::Delaunay dt = run(solid, 3);
   EXPECT_GT(dt.n_simplices(), 0u);
   expect_valid(dt, solid);
+}
+
+// Larger sets flat to within ~1e-300 of their extent (no circumcentre within
+// 2^50 extents, so hull completion wraps the whole triangulation from one
+// seed simplex): random points on a line and on a plane, some of them
+// lifted off it by multiples of 1e-300. Equal to CGAL, valid, and the same
+// on 1 and 2 threads. 3D points within rounding of a line give no facet to
+// start from and are refused.
+TEST(Delaunay, FlatToWithinRoundingEqualsCgal) {
+  auto u = random_points(120, 2, 53);
+  std::vector<double> line2, plane3;
+  for (std::size_t i = 0; i < 60; ++i) {
+    const double t = 16 * u[2 * i];
+    line2.insert(line2.end(), {t, i % 7 == 3 ? 1e-300 * static_cast<double>(i % 5 + 1) : 0.0});
+  }
+  for (std::size_t i = 0; i < 120; ++i) {
+    const double x = 16 * u[2 * i], y = 16 * u[2 * i + 1];
+    plane3.insert(plane3.end(), {x, y, i % 5 == 2 ? 3e-300 * static_cast<double>(i % 11 + 1) : 0.0});
+  }
+  for (int threads : {1, 2}) {
+    tessera::Delaunay d2 = run(line2, 2, threads);
+    EXPECT_EQ(d2.from_cells, 0u);
+    EXPECT_GT(d2.n_simplices(), 0u);
+    EXPECT_EQ(as_set(d2), cgal_simplices(line2, 2));
+    expect_valid(d2, line2);
+    tessera::Delaunay d3 = run(plane3, 3, threads);
+    EXPECT_EQ(d3.from_cells, 0u);
+    EXPECT_GT(d3.n_simplices(), 0u);
+    EXPECT_EQ(as_set(d3), cgal_simplices(plane3, 3));
+    expect_valid(d3, plane3);
+  }
+  std::vector<double> line3;
+  for (int k = 0; k < 12; ++k) line3.insert(line3.end(), {2.0 * k, 0.0, 0.0});
+  line3.insert(line3.end(), {5.0, 1e-300, 0.0, 7.0, 0.0, 1e-300});
+  EXPECT_THROW(run(line3, 3), tessera::InputError);
 }
 
 TEST(Delaunay, LabelsKeepInsideSimplicesOnly) {
