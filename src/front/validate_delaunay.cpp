@@ -103,20 +103,40 @@ DelaunayReport validate(const Delaunay& dt, std::span<const double> points, std:
   ctx.dim = D;
   auto pt = [&](std::int32_t id) { return points.data() + static_cast<std::size_t>(id) * static_cast<std::size_t>(D); };
   const double fact = D == 2 ? 2.0 : 6.0;
-  // Volumes are computed in units of a power of two near the domain's
-  // extent (an exact scaling of the coordinate differences), so points near
-  // 1e-150 or 1e150 neither under- nor overflow them; the report gives them
-  // back in the input's units, where they may not be representable.
-  // Half extents: a domain spanning most of double's range has an extent
-  // that overflows, and a coordinate difference that does too (diff).
-  double half = 0;
-  for (int d = 0; d < D; ++d)
-    half = std::max(half, 0.5 * dt.bounds.hi[static_cast<std::size_t>(d)] - 0.5 * dt.bounds.lo[static_cast<std::size_t>(d)]);
-  const int unit_exp = half > 0 && std::isfinite(half) ? std::clamp(std::ilogb(half) + 1, -1000, 1000) : 0;
-  const double unit = std::ldexp(1.0, -unit_exp);
-  auto diff = [unit](double a, double b) {
-    const double d = a - b;
-    return std::isfinite(d) ? d * unit : a * unit - b * unit;
+  // Volumes are computed in units of a power of two per axis, near the
+  // points' extent along it (exact scalings of the coordinate differences,
+  // which scale every volume by their product), so points near 1e-150 or
+  // 1e150 neither under- nor overflow them, and an axis a few subnormal ulps
+  // thick keeps its bits (a triangle 4e-321 high, flat input that hull
+  // completion triangulates: in one unit for all axes its area lost most
+  // of them and the sums disagreed; stop 23's fuzz). The report gives the
+  // volumes back in the input's units, where they may not be representable.
+  // Half extents where the extent overflows (a domain spanning most of
+  // double's range), and a coordinate difference that does too (diff).
+  double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0}, o[3] = {0, 0, 0}, unit[3] = {1, 1, 1};
+  int unit_exp_sum = 0;
+  for (int d = 0; d < D; ++d) {
+    const auto du = static_cast<std::size_t>(d);
+    lo[d] = dt.bounds.lo[du];
+    hi[d] = dt.bounds.hi[du];
+    if (dt.n_points > 0) {
+      lo[d] = hi[d] = points[du];
+      for (std::size_t i = 1; i < dt.n_points; ++i) {
+        const double x = points[i * static_cast<std::size_t>(D) + du];
+        lo[d] = std::min(lo[d], x);
+        hi[d] = std::max(hi[d], x);
+      }
+    }
+    double extent = hi[d] - lo[d];
+    if (!std::isfinite(extent)) extent = 0.5 * hi[d] - 0.5 * lo[d];
+    const int e = extent > 0 && std::isfinite(extent) ? std::clamp(std::ilogb(extent), -1000, 1000) : 0;
+    unit[d] = std::ldexp(1.0, -e);
+    unit_exp_sum += e;
+    o[d] = 0.5 * lo[d] + 0.5 * hi[d];  // the enclosed volume's origin
+  }
+  auto diff = [&unit](double a, double b, int d) {
+    const double x = a - b;
+    return std::isfinite(x) ? x * unit[d] : a * unit[d] - b * unit[d];
   };
   double volume_sum = 0, enclosed_volume = 0;  // in those units
 
@@ -128,7 +148,7 @@ DelaunayReport validate(const Delaunay& dt, std::span<const double> points, std:
     bad[s] = kernels::orientation(ctx, row) != 1;
     double r[3][3] = {};
     for (int k = 0; k < D; ++k)
-      for (int d = 0; d < D; ++d) r[k][d] = diff(pt(row[k + 1])[d], pt(row[0])[d]);
+      for (int d = 0; d < D; ++d) r[k][d] = diff(pt(row[k + 1])[d], pt(row[0])[d], d);
     double perm;
     vol[s] = det_rows(r, D, perm) / fact;
     vol_err[s] = 32 * std::numeric_limits<double>::epsilon() * perm / fact;
@@ -182,8 +202,6 @@ DelaunayReport validate(const Delaunay& dt, std::span<const double> points, std:
 
   // Boundary: the volume it encloses (facets in the simplex's induced
   // orientation, sign (-1)^k), and its ridges, each in exactly two boundary facets.
-  double o[3] = {0, 0, 0};
-  for (int d = 0; d < D; ++d) o[d] = 0.5 * (dt.bounds.lo[static_cast<std::size_t>(d)] + dt.bounds.hi[static_cast<std::size_t>(d)]);
   struct RidgeRec {
     std::array<std::int32_t, 2> ridge;
     std::int32_t facet;   // index into boundary
@@ -197,7 +215,7 @@ DelaunayReport validate(const Delaunay& dt, std::span<const double> points, std:
     double r[3][3] = {};
     for (std::size_t j = 0, c = 0; j < w; ++j) {
       if (static_cast<std::int32_t>(j) == f.k) continue;
-      for (int d = 0; d < D; ++d) r[c][d] = diff(pt(row[j])[d], o[d]);
+      for (int d = 0; d < D; ++d) r[c][d] = diff(pt(row[j])[d], o[d], d);
       ++c;
     }
     double perm;
@@ -258,8 +276,8 @@ DelaunayReport validate(const Delaunay& dt, std::span<const double> points, std:
   fail(rep.local_delaunay_violations, "interior facets are not locally Delaunay");
   // Float volumes: the comparison allows their rounding (a bound from each
   // determinant's permanent, which matters for nearly flat input) plus 1e-9.
-  rep.volume_sum = std::ldexp(volume_sum, D * unit_exp);
-  rep.enclosed_volume = std::ldexp(enclosed_volume, D * unit_exp);
+  rep.volume_sum = std::ldexp(volume_sum, unit_exp_sum);
+  rep.enclosed_volume = std::ldexp(enclosed_volume, unit_exp_sum);
   const double tol = 1e-9 * std::max(std::fabs(volume_sum), std::fabs(enclosed_volume)) + volume_err;
   if (!(std::fabs(volume_sum - enclosed_volume) <= tol)) {  // NaN fails too
     rep.ok = false;

@@ -491,6 +491,18 @@ TEST(Delaunay, FlatToWithinRoundingEqualsCgal) {
     EXPECT_EQ(as_set(d3), cgal_simplices(plane3, 3));
     expect_valid(d3, plane3);
   }
+  // Volumes a few subnormal ulps thick (stop 23's fuzz): the validator's
+  // volume check compared sums in one unit for all axes, where these areas
+  // and volumes had lost most of their bits, and failed valid results.
+  std::vector<double> thin2 = {2.5556214988546793, 0, 5.3033954811967954, 0, 11.679688587439584, 4.3774216221534444e-321};
+  std::vector<double> thin3 = {1000913.7698721843, 0, 1008876.7976716192, 1009986.9460027346, 5.9999999999999817e-310,
+                               1007452.9021873116, 1003758.5889666273, 0, 1007047.7483067012, 1000851.8551998042,
+                               0, 1008914.7045458721, 1004854.9801207645, 0, 1001702.877279316};
+  tessera::Delaunay t2 = run(thin2, 2), t3 = run(thin3, 3);
+  EXPECT_EQ(t2.n_simplices(), 1u);
+  expect_valid(t2, thin2);
+  EXPECT_EQ(as_set(t3), cgal_simplices(thin3, 3));
+  expect_valid(t3, thin3);
   std::vector<double> line3;
   for (int k = 0; k < 12; ++k) line3.insert(line3.end(), {2.0 * k, 0.0, 0.0});
   line3.insert(line3.end(), {5.0, 1e-300, 0.0, 7.0, 0.0, 1e-300});
