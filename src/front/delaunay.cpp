@@ -94,10 +94,7 @@ std::optional<std::array<std::int32_t, CellT::dim + 1>> seed_simplex(const front
   for (std::size_t t = 0; t < tries; ++t) {
     const std::int32_t gen = gens.order[t * n / tries];
     const double* p = gens.coords + static_cast<std::size_t>(gen) * D;
-    const kernels::BuildStatus st = gens.tree != nullptr && builder.in_overfull_bin(p)
-                                        ? builder.build_nearest_first(gen, p, cell)
-                                        : builder.build(gen, p, cell);
-    if (!st.has_cell) continue;
+    if (!builder.build_any(gen, p, cell).has_cell) continue;
     for (const auto& v : cell.vertices()) {
       std::array<std::int32_t, D> facet;
       facet[0] = gen;
@@ -196,16 +193,16 @@ Delaunay run(std::span<const double> input, std::span<const std::int32_t> labels
       diam2 += e * e;
     }
     front::HullCompletion<D> hc(pass.exact, candidates, std::sqrt(diam2));
-    std::optional<std::array<std::int32_t, D + 1>> seed;
-    std::vector<front::OpenFacet<D>> seed_facets;
-    if (none_found) {
+    if (!none_found) {
+      added = hc.run(found.open, pass.engine_options.threads);
+    } else {
       // Not flat, yet no circumcentre within 2^50 extents of the input: flat
       // to within ~1e-15 of its extent (points 1e-300 off a plane or a
       // line). Completion starts from one simplex found by gift wrapping a
       // facet the cells hold (seed_simplex) and wraps the whole
       // triangulation from there; every cell reaches the box, so every point
       // is a candidate.
-      seed = seed_simplex<CellT>(pass, hc);
+      const auto seed = seed_simplex<CellT>(pass, hc);
       if (!seed)
         // 3D points within rounding of a line: their bisectors are all but
         // parallel, and no cell searched has a vertex on a single box plane.
@@ -213,16 +210,8 @@ Delaunay run(std::span<const double> input, std::span<const std::int32_t> labels
         throw InputError(
             "the points are flat to within rounding (3D points all but on a line): no Delaunay simplex or facet "
             "could be found within 2^50 times the input's extent; remove the near-degenerate offsets or joggle");
-      for (int k = 0; k <= D; ++k) {
-        front::OpenFacet<D> o;
-        for (int m = 0, j = 0; m <= D; ++m)
-          if (m != k) o.facet[static_cast<std::size_t>(j++)] = (*seed)[static_cast<std::size_t>(m)];
-        o.apex = (*seed)[static_cast<std::size_t>(k)];
-        seed_facets.push_back(o);
-      }
+      added = hc.run_from(*seed, pass.engine_options.threads);
     }
-    added = hc.run(seed ? seed_facets : found.open, pass.engine_options.threads);
-    if (seed) added.insert(std::lower_bound(added.begin(), added.end(), *seed), *seed);
   }
   out.from_hull_completion = added.size();
 

@@ -175,6 +175,28 @@ class HullCompletion {
     return best;
   }
 
+  /// The facets of simplex s (ids ascending), each with its opposite vertex as apex.
+  static std::array<OpenFacet<D>, D + 1> facets_of(const Simplex& s) {
+    std::array<OpenFacet<D>, D + 1> out;
+    for (int k = 0; k <= D; ++k) {
+      OpenFacet<D>& o = out[static_cast<std::size_t>(k)];
+      for (int m = 0, j = 0; m <= D; ++m)
+        if (m != k) o.facet[static_cast<std::size_t>(j++)] = s[static_cast<std::size_t>(m)];
+      o.apex = s[static_cast<std::size_t>(k)];
+    }
+    return out;
+  }
+
+  /// The whole triangulation grown from one of its simplices, `seed` (ids
+  /// ascending): run() on the seed's facets, with the seed itself among the
+  /// simplices returned.
+  std::vector<Simplex> run_from(const Simplex& seed, int threads) {
+    const auto open = facets_of(seed);
+    std::vector<Simplex> added = run(std::vector<OpenFacet<D>>(open.begin(), open.end()), threads);
+    added.insert(std::lower_bound(added.begin(), added.end(), seed), seed);
+    return added;
+  }
+
   /// Close the complex whose open facets are `open`; returns the added
   /// simplices (ascending ids), in ascending order. Terminates: a simplex is
   /// never added twice (its facets would then be in three simplices, which
@@ -235,11 +257,7 @@ class HullCompletion {
       std::vector<OpenFacet<D>> next;
       for (const Simplex& s : fresh) {
         added.push_back(s);
-        for (int k = 0; k <= D; ++k) {
-          OpenFacet<D> o;
-          for (int m = 0, j = 0; m <= D; ++m)
-            if (m != k) o.facet[j++] = s[m];
-          o.apex = s[k];
+        for (const OpenFacet<D>& o : facets_of(s)) {
           const int held = facets.bump(o.facet);
           if (held > 2) throw std::logic_error("tessera: hull completion put a facet in three simplices");
           if (held == 1) next.push_back(o);

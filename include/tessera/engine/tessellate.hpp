@@ -74,9 +74,7 @@ std::uint64_t tessellate(const Generators<CellT::dim>& gens, Comp& comp, const E
       const std::int32_t gen = gens.order[g];
       const double* p = gens.slots.empty() ? gens.coords + static_cast<std::size_t>(gen) * CellT::dim
                                            : gens.locator->point(gens.slots[g]).data();
-      kernels::BuildStatus st = gens.tree != nullptr && ws.builder.in_overfull_bin(p)
-                                    ? ws.builder.build_nearest_first(gen, p, ws.cell)
-                                    : ws.builder.build(gen, p, ws.cell);
+      const kernels::BuildStatus st = ws.builder.build_any(gen, p, ws.cell);
       ws.exact_calls += ws.cell.exact_calls();
       comp.add(batch, gen, st, ws.cell);
     }

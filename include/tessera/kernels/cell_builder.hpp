@@ -194,6 +194,12 @@ class CellBuilder {
     return status;
   }
 
+  /// The cell of generator i by the path its bin asks for: build(), or
+  /// build_nearest_first() in an overfull bin.
+  BuildStatus build_any(std::int32_t i, const double* p, CellT& cell) {
+    return in_overfull_bin(p) ? build_nearest_first(i, p, cell) : build(i, p, cell);
+  }
+
   /// Whether a generator at p lies in an overfull bin of a pass that built a
   /// k-d tree: then build_nearest_first() is its cell's build (the engine asks).
   bool in_overfull_bin(const double* p) const {
