@@ -214,15 +214,28 @@ Pass<D>::Pass(std::span<const double> input, std::span<const std::int32_t> label
   });
 
   // A bin far fuller than the grid was sized for (a cluster much smaller
-  // than a bin): its cells search a k-d tree of all the located points.
+  // than a bin): its cells search a k-d tree of all the located points,
+  // built now. Otherwise the tree is built only if a long cell asks.
+  // Long cells (CellBuilder::certify_by_petals) search it too, where most
+  // bins are empty: points sampled on a surface. On volume-filling input
+  // (about 14% of the bins empty when uniform) a few cells at the domain's
+  // corners would ask for a tree the rest never use: the shell walk serves them.
   std::uint32_t fullest = 0;
-  for (std::size_t k = 0; k < locator->num_bins(); ++k)
-    fullest = std::max(fullest, locator->offsets()[k + 1] - locator->offsets()[k]);
-  if (fullest > kernels::overfull_bin) {
-    std::vector<std::int32_t> ids(locator->size());
-    for (std::size_t s = 0; s < ids.size(); ++s) ids[s] = locator->id(s);
-    tree.emplace(points, std::move(ids));
+  std::size_t empty = 0;
+  for (std::size_t k = 0; k < locator->num_bins(); ++k) {
+    const std::uint32_t count = locator->offsets()[k + 1] - locator->offsets()[k];
+    fullest = std::max(fullest, count);
+    empty += count == 0;
   }
+  const kernels::BinLocator<D>& loc = *locator;
+  tree.emplace(
+      points,
+      [&loc] {
+        std::vector<std::int32_t> ids(loc.size());
+        for (std::size_t s = 0; s < ids.size(); ++s) ids[s] = loc.id(s);
+        return ids;
+      },
+      fullest > kernels::overfull_bin, 2 * empty > locator->num_bins());
 
   // Generators with cells, in bin order (neighbouring cells run together).
   order.reserve(locator->size());
@@ -250,7 +263,7 @@ Pass<D>::Pass(std::span<const double> input, std::span<const std::int32_t> label
   gens.order = order;
   gens.slots = slots;
   gens.exact = &exact;
-  gens.tree = tree ? &*tree : nullptr;
+  gens.tree = &*tree;
 
   engine_options.progress = opt.progress;
 }

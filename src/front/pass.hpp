@@ -55,7 +55,7 @@ struct Pass {
   std::vector<std::uint8_t> in_box;          ///< per point: inside the domain
   std::vector<std::int32_t> ignored_outside; ///< points dropped (ignore_outside_points)
   std::optional<kernels::BinLocator<D>> locator;
-  std::optional<kernels::KdTree<D>> tree;    ///< built when a bin is overfull (CellBuilder)
+  std::optional<kernels::SharedKdTree<D>> tree;  ///< of the located points (CellBuilder)
   std::vector<std::int32_t> order;           ///< generators with cells wanted, bin order
   std::vector<std::uint32_t> slots;          ///< their slots in the locator
   kernels::ExactContext exact;

@@ -161,6 +161,45 @@ TEST(Delaunay, HubPointEmitsManySimplices) {
   expect_valid(dt, p);
 }
 
+// Points sampled on surfaces (a height field, an ellipsoid, a torus) and on a
+// closed curve in 2D: long needle cells whose security sphere holds much of
+// the input, the ones CellBuilder finishes by certifying their petals with
+// the k-d tree (certify_by_petals) or, failing that, by the shell walk.
+// The oracle is CGAL's triangulation: a cell missing a clip would miss or
+// add simplices.
+TEST(Delaunay, SurfaceSamplesEqualCgal) {
+  std::mt19937_64 rng(2026);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  const double pi = std::acos(-1.0);
+  std::vector<double> terrain, ellipsoid, torus, curve;
+  for (int k = 0; k < 6000; ++k) {
+    const double x = u(rng), y = u(rng);
+    terrain.insert(terrain.end(), {x, y, 0.1 * std::sin(6 * x) * std::cos(4 * y)});
+  }
+  for (int k = 0; k < 4000; ++k) {
+    const double z = 2 * u(rng) - 1, t = 2 * pi * u(rng), r = std::sqrt(1 - z * z);
+    ellipsoid.insert(ellipsoid.end(), {r * std::cos(t), 0.7 * r * std::sin(t), 0.4 * z});
+  }
+  for (int k = 0; k < 3000; ++k) {
+    const double a = 2 * pi * u(rng), b = 2 * pi * u(rng);
+    torus.insert(torus.end(), {(1 + 0.35 * std::cos(b)) * std::cos(a), (1 + 0.35 * std::cos(b)) * std::sin(a), 0.35 * std::sin(b)});
+  }
+  for (int k = 0; k < 4000; ++k) {
+    const double a = 2 * pi * u(rng), r = 1 + 0.2 * std::sin(5 * a);
+    curve.insert(curve.end(), {r * std::cos(a), 0.6 * r * std::sin(a)});
+  }
+  for (const auto* p : {&terrain, &ellipsoid, &torus}) {
+    const tessera::Delaunay dt = run(*p, 3, 2);
+    EXPECT_EQ(as_set(dt), cgal_simplices(*p, 3));
+    EXPECT_EQ(run(*p, 3, 1).simplices, dt.simplices);
+    expect_valid(dt, *p);
+  }
+  const tessera::Delaunay d2 = run(curve, 2, 2);
+  EXPECT_EQ(as_set(d2), cgal_simplices(curve, 2));
+  EXPECT_EQ(run(curve, 2, 1).simplices, d2.simplices);
+  expect_valid(d2, curve);
+}
+
 TEST(Delaunay, ThreadsGiveIdenticalOutput) {
   for (int dim : {2, 3}) {
     auto p = random_points(5000, dim, 11);

@@ -34,7 +34,8 @@ struct Generators {
   /// missed the cache (2D 1M on 2 threads: 4%).
   std::span<const std::uint32_t> slots;
   const kernels::ExactContext* exact = nullptr;
-  const kernels::KdTree<D>* tree = nullptr;        ///< for overfull bins, when built
+  /// The points' k-d tree, for cells of overfull bins and long cells (CellBuilder).
+  const kernels::SharedKdTree<D>* tree = nullptr;
 };
 
 struct EngineOptions {

@@ -18,8 +18,12 @@
 #include <array>
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <span>
+#include <utility>
 #include <vector>
+
+#include <tbb/collaborative_call_once.h>
 
 namespace tessera::kernels {
 
@@ -28,6 +32,7 @@ class KdTree {
  public:
   /// The points `ids` of `coords` (n * D, row-major).
   KdTree(std::span<const double> coords, std::vector<std::int32_t> ids) : coords_(coords), ids_(std::move(ids)) {
+    for (const std::int32_t j : ids_) id_bound_ = std::max(id_bound_, static_cast<std::size_t>(j) + 1);
     if (ids_.empty()) return;
     nodes_.reserve(2 * (ids_.size() / leaf_size + 1));
     build(0, static_cast<std::uint32_t>(ids_.size()));
@@ -96,6 +101,33 @@ class KdTree {
     }
   }
 
+  /// A ball for in_balls: centre and squared radius (absolute coordinates).
+  struct Ball {
+    double c[D];
+    double r2;
+  };
+
+  /// Visit once each point other than `self` that lies within some of the
+  /// balls (|p - c|^2 <= r2, computed as in nearest_first): f(id, ratio), the
+  /// smallest |p - c|^2 / r2 over the balls holding it; f returns false to
+  /// stop the walk, and then in_balls returns false. One depth-first walk
+  /// for all the balls, each node tested only against the balls that meet
+  /// its parent's box: balls that share a region (the petals of one cell all
+  /// pass through its generator) share the walk there. `active` is the
+  /// caller's scratch.
+  template <class F>
+  bool in_balls(const Ball* balls, std::size_t n, std::int32_t self, std::vector<std::uint32_t>& active, F&& f,
+                std::size_t budget = ~std::size_t{0}) const {
+    if (nodes_.empty() || n == 0) return true;
+    active.resize(n);
+    for (std::size_t k = 0; k < n; ++k) active[k] = static_cast<std::uint32_t>(k);
+    std::size_t left = budget;
+    return walk_balls(0, balls, 0, n, self, active, left, f);
+  }
+
+  /// One more than the largest point id it holds (0 when empty).
+  std::size_t id_bound() const { return id_bound_; }
+
  private:
   static constexpr std::uint32_t leaf_size = 16;
 
@@ -119,6 +151,50 @@ class KdTree {
       s += g * g;
     }
     return s;
+  }
+
+  // in_balls below node k; the balls meeting its parent are active[from, from + n).
+  template <class F>
+  bool walk_balls(std::size_t k, const Ball* balls, std::size_t from, std::size_t n, std::int32_t self,
+                  std::vector<std::uint32_t>& active, std::size_t& left, F& f) const {
+    if (left < n) return false;
+    left -= n;
+    const std::size_t mine = active.size();
+    for (std::size_t a = from; a < from + n; ++a) {
+      const Ball& b = balls[active[a]];
+      if (box_distance2(k, b.c) <= b.r2) active.push_back(active[a]);
+    }
+    const std::size_t m = active.size() - mine;
+    const Node& nd = nodes_[k];
+    bool go = true;
+    if (m != 0) {
+      if (nd.left < 0) {
+        for (std::uint32_t s = nd.begin; s < nd.end; ++s) {
+          const std::int32_t j = ids_[s];
+          if (j == self) continue;
+          const double* pj = at(j);
+          double best = 2;  // above any ratio reported
+          for (std::size_t a = mine; a < mine + m; ++a) {
+            const Ball& b = balls[active[a]];
+            double r2 = 0;
+            for (int d = 0; d < D; ++d) {
+              const double q = pj[d] - b.c[d];
+              r2 += q * q;
+            }
+            if (r2 <= b.r2) best = std::min(best, r2 / b.r2);
+          }
+          if (best <= 1 && !f(j, best)) {
+            go = false;
+            break;
+          }
+        }
+      } else {
+        go = walk_balls(static_cast<std::size_t>(nd.left), balls, mine, m, self, active, left, f) &&
+             walk_balls(static_cast<std::size_t>(nd.right), balls, mine, m, self, active, left, f);
+      }
+    }
+    active.resize(mine);
+    return go;
   }
 
   const double* at(std::int32_t id) const { return coords_.data() + static_cast<std::size_t>(id) * D; }
@@ -158,6 +234,43 @@ class KdTree {
   std::span<const double> coords_;
   std::vector<std::int32_t> ids_;
   std::vector<Node> nodes_;
+  std::size_t id_bound_ = 0;
+};
+
+/// The pass's k-d tree of its located points, built at most once: up front
+/// when a bin is overfull (the cells of such bins search it instead of the
+/// grid), otherwise on first use, by the cell that first asks, while other
+/// threads asking at the same time wait (tbb::collaborative_call_once). Most
+/// inputs never ask: only cells whose security radius spans many bins (the
+/// long cells of points sampled on a surface; CellBuilder) search it, and
+/// only where the pass allows it (long_cells).
+template <int D>
+class SharedKdTree {
+ public:
+  /// `ids()` lists the points the tree holds, when it is built.
+  SharedKdTree(std::span<const double> coords, std::function<std::vector<std::int32_t>()> ids, bool eager,
+               bool long_cells)
+      : coords_(coords), ids_(std::move(ids)), eager_(eager), long_cells_(long_cells) {
+    if (eager_) get();
+  }
+  SharedKdTree(const SharedKdTree&) = delete;
+  SharedKdTree& operator=(const SharedKdTree&) = delete;
+
+  const KdTree<D>& get() const {
+    tbb::collaborative_call_once(once_, [&] { tree_.emplace(coords_, ids_()); });
+    return *tree_;
+  }
+  /// Built up front: some bin is overfull.
+  bool eager() const { return eager_; }
+  /// Long cells may search it (most bins are empty: a surface sample).
+  bool long_cells() const { return long_cells_; }
+
+ private:
+  std::span<const double> coords_;
+  std::function<std::vector<std::int32_t>()> ids_;
+  bool eager_, long_cells_;
+  mutable tbb::collaborative_once_flag once_;
+  mutable std::optional<KdTree<D>> tree_;
 };
 
 }  // namespace tessera::kernels
