@@ -47,7 +47,8 @@ class CellBuilder {
  public:
   static constexpr int D = CellT::dim;
 
-  /// `tree`, when given, serves the cells of overfull bins (see KdTree).
+  /// `tree`, when given, serves the cells of overfull bins (see KdTree) and
+  /// long cells (certify_by_petals).
   CellBuilder(const BinLocator<D>& locator, const double* coords, const double* lo, const double* hi,
               const ExactContext* exact, const SharedKdTree<D>* tree = nullptr)
       : loc_(locator), coords_(coords), lo_(lo), hi_(hi), exact_(exact), tree_(tree) {}
