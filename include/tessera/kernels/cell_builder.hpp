@@ -314,24 +314,21 @@ class CellBuilder {
       if (4 * v.r2 * (1 + 1e-12) < near2) certified_[t] = vertex_key(v);
     }
     for (;;) {
-      const auto& verts = cell.vertices();
-      if (certified_.size() < verts.size()) certified_.resize(verts.size(), ~std::uint64_t{0});
+      const auto& verts = cell.vertices();  // certified_ has a slot for each (below)
       balls_.clear();
       round_.clear();
       for (std::size_t t = 0; t < verts.size(); ++t) {
         const auto& v = verts[t];
         if (certified_[t] == vertex_key(v)) continue;
-        // v's petal, widened past every rounding: the exact vertex lies
-        // within sqrt(D) e < 2e of y and no farther than sqrt(r2) from the
-        // generator; c = p + y and the tree's distances round by far less
-        // than the relative and absolute margins.
+        // v's petal in absolute coordinates: c = p + y and the tree's
+        // distances from it round by far less than the absolute margin.
         typename KdTree<D>::Ball& ball = balls_.emplace_back();
         double mag = 0;
         for (int d = 0; d < D; ++d) {
           ball.c[d] = p[d] + v.y[d];
           mag = std::max({mag, std::fabs(p[d]), std::fabs(ball.c[d])});
         }
-        const double reach = (std::sqrt(v.r2) + 2.0 * v.e) * (1.0 + 1e-9) + 1e-12 * mag;
+        const double reach = petal_radius(v) + 1e-12 * mag;
         ball.r2 = reach * reach * (1.0 + 1e-9);
         round_.push_back(vertex_key(v));
       }

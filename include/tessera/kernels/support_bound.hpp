@@ -144,6 +144,16 @@ class SupportBound {
 /// relative to the generator. A box is ruled out only when its distance to
 /// y exceeds sqrt(r2) + 2e, with a relative margin far above the rounding of
 /// these sums, so every point in it is strictly outside every exact petal.
+/// The radius of vertex v's petal (the ball centred at v through the
+/// generator), widened past every rounding: the exact vertex lies within
+/// sqrt(D) e < 2e of the stored y and no farther than sqrt(r2) from the
+/// generator, with a relative margin far above the rounding of the sum.
+/// PetalCover and CellBuilder::certify_by_petals test against it.
+template <class Vertex>
+double petal_radius(const Vertex& v) {
+  return (std::sqrt(v.r2) + 2.0 * v.e) * (1.0 + 1e-9);
+}
+
 template <int D>
 class PetalCover {
  public:
@@ -153,7 +163,7 @@ class PetalCover {
     for (const auto& v : vertices) {
       Petal pe;
       for (int d = 0; d < D; ++d) pe.y[d] = v.y[d];
-      const double r = (std::sqrt(v.r2) + 2.0 * v.e) * (1.0 + 1e-9);  // 2 > sqrt(3)
+      const double r = petal_radius(v);
       pe.r2 = r * r;
       petals_.push_back(pe);
     }
