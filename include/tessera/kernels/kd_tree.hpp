@@ -15,6 +15,7 @@
 #pragma once
 
 #include <algorithm>
+#include <cmath>
 #include <array>
 #include <cstdint>
 #include <functional>
@@ -36,6 +37,11 @@ class KdTree {
     if (ids_.empty()) return;
     nodes_.reserve(2 * (ids_.size() / leaf_size + 1));
     build(0, static_cast<std::uint32_t>(ids_.size()));
+    // The leaves' coordinates in slot order: a leaf's scan reads one
+    // contiguous run instead of a cache line per point.
+    pts_.resize(ids_.size() * D);
+    for (std::size_t k = 0; k < ids_.size(); ++k)
+      for (int d = 0; d < D; ++d) pts_[k * D + d] = at(ids_[k])[d];
   }
 
   /// One entry of the search's queue: a node (lower bound of its box's
@@ -83,7 +89,7 @@ class KdTree {
         for (std::uint32_t k = nd.begin; k < nd.end; ++k) {
           const std::int32_t j = ids_[k];
           if (j == self) continue;
-          const double* pj = coords_.data() + static_cast<std::size_t>(j) * D;
+          const double* pj = slot_point(k);
           double r2 = 0;
           for (int d = 0; d < D; ++d) {
             const double q = pj[d] - x[d];
@@ -101,28 +107,18 @@ class KdTree {
     }
   }
 
-  /// A ball for in_balls: centre and squared radius (absolute coordinates).
-  struct Ball {
-    double c[D];
-    double r2;
-  };
-
-  /// Visit once each point other than `self` that lies within some of the
-  /// balls (|p - c|^2 <= r2, computed as in nearest_first): f(id, ratio), the
-  /// smallest |p - c|^2 / r2 over the balls holding it; f returns false to
-  /// stop the walk, and then in_balls returns false. One depth-first walk
-  /// for all the balls, each node tested only against the balls that meet
-  /// its parent's box: balls that share a region (the petals of one cell all
-  /// pass through its generator) share the walk there. `active` is the
-  /// caller's scratch.
-  template <class F>
-  bool in_balls(const Ball* balls, std::size_t n, std::int32_t self, std::vector<std::uint32_t>& active, F&& f,
-                std::size_t budget = ~std::size_t{0}) const {
-    if (nodes_.empty() || n == 0) return true;
-    active.resize(n);
-    for (std::size_t k = 0; k < n; ++k) active[k] = static_cast<std::uint32_t>(k);
-    std::size_t left = budget;
-    return walk_balls(0, balls, 0, n, self, active, left, f);
+  /// The point nearest to x among those other than `self` for which
+  /// skip(id) is false, if its squared distance (computed as in
+  /// nearest_first) is at most r2max: its id; -1 when there is none. Each
+  /// node visited costs one unit of `budget`; a search that would exceed it
+  /// stops and returns -2 (nothing is known then). Exact ties go to the
+  /// lower id.
+  template <class Skip>
+  std::int32_t nearest(const double* x, std::int32_t self, double r2max, Skip&& skip, std::size_t& budget) const {
+    std::int32_t best = -1;
+    double bound = r2max;
+    if (nodes_.empty() || lower_bound2(0, x, bound) > bound) return -1;
+    return nearest_below(0, x, self, bound, best, skip, budget) ? best : -2;
   }
 
   /// One more than the largest point id it holds (0 when empty).
@@ -133,6 +129,8 @@ class KdTree {
 
   struct Node {
     std::array<double, D> lo, hi;  // bounding box of its points
+    std::array<double, D> c, nrm;  // slab bound: centre and unit normal
+    double rho = 0, thick = 0;     // in-plane radius and half-thickness about c
     std::uint32_t begin, end;      // its points: ids_[begin, end)
     std::int32_t left = -1, right = -1;  // children; -1 for a leaf
   };
@@ -153,51 +151,117 @@ class KdTree {
     return s;
   }
 
-  // in_balls below node k; the balls meeting its parent are active[from, from + n).
-  template <class F>
-  bool walk_balls(std::size_t k, const Ball* balls, std::size_t from, std::size_t n, std::int32_t self,
-                  std::vector<std::uint32_t>& active, std::size_t& left, F& f) const {
-    if (left < n) return false;
-    left -= n;
-    const std::size_t mine = active.size();
-    for (std::size_t a = from; a < from + n; ++a) {
-      const Ball& b = balls[active[a]];
-      if (box_distance2(k, b.c) <= b.r2) active.push_back(active[a]);
-    }
-    const std::size_t m = active.size() - mine;
+  // nearest below node k, whose points may lie within `bound` of x: the
+  // nearer child first, the other only if it still may. False: out of budget.
+  template <class Skip>
+  [[gnu::noinline]] bool nearest_below(std::size_t k, const double* x, std::int32_t self, double& bound, std::int32_t& best,
+                     Skip& skip, std::size_t& budget) const {
+    if (budget == 0) return false;
+    --budget;
     const Node& nd = nodes_[k];
-    bool go = true;
-    if (m != 0) {
-      if (nd.left < 0) {
-        for (std::uint32_t s = nd.begin; s < nd.end; ++s) {
-          const std::int32_t j = ids_[s];
-          if (j == self) continue;
-          const double* pj = at(j);
-          double best = 2;  // above any ratio reported
-          for (std::size_t a = mine; a < mine + m; ++a) {
-            const Ball& b = balls[active[a]];
-            double r2 = 0;
-            for (int d = 0; d < D; ++d) {
-              const double q = pj[d] - b.c[d];
-              r2 += q * q;
-            }
-            if (r2 <= b.r2) best = std::min(best, r2 / b.r2);
-          }
-          if (best <= 1 && !f(j, best)) {
-            go = false;
-            break;
-          }
+    if (nd.left < 0) {
+      for (std::uint32_t s = nd.begin; s < nd.end; ++s) {
+        const std::int32_t j = ids_[s];
+        const double* pj = slot_point(s);
+        double r2 = 0;
+        for (int d = 0; d < D; ++d) {
+          const double q = pj[d] - x[d];
+          r2 += q * q;
         }
-      } else {
-        go = walk_balls(static_cast<std::size_t>(nd.left), balls, mine, m, self, active, left, f) &&
-             walk_balls(static_cast<std::size_t>(nd.right), balls, mine, m, self, active, left, f);
+        if (r2 > bound || (r2 == bound && best >= 0 && j > best) || j == self || skip(j)) continue;
+        bound = r2;
+        best = j;
       }
+      return true;
     }
-    active.resize(mine);
-    return go;
+    const auto l = static_cast<std::size_t>(nd.left), r = static_cast<std::size_t>(nd.right);
+    const double bl = lower_bound2(l, x, bound), br = lower_bound2(r, x, bound);
+    const std::size_t first = bl <= br ? l : r, second = bl <= br ? r : l;
+    const double b1 = std::min(bl, br), b2 = std::max(bl, br);
+    if (b1 <= bound && !nearest_below(first, x, self, bound, best, skip, budget)) return false;
+    return b2 > bound || nearest_below(second, x, self, bound, best, skip, budget);
   }
 
   const double* at(std::int32_t id) const { return coords_.data() + static_cast<std::size_t>(id) * D; }
+  const double* slot_point(std::size_t s) const { return pts_.data() + s * D; }
+
+  void slab(Node& nd) const {
+    const double m = static_cast<double>(nd.end - nd.begin);
+    for (int d = 0; d < D; ++d) nd.c[d] = 0;
+    for (std::uint32_t k = nd.begin; k < nd.end; ++k)
+      for (int d = 0; d < D; ++d) nd.c[d] += at(ids_[k])[d];
+    for (int d = 0; d < D; ++d) nd.c[d] /= m;
+    double cov[D][D] = {};
+    for (std::uint32_t k = nd.begin; k < nd.end; ++k) {
+      double w[D];
+      for (int d = 0; d < D; ++d) w[d] = at(ids_[k])[d] - nd.c[d];
+      for (int a = 0; a < D; ++a)
+        for (int b = 0; b < D; ++b) cov[a][b] += w[a] * w[b];
+    }
+    double tr = 0;
+    for (int d = 0; d < D; ++d) tr += cov[d][d];
+    double n[D];
+    for (int d = 0; d < D; ++d) n[d] = 1.0 + 0.1 * d;
+    for (int it = 0; it < 24; ++it) {
+      double y[D];
+      for (int a = 0; a < D; ++a) {
+        y[a] = tr * n[a];
+        for (int b = 0; b < D; ++b) y[a] -= cov[a][b] * n[b];
+      }
+      double len = 0;
+      for (int d = 0; d < D; ++d) len += y[d] * y[d];
+      len = std::sqrt(len);
+      if (!(len > 0) || !std::isfinite(len)) break;
+      for (int d = 0; d < D; ++d) n[d] = y[d] / len;
+    }
+    double len = 0;
+    for (int d = 0; d < D; ++d) len += n[d] * n[d];
+    len = std::sqrt(len);
+    for (int d = 0; d < D; ++d) nd.nrm[d] = n[d] / len;
+    nd.rho = nd.thick = 0;
+    for (std::uint32_t k = nd.begin; k < nd.end; ++k) {
+      double w[D], a = 0;
+      for (int d = 0; d < D; ++d) { w[d] = at(ids_[k])[d] - nd.c[d]; a += w[d] * nd.nrm[d]; }
+      double b2 = 0;
+      for (int d = 0; d < D; ++d) { const double u = w[d] - a * nd.nrm[d]; b2 += u * u; }
+      nd.rho = std::max(nd.rho, std::sqrt(b2));
+      nd.thick = std::max(nd.thick, std::fabs(a));
+    }
+    double mag = 0;
+    for (int d = 0; d < D; ++d) mag = std::max(mag, std::fabs(nd.c[d]));
+    const double margin = 1e-9 * (mag + nd.rho + nd.thick);
+    nd.rho += margin;
+    nd.thick += margin;
+  }
+
+  // A lower bound on the squared distance from x to node k's points: the
+  // box's, and where that is at most `limit` and the node is flat, the
+  // larger of it and the slab's (a square root: only where the box does not
+  // already settle the test).
+  double lower_bound2(std::size_t k, const double* x, double limit) const {
+    const double box = box_distance2(k, x);
+    const Node& nd = nodes_[k];
+    if (box > limit || !(nd.thick < slab_flat * nd.rho)) return box;
+    double w[D], a = 0, wm = 0;
+    for (int d = 0; d < D; ++d) {
+      w[d] = x[d] - nd.c[d];
+      a += w[d] * nd.nrm[d];
+      wm = std::max(wm, std::fabs(w[d]));
+    }
+    double b2 = 0;
+    for (int d = 0; d < D; ++d) {
+      const double u = w[d] - a * nd.nrm[d];
+      b2 += u * u;
+    }
+    // Each gap less a margin far above the rounding of these sums (relative
+    // ~1e-15 of the magnitudes involved).
+    const double m = 1e-9 * wm;
+    const double gb = std::max(0.0, std::sqrt(b2) - nd.rho - m), ga = std::max(0.0, std::fabs(a) - nd.thick - m);
+    return std::max(box, gb * gb + ga * ga);
+  }
+  static constexpr double slab_flat = 0.25;
+
+
 
   // Node over ids_[begin, end): its box, then a median split on the widest axis.
   std::int32_t build(std::uint32_t begin, std::uint32_t end) {
@@ -213,6 +277,7 @@ class KdTree {
         nd.hi[d] = std::max(nd.hi[d], at(ids_[k])[d]);
       }
     }
+    slab(nd);
     if (end - begin > leaf_size) {
       int axis = 0;
       for (int d = 1; d < D; ++d)
@@ -234,6 +299,7 @@ class KdTree {
   std::span<const double> coords_;
   std::vector<std::int32_t> ids_;
   std::vector<Node> nodes_;
+  std::vector<double> pts_;  // coordinates of ids_[k] at k * D
   std::size_t id_bound_ = 0;
 };
 

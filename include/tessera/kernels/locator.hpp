@@ -132,6 +132,25 @@ class BinLocator {
     first = bin_coords(lo);
     last = bin_coords(hi);
   }
+  /// The number of points in the bins [first, last] (per axis, inclusive):
+  /// one subtraction per row of bins, which are contiguous along x.
+  std::size_t count_in(const std::array<std::int32_t, D>& first, const std::array<std::int32_t, D>& last) const {
+    std::size_t n = 0;
+    std::array<std::int32_t, D> a = first, e = first;
+    e[0] = last[0];
+    auto row = [&] { n += offsets_[bin_index(e) + 1] - offsets_[bin_index(a)]; };
+    if constexpr (D == 2) {
+      for (a[1] = e[1] = first[1]; a[1] <= last[1]; e[1] = ++a[1]) row();
+    } else {
+      for (a[2] = first[2]; a[2] <= last[2]; ++a[2])
+        for (a[1] = first[1]; a[1] <= last[1]; ++a[1]) {
+          e[1] = a[1];
+          e[2] = a[2];
+          row();
+        }
+    }
+    return n;
+  }
   std::size_t bin_index(const std::array<std::int32_t, D>& b) const {
     std::size_t idx = static_cast<std::size_t>(b[D - 1]);
     for (int d = D - 2; d >= 0; --d) idx = idx * static_cast<std::size_t>(divs_[d]) + static_cast<std::size_t>(b[d]);
