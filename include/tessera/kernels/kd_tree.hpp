@@ -115,11 +115,11 @@ class KdTree {
   /// lower id.
   template <class Skip>
   std::int32_t nearest(const double* x, std::int32_t self, double r2max, Skip&& skip, std::size_t& budget) const {
-    std::int32_t best = -1;
-    double bound = r2max;
-    if (nodes_.empty() || lower_bound2(0, x, bound) > bound) return -1;
-    return nearest_below(0, x, self, bound, best, skip, budget) ? best : -2;
+    Search q{x, r2max, std::sqrt(r2max), -1};
+    if (nodes_.empty() || box_distance2(0, x) > q.bound || slab_excludes(0, q)) return -1;
+    return nearest_below(0, q, self, skip, budget) ? q.best : -2;
   }
+
 
   /// One more than the largest point id it holds (0 when empty).
   std::size_t id_bound() const { return id_bound_; }
@@ -151,11 +151,19 @@ class KdTree {
     return s;
   }
 
-  // nearest below node k, whose points may lie within `bound` of x: the
-  // nearer child first, the other only if it still may. False: out of budget.
+  // A nearest search's state: the best point so far and its squared
+  // distance (the search's bound; r its square root, rounded).
+  struct Search {
+    const double* x;
+    double bound, r;
+    std::int32_t best;
+  };
+
+  // nearest below node k, whose points may lie within the bound: the child
+  // whose box is nearer first, the other only if it still may. False: out
+  // of budget.
   template <class Skip>
-  [[gnu::noinline]] bool nearest_below(std::size_t k, const double* x, std::int32_t self, double& bound, std::int32_t& best,
-                     Skip& skip, std::size_t& budget) const {
+  bool nearest_below(std::size_t k, Search& q, std::int32_t self, Skip& skip, std::size_t& budget) const {
     if (budget == 0) return false;
     --budget;
     const Node& nd = nodes_[k];
@@ -165,21 +173,22 @@ class KdTree {
         const double* pj = slot_point(s);
         double r2 = 0;
         for (int d = 0; d < D; ++d) {
-          const double q = pj[d] - x[d];
-          r2 += q * q;
+          const double t = pj[d] - q.x[d];
+          r2 += t * t;
         }
-        if (r2 > bound || (r2 == bound && best >= 0 && j > best) || j == self || skip(j)) continue;
-        bound = r2;
-        best = j;
+        if (r2 > q.bound || (r2 == q.bound && q.best >= 0 && j > q.best) || j == self || skip(j)) continue;
+        q.bound = r2;
+        q.r = std::sqrt(r2);
+        q.best = j;
       }
       return true;
     }
     const auto l = static_cast<std::size_t>(nd.left), r = static_cast<std::size_t>(nd.right);
-    const double bl = lower_bound2(l, x, bound), br = lower_bound2(r, x, bound);
+    const double bl = box_distance2(l, q.x), br = box_distance2(r, q.x);
     const std::size_t first = bl <= br ? l : r, second = bl <= br ? r : l;
-    const double b1 = std::min(bl, br), b2 = std::max(bl, br);
-    if (b1 <= bound && !nearest_below(first, x, self, bound, best, skip, budget)) return false;
-    return b2 > bound || nearest_below(second, x, self, bound, best, skip, budget);
+    if (std::min(bl, br) <= q.bound && !slab_excludes(first, q) && !nearest_below(first, q, self, skip, budget))
+      return false;
+    return std::max(bl, br) > q.bound || slab_excludes(second, q) || nearest_below(second, q, self, skip, budget);
   }
 
   const double* at(std::int32_t id) const { return coords_.data() + static_cast<std::size_t>(id) * D; }
@@ -234,30 +243,36 @@ class KdTree {
     nd.thick += margin;
   }
 
-  // A lower bound on the squared distance from x to node k's points: the
-  // box's, and where that is at most `limit` and the node is flat, the
-  // larger of it and the slab's (a square root: only where the box does not
-  // already settle the test).
-  double lower_bound2(std::size_t k, const double* x, double limit) const {
-    const double box = box_distance2(k, x);
+  // Whether node k's slab (a flat node's disc: within rho of c in the
+  // plane, within thick of it along the normal) lies wholly farther than
+  // the search's bound from x: then none of its points can be nearer. A
+  // node is flat where its points lie on a surface; elsewhere the box
+  // decides alone. Every gap is shrunk by a margin m far above the rounding
+  // of these sums (relative ~1e-15 of the magnitudes involved), and every
+  // reach grown by it.
+  bool slab_excludes(std::size_t k, const Search& q) const {
     const Node& nd = nodes_[k];
-    if (box > limit || !(nd.thick < slab_flat * nd.rho)) return box;
+    if (!(nd.thick < slab_flat * nd.rho)) return false;
     double w[D], a = 0, wm = 0;
     for (int d = 0; d < D; ++d) {
-      w[d] = x[d] - nd.c[d];
+      w[d] = q.x[d] - nd.c[d];
       a += w[d] * nd.nrm[d];
       wm = std::max(wm, std::fabs(w[d]));
     }
-    double b2 = 0;
+    const double m = 1e-9 * wm;
+    const double ga = std::fabs(a) - nd.thick - m;  // gap along the normal
+    if (ga > q.r) return true;
+    double b2 = 0;  // squared distance from the normal through c
     for (int d = 0; d < D; ++d) {
       const double u = w[d] - a * nd.nrm[d];
       b2 += u * u;
     }
-    // Each gap less a margin far above the rounding of these sums (relative
-    // ~1e-15 of the magnitudes involved).
-    const double m = 1e-9 * wm;
-    const double gb = std::max(0.0, std::sqrt(b2) - nd.rho - m), ga = std::max(0.0, std::fabs(a) - nd.thick - m);
-    return std::max(box, gb * gb + ga * ga);
+    const double rb = nd.rho + m;
+    if (b2 <= rb * rb) return false;  // over the disc: the normal gap decides
+    // Beside the disc: the gap in the plane, sqrt(b2) - rb, against the
+    // reach left after the normal gap.
+    const double reach = ga > 0 ? std::sqrt(std::max(0.0, q.r * q.r - ga * ga)) : q.r;
+    return b2 > (rb + reach) * (rb + reach);
   }
   static constexpr double slab_flat = 0.25;
 
