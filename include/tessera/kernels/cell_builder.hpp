@@ -300,9 +300,9 @@ class CellBuilder {
   /// cells cost more this way than by the shell walk. After a few searches
   /// the cost of the rest is predicted (vertices left times nodes per
   /// search so far); above the number of points the shell walk would
-  /// gather (those in the bins of the flower's box) divided by
-  /// node_cost, it gives up, unsure, and the shell walk goes on from the
-  /// cell as it is. The clip decisions are the exact ones either way, so
+  /// gather (those in the bins of the flower's box: a node searched costs
+  /// about as much as a point gathered and screened there), it gives up,
+  /// unsure, and the shell walk goes on from the cell as it is. The clip decisions are the exact ones either way, so
   /// the cell is the same.
   [[gnu::noinline]] Certified certify_by_petals(std::int32_t i, const double* p, CellT& cell, double near2) {
     const KdTree<D>& tree = tree_->get();
@@ -341,7 +341,7 @@ class CellBuilder {
         if (predicted > afford) {
           // Measured again only when needed: the flower shrinks with the cell.
           const auto* range = flower_bins(cell, p);
-          afford = loc_.count_in(range[0], range[1]) / node_cost;
+          afford = loc_.count_in(range[0], range[1]);
           if (predicted > afford) return Certified::unsure;
         }
       }
@@ -369,9 +369,6 @@ class CellBuilder {
       if (cell.clip(j, q) == ClipResult::emptied) return Certified::no_cell;
     }
   }
-  /// A tree node searched costs about as much as node_cost points gathered
-  /// by the shell walk (measured: ~50 ns against ~10 ns).
-  static constexpr std::size_t node_cost = 2;
   /// One search visits at most this many nodes (a bound that never binds
   /// in practice: the prediction above gives up far earlier).
   static constexpr std::size_t search_budget = std::size_t{1} << 22;
