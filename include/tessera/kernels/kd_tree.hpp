@@ -19,6 +19,7 @@
 #include <array>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <optional>
 #include <span>
 #include <utility>
@@ -31,11 +32,15 @@ namespace tessera::kernels {
 template <int D>
 class KdTree {
  public:
-  /// The points `ids` of `coords` (n * D, row-major).
-  KdTree(std::span<const double> coords, std::vector<std::int32_t> ids) : coords_(coords), ids_(std::move(ids)) {
+  /// The points `ids` of `coords` (n * D, row-major). With `slabs`, flat
+  /// nodes also get a slab bound (see slab), which `nearest` uses: points
+  /// sampled on a surface.
+  KdTree(std::span<const double> coords, std::vector<std::int32_t> ids, bool slabs = false)
+      : coords_(coords), ids_(std::move(ids)), with_slabs_(slabs) {
     for (const std::int32_t j : ids_) id_bound_ = std::max(id_bound_, static_cast<std::size_t>(j) + 1);
     if (ids_.empty()) return;
     nodes_.reserve(2 * (ids_.size() / leaf_size + 1));
+    slabs_.reserve(nodes_.capacity());
     build(0, static_cast<std::uint32_t>(ids_.size()));
     // The leaves' coordinates in slot order: a leaf's scan reads one
     // contiguous run instead of a cache line per point.
@@ -129,10 +134,14 @@ class KdTree {
 
   struct Node {
     std::array<double, D> lo, hi;  // bounding box of its points
-    std::array<double, D> c, nrm;  // slab bound: centre and unit normal
-    double rho = 0, thick = 0;     // in-plane radius and half-thickness about c
     std::uint32_t begin, end;      // its points: ids_[begin, end)
     std::int32_t left = -1, right = -1;  // children; -1 for a leaf
+  };
+  // A node's slab bound (kept apart from the nodes, which nearest_first
+  // walks without it: 64-byte nodes).
+  struct Slab {
+    std::array<double, D> c, nrm;  // centre and unit normal
+    double rho = 0, thick = std::numeric_limits<double>::infinity();  // in-plane radius, half-thickness
   };
 
   // Squared distance from x to node k's box, never above the true distance
@@ -194,14 +203,22 @@ class KdTree {
   const double* at(std::int32_t id) const { return coords_.data() + static_cast<std::size_t>(id) * D; }
   const double* slot_point(std::size_t s) const { return pts_.data() + s * D; }
 
-  void slab(Node& nd) const {
-    const double m = static_cast<double>(nd.end - nd.begin);
+  // Node nd's slab: its points' centroid c; nrm, the direction of least
+  // spread (the covariance's smallest eigenvector, by power iteration on
+  // trace - covariance: any unit vector gives a valid bound, a good one a
+  // tight bound); rho and thick, the largest distance from c within the
+  // plane and along nrm, grown by a margin far above the rounding of their
+  // sums. Without slabs: thick infinite, and slab_excludes never holds.
+  Slab slab(const Node& node) const {
+    Slab nd;
+    if (!with_slabs_) return nd;
+    const double m = static_cast<double>(node.end - node.begin);
     for (int d = 0; d < D; ++d) nd.c[d] = 0;
-    for (std::uint32_t k = nd.begin; k < nd.end; ++k)
+    for (std::uint32_t k = node.begin; k < node.end; ++k)
       for (int d = 0; d < D; ++d) nd.c[d] += at(ids_[k])[d];
     for (int d = 0; d < D; ++d) nd.c[d] /= m;
     double cov[D][D] = {};
-    for (std::uint32_t k = nd.begin; k < nd.end; ++k) {
+    for (std::uint32_t k = node.begin; k < node.end; ++k) {
       double w[D];
       for (int d = 0; d < D; ++d) w[d] = at(ids_[k])[d] - nd.c[d];
       for (int a = 0; a < D; ++a)
@@ -228,11 +245,17 @@ class KdTree {
     len = std::sqrt(len);
     for (int d = 0; d < D; ++d) nd.nrm[d] = n[d] / len;
     nd.rho = nd.thick = 0;
-    for (std::uint32_t k = nd.begin; k < nd.end; ++k) {
+    for (std::uint32_t k = node.begin; k < node.end; ++k) {
       double w[D], a = 0;
-      for (int d = 0; d < D; ++d) { w[d] = at(ids_[k])[d] - nd.c[d]; a += w[d] * nd.nrm[d]; }
+      for (int d = 0; d < D; ++d) {
+        w[d] = at(ids_[k])[d] - nd.c[d];
+        a += w[d] * nd.nrm[d];
+      }
       double b2 = 0;
-      for (int d = 0; d < D; ++d) { const double u = w[d] - a * nd.nrm[d]; b2 += u * u; }
+      for (int d = 0; d < D; ++d) {
+        const double u = w[d] - a * nd.nrm[d];
+        b2 += u * u;
+      }
       nd.rho = std::max(nd.rho, std::sqrt(b2));
       nd.thick = std::max(nd.thick, std::fabs(a));
     }
@@ -241,6 +264,7 @@ class KdTree {
     const double margin = 1e-9 * (mag + nd.rho + nd.thick);
     nd.rho += margin;
     nd.thick += margin;
+    return nd;
   }
 
   // Whether node k's slab (a flat node's disc: within rho of c in the
@@ -251,7 +275,7 @@ class KdTree {
   // of these sums (relative ~1e-15 of the magnitudes involved), and every
   // reach grown by it.
   bool slab_excludes(std::size_t k, const Search& q) const {
-    const Node& nd = nodes_[k];
+    const Slab& nd = slabs_[k];
     if (!(nd.thick < slab_flat * nd.rho)) return false;
     double w[D], a = 0, wm = 0;
     for (int d = 0; d < D; ++d) {
@@ -276,12 +300,11 @@ class KdTree {
   }
   static constexpr double slab_flat = 0.25;
 
-
-
   // Node over ids_[begin, end): its box, then a median split on the widest axis.
   std::int32_t build(std::uint32_t begin, std::uint32_t end) {
     const auto index = static_cast<std::int32_t>(nodes_.size());
     nodes_.push_back({});
+    slabs_.push_back({});
     Node nd;
     nd.begin = begin;
     nd.end = end;
@@ -292,7 +315,6 @@ class KdTree {
         nd.hi[d] = std::max(nd.hi[d], at(ids_[k])[d]);
       }
     }
-    slab(nd);
     if (end - begin > leaf_size) {
       int axis = 0;
       for (int d = 1; d < D; ++d)
@@ -308,6 +330,7 @@ class KdTree {
       nd.right = build(mid, end);
     }
     nodes_[static_cast<std::size_t>(index)] = nd;
+    slabs_[static_cast<std::size_t>(index)] = slab(nd);
     return index;
   }
 
@@ -315,6 +338,8 @@ class KdTree {
   std::vector<std::int32_t> ids_;
   std::vector<Node> nodes_;
   std::vector<double> pts_;  // coordinates of ids_[k] at k * D
+  std::vector<Slab> slabs_;  // per node
+  bool with_slabs_ = false;
   std::size_t id_bound_ = 0;
 };
 
@@ -338,7 +363,7 @@ class SharedKdTree {
   SharedKdTree& operator=(const SharedKdTree&) = delete;
 
   const KdTree<D>& get() const {
-    tbb::collaborative_call_once(once_, [&] { tree_.emplace(coords_, ids_()); });
+    tbb::collaborative_call_once(once_, [&] { tree_.emplace(coords_, ids_(), long_cells_); });
     return *tree_;
   }
   /// Built up front: some bin is overfull.
