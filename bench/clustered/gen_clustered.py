@@ -1,5 +1,6 @@
 #!/usr/bin/python3
-"""Strongly clustered 3D point sets, harder than gen_points.py's clustered3.
+"""Strongly clustered 3D point sets, harder than gen_points.py's clustered3,
+and points sampled on surfaces (scans, terrain, mesh vertices).
 
 Usage: gen_clustered.py KIND N OUT.npy [--seed S]
 
@@ -12,6 +13,13 @@ points a little outside it):
   hier   a Soneira-Peebles hierarchy: 6 levels, 6 children per point, each
          level's radius 1/1.9 of the one above (fractal clustering; the
          surplus points are dropped, a shortfall filled uniformly).
+
+Surface samples (no background; every cell is a needle reaching through
+the object or to the domain box):
+  terrain    a height field z = 0.1 sin(6x) cos(4y) over the unit square.
+  ellipsoid  uniform in the parameters of an ellipsoid of semi-axes 1, 0.7, 0.4.
+  torus      a torus of radii 1 and 0.35 (a tube: its inner cells' petals
+             touch the surface along whole circles, the hardest case).
 """
 import argparse
 
@@ -47,16 +55,36 @@ def hier(rng, n, levels=6, children=6, ratio=1.9):
     return np.vstack([pts, rng.random((max(0, n - len(pts)), 3))])
 
 
+def terrain(rng, n):
+    x, y = rng.random(n), rng.random(n)
+    return np.column_stack([x, y, 0.1 * np.sin(6 * x) * np.cos(4 * y)])
+
+
+def ellipsoid(rng, n):
+    z, t = 2 * rng.random(n) - 1, 2 * np.pi * rng.random(n)
+    r = np.sqrt(1 - z * z)
+    return np.column_stack([r * np.cos(t), 0.7 * r * np.sin(t), 0.4 * z])
+
+
+def torus(rng, n):
+    a, b = 2 * np.pi * rng.random(n), 2 * np.pi * rng.random(n)
+    ring = 1 + 0.35 * np.cos(b)
+    return np.column_stack([ring * np.cos(a), ring * np.sin(a), 0.35 * np.sin(b)])
+
+
+KINDS = {"blobs": blobs, "sheet": sheet, "hier": hier, "terrain": terrain, "ellipsoid": ellipsoid, "torus": torus}
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("kind", choices=["blobs", "sheet", "hier"])
+    ap.add_argument("kind", choices=list(KINDS))
     ap.add_argument("n", type=float)
     ap.add_argument("out")
     ap.add_argument("--seed", type=int, default=7)
     a = ap.parse_args()
     rng = np.random.default_rng(a.seed)
     n = int(a.n)
-    p = {"blobs": blobs, "sheet": sheet, "hier": hier}[a.kind](rng, n)
+    p = KINDS[a.kind](rng, n)
     np.save(a.out, np.ascontiguousarray(p, dtype="<f8"))
 
 

@@ -1,11 +1,12 @@
 #!/bin/bash
-# Strongly clustered inputs (gen_clustered.py: blobs, sheet, hier): Tessera's
-# cells and Delaunay against Voro++, CGAL and Gmsh HXT on the same files, in
-# one run. These are the inputs on which the meshless method is weakest (see
-# docs/design.md, known limits); this script keeps that visible.
+# Strongly clustered inputs and surface samples (gen_clustered.py: blobs,
+# sheet, hier; terrain, ellipsoid, torus): Tessera's cells and Delaunay
+# against Voro++, CGAL and Gmsh HXT on the same files, in one run. These are
+# the inputs on which the meshless method is weakest (see docs/design.md,
+# known limits); this script keeps that visible.
 #
 # usage: bench/clustered/run.sh [BUILD_DIR] [N]
-#   env: KINDS (default "blobs sheet hier"), REPEAT (default 3), THREADS (default 2),
+#   env: KINDS (default "blobs sheet hier"; the surfaces: "terrain ellipsoid torus"), REPEAT (default 3), THREADS (default 2),
 #        VORO=0 skips Voro++ (single-threaded; minutes per input at 1e6),
 #        TIMEOUT per command in seconds (default 900), DATA (default bench/data, git-ignored),
 #        OUT (default bench/clustered/results/clustered_N.jsonl)
