@@ -12,12 +12,15 @@
 #pragma once
 
 #include <algorithm>
+#include <cmath>
 #include <array>
 #include <cstdint>
 #include <limits>
 #include <numeric>
 #include <span>
 #include <vector>
+
+#include "tessera/kernels/slab.hpp"
 
 namespace tessera::front {
 
@@ -42,7 +45,11 @@ class CandidateTree {
     pts_.resize(ids_.size());
     for (std::size_t k = 0; k < ids_.size(); ++k)
       for (int d = 0; d < D; ++d) pts_[k][d] = coords[static_cast<std::size_t>(ids_[k]) * D + d];
-    if (!ids_.empty()) build(0, static_cast<std::uint32_t>(ids_.size()));
+    if (ids_.empty()) return;
+    build(0, static_cast<std::uint32_t>(ids_.size()));
+    slabs_.reserve(nodes_.size());
+    for (const Node& nd : nodes_)
+      slabs_.push_back(kernels::Slab<D>::fit(nd.end - nd.begin, [&](std::size_t k) { return pts_[nd.begin + k].data(); }));
   }
 
   std::size_t size() const { return ids_.size(); }
@@ -59,9 +66,19 @@ class CandidateTree {
     std::uint32_t stack[128];
     int top = 0;
     stack[top++] = 0;
+    double r2_seen = std::numeric_limits<double>::infinity(), r = r2_seen;  // r = sqrt(ball_r2), kept current
     while (top > 0) {
-      const Node& nd = nodes_[stack[--top]];
+      const std::uint32_t at = stack[--top];
+      const Node& nd = nodes_[at];
       if (distance2(q.ball_centre, nd) > q.ball_r2) continue;
+      if (q.ball_r2 != r2_seen) {
+        r2_seen = q.ball_r2;
+        r = std::sqrt(r2_seen);
+      }
+      // A patch of a surface sample (a terrain) whose box the ball meets
+      // may still lie wholly outside it: the ball of a thin simplex is a
+      // huge sphere nearly tangent to the surface.
+      if (slabs_[at].excludes(q.ball_centre, r)) continue;
       // Largest value of the plane function over the box: beyond test.
       double g = 0;
       for (int d = 0; d < D; ++d)
@@ -165,6 +182,7 @@ class CandidateTree {
   std::vector<std::int32_t> ids_;
   std::vector<std::array<double, D>> pts_;
   std::vector<Node> nodes_;
+  std::vector<kernels::Slab<D>> slabs_;  // per node (slab.hpp)
 };
 
 }  // namespace tessera::front

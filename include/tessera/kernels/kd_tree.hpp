@@ -27,13 +27,15 @@
 
 #include <tbb/collaborative_call_once.h>
 
+#include "tessera/kernels/slab.hpp"
+
 namespace tessera::kernels {
 
 template <int D>
 class KdTree {
  public:
   /// The points `ids` of `coords` (n * D, row-major). With `slabs`, flat
-  /// nodes also get a slab bound (see slab), which `nearest` uses: points
+  /// nodes also get a slab bound (slab.hpp), which `nearest` uses: points
   /// sampled on a surface.
   KdTree(std::span<const double> coords, std::vector<std::int32_t> ids, bool slabs = false)
       : coords_(coords), ids_(std::move(ids)), with_slabs_(slabs) {
@@ -137,12 +139,7 @@ class KdTree {
     std::uint32_t begin, end;      // its points: ids_[begin, end)
     std::int32_t left = -1, right = -1;  // children; -1 for a leaf
   };
-  // A node's slab bound (kept apart from the nodes, which nearest_first
-  // walks without it: 64-byte nodes).
-  struct Slab {
-    std::array<double, D> c, nrm;  // centre and unit normal
-    double rho = 0, thick = std::numeric_limits<double>::infinity();  // in-plane radius, half-thickness
-  };
+
 
   // Squared distance from x to node k's box, never above the true distance
   // of any of its points: each axis gap is computed from coordinates the
@@ -203,102 +200,9 @@ class KdTree {
   const double* at(std::int32_t id) const { return coords_.data() + static_cast<std::size_t>(id) * D; }
   const double* slot_point(std::size_t s) const { return pts_.data() + s * D; }
 
-  // Node nd's slab: its points' centroid c; nrm, the direction of least
-  // spread (the covariance's smallest eigenvector, by power iteration on
-  // trace - covariance: any unit vector gives a valid bound, a good one a
-  // tight bound); rho and thick, the largest distance from c within the
-  // plane and along nrm, grown by a margin far above the rounding of their
-  // sums. Without slabs: thick infinite, and slab_excludes never holds.
-  Slab slab(const Node& node) const {
-    Slab nd;
-    if (!with_slabs_) return nd;
-    const double m = static_cast<double>(node.end - node.begin);
-    for (int d = 0; d < D; ++d) nd.c[d] = 0;
-    for (std::uint32_t k = node.begin; k < node.end; ++k)
-      for (int d = 0; d < D; ++d) nd.c[d] += at(ids_[k])[d];
-    for (int d = 0; d < D; ++d) nd.c[d] /= m;
-    double cov[D][D] = {};
-    for (std::uint32_t k = node.begin; k < node.end; ++k) {
-      double w[D];
-      for (int d = 0; d < D; ++d) w[d] = at(ids_[k])[d] - nd.c[d];
-      for (int a = 0; a < D; ++a)
-        for (int b = 0; b < D; ++b) cov[a][b] += w[a] * w[b];
-    }
-    double tr = 0;
-    for (int d = 0; d < D; ++d) tr += cov[d][d];
-    double n[D];
-    for (int d = 0; d < D; ++d) n[d] = 1.0 + 0.1 * d;
-    for (int it = 0; it < 24; ++it) {
-      double y[D];
-      for (int a = 0; a < D; ++a) {
-        y[a] = tr * n[a];
-        for (int b = 0; b < D; ++b) y[a] -= cov[a][b] * n[b];
-      }
-      double len = 0;
-      for (int d = 0; d < D; ++d) len += y[d] * y[d];
-      len = std::sqrt(len);
-      if (!(len > 0) || !std::isfinite(len)) break;
-      for (int d = 0; d < D; ++d) n[d] = y[d] / len;
-    }
-    double len = 0;
-    for (int d = 0; d < D; ++d) len += n[d] * n[d];
-    len = std::sqrt(len);
-    for (int d = 0; d < D; ++d) nd.nrm[d] = n[d] / len;
-    nd.rho = nd.thick = 0;
-    for (std::uint32_t k = node.begin; k < node.end; ++k) {
-      double w[D], a = 0;
-      for (int d = 0; d < D; ++d) {
-        w[d] = at(ids_[k])[d] - nd.c[d];
-        a += w[d] * nd.nrm[d];
-      }
-      double b2 = 0;
-      for (int d = 0; d < D; ++d) {
-        const double u = w[d] - a * nd.nrm[d];
-        b2 += u * u;
-      }
-      nd.rho = std::max(nd.rho, std::sqrt(b2));
-      nd.thick = std::max(nd.thick, std::fabs(a));
-    }
-    double mag = 0;
-    for (int d = 0; d < D; ++d) mag = std::max(mag, std::fabs(nd.c[d]));
-    const double margin = 1e-9 * (mag + nd.rho + nd.thick);
-    nd.rho += margin;
-    nd.thick += margin;
-    return nd;
-  }
 
-  // Whether node k's slab (a flat node's disc: within rho of c in the
-  // plane, within thick of it along the normal) lies wholly farther than
-  // the search's bound from x: then none of its points can be nearer. A
-  // node is flat where its points lie on a surface; elsewhere the box
-  // decides alone. Every gap is shrunk by a margin m far above the rounding
-  // of these sums (relative ~1e-15 of the magnitudes involved), and every
-  // reach grown by it.
-  bool slab_excludes(std::size_t k, const Search& q) const {
-    const Slab& nd = slabs_[k];
-    if (!(nd.thick < slab_flat * nd.rho)) return false;
-    double w[D], a = 0, wm = 0;
-    for (int d = 0; d < D; ++d) {
-      w[d] = q.x[d] - nd.c[d];
-      a += w[d] * nd.nrm[d];
-      wm = std::max(wm, std::fabs(w[d]));
-    }
-    const double m = 1e-9 * wm;
-    const double ga = std::fabs(a) - nd.thick - m;  // gap along the normal
-    if (ga > q.r) return true;
-    double b2 = 0;  // squared distance from the normal through c
-    for (int d = 0; d < D; ++d) {
-      const double u = w[d] - a * nd.nrm[d];
-      b2 += u * u;
-    }
-    const double rb = nd.rho + m;
-    if (b2 <= rb * rb) return false;  // over the disc: the normal gap decides
-    // Beside the disc: the gap in the plane, sqrt(b2) - rb, against the
-    // reach left after the normal gap.
-    const double reach = ga > 0 ? std::sqrt(std::max(0.0, q.r * q.r - ga * ga)) : q.r;
-    return b2 > (rb + reach) * (rb + reach);
-  }
-  static constexpr double slab_flat = 0.25;
+  // Whether node k's slab lies wholly beyond the search's bound (Slab).
+  bool slab_excludes(std::size_t k, const Search& q) const { return slabs_[k].excludes(q.x, q.r); }
 
   // Node over ids_[begin, end): its box, then a median split on the widest axis.
   std::int32_t build(std::uint32_t begin, std::uint32_t end) {
@@ -330,7 +234,9 @@ class KdTree {
       nd.right = build(mid, end);
     }
     nodes_[static_cast<std::size_t>(index)] = nd;
-    slabs_[static_cast<std::size_t>(index)] = slab(nd);
+    if (with_slabs_)
+      slabs_[static_cast<std::size_t>(index)] =
+          Slab<D>::fit(end - begin, [&](std::size_t k) { return at(ids_[begin + k]); });
     return index;
   }
 
@@ -338,7 +244,7 @@ class KdTree {
   std::vector<std::int32_t> ids_;
   std::vector<Node> nodes_;
   std::vector<double> pts_;  // coordinates of ids_[k] at k * D
-  std::vector<Slab> slabs_;  // per node
+  std::vector<Slab<D>> slabs_;  // per node, kept apart from the 64-byte nodes nearest_first walks
   bool with_slabs_ = false;
   std::size_t id_bound_ = 0;
 };

@@ -1,0 +1,126 @@
+// A slab bound for a group of points: the thin disc (a thin rectangle in 2D)
+// that holds them, for pruning ball queries on points sampled on a surface.
+//
+// A tree node's axis-aligned box is a poor bound for a patch of a curved
+// surface: unless the surface is parallel to an axis, the box is about as
+// thick as it is wide. A ball that nearly touches the surface (a petal inside
+// a closed surface, the circumsphere of a thin simplex near a terrain's hull)
+// then meets the boxes of every patch within a wide band around the contact,
+// and each must be opened. The points themselves lie within a thin slab
+// around their best-fit plane, and the distance from a query to that slab
+// bounds the distance to every point: only the patches within about a patch
+// width of the contact remain (the ellipsoid's petal searches opened ~80
+// leaves by their boxes, ~7 by slabs).
+#pragma once
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstddef>
+#include <limits>
+
+namespace tessera::kernels {
+
+template <int D>
+struct Slab {
+  std::array<double, D> c{}, nrm{};  ///< centre (the points' centroid) and unit normal
+  double rho = 0;                    ///< largest distance from c within the plane, grown by a margin
+  double thick = std::numeric_limits<double>::infinity();  ///< largest distance along nrm, grown likewise
+
+  /// Only a slab much thinner than it is wide bounds better than the box it
+  /// comes with; the others are never tested (excludes() returns false).
+  static constexpr double flat = 0.25;
+
+  /// The slab of `count` points, at(k) the coordinates of the k-th. nrm is
+  /// the direction of least spread (the covariance's smallest eigenvector,
+  /// by power iteration on trace - covariance): any unit vector gives a
+  /// valid bound, a good one a tight bound. rho and thick are measured from
+  /// the same rounded c and nrm the queries use, then grown by a margin far
+  /// above the rounding of these sums (relative ~1e-15 of the magnitudes).
+  template <class At>
+  static Slab fit(std::size_t count, At&& at) {
+    Slab s;
+    if (count == 0) return s;
+    for (std::size_t k = 0; k < count; ++k)
+      for (int d = 0; d < D; ++d) s.c[d] += at(k)[d];
+    for (int d = 0; d < D; ++d) s.c[d] /= static_cast<double>(count);
+    double cov[D][D] = {};
+    for (std::size_t k = 0; k < count; ++k) {
+      double w[D];
+      for (int d = 0; d < D; ++d) w[d] = at(k)[d] - s.c[d];
+      for (int a = 0; a < D; ++a)
+        for (int b = 0; b < D; ++b) cov[a][b] += w[a] * w[b];
+    }
+    double tr = 0;
+    for (int d = 0; d < D; ++d) tr += cov[d][d];
+    double n[D];
+    for (int d = 0; d < D; ++d) n[d] = 1.0 + 0.1 * d;  // not orthogonal to any axis
+    for (int it = 0; it < 24; ++it) {
+      double y[D], len = 0;
+      for (int a = 0; a < D; ++a) {
+        y[a] = tr * n[a];
+        for (int b = 0; b < D; ++b) y[a] -= cov[a][b] * n[b];
+        len += y[a] * y[a];
+      }
+      len = std::sqrt(len);
+      if (!(len > 0) || !std::isfinite(len)) break;  // all points equal, or overflow: keep n
+      for (int d = 0; d < D; ++d) n[d] = y[d] / len;
+    }
+    double len = 0;
+    for (int d = 0; d < D; ++d) len += n[d] * n[d];
+    len = std::sqrt(len);
+    for (int d = 0; d < D; ++d) s.nrm[d] = n[d] / len;
+    s.thick = 0;
+    for (std::size_t k = 0; k < count; ++k) {
+      double w[D], a = 0, b2 = 0;
+      for (int d = 0; d < D; ++d) {
+        w[d] = at(k)[d] - s.c[d];
+        a += w[d] * s.nrm[d];
+      }
+      for (int d = 0; d < D; ++d) {
+        const double u = w[d] - a * s.nrm[d];
+        b2 += u * u;
+      }
+      s.rho = std::max(s.rho, std::sqrt(b2));
+      s.thick = std::max(s.thick, std::fabs(a));
+    }
+    double mag = 0;
+    for (int d = 0; d < D; ++d) mag = std::max(mag, std::fabs(s.c[d]));
+    const double margin = 1e-9 * (mag + s.rho + s.thick);
+    s.rho += margin;
+    s.thick += margin;
+    if (!std::isfinite(s.rho) || !std::isfinite(s.thick)) s.thick = std::numeric_limits<double>::infinity();
+    return s;
+  }
+
+  /// Whether the slab lies wholly farther than r from x (r: the query ball's
+  /// radius), so that none of its points is within r: false unless flat.
+  /// Every gap is shrunk by a margin m far above the rounding of these sums
+  /// and every reach grown by it (r's own rounding included: where a test
+  /// can exclude, the offset from c is at least about r).
+  bool excludes(const double* x, double r) const {
+    if (!(thick < flat * rho)) return false;
+    double w[D], a = 0, wm = 0;
+    for (int d = 0; d < D; ++d) {
+      w[d] = x[d] - c[d];
+      a += w[d] * nrm[d];
+      wm = std::max(wm, std::fabs(w[d]));
+    }
+    const double m = 1e-9 * wm;
+    const double ga = std::fabs(a) - thick - m;  // gap along the normal
+    if (ga > r) return true;
+    double b2 = 0;  // squared distance from the normal through c
+    for (int d = 0; d < D; ++d) {
+      const double u = w[d] - a * nrm[d];
+      b2 += u * u;
+    }
+    const double rb = rho + m;
+    if (b2 <= rb * rb) return false;  // over the disc: the normal gap decides
+    // Beside the disc: the gap in the plane, sqrt(b2) - rb, against the
+    // reach left after the normal gap.
+    const double reach = ga > 0 ? std::sqrt(std::max(0.0, r * r - ga * ga)) : r;
+    return b2 > (rb + reach) * (rb + reach);
+  }
+};
+
+}  // namespace tessera::kernels
