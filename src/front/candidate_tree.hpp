@@ -12,8 +12,8 @@
 #pragma once
 
 #include <algorithm>
-#include <cmath>
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <limits>
 #include <numeric>
@@ -49,7 +49,8 @@ class CandidateTree {
     build(0, static_cast<std::uint32_t>(ids_.size()));
     slabs_.reserve(nodes_.size());
     for (const Node& nd : nodes_)
-      slabs_.push_back(kernels::Slab<D>::fit(nd.end - nd.begin, [&](std::size_t k) { return pts_[nd.begin + k].data(); }));
+      slabs_.push_back(
+          kernels::Slab<D>::fit(nd.end - nd.begin, [&](std::size_t k) { return pts_[nd.begin + k].data(); }));
   }
 
   std::size_t size() const { return ids_.size(); }

@@ -69,8 +69,8 @@ class CellBuilder {
         if (s == 2 && sec2 > long_cell2_ && tree_ != nullptr && tree_->long_cells()) {
           // A long cell: try once to finish it by its petals (certify_by_petals).
           // Further tries, after shells that left the cell unchanged, cost
-          // the closed surfaces' cells more than they saved (an ellipsoid's
-          // 50k points 6.2 s against 5.4 s).
+          // the closed surfaces' cells more than they saved (stop 24's joint
+          // walk: an ellipsoid's 50k points 6.2 s against 5.4 s).
           const Certified c = certify_by_petals(i, p, cell, lb * lb);
           if (c == Certified::final) {
             ++petal_certified_;
@@ -309,8 +309,8 @@ class CellBuilder {
   /// search so far); above the number of points the shell walk would
   /// gather (those in the bins of the flower's box: a node searched costs
   /// about as much as a point gathered and screened there), it gives up,
-  /// unsure, and the shell walk goes on from the cell as it is. The clip decisions are the exact ones either way, so
-  /// the cell is the same.
+  /// unsure, and the shell walk goes on from the cell as it is. The clip
+  /// decisions are the exact ones either way, so the cell is the same.
   [[gnu::noinline]] Certified certify_by_petals(std::int32_t i, const double* p, CellT& cell, double near2) {
     const KdTree<D>& tree = tree_->get();
     if (tried_.size() < tree.id_bound()) tried_.assign(tree.id_bound(), 0);
@@ -321,12 +321,16 @@ class CellBuilder {
     auto mark = [&](std::int32_t j) {
       if (j >= 0 && static_cast<std::size_t>(j) < tried_.size()) tried_[static_cast<std::size_t>(j)] = epoch_;
     };
-    // The planes' own generators lie on their vertices' petal spheres; a
-    // tried point never lies inside a petal of the cell it clipped. A
-    // higher-id duplicate of the generator never clips (a lower one shares
-    // its bin and ended the build before).
+    // Searches skip the points already tried: the planes' own generators
+    // lie on their vertices' petal spheres, and a point that clipped the
+    // cell lies strictly inside no petal of it then or later (the cell stays
+    // on the generator's side of its bisector). A higher-id duplicate of the
+    // generator never clips (a lower one shares its bin and ended the build
+    // before).
     for (const auto& pl : cell.planes()) mark(pl.id);
-    auto skip = [&](std::int32_t j) { return tried_[static_cast<std::size_t>(j)] == epoch_ || exactly_equal(p, j); };
+    auto skip = [&](std::int32_t j) {
+      return tried_[static_cast<std::size_t>(j)] == epoch_ || exactly_equal(p, j);
+    };
     certified_.assign(cell.vertices().size(), ~std::uint64_t{0});
     for (std::size_t t = 0; t < cell.vertices().size(); ++t) {
       const auto& v = cell.vertices()[t];

@@ -12,11 +12,16 @@
 // Order: by (squared distance, id) — exact ties in id order, as the cell
 // builder's duplicate rule requires — with a node expanded before any point
 // at its lower bound, so no point inside it can be passed over.
+//
+// Its second use: the long cells of points sampled on a surface ask it for
+// the nearest point to a cell vertex inside the vertex's petal (`nearest`,
+// CellBuilder::certify_by_petals). Those searches prune nodes by slab bounds
+// too (slab.hpp), built only for such inputs.
 #pragma once
 
 #include <algorithm>
-#include <cmath>
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <functional>
 #include <limits>
@@ -127,7 +132,6 @@ class KdTree {
     return nearest_below(0, q, self, skip, budget) ? q.best : -2;
   }
 
-
   /// One more than the largest point id it holds (0 when empty).
   std::size_t id_bound() const { return id_bound_; }
 
@@ -139,7 +143,6 @@ class KdTree {
     std::uint32_t begin, end;      // its points: ids_[begin, end)
     std::int32_t left = -1, right = -1;  // children; -1 for a leaf
   };
-
 
   // Squared distance from x to node k's box, never above the true distance
   // of any of its points: each axis gap is computed from coordinates the
@@ -199,7 +202,6 @@ class KdTree {
 
   const double* at(std::int32_t id) const { return coords_.data() + static_cast<std::size_t>(id) * D; }
   const double* slot_point(std::size_t s) const { return pts_.data() + s * D; }
-
 
   // Whether node k's slab lies wholly beyond the search's bound (Slab).
   bool slab_excludes(std::size_t k, const Search& q) const { return slabs_[k].excludes(q.x, q.r); }
