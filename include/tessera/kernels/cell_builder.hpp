@@ -308,8 +308,9 @@ class CellBuilder {
   /// the cost of the rest is predicted (vertices left times nodes per
   /// search so far); above the number of points the shell walk would
   /// gather (those in the bins of the flower's box: a node searched costs
-  /// about as much as a point gathered and screened there), it gives up,
-  /// unsure, and the shell walk goes on from the cell as it is. The clip
+  /// about as much as a point gathered and screened there), or when one
+  /// search alone would spend what is left of that, it gives up, unsure,
+  /// and the shell walk goes on from the cell as it is. The clip
   /// decisions are the exact ones either way, so the cell is the same.
   [[gnu::noinline]] Certified certify_by_petals(std::int32_t i, const double* p, CellT& cell, double near2) {
     const KdTree<D>& tree = tree_->get();
@@ -365,9 +366,13 @@ class CellBuilder {
         mag = std::max({mag, std::fabs(p[d]), std::fabs(c[d])});
       }
       const double reach = petal_radius(v) + 1e-12 * mag;
-      std::size_t budget = search_budget;
+      // Once the shell walk's cost is known, one search may not spend more
+      // than what is left of it (a single search as costly as the rest was
+      // predicted to be is itself the sign to give up).
+      const std::size_t allowed = searches >= 4 ? afford - nodes : ~std::size_t{0};
+      std::size_t budget = allowed;
       const std::int32_t j = tree.nearest(c, i, reach * reach * (1.0 + 1e-9), skip, budget);
-      nodes += search_budget - budget;
+      nodes += allowed - budget;
       ++searches;
       if (j == -2) return Certified::unsure;
       if (j == -1) {
@@ -380,9 +385,6 @@ class CellBuilder {
       if (cell.clip(j, q) == ClipResult::emptied) return Certified::no_cell;
     }
   }
-  /// One search visits at most this many nodes (a bound that never binds
-  /// in practice: the prediction above gives up far earlier).
-  static constexpr std::size_t search_budget = std::size_t{1} << 22;
 
   /// A vertex's local planes packed (identifies it within one cell: a new
   /// vertex always holds the newest plane).
