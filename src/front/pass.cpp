@@ -228,14 +228,18 @@ Pass<D>::Pass(std::span<const double> input, std::span<const std::int32_t> label
     empty += count == 0;
   }
   const kernels::BinLocator<D>& loc = *locator;
-  tree.emplace(
-      points,
-      [&loc] {
-        std::vector<std::int32_t> ids(loc.size());
-        for (std::size_t s = 0; s < ids.size(); ++s) ids[s] = loc.id(s);
-        return ids;
-      },
-      fullest > kernels::overfull_bin, 2 * empty > locator->num_bins());
+  // In the arena: an eager tree's build runs parallel loops (its slabs),
+  // which honour --threads there.
+  tbb::task_arena(engine_options.threads).execute([&] {
+    tree.emplace(
+        points,
+        [&loc] {
+          std::vector<std::int32_t> ids(loc.size());
+          for (std::size_t s = 0; s < ids.size(); ++s) ids[s] = loc.id(s);
+          return ids;
+        },
+        fullest > kernels::overfull_bin, 2 * empty > locator->num_bins());
+  });
 
   // Generators with cells, in bin order (neighbouring cells run together).
   order.reserve(locator->size());
