@@ -47,6 +47,8 @@ class CandidateTree {
       for (int d = 0; d < D; ++d) pts_[k][d] = coords[static_cast<std::size_t>(ids_[k]) * D + d];
     if (ids_.empty()) return;
     build(0, static_cast<std::uint32_t>(ids_.size()));
+    rank_.assign(n, std::numeric_limits<std::uint32_t>::max());
+    for (std::size_t k = 0; k < ids_.size(); ++k) rank_[static_cast<std::size_t>(ids_[k])] = static_cast<std::uint32_t>(k);
     slabs_.reserve(nodes_.size());
     for (const Node& nd : nodes_)
       slabs_.push_back(
@@ -54,6 +56,15 @@ class CandidateTree {
   }
 
   std::size_t size() const { return ids_.size(); }
+
+  /// A spatial order key for point `id`: its position in the tree's leaf
+  /// order (points not in the tree after all others). Searches issued in
+  /// this order of their facets walk the same few branches one after
+  /// another, which then stay in cache.
+  std::uint32_t rank(std::int32_t id) const {
+    const auto at = static_cast<std::size_t>(id);
+    return at < rank_.size() ? rank_[at] : std::numeric_limits<std::uint32_t>::max();
+  }
 
   /// Calls visit(id) for every point that may satisfy the query (a superset).
   /// A node whose box the float plane test puts on the plane, within the
@@ -184,6 +195,7 @@ class CandidateTree {
   std::vector<std::array<double, D>> pts_;
   std::vector<Node> nodes_;
   std::vector<kernels::Slab<D>> slabs_;  // per node (slab.hpp)
+  std::vector<std::uint32_t> rank_;      // per input id: position in ids_
 };
 
 }  // namespace tessera::front

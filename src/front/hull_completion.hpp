@@ -222,10 +222,18 @@ class HullCompletion {
       // found do not. The queue is sorted by facet for the lookup.
       std::vector<std::int32_t> hit(queue.size(), -1);
       std::vector<std::atomic<std::uint8_t>> closed(queue.size());
+      std::vector<std::uint32_t> order(queue.size());
       arena.execute([&] {
         tbb::parallel_sort(queue.begin(), queue.end());
+        std::vector<std::uint64_t> keyed(queue.size());
+        tbb::parallel_for(std::size_t{0}, queue.size(), [&](std::size_t i) {
+          keyed[i] = std::uint64_t{tree_.rank(queue[i].facet[0])} << 32 | i;
+        });
+        tbb::parallel_sort(keyed.begin(), keyed.end());
+        for (std::size_t i = 0; i < queue.size(); ++i) order[i] = static_cast<std::uint32_t>(keyed[i]);
         tbb::parallel_for(tbb::blocked_range<std::size_t>(0, queue.size()), [&](const tbb::blocked_range<std::size_t>& r) {
-          for (std::size_t i = r.begin(); i != r.end(); ++i) {
+          for (std::size_t o = r.begin(); o != r.end(); ++o) {
+            const std::size_t i = order[o];
             if (closed[i].load(std::memory_order_relaxed)) continue;
             const Facet& f = queue[i].facet;
             const std::int32_t p = hit[i] = wrap(f, queue[i].apex);
@@ -321,9 +329,9 @@ class HullCompletion {
   };
 
   // The circumball of the facet and `best`, inflated: a better point lies in
-  // it (and beyond the facet). Float, with a margin; unbounded when the
-  // simplex is too flat for Cramer's rule to be trusted. Flatness is what
-  // matters, not the radius: a nearly flat simplex whose fourth point is
+  // it (and beyond the facet). Float, with a margin, where the simplex is
+  // well-conditioned; its centre solved exactly where it is flat. Flatness is
+  // what matters, not the radius: a nearly flat simplex whose fourth point is
   // also nearly on the facet's circle has a circumcentre of ordinary size
   // that the float solve can put anywhere (found on a rotated lattice, whose
   // hull faces are coplanar up to rounding: the ball pruned the true best).
@@ -332,8 +340,16 @@ class HullCompletion {
   // about 50 u cond (|y| + max |r_k|), cond = |r_0|...|r_{D-1}| / |det r|
   // (the permanents behind each rounding are at most 5.2 |r_0|...|r_{D-1}|).
   // With cond <= 1e7 that is below 1e-7 (|y| + diam), inside the margin.
-  // A cutoff of 1e4 made the common thin hull simplices unbounded: hull
-  // completion of 1M uniform points took 0.3 s longer.
+  // A cutoff of 1e4 sent the common thin hull simplices to the exact solve:
+  // hull completion of 1M uniform points took 0.3 s longer.
+  //
+  // Beyond the cutoff the centre comes from exact_vertex (the Voronoi vertex
+  // of f[0] with the others' bisectors, in rationals, rounded once per
+  // coordinate). These balls used to be unbounded, and an unbounded search
+  // visits every candidate beyond the facet: on a height field (a terrain),
+  // whose nearly flat stretches make such simplices by the hundred, that
+  // made hull completion quadratic (100k points: 752 searches of ~50k
+  // points each, half of all points visited). Slow (GMP), but rare.
   void circumball(const Facet& f, std::int32_t best, typename CandidateTree<D>::Query& q) const {
     const double* a = pt(f[0]);
     double r[D][D], s[D];
@@ -379,10 +395,28 @@ class HullCompletion {
     }
     double rad2 = 0;
     for (int d = 0; d < D; ++d) rad2 += y[d] * y[d];
-    const double rad = std::sqrt(rad2);
-    if (!(std::fabs(det) * 1e7 >= 2 * lengths) || !std::isfinite(rad) || rad > 1e6 * diam_) {
-      q.ball_r2 = std::numeric_limits<double>::infinity();  // NaN included
-      return;
+    double rad = std::sqrt(rad2);
+    double slack;  // the inflation: the centre's error, the radius's rounding, the margin
+    if (std::fabs(det) * 1e7 >= 2 * lengths && std::isfinite(rad) && rad <= 1e6 * diam_) {
+      slack = 1e-6 * (rad + diam_);
+    } else {
+      // best is strictly beyond the facet, so the simplex is not flat and
+      // its planes are independent. Each coordinate is within 2 ulp: the
+      // centre within 4 u |y|, the radius computed from it within a few
+      // more u; 1e-9 rad is far above both (and above the rounding of the
+      // tree's squared distances to a centre this far away).
+      std::int32_t planes[D];
+      for (int k = 0; k + 1 < D; ++k) planes[k] = f[static_cast<std::size_t>(k + 1)];
+      planes[D - 1] = best;
+      kernels::exact_vertex(ctx_, f[0], planes, y);
+      rad2 = 0;
+      for (int d = 0; d < D; ++d) rad2 += y[d] * y[d];
+      rad = std::sqrt(rad2);
+      if (!(rad <= 1e100 * diam_)) {  // squares would overflow: no ball
+        q.ball_r2 = std::numeric_limits<double>::infinity();
+        return;
+      }
+      slack = 1e-9 * rad;
     }
     // The centre is stored in absolute coordinates: a[d] + y[d] rounds to
     // the ulp of the larger, which on points far from the origin (a cloud of
@@ -393,7 +427,7 @@ class HullCompletion {
       q.ball_centre[d] = a[d] + y[d];
       big = std::max({big, std::fabs(a[d]), std::fabs(q.ball_centre[d])});
     }
-    const double reach = rad * (1 + 1e-6) + 1e-6 * diam_ + 64 * kernels::filter::u * big;
+    const double reach = rad + slack + 64 * kernels::filter::u * big;
     q.ball_r2 = reach * reach;
   }
 
