@@ -79,6 +79,7 @@ class CandidateTree {
     int top = 0;
     stack[top++] = 0;
     double r2_seen = std::numeric_limits<double>::infinity(), r = r2_seen;  // r = sqrt(ball_r2), kept current
+    const typename kernels::Slab<D>::Plane plane(q.normal, q.origin, q.margin);
     while (top > 0) {
       const std::uint32_t at = stack[--top];
       const Node& nd = nodes_[at];
@@ -90,12 +91,16 @@ class CandidateTree {
       // A patch of a surface sample (a terrain) whose box the ball meets
       // may still lie wholly outside it: the ball of a thin simplex is a
       // huge sphere nearly tangent to the surface.
-      if (slabs_[at].excludes(q.ball_centre, r)) continue;
+      if (r2_seen != std::numeric_limits<double>::infinity() && slabs_[at].excludes(q.ball_centre, r)) continue;
       // Largest value of the plane function over the box: beyond test.
       double g = 0;
       for (int d = 0; d < D; ++d)
         g += std::max(q.normal[d] * (nd.lo[d] - q.origin[d]), q.normal[d] * (nd.hi[d] - q.origin[d]));
       if (g < -q.margin) continue;
+      // While no ball bounds the search (a hull facet, with nothing beyond
+      // to find, keeps none), the slab's plane test: on a convex surface
+      // sample every hull facet's search is bounded by the plane alone.
+      if (r2_seen == std::numeric_limits<double>::infinity() && slabs_[at].below(plane)) continue;
       if (g <= q.margin && on_plane(nd.lo, nd.hi)) continue;
       if (nd.left == 0) {
         for (std::uint32_t k = nd.begin; k < nd.end; ++k) {

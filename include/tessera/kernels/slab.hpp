@@ -93,6 +93,51 @@ struct Slab {
     return s;
   }
 
+  /// A plane m.(x - o) = -margin for below(): the normal scaled by a power
+  /// of two to a largest component in [1, 2), and the margin with it. A
+  /// facet normal of coordinates with subnormal offsets can be so small that
+  /// its squares underflow (found by the subnormal-offset test, where |n|
+  /// computed as 0 dropped the rho term below). ok is false for a zero or
+  /// non-finite normal.
+  struct Plane {
+    double m[D], o[D], margin, mlen;
+    bool ok = false;
+    Plane(const double* n, const double* origin, double margin_n) {
+      double big = 0;
+      for (int d = 0; d < D; ++d) big = std::max(big, std::fabs(n[d]));
+      if (!(big > 0) || !std::isfinite(big)) return;
+      const int e = std::ilogb(big);
+      double mm = 0;
+      for (int d = 0; d < D; ++d) {
+        m[d] = std::scalbn(n[d], -e);
+        o[d] = origin[d];
+        mm += m[d] * m[d];
+      }
+      margin = std::scalbn(margin_n, -e);
+      mlen = std::sqrt(mm);
+      ok = true;
+    }
+  };
+
+  /// Whether the slab lies wholly below the plane, m.(x - o) < -margin for
+  /// every point x in it: false unless flat. The largest value over the slab
+  /// is m.(c - o) plus thick |m.nrm| plus rho |m - (m.nrm) nrm|, and a
+  /// tolerance far above the rounding of these sums is added, relative (1e-9
+  /// of the magnitudes) and absolute (2^-900, above any underflow of the
+  /// products). A curved patch's box crosses a plane tangent to the patch (a
+  /// convex hull facet of a surface sample) far more often than its slab does.
+  bool below(const Plane& p) const {
+    if (!(thick < flat * rho) || !p.ok) return false;
+    double top = 0, along = 0, wm = 0;
+    for (int d = 0; d < D; ++d) {
+      top += p.m[d] * (c[d] - p.o[d]);
+      along += p.m[d] * nrm[d];
+      wm = std::max(wm, std::fabs(c[d] - p.o[d]));
+    }
+    top += std::fabs(along) * thick + std::sqrt(std::max(0.0, p.mlen * p.mlen - along * along)) * rho;
+    return top + 1e-9 * p.mlen * (D * wm + rho + thick) + 0x1p-900 < -p.margin;
+  }
+
   /// Whether the slab lies wholly farther than r from x (r: the query ball's
   /// radius), so that none of its points is within r: false unless flat.
   /// Every gap is shrunk by a margin m far above the rounding of these sums
