@@ -222,18 +222,19 @@ class HullCompletion {
       // found do not. The queue is sorted by facet for the lookup.
       std::vector<std::int32_t> hit(queue.size(), -1);
       std::vector<std::atomic<std::uint8_t>> closed(queue.size());
-      std::vector<std::uint32_t> order(queue.size());
+      // Wraps run in spatial order (the tree's leaf order of the facet's
+      // lowest point): the searches of one thread's range then share warm
+      // branches of the tree. Key: rank above, queue index below.
+      std::vector<std::uint64_t> order(queue.size());
       arena.execute([&] {
         tbb::parallel_sort(queue.begin(), queue.end());
-        std::vector<std::uint64_t> keyed(queue.size());
         tbb::parallel_for(std::size_t{0}, queue.size(), [&](std::size_t i) {
-          keyed[i] = std::uint64_t{tree_.rank(queue[i].facet[0])} << 32 | i;
+          order[i] = std::uint64_t{tree_.rank(queue[i].facet[0])} << 32 | i;
         });
-        tbb::parallel_sort(keyed.begin(), keyed.end());
-        for (std::size_t i = 0; i < queue.size(); ++i) order[i] = static_cast<std::uint32_t>(keyed[i]);
+        tbb::parallel_sort(order.begin(), order.end());
         tbb::parallel_for(tbb::blocked_range<std::size_t>(0, queue.size()), [&](const tbb::blocked_range<std::size_t>& r) {
           for (std::size_t o = r.begin(); o != r.end(); ++o) {
-            const std::size_t i = order[o];
+            const std::size_t i = order[o] & 0xffffffffu;
             if (closed[i].load(std::memory_order_relaxed)) continue;
             const Facet& f = queue[i].facet;
             const std::int32_t p = hit[i] = wrap(f, queue[i].apex);
