@@ -34,6 +34,7 @@
 #include <cstdint>
 #include <limits>
 #include <optional>
+#include <span>
 #include <stdexcept>
 #include <vector>
 
@@ -59,21 +60,33 @@ class HullCompletion {
   HullCompletion(const kernels::ExactContext& ctx, const CandidateTree<D>& candidates, double diameter)
       : ctx_(ctx), tree_(candidates), diam_(diameter) {}
 
-  /// The point beyond `f` (away from `apex`) that closes it, or -1 for a hull facet.
-  std::int32_t wrap(const Facet& f, std::int32_t apex) const {
+  /// The point beyond `f` (away from `apex`) that closes it, or -1 for a
+  /// hull facet. `seeds` are likely answers, tried before the search (see
+  /// wrap_toward).
+  std::int32_t wrap(const Facet& f, std::int32_t apex, std::span<const std::int32_t> seeds = {}) const {
     std::array<std::int32_t, D + 1> ids;
     std::copy(f.begin(), f.end(), ids.begin());
     ids[D] = apex;
     const int apex_side = kernels::orientation(ctx_, ids.data());
     if (apex_side == 0) throw std::logic_error("tessera: hull completion met a flat simplex");
-    return wrap_toward(f, -apex_side, apex);
+    return wrap_toward(f, -apex_side, apex, seeds);
   }
 
   /// The point on `side` of `f` (the sign of orientation(f, x)) whose
   /// simplex with f is Delaunay, or -1 when no point lies strictly there.
   /// `skip` (an apex already known) is not considered. Precondition: f is a
   /// facet of the (perturbed) triangulation.
-  std::int32_t wrap_toward(const Facet& f, int side, std::int32_t skip = -1) const {
+  ///
+  /// `seeds` (point ids; negative entries are ignored) are considered first. They change the
+  /// work, never the answer: the answer is the point of least pencil
+  /// parameter beyond f, and a point is inside the sphere through f and the
+  /// current best exactly when its parameter is smaller, so whatever the
+  /// order, every better point is inside every ball the search prunes by.
+  /// A good seed makes the first ball the final one: the search then only
+  /// proves it empty (on a terrain's completion, ~10 points tested per wrap
+  /// instead of ~43, and one ball solved instead of ~13).
+  std::int32_t wrap_toward(const Facet& f, int side, std::int32_t skip = -1,
+                           std::span<const std::int32_t> seeds = {}) const {
     std::array<std::int32_t, D + 1> ids;
     std::copy(f.begin(), f.end(), ids.begin());
     // The facet's fixed rows of orientation(f, x): its value is the dot of
@@ -159,8 +172,10 @@ class HullCompletion {
       return true;
     };
     std::int32_t best = -1;
-    tree_.search(q, [&](std::int32_t p) {
-      if (p == skip || std::find(f.begin(), f.end(), p) != f.end()) return;
+    auto consider = [&](std::int32_t p) {
+      // best itself: a seed the search meets again (in_sphere is not asked
+      // about a sphere's own point).
+      if (p == skip || p == best || std::find(f.begin(), f.end(), p) != f.end()) return;
       ids[D] = p;
       if (side_of(pt(p), [&] { return kernels::orientation(ctx_, ids.data()); }) != side) return;  // not strictly beyond
       if (best >= 0) {
@@ -171,7 +186,10 @@ class HullCompletion {
       }
       best = p;
       circumball(f, best, q);
-    }, box_not_beyond);
+    };
+    for (std::int32_t p : seeds)
+      if (p >= 0) consider(p);
+    tree_.search(q, consider, box_not_beyond);
     return best;
   }
 
@@ -212,6 +230,8 @@ class HullCompletion {
       queue.push_back(o);
     }
     std::vector<Simplex> added;
+    std::vector<Ridge> ridges;
+    std::vector<std::int32_t> seeds;
     tbb::task_arena arena(std::max(1, threads));
     while (!queue.empty()) {
       // A thin hull simplex usually closes two open facets of the same
@@ -232,12 +252,13 @@ class HullCompletion {
           order[i] = std::uint64_t{tree_.rank(queue[i].facet[0])} << 32 | i;
         });
         tbb::parallel_sort(order.begin(), order.end());
+        find_seeds(queue, ridges, seeds);
         tbb::parallel_for(tbb::blocked_range<std::size_t>(0, queue.size()), [&](const tbb::blocked_range<std::size_t>& r) {
           for (std::size_t o = r.begin(); o != r.end(); ++o) {
             const std::size_t i = order[o] & 0xffffffffu;
             if (closed[i].load(std::memory_order_relaxed)) continue;
             const Facet& f = queue[i].facet;
-            const std::int32_t p = hit[i] = wrap(f, queue[i].apex);
+            const std::int32_t p = hit[i] = wrap(f, queue[i].apex, seeds_at(seeds, i));
             if (p < 0) continue;
             for (int k = 0; k < D; ++k) {  // the new simplex's other facets: f with f[k] replaced by p
               OpenFacet<D> g;
@@ -281,6 +302,64 @@ class HullCompletion {
   }
 
  private:
+  // Seeds from the front (the round's open facets). The simplex beyond an
+  // open facet f often has another facet on the front: then its apex is
+  // the far vertex of an open facet that shares a ridge (D - 1 points) with
+  // f, as the fan around that ridge closes. Each open facet keeps, per
+  // ridge, up to kSeedsPerRidge such vertices. On a terrain's completion
+  // (50k points, 379k wraps) the seed was the answer in 35% of the wraps,
+  // which then tested 10 points each instead of 43, and completion took
+  // 2.8 -> 2.0 s (with stop 26's wraps in spatial order).
+  static constexpr std::size_t kSeedsPerRidge = 2;
+  static constexpr std::size_t kSeeds = D * kSeedsPerRidge;
+
+  // An open facet's ridge: the facet without its vertex `k` (ids ascending,
+  // packed), the facet's place in the queue, and the vertex left out.
+  struct Ridge {
+    std::uint64_t key;
+    std::uint32_t facet;
+    std::int32_t other;
+    auto operator<=>(const Ridge&) const = default;
+  };
+
+  static std::uint64_t ridge_key(const Facet& f, int k) {
+    std::uint64_t key = 0;
+    for (int m = 0; m < D; ++m)
+      if (m != k) key = key << 32 | static_cast<std::uint32_t>(f[static_cast<std::size_t>(m)]);
+    return key;
+  }
+
+  // seeds[i * kSeeds + k * kSeedsPerRidge + j]: the j-th front vertex
+  // across ridge k of queue[i], or -1. Call within the arena.
+  static void find_seeds(const std::vector<OpenFacet<D>>& queue, std::vector<Ridge>& ridges,
+                         std::vector<std::int32_t>& seeds) {
+    const std::size_t n = queue.size();
+    ridges.resize(n * D);
+    seeds.assign(n * kSeeds, -1);
+    tbb::parallel_for(std::size_t{0}, n, [&](std::size_t i) {
+      for (int k = 0; k < D; ++k)
+        ridges[i * D + static_cast<std::size_t>(k)] = {ridge_key(queue[i].facet, k), static_cast<std::uint32_t>(i),
+                                                       queue[i].facet[static_cast<std::size_t>(k)]};
+    });
+    tbb::parallel_sort(ridges.begin(), ridges.end());
+    // Each entry fills its own facet's slots for its own ridge: no two
+    // entries write the same slot. (Two ridges of one facet have different keys.)
+    tbb::parallel_for(std::size_t{0}, ridges.size(), [&](std::size_t e) {
+      const Ridge& r = ridges[e];
+      const Facet& f = queue[r.facet].facet;
+      const auto k = static_cast<std::size_t>(std::find(f.begin(), f.end(), r.other) - f.begin());
+      std::int32_t* out = seeds.data() + r.facet * kSeeds + k * kSeedsPerRidge;
+      std::size_t m = 0;
+      for (std::size_t a = e; a-- > 0 && ridges[a].key == r.key && m < kSeedsPerRidge;) out[m++] = ridges[a].other;
+      for (std::size_t a = e + 1; a < ridges.size() && ridges[a].key == r.key && m < kSeedsPerRidge; ++a)
+        out[m++] = ridges[a].other;
+    });
+  }
+
+  static std::span<const std::int32_t> seeds_at(const std::vector<std::int32_t>& seeds, std::size_t i) {
+    return {seeds.data() + i * kSeeds, kSeeds};
+  }
+
   const double* pt(std::int32_t id) const { return ctx_.points + static_cast<std::size_t>(id) * D; }
 
   // The facet's plane in exact 128-bit integers when its coordinates are
