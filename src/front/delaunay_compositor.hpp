@@ -23,6 +23,7 @@
 
 #include <tbb/parallel_for.h>
 
+#include "tessera/buffer.hpp"
 #include "tessera/kernels/cell_builder.hpp"
 #include "tessera/kernels/hull.hpp"
 #include "tessera/kernels/tile.hpp"
