@@ -24,7 +24,9 @@
 //    triangulation of the convex hull, exactly CGAL's on points in general
 //    position.
 // Closing a facet can open new ones; rounds repeat until every open facet is
-// a hull facet. Each round's gift wraps run in parallel.
+// a hull facet. Each round's gift wraps run in parallel, each first trying
+// the vertices of the round's other open facets across its ridges (seeds:
+// often the answer, which then only has to be proved empty).
 #pragma once
 
 #include <algorithm>
@@ -77,14 +79,14 @@ class HullCompletion {
   /// `skip` (an apex already known) is not considered. Precondition: f is a
   /// facet of the (perturbed) triangulation.
   ///
-  /// `seeds` (point ids; negative entries are ignored) are considered first. They change the
-  /// work, never the answer: the answer is the point of least pencil
-  /// parameter beyond f, and a point is inside the sphere through f and the
-  /// current best exactly when its parameter is smaller, so whatever the
-  /// order, every better point is inside every ball the search prunes by.
-  /// A good seed makes the first ball the final one: the search then only
-  /// proves it empty (on a terrain's completion, ~10 points tested per wrap
-  /// instead of ~43, and one ball solved instead of ~13).
+  /// `seeds` (point ids; negative entries are ignored) are considered
+  /// first. They change the work, never the answer: the answer is the point
+  /// of least pencil parameter beyond f, and a point is inside the sphere
+  /// through f and the current best exactly when its parameter is smaller,
+  /// so whatever the order, every better point is inside every ball the
+  /// search prunes by. A right seed makes the first ball the final one: the
+  /// search then only proves it empty (on a terrain's completion, ~10
+  /// points tested instead of ~43, and one ball solved instead of ~13).
   std::int32_t wrap_toward(const Facet& f, int side, std::int32_t skip = -1,
                            std::span<const std::int32_t> seeds = {}) const {
     std::array<std::int32_t, D + 1> ids;
@@ -307,9 +309,9 @@ class HullCompletion {
   // the far vertex of an open facet that shares a ridge (D - 1 points) with
   // f, as the fan around that ridge closes. Each open facet keeps, per
   // ridge, up to kSeedsPerRidge such vertices. On a terrain's completion
-  // (50k points, 379k wraps) the seed was the answer in 35% of the wraps,
-  // which then tested 10 points each instead of 43, and completion took
-  // 2.8 -> 2.0 s (with stop 26's wraps in spatial order).
+  // (50k points, 379k wraps) a seed was the answer in 35% of the wraps,
+  // which then tested ~10 points each instead of ~43, and the Delaunay run
+  // took 2.8 -> 1.85 s on two threads (with the slack below).
   static constexpr std::size_t kSeedsPerRidge = 2;
   static constexpr std::size_t kSeeds = D * kSeedsPerRidge;
 

@@ -92,6 +92,24 @@ void expect_valid(const tessera::Delaunay& dt, const std::vector<double>& p,
   EXPECT_EQ(as_set(dt).size(), dt.n_simplices()) << "a simplex is listed twice";
 }
 
+// A k^3 lattice of unit step turned by a random rotation (a random unit
+// quaternion), each coordinate then moved by jitter times a normal draw
+// (none drawn for jitter 0).
+std::vector<double> rotated_lattice(int k, std::mt19937_64& rng, std::normal_distribution<double>& g, double jitter) {
+  double qw = g(rng), qx = g(rng), qy = g(rng), qz = g(rng);
+  const double qn = std::sqrt(qw * qw + qx * qx + qy * qy + qz * qz);
+  qw /= qn, qx /= qn, qy /= qn, qz /= qn;
+  const double m[3][3] = {{1 - 2 * (qy * qy + qz * qz), 2 * (qx * qy - qz * qw), 2 * (qx * qz + qy * qw)},
+                          {2 * (qx * qy + qz * qw), 1 - 2 * (qx * qx + qz * qz), 2 * (qy * qz - qx * qw)},
+                          {2 * (qx * qz - qy * qw), 2 * (qy * qz + qx * qw), 1 - 2 * (qx * qx + qy * qy)}};
+  std::vector<double> p;
+  for (int i = 0; i < k; ++i)
+    for (int j = 0; j < k; ++j)
+      for (int l = 0; l < k; ++l)
+        for (int r = 0; r < 3; ++r) p.push_back(m[r][0] * i + m[r][1] * j + m[r][2] * l + (jitter != 0 ? jitter * g(rng) : 0));
+  return p;
+}
+
 class EqualsCgal : public ::testing::TestWithParam<std::tuple<int, int, int>> {};
 
 TEST_P(EqualsCgal, RandomPoints) {
@@ -258,18 +276,7 @@ TEST(Delaunay, RandomlyRotatedSmallLatticesEqualCgal) {
   std::mt19937_64 rng(97);
   std::normal_distribution<double> g(0.0, 1.0);
   for (int trial = 0; trial < 12; ++trial) {
-    const int k = 3 + trial % 3;
-    double qw = g(rng), qx = g(rng), qy = g(rng), qz = g(rng);
-    const double qn = std::sqrt(qw * qw + qx * qx + qy * qy + qz * qz);
-    qw /= qn, qx /= qn, qy /= qn, qz /= qn;
-    const double m[3][3] = {{1 - 2 * (qy * qy + qz * qz), 2 * (qx * qy - qz * qw), 2 * (qx * qz + qy * qw)},
-                            {2 * (qx * qy + qz * qw), 1 - 2 * (qx * qx + qz * qz), 2 * (qy * qz - qx * qw)},
-                            {2 * (qx * qz - qy * qw), 2 * (qy * qz + qx * qw), 1 - 2 * (qx * qx + qy * qy)}};
-    std::vector<double> p;
-    for (int i = 0; i < k; ++i)
-      for (int j = 0; j < k; ++j)
-        for (int l = 0; l < k; ++l)
-          for (int r = 0; r < 3; ++r) p.push_back(m[r][0] * i + m[r][1] * j + m[r][2] * l);
+    const std::vector<double> p = rotated_lattice(3 + trial % 3, rng, g, 0.0);
     tessera::Delaunay dt = run(p, 3);
     EXPECT_EQ(as_set(dt), cgal_simplices(p, 3)) << "trial " << trial;
     expect_valid(dt, p);
@@ -310,17 +317,7 @@ TEST(Delaunay, NearlyDegenerateHullsEqualCgal) {
       std::vector<double> p;
       const double jitter = trial % 3 == 0 ? 0.0 : std::pow(10.0, -12.0 - trial % 5);
       if (family == 0) {
-        const int k = 3 + trial % 3;
-        double qw = g(rng), qx = g(rng), qy = g(rng), qz = g(rng);
-        const double qn = std::sqrt(qw * qw + qx * qx + qy * qy + qz * qz);
-        qw /= qn, qx /= qn, qy /= qn, qz /= qn;
-        const double m[3][3] = {{1 - 2 * (qy * qy + qz * qz), 2 * (qx * qy - qz * qw), 2 * (qx * qz + qy * qw)},
-                                {2 * (qx * qy + qz * qw), 1 - 2 * (qx * qx + qz * qz), 2 * (qy * qz - qx * qw)},
-                                {2 * (qx * qz - qy * qw), 2 * (qy * qz + qx * qw), 1 - 2 * (qx * qx + qy * qy)}};
-        for (int i = 0; i < k; ++i)
-          for (int j = 0; j < k; ++j)
-            for (int l = 0; l < k; ++l)
-              for (int r = 0; r < 3; ++r) p.push_back(m[r][0] * i + m[r][1] * j + m[r][2] * l + jitter * g(rng));
+        p = rotated_lattice(3 + trial % 3, rng, g, jitter);
       } else if (family == 1) {
         const double eps = std::pow(10.0, -2.0 - trial % 7);
         for (int i = 0; i < 150; ++i) {
