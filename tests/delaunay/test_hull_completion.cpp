@@ -43,19 +43,20 @@ void check_wraps(const std::vector<double>& p, std::uint64_t seed) {
   const tessera::Delaunay dt = tessera::delaunay(p, 3, {}, o);
   ASSERT_GT(dt.n_simplices(), 0u);
 
+  // The points' box: the exact context's domain and the diameter the
+  // completion's float margins scale with (delaunay.cpp passes the same).
   tessera::kernels::ExactContext ctx;
   ctx.points = p.data();
   ctx.dim = 3;
-  for (int d = 0; d < 3; ++d) {
-    ctx.lo[static_cast<std::size_t>(d)] = ctx.hi[static_cast<std::size_t>(d)] = p[static_cast<std::size_t>(d)];
-    for (std::int32_t i = 0; i < n; ++i) {
-      const double x = p[static_cast<std::size_t>(i) * 3 + static_cast<std::size_t>(d)];
-      ctx.lo[static_cast<std::size_t>(d)] = std::min(ctx.lo[static_cast<std::size_t>(d)], x);
-      ctx.hi[static_cast<std::size_t>(d)] = std::max(ctx.hi[static_cast<std::size_t>(d)], x);
-    }
-  }
   double diam2 = 0;
-  for (int d = 0; d < 3; ++d) diam2 += std::pow(ctx.hi[static_cast<std::size_t>(d)] - ctx.lo[static_cast<std::size_t>(d)], 2);
+  for (std::size_t d = 0; d < 3; ++d) {
+    ctx.lo[d] = ctx.hi[d] = p[d];
+    for (std::size_t at = d; at < p.size(); at += 3) {
+      ctx.lo[d] = std::min(ctx.lo[d], p[at]);
+      ctx.hi[d] = std::max(ctx.hi[d], p[at]);
+    }
+    diam2 += (ctx.hi[d] - ctx.lo[d]) * (ctx.hi[d] - ctx.lo[d]);
+  }
   const std::vector<std::uint8_t> use(static_cast<std::size_t>(n), 1);
   const tessera::front::CandidateTree<3> tree(p, use);
   const tessera::front::HullCompletion<3> hc(ctx, tree, std::sqrt(diam2));
