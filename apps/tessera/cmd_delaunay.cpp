@@ -66,7 +66,9 @@ int run_delaunay(const DelaunayArgs& a) {
     throw InputError("output " + a.output + ": a 3D triangulation is written as .vtu");
 
   double compute_s = 0;
-  const Delaunay dt = triangulate(pc, delaunay_options(a.compute, pc.dim, !a.no_hull_completion),
+  DelaunayOptions opt = delaunay_options(a.compute, pc.dim, !a.no_hull_completion);
+  opt.skip_cells = a.skip_cells;
+  const Delaunay dt = triangulate(pc, opt,
                                   !a.quiet && stderr_is_terminal(), compute_s);
 
   t0 = Clock::now();
@@ -124,7 +126,8 @@ int run_bench_delaunay(const BenchArgs& a) {
   check_bounds_arg(a.compute.bounds);
   if (a.repeat < 1) throw InputError("--repeat must be at least 1");
   const io::PointCloud pc = read_input(a.compute);
-  const DelaunayOptions opt = delaunay_options(a.compute, pc.dim, true);
+  DelaunayOptions opt = delaunay_options(a.compute, pc.dim, true);
+  opt.skip_cells = a.skip_cells;
   for (int rep = 0; rep < a.repeat; ++rep) {
     // Timed region: the library call only (no I/O), as the peers do.
     const Usage u0 = usage_now();
@@ -135,9 +138,9 @@ int run_bench_delaunay(const BenchArgs& a) {
     std::printf(
         "{\"tool\":\"tessera\",\"op\":\"delaunay%d\",\"n\":%zu,\"threads\":%d,\"seconds\":%.6f,\"simplices\":%zu,"
         "\"extra\":{\"cpu_user_s\":%.6f,\"cpu_sys_s\":%.6f,\"minflt\":%lld,\"peak_rss_bytes\":%lld,"
-        "\"from_cells\":%zu,\"from_hull_completion\":%zu,\"exact_calls\":%llu,\"repeat\":%d}}\n",
+        "\"from_cells\":%zu,\"from_hull_completion\":%zu,\"skipped_cells\":%zu,\"exact_calls\":%llu,\"repeat\":%d}}\n",
         pc.dim, pc.n, dt.threads_used, secs, dt.n_simplices(), u1.user_s - u0.user_s, u1.sys_s - u0.sys_s,
-        u1.minflt - u0.minflt, u1.maxrss_bytes, dt.from_cells, dt.from_hull_completion,
+        u1.minflt - u0.minflt, u1.maxrss_bytes, dt.from_cells, dt.from_hull_completion, dt.skipped_cells,
         static_cast<unsigned long long>(dt.exact_predicate_calls), rep);
     std::fflush(stdout);
   }

@@ -51,6 +51,7 @@ struct BenchArgs {
   ComputeArgs compute;
   int repeat = 1;
   bool mesh = false;        ///< also build the merged mesh (what VTK output needs)
+  double skip_cells = -1;   ///< bench delaunay: DelaunayOptions::skip_cells
 };
 
 struct DemoArgs {
@@ -93,6 +94,7 @@ struct DelaunayArgs {
   std::string output;          ///< .vtu (VTK_TETRA / VTK_TRIANGLE) or .vtp (2D), or empty
   std::string simplices;       ///< .npy int64 (M, D+1), or empty
   bool no_hull_completion = false;
+  double skip_cells = -1;      ///< DelaunayOptions::skip_cells (negative: automatic)
   bool validate = false;
   bool quiet = false;
 };

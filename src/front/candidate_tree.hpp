@@ -20,6 +20,8 @@
 #include <span>
 #include <vector>
 
+#include <tbb/parallel_for.h>
+
 #include "tessera/kernels/slab.hpp"
 
 namespace tessera::front {
@@ -49,10 +51,13 @@ class CandidateTree {
     build(0, static_cast<std::uint32_t>(ids_.size()));
     rank_.assign(n, std::numeric_limits<std::uint32_t>::max());
     for (std::size_t k = 0; k < ids_.size(); ++k) rank_[static_cast<std::size_t>(ids_[k])] = static_cast<std::uint32_t>(k);
-    slabs_.reserve(nodes_.size());
-    for (const Node& nd : nodes_)
-      slabs_.push_back(
-          kernels::Slab<D>::fit(nd.end - nd.begin, [&](std::size_t k) { return pts_[nd.begin + k].data(); }));
+    slabs_.resize(nodes_.size());
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nodes_.size(), 64), [&](const tbb::blocked_range<std::size_t>& r) {
+      for (std::size_t i = r.begin(); i != r.end(); ++i) {
+        const Node& nd = nodes_[i];
+        slabs_[i] = kernels::Slab<D>::fit(nd.end - nd.begin, [&](std::size_t k) { return pts_[nd.begin + k].data(); });
+      }
+    });
   }
 
   std::size_t size() const { return ids_.size(); }
@@ -147,58 +152,72 @@ class CandidateTree {
   }
 
   // Builds the node for [begin, end) at the end of nodes_, then its children
-  // (pairs, adjacent). Depth is about log2(n / kLeaf): far below the stack size.
+  // (pairs, adjacent), one level at a time: a level's nodes own disjoint
+  // ranges of the points, so they are split in parallel, and their children
+  // are numbered afterwards in level order (the same tree for any thread
+  // count). Depth is about log2(n / kLeaf): far below the stack size.
   void build(std::uint32_t begin, std::uint32_t end) {
     nodes_.push_back({});
-    std::vector<std::uint32_t> work{0};  // nodes to finish, breadth first
     nodes_[0].begin = begin;
     nodes_[0].end = end;
-    for (std::size_t w = 0; w < work.size(); ++w) {
-      const std::uint32_t at = work[w];
-      Node nd = nodes_[at];
-      for (int d = 0; d < D; ++d) {
-        nd.lo[d] = std::numeric_limits<double>::infinity();
-        nd.hi[d] = -std::numeric_limits<double>::infinity();
-      }
-      for (std::uint32_t k = nd.begin; k < nd.end; ++k)
-        for (int d = 0; d < D; ++d) {
-          nd.lo[d] = std::min(nd.lo[d], pts_[k][d]);
-          nd.hi[d] = std::max(nd.hi[d], pts_[k][d]);
-        }
-      if (nd.end - nd.begin > kLeaf) {
-        int axis = 0;
-        for (int d = 1; d < D; ++d)
-          if (nd.hi[d] - nd.lo[d] > nd.hi[axis] - nd.lo[axis]) axis = d;
+    std::vector<std::uint32_t> level{0}, next;
+    while (!level.empty()) {
+      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, level.size(), 1), [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t w = r.begin(); w != r.end(); ++w) split(nodes_[level[w]]);
+      });
+      next.clear();
+      for (std::uint32_t at : level) {
+        Node& nd = nodes_[at];
+        if (nd.end - nd.begin <= kLeaf) continue;
         const std::uint32_t mid = nd.begin + (nd.end - nd.begin) / 2;
-        // Sort a permutation of the range, then apply it to ids and points.
-        std::vector<std::uint32_t> perm(nd.end - nd.begin);
-        std::iota(perm.begin(), perm.end(), nd.begin);
-        std::nth_element(perm.begin(), perm.begin() + (mid - nd.begin), perm.end(), [&](std::uint32_t x, std::uint32_t y) {
-          return pts_[x][axis] != pts_[y][axis] ? pts_[x][axis] < pts_[y][axis] : ids_[x] < ids_[y];
-        });
-        std::vector<std::int32_t> ids(perm.size());
-        std::vector<std::array<double, D>> pts(perm.size());
-        for (std::size_t k = 0; k < perm.size(); ++k) {
-          ids[k] = ids_[perm[k]];
-          pts[k] = pts_[perm[k]];
-        }
-        std::copy(ids.begin(), ids.end(), ids_.begin() + nd.begin);
-        std::copy(pts.begin(), pts.end(), pts_.begin() + nd.begin);
-        nd.axis = static_cast<std::uint32_t>(axis);
-        nd.split = pts_[mid][axis];  // the median: an order for the search, nothing more
         nd.left = static_cast<std::uint32_t>(nodes_.size());
         Node l{}, r{};
         l.begin = nd.begin;
         l.end = mid;
         r.begin = mid;
         r.end = nd.end;
-        nodes_.push_back(l);
+        next.push_back(nd.left);
+        next.push_back(nd.left + 1);
+        nodes_.push_back(l);  // may move nodes_: nd is not used after this
         nodes_.push_back(r);
-        work.push_back(nd.left);
-        work.push_back(nd.left + 1);
       }
-      nodes_[at] = nd;
+      level.swap(next);
     }
+  }
+
+  // The node's box; and for an inner node, its points ordered about the
+  // median on the widest axis (ties by id), which sets its split.
+  void split(Node& nd) {
+    for (int d = 0; d < D; ++d) {
+      nd.lo[d] = std::numeric_limits<double>::infinity();
+      nd.hi[d] = -std::numeric_limits<double>::infinity();
+    }
+    for (std::uint32_t k = nd.begin; k < nd.end; ++k)
+      for (int d = 0; d < D; ++d) {
+        nd.lo[d] = std::min(nd.lo[d], pts_[k][d]);
+        nd.hi[d] = std::max(nd.hi[d], pts_[k][d]);
+      }
+    if (nd.end - nd.begin <= kLeaf) return;
+    int axis = 0;
+    for (int d = 1; d < D; ++d)
+      if (nd.hi[d] - nd.lo[d] > nd.hi[axis] - nd.lo[axis]) axis = d;
+    const std::uint32_t mid = nd.begin + (nd.end - nd.begin) / 2;
+    // Sort a permutation of the range, then apply it to ids and points.
+    std::vector<std::uint32_t> perm(nd.end - nd.begin);
+    std::iota(perm.begin(), perm.end(), nd.begin);
+    std::nth_element(perm.begin(), perm.begin() + (mid - nd.begin), perm.end(), [&](std::uint32_t x, std::uint32_t y) {
+      return pts_[x][axis] != pts_[y][axis] ? pts_[x][axis] < pts_[y][axis] : ids_[x] < ids_[y];
+    });
+    std::vector<std::int32_t> ids(perm.size());
+    std::vector<std::array<double, D>> pts(perm.size());
+    for (std::size_t k = 0; k < perm.size(); ++k) {
+      ids[k] = ids_[perm[k]];
+      pts[k] = pts_[perm[k]];
+    }
+    std::copy(ids.begin(), ids.end(), ids_.begin() + nd.begin);
+    std::copy(pts.begin(), pts.end(), pts_.begin() + nd.begin);
+    nd.axis = static_cast<std::uint32_t>(axis);
+    nd.split = pts_[mid][axis];  // the median: an order for the search, nothing more
   }
 
   std::vector<std::int32_t> ids_;

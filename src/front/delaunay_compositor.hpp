@@ -17,11 +17,13 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cstdint>
 #include <span>
 #include <vector>
 
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_sort.h>
 
 #include "tessera/buffer.hpp"
 #include "tessera/kernels/cell_builder.hpp"
@@ -55,6 +57,9 @@ struct DelaunayPassResult {
   std::vector<OpenFacet<D>> open;          ///< ascending
   std::vector<std::uint8_t> touches_box;   ///< per point (hull info only)
   std::vector<std::pair<std::int32_t, std::int32_t>> duplicates;
+  /// Simplices whose lowest id is a skipped point (oriented rows, their
+  /// lowest id first: that point has no cell to lay them out under).
+  std::vector<std::array<std::int32_t, D + 1>> foreign;
 };
 
 template <class CellT>
@@ -73,13 +78,29 @@ class DelaunayCompositor {
     std::vector<Simplex> simplices;
     std::vector<OpenFacet<D>> open;
     std::vector<std::int32_t> touches_box;
+    std::vector<Simplex> foreign;            // rows whose lowest id is skipped
+    std::vector<OpenFacet<D>> skipped_facets;  // facets of skipped points only, apex the generator
     std::vector<Pending> pending;  // scratch of add()
+    std::vector<std::uint8_t> plane_skipped;  // scratch of add(): per plane of the cell
   };
 
   /// `hull_info`: also collect open facets and box-touching generators.
+  /// `skipped` (empty, or one flag per point; only with hull_info): points
+  /// whose cells are not built (see docs/design.md, "Skipped cells"). A
+  /// simplex is then emitted by its lowest id among the built points, and
+  /// the facets of skipped points only that one found simplex holds are
+  /// open facets too.
   DelaunayCompositor(DelaunayPassResult<D>& out, std::size_t n_points, std::span<const std::int32_t> labels,
-                     bool hull_info)
-      : out_(out), n_(n_points), labels_(labels), hull_info_(hull_info) {}
+                     bool hull_info, std::span<const std::uint8_t> skipped = {})
+      : out_(out), n_(n_points), labels_(labels), hull_info_(hull_info), skipped_(skipped) {
+    // The cells look their neighbours up in a bit set: an eighth of the
+    // bytes, so it stays in cache (a byte per point cost a cache miss per
+    // neighbour, on ids in input order).
+    if (!skipped_.empty()) {
+      skipped_bits_.assign((n_ + 63) / 64, 0);
+      for (std::size_t i = 0; i < n_; ++i) skipped_bits_[i >> 6] |= std::uint64_t{skipped_[i] != 0} << (i & 63);
+    }
+  }
 
   void add(Batch& b, std::int32_t gen, const kernels::BuildStatus& st, CellT& cell) {
     b.gen.push_back(gen);
@@ -94,6 +115,13 @@ class DelaunayCompositor {
         for (const auto& v : verts)
           for (int k = 0; k < D; ++k) touches |= v.p[k] < CellT::box_planes;
       b.pending.clear();
+      // Per plane: whether its generator is skipped (one lookup per
+      // neighbour, not one per vertex and id).
+      if (!skipped_.empty()) {
+        b.plane_skipped.resize(planes.size());
+        for (std::size_t k = 0; k < planes.size(); ++k)
+          b.plane_skipped[k] = planes[k].id >= 0 && is_skipped(planes[k].id);
+      }
       for (std::size_t t = 0; t < verts.size(); ++t) {
         std::array<std::int32_t, D> ids;
         for (int k = 0; k < D; ++k) ids[k] = planes[verts[t].p[k]].id;
@@ -106,6 +134,16 @@ class DelaunayCompositor {
           if (!labels_.empty())
             for (int k = 0; k < D; ++k) inside &= labels_[static_cast<std::size_t>(ids[k])] >= 0;
           if (inside) emit(b, gen, ids);
+          if (!skipped_.empty() && all_skipped(b, verts[t])) {
+            auto asc = ids;
+            std::sort(asc.begin(), asc.end());
+            record_skipped_facet(b, gen, asc);
+          }
+        } else if (!skipped_.empty() && lowest >= 0) {
+          // Ours all the same when every lower id is skipped: it has no cell.
+          bool ours = true;
+          for (int k = 0; k < D; ++k) ours &= ids[k] > gen || b.plane_skipped[verts[t].p[k]];
+          if (ours) emit_beside_skipped(b, gen, ids, all_skipped(b, verts[t]));
         }
         if (hull_info_ && touches && lowest >= 0) open_facets(b, gen, cell, t);
       }
@@ -137,28 +175,70 @@ class DelaunayCompositor {
     }
     if (hull_info_) {
       out_.touches_box.assign(n_, 0);
+      std::vector<OpenFacet<D>> skipped_facets;
       for (const Batch& b : batches) {
         out_.open.insert(out_.open.end(), b.open.begin(), b.open.end());
         for (std::int32_t g : b.touches_box) out_.touches_box[static_cast<std::size_t>(g)] = 1;
+        out_.foreign.insert(out_.foreign.end(), b.foreign.begin(), b.foreign.end());
+        skipped_facets.insert(skipped_facets.end(), b.skipped_facets.begin(), b.skipped_facets.end());
       }
-      std::sort(out_.open.begin(), out_.open.end());
+      out_.found += out_.foreign.size();
+      // A facet of skipped points only is held by the found simplices on
+      // each side that have a built point: both (two records, closed) or
+      // one (open: the simplex beyond it has skipped points only, or its
+      // circumcentre lies outside the box).
+      tbb::parallel_sort(skipped_facets.begin(), skipped_facets.end());
+      for (std::size_t i = 0; i < skipped_facets.size();) {
+        std::size_t j = i + 1;
+        while (j < skipped_facets.size() && skipped_facets[j].facet == skipped_facets[i].facet) ++j;
+        if (j == i + 1) out_.open.push_back(skipped_facets[i]);
+        i = j;
+      }
+      tbb::parallel_sort(out_.open.begin(), out_.open.end());
     }
   }
 
   /// Every simplex as rows of D+1 ids into `rows`, ascending by key
-  /// (simplex_key): the found ones with `extra` (oriented rows, ascending by
-  /// key: hull completion's) merged in. Each generator's rows, found and
-  /// extra, hold it as their lowest id and come ascending, so laying them out
-  /// in generator order sorts the whole list; generators are written in
-  /// parallel, straight into their final place.
-  void write(const std::vector<Simplex>& extra, Buffer<std::int32_t>& rows) {
+  /// (simplex_key): the found ones with `extra` merged in (oriented rows,
+  /// each with its lowest id first, in any order: hull completion's, and
+  /// the foreign ones of skipped generators). Extra rows are bucketed by
+  /// their lowest id (a counting sort) and each bucket sorted by key; then
+  /// each generator's rows, found and extra, hold it as their lowest id and
+  /// come ascending, so laying them out in generator order sorts the whole
+  /// list; generators are written in parallel, straight into their final
+  /// place.
+  void write(const std::vector<Simplex>& unsorted_extra, Buffer<std::int32_t>& rows) {
     std::vector<std::int64_t> offset(n_ + 1, 0);
     std::vector<std::uint32_t> extra_begin(n_ + 1, 0);
-    for (const Simplex& s : extra) ++extra_begin[static_cast<std::size_t>(*std::min_element(s.begin(), s.end())) + 1];
+    // Counts and places by atomic increments, in parallel (~2M foreign rows
+    // at 1M points): the order within a bucket depends on timing, and the
+    // sort by key below removes that.
+    const std::size_t m = unsorted_extra.size();
+    constexpr std::size_t grain = 1 << 14;
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, m, grain), [&](const tbb::blocked_range<std::size_t>& r) {
+      for (std::size_t i = r.begin(); i != r.end(); ++i)
+        std::atomic_ref<std::uint32_t>(extra_begin[static_cast<std::size_t>(unsorted_extra[i][0]) + 1])
+            .fetch_add(1, std::memory_order_relaxed);
+    });
     for (std::size_t g = 0; g < n_; ++g) {
       extra_begin[g + 1] += extra_begin[g];
       offset[g + 1] = offset[g] + count_[g] + (extra_begin[g + 1] - extra_begin[g]);
     }
+    std::vector<Simplex> extra(m);
+    {
+      std::vector<std::uint32_t> at(extra_begin.begin(), extra_begin.end() - 1);
+      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, m, grain), [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t i = r.begin(); i != r.end(); ++i) {
+          const Simplex& s = unsorted_extra[i];
+          extra[std::atomic_ref<std::uint32_t>(at[static_cast<std::size_t>(s[0])]).fetch_add(1, std::memory_order_relaxed)] = s;
+        }
+      });
+    }
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n_, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
+      for (std::size_t g = r.begin(); g != r.end(); ++g)
+        if (extra_begin[g + 1] - extra_begin[g] > 1)
+          std::sort(extra.begin() + extra_begin[g], extra.begin() + extra_begin[g + 1], key_less);
+    });
     rows.resize(static_cast<std::size_t>(offset[n_]) * (D + 1));  // every row is written below
     tbb::parallel_for(std::size_t(0), kept_.size(), [&](std::size_t k) {
       const Kept& b = kept_[k];
@@ -183,11 +263,31 @@ class DelaunayCompositor {
         }
       }
     });
+    // Skipped generators have no batch: their rows are all extra.
+    if (!skipped_.empty())
+      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n_, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t g = r.begin(); g != r.end(); ++g) {
+          if (!skipped_[g]) continue;
+          std::int32_t* o = rows.data() + static_cast<std::size_t>(offset[g]) * (D + 1);
+          for (std::uint32_t x = extra_begin[g]; x != extra_begin[g + 1]; ++x)
+            o = std::copy(extra[x].begin(), extra[x].end(), o);
+        }
+      });
     kept_.clear();
   }
 
  private:
   static constexpr std::size_t prefetch_ahead = 8;  // generators (write)
+
+  // simplex_key(x) < simplex_key(y) for oriented rows (ascending but for a
+  // swap of the last two), without building the keys.
+  static bool key_less(const Simplex& x, const Simplex& y) {
+    for (int k = 0; k + 1 < D; ++k)
+      if (x[k] != y[k]) return x[k] < y[k];
+    const std::int32_t xa = std::min(x[D - 1], x[D]), ya = std::min(y[D - 1], y[D]);
+    if (xa != ya) return xa < ya;
+    return std::max(x[D - 1], x[D]) < std::max(y[D - 1], y[D]);
+  }
 
   // Append the pending rows to b.simplices ascending by key, oriented. All
   // share row[0] (the generator), so the key is (row[1], row[2]) packed in
@@ -258,12 +358,12 @@ class DelaunayCompositor {
     const auto& verts = cell.vertices();
     const auto& planes = cell.planes();
     auto emit = [&](std::array<std::int32_t, D - 1> shared, std::int32_t apex) {
-      for (std::int32_t id : shared)
-        if (id < gen) return;
+      for (std::int32_t id : shared)  // reported by its lowest built id
+        if (id < gen && (skipped_.empty() || !is_skipped(id))) return;
       OpenFacet<D> f;
       f.facet[0] = gen;
-      std::sort(shared.begin(), shared.end());
       std::copy(shared.begin(), shared.end(), f.facet.begin() + 1);
+      std::sort(f.facet.begin(), f.facet.end());  // gen may follow skipped ids
       f.apex = apex;
       b.open.push_back(f);
     };
@@ -287,6 +387,44 @@ class DelaunayCompositor {
     }
   }
 
+  template <class Vertex>
+  static bool all_skipped(const Batch& b, const Vertex& v) {
+    bool all = true;
+    for (int k = 0; k < D; ++k) all &= b.plane_skipped[v.p[k]] != 0;
+    return all;
+  }
+
+  // The simplex {gen, ids} of a cell vertex whose lower ids are all skipped
+  // points: ours to emit (emitted by its lowest built id). Its row goes to
+  // `foreign`, fully ascending with the orientation's swap, as hull
+  // completion's rows. When every other id is skipped, the facet they form
+  // is recorded: if no other found simplex holds it, it is open.
+  void emit_beside_skipped(Batch& b, std::int32_t gen, std::array<std::int32_t, D> ids, bool others_skipped) {
+    // Orientation: {gen, ids} in the vertex's plane order is positive (emit).
+    // Sort ids ascending, counting swaps, then move gen to its place.
+    int sign = 1;
+    for (int i = 1; i < D; ++i)
+      for (int j = i; j > 0 && ids[j] < ids[j - 1]; --j) {
+        std::swap(ids[j], ids[j - 1]);
+        sign = -sign;
+      }
+    Simplex row;
+    int below = 0;
+    for (int k = 0; k < D; ++k) below += ids[k] < gen;
+    for (int k = 0, m = 0; k <= D; ++k) row[k] = k == below ? gen : ids[m++];
+    if (below & 1) sign = -sign;
+    if (sign < 0) std::swap(row[D - 1], row[D]);
+    b.foreign.push_back(row);
+    if (others_skipped) record_skipped_facet(b, gen, ids);
+  }
+
+  void record_skipped_facet(Batch& b, std::int32_t gen, const std::array<std::int32_t, D>& ascending) {
+    OpenFacet<D> f;
+    f.facet = ascending;
+    f.apex = gen;
+    b.skipped_facets.push_back(f);
+  }
+
   struct Kept {  // a batch's rows, from finish() to write()
     std::vector<std::int32_t> gen;
     std::vector<std::uint32_t> simplex_end;
@@ -299,6 +437,13 @@ class DelaunayCompositor {
   std::size_t n_;
   std::span<const std::int32_t> labels_;
   bool hull_info_;
+  std::span<const std::uint8_t> skipped_;
+  std::vector<std::uint64_t> skipped_bits_;  // skipped_ as bits
+
+  bool is_skipped(std::int32_t id) const {
+    const auto i = static_cast<std::size_t>(id);
+    return (skipped_bits_[i >> 6] >> (i & 63)) & 1;
+  }
 };
 
 }  // namespace tessera::front

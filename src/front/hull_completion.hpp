@@ -225,7 +225,7 @@ class HullCompletion {
     // Facets on the current boundary and those closed by completion, with
     // the number of simplices holding each (found ones count once: the
     // other side of an open facet is what completion looks for).
-    FacetTable<D> facets(8 * open.size());
+    FacetTable<D> facets(2 * open.size());
     std::vector<OpenFacet<D>> queue;
     for (const auto& o : open) {
       facets.bump(o.facet);
