@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <random>
 #include <set>
 #include <string>
@@ -455,6 +456,90 @@ TEST(Delaunay, NearDuplicatesAndDuplicates) {
   tessera::Delaunay dt = run(p, 3);
   EXPECT_EQ(dt.duplicates.size(), 20u);
   expect_valid(dt, p);
+}
+
+// Skipped cells (DelaunayOptions::skip_cells): the simplices of skipped
+// points come from their neighbours' cells, and gift wrapping closes the
+// cavities of skipped points only; the rows must be those of every cell
+// built, byte for byte, on 1 and 2 threads, on general-position and on
+// degenerate input (lattices and co-spherical points, where the symbolic
+// perturbation chooses), and with duplicates (never skipped).
+TEST(Delaunay, SkippedCellsGiveTheSameRows) {
+  std::mt19937_64 rng(77);
+  std::normal_distribution<double> g;
+  std::vector<std::pair<std::vector<double>, int>> inputs;
+  inputs.emplace_back(random_points(3000, 3, 31), 3);
+  inputs.emplace_back(random_points(3000, 2, 32), 2);
+  {
+    std::vector<double> blobs;  // clusters of very different density
+    for (int c = 0; c < 6; ++c) {
+      const double cx = g(rng), cy = g(rng), cz = g(rng), r = c % 2 ? 0.01 : 0.2;
+      for (int i = 0; i < 400; ++i) blobs.insert(blobs.end(), {cx + r * g(rng), cy + r * g(rng), cz + r * g(rng)});
+    }
+    inputs.emplace_back(std::move(blobs), 3);
+  }
+  {
+    std::vector<double> terrain;  // a height field: nearly every simplex from completion
+    std::uniform_real_distribution<double> u;
+    for (int i = 0; i < 2000; ++i) {
+      const double x = u(rng), y = u(rng);
+      terrain.insert(terrain.end(), {x, y, 0.1 * std::sin(6 * x) * std::cos(5 * y)});
+    }
+    inputs.emplace_back(std::move(terrain), 3);
+  }
+  inputs.emplace_back(grid(9, 3), 3);
+  inputs.emplace_back(grid(40, 2), 2);
+  inputs.emplace_back(rotated_lattice(7, rng, g, 0.0), 3);
+  {
+    std::vector<double> sphere;
+    for (int x = -7; x <= 7; ++x)
+      for (int y = -7; y <= 7; ++y)
+        for (int z = -7; z <= 7; ++z)
+          if (x * x + y * y + z * z == 49 || x * x + y * y + z * z == 25) sphere.insert(sphere.end(), {double(x), double(y), double(z)});
+    inputs.emplace_back(std::move(sphere), 3);
+  }
+  {
+    auto p = random_points(2000, 3, 33);
+    for (int i = 0; i < 200; ++i) {
+      const std::size_t a = static_cast<std::size_t>(i) * 3;
+      p.insert(p.end(), {p[a] + 1e-12, p[a + 1], p[a + 2]});
+      p.insert(p.end(), {p[a + 3], p[a + 4], p[a + 5]});
+    }
+    inputs.emplace_back(std::move(p), 3);
+  }
+  for (std::size_t in = 0; in < inputs.size(); ++in) {
+    const auto& [p, dim] = inputs[in];
+    tessera::DelaunayOptions o;
+    o.dim = dim;
+    o.threads = 2;
+    o.skip_cells = 0;
+    const tessera::Delaunay all = tessera::delaunay(p, dim, {}, o);
+    for (const double skip : {0.3, 0.7, 0.95})
+      for (const int threads : {1, 2}) {
+        o.skip_cells = skip;
+        o.threads = threads;
+        const tessera::Delaunay dt = tessera::delaunay(p, dim, {}, o);
+        EXPECT_EQ(dt.simplices, all.simplices) << "input " << in << ", skip " << skip << ", threads " << threads;
+        EXPECT_EQ(dt.duplicates, all.duplicates) << "input " << in;
+        EXPECT_GT(dt.skipped_cells, 0u) << "input " << in;
+        EXPECT_EQ(dt.from_cells + dt.from_hull_completion, dt.n_simplices());
+      }
+  }
+  // The automatic choice (3D, 20,000 points and more) against CGAL.
+  auto p = random_points(30000, 3, 34);
+  tessera::Delaunay dt = run(p, 3);
+  EXPECT_GT(dt.skipped_cells, 0u);
+  EXPECT_EQ(as_set(dt), cgal_simplices(p, 3));
+  expect_valid(dt, p);
+}
+
+TEST(Delaunay, SkipCellsOutOfRangeIsAnInputError) {
+  auto p = random_points(100, 3, 35);
+  tessera::DelaunayOptions o;
+  for (double bad : {1.0, 2.0, std::numeric_limits<double>::quiet_NaN()}) {
+    o.skip_cells = bad;
+    EXPECT_THROW(tessera::delaunay(p, 3, {}, o), tessera::InputError);
+  }
 }
 
 TEST(Delaunay, FewPointsAndFlatInput) {
