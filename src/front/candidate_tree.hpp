@@ -5,7 +5,9 @@
 // Median splits on the widest axis, leaves of up to 32 points, and each node's
 // box shrunk to its points (not to a grid), so empty space is cut away: the
 // candidates form a thin shell along the domain box, and the lens a query
-// covers is thin too. Written here rather than taken from a library because
+// covers is thin too. (With skipped cells the skipped points are candidates
+// as well, spread through the volume.) Built level by level, each level's
+// nodes split in parallel. Written here rather than taken from a library because
 // the pruning test (a ball that shrinks during the search, intersected with a
 // half-space) is the whole point and no Debian-packaged tree (nanoflann, CGAL's
 // Kd_tree) takes a custom, changing predicate cheaply.

@@ -14,7 +14,6 @@
 #include <stdexcept>
 
 #include <tbb/parallel_for.h>
-#include <tbb/parallel_sort.h>
 #include <tbb/task_arena.h>
 
 #include "delaunay_compositor.hpp"
@@ -194,7 +193,7 @@ Delaunay run(std::span<const double> input, std::span<const std::int32_t> labels
   std::vector<std::int32_t> built_order;
   std::vector<std::uint32_t> built_slots;
   if (skip > 0) {
-    skipped = choose_skipped<D>(pass, skip, n);
+    tbb::task_arena(pass.engine_options.threads).execute([&] { skipped = choose_skipped<D>(pass, skip, n); });
     for (std::size_t g = 0; g < pass.order.size(); ++g)
       if (!skipped[static_cast<std::size_t>(pass.order[g])]) {
         built_order.push_back(pass.order[g]);
@@ -299,8 +298,9 @@ Delaunay run(std::span<const double> input, std::span<const std::int32_t> labels
   out.from_hull_completion = added.size();
 
   // Orient the completion's simplices (they have no cell to read it from)
-  // by the exact predicate; they stay in key order, a row's key being its
-  // ascending form. Then lay out both lists in one pass.
+  // by the exact predicate. The cells' foreign rows (skipped cells) join
+  // them, and write() lays out the found rows and these extra ones in one
+  // pass.
   std::atomic<std::size_t> flat = 0;
   tbb::task_arena(pass.engine_options.threads).execute([&] {
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, added.size(), 4096), [&](const tbb::blocked_range<std::size_t>& r) {
@@ -314,7 +314,9 @@ Delaunay run(std::span<const double> input, std::span<const std::int32_t> labels
   });
   if (flat != 0)
     throw std::logic_error("tessera: " + std::to_string(flat.load()) + " Delaunay simplices are flat (inconsistent topology)");
+  if (added.size() < found.foreign.size()) added.swap(found.foreign);  // append the shorter list
   added.insert(added.end(), found.foreign.begin(), found.foreign.end());
+  std::vector<std::array<std::int32_t, D + 1>>().swap(found.foreign);
   tbb::task_arena(pass.engine_options.threads).execute([&] { comp.write(added, out.simplices); });
   std::sort(out.duplicates.begin(), out.duplicates.end());
   return out;

@@ -13,6 +13,13 @@
 //
 // Each simplex is oriented as it is emitted, from the cell's topology alone
 // (emit): no predicate, no coordinates.
+//
+// With skipped cells (DelaunayOptions::skip_cells; docs/design.md, "Skipped
+// cells") a simplex is emitted by its lowest *built* id; a row whose lowest
+// id is a skipped point is kept apart (`foreign`) and laid out under that
+// point by write(). A simplex of skipped points only is found by no cell:
+// the facets of skipped points only that some found simplex holds are
+// recorded, and those held once are open facets, which completion closes.
 #pragma once
 
 #include <algorithm>

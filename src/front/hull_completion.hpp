@@ -23,6 +23,10 @@
 //    triangulation the cells pass computed: together they are one
 //    triangulation of the convex hull, exactly CGAL's on points in general
 //    position.
+// The same wrapping closes the cavities that skipped cells leave (simplices
+// of skipped points only; docs/design.md, "Skipped cells"): the skipped
+// points are candidates too, and the open facets around a cavity come from
+// the compositor like the hull's.
 // Closing a facet can open new ones; rounds repeat until every open facet is
 // a hull facet. Each round's gift wraps run in parallel, each first trying
 // the vertices of the round's other open facets across its ridges (seeds:
