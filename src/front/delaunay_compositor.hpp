@@ -274,7 +274,7 @@ class DelaunayCompositor {
     if (!skipped_.empty())
       tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n_, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
         for (std::size_t g = r.begin(); g != r.end(); ++g) {
-          if (!skipped_[g]) continue;
+          if (!is_skipped(static_cast<std::int32_t>(g))) continue;
           std::int32_t* o = rows.data() + static_cast<std::size_t>(offset[g]) * (D + 1);
           for (std::uint32_t x = extra_begin[g]; x != extra_begin[g + 1]; ++x)
             o = std::copy(extra[x].begin(), extra[x].end(), o);
