@@ -44,15 +44,25 @@ class CandidateTree {
   /// The points of `coords` (n*D) whose `use[id]` is set.
   CandidateTree(std::span<const double> coords, std::span<const std::uint8_t> use) {
     const std::size_t n = use.size();
+    std::vector<Entry> entries;
     for (std::size_t i = 0; i < n; ++i)
-      if (use[i]) ids_.push_back(static_cast<std::int32_t>(i));
-    pts_.resize(ids_.size());
-    for (std::size_t k = 0; k < ids_.size(); ++k)
-      for (int d = 0; d < D; ++d) pts_[k][d] = coords[static_cast<std::size_t>(ids_[k]) * D + d];
-    if (ids_.empty()) return;
-    build(0, static_cast<std::uint32_t>(ids_.size()));
+      if (use[i]) {
+        Entry& e = entries.emplace_back();
+        for (int d = 0; d < D; ++d) e.p[d] = coords[i * D + static_cast<std::size_t>(d)];
+        e.id = static_cast<std::int32_t>(i);
+      }
+    if (entries.empty()) return;
+    build(entries);
+    ids_.resize(entries.size());
+    pts_.resize(entries.size());
     rank_.assign(n, std::numeric_limits<std::uint32_t>::max());
-    for (std::size_t k = 0; k < ids_.size(); ++k) rank_[static_cast<std::size_t>(ids_[k])] = static_cast<std::uint32_t>(k);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, entries.size(), 1 << 14), [&](const tbb::blocked_range<std::size_t>& r) {
+      for (std::size_t k = r.begin(); k != r.end(); ++k) {
+        ids_[k] = entries[k].id;
+        pts_[k] = entries[k].p;
+        rank_[static_cast<std::size_t>(entries[k].id)] = static_cast<std::uint32_t>(k);
+      }
+    });
     slabs_.resize(nodes_.size());
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nodes_.size(), 64), [&](const tbb::blocked_range<std::size_t>& r) {
       for (std::size_t i = r.begin(); i != r.end(); ++i) {
@@ -153,19 +163,27 @@ class CandidateTree {
     return s;
   }
 
+  // A point while the tree is built: the splits move points and ids together
+  // (nth_element on these directly, not on a permutation of indices whose
+  // every comparison loads two scattered points).
+  struct Entry {
+    std::array<double, D> p;
+    std::int32_t id;
+  };
+
   // Builds the node for [begin, end) at the end of nodes_, then its children
   // (pairs, adjacent), one level at a time: a level's nodes own disjoint
   // ranges of the points, so they are split in parallel, and their children
   // are numbered afterwards in level order (the same tree for any thread
   // count). Depth is about log2(n / kLeaf): far below the stack size.
-  void build(std::uint32_t begin, std::uint32_t end) {
+  void build(std::vector<Entry>& entries) {
     nodes_.push_back({});
-    nodes_[0].begin = begin;
-    nodes_[0].end = end;
+    nodes_[0].begin = 0;
+    nodes_[0].end = static_cast<std::uint32_t>(entries.size());
     std::vector<std::uint32_t> level{0}, next;
     while (!level.empty()) {
       tbb::parallel_for(tbb::blocked_range<std::size_t>(0, level.size(), 1), [&](const tbb::blocked_range<std::size_t>& r) {
-        for (std::size_t w = r.begin(); w != r.end(); ++w) split(nodes_[level[w]]);
+        for (std::size_t w = r.begin(); w != r.end(); ++w) split(nodes_[level[w]], entries);
       });
       next.clear();
       for (std::uint32_t at : level) {
@@ -189,37 +207,27 @@ class CandidateTree {
 
   // The node's box; and for an inner node, its points ordered about the
   // median on the widest axis (ties by id), which sets its split.
-  void split(Node& nd) {
+  static void split(Node& nd, std::vector<Entry>& entries) {
     for (int d = 0; d < D; ++d) {
       nd.lo[d] = std::numeric_limits<double>::infinity();
       nd.hi[d] = -std::numeric_limits<double>::infinity();
     }
     for (std::uint32_t k = nd.begin; k < nd.end; ++k)
       for (int d = 0; d < D; ++d) {
-        nd.lo[d] = std::min(nd.lo[d], pts_[k][d]);
-        nd.hi[d] = std::max(nd.hi[d], pts_[k][d]);
+        nd.lo[d] = std::min(nd.lo[d], entries[k].p[d]);
+        nd.hi[d] = std::max(nd.hi[d], entries[k].p[d]);
       }
     if (nd.end - nd.begin <= kLeaf) return;
     int axis = 0;
     for (int d = 1; d < D; ++d)
       if (nd.hi[d] - nd.lo[d] > nd.hi[axis] - nd.lo[axis]) axis = d;
     const std::uint32_t mid = nd.begin + (nd.end - nd.begin) / 2;
-    // Sort a permutation of the range, then apply it to ids and points.
-    std::vector<std::uint32_t> perm(nd.end - nd.begin);
-    std::iota(perm.begin(), perm.end(), nd.begin);
-    std::nth_element(perm.begin(), perm.begin() + (mid - nd.begin), perm.end(), [&](std::uint32_t x, std::uint32_t y) {
-      return pts_[x][axis] != pts_[y][axis] ? pts_[x][axis] < pts_[y][axis] : ids_[x] < ids_[y];
+    const auto first = entries.begin() + nd.begin;
+    std::nth_element(first, entries.begin() + mid, entries.begin() + nd.end, [axis](const Entry& x, const Entry& y) {
+      return x.p[axis] != y.p[axis] ? x.p[axis] < y.p[axis] : x.id < y.id;
     });
-    std::vector<std::int32_t> ids(perm.size());
-    std::vector<std::array<double, D>> pts(perm.size());
-    for (std::size_t k = 0; k < perm.size(); ++k) {
-      ids[k] = ids_[perm[k]];
-      pts[k] = pts_[perm[k]];
-    }
-    std::copy(ids.begin(), ids.end(), ids_.begin() + nd.begin);
-    std::copy(pts.begin(), pts.end(), pts_.begin() + nd.begin);
     nd.axis = static_cast<std::uint32_t>(axis);
-    nd.split = pts_[mid][axis];  // the median: an order for the search, nothing more
+    nd.split = entries[mid].p[axis];  // the median: an order for the search, nothing more
   }
 
   std::vector<std::int32_t> ids_;

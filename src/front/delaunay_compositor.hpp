@@ -36,6 +36,7 @@
 #include "tessera/kernels/cell_builder.hpp"
 #include "tessera/kernels/hull.hpp"
 #include "tessera/kernels/tile.hpp"
+#include "point_buckets.hpp"
 
 namespace tessera::front {
 
@@ -215,32 +216,17 @@ class DelaunayCompositor {
   /// list; generators are written in parallel, straight into their final
   /// place.
   void write(const std::vector<Simplex>& unsorted_extra, Buffer<std::int32_t>& rows) {
+    // The extra rows by lowest id (bucket_rows: one histogram per chunk of
+    // rows, no atomics; with an atomic counter per point, the ~2M foreign
+    // rows of 1M points took 0.057 s to bucket, ~0.02 s now).
+    std::vector<std::int64_t> extra_begin;
+    std::vector<Simplex> extra;
+    bucket_rows(
+        n_, unsorted_extra.size(), [](std::size_t) { return 1; },
+        [&](std::size_t r, std::size_t) { return unsorted_extra[r][0]; },
+        [&](std::size_t r, std::size_t) { return unsorted_extra[r]; }, extra_begin, extra);
     std::vector<std::int64_t> offset(n_ + 1, 0);
-    std::vector<std::uint32_t> extra_begin(n_ + 1, 0);
-    // Counts and places by atomic increments, in parallel (~2M foreign rows
-    // at 1M points): the order within a bucket depends on timing, and the
-    // sort by key below removes that.
-    const std::size_t m = unsorted_extra.size();
-    constexpr std::size_t grain = 1 << 14;
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, m, grain), [&](const tbb::blocked_range<std::size_t>& r) {
-      for (std::size_t i = r.begin(); i != r.end(); ++i)
-        std::atomic_ref<std::uint32_t>(extra_begin[static_cast<std::size_t>(unsorted_extra[i][0]) + 1])
-            .fetch_add(1, std::memory_order_relaxed);
-    });
-    for (std::size_t g = 0; g < n_; ++g) {
-      extra_begin[g + 1] += extra_begin[g];
-      offset[g + 1] = offset[g] + count_[g] + (extra_begin[g + 1] - extra_begin[g]);
-    }
-    std::vector<Simplex> extra(m);
-    {
-      std::vector<std::uint32_t> at(extra_begin.begin(), extra_begin.end() - 1);
-      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, m, grain), [&](const tbb::blocked_range<std::size_t>& r) {
-        for (std::size_t i = r.begin(); i != r.end(); ++i) {
-          const Simplex& s = unsorted_extra[i];
-          extra[std::atomic_ref<std::uint32_t>(at[static_cast<std::size_t>(s[0])]).fetch_add(1, std::memory_order_relaxed)] = s;
-        }
-      });
-    }
+    for (std::size_t g = 0; g < n_; ++g) offset[g + 1] = offset[g] + count_[g] + (extra_begin[g + 1] - extra_begin[g]);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n_, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
       for (std::size_t g = r.begin(); g != r.end(); ++g)
         if (extra_begin[g + 1] - extra_begin[g] > 1)
@@ -276,7 +262,7 @@ class DelaunayCompositor {
         for (std::size_t g = r.begin(); g != r.end(); ++g) {
           if (!is_skipped(static_cast<std::int32_t>(g))) continue;
           std::int32_t* o = rows.data() + static_cast<std::size_t>(offset[g]) * (D + 1);
-          for (std::uint32_t x = extra_begin[g]; x != extra_begin[g + 1]; ++x)
+          for (std::int64_t x = extra_begin[g]; x != extra_begin[g + 1]; ++x)
             o = std::copy(extra[x].begin(), extra[x].end(), o);
         }
       });

@@ -229,16 +229,14 @@ class HullCompletion {
     // Facets on the current boundary and those closed by completion, with
     // the number of simplices holding each (found ones count once: the
     // other side of an open facet is what completion looks for).
+    tbb::task_arena arena(std::max(1, threads));
     FacetTable<D> facets(2 * open.size());
-    std::vector<OpenFacet<D>> queue;
-    for (const auto& o : open) {
-      facets.bump(o.facet);
-      queue.push_back(o);
-    }
+    std::vector<OpenFacet<D>> queue = open;
+    std::vector<std::uint8_t> counts;
+    arena.execute([&] { facets.bump_all(queue.size(), [&](std::size_t i) { return queue[i].facet; }, counts); });
     std::vector<Simplex> added;
     std::vector<Ridge> ridges;
     std::vector<std::int32_t> seeds;
-    tbb::task_arena arena(std::max(1, threads));
     while (!queue.empty()) {
       // A thin hull simplex usually closes two open facets of the same
       // round. The simplex beyond a facet is unique (the perturbed
@@ -290,18 +288,22 @@ class HullCompletion {
       }
       arena.execute([&] { tbb::parallel_sort(fresh.begin(), fresh.end()); });
       fresh.erase(std::unique(fresh.begin(), fresh.end()), fresh.end());
-      std::vector<OpenFacet<D>> next;
-      for (const Simplex& s : fresh) {
-        added.push_back(s);
-        for (const OpenFacet<D>& o : facets_of(s)) {
-          const int held = facets.bump(o.facet);
-          if (held > 2) throw std::logic_error("tessera: hull completion put a facet in three simplices");
-          if (held == 1) next.push_back(o);
-        }
-      }
+      // The new simplices' facets, counted with all of them in: a facet
+      // held once is open (the next round wraps it), twice closed.
+      added.insert(added.end(), fresh.begin(), fresh.end());
+      std::vector<OpenFacet<D>> held(fresh.size() * (D + 1));
+      arena.execute([&] {
+        tbb::parallel_for(std::size_t{0}, fresh.size(), [&](std::size_t j) {
+          const auto f = facets_of(fresh[j]);
+          std::copy(f.begin(), f.end(), held.begin() + static_cast<std::ptrdiff_t>(j * (D + 1)));
+        });
+        facets.bump_all(held.size(), [&](std::size_t i) { return held[i].facet; }, counts);
+      });
       queue.clear();
-      for (const auto& o : next)
-        if (facets.count(o.facet) == 1) queue.push_back(o);
+      for (std::size_t i = 0; i < held.size(); ++i) {
+        if (counts[i] > 2) throw std::logic_error("tessera: hull completion put a facet in three simplices");
+        if (counts[i] == 1) queue.push_back(held[i]);
+      }
     }
     arena.execute([&] { tbb::parallel_sort(added.begin(), added.end()); });
     return added;
