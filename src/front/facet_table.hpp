@@ -25,6 +25,8 @@
 
 #include <tbb/parallel_for.h>
 
+#include "point_buckets.hpp"
+
 namespace tessera::front {
 
 template <int D>
@@ -54,43 +56,23 @@ class FacetTable {
   /// of the bumps, so nothing here depends on the thread count.
   template <class FacetOf>
   void bump_all(std::size_t m, FacetOf&& facet, std::vector<std::uint8_t>& count_after) {
-    // The items gathered by shard, each with its facet (so a shard streams
-    // through its own), by a parallel counting sort: blocks of items count
-    // their shards, each (shard, block) pair gets its range, and the blocks
-    // scatter at once.
-    constexpr std::size_t block = 1 << 15;
-    const std::size_t blocks = (m + block - 1) / block;
-    std::vector<std::array<std::uint32_t, kShards>> at(blocks);
-    tbb::parallel_for(std::size_t{0}, blocks, [&](std::size_t b) {
-      at[b].fill(0);
-      for (std::size_t i = b * block, e = std::min(m, i + block); i < e; ++i) ++at[b][hash(facet(i)) >> kShardShift];
-    });
-    std::array<std::size_t, kShards + 1> begin{};
-    for (std::size_t k = 0, total = 0; k < kShards; ++k) {
-      begin[k] = total;
-      for (std::size_t b = 0; b < blocks; ++b) {
-        const std::uint32_t c = at[b][k];
-        at[b][k] = static_cast<std::uint32_t>(total);
-        total += c;
-      }
-      begin[k + 1] = total;
-    }
+    // The items gathered by shard, each with its facet, so that a shard
+    // streams through its own (bucket_rows: a parallel counting sort).
     struct Entry {
       Facet f;
       std::uint32_t item;
     };
-    std::vector<Entry> entries(m);
-    tbb::parallel_for(std::size_t{0}, blocks, [&](std::size_t b) {
-      for (std::size_t i = b * block, e = std::min(m, i + block); i < e; ++i) {
-        const Facet f = facet(i);
-        entries[at[b][hash(f) >> kShardShift]++] = {f, static_cast<std::uint32_t>(i)};
-      }
-    });
+    std::vector<std::int64_t> begin;
+    std::vector<Entry> entries;
+    bucket_rows(
+        kShards, m, [](std::size_t) { return 1; }, [&](std::size_t i, std::size_t) { return hash(facet(i)) >> kShardShift; },
+        [&](std::size_t i, std::size_t) { return Entry{facet(i), static_cast<std::uint32_t>(i)}; }, begin, entries);
     count_after.resize(m);
     tbb::parallel_for(std::size_t{0}, kShards, [&](std::size_t k) {
       Shard& s = shards_[k];
-      for (std::size_t e = begin[k]; e < begin[k + 1]; ++e) s.bump(entries[e].f, hash(entries[e].f));
-      for (std::size_t e = begin[k]; e < begin[k + 1]; ++e)
+      const auto first = static_cast<std::size_t>(begin[k]), last = static_cast<std::size_t>(begin[k + 1]);
+      for (std::size_t e = first; e < last; ++e) s.bump(entries[e].f, hash(entries[e].f));
+      for (std::size_t e = first; e < last; ++e)
         count_after[entries[e].item] = static_cast<std::uint8_t>(std::min(255, s.count(entries[e].f, hash(entries[e].f))));
     });
   }
