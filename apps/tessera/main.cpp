@@ -149,7 +149,8 @@ int main(int argc, char** argv) {
   del->add_option("--skip-cells", dla.skip_cells,
                   "Fraction of the points (picked by a hash of their id) whose cells are not built: their simplices "
                   "come from their neighbours' cells, and gift wrapping closes the cavities between skipped points. "
-                  "Same result. Default: 0.3 in 3D from 20,000 points, else 0; ignored with labels or "
+                  "Same result. Default in 3D from 20,000 points: 0.3 to 0.9, by what a sample of cells costs "
+                  "(more on surface samples, whose cells are needles); else 0. Ignored with labels or "
                   "--no-hull-completion")
       ->check(CLI::Range(0.0, 0.99));
   del->add_flag("--validate", dla.validate,

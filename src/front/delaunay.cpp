@@ -168,6 +168,100 @@ std::vector<std::uint8_t> choose_skipped(const front::Pass<D>& pass, double frac
   return skipped;
 }
 
+// The pilot's compositor: what the cells it is given cost to search
+// (BuildStatus::work) and how many of their vertices are Delaunay simplices
+// (no box plane). The cells themselves are not kept.
+template <class CellT>
+struct PilotCompositor {
+  struct Batch {
+    std::uint64_t cells = 0, work = 0, vertices = 0, found = 0;
+  };
+  Batch total;
+  void add(Batch& b, std::int32_t, const kernels::BuildStatus& st, CellT& cell) {
+    ++b.cells;
+    b.work += st.work;
+    if (!st.has_cell) return;
+    b.vertices += cell.vertices().size();
+    for (const auto& v : cell.vertices()) {
+      bool found = true;
+      for (int k = 0; k < CellT::dim; ++k) found &= v.p[k] >= CellT::box_planes;
+      b.found += found;
+    }
+  }
+  void finish(std::span<Batch> batches) {
+    for (const Batch& b : batches) {
+      total.cells += b.cells;
+      total.work += b.work;
+      total.vertices += b.vertices;
+      total.found += b.found;
+    }
+  }
+};
+
+// The automatic fraction of skipped cells (3D). Skipping a cell saves its
+// build; what its simplices then cost depends on the others' cells (a
+// fraction ~tau^4 of the simplices have skipped points only and are
+// wrapped, each at several times what a cell spends per simplex). So the
+// fraction should grow with what a cell costs per simplex it finds, which
+// differs by two orders between inputs. Measured optima (docs/design.md,
+// "Skipped cells"): 1M uniform points 0.3 (0.2-0.4 alike); lattices 0.3;
+// clustered volumes (the benchmark's clustered 100k, blobs and sheets of
+// 200k: cells 3-4 times a uniform one's search) 0.55-0.65; surface samples
+// (needle cells: the ellipsoid's 8-12 times, the torus's 40-160 times; a
+// terrain's 4-7 times, but nine in ten of its cells' vertices lie on the
+// box, as its simplices' balls reach far outside) 0.9 or more. The rule
+// tau = 0.3 sqrt(cost per found simplex, relative to uniform input),
+// clamped to [0.3, 0.9], fits all of them. The cost is measured, not
+// guessed from the bins (a surface and a set of blobs both leave ~80% of
+// the bins empty): a pilot builds the cells of points spread by their hash
+// (the highest hashes, which are never skipped) and counts their search
+// work (BuildStatus::work) and found vertices, both deterministic, so the
+// choice is the same for every thread count and run. It goes in bands of
+// pilot_band cells until pilot_bands are done or the estimate is far past
+// the clamp (costly cells need no more precision). The pilot's cells are
+// built again in the pass: at 1M uniform points that is ~0.2% of the run.
+inline constexpr std::size_t pilot_band = 256;
+inline constexpr std::size_t pilot_bands = 4;
+/// BuildStatus::work of a uniform 3D cell, on average, with the default two
+/// points per bin (307 at 100k and at 1M points; 169 on the 50^3 lattice).
+inline constexpr double uniform_cell_work = 307.0;
+
+template <class CellT>
+double automatic_skip_fraction(const front::Pass<CellT::dim>& pass) {
+  constexpr double lowest = 0.3, highest = 0.9;
+  if (pass.order.empty()) return lowest;
+  // Band k: the points whose hash lies in the k-th pilot_band / n of the
+  // range, counted down from the top (n: the generators).
+  const double band = static_cast<double>(pilot_band) / static_cast<double>(pass.order.size());
+  PilotCompositor<CellT> comp;
+  double ratio = 1;
+  for (std::size_t k = 0; k < pilot_bands && (k + 1) * band < 1 - highest; ++k) {
+    const auto from = static_cast<std::uint64_t>(std::ldexp(1.0 - static_cast<double>(k + 1) * band, 64));
+    const auto to = static_cast<std::uint64_t>(std::ldexp(1.0 - static_cast<double>(k) * band, 64));
+    std::vector<std::int32_t> order;
+    std::vector<std::uint32_t> slots;
+    for (std::size_t g = 0; g < pass.order.size(); ++g)
+      if (const std::uint64_t h = id_hash(pass.order[g]); h >= from && (k == 0 || h < to)) {
+        order.push_back(pass.order[g]);
+        slots.push_back(pass.slots[g]);
+      }
+    engine::Generators<CellT::dim> gens = pass.gens;
+    gens.order = order;
+    gens.slots = slots;
+    engine::EngineOptions eo = pass.engine_options;
+    eo.progress = nullptr;
+    eo.batch_size = 16;  // a band is a few batches of the pass's size
+    engine::tessellate<CellT>(gens, comp, eo);
+    const auto& t = comp.total;
+    if (t.vertices == 0) continue;    // no cell yet (duplicates only)
+    if (t.found == 0) return highest;  // no cell finds a simplex: all comes from completion
+    const double work = static_cast<double>(t.work) / static_cast<double>(t.cells) / uniform_cell_work;
+    ratio = work / (static_cast<double>(t.found) / static_cast<double>(t.vertices));
+    if (lowest * std::sqrt(ratio) > 2 * highest) break;
+  }
+  return std::clamp(lowest * std::sqrt(ratio), lowest, highest);
+}
+
 template <class CellT>
 Delaunay run(std::span<const double> input, std::span<const std::int32_t> labels, const DelaunayOptions& opt,
              int attempt = 0) {
@@ -183,12 +277,15 @@ Delaunay run(std::span<const double> input, std::span<const std::int32_t> labels
   out.threads_used = pass.engine_options.threads;
 
   // Skipped cells (docs/design.md, "Skipped cells"): only where completion
-  // runs, as it closes their cavities. Automatically 30% in 3D from 20,000
-  // points (1M uniform points: 3.0 -> 2.7 s on two threads; 40% and 50%
-  // gain less in the pass than the wraps cost). Not in 2D, whose cells are
-  // cheap next to the wraps that would replace them (1M points 0.59 ->
-  // 0.70 s at 30%).
-  const double skip = !complete ? 0 : opt.skip_cells < 0 ? (D == 3 && n >= 20000 ? 0.3 : 0) : opt.skip_cells;
+  // runs, as it closes their cavities. Automatically in 3D from 20,000
+  // points, 30% to 90% by what the cells cost (automatic_skip_fraction; 1M
+  // uniform points: 3.0 -> 2.7 s on two threads at 30%). Not in 2D, whose
+  // cells are cheap next to the wraps that would replace them (1M points
+  // 0.59 -> 0.70 s at 30%).
+  const double skip = !complete              ? 0
+                      : opt.skip_cells >= 0 ? opt.skip_cells
+                      : D == 3 && n >= 20000 ? automatic_skip_fraction<CellT>(pass)
+                                             : 0;
   std::vector<std::uint8_t> skipped;
   std::vector<std::int32_t> built_order;
   std::vector<std::uint32_t> built_slots;

@@ -525,12 +525,43 @@ TEST(Delaunay, SkippedCellsGiveTheSameRows) {
         EXPECT_EQ(dt.from_cells + dt.from_hull_completion, dt.n_simplices());
       }
   }
-  // The automatic choice (3D, 20,000 points and more) against CGAL.
+  // The automatic choice (3D, 20,000 points and more) against CGAL. Uniform
+  // cells cost what the pilot's reference does: the fraction stays near 0.3.
   auto p = random_points(30000, 3, 34);
   tessera::Delaunay dt = run(p, 3);
-  EXPECT_GT(dt.skipped_cells, 0u);
+  EXPECT_GT(dt.skipped_cells, 0.25 * 30000);
+  EXPECT_LT(dt.skipped_cells, 0.35 * 30000);
   EXPECT_EQ(as_set(dt), cgal_simplices(p, 3));
   expect_valid(dt, p);
+}
+
+TEST(Delaunay, AutomaticSkipFractionFollowsTheCellsCost) {
+  // A height field: its cells are needles to the box, and nine in ten of
+  // their vertices lie on it, so the pilot (automatic_skip_fraction) skips
+  // more cells than on uniform input. The choice is measured in
+  // deterministic units: the same for 1 and 2 threads, and the rows are
+  // those of the pass without skipping.
+  std::mt19937_64 rng(78);
+  std::uniform_real_distribution<double> u;
+  std::vector<double> terrain;
+  for (int i = 0; i < 24000; ++i) {
+    const double x = u(rng), y = u(rng);
+    terrain.insert(terrain.end(), {x, y, 0.1 * std::sin(6 * x) * std::cos(5 * y)});
+  }
+  tessera::DelaunayOptions o;
+  o.skip_cells = 0;
+  o.threads = 2;
+  const tessera::Delaunay all = tessera::delaunay(terrain, 3, {}, o);
+  o.skip_cells = -1;
+  std::size_t skipped = 0;
+  for (const int threads : {1, 2}) {
+    o.threads = threads;
+    const tessera::Delaunay dt = tessera::delaunay(terrain, 3, {}, o);
+    EXPECT_EQ(dt.simplices, all.simplices) << "threads " << threads;
+    EXPECT_GT(dt.skipped_cells, 0.6 * 24000) << "threads " << threads;
+    if (threads == 1) skipped = dt.skipped_cells;
+    else EXPECT_EQ(dt.skipped_cells, skipped);
+  }
 }
 
 TEST(Delaunay, SkipCellsOutOfRangeIsAnInputError) {

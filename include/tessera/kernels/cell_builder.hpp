@@ -40,6 +40,12 @@ inline constexpr std::uint32_t overfull_bin = 1024;
 struct BuildStatus {
   bool has_cell = true;          ///< false: an exact duplicate of `duplicate_of`
   std::int32_t duplicate_of = -1;
+  /// The search's work in deterministic units: points scanned in the bins,
+  /// plus k-d tree nodes visited, plus four per candidate tested against the
+  /// cell (a sign pass costs about four scanned points). Used to estimate
+  /// what cells cost on an input (delaunay's skipped-cell fraction); the
+  /// same for any thread count.
+  std::uint64_t work = 0;
 };
 
 template <class CellT>
@@ -56,6 +62,46 @@ class CellBuilder {
   /// Build the cell of generator i, whose coordinates p holds (the same
   /// doubles as the input's: the locator's copy), into `cell`.
   BuildStatus build(std::int32_t i, const double* p, CellT& cell) {
+    work_ = 0;
+    BuildStatus status = walk_shells(i, p, cell);
+    status.work = work_;
+    return status;
+  }
+
+  /// How many cells this builder finished by certify_by_petals (the rest
+  /// of its long cells fell back to the shell walk): for tests and tuning.
+  std::uint64_t petal_certified() const { return petal_certified_; }
+
+  /// The cell of generator i by the path its bin asks for: build(), or
+  /// build_nearest_first() in an overfull bin.
+  BuildStatus build_any(std::int32_t i, const double* p, CellT& cell) {
+    return in_overfull_bin(p) ? build_nearest_first(i, p, cell) : build(i, p, cell);
+  }
+
+  /// Whether a generator at p lies in an overfull bin of a pass that built a
+  /// k-d tree: then build_nearest_first() is its cell's build (the engine asks).
+  bool in_overfull_bin(const double* p) const {
+    if (tree_ == nullptr || !tree_->eager()) return false;
+    const std::size_t own = loc_.bin_index(loc_.bin_coords(p));
+    return loc_.offsets()[own + 1] - loc_.offsets()[own] > overfull_bin;
+  }
+
+  /// build() by the k-d tree: candidates nearest first, until the next one
+  /// lies beyond the security radius. The same clips as the shell walk's,
+  /// from the same differences; exact ties come in id order, so the
+  /// duplicate rule holds as there. A separate function, chosen by the
+  /// engine: with both paths in build() the compiler laid out the hot loops
+  /// worse (2D on 2 threads ~5% slower).
+  [[gnu::noinline]] BuildStatus build_nearest_first(std::int32_t i, const double* p, CellT& cell) {
+    work_ = 0;
+    BuildStatus status = search_nearest_first(i, p, cell);
+    status.work = work_;
+    return status;
+  }
+
+ private:
+  /// build(): the shell walk.
+  BuildStatus walk_shells(std::int32_t i, const double* p, CellT& cell) {
     cell.reset(i, p, lo_, hi_, exact_);
     const auto b = loc_.bin_coords(p);
     const int last = loc_.max_shell(b);
@@ -97,6 +143,7 @@ class CellBuilder {
       // is a few bins' worth of contiguous slots: this loop is the search.
       std::size_t nc = 0;
       auto gather = [&](std::uint32_t a, std::uint32_t e) {
+        work_ += e - a;
         if (cand_.size() < nc + (e - a)) [[unlikely]] {
           cand_.resize(2 * (nc + (e - a)));
           keys_.resize(cand_.size());
@@ -180,6 +227,7 @@ class CellBuilder {
           }
           return Next::go;  // a higher-id duplicate of ours never clips
         }
+        work_ += 4;
         const ClipResult r = cell.clip(cd.id, cd.q);
         sec2 = cell.security_radius2();  // unchanged unless it clipped: a load, not a branch
         if (r == ClipResult::emptied) [[unlikely]] {
@@ -211,31 +259,8 @@ class CellBuilder {
     return status;
   }
 
-  /// How many cells this builder finished by certify_by_petals (the rest
-  /// of its long cells fell back to the shell walk): for tests and tuning.
-  std::uint64_t petal_certified() const { return petal_certified_; }
-
-  /// The cell of generator i by the path its bin asks for: build(), or
-  /// build_nearest_first() in an overfull bin.
-  BuildStatus build_any(std::int32_t i, const double* p, CellT& cell) {
-    return in_overfull_bin(p) ? build_nearest_first(i, p, cell) : build(i, p, cell);
-  }
-
-  /// Whether a generator at p lies in an overfull bin of a pass that built a
-  /// k-d tree: then build_nearest_first() is its cell's build (the engine asks).
-  bool in_overfull_bin(const double* p) const {
-    if (tree_ == nullptr || !tree_->eager()) return false;
-    const std::size_t own = loc_.bin_index(loc_.bin_coords(p));
-    return loc_.offsets()[own + 1] - loc_.offsets()[own] > overfull_bin;
-  }
-
-  /// build() by the k-d tree: candidates nearest first, until the next one
-  /// lies beyond the security radius. The same clips as the shell walk's,
-  /// from the same differences; exact ties come in id order, so the
-  /// duplicate rule holds as there. A separate function, chosen by the
-  /// engine: with both paths in build() the compiler laid out the hot loops
-  /// worse (2D on 2 threads ~5% slower).
-  [[gnu::noinline]] BuildStatus build_nearest_first(std::int32_t i, const double* p, CellT& cell) {
+  /// build_nearest_first(): the k-d tree's search.
+  BuildStatus search_nearest_first(std::int32_t i, const double* p, CellT& cell) {
     cell.reset(i, p, lo_, hi_, exact_);
     BuildStatus status;
     double sec2 = cell.security_radius2();
@@ -254,6 +279,7 @@ class CellBuilder {
     };
     tree_->get().nearest_first(p, i, heap_, [&] { return sec2; }, [&](std::int32_t j, double r2) {
       ++visited;
+      work_ += 4;
       if (r2 == 0 && exactly_equal(p, j)) {
         if (j < i) {  // the first duplicate met is the lowest id
           status.has_cell = false;
@@ -277,7 +303,6 @@ class CellBuilder {
     return status;
   }
 
- private:
   enum class Certified { final, unsure, no_cell };
 
   /// Try to finish a long cell by certifying its vertices (corner
@@ -373,6 +398,7 @@ class CellBuilder {
       std::size_t budget = allowed;
       const std::int32_t j = tree.nearest(c, i, reach * reach * (1.0 + 1e-9), skip, budget);
       nodes += allowed - budget;
+      work_ += allowed - budget;
       ++searches;
       if (j == -2) return Certified::unsure;
       if (j == -1) {
@@ -380,6 +406,7 @@ class CellBuilder {
         continue;
       }
       mark(j);
+      work_ += 4;
       double q[D];
       for (int d = 0; d < D; ++d) q[d] = coords_[static_cast<std::size_t>(j) * D + d] - p[d];
       if (cell.clip(j, q) == ClipResult::emptied) return Certified::no_cell;
@@ -570,6 +597,7 @@ class CellBuilder {
   std::vector<std::uint32_t> tried_;  // certify_by_petals: per point, the epoch it was last marked in
   std::uint32_t epoch_ = 0;
   std::uint64_t petal_certified_ = 0;
+  std::uint64_t work_ = 0;  // the current cell's BuildStatus::work
   std::vector<std::uint64_t> certified_;  // per vertex slot: the key it was certified with
   PetalCover<D> petals_;  // build_nearest_first's
   std::vector<Candidate> cand_;
