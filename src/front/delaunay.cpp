@@ -233,24 +233,36 @@ double automatic_skip_fraction(const front::Pass<CellT::dim>& pass) {
   // Band k: the points whose hash lies in the k-th pilot_band / n of the
   // range, counted down from the top (n: the generators).
   const double band = static_cast<double>(pilot_band) / static_cast<double>(pass.order.size());
+  const std::size_t bands = std::min<std::size_t>(pilot_bands, static_cast<std::size_t>((1 - highest) / band));
+  if (bands == 0) return lowest;
+  // Every band's generators in one scan (bin order kept), with their band.
+  const auto from = static_cast<std::uint64_t>(std::ldexp(1.0 - static_cast<double>(bands) * band, 64));
+  struct Pick {
+    std::int32_t gen;
+    std::uint32_t slot, band;
+  };
+  std::vector<Pick> picks;
+  for (std::size_t g = 0; g < pass.order.size(); ++g)
+    if (const std::uint64_t h = id_hash(pass.order[g]); h >= from)
+      picks.push_back({pass.order[g], pass.slots[g],
+                       std::min(static_cast<std::uint32_t>(bands - 1),
+                                static_cast<std::uint32_t>((1.0 - std::ldexp(static_cast<double>(h), -64)) / band))});
   PilotCompositor<CellT> comp;
   double ratio = 1;
-  for (std::size_t k = 0; k < pilot_bands && (k + 1) * band < 1 - highest; ++k) {
-    const auto from = static_cast<std::uint64_t>(std::ldexp(1.0 - static_cast<double>(k + 1) * band, 64));
-    const auto to = static_cast<std::uint64_t>(std::ldexp(1.0 - static_cast<double>(k) * band, 64));
+  for (std::size_t k = 0; k < bands; ++k) {
     std::vector<std::int32_t> order;
     std::vector<std::uint32_t> slots;
-    for (std::size_t g = 0; g < pass.order.size(); ++g)
-      if (const std::uint64_t h = id_hash(pass.order[g]); h >= from && (k == 0 || h < to)) {
-        order.push_back(pass.order[g]);
-        slots.push_back(pass.slots[g]);
+    for (const Pick& pk : picks)
+      if (pk.band == k) {
+        order.push_back(pk.gen);
+        slots.push_back(pk.slot);
       }
     engine::Generators<CellT::dim> gens = pass.gens;
     gens.order = order;
     gens.slots = slots;
     engine::EngineOptions eo = pass.engine_options;
     eo.progress = nullptr;
-    eo.batch_size = 16;  // a band is a few batches of the pass's size
+    eo.batch_size = 16;  // a band of 256 cells in 16 batches, shared among the threads
     engine::tessellate<CellT>(gens, comp, eo);
     const auto& t = comp.total;
     if (t.vertices == 0) continue;    // no cell yet (duplicates only)
