@@ -8,6 +8,7 @@
 #include <atomic>
 #include <cmath>
 #include <cstring>
+#include <numbers>
 #include <numeric>
 #include <optional>
 #include <span>
@@ -129,31 +130,124 @@ std::uint64_t id_hash(std::int32_t id) {
   return z ^ (z >> 31);
 }
 
-// The points whose cells are skipped: those whose hash falls below
-// `fraction` of the range, except points with an exact duplicate (a cell
-// decides which of them owns it). Coincident points share a bin, so each
-// bin's points are compared with each other (sorted first when there are
-// many). Located points only.
+// The points whose cells are skipped (docs/design.md, "Skipped cells").
+//
+// A point is skipped when its hash ranks in the lowest `fraction` of the
+// hashes of the points near it: those within the radius that holds about
+// spread_neighbours of them at the density of the 3^D bins around its own.
+// Ranking among neighbours spreads the skipped points out, so fewer
+// simplices have skipped points only (they are wrapped, at several times a
+// cell's cost per simplex) than when a point is skipped by its hash alone.
+// Simulated on 100k uniform 3D points: 0.30 of them skipped by hash leave
+// 0.81% of the simplices to the wraps; ranking among ~8 neighbours skips
+// 0.32 for 0.55%, and 0.38 for 1.1% (hash alone at 0.4: 2.5%). 1M uniform
+// points on two threads: 2.78 -> 2.67 s (medians of 5, alternating runs;
+// 0.3 by hash against 0.35 ranked, which skips 0.37), though choosing
+// costs ~0.1 s (~54 distances per point); clustered inputs, which ask for
+// larger fractions, gain nothing.
+//
+// Where those bins are crowded (over spread_max points: dense clusters,
+// where the scan would cost more than it spares) a point is skipped when
+// its hash falls below `fraction` of the range. Points with an exact
+// duplicate are never skipped (a cell decides which of them owns it):
+// coincident points share a bin, so the scan sees them (a crowded bin's
+// points are sorted first). The choice depends on the points and their ids
+// only, not on the thread count. Located points only.
+inline constexpr double spread_neighbours = 8;
+inline constexpr std::size_t spread_max = 160;
+
 template <int D>
 std::vector<std::uint8_t> choose_skipped(const front::Pass<D>& pass, double fraction, std::size_t n) {
   std::vector<std::uint8_t> skipped(n, 0);
   const auto& loc = *pass.locator;
   const auto threshold = static_cast<std::uint64_t>(std::ldexp(fraction, 64));
   const auto& off = loc.offsets();
+  // Per slot, the hash's top 53 bits as a double: ranks compare exactly,
+  // and the scan below runs in double lanes.
+  std::vector<double> rank_key(loc.size());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, loc.size(), 1 << 14), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t k = r.begin(); k != r.end(); ++k) rank_key[k] = static_cast<double>(id_hash(loc.id(k)) >> 11);
+  });
+  double bin_volume = 1;
+  for (int d = 0; d < D; ++d) {
+    const auto du = static_cast<std::size_t>(d);
+    bin_volume *= (pass.gens.hi[du] - pass.gens.lo[du]) / loc.divisions()[du];
+  }
+  const double ball = spread_neighbours / (D == 3 ? 4.0 / 3.0 * std::numbers::pi : std::numbers::pi);
+
+  // Bin k by the rank among neighbours; false (nothing decided) when the
+  // 3^D bins around it are crowded.
+  auto by_rank = [&](std::size_t k) {
+    std::array<std::int32_t, D> lo, hi;
+    std::size_t rest = k, bins = 1;
+    for (int d = 0; d < D; ++d) {
+      const auto du = static_cast<std::size_t>(d);
+      const auto divs = static_cast<std::size_t>(loc.divisions()[du]);
+      const auto c = static_cast<std::int32_t>(rest % divs);
+      rest /= divs;
+      lo[du] = std::max(c - 1, 0);
+      hi[du] = std::min(c + 1, loc.divisions()[du] - 1);
+      bins *= static_cast<std::size_t>(hi[du] - lo[du] + 1);
+    }
+    // Their slots, as one run per row of bins (rows are contiguous along x).
+    constexpr int rows = D == 3 ? 9 : 3;
+    std::uint32_t first[rows], last[rows];
+    int nr = 0;
+    std::size_t count = 0;
+    {
+      std::array<std::int32_t, D> a = lo, e = lo;
+      e[0] = hi[0];
+      auto row = [&] {
+        first[nr] = off[loc.bin_index(a)];
+        last[nr] = off[loc.bin_index(e) + 1];
+        count += last[nr] - first[nr];
+        ++nr;
+      };
+      if constexpr (D == 2) {
+        for (a[1] = e[1] = lo[1]; a[1] <= hi[1]; e[1] = ++a[1]) row();
+      } else {
+        for (a[2] = lo[2]; a[2] <= hi[2]; ++a[2])
+          for (a[1] = lo[1]; a[1] <= hi[1]; ++a[1]) {
+            e[1] = a[1];
+            e[2] = a[2];
+            row();
+          }
+      }
+    }
+    if (count > spread_max) return false;
+    // The radius of a ball that holds spread_neighbours points at the density around.
+    const double density = static_cast<double>(count - 1) / (static_cast<double>(bins) * bin_volume);
+    const double r2 = density > 0 ? std::pow(ball / density, 2.0 / D) : 0.0;
+    for (std::uint32_t i = off[k]; i < off[k + 1]; ++i) {
+      const auto& p = loc.point(i);
+      const double own = rank_key[i];
+      // Counted over every slot, the point itself included (d2 = 0, not lower).
+      std::uint32_t zero = 0, near = 0, lower = 0;
+      for (int w = 0; w < nr; ++w)
+        for (std::uint32_t j = first[w]; j < last[w]; ++j) {
+          const auto& q = loc.point(j);
+          double d2 = 0;
+          for (int d = 0; d < D; ++d) d2 += (q[static_cast<std::size_t>(d)] - p[static_cast<std::size_t>(d)]) * (q[static_cast<std::size_t>(d)] - p[static_cast<std::size_t>(d)]);
+          const bool in = d2 <= r2;
+          zero += d2 == 0;  // also for points within ~1e-162: kept, which is always safe
+          near += in;
+          lower += in & (rank_key[j] < own);
+        }
+      const bool alone = zero == 1;
+      near -= 1;
+      const bool pick = near == 0 ? id_hash(loc.id(i)) < threshold
+                                  : static_cast<double>(lower) < fraction * static_cast<double>(near);
+      skipped[static_cast<std::size_t>(loc.id(i))] = alone && pick;
+    }
+    return true;
+  };
+
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, loc.num_bins(), 4096), [&](const tbb::blocked_range<std::size_t>& r) {
     std::vector<std::uint32_t> order;
     for (std::size_t k = r.begin(); k != r.end(); ++k) {
       const std::uint32_t a = off[k], e = off[k + 1];
-      if (e - a <= 16) {
-        for (std::uint32_t i = a; i < e; ++i) {
-          const std::int32_t id = loc.id(i);
-          if (id_hash(id) >= threshold) continue;
-          bool alone = true;
-          for (std::uint32_t j = a; j < e; ++j) alone &= j == i || loc.point(j) != loc.point(i);
-          skipped[static_cast<std::size_t>(id)] = alone;
-        }
-        continue;
-      }
+      if (a == e || by_rank(k)) continue;
+      // Crowded: by hash.
       order.resize(e - a);
       std::iota(order.begin(), order.end(), a);
       std::sort(order.begin(), order.end(), [&](std::uint32_t x, std::uint32_t y) { return loc.point(x) < loc.point(y); });
@@ -199,23 +293,23 @@ struct PilotCompositor {
 };
 
 // The automatic fraction of skipped cells (3D). Skipping a cell saves its
-// build; what its simplices then cost depends on the others' cells (a
-// fraction ~tau^4 of the simplices have skipped points only and are
-// wrapped, each at several times what a cell spends per simplex). So the
-// fraction should grow with what a cell costs per simplex it finds, which
-// differs by two orders between inputs. Measured optima (docs/design.md,
-// "Skipped cells"): 1M uniform points 0.3 (0.2-0.4 alike); lattices 0.3;
+// build; what its simplices then cost depends on the others' cells (the
+// simplices of skipped points only are wrapped, each at several times what
+// a cell spends per simplex). So the fraction should grow with what a cell
+// costs per simplex it finds, which differs by two orders between inputs.
+// Measured optima (docs/design.md, "Skipped cells"; the fraction as
+// choose_skipped takes it): 1M uniform points and lattices 0.35-0.4;
 // clustered volumes (the benchmark's clustered 100k, blobs and sheets of
-// 200k: cells 3-4 times a uniform one's search) 0.55-0.65; surface samples
+// 200k: cells 3-4 times a uniform one's search) 0.5-0.6; surface samples
 // (needle cells: the ellipsoid's 8-12 times, the torus's 40-160 times; a
 // terrain's 4-7 times, but nine in ten of its cells' vertices lie on the
 // box, as its simplices' balls reach far outside) 0.9 or more. The rule
 // tau = 0.3 sqrt(cost per found simplex, relative to uniform input),
-// clamped to [0.3, 0.9], fits all of them. The cost is measured, not
+// clamped to [0.35, 0.9], fits all of them. The cost is measured, not
 // guessed from the bins (a surface and a set of blobs both leave ~80% of
 // the bins empty): a pilot builds the cells of points spread by their hash
-// (the highest hashes, which are never skipped) and counts their search
-// work (BuildStatus::work) and found vertices, both deterministic, so the
+// (any spatially random sample would do) and counts their search work
+// (BuildStatus::work) and found vertices, both deterministic, so the
 // choice is the same for every thread count and run. It goes in bands of
 // pilot_band cells until pilot_bands are done or the estimate is far past
 // the clamp (costly cells need no more precision). The pilot's cells are
@@ -228,7 +322,7 @@ inline constexpr double uniform_cell_work = 307.0;
 
 template <class CellT>
 double automatic_skip_fraction(const front::Pass<CellT::dim>& pass) {
-  constexpr double lowest = 0.3, highest = 0.9;
+  constexpr double slope = 0.3, lowest = 0.35, highest = 0.9;
   if (pass.order.empty()) return lowest;
   // Band k: the points whose hash lies in the k-th pilot_band / n of the
   // range, counted down from the top (n: the generators).
@@ -269,9 +363,9 @@ double automatic_skip_fraction(const front::Pass<CellT::dim>& pass) {
     if (t.found == 0) return highest;  // no cell finds a simplex: all comes from completion
     const double work = static_cast<double>(t.work) / static_cast<double>(t.cells) / uniform_cell_work;
     ratio = work / (static_cast<double>(t.found) / static_cast<double>(t.vertices));
-    if (lowest * std::sqrt(ratio) > 2 * highest) break;
+    if (slope * std::sqrt(ratio) > 2 * highest) break;
   }
-  return std::clamp(lowest * std::sqrt(ratio), lowest, highest);
+  return std::clamp(slope * std::sqrt(ratio), lowest, highest);
 }
 
 template <class CellT>
@@ -290,8 +384,8 @@ Delaunay run(std::span<const double> input, std::span<const std::int32_t> labels
 
   // Skipped cells (docs/design.md, "Skipped cells"): only where completion
   // runs, as it closes their cavities. Automatically in 3D from 20,000
-  // points, 30% to 90% by what the cells cost (automatic_skip_fraction; 1M
-  // uniform points: 3.0 -> 2.7 s on two threads at 30%). Not in 2D, whose
+  // points, 35% to 90% by what the cells cost (automatic_skip_fraction; 1M
+  // uniform points: 3.0 -> 2.7 s on two threads at 30% by hash). Not in 2D, whose
   // cells are cheap next to the wraps that would replace them (1M points
   // 0.59 -> 0.70 s at 30%).
   const double skip = !complete              ? 0

@@ -526,11 +526,12 @@ TEST(Delaunay, SkippedCellsGiveTheSameRows) {
       }
   }
   // The automatic choice (3D, 20,000 points and more) against CGAL. Uniform
-  // cells cost what the pilot's reference does: the fraction stays near 0.3.
+  // cells cost what the pilot's reference does: the fraction stays at its
+  // least, 0.35 of the neighbours' ranks (which skips ~0.37 of the points).
   auto p = random_points(30000, 3, 34);
   tessera::Delaunay dt = run(p, 3);
-  EXPECT_GT(dt.skipped_cells, 0.25 * 30000);
-  EXPECT_LT(dt.skipped_cells, 0.35 * 30000);
+  EXPECT_GT(dt.skipped_cells, 0.33 * 30000);
+  EXPECT_LT(dt.skipped_cells, 0.42 * 30000);
   EXPECT_EQ(as_set(dt), cgal_simplices(p, 3));
   expect_valid(dt, p);
 }
