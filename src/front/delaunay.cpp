@@ -189,31 +189,17 @@ std::vector<std::uint8_t> choose_skipped(const front::Pass<D>& pass, double frac
       hi[du] = std::min(c + 1, loc.divisions()[du] - 1);
       bins *= static_cast<std::size_t>(hi[du] - lo[du] + 1);
     }
-    // Their slots, as one run per row of bins (rows are contiguous along x).
+    // Their slots, as one run per row of bins.
     constexpr int rows = D == 3 ? 9 : 3;
     std::uint32_t first[rows], last[rows];
     int nr = 0;
     std::size_t count = 0;
-    {
-      std::array<std::int32_t, D> a = lo, e = lo;
-      e[0] = hi[0];
-      auto row = [&] {
-        first[nr] = off[loc.bin_index(a)];
-        last[nr] = off[loc.bin_index(e) + 1];
-        count += last[nr] - first[nr];
-        ++nr;
-      };
-      if constexpr (D == 2) {
-        for (a[1] = e[1] = lo[1]; a[1] <= hi[1]; e[1] = ++a[1]) row();
-      } else {
-        for (a[2] = lo[2]; a[2] <= hi[2]; ++a[2])
-          for (a[1] = lo[1]; a[1] <= hi[1]; ++a[1]) {
-            e[1] = a[1];
-            e[2] = a[2];
-            row();
-          }
-      }
-    }
+    loc.for_each_row_run(lo, hi, [&](std::uint32_t a, std::uint32_t e) {
+      first[nr] = a;
+      last[nr] = e;
+      count += e - a;
+      ++nr;
+    });
     if (count > spread_max) return false;
     // The radius of a ball that holds spread_neighbours points at the density around.
     const double density = static_cast<double>(count - 1) / (static_cast<double>(bins) * bin_volume);

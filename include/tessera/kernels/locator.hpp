@@ -132,13 +132,14 @@ class BinLocator {
     first = bin_coords(lo);
     last = bin_coords(hi);
   }
-  /// The number of points in the bins [first, last] (per axis, inclusive):
-  /// one subtraction per row of bins, which are contiguous along x.
-  std::size_t count_in(const std::array<std::int32_t, D>& first, const std::array<std::int32_t, D>& last) const {
-    std::size_t n = 0;
+  /// The slots of the bins [first, last] (per axis, inclusive) as one run
+  /// per row of bins (rows are contiguous along x): f(begin slot, end slot).
+  template <class F>
+  void for_each_row_run(const std::array<std::int32_t, D>& first, const std::array<std::int32_t, D>& last,
+                        F&& f) const {
     std::array<std::int32_t, D> a = first, e = first;
     e[0] = last[0];
-    auto row = [&] { n += offsets_[bin_index(e) + 1] - offsets_[bin_index(a)]; };
+    auto row = [&] { f(offsets_[bin_index(a)], offsets_[bin_index(e) + 1]); };
     if constexpr (D == 2) {
       for (a[1] = e[1] = first[1]; a[1] <= last[1]; e[1] = ++a[1]) row();
     } else {
@@ -149,6 +150,12 @@ class BinLocator {
           row();
         }
     }
+  }
+  /// The number of points in the bins [first, last] (per axis, inclusive):
+  /// one subtraction per row of bins.
+  std::size_t count_in(const std::array<std::int32_t, D>& first, const std::array<std::int32_t, D>& last) const {
+    std::size_t n = 0;
+    for_each_row_run(first, last, [&](std::uint32_t a, std::uint32_t e) { n += e - a; });
     return n;
   }
   std::size_t bin_index(const std::array<std::int32_t, D>& b) const {
