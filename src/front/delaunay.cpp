@@ -300,21 +300,42 @@ struct PilotCompositor {
 // pilot_band cells until pilot_bands are done or the estimate is far past
 // the clamp (costly cells need no more precision). The pilot's cells are
 // built again in the pass: at 1M uniform points that is ~0.2% of the run.
+//
+// In 2D a cell is cheap next to the wraps that would replace it: uniform
+// points want none skipped (1M points: 0.63 s, 0.65 s at 0.2, 0.67 s at
+// 0.35), but clustered ones (200k points in blobs, along curves, along
+// segments: ratios 5.8-7.1) gain 15-25% at 0.45-0.6 (curves 0.50 -> 0.37
+// s). So in 2D nothing is skipped below a ratio of 2, and above it the
+// fraction is 0.2 sqrt(ratio) in [0.3, 0.6].
 inline constexpr std::size_t pilot_band = 256;
 inline constexpr std::size_t pilot_bands = 4;
-/// BuildStatus::work of a uniform 3D cell, on average, with the default two
-/// points per bin (307 at 100k and at 1M points; 169 on the 50^3 lattice).
-inline constexpr double uniform_cell_work = 307.0;
+
+template <int D>
+struct SkipRule {
+  /// BuildStatus::work of a uniform cell, on average, with the default two
+  /// points per bin (3D: 307 at 100k and at 1M points, 169 on the 50^3
+  /// lattice; 2D: 81-83 at 200k and 1M).
+  double uniform_work;
+  double off_below;  ///< no skipping below this ratio
+  double slope, lowest, highest;
+};
+inline constexpr SkipRule<3> skip_rule_3d{307.0, 0.0, 0.3, 0.35, 0.9};
+inline constexpr SkipRule<2> skip_rule_2d{82.0, 2.0, 0.2, 0.3, 0.6};
 
 template <class CellT>
 double automatic_skip_fraction(const front::Pass<CellT::dim>& pass) {
-  constexpr double slope = 0.3, lowest = 0.35, highest = 0.9;
-  if (pass.order.empty()) return lowest;
+  constexpr int D = CellT::dim;
+  constexpr auto rule = [] {
+    if constexpr (D == 3) return skip_rule_3d;
+    else return skip_rule_2d;
+  }();
+  constexpr double slope = rule.slope, lowest = rule.lowest, highest = rule.highest;
+  if (pass.order.empty()) return D == 3 ? lowest : 0.0;
   // Band k: the points whose hash lies in the k-th pilot_band / n of the
   // range, counted down from the top (n: the generators).
   const double band = static_cast<double>(pilot_band) / static_cast<double>(pass.order.size());
   const std::size_t bands = std::min<std::size_t>(pilot_bands, static_cast<std::size_t>((1 - highest) / band));
-  if (bands == 0) return lowest;
+  if (bands == 0) return D == 3 ? lowest : 0.0;
   // Every band's generators in one scan (bin order kept), with their band.
   const auto from = static_cast<std::uint64_t>(std::ldexp(1.0 - static_cast<double>(bands) * band, 64));
   struct Pick {
@@ -347,10 +368,11 @@ double automatic_skip_fraction(const front::Pass<CellT::dim>& pass) {
     const auto& t = comp.total;
     if (t.vertices == 0) continue;    // no cell yet (duplicates only)
     if (t.found == 0) return highest;  // no cell finds a simplex: all comes from completion
-    const double work = static_cast<double>(t.work) / static_cast<double>(t.cells) / uniform_cell_work;
+    const double work = static_cast<double>(t.work) / static_cast<double>(t.cells) / rule.uniform_work;
     ratio = work / (static_cast<double>(t.found) / static_cast<double>(t.vertices));
     if (slope * std::sqrt(ratio) > 2 * highest) break;
   }
+  if (ratio < rule.off_below) return 0.0;
   return std::clamp(slope * std::sqrt(ratio), lowest, highest);
 }
 
@@ -369,14 +391,14 @@ Delaunay run(std::span<const double> input, std::span<const std::int32_t> labels
   out.threads_used = pass.engine_options.threads;
 
   // Skipped cells (docs/design.md, "Skipped cells"): only where completion
-  // runs, as it closes their cavities. Automatically in 3D from 20,000
-  // points, 35% to 90% by what the cells cost (automatic_skip_fraction; 1M
-  // uniform points: 3.0 -> 2.7 s on two threads at 30% by hash). Not in 2D, whose
-  // cells are cheap next to the wraps that would replace them (1M points
-  // 0.59 -> 0.70 s at 30%).
+  // runs, as it closes their cavities. Automatically from 20,000 points, by
+  // what the cells cost (automatic_skip_fraction): in 3D 35% to 90% (1M
+  // uniform points: 3.0 -> 2.7 s on two threads at 30% by hash); in 2D none
+  // on uniform points, whose cells are cheap next to the wraps that would
+  // replace them, 30% to 60% on clustered ones.
   const double skip = !complete              ? 0
                       : opt.skip_cells >= 0 ? opt.skip_cells
-                      : D == 3 && n >= 20000 ? automatic_skip_fraction<CellT>(pass)
+                      : n >= 20000           ? automatic_skip_fraction<CellT>(pass)
                                              : 0;
   std::vector<std::uint8_t> skipped;
   std::vector<std::int32_t> built_order;

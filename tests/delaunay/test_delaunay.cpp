@@ -565,6 +565,34 @@ TEST(Delaunay, AutomaticSkipFractionFollowsTheCellsCost) {
   }
 }
 
+TEST(Delaunay, AutomaticSkipFractionIn2D) {
+  // 2D cells are cheap: uniform points skip none. Points along curves (a
+  // cell reaches across the gaps between them) skip some, with the same rows.
+  tessera::DelaunayOptions o;
+  o.dim = 2;
+  o.threads = 2;
+  const auto uniform = random_points(25000, 2, 35);
+  EXPECT_EQ(tessera::delaunay(uniform, 2, {}, o).skipped_cells, 0u);
+  std::mt19937_64 rng(79);
+  std::uniform_real_distribution<double> u;
+  std::normal_distribution<double> g;
+  std::vector<double> curves;
+  for (int i = 0; i < 24000; ++i) {
+    const int c = i % 12;
+    const double t = 6.283185307179586 * u(rng), r = 0.05 + 0.02 * c;
+    curves.insert(curves.end(), {0.3 * (c % 4) + r * std::cos(t) + 1e-4 * g(rng), 0.4 * (c / 4) + r * std::sin(t) + 1e-4 * g(rng)});
+  }
+  o.skip_cells = 0;
+  const tessera::Delaunay all = tessera::delaunay(curves, 2, {}, o);
+  o.skip_cells = -1;
+  for (const int threads : {1, 2}) {
+    o.threads = threads;
+    const tessera::Delaunay dt = tessera::delaunay(curves, 2, {}, o);
+    EXPECT_GT(dt.skipped_cells, 0.25 * 24000) << "threads " << threads;
+    EXPECT_EQ(dt.simplices, all.simplices) << "threads " << threads;
+  }
+}
+
 TEST(Delaunay, SkipCellsOutOfRangeIsAnInputError) {
   auto p = random_points(100, 3, 35);
   tessera::DelaunayOptions o;
