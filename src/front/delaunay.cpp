@@ -278,7 +278,7 @@ struct PilotCompositor {
   }
 };
 
-// The automatic fraction of skipped cells (3D). Skipping a cell saves its
+// The automatic fraction of skipped cells (3D; 2D below). Skipping a cell saves its
 // build; what its simplices then cost depends on the others' cells (the
 // simplices of skipped points only are wrapped, each at several times what
 // a cell spends per simplex). So the fraction should grow with what a cell
@@ -310,7 +310,6 @@ struct PilotCompositor {
 inline constexpr std::size_t pilot_band = 256;
 inline constexpr std::size_t pilot_bands = 4;
 
-template <int D>
 struct SkipRule {
   /// BuildStatus::work of a uniform cell, on average, with the default two
   /// points per bin (3D: 307 at 100k and at 1M points, 169 on the 50^3
@@ -319,23 +318,21 @@ struct SkipRule {
   double off_below;  ///< no skipping below this ratio
   double slope, lowest, highest;
 };
-inline constexpr SkipRule<3> skip_rule_3d{307.0, 0.0, 0.3, 0.35, 0.9};
-inline constexpr SkipRule<2> skip_rule_2d{82.0, 2.0, 0.2, 0.3, 0.6};
+inline constexpr SkipRule skip_rule_3d{307.0, 0.0, 0.3, 0.35, 0.9};
+inline constexpr SkipRule skip_rule_2d{82.0, 2.0, 0.2, 0.3, 0.6};
 
 template <class CellT>
 double automatic_skip_fraction(const front::Pass<CellT::dim>& pass) {
   constexpr int D = CellT::dim;
-  constexpr auto rule = [] {
-    if constexpr (D == 3) return skip_rule_3d;
-    else return skip_rule_2d;
-  }();
+  constexpr SkipRule rule = D == 3 ? skip_rule_3d : skip_rule_2d;
   constexpr double slope = rule.slope, lowest = rule.lowest, highest = rule.highest;
-  if (pass.order.empty()) return D == 3 ? lowest : 0.0;
+  constexpr double unmeasured = D == 3 ? lowest : 0.0;  // too few points for a pilot
+  if (pass.order.empty()) return unmeasured;
   // Band k: the points whose hash lies in the k-th pilot_band / n of the
   // range, counted down from the top (n: the generators).
   const double band = static_cast<double>(pilot_band) / static_cast<double>(pass.order.size());
   const std::size_t bands = std::min<std::size_t>(pilot_bands, static_cast<std::size_t>((1 - highest) / band));
-  if (bands == 0) return D == 3 ? lowest : 0.0;
+  if (bands == 0) return unmeasured;
   // Every band's generators in one scan (bin order kept), with their band.
   const auto from = static_cast<std::uint64_t>(std::ldexp(1.0 - static_cast<double>(bands) * band, 64));
   struct Pick {
