@@ -25,6 +25,12 @@ DelaunayOptions delaunay_options(const ComputeArgs& c, int dim, bool complete_hu
 }
 
 /// tessera::delaunay with a progress bar and Ctrl-C cancellation (as compute()).
+DelaunayMethod delaunay_method(const std::string& name) {
+  if (name == "cells") return DelaunayMethod::cells;
+  if (name == "insertion") return DelaunayMethod::insertion;
+  return DelaunayMethod::automatic;  // CLI11 admits only auto|cells|insertion
+}
+
 Delaunay triangulate(const io::PointCloud& pc, DelaunayOptions opt, bool show_progress, double& seconds) {
   ProgressBar bar("tessera: computing the triangulation", show_progress);
   InterruptGuard guard;
@@ -68,6 +74,7 @@ int run_delaunay(const DelaunayArgs& a) {
   double compute_s = 0;
   DelaunayOptions opt = delaunay_options(a.compute, pc.dim, !a.no_hull_completion);
   opt.skip_cells = a.skip_cells;
+  opt.method = delaunay_method(a.method);
   const Delaunay dt = triangulate(pc, opt,
                                   !a.quiet && stderr_is_terminal(), compute_s);
 
@@ -86,9 +93,13 @@ int run_delaunay(const DelaunayArgs& a) {
   const double write_s = seconds_since(t0);
 
   if (!a.quiet) {
-    std::fprintf(stderr, "tessera: %zu points (%dD) -> %zu %s (%zu from the cells, %zu by hull completion%s)\n",
-                 pc.n, pc.dim, dt.n_simplices(), pc.dim == 3 ? "tetrahedra" : "triangles", dt.from_cells,
-                 dt.from_hull_completion, dt.hull_completed ? "" : ": off");
+    if (dt.from_insertion > 0)
+      std::fprintf(stderr, "tessera: %zu points (%dD) -> %zu %s (by incremental insertion)\n", pc.n, pc.dim,
+                   dt.n_simplices(), pc.dim == 3 ? "tetrahedra" : "triangles");
+    else
+      std::fprintf(stderr, "tessera: %zu points (%dD) -> %zu %s (%zu from the cells, %zu by hull completion%s)\n",
+                   pc.n, pc.dim, dt.n_simplices(), pc.dim == 3 ? "tetrahedra" : "triangles", dt.from_cells,
+                   dt.from_hull_completion, dt.hull_completed ? "" : ": off");
     if (dt.n_simplices() == 0)
       std::fprintf(stderr, "tessera: no simplices: the points are %s%s\n",
                    pc.dim == 3 ? "coplanar (for a 2D triangulation use --dim 2 on in-plane coordinates)" : "collinear",
@@ -128,6 +139,7 @@ int run_bench_delaunay(const BenchArgs& a) {
   const io::PointCloud pc = read_input(a.compute);
   DelaunayOptions opt = delaunay_options(a.compute, pc.dim, true);
   opt.skip_cells = a.skip_cells;
+  opt.method = delaunay_method(a.method);
   for (int rep = 0; rep < a.repeat; ++rep) {
     // Timed region: the library call only (no I/O), as the peers do.
     const Usage u0 = usage_now();
@@ -138,9 +150,9 @@ int run_bench_delaunay(const BenchArgs& a) {
     std::printf(
         "{\"tool\":\"tessera\",\"op\":\"delaunay%d\",\"n\":%zu,\"threads\":%d,\"seconds\":%.6f,\"simplices\":%zu,"
         "\"extra\":{\"cpu_user_s\":%.6f,\"cpu_sys_s\":%.6f,\"minflt\":%lld,\"peak_rss_bytes\":%lld,"
-        "\"from_cells\":%zu,\"from_hull_completion\":%zu,\"skipped_cells\":%zu,\"exact_calls\":%llu,\"repeat\":%d}}\n",
+        "\"from_cells\":%zu,\"from_hull_completion\":%zu,\"from_insertion\":%zu,\"skipped_cells\":%zu,\"exact_calls\":%llu,\"repeat\":%d}}\n",
         pc.dim, pc.n, dt.threads_used, secs, dt.n_simplices(), u1.user_s - u0.user_s, u1.sys_s - u0.sys_s,
-        u1.minflt - u0.minflt, u1.maxrss_bytes, dt.from_cells, dt.from_hull_completion, dt.skipped_cells,
+        u1.minflt - u0.minflt, u1.maxrss_bytes, dt.from_cells, dt.from_hull_completion, dt.from_insertion, dt.skipped_cells,
         static_cast<unsigned long long>(dt.exact_predicate_calls), rep);
     std::fflush(stdout);
   }

@@ -52,6 +52,7 @@ struct BenchArgs {
   int repeat = 1;
   bool mesh = false;        ///< also build the merged mesh (what VTK output needs)
   double skip_cells = -1;   ///< bench delaunay: DelaunayOptions::skip_cells
+  std::string method = "auto";  ///< bench delaunay: DelaunayOptions::method (auto|cells|insertion)
 };
 
 struct DemoArgs {
@@ -95,6 +96,7 @@ struct DelaunayArgs {
   std::string simplices;       ///< .npy int64 (M, D+1), or empty
   bool no_hull_completion = false;
   double skip_cells = -1;      ///< DelaunayOptions::skip_cells (negative: automatic)
+  std::string method = "auto"; ///< DelaunayOptions::method: auto|cells|insertion
   bool validate = false;
   bool quiet = false;
 };

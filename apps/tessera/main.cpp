@@ -153,6 +153,12 @@ int main(int argc, char** argv) {
                   "in 3D 0.35 to 0.9 (more on surface samples, whose cells are needles), in 2D 0 on uniform points "
                   "and 0.3 to 0.6 on clustered ones; else 0. Ignored with labels or --no-hull-completion")
       ->check(CLI::Range(0.0, 0.99));
+  del->add_option("--method", dla.method,
+                  "cells: the cells pass and hull completion; insertion: serial incremental insertion (3D without "
+                  "labels); auto: the cells, unless a sample of them costs far more than it finds (3D points "
+                  "sampled on surfaces, from 20,000 points, without --skip-cells): then insertion. Same result")
+      ->check(CLI::IsMember({"auto", "cells", "insertion"}))
+      ->capture_default_str();
   del->add_flag("--validate", dla.validate,
                 "Check the triangulation (orientation, conformity, closed convex hull, every point used, local "
                 "Delaunay, volumes), print the report, exit 1 if a check fails");
@@ -243,13 +249,16 @@ int main(int argc, char** argv) {
       "delaunay",
       "Time tessera::delaunay (hull completion included; no output files) K times. Each run prints "
       "{\"tool\":\"tessera\",\"op\":\"delaunay3\"|\"delaunay2\",\"n\",\"threads\",\"seconds\",\"simplices\","
-      "\"extra\":{cpu_user_s,cpu_sys_s,minflt,peak_rss_bytes,from_cells,from_hull_completion,skipped_cells,exact_calls,repeat}}");
+      "\"extra\":{cpu_user_s,cpu_sys_s,minflt,peak_rss_bytes,from_cells,from_hull_completion,from_insertion,skipped_cells,exact_calls,repeat}}");
   add_compute_options(bench_del, bda.compute, bench_del_bounds);
   bench_del->add_option("--repeat", bda.repeat, "Number of timed runs")
       ->check(Positive)
       ->capture_default_str();
   bench_del->add_option("--skip-cells", bda.skip_cells, "As for `tessera delaunay --skip-cells`")
       ->check(CLI::Range(0.0, 0.99));
+  bench_del->add_option("--method", bda.method, "As for `tessera delaunay --method`")
+      ->check(CLI::IsMember({"auto", "cells", "insertion"}))
+      ->capture_default_str();
 
   SurfaceNetsArgs bsna;
   std::vector<std::string> bench_sn_bounds;

@@ -5,7 +5,9 @@
 // circumcentre lies in the domain box; without labels, hull completion then
 // adds the thin simplices near the convex hull whose circumcentres lie outside
 // it, so the result covers the convex hull of the input exactly (docs/design.md,
-// "Delaunay and hull completion").
+// "Delaunay and hull completion"). Where a pilot finds the cells far costlier
+// than what they find (points sampled on surfaces), 3D points go to
+// incremental insertion instead, which builds the same simplices.
 #pragma once
 
 #include <cstddef>
@@ -18,6 +20,16 @@
 #include "tessera/cells.hpp"
 
 namespace tessera {
+
+/// How tessera::delaunay builds the triangulation (the result is the same).
+enum class DelaunayMethod {
+  /// The cells pass, unless a pilot finds the cells far costlier than they
+  /// find simplices (3D without labels, from 20,000 points, with automatic
+  /// skip_cells): points sampled on surfaces then go to insertion.
+  automatic,
+  cells,      ///< the cells pass (and hull completion)
+  insertion,  ///< serial incremental insertion; 3D without labels and with complete_hull only
+};
 
 struct DelaunayOptions : VoronoiOptions {
   /// Without labels: close the triangulation up to the convex hull (simplices
@@ -34,6 +46,7 @@ struct DelaunayOptions : VoronoiOptions {
   /// first: in 3D 0.35 to 0.9; in 2D 0 on uniform points, 0.3 to 0.6 on
   /// clustered ones; else 0). Ignored with labels or without hull completion.
   double skip_cells = -1;
+  DelaunayMethod method = DelaunayMethod::automatic;
 };
 
 /// Simplices of the Delaunay triangulation (triangles in 2D, tetrahedra in 3D).
@@ -49,6 +62,7 @@ struct Delaunay {
   std::size_t from_cells = 0;              ///< simplices found by the cells pass
   std::size_t from_hull_completion = 0;    ///< simplices added by hull completion (and skipped cells' cavities)
   std::size_t skipped_cells = 0;           ///< generators whose cells were not built (DelaunayOptions::skip_cells)
+  std::size_t from_insertion = 0;          ///< simplices built by incremental insertion (DelaunayOptions::method)
   bool hull_completed = false;             ///< hull completion ran (no labels, complete_hull)
   std::vector<std::pair<std::int32_t, std::int32_t>> duplicates;  ///< (duplicate, owner): not vertices
   std::vector<std::int32_t> ignored_outside_bounds;

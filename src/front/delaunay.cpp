@@ -8,6 +8,7 @@
 #include <atomic>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <numbers>
 #include <numeric>
 #include <optional>
@@ -15,10 +16,12 @@
 #include <stdexcept>
 
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_sort.h>
 #include <tbb/task_arena.h>
 
 #include "delaunay_compositor.hpp"
 #include "hull_completion.hpp"
+#include "insertion.hpp"
 #include "pass.hpp"
 #include "point_buckets.hpp"
 #include "simplex_facets.hpp"
@@ -321,18 +324,26 @@ struct SkipRule {
 inline constexpr SkipRule skip_rule_3d{307.0, 0.0, 0.3, 0.35, 0.9};
 inline constexpr SkipRule skip_rule_2d{82.0, 2.0, 0.2, 0.3, 0.6};
 
+/// The pilot's measure: ratio, the cells' search work per simplex they find
+/// relative to uniform input (infinite when they find none; 1 when too few
+/// points to measure), and the skipped fraction it asks for.
+struct PilotEstimate {
+  double ratio = 1;
+  double fraction = 0;
+};
+
 template <class CellT>
-double automatic_skip_fraction(const front::Pass<CellT::dim>& pass) {
+PilotEstimate pilot_estimate(const front::Pass<CellT::dim>& pass) {
   constexpr int D = CellT::dim;
   constexpr SkipRule rule = D == 3 ? skip_rule_3d : skip_rule_2d;
   constexpr double slope = rule.slope, lowest = rule.lowest, highest = rule.highest;
   constexpr double unmeasured = D == 3 ? lowest : 0.0;  // too few points for a pilot
-  if (pass.order.empty()) return unmeasured;
+  if (pass.order.empty()) return {1.0, unmeasured};
   // Band k: the points whose hash lies in the k-th pilot_band / n of the
   // range, counted down from the top (n: the generators).
   const double band = static_cast<double>(pilot_band) / static_cast<double>(pass.order.size());
   const std::size_t bands = std::min<std::size_t>(pilot_bands, static_cast<std::size_t>((1 - highest) / band));
-  if (bands == 0) return unmeasured;
+  if (bands == 0) return {1.0, unmeasured};
   // Every band's generators in one scan (bin order kept), with their band.
   const auto from = static_cast<std::uint64_t>(std::ldexp(1.0 - static_cast<double>(bands) * band, 64));
   struct Pick {
@@ -364,13 +375,53 @@ double automatic_skip_fraction(const front::Pass<CellT::dim>& pass) {
     engine::tessellate<CellT>(gens, comp, eo);
     const auto& t = comp.total;
     if (t.vertices == 0) continue;    // no cell yet (duplicates only)
-    if (t.found == 0) return highest;  // no cell finds a simplex: all comes from completion
+    if (t.found == 0) return {std::numeric_limits<double>::infinity(), highest};  // all comes from completion
     const double work = static_cast<double>(t.work) / static_cast<double>(t.cells) / rule.uniform_work;
     ratio = work / (static_cast<double>(t.found) / static_cast<double>(t.vertices));
     if (slope * std::sqrt(ratio) > 2 * highest) break;
   }
-  if (ratio < rule.off_below) return 0.0;
-  return std::clamp(slope * std::sqrt(ratio), lowest, highest);
+  if (ratio < rule.off_below) return {ratio, 0.0};
+  return {ratio, std::clamp(slope * std::sqrt(ratio), lowest, highest)};
+}
+
+/// From this pilot ratio on, 3D points go to insertion: surface samples
+/// (an ellipsoid's 12-16, a terrain's 42-73, a torus's 52-176) rather than
+/// clustered volumes (3.4-3.8) or uniform points (1).
+inline constexpr double insertion_ratio = 8.0;
+
+// The triangulation by insertion (front/insertion.hpp) of the located
+// points, exact duplicates left out: of each set of coincident points the
+// lowest id is the vertex, as the cells pass decides.
+Delaunay by_insertion(const front::Pass<3>& pass, Delaunay out) {
+  const std::size_t n = pass.in_box.size();
+  tbb::task_arena(pass.engine_options.threads).execute([&] {
+    std::vector<std::int32_t> ids;
+    ids.reserve(n);
+    for (std::size_t i = 0; i < n; ++i)
+      if (pass.in_box[i]) ids.push_back(static_cast<std::int32_t>(i));
+    const double* pts = pass.points.data();
+    auto at = [&](std::int32_t i) { return std::array<double, 3>{pts[3 * i], pts[3 * i + 1], pts[3 * i + 2]}; };
+    tbb::parallel_sort(ids.begin(), ids.end(), [&](std::int32_t a, std::int32_t b) {
+      const auto pa = at(a), pb = at(b);
+      return pa != pb ? pa < pb : a < b;
+    });
+    std::vector<std::int32_t> distinct;
+    distinct.reserve(ids.size());
+    for (std::size_t k = 0; k < ids.size(); ++k) {
+      if (k > 0 && at(ids[k]) == at(ids[k - 1])) out.duplicates.emplace_back(ids[k], distinct.back());
+      else distinct.push_back(ids[k]);
+    }
+    std::sort(out.duplicates.begin(), out.duplicates.end());
+    out.hull_completed = true;
+    auto rows = front::insertion_delaunay(pass.exact, distinct, pass.gens.lo.data(), pass.gens.hi.data());
+    if (!rows) return;  // all on one plane: no simplex exists
+    out.from_insertion = rows->size();
+    out.simplices.resize(rows->size() * 4);  // every entry is written below
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rows->size(), 1 << 14), [&](const tbb::blocked_range<std::size_t>& r) {
+      for (std::size_t i = r.begin(); i != r.end(); ++i) std::copy((*rows)[i].begin(), (*rows)[i].end(), out.simplices.data() + 4 * i);
+    });
+  });
+  return out;
 }
 
 template <class CellT>
@@ -389,14 +440,20 @@ Delaunay run(std::span<const double> input, std::span<const std::int32_t> labels
 
   // Skipped cells (docs/design.md, "Skipped cells"): only where completion
   // runs, as it closes their cavities. Automatically from 20,000 points, by
-  // what the cells cost (automatic_skip_fraction): in 3D 35% to 90% (1M
-  // uniform points: 3.0 -> 2.7 s on two threads at 30% by hash); in 2D none
-  // on uniform points, whose cells are cheap next to the wraps that would
+  // what the cells cost (pilot_estimate): in 3D 35% to 90% (1M uniform
+  // points: 3.0 -> 2.7 s on two threads at 30% by hash); in 2D none on
+  // uniform points, whose cells are cheap next to the wraps that would
   // replace them, 30% to 60% on clustered ones.
-  const double skip = !complete              ? 0
-                      : opt.skip_cells >= 0 ? opt.skip_cells
-                      : n >= 20000           ? automatic_skip_fraction<CellT>(pass)
-                                             : 0;
+  const bool pilot = complete && opt.skip_cells < 0 && n >= 20000 && opt.method != DelaunayMethod::insertion;
+  const PilotEstimate estimate = pilot ? pilot_estimate<CellT>(pass) : PilotEstimate{};
+  if constexpr (D == 3) {
+    // Cells far costlier than what they find (surface samples): insertion
+    // (docs/design.md, "Insertion for costly inputs").
+    const bool insert = opt.method == DelaunayMethod::insertion ||
+                        (opt.method == DelaunayMethod::automatic && pilot && estimate.ratio >= insertion_ratio);
+    if (insert && complete && attempt == 0) return by_insertion(pass, std::move(out));
+  }
+  const double skip = !complete ? 0 : opt.skip_cells >= 0 ? opt.skip_cells : pilot ? estimate.fraction : 0;
   std::vector<std::uint8_t> skipped;
   std::vector<std::int32_t> built_order;
   std::vector<std::uint32_t> built_slots;
@@ -571,6 +628,11 @@ std::int32_t* distinct_ascending(std::int32_t* first, std::int32_t* last) {
 Delaunay delaunay(std::span<const double> points, int dim, std::span<const std::int32_t> labels,
                   const DelaunayOptions& options) {
   front::check_input(points, dim, labels);
+  if (options.method == DelaunayMethod::insertion) {
+    if (dim != 3) throw InputError("the insertion method is 3D only (2D: use the cells method)");
+    if (!labels.empty() || !options.complete_hull)
+      throw InputError("the insertion method triangulates the whole convex hull: no labels, hull completion on");
+  }
   if (!(options.skip_cells < 1))
     throw InputError("skip_cells must be below 1 (a fraction of the points; negative: automatic), got " +
                      std::to_string(options.skip_cells));

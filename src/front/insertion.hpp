@@ -1,0 +1,46 @@
+// The 3D Delaunay triangulation by incremental insertion (Bowyer–Watson), for
+// the inputs whose cells cost far more than they find: points sampled on
+// surfaces, whose Voronoi cells are needles reaching across the object
+// (docs/design.md, "Insertion for costly inputs").
+//
+// The triangulation is kept with one infinite vertex: each convex hull facet
+// has a "ghost" tetrahedron (facet + infinite vertex), so a point outside the
+// hull is located and inserted as any other (the ghosts whose facet it sees
+// are in its cavity). Conflicts are decided by the same perturbed in-sphere
+// predicate as gift wrapping (kernels::in_sphere, the clip predicate in
+// disguise), so the result is the triangulation the cells pass and hull
+// completion produce, row for row, on any input — lattices and co-spherical
+// points included. A point on the plane of a hull facet is in that ghost's
+// conflict when it lies in the facet's circumcircle: the circumsphere of the
+// finite tetrahedron behind the facet meets the plane in that circle, and the
+// perturbation of the in-sphere test restricted to the plane depends only on
+// the facet's points, so asking that tetrahedron gives the perturbed answer.
+// Every finite tetrahedron is therefore strictly positively oriented.
+//
+// Serial: the order (BRIO, Amenta, Choi & Rote, "Incremental constructions
+// con BRIO", 2003: rounds of doubling size, each in Morton order) keeps the
+// walk from the last inserted point short.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <vector>
+
+#include "tessera/kernels/exact_predicates.hpp"
+
+namespace tessera::front {
+
+/// The Delaunay tetrahedra of the points `ids` (distinct coordinates: no exact
+/// duplicates; ids into ctx.points, ctx.dim == 3). Each row lists its ids
+/// ascending, except that the last two are swapped where that order is
+/// negatively oriented; rows are in ascending order of their sorted ids (the
+/// layout of tessera::Delaunay::simplices). nullopt when the points are all
+/// coplanar (no tetrahedron exists). `lo`/`hi` bound the points (for the
+/// insertion order only).
+std::optional<std::vector<std::array<std::int32_t, 4>>> insertion_delaunay(const kernels::ExactContext& ctx,
+                                                                            std::span<const std::int32_t> ids,
+                                                                            const double* lo, const double* hi);
+
+}  // namespace tessera::front
