@@ -538,10 +538,11 @@ TEST(Delaunay, SkippedCellsGiveTheSameRows) {
 
 TEST(Delaunay, AutomaticSkipFractionFollowsTheCellsCost) {
   // A height field: its cells are needles to the box, and nine in ten of
-  // their vertices lie on it, so the pilot (automatic_skip_fraction) skips
-  // more cells than on uniform input. The choice is measured in
-  // deterministic units: the same for 1 and 2 threads, and the rows are
-  // those of the pass without skipping.
+  // their vertices lie on it, so the pilot (pilot_estimate) skips more
+  // cells than on uniform input. The choice is measured in deterministic
+  // units: the same for 1 and 2 threads, and the rows are those of the pass
+  // without skipping. (The automatic method would send this input to
+  // insertion: the cells method is asked for, test_insertion.cpp tests that.)
   std::mt19937_64 rng(78);
   std::uniform_real_distribution<double> u;
   std::vector<double> terrain;
@@ -552,6 +553,7 @@ TEST(Delaunay, AutomaticSkipFractionFollowsTheCellsCost) {
   tessera::DelaunayOptions o;
   o.skip_cells = 0;
   o.threads = 2;
+  o.method = tessera::DelaunayMethod::cells;
   const tessera::Delaunay all = tessera::delaunay(terrain, 3, {}, o);
   o.skip_cells = -1;
   std::size_t skipped = 0;

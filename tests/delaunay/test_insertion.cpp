@@ -1,0 +1,209 @@
+// Delaunay by incremental insertion (DelaunayMethod::insertion): the same rows
+// as the cells pass, byte for byte, on general-position and degenerate input
+// (lattices, co-spherical and co-planar points, where the symbolic
+// perturbation chooses), the same duplicates, a valid triangulation; and the
+// automatic choice takes it for surface samples only.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "common/hostile_points.hpp"
+#include "random_points.hpp"
+#include "tessera/delaunay.hpp"
+
+namespace {
+
+tessera::Delaunay triangulate(const std::vector<double>& p, tessera::DelaunayMethod method, int threads = 2) {
+  tessera::DelaunayOptions o;
+  o.dim = 3;
+  o.threads = threads;
+  o.method = method;
+  return tessera::delaunay(p, 3, {}, o);
+}
+
+void expect_valid(const tessera::Delaunay& dt, const std::vector<double>& p, const std::string& what) {
+  const tessera::DelaunayReport r = tessera::validate(dt, p, {});
+  for (const auto& m : r.messages) ADD_FAILURE() << what << ": " << m;
+  EXPECT_TRUE(r.ok) << what;
+}
+
+std::vector<double> grid3(int k, double step = 1) {
+  std::vector<double> p;
+  for (int i = 0; i < k; ++i)
+    for (int j = 0; j < k; ++j)
+      for (int l = 0; l < k; ++l) p.insert(p.end(), {step * i, step * j, step * l});
+  return p;
+}
+
+std::vector<std::pair<std::string, std::vector<double>>> inputs() {
+  std::mt19937_64 rng(5);
+  std::normal_distribution<double> g;
+  std::uniform_real_distribution<double> u;
+  std::vector<std::pair<std::string, std::vector<double>>> in;
+  in.emplace_back("uniform", uniform_points(3000, 3, 41));
+  {
+    std::vector<double> blobs;  // clusters of very different density
+    for (int c = 0; c < 6; ++c) {
+      const double cx = g(rng), cy = g(rng), cz = g(rng), r = c % 2 ? 0.01 : 0.2;
+      for (int i = 0; i < 400; ++i) blobs.insert(blobs.end(), {cx + r * g(rng), cy + r * g(rng), cz + r * g(rng)});
+    }
+    in.emplace_back("blobs", std::move(blobs));
+  }
+  {
+    std::vector<double> terrain;  // a height field: needle cells
+    for (int i = 0; i < 3000; ++i) {
+      const double x = u(rng), y = u(rng);
+      terrain.insert(terrain.end(), {x, y, 0.1 * std::sin(6 * x) * std::cos(5 * y)});
+    }
+    in.emplace_back("terrain", std::move(terrain));
+  }
+  {
+    // A height field on a grid with a flat floor: co-planar hull facets with
+    // co-circular points (the floor), vertical sides of co-planar points.
+    std::vector<double> dem;
+    for (int i = 0; i < 30; ++i)
+      for (int j = 0; j < 30; ++j) dem.insert(dem.end(), {double(i), double(j), std::max(0.0, std::round(8 * std::sin(0.3 * i) * std::cos(0.2 * j)))});
+    in.emplace_back("grid height field", std::move(dem));
+  }
+  in.emplace_back("lattice", grid3(9));
+  in.emplace_back("lattice of step 0.1", grid3(7, 0.1));
+  {
+    std::vector<double> rot;  // a rotated lattice: inexact coordinates
+    const double c = std::cos(0.3), s = std::sin(0.3);
+    for (int i = 0; i < 7; ++i)
+      for (int j = 0; j < 7; ++j)
+        for (int l = 0; l < 7; ++l) rot.insert(rot.end(), {c * i - s * j, s * i + c * j, double(l)});
+    in.emplace_back("rotated lattice", std::move(rot));
+  }
+  {
+    std::vector<double> shells;  // integer points on two spheres: co-spherical
+    for (int x = -7; x <= 7; ++x)
+      for (int y = -7; y <= 7; ++y)
+        for (int z = -7; z <= 7; ++z)
+          if (x * x + y * y + z * z == 49 || x * x + y * y + z * z == 25) shells.insert(shells.end(), {double(x), double(y), double(z)});
+    in.emplace_back("sphere shells", std::move(shells));
+  }
+  {
+    std::vector<double> sphere;  // random points normalised onto a sphere
+    for (int i = 0; i < 400; ++i) {
+      double x = g(rng), y = g(rng), z = g(rng);
+      const double r = std::sqrt(x * x + y * y + z * z);
+      sphere.insert(sphere.end(), {x / r, y / r, z / r});
+    }
+    in.emplace_back("sphere", std::move(sphere));
+  }
+  {
+    std::vector<double> cube;  // random points on a cube's faces, its corners, inside points
+    for (int c = 0; c < 8; ++c) cube.insert(cube.end(), {double(c & 1), double((c >> 1) & 1), double((c >> 2) & 1)});
+    for (int face = 0; face < 6; ++face)
+      for (int i = 0; i < 200; ++i) {
+        double x[3] = {u(rng), u(rng), u(rng)};
+        x[face / 2] = face % 2;
+        cube.insert(cube.end(), {x[0], x[1], x[2]});
+      }
+    for (int i = 0; i < 500; ++i) cube.insert(cube.end(), {u(rng), u(rng), u(rng)});
+    in.emplace_back("cube faces", std::move(cube));
+  }
+  {
+    std::vector<double> spiral;  // near the moment curve: many thin hull simplices
+    for (int i = 0; i < 300; ++i) {
+      const double t = 0.05 * i;
+      spiral.insert(spiral.end(), {t * std::cos(t), t * std::sin(t), 0.1 * t});
+    }
+    in.emplace_back("spiral", std::move(spiral));
+  }
+  {
+    auto p = uniform_points(2000, 3, 43);  // near and exact duplicates
+    for (int i = 0; i < 200; ++i) {
+      const std::size_t a = static_cast<std::size_t>(i) * 3;
+      p.insert(p.end(), {p[a] + 1e-12, p[a + 1], p[a + 2]});
+      p.insert(p.end(), {p[a + 3], p[a + 4], p[a + 5]});
+      if (i % 50 == 0) p.insert(p.end(), {p[a + 3], p[a + 4], p[a + 5]});  // a third copy
+    }
+    in.emplace_back("duplicates", std::move(p));
+  }
+  in.emplace_back("subnormal offsets", subnormal_offset_points(300, 3, 7));
+  {
+    auto far = uniform_points(2000, 3, 44);  // far from the origin: large, rounded differences
+    for (double& x : far) x = 1e9 + x;
+    in.emplace_back("far from the origin", std::move(far));
+  }
+  return in;
+}
+
+TEST(Insertion, GivesTheRowsOfTheCellsPass) {
+  for (const auto& [what, p] : inputs()) {
+    const tessera::Delaunay cells = triangulate(p, tessera::DelaunayMethod::cells);
+    for (const int threads : {1, 2}) {
+      const tessera::Delaunay ins = triangulate(p, tessera::DelaunayMethod::insertion, threads);
+      EXPECT_EQ(ins.simplices, cells.simplices) << what << ", threads " << threads;
+      EXPECT_EQ(ins.duplicates, cells.duplicates) << what;
+      EXPECT_EQ(ins.from_insertion, ins.n_simplices()) << what;
+      EXPECT_EQ(ins.from_cells + ins.from_hull_completion, 0u) << what;
+      EXPECT_TRUE(ins.hull_completed) << what;
+    }
+    expect_valid(triangulate(p, tessera::DelaunayMethod::insertion), p, what);
+  }
+}
+
+TEST(Insertion, FewAndFlatPoints) {
+  // Fewer than four points, and coplanar points (on the tilted plane z = x + y,
+  // so the box has extent): no tetrahedron, no error.
+  for (const std::vector<double>& p : {std::vector<double>{0, 0, 0, 1, 0, 1, 0, 1, 1},
+                                       std::vector<double>{0, 0, 0, 1, 0, 1, 0, 1, 1, 1, 1, 2, 0.5, 0.25, 0.75}}) {
+    const tessera::Delaunay dt = triangulate(p, tessera::DelaunayMethod::insertion);
+    EXPECT_EQ(dt.n_simplices(), 0u);
+  }
+  // Four points, one tetrahedron, listed with positive orientation.
+  const std::vector<double> tet{0, 0, 0, 0, 1, 0, 1, 0, 0, 0, 0, 1};
+  const tessera::Delaunay dt = triangulate(tet, tessera::DelaunayMethod::insertion);
+  ASSERT_EQ(dt.n_simplices(), 1u);
+  EXPECT_EQ(std::vector<std::int32_t>(dt.simplices.begin(), dt.simplices.end()), (std::vector<std::int32_t>{0, 1, 3, 2}));  // det[p1-p0, p3-p0, p2-p0] = +1
+  // Collinear points then one off the line, then one off the plane.
+  std::vector<double> line;
+  for (int i = 0; i < 20; ++i) line.insert(line.end(), {double(i), 2.0 * i, 3.0 * i});
+  line.insert(line.end(), {0.0, 1.0, 0.0, 0.0, 0.0, 1.0});
+  const tessera::Delaunay l = triangulate(line, tessera::DelaunayMethod::insertion);
+  EXPECT_EQ(l.simplices, triangulate(line, tessera::DelaunayMethod::cells).simplices);
+  EXPECT_GT(l.n_simplices(), 0u);
+}
+
+TEST(Insertion, BadRequestsAreInputErrors) {
+  tessera::DelaunayOptions o;
+  o.method = tessera::DelaunayMethod::insertion;
+  const auto p2 = uniform_points(100, 2, 1);
+  o.dim = 2;
+  EXPECT_THROW(tessera::delaunay(p2, 2, {}, o), tessera::InputError);
+  const auto p3 = uniform_points(100, 3, 1);
+  o.dim = 3;
+  const std::vector<std::int32_t> labels(100, 1);
+  EXPECT_THROW(tessera::delaunay(p3, 3, labels, o), tessera::InputError);
+  o.complete_hull = false;
+  EXPECT_THROW(tessera::delaunay(p3, 3, {}, o), tessera::InputError);
+}
+
+TEST(Insertion, AutomaticChoiceTakesItForSurfaceSamplesOnly) {
+  // A 24k-point height field: the pilot finds its needle cells far costlier
+  // than what they find, and insertion builds the rows the cells would.
+  std::mt19937_64 rng(9);
+  std::uniform_real_distribution<double> u;
+  std::vector<double> terrain;
+  for (int i = 0; i < 24000; ++i) {
+    const double x = u(rng), y = u(rng);
+    terrain.insert(terrain.end(), {x, y, 0.1 * std::sin(6 * x) * std::cos(5 * y)});
+  }
+  const tessera::Delaunay automatic = triangulate(terrain, tessera::DelaunayMethod::automatic);
+  EXPECT_EQ(automatic.from_insertion, automatic.n_simplices());
+  EXPECT_EQ(automatic.simplices, triangulate(terrain, tessera::DelaunayMethod::cells).simplices);
+  // Uniform points stay with the cells.
+  const auto uniform = uniform_points(25000, 3, 45);
+  const tessera::Delaunay cells = triangulate(uniform, tessera::DelaunayMethod::automatic);
+  EXPECT_EQ(cells.from_insertion, 0u);
+  EXPECT_GT(cells.from_cells, 0u);
+}
+
+}  // namespace
