@@ -24,11 +24,15 @@ using Points = py::array_t<double, py::array::c_style>;
 
 DelaunayResult run_delaunay(const Points& points, const py::object& labels,
                             const std::optional<std::vector<double>>& bounds, double padding, bool ignore_outside,
-                            int threads, bool complete_hull) {
+                            int threads, bool complete_hull, const std::string& method) {
   const int dim = checked_dim(points);
   DelaunayOptions opt;
   fill_common(opt, dim, bounds, padding, ignore_outside, threads);
   opt.complete_hull = complete_hull;
+  if (method == "auto") opt.method = DelaunayMethod::automatic;
+  else if (method == "cells") opt.method = DelaunayMethod::cells;
+  else if (method == "insertion") opt.method = DelaunayMethod::insertion;
+  else throw py::value_error("delaunay: method must be 'auto', 'cells' or 'insertion', got '" + method + "'");
   const auto pts = as_span(points);
   const auto lab = as_labels(labels);
   return DelaunayResult{without_gil([&] { return delaunay(pts, dim, lab, opt); }), {}, {}, {}};
@@ -114,6 +118,7 @@ void bind_delaunay(py::module_& m) {
       .def("vertex_to_simplex", [](const DelaunayResult& r) { return adopt_flat(vertex_to_simplex(r.dt)); })
       .def_property_readonly("from_cells", [](const DelaunayResult& r) { return r.dt.from_cells; })
       .def_property_readonly("from_hull_completion", [](const DelaunayResult& r) { return r.dt.from_hull_completion; })
+      .def_property_readonly("from_insertion", [](const DelaunayResult& r) { return r.dt.from_insertion; })
       .def_property_readonly("hull_completed", [](const DelaunayResult& r) { return r.dt.hull_completed; })
       .def_property_readonly("duplicates", [](const DelaunayResult& r) { return pairs_copy(r.dt.duplicates); })
       .def_property_readonly("ignored_outside_bounds",
@@ -126,7 +131,7 @@ void bind_delaunay(py::module_& m) {
 
   m.def("delaunay", &run_delaunay, py::arg("points").noconvert(), py::arg("labels").none(true), py::arg("bounds"),
         py::arg("padding"), py::arg("ignore_outside"), py::arg("threads"), py::arg("complete_hull"),
-        "Delaunay simplices of float64 C-ordered (N, D) points; labels None or int32 (N,). Runs without the GIL.");
+        py::arg("method"), "Delaunay simplices of float64 C-ordered (N, D) points; labels None or int32 (N,). Runs without the GIL.");
 
   m.def("locate", &locate_points, py::arg("delaunay"), py::arg("points").noconvert(), py::arg("queries").noconvert(),
         py::arg("threads"),

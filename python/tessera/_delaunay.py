@@ -180,6 +180,11 @@ class Delaunay:
         return self._dt.from_hull_completion
 
     @property
+    def from_insertion(self) -> int:
+        """Simplices built by incremental insertion (``method``; then all of them)."""
+        return self._dt.from_insertion
+
+    @property
     def hull_completed(self) -> bool:
         return self._dt.hull_completed
 
@@ -237,6 +242,7 @@ def delaunay(
     *,
     complete_hull: bool = True,
     ignore_outside: bool = False,
+    method: str = "auto",
 ) -> Delaunay:
     """Delaunay triangulation of 2D or 3D points, the dual of the Voronoi cells.
 
@@ -247,6 +253,12 @@ def delaunay(
         Without labels, add the thin simplices near the convex hull whose
         circumcentres lie outside the domain box, so the simplices cover the
         hull exactly (as scipy's). Ignored with labels.
+    method : {"auto", "cells", "insertion"}
+        How the simplices are built; the result is the same. ``"cells"``: the
+        parallel cells pass and hull completion. ``"insertion"``: serial
+        incremental insertion (3D, no labels, ``complete_hull``). ``"auto"``:
+        the cells, unless a sample of them costs far more than it finds (3D
+        points sampled on surfaces, from 20,000 points): then insertion.
 
     Exact predicates and a symbolic perturbation decide every simplex, so
     degenerate input (lattices, cospherical points) gets a valid triangulation
@@ -264,5 +276,6 @@ def delaunay(
         bool(ignore_outside),
         _inputs.as_threads(threads),
         bool(complete_hull),
+        str(method),
     )
     return Delaunay(dt, pts, lab)

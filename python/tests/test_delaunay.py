@@ -88,3 +88,15 @@ def test_lattice_gets_a_valid_triangulation():
 def test_repr():
     dt = tessera.delaunay(random_points(20, 2))
     assert repr(dt).startswith("<tessera.Delaunay 2D: 20 points,")
+
+
+def test_insertion_method_gives_the_same_simplices():
+    pts = random_points(2000, 3, seed=7)
+    cells = tessera.delaunay(pts, method="cells")
+    ins = tessera.delaunay(pts, method="insertion")
+    assert np.array_equal(cells.simplices, ins.simplices)
+    assert ins.from_insertion == ins.nsimplex and cells.from_insertion == 0
+    with pytest.raises(ValueError, match="method"):
+        tessera.delaunay(pts, method="qhull")
+    with pytest.raises(ValueError, match="3D only"):
+        tessera.delaunay(random_points(100, 2, seed=1), method="insertion")
