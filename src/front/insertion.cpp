@@ -10,6 +10,7 @@
 #include <tbb/parallel_sort.h>
 
 #include "tessera/kernels/delaunay_predicates.hpp"
+#include "tessera/kernels/filter.hpp"
 
 namespace tessera::front {
 namespace {
@@ -83,9 +84,73 @@ std::vector<std::int32_t> brio_order(const ExactContext& ctx, std::span<const st
   return order;
 }
 
+// The filters in front of kernels::orientation and kernels::in_sphere,
+// written out for 3D and for points that are ids into one array: the walk and
+// the cavity search ask tens of them per point. Each returns the exact sign
+// when its float evaluation is certain, and 0 otherwise (then the kernels'
+// predicates decide, with their exact arithmetic and perturbation). The
+// quantities and bounds are those of the kernels' filters
+// (delaunay_predicates.hpp), evaluated in another order: the bounds hold for
+// any order of the sums.
+
+// Sign of det[b - a, c - a, d - a].
+inline int orientation_filter(const double* a, const double* b, const double* c, const double* d) {
+  const double r0[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+  const double r1[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+  const double r2[3] = {d[0] - a[0], d[1] - a[1], d[2] - a[2]};
+  const double m0 = r1[1] * r2[2], m1 = r1[2] * r2[1];
+  const double m2 = r1[2] * r2[0], m3 = r1[0] * r2[2];
+  const double m4 = r1[0] * r2[1], m5 = r1[1] * r2[0];
+  const double det = r0[0] * (m0 - m1) + r0[1] * (m2 - m3) + r0[2] * (m4 - m5);
+  const double perm = std::fabs(r0[0]) * (std::fabs(m0) + std::fabs(m1)) +
+                      std::fabs(r0[1]) * (std::fabs(m2) + std::fabs(m3)) +
+                      std::fabs(r0[2]) * (std::fabs(m4) + std::fabs(m5));
+  const double bound = 16 * kernels::filter::u * perm + kernels::filter::abs_eps;
+  return det > bound ? 1 : (det < -bound ? -1 : 0);
+}
+
+// For a positively oriented tetrahedron abcd: +1 when q is surely inside its
+// circumsphere, -1 surely outside, 0 undecided. With rows r_k = p_k - a and
+// s_k = |r_k|^2 (k = b, c, d, q), q is inside iff det[[r_k, s_k]] < 0
+// (kernels::in_sphere; det R > 0 here).
+inline int in_sphere_filter(const double* a, const double* b, const double* c, const double* d, const double* q) {
+  double r[4][3], s[4];
+  const double* p[4] = {b, c, d, q};
+  for (int k = 0; k < 4; ++k) {
+    for (int e = 0; e < 3; ++e) r[k][e] = p[k][e] - a[e];
+    s[k] = r[k][0] * r[k][0] + r[k][1] * r[k][1] + r[k][2] * r[k][2];
+  }
+  // 2x2 minors of the x, y columns for each pair of rows, and their permanents.
+  double xy[4][4], axy[4][4];
+  for (int i = 0; i < 4; ++i)
+    for (int j = i + 1; j < 4; ++j) {
+      const double u = r[i][0] * r[j][1], v = r[i][1] * r[j][0];
+      xy[i][j] = u - v;
+      axy[i][j] = std::fabs(u) + std::fabs(v);
+    }
+  // The 3x3 minor of rows i < j < k (columns x, y, z), expanded along z.
+  auto minor = [&](int i, int j, int k, double& perm) {
+    perm = std::fabs(r[i][2]) * axy[j][k] + std::fabs(r[j][2]) * axy[i][k] + std::fabs(r[k][2]) * axy[i][j];
+    return r[i][2] * xy[j][k] - r[j][2] * xy[i][k] + r[k][2] * xy[i][j];
+  };
+  double p0, p1, p2, p3;
+  const double d0 = minor(1, 2, 3, p0), d1 = minor(0, 2, 3, p1), d2 = minor(0, 1, 3, p2), d3 = minor(0, 1, 2, p3);
+  const double det = -s[0] * d0 + s[1] * d1 - s[2] * d2 + s[3] * d3;
+  const double perm = s[0] * p0 + s[1] * p1 + s[2] * p2 + s[3] * p3;
+  const double bound = 64 * kernels::filter::u * perm + kernels::filter::abs_eps;
+  return det < -bound ? 1 : (det > bound ? -1 : 0);
+}
+
 class Triangulation {
  public:
-  explicit Triangulation(const ExactContext& ctx) : ctx_(ctx) {}
+  /// Vertices are numbered by `global`, the insertion order: vertex k is
+  /// point global[k] of ctx, and its coordinates are copied in that order, so
+  /// the points a walk and a cavity meet lie close in memory too.
+  Triangulation(const ExactContext& ctx, std::vector<std::int32_t> global) : ctx_(ctx), global_(std::move(global)) {
+    coords_.resize(3 * global_.size());
+    for (std::size_t k = 0; k < global_.size(); ++k)
+      for (int e = 0; e < 3; ++e) coords_[3 * k + static_cast<std::size_t>(e)] = ctx.points[static_cast<std::size_t>(global_[k]) * 3 + static_cast<std::size_t>(e)];
+  }
 
   /// Start from the positively oriented tetrahedron s and its four ghosts.
   void start(std::array<std::int32_t, 4> s) {
@@ -200,13 +265,18 @@ class Triangulation {
 
   /// The finite tetrahedra, in the layout of insertion_delaunay.
   std::vector<std::array<std::int32_t, 4>> rows() const {
-    std::vector<std::array<std::int32_t, 4>> out;
-    out.reserve(tets_.size() / 2);
+    using Row = std::array<std::int32_t, 4>;
     std::vector<std::uint8_t> is_free(tets_.size(), 0);
     for (const std::int32_t t : free_) is_free[static_cast<std::size_t>(t)] = 1;
+    // Rows by their lowest id (a counting sort), then each point's few sorted.
+    std::size_t n_ids = 0;
+    for (const std::int32_t g : global_) n_ids = std::max(n_ids, static_cast<std::size_t>(g) + 1);
+    std::vector<std::size_t> start(n_ids + 1, 0);
+    std::vector<Row> rows;
+    rows.reserve(tets_.size());
     for (std::size_t i = 0; i < tets_.size(); ++i) {
       if (is_free[i] || infinite_slot(tets_[i]) != 4) continue;
-      std::array<std::int32_t, 4> r{tets_[i].v[0], tets_[i].v[1], tets_[i].v[2], tets_[i].v[3]};
+      Row r{global(tets_[i].v[0]), global(tets_[i].v[1]), global(tets_[i].v[2]), global(tets_[i].v[3])};
       // Sort, counting the swaps: an odd permutation of a positive order is
       // negative, which the layout writes with its last two swapped.
       bool odd = false;
@@ -216,15 +286,25 @@ class Triangulation {
           odd = !odd;
         }
       if (odd) std::swap(r[2], r[3]);
-      out.push_back(r);
+      rows.push_back(r);
+      ++start[static_cast<std::size_t>(r[0]) + 1];
     }
-    tbb::parallel_sort(out.begin(), out.end(), [](const auto& a, const auto& b) {
-      for (int k = 0; k < 2; ++k)
-        if (a[k] != b[k]) return a[k] < b[k];
+    for (std::size_t g = 0; g < n_ids; ++g) start[g + 1] += start[g];
+    std::vector<Row> out(rows.size());
+    {
+      std::vector<std::size_t> next(start.begin(), start.end() - 1);
+      for (const Row& r : rows) out[next[static_cast<std::size_t>(r[0])]++] = r;
+    }
+    auto key_less = [](const Row& a, const Row& b) {  // row[0] is shared
+      if (a[1] != b[1]) return a[1] < b[1];
       const std::int32_t a2 = std::min(a[2], a[3]), b2 = std::min(b[2], b[3]);
       if (a2 != b2) return a2 < b2;
       return std::max(a[2], a[3]) < std::max(b[2], b[3]);
-    });
+    };
+    for (std::size_t g = 0; g < n_ids; ++g)
+      if (start[g + 1] - start[g] > 1)
+        std::sort(out.begin() + static_cast<std::ptrdiff_t>(start[g]), out.begin() + static_cast<std::ptrdiff_t>(start[g + 1]),
+                  key_less);
     return out;
   }
 
@@ -279,12 +359,29 @@ class Triangulation {
   bool conflicts(std::int32_t ti, std::int32_t q) const {
     const Tet& t = tets_[static_cast<std::size_t>(ti)];
     const int inf = infinite_slot(t);
-    if (inf == 4) return kernels::in_sphere(ctx_, t.v[0], t.v + 1, q);
+    if (inf == 4) return in_sphere(t, q);
     std::int32_t ids[4] = {t.v[0], t.v[1], t.v[2], t.v[3]};
     ids[inf] = q;
-    if (const int o = kernels::orientation(ctx_, ids); o != 0) return o > 0;
-    const Tet& f = tets_[static_cast<std::size_t>(t.n[inf])];
-    return kernels::in_sphere(ctx_, f.v[0], f.v + 1, q);
+    if (const int o = orientation(ids); o != 0) return o > 0;
+    return in_sphere(tets_[static_cast<std::size_t>(t.n[inf])], q);
+  }
+
+  const double* at(std::int32_t k) const { return coords_.data() + static_cast<std::size_t>(k) * 3; }
+  std::int32_t global(std::int32_t k) const { return global_[static_cast<std::size_t>(k)]; }
+
+  // kernels::orientation, its filter inline. The exact stages (and the
+  // perturbation, by point id) are asked with the input's ids.
+  int orientation(const std::int32_t* ks) const {
+    if (const int o = orientation_filter(at(ks[0]), at(ks[1]), at(ks[2]), at(ks[3]))) return o;
+    const std::int32_t ids[4] = {global(ks[0]), global(ks[1]), global(ks[2]), global(ks[3])};
+    return kernels::orientation(ctx_, ids);
+  }
+
+  // kernels::in_sphere for a finite tetrahedron, its filter inline.
+  bool in_sphere(const Tet& t, std::int32_t q) const {
+    if (const int s = in_sphere_filter(at(t.v[0]), at(t.v[1]), at(t.v[2]), at(t.v[3]), at(q))) return s > 0;
+    const std::int32_t planes[3] = {global(t.v[1]), global(t.v[2]), global(t.v[3])};
+    return kernels::in_sphere(ctx_, global(t.v[0]), planes, global(q));
   }
 
   /// A tetrahedron whose closure holds q, or a ghost whose facet q lies
@@ -292,7 +389,7 @@ class Triangulation {
   /// from a varying first one (a stochastic walk terminates; Devillers,
   /// Pion & Teillaud, "Walking in a triangulation", 2002).
   std::int32_t locate(std::int32_t q, std::int32_t from) {
-    std::int32_t t = from;
+    std::int32_t t = from, came_from = -1;
     if (const int inf = infinite_slot(tets_[static_cast<std::size_t>(t)]); inf != 4)
       t = tets_[static_cast<std::size_t>(t)].n[inf];
     for (;;) {
@@ -303,19 +400,23 @@ class Triangulation {
       std::int32_t next = -1;
       for (int i = 0; i < 4; ++i) {
         const int k = (first + i) & 3;
+        if (tt.n[k] == came_from) continue;  // q lies on this side of the face just crossed
         std::int32_t ids[4] = {tt.v[0], tt.v[1], tt.v[2], tt.v[3]};
         ids[k] = q;
-        if (kernels::orientation(ctx_, ids) < 0) {
+        if (orientation(ids) < 0) {
           next = tt.n[k];
           break;
         }
       }
       if (next < 0) return t;
+      came_from = t;
       t = next;
     }
   }
 
   const ExactContext& ctx_;
+  std::vector<std::int32_t> global_;  // vertex -> input id
+  std::vector<double> coords_;        // vertex -> coordinates (3 each)
   std::vector<Tet> tets_;
   std::vector<std::uint32_t> state_;  // (epoch << 1) | in conflict, per tetrahedron
   std::uint32_t epoch_ = 0;
@@ -362,11 +463,13 @@ std::optional<std::vector<std::array<std::int32_t, 4>>> insertion_delaunay(const
     if ((o = kernels::orientation(ctx, s.data())) != 0) break;
   }
   if (d == order.size()) return std::nullopt;
-  if (o < 0) std::swap(s[2], s[3]);
-  Triangulation tri(ctx);
-  tri.start(s);
-  for (std::size_t i = 2; i < order.size(); ++i)
-    if (i != c && i != d) tri.insert(order[i]);
+  std::array<std::int32_t, 4> local{0, 1, static_cast<std::int32_t>(c), static_cast<std::int32_t>(d)};
+  if (o < 0) std::swap(local[2], local[3]);
+  const std::size_t m = order.size();
+  Triangulation tri(ctx, std::move(order));
+  tri.start(local);
+  for (std::size_t i = 2; i < m; ++i)
+    if (i != c && i != d) tri.insert(static_cast<std::int32_t>(i));
   return tri.rows();
 }
 
