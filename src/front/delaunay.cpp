@@ -384,10 +384,19 @@ PilotEstimate pilot_estimate(const front::Pass<CellT::dim>& pass) {
   return {ratio, std::clamp(slope * std::sqrt(ratio), lowest, highest)};
 }
 
-/// From this pilot ratio on, 3D points go to insertion: surface samples
-/// (an ellipsoid's 12-16, a terrain's 42-73, a torus's 52-176) rather than
-/// clustered volumes (3.4-3.8) or uniform points (1).
-inline constexpr double insertion_ratio = 8.0;
+/// From this pilot ratio on, 3D points go to insertion (serial) rather than
+/// to the cells (parallel). Both build the same rows, so the choice may
+/// follow the thread count. Measured on two threads at 1M points
+/// (docs/design.md, "Insertion for costly inputs"): insertion takes ~5 s
+/// whatever the input; the cells 2.5 s on uniform points (ratio 1) and 3.0 s
+/// on a fractal hierarchy (1.3), but 7.8-8.3 s on blobs and sheets (3.4-3.8),
+/// and several times insertion's time on surface samples (an ellipsoid's
+/// 12-16, a terrain's 42-73, a torus's 52-176). On one thread the two are
+/// level on uniform points. The cells' time grows about as ratio^0.7 and
+/// falls with the threads, so the threshold is 3 on two threads and grows
+/// as threads^1.4 (1.14 on one, 7.9 on four; beyond two threads a model,
+/// not a measurement).
+inline double insertion_ratio(int threads) { return 3.0 * std::pow(std::max(threads, 1) / 2.0, 1.4); }
 
 // The triangulation by insertion (front/insertion.hpp) of the located
 // points, exact duplicates left out: of each set of coincident points the
@@ -450,7 +459,8 @@ Delaunay run(std::span<const double> input, std::span<const std::int32_t> labels
     // Cells far costlier than what they find (surface samples): insertion
     // (docs/design.md, "Insertion for costly inputs").
     const bool insert = opt.method == DelaunayMethod::insertion ||
-                        (opt.method == DelaunayMethod::automatic && pilot && estimate.ratio >= insertion_ratio);
+                        (opt.method == DelaunayMethod::automatic && pilot &&
+                         estimate.ratio >= insertion_ratio(pass.engine_options.threads));
     if (insert && complete && attempt == 0) return by_insertion(pass, std::move(out));
   }
   const double skip = !complete ? 0 : opt.skip_cells >= 0 ? opt.skip_cells : pilot ? estimate.fraction : 0;
