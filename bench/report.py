@@ -380,14 +380,15 @@ def delaunay_section(w, meta, dd, g, t1, t2):
     w("")
     w("Simplex counts and memory. Tessera's count must equal CGAL's (and HXT's) on general-position input "
       "such as uniform points; on degenerate input (lattices: cospherical points) the Delaunay "
-      "triangulation is not unique and counts may legitimately differ. From cells / from hull completion "
-      "= Tessera's simplices read off the Voronoi cells / added by completing the convex hull; exact calls "
+      "triangulation is not unique and counts may legitimately differ. From cells / from hull completion / "
+      "by insertion = Tessera's simplices read off the Voronoi cells / added by completing the convex hull / "
+      "built by incremental insertion (the method chosen where cells cost far more than they find); exact calls "
       "= exact-arithmetic fallbacks. Peak B/pt = the process's peak resident set / points.")
     w("")
     w(f"| input | Tessera simplices | CGAL simplices | Tessera − CGAL | HXT simplices | from cells | "
-      f"from hull completion | exact calls | Tessera {t1}T peak B/pt | Tessera {t2}T peak B/pt | "
+      f"from hull completion | by insertion | exact calls | Tessera {t1}T peak B/pt | Tessera {t2}T peak B/pt | "
       f"CGAL {p1}T peak B/pt | CGAL {p2}T peak B/pt | HXT {p2}T peak B/pt |")
-    w("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
+    w("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
 
     def cnt(x):
         return DASH if x is None else fn(x.simplices)
@@ -407,7 +408,7 @@ def delaunay_section(w, meta, dd, g, t1, t2):
         h = h2 or h1
         w(f"| {name} | {tcount} | {cnt(c)} | {diff} | {cnt(h) if d3 else NA} | "
           f"{fx(ta.extra_med('from_cells')) if ta else DASH} | {fx(ta.extra_med('from_hull_completion')) if ta else DASH} | "
-          f"{fx(ta.extra_med('exact_calls')) if ta else DASH} | {fb(bpp(a))} | {fb(bpp(b))} | {fb(bpp(c1))} | "
+          f"{fx(ta.extra_med('from_insertion')) if ta else DASH} | {fx(ta.extra_med('exact_calls')) if ta else DASH} | {fb(bpp(a))} | {fb(bpp(b))} | {fb(bpp(c1))} | "
           f"{fb(bpp(c2)) if d3 else NA} | {fb(bpp(h2)) if d3 else NA} |")
     w("")
 

@@ -7,7 +7,7 @@
 #
 # usage: bench/clustered/run.sh [BUILD_DIR] [N]
 #   env: KINDS (default "blobs sheet hier"; the surfaces: "terrain ellipsoid torus"), REPEAT (default 3), THREADS (default 2),
-#        VORO=0 skips Voro++ (single-threaded; minutes per input at 1e6),
+#        VORO=0 skips Voro++ (single-threaded; minutes per input at 1e6), CELLS=0 skips Tessera's cells,
 #        TIMEOUT per command in seconds (default 900), DATA (default bench/data, git-ignored),
 #        OUT (default bench/clustered/results/clustered_N.jsonl)
 # Needs the peer drivers in bench/build-peers: bench/run_bench.sh builds them
@@ -21,6 +21,7 @@ repeat=${REPEAT:-3}
 threads=${THREADS:-2}
 timeout=${TIMEOUT:-900}
 voro=${VORO:-1}
+cells=${CELLS:-1}
 data=${DATA:-$here/../data}
 peers=$here/../build-peers
 py=/usr/bin/python3
@@ -42,7 +43,7 @@ for kind in $kinds; do
   f=$data/clustered_${kind}_$n.npy
   [[ -f $f ]] || $py "$here/gen_clustered.py" "$kind" "$n" "$f"
   note "$kind: tessera"
-  run "$kind" "$build/tessera" bench voronoi "$f" --threads "$threads" --repeat 1
+  [[ $cells == 1 ]] && run "$kind" "$build/tessera" bench voronoi "$f" --threads "$threads" --repeat 1
   run "$kind" "$build/tessera" bench delaunay "$f" --threads "$threads" --repeat 1
   if [[ -x $peers/cgal_delaunay3 ]]; then
     note "$kind: CGAL"
