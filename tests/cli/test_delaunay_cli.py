@@ -103,6 +103,16 @@ class DelaunayCommand(unittest.TestCase):
         with open(self.path("a.npy"), "rb") as a, open(self.path("b.npy"), "rb") as b:
             self.assertEqual(a.read(), b.read())
 
+    def test_methods_give_the_same_file(self):
+        self.ok(["delaunay", self.path("p3.npy"), "--simplices", self.path("a.npy"), "--method", "cells"])
+        r = self.ok(["delaunay", self.path("p3.npy"), "--simplices", self.path("b.npy"), "--method", "insertion"])
+        self.assertIn("by incremental insertion", r.stderr)
+        with open(self.path("a.npy"), "rb") as a, open(self.path("b.npy"), "rb") as b:
+            self.assertEqual(a.read(), b.read())
+        r = self.ok(["bench", "delaunay", self.path("p3.npy"), "--method", "insertion"])
+        j = json.loads(r.stdout)
+        self.assertEqual(j["extra"]["from_insertion"], j["simplices"])
+
     def test_no_hull_completion_is_a_subset(self):
         self.ok(["delaunay", self.path("p3.npy"), "--simplices", self.path("a.npy"), "--no-hull-completion"])
         self.ok(["delaunay", self.path("p3.npy"), "--simplices", self.path("b.npy")])
@@ -163,6 +173,9 @@ class DelaunayCommand(unittest.TestCase):
         self.fails(["delaunay", self.path("nan.npy"), "-o", out], [out])
         self.fails(["delaunay", self.path("p3.npy"), "-o", out, "--bounds", "0", "0.5", "0", "1", "0", "1"], [out])
         self.fails(["bench", "delaunay", self.path("p3.npy"), "--repeat", "0"])
+        self.fails(["delaunay", self.path("p2.npy"), "-o", out, "--method", "insertion"], [out])
+        self.fails(["delaunay", self.path("p3.npy"), "-o", out, "--method", "insertion", "--no-hull-completion"], [out])
+        self.fails(["delaunay", self.path("p3.npy"), "-o", out, "--method", "qhull"], [out])
 
 
 def main():
