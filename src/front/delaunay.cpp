@@ -21,6 +21,7 @@
 
 #include "delaunay_compositor.hpp"
 #include "hull_completion.hpp"
+#include "id_hash.hpp"
 #include "insertion.hpp"
 #include "pass.hpp"
 #include "point_buckets.hpp"
@@ -53,15 +54,8 @@ bool exactly_flat(std::span<const double> points, std::span<const std::uint8_t> 
       rank = 1;
     } else if (rank == 1) {
       if (!std::equal(p, p + D, basis[0])) basis[static_cast<std::size_t>(rank++)] = p;
-    } else if (rank < D) {  // 3D with two points: is p on their line? (all three projections)
-      bool collinear = true;
-      for (int d = 0; d < 3 && collinear; ++d) {
-        const int e = (d + 1) % 3;
-        const double a[2] = {basis[0][d], basis[0][e]}, b[2] = {basis[1][d], basis[1][e]}, c[2] = {p[d], p[e]};
-        const double* tri[3] = {a, b, c};
-        collinear = kernels::orientation(2, tri) == 0;
-      }
-      if (!collinear) basis[static_cast<std::size_t>(rank++)] = p;
+    } else if (rank < D) {  // 3D with two points: is p on their line?
+      if (!kernels::collinear3(basis[0], basis[1], p)) basis[static_cast<std::size_t>(rank++)] = p;
     } else {
       const double* s[D + 1];
       for (int k = 0; k < D; ++k) s[k] = basis[static_cast<std::size_t>(k)];
@@ -125,13 +119,7 @@ std::optional<std::array<std::int32_t, CellT::dim + 1>> seed_simplex(const front
   return std::nullopt;
 }
 
-// A point's hash in [0, 2^64): splitmix64's finaliser over its id.
-std::uint64_t id_hash(std::int32_t id) {
-  std::uint64_t z = static_cast<std::uint64_t>(id) + 0x9E3779B97F4A7C15ull;
-  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-  return z ^ (z >> 31);
-}
+using front::id_hash;
 
 // The points whose cells are skipped (docs/design.md, "Skipped cells").
 //

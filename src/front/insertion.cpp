@@ -9,6 +9,7 @@
 
 #include <tbb/parallel_sort.h>
 
+#include "id_hash.hpp"
 #include "tessera/kernels/delaunay_predicates.hpp"
 #include "tessera/kernels/filter.hpp"
 
@@ -31,14 +32,6 @@ int infinite_slot(const Tet& t) {
   for (int k = 0; k < 4; ++k)
     if (t.v[k] == infinite) return k;
   return 4;
-}
-
-// splitmix64's finaliser (as delaunay.cpp's id_hash): the BRIO round of a point.
-std::uint64_t mix(std::uint64_t z) {
-  z += 0x9E3779B97F4A7C15ull;
-  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-  return z ^ (z >> 31);
 }
 
 // 21 bits of x spread to every third bit.
@@ -72,7 +65,7 @@ std::vector<std::int32_t> brio_order(const ExactContext& ctx, std::span<const st
       const double c = std::clamp((p[d] - lo[d]) * scale[d], 0.0, 2097151.0);
       code |= spread3(static_cast<std::uint64_t>(c)) << d;
     }
-    const int round = std::min(std::countl_zero(mix(static_cast<std::uint64_t>(ids[i]))), max_round);
+    const int round = std::min(std::countl_zero(id_hash(ids[i])), max_round);
     keys[i] = {static_cast<std::uint64_t>(max_round - round), code, ids[i]};
   }
   tbb::parallel_sort(keys.begin(), keys.end(), [](const Key& a, const Key& b) {
@@ -250,7 +243,7 @@ class Triangulation {
             used_.push_back(h);
             break;
           }
-          if (e.key == key && e.tet != nt) {
+          if (e.key == key) {
             t.n[j] = e.tet;
             tets_[static_cast<std::size_t>(e.tet)].n[e.slot] = nt;
             e.key = ~std::uint64_t{0};  // matched: keep the probe chain, never match again
@@ -429,19 +422,6 @@ class Triangulation {
   std::vector<std::uint64_t> used_;
 };
 
-// Three points on one line? (Their projections on all three coordinate planes are.)
-bool collinear(const ExactContext& ctx, std::int32_t a, std::int32_t b, std::int32_t c) {
-  const double* p[3] = {ctx.points + static_cast<std::size_t>(a) * 3, ctx.points + static_cast<std::size_t>(b) * 3,
-                        ctx.points + static_cast<std::size_t>(c) * 3};
-  for (int d = 0; d < 3; ++d) {
-    const int e = (d + 1) % 3;
-    const double x[2] = {p[0][d], p[0][e]}, y[2] = {p[1][d], p[1][e]}, z[2] = {p[2][d], p[2][e]};
-    const double* tri[3] = {x, y, z};
-    if (kernels::orientation(2, tri) != 0) return false;
-  }
-  return true;
-}
-
 }  // namespace
 
 std::optional<std::vector<std::array<std::int32_t, 4>>> insertion_delaunay(const ExactContext& ctx,
@@ -453,7 +433,8 @@ std::optional<std::vector<std::array<std::int32_t, 4>>> insertion_delaunay(const
   // line, the first off their plane (in insertion order).
   if (order.size() < 4) return std::nullopt;
   std::size_t c = 2;
-  while (c < order.size() && collinear(ctx, order[0], order[1], order[c])) ++c;
+  auto at = [&](std::size_t k) { return ctx.points + static_cast<std::size_t>(order[k]) * 3; };
+  while (c < order.size() && kernels::collinear3(at(0), at(1), at(c))) ++c;
   if (c == order.size()) return std::nullopt;
   std::size_t d = c + 1;
   std::array<std::int32_t, 4> s{order[0], order[1], order[c], -1};

@@ -426,17 +426,9 @@ TEST(Delaunay, CoplanarHullFaces) {
   // tree nodes at once, by their box corners) without missing a simplex. No
   // four face points are co-circular, so the triangulation is unique: CGAL's.
   // (The hull volume is 1 up to the tiny bumps below.)
-  std::mt19937_64 rng(61);
+  std::vector<double> p = cube_face_points(300, 1000, 61);
+  std::mt19937_64 rng(62);
   std::uniform_real_distribution<double> u(0.0, 1.0);
-  std::vector<double> p;
-  for (int c = 0; c < 8; ++c) p.insert(p.end(), {double(c & 1), double((c >> 1) & 1), double((c >> 2) & 1)});
-  for (int face = 0; face < 6; ++face)
-    for (int i = 0; i < 300; ++i) {
-      double x[3] = {u(rng), u(rng), u(rng)};
-      x[face / 2] = face % 2;
-      p.insert(p.end(), {x[0], x[1], x[2]});
-    }
-  for (int i = 0; i < 1000; ++i) p.insert(p.end(), {u(rng), u(rng), u(rng)});
   // A few points a hair outside face z = 0, well within the float margin of
   // its plane: the facets of that face near them are not hull facets.
   for (int i = 0; i < 5; ++i) p.insert(p.end(), {0.1 + 0.2 * u(rng), 0.1 + 0.2 * u(rng), -1e-13});
@@ -478,15 +470,7 @@ TEST(Delaunay, SkippedCellsGiveTheSameRows) {
     }
     inputs.emplace_back(std::move(blobs), 3);
   }
-  {
-    std::vector<double> terrain;  // a height field: nearly every simplex from completion
-    std::uniform_real_distribution<double> u;
-    for (int i = 0; i < 2000; ++i) {
-      const double x = u(rng), y = u(rng);
-      terrain.insert(terrain.end(), {x, y, 0.1 * std::sin(6 * x) * std::cos(5 * y)});
-    }
-    inputs.emplace_back(std::move(terrain), 3);
-  }
+  inputs.emplace_back(height_field(2000, 79), 3);  // nearly every simplex from completion
   inputs.emplace_back(grid(9, 3), 3);
   inputs.emplace_back(grid(40, 2), 2);
   inputs.emplace_back(rotated_lattice(7, rng, g, 0.0), 3);
@@ -543,13 +527,7 @@ TEST(Delaunay, AutomaticSkipFractionFollowsTheCellsCost) {
   // units: the same for 1 and 2 threads, and the rows are those of the pass
   // without skipping. (The automatic method would send this input to
   // insertion: the cells method is asked for, test_insertion.cpp tests that.)
-  std::mt19937_64 rng(78);
-  std::uniform_real_distribution<double> u;
-  std::vector<double> terrain;
-  for (int i = 0; i < 24000; ++i) {
-    const double x = u(rng), y = u(rng);
-    terrain.insert(terrain.end(), {x, y, 0.1 * std::sin(6 * x) * std::cos(5 * y)});
-  }
+  const std::vector<double> terrain = height_field(24000, 78);
   tessera::DelaunayOptions o;
   o.skip_cells = 0;
   o.threads = 2;

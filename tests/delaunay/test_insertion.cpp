@@ -42,7 +42,6 @@ std::vector<double> grid3(int k, double step = 1) {
 std::vector<std::pair<std::string, std::vector<double>>> inputs() {
   std::mt19937_64 rng(5);
   std::normal_distribution<double> g;
-  std::uniform_real_distribution<double> u;
   std::vector<std::pair<std::string, std::vector<double>>> in;
   in.emplace_back("uniform", uniform_points(3000, 3, 41));
   {
@@ -53,14 +52,7 @@ std::vector<std::pair<std::string, std::vector<double>>> inputs() {
     }
     in.emplace_back("blobs", std::move(blobs));
   }
-  {
-    std::vector<double> terrain;  // a height field: needle cells
-    for (int i = 0; i < 3000; ++i) {
-      const double x = u(rng), y = u(rng);
-      terrain.insert(terrain.end(), {x, y, 0.1 * std::sin(6 * x) * std::cos(5 * y)});
-    }
-    in.emplace_back("terrain", std::move(terrain));
-  }
+  in.emplace_back("terrain", height_field(3000, 42));  // needle cells
   {
     // A height field on a grid with a flat floor: co-planar hull facets with
     // co-circular points (the floor), vertical sides of co-planar points.
@@ -96,18 +88,7 @@ std::vector<std::pair<std::string, std::vector<double>>> inputs() {
     }
     in.emplace_back("sphere", std::move(sphere));
   }
-  {
-    std::vector<double> cube;  // random points on a cube's faces, its corners, inside points
-    for (int c = 0; c < 8; ++c) cube.insert(cube.end(), {double(c & 1), double((c >> 1) & 1), double((c >> 2) & 1)});
-    for (int face = 0; face < 6; ++face)
-      for (int i = 0; i < 200; ++i) {
-        double x[3] = {u(rng), u(rng), u(rng)};
-        x[face / 2] = face % 2;
-        cube.insert(cube.end(), {x[0], x[1], x[2]});
-      }
-    for (int i = 0; i < 500; ++i) cube.insert(cube.end(), {u(rng), u(rng), u(rng)});
-    in.emplace_back("cube faces", std::move(cube));
-  }
+  in.emplace_back("cube faces", cube_face_points(200, 500, 46));
   {
     std::vector<double> spiral;  // near the moment curve: many thin hull simplices
     for (int i = 0; i < 300; ++i) {
@@ -189,13 +170,7 @@ TEST(Insertion, BadRequestsAreInputErrors) {
 TEST(Insertion, AutomaticChoiceTakesItForSurfaceSamplesOnly) {
   // A 24k-point height field: the pilot finds its needle cells far costlier
   // than what they find, and insertion builds the rows the cells would.
-  std::mt19937_64 rng(9);
-  std::uniform_real_distribution<double> u;
-  std::vector<double> terrain;
-  for (int i = 0; i < 24000; ++i) {
-    const double x = u(rng), y = u(rng);
-    terrain.insert(terrain.end(), {x, y, 0.1 * std::sin(6 * x) * std::cos(5 * y)});
-  }
+  const std::vector<double> terrain = height_field(24000, 9);
   const tessera::Delaunay automatic = triangulate(terrain, tessera::DelaunayMethod::automatic);
   EXPECT_EQ(automatic.from_insertion, automatic.n_simplices());
   EXPECT_EQ(automatic.simplices, triangulate(terrain, tessera::DelaunayMethod::cells).simplices);

@@ -62,6 +62,18 @@ int orientation(const ExactContext& ctx, const std::int32_t* ids);
 /// need not be input points (hull completion asks it of box corners).
 int orientation(int D, const double* const* pts);
 
+/// Do three 3D points lie on one line? Exactly: their projections on all
+/// three coordinate planes are collinear. No perturbation.
+inline bool collinear3(const double* a, const double* b, const double* c) {
+  for (int d = 0; d < 3; ++d) {
+    const int e = (d + 1) % 3;
+    const double x[2] = {a[d], a[e]}, y[2] = {b[d], b[e]}, z[2] = {c[d], c[e]};
+    const double* tri[3] = {x, y, z};
+    if (orientation(2, tri) != 0) return false;
+  }
+  return true;
+}
+
 /// Is q strictly inside the circumsphere of a and planes[0..D) (D = ctx.dim), in
 /// the perturbed sense of the clip predicate? Never undecided. Precondition: a
 /// and the planes are affinely independent, q is none of them.
