@@ -410,7 +410,9 @@ Delaunay by_insertion(const front::Pass<3>& pass, Delaunay out) {
     }
     std::sort(out.duplicates.begin(), out.duplicates.end());
     out.hull_completed = true;
-    auto rows = front::insertion_delaunay(pass.exact, distinct, pass.gens.lo.data(), pass.gens.hi.data());
+    front::InsertionOptions io;
+    io.threads = pass.engine_options.threads;
+    auto rows = front::insertion_delaunay(pass.exact, distinct, pass.gens.lo.data(), pass.gens.hi.data(), io);
     if (!rows) return;  // all on one plane: no simplex exists
     out.from_insertion = rows->size();
     out.simplices.resize(rows->size() * 4);  // every entry is written below

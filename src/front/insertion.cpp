@@ -2,11 +2,16 @@
 #include "insertion.hpp"
 
 #include <algorithm>
+#include <atomic>
+#include <memory>
+#include <optional>
 #include <bit>
 #include <cmath>
 #include <stdexcept>
 #include <utility>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 #include <tbb/parallel_sort.h>
 
 #include "id_hash.hpp"
@@ -45,10 +50,33 @@ std::uint64_t spread3(std::uint64_t x) {
   return x;
 }
 
+// A point's Morton code on the 2^21 grid over [lo, hi].
+struct MortonGrid {
+  double lo[3], scale[3];
+  MortonGrid(const double* l, const double* h) {
+    for (int d = 0; d < 3; ++d) {
+      lo[d] = l[d];
+      scale[d] = h[d] > l[d] ? 2097151.0 / (h[d] - l[d]) : 0.0;
+    }
+  }
+  std::uint64_t code(const double* p) const {
+    std::uint64_t c = 0;
+    for (int d = 0; d < 3; ++d) {
+      const double x = std::clamp((p[d] - lo[d]) * scale[d], 0.0, 2097151.0);
+      c |= spread3(static_cast<std::uint64_t>(x)) << d;
+    }
+    return c;
+  }
+};
+
 // The insertion order: BRIO rounds (a point joins round r with probability
 // 2^-(r+1), by its hash; the smallest rounds first), each in Morton order.
-std::vector<std::int32_t> brio_order(const ExactContext& ctx, std::span<const std::int32_t> ids, const double* lo,
-                                     const double* hi) {
+struct BrioOrder {
+  std::vector<std::int32_t> ids;
+  std::vector<std::size_t> rounds;  // each round's first position, then ids.size()
+};
+
+BrioOrder brio_order(const ExactContext& ctx, std::span<const std::int32_t> ids, const MortonGrid& grid) {
   struct Key {
     std::uint64_t round;  // smallest rounds first
     std::uint64_t code;
@@ -56,24 +84,21 @@ std::vector<std::int32_t> brio_order(const ExactContext& ctx, std::span<const st
   };
   constexpr int max_round = 24;
   std::vector<Key> keys(ids.size());
-  double scale[3];
-  for (int d = 0; d < 3; ++d) scale[d] = hi[d] > lo[d] ? 2097151.0 / (hi[d] - lo[d]) : 0.0;
   for (std::size_t i = 0; i < ids.size(); ++i) {
-    const double* p = ctx.points + static_cast<std::size_t>(ids[i]) * 3;
-    std::uint64_t code = 0;
-    for (int d = 0; d < 3; ++d) {
-      const double c = std::clamp((p[d] - lo[d]) * scale[d], 0.0, 2097151.0);
-      code |= spread3(static_cast<std::uint64_t>(c)) << d;
-    }
     const int round = std::min(std::countl_zero(id_hash(ids[i])), max_round);
-    keys[i] = {static_cast<std::uint64_t>(max_round - round), code, ids[i]};
+    keys[i] = {static_cast<std::uint64_t>(max_round - round), grid.code(ctx.points + static_cast<std::size_t>(ids[i]) * 3), ids[i]};
   }
   tbb::parallel_sort(keys.begin(), keys.end(), [](const Key& a, const Key& b) {
     return a.round != b.round ? a.round < b.round
                                                 : (a.code != b.code ? a.code < b.code : a.id < b.id);
   });
-  std::vector<std::int32_t> order(ids.size());
-  for (std::size_t i = 0; i < keys.size(); ++i) order[i] = keys[i].id;
+  BrioOrder order;
+  order.ids.resize(ids.size());
+  for (std::size_t i = 0; i < keys.size(); ++i) {
+    order.ids[i] = keys[i].id;
+    if (i == 0 || keys[i].round != keys[i - 1].round) order.rounds.push_back(i);
+  }
+  order.rounds.push_back(ids.size());
   return order;
 }
 
@@ -87,7 +112,7 @@ std::vector<std::int32_t> brio_order(const ExactContext& ctx, std::span<const st
 // any order of the sums.
 
 // Sign of det[b - a, c - a, d - a].
-inline int orientation_filter(const double* a, const double* b, const double* c, const double* d) {
+[[gnu::always_inline]] inline int orientation_filter(const double* a, const double* b, const double* c, const double* d) {
   const double r0[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
   const double r1[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
   const double r2[3] = {d[0] - a[0], d[1] - a[1], d[2] - a[2]};
@@ -106,7 +131,7 @@ inline int orientation_filter(const double* a, const double* b, const double* c,
 // circumsphere, -1 surely outside, 0 undecided. With rows r_k = p_k - a and
 // s_k = |r_k|^2 (k = b, c, d, q), q is inside iff det[[r_k, s_k]] < 0
 // (kernels::in_sphere; det R > 0 here).
-inline int in_sphere_filter(const double* a, const double* b, const double* c, const double* d, const double* q) {
+[[gnu::always_inline]] inline int in_sphere_filter(const double* a, const double* b, const double* c, const double* d, const double* q) {
   double r[4][3], s[4];
   const double* p[4] = {b, c, d, q};
   for (int k = 0; k < 4; ++k) {
@@ -134,95 +159,324 @@ inline int in_sphere_filter(const double* a, const double* b, const double* c, c
   return det < -bound ? 1 : (det > bound ? -1 : 0);
 }
 
+// The tetrahedra and their conflict marks, in arrays whose slots are written
+// before they are read (allocated without initialising: the capacity
+// reserved ahead of a parallel phase costs no page until it is used). Fresh
+// slots are claimed in blocks, atomically, so that the parallel phases can
+// take them; only the serial code grows the arrays.
+class TetStore {
+ public:
+  Tet* tets() { return tets_.get(); }
+  const Tet* tets() const { return tets_.get(); }
+  std::uint32_t* state() { return state_.get(); }
+  std::size_t size() const { return size_.load(std::memory_order_relaxed); }
+
+  /// Room for `extra` more slots without growing (serial only).
+  void reserve(std::size_t extra) {
+    const std::size_t need = size() + extra;
+    if (need <= cap_) return;
+    const std::size_t cap = std::max(need, 2 * cap_);
+    std::unique_ptr<Tet[]> t(new Tet[cap]);
+    std::unique_ptr<std::uint32_t[]> s(new std::uint32_t[cap]);
+    std::copy(tets_.get(), tets_.get() + size(), t.get());
+    std::copy(state_.get(), state_.get() + size(), s.get());
+    tets_ = std::move(t);
+    state_ = std::move(s);
+    cap_ = cap;
+  }
+  /// The first of `count` fresh slots, or nullopt when the capacity is spent.
+  std::optional<std::size_t> claim(std::size_t count) {
+    std::size_t s = size_.load(std::memory_order_relaxed);
+    do {
+      if (s + count > cap_) return std::nullopt;
+    } while (!size_.compare_exchange_weak(s, s + count, std::memory_order_relaxed));
+    return s;
+  }
+
+ private:
+  std::unique_ptr<Tet[]> tets_;
+  std::unique_ptr<std::uint32_t[]> state_;  // (epoch << 1) | in conflict
+  std::size_t cap_ = 0;
+  std::atomic<std::size_t> size_{0};
+};
+
+/// What one thread of insertion keeps: its partition, its conflict-mark
+/// epochs, its walk's start, its free and fresh slots and its buffers.
+struct Worker {
+  std::uint8_t part = 0;      // the partition it inserts in a parallel phase
+  std::uint32_t epoch = 0;    // its marks: part + 1, then steps of the worker count
+  std::int32_t last = -1;     // a tetrahedron of its last insertion (the next walk's start), or -1
+  std::uint64_t rng = 0x2545F4914F6CDD1Dull;
+  std::vector<std::int32_t> free;     // slots of tetrahedra it removed
+  std::size_t fresh = 0, fresh_end = 0;  // claimed slots never used
+  std::vector<std::int32_t> deferred;  // points a parallel phase left for later
+  struct Face {
+    std::int32_t v[4];  // the new tetrahedron's vertices (q at k)
+    int k;
+    std::int32_t outside;  // the tetrahedron across the face, not in conflict
+    int back;              // its slot pointing at the cavity
+  };
+  struct Edge {
+    std::uint64_t key = 0;
+    std::int32_t tet = -1;
+    int slot = 0;
+  };
+  std::vector<std::int32_t> stack, cavity;
+  std::vector<Face> boundary;
+  std::vector<Edge> edges;
+  std::vector<std::uint64_t> used;
+};
+
 class Triangulation {
  public:
   /// Vertices are numbered by `global`, the insertion order: vertex k is
   /// point global[k] of ctx, and its coordinates are copied in that order, so
   /// the points a walk and a cavity meet lie close in memory too.
-  Triangulation(const ExactContext& ctx, std::vector<std::int32_t> global) : ctx_(ctx), global_(std::move(global)) {
+  Triangulation(const ExactContext& ctx, std::vector<std::int32_t> global, int threads)
+      : ctx_(ctx), global_(std::move(global)), workers_(static_cast<std::size_t>(std::max(threads, 1))) {
     coords_.resize(3 * global_.size());
     for (std::size_t k = 0; k < global_.size(); ++k)
       for (int e = 0; e < 3; ++e) coords_[3 * k + static_cast<std::size_t>(e)] = ctx.points[static_cast<std::size_t>(global_[k]) * 3 + static_cast<std::size_t>(e)];
+    for (std::size_t w = 0; w < workers_.size(); ++w) {
+      workers_[w].part = static_cast<std::uint8_t>(w);
+      workers_[w].epoch = static_cast<std::uint32_t>(w) + 1;
+      workers_[w].rng += 0x9E3779B97F4A7C15ull * w;
+    }
+    // A Delaunay tetrahedralisation has about 6.5 tetrahedra per point.
+    store_.reserve(7 * global_.size() + 64);
   }
 
   /// Start from the positively oriented tetrahedron s and its four ghosts.
   void start(std::array<std::int32_t, 4> s) {
-    tets_.clear();
+    const std::size_t first = *store_.claim(5);  // the constructor reserved room
+    Tet* const tets = store_.tets() + first;
     Tet t0{{s[0], s[1], s[2], s[3]}, {-1, -1, -1, -1}};
-    tets_.push_back(t0);
+    tets[0] = t0;
     for (int k = 0; k < 4; ++k) {
       Tet g = t0;
       g.v[k] = infinite;
       // With the infinite vertex standing for a point beyond face k (the
       // side away from v[k]) the order is negative: swap two others.
       std::swap(g.v[(k + 1) % 4], g.v[(k + 2) % 4]);
-      tets_.push_back(g);
+      tets[k + 1] = g;
     }
     // Link the five by their shared faces.
-    for (std::size_t a = 0; a < tets_.size(); ++a)
+    for (int a = 0; a < 5; ++a) {
+      store_.state()[first + static_cast<std::size_t>(a)] = 0;
       for (int ka = 0; ka < 4; ++ka)
-        for (std::size_t b = 0; b < tets_.size(); ++b) {
+        for (int b = 0; b < 5; ++b) {
           if (a == b) continue;
           for (int kb = 0; kb < 4; ++kb)
-            if (same_face(tets_[a], ka, tets_[b], kb)) tets_[a].n[ka] = static_cast<std::int32_t>(b);
+            if (same_face(tets[a], ka, tets[b], kb)) tets[a].n[ka] = static_cast<std::int32_t>(first) + b;
         }
-    state_.assign(tets_.size(), 0);
-    last_ = 0;
+    }
+    hint_ = static_cast<std::int32_t>(first);
   }
 
-  /// Insert point q (not yet in the triangulation, at no vertex's place).
-  void insert(std::int32_t q) {
-    const std::int32_t t0 = locate(q, last_);
-    if (++epoch_ == (1u << 31)) {  // stale marks could read as this insertion's
-      std::fill(state_.begin(), state_.end(), 0);
-      epoch_ = 1;
+  /// Insert the points `pts` (vertex numbers; none in the triangulation yet),
+  /// in their order; `end` bounds every vertex number so far. A large set
+  /// goes through two parallel phases (see phase), cut across different
+  /// axes; what they leave is inserted serially.
+  void insert_round(std::vector<std::int32_t> pts, std::size_t end, std::size_t parallel_min) {
+    const std::size_t threads = workers_.size();
+    int cut_axis = -1;
+    for (int k = 0; k < 2 && parallel_ && threads > 1 && pts.size() >= parallel_min * threads; ++k) {
+      const std::size_t tried = pts.size();
+      pts = phase(pts, end, cut_axis);
+      // Points on a surface (a torus, a terrain) have long tetrahedra
+      // across the object, so walks and cavities cross the cuts: when a
+      // phase of 2048 points or more defers over a third, the later rounds
+      // go serially (a failed walk costs about what its insertion would
+      // have). Smaller phases defer many anyway, as their tetrahedra are
+      // large next to the slabs.
+      if (tried >= 2048 && 3 * pts.size() > tried) parallel_ = false;
     }
+    Worker& w = workers_[0];
+    w.last = hint_;
+    for (const std::int32_t q : pts) {
+      if (w.epoch >= epoch_limit()) reset_marks();
+      if (!insert<false>(w, q)) throw std::logic_error("tessera: insertion: a serial insertion was refused");
+    }
+    hint_ = w.last;
+  }
+
+  /// The finite tetrahedra, in the layout of insertion_delaunay.
+  std::vector<std::array<std::int32_t, 4>> rows() const;
+
+ private:
+  using Face = Worker::Face;
+  using Edge = Worker::Edge;
+
+  /// One parallel phase (after Marot, Pellerin & Remacle, "One machine, one
+  /// minute, three billion tetrahedra", 2019). Space is cut into slabs
+  /// across the widest axis of `pts` other than `cut_axis` (the previous
+  /// phase's, which is then set to this one's), at quantiles of the points,
+  /// so that each worker gets as many; every vertex so far belongs to the
+  /// slab it lies in. A worker inserts its slab's points, in their order,
+  /// and may only change tetrahedra whose finite vertices all lie in its
+  /// slab (`owned`); a point whose walk or cavity meets another one is
+  /// deferred and returned. No two workers then touch the same tetrahedron:
+  /// * a worker changes a tetrahedron's vertices only if it owns it, and
+  ///   its links only across a face whose finite vertices are all its own
+  ///   (a face of a cavity it removes), where the new tetrahedron goes;
+  /// * it reads and marks only tetrahedra it owns and those across a face of
+  ///   one (walk steps, cavity neighbours);
+  /// * a tetrahedron with a face all of worker A's (two finite vertices at
+  ///   least) and a face all of B's would need two finite vertices of each
+  ///   among its four vertices, with one of every face's three left out: no
+  ///   such tetrahedron exists (the infinite vertex belongs to everyone).
+  /// The triangulation stays the Delaunay triangulation of the points
+  /// inserted so far; it is unique (perturbed predicates), so the order of
+  /// insertion, and with it the thread count, does not change the result.
+  /// Slabs rather than runs of the Morton order: a run's boundary follows
+  /// the curve's top bits, which cut a flat input (a torus, a terrain)
+  /// along its thin side, where nearly every tetrahedron crosses the cut.
+  std::vector<std::int32_t> phase(const std::vector<std::int32_t>& pts, std::size_t end, int& cut_axis) {
+    const std::size_t threads = workers_.size();
+    double lo[3], hi[3];
+    for (int a = 0; a < 3; ++a) lo[a] = hi[a] = at(pts[0])[a];
+    for (const std::int32_t q : pts)
+      for (int a = 0; a < 3; ++a) {
+        lo[a] = std::min(lo[a], at(q)[a]);
+        hi[a] = std::max(hi[a], at(q)[a]);
+      }
+    int axis = -1;
+    for (int a = 0; a < 3; ++a)
+      if (a != cut_axis && (axis < 0 || hi[a] - lo[a] > hi[axis] - lo[axis])) axis = a;
+    cut_axis = axis;
+    std::vector<double> x(pts.size());
+    for (std::size_t i = 0; i < pts.size(); ++i) x[i] = at(pts[i])[axis];
+    std::vector<double> cut(threads - 1);
+    for (std::size_t t = threads - 1; t >= 1; --t) {  // descending: each nth_element narrows the next
+      const auto nth = x.begin() + static_cast<std::ptrdiff_t>(t * pts.size() / threads);
+      std::nth_element(x.begin(), nth, x.end());
+      cut[t - 1] = *nth;
+      x.resize(static_cast<std::size_t>(nth - x.begin()) + 1);
+    }
+    part_.resize(end);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, end, 1 << 14), [&](const tbb::blocked_range<std::size_t>& r) {
+      for (std::size_t v = r.begin(); v != r.end(); ++v)
+        part_[v] = static_cast<std::uint8_t>(std::upper_bound(cut.begin(), cut.end(), at(static_cast<std::int32_t>(v))[axis]) - cut.begin());
+    });
+    // Each worker's points, in their order.
+    std::vector<std::vector<std::int32_t>> mine(threads);
+    for (const std::int32_t q : pts) mine[part_[static_cast<std::size_t>(q)]].push_back(q);
+    // A tetrahedron each worker owns holding its first point, found
+    // serially (each walk starts where the last ended); points met before
+    // one is found are deferred.
+    std::vector<std::size_t> from(threads);
+    std::int32_t walk_from = hint_;
+    for (std::size_t t = 0; t < threads; ++t) {
+      Worker& w = workers_[t];
+      w.deferred.clear();
+      w.last = -1;
+      std::size_t i = 0;
+      for (const std::size_t give_up = std::min<std::size_t>(mine[t].size(), 64); i < give_up; ++i) {
+        const std::int32_t t0 = locate<false>(w, mine[t][i], walk_from);
+        walk_from = t0;
+        if (owned(store_.tets()[t0], w.part)) {
+          w.last = t0;
+          break;
+        }
+        w.deferred.push_back(mine[t][i]);
+      }
+      if (w.last < 0)
+        for (; i < mine[t].size(); ++i) w.deferred.push_back(mine[t][i]);
+      from[t] = i;
+    }
+    // Room for every fresh slot the phase may claim (claims beyond it defer
+    // their points), and marks that cannot wrap within it.
+    store_.reserve(8 * pts.size() + threads * fresh_block);
+    for (const Worker& w : workers_)
+      if (w.epoch + threads * (pts.size() + 1) >= epoch_limit()) reset_marks();
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, threads, 1), [&](const tbb::blocked_range<std::size_t>& r) {
+      for (std::size_t t = r.begin(); t != r.end(); ++t) {
+        Worker& w = workers_[t];
+        if (w.last < 0) continue;
+        for (std::size_t i = from[t]; i < mine[t].size(); ++i)
+          if (!insert<true>(w, mine[t][i])) w.deferred.push_back(mine[t][i]);
+      }
+    }, tbb::simple_partitioner());
+    // A worker's last tetrahedron is its own and alive; with none (nothing
+    // inserted) the previous hint was not touched.
+    for (const Worker& w : workers_)
+      if (w.last >= 0) {
+        hint_ = w.last;
+        break;
+      }
+    std::vector<std::int32_t> rest;
+    for (const Worker& w : workers_) rest.insert(rest.end(), w.deferred.begin(), w.deferred.end());
+    return rest;
+  }
+
+  /// Insert point q (not yet in the triangulation, at no vertex's place) by
+  /// worker w, starting the walk from w.last. With Check (a parallel phase),
+  /// false when the walk or the cavity meets a tetrahedron w does not own,
+  /// or no fresh slot is left: nothing has been changed then.
+  template <bool Check>
+  bool insert(Worker& w, std::int32_t q) {
+    const std::int32_t t0 = locate<Check>(w, q, w.last);
+    if (t0 < 0) return false;
+    w.epoch += static_cast<std::uint32_t>(workers_.size());
+    const std::uint32_t mark_out = w.epoch << 1, mark_in = mark_out | 1;
+    Tet* tets = store_.tets();
+    std::uint32_t* state = store_.state();
     if (!conflicts(t0, q)) throw std::logic_error("tessera: insertion: the located tetrahedron is not in conflict");
-    mark(t0, true);
-    stack_.assign(1, t0);
-    cavity_.clear();
-    boundary_.clear();
-    while (!stack_.empty()) {
-      const std::int32_t t = stack_.back();
-      stack_.pop_back();
-      cavity_.push_back(t);
+    state[t0] = mark_in;
+    w.stack.assign(1, t0);
+    w.cavity.clear();
+    w.boundary.clear();
+    while (!w.stack.empty()) {
+      const std::int32_t t = w.stack.back();
+      w.stack.pop_back();
+      w.cavity.push_back(t);
       for (int k = 0; k < 4; ++k) {
-        const std::int32_t u = tets_[static_cast<std::size_t>(t)].n[k];
+        const std::int32_t u = tets[t].n[k];
         bool in;
-        if (tested(u)) {
-          in = in_conflict(u);
+        if ((state[u] | 1) == mark_in) {
+          in = state[u] & 1;
         } else {
           in = conflicts(u, q);
-          mark(u, in);
-          if (in) stack_.push_back(u);
+          state[u] = in ? mark_in : mark_out;
+          if (in) {
+            if (Check && !owned(tets[u], w.part)) return false;
+            w.stack.push_back(u);
+          }
         }
         if (in) continue;
         // A face of the cavity's boundary: the new tetrahedron is t with q
         // in place of v[k] (q sees the face from v[k]'s side).
         Face f;
-        const Tet& tt = tets_[static_cast<std::size_t>(t)];
-        for (int m = 0; m < 4; ++m) f.v[m] = tt.v[m];
+        for (int m = 0; m < 4; ++m) f.v[m] = tets[t].v[m];
         f.v[k] = q;
         f.k = k;
         f.outside = u;
         f.back = back_slot(u, t);
-        boundary_.push_back(f);
+        w.boundary.push_back(f);
       }
     }
-    for (const std::int32_t t : cavity_) free_.push_back(t);
+    // Slots for the new tetrahedra: the cavity's, the worker's free ones,
+    // then fresh ones.
+    const std::size_t have = w.cavity.size() + w.free.size() + (w.fresh_end - w.fresh);
+    if (w.boundary.size() > have) {
+      if (!claim(w, w.boundary.size() - have, Check)) return false;
+      tets = store_.tets();  // a serial claim may have moved the arrays
+      state = store_.state();
+    }
+    for (const std::int32_t t : w.cavity) w.free.push_back(t);
     // Each boundary edge bounds two of the new tetrahedra: they meet across
     // the face through it and q.
-    const std::size_t need = std::bit_ceil(4 * boundary_.size() + 16);
-    if (edges_.size() < need) edges_.assign(need, Edge{});
-    const std::uint64_t mask = edges_.size() - 1;
-    const int shift = 64 - std::countr_zero(edges_.size());
-    used_.clear();
-    for (const Face& f : boundary_) {
-      const std::int32_t nt = allocate();
-      Tet& t = tets_[static_cast<std::size_t>(nt)];
+    const std::size_t need = std::bit_ceil(4 * w.boundary.size() + 16);
+    if (w.edges.size() < need) w.edges.assign(need, Edge{});
+    const std::uint64_t mask = w.edges.size() - 1;
+    const int shift = 64 - std::countr_zero(w.edges.size());
+    w.used.clear();
+    for (const Face& f : w.boundary) {
+      const std::int32_t nt = allocate(w);
+      Tet& t = tets[nt];
       for (int m = 0; m < 4; ++m) t.v[m] = f.v[m];
       t.n[f.k] = f.outside;
-      tets_[static_cast<std::size_t>(f.outside)].n[f.back] = nt;
+      tets[f.outside].n[f.back] = nt;
       for (int j = 0; j < 4; ++j) {
         if (j == f.k) continue;
         std::int32_t a = infinite, b = infinite;
@@ -237,82 +491,70 @@ class Triangulation {
                                   static_cast<std::uint32_t>(b);
         std::uint64_t h = (key * 0x9E3779B97F4A7C15ull) >> shift;
         for (;; h = (h + 1) & mask) {
-          Edge& e = edges_[h];
+          Edge& e = w.edges[h];
           if (e.tet < 0) {
             e = {key, nt, j};
-            used_.push_back(h);
+            w.used.push_back(h);
             break;
           }
           if (e.key == key) {
             t.n[j] = e.tet;
-            tets_[static_cast<std::size_t>(e.tet)].n[e.slot] = nt;
+            tets[e.tet].n[e.slot] = nt;
             e.key = ~std::uint64_t{0};  // matched: keep the probe chain, never match again
             break;
           }
         }
       }
-      last_ = nt;
+      w.last = nt;
     }
-    for (const std::uint64_t h : used_) edges_[h] = Edge{};
+    for (const std::uint64_t h : w.used) w.edges[h] = Edge{};
+    return true;
   }
 
-  /// The finite tetrahedra, in the layout of insertion_delaunay.
-  std::vector<std::array<std::int32_t, 4>> rows() const {
-    using Row = std::array<std::int32_t, 4>;
-    std::vector<std::uint8_t> is_free(tets_.size(), 0);
-    for (const std::int32_t t : free_) is_free[static_cast<std::size_t>(t)] = 1;
-    // Rows by their lowest id (a counting sort), then each point's few sorted.
-    std::size_t n_ids = 0;
-    for (const std::int32_t g : global_) n_ids = std::max(n_ids, static_cast<std::size_t>(g) + 1);
-    std::vector<std::size_t> start(n_ids + 1, 0);
-    std::vector<Row> rows;
-    rows.reserve(tets_.size());
-    for (std::size_t i = 0; i < tets_.size(); ++i) {
-      if (is_free[i] || infinite_slot(tets_[i]) != 4) continue;
-      Row r{global(tets_[i].v[0]), global(tets_[i].v[1]), global(tets_[i].v[2]), global(tets_[i].v[3])};
-      // Sort, counting the swaps: an odd permutation of a positive order is
-      // negative, which the layout writes with its last two swapped.
-      bool odd = false;
-      for (int a = 1; a < 4; ++a)
-        for (int b = a; b > 0 && r[b - 1] > r[b]; --b) {
-          std::swap(r[b - 1], r[b]);
-          odd = !odd;
-        }
-      if (odd) std::swap(r[2], r[3]);
-      rows.push_back(r);
-      ++start[static_cast<std::size_t>(r[0]) + 1];
+  /// At least `count` more fresh slots for w. Serially the store grows; in
+  /// a parallel phase a spent capacity is a refusal (false).
+  bool claim(Worker& w, std::size_t count, bool parallel) {
+    for (std::size_t s = w.fresh; s < w.fresh_end; ++s) {  // keep the old block's rest as free slots
+      store_.state()[s] = 0;
+      w.free.push_back(static_cast<std::int32_t>(s));
     }
-    for (std::size_t g = 0; g < n_ids; ++g) start[g + 1] += start[g];
-    std::vector<Row> out(rows.size());
-    {
-      std::vector<std::size_t> next(start.begin(), start.end() - 1);
-      for (const Row& r : rows) out[next[static_cast<std::size_t>(r[0])]++] = r;
-    }
-    auto key_less = [](const Row& a, const Row& b) {  // row[0] is shared
-      if (a[1] != b[1]) return a[1] < b[1];
-      const std::int32_t a2 = std::min(a[2], a[3]), b2 = std::min(b[2], b[3]);
-      if (a2 != b2) return a2 < b2;
-      return std::max(a[2], a[3]) < std::max(b[2], b[3]);
-    };
-    for (std::size_t g = 0; g < n_ids; ++g)
-      if (start[g + 1] - start[g] > 1)
-        std::sort(out.begin() + static_cast<std::ptrdiff_t>(start[g]), out.begin() + static_cast<std::ptrdiff_t>(start[g + 1]),
-                  key_less);
-    return out;
+    w.fresh = w.fresh_end = 0;
+    const std::size_t block = std::max(count, fresh_block);
+    if (!parallel) store_.reserve(block);
+    const std::optional<std::size_t> first = store_.claim(block);
+    if (!first) return false;
+    w.fresh = *first;
+    w.fresh_end = *first + block;
+    return true;
   }
 
- private:
-  struct Face {
-    std::int32_t v[4];  // the new tetrahedron's vertices (q at k)
-    int k;
-    std::int32_t outside;  // the tetrahedron across the face, not in conflict
-    int back;              // its slot pointing at the cavity
-  };
-  struct Edge {
-    std::uint64_t key = 0;
-    std::int32_t tet = -1;
-    int slot = 0;
-  };
+  std::int32_t allocate(Worker& w) {
+    if (!w.free.empty()) {
+      const std::int32_t t = w.free.back();
+      w.free.pop_back();
+      return t;
+    }
+    const std::size_t t = w.fresh++;  // insert() made sure there is one
+    store_.state()[t] = 0;  // marked by no epoch
+    return static_cast<std::int32_t>(t);
+  }
+
+  /// Whether worker `part` may change t: its finite vertices all lie in its
+  /// partition.
+  bool owned(const Tet& t, std::uint8_t part) const {
+    for (int k = 0; k < 4; ++k)
+      if (t.v[k] != infinite && part_[static_cast<std::size_t>(t.v[k])] != part) return false;
+    return true;
+  }
+
+  /// Marks are (epoch << 1) | bit in 32 bits; the workers' epochs are
+  /// distinct (worker w's are w + 1 modulo the worker count), so a slot
+  /// marked by one never reads as marked by another's current insertion.
+  static constexpr std::uint32_t epoch_limit() { return 1u << 30; }
+  void reset_marks() {
+    std::fill(store_.state(), store_.state() + store_.size(), 0u);
+    for (std::size_t w = 0; w < workers_.size(); ++w) workers_[w].epoch = static_cast<std::uint32_t>(w) + 1;
+  }
 
   static bool same_face(const Tet& a, int ka, const Tet& b, int kb) {
     std::int32_t fa[3], fb[3];
@@ -326,37 +568,22 @@ class Triangulation {
   }
 
   int back_slot(std::int32_t u, std::int32_t t) const {
-    const Tet& tu = tets_[static_cast<std::size_t>(u)];
+    const Tet& tu = store_.tets()[u];
     for (int m = 0; m < 4; ++m)
       if (tu.n[m] == t) return m;
     throw std::logic_error("tessera: insertion: one-sided adjacency");
   }
 
-  std::int32_t allocate() {
-    if (!free_.empty()) {
-      const std::int32_t t = free_.back();
-      free_.pop_back();
-      return t;
-    }
-    tets_.emplace_back();
-    state_.push_back(0);
-    return static_cast<std::int32_t>(tets_.size() - 1);
-  }
-
-  bool tested(std::int32_t t) const { return (state_[static_cast<std::size_t>(t)] >> 1) == epoch_; }
-  bool in_conflict(std::int32_t t) const { return state_[static_cast<std::size_t>(t)] & 1; }
-  void mark(std::int32_t t, bool in) { state_[static_cast<std::size_t>(t)] = (epoch_ << 1) | (in ? 1u : 0u); }
-
   /// Is q strictly inside t's (perturbed) circumsphere? For a ghost: is q
   /// beyond its facet, or on the facet's plane within its circumcircle?
   bool conflicts(std::int32_t ti, std::int32_t q) const {
-    const Tet& t = tets_[static_cast<std::size_t>(ti)];
+    const Tet& t = store_.tets()[ti];
     const int inf = infinite_slot(t);
     if (inf == 4) return in_sphere(t, q);
     std::int32_t ids[4] = {t.v[0], t.v[1], t.v[2], t.v[3]};
     ids[inf] = q;
     if (const int o = orientation(ids); o != 0) return o > 0;
-    return in_sphere(tets_[static_cast<std::size_t>(t.n[inf])], q);
+    return in_sphere(store_.tets()[t.n[inf]], q);
   }
 
   const double* at(std::int32_t k) const { return coords_.data() + static_cast<std::size_t>(k) * 3; }
@@ -380,16 +607,21 @@ class Triangulation {
   /// A tetrahedron whose closure holds q, or a ghost whose facet q lies
   /// strictly beyond: a visibility walk from `from`, which tries the faces
   /// from a varying first one (a stochastic walk terminates; Devillers,
-  /// Pion & Teillaud, "Walking in a triangulation", 2002).
-  std::int32_t locate(std::int32_t q, std::int32_t from) {
+  /// Pion & Teillaud, "Walking in a triangulation", 2002). With Check, -1
+  /// once it steps into a tetrahedron w does not own (`from` is w's).
+  template <bool Check>
+  std::int32_t locate(Worker& w, std::int32_t q, std::int32_t from) {
+    const Tet* const tets = store_.tets();
     std::int32_t t = from, came_from = -1;
-    if (const int inf = infinite_slot(tets_[static_cast<std::size_t>(t)]); inf != 4)
-      t = tets_[static_cast<std::size_t>(t)].n[inf];
+    if (const int inf = infinite_slot(tets[t]); inf != 4) {
+      t = tets[t].n[inf];
+      if (Check && !owned(tets[t], w.part)) return -1;
+    }
     for (;;) {
-      const Tet& tt = tets_[static_cast<std::size_t>(t)];
+      const Tet& tt = tets[t];
       if (infinite_slot(tt) != 4) return t;
-      rng_ = rng_ * 6364136223846793005ull + 1442695040888963407ull;
-      const int first = static_cast<int>(rng_ >> 62);
+      w.rng = w.rng * 6364136223846793005ull + 1442695040888963407ull;
+      const int first = static_cast<int>(w.rng >> 62);
       std::int32_t next = -1;
       for (int i = 0; i < 4; ++i) {
         const int k = (first + i) & 3;
@@ -402,55 +634,124 @@ class Triangulation {
         }
       }
       if (next < 0) return t;
+      if (Check && !owned(tets[next], w.part)) return -1;
       came_from = t;
       t = next;
     }
   }
 
+  /// Fresh slots a worker claims at a time.
+  static constexpr std::size_t fresh_block = 4096;
+
   const ExactContext& ctx_;
   std::vector<std::int32_t> global_;  // vertex -> input id
   std::vector<double> coords_;        // vertex -> coordinates (3 each)
-  std::vector<Tet> tets_;
-  std::vector<std::uint32_t> state_;  // (epoch << 1) | in conflict, per tetrahedron
-  std::uint32_t epoch_ = 0;
-  std::vector<std::int32_t> free_;  // slots of removed tetrahedra
-  std::int32_t last_ = 0;           // a tetrahedron of the last insertion: the next walk's start
-  std::uint64_t rng_ = 0x2545F4914F6CDD1Dull;
-  std::vector<std::int32_t> stack_, cavity_;
-  std::vector<Face> boundary_;
-  std::vector<Edge> edges_;
-  std::vector<std::uint64_t> used_;
+  TetStore store_;
+  std::vector<Worker> workers_;
+  std::vector<std::uint8_t> part_;  // vertex -> partition, in a parallel phase
+  std::int32_t hint_ = 0;           // a live tetrahedron: the serial walk's start
+  bool parallel_ = true;            // whether rounds still try parallel phases
 };
+
+std::vector<std::array<std::int32_t, 4>> Triangulation::rows() const {
+  using Row = std::array<std::int32_t, 4>;
+  const std::size_t size = store_.size();
+  const Tet* const tets = store_.tets();
+  std::vector<std::uint8_t> is_free(size, 0);
+  for (const Worker& w : workers_) {
+    for (const std::int32_t t : w.free) is_free[static_cast<std::size_t>(t)] = 1;
+    for (std::size_t t = w.fresh; t < w.fresh_end; ++t) is_free[t] = 1;
+  }
+  // Slot i's row, its ids ascending except that the last two are swapped
+  // where that order is negative (an odd permutation of the positive one);
+  // false for free slots and ghosts.
+  auto row_of = [&](std::size_t i, Row& r) {
+    if (is_free[i] || infinite_slot(tets[i]) != 4) return false;
+    r = {global(tets[i].v[0]), global(tets[i].v[1]), global(tets[i].v[2]), global(tets[i].v[3])};
+    bool odd = false;
+    for (int a = 1; a < 4; ++a)
+      for (int b = a; b > 0 && r[b - 1] > r[b]; --b) {
+        std::swap(r[b - 1], r[b]);
+        odd = !odd;
+      }
+    if (odd) std::swap(r[2], r[3]);
+    return true;
+  };
+  // Rows bucketed by their lowest id (counted, then placed, both in
+  // parallel: the order within a bucket is then arbitrary), then each
+  // bucket's few sorted, which makes the result the same for any order.
+  std::size_t n_ids = 0;
+  for (const std::int32_t g : global_) n_ids = std::max(n_ids, static_cast<std::size_t>(g) + 1);
+  std::vector<std::size_t> start(n_ids + 1, 0);
+  const tbb::blocked_range<std::size_t> slots(0, size, 1 << 14);
+  tbb::parallel_for(slots, [&](const tbb::blocked_range<std::size_t>& range) {
+    Row r;
+    for (std::size_t i = range.begin(); i != range.end(); ++i)
+      if (row_of(i, r)) std::atomic_ref(start[static_cast<std::size_t>(r[0]) + 1]).fetch_add(1, std::memory_order_relaxed);
+  });
+  for (std::size_t g = 0; g < n_ids; ++g) start[g + 1] += start[g];
+  std::vector<Row> out(start[n_ids]);
+  {
+    std::vector<std::size_t> next(start.begin(), start.end() - 1);
+    tbb::parallel_for(slots, [&](const tbb::blocked_range<std::size_t>& range) {
+      Row r;
+      for (std::size_t i = range.begin(); i != range.end(); ++i)
+        if (row_of(i, r)) out[std::atomic_ref(next[static_cast<std::size_t>(r[0])]).fetch_add(1, std::memory_order_relaxed)] = r;
+    });
+  }
+  auto key_less = [](const Row& a, const Row& b) {  // row[0] is shared
+    if (a[1] != b[1]) return a[1] < b[1];
+    const std::int32_t a2 = std::min(a[2], a[3]), b2 = std::min(b[2], b[3]);
+    if (a2 != b2) return a2 < b2;
+    return std::max(a[2], a[3]) < std::max(b[2], b[3]);
+  };
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n_ids, 1 << 12), [&](const tbb::blocked_range<std::size_t>& range) {
+    for (std::size_t g = range.begin(); g != range.end(); ++g)
+      if (start[g + 1] - start[g] > 1)
+        std::sort(out.begin() + static_cast<std::ptrdiff_t>(start[g]), out.begin() + static_cast<std::ptrdiff_t>(start[g + 1]),
+                  key_less);
+  });
+  return out;
+}
 
 }  // namespace
 
 std::optional<std::vector<std::array<std::int32_t, 4>>> insertion_delaunay(const ExactContext& ctx,
                                                                             std::span<const std::int32_t> ids,
-                                                                            const double* lo, const double* hi) {
+                                                                            const double* lo, const double* hi,
+                                                                            const InsertionOptions& options) {
   if (ctx.dim != 3) throw std::logic_error("tessera: insertion_delaunay is 3D only");
-  std::vector<std::int32_t> order = brio_order(ctx, ids, lo, hi);
+  const MortonGrid grid(lo, hi);
+  BrioOrder order = brio_order(ctx, ids, grid);
   // The first tetrahedron: the first two points, the first point off their
   // line, the first off their plane (in insertion order).
-  if (order.size() < 4) return std::nullopt;
+  const std::size_t m = order.ids.size();
+  if (m < 4) return std::nullopt;
   std::size_t c = 2;
-  auto at = [&](std::size_t k) { return ctx.points + static_cast<std::size_t>(order[k]) * 3; };
-  while (c < order.size() && kernels::collinear3(at(0), at(1), at(c))) ++c;
-  if (c == order.size()) return std::nullopt;
+  auto at = [&](std::size_t k) { return ctx.points + static_cast<std::size_t>(order.ids[k]) * 3; };
+  while (c < m && kernels::collinear3(at(0), at(1), at(c))) ++c;
+  if (c == m) return std::nullopt;
   std::size_t d = c + 1;
-  std::array<std::int32_t, 4> s{order[0], order[1], order[c], -1};
+  std::array<std::int32_t, 4> s{order.ids[0], order.ids[1], order.ids[c], -1};
   int o = 0;
-  for (; d < order.size(); ++d) {
-    s[3] = order[d];
+  for (; d < m; ++d) {
+    s[3] = order.ids[d];
     if ((o = kernels::orientation(ctx, s.data())) != 0) break;
   }
-  if (d == order.size()) return std::nullopt;
+  if (d == m) return std::nullopt;
   std::array<std::int32_t, 4> local{0, 1, static_cast<std::int32_t>(c), static_cast<std::int32_t>(d)};
   if (o < 0) std::swap(local[2], local[3]);
-  const std::size_t m = order.size();
-  Triangulation tri(ctx, std::move(order));
+  Triangulation tri(ctx, std::move(order.ids), options.threads);
   tri.start(local);
-  for (std::size_t i = 2; i < m; ++i)
-    if (i != c && i != d) tri.insert(static_cast<std::int32_t>(i));
+  for (std::size_t r = 0; r + 1 < order.rounds.size(); ++r) {
+    const std::size_t a = order.rounds[r], b = order.rounds[r + 1];
+    std::vector<std::int32_t> pts;
+    pts.reserve(b - a);
+    for (std::size_t i = std::max<std::size_t>(a, 2); i < b; ++i)
+      if (i != c && i != d) pts.push_back(static_cast<std::int32_t>(i));
+    // Every vertex so far: the round's points, those before, and c and d.
+    tri.insert_round(std::move(pts), std::max(b, d + 1), options.parallel_min);
+  }
   return tri.rows();
 }
 

@@ -32,6 +32,12 @@
 
 namespace tessera::front {
 
+struct InsertionOptions {
+  int threads = 1;  ///< workers of the parallel phases (1: serial)
+  /// Rounds with fewer points than this per thread are inserted serially.
+  std::size_t parallel_min = 1024;
+};
+
 /// The Delaunay tetrahedra of the points `ids` (distinct coordinates: no exact
 /// duplicates; ids into ctx.points, ctx.dim == 3). Each row lists its ids
 /// ascending, except that the last two are swapped where that order is
@@ -41,6 +47,7 @@ namespace tessera::front {
 /// insertion order only).
 std::optional<std::vector<std::array<std::int32_t, 4>>> insertion_delaunay(const kernels::ExactContext& ctx,
                                                                             std::span<const std::int32_t> ids,
-                                                                            const double* lo, const double* hi);
+                                                                            const double* lo, const double* hi,
+                                                                            const InsertionOptions& options = {});
 
 }  // namespace tessera::front

@@ -2,9 +2,12 @@
 // as the cells pass, byte for byte, on general-position and degenerate input
 // (lattices, co-spherical and co-planar points, where the symbolic
 // perturbation chooses), the same duplicates, a valid triangulation; and the
-// automatic choice takes it for surface samples only.
+// automatic choice takes it for surface samples only. Its parallel phases
+// give the serial rows for any thread count.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <random>
 #include <string>
@@ -12,6 +15,7 @@
 #include <vector>
 
 #include "common/hostile_points.hpp"
+#include "front/insertion.hpp"
 #include "random_points.hpp"
 #include "tessera/delaunay.hpp"
 
@@ -128,6 +132,47 @@ TEST(Insertion, GivesTheRowsOfTheCellsPass) {
       EXPECT_TRUE(ins.hull_completed) << what;
     }
     expect_valid(triangulate(p, tessera::DelaunayMethod::insertion), p, what);
+  }
+}
+
+// insertion_delaunay itself, on the distinct points of p (the lowest id of
+// each set of coincident ones).
+std::vector<std::array<std::int32_t, 4>> insert_points(const std::vector<double>& p, int threads, std::size_t parallel_min) {
+  const std::size_t n = p.size() / 3;
+  tessera::kernels::ExactContext ctx;
+  ctx.points = p.data();
+  ctx.dim = 3;
+  for (int d = 0; d < 3; ++d) {
+    ctx.lo[d] = ctx.hi[d] = p[d];
+    for (std::size_t i = 0; i < n; ++i) {
+      ctx.lo[d] = std::min(ctx.lo[d], p[3 * i + d]);
+      ctx.hi[d] = std::max(ctx.hi[d], p[3 * i + d]);
+    }
+  }
+  std::vector<std::int32_t> ids(n);
+  for (std::size_t i = 0; i < n; ++i) ids[i] = static_cast<std::int32_t>(i);
+  auto at = [&](std::int32_t i) { return std::array<double, 3>{p[3 * i], p[3 * i + 1], p[3 * i + 2]}; };
+  std::stable_sort(ids.begin(), ids.end(), [&](std::int32_t a, std::int32_t b) { return at(a) < at(b); });
+  ids.erase(std::unique(ids.begin(), ids.end(), [&](std::int32_t a, std::int32_t b) { return at(a) == at(b); }), ids.end());
+  tessera::front::InsertionOptions o;
+  o.threads = threads;
+  o.parallel_min = parallel_min;
+  auto rows = tessera::front::insertion_delaunay(ctx, ids, ctx.lo.data(), ctx.hi.data(), o);
+  return rows ? *rows : std::vector<std::array<std::int32_t, 4>>{};
+}
+
+TEST(Insertion, ParallelPhasesGiveTheSerialRows) {
+  // Rounds from 8 points per thread on go through the parallel phases, so
+  // even these small inputs take several, cut across two axes, with points
+  // deferred along every cut; a surface (the sphere, the terrain) turns
+  // them off after a phase that defers too many. Three and four workers
+  // run on whatever cores there are: the partition does not depend on them.
+  auto in = inputs();
+  in.emplace_back("uniform 20k", uniform_points(20000, 3, 47));
+  for (const auto& [what, p] : in) {
+    const auto serial = insert_points(p, 1, 8);
+    EXPECT_FALSE(serial.empty()) << what;
+    for (const int threads : {2, 3, 4}) EXPECT_EQ(insert_points(p, threads, 8), serial) << what << ", threads " << threads;
   }
 }
 
