@@ -372,19 +372,22 @@ PilotEstimate pilot_estimate(const front::Pass<CellT::dim>& pass) {
   return {ratio, std::clamp(slope * std::sqrt(ratio), lowest, highest)};
 }
 
-/// From this pilot ratio on, 3D points go to insertion (serial) rather than
-/// to the cells (parallel). Both build the same rows, so the choice may
-/// follow the thread count. Measured on two threads at 1M points
-/// (docs/design.md, "Insertion for costly inputs"): insertion takes ~5 s
-/// whatever the input; the cells 2.5 s on uniform points (ratio 1) and 3.0 s
-/// on a fractal hierarchy (1.3), but 7.8-8.3 s on blobs and sheets (3.4-3.8),
-/// and several times insertion's time on surface samples (an ellipsoid's
-/// 12-16, a terrain's 42-73, a torus's 52-176). On one thread the two are
-/// level on uniform points. The cells' time grows about as ratio^0.7 and
-/// falls with the threads, so the threshold is 3 on two threads and grows
-/// as threads^1.4 (1.14 on one, 7.9 on four; beyond two threads a model,
-/// not a measurement).
-inline double insertion_ratio(int threads) { return 3.0 * std::pow(std::max(threads, 1) / 2.0, 1.4); }
+/// From this pilot ratio on, 3D points go to insertion rather than to the
+/// cells. Both build the same rows, so the choice may follow the thread
+/// count. Measured at 1M points (docs/design.md, "Insertion for costly
+/// inputs"): insertion takes ~5 s on one thread whatever the input, and
+/// ~3.0-3.5 s on two where its parallel phases work (volumes: uniform,
+/// blobs, sheets, hierarchies); on surfaces they turn themselves off and
+/// it stays serial, but there the cells cost several times more. The cells
+/// take 4.8 s on one thread and 2.55 s on two on uniform points (ratio 1),
+/// 2.7 s on two on a fractal hierarchy (1.3), 7.8-8.3 s on blobs and
+/// sheets (3.4-3.8), more on surface samples (an ellipsoid's 12-16, a
+/// terrain's 42-73, a torus's 52-176): about 2.55 s times ratio^0.7. So the
+/// threshold is 1.6 on two threads (break-even near 1.4) and 1.13 on one;
+/// beyond two threads it grows as sqrt(threads), a model (the cells scale
+/// nearly linearly, the phases defer more as their slabs thin), not a
+/// measurement.
+inline double insertion_ratio(int threads) { return 1.6 * std::sqrt(std::max(threads, 1) / 2.0); }
 
 // The triangulation by insertion (front/insertion.hpp) of the located
 // points, exact duplicates left out: of each set of coincident points the

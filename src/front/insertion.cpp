@@ -361,28 +361,23 @@ class Triangulation {
     // Each worker's points, in their order.
     std::vector<std::vector<std::int32_t>> mine(threads);
     for (const std::int32_t q : pts) mine[part_[static_cast<std::size_t>(q)]].push_back(q);
-    // A tetrahedron each worker owns holding its first point, found
-    // serially (each walk starts where the last ended); points met before
-    // one is found are deferred.
-    std::vector<std::size_t> from(threads);
+    // A tetrahedron each worker owns, to start its walks from: the one
+    // holding one of its points, tried at spread positions of its list, as
+    // the first points in Morton order of a slab may all lie along its cut
+    // (found serially, each walk starting where the last ended). A worker
+    // with none defers its points.
     std::int32_t walk_from = hint_;
     for (std::size_t t = 0; t < threads; ++t) {
       Worker& w = workers_[t];
       w.deferred.clear();
       w.last = -1;
-      std::size_t i = 0;
-      for (const std::size_t give_up = std::min<std::size_t>(mine[t].size(), 64); i < give_up; ++i) {
-        const std::int32_t t0 = locate<false>(w, mine[t][i], walk_from);
+      const std::size_t tries = std::min<std::size_t>(mine[t].size(), 64);
+      for (std::size_t k = 0; k < tries && w.last < 0; ++k) {
+        const std::int32_t t0 = locate<false>(w, mine[t][k * mine[t].size() / tries], walk_from);
         walk_from = t0;
-        if (owned(store_.tets()[t0], w.part)) {
-          w.last = t0;
-          break;
-        }
-        w.deferred.push_back(mine[t][i]);
+        if (owned(store_.tets()[t0], w.part)) w.last = t0;
       }
-      if (w.last < 0)
-        for (; i < mine[t].size(); ++i) w.deferred.push_back(mine[t][i]);
-      from[t] = i;
+      if (w.last < 0) w.deferred = mine[t];
     }
     // Room for every fresh slot the phase may claim (claims beyond it defer
     // their points), and marks that cannot wrap within it.
@@ -393,8 +388,8 @@ class Triangulation {
       for (std::size_t t = r.begin(); t != r.end(); ++t) {
         Worker& w = workers_[t];
         if (w.last < 0) continue;
-        for (std::size_t i = from[t]; i < mine[t].size(); ++i)
-          if (!insert<true>(w, mine[t][i])) w.deferred.push_back(mine[t][i]);
+        for (const std::int32_t q : mine[t])
+          if (!insert<true>(w, q)) w.deferred.push_back(q);
       }
     }, tbb::simple_partitioner());
     // A worker's last tetrahedron is its own and alive; with none (nothing
