@@ -6,6 +6,7 @@
 #include <memory>
 #include <optional>
 #include <bit>
+#include <cstring>
 #include <cmath>
 #include <stdexcept>
 #include <utility>
@@ -178,8 +179,9 @@ class TetStore {
     const std::size_t cap = std::max(need, 2 * cap_);
     std::unique_ptr<Tet[]> t(new Tet[cap]);
     std::unique_ptr<std::uint32_t[]> s(new std::uint32_t[cap]);
-    std::copy(tets_.get(), tets_.get() + size(), t.get());
-    std::copy(state_.get(), state_.get() + size(), s.get());
+    // memcpy: claimed slots not yet written hold indeterminate bytes.
+    std::memcpy(t.get(), tets_.get(), size() * sizeof(Tet));
+    std::memcpy(s.get(), state_.get(), size() * sizeof(std::uint32_t));
     tets_ = std::move(t);
     state_ = std::move(s);
     cap_ = cap;
@@ -233,7 +235,7 @@ class Triangulation {
   /// point global[k] of ctx, and its coordinates are copied in that order, so
   /// the points a walk and a cavity meet lie close in memory too.
   Triangulation(const ExactContext& ctx, std::vector<std::int32_t> global, int threads)
-      : ctx_(ctx), global_(std::move(global)), workers_(static_cast<std::size_t>(std::max(threads, 1))) {
+      : ctx_(ctx), global_(std::move(global)), workers_(static_cast<std::size_t>(std::clamp(threads, 1, max_workers))) {
     coords_.resize(3 * global_.size());
     for (std::size_t k = 0; k < global_.size(); ++k)
       for (int e = 0; e < 3; ++e) coords_[3 * k + static_cast<std::size_t>(e)] = ctx.points[static_cast<std::size_t>(global_[k]) * 3 + static_cast<std::size_t>(e)];
@@ -635,6 +637,8 @@ class Triangulation {
     }
   }
 
+  /// Partitions are bytes.
+  static constexpr int max_workers = 255;
   /// Fresh slots a worker claims at a time.
   static constexpr std::size_t fresh_block = 4096;
 

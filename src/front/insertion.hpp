@@ -17,9 +17,11 @@
 // the facet's points, so asking that tetrahedron gives the perturbed answer.
 // Every finite tetrahedron is therefore strictly positively oriented.
 //
-// Serial: the order (BRIO, Amenta, Choi & Rote, "Incremental constructions
-// con BRIO", 2003: rounds of doubling size, each in Morton order) keeps the
-// walk from the last inserted point short.
+// The order (BRIO, Amenta, Choi & Rote, "Incremental constructions con
+// BRIO", 2003: rounds of doubling size, each in Morton order) keeps the walk
+// from the last inserted point short. Large rounds are inserted in parallel
+// phases, one slab of space per worker (insertion.cpp, Triangulation::phase);
+// the result does not depend on the order, so neither on the thread count.
 #pragma once
 
 #include <array>
@@ -33,7 +35,7 @@
 namespace tessera::front {
 
 struct InsertionOptions {
-  int threads = 1;  ///< workers of the parallel phases (1: serial)
+  int threads = 1;  ///< workers of the parallel phases (1: serial; at most 255)
   /// Rounds with fewer points than this per thread are inserted serially.
   std::size_t parallel_min = 1024;
 };
