@@ -3,11 +3,11 @@
 
 #include <algorithm>
 #include <atomic>
+#include <bit>
+#include <cmath>
+#include <cstring>
 #include <memory>
 #include <optional>
-#include <bit>
-#include <cstring>
-#include <cmath>
 #include <stdexcept>
 #include <utility>
 
@@ -51,25 +51,6 @@ std::uint64_t spread3(std::uint64_t x) {
   return x;
 }
 
-// A point's Morton code on the 2^21 grid over [lo, hi].
-struct MortonGrid {
-  double lo[3], scale[3];
-  MortonGrid(const double* l, const double* h) {
-    for (int d = 0; d < 3; ++d) {
-      lo[d] = l[d];
-      scale[d] = h[d] > l[d] ? 2097151.0 / (h[d] - l[d]) : 0.0;
-    }
-  }
-  std::uint64_t code(const double* p) const {
-    std::uint64_t c = 0;
-    for (int d = 0; d < 3; ++d) {
-      const double x = std::clamp((p[d] - lo[d]) * scale[d], 0.0, 2097151.0);
-      c |= spread3(static_cast<std::uint64_t>(x)) << d;
-    }
-    return c;
-  }
-};
-
 // The insertion order: BRIO rounds (a point joins round r with probability
 // 2^-(r+1), by its hash; the smallest rounds first), each in Morton order.
 struct BrioOrder {
@@ -77,7 +58,7 @@ struct BrioOrder {
   std::vector<std::size_t> rounds;  // each round's first position, then ids.size()
 };
 
-BrioOrder brio_order(const ExactContext& ctx, std::span<const std::int32_t> ids, const MortonGrid& grid) {
+BrioOrder brio_order(const ExactContext& ctx, std::span<const std::int32_t> ids, const double* lo, const double* hi) {
   struct Key {
     std::uint64_t round;  // smallest rounds first
     std::uint64_t code;
@@ -85,9 +66,17 @@ BrioOrder brio_order(const ExactContext& ctx, std::span<const std::int32_t> ids,
   };
   constexpr int max_round = 24;
   std::vector<Key> keys(ids.size());
+  double scale[3];
+  for (int d = 0; d < 3; ++d) scale[d] = hi[d] > lo[d] ? 2097151.0 / (hi[d] - lo[d]) : 0.0;
   for (std::size_t i = 0; i < ids.size(); ++i) {
+    const double* p = ctx.points + static_cast<std::size_t>(ids[i]) * 3;
+    std::uint64_t code = 0;
+    for (int d = 0; d < 3; ++d) {
+      const double c = std::clamp((p[d] - lo[d]) * scale[d], 0.0, 2097151.0);
+      code |= spread3(static_cast<std::uint64_t>(c)) << d;
+    }
     const int round = std::min(std::countl_zero(id_hash(ids[i])), max_round);
-    keys[i] = {static_cast<std::uint64_t>(max_round - round), grid.code(ctx.points + static_cast<std::size_t>(ids[i]) * 3), ids[i]};
+    keys[i] = {static_cast<std::uint64_t>(max_round - round), code, ids[i]};
   }
   tbb::parallel_sort(keys.begin(), keys.end(), [](const Key& a, const Key& b) {
     return a.round != b.round ? a.round < b.round
@@ -285,6 +274,9 @@ class Triangulation {
     for (int k = 0; k < 2 && parallel_ && threads > 1 && pts.size() >= parallel_min * threads; ++k) {
       const std::size_t tried = pts.size();
       pts = phase(pts, end, cut_axis);
+      ++stats_.phases;
+      stats_.phase_points += tried;
+      stats_.deferred += pts.size();
       // Points on a surface (a torus, a terrain) have long tetrahedra
       // across the object, so walks and cavities cross the cuts: when a
       // phase of 2048 points or more defers over a third, the later rounds
@@ -304,6 +296,7 @@ class Triangulation {
 
   /// The finite tetrahedra, in the layout of insertion_delaunay.
   std::vector<std::array<std::int32_t, 4>> rows() const;
+  const InsertionStats& stats() const { return stats_; }
 
  private:
   using Face = Worker::Face;
@@ -650,6 +643,7 @@ class Triangulation {
   std::vector<std::uint8_t> part_;  // vertex -> partition, in a parallel phase
   std::int32_t hint_ = 0;           // a live tetrahedron: the serial walk's start
   bool parallel_ = true;            // whether rounds still try parallel phases
+  InsertionStats stats_;
 };
 
 std::vector<std::array<std::int32_t, 4>> Triangulation::rows() const {
@@ -720,8 +714,7 @@ std::optional<std::vector<std::array<std::int32_t, 4>>> insertion_delaunay(const
                                                                             const double* lo, const double* hi,
                                                                             const InsertionOptions& options) {
   if (ctx.dim != 3) throw std::logic_error("tessera: insertion_delaunay is 3D only");
-  const MortonGrid grid(lo, hi);
-  BrioOrder order = brio_order(ctx, ids, grid);
+  BrioOrder order = brio_order(ctx, ids, lo, hi);
   // The first tetrahedron: the first two points, the first point off their
   // line, the first off their plane (in insertion order).
   const std::size_t m = order.ids.size();
@@ -751,6 +744,7 @@ std::optional<std::vector<std::array<std::int32_t, 4>>> insertion_delaunay(const
     // Every vertex so far: the round's points, those before, and c and d.
     tri.insert_round(std::move(pts), std::max(b, d + 1), options.parallel_min);
   }
+  if (options.stats != nullptr) *options.stats = tri.stats();
   return tri.rows();
 }
 

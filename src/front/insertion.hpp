@@ -34,10 +34,18 @@
 
 namespace tessera::front {
 
+/// What the parallel phases did (for tests and tuning).
+struct InsertionStats {
+  std::size_t phases = 0;        ///< parallel phases run
+  std::size_t phase_points = 0;  ///< points they were given
+  std::size_t deferred = 0;      ///< of those, points they left for later
+};
+
 struct InsertionOptions {
   int threads = 1;  ///< workers of the parallel phases (1: serial; at most 255)
   /// Rounds with fewer points than this per thread are inserted serially.
   std::size_t parallel_min = 1024;
+  InsertionStats* stats = nullptr;  ///< filled when given
 };
 
 /// The Delaunay tetrahedra of the points `ids` (distinct coordinates: no exact

@@ -137,7 +137,8 @@ TEST(Insertion, GivesTheRowsOfTheCellsPass) {
 
 // insertion_delaunay itself, on the distinct points of p (the lowest id of
 // each set of coincident ones).
-std::vector<std::array<std::int32_t, 4>> insert_points(const std::vector<double>& p, int threads, std::size_t parallel_min) {
+std::vector<std::array<std::int32_t, 4>> insert_points(const std::vector<double>& p, int threads, std::size_t parallel_min,
+                                                        tessera::front::InsertionStats* stats = nullptr) {
   const std::size_t n = p.size() / 3;
   tessera::kernels::ExactContext ctx;
   ctx.points = p.data();
@@ -157,6 +158,7 @@ std::vector<std::array<std::int32_t, 4>> insert_points(const std::vector<double>
   tessera::front::InsertionOptions o;
   o.threads = threads;
   o.parallel_min = parallel_min;
+  o.stats = stats;
   auto rows = tessera::front::insertion_delaunay(ctx, ids, ctx.lo.data(), ctx.hi.data(), o);
   return rows ? *rows : std::vector<std::array<std::int32_t, 4>>{};
 }
@@ -174,6 +176,15 @@ TEST(Insertion, ParallelPhasesGiveTheSerialRows) {
     EXPECT_FALSE(serial.empty()) << what;
     for (const int threads : {2, 3, 4}) EXPECT_EQ(insert_points(p, threads, 8), serial) << what << ", threads " << threads;
   }
+  // The phases did run and inserted most of their points: on uniform points
+  // they defer only those along the cuts.
+  tessera::front::InsertionStats stats;
+  insert_points(uniform_points(20000, 3, 47), 2, 8, &stats);
+  EXPECT_GE(stats.phases, 8u);
+  EXPECT_LT(4 * stats.deferred, stats.phase_points) << stats.deferred << " of " << stats.phase_points;
+  // A serial run runs none.
+  insert_points(uniform_points(20000, 3, 47), 1, 8, &stats);
+  EXPECT_EQ(stats.phases, 0u);
 }
 
 TEST(Insertion, FewAndFlatPoints) {
