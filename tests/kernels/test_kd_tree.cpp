@@ -123,6 +123,9 @@ TEST(KdTree, NearestEqualsBruteForce) {
   check_nearest<3>(surface_points<3>(4000, 2, 300), false, "ellipsoid with duplicates");
   check_nearest<2>(surface_points<2>(3000, 3, 200), true, "ellipse with duplicates, slabs");
   check_nearest<2>(kernels_test::random_points<2>(3000, 4, -1, 1), true, "uniform 2D, slabs");
+  // Enough points that the build splits its subtrees among threads.
+  check_nearest<3>(surface_points<3>(60000, 8, 2000), true, "large ellipsoid with duplicates, slabs");
+  check_nearest<2>(kernels_test::random_points<2>(50000, 9, -1, 1), false, "large uniform 2D");
 }
 
 TEST(KdTree, NearestStopsAtItsBudget) {

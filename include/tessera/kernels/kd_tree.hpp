@@ -33,6 +33,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/collaborative_call_once.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
 
 #include "tessera/kernels/slab.hpp"
 
@@ -48,13 +49,23 @@ class KdTree {
       : coords_(coords), ids_(std::move(ids)), with_slabs_(slabs) {
     for (const std::int32_t j : ids_) id_bound_ = std::max(id_bound_, static_cast<std::size_t>(j) + 1);
     if (ids_.empty()) return;
-    nodes_.reserve(2 * (ids_.size() / leaf_size + 1));
-    build(0, static_cast<std::uint32_t>(ids_.size()));
-    // The leaves' coordinates in slot order: a leaf's scan reads one
-    // contiguous run instead of a cache line per point.
+    // The build partitions the points with their coordinates beside them
+    // (contiguous items rather than ids into the input: the selections then
+    // stream instead of gathering a cache line per point), subtrees in
+    // parallel; the leaves' coordinates stay in slot order (pts_), so a
+    // leaf's scan reads one contiguous run.
+    std::vector<Item> items(ids_.size());
+    for (std::size_t k = 0; k < ids_.size(); ++k) {
+      items[k].id = ids_[k];
+      for (int d = 0; d < D; ++d) items[k].p[static_cast<std::size_t>(d)] = at(ids_[k])[d];
+    }
+    nodes_.resize(node_count(ids_.size()));
+    build(items, 0, 0, static_cast<std::uint32_t>(items.size()));
     pts_.resize(ids_.size() * D);
-    for (std::size_t k = 0; k < ids_.size(); ++k)
-      for (int d = 0; d < D; ++d) pts_[k * D + d] = at(ids_[k])[d];
+    for (std::size_t k = 0; k < ids_.size(); ++k) {
+      ids_[k] = items[k].id;
+      for (int d = 0; d < D; ++d) pts_[k * D + static_cast<std::size_t>(d)] = items[k].p[static_cast<std::size_t>(d)];
+    }
     slabs_.resize(nodes_.size());  // without slabs: never flat, never excludes
     // The slabs, in parallel: threads that wait for this tree
     // (SharedKdTree's collaborative_call_once) join in. Serial, they were
@@ -218,37 +229,63 @@ class KdTree {
   // Whether node k's slab lies wholly beyond the search's bound (Slab).
   bool slab_excludes(std::size_t k, const Search& q) const { return slabs_[k].excludes(q.x, q.r); }
 
-  // Node over ids_[begin, end): its box, then a median split on the widest axis.
-  std::int32_t build(std::uint32_t begin, std::uint32_t end) {
-    const auto index = static_cast<std::int32_t>(nodes_.size());
-    nodes_.push_back({});
+  // A point with its coordinates, as the build moves it.
+  struct Item {
+    std::array<double, D> p;
+    std::int32_t id;
+  };
+
+  // Nodes of a subtree over n points: a full binary tree with L(n) leaves,
+  // L(n) = 1 for n <= leaf_size, else L(floor(n/2)) + L(ceil(n/2)). Each
+  // level holds subtrees of two consecutive sizes, so (L(m), L(m+1)) follows
+  // from (L(h), L(h+1)), h = floor(m/2): O(log n).
+  static std::size_t node_count(std::size_t n) { return 2 * leaf_pair(n).first - 1; }
+  static std::pair<std::size_t, std::size_t> leaf_pair(std::size_t m) {
+    if (m < leaf_size) return {1, 1};
+    if (m == leaf_size) return {1, 2};
+    const auto [a, b] = leaf_pair(m / 2);  // L(h), L(h + 1)
+    return m % 2 == 0 ? std::pair{2 * a, a + b} : std::pair{a + b, 2 * b};
+  }
+
+  // Node `index` over items[begin, end): its box, then a median split on
+  // the widest axis; the children follow in preorder (left at index + 1,
+  // right after the left subtree's node_count), so the layout does not
+  // depend on which thread builds what. Subtrees of many points are built
+  // in parallel.
+  void build(std::vector<Item>& items, std::size_t index, std::uint32_t begin, std::uint32_t end) {
     Node nd;
     nd.begin = begin;
     nd.end = end;
-    for (int d = 0; d < D; ++d) {
-      nd.lo[d] = nd.hi[d] = at(ids_[begin])[d];
-      for (std::uint32_t k = begin + 1; k < end; ++k) {
-        nd.lo[d] = std::min(nd.lo[d], at(ids_[k])[d]);
-        nd.hi[d] = std::max(nd.hi[d], at(ids_[k])[d]);
+    nd.lo = nd.hi = items[begin].p;
+    for (std::uint32_t k = begin + 1; k < end; ++k)
+      for (int d = 0; d < D; ++d) {
+        nd.lo[static_cast<std::size_t>(d)] = std::min(nd.lo[static_cast<std::size_t>(d)], items[k].p[static_cast<std::size_t>(d)]);
+        nd.hi[static_cast<std::size_t>(d)] = std::max(nd.hi[static_cast<std::size_t>(d)], items[k].p[static_cast<std::size_t>(d)]);
       }
-    }
     if (end - begin > leaf_size) {
-      int axis = 0;
-      for (int d = 1; d < D; ++d)
+      std::size_t axis = 0;
+      for (std::size_t d = 1; d < D; ++d)
         if (nd.hi[d] - nd.lo[d] > nd.hi[axis] - nd.lo[axis]) axis = d;
       const std::uint32_t mid = begin + (end - begin) / 2;
       // (coordinate, id): a strict order, so the tree does not depend on the
       // library's nth_element.
-      std::nth_element(ids_.begin() + begin, ids_.begin() + mid, ids_.begin() + end, [&](std::int32_t a, std::int32_t b) {
-        const double xa = at(a)[axis], xb = at(b)[axis];
-        return xa < xb || (xa == xb && a < b);
+      std::nth_element(items.begin() + begin, items.begin() + mid, items.begin() + end, [axis](const Item& a, const Item& b) {
+        return a.p[axis] < b.p[axis] || (a.p[axis] == b.p[axis] && a.id < b.id);
       });
-      nd.left = build(begin, mid);
-      nd.right = build(mid, end);
+      const std::size_t left = index + 1, right = left + node_count(mid - begin);
+      nd.left = static_cast<std::int32_t>(left);
+      nd.right = static_cast<std::int32_t>(right);
+      if (end - begin >= parallel_build)
+        tbb::parallel_invoke([&] { build(items, left, begin, mid); }, [&] { build(items, right, mid, end); });
+      else {
+        build(items, left, begin, mid);
+        build(items, right, mid, end);
+      }
     }
-    nodes_[static_cast<std::size_t>(index)] = nd;
-    return index;
+    nodes_[index] = nd;
   }
+  /// Subtrees of at least this many points split their build among threads.
+  static constexpr std::uint32_t parallel_build = 1 << 14;
 
   std::span<const double> coords_;
   std::vector<std::int32_t> ids_;
