@@ -421,11 +421,8 @@ Delaunay by_insertion(const front::Pass<3>& pass, Delaunay out) {
     io.threads = pass.engine_options.threads;
     auto rows = front::insertion_delaunay(pass.exact, distinct, pass.gens.lo.data(), pass.gens.hi.data(), io);
     if (!rows) return;  // all on one plane: no simplex exists
-    out.from_insertion = rows->size();
-    out.simplices.resize(rows->size() * 4);  // every entry is written below
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rows->size(), 1 << 14), [&](const tbb::blocked_range<std::size_t>& r) {
-      for (std::size_t i = r.begin(); i != r.end(); ++i) std::copy((*rows)[i].begin(), (*rows)[i].end(), out.simplices.data() + 4 * i);
-    });
+    out.from_insertion = rows->size() / 4;
+    out.simplices = std::move(*rows);
   });
   return out;
 }

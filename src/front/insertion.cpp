@@ -2,6 +2,7 @@
 #include "insertion.hpp"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <bit>
 #include <cmath>
@@ -295,7 +296,7 @@ class Triangulation {
   }
 
   /// The finite tetrahedra, in the layout of insertion_delaunay.
-  std::vector<std::array<std::int32_t, 4>> rows() const;
+  Buffer<std::int32_t> rows() const;
   const InsertionStats& stats() const { return stats_; }
 
  private:
@@ -646,7 +647,7 @@ class Triangulation {
   InsertionStats stats_;
 };
 
-std::vector<std::array<std::int32_t, 4>> Triangulation::rows() const {
+Buffer<std::int32_t> Triangulation::rows() const {
   using Row = std::array<std::int32_t, 4>;
   const std::size_t size = store_.size();
   const Tet* const tets = store_.tets();
@@ -655,12 +656,14 @@ std::vector<std::array<std::int32_t, 4>> Triangulation::rows() const {
     for (const std::int32_t t : w.free) is_free[static_cast<std::size_t>(t)] = 1;
     for (std::size_t t = w.fresh; t < w.fresh_end; ++t) is_free[t] = 1;
   }
+  auto live = [&](std::size_t i) { return !is_free[i] && infinite_slot(tets[i]) == 4; };
+  auto lowest = [&](std::size_t i) {
+    return std::min(std::min(global(tets[i].v[0]), global(tets[i].v[1])), std::min(global(tets[i].v[2]), global(tets[i].v[3])));
+  };
   // Slot i's row, its ids ascending except that the last two are swapped
-  // where that order is negative (an odd permutation of the positive one);
-  // false for free slots and ghosts.
-  auto row_of = [&](std::size_t i, Row& r) {
-    if (is_free[i] || infinite_slot(tets[i]) != 4) return false;
-    r = {global(tets[i].v[0]), global(tets[i].v[1]), global(tets[i].v[2]), global(tets[i].v[3])};
+  // where that order is negative (an odd permutation of the positive one).
+  auto row_of = [&](std::size_t i) {
+    Row r{global(tets[i].v[0]), global(tets[i].v[1]), global(tets[i].v[2]), global(tets[i].v[3])};
     bool odd = false;
     for (int a = 1; a < 4; ++a)
       for (int b = a; b > 0 && r[b - 1] > r[b]; --b) {
@@ -668,51 +671,87 @@ std::vector<std::array<std::int32_t, 4>> Triangulation::rows() const {
         odd = !odd;
       }
     if (odd) std::swap(r[2], r[3]);
-    return true;
+    return r;
   };
-  // Rows bucketed by their lowest id (counted, then placed, both in
-  // parallel: the order within a bucket is then arbitrary), then each
-  // bucket's few sorted, which makes the result the same for any order.
-  std::size_t n_ids = 0;
+  // Rows ordered by lowest id in two counting passes, each of whose writes
+  // go to a thousand or so streams at most (one pass to a million ids wrote
+  // a cache line per row, at random: 0.7 s of one thread at 1M points).
+  // Pass 1: each fixed chunk of slots counts its rows per coarse bucket (the
+  // lowest id's top bits), and scatters them there, at offsets from the
+  // counts in (bucket, chunk) order. Pass 2, per bucket: a counting sort by
+  // the lowest id into the output, then each id's few rows sorted by the
+  // rest, which makes the result the same for any slot layout.
+  std::size_t n_ids = 1;
   for (const std::int32_t g : global_) n_ids = std::max(n_ids, static_cast<std::size_t>(g) + 1);
-  std::vector<std::size_t> start(n_ids + 1, 0);
-  const tbb::blocked_range<std::size_t> slots(0, size, 1 << 14);
-  tbb::parallel_for(slots, [&](const tbb::blocked_range<std::size_t>& range) {
-    Row r;
-    for (std::size_t i = range.begin(); i != range.end(); ++i)
-      if (row_of(i, r)) std::atomic_ref(start[static_cast<std::size_t>(r[0]) + 1]).fetch_add(1, std::memory_order_relaxed);
+  const int shift = std::max(0, static_cast<int>(std::bit_width(n_ids - 1)) - 10);
+  const std::size_t buckets = ((n_ids - 1) >> shift) + 1;
+  constexpr std::size_t chunk = 1 << 14;
+  const std::size_t chunks = (size + chunk - 1) / chunk;
+  std::vector<std::uint32_t> count(chunks * buckets, 0);  // [chunk][bucket]
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, chunks, 1), [&](const tbb::blocked_range<std::size_t>& range) {
+    for (std::size_t c = range.begin(); c != range.end(); ++c) {
+      std::uint32_t* const mine = count.data() + c * buckets;
+      for (std::size_t i = c * chunk; i < std::min(size, (c + 1) * chunk); ++i)
+        if (live(i)) ++mine[static_cast<std::size_t>(lowest(i)) >> shift];
+    }
   });
-  for (std::size_t g = 0; g < n_ids; ++g) start[g + 1] += start[g];
-  std::vector<Row> out(start[n_ids]);
+  std::vector<std::size_t> bucket_start(buckets + 1, 0);
+  std::vector<std::size_t> offset(chunks * buckets);  // [chunk][bucket]: where that chunk's rows of the bucket go
   {
-    std::vector<std::size_t> next(start.begin(), start.end() - 1);
-    tbb::parallel_for(slots, [&](const tbb::blocked_range<std::size_t>& range) {
-      Row r;
-      for (std::size_t i = range.begin(); i != range.end(); ++i)
-        if (row_of(i, r)) out[std::atomic_ref(next[static_cast<std::size_t>(r[0])]).fetch_add(1, std::memory_order_relaxed)] = r;
-    });
+    std::size_t at = 0;
+    for (std::size_t b = 0; b < buckets; ++b) {
+      bucket_start[b] = at;
+      for (std::size_t c = 0; c < chunks; ++c) {
+        offset[c * buckets + b] = at;
+        at += count[c * buckets + b];
+      }
+    }
+    bucket_start[buckets] = at;
   }
+  std::vector<Row> coarse(bucket_start[buckets]);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, chunks, 1), [&](const tbb::blocked_range<std::size_t>& range) {
+    for (std::size_t c = range.begin(); c != range.end(); ++c) {
+      std::size_t* const next = offset.data() + c * buckets;
+      for (std::size_t i = c * chunk; i < std::min(size, (c + 1) * chunk); ++i)
+        if (live(i)) {
+          const Row r = row_of(i);
+          coarse[next[static_cast<std::size_t>(r[0]) >> shift]++] = r;
+        }
+    }
+  });
   auto key_less = [](const Row& a, const Row& b) {  // row[0] is shared
     if (a[1] != b[1]) return a[1] < b[1];
     const std::int32_t a2 = std::min(a[2], a[3]), b2 = std::min(b[2], b[3]);
     if (a2 != b2) return a2 < b2;
     return std::max(a[2], a[3]) < std::max(b[2], b[3]);
   };
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n_ids, 1 << 12), [&](const tbb::blocked_range<std::size_t>& range) {
-    for (std::size_t g = range.begin(); g != range.end(); ++g)
-      if (start[g + 1] - start[g] > 1)
-        std::sort(out.begin() + static_cast<std::ptrdiff_t>(start[g]), out.begin() + static_cast<std::ptrdiff_t>(start[g + 1]),
-                  key_less);
+  Buffer<std::int32_t> out(4 * coarse.size());  // every entry is written below
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, buckets, 1), [&](const tbb::blocked_range<std::size_t>& range) {
+    std::vector<std::size_t> start;
+    std::vector<Row> sorted;
+    for (std::size_t b = range.begin(); b != range.end(); ++b) {
+      const std::size_t first = bucket_start[b], last = bucket_start[b + 1];
+      const std::size_t id0 = b << shift, ids = std::min(n_ids - id0, std::size_t{1} << shift);
+      start.assign(ids + 1, 0);
+      for (std::size_t k = first; k < last; ++k) ++start[static_cast<std::size_t>(coarse[k][0]) - id0 + 1];
+      for (std::size_t g = 0; g < ids; ++g) start[g + 1] += start[g];
+      sorted.resize(last - first);
+      Row* const dst = sorted.data();
+      for (std::size_t k = first; k < last; ++k) dst[start[static_cast<std::size_t>(coarse[k][0]) - id0]++] = coarse[k];
+      // start[g] is now where id g's rows end.
+      for (std::size_t g = 0, from = 0; g < ids; from = start[g++])
+        if (start[g] - from > 1) std::sort(dst + from, dst + start[g], key_less);
+      if (first != last) std::memcpy(out.data() + 4 * first, dst, (last - first) * sizeof(Row));
+    }
   });
   return out;
 }
 
 }  // namespace
 
-std::optional<std::vector<std::array<std::int32_t, 4>>> insertion_delaunay(const ExactContext& ctx,
-                                                                            std::span<const std::int32_t> ids,
-                                                                            const double* lo, const double* hi,
-                                                                            const InsertionOptions& options) {
+std::optional<Buffer<std::int32_t>> insertion_delaunay(const ExactContext& ctx, std::span<const std::int32_t> ids,
+                                                       const double* lo, const double* hi,
+                                                       const InsertionOptions& options) {
   if (ctx.dim != 3) throw std::logic_error("tessera: insertion_delaunay is 3D only");
   BrioOrder order = brio_order(ctx, ids, lo, hi);
   // The first tetrahedron: the first two points, the first point off their

@@ -24,12 +24,11 @@
 // the result does not depend on the order, so neither on the thread count.
 #pragma once
 
-#include <array>
 #include <cstdint>
 #include <optional>
 #include <span>
-#include <vector>
 
+#include "tessera/buffer.hpp"
 #include "tessera/kernels/exact_predicates.hpp"
 
 namespace tessera::front {
@@ -52,12 +51,11 @@ struct InsertionOptions {
 /// duplicates; ids into ctx.points, ctx.dim == 3). Each row lists its ids
 /// ascending, except that the last two are swapped where that order is
 /// negatively oriented; rows are in ascending order of their sorted ids (the
-/// layout of tessera::Delaunay::simplices). nullopt when the points are all
+/// layout of tessera::Delaunay::simplices: 4 ids per row, flat). nullopt when the points are all
 /// coplanar (no tetrahedron exists). `lo`/`hi` bound the points (for the
 /// insertion order only).
-std::optional<std::vector<std::array<std::int32_t, 4>>> insertion_delaunay(const kernels::ExactContext& ctx,
-                                                                            std::span<const std::int32_t> ids,
-                                                                            const double* lo, const double* hi,
-                                                                            const InsertionOptions& options = {});
+std::optional<Buffer<std::int32_t>> insertion_delaunay(const kernels::ExactContext& ctx,
+                                                       std::span<const std::int32_t> ids, const double* lo,
+                                                       const double* hi, const InsertionOptions& options = {});
 
 }  // namespace tessera::front

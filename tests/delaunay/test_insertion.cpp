@@ -159,8 +159,11 @@ std::vector<std::array<std::int32_t, 4>> insert_points(const std::vector<double>
   o.threads = threads;
   o.parallel_min = parallel_min;
   o.stats = stats;
-  auto rows = tessera::front::insertion_delaunay(ctx, ids, ctx.lo.data(), ctx.hi.data(), o);
-  return rows ? *rows : std::vector<std::array<std::int32_t, 4>>{};
+  const auto flat = tessera::front::insertion_delaunay(ctx, ids, ctx.lo.data(), ctx.hi.data(), o);
+  std::vector<std::array<std::int32_t, 4>> rows(flat ? flat->size() / 4 : 0);
+  for (std::size_t r = 0; r < rows.size(); ++r)
+    for (std::size_t k = 0; k < 4; ++k) rows[r][k] = (*flat)[4 * r + k];
+  return rows;
 }
 
 TEST(Insertion, ParallelPhasesGiveTheSerialRows) {
