@@ -421,6 +421,12 @@ class Triangulation {
       const std::int32_t t = w.stack.back();
       w.stack.pop_back();
       w.cavity.push_back(t);
+      // The four neighbours' marks and vertices are read below one after
+      // the other: ask for all of them first, so their misses overlap.
+      for (int k = 0; k < 4; ++k) {
+        __builtin_prefetch(state + tets[t].n[k]);
+        __builtin_prefetch(tets + tets[t].n[k]);
+      }
       for (int k = 0; k < 4; ++k) {
         const std::int32_t u = tets[t].n[k];
         bool in;
