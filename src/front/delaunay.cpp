@@ -397,23 +397,41 @@ inline double insertion_ratio(int threads) { return 1.6 * std::sqrt(std::max(thr
 // points, exact duplicates left out: of each set of coincident points the
 // lowest id is the vertex, as the cells pass decides.
 Delaunay by_insertion(const front::Pass<3>& pass, Delaunay out) {
-  const std::size_t n = pass.in_box.size();
   tbb::task_arena(pass.engine_options.threads).execute([&] {
-    std::vector<std::int32_t> ids;
-    ids.reserve(n);
-    for (std::size_t i = 0; i < n; ++i)
-      if (pass.in_box[i]) ids.push_back(static_cast<std::int32_t>(i));
-    const double* pts = pass.points.data();
-    auto at = [&](std::int32_t i) { return std::array<double, 3>{pts[3 * i], pts[3 * i + 1], pts[3 * i + 2]}; };
-    tbb::parallel_sort(ids.begin(), ids.end(), [&](std::int32_t a, std::int32_t b) {
-      const auto pa = at(a), pb = at(b);
-      return pa != pb ? pa < pb : a < b;
+    // Exact duplicates, found bin by bin: coincident points share a bin,
+    // whose slots the locator keeps in id order, so the first earlier slot
+    // with the same coordinates holds the group's lowest id. A crowded bin
+    // is sorted by coordinates instead of compared pairwise.
+    const auto& loc = *pass.locator;
+    std::vector<std::int32_t> lowest(loc.size(), -1);  // per slot: the lowest coincident id, -1: itself
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, loc.num_bins(), 1 << 10), [&](const tbb::blocked_range<std::size_t>& r) {
+      std::vector<std::uint32_t> crowd;
+      for (std::size_t k = r.begin(); k != r.end(); ++k) {
+        const std::uint32_t a = loc.offsets()[k], e = loc.offsets()[k + 1];
+        if (e - a <= 32) {
+          for (std::uint32_t i = a + 1; i < e; ++i)
+            for (std::uint32_t j = a; j < i; ++j)
+              if (loc.point(j) == loc.point(i)) {
+                lowest[i] = loc.id(j);
+                break;
+              }
+          continue;
+        }
+        crowd.resize(e - a);
+        for (std::uint32_t i = a; i < e; ++i) crowd[i - a] = i;
+        std::sort(crowd.begin(), crowd.end(), [&](std::uint32_t x, std::uint32_t y) {
+          return loc.point(x) != loc.point(y) ? loc.point(x) < loc.point(y) : x < y;
+        });
+        for (std::size_t m = 1; m < crowd.size(); ++m)
+          if (loc.point(crowd[m]) == loc.point(crowd[m - 1]))
+            lowest[crowd[m]] = lowest[crowd[m - 1]] >= 0 ? lowest[crowd[m - 1]] : loc.id(crowd[m - 1]);
+      }
     });
     std::vector<std::int32_t> distinct;
-    distinct.reserve(ids.size());
-    for (std::size_t k = 0; k < ids.size(); ++k) {
-      if (k > 0 && at(ids[k]) == at(ids[k - 1])) out.duplicates.emplace_back(ids[k], distinct.back());
-      else distinct.push_back(ids[k]);
+    distinct.reserve(loc.size());
+    for (std::size_t k = 0; k < loc.size(); ++k) {
+      if (lowest[k] >= 0) out.duplicates.emplace_back(loc.id(k), lowest[k]);
+      else distinct.push_back(loc.id(k));
     }
     std::sort(out.duplicates.begin(), out.duplicates.end());
     out.hull_completed = true;

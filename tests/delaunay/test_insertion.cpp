@@ -111,6 +111,19 @@ std::vector<std::pair<std::string, std::vector<double>>> inputs() {
     }
     in.emplace_back("duplicates", std::move(p));
   }
+  {
+    // A blob far smaller than a bin, with exact copies: its bin is crowded
+    // (duplicates found by sorting it, not pairwise).
+    auto p = uniform_points(300, 3, 48);
+    const auto blob = uniform_points(400, 3, 49);
+    for (std::size_t i = 0; i < 400; ++i) {
+      const double x[3] = {0.5 + 1e-4 * blob[3 * i], 0.5 + 1e-4 * blob[3 * i + 1], 0.5 + 1e-4 * blob[3 * i + 2]};
+      p.insert(p.end(), x, x + 3);
+      if (i % 7 == 0) p.insert(p.end(), x, x + 3);
+      if (i % 21 == 0) p.insert(p.end(), x, x + 3);  // a third copy
+    }
+    in.emplace_back("crowded duplicates", std::move(p));
+  }
   in.emplace_back("subnormal offsets", subnormal_offset_points(300, 3, 7));
   {
     auto far = uniform_points(2000, 3, 44);  // far from the origin: large, rounded differences
