@@ -7,6 +7,7 @@
 #include <bit>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <stdexcept>
@@ -56,7 +57,8 @@ std::uint64_t spread3(std::uint64_t x) {
 // 2^-(r+1), by its hash; the smallest rounds first), each in Morton order.
 struct BrioOrder {
   std::vector<std::int32_t> ids;
-  std::vector<std::size_t> rounds;  // each round's first position, then ids.size()
+  std::vector<std::uint64_t> codes;  // each position's Morton code
+  std::vector<std::size_t> rounds;   // each round's first position, then ids.size()
 };
 
 BrioOrder brio_order(const ExactContext& ctx, std::span<const std::int32_t> ids, const double* lo, const double* hi) {
@@ -85,8 +87,10 @@ BrioOrder brio_order(const ExactContext& ctx, std::span<const std::int32_t> ids,
   });
   BrioOrder order;
   order.ids.resize(ids.size());
+  order.codes.resize(ids.size());
   for (std::size_t i = 0; i < keys.size(); ++i) {
     order.ids[i] = keys[i].id;
+    order.codes[i] = keys[i].code;
     if (i == 0 || keys[i].round != keys[i - 1].round) order.rounds.push_back(i);
   }
   order.rounds.push_back(ids.size());
@@ -198,6 +202,8 @@ struct Worker {
   std::uint8_t part = 0;      // the partition it inserts in a parallel phase
   std::uint32_t epoch = 0;    // its marks: part + 1, then steps of the worker count
   std::int32_t last = -1;     // a tetrahedron of its last insertion (the next walk's start), or -1
+  std::int32_t prev = -1;     // the vertex it inserted last, or -1
+  std::size_t guided = 0;     // walks it started by a guide (walk_start)
   std::uint64_t rng = 0x2545F4914F6CDD1Dull;
   std::vector<std::int32_t> free;     // slots of tetrahedra it removed
   std::size_t fresh = 0, fresh_end = 0;  // claimed slots never used
@@ -224,8 +230,10 @@ class Triangulation {
   /// Vertices are numbered by `global`, the insertion order: vertex k is
   /// point global[k] of ctx, and its coordinates are copied in that order, so
   /// the points a walk and a cavity meet lie close in memory too.
-  Triangulation(const ExactContext& ctx, std::vector<std::int32_t> global, int threads)
-      : ctx_(ctx), global_(std::move(global)), workers_(static_cast<std::size_t>(std::clamp(threads, 1, max_workers))) {
+  Triangulation(const ExactContext& ctx, std::vector<std::int32_t> global, std::vector<std::int32_t> guide, int threads)
+      : ctx_(ctx), global_(std::move(global)), guide_(std::move(guide)),
+        workers_(static_cast<std::size_t>(std::clamp(threads, 1, max_workers))) {
+    vtet_.resize(global_.size());  // written for each vertex as it is inserted
     coords_.resize(3 * global_.size());
     for (std::size_t k = 0; k < global_.size(); ++k)
       for (int e = 0; e < 3; ++e) coords_[3 * k + static_cast<std::size_t>(e)] = ctx.points[static_cast<std::size_t>(global_[k]) * 3 + static_cast<std::size_t>(e)];
@@ -263,6 +271,7 @@ class Triangulation {
         }
     }
     hint_ = static_cast<std::int32_t>(first);
+    for (const std::int32_t v : s) vtet_[static_cast<std::size_t>(v)] = hint_;
   }
 
   /// Insert the points `pts` (vertex numbers; none in the triangulation yet),
@@ -288,6 +297,7 @@ class Triangulation {
     }
     Worker& w = workers_[0];
     w.last = hint_;
+    w.prev = -1;
     for (const std::int32_t q : pts) {
       if (w.epoch >= epoch_limit()) reset_marks();
       if (!insert<false>(w, q)) throw std::logic_error("tessera: insertion: a serial insertion was refused");
@@ -297,7 +307,11 @@ class Triangulation {
 
   /// The finite tetrahedra, in the layout of insertion_delaunay.
   Buffer<std::int32_t> rows() const;
-  const InsertionStats& stats() const { return stats_; }
+  InsertionStats stats() const {
+    InsertionStats s = stats_;
+    for (const Worker& w : workers_) s.guided += w.guided;
+    return s;
+  }
 
  private:
   using Face = Worker::Face;
@@ -367,6 +381,7 @@ class Triangulation {
       Worker& w = workers_[t];
       w.deferred.clear();
       w.last = -1;
+      w.prev = -1;
       const std::size_t tries = std::min<std::size_t>(mine[t].size(), 64);
       for (std::size_t k = 0; k < tries && w.last < 0; ++k) {
         const std::int32_t t0 = locate<false>(w, mine[t][k * mine[t].size() / tries], walk_from);
@@ -406,7 +421,7 @@ class Triangulation {
   /// or no fresh slot is left: nothing has been changed then.
   template <bool Check>
   bool insert(Worker& w, std::int32_t q) {
-    const std::int32_t t0 = locate<Check>(w, q, w.last);
+    const std::int32_t t0 = locate<Check>(w, q, walk_start<Check>(w, q));
     if (t0 < 0) return false;
     w.epoch += static_cast<std::uint32_t>(workers_.size());
     const std::uint32_t mark_out = w.epoch << 1, mark_in = mark_out | 1;
@@ -471,7 +486,12 @@ class Triangulation {
     for (const Face& f : w.boundary) {
       const std::int32_t nt = allocate(w);
       Tet& t = tets[nt];
-      for (int m = 0; m < 4; ++m) t.v[m] = f.v[m];
+      for (int m = 0; m < 4; ++m) {
+        t.v[m] = f.v[m];
+        // Every vertex of a removed tetrahedron lies on the cavity's
+        // boundary, so each keeps a live one.
+        if (f.v[m] != infinite) vtet_[static_cast<std::size_t>(f.v[m])] = nt;
+      }
       t.n[f.k] = f.outside;
       tets[f.outside].n[f.back] = nt;
       for (int j = 0; j < 4; ++j) {
@@ -505,7 +525,31 @@ class Triangulation {
       w.last = nt;
     }
     for (const std::uint64_t h : w.used) w.edges[h] = Edge{};
+    w.prev = q;
     return true;
+  }
+
+  /// Where q's walk starts: by its last insertion (w.last), or, where q's
+  /// guide vertex (an earlier round's point near it in Morton order) is
+  /// nearer to q than the last inserted point, by a tetrahedron of the guide.
+  /// Consecutive points of a round lie close on the whole, but the Morton
+  /// curve jumps now and then; on a surface sample (a torus) those walks
+  /// crossed hundreds of long tetrahedra and averaged 68 steps a point. In a
+  /// phase the guide must be w's vertex and its tetrahedron w's own.
+  template <bool Check>
+  std::int32_t walk_start(Worker& w, std::int32_t q) const {
+    const std::int32_t g = guide_[static_cast<std::size_t>(q)];
+    if (g < 0 || w.prev < 0 || (Check && part_[static_cast<std::size_t>(g)] != w.part)) return w.last;
+    auto dist2 = [&](std::int32_t v) {
+      double r2 = 0;
+      for (int e = 0; e < 3; ++e) r2 += (at(v)[e] - at(q)[e]) * (at(v)[e] - at(q)[e]);
+      return r2;
+    };
+    if (dist2(g) >= dist2(w.prev)) return w.last;
+    const std::int32_t t = vtet_[static_cast<std::size_t>(g)];
+    if (Check && !owned(store_.tets()[t], w.part)) return w.last;
+    ++w.guided;
+    return t;
   }
 
   /// At least `count` more fresh slots for w. Serially the store grows; in
@@ -644,6 +688,8 @@ class Triangulation {
 
   const ExactContext& ctx_;
   std::vector<std::int32_t> global_;  // vertex -> input id
+  std::vector<std::int32_t> guide_;   // vertex -> an earlier round's vertex near it, or -1 (walk_start)
+  std::vector<std::int32_t> vtet_;    // inserted vertex -> a live tetrahedron of it
   std::vector<double> coords_;        // vertex -> coordinates (3 each)
   TetStore store_;
   std::vector<Worker> workers_;
@@ -778,7 +824,28 @@ std::optional<Buffer<std::int32_t>> insertion_delaunay(const ExactContext& ctx, 
   if (d == m) return std::nullopt;
   std::array<std::int32_t, 4> local{0, 1, static_cast<std::int32_t>(c), static_cast<std::int32_t>(d)};
   if (o < 0) std::swap(local[2], local[3]);
-  Triangulation tri(ctx, std::move(order.ids), options.threads);
+  // Each point's guide: of the previous round's two points around it in
+  // Morton order, the nearer (both rounds are sorted by code).
+  std::vector<std::int32_t> guide(m, -1);
+  for (std::size_t r = 1; r + 1 < order.rounds.size(); ++r) {
+    const std::size_t pa = order.rounds[r - 1], a = order.rounds[r], b = order.rounds[r + 1];
+    std::size_t j = pa;  // the first of the previous round with a code above q's
+    for (std::size_t i = a; i < b; ++i) {
+      while (j < a && order.codes[j] <= order.codes[i]) ++j;
+      double best = std::numeric_limits<double>::infinity();
+      for (const std::size_t k : {j - 1, j}) {
+        if (k < pa || k >= a) continue;
+        double r2 = 0;
+        for (int e = 0; e < 3; ++e) r2 += (at(k)[e] - at(i)[e]) * (at(k)[e] - at(i)[e]);
+        if (r2 < best) {
+          best = r2;
+          guide[i] = static_cast<std::int32_t>(k);
+        }
+      }
+    }
+  }
+  order.codes = {};
+  Triangulation tri(ctx, std::move(order.ids), std::move(guide), options.threads);
   tri.start(local);
   for (std::size_t r = 0; r + 1 < order.rounds.size(); ++r) {
     const std::size_t a = order.rounds[r], b = order.rounds[r + 1];

@@ -38,6 +38,7 @@ struct InsertionStats {
   std::size_t phases = 0;        ///< parallel phases run
   std::size_t phase_points = 0;  ///< points they were given
   std::size_t deferred = 0;      ///< of those, points they left for later
+  std::size_t guided = 0;        ///< walks started from a guide vertex rather than the last insertion
 };
 
 struct InsertionOptions {
