@@ -379,15 +379,16 @@ PilotEstimate pilot_estimate(const front::Pass<CellT::dim>& pass, double enough)
 /// From this pilot ratio on, 3D points go to insertion rather than to the
 /// cells. Both build the same rows, so the choice may follow the thread
 /// count. Measured at 1M points (docs/design.md, "Insertion for costly
-/// inputs"): insertion takes ~5 s on one thread whatever the input, and
-/// ~3.0-3.5 s on two where its parallel phases work (volumes: uniform,
-/// blobs, sheets, hierarchies); on surfaces they turn themselves off and
+/// inputs"): insertion takes ~4.5-5 s on one thread whatever the input,
+/// and ~2.6-3.0 s on two where its parallel phases work (volumes: uniform,
+/// blobs, sheets, hierarchies; stop 33); on surfaces they turn themselves off and
 /// it stays serial, but there the cells cost several times more. The cells
 /// take 4.8 s on one thread and 2.55 s on two on uniform points (ratio 1),
 /// 2.7 s on two on a fractal hierarchy (1.3), 7.8-8.3 s on blobs and
 /// sheets (3.4-3.8), more on surface samples (an ellipsoid's 12-16, a
 /// terrain's 42-73, a torus's 52-176): about 2.55 s times ratio^0.7. So the
-/// threshold is 1.6 on two threads (break-even near 1.4) and 1.13 on one;
+/// threshold is 1.6 on two threads (the hierarchy, 1.3, measures level
+/// both ways; lattices, ~1, take twice as long by insertion) and 1.13 on one;
 /// beyond two threads it grows as sqrt(threads), a model (the cells scale
 /// nearly linearly, the phases defer more as their slabs thin), not a
 /// measurement.

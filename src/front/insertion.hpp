@@ -19,7 +19,9 @@
 //
 // The order (BRIO, Amenta, Choi & Rote, "Incremental constructions con
 // BRIO", 2003: rounds of doubling size, each in Morton order) keeps the walk
-// from the last inserted point short. Large rounds are inserted in parallel
+// from the last inserted point short; where the Morton curve jumps, a walk
+// starts instead from a nearby point of the previous round (insertion.cpp,
+// walk_start). Large rounds are inserted in parallel
 // phases, one slab of space per worker (insertion.cpp, Triangulation::phase);
 // the result does not depend on the order, so neither on the thread count.
 #pragma once
