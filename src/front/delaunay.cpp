@@ -399,35 +399,10 @@ inline double insertion_ratio(int threads) { return 1.6 * std::sqrt(std::max(thr
 // lowest id is the vertex, as the cells pass decides.
 Delaunay by_insertion(const front::Pass<3>& pass, Delaunay out) {
   tbb::task_arena(pass.engine_options.threads).execute([&] {
-    // Exact duplicates, found bin by bin: coincident points share a bin,
-    // whose slots the locator keeps in id order, so the first earlier slot
-    // with the same coordinates holds the group's lowest id. A crowded bin
-    // is sorted by coordinates instead of compared pairwise.
+    // Exact duplicates, bin by bin (BinLocator::lowest_coincident): sorting
+    // every id by its coordinates gathered a cache line per comparison.
     const auto& loc = *pass.locator;
-    std::vector<std::int32_t> lowest(loc.size(), -1);  // per slot: the lowest coincident id, -1: itself
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, loc.num_bins(), 1 << 10), [&](const tbb::blocked_range<std::size_t>& r) {
-      std::vector<std::uint32_t> crowd;
-      for (std::size_t k = r.begin(); k != r.end(); ++k) {
-        const std::uint32_t a = loc.offsets()[k], e = loc.offsets()[k + 1];
-        if (e - a <= 32) {
-          for (std::uint32_t i = a + 1; i < e; ++i)
-            for (std::uint32_t j = a; j < i; ++j)
-              if (loc.point(j) == loc.point(i)) {
-                lowest[i] = loc.id(j);
-                break;
-              }
-          continue;
-        }
-        crowd.resize(e - a);
-        for (std::uint32_t i = a; i < e; ++i) crowd[i - a] = i;
-        std::sort(crowd.begin(), crowd.end(), [&](std::uint32_t x, std::uint32_t y) {
-          return loc.point(x) != loc.point(y) ? loc.point(x) < loc.point(y) : x < y;
-        });
-        for (std::size_t m = 1; m < crowd.size(); ++m)
-          if (loc.point(crowd[m]) == loc.point(crowd[m - 1]))
-            lowest[crowd[m]] = lowest[crowd[m - 1]] >= 0 ? lowest[crowd[m - 1]] : loc.id(crowd[m - 1]);
-      }
-    });
+    const std::vector<std::int32_t> lowest = loc.lowest_coincident();
     std::vector<std::int32_t> distinct;
     distinct.reserve(loc.size());
     for (std::size_t k = 0; k < loc.size(); ++k) {

@@ -403,4 +403,38 @@ TEST(BinLocator, MayHaveCoincident) {
   EXPECT_TRUE((BinLocator<2>(r, {}, {0, 0}, {1, 1}, 2.0).may_have_coincident()));
 }
 
+// lowest_coincident against brute force: every slot maps to the lowest id
+// at its coordinates (other than its own), in ordinary bins (pairwise) and in
+// one crowded bin (sorted), with pairs and triples and an unused copy.
+TEST(BinLocator, LowestCoincidentEqualsBruteForce) {
+  std::mt19937_64 g(7);
+  std::uniform_real_distribution<double> u(0, 1), blob(0.5, 0.5001);
+  std::vector<double> p;
+  for (int i = 0; i < 1500; ++i) {
+    const bool in_blob = i % 3 == 0;  // a third in one tiny blob: a crowded bin
+    const double x[3] = {in_blob ? blob(g) : u(g), in_blob ? blob(g) : u(g), in_blob ? blob(g) : u(g)};
+    p.insert(p.end(), x, x + 3);
+    if (i % 5 == 0) p.insert(p.end(), x, x + 3);   // a copy
+    if (i % 15 == 0) p.insert(p.end(), x, x + 3);  // and a third
+  }
+  const std::size_t n = p.size() / 3;
+  std::vector<std::uint8_t> use(n, 1);
+  use[n - 1] = 0;  // not located: neither a duplicate nor a group's lowest
+  const BinLocator<3> loc(p, use, {0, 0, 0}, {1, 1, 1}, 2.0);
+  const std::vector<std::int32_t> lowest = loc.lowest_coincident();
+  std::size_t found = 0;
+  auto same = [&](std::size_t a, std::size_t b) {
+    return p[3 * a] == p[3 * b] && p[3 * a + 1] == p[3 * b + 1] && p[3 * a + 2] == p[3 * b + 2];
+  };
+  for (std::size_t s = 0; s < loc.size(); ++s) {
+    const auto i = static_cast<std::size_t>(loc.id(s));
+    std::int32_t want = -1;
+    for (std::size_t j = 0; j < i && want < 0; ++j)
+      if (use[j] && same(i, j)) want = static_cast<std::int32_t>(j);
+    ASSERT_EQ(lowest[s], want) << "point " << i;
+    found += want >= 0;
+  }
+  EXPECT_GT(found, 350u);
+}
+
 }  // namespace

@@ -15,6 +15,7 @@
 #include <span>
 #include <vector>
 
+#include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
@@ -275,6 +276,39 @@ class BinLocator {
           if (sorted_[i] == sorted_[j]) return true;
     }
     return false;
+  }
+
+  /// Per slot, the lowest id among the located points at exactly its
+  /// coordinates when that is another point's, else -1: each group of
+  /// coincident points (which share a bin, whose slots keep id order)
+  /// maps to its first member. A bin of up to `crowded` points is compared
+  /// pairwise, a fuller one sorted by coordinates; bins in parallel.
+  std::vector<std::int32_t> lowest_coincident(std::uint32_t crowded = 32) const {
+    std::vector<std::int32_t> lowest(ids_.size(), -1);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, num_bins(), 1 << 10), [&](const tbb::blocked_range<std::size_t>& r) {
+      std::vector<std::uint32_t> crowd;
+      for (std::size_t k = r.begin(); k != r.end(); ++k) {
+        const std::uint32_t a = offsets_[k], e = offsets_[k + 1];
+        if (e - a <= crowded) {
+          for (std::uint32_t i = a + 1; i < e; ++i)
+            for (std::uint32_t j = a; j < i; ++j)
+              if (sorted_[j] == sorted_[i]) {
+                lowest[i] = ids_[j];
+                break;
+              }
+          continue;
+        }
+        crowd.resize(e - a);
+        for (std::uint32_t i = a; i < e; ++i) crowd[i - a] = i;
+        std::sort(crowd.begin(), crowd.end(), [&](std::uint32_t x, std::uint32_t y) {
+          return sorted_[x] != sorted_[y] ? sorted_[x] < sorted_[y] : x < y;
+        });
+        for (std::size_t m = 1; m < crowd.size(); ++m)
+          if (sorted_[crowd[m]] == sorted_[crowd[m - 1]])
+            lowest[crowd[m]] = lowest[crowd[m - 1]] >= 0 ? lowest[crowd[m - 1]] : ids_[crowd[m - 1]];
+      }
+    });
+    return lowest;
   }
 
   std::size_t num_bins() const { return offsets_.size() - 1; }
