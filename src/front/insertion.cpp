@@ -62,36 +62,42 @@ struct BrioOrder {
 };
 
 BrioOrder brio_order(const ExactContext& ctx, std::span<const std::int32_t> ids, const double* lo, const double* hi) {
+  // One 64-bit key per point: the round in the top bits (smallest rounds
+  // first), then a Morton code of 19 bits per axis; ties go by id.
   struct Key {
-    std::uint64_t round;  // smallest rounds first
-    std::uint64_t code;
+    std::uint64_t key;
     std::int32_t id;
   };
-  constexpr int max_round = 24;
-  std::vector<Key> keys(ids.size());
+  constexpr int max_round = 24, bits = 19, code_bits = 3 * bits;
+  constexpr double top = (1 << bits) - 1;
+  Buffer<Key> keys(ids.size());  // every one written below
   double scale[3];
-  for (int d = 0; d < 3; ++d) scale[d] = hi[d] > lo[d] ? 2097151.0 / (hi[d] - lo[d]) : 0.0;
-  for (std::size_t i = 0; i < ids.size(); ++i) {
-    const double* p = ctx.points + static_cast<std::size_t>(ids[i]) * 3;
-    std::uint64_t code = 0;
-    for (int d = 0; d < 3; ++d) {
-      const double c = std::clamp((p[d] - lo[d]) * scale[d], 0.0, 2097151.0);
-      code |= spread3(static_cast<std::uint64_t>(c)) << d;
+  for (int d = 0; d < 3; ++d) scale[d] = hi[d] > lo[d] ? top / (hi[d] - lo[d]) : 0.0;
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, ids.size(), 1 << 14), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t i = r.begin(); i != r.end(); ++i) {
+      const double* p = ctx.points + static_cast<std::size_t>(ids[i]) * 3;
+      std::uint64_t code = 0;
+      for (int d = 0; d < 3; ++d) {
+        const double c = std::clamp((p[d] - lo[d]) * scale[d], 0.0, top);
+        code |= spread3(static_cast<std::uint64_t>(c)) << d;
+      }
+      const int round = std::min(std::countl_zero(id_hash(ids[i])), max_round);
+      keys[i] = {static_cast<std::uint64_t>(max_round - round) << code_bits | code, ids[i]};
     }
-    const int round = std::min(std::countl_zero(id_hash(ids[i])), max_round);
-    keys[i] = {static_cast<std::uint64_t>(max_round - round), code, ids[i]};
-  }
-  tbb::parallel_sort(keys.begin(), keys.end(), [](const Key& a, const Key& b) {
-    return a.round != b.round ? a.round < b.round
-                                                : (a.code != b.code ? a.code < b.code : a.id < b.id);
   });
+  tbb::parallel_sort(keys.begin(), keys.end(),
+                     [](const Key& a, const Key& b) { return a.key != b.key ? a.key < b.key : a.id < b.id; });
   BrioOrder order;
   order.ids.resize(ids.size());
   order.codes.resize(ids.size());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, keys.size(), 1 << 14), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t i = r.begin(); i != r.end(); ++i) {
+      order.ids[i] = keys[i].id;
+      order.codes[i] = keys[i].key & ((std::uint64_t{1} << code_bits) - 1);
+    }
+  });
   for (std::size_t i = 0; i < keys.size(); ++i) {
-    order.ids[i] = keys[i].id;
-    order.codes[i] = keys[i].code;
-    if (i == 0 || keys[i].round != keys[i - 1].round) order.rounds.push_back(i);
+    if (i == 0 || keys[i].key >> code_bits != keys[i - 1].key >> code_bits) order.rounds.push_back(i);
   }
   order.rounds.push_back(ids.size());
   return order;
@@ -305,8 +311,9 @@ class Triangulation {
     hint_ = w.last;
   }
 
-  /// The finite tetrahedra, in the layout of insertion_delaunay.
-  Buffer<std::int32_t> rows() const;
+  /// The finite tetrahedra, in the layout of insertion_delaunay. It
+  /// overwrites the store (the triangulation is spent).
+  Buffer<std::int32_t> take_rows();
   InsertionStats stats() const {
     InsertionStats s = stats_;
     for (const Worker& w : workers_) s.guided += w.guided;
@@ -699,7 +706,7 @@ class Triangulation {
   InsertionStats stats_;
 };
 
-Buffer<std::int32_t> Triangulation::rows() const {
+Buffer<std::int32_t> Triangulation::take_rows() {
   using Row = std::array<std::int32_t, 4>;
   const std::size_t size = store_.size();
   const Tet* const tets = store_.tets();
@@ -709,91 +716,120 @@ Buffer<std::int32_t> Triangulation::rows() const {
     for (std::size_t t = w.fresh; t < w.fresh_end; ++t) is_free[t] = 1;
   }
   auto live = [&](std::size_t i) { return !is_free[i] && infinite_slot(tets[i]) == 4; };
-  auto lowest = [&](std::size_t i) {
-    return std::min(std::min(global(tets[i].v[0]), global(tets[i].v[1])), std::min(global(tets[i].v[2]), global(tets[i].v[3])));
-  };
   // Slot i's row, its ids ascending except that the last two are swapped
   // where that order is negative (an odd permutation of the positive one).
   auto row_of = [&](std::size_t i) {
     Row r{global(tets[i].v[0]), global(tets[i].v[1]), global(tets[i].v[2]), global(tets[i].v[3])};
-    bool odd = false;
-    for (int a = 1; a < 4; ++a)
-      for (int b = a; b > 0 && r[b - 1] > r[b]; --b) {
-        std::swap(r[b - 1], r[b]);
-        odd = !odd;
-      }
-    if (odd) std::swap(r[2], r[3]);
+    // The permutation's parity from its inversions, then a sorting network
+    // of min/max: no branch on the ids' order (they are random here).
+    const int inversions = (r[0] > r[1]) + (r[0] > r[2]) + (r[0] > r[3]) + (r[1] > r[2]) + (r[1] > r[3]) + (r[2] > r[3]);
+    auto order = [&](int a, int b) {
+      const std::int32_t lo = std::min(r[a], r[b]), hi = std::max(r[a], r[b]);
+      r[a] = lo;
+      r[b] = hi;
+    };
+    order(0, 1);
+    order(2, 3);
+    order(0, 2);
+    order(1, 3);
+    order(1, 2);
+    if (inversions & 1) std::swap(r[2], r[3]);
     return r;
   };
   // Rows ordered by lowest id in two counting passes, each of whose writes
-  // go to a thousand or so streams at most (one pass to a million ids wrote
-  // a cache line per row, at random: 0.7 s of one thread at 1M points).
-  // Pass 1: each fixed chunk of slots counts its rows per coarse bucket (the
-  // lowest id's top bits), and scatters them there, at offsets from the
-  // counts in (bucket, chunk) order. Pass 2, per bucket: a counting sort by
-  // the lowest id into the output, then each id's few rows sorted by the
-  // rest, which makes the result the same for any slot layout.
+  // stay within a cache-sized region (one scatter to a million ids wrote a
+  // cache line per row, at random: 0.7 s of one thread at 1M points).
+  // Pass 1, per fixed chunk of slots: its rows, grouped by coarse bucket
+  // (the lowest id's top bits), written over the chunk's own tetrahedra
+  // once it has read them (a row takes half a tetrahedron's room; a fresh
+  // array faulted in 115 MB at 1M points). Pass 2,
+  // per bucket: its groups from every chunk, counting-sorted by lowest id
+  // straight into the output, then each id's few rows sorted by the rest,
+  // which makes the result the same for any slot layout. The tetrahedra are
+  // read once, each row is written twice.
+  static_assert(2 * sizeof(Row) == sizeof(Tet));
   std::size_t n_ids = 1;
   for (const std::int32_t g : global_) n_ids = std::max(n_ids, static_cast<std::size_t>(g) + 1);
   const int shift = std::max(0, static_cast<int>(std::bit_width(n_ids - 1)) - 10);
   const std::size_t buckets = ((n_ids - 1) >> shift) + 1;
   constexpr std::size_t chunk = 1 << 14;
   const std::size_t chunks = (size + chunk - 1) / chunk;
-  std::vector<std::uint32_t> count(chunks * buckets, 0);  // [chunk][bucket]
+  // group[c * (buckets + 1) + b]: where chunk c's rows of bucket b start, in
+  // rows from grouped(c).
+  std::vector<std::uint32_t> group(chunks * (buckets + 1));
+  auto grouped = [&](std::size_t c) { return reinterpret_cast<unsigned char*>(store_.tets() + c * chunk); };
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, chunks, 1), [&](const tbb::blocked_range<std::size_t>& range) {
+    std::vector<Row> rows;
+    rows.reserve(chunk);
     for (std::size_t c = range.begin(); c != range.end(); ++c) {
-      std::uint32_t* const mine = count.data() + c * buckets;
-      for (std::size_t i = c * chunk; i < std::min(size, (c + 1) * chunk); ++i)
-        if (live(i)) ++mine[static_cast<std::size_t>(lowest(i)) >> shift];
+      rows.clear();
+      std::uint32_t* const start = group.data() + c * (buckets + 1);
+      std::fill(start, start + buckets + 1, 0u);
+      const std::size_t end = std::min(size, (c + 1) * chunk);
+      for (std::size_t i = c * chunk; i < end; ++i) {
+        // The vertices' ids lie anywhere in global_: ask for them ahead.
+        if (i + 16 < end)
+          for (int k = 0; k < 4; ++k) __builtin_prefetch(global_.data() + std::max(tets[i + 16].v[k], 0));
+        if (live(i)) {
+          rows.push_back(row_of(i));
+          ++start[(static_cast<std::size_t>(rows.back()[0]) >> shift) + 1];
+        }
+      }
+      for (std::size_t b = 0; b < buckets; ++b) start[b + 1] += start[b];
+      unsigned char* const dst = grouped(c);
+      for (const Row& r : rows) std::memcpy(dst + sizeof(Row) * start[static_cast<std::size_t>(r[0]) >> shift]++, r.data(), sizeof(Row));
+      // start[b] is now where bucket b ends: shift back to where it starts.
+      for (std::size_t b = buckets; b > 0; --b) start[b] = start[b - 1];
+      start[0] = 0;
     }
   });
   std::vector<std::size_t> bucket_start(buckets + 1, 0);
-  std::vector<std::size_t> offset(chunks * buckets);  // [chunk][bucket]: where that chunk's rows of the bucket go
-  {
-    std::size_t at = 0;
-    for (std::size_t b = 0; b < buckets; ++b) {
-      bucket_start[b] = at;
-      for (std::size_t c = 0; c < chunks; ++c) {
-        offset[c * buckets + b] = at;
-        at += count[c * buckets + b];
-      }
-    }
-    bucket_start[buckets] = at;
+  for (std::size_t c = 0; c < chunks; ++c) {
+    const std::uint32_t* const start = group.data() + c * (buckets + 1);
+    for (std::size_t b = 0; b < buckets; ++b) bucket_start[b + 1] += start[b + 1] - start[b];
   }
-  std::vector<Row> coarse(bucket_start[buckets]);
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, chunks, 1), [&](const tbb::blocked_range<std::size_t>& range) {
-    for (std::size_t c = range.begin(); c != range.end(); ++c) {
-      std::size_t* const next = offset.data() + c * buckets;
-      for (std::size_t i = c * chunk; i < std::min(size, (c + 1) * chunk); ++i)
-        if (live(i)) {
-          const Row r = row_of(i);
-          coarse[next[static_cast<std::size_t>(r[0]) >> shift]++] = r;
-        }
-    }
-  });
+  for (std::size_t b = 0; b < buckets; ++b) bucket_start[b + 1] += bucket_start[b];
   auto key_less = [](const Row& a, const Row& b) {  // row[0] is shared
     if (a[1] != b[1]) return a[1] < b[1];
     const std::int32_t a2 = std::min(a[2], a[3]), b2 = std::min(b[2], b[3]);
     if (a2 != b2) return a2 < b2;
     return std::max(a[2], a[3]) < std::max(b[2], b[3]);
   };
-  Buffer<std::int32_t> out(4 * coarse.size());  // every entry is written below
+  Buffer<std::int32_t> out(4 * bucket_start[buckets]);  // every entry is written below
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, buckets, 1), [&](const tbb::blocked_range<std::size_t>& range) {
     std::vector<std::size_t> start;
-    std::vector<Row> sorted;
+    std::vector<Row> few;
     for (std::size_t b = range.begin(); b != range.end(); ++b) {
-      const std::size_t first = bucket_start[b], last = bucket_start[b + 1];
       const std::size_t id0 = b << shift, ids = std::min(n_ids - id0, std::size_t{1} << shift);
-      start.assign(ids + 1, 0);
-      for (std::size_t k = first; k < last; ++k) ++start[static_cast<std::size_t>(coarse[k][0]) - id0 + 1];
-      for (std::size_t g = 0; g < ids; ++g) start[g + 1] += start[g];
-      sorted.resize(last - first);
-      Row* const dst = sorted.data();
-      for (std::size_t k = first; k < last; ++k) dst[start[static_cast<std::size_t>(coarse[k][0]) - id0]++] = coarse[k];
+      auto each_row = [&](auto&& f) {
+        for (std::size_t c = 0; c < chunks; ++c) {
+          const std::uint32_t* const g = group.data() + c * (buckets + 1) + b;
+          const unsigned char* const rows = grouped(c);
+          for (std::uint32_t k = g[0]; k < g[1]; ++k) {
+            Row r;
+            std::memcpy(r.data(), rows + sizeof(Row) * k, sizeof(Row));
+            f(r);
+          }
+        }
+      };
+      start.assign(ids + 1, bucket_start[b]);
+      each_row([&](const Row& r) { ++start[static_cast<std::size_t>(r[0]) - id0 + 1]; });
+      for (std::size_t g = 0; g < ids; ++g) start[g + 1] += start[g] - bucket_start[b];
+      std::int32_t* const dst = out.data();
+      each_row([&](const Row& r) { std::memcpy(dst + 4 * start[static_cast<std::size_t>(r[0]) - id0]++, r.data(), sizeof(Row)); });
       // start[g] is now where id g's rows end.
-      for (std::size_t g = 0, from = 0; g < ids; from = start[g++])
-        if (start[g] - from > 1) std::sort(dst + from, dst + start[g], key_less);
-      if (first != last) std::memcpy(out.data() + 4 * first, dst, (last - first) * sizeof(Row));
+      for (std::size_t g = 0, from = bucket_start[b]; g < ids; from = start[g++])
+        if (const std::size_t n = start[g] - from; n > 1) {  // sorted as Rows, copied in and out (no aliasing)
+          few.resize(n);
+          std::memcpy(few.data(), dst + 4 * from, n * sizeof(Row));
+          if (n > 32) {
+            std::sort(few.begin(), few.end(), key_less);
+          } else {  // an id has 7 rows on average
+            for (std::size_t a = 1; a < n; ++a)
+              for (std::size_t k = a; k > 0 && key_less(few[k], few[k - 1]); --k) std::swap(few[k], few[k - 1]);
+          }
+          std::memcpy(dst + 4 * from, few.data(), n * sizeof(Row));
+        }
     }
   });
   return out;
@@ -829,20 +865,25 @@ std::optional<Buffer<std::int32_t>> insertion_delaunay(const ExactContext& ctx, 
   std::vector<std::int32_t> guide(m, -1);
   for (std::size_t r = 1; r + 1 < order.rounds.size(); ++r) {
     const std::size_t pa = order.rounds[r - 1], a = order.rounds[r], b = order.rounds[r + 1];
-    std::size_t j = pa;  // the first of the previous round with a code above q's
-    for (std::size_t i = a; i < b; ++i) {
-      while (j < a && order.codes[j] <= order.codes[i]) ++j;
-      double best = std::numeric_limits<double>::infinity();
-      for (const std::size_t k : {j - 1, j}) {
-        if (k < pa || k >= a) continue;
-        double r2 = 0;
-        for (int e = 0; e < 3; ++e) r2 += (at(k)[e] - at(i)[e]) * (at(k)[e] - at(i)[e]);
-        if (r2 < best) {
-          best = r2;
-          guide[i] = static_cast<std::int32_t>(k);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(a, b, 1 << 13), [&](const tbb::blocked_range<std::size_t>& range) {
+      // The first of the previous round with a code above q's.
+      std::size_t j = static_cast<std::size_t>(
+          std::upper_bound(order.codes.begin() + static_cast<std::ptrdiff_t>(pa), order.codes.begin() + static_cast<std::ptrdiff_t>(a),
+                           order.codes[range.begin()]) - order.codes.begin());
+      for (std::size_t i = range.begin(); i != range.end(); ++i) {
+        while (j < a && order.codes[j] <= order.codes[i]) ++j;
+        double best = std::numeric_limits<double>::infinity();
+        for (const std::size_t k : {j - 1, j}) {
+          if (k < pa || k >= a) continue;
+          double r2 = 0;
+          for (int e = 0; e < 3; ++e) r2 += (at(k)[e] - at(i)[e]) * (at(k)[e] - at(i)[e]);
+          if (r2 < best) {
+            best = r2;
+            guide[i] = static_cast<std::int32_t>(k);
+          }
         }
       }
-    }
+    });
   }
   order.codes = {};
   Triangulation tri(ctx, std::move(order.ids), std::move(guide), options.threads);
@@ -857,7 +898,7 @@ std::optional<Buffer<std::int32_t>> insertion_delaunay(const ExactContext& ctx, 
     tri.insert_round(std::move(pts), std::max(b, d + 1), options.parallel_min);
   }
   if (options.stats != nullptr) *options.stats = tri.stats();
-  return tri.rows();
+  return tri.take_rows();
 }
 
 }  // namespace tessera::front
