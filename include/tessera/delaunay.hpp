@@ -23,12 +23,16 @@ namespace tessera {
 
 /// How tessera::delaunay builds the triangulation (the result is the same).
 enum class DelaunayMethod {
-  /// The cells pass, unless a pilot finds the cells far costlier than they
-  /// find simplices (3D without labels, from 20,000 points, with automatic
-  /// skip_cells): points sampled on surfaces then go to insertion.
+  /// 3D without labels, with complete_hull and automatic skip_cells:
+  /// insertion below 20,000 points; from there the cells pass, unless a
+  /// pilot finds the cells far costlier than the simplices they find
+  /// (surface samples, clustered volumes, points nearly on a sphere) or
+  /// hull completion runs past its budget (near-coplanar hull faces: a
+  /// rotated or slightly jittered lattice), which go to insertion. Otherwise
+  /// the cells pass. Every path gives the same rows.
   automatic,
   cells,      ///< the cells pass (and hull completion)
-  insertion,  ///< serial incremental insertion; 3D without labels and with complete_hull only
+  insertion,  ///< incremental insertion, parallel by phases; 3D without labels and with complete_hull only
 };
 
 struct DelaunayOptions : VoronoiOptions {

@@ -24,7 +24,7 @@ def test_validate_orientation_and_hull(dim):
     assert dt.simplices.dtype == np.int32 and dt.simplices.shape == (dt.nsimplex, dim + 1)
     assert (signed_volumes(pts, dt.simplices) > 0).all()  # positively oriented
     assert (dt.simplices[:, 0] == dt.simplices.min(axis=1)).all()  # lowest id first
-    assert dt.hull_completed and dt.from_cells + dt.from_hull_completion == dt.nsimplex
+    assert dt.hull_completed and dt.from_cells + dt.from_hull_completion + dt.from_insertion == dt.nsimplex
     assert set(np.unique(dt.simplices).tolist()) == set(range(3000))  # every point used
 
 

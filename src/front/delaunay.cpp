@@ -245,12 +245,13 @@ std::vector<std::uint8_t> choose_skipped(const front::Pass<D>& pass, double frac
 template <class CellT>
 struct PilotCompositor {
   struct Batch {
-    std::uint64_t cells = 0, work = 0, vertices = 0, found = 0;
+    std::uint64_t cells = 0, work = 0, vertices = 0, found = 0, capped = 0;
   };
   Batch total;
   void add(Batch& b, std::int32_t, const kernels::BuildStatus& st, CellT& cell) {
     ++b.cells;
-    b.work += st.work;
+    b.work += st.work;  // a capped cell's counts up to the cap: a lower bound
+    b.capped += st.capped;
     if (!st.has_cell) return;
     b.vertices += cell.vertices().size();
     for (const auto& v : cell.vertices()) {
@@ -265,6 +266,7 @@ struct PilotCompositor {
       total.work += b.work;
       total.vertices += b.vertices;
       total.found += b.found;
+      total.capped += b.capped;
     }
   }
 };
@@ -298,8 +300,16 @@ struct PilotCompositor {
 // segments: ratios 5.8-7.1) gain 15-25% at 0.45-0.6 (curves 0.50 -> 0.37
 // s). So in 2D nothing is skipped below a ratio of 2, and above it the
 // fraction is 0.2 sqrt(ratio) in [0.3, 0.6].
+inline constexpr std::size_t pilot_min_points = 20000;
 inline constexpr std::size_t pilot_band = 256;
 inline constexpr std::size_t pilot_bands = 4;
+/// A pilot cell is abandoned past this many times a uniform cell's work
+/// (CellBuilder::set_work_cap; the ratio past which insertion is chosen is
+/// 1.6 on two threads). Points nearly on one sphere have cells that all
+/// reach its centre, where every point is nearly cospherical with them:
+/// each cell tests every point, most exactly (200k points: 2.3M exact
+/// evaluations per cell; the pilot's first band alone ran for minutes).
+inline constexpr double pilot_work_cap = 64;
 
 struct SkipRule {
   /// BuildStatus::work of a uniform cell, on average, with the default two
@@ -364,10 +374,12 @@ PilotEstimate pilot_estimate(const front::Pass<CellT::dim>& pass, double enough)
     engine::EngineOptions eo = pass.engine_options;
     eo.progress = nullptr;
     eo.batch_size = 16;  // a band of 256 cells in 16 batches, shared among the threads
+    eo.work_cap = static_cast<std::uint64_t>(pilot_work_cap * rule.uniform_work);
     engine::tessellate<CellT>(gens, comp, eo);
     const auto& t = comp.total;
-    if (t.vertices == 0) continue;    // no cell yet (duplicates only)
-    if (t.found == 0) return {std::numeric_limits<double>::infinity(), highest};  // all comes from completion
+    if (t.vertices == 0 && t.capped == 0) continue;  // no cell yet (duplicates only)
+    // None found: all comes from completion, or every cell was abandoned.
+    if (t.found == 0) return {std::numeric_limits<double>::infinity(), highest};
     const double work = static_cast<double>(t.work) / static_cast<double>(t.cells) / rule.uniform_work;
     ratio = work / (static_cast<double>(t.found) / static_cast<double>(t.vertices));
     if (slope * std::sqrt(ratio) > 2 * highest || ratio >= enough) break;
@@ -393,6 +405,16 @@ PilotEstimate pilot_estimate(const front::Pass<CellT::dim>& pass, double enough)
 /// nearly linearly, the phases defer more as their slabs thin), not a
 /// measurement.
 inline double insertion_ratio(int threads) { return 1.6 * std::sqrt(std::max(threads, 1) / 2.0); }
+
+/// Completion's budget, in candidates its wraps consider per input point,
+/// beyond which the automatic method turns to insertion. Measured per point
+/// (stop 34, two threads): 1.6 at 1M uniform points, 3.5 at 100k, 5.5 on the
+/// benchmark's clustered 100k, 2.4 on a 200k fractal hierarchy, 1.1 on the
+/// 50^3 lattice, 29 on a 60^3 lattice jittered by 1e-3 (cells 0.66 s,
+/// insertion 0.60 s); 337-522 on rotated lattices of 10^3-20^3 points (20^3:
+/// 8.2 s, insertion 0.49 s) and 1041 on a 60^3 lattice jittered by 1e-9
+/// (10.7 s, insertion 0.60 s).
+inline constexpr std::uint64_t completion_budget = 64;
 
 // The triangulation by insertion (front/insertion.hpp) of the located
 // points, exact duplicates left out: of each set of coincident points the
@@ -441,7 +463,7 @@ Delaunay run(std::span<const double> input, std::span<const std::int32_t> labels
   // points: 3.0 -> 2.7 s on two threads at 30% by hash); in 2D none on
   // uniform points, whose cells are cheap next to the wraps that would
   // replace them, 30% to 60% on clustered ones.
-  const bool pilot = complete && opt.skip_cells < 0 && n >= 20000 && opt.method != DelaunayMethod::insertion;
+  const bool pilot = complete && opt.skip_cells < 0 && n >= pilot_min_points && opt.method != DelaunayMethod::insertion;
   const bool may_insert = D == 3 && opt.method == DelaunayMethod::automatic;
   const double insert_from = insertion_ratio(pass.engine_options.threads);
   const PilotEstimate estimate =
@@ -449,7 +471,13 @@ Delaunay run(std::span<const double> input, std::span<const std::int32_t> labels
   if constexpr (D == 3) {
     // Cells far costlier than what they find (surface samples, clustered
     // volumes): insertion (docs/design.md, "Insertion for costly inputs").
-    const bool insert = opt.method == DelaunayMethod::insertion || (may_insert && pilot && estimate.ratio >= insert_from);
+    // Too few points for a pilot: insertion, which no input makes costly
+    // (the cells of points nearly on a sphere each test every point: 5,000
+    // such points took 4.1 s, 0.13 s by insertion); 10,000 uniform points
+    // take 0.029 s against 0.042 s, a 20^3 lattice 0.037 s against 0.028.
+    const bool small = may_insert && complete && opt.skip_cells < 0 && n < pilot_min_points;
+    const bool insert = opt.method == DelaunayMethod::insertion || small ||
+                        (may_insert && pilot && estimate.ratio >= insert_from);
     if (insert && complete && attempt == 0) return by_insertion(pass, std::move(out));
   }
   const double skip = !complete ? 0 : opt.skip_cells >= 0 ? opt.skip_cells : pilot ? estimate.fraction : 0;
@@ -467,6 +495,12 @@ Delaunay run(std::span<const double> input, std::span<const std::int32_t> labels
     pass.gens.slots = built_slots;
   }
 
+  // Where completion turns out far costlier than the cells (near-coplanar
+  // hull faces: a rotated or slightly jittered lattice), insertion takes
+  // over (HullCompletion::set_budget). It builds the same rows, so only
+  // the automatic method may switch.
+  const bool fall_back = D == 3 && complete && opt.method == DelaunayMethod::automatic && attempt == 0;
+  const Delaunay before_cells = fall_back ? out : Delaunay{};
   front::DelaunayPassResult<D> found;
   front::DelaunayCompositor<CellT> comp(found, n, labels, complete, skipped);
   out.exact_predicate_calls = engine::tessellate<CellT>(pass.gens, comp, pass.engine_options);
@@ -539,6 +573,7 @@ Delaunay run(std::span<const double> input, std::span<const std::int32_t> labels
       diam2 += e * e;
     }
     front::HullCompletion<D> hc(pass.exact, candidates, std::sqrt(diam2));
+    if (fall_back) hc.set_budget(completion_budget * n + (1u << 16));
     if (!none_found) {
       added = hc.run(found.open, pass.engine_options.threads);
     } else {
@@ -558,6 +593,8 @@ Delaunay run(std::span<const double> input, std::span<const std::int32_t> labels
             "could be found within 2^50 times the input's extent; remove the near-degenerate offsets or joggle");
       added = hc.run_from(*seed, pass.engine_options.threads);
     }
+    if constexpr (D == 3)
+      if (hc.over_budget()) return by_insertion(pass, std::move(before_cells));
   }
   out.from_hull_completion = added.size();
 

@@ -2,7 +2,8 @@
 // as the cells pass, byte for byte, on general-position and degenerate input
 // (lattices, co-spherical and co-planar points, where the symbolic
 // perturbation chooses), the same duplicates, a valid triangulation; and the
-// automatic choice takes it for surface samples only. Its parallel phases
+// automatic choice takes it for surface samples and where the cells pass
+// would stall (points nearly on a sphere, near-coplanar hull faces). Its parallel phases
 // give the serial rows for any thread count.
 #include <gtest/gtest.h>
 
@@ -255,6 +256,40 @@ TEST(Insertion, AutomaticChoiceTakesItForSurfaceSamplesOnly) {
   const tessera::Delaunay cells = triangulate(uniform, tessera::DelaunayMethod::automatic);
   EXPECT_EQ(cells.from_insertion, 0u);
   EXPECT_GT(cells.from_cells, 0u);
+}
+
+TEST(Insertion, AutomaticChoiceTakesItWhereTheCellsPassWouldStall) {
+  std::mt19937_64 rng(46);
+  std::normal_distribution<double> g;
+  // Points nearly on one sphere: every cell reaches the centre, where all
+  // points are nearly cospherical, and tests every point, most exactly. The
+  // pilot abandons its cells at its work cap (pilot_work_cap) and chooses
+  // insertion; before the cap its first band alone ran for minutes.
+  std::vector<double> sphere;
+  for (int i = 0; i < 24000; ++i) {
+    const double x = g(rng), y = g(rng), z = g(rng), r = std::sqrt(x * x + y * y + z * z);
+    sphere.insert(sphere.end(), {x / r, y / r, z / r});
+  }
+  const tessera::Delaunay on_sphere = triangulate(sphere, tessera::DelaunayMethod::automatic);
+  EXPECT_EQ(on_sphere.from_insertion, on_sphere.n_simplices());
+  expect_valid(on_sphere, sphere, "sphere");
+  // A rotated 28^3 lattice: its cells are cheap and the pilot keeps them,
+  // but its hull faces are coplanar to within rounding, and each of
+  // completion's wraps scans a whole face, most of it exactly (a 20^3 one
+  // took 8 s). Completion stops at its budget (completion_budget) and
+  // insertion builds the rows.
+  std::vector<double> lattice;
+  const double a = 0.3, b = 0.7;
+  for (int i = 0; i < 28; ++i)
+    for (int j = 0; j < 28; ++j)
+      for (int k = 0; k < 28; ++k) {
+        const double x = std::cos(a) * i - std::sin(a) * j, y = std::sin(a) * i + std::cos(a) * j;
+        lattice.insert(lattice.end(), {x, std::cos(b) * y - std::sin(b) * k, std::sin(b) * y + std::cos(b) * k});
+      }
+  const tessera::Delaunay rotated = triangulate(lattice, tessera::DelaunayMethod::automatic);
+  EXPECT_EQ(rotated.from_insertion, rotated.n_simplices());
+  EXPECT_EQ(rotated.from_cells, 0u);
+  expect_valid(rotated, lattice, "rotated lattice");
 }
 
 }  // namespace

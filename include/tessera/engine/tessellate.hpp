@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <span>
 #include <stdexcept>
 #include <vector>
@@ -42,6 +43,8 @@ struct EngineOptions {
   int threads = 1;
   std::size_t batch_size = 512;   ///< fixed: results never depend on the thread count
   std::function<void(double)> progress;
+  /// Cells whose search passes this are abandoned (CellBuilder::set_work_cap).
+  std::uint64_t work_cap = std::numeric_limits<std::uint64_t>::max();
 };
 
 /// Build every cell of `gens.order` and hand each to the compositor; returns
@@ -62,9 +65,11 @@ std::uint64_t tessellate(const Generators<CellT::dim>& gens, Comp& comp, const E
     std::uint64_t exact_calls = 0;
   };
   tbb::enumerable_thread_specific<Workspace> workspaces([&] {
-    return Workspace{kernels::CellBuilder<CellT>(*gens.locator, gens.coords, gens.lo.data(),
-                                                 gens.hi.data(), gens.exact, gens.tree),
-                     CellT{}, 0};
+    Workspace ws{kernels::CellBuilder<CellT>(*gens.locator, gens.coords, gens.lo.data(), gens.hi.data(),
+                                             gens.exact, gens.tree),
+                 CellT{}, 0};
+    ws.builder.set_work_cap(opt.work_cap);
+    return ws;
   });
 
   auto run_batch = [&](std::size_t k) {

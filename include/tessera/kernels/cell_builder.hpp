@@ -46,6 +46,9 @@ struct BuildStatus {
   /// what cells cost on an input (delaunay's skipped-cell fraction); the
   /// same for any thread count.
   std::uint64_t work = 0;
+  /// The search passed the builder's work cap (set_work_cap) and was
+  /// abandoned: no cell (has_cell is false, duplicate_of -1).
+  bool capped = false;
 };
 
 template <class CellT>
@@ -67,6 +70,13 @@ class CellBuilder {
     status.work = work_;
     return status;
   }
+
+  /// Abandon a cell once its work, each exact predicate evaluation counted
+  /// exact_weight times, passes `cap` (BuildStatus::capped). For a pilot
+  /// measuring what cells cost: on points nearly on one sphere every cell
+  /// reaches its centre and tests every point there, most of them exactly.
+  void set_work_cap(std::uint64_t cap) { work_cap_ = cap; }
+  static constexpr std::uint64_t exact_weight = 32;
 
   /// How many cells this builder finished by certify_by_petals (the rest
   /// of its long cells fell back to the shell walk): for tests and tuning.
@@ -108,6 +118,8 @@ class CellBuilder {
     BuildStatus status;
     const std::array<std::int32_t, D>* range = nullptr;  // the flower's bins, once measured
     for (int s = 0; s <= last; ++s) {
+      if (over_cap(cell)) [[unlikely]]
+        return capped(status);
       double sec2 = cell.security_radius2();
       if (s > 1) {
         double lb = loc_.shell_lower_bound(p, b, s);
@@ -280,6 +292,10 @@ class CellBuilder {
     tree_->get().nearest_first(p, i, heap_, [&] { return sec2; }, [&](std::int32_t j, double r2) {
       ++visited;
       work_ += 4;
+      if ((visited & 63) == 0 && over_cap(cell)) [[unlikely]] {
+        capped(status);
+        return false;
+      }
       if (r2 == 0 && exactly_equal(p, j)) {
         if (j < i) {  // the first duplicate met is the lowest id
           status.has_cell = false;
@@ -598,6 +614,14 @@ class CellBuilder {
   std::uint32_t epoch_ = 0;
   std::uint64_t petal_certified_ = 0;
   std::uint64_t work_ = 0;  // the current cell's BuildStatus::work
+  std::uint64_t work_cap_ = std::numeric_limits<std::uint64_t>::max();  // set_work_cap
+
+  bool over_cap(const CellT& cell) const { return work_ + exact_weight * cell.exact_calls() > work_cap_; }
+  static BuildStatus& capped(BuildStatus& status) {
+    status.capped = true;
+    status.has_cell = false;
+    return status;
+  }
   std::vector<std::uint64_t> certified_;  // per vertex slot: the key it was certified with
   PetalCover<D> petals_;  // build_nearest_first's
   std::vector<Candidate> cand_;
