@@ -5,7 +5,9 @@
 
 #include <cmath>
 #include <cstdint>
+#include <tuple>
 
+#include "tessera/kernels/expansion.hpp"
 #include "tessera/kernels/filter.hpp"
 
 namespace tessera::kernels {
@@ -43,6 +45,68 @@ bool orientation_int128(int D, const double* const* p, int& sign) {
     det = r[0][0] * (r[1][1] * r[2][2] - r[1][2] * r[2][1]) - r[0][1] * (r[1][0] * r[2][2] - r[1][2] * r[2][0]) +
           r[0][2] * (r[1][0] * r[2][1] - r[1][1] * r[2][0]);
   sign = det > 0 ? 1 : (det < 0 ? -1 : 0);
+  return true;
+}
+
+// The exact stage by expansions (expansion.hpp): rows of differences p_k - p_0
+// held exactly, determinants of up to 3x3 of them, and the lifted column.
+struct ExpansionStage {
+  using E = expansion::Expansion;
+  E r[4][3];   // row k, coordinate d
+  E lift[4];   // |r_k|^2
+  E t[6];      // temporaries
+  E det_m, det_r, minor, term, next;
+  expansion::Workspace ws;
+
+  // out = a * d - b * c
+  void det2(const E& a, const E& b, const E& c, const E& d, E& out) {
+    expansion::product(a, d, t[0], ws);
+    expansion::product(b, c, t[1], ws);
+    expansion::negate(t[1]);
+    expansion::sum(t[0], t[1], out);
+  }
+  // The determinant of rows `rows` (D of them) of r, into out.
+  void det(int D, const int* rows, E& out) {
+    if (D == 2) {
+      det2(r[rows[0]][0], r[rows[0]][1], r[rows[1]][0], r[rows[1]][1], out);
+      return;
+    }
+    out.clear();
+    for (int d = 0; d < 3; ++d) {
+      const int d1 = (d + 1) % 3, d2 = (d + 2) % 3;
+      det2(r[rows[1]][d1], r[rows[1]][d2], r[rows[2]][d1], r[rows[2]][d2], t[2]);  // cofactor of (0, d)
+      expansion::product(r[rows[0]][d], t[2], t[3], ws);
+      expansion::sum(out, t[3], t[4]);
+      out.swap(t[4]);
+    }
+  }
+  auto parts() { return std::tie(det_m, det_r, minor, term, next); }
+  // r's rows 0..count-1 from points p[1..count] minus p[0].
+  void rows_from(int D, const double* const* p, int count) {
+    for (int k = 0; k < count; ++k)
+      for (int d = 0; d < D; ++d) expansion::difference(p[k + 1][d], p[0][d], r[k][d]);
+  }
+};
+
+ExpansionStage& expansion_stage() {
+  thread_local ExpansionStage st;
+  return st;
+}
+
+bool in_exact_range(int D, const double* const* p, int count) {
+  for (int k = 0; k < count; ++k)
+    if (!expansion::exact_range(p[k], D)) return false;
+  return true;
+}
+
+// Exact orientation by expansions; false when the input is outside their range.
+bool orientation_expansion(int D, const double* const* p, int& sign) {
+  if (!in_exact_range(D, p, D + 1)) return false;
+  ExpansionStage& st = expansion_stage();
+  st.rows_from(D, p, D);
+  const int rows[3] = {0, 1, 2};
+  st.det(D, rows, st.t[5]);
+  sign = expansion::sign(st.t[5]);
   return true;
 }
 
@@ -101,6 +165,7 @@ int orientation(int D, const double* const* pts) {
   if (const int sign = orientation_filter(D, rows)) return sign;
   int sign;
   if (orientation_int128(D, pts, sign)) return sign;
+  if (orientation_expansion(D, pts, sign)) return sign;
   return orientation_exact(D, pts);
 }
 
