@@ -5,7 +5,6 @@
 
 #include <cmath>
 #include <cstdint>
-#include <tuple>
 
 #include "tessera/kernels/expansion.hpp"
 #include "tessera/kernels/filter.hpp"
@@ -52,10 +51,9 @@ bool orientation_int128(int D, const double* const* p, int& sign) {
 // held exactly, determinants of up to 3x3 of them, and the lifted column.
 struct ExpansionStage {
   using E = expansion::Expansion;
-  E r[4][3];   // row k, coordinate d
-  E lift[4];   // |r_k|^2
-  E t[6];      // temporaries
-  E det_m, det_r, minor, term, next;
+  E r[3][3];  // row k, coordinate d
+  E t[5];     // temporaries
+  E det_r;
   expansion::Workspace ws;
 
   // out = a * d - b * c
@@ -77,10 +75,9 @@ struct ExpansionStage {
       det2(r[rows[1]][d1], r[rows[1]][d2], r[rows[2]][d1], r[rows[2]][d2], t[2]);  // cofactor of (0, d)
       expansion::product(r[rows[0]][d], t[2], t[3], ws);
       expansion::sum(out, t[3], t[4]);
-      out.swap(t[4]);
+      expansion::assign(t[4], out);
     }
   }
-  auto parts() { return std::tie(det_m, det_r, minor, term, next); }
   // r's rows 0..count-1 from points p[1..count] minus p[0].
   void rows_from(int D, const double* const* p, int count) {
     for (int k = 0; k < count; ++k)
@@ -105,8 +102,9 @@ bool orientation_expansion(int D, const double* const* p, int& sign) {
   ExpansionStage& st = expansion_stage();
   st.rows_from(D, p, D);
   const int rows[3] = {0, 1, 2};
-  st.det(D, rows, st.t[5]);
-  sign = expansion::sign(st.t[5]);
+  st.det(D, rows, st.det_r);
+  if (!st.det_r.valid()) return false;
+  sign = expansion::sign(st.det_r);
   return true;
 }
 

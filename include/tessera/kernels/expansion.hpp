@@ -18,20 +18,32 @@
 // rationals stay behind for the rest. Where hull completion met a rotated
 // lattice's near-coplanar faces, the rational orientation (a gcd per
 // operation) dominated: 20^3 points took 4.1 s by the cells pass, 1.8 s with
-// this stage. The in-sphere test keeps its GMP integers: with these
-// operations on std::vector its exact stage took twice as long (its
-// expansions are short after compress(), so the cost is per operation; a
-// fixed-size version is the way to try next).
+// this stage. The in-sphere test keeps its GMP integers: an expansion stage
+// for it (about 90 sums and products per test, on these arrays or on
+// vectors) took twice as long as GMP on a rotated lattice and on points
+// nearly on a sphere; a hand-unrolled one is what to try next.
 #pragma once
 
 #include <algorithm>
 #include <cmath>
-#include <vector>
+#include <utility>
 
 namespace tessera::kernels::expansion {
 
-/// Components from the smallest magnitude up, none zero; empty is zero.
-using Expansion = std::vector<double>;
+/// Components from the smallest magnitude up, none zero (n == 0 is zero),
+/// in a fixed array (no allocation: the predicates' expansions stay short
+/// once compressed). A result that would outgrow the array is marked invalid
+/// (n == -1), and so is everything computed from it: the caller then falls
+/// back to GMP. With compress() after every sum that never happens for
+/// inputs in exact_range() (their values span under 1500 bits, so at most
+/// about 30 nonadjacent components each, 60 in a sum before compressing).
+struct Expansion {
+  static constexpr int capacity = 160;
+  int n = 0;
+  double c[capacity];  // only c[0..n) is ever read
+  bool valid() const { return n >= 0; }
+  void clear() { n = 0; }
+};
 
 /// s + e == a + b exactly, s the rounded sum.
 inline void two_sum(double a, double b, double& s, double& e) {
@@ -65,19 +77,20 @@ inline void two_product(double a, double b, double& p, double& e) {
   e = ((ah * bh - p) + ah * bl + al * bh) + al * bl;
 }
 
-inline int sign(const Expansion& e) { return e.empty() ? 0 : (e.back() > 0 ? 1 : -1); }
+/// Of a valid expansion.
+inline int sign(const Expansion& e) { return e.n == 0 ? 0 : (e.c[e.n - 1] > 0 ? 1 : -1); }
 
 /// a - b as an expansion (one or two components).
 inline void difference(double a, double b, Expansion& out) {
   double s, e;
   two_sum(a, -b, s, e);
-  out.clear();
-  if (e != 0) out.push_back(e);
-  if (s != 0) out.push_back(s);
+  out.n = 0;
+  if (e != 0) out.c[out.n++] = e;
+  if (s != 0) out.c[out.n++] = s;
 }
 
 inline void negate(Expansion& e) {
-  for (double& x : e) x = -x;
+  for (int i = 0; i < e.n; ++i) e.c[i] = -e.c[i];
 }
 
 /// e with as few components as its value needs (about its bits / 53), by
@@ -88,98 +101,117 @@ inline void negate(Expansion& e) {
 /// carrying a few bits each, and the sums and products over them cost more
 /// than GMP's integers.
 inline void compress(Expansion& e) {
-  if (e.size() < 3) return;
-  const std::size_t m = e.size();
-  // Down: e[m-1] first; a nonzero error closes the run, whose sum is kept
-  // at the top of the free part of e.
-  std::size_t bottom = m - 1;
-  double q = e[m - 1];
-  for (std::size_t i = m - 1; i-- > 0;) {
+  if (e.n < 3) return;
+  double* const c = e.c;
+  const int m = e.n;
+  // Down: c[m-1] first; a nonzero error closes the run, whose sum is kept
+  // at the top of the free part of c.
+  int bottom = m - 1;
+  double q = c[m - 1];
+  for (int i = m - 2; i >= 0; --i) {
     double s, err;
-    fast_two_sum(q, e[i], s, err);
+    fast_two_sum(q, c[i], s, err);
     if (err != 0) {
-      e[bottom--] = s;
+      c[bottom--] = s;
       q = err;
     } else {
       q = s;
     }
   }
-  e[bottom] = q;
+  c[bottom] = q;
   // Up: from the smallest kept value, each sum's error is final.
-  std::size_t top = 0;
-  for (std::size_t i = bottom + 1; i < m; ++i) {
+  int top = 0;
+  for (int i = bottom + 1; i < m; ++i) {
     double s, err;
-    fast_two_sum(e[i], q, s, err);
-    if (err != 0) e[top++] = err;
+    fast_two_sum(c[i], q, s, err);
+    if (err != 0) c[top++] = err;
     q = s;
   }
-  if (q != 0 || top == 0) e[top++] = q;
-  e.resize(top);
-  if (top == 1 && e[0] == 0) e.clear();
+  if (q != 0) c[top++] = q;
+  e.n = top;
 }
 
-/// h = e + f. h must be another vector than e and f.
+/// to = from.
+inline void assign(const Expansion& from, Expansion& to) {
+  if (&from == &to) return;
+  to.n = from.n;
+  if (from.n > 0) std::copy(from.c, from.c + from.n, to.c);
+}
+
+/// h = e + f, compressed. h must be another object than e and f.
 inline void sum(const Expansion& e, const Expansion& f, Expansion& h) {
-  h.clear();
-  if (e.empty() || f.empty()) {
-    h = e.empty() ? f : e;
+  if (!e.valid() || !f.valid() || e.n + f.n > Expansion::capacity) {
+    h.n = -1;
+    return;
+  }
+  h.n = 0;
+  if (e.n == 0 || f.n == 0) {
+    assign(e.n == 0 ? f : e, h);
     return;
   }
   // The components of both by increasing magnitude, swept from the
   // smallest with two-sum: each step's error is final (no later, larger
   // component overlaps it), the running sum carries on.
-  std::size_t i = 0, j = 0;
+  int i = 0, j = 0;
   auto next = [&] {
-    if (j == f.size() || (i < e.size() && std::fabs(e[i]) < std::fabs(f[j]))) return e[i++];
-    return f[j++];
+    if (j == f.n || (i < e.n && std::fabs(e.c[i]) < std::fabs(f.c[j]))) return e.c[i++];
+    return f.c[j++];
   };
   double q = next();
-  while (i < e.size() || j < f.size()) {
+  while (i < e.n || j < f.n) {
     double s, err;
     two_sum(q, next(), s, err);
-    if (err != 0) h.push_back(err);
+    if (err != 0) h.c[h.n++] = err;
     q = s;
   }
-  if (q != 0 || h.empty()) h.push_back(q);
-  if (h.size() == 1 && h[0] == 0) h.clear();
-  if (h.size() > 4) compress(h);
+  if (q != 0) h.c[h.n++] = q;
+  if (h.n > 4) compress(h);
 }
 
-/// h = e * b. h must be another vector than e.
+/// h = e * b. h must be another object than e.
 inline void scale(const Expansion& e, double b, Expansion& h) {
-  h.clear();
-  if (e.empty() || b == 0) return;
-  double q, err;
-  two_product(e[0], b, q, err);
-  if (err != 0) h.push_back(err);
-  for (std::size_t i = 1; i < e.size(); ++i) {
-    double p, p_err, s, s_err;
-    two_product(e[i], b, p, p_err);
-    two_sum(q, p_err, s, s_err);
-    if (s_err != 0) h.push_back(s_err);
-    fast_two_sum(p, s, q, s_err);
-    if (s_err != 0) h.push_back(s_err);
+  if (!e.valid() || 2 * e.n > Expansion::capacity) {
+    h.n = -1;
+    return;
   }
-  if (q != 0) h.push_back(q);
+  h.n = 0;
+  if (e.n == 0 || b == 0) return;
+  double q, err;
+  two_product(e.c[0], b, q, err);
+  if (err != 0) h.c[h.n++] = err;
+  for (int i = 1; i < e.n; ++i) {
+    double p, p_err, s, s_err;
+    two_product(e.c[i], b, p, p_err);
+    two_sum(q, p_err, s, s_err);
+    if (s_err != 0) h.c[h.n++] = s_err;
+    fast_two_sum(p, s, q, s_err);
+    if (s_err != 0) h.c[h.n++] = s_err;
+  }
+  if (q != 0) h.c[h.n++] = q;
 }
 
-/// Scratch vectors for products; reused, so a thread's evaluations stop
-/// allocating once they have seen their largest sizes.
+/// Scratch for products.
 struct Workspace {
   Expansion term, acc, next;
 };
 
-/// h = e * f (h another vector than e and f).
+/// h = e * f (h another object than e and f).
 inline void product(const Expansion& e, const Expansion& f, Expansion& h, Workspace& ws) {
-  const Expansion& small = e.size() <= f.size() ? e : f;
-  const Expansion& large = e.size() <= f.size() ? f : e;
-  ws.acc.clear();
-  for (const double x : small) {
-    scale(large, x, ws.term);
-    sum(ws.acc, ws.term, ws.next);
-    ws.acc.swap(ws.next);
+  if (!e.valid() || !f.valid()) {
+    h.n = -1;
+    return;
   }
-  h.swap(ws.acc);
+  const Expansion& small = e.n <= f.n ? e : f;
+  const Expansion& large = e.n <= f.n ? f : e;
+  Expansion* acc = &ws.acc;
+  Expansion* next = &ws.next;
+  acc->n = 0;
+  for (int i = 0; i < small.n; ++i) {
+    scale(large, small.c[i], ws.term);
+    sum(*acc, ws.term, *next);
+    std::swap(acc, next);
+  }
+  assign(*acc, h);
 }
 
 /// Whether every value is zero or of magnitude in [2^-120, 2^120]. Then the
