@@ -24,12 +24,15 @@ namespace tessera {
 /// How tessera::delaunay builds the triangulation (the result is the same).
 enum class DelaunayMethod {
   /// 3D without labels, with complete_hull and automatic skip_cells:
-  /// insertion below 20,000 points; from there the cells pass, unless a
-  /// pilot finds the cells far costlier than the simplices they find
-  /// (surface samples, clustered volumes, points nearly on a sphere) or
-  /// hull completion runs past its budget (near-coplanar hull faces: a
-  /// rotated or slightly jittered lattice), which go to insertion. Otherwise
-  /// the cells pass. Every path gives the same rows.
+  /// insertion below 20,000 points. From there a pilot builds a few
+  /// hundred cells; insertion is chosen where they cost far more than the
+  /// simplices they find (surface samples, clustered volumes, points nearly
+  /// on a sphere) and, on one or two threads, where they met no ties (no
+  /// exact evaluations: uniform and jittered points). The rest (lattices,
+  /// whose ties make insertion slower) goes to the cells pass, which hands
+  /// over to insertion if hull completion runs past its budget
+  /// (near-coplanar hull faces: a rotated lattice). Otherwise the cells
+  /// pass. Every path gives the same rows.
   automatic,
   cells,      ///< the cells pass (and hull completion)
   insertion,  ///< incremental insertion, parallel by phases; 3D without labels and with complete_hull only

@@ -328,6 +328,10 @@ inline constexpr SkipRule skip_rule_2d{82.0, 2.0, 0.2, 0.3, 0.6};
 struct PilotEstimate {
   double ratio = 1;
   double fraction = 0;
+  /// Exact predicate evaluations per pilot cell: ~53 on lattices (rotated
+  /// or not), where ties are everywhere; below 0.2 on uniform, clustered
+  /// and jittered input. Infinite when not measured.
+  double exact_per_cell = std::numeric_limits<double>::infinity();
 };
 
 /// `enough`: a ratio at which the caller's choice is made (insertion), so
@@ -360,6 +364,10 @@ PilotEstimate pilot_estimate(const front::Pass<CellT::dim>& pass, double enough)
                                 static_cast<std::uint32_t>((1.0 - std::ldexp(static_cast<double>(h), -64)) / band))});
   PilotCompositor<CellT> comp;
   double ratio = 1;
+  std::uint64_t exact = 0;
+  auto estimate = [&](double r, double fraction) {
+    return PilotEstimate{r, fraction, static_cast<double>(exact) / static_cast<double>(std::max<std::uint64_t>(comp.total.cells, 1))};
+  };
   for (std::size_t k = 0; k < bands; ++k) {
     std::vector<std::int32_t> order;
     std::vector<std::uint32_t> slots;
@@ -375,17 +383,17 @@ PilotEstimate pilot_estimate(const front::Pass<CellT::dim>& pass, double enough)
     eo.progress = nullptr;
     eo.batch_size = 16;  // a band of 256 cells in 16 batches, shared among the threads
     eo.work_cap = static_cast<std::uint64_t>(pilot_work_cap * rule.uniform_work);
-    engine::tessellate<CellT>(gens, comp, eo);
+    exact += engine::tessellate<CellT>(gens, comp, eo);
     const auto& t = comp.total;
     if (t.vertices == 0 && t.capped == 0) continue;  // no cell yet (duplicates only)
     // None found: all comes from completion, or every cell was abandoned.
-    if (t.found == 0) return {std::numeric_limits<double>::infinity(), highest};
+    if (t.found == 0) return estimate(std::numeric_limits<double>::infinity(), highest);
     const double work = static_cast<double>(t.work) / static_cast<double>(t.cells) / rule.uniform_work;
     ratio = work / (static_cast<double>(t.found) / static_cast<double>(t.vertices));
     if (slope * std::sqrt(ratio) > 2 * highest || ratio >= enough) break;
   }
-  if (ratio < rule.off_below) return {ratio, 0.0};
-  return {ratio, std::clamp(slope * std::sqrt(ratio), lowest, highest)};
+  if (ratio < rule.off_below) return estimate(ratio, 0.0);
+  return estimate(ratio, std::clamp(slope * std::sqrt(ratio), lowest, highest));
 }
 
 /// From this pilot ratio on, 3D points go to insertion rather than to the
@@ -415,6 +423,10 @@ inline double insertion_ratio(int threads) { return 1.6 * std::sqrt(std::max(thr
 /// 8.2 s, insertion 0.49 s) and 1041 on a 60^3 lattice jittered by 1e-9
 /// (10.7 s, insertion 0.60 s).
 inline constexpr std::uint64_t completion_budget = 64;
+
+/// Below this many exact evaluations per pilot cell an input has no ties to
+/// speak of (PilotEstimate::exact_per_cell).
+inline constexpr double clean_exact_per_cell = 1.0;
 
 // The triangulation by insertion (front/insertion.hpp) of the located
 // points, exact duplicates left out: of each set of coincident points the
@@ -476,8 +488,17 @@ Delaunay run(std::span<const double> input, std::span<const std::int32_t> labels
     // such points took 4.1 s, 0.13 s by insertion); 10,000 uniform points
     // take 0.029 s against 0.042 s, a 20^3 lattice 0.037 s against 0.028.
     const bool small = may_insert && complete && opt.skip_cells < 0 && n < pilot_min_points;
+    // On one or two threads, inputs without ties (the pilot's cells met
+    // next to no exact evaluations) go to insertion too: 1M uniform points
+    // 2.47 against 2.55 s on two threads, 4.34 against 4.81 s on one; a 1M
+    // fractal hierarchy 2.79 against 2.71 s; a 60^3 lattice jittered by
+    // 1e-9, whose near-coplanar hull makes completion stall, 0.60 against
+    // 2.0 s (cells, then insertion past completion_budget). Lattices, whose
+    // ties make insertion twice as slow, stay with the cells. Beyond two
+    // threads the cells scale better (a model; this machine has two cores).
+    const bool clean = estimate.exact_per_cell < clean_exact_per_cell && pass.engine_options.threads <= 2;
     const bool insert = opt.method == DelaunayMethod::insertion || small ||
-                        (may_insert && pilot && estimate.ratio >= insert_from);
+                        (may_insert && pilot && (estimate.ratio >= insert_from || clean));
     if (insert && complete && attempt == 0) return by_insertion(pass, std::move(out));
   }
   const double skip = !complete ? 0 : opt.skip_cells >= 0 ? opt.skip_cells : pilot ? estimate.fraction : 0;

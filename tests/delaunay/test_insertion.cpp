@@ -2,8 +2,9 @@
 // as the cells pass, byte for byte, on general-position and degenerate input
 // (lattices, co-spherical and co-planar points, where the symbolic
 // perturbation chooses), the same duplicates, a valid triangulation; and the
-// automatic choice takes it for surface samples and where the cells pass
-// would stall (points nearly on a sphere, near-coplanar hull faces). Its parallel phases
+// automatic choice takes it for surface samples, for inputs without ties on
+// one or two threads, and where the cells pass would stall (points nearly
+// on a sphere, near-coplanar hull faces). Its parallel phases
 // give the serial rows for any thread count.
 #include <gtest/gtest.h>
 
@@ -244,18 +245,30 @@ TEST(Insertion, BadRequestsAreInputErrors) {
   EXPECT_THROW(tessera::delaunay(p3, 3, {}, o), tessera::InputError);
 }
 
-TEST(Insertion, AutomaticChoiceTakesItForSurfaceSamplesOnly) {
+TEST(Insertion, AutomaticChoiceFollowsThePilot) {
   // A 24k-point height field: the pilot finds its needle cells far costlier
-  // than what they find, and insertion builds the rows the cells would.
+  // than what they find, and insertion builds the rows the cells would, on
+  // any thread count.
   const std::vector<double> terrain = height_field(24000, 9);
-  const tessera::Delaunay automatic = triangulate(terrain, tessera::DelaunayMethod::automatic);
-  EXPECT_EQ(automatic.from_insertion, automatic.n_simplices());
-  EXPECT_EQ(automatic.simplices, triangulate(terrain, tessera::DelaunayMethod::cells).simplices);
-  // Uniform points stay with the cells.
+  for (const int threads : {2, 4}) {
+    const tessera::Delaunay automatic = triangulate(terrain, tessera::DelaunayMethod::automatic, threads);
+    EXPECT_EQ(automatic.from_insertion, automatic.n_simplices()) << threads;
+    if (threads == 2) EXPECT_EQ(automatic.simplices, triangulate(terrain, tessera::DelaunayMethod::cells).simplices);
+  }
+  // Uniform points have no ties: insertion on one or two threads, the
+  // cells beyond (they scale better).
   const auto uniform = uniform_points(25000, 3, 45);
-  const tessera::Delaunay cells = triangulate(uniform, tessera::DelaunayMethod::automatic);
-  EXPECT_EQ(cells.from_insertion, 0u);
-  EXPECT_GT(cells.from_cells, 0u);
+  const tessera::Delaunay two = triangulate(uniform, tessera::DelaunayMethod::automatic, 2);
+  EXPECT_EQ(two.from_insertion, two.n_simplices());
+  const tessera::Delaunay four = triangulate(uniform, tessera::DelaunayMethod::automatic, 4);
+  EXPECT_EQ(four.from_insertion, 0u);
+  EXPECT_GT(four.from_cells, 0u);
+  EXPECT_EQ(four.simplices, two.simplices);
+  // A lattice's ties make insertion twice as slow: it stays with the cells.
+  const std::vector<double> lattice = grid3(30);
+  const tessera::Delaunay ties = triangulate(lattice, tessera::DelaunayMethod::automatic, 2);
+  EXPECT_EQ(ties.from_insertion, 0u);
+  EXPECT_GT(ties.from_cells, 0u);
 }
 
 TEST(Insertion, AutomaticChoiceTakesItWhereTheCellsPassWouldStall) {
