@@ -28,13 +28,20 @@ using kernels::ExactContext;
 
 constexpr std::int32_t infinite = -1;  ///< the vertex every ghost tetrahedron shares
 
-/// A tetrahedron: vertices, and for each k the tetrahedron across the face
-/// opposite v[k]. Finite ones are positively oriented; a ghost (one vertex
-/// infinite) is oriented as if that vertex were a point beyond its facet.
+/// A tetrahedron: vertices, and for each k what lies across the face
+/// opposite v[k]: 4 u + m for the tetrahedron u whose face m it is (so the
+/// way back needs no search). Finite ones are positively oriented; a ghost
+/// (one vertex infinite) is oriented as if that vertex were a point beyond
+/// its facet.
 struct Tet {
   std::int32_t v[4];
   std::int32_t n[4];
 };
+
+/// Tetrahedron u's face m, as Tet::n holds it; and back.
+inline std::int32_t across(std::int32_t u, int m) { return 4 * u + m; }
+inline std::int32_t tet_of(std::int32_t a) { return a >> 2; }
+inline int face_of(std::int32_t a) { return a & 3; }
 
 int infinite_slot(const Tet& t) {
   for (int k = 0; k < 4; ++k)
@@ -176,7 +183,8 @@ class TetStore {
   void reserve(std::size_t extra) {
     const std::size_t need = size() + extra;
     if (need <= cap_) return;
-    const std::size_t cap = std::max(need, 2 * cap_);
+    const std::size_t cap = std::min(std::max(need, 2 * cap_), max_slots);
+    if (need > max_slots) throw std::length_error("tessera: insertion: more tetrahedra than Tet::n can number (about 75 million points)");
     std::unique_ptr<Tet[]> t(new Tet[cap]);
     std::unique_ptr<std::uint32_t[]> s(new std::uint32_t[cap]);
     // memcpy: claimed slots not yet written hold indeterminate bytes.
@@ -200,6 +208,7 @@ class TetStore {
   std::unique_ptr<std::uint32_t[]> state_;  // (epoch << 1) | in conflict
   std::size_t cap_ = 0;
   std::atomic<std::size_t> size_{0};
+  static constexpr std::size_t max_slots = std::size_t{1} << 29;  // across() fits in int32
 };
 
 /// What one thread of insertion keeps: its partition, its conflict-mark
@@ -218,7 +227,7 @@ struct Worker {
     std::int32_t v[4];  // the new tetrahedron's vertices (q at k)
     int k;
     std::int32_t outside;  // the tetrahedron across the face, not in conflict
-    int back;              // its slot pointing at the cavity
+    int back;              // its face towards the cavity
   };
   struct Edge {
     std::uint64_t key = 0;
@@ -273,7 +282,7 @@ class Triangulation {
         for (int b = 0; b < 5; ++b) {
           if (a == b) continue;
           for (int kb = 0; kb < 4; ++kb)
-            if (same_face(tets[a], ka, tets[b], kb)) tets[a].n[ka] = static_cast<std::int32_t>(first) + b;
+            if (same_face(tets[a], ka, tets[b], kb)) tets[a].n[ka] = across(static_cast<std::int32_t>(first) + b, kb);
         }
     }
     hint_ = static_cast<std::int32_t>(first);
@@ -446,11 +455,11 @@ class Triangulation {
       // The four neighbours' marks and vertices are read below one after
       // the other: ask for all of them first, so their misses overlap.
       for (int k = 0; k < 4; ++k) {
-        __builtin_prefetch(state + tets[t].n[k]);
-        __builtin_prefetch(tets + tets[t].n[k]);
+        __builtin_prefetch(state + tet_of(tets[t].n[k]));
+        __builtin_prefetch(tets + tet_of(tets[t].n[k]));
       }
       for (int k = 0; k < 4; ++k) {
-        const std::int32_t u = tets[t].n[k];
+        const std::int32_t u = tet_of(tets[t].n[k]);
         bool in;
         if ((state[u] | 1) == mark_in) {
           in = state[u] & 1;
@@ -470,7 +479,7 @@ class Triangulation {
         f.v[k] = q;
         f.k = k;
         f.outside = u;
-        f.back = back_slot(u, t);
+        f.back = face_of(tets[t].n[k]);
         w.boundary.push_back(f);
       }
     }
@@ -499,8 +508,8 @@ class Triangulation {
         // boundary, so each keeps a live one.
         if (f.v[m] != infinite) vtet_[static_cast<std::size_t>(f.v[m])] = nt;
       }
-      t.n[f.k] = f.outside;
-      tets[f.outside].n[f.back] = nt;
+      t.n[f.k] = across(f.outside, f.back);
+      tets[f.outside].n[f.back] = across(nt, f.k);
       for (int j = 0; j < 4; ++j) {
         if (j == f.k) continue;
         std::int32_t a = infinite, b = infinite;
@@ -522,8 +531,8 @@ class Triangulation {
             break;
           }
           if (e.key == key) {
-            t.n[j] = e.tet;
-            tets[e.tet].n[e.slot] = nt;
+            t.n[j] = across(e.tet, e.slot);
+            tets[e.tet].n[e.slot] = across(nt, j);
             e.key = ~std::uint64_t{0};  // matched: keep the probe chain, never match again
             break;
           }
@@ -615,13 +624,6 @@ class Triangulation {
     return std::equal(fa, fa + 3, fb);
   }
 
-  int back_slot(std::int32_t u, std::int32_t t) const {
-    const Tet& tu = store_.tets()[u];
-    for (int m = 0; m < 4; ++m)
-      if (tu.n[m] == t) return m;
-    throw std::logic_error("tessera: insertion: one-sided adjacency");
-  }
-
   /// Is q strictly inside t's (perturbed) circumsphere? For a ghost: is q
   /// beyond its facet, or on the facet's plane within its circumcircle?
   bool conflicts(std::int32_t ti, std::int32_t q) const {
@@ -631,7 +633,7 @@ class Triangulation {
     std::int32_t ids[4] = {t.v[0], t.v[1], t.v[2], t.v[3]};
     ids[inf] = q;
     if (const int o = orientation(ids); o != 0) return o > 0;
-    return in_sphere(store_.tets()[t.n[inf]], q);
+    return in_sphere(store_.tets()[tet_of(t.n[inf])], q);
   }
 
   const double* at(std::int32_t k) const { return coords_.data() + static_cast<std::size_t>(k) * 3; }
@@ -662,7 +664,7 @@ class Triangulation {
     const Tet* const tets = store_.tets();
     std::int32_t t = from, came_from = -1;
     if (const int inf = infinite_slot(tets[t]); inf != 4) {
-      t = tets[t].n[inf];
+      t = tet_of(tets[t].n[inf]);
       if (Check && !owned(tets[t], w.part)) return -1;
     }
     for (;;) {
@@ -673,11 +675,11 @@ class Triangulation {
       std::int32_t next = -1;
       for (int i = 0; i < 4; ++i) {
         const int k = (first + i) & 3;
-        if (tt.n[k] == came_from) continue;  // q lies on this side of the face just crossed
+        if (tet_of(tt.n[k]) == came_from) continue;  // q lies on this side of the face just crossed
         std::int32_t ids[4] = {tt.v[0], tt.v[1], tt.v[2], tt.v[3]};
         ids[k] = q;
         if (orientation(ids) < 0) {
-          next = tt.n[k];
+          next = tet_of(tt.n[k]);
           break;
         }
       }
