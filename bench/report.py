@@ -349,8 +349,9 @@ def delaunay_section(w, meta, dd, g, t1, t2):
     NA = "n/a"
     w("## Delaunay: Tessera vs CGAL 5.5.1 and Gmsh 4.8.4 HXT")
     w("")
-    w("Tessera: `tessera bench delaunay` (the `tessera::delaunay` call: tetrahedra / triangles from the "
-      "cells, plus hull completion). CGAL: `Delaunay_triangulation_3` range constructor (sequential, and "
+    w("Tessera: `tessera bench delaunay` (the `tessera::delaunay` call with its automatic method: "
+      "tetrahedra / triangles from the cells plus hull completion, or in 3D by incremental insertion "
+      "where the method chooses it; the table below says which). CGAL: `Delaunay_triangulation_3` range constructor (sequential, and "
       "`Parallel_tag` with TBB), `Delaunay_triangulation_2` in 2D (sequential only). HXT: Gmsh's "
       "`tetrahedralize` with `Mesh.Algorithm3D = 10` (OpenMP). All three return the Delaunay "
       "triangulation of the convex hull. Seconds (wall); ratio = peer seconds / Tessera seconds at the "
