@@ -154,9 +154,11 @@ int main(int argc, char** argv) {
                   "and 0.3 to 0.6 on clustered ones; else 0. Ignored with labels or --no-hull-completion")
       ->check(CLI::Range(0.0, 0.99));
   del->add_option("--method", dla.method,
-                  "cells: the cells pass and hull completion; insertion: serial incremental insertion (3D without "
-                  "labels); auto: the cells, unless a sample of them costs far more than it finds (3D points "
-                  "sampled on surfaces, from 20,000 points, without --skip-cells): then insertion. Same result")
+                  "cells: the cells pass and hull completion; insertion: incremental insertion, parallel by "
+                  "phases (3D without labels); auto (3D without labels or --skip-cells): insertion below 20,000 "
+                  "points, and from there where a sample of cells costs far more than it finds (surface samples) "
+                  "or, on 1-2 threads, meets no ties (uniform points), or where hull completion stalls; else the "
+                  "cells (lattices). Same result")
       ->check(CLI::IsMember({"auto", "cells", "insertion"}))
       ->capture_default_str();
   del->add_flag("--validate", dla.validate,

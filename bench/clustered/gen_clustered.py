@@ -20,6 +20,16 @@ the object or to the domain box):
   ellipsoid  uniform in the parameters of an ellipsoid of semi-axes 1, 0.7, 0.4.
   torus      a torus of radii 1 and 0.35 (a tube: its inner cells' petals
              touch the surface along whole circles, the hardest case).
+
+Near-degenerate sets (ties to within rounding everywhere; docs/design.md,
+"Stalls, ties and the automatic method"): N is rounded to a cube k^3.
+  latrot     the k^3 integer lattice rotated by 0.3 rad about z, then 0.7 rad
+             about x (a crystal in lab coordinates: every hull face and every
+             cube of neighbours coplanar or cospherical to within rounding).
+  latjit     the k^3 integer lattice, each coordinate moved by up to 1e-9
+             (a lattice with float noise).
+  sphere     N points uniform on the unit sphere (every point on the hull,
+             all nearly cospherical with the centre).
 """
 import argparse
 
@@ -72,7 +82,30 @@ def torus(rng, n):
     return np.column_stack([ring * np.cos(a), ring * np.sin(a), 0.35 * np.sin(b)])
 
 
-KINDS = {"blobs": blobs, "sheet": sheet, "hier": hier, "terrain": terrain, "ellipsoid": ellipsoid, "torus": torus}
+def _lattice(n):
+    k = max(2, round(n ** (1 / 3)))
+    return np.stack(np.meshgrid(*[np.arange(k, dtype=float)] * 3, indexing="ij"), -1).reshape(-1, 3)
+
+
+def latrot(rng, n):
+    a, b = 0.3, 0.7
+    rz = np.array([[np.cos(a), -np.sin(a), 0], [np.sin(a), np.cos(a), 0], [0, 0, 1]])
+    rx = np.array([[1, 0, 0], [0, np.cos(b), -np.sin(b)], [0, np.sin(b), np.cos(b)]])
+    return _lattice(n) @ (rz @ rx).T
+
+
+def latjit(rng, n):
+    g = _lattice(n)
+    return g + rng.uniform(-1e-9, 1e-9, g.shape)
+
+
+def sphere(rng, n):
+    p = rng.normal(size=(n, 3))
+    return p / np.linalg.norm(p, axis=1)[:, None]
+
+
+KINDS = {"blobs": blobs, "sheet": sheet, "hier": hier, "terrain": terrain, "ellipsoid": ellipsoid, "torus": torus,
+         "latrot": latrot, "latjit": latjit, "sphere": sphere}
 
 
 def main():

@@ -255,10 +255,13 @@ def delaunay(
         hull exactly (as scipy's). Ignored with labels.
     method : {"auto", "cells", "insertion"}
         How the simplices are built; the result is the same. ``"cells"``: the
-        parallel cells pass and hull completion. ``"insertion"``: serial
-        incremental insertion (3D, no labels, ``complete_hull``). ``"auto"``:
-        the cells, unless a sample of them costs far more than it finds (3D
-        points sampled on surfaces, from 20,000 points): then insertion.
+        parallel cells pass and hull completion. ``"insertion"``: incremental
+        insertion, parallel by phases (3D, no labels, ``complete_hull``).
+        ``"auto"`` (3D, no labels): insertion below 20,000 points, and from
+        there where a sample of cells costs far more than it finds (surface
+        samples) or, on one or two threads, meets no ties (uniform points),
+        or where hull completion stalls (rotated lattices); else the cells
+        (lattices).
 
     Exact predicates and a symbolic perturbation decide every simplex, so
     degenerate input (lattices, cospherical points) gets a valid triangulation
