@@ -27,9 +27,10 @@ enum class DelaunayMethod {
   /// insertion below 20,000 points. From there a pilot builds a few
   /// hundred cells; insertion is chosen where they cost far more than the
   /// simplices they find (surface samples, clustered volumes, points nearly
-  /// on a sphere) and, on one or two threads, where they met no ties (no
-  /// exact evaluations: uniform and jittered points). The rest (lattices,
-  /// whose ties make insertion slower) goes to the cells pass, which hands
+  /// on a sphere) and, on one or two threads, where they met no exact ties
+  /// (uniform, jittered, rotated points: ties need coordinates on a grid).
+  /// The rest (lattices, whose ties make insertion slower) goes to the
+  /// cells pass, which hands
   /// over to insertion if hull completion runs past its budget
   /// (near-coplanar hull faces: a rotated lattice). Otherwise the cells
   /// pass. Every path gives the same rows.

@@ -425,7 +425,7 @@ inline double insertion_ratio(int threads) { return 1.6 * std::sqrt(std::max(thr
 inline constexpr std::uint64_t completion_budget = 64;
 
 /// Below this many exact evaluations per pilot cell an input has no ties to
-/// speak of (PilotEstimate::exact_per_cell).
+/// speak of (PilotEstimate::exact_per_cell; lattices ~53).
 inline constexpr double clean_exact_per_cell = 1.0;
 
 // The triangulation by insertion (front/insertion.hpp) of the located
@@ -488,15 +488,21 @@ Delaunay run(std::span<const double> input, std::span<const std::int32_t> labels
     // such points took 4.1 s, 0.13 s by insertion); 10,000 uniform points
     // take 0.029 s against 0.042 s, a 20^3 lattice 0.037 s against 0.028.
     const bool small = may_insert && complete && opt.skip_cells < 0 && n < pilot_min_points;
-    // On one or two threads, inputs without ties (the pilot's cells met
-    // next to no exact evaluations) go to insertion too: 1M uniform points
-    // 2.47 against 2.55 s on two threads, 4.34 against 4.81 s on one; a 1M
-    // fractal hierarchy 2.79 against 2.71 s; a 60^3 lattice jittered by
-    // 1e-9, whose near-coplanar hull makes completion stall, 0.60 against
-    // 2.0 s (cells, then insertion past completion_budget). Lattices, whose
-    // ties make insertion twice as slow, stay with the cells. Beyond two
-    // threads the cells scale better (a model; this machine has two cores).
-    const bool clean = estimate.exact_per_cell < clean_exact_per_cell && pass.engine_options.threads <= 2;
+    // On one or two threads, inputs without exact ties go to insertion too:
+    // 1M uniform points 2.47 against 2.55 s on two threads, 4.34 against
+    // 4.81 s on one; a 1M fractal hierarchy 2.79 against 2.71 s; a 60^3
+    // lattice jittered by 1e-9, whose near-coplanar hull makes completion
+    // stall, 0.60 against 2.0 s (cells, then insertion past
+    // completion_budget). Exact ties need both many exact evaluations in
+    // the pilot's cells and coordinates on a grid (make_grid): a 60^3
+    // lattice, or one offset by 1e6, takes 0.55 s by the cells and 1.16 s
+    // by insertion, whose every in-sphere test is then a tie; the same
+    // lattice rotated, or scaled by 0.1, is off any grid, its near-ties
+    // settled by the extended filter: 1.29 s and 2.54 s by insertion,
+    // minutes and 4.49 s by the cells. Beyond two threads the cells scale
+    // better (a model; this machine has two cores).
+    const bool ties = estimate.exact_per_cell >= clean_exact_per_cell && pass.exact.grid != nullptr;
+    const bool clean = !ties && pass.engine_options.threads <= 2;
     const bool insert = opt.method == DelaunayMethod::insertion || small ||
                         (may_insert && pilot && (estimate.ratio >= insert_from || clean));
     if (insert && complete && attempt == 0) return by_insertion(pass, std::move(out));

@@ -286,11 +286,11 @@ TEST(Insertion, AutomaticChoiceTakesItWhereTheCellsPassWouldStall) {
   const tessera::Delaunay on_sphere = triangulate(sphere, tessera::DelaunayMethod::automatic);
   EXPECT_EQ(on_sphere.from_insertion, on_sphere.n_simplices());
   expect_valid(on_sphere, sphere, "sphere");
-  // A rotated 28^3 lattice: its cells are cheap and the pilot keeps them,
-  // but its hull faces are coplanar to within rounding, and each of
-  // completion's wraps scans a whole face, most of it exactly (a 20^3 one
-  // took 8 s). Completion stops at its budget (completion_budget) and
-  // insertion builds the rows.
+  // A rotated 28^3 lattice: its hull faces are coplanar to within rounding,
+  // and each of completion's wraps scans a whole face, most of it exactly
+  // (a 20^3 one took 8 s). On two threads the pilot sends it to insertion
+  // (near-ties off any grid); on four it keeps the cells, and completion
+  // stops at its budget (completion_budget) and hands over to insertion.
   std::vector<double> lattice;
   const double a = 0.3, b = 0.7;
   for (int i = 0; i < 28; ++i)
@@ -299,10 +299,11 @@ TEST(Insertion, AutomaticChoiceTakesItWhereTheCellsPassWouldStall) {
         const double x = std::cos(a) * i - std::sin(a) * j, y = std::sin(a) * i + std::cos(a) * j;
         lattice.insert(lattice.end(), {x, std::cos(b) * y - std::sin(b) * k, std::sin(b) * y + std::cos(b) * k});
       }
-  const tessera::Delaunay rotated = triangulate(lattice, tessera::DelaunayMethod::automatic);
+  const tessera::Delaunay rotated = triangulate(lattice, tessera::DelaunayMethod::automatic, 4);
   EXPECT_EQ(rotated.from_insertion, rotated.n_simplices());
   EXPECT_EQ(rotated.from_cells, 0u);
   expect_valid(rotated, lattice, "rotated lattice");
+  EXPECT_EQ(triangulate(lattice, tessera::DelaunayMethod::automatic, 2).simplices, rotated.simplices);
 }
 
 }  // namespace
