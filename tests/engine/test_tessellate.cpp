@@ -2,10 +2,12 @@
 // compositor of our own (the public extension point, as in
 // examples/volume_sum): cells do not depend on where their generator's
 // coordinates are read from (Generators::slots or the input order) nor on
-// the thread count, and a malformed Generators is refused.
+// the thread count, a malformed Generators is refused, and a work cap
+// abandons the costly cells only.
 #include <gtest/gtest.h>
 
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <random>
 #include <span>
@@ -123,6 +125,75 @@ TEST(Tessellate, SlotsOfTheWrongLengthAreRefused) {
   gens.exact = &scene.exact;
   Record<kernels::Hull> rec;
   EXPECT_THROW(tessera::engine::tessellate<kernels::Hull>(gens, rec, {}), std::invalid_argument);
+}
+
+// How many cells a pass abandons at EngineOptions::work_cap, and how many it
+// builds.
+struct CapCount {
+  struct Batch {
+    std::size_t capped = 0, built = 0;
+  };
+  std::size_t capped = 0, built = 0;
+  void add(Batch& b, std::int32_t, const kernels::BuildStatus& st, kernels::Hull&) {
+    b.capped += st.capped;
+    b.built += st.has_cell;
+    if (st.capped) EXPECT_FALSE(st.has_cell);
+  }
+  void finish(std::span<Batch> batches) {
+    for (const Batch& b : batches) {
+      capped += b.capped;
+      built += b.built;
+    }
+  }
+};
+
+CapCount run_capped(std::vector<double>& points, double box, std::uint64_t cap) {
+  const std::array<double, 3> lo{-box, -box, -box}, hi{box, box, box};
+  kernels::ExactContext exact;
+  exact.points = points.data();
+  exact.dim = 3;
+  exact.lo = lo;
+  exact.hi = hi;
+  kernels::BinLocator<3> locator(points, {}, lo, hi, 2.0);
+  std::vector<std::int32_t> order(locator.size());
+  for (std::size_t k = 0; k < locator.size(); ++k) order[k] = locator.id(k);
+  tessera::engine::Generators<3> gens;
+  gens.coords = points.data();
+  gens.locator = &locator;
+  gens.lo = lo;
+  gens.hi = hi;
+  gens.order = order;
+  gens.exact = &exact;
+  tessera::engine::EngineOptions opt;
+  opt.threads = 2;
+  opt.work_cap = cap;
+  CapCount count;
+  tessera::engine::tessellate<kernels::Hull>(gens, count, opt);
+  return count;
+}
+
+TEST(Tessellate, WorkCapAbandonsOnlyCostlyCells) {
+  // Uniform cells do ~300 units of work (BuildStatus::work): a cap of 64
+  // times that abandons none, a cap of 10 every one.
+  std::mt19937_64 rng(8);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::vector<double> uniform(3 * 2000);
+  for (double& x : uniform) x = u(rng);
+  const CapCount loose = run_capped(uniform, 1.0, 64 * 307);
+  EXPECT_EQ(loose.capped, 0u);
+  EXPECT_EQ(loose.built, 2000u);
+  const CapCount tight = run_capped(uniform, 1.0, 10);
+  EXPECT_EQ(tight.capped, 2000u);
+  // Points on one sphere: every cell reaches the centre and tests every
+  // point there (the pilot's stall, delaunay.cpp's pilot_work_cap).
+  std::normal_distribution<double> g;
+  std::vector<double> sphere;
+  for (int i = 0; i < 3000; ++i) {
+    const double x = g(rng), y = g(rng), z = g(rng), r = std::sqrt(x * x + y * y + z * z);
+    sphere.insert(sphere.end(), {x / r, y / r, z / r});
+  }
+  const CapCount stalled = run_capped(sphere, 1.1, 64 * 307);
+  EXPECT_GT(stalled.capped, 2900u);
 }
 
 }  // namespace
