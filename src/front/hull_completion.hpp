@@ -68,8 +68,7 @@ class HullCompletion {
 
   /// Stop once the wraps have done more than `work` in all, counting each
   /// candidate considered once and each side test that needs the exact
-  /// orientation (in rationals: ~100 times a float test) exact_weight
-  /// times: run() then returns what it has, and over_budget() says so. The
+  /// orientation (tens of times a float test) exact_weight times: run() then returns what it has, and over_budget() says so. The
   /// wraps consider a few candidates per input point on most inputs (1.6 at
   /// 1M uniform points, 5.5 on the benchmark's clustered set), with next to
   /// no exact tests; near-coplanar hull faces (a rotated or slightly
