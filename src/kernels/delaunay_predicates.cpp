@@ -166,34 +166,14 @@ int in_sphere_filter(int D, const double* pa, const double* const* p, T unit, T 
       s[k] += r[k][d] * r[k][d];
     }
   }
-  // The determinant of rows `rows` of r, and its permanent (for the bound).
-  auto det_perm_of = [&](const int* rows, T& perm) -> T {
-    const T* r0 = r[rows[0]];
-    const T* r1 = r[rows[1]];
-    if (D == 2) {
-      const T x = r0[0] * r1[1], y = r0[1] * r1[0];
-      perm = std::fabs(x) + std::fabs(y);
-      return x - y;
-    }
-    const T* r2 = r[rows[2]];
-    T det = 0;
-    perm = 0;
-    for (int d = 0; d < 3; ++d) {
-      const int d1 = (d + 1) % 3, d2 = (d + 2) % 3;
-      const T x = r1[d1] * r2[d2], y = r1[d2] * r2[d1];
-      det += r0[d] * (x - y);
-      perm += std::fabs(r0[d]) * (std::fabs(x) + std::fabs(y));
-    }
-    return det;
-  };
   // det R (rows 0..D-1) and the full determinant by expansion along the s column.
   T det_r = 0, perm_r = 0, det_m = 0, perm_m = 0;
   for (int k = 0; k <= D; ++k) {
-    int rows[3] = {0, 0, 0}, m = 0;
-    for (int j = 0; j <= D; ++j)
+    int rows[3] = {0, 0, 0};
+    for (int j = 0, m = 0; j <= D; ++j)
       if (j != k) rows[m++] = j;
     T pm;
-    const T dm = det_perm_of(rows, pm);
+    const T dm = det_perm(r[rows[0]], r[rows[1]], r[rows[2]], D, pm);
     if (k == D) {
       det_r = dm;
       perm_r = pm;

@@ -53,6 +53,21 @@ struct Record {
   }
 };
 
+// A pass over every point of `locator`, in its bin order.
+template <int D>
+tessera::engine::Generators<D> generators(const std::vector<double>& points, const kernels::BinLocator<D>& locator,
+                                          const std::array<double, D>& lo, const std::array<double, D>& hi,
+                                          std::span<const std::int32_t> order, const kernels::ExactContext& exact) {
+  tessera::engine::Generators<D> gens;
+  gens.coords = points.data();
+  gens.locator = &locator;
+  gens.lo = lo;
+  gens.hi = hi;
+  gens.order = order;
+  gens.exact = &exact;
+  return gens;
+}
+
 template <class CellT>
 struct Scene {
   static constexpr int D = CellT::dim;
@@ -81,14 +96,8 @@ struct Scene {
       order[k] = locator.id(k);
       slots[k] = static_cast<std::uint32_t>(k);
     }
-    tessera::engine::Generators<D> gens;
-    gens.coords = points.data();
-    gens.locator = &locator;
-    gens.lo = lo;
-    gens.hi = hi;
-    gens.order = order;
+    tessera::engine::Generators<D> gens = generators<D>(points, locator, lo, hi, order, exact);
     if (with_slots) gens.slots = slots;
-    gens.exact = &exact;
     tessera::engine::EngineOptions opt;
     opt.threads = threads;
     Record<CellT> rec;
@@ -116,13 +125,8 @@ TEST(Tessellate, SlotsOfTheWrongLengthAreRefused) {
   std::vector<std::int32_t> order(locator.size());
   for (std::size_t k = 0; k < locator.size(); ++k) order[k] = locator.id(k);
   std::vector<std::uint32_t> slots(order.size() - 1, 0);
-  tessera::engine::Generators<3> gens;
-  gens.coords = scene.points.data();
-  gens.locator = &locator;
-  gens.hi = scene.hi;
-  gens.order = order;
+  tessera::engine::Generators<3> gens = generators<3>(scene.points, locator, scene.lo, scene.hi, order, scene.exact);
   gens.slots = slots;
-  gens.exact = &scene.exact;
   Record<kernels::Hull> rec;
   EXPECT_THROW(tessera::engine::tessellate<kernels::Hull>(gens, rec, {}), std::invalid_argument);
 }
@@ -157,13 +161,7 @@ CapCount run_capped(std::vector<double>& points, double box, std::uint64_t cap) 
   kernels::BinLocator<3> locator(points, {}, lo, hi, 2.0);
   std::vector<std::int32_t> order(locator.size());
   for (std::size_t k = 0; k < locator.size(); ++k) order[k] = locator.id(k);
-  tessera::engine::Generators<3> gens;
-  gens.coords = points.data();
-  gens.locator = &locator;
-  gens.lo = lo;
-  gens.hi = hi;
-  gens.order = order;
-  gens.exact = &exact;
+  const tessera::engine::Generators<3> gens = generators<3>(points, locator, lo, hi, order, exact);
   tessera::engine::EngineOptions opt;
   opt.threads = 2;
   opt.work_cap = cap;

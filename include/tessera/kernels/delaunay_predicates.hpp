@@ -19,22 +19,27 @@
 namespace tessera::kernels {
 
 namespace detail {
-/// det of the D x D matrix of rows and its permanent (for the error bound).
-inline double det_perm(const double (*r)[3], int dim, double& perm) {
+/// det of the D x D matrix of rows r0, r1 (and r2 in 3D) and its permanent
+/// (for the error bound), in the arithmetic T of the rows (double, or long
+/// double for the in-sphere test's second filter).
+template <class T>
+inline T det_perm(const T* r0, const T* r1, const T* r2, int dim, T& perm) {
+  using std::fabs;
   if (dim == 2) {
-    double a = r[0][0] * r[1][1], b = r[0][1] * r[1][0];
-    perm = std::fabs(a) + std::fabs(b);
+    const T a = r0[0] * r1[1], b = r0[1] * r1[0];
+    perm = fabs(a) + fabs(b);
     return a - b;
   }
-  double c0 = r[1][1] * r[2][2] - r[1][2] * r[2][1];
-  double c1 = r[1][2] * r[2][0] - r[1][0] * r[2][2];
-  double c2 = r[1][0] * r[2][1] - r[1][1] * r[2][0];
-  double p0 = std::fabs(r[1][1] * r[2][2]) + std::fabs(r[1][2] * r[2][1]);
-  double p1 = std::fabs(r[1][2] * r[2][0]) + std::fabs(r[1][0] * r[2][2]);
-  double p2 = std::fabs(r[1][0] * r[2][1]) + std::fabs(r[1][1] * r[2][0]);
-  perm = std::fabs(r[0][0]) * p0 + std::fabs(r[0][1]) * p1 + std::fabs(r[0][2]) * p2;
-  return r[0][0] * c0 + r[0][1] * c1 + r[0][2] * c2;
+  const T c0 = r1[1] * r2[2] - r1[2] * r2[1];
+  const T c1 = r1[2] * r2[0] - r1[0] * r2[2];
+  const T c2 = r1[0] * r2[1] - r1[1] * r2[0];
+  const T p0 = fabs(r1[1] * r2[2]) + fabs(r1[2] * r2[1]);
+  const T p1 = fabs(r1[2] * r2[0]) + fabs(r1[0] * r2[2]);
+  const T p2 = fabs(r1[0] * r2[1]) + fabs(r1[1] * r2[0]);
+  perm = fabs(r0[0]) * p0 + fabs(r0[1]) * p1 + fabs(r0[2]) * p2;
+  return r0[0] * c0 + r0[1] * c1 + r0[2] * c2;
 }
+inline double det_perm(const double (*r)[3], int dim, double& perm) { return det_perm(r[0], r[1], r[2], dim, perm); }
 }  // namespace detail
 
 /// The float filter of `orientation`: rows[k] = p_{k+1} - p_0, each
