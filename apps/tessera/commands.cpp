@@ -165,6 +165,10 @@ VoronoiOptions make_options(const ComputeArgs& a, int dim) {
   o.ignore_outside_points = a.ignore_outside;
   o.threads = a.threads;
   o.points_per_bin = a.bin_points;
+  // CLI11 admits only these three (add_cell_method_option).
+  o.cell_method = a.cell_method == "search"      ? CellMethod::search
+                  : a.cell_method == "insertion" ? CellMethod::insertion
+                                                 : CellMethod::automatic;
   return o;
 }
 
@@ -254,13 +258,16 @@ void print_summary(const VoronoiArgs& a, const io::PointCloud& pc, const Cells& 
   print_volume_line(c, d3 ? "volume sum" : "area sum");
   std::printf("  %-18s %.3f s on %d thread%s (read %.3f s, write %.3f s)\n", "compute", compute_s,
               c.threads_used, c.threads_used == 1 ? "" : "s", read_s, write_s);
+  if (c.from_insertion)
+    std::printf("  %-18s %s\n", "method", "insertion (each cell clipped by its Delaunay neighbours)");
   // Lattices tie often but cheaply (tens of exact calls per cell, on the
   // integer path); thousands per cell mean a many-fold near-degenerate vertex
-  // (points on one sphere: docs/design.md, known limits): quadratic work.
+  // (points on one sphere, searched with --method search: docs/design.md,
+  // "Cells from Delaunay neighbours"): quadratic work.
   const bool tie_heavy = c.exact_predicate_calls > 1000 * static_cast<std::uint64_t>(c.n_cells());
   std::printf("  %-18s %llu%s\n", "exact predicates", static_cast<unsigned long long>(c.exact_predicate_calls),
               tie_heavy ? " (over 1000 per cell: near-degenerate input, e.g. points on one sphere; "
-                          "`tessera joggle` removes such ties)"
+                          "`--method insertion` avoids the search, `tessera joggle` removes such ties)"
                         : "");
   std::string out;
   for (const auto& w : written) out += (out.empty() ? "" : ", ") + w;
@@ -375,9 +382,9 @@ int run_bench_voronoi(const BenchArgs& a) {
     std::printf(
         "{\"tool\":\"tessera\",\"op\":\"%s\",\"n\":%zu,\"threads\":%d,\"seconds\":%.6f,\"simplices\":%zu,"
         "\"extra\":{\"cpu_user_s\":%.6f,\"cpu_sys_s\":%.6f,\"minflt\":%lld,\"peak_rss_bytes\":%lld,"
-        "\"neighbors\":%zu,\"exact_calls\":%llu,\"volume_sum\":%.17g,\"repeat\":%d}}\n",
+        "\"neighbors\":%zu,\"from_insertion\":%s,\"exact_calls\":%llu,\"volume_sum\":%.17g,\"repeat\":%d}}\n",
         op, pc.n, cells.threads_used, secs, cells.n_cells(), u1.user_s - u0.user_s, u1.sys_s - u0.sys_s,
-        u1.minflt - u0.minflt, u1.maxrss_bytes, cells.neighbors.size(),
+        u1.minflt - u0.minflt, u1.maxrss_bytes, cells.neighbors.size(), cells.from_insertion ? "true" : "false",
         static_cast<unsigned long long>(cells.exact_predicate_calls), accurate_sum(cells.volume), rep);
     std::fflush(stdout);
   }

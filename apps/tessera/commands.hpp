@@ -36,6 +36,7 @@ struct ComputeArgs {
   bool ignore_outside = false;
   int threads = 0;              ///< 0: TESSERA_NUM_THREADS, else all cores
   double bin_points = 0;        ///< 0: automatic
+  std::string cell_method = "auto";  ///< auto | search | insertion (voronoi only; add_cell_method_option)
 };
 
 struct VoronoiArgs {

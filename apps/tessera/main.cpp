@@ -75,6 +75,18 @@ void add_compute_options(CLI::App* app, ComputeArgs& c, std::vector<std::string>
       ->check(NonNegative);
 }
 
+/// --method of the commands whose product is the cells themselves.
+void add_cell_method_option(CLI::App* app, ComputeArgs& c) {
+  app->add_option("--method", c.cell_method,
+                  "How each 3D cell finds the points that clip it. search: the bins around it (the meshless "
+                  "method); insertion: its Delaunay neighbours, from incremental insertion (faster where cells "
+                  "reach far: points nearly on a sphere, surface samples, dense clusters); auto: insertion below "
+                  "20,000 points and where a sample of cells costs far more than on uniform points, else search. "
+                  "Same cells; 2D always searches")
+      ->check(CLI::IsMember({"auto", "search", "insertion"}))
+      ->capture_default_str();
+}
+
 /// Converts the --bounds words to numbers. A fifth word that is not a number
 /// is the INPUT that CLI11 attached to a 2D --bounds (when INPUT is otherwise
 /// missing). Throws InputError for anything else that is not a number.
@@ -112,6 +124,7 @@ int main(int argc, char** argv) {
   CLI::App* vor = app.add_subcommand("voronoi", "Compute the Voronoi cells of a point cloud and write them");
   std::vector<std::string> vor_bounds, bench_bounds;
   add_compute_options(vor, va.compute, vor_bounds);
+  add_cell_method_option(vor, va.compute);
   vor->add_option("-o,--output", va.output,
                   "Cells as VTK XML: .vtu (3D, one polyhedron per cell) or .vtp (2D, one polygon per cell), "
                   "with cell data GeneratorId, Region, Volume/Area, NumberOfFaces/Edges, NumberOfNeighbors");
@@ -237,9 +250,10 @@ int main(int argc, char** argv) {
       "voronoi",
       "Time tessera::voronoi (cells, volumes and neighbour lists; no mesh, no output files) K times. "
       "Each run prints {\"tool\":\"tessera\",\"op\":\"voronoi3\"|\"voronoi2\",\"n\",\"threads\",\"seconds\","
-      "\"simplices\" (= cells),\"extra\":{cpu_user_s,cpu_sys_s,minflt,peak_rss_bytes,neighbors,exact_calls,"
+      "\"simplices\" (= cells),\"extra\":{cpu_user_s,cpu_sys_s,minflt,peak_rss_bytes,neighbors,from_insertion,exact_calls,"
       "volume_sum,repeat}}; seconds is wall time of the computation only");
   add_compute_options(bench_vor, ba.compute, bench_bounds);
+  add_cell_method_option(bench_vor, ba.compute);
   bench_vor->add_option("--repeat", ba.repeat, "Number of timed runs")
       ->check(Positive)
       ->capture_default_str();

@@ -38,6 +38,19 @@ struct Cancelled : std::runtime_error {
   Cancelled() : std::runtime_error("cancelled") {}
 };
 
+/// How a 3D cell finds the points that clip it (tessera::voronoi).
+enum class CellMethod {
+  /// The search, unless a pilot of a few hundred cells finds them far
+  /// costlier than uniform input's (points nearly on a sphere, surface
+  /// samples, dense clusters), or the input is small: then insertion.
+  automatic,
+  search,     ///< each cell searches the bins around it (the meshless method)
+  /// The neighbours from the Delaunay triangulation by incremental
+  /// insertion; each cell is the box clipped by them alone. 3D only (2D
+  /// searches), and the same cells as the search's.
+  insertion,
+};
+
 struct VoronoiOptions {
   int dim = 3;                          ///< 2 or 3
   std::optional<Bounds> bounds;         ///< explicit domain; default: padded bbox
@@ -46,6 +59,7 @@ struct VoronoiOptions {
   int threads = 0;                      ///< 0: TESSERA_NUM_THREADS, else all cores
   double points_per_bin = 0;            ///< locator bin occupancy; 0 = automatic
   bool build_mesh = true;               ///< merged vertices + per-cell faces (needed for VTK output)
+  CellMethod cell_method = CellMethod::automatic;  ///< tessera::voronoi only (Delaunay has its own)
   /// Called from the calling thread with the fraction done, in [0,1]; may throw
   /// Cancelled to stop the run (the engine stops between batches).
   std::function<void(double)> progress;
@@ -108,6 +122,8 @@ struct Cells {
   std::vector<std::int32_t> ignored_outside_bounds;  ///< with ignore_outside_points
   std::uint64_t exact_predicate_calls = 0;          ///< filter failures resolved exactly
   int threads_used = 1;
+  /// The cells were clipped by Delaunay neighbours from insertion (CellMethod).
+  bool from_insertion = false;
 
   std::size_t n_cells() const { return generator.size(); }
   std::size_t n_vertices() const { return vertex_keys.size() / (dim + 1); }

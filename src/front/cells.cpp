@@ -5,11 +5,14 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <optional>
 #include <string>
 
 #include <tbb/info.h>
 
 #include "cells_compositor.hpp"
+#include "delaunay_neighbours.hpp"
+#include "pilot.hpp"
 #include "pass.hpp"
 #include "tessera/engine/tessellate.hpp"
 #include "tessera/kernels/hull.hpp"
@@ -36,6 +39,13 @@ int resolve_threads(int requested) {
 
 namespace {
 
+/// From this pilot ratio on (front/pilot.hpp: the cells' search work per
+/// Delaunay simplex they find, relative to uniform input), 3D cells are
+/// clipped by their Delaunay neighbours (CellMethod::insertion).
+inline double neighbours_ratio(int threads) { return 2.0 * std::sqrt(std::max(threads, 2) / 2.0); }
+/// The share of the generators the pilot may build: on small inputs too.
+inline constexpr double pilot_share = 0.5;
+
 template <class CellT>
 Cells run(std::span<const double> input, std::span<const std::int32_t> labels, const VoronoiOptions& opt) {
   constexpr int D = CellT::dim;
@@ -50,6 +60,20 @@ Cells run(std::span<const double> input, std::span<const std::int32_t> labels, c
   // Without coincident points, a merged vertex's owner is known while its
   // cell is added, and only owners keep its position (CellsCompositor).
   const bool owners_known = opt.build_mesh && !pass.locator->may_have_coincident();
+  std::optional<engine::NeighbourLists> neighbours;
+  if constexpr (D == 3) {
+    bool insert = opt.cell_method == CellMethod::insertion;
+    if (opt.cell_method == CellMethod::automatic) {
+      const double from = neighbours_ratio(pass.engine_options.threads);
+      const front::PilotEstimate e = front::pilot_estimate<CellT>(pass, from, pilot_share);
+      insert = e.ratio >= from;
+    }
+    if (insert) neighbours = front::delaunay_neighbours(pass);
+    if (neighbours) {
+      pass.gens.neighbours = &*neighbours;
+      out.from_insertion = true;
+    }
+  }
   front::CellsCompositor<CellT> comp(out, labels, opt.build_mesh, owners_known);
   out.exact_predicate_calls = engine::tessellate<CellT>(pass.gens, comp, pass.engine_options);
   std::sort(out.duplicates.begin(), out.duplicates.end());

@@ -24,6 +24,7 @@
 #include "id_hash.hpp"
 #include "insertion.hpp"
 #include "pass.hpp"
+#include "pilot.hpp"
 #include "point_buckets.hpp"
 #include "simplex_facets.hpp"
 #include "tessera/engine/tessellate.hpp"
@@ -33,6 +34,10 @@
 
 namespace tessera {
 namespace {
+
+using front::pilot_estimate;
+using front::pilot_min_points;
+using front::PilotEstimate;
 
 // Whether every point inside the domain lies on one hyperplane (a plane in
 // 3D, a line in 2D), decided exactly. Such input has no simplex at all. It is
@@ -239,162 +244,6 @@ std::vector<std::uint8_t> choose_skipped(const front::Pass<D>& pass, double frac
   return skipped;
 }
 
-// The pilot's compositor: what the cells it is given cost to search
-// (BuildStatus::work) and how many of their vertices are Delaunay simplices
-// (no box plane). The cells themselves are not kept.
-template <class CellT>
-struct PilotCompositor {
-  struct Batch {
-    std::uint64_t cells = 0, work = 0, vertices = 0, found = 0, capped = 0;
-  };
-  Batch total;
-  void add(Batch& b, std::int32_t, const kernels::BuildStatus& st, CellT& cell) {
-    ++b.cells;
-    b.work += st.work;  // a capped cell's counts up to the cap: a lower bound
-    b.capped += st.capped;
-    if (!st.has_cell) return;
-    b.vertices += cell.vertices().size();
-    for (const auto& v : cell.vertices()) {
-      bool found = true;
-      for (int k = 0; k < CellT::dim; ++k) found &= v.p[k] >= CellT::box_planes;
-      b.found += found;
-    }
-  }
-  void finish(std::span<Batch> batches) {
-    for (const Batch& b : batches) {
-      total.cells += b.cells;
-      total.work += b.work;
-      total.vertices += b.vertices;
-      total.found += b.found;
-      total.capped += b.capped;
-    }
-  }
-};
-
-// The automatic fraction of skipped cells (3D; 2D below). Skipping a cell saves its
-// build; what its simplices then cost depends on the others' cells (the
-// simplices of skipped points only are wrapped, each at several times what
-// a cell spends per simplex). So the fraction should grow with what a cell
-// costs per simplex it finds, which differs by two orders between inputs.
-// Measured optima (docs/design.md, "Skipped cells"; the fraction as
-// choose_skipped takes it): 1M uniform points and lattices 0.35-0.4;
-// clustered volumes (the benchmark's clustered 100k, blobs and sheets of
-// 200k: cells 3-4 times a uniform one's search) 0.5-0.6; surface samples
-// (needle cells: the ellipsoid's 8-12 times, the torus's 40-160 times; a
-// terrain's 4-7 times, but nine in ten of its cells' vertices lie on the
-// box, as its simplices' balls reach far outside) 0.9 or more. The rule
-// tau = 0.3 sqrt(cost per found simplex, relative to uniform input),
-// clamped to [0.35, 0.9], fits all of them. The cost is measured, not
-// guessed from the bins (a surface and a set of blobs both leave ~80% of
-// the bins empty): a pilot builds the cells of points spread by their hash
-// (any spatially random sample would do) and counts their search work
-// (BuildStatus::work) and found vertices, both deterministic, so the
-// choice is the same for every thread count and run. It goes in bands of
-// pilot_band cells until pilot_bands are done or the estimate is far past
-// the clamp (costly cells need no more precision). The pilot's cells are
-// built again in the pass: at 1M uniform points that is ~0.2% of the run.
-//
-// In 2D a cell is cheap next to the wraps that would replace it: uniform
-// points want none skipped (1M points: 0.63 s, 0.65 s at 0.2, 0.67 s at
-// 0.35), but clustered ones (200k points in blobs, along curves, along
-// segments: ratios 5.8-7.1) gain 15-25% at 0.45-0.6 (curves 0.50 -> 0.37
-// s). So in 2D nothing is skipped below a ratio of 2, and above it the
-// fraction is 0.2 sqrt(ratio) in [0.3, 0.6].
-inline constexpr std::size_t pilot_min_points = 20000;
-inline constexpr std::size_t pilot_band = 256;
-inline constexpr std::size_t pilot_bands = 4;
-/// A pilot cell is abandoned past this many times a uniform cell's work
-/// (CellBuilder::set_work_cap; the ratio past which insertion is chosen is
-/// 1.6 on two threads). Points nearly on one sphere have cells that all
-/// reach its centre, where every point is nearly cospherical with them:
-/// each cell tests every point, most exactly (200k points: 2.3M exact
-/// evaluations per cell; the pilot's first band alone ran for minutes).
-inline constexpr double pilot_work_cap = 64;
-
-struct SkipRule {
-  /// BuildStatus::work of a uniform cell, on average, with the default two
-  /// points per bin (3D: 307 at 100k and at 1M points, 169 on the 50^3
-  /// lattice; 2D: 81-83 at 200k and 1M).
-  double uniform_work;
-  double off_below;  ///< no skipping below this ratio
-  double slope, lowest, highest;
-};
-inline constexpr SkipRule skip_rule_3d{307.0, 0.0, 0.3, 0.35, 0.9};
-inline constexpr SkipRule skip_rule_2d{82.0, 2.0, 0.2, 0.3, 0.6};
-
-/// The pilot's measure: ratio, the cells' search work per simplex they find
-/// relative to uniform input (infinite when they find none; 1 when too few
-/// points to measure), and the skipped fraction it asks for.
-struct PilotEstimate {
-  double ratio = 1;
-  double fraction = 0;
-  /// Exact predicate evaluations per pilot cell: ~53 on lattices (rotated
-  /// or not), where ties are everywhere; below 0.2 on uniform, clustered
-  /// and jittered input. Infinite when not measured.
-  double exact_per_cell = std::numeric_limits<double>::infinity();
-};
-
-/// `enough`: a ratio at which the caller's choice is made (insertion), so
-/// the pilot stops at the first band that reaches it. A band of a thin
-/// sheet's 1M points costs ~0.16 s, and all four took 0.63 s where the
-/// insertion then took 2.9.
-template <class CellT>
-PilotEstimate pilot_estimate(const front::Pass<CellT::dim>& pass, double enough) {
-  constexpr int D = CellT::dim;
-  constexpr SkipRule rule = D == 3 ? skip_rule_3d : skip_rule_2d;
-  constexpr double slope = rule.slope, lowest = rule.lowest, highest = rule.highest;
-  constexpr double unmeasured = D == 3 ? lowest : 0.0;  // too few points for a pilot
-  if (pass.order.empty()) return {1.0, unmeasured};
-  // Band k: the points whose hash lies in the k-th pilot_band / n of the
-  // range, counted down from the top (n: the generators).
-  const double band = static_cast<double>(pilot_band) / static_cast<double>(pass.order.size());
-  const std::size_t bands = std::min<std::size_t>(pilot_bands, static_cast<std::size_t>((1 - highest) / band));
-  if (bands == 0) return {1.0, unmeasured};
-  // Every band's generators in one scan (bin order kept), with their band.
-  const auto from = static_cast<std::uint64_t>(std::ldexp(1.0 - static_cast<double>(bands) * band, 64));
-  struct Pick {
-    std::int32_t gen;
-    std::uint32_t slot, band;
-  };
-  std::vector<Pick> picks;
-  for (std::size_t g = 0; g < pass.order.size(); ++g)
-    if (const std::uint64_t h = id_hash(pass.order[g]); h >= from)
-      picks.push_back({pass.order[g], pass.slots[g],
-                       std::min(static_cast<std::uint32_t>(bands - 1),
-                                static_cast<std::uint32_t>((1.0 - std::ldexp(static_cast<double>(h), -64)) / band))});
-  PilotCompositor<CellT> comp;
-  double ratio = 1;
-  std::uint64_t exact = 0;
-  auto estimate = [&](double r, double fraction) {
-    return PilotEstimate{r, fraction, static_cast<double>(exact) / static_cast<double>(std::max<std::uint64_t>(comp.total.cells, 1))};
-  };
-  for (std::size_t k = 0; k < bands; ++k) {
-    std::vector<std::int32_t> order;
-    std::vector<std::uint32_t> slots;
-    for (const Pick& pk : picks)
-      if (pk.band == k) {
-        order.push_back(pk.gen);
-        slots.push_back(pk.slot);
-      }
-    engine::Generators<CellT::dim> gens = pass.gens;
-    gens.order = order;
-    gens.slots = slots;
-    engine::EngineOptions eo = pass.engine_options;
-    eo.progress = nullptr;
-    eo.batch_size = 16;  // a band of 256 cells in 16 batches, shared among the threads
-    eo.work_cap = static_cast<std::uint64_t>(pilot_work_cap * rule.uniform_work);
-    exact += engine::tessellate<CellT>(gens, comp, eo);
-    const auto& t = comp.total;
-    if (t.vertices == 0 && t.capped == 0) continue;  // no cell yet (duplicates only)
-    // None found: all comes from completion, or every cell was abandoned.
-    if (t.found == 0) return estimate(std::numeric_limits<double>::infinity(), highest);
-    const double work = static_cast<double>(t.work) / static_cast<double>(t.cells) / rule.uniform_work;
-    ratio = work / (static_cast<double>(t.found) / static_cast<double>(t.vertices));
-    if (slope * std::sqrt(ratio) > 2 * highest || ratio >= enough) break;
-  }
-  if (ratio < rule.off_below) return estimate(ratio, 0.0);
-  return estimate(ratio, std::clamp(slope * std::sqrt(ratio), lowest, highest));
-}
 
 /// From this pilot ratio on, 3D points go to insertion rather than to the
 /// cells. Both build the same rows, so the choice may follow the thread

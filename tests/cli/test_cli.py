@@ -340,15 +340,25 @@ class Voronoi3D(TempDirCase):
 
     def test_tie_heavy_input_hint(self):
         # Points normalized onto one sphere tie (to rounding) at its centre:
-        # thousands of exact calls per cell, which the summary points out
-        # along with the remedy; ordinary input gets no such remark.
+        # searched, thousands of exact calls per cell, which the summary
+        # points out along with the remedies; ordinary input gets no such
+        # remark. The automatic method clips them by their Delaunay
+        # neighbours instead (and says so), with the same cells.
         v = np.random.default_rng(5).normal(size=(200, 3))
         v /= np.linalg.norm(v, axis=1)[:, None]
-        r = self.ok(["voronoi", self.save("sphere.npy", v), "-o", self.p("s.vtu")])
+        sph = self.save("sphere.npy", v)
+        r = self.ok(["voronoi", sph, "--method", "search", "-o", self.p("s.vtu"), "--neighbors", self.p("s.npy")])
         self.assertIn("over 1000 per cell", r.stdout)
+        self.assertIn("--method insertion", r.stdout)
         self.assertIn("tessera joggle", r.stdout)
+        self.assertNotIn("Delaunay neighbours", r.stdout)
+        r = self.ok(["voronoi", sph, "-o", self.p("a.vtu"), "--neighbors", self.p("a.npy")])
+        self.assertNotIn("over 1000 per cell", r.stdout)
+        self.assertIn("method             insertion (each cell clipped by its Delaunay neighbours)", r.stdout)
+        self.assertTrue(np.array_equal(np.load(self.p("s.npy")), np.load(self.p("a.npy"))))
         r = self.ok(["voronoi", self.inp, "-o", self.p("u.vtu")])
         self.assertNotIn("over 1000 per cell", r.stdout)
+        self.assertNotIn("Delaunay neighbours", r.stdout)
 
     def test_extreme_scale_validates(self):
         # Coordinates near 1e-124: the cells are exact, but their volumes

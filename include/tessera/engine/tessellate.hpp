@@ -21,6 +21,19 @@
 
 namespace tessera::engine {
 
+/// Every located point's clipping neighbours, known in advance (the
+/// Delaunay neighbours: front/delaunay_neighbours.hpp), by locator slot: slot
+/// s's neighbours are the slots `slots[offsets[s] .. offsets[s + 1])`, in an
+/// order independent of the thread count. `duplicate_of[s]` is the lowest
+/// id at exactly s's coordinates when that is another point's (s then has
+/// no cell), else -1. Slots, not ids: the cells run in slot order, and the
+/// locator's copies of ids and coordinates are in it too.
+struct NeighbourLists {
+  std::vector<std::int64_t> offsets;
+  std::vector<std::uint32_t> slots;
+  std::vector<std::int32_t> duplicate_of;
+};
+
 /// What the driver needs: input, domain, locator and the generators whose
 /// cells are wanted, listed in the order to process them (bin order).
 template <int D>
@@ -37,6 +50,9 @@ struct Generators {
   const kernels::ExactContext* exact = nullptr;
   /// The points' k-d tree, for cells of overfull bins and long cells (CellBuilder).
   const kernels::SharedKdTree<D>* tree = nullptr;
+  /// Optional: then each cell is the box clipped by its list alone
+  /// (CellBuilder::build_from), with no search. Needs `slots`.
+  const NeighbourLists* neighbours = nullptr;
 };
 
 struct EngineOptions {
@@ -55,6 +71,8 @@ std::uint64_t tessellate(const Generators<CellT::dim>& gens, Comp& comp, const E
   const std::size_t n = gens.order.size();
   if (!gens.slots.empty() && gens.slots.size() != n)
     throw std::invalid_argument("tessera: Generators::slots must be empty or as long as Generators::order");
+  if (gens.neighbours != nullptr && gens.slots.size() != n)
+    throw std::invalid_argument("tessera: Generators::neighbours needs Generators::slots");
   const std::size_t bs = std::max<std::size_t>(1, opt.batch_size);
   const std::size_t nb = (n + bs - 1) / bs;
   std::vector<typename Comp::Batch> batches(nb);
@@ -80,7 +98,21 @@ std::uint64_t tessellate(const Generators<CellT::dim>& gens, Comp& comp, const E
       const std::int32_t gen = gens.order[g];
       const double* p = gens.slots.empty() ? gens.coords + static_cast<std::size_t>(gen) * CellT::dim
                                            : gens.locator->point(gens.slots[g]).data();
-      const kernels::BuildStatus st = ws.builder.build_any(gen, p, ws.cell);
+      kernels::BuildStatus st;
+      if (const NeighbourLists* nl = gens.neighbours) {
+        const std::size_t at = gens.slots[g];
+        if (const std::int32_t owner = nl->duplicate_of[at]; owner >= 0) {
+          st.has_cell = false;  // and the cell's counts are its predecessor's: not added
+          st.duplicate_of = owner;
+          comp.add(batch, gen, st, ws.cell);
+          continue;
+        } else {
+          const auto a = static_cast<std::size_t>(nl->offsets[at]), e = static_cast<std::size_t>(nl->offsets[at + 1]);
+          st = ws.builder.build_from(gen, p, std::span<const std::uint32_t>(nl->slots.data() + a, e - a), ws.cell);
+        }
+      } else {
+        st = ws.builder.build_any(gen, p, ws.cell);
+      }
       ws.exact_calls += ws.cell.exact_calls();
       comp.add(batch, gen, st, ws.cell);
     }

@@ -20,6 +20,7 @@
 #include <cstring>
 #include <cmath>
 #include <limits>
+#include <span>
 #include <utility>
 #include <vector>
 
@@ -105,6 +106,48 @@ class CellBuilder {
   [[gnu::noinline]] BuildStatus build_nearest_first(std::int32_t i, const double* p, CellT& cell) {
     work_ = 0;
     BuildStatus status = search_nearest_first(i, p, cell);
+    status.work = work_;
+    return status;
+  }
+
+  /// The cell of generator i clipped by the points of locator slots `slots`
+  /// alone, nearest first, with no search: for a caller that knows every
+  /// point that clips (the Delaunay neighbours, from incremental insertion,
+  /// whose perturbed in-sphere test is this clip predicate:
+  /// front/delaunay_neighbours.hpp). The points are distinct, exclude i and
+  /// its coincident points, and come in an order that does not depend on the
+  /// thread count (the clip order follows it among near-ties, and with it
+  /// the last bits of the cell's geometry).
+  BuildStatus build_from(std::int32_t i, const double* p, std::span<const std::uint32_t> slots, CellT& cell) {
+    cell.reset(i, p, lo_, hi_, exact_);
+    BuildStatus status;
+    const std::size_t n = slots.size();
+    if (cand_.size() < n) {
+      cand_.resize(2 * n);
+      keys_.resize(cand_.size());
+    }
+    for (std::size_t k = 0; k < n; ++k) {
+      Candidate& cd = cand_[k];
+      const auto& pj = loc_.point(slots[k]);
+      double r2 = 0;
+      for (int d = 0; d < D; ++d) {
+        cd.q[d] = pj[d] - p[d];
+        r2 += cd.q[d] * cd.q[d];
+      }
+      cd.r2 = r2;
+      cd.id = loc_.id(slots[k]);
+      keys_[k] = (static_cast<std::uint64_t>(std::bit_cast<std::uint32_t>(static_cast<float>(r2 * key_scale_))) << 32) | k;
+    }
+    std::uint64_t* const keys = keys_.data();
+    sort_keys(keys, keys + n);
+    work_ = 4 * n;
+    for (std::size_t k = 0; k < n; ++k) {
+      const Candidate& cd = cand_[static_cast<std::uint32_t>(keys[k])];
+      if (cell.clip(cd.id, cd.q) == ClipResult::emptied) [[unlikely]] {
+        status.has_cell = false;  // only coincident points empty a cell, and they are not listed
+        break;
+      }
+    }
     status.work = work_;
     return status;
   }

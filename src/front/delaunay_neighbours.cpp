@@ -1,0 +1,145 @@
+#include "delaunay_neighbours.hpp"
+
+#include <algorithm>
+#include <cstdint>
+#include <cstring>
+#include <vector>
+
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include "insertion.hpp"
+
+namespace tessera::front {
+
+namespace {
+
+/// Appends to `out` the vertices of the tetrahedra `tets` (rows of four)
+/// other than s, each once, in order of first appearance (the tetrahedra
+/// ascending: an order that does not depend on the thread count).
+void collect(std::uint32_t s, const std::uint32_t* rows, const std::uint32_t* tets, std::size_t count,
+             std::vector<std::uint32_t>& out) {
+  const std::size_t start = out.size();
+  // A vertex has ~27 tetrahedra and ~15 neighbours on uniform input: each
+  // vertex met is compared with the neighbours so far, four at a time (marks
+  // in an array by point would need one such array per thread). Past the
+  // last neighbour the list holds s itself, so s is never taken either.
+  constexpr std::size_t most = 96;
+  if (count <= most) {
+    using Quad = std::uint32_t __attribute__((vector_size(16)));
+    std::uint32_t have[3 * most + 8];
+    const Quad own = {s, s, s, s};
+    std::memcpy(have, &own, sizeof own);
+    std::size_t m = 0;
+    for (std::size_t t = 0; t < count; ++t) {
+      const std::uint32_t* row = rows + 4 * static_cast<std::size_t>(tets[t]);
+      for (int c = 0; c < 4; ++c) {
+        const std::uint32_t v = row[c];
+        const Quad vv = {v, v, v, v};
+        Quad seen = {};
+        for (std::size_t g = 0; g <= m; g += 4) {
+          Quad h;
+          std::memcpy(&h, have + g, sizeof h);
+          seen |= h == vv;
+        }
+        if ((seen[0] | seen[1] | seen[2] | seen[3]) == 0) {
+          have[m++] = v;
+          std::memcpy(have + m, &own, sizeof own);
+        }
+      }
+    }
+    out.insert(out.end(), have, have + m);
+    return;
+  }
+  // A vertex of high degree (points in convex position can have hundreds):
+  // sorted instead, no less deterministic.
+  for (std::size_t t = 0; t < count; ++t) {
+    const std::uint32_t* row = rows + 4 * static_cast<std::size_t>(tets[t]);
+    for (int c = 0; c < 4; ++c)
+      if (row[c] != s) out.push_back(row[c]);
+  }
+  std::sort(out.begin() + static_cast<std::ptrdiff_t>(start), out.end());
+  out.erase(std::unique(out.begin() + static_cast<std::ptrdiff_t>(start), out.end()), out.end());
+}
+
+}  // namespace
+
+std::optional<engine::NeighbourLists> delaunay_neighbours(const Pass<3>& pass) {
+  const auto& loc = *pass.locator;
+  const std::size_t n = pass.points.size() / 3, located = loc.size();
+  engine::NeighbourLists out;
+  bool flat = false;
+  tbb::task_arena(pass.engine_options.threads).execute([&] {
+    // Of each set of coincident points the lowest id is the vertex, as the
+    // cells pass decides (BinLocator::lowest_coincident).
+    out.duplicate_of = loc.lowest_coincident();
+    std::vector<std::int32_t> distinct;
+    distinct.reserve(located);
+    for (std::size_t k = 0; k < located; ++k)
+      if (out.duplicate_of[k] < 0) distinct.push_back(loc.id(k));
+    InsertionOptions io;
+    io.threads = pass.engine_options.threads;
+    auto simplices = insertion_delaunay(pass.exact, distinct, pass.gens.lo.data(), pass.gens.hi.data(), io);
+    if (!simplices) {
+      flat = true;
+      return;
+    }
+    // Rows of slots from here on: the lists are built in slot order (the
+    // cells' order), where neighbouring points share most of their
+    // tetrahedra, and the cells read the locator's slot-ordered copies.
+    std::vector<std::uint32_t> slot_of(n, 0);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, located), [&](const tbb::blocked_range<std::size_t>& r) {
+      for (std::size_t k = r.begin(); k != r.end(); ++k) slot_of[static_cast<std::size_t>(loc.id(k))] = static_cast<std::uint32_t>(k);
+    });
+    const std::size_t m = simplices->size();
+    auto* const rows = reinterpret_cast<std::uint32_t*>(simplices->data());
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, m), [&](const tbb::blocked_range<std::size_t>& r) {
+      for (std::size_t k = r.begin(); k != r.end(); ++k) rows[k] = slot_of[rows[k]];
+    });
+    // Each slot's tetrahedra, ascending: counted and filled serially, so
+    // their order is fixed (one pass each over the rows). m < 2^32: the
+    // insertion holds fewer than 2^29 tetrahedra.
+    std::vector<std::uint32_t> first(located + 1, 0);
+    for (std::size_t k = 0; k < m; ++k) ++first[rows[k] + 1];
+    for (std::size_t k = 0; k < located; ++k) first[k + 1] += first[k];
+    std::vector<std::uint32_t> tets(m);
+    {
+      std::vector<std::uint32_t> at(first.begin(), first.end() - 1);
+      for (std::size_t k = 0; k < m; ++k) tets[at[rows[k]]++] = static_cast<std::uint32_t>(k / 4);
+    }
+    // The lists per fixed chunk of slots, then laid end to end.
+    constexpr std::size_t chunk = 4096;
+    constexpr std::size_t ahead = 4;  // slots whose rows are prefetched ahead of their turn
+    const std::size_t chunks = (located + chunk - 1) / chunk;
+    std::vector<std::vector<std::uint32_t>> parts(chunks);
+    std::vector<std::int64_t> count(located + 1, 0);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, chunks, 1), [&](const tbb::blocked_range<std::size_t>& r) {
+      for (std::size_t c = r.begin(); c != r.end(); ++c) {
+        auto& part = parts[c];
+        const std::size_t end = std::min(located, (c + 1) * chunk);
+        for (std::size_t k = c * chunk; k < end; ++k) {
+          // A point's tetrahedra lie all over the rows: ask for those of a
+          // later slot now (its list of them is at hand, in slot order).
+          if (k + ahead < end)
+            for (std::uint32_t t = first[k + ahead]; t < first[k + ahead + 1]; ++t)
+              __builtin_prefetch(rows + 4 * static_cast<std::size_t>(tets[t]));
+          if (out.duplicate_of[k] >= 0) continue;
+          const std::size_t before = part.size();
+          collect(static_cast<std::uint32_t>(k), rows, tets.data() + first[k], first[k + 1] - first[k], part);
+          count[k + 1] = static_cast<std::int64_t>(part.size() - before);
+        }
+      }
+    });
+    for (std::size_t k = 0; k < located; ++k) count[k + 1] += count[k];
+    out.offsets = std::move(count);
+    out.slots.resize(static_cast<std::size_t>(out.offsets[located]));
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, chunks, 1), [&](const tbb::blocked_range<std::size_t>& r) {
+      for (std::size_t c = r.begin(); c != r.end(); ++c)
+        std::copy(parts[c].begin(), parts[c].end(), out.slots.begin() + out.offsets[c * chunk]);
+    });
+  });
+  if (flat) return std::nullopt;
+  return out;
+}
+
+}  // namespace tessera::front

@@ -1,0 +1,27 @@
+// Every point's Voronoi neighbours from the Delaunay triangulation by
+// incremental insertion: the cells of inputs where the meshless search costs
+// far more than the cells it finds (points nearly on a sphere, surface
+// samples, dense clusters: docs/design.md, "Cells from Delaunay neighbours").
+//
+// The cells pass decides a clip by the exact clip predicate with symbolic
+// perturbation; insertion decides conflicts by the same predicate in
+// in-sphere form (kernels::in_sphere), so its tetrahedra are the cells
+// pass's vertices, ties included. A point clips a cell exactly when it
+// shares a tetrahedron with the cell's generator, so the box clipped by
+// those points alone is the cell the search would build.
+#pragma once
+
+#include <optional>
+
+#include "pass.hpp"
+#include "tessera/engine/tessellate.hpp"
+
+namespace tessera::front {
+
+/// The Delaunay neighbours of the pass's located points (3D), each list in
+/// ascending order of the tetrahedra it comes from; exact duplicates point
+/// to their lowest coincident id and are no vertex. nullopt when the points
+/// are all on one plane (no tetrahedron exists: the search serves them).
+std::optional<engine::NeighbourLists> delaunay_neighbours(const Pass<3>& pass);
+
+}  // namespace tessera::front
