@@ -2,6 +2,7 @@
 // (include/tessera/cells.hpp) as a Python class whose arrays view its buffers.
 #include <cstdint>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include <pybind11/numpy.h>
@@ -20,11 +21,15 @@ namespace {
 using Points = py::array_t<double, py::array::c_style>;
 
 Cells run_voronoi(const Points& points, const py::object& labels, const std::optional<std::vector<double>>& bounds,
-                  double padding, bool ignore_outside, int threads, bool merge) {
+                  double padding, bool ignore_outside, int threads, bool merge, const std::string& method) {
   const int dim = checked_dim(points);
   VoronoiOptions opt;
   fill_common(opt, dim, bounds, padding, ignore_outside, threads);
   opt.build_mesh = merge;
+  if (method == "auto") opt.cell_method = CellMethod::automatic;
+  else if (method == "search") opt.cell_method = CellMethod::search;
+  else if (method == "insertion") opt.cell_method = CellMethod::insertion;
+  else throw py::value_error("voronoi: method must be 'auto', 'search' or 'insertion', got '" + method + "'");
   const auto pts = as_span(points);
   const auto lab = as_labels(labels);
   return without_gil([&] { return voronoi(pts, dim, lab, opt); });
@@ -74,6 +79,7 @@ void bind_voronoi(py::module_& m) {
       .def_property_readonly("bounds", [](const Cells& c) { return bounds_tuple(c.bounds, c.dim); })
       .def_readonly("exact_predicate_calls", &Cells::exact_predicate_calls)
       .def_readonly("threads_used", &Cells::threads_used)
+      .def_readonly("from_insertion", &Cells::from_insertion)
       // per cell
       .def_property_readonly("generator", [](py::object s) { return view_flat(s.cast<const Cells&>().generator, s); })
       .def_property_readonly("region", [](py::object s) { return view_flat(s.cast<const Cells&>().region, s); })
@@ -126,7 +132,7 @@ void bind_voronoi(py::module_& m) {
 
   m.def("voronoi", &run_voronoi, py::arg("points").noconvert(), py::arg("labels").none(true), py::arg("bounds"),
         py::arg("padding"), py::arg("ignore_outside"), py::arg("threads"), py::arg("merge"),
-        "Cells of float64 C-ordered (N, D) points; labels None or int32 (N,). Runs without the GIL.");
+        py::arg("method"), "Cells of float64 C-ordered (N, D) points; labels None or int32 (N,). Runs without the GIL.");
 
   m.def(
       "validate_cells",

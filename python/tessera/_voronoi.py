@@ -199,6 +199,11 @@ class Voronoi:
     def threads_used(self) -> int:
         return self._cells.threads_used
 
+    @property
+    def from_insertion(self) -> bool:
+        """The cells were clipped by Delaunay neighbours from insertion (``method``)."""
+        return self._cells.from_insertion
+
     # ---- checks, views, files ---------------------------------------------
     def validate(self) -> "_core.ValidationReport":
         """Invariant checks (the CLI's ``--validate``): volumes sum to the domain,
@@ -252,6 +257,7 @@ def voronoi(
     merge: bool = True,
     *,
     ignore_outside: bool = False,
+    method: str = "auto",
 ) -> Voronoi:
     """Voronoi cells of 2D or 3D points, clipped to a box, with exact topology.
 
@@ -278,6 +284,14 @@ def voronoi(
     ignore_outside : bool
         With ``bounds``: drop points outside the box (listed in
         ``ignored_outside_bounds``) instead of raising ValueError.
+    method : {"auto", "search", "insertion"}
+        How each 3D cell finds the points that clip it; the cells are the
+        same. ``"search"``: the bins around it (the meshless method).
+        ``"insertion"``: its Delaunay neighbours, from incremental insertion
+        (much faster where cells reach far: points nearly on a sphere,
+        surface samples, dense clusters). ``"auto"``: insertion where a
+        sample of cells costs far more than on uniform points, else search
+        (:attr:`Voronoi.from_insertion` says which ran). 2D always searches.
 
     Returns
     -------
@@ -306,5 +320,6 @@ def voronoi(
         bool(ignore_outside),
         _inputs.as_threads(threads),
         bool(merge),
+        str(method),
     )
     return Voronoi(cells, pts, lab)

@@ -129,6 +129,24 @@ def test_duplicates_are_reported_and_own_no_cell():
     assert vor.n_cells == 200
 
 
+def test_method_insertion_gives_the_searched_cells():
+    # Points nearly on one sphere: searched, every cell tests every point at
+    # the centre; "auto" clips them by their Delaunay neighbours instead.
+    v = np.random.default_rng(4).normal(size=(600, 3))
+    v /= np.linalg.norm(v, axis=1)[:, None]
+    searched = tessera.voronoi(v, method="search")
+    auto = tessera.voronoi(v)
+    assert not searched.from_insertion and auto.from_insertion
+    assert np.array_equal(searched.neighbors, auto.neighbors)
+    assert np.array_equal(searched.neighbor_offsets, auto.neighbor_offsets)
+    np.testing.assert_allclose(searched.volumes, auto.volumes, rtol=1e-12)
+    assert auto.validate()
+    assert not tessera.voronoi(random_points(500, 3)).from_insertion
+    assert not tessera.voronoi(random_points(500, 2), method="insertion").from_insertion  # 2D searches
+    with pytest.raises(ValueError, match="method must be 'auto', 'search' or 'insertion'"):
+        tessera.voronoi(v, method="cells")
+
+
 def test_ignore_outside_drops_points_outside_the_bounds():
     pts = random_points(300, 2) * 2  # in [0, 2)^2
     with pytest.raises(ValueError, match=r"outside the bounds \(use ignore_outside=True"):

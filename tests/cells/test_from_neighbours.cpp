@@ -1,0 +1,219 @@
+// Cells clipped by their Delaunay neighbours (CellMethod::insertion) against
+// the search's cells: the same topology on every input, degenerate and
+// hostile ones included, volumes equal to rounding (the clip order differs),
+// and byte-identical for 1 and 2 threads. Then the automatic choice.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <string>
+#include <vector>
+
+#include "common/hostile_points.hpp"
+#include "helpers.hpp"
+
+namespace {
+
+using namespace cells_test;
+
+tessera::Cells run_method(const std::vector<double>& pts, int dim, tessera::CellMethod method,
+                          const std::vector<std::int32_t>& labels = {}, int threads = 1,
+                          std::optional<tessera::Bounds> bounds = std::nullopt, bool ignore_outside = false) {
+  tessera::VoronoiOptions o = options(dim, bounds, threads);
+  o.cell_method = method;
+  o.ignore_outside_points = ignore_outside;
+  return tessera::voronoi(std::span<const double>(pts), dim, std::span<const std::int32_t>(labels), o);
+}
+
+/// The merged vertices' keys as a sorted set of rows (the numbering follows
+/// the order each cell met its vertices, which is the clip order).
+std::vector<std::vector<std::int32_t>> key_rows(const tessera::Cells& c) {
+  std::vector<std::vector<std::int32_t>> rows;
+  const std::size_t w = static_cast<std::size_t>(c.dim + 1);
+  for (std::size_t v = 0; v < c.n_vertices(); ++v)
+    rows.emplace_back(c.vertex_keys.begin() + v * w, c.vertex_keys.begin() + (v + 1) * w);
+  std::sort(rows.begin(), rows.end());
+  return rows;
+}
+
+/// Search and insertion give the same cells: the same neighbours, faces,
+/// duplicates, owners and merged vertices, volumes and centroids equal to
+/// rounding; the insertion's cells pass every invariant (`hostile`: those
+/// of tessera::validate, as check_invariants measures the mesh in doubles,
+/// which cannot hold the volumes of cells a subnormal thick or 2^300 wide).
+void same_as_search(const std::vector<double>& pts, const std::string& what,
+                    const std::vector<std::int32_t>& labels = {}, std::optional<tessera::Bounds> bounds = std::nullopt,
+                    bool ignore_outside = false, InvariantOptions inv = {}, bool hostile = false) {
+  SCOPED_TRACE(what);
+  const auto s = run_method(pts, 3, tessera::CellMethod::search, labels, 1, bounds, ignore_outside);
+  const auto d = run_method(pts, 3, tessera::CellMethod::insertion, labels, 1, bounds, ignore_outside);
+  EXPECT_FALSE(s.from_insertion);
+  EXPECT_TRUE(d.from_insertion);
+  EXPECT_EQ(s.generator, d.generator);
+  EXPECT_EQ(s.cell_of, d.cell_of);
+  EXPECT_EQ(s.neighbor_offsets, d.neighbor_offsets);
+  EXPECT_EQ(s.neighbors, d.neighbors);
+  EXPECT_EQ(s.num_faces, d.num_faces);
+  EXPECT_EQ(s.cell_face_offsets, d.cell_face_offsets);
+  EXPECT_EQ(s.duplicates, d.duplicates);
+  EXPECT_EQ(s.ignored_outside_bounds, d.ignored_outside_bounds);
+  EXPECT_EQ(key_rows(s), key_rows(d));
+  ASSERT_EQ(s.volume.size(), d.volume.size());
+  for (std::size_t c = 0; c < s.volume.size(); ++c) {
+    EXPECT_NEAR(s.volume[c], d.volume[c], 1e-12 * std::max(std::fabs(s.volume[c]), 1e-300)) << "cell " << c;
+    for (int a = 0; a < 3; ++a) {
+      const double x = s.centroid[3 * c + static_cast<std::size_t>(a)], y = d.centroid[3 * c + static_cast<std::size_t>(a)];
+      EXPECT_NEAR(x, y, 1e-12 * (std::fabs(x) + box_size(s.bounds, 3))) << "cell " << c;
+    }
+  }
+  if (!hostile) {
+    check_invariants(d, pts, labels, what + " (insertion)", inv);
+    return;
+  }
+  const tessera::ValidationReport r = tessera::validate(d, labels);
+  for (const auto& m : r.messages) ADD_FAILURE() << m;
+  EXPECT_EQ(r.asymmetric_spokes, 0u);
+  EXPECT_EQ(r.bad_vertex_degree, 0u);
+  EXPECT_EQ(r.bad_euler, 0u);
+}
+
+std::vector<double> sphere_points(std::size_t n, std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> g;
+  std::vector<double> p;
+  for (std::size_t i = 0; i < n; ++i) {
+    double v[3] = {g(rng), g(rng), g(rng)};
+    const double r = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+    p.insert(p.end(), {v[0] / r, v[1] / r, v[2] / r});
+  }
+  return p;
+}
+
+TEST(FromNeighbours, SameCellsAsTheSearch) {
+  same_as_search(random_points(3000, 3, 901), "uniform 3000");
+  same_as_search(grid_points(8, 3), "integer grid 8^3");
+  same_as_search(grid_points(7, 3, 0.1, 0.05), "tenth grid 7^3");
+  // A rotated lattice: every 8 neighbouring points co-spherical to rounding.
+  {
+    const auto g = grid_points(7, 3);
+    std::vector<double> p(g.size());
+    const double c = std::cos(0.4), s = std::sin(0.4), c2 = std::cos(0.9), s2 = std::sin(0.9);
+    for (std::size_t i = 0; i < g.size() / 3; ++i) {
+      const double x = c * g[3 * i] - s * g[3 * i + 1], y = s * g[3 * i] + c * g[3 * i + 1], z = g[3 * i + 2];
+      p[3 * i] = x;
+      p[3 * i + 1] = c2 * y - s2 * z;
+      p[3 * i + 2] = s2 * y + c2 * z;
+    }
+    same_as_search(p, "rotated lattice 7^3");
+  }
+  // Points nearly on one sphere, with and without its centre; all 390
+  // integer points exactly on a sphere of radius 33, with its centre.
+  same_as_search(sphere_points(400, 902), "random sphere 400");
+  {
+    auto p = sphere_points(300, 903);
+    p.insert(p.end(), {0.0, 0.0, 0.0});
+    same_as_search(p, "random sphere 300 + centre");
+  }
+  {
+    std::vector<double> p;
+    for (int x = -33; x <= 33; ++x)
+      for (int y = -33; y <= 33; ++y)
+        for (int z = -33; z <= 33; ++z)
+          if (x * x + y * y + z * z == 33 * 33) p.insert(p.end(), {double(x), double(y), double(z)});
+    p.insert(p.end(), {0.0, 0.0, 0.0});
+    same_as_search(p, "integer sphere r=33 + centre");
+  }
+  // Exact duplicates (the lowest id owns the cell), on random points and on a grid.
+  {
+    auto p = random_points(1500, 3, 904);
+    p.insert(p.end(), p.begin(), p.begin() + 3 * 200);
+    same_as_search(p, "uniform with 200 duplicates");
+    auto g = grid_points(6, 3);
+    g.insert(g.end(), g.begin() + 30, g.begin() + 90);
+    same_as_search(g, "grid with duplicates");
+  }
+  // Labels: outside points (label < 0) clip their neighbours but own no cell.
+  {
+    auto p = random_points(2000, 3, 905);
+    std::mt19937_64 rng(6);
+    std::vector<std::int32_t> labels(2000);
+    for (auto& l : labels) l = std::int32_t(rng() % 3) - 1;
+    p.insert(p.end(), p.begin(), p.begin() + 3 * 50);
+    labels.insert(labels.end(), labels.begin(), labels.begin() + 50);
+    InvariantOptions inv;
+    inv.all_inside = false;
+    same_as_search(p, "labelled with outside points and duplicates", labels, std::nullopt, false, inv);
+  }
+  // Explicit bounds cutting through the points, outside points dropped.
+  {
+    const auto p = random_points(2000, 3, 906);
+    same_as_search(p, "bounds with points outside", {}, make_bounds({0.1, 0.2, 0.0}, {0.9, 0.7, 0.8}), true);
+  }
+  // Points a subnormal distance off the planes their neighbours span.
+  for (std::uint64_t seed = 1; seed <= 4; ++seed)
+    same_as_search(subnormal_offset_points(60, 3, seed + 100), "subnormal offsets seed " + std::to_string(seed), {},
+                   std::nullopt, false, {}, true);
+  // Extreme scales: the pass computes in a rescaled frame.
+  {
+    auto p = random_points(300, 3, 907);
+    for (double& x : p) x = std::ldexp(x, 300);
+    same_as_search(p, "uniform scaled by 2^300", {}, std::nullopt, false, {}, true);
+  }
+}
+
+TEST(FromNeighbours, ThreadCountDoesNotChangeResult) {
+  auto p = sphere_points(1500, 908);
+  const auto r = random_points(1500, 3, 909);
+  p.insert(p.end(), r.begin(), r.end());
+  p.insert(p.end(), p.begin(), p.begin() + 3 * 40);
+  const auto a = run_method(p, 3, tessera::CellMethod::insertion, {}, 1);
+  const auto b = run_method(p, 3, tessera::CellMethod::insertion, {}, 2);
+  EXPECT_EQ(b.threads_used, 2);
+#define SAME(f) EXPECT_TRUE(a.f == b.f) << #f " differs between 1 and 2 threads"
+  SAME(generator);
+  SAME(volume);
+  SAME(centroid);
+  SAME(num_faces);
+  SAME(neighbor_offsets);
+  SAME(neighbors);
+  SAME(vertices);
+  SAME(vertex_keys);
+  SAME(face_vertex_offsets);
+  SAME(face_vertices);
+  SAME(face_neighbor);
+  SAME(duplicates);
+#undef SAME
+}
+
+// The automatic method searches where cells are cheap (uniform points,
+// lattices, 2D) and clips by Delaunay neighbours where the pilot finds them
+// costly: points nearly on one sphere, whose every cell reaches the centre
+// and would test every point there (quadratic work), at any size.
+TEST(FromNeighbours, AutomaticChoiceFollowsThePilot) {
+  auto automatic = [](const std::vector<double>& p, int dim) {
+    return run_method(p, dim, tessera::CellMethod::automatic, {}, 2);
+  };
+  EXPECT_FALSE(automatic(random_points(3000, 3, 910), 3).from_insertion);
+  EXPECT_FALSE(automatic(random_points(30000, 3, 911), 3).from_insertion);
+  EXPECT_FALSE(automatic(grid_points(12, 3), 3).from_insertion);
+  EXPECT_FALSE(automatic(random_points(3000, 2, 912), 2).from_insertion);
+  for (std::size_t n : {100, 500, 3000, 25000}) {
+    const auto p = sphere_points(n, 913 + n);
+    const tessera::Cells c = automatic(p, 3);
+    EXPECT_TRUE(c.from_insertion) << n << " points on a sphere";
+    EXPECT_TRUE(tessera::validate(c, {}).ok) << n << " points on a sphere";
+  }
+  // Insertion asked for on 2D points, or on 3D points all on one plane (no
+  // tetrahedron): the search serves them.
+  EXPECT_FALSE(run_method(random_points(500, 2, 914), 2, tessera::CellMethod::insertion).from_insertion);
+  std::vector<double> flat;
+  const auto q = random_points(400, 2, 915);
+  for (std::size_t i = 0; i < 400; ++i) flat.insert(flat.end(), {q[2 * i], q[2 * i + 1], 0.5});
+  const tessera::Cells f = run_method(flat, 3, tessera::CellMethod::insertion, {}, 1, make_bounds({0, 0, 0}, {1, 1, 1}));
+  EXPECT_FALSE(f.from_insertion);
+  EXPECT_EQ(f.n_cells(), 400u);
+  EXPECT_TRUE(tessera::validate(f, {}).ok);
+}
+
+}  // namespace
