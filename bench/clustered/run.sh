@@ -8,6 +8,7 @@
 # usage: bench/clustered/run.sh [BUILD_DIR] [N]
 #   env: KINDS (default "blobs sheet hier"; the surfaces: "terrain ellipsoid torus"; near-degenerate: "latrot latjit sphere"), REPEAT (default 3), THREADS (default 2),
 #        VORO=0 skips Voro++ (single-threaded; minutes per input at 1e6), CELLS=0 skips Tessera's cells,
+#        SEARCH=1 also times the cells with --method search (tool "tessera-search"; the default is auto),
 #        TIMEOUT per command in seconds (default 900), DATA (default bench/data, git-ignored),
 #        OUT (default bench/clustered/results/clustered_N.jsonl)
 # Needs the peer drivers in bench/build-peers: bench/run_bench.sh builds them
@@ -22,6 +23,7 @@ threads=${THREADS:-2}
 timeout=${TIMEOUT:-900}
 voro=${VORO:-1}
 cells=${CELLS:-1}
+search=${SEARCH:-0}
 data=${DATA:-$here/../data}
 peers=$here/../build-peers
 py=/usr/bin/python3
@@ -31,11 +33,13 @@ out=${OUT:-$here/results/clustered_$n.jsonl}
 note() { echo "clustered: $*" >&2; }
 [[ -x $build/tessera ]] || { note "error: no $build/tessera (build it first)"; exit 1; }
 echo "# $(date -u +%FT%TZ) $(uname -m) $(nproc) cores; tessera $(git -C "$here" rev-parse --short HEAD 2>/dev/null || echo '?')" >&2
-# run LABEL CMD...: REPEAT runs, each JSON line tagged with the input's label.
+# run LABEL CMD...: REPEAT runs, each JSON line tagged with the input's label
+# (and its tool renamed to $tool_tag when set).
 run() {
   local label=$1 i; shift
   for ((i = 0; i < repeat; i++)); do
-    timeout "$timeout" "$@" 2>/dev/null | grep '^{' | sed "s/^{/{\"input\":\"$label\",/" >>"$out" ||
+    timeout "$timeout" "$@" 2>/dev/null | grep '^{' |
+      sed "s/^{/{\"input\":\"$label\",/; s/\"tool\":\"tessera\"/\"tool\":\"${tool_tag:-tessera}\"/" >>"$out" ||
       { note "FAILED or timed out: $*"; return 0; }
   done
 }
@@ -44,6 +48,8 @@ for kind in $kinds; do
   [[ -f $f ]] || $py "$here/gen_clustered.py" "$kind" "$n" "$f"
   note "$kind: tessera"
   [[ $cells == 1 ]] && run "$kind" "$build/tessera" bench voronoi "$f" --threads "$threads" --repeat 1
+  [[ $cells == 1 && $search == 1 ]] &&
+    tool_tag=tessera-search run "$kind" "$build/tessera" bench voronoi "$f" --method search --threads "$threads" --repeat 1
   run "$kind" "$build/tessera" bench delaunay "$f" --threads "$threads" --repeat 1
   if [[ -x $peers/cgal_delaunay3 ]]; then
     note "$kind: CGAL"

@@ -49,6 +49,21 @@ def main():
             i, format(n, ","), fmt(cells), fmt(voro), ratio(voro, cells), fmt(dt), fmt(cgal), fmt(hxt),
             ratio(cgal, dt), ratio(hxt, dt), " / ".join(simp)))
 
+    # The cells by the automatic method against --method search (run.sh SEARCH=1).
+    if any(k[1] == "tessera-search" for k in runs):
+        print("\nTessera's cells, automatic method (`from_insertion`: clipped by Delaunay neighbours) against "
+              "`--method search`. Speed-up = search seconds / automatic seconds.\n")
+        print("| input | points | automatic s | method | search s | speed-up |")
+        print("|---|---:|---:|---|---:|---:|")
+        for i in inputs:
+            auto = med((i, "tessera", "voronoi3"))
+            search = med((i, "tessera-search", "voronoi3"))
+            rs = runs.get((i, "tessera", "voronoi3"), [])
+            how = "-" if not rs else ("insertion" if rs[0]["extra"].get("from_insertion") else "search")
+            n = next(r["n"] for k, v in runs.items() if k[0] == i for r in v)
+            print("| %s | %s | %s | %s | %s | %s |" % (i, format(n, ","), fmt(auto), how, fmt(search),
+                                                      ratio(search, auto)))
+
 
 if __name__ == "__main__":
     main()
