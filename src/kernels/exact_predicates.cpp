@@ -502,12 +502,12 @@ double rational_to_double(mpq_ptr q) {
   return std::ldexp(mpq_get_d(q), -1100);
 }
 
-// The vertex of cell i where planes[0..dim) meet, relative to p_i, exactly:
-// y[d] for d < dim. Cramer's rule on the integer rows (build_rows): det A,
-// then numerator d = det(A with column d replaced by b). Weights are
+// The vertex of cell i where planes[0..dim) meet, relative to p_i, as
+// integers: y[d] = minor[d] / minor[dim] * 2^shift (returned), for d < dim.
+// Cramer's rule on the integer rows (build_rows): det A, then numerator
+// d = det(A with column d replaced by b), less det times p_i. Weights are
 // infinitesimal and do not move the vertex in the limit.
-void solve_vertex_exactly(const ExactContext& ctx, std::int32_t i, const std::int32_t* planes, Scratch& s,
-                          mpq_ptr* y) {
+int vertex_numerators(const ExactContext& ctx, std::int32_t i, const std::int32_t* planes, Scratch& s) {
   const int dim = ctx.dim;
   const int shift = build_rows(ctx, i, planes, dim, s);
   int sel[Scratch::kMaxDim] = {0, 1, 2};
@@ -519,27 +519,54 @@ void solve_vertex_exactly(const ExactContext& ctx, std::int32_t i, const std::in
     for (int r = 0; r < dim; ++r) mpz_swap(s.a[r][d], s.b[r]);
     det_rows(s.minor[d], s.a, sel, dim, s);
     for (int r = 0; r < dim; ++r) mpz_swap(s.a[r][d], s.b[r]);
-    // y_d = num_d / det - p_i,d = (num_d - det * P_i,d) / det, in units of 2^shift.
     mpz_submul(s.minor[d], s.minor[dim], s.coord[Scratch::kRows][d]);
+  }
+  return shift;
+}
+
+// The same vertex as rationals (canonical, as GMP's rational arithmetic needs).
+void solve_vertex_exactly(const ExactContext& ctx, std::int32_t i, const std::int32_t* planes, Scratch& s,
+                          mpq_ptr* y) {
+  const int shift = vertex_numerators(ctx, i, planes, s);
+  for (int d = 0; d < ctx.dim; ++d) {
     mpq_set_num(y[d], s.minor[d]);
-    mpq_set_den(y[d], s.minor[dim]);
+    mpq_set_den(y[d], s.minor[ctx.dim]);
     mpq_canonicalize(y[d]);
     if (shift > 0) mpq_mul_2exp(y[d], y[d], static_cast<mp_bitcnt_t>(shift));
     else if (shift < 0) mpq_div_2exp(y[d], y[d], static_cast<mp_bitcnt_t>(-shift));
   }
 }
+
+// num / den * 2^shift rounded toward zero to 66 bits, then to double (within
+// 2 ulp): an integer division, where the rational's canonical form cost two
+// gcds per coordinate (a lattice jittered by 1e-9 solves a few vertices per
+// cell exactly, and those gcds were a fifth of its run). `q` is scratch.
+double quotient_to_double(mpz_srcptr num, mpz_srcptr den, long shift, mpz_ptr q) {
+  if (mpz_sgn(num) == 0) return 0.0;
+  const long k = 66 - (static_cast<long>(mpz_sizeinbase(num, 2)) - static_cast<long>(mpz_sizeinbase(den, 2)));
+  if (k >= 0) {
+    mpz_mul_2exp(q, num, static_cast<mp_bitcnt_t>(k));
+    mpz_tdiv_q(q, q, den);
+  } else {
+    // trunc(trunc(num / 2^-k) / den) = trunc(num / (2^-k den)): nothing lost.
+    mpz_tdiv_q_2exp(q, num, static_cast<mp_bitcnt_t>(-k));
+    mpz_tdiv_q(q, q, den);
+  }
+  // q holds 65 to 67 bits, below the exact quotient by less than one unit
+  // of them; mpz_get_d truncates it to 53 (together under 2 ulp), and ldexp
+  // scales, rounding once where the result is subnormal (as mpq_get_d did).
+  const long e = shift - k;
+  const double m = mpz_get_d(q);
+  if (e > 2100) return std::copysign(std::numeric_limits<double>::infinity(), m);
+  if (e < -2300) return std::copysign(0.0, m);
+  return std::ldexp(m, static_cast<int>(e));
+}
 }  // namespace
 
 void exact_vertex(const ExactContext& ctx, std::int32_t i, const std::int32_t* planes, double* y) {
   thread_local Scratch s;
-  thread_local struct Q {
-    mpq_t q[Scratch::kMaxDim];
-    Q() { for (auto& x : q) mpq_init(x); }
-    ~Q() { for (auto& x : q) mpq_clear(x); }
-  } qs;
-  mpq_ptr yq[Scratch::kMaxDim] = {qs.q[0], qs.q[1], qs.q[2]};
-  solve_vertex_exactly(ctx, i, planes, s, yq);
-  for (int d = 0; d < ctx.dim; ++d) y[d] = rational_to_double(yq[d]);
+  const int shift = vertex_numerators(ctx, i, planes, s);
+  for (int d = 0; d < ctx.dim; ++d) y[d] = quotient_to_double(s.minor[d], s.minor[ctx.dim], shift, s.t0);
 }
 
 double exact_cell_measure(const ExactContext& ctx, std::int32_t i, std::span<const std::int32_t> vertex_planes,
