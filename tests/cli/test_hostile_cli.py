@@ -1,7 +1,8 @@
 #!/usr/bin/python3
 """Hostile inputs, generated at random from a seed, through every product's
 own validation: `voronoi --validate`, `delaunay --validate`, and graph, faces
-and flower (which must succeed).
+and flower (which must succeed); in 3D also the cells by `--method search` and
+by `--method insertion`, whose neighbours must be equal.
 
 Usage: /usr/bin/python3 tests/cli/test_hostile_cli.py PATH_TO_tessera [unittest args...]
   env: TESSERA_HOSTILE_CASES (default 150), TESSERA_HOSTILE_SEED (default 1),
@@ -134,6 +135,15 @@ class Hostile(base.TempDirCase):
             if not self.check(["voronoi"] + common + ["-o", out, "--validate"], inp, labels, kind, d, case):
                 continue  # a zero extent: every product refuses it alike
             self.check(["delaunay"] + common + ["-o", self.p("t.vtu"), "--validate"], inp, labels, kind, d, case)
+            if d == 3:
+                # The cells clipped by Delaunay neighbours are the searched ones.
+                nb = {}
+                for method in ("search", "insertion"):
+                    nb[method] = self.p("nb_%s.npy" % method)
+                    self.check(["voronoi"] + common + ["--method", method, "--neighbors", nb[method], "--validate"],
+                               inp, labels, kind, d, case)
+                self.assertTrue(np.array_equal(np.load(nb["search"]), np.load(nb["insertion"])),
+                                "case %d (%s): neighbours by search and by insertion differ" % (case, kind))
             if case % 4 == 0:
                 self.check(["graph"] + common + ["-o", self.p("g.vtp")], inp, labels, kind, d, case)
                 for k in ("complex", "boundary", "surface-net"):
