@@ -12,8 +12,8 @@
 
 #include "cells_compositor.hpp"
 #include "delaunay_neighbours.hpp"
-#include "pilot.hpp"
 #include "pass.hpp"
+#include "pilot.hpp"
 #include "tessera/engine/tessellate.hpp"
 #include "tessera/kernels/hull.hpp"
 #include "tessera/kernels/tile.hpp"
@@ -60,6 +60,10 @@ Cells run(std::span<const double> input, std::span<const std::int32_t> labels, c
   // Without coincident points, a merged vertex's owner is known while its
   // cell is added, and only owners keep its position (CellsCompositor).
   const bool owners_known = opt.build_mesh && !pass.locator->may_have_coincident();
+  // 3D cells whose search would cost far more than on uniform points
+  // (points nearly on a sphere, surface samples, dense clusters) are
+  // clipped by their Delaunay neighbours instead: the same cells
+  // (docs/design.md, "Cells from Delaunay neighbours").
   std::optional<engine::NeighbourLists> neighbours;
   if constexpr (D == 3) {
     bool insert = opt.cell_method == CellMethod::insertion;

@@ -113,15 +113,15 @@ struct PilotEstimate {
 };
 
 /// `enough`: a ratio at which the caller's choice is made (insertion), so
-/// the pilot stops at the first band that reaches it. `max_share`: the
-/// fraction of the generators the pilot may build; bands are then smaller
-/// than pilot_band where that many would exceed it (tessera::voronoi, whose
-/// small inputs need the measure too: 500 points nearly on a sphere take
-/// 0.11 s by the search, 0.012 s from their Delaunay neighbours). 0: the
-/// top hash range that skipped cells leave alone (1 - the highest skipped
-/// fraction), in bands of pilot_band. A band of a thin
+/// the pilot stops at the first band that reaches it. A band of a thin
 /// sheet's 1M points costs ~0.16 s, and all four took 0.63 s where the
-/// insertion then took 2.9.
+/// insertion then took 2.9. `max_share`: the fraction of the generators the
+/// pilot may build, in bands of pilot_band or fewer cells (at least 16)
+/// where that many would exceed it (tessera::voronoi, whose small inputs
+/// need the measure too: 500 points nearly on a sphere take 0.11 s by the
+/// search, 0.014 s from their Delaunay neighbours). 0: bands of pilot_band
+/// in the top hash range that skipped cells leave alone (1 - the highest
+/// skipped fraction).
 template <class CellT>
 PilotEstimate pilot_estimate(const Pass<CellT::dim>& pass, double enough, double max_share = 0) {
   constexpr int D = CellT::dim;
@@ -129,8 +129,8 @@ PilotEstimate pilot_estimate(const Pass<CellT::dim>& pass, double enough, double
   constexpr double slope = rule.slope, lowest = rule.lowest, highest = rule.highest;
   constexpr double unmeasured = D == 3 ? lowest : 0.0;  // too few points for a pilot
   if (pass.order.empty()) return {1.0, unmeasured};
-  // Band k: the points whose hash lies in the k-th pilot_band / n of the
-  // range, counted down from the top (n: the generators).
+  // Band k: the points whose hash lies in the k-th cells / n of the range,
+  // counted down from the top (n: the generators).
   const double share = max_share > 0 ? max_share : 1 - highest;
   const double cells = max_share > 0 ? std::clamp(share * static_cast<double>(pass.order.size()) / pilot_bands, 16.0,
                                                   static_cast<double>(pilot_band))

@@ -102,14 +102,13 @@ std::uint64_t tessellate(const Generators<CellT::dim>& gens, Comp& comp, const E
       if (const NeighbourLists* nl = gens.neighbours) {
         const std::size_t at = gens.slots[g];
         if (const std::int32_t owner = nl->duplicate_of[at]; owner >= 0) {
-          st.has_cell = false;  // and the cell's counts are its predecessor's: not added
+          st.has_cell = false;
           st.duplicate_of = owner;
-          comp.add(batch, gen, st, ws.cell);
+          comp.add(batch, gen, st, ws.cell);  // no cell built: its exact calls are not this one's
           continue;
-        } else {
-          const auto a = static_cast<std::size_t>(nl->offsets[at]), e = static_cast<std::size_t>(nl->offsets[at + 1]);
-          st = ws.builder.build_from(gen, p, std::span<const std::uint32_t>(nl->slots.data() + a, e - a), ws.cell);
         }
+        const auto a = static_cast<std::size_t>(nl->offsets[at]), e = static_cast<std::size_t>(nl->offsets[at + 1]);
+        st = ws.builder.build_from(gen, p, std::span<const std::uint32_t>(nl->slots.data() + a, e - a), ws.cell);
       } else {
         st = ws.builder.build_any(gen, p, ws.cell);
       }
