@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <cstring>
+#include <utility>
 #include <vector>
 
 #include <tbb/parallel_for.h>
@@ -96,17 +97,37 @@ std::optional<engine::NeighbourLists> delaunay_neighbours(const Pass<3>& pass) {
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, m), [&](const tbb::blocked_range<std::size_t>& r) {
       for (std::size_t k = r.begin(); k != r.end(); ++k) rows[k] = slot_of[rows[k]];
     });
-    // Each slot's tetrahedra, ascending: counted and filled serially, so
-    // their order is fixed (one pass each over the rows). m < 2^32: the
-    // insertion holds fewer than 2^29 tetrahedra.
+    // Each slot's tetrahedra, ascending (m < 2^32: the insertion holds
+    // fewer than 2^29 tetrahedra). The rows are cut into one part per
+    // thread (at most 8: each has a count per slot); each part counts its
+    // entries per slot, and fills them after those of the parts before it,
+    // so every slot's list is ascending whatever the number of parts.
+    const std::size_t nparts = std::clamp<std::size_t>(static_cast<std::size_t>(pass.engine_options.threads), 1, 8);
+    std::vector<std::vector<std::uint32_t>> at(nparts, std::vector<std::uint32_t>(located, 0));
+    auto part_range = [&](std::size_t c) { return std::pair{m * c / nparts, m * (c + 1) / nparts}; };
+    tbb::parallel_for(std::size_t{0}, nparts, [&](std::size_t c) {
+      const auto [a, e] = part_range(c);
+      std::uint32_t* const cnt = at[c].data();
+      for (std::size_t k = a; k < e; ++k) ++cnt[rows[k]];
+    });
     std::vector<std::uint32_t> first(located + 1, 0);
-    for (std::size_t k = 0; k < m; ++k) ++first[rows[k] + 1];
-    for (std::size_t k = 0; k < located; ++k) first[k + 1] += first[k];
-    std::vector<std::uint32_t> tets(m);
-    {
-      std::vector<std::uint32_t> at(first.begin(), first.end() - 1);
-      for (std::size_t k = 0; k < m; ++k) tets[at[rows[k]]++] = static_cast<std::uint32_t>(k / 4);
+    for (std::size_t k = 0; k < located; ++k) {
+      std::uint32_t next = first[k];
+      for (std::size_t c = 0; c < nparts; ++c) {  // counts become each part's first place
+        const std::uint32_t n_c = at[c][k];
+        at[c][k] = next;
+        next += n_c;
+      }
+      first[k + 1] = next;
     }
+    std::vector<std::uint32_t> tets(m);
+    tbb::parallel_for(std::size_t{0}, nparts, [&](std::size_t c) {
+      const auto [a, e] = part_range(c);
+      std::uint32_t* const place = at[c].data();
+      for (std::size_t k = a; k < e; ++k) tets[place[rows[k]]++] = static_cast<std::uint32_t>(k / 4);
+    });
+    at.clear();
+    at.shrink_to_fit();
     // The lists per fixed chunk of slots, then laid end to end.
     constexpr std::size_t chunk = 4096;
     constexpr std::size_t ahead = 4;  // slots whose rows are prefetched ahead of their turn
