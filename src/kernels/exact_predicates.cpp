@@ -679,7 +679,10 @@ constexpr bool kExtUsable = std::numeric_limits<Ext>::digits >= 64;
 constexpr Ext kExtBound = 2 * (24 * 0x1p-64L) / (1 - 24 * 0x1p-64L);
 
 // a x b, and the same on absolute values (each product's magnitude summed).
-void cross_ext(const Ext* a, const Ext* b, Ext* out, Ext* out_abs) {
+// Inlined: called out of line, its x87 values went through memory (80-bit
+// loads and stores are microcoded), and the prepare of a rotated lattice's
+// ties took a fifth of its cells' time (216,000 points: 2.10 -> 1.75 s).
+[[gnu::always_inline]] inline void cross_ext(const Ext* a, const Ext* b, Ext* out, Ext* out_abs) {
   out[0] = a[1] * b[2] - a[2] * b[1];
   out[1] = a[2] * b[0] - a[0] * b[2];
   out[2] = a[0] * b[1] - a[1] * b[0];
