@@ -272,7 +272,9 @@ class Hull {
     if (pr.cell != cells_ || pr.p[0] != v.p[0] || pr.p[1] != v.p[1] || pr.p[2] != v.p[2]) {
       pr.cell = cells_;
       for (int k = 0; k < 3; ++k) pr.p[k] = v.p[k];
-      pr.usable = pr.pred.prepare(*exact_, gen_, ids);
+      const bool tried = local_grid_.open(*exact_);
+      pr.usable = tried && pr.pred.prepare(*exact_, gen_, ids);
+      if (tried) local_grid_.record(*exact_, pr.usable);
       pr.extended = !pr.usable && pr.ext.prepare(*exact_, gen_, ids);
     }
     if (pr.usable) return pr.pred.sign(*exact_, j);
@@ -426,6 +428,7 @@ class Hull {
   };
   std::vector<Prepared> prepared_;
   std::uint64_t cells_ = 0;  // cells started by reset (prepared_'s epoch)
+  LocalGridGate local_grid_;  // whether exact_sign tries VertexPredicate
 };
 
 }  // namespace tessera::kernels

@@ -171,7 +171,9 @@ class Tile {
       pr.cell = cells_;
       pr.p[0] = v.p[0];
       pr.p[1] = v.p[1];
-      pr.usable = pr.pred.prepare(*exact_, gen_, ids);
+      const bool tried = local_grid_.open(*exact_);
+      pr.usable = tried && pr.pred.prepare(*exact_, gen_, ids);
+      if (tried) local_grid_.record(*exact_, pr.usable);
       pr.extended = !pr.usable && pr.ext.prepare(*exact_, gen_, ids);
     }
     if (pr.usable) return pr.pred.sign(*exact_, j);
@@ -262,6 +264,7 @@ class Tile {
   };
   std::vector<Prepared> prepared_;
   std::uint64_t cells_ = 0;
+  LocalGridGate local_grid_;  // as Hull's
 };
 
 }  // namespace tessera::kernels
