@@ -909,4 +909,31 @@ TEST(ExactPredicates, GridContext) {
   }
 }
 
+// LocalGridGate: on a global grid it always lets VertexPredicate try; off
+// one, after 64 failures in a row only one vertex in 64, and a success opens
+// it again.
+TEST(ExactPredicates, LocalGridGateClosesAfterRepeatedFailures) {
+  tessera::kernels::LocalGridGate gate;
+  ExactContext off;
+  for (int k = 0; k < 64; ++k) {
+    ASSERT_TRUE(gate.open(off)) << k;
+    gate.record(off, false);
+  }
+  int opened = 0;
+  for (int k = 0; k < 640; ++k) opened += gate.open(off);
+  EXPECT_EQ(opened, 10);
+  while (!gate.open(off)) {
+  }
+  gate.record(off, true);
+  for (int k = 0; k < 10; ++k) EXPECT_TRUE(gate.open(off));
+  std::int32_t grid[3] = {0, 0, 0};
+  ExactContext on;
+  on.grid = grid;
+  tessera::kernels::LocalGridGate always;
+  for (int k = 0; k < 200; ++k) {
+    ASSERT_TRUE(always.open(on));
+    always.record(on, false);
+  }
+}
+
 }  // namespace
