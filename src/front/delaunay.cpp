@@ -277,29 +277,18 @@ inline constexpr std::uint64_t completion_budget = 64;
 /// speak of (PilotEstimate::exact_per_cell; lattices ~53).
 inline constexpr double clean_exact_per_cell = 1.0;
 
-// The triangulation by insertion (front/insertion.hpp) of the located
-// points, exact duplicates left out: of each set of coincident points the
-// lowest id is the vertex, as the cells pass decides.
+// The triangulation by insertion of the located points (front::insert_located).
 Delaunay by_insertion(const front::Pass<3>& pass, Delaunay out) {
   tbb::task_arena(pass.engine_options.threads).execute([&] {
-    // Exact duplicates, bin by bin (BinLocator::lowest_coincident): sorting
-    // every id by its coordinates gathered a cache line per comparison.
+    front::LocatedInsertion ins = front::insert_located(pass);
     const auto& loc = *pass.locator;
-    const std::vector<std::int32_t> lowest = loc.lowest_coincident();
-    std::vector<std::int32_t> distinct;
-    distinct.reserve(loc.size());
-    for (std::size_t k = 0; k < loc.size(); ++k) {
-      if (lowest[k] >= 0) out.duplicates.emplace_back(loc.id(k), lowest[k]);
-      else distinct.push_back(loc.id(k));
-    }
+    for (std::size_t k = 0; k < loc.size(); ++k)
+      if (ins.lowest[k] >= 0) out.duplicates.emplace_back(loc.id(k), ins.lowest[k]);
     std::sort(out.duplicates.begin(), out.duplicates.end());
     out.hull_completed = true;
-    front::InsertionOptions io;
-    io.threads = pass.engine_options.threads;
-    auto rows = front::insertion_delaunay(pass.exact, distinct, pass.gens.lo.data(), pass.gens.hi.data(), io);
-    if (!rows) return;  // all on one plane: no simplex exists
-    out.from_insertion = rows->size() / 4;
-    out.simplices = std::move(*rows);
+    if (!ins.rows) return;  // all on one plane: no simplex exists
+    out.from_insertion = ins.rows->size() / 4;
+    out.simplices = std::move(*ins.rows);
   });
   return out;
 }

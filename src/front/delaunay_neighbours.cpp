@@ -71,16 +71,9 @@ std::optional<engine::NeighbourLists> delaunay_neighbours(const Pass<3>& pass) {
   engine::NeighbourLists out;
   bool flat = false;
   tbb::task_arena(pass.engine_options.threads).execute([&] {
-    // Of each set of coincident points the lowest id is the vertex, as the
-    // cells pass decides (BinLocator::lowest_coincident).
-    out.duplicate_of = loc.lowest_coincident();
-    std::vector<std::int32_t> distinct;
-    distinct.reserve(located);
-    for (std::size_t k = 0; k < located; ++k)
-      if (out.duplicate_of[k] < 0) distinct.push_back(loc.id(k));
-    InsertionOptions io;
-    io.threads = pass.engine_options.threads;
-    auto simplices = insertion_delaunay(pass.exact, distinct, pass.gens.lo.data(), pass.gens.hi.data(), io);
+    LocatedInsertion ins = insert_located(pass);
+    out.duplicate_of = std::move(ins.lowest);
+    auto& simplices = ins.rows;
     if (!simplices) {
       flat = true;
       return;

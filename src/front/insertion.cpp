@@ -18,6 +18,7 @@
 #include <tbb/parallel_sort.h>
 
 #include "id_hash.hpp"
+#include "pass.hpp"
 #include "tessera/kernels/delaunay_predicates.hpp"
 #include "tessera/kernels/filter.hpp"
 
@@ -901,6 +902,22 @@ std::optional<Buffer<std::int32_t>> insertion_delaunay(const ExactContext& ctx, 
   }
   if (options.stats != nullptr) *options.stats = tri.stats();
   return tri.take_rows();
+}
+
+LocatedInsertion insert_located(const Pass<3>& pass) {
+  // Exact duplicates, bin by bin (BinLocator::lowest_coincident): sorting
+  // every id by its coordinates gathered a cache line per comparison.
+  const auto& loc = *pass.locator;
+  LocatedInsertion out;
+  out.lowest = loc.lowest_coincident();
+  std::vector<std::int32_t> distinct;
+  distinct.reserve(loc.size());
+  for (std::size_t k = 0; k < loc.size(); ++k)
+    if (out.lowest[k] < 0) distinct.push_back(loc.id(k));
+  InsertionOptions io;
+  io.threads = pass.engine_options.threads;
+  out.rows = insertion_delaunay(pass.exact, distinct, pass.gens.lo.data(), pass.gens.hi.data(), io);
+  return out;
 }
 
 }  // namespace tessera::front

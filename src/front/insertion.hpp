@@ -29,6 +29,7 @@
 #include <cstdint>
 #include <optional>
 #include <span>
+#include <vector>
 
 #include "tessera/buffer.hpp"
 #include "tessera/kernels/exact_predicates.hpp"
@@ -60,5 +61,18 @@ struct InsertionOptions {
 std::optional<Buffer<std::int32_t>> insertion_delaunay(const kernels::ExactContext& ctx,
                                                        std::span<const std::int32_t> ids, const double* lo,
                                                        const double* hi, const InsertionOptions& options = {});
+
+template <int D>
+struct Pass;
+
+/// insertion_delaunay of a pass's located points, exact duplicates left out:
+/// of each set of coincident points the lowest id is the vertex, as the
+/// cells pass decides. For tessera::delaunay (its rows) and
+/// tessera::voronoi (the cells' neighbours). Call it in the pass's arena.
+struct LocatedInsertion {
+  std::vector<std::int32_t> lowest;          ///< per locator slot: BinLocator::lowest_coincident
+  std::optional<Buffer<std::int32_t>> rows;  ///< nullopt when the points are all on one plane
+};
+LocatedInsertion insert_located(const Pass<3>& pass);
 
 }  // namespace tessera::front

@@ -136,11 +136,11 @@ class CellBuilder {
       }
       cd.r2 = r2;
       cd.id = loc_.id(slots[k]);
-      keys_[k] = (static_cast<std::uint64_t>(std::bit_cast<std::uint32_t>(static_cast<float>(r2 * key_scale_))) << 32) | k;
+      keys_[k] = sort_key(r2, static_cast<std::uint32_t>(k));
     }
     std::uint64_t* const keys = keys_.data();
     sort_keys(keys, keys + n);
-    work_ = 4 * n;
+    status.work = 4 * n;
     for (std::size_t k = 0; k < n; ++k) {
       const Candidate& cd = cand_[static_cast<std::uint32_t>(keys[k])];
       if (cell.clip(cd.id, cd.q) == ClipResult::emptied) [[unlikely]] {
@@ -148,7 +148,6 @@ class CellBuilder {
         break;
       }
     }
-    status.work = work_;
     return status;
   }
 
@@ -217,11 +216,7 @@ class CellBuilder {
           if (r2 > sec2 || j == i) continue;
           cd->r2 = r2;
           cd->id = j;
-          // Sort key: r2 in key units (key_scale_) rounded to float
-          // (non-negative floats order as their bits), then gather order,
-          // which is deterministic.
-          *key++ = (static_cast<std::uint64_t>(std::bit_cast<std::uint32_t>(static_cast<float>(r2 * key_scale_)))
-                    << 32) | m;
+          *key++ = sort_key(r2, m);
           ++cd;
           ++m;
         }
@@ -591,6 +586,14 @@ class CellBuilder {
       for (std::size_t a = 0; a < 4 && i + a < n; ++a)
         first[-(below[a][0] + below[a][1] + below[a][2] + below[a][3])] = whole[i + a];
     }
+  }
+
+  /// A candidate's sort key: r2 in key units (key_scale_) rounded to float
+  /// (non-negative floats order as their bits), then its position in the
+  /// gather, which is deterministic.
+  std::uint64_t sort_key(double r2, std::uint32_t position) const {
+    return (static_cast<std::uint64_t>(std::bit_cast<std::uint32_t>(static_cast<float>(r2 * key_scale_))) << 32) |
+           position;
   }
 
   /// A key's float r2 bits without their low 8 (the compact key's order).
