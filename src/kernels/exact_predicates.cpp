@@ -309,7 +309,11 @@ int exact_clip_sign(const ExactContext& ctx, std::int32_t i, const std::int32_t*
   for (int r = 0; r < dim; ++r) gen[r] = planes[r];
   gen[dim] = j;
   ClipSigns sg;
-  if (!signs_int128(ctx, i, gen, sg)) signs_gmp(ctx, i, gen, sg);
+  if (signs_int128(ctx, i, gen, sg)) return decide(sg, i, gen, dim);
+  WidePredicate wide;
+  int s;
+  if (wide.prepare(ctx, i, planes, j) && wide.sign_on_grid(ctx, j, s)) return s;
+  signs_gmp(ctx, i, gen, sg);
   return decide(sg, i, gen, dim);
 }
 
@@ -488,6 +492,112 @@ int VertexPredicate::sign(const ExactContext& ctx, std::int32_t j) const {
     sign_m = terms_.decide(j, -det_a_sign_, [&](int row) { return row < 0 ? sign_of(wi) : sign_of(dr[row]); });
   }
   return sign_m * det_a_sign_ > 0 ? +1 : -1;
+}
+
+// ---- WidePredicate (see the header for the bounds) ----
+
+bool WidePredicate::prepare(const ExactContext& ctx, std::int32_t i, const std::int32_t* planes, std::int32_t also) {
+  using I = __int128;
+  dim_ = ctx.dim;
+  i_ = i;
+  if (dim_ != 2 && dim_ != 3) return false;
+  for (int r = 0; r < dim_; ++r) gen_[r] = planes[r];
+  // The doubles by their bits (p_i last), and their common grid.
+  DoubleParts pv[Scratch::kRows][Scratch::kMaxDim];
+  GridScale span;
+  const double* pi = ctx.points + static_cast<std::size_t>(i) * dim_;
+  for (int d = 0; d < dim_; ++d) pv[dim_][d] = span.see(pi[d]);
+  for (int r = 0; r < dim_; ++r) {
+    if (gen_[r] >= 0) {
+      const double* pk = ctx.points + static_cast<std::size_t>(gen_[r]) * dim_;
+      for (int d = 0; d < dim_; ++d) pv[r][d] = span.see(pk[d]);
+    } else {
+      const int axis = box_plane_axis(gen_[r]);
+      pv[r][0] = span.see(box_plane_upper(gen_[r]) ? ctx.hi[axis] : ctx.lo[axis]);
+    }
+  }
+  if (also >= 0)
+    for (int d = 0; d < dim_; ++d) span.see(ctx.points[static_cast<std::size_t>(also) * dim_ + d]);
+  if (span.all_zero() || !span.fits(bits)) return false;
+  // The grid as fine as the bound allows, up to two bits of headroom above:
+  // candidates near the vertex may reach a binade lower or higher.
+  shift_ = std::min(span.shift, span.top + 2 - bits);
+  for (int d = 0; d < dim_; ++d) ci_[d] = on_grid(pv[dim_][d], shift_);
+  std::int64_t a[Scratch::kMaxDim][Scratch::kMaxDim] = {};
+  for (int r = 0; r < dim_; ++r) {
+    if (gen_[r] >= 0) {
+      I sq = 0;
+      for (int d = 0; d < dim_; ++d) {
+        const std::int64_t q = on_grid(pv[r][d], shift_) - ci_[d];
+        a[r][d] = 2 * q;
+        sq += static_cast<I>(q) * q;
+      }
+      b_[r] = sq;
+    } else {
+      const int axis = box_plane_axis(gen_[r]);
+      a[r][axis] = 1;
+      b_[r] = on_grid(pv[r][0], shift_) - ci_[axis];
+    }
+  }
+  using W = WideInt<3>;
+  if (dim_ == 2) {
+    cof_[0][0] = a[1][1]; cof_[0][1] = -a[1][0];
+    cof_[1][0] = -a[0][1]; cof_[1][1] = a[0][0];
+  } else {
+    for (int r = 0; r < 3; ++r) {
+      const std::int64_t* u = a[(r + 1) % 3];
+      const std::int64_t* w = a[(r + 2) % 3];
+      cof_[r][0] = static_cast<I>(u[1]) * w[2] - static_cast<I>(u[2]) * w[1];
+      cof_[r][1] = static_cast<I>(u[2]) * w[0] - static_cast<I>(u[0]) * w[2];
+      cof_[r][2] = static_cast<I>(u[0]) * w[1] - static_cast<I>(u[1]) * w[0];
+    }
+  }
+  det_a_ = W::from(0);
+  for (int d = 0; d < dim_; ++d) det_a_ = det_a_ + W::from(a[0][d]) * W::from(cof_[0][d]);
+  det_a_sign_ = det_a_.sign();
+  terms_.set(i_, gen_, dim_);
+  return det_a_sign_ != 0;  // dependent planes: exact_clip_sign reports it
+}
+
+bool WidePredicate::sign_on_grid(const ExactContext& ctx, std::int32_t j, int& out) const {
+  using I = __int128;
+  using W3 = WideInt<3>;
+  using W5 = WideInt<5>;
+  const double* pj = ctx.points + static_cast<std::size_t>(j) * dim_;
+  std::int64_t aj[Scratch::kMaxDim];
+  I bj = 0;
+  for (int d = 0; d < dim_; ++d) {
+    const DoubleParts pt = double_parts(pj[d]);
+    if (pt.mant != 0) {
+      const auto m = static_cast<std::uint64_t>(pt.mant < 0 ? -pt.mant : pt.mant);
+      const int low = pt.e2 + std::countr_zero(m), high = pt.e2 + 64 - std::countl_zero(m);
+      if (low < shift_ || high - shift_ > bits) return false;
+    }
+    const std::int64_t q = on_grid(pt, shift_) - ci_[d];
+    aj[d] = 2 * q;
+    bj += static_cast<I>(q) * q;
+  }
+  // det M0 = b_j det A - sum_r b_r dr_r, dr_r = det A with row r replaced by
+  // a_j (as VertexPredicate::sign); w_i's coefficient det A - the bisector
+  // rows' dr_r, below 4 * 3 * 2^187 < 2^191 (3 limbs).
+  W5 m0 = W5::from(bj) * det_a_.widen<5>();
+  W3 wi = det_a_, dr[Scratch::kMaxDim];
+  for (int r = 0; r < dim_; ++r) {
+    dr[r] = W3::from(0);
+    for (int d = 0; d < dim_; ++d) dr[r] = dr[r] + W3::from(aj[d]) * W3::from(cof_[r][d]);
+    m0 = m0 - W5::from(b_[r]) * dr[r].widen<5>();
+    if (gen_[r] >= 0) wi = wi - dr[r];
+  }
+  int sign_m = m0.sign();
+  if (sign_m == 0)
+    sign_m = terms_.decide(j, -det_a_sign_, [&](int row) { return row < 0 ? wi.sign() : dr[row].sign(); });
+  out = sign_m * det_a_sign_ > 0 ? +1 : -1;
+  return true;
+}
+
+int WidePredicate::sign(const ExactContext& ctx, std::int32_t j) const {
+  int s;
+  return sign_on_grid(ctx, j, s) ? s : exact_clip_sign(ctx, i_, gen_, j);
 }
 
 namespace {

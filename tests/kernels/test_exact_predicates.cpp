@@ -202,6 +202,21 @@ int prepared_sign(const ExactContext& c, std::int32_t i, const std::int32_t* pla
   return vp.sign(c, j);
 }
 
+/// How many queries the fixed-width stage (WidePredicate) served, over the
+/// whole test binary.
+int wide_used = 0;
+
+/// The fixed-width stage's sign: it must agree with exact_clip_sign wherever
+/// it prepares (and is exact_clip_sign for a candidate off its grid).
+int wide_sign(const ExactContext& c, std::int32_t i, const std::int32_t* planes, std::int32_t j) {
+  tessera::kernels::WidePredicate wp;
+  if (!wp.prepare(c, i, planes)) return exact_clip_sign(c, i, planes, j);
+  int s = 0;
+  if (wp.sign_on_grid(c, j, s)) ++wide_used;
+  else s = wp.sign(c, j);
+  return s;
+}
+
 /// The extended-precision stage's sign, 0 when it is unusable or undecided
 /// (counted in extended_decided when it answers).
 int extended_decided = 0;
@@ -218,6 +233,7 @@ int extended_sign(const ExactContext& c, std::int32_t i, const std::int32_t* pla
 int check_sign(const ExactContext& c, std::int32_t i, const std::int32_t* planes, std::int32_t j) {
   const int got = exact_clip_sign(c, i, planes, j);
   EXPECT_EQ(prepared_sign(c, i, planes, j), got) << "prepared: " << describe(c, i, planes, j);
+  EXPECT_EQ(wide_sign(c, i, planes, j), got) << "wide: " << describe(c, i, planes, j);
   if (const int e = extended_sign(c, i, planes, j); e != 0) EXPECT_EQ(e, got) << "extended: " << describe(c, i, planes, j);
   const int want = oracle_sign(c, i, planes, j);
   EXPECT_NE(want, 0) << "oracle: every perturbation coefficient vanished for " << describe(c, i, planes, j);
@@ -241,6 +257,7 @@ int check_views(const ExactContext& c, const std::array<std::int32_t, 4>& defs, 
     do {
       const int s = exact_clip_sign(c, defs[g], others.data(), j);
       EXPECT_EQ(prepared_sign(c, defs[g], others.data(), j), s) << "prepared: " << describe(c, defs[g], others.data(), j);
+      EXPECT_EQ(wide_sign(c, defs[g], others.data(), j), s) << "wide: " << describe(c, defs[g], others.data(), j);
       if (const int e = extended_sign(c, defs[g], others.data(), j); e != 0)
         EXPECT_EQ(e, s) << "extended: " << describe(c, defs[g], others.data(), j);
       EXPECT_TRUE(s == 1 || s == -1) << describe(c, defs[g], others.data(), j);
@@ -605,6 +622,66 @@ TEST(ExactPredicates, GridCornerTies) {
     }
     EXPECT_EQ(checked, dim == 2 ? 4 : (70 - 12) * 4) << "dim " << dim;  // 3D: 4-subsets minus the 12 coplanar ones
   }
+}
+
+// Box corners with full-mantissa coordinates (a lattice of spacing 0.1, voxel
+// centres of a non-dyadic spacing): exactly cospherical, yet on no small
+// grid, so neither VertexPredicate nor the extended stage decides them and
+// WidePredicate must, from every view. In 3D also the tie of a face's four
+// corners with the domain's lower x plane through their midpoints' line
+// (the lattice's boundary cells). Corners spanning more than 60 bits (1e-30
+// next to 1) go to GMP and must agree as well.
+TEST(ExactPredicates, FullMantissaCornerTies) {
+  Rng r(91);
+  const int before = wide_used;
+  for (int dim : {2, 3}) {
+    const int nc = 1 << dim;
+    for (const double offset : {0.0, 5.3, -1234.567, 1e-3, 1e-30}) {
+      Problem p;
+      p.dim = dim;
+      std::array<double, 3> x0{}, x1{};
+      for (int d = 0; d < 3; ++d) {
+        x0[d] = offset + 0.1 * (1 + r.index(50));
+        x1[d] = offset + 0.1 * (51 + r.index(3));
+        if (offset == 1e-30 && d == 0) x0[d] = offset;  // spans ~100 bits with x1
+        p.lo[d] = x0[d] - 0.1;
+        p.hi[d] = x1[d] + 0.1;
+      }
+      for (int m = 0; m < nc; ++m) {
+        std::array<double, 3> x{};
+        for (int d = 0; d < dim; ++d) x[d] = (m >> d & 1) ? x1[d] : x0[d];
+        p.add(x);
+      }
+      if (dim == 3) p.lo[0] = x0[0] - 0.1;
+      const auto c = p.ctx();
+      int checked = 0;
+      for (int mask = 0; mask < (1 << nc); ++mask) {
+        if (__builtin_popcount(static_cast<unsigned>(mask)) != dim + 1) continue;
+        std::array<std::int32_t, 4> defs{};
+        int k = 0;
+        for (int b = 0; b < nc; ++b)
+          if (mask >> b & 1) defs[k++] = b;
+        if (!independent(c, defs[0], defs.data() + 1)) continue;
+        for (std::int32_t j = 0; j < nc; ++j) {
+          if (mask >> j & 1) continue;
+          ASSERT_EQ(power_diff(c, defs[0], defs.data() + 1, j), 0) << "offset " << offset;
+          check_views(c, defs, j);
+          ++checked;
+        }
+      }
+      EXPECT_EQ(checked, dim == 2 ? 4 : (70 - 12) * 4) << "dim " << dim << " offset " << offset;
+      if (dim == 3) {
+        // Corners 0, 2, 4, 6 form the face x = x0; the lower x plane lies 0.1
+        // (rounded) below it, and the vertex on it equidistant from the first
+        // three is equidistant from the fourth.
+        const std::array<std::int32_t, 4> defs{box_plane_id(0, false), 0, 2, 4};
+        ASSERT_EQ(power_diff(c, 0, std::array<std::int32_t, 3>{defs[0], 2, 4}.data(), 6), 0);
+        check_views(c, defs, 6);
+        check_sign(c, 0, std::array<std::int32_t, 3>{defs[0], 2, 4}.data(), 1);  // off the tie
+      }
+    }
+  }
+  EXPECT_GT(wide_used - before, 1000) << "the fixed-width stage hardly ran";
 }
 
 // Exact duplicates p_j == p_i: the lower id keeps its vertices (+1 when i < j,

@@ -32,6 +32,8 @@
 #include <utility>
 #include <vector>
 
+#include "tessera/kernels/wide_int.hpp"
+
 namespace tessera::kernels {
 
 /// Domain-box plane ids as they appear in topological coordinates.
@@ -256,6 +258,47 @@ class ExtendedPredicate {
   L w_[3] = {0, 0, 0}, w_abs_[3] = {0, 0, 0};  // W, and W on absolute values
   L d3_ = 0, d3_abs_ = 0;                     // D3 (2D: D2), and on absolute values
   bool d3_positive_ = false;
+};
+
+/// The stage after ExtendedPredicate, for what it cannot decide: exact ties
+/// and near-ties off any small grid (a lattice of spacing 0.1, whose cube
+/// corners are exactly cospherical while every coordinate has a full
+/// mantissa). exact_clip_sign's sign, computed in fixed-width integers
+/// (WideInt) when the vertex's points, the candidate's and the box
+/// coordinates involved lie on a common grid of at most `bits` bits: any
+/// input whose nearby coordinates share a binade or a few. Prepared once per
+/// vertex, as VertexPredicate; each candidate then costs a few dozen
+/// multiplications instead of GMP's ~1 µs.
+///
+/// The rows are taken relative to p_i (translating the vertex leaves det M
+/// and its last-column cofactors unchanged): a bisector row is (2 q_k,
+/// |q_k|^2) with q_k = p_k - p_i, a box row (e_axis, c - p_i). On the grid
+/// |q| < 2^61, so |a| < 2^62, |b| < 2^124, A's cofactors < 2^125 (int128),
+/// det A and a_j . C_r < 3 * 2^187 (3 limbs), and det M0, four products of a
+/// b and one of those, < 2^315 (5 limbs).
+class WidePredicate {
+ public:
+  /// The bound on the grid integers' magnitude, in bits.
+  static constexpr int bits = 60;
+  /// Prepare for the vertex of cell i where planes[0..dim) meet; `also`, when
+  /// >= 0, is a candidate whose coordinates must fit the grid as well. False
+  /// (unusable) when the points do not fit, or the planes are dependent.
+  bool prepare(const ExactContext& ctx, std::int32_t i, const std::int32_t* planes, std::int32_t also = -1);
+  /// Equal to exact_clip_sign(ctx, i, planes, j); a candidate off the
+  /// vertex's grid goes through exact_clip_sign.
+  int sign(const ExactContext& ctx, std::int32_t j) const;
+  /// The same sign into `out`, or false when p_j is off the vertex's grid.
+  bool sign_on_grid(const ExactContext& ctx, std::int32_t j, int& out) const;
+
+ private:
+  int dim_ = 3, shift_ = 0;
+  std::int32_t i_ = -1, gen_[3] = {0, 0, 0};
+  std::int64_t ci_[3] = {0, 0, 0};  // p_i on the grid
+  __int128 cof_[3][3] = {};         // row r: A's cofactors along row r
+  __int128 b_[3] = {0, 0, 0};
+  WideInt<3> det_a_{};
+  int det_a_sign_ = 0;
+  PerturbationTerms terms_;
 };
 
 /// The vertex of cell `i` where `planes[0..dim)` meet, relative to p_i,

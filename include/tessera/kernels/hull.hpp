@@ -27,6 +27,7 @@
 
 #include "tessera/kernels/exact_predicates.hpp"
 #include "tessera/kernels/filter.hpp"
+#include "tessera/kernels/prepared_signs.hpp"
 
 namespace tessera::kernels {
 
@@ -57,8 +58,7 @@ class Hull {
     for (int a = 0; a < 3; ++a) site_[a] = p[a];
     exact_ = exact;
     may_underflow_ = exact != nullptr && exact->may_underflow;
-    exact_calls_ = 0;
-    ++cells_;
+    signs_.start_cell();
     // Planes and corners are written in place: a local struct copied in
     // would be read back wider than it was written (a store-forwarding stall).
     planes_.resize(box_planes);
@@ -187,7 +187,7 @@ class Hull {
   std::size_t num_vertices() const { return verts_.size(); }
   const std::vector<Vertex>& vertices() const { return verts_; }
   const std::vector<Plane>& planes() const { return planes_; }
-  std::uint64_t exact_calls() const { return exact_calls_; }
+  std::uint64_t exact_calls() const { return signs_.calls(); }
   /// The input's exact context (null in bare kernel tests).
   const ExactContext* exact_context() const { return exact_; }
   /// The triangle (vertex) sharing edge k of triangle t, i.e. the directed
@@ -261,26 +261,11 @@ class Hull {
   }
 
  private:
-  // The exact predicate of vertex slot t, prepared once per vertex: on grid
-  // input a vertex ties with several candidates (VertexPredicate).
+  // The exact sign of vertex slot t against j (prepared_signs.hpp).
   int exact_sign(std::size_t t, std::int32_t j) {
-    ++exact_calls_;
     const Vertex& v = verts_[t];
-    if (prepared_.size() < verts_.size()) prepared_.resize(verts_.size());
-    Prepared& pr = prepared_[t];
-    std::int32_t ids[3] = {planes_[v.p[0]].id, planes_[v.p[1]].id, planes_[v.p[2]].id};
-    if (pr.cell != cells_ || pr.p[0] != v.p[0] || pr.p[1] != v.p[1] || pr.p[2] != v.p[2]) {
-      pr.cell = cells_;
-      for (int k = 0; k < 3; ++k) pr.p[k] = v.p[k];
-      const bool tried = local_grid_.open(*exact_);
-      pr.usable = tried && pr.pred.prepare(*exact_, gen_, ids);
-      if (tried) local_grid_.record(*exact_, pr.usable);
-      pr.extended = !pr.usable && pr.ext.prepare(*exact_, gen_, ids);
-    }
-    if (pr.usable) return pr.pred.sign(*exact_, j);
-    if (pr.extended)
-      if (const int s = pr.ext.sign(*exact_, j); s != 0) return s;
-    return exact_clip_sign(*exact_, gen_, ids, j);
+    const std::int32_t ids[3] = {planes_[v.p[0]].id, planes_[v.p[1]].id, planes_[v.p[2]].id};
+    return signs_.sign(*exact_, gen_, t, v.p, ids, j);
   }
 
   // Every change to the vertex list goes through these, which keep the sign
@@ -399,7 +384,6 @@ class Hull {
   double site_[3] = {};  // the generator's coordinates
   const ExactContext* exact_ = nullptr;
   bool may_underflow_ = false;  // exact_->may_underflow: solve() adds filter::underflow_slack
-  std::uint64_t exact_calls_ = 0;
   std::vector<Plane> planes_;
   std::vector<Vertex> verts_;
   filter::FilterLanes<3> lanes_;  // verts_' filter data, for the sign pass
@@ -413,22 +397,7 @@ class Hull {
   std::vector<std::uint8_t> seen_;
   std::vector<std::uint32_t> loop_;
   std::vector<std::uint32_t> next_;  // for_each_face's successor links
-  // Per vertex slot: its prepared exact predicate, valid while the slot holds
-  // the same planes in the same cell (a cell's local plane indices only grow,
-  // and a removed vertex never returns).
-  // Off the integer grid, the extended-precision stage comes first
-  // (ExtendedPredicate) and GMP decides what it cannot.
-  struct Prepared {
-    std::uint64_t cell = 0;
-    std::uint16_t p[3] = {0, 0, 0};
-    bool usable = false;    // pred: the integer-grid path
-    bool extended = false;  // ext
-    VertexPredicate pred;
-    ExtendedPredicate ext;
-  };
-  std::vector<Prepared> prepared_;
-  std::uint64_t cells_ = 0;  // cells started by reset (prepared_'s epoch)
-  LocalGridGate local_grid_;  // whether exact_sign tries VertexPredicate
+  PreparedSigns<3> signs_;  // the exact stages, prepared per vertex slot
 };
 
 }  // namespace tessera::kernels

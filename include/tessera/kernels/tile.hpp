@@ -21,6 +21,7 @@
 #include "tessera/kernels/exact_predicates.hpp"
 #include "tessera/kernels/filter.hpp"
 #include "tessera/kernels/hull.hpp"  // ClipResult
+#include "tessera/kernels/prepared_signs.hpp"
 
 namespace tessera::kernels {
 
@@ -48,8 +49,7 @@ class Tile {
     for (int a = 0; a < 2; ++a) site_[a] = p[a];
     exact_ = exact;
     may_underflow_ = exact != nullptr && exact->may_underflow;
-    exact_calls_ = 0;
-    ++cells_;
+    signs_.start_cell();
     // Planes and corners are written in place: a local struct copied in
     // would be read back wider than it was written (a store-forwarding stall).
     planes_.resize(box_planes);
@@ -155,31 +155,16 @@ class Tile {
   std::size_t num_vertices() const { return verts_.size(); }
   const std::vector<Vertex>& vertices() const { return verts_; }
   const std::vector<Plane>& planes() const { return planes_; }
-  std::uint64_t exact_calls() const { return exact_calls_; }
+  std::uint64_t exact_calls() const { return signs_.calls(); }
   /// The input's exact context (null in bare kernel tests).
   const ExactContext* exact_context() const { return exact_; }
 
  private:
-  // As Hull::exact_sign: prepared once per vertex (VertexPredicate).
+  // The exact sign of vertex slot t against j (prepared_signs.hpp).
   int exact_sign(std::size_t t, std::int32_t j) {
-    ++exact_calls_;
     const Vertex& v = verts_[t];
-    if (prepared_.size() < verts_.size()) prepared_.resize(verts_.size());
-    Prepared& pr = prepared_[t];
-    std::int32_t ids[2] = {planes_[v.p[0]].id, planes_[v.p[1]].id};
-    if (pr.cell != cells_ || pr.p[0] != v.p[0] || pr.p[1] != v.p[1]) {
-      pr.cell = cells_;
-      pr.p[0] = v.p[0];
-      pr.p[1] = v.p[1];
-      const bool tried = local_grid_.open(*exact_);
-      pr.usable = tried && pr.pred.prepare(*exact_, gen_, ids);
-      if (tried) local_grid_.record(*exact_, pr.usable);
-      pr.extended = !pr.usable && pr.ext.prepare(*exact_, gen_, ids);
-    }
-    if (pr.usable) return pr.pred.sign(*exact_, j);
-    if (pr.extended)
-      if (const int s = pr.ext.sign(*exact_, j); s != 0) return s;
-    return exact_clip_sign(*exact_, gen_, ids, j);
+    const std::int32_t ids[2] = {planes_[v.p[0]].id, planes_[v.p[1]].id};
+    return signs_.sign(*exact_, gen_, t, v.p, ids, j);
   }
 
   // verts_ and its sign-pass mirror (lanes_) change together.
@@ -248,23 +233,12 @@ class Tile {
   double site_[2] = {};  // the generator's coordinates
   const ExactContext* exact_ = nullptr;
   bool may_underflow_ = false;  // exact_->may_underflow: solve() adds filter::underflow_slack
-  std::uint64_t exact_calls_ = 0;
   std::vector<Plane> planes_;
   std::vector<Vertex> verts_;
   filter::FilterLanes<2> lanes_;  // verts_' filter data, for the sign pass
   std::vector<filter::Sign> sign_;
   double security2_ = 0;
-  struct Prepared {  // see Hull::Prepared
-    std::uint64_t cell = 0;
-    std::uint16_t p[2] = {0, 0};
-    bool usable = false;
-    bool extended = false;
-    VertexPredicate pred;
-    ExtendedPredicate ext;
-  };
-  std::vector<Prepared> prepared_;
-  std::uint64_t cells_ = 0;
-  LocalGridGate local_grid_;  // as Hull's
+  PreparedSigns<2> signs_;  // the exact stages, prepared per vertex slot
 };
 
 }  // namespace tessera::kernels

@@ -1,0 +1,85 @@
+// The exact stages of a cell's sign pass, prepared once per vertex.
+//
+// When the float filter cannot decide whether candidate j removes vertex v,
+// the sign is exact_clip_sign's. A vertex is asked against many candidates
+// (on lattices nearly every vertex ties with several), so what depends only
+// on the vertex is prepared once, in the first stage that can serve it:
+//   1. VertexPredicate: the vertex's points on a small integer grid (lattices,
+//      voxel centres, integer and dyadic grids);
+//   2. ExtendedPredicate: x87 extended precision with a certified bound, for
+//      near-ties at the level of double rounding (points normalized onto a
+//      sphere); it answers 0 when unsure;
+//   3. WidePredicate: fixed-width integers on a grid of up to 60 bits, for
+//      exact ties off a small grid (a lattice of spacing 0.1) and what the
+//      extended stage leaves; prepared on the vertex's first such call;
+//   4. exact_clip_sign itself (GMP), for points spanning more bits.
+// Every stage returns the same sign; the order is speed only.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "tessera/kernels/exact_predicates.hpp"
+
+namespace tessera::kernels {
+
+template <int D>
+class PreparedSigns {
+ public:
+  /// A new cell: every slot's preparation is stale.
+  void start_cell() {
+    ++cell_;
+    calls_ = 0;
+  }
+
+  /// exact_clip_sign(ctx, gen, ids, j) for the vertex in slot t, whose local
+  /// plane indices are p[0..D) and their ids ids[0..D). A slot's preparation
+  /// stays valid while it holds the same local planes in the same cell (a
+  /// cell's local plane indices only grow, and a removed vertex never returns).
+  int sign(const ExactContext& ctx, std::int32_t gen, std::size_t t, const std::uint16_t* p, const std::int32_t* ids,
+           std::int32_t j) {
+    ++calls_;
+    if (slots_.size() <= t) slots_.resize(t + 1);
+    Slot& s = slots_[t];
+    bool same = s.cell == cell_;
+    for (int k = 0; k < D; ++k) same &= s.p[k] == p[k];
+    if (!same) {
+      s.cell = cell_;
+      for (int k = 0; k < D; ++k) s.p[k] = p[k];
+      const bool tried = local_grid_.open(ctx);
+      s.grid = tried && s.pred.prepare(ctx, gen, ids);
+      if (tried) local_grid_.record(ctx, s.grid);
+      s.extended = !s.grid && s.ext.prepare(ctx, gen, ids);
+      s.wide = Wide::untried;
+    }
+    if (s.grid) return s.pred.sign(ctx, j);
+    if (s.extended)
+      if (const int r = s.ext.sign(ctx, j); r != 0) return r;
+    if (s.wide == Wide::untried) s.wide = s.wide_pred.prepare(ctx, gen, ids) ? Wide::usable : Wide::unusable;
+    if (s.wide == Wide::usable) return s.wide_pred.sign(ctx, j);
+    return exact_clip_sign(ctx, gen, ids, j);
+  }
+
+  /// Exact evaluations since start_cell.
+  std::uint64_t calls() const { return calls_; }
+
+ private:
+  enum class Wide : std::uint8_t { untried, usable, unusable };
+  struct Slot {
+    std::uint64_t cell = 0;
+    std::uint16_t p[D] = {};
+    bool grid = false;      // pred serves the vertex
+    bool extended = false;  // ext prepared
+    Wide wide = Wide::untried;
+    VertexPredicate pred;
+    ExtendedPredicate ext;
+    WidePredicate wide_pred;
+  };
+  std::vector<Slot> slots_;
+  std::uint64_t cell_ = 0;  // cells started (the slots' epoch)
+  std::uint64_t calls_ = 0;
+  LocalGridGate local_grid_;  // whether a slot tries VertexPredicate
+};
+
+}  // namespace tessera::kernels
