@@ -539,7 +539,6 @@ bool WidePredicate::prepare(const ExactContext& ctx, std::int32_t i, const std::
       b_[r] = on_grid(pv[r][0], shift_) - ci_[axis];
     }
   }
-  using W = WideInt<3>;
   if (dim_ == 2) {
     cof_[0][0] = a[1][1]; cof_[0][1] = -a[1][0];
     cof_[1][0] = -a[0][1]; cof_[1][1] = a[0][0];
@@ -552,8 +551,9 @@ bool WidePredicate::prepare(const ExactContext& ctx, std::int32_t i, const std::
       cof_[r][2] = static_cast<I>(u[0]) * w[1] - static_cast<I>(u[1]) * w[0];
     }
   }
-  det_a_ = W::from(0);
-  for (int d = 0; d < dim_; ++d) det_a_ = det_a_ + W::from(a[0][d]) * W::from(cof_[0][d]);
+  det_a_ = WideInt<3>::from(0);
+  for (int d = 0; d < dim_; ++d)
+    det_a_ = det_a_ + multiply(WideInt<1>::from_int64(a[0][d]), WideInt<2>::from(cof_[0][d]));
   det_a_sign_ = det_a_.sign();
   terms_.set(i_, gen_, dim_);
   return det_a_sign_ != 0;  // dependent planes: exact_clip_sign reports it
@@ -561,8 +561,9 @@ bool WidePredicate::prepare(const ExactContext& ctx, std::int32_t i, const std::
 
 bool WidePredicate::sign_on_grid(const ExactContext& ctx, std::int32_t j, int& out) const {
   using I = __int128;
+  using W1 = WideInt<1>;
+  using W2 = WideInt<2>;
   using W3 = WideInt<3>;
-  using W5 = WideInt<5>;
   const double* pj = ctx.points + static_cast<std::size_t>(j) * dim_;
   std::int64_t aj[Scratch::kMaxDim];
   I bj = 0;
@@ -580,12 +581,12 @@ bool WidePredicate::sign_on_grid(const ExactContext& ctx, std::int32_t j, int& o
   // det M0 = b_j det A - sum_r b_r dr_r, dr_r = det A with row r replaced by
   // a_j (as VertexPredicate::sign); w_i's coefficient det A - the bisector
   // rows' dr_r, below 4 * 3 * 2^187 < 2^191 (3 limbs).
-  W5 m0 = W5::from(bj) * det_a_.widen<5>();
+  WideInt<5> m0 = multiply(W2::from(bj), det_a_);
   W3 wi = det_a_, dr[Scratch::kMaxDim];
   for (int r = 0; r < dim_; ++r) {
     dr[r] = W3::from(0);
-    for (int d = 0; d < dim_; ++d) dr[r] = dr[r] + W3::from(aj[d]) * W3::from(cof_[r][d]);
-    m0 = m0 - W5::from(b_[r]) * dr[r].widen<5>();
+    for (int d = 0; d < dim_; ++d) dr[r] = dr[r] + multiply(W1::from_int64(aj[d]), W2::from(cof_[r][d]));
+    m0 = m0 - multiply(W2::from(b_[r]), dr[r]);
     if (gen_[r] >= 0) wi = wi - dr[r];
   }
   int sign_m = m0.sign();

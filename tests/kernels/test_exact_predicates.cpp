@@ -33,6 +33,7 @@
 #include <vector>
 
 #include "tessera/kernels/exact_predicates.hpp"
+#include "tessera/kernels/prepared_signs.hpp"
 
 namespace {
 
@@ -986,31 +987,21 @@ TEST(ExactPredicates, GridContext) {
   }
 }
 
-// LocalGridGate: on a global grid it always lets VertexPredicate try; off
-// one, after 64 failures in a row only one vertex in 64, and a success opens
-// it again.
-TEST(ExactPredicates, LocalGridGateClosesAfterRepeatedFailures) {
-  tessera::kernels::LocalGridGate gate;
-  ExactContext off;
+// StageGate: open for 64 failures in a row, then once in 64, and open again
+// after a success.
+TEST(ExactPredicates, StageGateClosesAfterRepeatedFailures) {
+  tessera::kernels::StageGate gate;
   for (int k = 0; k < 64; ++k) {
-    ASSERT_TRUE(gate.open(off)) << k;
-    gate.record(off, false);
+    ASSERT_TRUE(gate.open()) << k;
+    gate.record(false);
   }
   int opened = 0;
-  for (int k = 0; k < 640; ++k) opened += gate.open(off);
+  for (int k = 0; k < 640; ++k) opened += gate.open();
   EXPECT_EQ(opened, 10);
-  while (!gate.open(off)) {
+  while (!gate.open()) {
   }
-  gate.record(off, true);
-  for (int k = 0; k < 10; ++k) EXPECT_TRUE(gate.open(off));
-  std::int32_t grid[3] = {0, 0, 0};
-  ExactContext on;
-  on.grid = grid;
-  tessera::kernels::LocalGridGate always;
-  for (int k = 0; k < 200; ++k) {
-    ASSERT_TRUE(always.open(on));
-    always.record(on, false);
-  }
+  gate.record(true);
+  for (int k = 0; k < 10; ++k) EXPECT_TRUE(gate.open());
 }
 
 }  // namespace

@@ -198,28 +198,6 @@ class VertexPredicate {
   PerturbationTerms terms_;
 };
 
-/// Whether a cell should try VertexPredicate's integer path for its next
-/// vertex. On a global grid (ExactContext::grid) always. Off it the path
-/// looks for a grid common to the vertex's points, which fails on every
-/// vertex of, say, a rotated lattice (coordinates with all 53 bits): after 64
-/// failures in a row only one vertex in 64 tries, until one succeeds (a
-/// rotated 60^3 lattice: 6% of its cells' time went to failed tries). Speed
-/// only: every stage decides the same exact sign. One per cell builder.
-class LocalGridGate {
- public:
-  bool open(const ExactContext& ctx) {
-    if (ctx.grid != nullptr || misses_ < 64) return true;
-    return (++skipped_ & 63) == 0;
-  }
-  /// After a try: whether the path was usable.
-  void record(const ExactContext& ctx, bool usable) {
-    if (ctx.grid == nullptr) misses_ = usable ? 0 : misses_ + 1;
-  }
-
- private:
-  std::uint64_t misses_ = 0, skipped_ = 0;
-};
-
 /// The stage between the float filter and exact_clip_sign for a 3D vertex of
 /// three bisectors, asked against many candidates: the same sign, computed
 /// in x87 extended precision (64-bit mantissa) with a certified error bound,

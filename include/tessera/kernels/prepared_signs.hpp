@@ -8,12 +8,13 @@
 //      voxel centres, integer and dyadic grids);
 //   2. ExtendedPredicate: x87 extended precision with a certified bound, for
 //      near-ties at the level of double rounding (points normalized onto a
-//      sphere); it answers 0 when unsure;
+//      sphere); it answers 0 when unsure, as on every exact tie;
 //   3. WidePredicate: fixed-width integers on a grid of up to 60 bits, for
 //      exact ties off a small grid (a lattice of spacing 0.1) and what the
 //      extended stage leaves; prepared on the vertex's first such call;
 //   4. exact_clip_sign itself (GMP), for points spanning more bits.
-// Every stage returns the same sign; the order is speed only.
+// Every stage returns the same sign; the order, and the gates that skip a
+// stage that keeps failing (StageGate), are speed only.
 #pragma once
 
 #include <cstddef>
@@ -23,6 +24,24 @@
 #include "tessera/kernels/exact_predicates.hpp"
 
 namespace tessera::kernels {
+
+/// Whether a stage that keeps failing on an input is still worth trying.
+/// After 64 failures in a row only one try in 64 is let through, until one
+/// succeeds. Speed only: every stage decides the same exact sign. Used for
+/// VertexPredicate off a global grid, whose search for a small grid common
+/// to the vertex's points fails on every vertex of, say, a rotated lattice (6%
+/// of its cells' time went to failed tries), and for ExtendedPredicate, which
+/// cannot decide exact ties (a 0.1-spaced lattice: its prepare took a quarter
+/// of the cells' time, for nothing).
+class StageGate {
+ public:
+  bool open() { return misses_ < 64 || (++skipped_ & 63) == 0; }
+  /// After a try: whether the stage served.
+  void record(bool served) { misses_ = served ? 0 : misses_ + 1; }
+
+ private:
+  std::uint64_t misses_ = 0, skipped_ = 0;
+};
 
 template <int D>
 class PreparedSigns {
@@ -47,15 +66,20 @@ class PreparedSigns {
     if (!same) {
       s.cell = cell_;
       for (int k = 0; k < D; ++k) s.p[k] = p[k];
-      const bool tried = local_grid_.open(ctx);
+      // On a global grid (ExactContext::grid) VertexPredicate always serves.
+      const bool global = ctx.grid != nullptr;
+      const bool tried = global || grid_gate_.open();
       s.grid = tried && s.pred.prepare(ctx, gen, ids);
-      if (tried) local_grid_.record(ctx, s.grid);
-      s.extended = !s.grid && s.ext.prepare(ctx, gen, ids);
+      if (tried && !global) grid_gate_.record(s.grid);
+      s.extended = !s.grid && extended_gate_.open() && s.ext.prepare(ctx, gen, ids);
       s.wide = Wide::untried;
     }
     if (s.grid) return s.pred.sign(ctx, j);
-    if (s.extended)
-      if (const int r = s.ext.sign(ctx, j); r != 0) return r;
+    if (s.extended) {
+      const int r = s.ext.sign(ctx, j);
+      extended_gate_.record(r != 0);
+      if (r != 0) return r;
+    }
     if (s.wide == Wide::untried) s.wide = s.wide_pred.prepare(ctx, gen, ids) ? Wide::usable : Wide::unusable;
     if (s.wide == Wide::usable) return s.wide_pred.sign(ctx, j);
     return exact_clip_sign(ctx, gen, ids, j);
@@ -79,7 +103,8 @@ class PreparedSigns {
   std::vector<Slot> slots_;
   std::uint64_t cell_ = 0;  // cells started (the slots' epoch)
   std::uint64_t calls_ = 0;
-  LocalGridGate local_grid_;  // whether a slot tries VertexPredicate
+  StageGate grid_gate_;      // whether a slot tries VertexPredicate (off a global grid)
+  StageGate extended_gate_;  // whether a slot prepares ExtendedPredicate
 };
 
 }  // namespace tessera::kernels
