@@ -79,7 +79,7 @@ struct WideInt {
 /// shifted by that much is subtracted. Branch-free: the predicate's signs are
 /// random, and a branch on them was mispredicted half the time.
 template <int A, int B>
-WideInt<A + B> multiply(const WideInt<A>& a, const WideInt<B>& b) {
+[[gnu::always_inline]] inline WideInt<A + B> multiply(const WideInt<A>& a, const WideInt<B>& b) {
   WideInt<A + B> r;
   for (int k = 0; k < A + B; ++k) r.limb[k] = 0;
   for (int x = 0; x < A; ++x) {
