@@ -280,7 +280,7 @@ inline constexpr double clean_exact_per_cell = 1.0;
 // The triangulation by insertion of the located points (front::insert_located).
 Delaunay by_insertion(const front::Pass<3>& pass, Delaunay out) {
   tbb::task_arena(pass.engine_options.threads).execute([&] {
-    front::LocatedInsertion ins = front::insert_located(pass);
+    front::LocatedInsertion ins = front::insert_located(pass, pass.engine_options.progress);
     const auto& loc = *pass.locator;
     for (std::size_t k = 0; k < loc.size(); ++k)
       if (ins.lowest[k] >= 0) out.duplicates.emplace_back(loc.id(k), ins.lowest[k]);

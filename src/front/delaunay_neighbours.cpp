@@ -65,13 +65,14 @@ void collect(std::uint32_t s, const std::uint32_t* rows, const std::uint32_t* te
 
 }  // namespace
 
-std::optional<engine::NeighbourLists> delaunay_neighbours(const Pass<3>& pass) {
+std::optional<engine::NeighbourLists> delaunay_neighbours(const Pass<3>& pass,
+                                                          const std::function<void(double)>& progress) {
   const auto& loc = *pass.locator;
   const std::size_t n = pass.points.size() / 3, located = loc.size();
   engine::NeighbourLists out;
   bool flat = false;
   tbb::task_arena(pass.engine_options.threads).execute([&] {
-    LocatedInsertion ins = insert_located(pass);
+    LocatedInsertion ins = insert_located(pass, progress);
     out.duplicate_of = std::move(ins.lowest);
     auto& simplices = ins.rows;
     if (!simplices) {

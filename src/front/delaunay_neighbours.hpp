@@ -11,6 +11,7 @@
 // those points alone is the cell the search would build.
 #pragma once
 
+#include <functional>
 #include <optional>
 
 #include "pass.hpp"
@@ -22,6 +23,9 @@ namespace tessera::front {
 /// ascending order of the tetrahedra it comes from; exact duplicates point
 /// to their lowest coincident id and are no vertex. nullopt when the points
 /// are all on one plane (no tetrahedron exists: the search serves them).
-std::optional<engine::NeighbourLists> delaunay_neighbours(const Pass<3>& pass);
+/// `progress`, when set, is told the fraction of the insertion done, from
+/// the calling thread, and may throw (tessera::Cancelled) to stop.
+std::optional<engine::NeighbourLists> delaunay_neighbours(const Pass<3>& pass,
+                                                          const std::function<void(double)>& progress = {});
 
 }  // namespace tessera::front

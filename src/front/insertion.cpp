@@ -294,7 +294,11 @@ class Triangulation {
   /// in their order; `end` bounds every vertex number so far. A large set
   /// goes through two parallel phases (see phase), cut across different
   /// axes; what they leave is inserted serially.
-  void insert_round(std::vector<std::int32_t> pts, std::size_t end, std::size_t parallel_min) {
+  /// `placed(k)` is told, from the calling thread, that k of the round's
+  /// points are in (after each phase and every 16,384 serial insertions).
+  template <class Placed>
+  void insert_round(std::vector<std::int32_t> pts, std::size_t end, std::size_t parallel_min, Placed&& placed) {
+    const std::size_t total = pts.size();
     const std::size_t threads = workers_.size();
     int cut_axis = -1;
     for (int k = 0; k < 2 && parallel_ && threads > 1 && pts.size() >= parallel_min * threads; ++k) {
@@ -310,13 +314,19 @@ class Triangulation {
       // have). Smaller phases defer many anyway, as their tetrahedra are
       // large next to the slabs.
       if (tried >= 2048 && 3 * pts.size() > tried) parallel_ = false;
+      placed(total - pts.size());
     }
     Worker& w = workers_[0];
     w.last = hint_;
     w.prev = -1;
-    for (const std::int32_t q : pts) {
+    const std::size_t before = total - pts.size();
+    for (std::size_t k = 0; k < pts.size(); ++k) {
       if (w.epoch >= epoch_limit()) reset_marks();
-      if (!insert<false>(w, q)) throw std::logic_error("tessera: insertion: a serial insertion was refused");
+      if (!insert<false>(w, pts[k])) throw std::logic_error("tessera: insertion: a serial insertion was refused");
+      if ((k & 16383) == 16383) {
+        hint_ = w.last;  // the state stays whole if placed() throws
+        placed(before + k + 1);
+      }
     }
     hint_ = w.last;
   }
@@ -898,13 +908,17 @@ std::optional<Buffer<std::int32_t>> insertion_delaunay(const ExactContext& ctx, 
     for (std::size_t i = std::max<std::size_t>(a, 2); i < b; ++i)
       if (i != c && i != d) pts.push_back(static_cast<std::int32_t>(i));
     // Every vertex so far: the round's points, those before, and c and d.
-    tri.insert_round(std::move(pts), std::max(b, d + 1), options.parallel_min);
+    auto placed = [&](std::size_t k) {
+      if (options.progress) options.progress(static_cast<double>(a + k) / static_cast<double>(m));
+    };
+    tri.insert_round(std::move(pts), std::max(b, d + 1), options.parallel_min, placed);
+    if (options.progress) options.progress(static_cast<double>(b) / static_cast<double>(m));
   }
   if (options.stats != nullptr) *options.stats = tri.stats();
   return tri.take_rows();
 }
 
-LocatedInsertion insert_located(const Pass<3>& pass) {
+LocatedInsertion insert_located(const Pass<3>& pass, const std::function<void(double)>& progress) {
   // Exact duplicates, bin by bin (BinLocator::lowest_coincident): sorting
   // every id by its coordinates gathered a cache line per comparison.
   const auto& loc = *pass.locator;
@@ -916,6 +930,7 @@ LocatedInsertion insert_located(const Pass<3>& pass) {
     if (out.lowest[k] < 0) distinct.push_back(loc.id(k));
   InsertionOptions io;
   io.threads = pass.engine_options.threads;
+  io.progress = progress;
   out.rows = insertion_delaunay(pass.exact, distinct, pass.gens.lo.data(), pass.gens.hi.data(), io);
   return out;
 }

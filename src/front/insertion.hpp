@@ -27,6 +27,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <span>
 #include <vector>
@@ -49,6 +50,10 @@ struct InsertionOptions {
   /// Rounds with fewer points than this per thread are inserted serially.
   std::size_t parallel_min = 1024;
   InsertionStats* stats = nullptr;  ///< filled when given
+  /// Called from the calling thread with the fraction of the points
+  /// inserted, after each round, each parallel phase and every 16,384
+  /// serial insertions; may throw (tessera::Cancelled) to stop the run.
+  std::function<void(double)> progress;
 };
 
 /// The Delaunay tetrahedra of the points `ids` (distinct coordinates: no exact
@@ -73,6 +78,7 @@ struct LocatedInsertion {
   std::vector<std::int32_t> lowest;          ///< per locator slot: BinLocator::lowest_coincident
   std::optional<Buffer<std::int32_t>> rows;  ///< nullopt when the points are all on one plane
 };
-LocatedInsertion insert_located(const Pass<3>& pass);
+/// `progress`, when set, as InsertionOptions::progress.
+LocatedInsertion insert_located(const Pass<3>& pass, const std::function<void(double)>& progress = {});
 
 }  // namespace tessera::front

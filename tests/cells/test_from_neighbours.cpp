@@ -216,4 +216,30 @@ TEST(FromNeighbours, AutomaticChoiceFollowsThePilot) {
   EXPECT_TRUE(tessera::validate(f, {}).ok);
 }
 
+// The progress callback sees the insertion (the first half) and then the
+// cells: fractions in [0, 1], never decreasing, ending at 1; one that throws
+// Cancelled during the insertion stops the run there (Ctrl-C in the CLI).
+TEST(FromNeighbours, ProgressAndCancellationDuringInsertion) {
+  const auto p = sphere_points(40000, 916);
+  std::vector<double> seen;
+  tessera::VoronoiOptions o = options(3, std::nullopt, 2);
+  o.cell_method = tessera::CellMethod::insertion;
+  o.progress = [&](double f) { seen.push_back(f); };
+  const tessera::Cells c = tessera::voronoi(std::span<const double>(p), 3, {}, o);
+  EXPECT_TRUE(c.from_insertion);
+  ASSERT_FALSE(seen.empty());
+  EXPECT_TRUE(std::is_sorted(seen.begin(), seen.end()));
+  EXPECT_GE(seen.front(), 0.0);
+  EXPECT_EQ(seen.back(), 1.0);
+  const auto during = std::count_if(seen.begin(), seen.end(), [](double f) { return f > 0 && f < 0.5; });
+  EXPECT_GE(during, 3) << "the insertion reported too little";
+  int calls = 0;
+  o.progress = [&](double f) {
+    ++calls;
+    if (f > 0.1) throw tessera::Cancelled();
+  };
+  EXPECT_THROW(tessera::voronoi(std::span<const double>(p), 3, {}, o), tessera::Cancelled);
+  EXPECT_LT(calls, static_cast<int>(seen.size()) / 2) << "not cancelled during the insertion";
+}
+
 }  // namespace

@@ -271,6 +271,27 @@ TEST(Insertion, AutomaticChoiceFollowsThePilot) {
   EXPECT_GT(ties.from_cells, 0u);
 }
 
+// tessera::delaunay by insertion reports its progress (never decreasing,
+// ending at 1) and stops when the callback throws Cancelled.
+TEST(Insertion, ProgressAndCancellation) {
+  const auto uniform = uniform_points(60000, 3, 47);
+  tessera::DelaunayOptions o;
+  o.dim = 3;
+  o.threads = 2;
+  o.method = tessera::DelaunayMethod::insertion;
+  std::vector<double> seen;
+  o.progress = [&](double f) { seen.push_back(f); };
+  const tessera::Delaunay dt = tessera::delaunay(uniform, 3, {}, o);
+  EXPECT_EQ(dt.from_insertion, dt.n_simplices());
+  ASSERT_GE(seen.size(), 5u);
+  EXPECT_TRUE(std::is_sorted(seen.begin(), seen.end()));
+  EXPECT_EQ(seen.back(), 1.0);
+  o.progress = [](double f) {
+    if (f > 0.2) throw tessera::Cancelled();
+  };
+  EXPECT_THROW(tessera::delaunay(uniform, 3, {}, o), tessera::Cancelled);
+}
+
 TEST(Insertion, AutomaticChoiceTakesItWhereTheCellsPassWouldStall) {
   std::mt19937_64 rng(46);
   std::normal_distribution<double> g;
