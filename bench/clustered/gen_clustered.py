@@ -30,6 +30,12 @@ Near-degenerate sets (ties to within rounding everywhere; docs/design.md,
              (a lattice with float noise).
   sphere     N points uniform on the unit sphere (every point on the hull,
              all nearly cospherical with the centre).
+  lat01      the k^3 lattice of spacing 0.1 (0.1 * i in doubles): every cube
+             corner an exact tie, every coordinate a full mantissa, so no
+             small integer grid holds them.
+  voxels     voxel centres of a scan: origin (-20.5, -18.25, -30.1), spacing
+             (0.7, 0.7, 1.2) mm, k^3 of them (exact ties off any small grid,
+             as lat01, on an anisotropic lattice).
 """
 import argparse
 
@@ -99,13 +105,21 @@ def latjit(rng, n):
     return g + rng.uniform(-1e-9, 1e-9, g.shape)
 
 
+def lat01(rng, n):
+    return 0.1 * _lattice(n)
+
+
+def voxels(rng, n):
+    return np.array([-20.5, -18.25, -30.1]) + np.array([0.7, 0.7, 1.2]) * _lattice(n)
+
+
 def sphere(rng, n):
     p = rng.normal(size=(n, 3))
     return p / np.linalg.norm(p, axis=1)[:, None]
 
 
 KINDS = {"blobs": blobs, "sheet": sheet, "hier": hier, "terrain": terrain, "ellipsoid": ellipsoid, "torus": torus,
-         "latrot": latrot, "latjit": latjit, "sphere": sphere}
+         "latrot": latrot, "latjit": latjit, "sphere": sphere, "lat01": lat01, "voxels": voxels}
 
 
 def main():

@@ -6,7 +6,7 @@
 # known limits); this script keeps that visible.
 #
 # usage: bench/clustered/run.sh [BUILD_DIR] [N]
-#   env: KINDS (default "blobs sheet hier"; the surfaces: "terrain ellipsoid torus"; near-degenerate: "latrot latjit sphere"), REPEAT (default 3), THREADS (default 2),
+#   env: KINDS (default "blobs sheet hier"; the surfaces: "terrain ellipsoid torus"; near-degenerate: "latrot latjit sphere"; ties off a small grid: "lat01 voxels"), REPEAT (default 3), THREADS (default 2),
 #        VORO=0 skips Voro++ (single-threaded; minutes per input at 1e6), CELLS=0 skips Tessera's cells,
 #        SEARCH=1 also times the cells with --method search (tool "tessera-search"; the default is auto),
 #        TIMEOUT per command in seconds (default 900), DATA (default bench/data, git-ignored),
