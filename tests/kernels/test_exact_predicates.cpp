@@ -594,6 +594,31 @@ TEST(ExactPredicates, CosphericalTies) { lattice_ties(3, 27, 0, 33); }        //
 TEST(ExactPredicates, CosphericalTiesBoxFace) { lattice_ties(3, 50, 1, 34); } // on x0
 TEST(ExactPredicates, CosphericalTiesBoxEdge) { lattice_ties(3, 50, 2, 35); } // on x0 and y0
 
+/// The 2^dim corners of a box, the context's points 0.. in binary order
+/// (bit d: the upper side on axis d), tie at their common vertex. Every
+/// (dim+1)-subset that defines a vertex, with every other corner as j, is an
+/// exact tie and goes through check_views. Returns how many were checked
+/// (3D: 4-subsets minus the 12 coplanar ones, times 4).
+int check_corner_ties(const ExactContext& c) {
+  const int nc = 1 << c.dim;
+  int checked = 0;
+  for (int mask = 0; mask < (1 << nc); ++mask) {
+    if (__builtin_popcount(static_cast<unsigned>(mask)) != c.dim + 1) continue;
+    std::array<std::int32_t, 4> defs{};
+    int k = 0;
+    for (int b = 0; b < nc; ++b)
+      if (mask >> b & 1) defs[k++] = b;
+    if (!independent(c, defs[0], defs.data() + 1)) continue;
+    for (std::int32_t j = 0; j < nc; ++j) {
+      if (mask >> j & 1) continue;
+      EXPECT_EQ(power_diff(c, defs[0], defs.data() + 1, j), 0) << describe(c, defs[0], defs.data() + 1, j);
+      check_views(c, defs, j);
+      ++checked;
+    }
+  }
+  return checked;
+}
+
 // Square and cube corners: the classic degenerate grid vertex, seen from all
 // 4 (2D) / 8 (3D) corners with every choice of defining corners.
 TEST(ExactPredicates, GridCornerTies) {
@@ -604,24 +629,7 @@ TEST(ExactPredicates, GridCornerTies) {
     p.hi = {2, 2, 2};
     const int nc = 1 << dim;
     for (int m = 0; m < nc; ++m) p.add({0.1 * (m & 1), 0.1 * ((m >> 1) & 1), 0.1 * ((m >> 2) & 1)});
-    const auto c = p.ctx();
-    int checked = 0;
-    // Every (dim+1)-subset of corners that defines a vertex, every other corner as j.
-    for (int mask = 0; mask < (1 << nc); ++mask) {
-      if (__builtin_popcount(static_cast<unsigned>(mask)) != dim + 1) continue;
-      std::array<std::int32_t, 4> defs{};
-      int k = 0;
-      for (int b = 0; b < nc; ++b)
-        if (mask >> b & 1) defs[k++] = b;
-      if (!independent(c, defs[0], defs.data() + 1)) continue;
-      for (std::int32_t j = 0; j < nc; ++j) {
-        if (mask >> j & 1) continue;
-        EXPECT_EQ(power_diff(c, defs[0], defs.data() + 1, j), 0);
-        check_views(c, defs, j);
-        ++checked;
-      }
-    }
-    EXPECT_EQ(checked, dim == 2 ? 4 : (70 - 12) * 4) << "dim " << dim;  // 3D: 4-subsets minus the 12 coplanar ones
+    EXPECT_EQ(check_corner_ties(p.ctx()), dim == 2 ? 4 : (70 - 12) * 4) << "dim " << dim;
   }
 }
 
@@ -653,24 +661,8 @@ TEST(ExactPredicates, FullMantissaCornerTies) {
         for (int d = 0; d < dim; ++d) x[d] = (m >> d & 1) ? x1[d] : x0[d];
         p.add(x);
       }
-      if (dim == 3) p.lo[0] = x0[0] - 0.1;
       const auto c = p.ctx();
-      int checked = 0;
-      for (int mask = 0; mask < (1 << nc); ++mask) {
-        if (__builtin_popcount(static_cast<unsigned>(mask)) != dim + 1) continue;
-        std::array<std::int32_t, 4> defs{};
-        int k = 0;
-        for (int b = 0; b < nc; ++b)
-          if (mask >> b & 1) defs[k++] = b;
-        if (!independent(c, defs[0], defs.data() + 1)) continue;
-        for (std::int32_t j = 0; j < nc; ++j) {
-          if (mask >> j & 1) continue;
-          ASSERT_EQ(power_diff(c, defs[0], defs.data() + 1, j), 0) << "offset " << offset;
-          check_views(c, defs, j);
-          ++checked;
-        }
-      }
-      EXPECT_EQ(checked, dim == 2 ? 4 : (70 - 12) * 4) << "dim " << dim << " offset " << offset;
+      EXPECT_EQ(check_corner_ties(c), dim == 2 ? 4 : (70 - 12) * 4) << "dim " << dim << " offset " << offset;
       if (dim == 3) {
         // Corners 0, 2, 4, 6 form the face x = x0; the lower x plane lies 0.1
         // (rounded) below it, and the vertex on it equidistant from the first
