@@ -19,7 +19,9 @@
 // sign(P) = sign(det M) * sign(det A). det M is linear in the weights; its
 // coefficients are the last-column cofactors, so the perturbed sign costs
 // nothing beyond the determinant. All of it is evaluated on the input doubles
-// scaled to integers (every double is an integer times a power of two) in GMP.
+// scaled to integers (every double is an integer times a power of two): in
+// 64/128-bit integers on a grid of at most 22 bits, in fixed-width integers
+// (WidePredicate) on one of at most 60, else in GMP.
 #pragma once
 
 #include <algorithm>
