@@ -24,6 +24,25 @@ std::int64_t on_grid(const DoubleParts& pt, int shift) {
   return k >= 0 ? pt.mant * (std::int64_t{1} << k) : pt.mant >> -k;
 }
 
+// The doubles of a vertex's rows by their bits, and their common grid: p_i
+// into pv[rows], each generator row's point into pv[r], a box row's constant
+// into pv[r][0]. For the integer paths, which go on to put them on the grid.
+void row_parts(const ExactContext& ctx, std::int32_t i, const std::int32_t* gen, int rows, DoubleParts (*pv)[3],
+               GridScale& span) {
+  const int dim = ctx.dim;
+  const double* pi = ctx.points + static_cast<std::size_t>(i) * dim;
+  for (int d = 0; d < dim; ++d) pv[rows][d] = span.see(pi[d]);
+  for (int r = 0; r < rows; ++r) {
+    if (gen[r] >= 0) {
+      const double* pk = ctx.points + static_cast<std::size_t>(gen[r]) * dim;
+      for (int d = 0; d < dim; ++d) pv[r][d] = span.see(pk[d]);
+    } else {
+      const int axis = box_plane_axis(gen[r]);
+      pv[r][0] = span.see(box_plane_upper(gen[r]) ? ctx.hi[axis] : ctx.lo[axis]);
+    }
+  }
+}
+
 // Scratch integers reused across calls on one thread: the exact path is rare on
 // random input but common on lattices, and GMP allocation would dominate it.
 struct Scratch {
@@ -185,27 +204,10 @@ bool signs_int128(const ExactContext& ctx, std::int32_t i, const std::int32_t* g
   const int dim = ctx.dim, rows = dim + 1;
   if (dim != 2 && dim != 3) return false;
   constexpr int kBits = 22;
-  const double* pi = ctx.points + static_cast<std::size_t>(i) * dim;
-  // Gather the doubles: p_i, then per row either p_k or the box constant.
-  double v[Scratch::kRows + 1][Scratch::kMaxDim];
-  for (int d = 0; d < dim; ++d) v[rows][d] = pi[d];
-  for (int r = 0; r < rows; ++r) {
-    if (gen[r] >= 0) {
-      const double* pk = ctx.points + static_cast<std::size_t>(gen[r]) * dim;
-      for (int d = 0; d < dim; ++d) v[r][d] = pk[d];
-    } else {
-      int axis = box_plane_axis(gen[r]);
-      v[r][0] = box_plane_upper(gen[r]) ? ctx.hi[axis] : ctx.lo[axis];
-    }
-  }
   // Each double by its bits (double_parts), and the common scale.
   DoubleParts pv[Scratch::kRows + 1][Scratch::kMaxDim];
   GridScale span;
-  for (int d = 0; d < dim; ++d) pv[rows][d] = span.see(v[rows][d]);
-  for (int r = 0; r < rows; ++r) {
-    if (gen[r] >= 0) for (int d = 0; d < dim; ++d) pv[r][d] = span.see(v[r][d]);
-    else pv[r][0] = span.see(v[r][0]);
-  }
+  row_parts(ctx, i, gen, rows, pv, span);
   if (!span.fits(kBits)) return false;
   const int shift = span.scale();
   auto scaled_p = [&](const DoubleParts& pt) { return on_grid(pt, shift); };
@@ -392,21 +394,8 @@ bool VertexPredicate::prepare(const ExactContext& ctx, std::int32_t i, const std
   }
   // The vertex's doubles by their bits, and their common grid.
   DoubleParts pv[Scratch::kRows][Scratch::kMaxDim];
-  int nd[Scratch::kRows];
-  const double* pi = ctx.points + static_cast<std::size_t>(i) * dim_;
   GridScale span;
-  for (int d = 0; d < dim_; ++d) pv[dim_][d] = span.see(pi[d]);
-  for (int r = 0; r < dim_; ++r) {
-    if (gen_[r] >= 0) {
-      const double* pk = ctx.points + static_cast<std::size_t>(gen_[r]) * dim_;
-      for (int d = 0; d < dim_; ++d) pv[r][d] = span.see(pk[d]);
-      nd[r] = dim_;
-    } else {
-      const int axis = box_plane_axis(gen_[r]);
-      pv[r][0] = span.see(box_plane_upper(gen_[r]) ? ctx.hi[axis] : ctx.lo[axis]);
-      nd[r] = 1;
-    }
-  }
+  row_parts(ctx, i, gen_, dim_, pv, span);
   if (!span.fits(kBits)) return false;
   shift_ = span.scale();
   auto scaled = [&](const DoubleParts& pt) { return on_grid(pt, shift_); };
@@ -417,7 +406,7 @@ bool VertexPredicate::prepare(const ExactContext& ctx, std::int32_t i, const std
   }
   std::int64_t a[Scratch::kMaxDim][Scratch::kMaxDim] = {};
   for (int r = 0; r < dim_; ++r) {
-    if (nd[r] == dim_) {
+    if (gen_[r] >= 0) {
       I sq = 0;
       for (int d = 0; d < dim_; ++d) {
         const std::int64_t x = scaled(pv[r][d]);
@@ -466,10 +455,7 @@ int VertexPredicate::sign(const ExactContext& ctx, std::int32_t j) const {
       xj[d] = ctx.grid[static_cast<std::size_t>(j) * dim_ + d];
       continue;
     }
-    GridScale span;  // p_j's coordinate: on the vertex's grid, within its bounds?
-    const DoubleParts pt = span.see(pj[d]);
-    if (pt.mant != 0 && (span.shift < shift_ || span.top - shift_ > kBits)) return exact_clip_sign(ctx, i_, gen_, j);
-    xj[d] = on_grid(pt, shift_);
+    if (!grid_integer(pj[d], shift_, kBits, xj[d])) return exact_clip_sign(ctx, i_, gen_, j);
   }
   std::int64_t aj[Scratch::kMaxDim];
   I bj = -ci2_;
@@ -505,17 +491,7 @@ bool WidePredicate::prepare(const ExactContext& ctx, std::int32_t i, const std::
   // The doubles by their bits (p_i last), and their common grid.
   DoubleParts pv[Scratch::kRows][Scratch::kMaxDim];
   GridScale span;
-  const double* pi = ctx.points + static_cast<std::size_t>(i) * dim_;
-  for (int d = 0; d < dim_; ++d) pv[dim_][d] = span.see(pi[d]);
-  for (int r = 0; r < dim_; ++r) {
-    if (gen_[r] >= 0) {
-      const double* pk = ctx.points + static_cast<std::size_t>(gen_[r]) * dim_;
-      for (int d = 0; d < dim_; ++d) pv[r][d] = span.see(pk[d]);
-    } else {
-      const int axis = box_plane_axis(gen_[r]);
-      pv[r][0] = span.see(box_plane_upper(gen_[r]) ? ctx.hi[axis] : ctx.lo[axis]);
-    }
-  }
+  row_parts(ctx, i, gen_, dim_, pv, span);
   if (also >= 0)
     for (int d = 0; d < dim_; ++d) span.see(ctx.points[static_cast<std::size_t>(also) * dim_ + d]);
   if (span.all_zero() || !span.fits(bits)) return false;
@@ -568,13 +544,9 @@ bool WidePredicate::sign_on_grid(const ExactContext& ctx, std::int32_t j, int& o
   std::int64_t aj[Scratch::kMaxDim];
   I bj = 0;
   for (int d = 0; d < dim_; ++d) {
-    const DoubleParts pt = double_parts(pj[d]);
-    if (pt.mant != 0) {
-      const auto m = static_cast<std::uint64_t>(pt.mant < 0 ? -pt.mant : pt.mant);
-      const int low = pt.e2 + std::countr_zero(m), high = pt.e2 + 64 - std::countl_zero(m);
-      if (low < shift_ || high - shift_ > bits) return false;
-    }
-    const std::int64_t q = on_grid(pt, shift_) - ci_[d];
+    std::int64_t x;
+    if (!grid_integer(pj[d], shift_, bits, x)) return false;
+    const std::int64_t q = x - ci_[d];
     aj[d] = 2 * q;
     bj += static_cast<I>(q) * q;
   }

@@ -67,6 +67,25 @@ inline DoubleParts double_parts(double x) {
   return {(bits >> 63) ? -sm : sm, e2};
 }
 
+/// x / 2^shift into `out` when that is an integer below 2^bits in magnitude
+/// (x lies on the grid of step 2^shift, within its bound); false otherwise.
+/// Read from the bits, not computed in floating point: x * 2^-shift can
+/// round (a subnormal x halved rounds to a neighbour, or to zero), and a
+/// rounded value would pass for a grid point.
+inline bool grid_integer(double x, int shift, int bits, std::int64_t& out) {
+  const DoubleParts pt = double_parts(x);
+  if (pt.mant == 0) {
+    out = 0;
+    return true;
+  }
+  const auto m = static_cast<std::uint64_t>(pt.mant < 0 ? -pt.mant : pt.mant);
+  const int low = pt.e2 + std::countr_zero(m), high = pt.e2 + 64 - std::countl_zero(m);
+  if (low < shift || high - shift > bits) return false;  // off the grid, or |x| / 2^shift >= 2^bits
+  const int k = pt.e2 - shift;
+  out = k >= 0 ? pt.mant * (std::int64_t{1} << k) : pt.mant >> -k;  // exact: the bits shifted out are zero
+  return true;
+}
+
 /// The common grid of a set of doubles (lattices, voxel centres, integer and
 /// dyadic grids): see() each value; then every one is an integer times
 /// 2^shift, below 2^top in magnitude, so fits(bits) says whether those
@@ -89,24 +108,13 @@ struct GridScale {
   /// The grid's exponent (0 when every value seen was zero).
   int scale() const { return all_zero() ? 0 : shift; }
   /// x / 2^scale() when it is an integer below 2^bits in magnitude (x on the
-  /// grid). Read from the bits, not computed in floating point: x * 2^-scale()
-  /// can round (a subnormal x halved rounds to a neighbour, or to zero), and a
-  /// rounded value would pass for a grid point.
-  bool scaled(double x, int bits, std::int64_t& out) const {
-    const DoubleParts pt = double_parts(x);
-    if (pt.mant == 0) {
-      out = 0;
-      return true;
-    }
-    const auto m = static_cast<std::uint64_t>(pt.mant < 0 ? -pt.mant : pt.mant);
-    const int low = pt.e2 + std::countr_zero(m), high = pt.e2 + 64 - std::countl_zero(m);
-    const int s = scale();
-    if (low < s || high - s > bits) return false;  // off the grid, or |x| / 2^s >= 2^bits
-    const int k = pt.e2 - s;
-    out = k >= 0 ? pt.mant * (std::int64_t{1} << k) : pt.mant >> -k;  // exact: the bits shifted out are zero
-    return true;
-  }
+  /// grid): grid_integer.
+  bool scaled(double x, int bits, std::int64_t& out) const;
 };
+
+inline bool GridScale::scaled(double x, int bits, std::int64_t& out) const {
+  return grid_integer(x, scale(), bits, out);
+}
 
 /// Everything the exact predicate needs to know about the input.
 struct ExactContext {
