@@ -98,5 +98,12 @@ def test_insertion_method_gives_the_same_simplices():
     assert ins.from_insertion == ins.nsimplex and cells.from_insertion == 0
     with pytest.raises(ValueError, match="method"):
         tessera.delaunay(pts, method="qhull")
-    with pytest.raises(ValueError, match="3D only"):
-        tessera.delaunay(random_points(100, 2, seed=1), method="insertion")
+    # 2D: points on a circle (whose cells each reach the centre) and random ones.
+    t = np.random.default_rng(3).random(3000) * 2 * np.pi
+    for p2 in (np.c_[np.cos(t), np.sin(t)], random_points(3000, 2, seed=1)):
+        by_cells = tessera.delaunay(p2, method="cells")
+        by_insertion = tessera.delaunay(p2, method="insertion")
+        assert np.array_equal(by_cells.simplices, by_insertion.simplices)
+        assert by_insertion.from_insertion == by_insertion.nsimplex and by_cells.from_insertion == 0
+    with pytest.raises(ValueError, match="whole convex hull"):
+        tessera.delaunay(random_points(100, 2, seed=1), method="insertion", labels=np.zeros(100, np.int32))

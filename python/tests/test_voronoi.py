@@ -142,7 +142,15 @@ def test_method_insertion_gives_the_searched_cells():
     np.testing.assert_allclose(searched.volumes, auto.volumes, rtol=1e-12)
     assert auto.validate()
     assert not tessera.voronoi(random_points(500, 3)).from_insertion
-    assert not tessera.voronoi(random_points(500, 2), method="insertion").from_insertion  # 2D searches
+    # 2D: points on a circle, whose searched cells each test every point.
+    t = np.random.default_rng(5).random(1500) * 2 * np.pi
+    c = np.c_[np.cos(t), np.sin(t)]
+    searched2, auto2 = tessera.voronoi(c, method="search"), tessera.voronoi(c)
+    assert not searched2.from_insertion and auto2.from_insertion
+    assert np.array_equal(searched2.neighbors, auto2.neighbors)
+    assert np.array_equal(searched2.neighbor_offsets, auto2.neighbor_offsets)
+    np.testing.assert_allclose(searched2.volumes, auto2.volumes, rtol=1e-12)
+    assert not tessera.voronoi(random_points(500, 2)).from_insertion
     with pytest.raises(ValueError, match="method must be 'auto', 'search' or 'insertion'"):
         tessera.voronoi(v, method="cells")
 

@@ -41,9 +41,19 @@ int resolve_threads(int requested) {
 namespace {
 
 /// From this pilot ratio on (front/pilot.hpp: the cells' search work per
-/// Delaunay simplex they find, relative to uniform input), 3D cells are
-/// clipped by their Delaunay neighbours (CellMethod::insertion).
-inline double neighbours_ratio(int threads) { return 2.0 * std::sqrt(std::max(threads, 2) / 2.0); }
+/// Delaunay simplex they find, relative to uniform input), cells are
+/// clipped by their Delaunay neighbours (CellMethod::insertion). The same
+/// for every thread count: the two methods' cells differ in the last bits of
+/// their volumes and centroids (the clip order differs), and the output must
+/// not depend on the thread count. In 3D the two methods are level at about
+/// 2 on two threads (docs/design.md, "Cells from Delaunay neighbours"). In
+/// 2D the insertion is serial: 200k uniform points take 0.23 s on one
+/// thread and 0.12 s on two by the search, 0.30 s and 0.20 s by insertion,
+/// which costs about the same on any input, while the search grows as
+/// ratio^0.7 (curves, segments and blobs of 200k points: ratios 6-7,
+/// 0.34-0.46 s on two threads, 0.20-0.23 s by insertion); level at ~1.45 on
+/// one thread and ~2.1 on two.
+inline constexpr double neighbours_ratio = 2.0;
 /// The share of the generators the pilot may build: on small inputs too.
 inline constexpr double pilot_share = 0.5;
 
@@ -61,17 +71,17 @@ Cells run(std::span<const double> input, std::span<const std::int32_t> labels, c
   // Without coincident points, a merged vertex's owner is known while its
   // cell is added, and only owners keep its position (CellsCompositor).
   const bool owners_known = opt.build_mesh && !pass.locator->may_have_coincident();
-  // 3D cells whose search would cost far more than on uniform points
-  // (points nearly on a sphere, surface samples, dense clusters) are
-  // clipped by their Delaunay neighbours instead: the same cells
-  // (docs/design.md, "Cells from Delaunay neighbours").
+  // Cells whose search would cost far more than on uniform points (points
+  // nearly on a sphere, surface samples, dense clusters; in 2D points on a
+  // circle, along curves, in blobs) are clipped by their Delaunay
+  // neighbours instead: the same cells (docs/design.md, "Cells from
+  // Delaunay neighbours").
   std::optional<engine::NeighbourLists> neighbours;
-  if constexpr (D == 3) {
+  {
     bool insert = opt.cell_method == CellMethod::insertion;
     if (opt.cell_method == CellMethod::automatic) {
-      const double from = neighbours_ratio(pass.engine_options.threads);
-      const front::PilotEstimate e = front::pilot_estimate<CellT>(pass, from, pilot_share);
-      insert = e.ratio >= from;
+      const front::PilotEstimate e = front::pilot_estimate<CellT>(pass, neighbours_ratio, pilot_share);
+      insert = e.ratio >= neighbours_ratio;
     }
     if (insert) {
       // The progress bar gives the insertion its first half, the cells the

@@ -245,7 +245,7 @@ std::vector<std::uint8_t> choose_skipped(const front::Pass<D>& pass, double frac
 }
 
 
-/// From this pilot ratio on, 3D points go to insertion rather than to the
+/// From this pilot ratio on, points go to insertion rather than to the
 /// cells. Both build the same rows, so the choice may follow the thread
 /// count. Measured at 1M points (docs/design.md, "Insertion for costly
 /// inputs"): insertion takes ~4.5-5 s on one thread whatever the input,
@@ -261,7 +261,17 @@ std::vector<std::uint8_t> choose_skipped(const front::Pass<D>& pass, double frac
 /// beyond two threads it grows as sqrt(threads), a model (the cells scale
 /// nearly linearly, the phases defer more as their slabs thin), not a
 /// measurement.
-inline double insertion_ratio(int threads) { return 1.6 * std::sqrt(std::max(threads, 1) / 2.0); }
+///
+/// In 2D the insertion is serial (insertion_2d.cpp) and cheap: 0.87 s for
+/// 1M uniform points, 0.15 s for 200k, about the same on curves, blobs and
+/// segments. The cells take 1.13 s on one thread and 0.58 s on two at 1M
+/// uniform points, 0.125 s on two at 200k, and on 200k clustered points
+/// (ratios 6-7) 0.29-0.34 s on two: about ratio^0.55. Level on two threads
+/// at a ratio of ~1.4 (1M) to 1 (200k): 1.4 on two threads, as sqrt(threads).
+template <int D>
+double insertion_ratio(int threads) {
+  return (D == 3 ? 1.6 : 1.4) * std::sqrt(std::max(threads, 1) / 2.0);
+}
 
 /// Completion's budget, in candidates its wraps consider per input point,
 /// beyond which the automatic method turns to insertion. Measured per point
@@ -278,7 +288,8 @@ inline constexpr std::uint64_t completion_budget = 64;
 inline constexpr double clean_exact_per_cell = 1.0;
 
 // The triangulation by insertion of the located points (front::insert_located).
-Delaunay by_insertion(const front::Pass<3>& pass, Delaunay out) {
+template <int D>
+Delaunay by_insertion(const front::Pass<D>& pass, Delaunay out) {
   tbb::task_arena(pass.engine_options.threads).execute([&] {
     front::LocatedInsertion ins = front::insert_located(pass, pass.engine_options.progress);
     const auto& loc = *pass.locator;
@@ -287,7 +298,7 @@ Delaunay by_insertion(const front::Pass<3>& pass, Delaunay out) {
     std::sort(out.duplicates.begin(), out.duplicates.end());
     out.hull_completed = true;
     if (!ins.rows) return;  // all on one plane: no simplex exists
-    out.from_insertion = ins.rows->size() / 4;
+    out.from_insertion = ins.rows->size() / (D + 1);
     out.simplices = std::move(*ins.rows);
   });
   return out;
@@ -314,17 +325,20 @@ Delaunay run(std::span<const double> input, std::span<const std::int32_t> labels
   // uniform points, whose cells are cheap next to the wraps that would
   // replace them, 30% to 60% on clustered ones.
   const bool pilot = complete && opt.skip_cells < 0 && n >= pilot_min_points && opt.method != DelaunayMethod::insertion;
-  const bool may_insert = D == 3 && opt.method == DelaunayMethod::automatic;
-  const double insert_from = insertion_ratio(pass.engine_options.threads);
+  const bool may_insert = opt.method == DelaunayMethod::automatic;
+  const double insert_from = insertion_ratio<D>(pass.engine_options.threads);
   const PilotEstimate estimate =
       pilot ? pilot_estimate<CellT>(pass, may_insert ? insert_from : std::numeric_limits<double>::infinity()) : PilotEstimate{};
-  if constexpr (D == 3) {
+  {
     // Cells far costlier than what they find (surface samples, clustered
-    // volumes): insertion (docs/design.md, "Insertion for costly inputs").
+    // volumes; in 2D curves, blobs, points on a circle): insertion
+    // (docs/design.md, "Insertion for costly inputs").
     // Too few points for a pilot: insertion, which no input makes costly
     // (the cells of points nearly on a sphere each test every point: 5,000
-    // such points took 4.1 s, 0.13 s by insertion); 10,000 uniform points
-    // take 0.029 s against 0.042 s, a 20^3 lattice 0.037 s against 0.028.
+    // such points took 4.1 s, 0.13 s by insertion; 5,000 on a circle 1.0 s,
+    // 0.003 s); 10,000 uniform 3D points take 0.029 s against 0.042 s, a
+    // 20^3 lattice 0.037 s against 0.028; 5,000 uniform 2D points 0.003 s
+    // against 0.004.
     const bool small = may_insert && complete && opt.skip_cells < 0 && n < pilot_min_points;
     // On one or two threads, inputs without exact ties go to insertion too:
     // 1M uniform points 2.47 against 2.55 s on two threads, 4.34 against
@@ -338,9 +352,11 @@ Delaunay run(std::span<const double> input, std::span<const std::int32_t> labels
     // lattice rotated, or scaled by 0.1, is off any grid, its near-ties
     // settled by the extended filter: 1.29 s and 2.54 s by insertion,
     // minutes and 4.49 s by the cells. Beyond two threads the cells scale
-    // better (a model; this machine has two cores).
+    // better (a model; this machine has two cores). In 2D only on one
+    // thread (1M uniform points: 0.87 against 1.13 s; on two the cells
+    // take 0.58 s, the serial insertion 0.71).
     const bool ties = estimate.exact_per_cell >= clean_exact_per_cell && pass.exact.grid != nullptr;
-    const bool clean = !ties && pass.engine_options.threads <= 2;
+    const bool clean = !ties && pass.engine_options.threads <= (D == 3 ? 2 : 1);
     const bool insert = opt.method == DelaunayMethod::insertion || small ||
                         (may_insert && pilot && (estimate.ratio >= insert_from || clean));
     if (insert && complete && attempt == 0) return by_insertion(pass, std::move(out));
@@ -530,7 +546,6 @@ Delaunay delaunay(std::span<const double> points, int dim, std::span<const std::
                   const DelaunayOptions& options) {
   front::check_input(points, dim, labels);
   if (options.method == DelaunayMethod::insertion) {
-    if (dim != 3) throw InputError("the insertion method is 3D only (2D: use the cells method)");
     if (!labels.empty() || !options.complete_hull)
       throw InputError("the insertion method triangulates the whole convex hull: no labels, hull completion on");
   }

@@ -15,9 +15,10 @@ namespace tessera::front {
 
 namespace {
 
-/// Appends to `out` the vertices of the tetrahedra `tets` (rows of four)
-/// other than s, each once, in order of first appearance (the tetrahedra
-/// ascending: an order that does not depend on the thread count).
+/// Appends to `out` the vertices of the simplices `tets` (rows of W: 4 in
+/// 3D, 3 in 2D) other than s, each once, in order of first appearance (the
+/// simplices ascending: an order that does not depend on the thread count).
+template <int W>
 void collect(std::uint32_t s, const std::uint32_t* rows, const std::uint32_t* tets, std::size_t count,
              std::vector<std::uint32_t>& out) {
   const std::size_t start = out.size();
@@ -33,8 +34,8 @@ void collect(std::uint32_t s, const std::uint32_t* rows, const std::uint32_t* te
     std::memcpy(have, &own, sizeof own);
     std::size_t m = 0;
     for (std::size_t t = 0; t < count; ++t) {
-      const std::uint32_t* row = rows + 4 * static_cast<std::size_t>(tets[t]);
-      for (int c = 0; c < 4; ++c) {
+      const std::uint32_t* row = rows + W * static_cast<std::size_t>(tets[t]);
+      for (int c = 0; c < W; ++c) {
         const std::uint32_t v = row[c];
         const Quad vv = {v, v, v, v};
         Quad seen = {};
@@ -55,8 +56,8 @@ void collect(std::uint32_t s, const std::uint32_t* rows, const std::uint32_t* te
   // A vertex of high degree (points in convex position can have hundreds):
   // sorted instead, no less deterministic.
   for (std::size_t t = 0; t < count; ++t) {
-    const std::uint32_t* row = rows + 4 * static_cast<std::size_t>(tets[t]);
-    for (int c = 0; c < 4; ++c)
+    const std::uint32_t* row = rows + W * static_cast<std::size_t>(tets[t]);
+    for (int c = 0; c < W; ++c)
       if (row[c] != s) out.push_back(row[c]);
   }
   std::sort(out.begin() + static_cast<std::ptrdiff_t>(start), out.end());
@@ -65,10 +66,12 @@ void collect(std::uint32_t s, const std::uint32_t* rows, const std::uint32_t* te
 
 }  // namespace
 
-std::optional<engine::NeighbourLists> delaunay_neighbours(const Pass<3>& pass,
+template <int D>
+std::optional<engine::NeighbourLists> delaunay_neighbours(const Pass<D>& pass,
                                                           const std::function<void(double)>& progress) {
+  constexpr int W = D + 1;
   const auto& loc = *pass.locator;
-  const std::size_t n = pass.points.size() / 3, located = loc.size();
+  const std::size_t n = pass.points.size() / D, located = loc.size();
   engine::NeighbourLists out;
   bool flat = false;
   tbb::task_arena(pass.engine_options.threads).execute([&] {
@@ -118,7 +121,7 @@ std::optional<engine::NeighbourLists> delaunay_neighbours(const Pass<3>& pass,
     tbb::parallel_for(std::size_t{0}, nparts, [&](std::size_t c) {
       const auto [a, e] = part_range(c);
       std::uint32_t* const place = at[c].data();
-      for (std::size_t k = a; k < e; ++k) tets[place[rows[k]]++] = static_cast<std::uint32_t>(k / 4);
+      for (std::size_t k = a; k < e; ++k) tets[place[rows[k]]++] = static_cast<std::uint32_t>(k / W);
     });
     at.clear();
     at.shrink_to_fit();
@@ -137,10 +140,10 @@ std::optional<engine::NeighbourLists> delaunay_neighbours(const Pass<3>& pass,
           // later slot now (its list of them is at hand, in slot order).
           if (k + ahead < end)
             for (std::uint32_t t = first[k + ahead]; t < first[k + ahead + 1]; ++t)
-              __builtin_prefetch(rows + 4 * static_cast<std::size_t>(tets[t]));
+              __builtin_prefetch(rows + W * static_cast<std::size_t>(tets[t]));
           if (out.duplicate_of[k] >= 0) continue;
           const std::size_t before = part.size();
-          collect(static_cast<std::uint32_t>(k), rows, tets.data() + first[k], first[k + 1] - first[k], part);
+          collect<W>(static_cast<std::uint32_t>(k), rows, tets.data() + first[k], first[k + 1] - first[k], part);
           count[k + 1] = static_cast<std::int64_t>(part.size() - before);
         }
       }
@@ -156,5 +159,8 @@ std::optional<engine::NeighbourLists> delaunay_neighbours(const Pass<3>& pass,
   if (flat) return std::nullopt;
   return out;
 }
+
+template std::optional<engine::NeighbourLists> delaunay_neighbours(const Pass<2>&, const std::function<void(double)>&);
+template std::optional<engine::NeighbourLists> delaunay_neighbours(const Pass<3>&, const std::function<void(double)>&);
 
 }  // namespace tessera::front

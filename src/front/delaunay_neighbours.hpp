@@ -19,13 +19,15 @@
 
 namespace tessera::front {
 
-/// The Delaunay neighbours of the pass's located points (3D), each list in
-/// ascending order of the tetrahedra it comes from; exact duplicates point
+/// The Delaunay neighbours of the pass's located points (2D or 3D), each list
+/// in ascending order of the simplices it comes from; exact duplicates point
 /// to their lowest coincident id and are no vertex. nullopt when the points
-/// are all on one plane (no tetrahedron exists: the search serves them).
+/// are all on one plane, or in 2D on one line (no simplex exists: the search
+/// serves them).
 /// `progress`, when set, is told the fraction of the insertion done, from
 /// the calling thread, and may throw (tessera::Cancelled) to stop.
-std::optional<engine::NeighbourLists> delaunay_neighbours(const Pass<3>& pass,
+template <int D>
+std::optional<engine::NeighbourLists> delaunay_neighbours(const Pass<D>& pass,
                                                           const std::function<void(double)>& progress = {});
 
 }  // namespace tessera::front

@@ -7,7 +7,6 @@
 #include <bit>
 #include <cmath>
 #include <cstring>
-#include <limits>
 #include <memory>
 #include <optional>
 #include <stdexcept>
@@ -15,9 +14,8 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
-#include <tbb/parallel_sort.h>
 
-#include "id_hash.hpp"
+#include "insertion_order.hpp"
 #include "pass.hpp"
 #include "tessera/kernels/delaunay_predicates.hpp"
 #include "tessera/kernels/filter.hpp"
@@ -48,67 +46,6 @@ int infinite_slot(const Tet& t) {
   for (int k = 0; k < 4; ++k)
     if (t.v[k] == infinite) return k;
   return 4;
-}
-
-// 21 bits of x spread to every third bit.
-std::uint64_t spread3(std::uint64_t x) {
-  x &= 0x1FFFFF;
-  x = (x | x << 32) & 0x1F00000000FFFFull;
-  x = (x | x << 16) & 0x1F0000FF0000FFull;
-  x = (x | x << 8) & 0x100F00F00F00F00Full;
-  x = (x | x << 4) & 0x10C30C30C30C30C3ull;
-  x = (x | x << 2) & 0x1249249249249249ull;
-  return x;
-}
-
-// The insertion order: BRIO rounds (a point joins round r with probability
-// 2^-(r+1), by its hash; the smallest rounds first), each in Morton order.
-struct BrioOrder {
-  std::vector<std::int32_t> ids;
-  std::vector<std::uint64_t> codes;  // each position's Morton code
-  std::vector<std::size_t> rounds;   // each round's first position, then ids.size()
-};
-
-BrioOrder brio_order(const ExactContext& ctx, std::span<const std::int32_t> ids, const double* lo, const double* hi) {
-  // One 64-bit key per point: the round in the top bits (smallest rounds
-  // first), then a Morton code of 19 bits per axis; ties go by id.
-  struct Key {
-    std::uint64_t key;
-    std::int32_t id;
-  };
-  constexpr int max_round = 24, bits = 19, code_bits = 3 * bits;
-  constexpr double top = (1 << bits) - 1;
-  Buffer<Key> keys(ids.size());  // every one written below
-  double scale[3];
-  for (int d = 0; d < 3; ++d) scale[d] = hi[d] > lo[d] ? top / (hi[d] - lo[d]) : 0.0;
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, ids.size(), 1 << 14), [&](const tbb::blocked_range<std::size_t>& r) {
-    for (std::size_t i = r.begin(); i != r.end(); ++i) {
-      const double* p = ctx.points + static_cast<std::size_t>(ids[i]) * 3;
-      std::uint64_t code = 0;
-      for (int d = 0; d < 3; ++d) {
-        const double c = std::clamp((p[d] - lo[d]) * scale[d], 0.0, top);
-        code |= spread3(static_cast<std::uint64_t>(c)) << d;
-      }
-      const int round = std::min(std::countl_zero(id_hash(ids[i])), max_round);
-      keys[i] = {static_cast<std::uint64_t>(max_round - round) << code_bits | code, ids[i]};
-    }
-  });
-  tbb::parallel_sort(keys.begin(), keys.end(),
-                     [](const Key& a, const Key& b) { return a.key != b.key ? a.key < b.key : a.id < b.id; });
-  BrioOrder order;
-  order.ids.resize(ids.size());
-  order.codes.resize(ids.size());
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, keys.size(), 1 << 14), [&](const tbb::blocked_range<std::size_t>& r) {
-    for (std::size_t i = r.begin(); i != r.end(); ++i) {
-      order.ids[i] = keys[i].id;
-      order.codes[i] = keys[i].key & ((std::uint64_t{1} << code_bits) - 1);
-    }
-  });
-  for (std::size_t i = 0; i < keys.size(); ++i) {
-    if (i == 0 || keys[i].key >> code_bits != keys[i - 1].key >> code_bits) order.rounds.push_back(i);
-  }
-  order.rounds.push_back(ids.size());
-  return order;
 }
 
 // The filters in front of kernels::orientation and kernels::in_sphere,
@@ -873,31 +810,7 @@ std::optional<Buffer<std::int32_t>> insertion_delaunay(const ExactContext& ctx, 
   if (d == m) return std::nullopt;
   std::array<std::int32_t, 4> local{0, 1, static_cast<std::int32_t>(c), static_cast<std::int32_t>(d)};
   if (o < 0) std::swap(local[2], local[3]);
-  // Each point's guide: of the previous round's two points around it in
-  // Morton order, the nearer (both rounds are sorted by code).
-  std::vector<std::int32_t> guide(m, -1);
-  for (std::size_t r = 1; r + 1 < order.rounds.size(); ++r) {
-    const std::size_t pa = order.rounds[r - 1], a = order.rounds[r], b = order.rounds[r + 1];
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(a, b, 1 << 13), [&](const tbb::blocked_range<std::size_t>& range) {
-      // The first of the previous round with a code above q's.
-      std::size_t j = static_cast<std::size_t>(
-          std::upper_bound(order.codes.begin() + static_cast<std::ptrdiff_t>(pa), order.codes.begin() + static_cast<std::ptrdiff_t>(a),
-                           order.codes[range.begin()]) - order.codes.begin());
-      for (std::size_t i = range.begin(); i != range.end(); ++i) {
-        while (j < a && order.codes[j] <= order.codes[i]) ++j;
-        double best = std::numeric_limits<double>::infinity();
-        for (const std::size_t k : {j - 1, j}) {
-          if (k < pa || k >= a) continue;
-          double r2 = 0;
-          for (int e = 0; e < 3; ++e) r2 += (at(k)[e] - at(i)[e]) * (at(k)[e] - at(i)[e]);
-          if (r2 < best) {
-            best = r2;
-            guide[i] = static_cast<std::int32_t>(k);
-          }
-        }
-      }
-    });
-  }
+  std::vector<std::int32_t> guide = brio_guides(ctx, order);
   order.codes = {};
   Triangulation tri(ctx, std::move(order.ids), std::move(guide), options.threads);
   tri.start(local);
@@ -918,7 +831,8 @@ std::optional<Buffer<std::int32_t>> insertion_delaunay(const ExactContext& ctx, 
   return tri.take_rows();
 }
 
-LocatedInsertion insert_located(const Pass<3>& pass, const std::function<void(double)>& progress) {
+template <int D>
+LocatedInsertion insert_located(const Pass<D>& pass, const std::function<void(double)>& progress) {
   // Exact duplicates, bin by bin (BinLocator::lowest_coincident): sorting
   // every id by its coordinates gathered a cache line per comparison.
   const auto& loc = *pass.locator;
@@ -928,11 +842,18 @@ LocatedInsertion insert_located(const Pass<3>& pass, const std::function<void(do
   distinct.reserve(loc.size());
   for (std::size_t k = 0; k < loc.size(); ++k)
     if (out.lowest[k] < 0) distinct.push_back(loc.id(k));
-  InsertionOptions io;
-  io.threads = pass.engine_options.threads;
-  io.progress = progress;
-  out.rows = insertion_delaunay(pass.exact, distinct, pass.gens.lo.data(), pass.gens.hi.data(), io);
+  if constexpr (D == 2) {
+    out.rows = insertion_delaunay_2d(pass.exact, distinct, pass.gens.lo.data(), pass.gens.hi.data(), progress);
+  } else {
+    InsertionOptions io;
+    io.threads = pass.engine_options.threads;
+    io.progress = progress;
+    out.rows = insertion_delaunay(pass.exact, distinct, pass.gens.lo.data(), pass.gens.hi.data(), io);
+  }
   return out;
 }
+
+template LocatedInsertion insert_located(const Pass<2>&, const std::function<void(double)>&);
+template LocatedInsertion insert_located(const Pass<3>&, const std::function<void(double)>&);
 
 }  // namespace tessera::front

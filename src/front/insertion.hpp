@@ -18,12 +18,16 @@
 // Every finite tetrahedron is therefore strictly positively oriented.
 //
 // The order (BRIO, Amenta, Choi & Rote, "Incremental constructions con
-// BRIO", 2003: rounds of doubling size, each in Morton order) keeps the walk
-// from the last inserted point short; where the Morton curve jumps, a walk
-// starts instead from a nearby point of the previous round (insertion.cpp,
-// walk_start). Large rounds are inserted in parallel
+// BRIO", 2003: rounds of doubling size, each in Morton order;
+// insertion_order.hpp) keeps the walk from the last inserted point short;
+// where the Morton curve jumps, a walk starts instead from a nearby point of
+// the previous round (insertion.cpp, walk_start). Large rounds are inserted in parallel
 // phases, one slab of space per worker (insertion.cpp, Triangulation::phase);
 // the result does not depend on the order, so neither on the thread count.
+//
+// 2D (insertion_2d.cpp) is the same scheme with triangles, serial: it
+// serves the 2D inputs whose cells cost far more than they find (points on
+// a circle or along curves).
 #pragma once
 
 #include <cstdint>
@@ -67,6 +71,14 @@ std::optional<Buffer<std::int32_t>> insertion_delaunay(const kernels::ExactConte
                                                        std::span<const std::int32_t> ids, const double* lo,
                                                        const double* hi, const InsertionOptions& options = {});
 
+/// The same in 2D (ctx.dim == 2): 3 ids per row, counter-clockwise rows as
+/// tessera::Delaunay lays them out; nullopt when the points are all on one
+/// line. Serial; `progress`, when set, as InsertionOptions::progress.
+std::optional<Buffer<std::int32_t>> insertion_delaunay_2d(const kernels::ExactContext& ctx,
+                                                          std::span<const std::int32_t> ids, const double* lo,
+                                                          const double* hi,
+                                                          const std::function<void(double)>& progress = {});
+
 template <int D>
 struct Pass;
 
@@ -76,9 +88,10 @@ struct Pass;
 /// tessera::voronoi (the cells' neighbours). Call it in the pass's arena.
 struct LocatedInsertion {
   std::vector<std::int32_t> lowest;          ///< per locator slot: BinLocator::lowest_coincident
-  std::optional<Buffer<std::int32_t>> rows;  ///< nullopt when the points are all on one plane
+  std::optional<Buffer<std::int32_t>> rows;  ///< nullopt when the points are all on one plane (2D: line)
 };
-/// `progress`, when set, as InsertionOptions::progress.
-LocatedInsertion insert_located(const Pass<3>& pass, const std::function<void(double)>& progress = {});
+/// `progress`, when set, as InsertionOptions::progress. D = 2 or 3.
+template <int D>
+LocatedInsertion insert_located(const Pass<D>& pass, const std::function<void(double)>& progress = {});
 
 }  // namespace tessera::front

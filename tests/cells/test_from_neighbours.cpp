@@ -44,10 +44,10 @@ std::vector<std::vector<std::int32_t>> key_rows(const tessera::Cells& c) {
 /// which cannot hold the volumes of cells a subnormal thick or 2^300 wide).
 void same_as_search(const std::vector<double>& pts, const std::string& what,
                     const std::vector<std::int32_t>& labels = {}, std::optional<tessera::Bounds> bounds = std::nullopt,
-                    bool ignore_outside = false, InvariantOptions inv = {}, bool hostile = false) {
+                    bool ignore_outside = false, InvariantOptions inv = {}, bool hostile = false, int dim = 3) {
   SCOPED_TRACE(what);
-  const auto s = run_method(pts, 3, tessera::CellMethod::search, labels, 1, bounds, ignore_outside);
-  const auto d = run_method(pts, 3, tessera::CellMethod::insertion, labels, 1, bounds, ignore_outside);
+  const auto s = run_method(pts, dim, tessera::CellMethod::search, labels, 1, bounds, ignore_outside);
+  const auto d = run_method(pts, dim, tessera::CellMethod::insertion, labels, 1, bounds, ignore_outside);
   EXPECT_FALSE(s.from_insertion);
   EXPECT_TRUE(d.from_insertion);
   EXPECT_EQ(s.generator, d.generator);
@@ -62,9 +62,10 @@ void same_as_search(const std::vector<double>& pts, const std::string& what,
   ASSERT_EQ(s.volume.size(), d.volume.size());
   for (std::size_t c = 0; c < s.volume.size(); ++c) {
     EXPECT_NEAR(s.volume[c], d.volume[c], 1e-12 * std::max(std::fabs(s.volume[c]), 1e-300)) << "cell " << c;
-    for (int a = 0; a < 3; ++a) {
-      const double x = s.centroid[3 * c + static_cast<std::size_t>(a)], y = d.centroid[3 * c + static_cast<std::size_t>(a)];
-      EXPECT_NEAR(x, y, 1e-12 * (std::fabs(x) + box_size(s.bounds, 3))) << "cell " << c;
+    for (int a = 0; a < dim; ++a) {
+      const std::size_t at = static_cast<std::size_t>(dim) * c + static_cast<std::size_t>(a);
+      const double x = s.centroid[at], y = d.centroid[at];
+      EXPECT_NEAR(x, y, 1e-12 * (std::fabs(x) + box_size(s.bounds, dim))) << "cell " << c;
     }
   }
   if (!hostile) {
@@ -162,6 +163,62 @@ TEST(FromNeighbours, SameCellsAsTheSearch) {
   }
 }
 
+std::vector<double> circle_points(std::size_t n, std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(0, 2 * std::numbers::pi);
+  std::vector<double> p;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double t = u(rng);
+    p.insert(p.end(), {std::cos(t), std::sin(t)});
+  }
+  return p;
+}
+
+// 2D: the same cells from the 2D insertion (front/insertion_2d.cpp), on the
+// inputs where its predicates meet ties (lattices: four co-circular points
+// at every square; collinear hull points) and where the search is costly.
+TEST(FromNeighbours, SameCellsAsTheSearch2D) {
+  auto same2 = [](const std::vector<double>& p, const std::string& what, const std::vector<std::int32_t>& labels = {},
+                  std::optional<tessera::Bounds> bounds = std::nullopt, bool ignore_outside = false,
+                  InvariantOptions inv = {}) { same_as_search(p, what, labels, bounds, ignore_outside, inv, false, 2); };
+  same2(random_points(3000, 2, 920), "uniform 3000");
+  same2(grid_points(30, 2), "integer grid 30^2");
+  same2(grid_points(25, 2, 0.1, 0.05), "tenth grid 25^2");
+  same2(circle_points(700, 921), "random circle 700");
+  {
+    auto p = circle_points(500, 922);
+    p.insert(p.end(), {0.0, 0.0});
+    same2(p, "random circle 500 + centre");
+  }
+  {
+    std::vector<double> p;  // integer points exactly on a circle of radius 65 (co-circular), and the centre
+    for (int x = -65; x <= 65; ++x)
+      for (int y = -65; y <= 65; ++y)
+        if (x * x + y * y == 65 * 65) p.insert(p.end(), {double(x), double(y)});
+    p.insert(p.end(), {0.0, 0.0});
+    same2(p, "integer circle r=65 + centre");
+  }
+  {
+    std::vector<double> p;  // a square's edges, densely sampled (collinear hull points), and inside points
+    for (int i = 0; i < 40; ++i) p.insert(p.end(), {double(i), 0.0, 0.0, double(i), double(i), 39.0, 39.0, double(i)});
+    const auto q = random_points(300, 2, 923);
+    for (const double x : q) p.push_back(1 + 37 * x);
+    same2(p, "square edges");
+  }
+  {
+    auto p = random_points(1500, 2, 924);
+    p.insert(p.end(), p.begin(), p.begin() + 2 * 200);
+    same2(p, "uniform with 200 duplicates");
+    std::mt19937_64 rng(7);
+    std::vector<std::int32_t> labels(p.size() / 2);
+    for (auto& l : labels) l = std::int32_t(rng() % 3) - 1;
+    InvariantOptions inv;
+    inv.all_inside = false;
+    same2(p, "labelled with outside points and duplicates", labels, std::nullopt, false, inv);
+    same2(p, "bounds with points outside", {}, make_bounds({0.1, 0.2}, {0.9, 0.7}), true);
+  }
+}
+
 TEST(FromNeighbours, ThreadCountDoesNotChangeResult) {
   auto p = sphere_points(1500, 908);
   const auto r = random_points(1500, 3, 909);
@@ -184,12 +241,22 @@ TEST(FromNeighbours, ThreadCountDoesNotChangeResult) {
   SAME(face_neighbor);
   SAME(duplicates);
 #undef SAME
+  // 2D: circle points with duplicates.
+  auto c = circle_points(2000, 926);
+  const auto r2 = random_points(1000, 2, 927);
+  c.insert(c.end(), r2.begin(), r2.end());
+  c.insert(c.end(), c.begin(), c.begin() + 2 * 40);
+  const auto a2 = run_method(c, 2, tessera::CellMethod::insertion, {}, 1);
+  const auto b2 = run_method(c, 2, tessera::CellMethod::insertion, {}, 2);
+  EXPECT_TRUE(a2.from_insertion);
+  EXPECT_TRUE(a2.volume == b2.volume && a2.neighbors == b2.neighbors && a2.vertices == b2.vertices &&
+              a2.vertex_keys == b2.vertex_keys && a2.face_vertices == b2.face_vertices && a2.duplicates == b2.duplicates);
 }
 
 // The automatic method searches where cells are cheap (uniform points,
-// lattices, 2D) and clips by Delaunay neighbours where the pilot finds them
-// costly: points nearly on one sphere, whose every cell reaches the centre
-// and would test every point there (quadratic work), at any size.
+// lattices) and clips by Delaunay neighbours where the pilot finds them
+// costly: points nearly on one sphere (or circle), whose every cell reaches
+// the centre and would test every point there (quadratic work), at any size.
 TEST(FromNeighbours, AutomaticChoiceFollowsThePilot) {
   auto automatic = [](const std::vector<double>& p, int dim) {
     return run_method(p, dim, tessera::CellMethod::automatic, {}, 2);
@@ -198,15 +265,28 @@ TEST(FromNeighbours, AutomaticChoiceFollowsThePilot) {
   EXPECT_FALSE(automatic(random_points(30000, 3, 911), 3).from_insertion);
   EXPECT_FALSE(automatic(grid_points(12, 3), 3).from_insertion);
   EXPECT_FALSE(automatic(random_points(3000, 2, 912), 2).from_insertion);
+  EXPECT_FALSE(automatic(random_points(30000, 2, 912), 2).from_insertion);
+  EXPECT_FALSE(automatic(grid_points(200, 2), 2).from_insertion);
   for (std::size_t n : {100, 500, 3000, 25000}) {
     const auto p = sphere_points(n, 913 + n);
     const tessera::Cells c = automatic(p, 3);
     EXPECT_TRUE(c.from_insertion) << n << " points on a sphere";
     EXPECT_TRUE(tessera::validate(c, {}).ok) << n << " points on a sphere";
   }
-  // Insertion asked for on 2D points, or on 3D points all on one plane (no
-  // tetrahedron): the search serves them.
-  EXPECT_FALSE(run_method(random_points(500, 2, 914), 2, tessera::CellMethod::insertion).from_insertion);
+  // 2D points on a circle: every cell reaches the centre.
+  for (std::size_t n : {100, 3000, 25000}) {
+    const tessera::Cells c = automatic(circle_points(n, 925 + n), 2);
+    EXPECT_TRUE(c.from_insertion) << n << " points on a circle";
+    EXPECT_TRUE(tessera::validate(c, {}).ok) << n << " points on a circle";
+  }
+  // Insertion asked for on points all on one line (2D) or plane (3D): no
+  // simplex exists, and the search serves them.
+  std::vector<double> line;
+  for (const double x : random_points(300, 1, 914)) line.insert(line.end(), {x, 0.5});
+  const tessera::Cells l = run_method(line, 2, tessera::CellMethod::insertion, {}, 1, make_bounds({0, 0}, {1, 1}));
+  EXPECT_FALSE(l.from_insertion);
+  EXPECT_EQ(l.n_cells(), 300u);
+  EXPECT_TRUE(tessera::validate(l, {}).ok);
   std::vector<double> flat;
   const auto q = random_points(400, 2, 915);
   for (std::size_t i = 0; i < 400; ++i) flat.insert(flat.end(), {q[2 * i], q[2 * i + 1], 0.5});

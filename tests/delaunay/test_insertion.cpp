@@ -234,9 +234,6 @@ TEST(Insertion, FewAndFlatPoints) {
 TEST(Insertion, BadRequestsAreInputErrors) {
   tessera::DelaunayOptions o;
   o.method = tessera::DelaunayMethod::insertion;
-  const auto p2 = uniform_points(100, 2, 1);
-  o.dim = 2;
-  EXPECT_THROW(tessera::delaunay(p2, 2, {}, o), tessera::InputError);
   const auto p3 = uniform_points(100, 3, 1);
   o.dim = 3;
   const std::vector<std::int32_t> labels(100, 1);

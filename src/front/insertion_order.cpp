@@ -1,0 +1,117 @@
+// BRIO order and guides; see insertion_order.hpp.
+#include "insertion_order.hpp"
+
+#include <algorithm>
+#include <bit>
+#include <limits>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_sort.h>
+
+#include "id_hash.hpp"
+#include "tessera/buffer.hpp"
+
+namespace tessera::front {
+namespace {
+
+// 21 bits of x spread to every third bit.
+std::uint64_t spread3(std::uint64_t x) {
+  x &= 0x1FFFFF;
+  x = (x | x << 32) & 0x1F00000000FFFFull;
+  x = (x | x << 16) & 0x1F0000FF0000FFull;
+  x = (x | x << 8) & 0x100F00F00F00F00Full;
+  x = (x | x << 4) & 0x10C30C30C30C30C3ull;
+  x = (x | x << 2) & 0x1249249249249249ull;
+  return x;
+}
+
+// 32 bits of x spread to every second bit.
+std::uint64_t spread2(std::uint64_t x) {
+  x &= 0xFFFFFFFF;
+  x = (x | x << 16) & 0x0000FFFF0000FFFFull;
+  x = (x | x << 8) & 0x00FF00FF00FF00FFull;
+  x = (x | x << 4) & 0x0F0F0F0F0F0F0F0Full;
+  x = (x | x << 2) & 0x3333333333333333ull;
+  x = (x | x << 1) & 0x5555555555555555ull;
+  return x;
+}
+
+}  // namespace
+
+BrioOrder brio_order(const kernels::ExactContext& ctx, std::span<const std::int32_t> ids, const double* lo, const double* hi) {
+  // One 64-bit key per point: the round in the top bits (smallest rounds
+  // first), then a Morton code of 19 bits per axis in 3D, 28 in 2D; ties go
+  // by id.
+  struct Key {
+    std::uint64_t key;
+    std::int32_t id;
+  };
+  const int D = ctx.dim;
+  constexpr int max_round = 24;
+  const int bits = D == 3 ? 19 : 28, code_bits = D * bits;
+  const double top = static_cast<double>((std::uint64_t{1} << bits) - 1);
+  Buffer<Key> keys(ids.size());  // every one written below
+  double scale[3] = {};
+  for (int d = 0; d < D; ++d) scale[d] = hi[d] > lo[d] ? top / (hi[d] - lo[d]) : 0.0;
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, ids.size(), 1 << 14), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t i = r.begin(); i != r.end(); ++i) {
+      const double* p = ctx.points + static_cast<std::size_t>(ids[i]) * static_cast<std::size_t>(D);
+      std::uint64_t code = 0;
+      for (int d = 0; d < D; ++d) {
+        const auto c = static_cast<std::uint64_t>(std::clamp((p[d] - lo[d]) * scale[d], 0.0, top));
+        code |= (D == 3 ? spread3(c) : spread2(c)) << d;
+      }
+      const int round = std::min(std::countl_zero(id_hash(ids[i])), max_round);
+      keys[i] = {static_cast<std::uint64_t>(max_round - round) << code_bits | code, ids[i]};
+    }
+  });
+  tbb::parallel_sort(keys.begin(), keys.end(),
+                     [](const Key& a, const Key& b) { return a.key != b.key ? a.key < b.key : a.id < b.id; });
+  BrioOrder order;
+  order.ids.resize(ids.size());
+  order.codes.resize(ids.size());
+  const std::uint64_t code_mask = (std::uint64_t{1} << code_bits) - 1;
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, keys.size(), 1 << 14), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t i = r.begin(); i != r.end(); ++i) {
+      order.ids[i] = keys[i].id;
+      order.codes[i] = keys[i].key & code_mask;
+    }
+  });
+  for (std::size_t i = 0; i < keys.size(); ++i) {
+    if (i == 0 || keys[i].key >> code_bits != keys[i - 1].key >> code_bits) order.rounds.push_back(i);
+  }
+  order.rounds.push_back(ids.size());
+  return order;
+}
+
+std::vector<std::int32_t> brio_guides(const kernels::ExactContext& ctx, const BrioOrder& order) {
+  const auto D = static_cast<std::size_t>(ctx.dim);
+  auto at = [&](std::size_t k) { return ctx.points + static_cast<std::size_t>(order.ids[k]) * D; };
+  std::vector<std::int32_t> guide(order.ids.size(), -1);
+  for (std::size_t r = 1; r + 1 < order.rounds.size(); ++r) {
+    const std::size_t pa = order.rounds[r - 1], a = order.rounds[r], b = order.rounds[r + 1];
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(a, b, 1 << 13), [&](const tbb::blocked_range<std::size_t>& range) {
+      // The first of the previous round with a code above q's.
+      std::size_t j = static_cast<std::size_t>(
+          std::upper_bound(order.codes.begin() + static_cast<std::ptrdiff_t>(pa), order.codes.begin() + static_cast<std::ptrdiff_t>(a),
+                           order.codes[range.begin()]) - order.codes.begin());
+      for (std::size_t i = range.begin(); i != range.end(); ++i) {
+        while (j < a && order.codes[j] <= order.codes[i]) ++j;
+        double best = std::numeric_limits<double>::infinity();
+        for (const std::size_t k : {j - 1, j}) {
+          if (k < pa || k >= a) continue;
+          double r2 = 0;
+          for (std::size_t e = 0; e < D; ++e) r2 += (at(k)[e] - at(i)[e]) * (at(k)[e] - at(i)[e]);
+          if (r2 < best) {
+            best = r2;
+            guide[i] = static_cast<std::int32_t>(k);
+          }
+        }
+      }
+    });
+  }
+  return guide;
+}
+
+}  // namespace tessera::front
