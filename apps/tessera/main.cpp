@@ -78,11 +78,11 @@ void add_compute_options(CLI::App* app, ComputeArgs& c, std::vector<std::string>
 /// --method of the commands whose product is the cells themselves.
 void add_cell_method_option(CLI::App* app, ComputeArgs& c) {
   app->add_option("--method", c.cell_method,
-                  "How each 3D cell finds the points that clip it. search: the bins around it (the meshless "
+                  "How each cell finds the points that clip it. search: the bins around it (the meshless "
                   "method); insertion: its Delaunay neighbours, from incremental insertion (faster where cells "
-                  "reach far: points nearly on a sphere, surface samples, dense clusters); auto: insertion below "
-                  "20,000 points and where a sample of cells costs far more than on uniform points, else search. "
-                  "Same cells; 2D always searches")
+                  "reach far: points nearly on a sphere or circle, surface samples, dense clusters, 2D curves); "
+                  "auto: insertion where a sample of cells costs far more than on uniform points, else search. "
+                  "Same cells")
       ->check(CLI::IsMember({"auto", "search", "insertion"}))
       ->capture_default_str();
 }
@@ -167,11 +167,11 @@ int main(int argc, char** argv) {
                   "and 0.3 to 0.6 on clustered ones; else 0. Ignored with labels or --no-hull-completion")
       ->check(CLI::Range(0.0, 0.99));
   del->add_option("--method", dla.method,
-                  "cells: the cells pass and hull completion; insertion: incremental insertion, parallel by "
-                  "phases (3D without labels); auto (3D without labels or --skip-cells): insertion below 20,000 "
-                  "points, and from there where a sample of cells costs far more than it finds (surface samples) "
-                  "or, on 1-2 threads, meets no ties (uniform points), or where hull completion stalls; else the "
-                  "cells (lattices). Same result")
+                  "cells: the cells pass and hull completion; insertion: incremental insertion (without labels; "
+                  "3D parallel by phases, 2D serial); auto (without labels or --skip-cells): insertion below 20,000 "
+                  "points, and from there where a sample of cells costs far more than it finds (surface samples, "
+                  "2D curves and circles) or meets no ties on 1-2 threads in 3D, 1 in 2D (uniform points), or "
+                  "where 3D hull completion stalls; else the cells (lattices). Same result")
       ->check(CLI::IsMember({"auto", "cells", "insertion"}))
       ->capture_default_str();
   del->add_flag("--validate", dla.validate,

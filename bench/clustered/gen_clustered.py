@@ -36,6 +36,13 @@ Near-degenerate sets (ties to within rounding everywhere; docs/design.md,
   voxels     voxel centres of a scan: origin (-20.5, -18.25, -30.1), spacing
              (0.7, 0.7, 1.2) mm, k^3 of them (exact ties off any small grid,
              as lat01, on an anisotropic lattice).
+
+2D (shape (N, 2); run.sh times them against CGAL's and scipy's 2D peers):
+  circle2    N points uniform on the unit circle (every cell a needle
+             reaching the centre, where all points are nearly co-circular).
+  curves2    N points on 12 circles of radii 0.05-0.27 in a 4 x 3 grid,
+             moved by N(0, 1e-4) (contour lines, particle tracks).
+  blobs2     as blobs, in the unit square.
 """
 import argparse
 
@@ -118,8 +125,30 @@ def sphere(rng, n):
     return p / np.linalg.norm(p, axis=1)[:, None]
 
 
+def circle2(rng, n):
+    t = rng.random(n) * 2 * np.pi
+    return np.c_[np.cos(t), np.sin(t)]
+
+
+def curves2(rng, n):
+    c = np.arange(n) % 12
+    t = rng.random(n) * 2 * np.pi
+    r = 0.05 + 0.02 * c
+    return np.c_[0.3 * (c % 4) + r * np.cos(t), 0.4 * (c // 4) + r * np.sin(t)] + rng.normal(size=(n, 2)) * 1e-4
+
+
+def blobs2(rng, n):
+    c = max(1, int(np.sqrt(n) / 4))
+    centres = rng.random((c, 2))
+    sigma = rng.uniform(1e-3, 5e-3, c)
+    m = int(0.9 * n)
+    lab = rng.integers(0, c, m)
+    return np.vstack([centres[lab] + rng.normal(size=(m, 2)) * sigma[lab, None], rng.random((n - m, 2))])
+
+
 KINDS = {"blobs": blobs, "sheet": sheet, "hier": hier, "terrain": terrain, "ellipsoid": ellipsoid, "torus": torus,
-         "latrot": latrot, "latjit": latjit, "sphere": sphere, "lat01": lat01, "voxels": voxels}
+         "latrot": latrot, "latjit": latjit, "sphere": sphere, "lat01": lat01, "voxels": voxels,
+         "circle2": circle2, "curves2": curves2, "blobs2": blobs2}
 
 
 def main():

@@ -6,7 +6,7 @@
 # known limits); this script keeps that visible.
 #
 # usage: bench/clustered/run.sh [BUILD_DIR] [N]
-#   env: KINDS (default "blobs sheet hier"; the surfaces: "terrain ellipsoid torus"; near-degenerate: "latrot latjit sphere"; ties off a small grid: "lat01 voxels"), REPEAT (default 3), THREADS (default 2),
+#   env: KINDS (default "blobs sheet hier"; the surfaces: "terrain ellipsoid torus"; near-degenerate: "latrot latjit sphere"; ties off a small grid: "lat01 voxels"; 2D: "circle2 curves2 blobs2"), REPEAT (default 3), THREADS (default 2),
 #        VORO=0 skips Voro++ (single-threaded; minutes per input at 1e6), CELLS=0 skips Tessera's cells,
 #        SEARCH=1 also times the cells with --method search (tool "tessera-search"; the default is auto),
 #        TIMEOUT per command in seconds (default 900), DATA (default bench/data, git-ignored),
@@ -26,6 +26,9 @@ cells=${CELLS:-1}
 search=${SEARCH:-0}
 data=${DATA:-$here/../data}
 peers=$here/../build-peers
+# The shared harness's Python drivers (scipy), for the 2D kinds.
+shared_peers=${SHARED:-$(cd "$here/../../.." && pwd)/shared}/peers
+[[ -f $shared_peers/scipy_bench.py ]] || shared_peers=""
 py=/usr/bin/python3
 mkdir -p "$data" "$here/results"
 out=${OUT:-$here/results/clustered_$n.jsonl}
@@ -46,6 +49,23 @@ run() {
 for kind in $kinds; do
   f=$data/clustered_${kind}_$n.npy
   [[ -f $f ]] || $py "$here/gen_clustered.py" "$kind" "$n" "$f"
+  if [[ $kind == *2 ]]; then  # 2D: CGAL's Delaunay_triangulation_2 and scipy (Qhull, one thread) are the peers
+    note "$kind: tessera (2D)"
+    [[ $cells == 1 ]] && run "$kind" "$build/tessera" bench voronoi "$f" --threads "$threads" --repeat 1
+    [[ $cells == 1 && $search == 1 ]] &&
+      tool_tag=tessera-search run "$kind" "$build/tessera" bench voronoi "$f" --method search --threads "$threads" --repeat 1
+    run "$kind" "$build/tessera" bench delaunay "$f" --threads "$threads" --repeat 1
+    if [[ -x $peers/cgal_delaunay2 ]]; then
+      note "$kind: CGAL"
+      run "$kind" "$peers/cgal_delaunay2" "$f"
+    else note "skip: no $peers/cgal_delaunay2"; fi
+    if [[ -n $shared_peers ]]; then
+      note "$kind: scipy (Qhull)"
+      run "$kind" $py "$shared_peers/scipy_bench.py" "$f" --op delaunay
+      run "$kind" $py "$shared_peers/scipy_bench.py" "$f" --op voronoi
+    fi
+    continue
+  fi
   note "$kind: tessera"
   [[ $cells == 1 ]] && run "$kind" "$build/tessera" bench voronoi "$f" --threads "$threads" --repeat 1
   [[ $cells == 1 && $search == 1 ]] &&

@@ -38,16 +38,19 @@ struct Cancelled : std::runtime_error {
   Cancelled() : std::runtime_error("cancelled") {}
 };
 
-/// How a 3D cell finds the points that clip it (tessera::voronoi).
+/// How a cell finds the points that clip it (tessera::voronoi).
 enum class CellMethod {
   /// The search, unless a pilot of a few hundred cells finds them far
-  /// costlier than uniform input's (points nearly on a sphere, surface
-  /// samples, dense clusters), or the input is small: then insertion.
+  /// costlier than uniform input's (points nearly on a sphere or circle,
+  /// surface samples, dense clusters, 2D curves): then insertion. The
+  /// choice does not depend on the thread count.
   automatic,
   search,     ///< each cell searches the bins around it (the meshless method)
   /// The neighbours from the Delaunay triangulation by incremental
-  /// insertion; each cell is the box clipped by them alone. 3D only (2D
-  /// searches), and the same cells as the search's.
+  /// insertion; each cell is the box clipped by them alone. The same cells
+  /// as the search's (volumes and centroids to the last bits: the clip order
+  /// differs). Points all on one plane (3D) or line (2D) have no
+  /// triangulation: the search serves them.
   insertion,
 };
 

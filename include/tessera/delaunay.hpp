@@ -23,20 +23,23 @@ namespace tessera {
 
 /// How tessera::delaunay builds the triangulation (the result is the same).
 enum class DelaunayMethod {
-  /// 3D without labels, with complete_hull and automatic skip_cells:
+  /// Without labels, with complete_hull and automatic skip_cells:
   /// insertion below 20,000 points. From there a pilot builds a few
   /// hundred cells; insertion is chosen where they cost far more than the
   /// simplices they find (surface samples, clustered volumes, points nearly
-  /// on a sphere) and, on one or two threads, where they met no exact ties
+  /// on a sphere; in 2D points on a circle or along curves) and, on one or
+  /// two threads in 3D and one in 2D, where they met no exact ties
   /// (uniform, jittered, rotated points: ties need coordinates on a grid).
   /// The rest (lattices, whose ties make insertion slower) goes to the
-  /// cells pass, which hands
+  /// cells pass, which in 3D hands
   /// over to insertion if hull completion runs past its budget
   /// (near-coplanar hull faces: a rotated lattice). Otherwise the cells
   /// pass. Every path gives the same rows.
   automatic,
   cells,      ///< the cells pass (and hull completion)
-  insertion,  ///< incremental insertion, parallel by phases; 3D without labels and with complete_hull only
+  /// Incremental insertion (3D: parallel by phases; 2D: serial); without
+  /// labels and with complete_hull only.
+  insertion,
 };
 
 struct DelaunayOptions : VoronoiOptions {

@@ -285,13 +285,14 @@ def voronoi(
         With ``bounds``: drop points outside the box (listed in
         ``ignored_outside_bounds``) instead of raising ValueError.
     method : {"auto", "search", "insertion"}
-        How each 3D cell finds the points that clip it; the cells are the
+        How each cell finds the points that clip it; the cells are the
         same. ``"search"``: the bins around it (the meshless method).
         ``"insertion"``: its Delaunay neighbours, from incremental insertion
-        (much faster where cells reach far: points nearly on a sphere,
-        surface samples, dense clusters). ``"auto"``: insertion where a
-        sample of cells costs far more than on uniform points, else search
-        (:attr:`Voronoi.from_insertion` says which ran). 2D always searches.
+        (much faster where cells reach far: points nearly on a sphere or
+        circle, surface samples, dense clusters, 2D curves). ``"auto"``:
+        insertion where a sample of cells costs far more than on uniform
+        points, else search (:attr:`Voronoi.from_insertion` says which
+        ran).
 
     Returns
     -------
