@@ -297,7 +297,7 @@ Delaunay by_insertion(const front::Pass<D>& pass, Delaunay out) {
       if (ins.lowest[k] >= 0) out.duplicates.emplace_back(loc.id(k), ins.lowest[k]);
     std::sort(out.duplicates.begin(), out.duplicates.end());
     out.hull_completed = true;
-    if (!ins.rows) return;  // all on one plane: no simplex exists
+    if (!ins.rows) return;  // all on one plane (2D: line): no simplex exists
     out.from_insertion = ins.rows->size() / (D + 1);
     out.simplices = std::move(*ins.rows);
   });

@@ -82,7 +82,7 @@ std::optional<Buffer<std::int32_t>> insertion_delaunay_2d(const kernels::ExactCo
 template <int D>
 struct Pass;
 
-/// insertion_delaunay of a pass's located points, exact duplicates left out:
+/// insertion_delaunay (2D: insertion_delaunay_2d) of a pass's located points, exact duplicates left out:
 /// of each set of coincident points the lowest id is the vertex, as the
 /// cells pass decides. For tessera::delaunay (its rows) and
 /// tessera::voronoi (the cells' neighbours). Call it in the pass's arena.

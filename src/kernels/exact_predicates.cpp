@@ -537,27 +537,40 @@ bool WidePredicate::prepare(const ExactContext& ctx, std::int32_t i, const std::
 
 bool WidePredicate::sign_on_grid(const ExactContext& ctx, std::int32_t j, int& out) const {
   using I = __int128;
-  using W1 = WideInt<1>;
   using W2 = WideInt<2>;
   using W3 = WideInt<3>;
   const double* pj = ctx.points + static_cast<std::size_t>(j) * dim_;
-  std::int64_t aj[Scratch::kMaxDim];
+  std::int64_t qj[Scratch::kMaxDim];
   I bj = 0;
   for (int d = 0; d < dim_; ++d) {
     std::int64_t x;
     if (!grid_integer(pj[d], shift_, bits, x)) return false;
     const std::int64_t q = x - ci_[d];
-    aj[d] = 2 * q;
+    qj[d] = q;
     bj += static_cast<I>(q) * q;
   }
   // det M0 = b_j det A - sum_r b_r dr_r, dr_r = det A with row r replaced by
-  // a_j (as VertexPredicate::sign); w_i's coefficient det A - the bisector
-  // rows' dr_r, below 4 * 3 * 2^187 < 2^191 (3 limbs).
+  // a_j = 2 q_j (as VertexPredicate::sign); w_i's coefficient det A - the
+  // bisector rows' dr_r, below 4 * 3 * 2^187 < 2^191 (3 limbs).
   WideInt<5> m0 = multiply(W2::from(bj), det_a_);
   W3 wi = det_a_, dr[Scratch::kMaxDim];
   for (int r = 0; r < dim_; ++r) {
-    dr[r] = W3::from(0);
-    for (int d = 0; d < dim_; ++d) dr[r] = dr[r] + multiply(W1::from_int64(aj[d]), W2::from(cof_[r][d]));
+    // dr_r / 2 = sum_d q_d c_d, each cofactor c = h 2^64 + l split into its
+    // signed high and unsigned low limbs: |q| < 2^61 and |h| < 2^61, so the
+    // sums of q h (< 3 * 2^122) and of q l (< 3 * 2^125) are exact in
+    // int128, and the 3-limb products are left for the combination.
+    I hi = 0, lo = 0;
+    for (int d = 0; d < dim_; ++d) {
+      const I c = cof_[r][d];
+      hi += static_cast<I>(qj[d]) * static_cast<std::int64_t>(c >> 64);
+      lo += static_cast<I>(qj[d]) * static_cast<I>(static_cast<std::uint64_t>(c));
+    }
+    W3 h;
+    h.limb[0] = 0;
+    h.limb[1] = static_cast<std::uint64_t>(hi);
+    h.limb[2] = static_cast<std::uint64_t>(hi >> 64);
+    const W3 half = h + W3::from(lo);
+    dr[r] = half + half;
     m0 = m0 - multiply(W2::from(b_[r]), dr[r]);
     if (gen_[r] >= 0) wi = wi - dr[r];
   }
