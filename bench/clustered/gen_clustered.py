@@ -49,13 +49,13 @@ import argparse
 import numpy as np
 
 
-def blobs(rng, n):
+def blobs(rng, n, dim=3):
     c = max(1, int(np.sqrt(n) / 4))
-    centres = rng.random((c, 3))
+    centres = rng.random((c, dim))
     sigma = rng.uniform(1e-3, 5e-3, c)
     m = int(0.9 * n)
     lab = rng.integers(0, c, m)
-    return np.vstack([centres[lab] + rng.normal(size=(m, 3)) * sigma[lab, None], rng.random((n - m, 3))])
+    return np.vstack([centres[lab] + rng.normal(size=(m, dim)) * sigma[lab, None], rng.random((n - m, dim))])
 
 
 def sheet(rng, n):
@@ -138,12 +138,7 @@ def curves2(rng, n):
 
 
 def blobs2(rng, n):
-    c = max(1, int(np.sqrt(n) / 4))
-    centres = rng.random((c, 2))
-    sigma = rng.uniform(1e-3, 5e-3, c)
-    m = int(0.9 * n)
-    lab = rng.integers(0, c, m)
-    return np.vstack([centres[lab] + rng.normal(size=(m, 2)) * sigma[lab, None], rng.random((n - m, 2))])
+    return blobs(rng, n, dim=2)
 
 
 KINDS = {"blobs": blobs, "sheet": sheet, "hier": hier, "terrain": terrain, "ellipsoid": ellipsoid, "torus": torus,

@@ -49,12 +49,12 @@ run() {
 for kind in $kinds; do
   f=$data/clustered_${kind}_$n.npy
   [[ -f $f ]] || $py "$here/gen_clustered.py" "$kind" "$n" "$f"
+  note "$kind: tessera"
+  [[ $cells == 1 ]] && run "$kind" "$build/tessera" bench voronoi "$f" --threads "$threads" --repeat 1
+  [[ $cells == 1 && $search == 1 ]] &&
+    tool_tag=tessera-search run "$kind" "$build/tessera" bench voronoi "$f" --method search --threads "$threads" --repeat 1
+  run "$kind" "$build/tessera" bench delaunay "$f" --threads "$threads" --repeat 1
   if [[ $kind == *2 ]]; then  # 2D: CGAL's Delaunay_triangulation_2 and scipy (Qhull, one thread) are the peers
-    note "$kind: tessera (2D)"
-    [[ $cells == 1 ]] && run "$kind" "$build/tessera" bench voronoi "$f" --threads "$threads" --repeat 1
-    [[ $cells == 1 && $search == 1 ]] &&
-      tool_tag=tessera-search run "$kind" "$build/tessera" bench voronoi "$f" --method search --threads "$threads" --repeat 1
-    run "$kind" "$build/tessera" bench delaunay "$f" --threads "$threads" --repeat 1
     if [[ -x $peers/cgal_delaunay2 ]]; then
       note "$kind: CGAL"
       run "$kind" "$peers/cgal_delaunay2" "$f"
@@ -66,11 +66,6 @@ for kind in $kinds; do
     fi
     continue
   fi
-  note "$kind: tessera"
-  [[ $cells == 1 ]] && run "$kind" "$build/tessera" bench voronoi "$f" --threads "$threads" --repeat 1
-  [[ $cells == 1 && $search == 1 ]] &&
-    tool_tag=tessera-search run "$kind" "$build/tessera" bench voronoi "$f" --method search --threads "$threads" --repeat 1
-  run "$kind" "$build/tessera" bench delaunay "$f" --threads "$threads" --repeat 1
   if [[ -x $peers/cgal_delaunay3 ]]; then
     note "$kind: CGAL"
     run "$kind" "$peers/cgal_delaunay3" "$f" --threads "$threads"
