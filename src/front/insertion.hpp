@@ -1,7 +1,9 @@
-// The 3D Delaunay triangulation by incremental insertion (Bowyer–Watson), for
-// the inputs whose cells cost far more than they find: points sampled on
-// surfaces, whose Voronoi cells are needles reaching across the object
-// (docs/design.md, "Insertion for costly inputs").
+// The 2D and 3D Delaunay triangulation by incremental insertion
+// (Bowyer–Watson), for the inputs whose cells cost far more than they find:
+// points sampled on surfaces, whose Voronoi cells are needles reaching across
+// the object, and in 2D points on circles or along curves (docs/design.md,
+// "Insertion for costly inputs", "2D insertion"). Described here for 3D; 2D
+// is the same with triangles, edges for facets and circles for spheres.
 //
 // The triangulation is kept with one infinite vertex: each convex hull facet
 // has a "ghost" tetrahedron (facet + infinite vertex), so a point outside the
@@ -24,10 +26,6 @@
 // the previous round (insertion.cpp, walk_start). Large rounds are inserted in parallel
 // phases, one slab of space per worker (insertion.cpp, Triangulation::phase);
 // the result does not depend on the order, so neither on the thread count.
-//
-// 2D (insertion_2d.cpp) is the same scheme with triangles, serial: it
-// serves the 2D inputs whose cells cost far more than they find (points on
-// a circle or along curves).
 #pragma once
 
 #include <cstdint>
@@ -60,29 +58,22 @@ struct InsertionOptions {
   std::function<void(double)> progress;
 };
 
-/// The Delaunay tetrahedra of the points `ids` (distinct coordinates: no exact
-/// duplicates; ids into ctx.points, ctx.dim == 3). Each row lists its ids
-/// ascending, except that the last two are swapped where that order is
-/// negatively oriented; rows are in ascending order of their sorted ids (the
-/// layout of tessera::Delaunay::simplices: 4 ids per row, flat). nullopt when the points are all
-/// coplanar (no tetrahedron exists). `lo`/`hi` bound the points (for the
-/// insertion order only).
+/// The Delaunay tetrahedra (ctx.dim == 3) or triangles (ctx.dim == 2) of the
+/// points `ids` (distinct coordinates: no exact duplicates; ids into
+/// ctx.points). Each row lists its ids ascending, except that the last two
+/// are swapped where that order is negatively oriented (2D: clockwise); rows
+/// are in ascending order of their sorted ids (the layout of
+/// tessera::Delaunay::simplices: D + 1 ids per row, flat). nullopt when the
+/// points are all on one plane (2D: line), so no simplex exists. `lo`/`hi`
+/// bound the points (for the insertion order only).
 std::optional<Buffer<std::int32_t>> insertion_delaunay(const kernels::ExactContext& ctx,
                                                        std::span<const std::int32_t> ids, const double* lo,
                                                        const double* hi, const InsertionOptions& options = {});
 
-/// The same in 2D (ctx.dim == 2): 3 ids per row, counter-clockwise rows as
-/// tessera::Delaunay lays them out; nullopt when the points are all on one
-/// line. Serial; `progress`, when set, as InsertionOptions::progress.
-std::optional<Buffer<std::int32_t>> insertion_delaunay_2d(const kernels::ExactContext& ctx,
-                                                          std::span<const std::int32_t> ids, const double* lo,
-                                                          const double* hi,
-                                                          const std::function<void(double)>& progress = {});
-
 template <int D>
 struct Pass;
 
-/// insertion_delaunay (2D: insertion_delaunay_2d) of a pass's located points, exact duplicates left out:
+/// insertion_delaunay of a pass's located points, exact duplicates left out:
 /// of each set of coincident points the lowest id is the vertex, as the
 /// cells pass decides. For tessera::delaunay (its rows) and
 /// tessera::voronoi (the cells' neighbours). Call it in the pass's arena.

@@ -17,7 +17,7 @@
 #include <vector>
 
 #include "common/hostile_points.hpp"
-#include "front/insertion.hpp"
+#include "insert_points.hpp"
 #include "random_points.hpp"
 #include "tessera/delaunay.hpp"
 
@@ -150,37 +150,6 @@ TEST(Insertion, GivesTheRowsOfTheCellsPass) {
   }
 }
 
-// insertion_delaunay itself, on the distinct points of p (the lowest id of
-// each set of coincident ones).
-std::vector<std::array<std::int32_t, 4>> insert_points(const std::vector<double>& p, int threads, std::size_t parallel_min,
-                                                        tessera::front::InsertionStats* stats = nullptr) {
-  const std::size_t n = p.size() / 3;
-  tessera::kernels::ExactContext ctx;
-  ctx.points = p.data();
-  ctx.dim = 3;
-  for (int d = 0; d < 3; ++d) {
-    ctx.lo[d] = ctx.hi[d] = p[d];
-    for (std::size_t i = 0; i < n; ++i) {
-      ctx.lo[d] = std::min(ctx.lo[d], p[3 * i + d]);
-      ctx.hi[d] = std::max(ctx.hi[d], p[3 * i + d]);
-    }
-  }
-  std::vector<std::int32_t> ids(n);
-  for (std::size_t i = 0; i < n; ++i) ids[i] = static_cast<std::int32_t>(i);
-  auto at = [&](std::int32_t i) { return std::array<double, 3>{p[3 * i], p[3 * i + 1], p[3 * i + 2]}; };
-  std::stable_sort(ids.begin(), ids.end(), [&](std::int32_t a, std::int32_t b) { return at(a) < at(b); });
-  ids.erase(std::unique(ids.begin(), ids.end(), [&](std::int32_t a, std::int32_t b) { return at(a) == at(b); }), ids.end());
-  tessera::front::InsertionOptions o;
-  o.threads = threads;
-  o.parallel_min = parallel_min;
-  o.stats = stats;
-  const auto flat = tessera::front::insertion_delaunay(ctx, ids, ctx.lo.data(), ctx.hi.data(), o);
-  std::vector<std::array<std::int32_t, 4>> rows(flat ? flat->size() / 4 : 0);
-  for (std::size_t r = 0; r < rows.size(); ++r)
-    for (std::size_t k = 0; k < 4; ++k) rows[r][k] = (*flat)[4 * r + k];
-  return rows;
-}
-
 TEST(Insertion, ParallelPhasesGiveTheSerialRows) {
   // Rounds from 8 points per thread on go through the parallel phases, so
   // even these small inputs take several, cut across two axes, with points
@@ -190,21 +159,21 @@ TEST(Insertion, ParallelPhasesGiveTheSerialRows) {
   auto in = inputs();
   in.emplace_back("uniform 20k", uniform_points(20000, 3, 47));
   for (const auto& [what, p] : in) {
-    const auto serial = insert_points(p, 1, 8);
+    const auto serial = insert_points(p, 3, 1, 8);
     EXPECT_FALSE(serial.empty()) << what;
-    for (const int threads : {2, 3, 4}) EXPECT_EQ(insert_points(p, threads, 8), serial) << what << ", threads " << threads;
+    for (const int threads : {2, 3, 4}) EXPECT_EQ(insert_points(p, 3, threads, 8), serial) << what << ", threads " << threads;
   }
   // The phases did run and inserted most of their points: on uniform points
   // they defer only those along the cuts.
   tessera::front::InsertionStats stats;
-  insert_points(uniform_points(20000, 3, 47), 2, 8, &stats);
+  insert_points(uniform_points(20000, 3, 47), 3, 2, 8, &stats);
   EXPECT_GE(stats.phases, 8u);
   EXPECT_LT(4 * stats.deferred, stats.phase_points) << stats.deferred << " of " << stats.phase_points;
   // Some walks start from their guide vertex, in the phases too (the rows
   // above are the same whichever start a walk takes).
   EXPECT_GT(stats.guided, 100u);
   // A serial run runs none.
-  insert_points(uniform_points(20000, 3, 47), 1, 8, &stats);
+  insert_points(uniform_points(20000, 3, 47), 3, 1, 8, &stats);
   EXPECT_EQ(stats.phases, 0u);
   EXPECT_GT(stats.guided, 100u);
 }

@@ -1,10 +1,11 @@
-// 2D Delaunay by incremental insertion (front/insertion_2d.cpp): the rows of
+// 2D Delaunay by incremental insertion (front/insertion.cpp): the rows of
 // the cells pass, byte for byte, on general-position and degenerate input
 // (lattices, co-circular and collinear points, where the symbolic
 // perturbation chooses), the same duplicates, a valid triangulation; the
 // automatic choice takes it for small inputs, costly cells (points on a
 // circle, along curves) and one thread, and leaves lattices and uniform
-// points on two threads to the cells.
+// points on two threads to the cells. Its parallel phases give the serial
+// rows for any thread count.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -16,6 +17,7 @@
 #include <vector>
 
 #include "common/hostile_points.hpp"
+#include "insert_points.hpp"
 #include "random_points.hpp"
 #include "tessera/delaunay.hpp"
 
@@ -137,6 +139,30 @@ TEST(Insertion2D, GivesTheRowsOfTheCellsPass) {
     for (const auto& m : r.messages) ADD_FAILURE() << what << ": " << m;
     EXPECT_TRUE(r.ok) << what;
   }
+}
+
+TEST(Insertion2D, ParallelPhasesGiveTheSerialRows) {
+  // As Insertion.ParallelPhasesGiveTheSerialRows: rounds from 8 points per
+  // thread on go through the parallel phases, cut across both axes. In 2D
+  // no worker owns a ghost triangle, so points outside the hull so far are
+  // deferred too: the circles defer most of theirs.
+  auto in = inputs2();
+  in.emplace_back("uniform 20k", uniform_points(20000, 2, 74));
+  in.emplace_back("circle 20k", circle(20000, 75));
+  for (const auto& [what, p] : in) {
+    const auto serial = insert_points(p, 2, 1, 8);
+    EXPECT_FALSE(serial.empty()) << what;
+    for (const int threads : {2, 3, 4}) EXPECT_EQ(insert_points(p, 2, threads, 8), serial) << what << ", threads " << threads;
+  }
+  // The phases did run and inserted most of their points: on uniform points
+  // they defer only those along the cuts and outside the hull.
+  tessera::front::InsertionStats stats;
+  insert_points(uniform_points(20000, 2, 74), 2, 2, 8, &stats);
+  EXPECT_GE(stats.phases, 8u);
+  EXPECT_LT(4 * stats.deferred, stats.phase_points) << stats.deferred << " of " << stats.phase_points;
+  EXPECT_GT(stats.guided, 100u);
+  insert_points(uniform_points(20000, 2, 74), 2, 1, 8, &stats);
+  EXPECT_EQ(stats.phases, 0u);
 }
 
 TEST(Insertion2D, FewAndCollinearPoints) {

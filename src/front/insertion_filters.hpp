@@ -1,0 +1,99 @@
+// The float filters of the 2D and 3D insertions (insertion.cpp).
+#pragma once
+
+#include <cmath>
+
+#include "tessera/kernels/filter.hpp"
+
+namespace tessera::front::insertion {
+
+// The filters in front of kernels::orientation and kernels::in_sphere,
+// written out for 2D and 3D and for points that are ids into one array: the walk and
+// the cavity search ask tens of them per point. Each returns the exact sign
+// when its float evaluation is certain, and 0 otherwise (then the kernels'
+// predicates decide, with their exact arithmetic and perturbation). The
+// quantities and bounds are those of the kernels' filters
+// (delaunay_predicates.hpp), evaluated in another order: the bounds hold for
+// any order of the sums.
+
+// Sign of det[b - a, c - a, d - a].
+[[gnu::always_inline]] inline int orientation_filter(const double* a, const double* b, const double* c, const double* d) {
+  const double r0[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+  const double r1[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+  const double r2[3] = {d[0] - a[0], d[1] - a[1], d[2] - a[2]};
+  const double m0 = r1[1] * r2[2], m1 = r1[2] * r2[1];
+  const double m2 = r1[2] * r2[0], m3 = r1[0] * r2[2];
+  const double m4 = r1[0] * r2[1], m5 = r1[1] * r2[0];
+  const double det = r0[0] * (m0 - m1) + r0[1] * (m2 - m3) + r0[2] * (m4 - m5);
+  const double perm = std::fabs(r0[0]) * (std::fabs(m0) + std::fabs(m1)) +
+                      std::fabs(r0[1]) * (std::fabs(m2) + std::fabs(m3)) +
+                      std::fabs(r0[2]) * (std::fabs(m4) + std::fabs(m5));
+  const double bound = 16 * kernels::filter::u * perm + kernels::filter::abs_eps;
+  return det > bound ? 1 : (det < -bound ? -1 : 0);
+}
+
+// For a positively oriented tetrahedron abcd: +1 when q is surely inside its
+// circumsphere, -1 surely outside, 0 undecided. With rows r_k = p_k - a and
+// s_k = |r_k|^2 (k = b, c, d, q), q is inside iff det[[r_k, s_k]] < 0
+// (kernels::in_sphere; det R > 0 here).
+[[gnu::always_inline]] inline int in_sphere_filter(const double* a, const double* b, const double* c, const double* d, const double* q) {
+  double r[4][3], s[4];
+  const double* p[4] = {b, c, d, q};
+  for (int k = 0; k < 4; ++k) {
+    for (int e = 0; e < 3; ++e) r[k][e] = p[k][e] - a[e];
+    s[k] = r[k][0] * r[k][0] + r[k][1] * r[k][1] + r[k][2] * r[k][2];
+  }
+  // 2x2 minors of the x, y columns for each pair of rows, and their permanents.
+  double xy[4][4], axy[4][4];
+  for (int i = 0; i < 4; ++i)
+    for (int j = i + 1; j < 4; ++j) {
+      const double u = r[i][0] * r[j][1], v = r[i][1] * r[j][0];
+      xy[i][j] = u - v;
+      axy[i][j] = std::fabs(u) + std::fabs(v);
+    }
+  // The 3x3 minor of rows i < j < k (columns x, y, z), expanded along z.
+  auto minor = [&](int i, int j, int k, double& perm) {
+    perm = std::fabs(r[i][2]) * axy[j][k] + std::fabs(r[j][2]) * axy[i][k] + std::fabs(r[k][2]) * axy[i][j];
+    return r[i][2] * xy[j][k] - r[j][2] * xy[i][k] + r[k][2] * xy[i][j];
+  };
+  double p0, p1, p2, p3;
+  const double d0 = minor(1, 2, 3, p0), d1 = minor(0, 2, 3, p1), d2 = minor(0, 1, 3, p2), d3 = minor(0, 1, 2, p3);
+  const double det = -s[0] * d0 + s[1] * d1 - s[2] * d2 + s[3] * d3;
+  const double perm = s[0] * p0 + s[1] * p1 + s[2] * p2 + s[3] * p3;
+  const double bound = 64 * kernels::filter::u * perm + kernels::filter::abs_eps;
+  return det < -bound ? 1 : (det > bound ? -1 : 0);
+}
+
+// Sign of det[b - a, c - a].
+[[gnu::always_inline]] inline int orientation_filter(const double* a, const double* b, const double* c) {
+  const double m0 = (b[0] - a[0]) * (c[1] - a[1]), m1 = (b[1] - a[1]) * (c[0] - a[0]);
+  const double det = m0 - m1;
+  const double bound = 16 * kernels::filter::u * (std::fabs(m0) + std::fabs(m1)) + kernels::filter::abs_eps;
+  return det > bound ? 1 : (det < -bound ? -1 : 0);
+}
+
+// For a counter-clockwise triangle abc: +1 when q is surely inside its
+// circumcircle, -1 surely outside, 0 undecided. With rows r_k = p_k - a and
+// s_k = |r_k|^2 (k = b, c, q), q is inside iff det[[r_k, s_k]] < 0.
+[[gnu::always_inline]] inline int in_circle_filter(const double* a, const double* b, const double* c, const double* q) {
+  double r[3][2], s[3];
+  const double* p[3] = {b, c, q};
+  for (int k = 0; k < 3; ++k) {
+    r[k][0] = p[k][0] - a[0];
+    r[k][1] = p[k][1] - a[1];
+    s[k] = r[k][0] * r[k][0] + r[k][1] * r[k][1];
+  }
+  // The 2x2 minor of the rows other than k, and its permanent.
+  auto minor = [&](int i, int j, double& perm) {
+    const double u = r[i][0] * r[j][1], v = r[i][1] * r[j][0];
+    perm = std::fabs(u) + std::fabs(v);
+    return u - v;
+  };
+  double p0, p1, p2;
+  const double d0 = minor(1, 2, p0), d1 = minor(0, 2, p1), d2 = minor(0, 1, p2);
+  const double det = s[0] * d0 - s[1] * d1 + s[2] * d2;
+  const double bound = 64 * kernels::filter::u * (s[0] * p0 + s[1] * p1 + s[2] * p2) + kernels::filter::abs_eps;
+  return det < -bound ? 1 : (det > bound ? -1 : 0);
+}
+
+}  // namespace tessera::front::insertion

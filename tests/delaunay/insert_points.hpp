@@ -1,0 +1,43 @@
+// front::insertion_delaunay called directly (its parallel phases' knobs and
+// statistics), on the distinct points of p (the lowest id of each set of
+// coincident ones), dim coordinates per point. Rows of dim + 1 ids.
+#pragma once
+
+#include <algorithm>
+#include <cstdint>
+#include <vector>
+
+#include "front/insertion.hpp"
+
+inline std::vector<std::vector<std::int32_t>> insert_points(const std::vector<double>& p, int dim, int threads,
+                                                            std::size_t parallel_min,
+                                                            tessera::front::InsertionStats* stats = nullptr) {
+  const std::size_t d = static_cast<std::size_t>(dim), n = p.size() / d;
+  tessera::kernels::ExactContext ctx;
+  ctx.points = p.data();
+  ctx.dim = dim;
+  for (std::size_t a = 0; a < d; ++a) {
+    ctx.lo[a] = ctx.hi[a] = p[a];
+    for (std::size_t i = 0; i < n; ++i) {
+      ctx.lo[a] = std::min(ctx.lo[a], p[d * i + a]);
+      ctx.hi[a] = std::max(ctx.hi[a], p[d * i + a]);
+    }
+  }
+  std::vector<std::int32_t> ids(n);
+  for (std::size_t i = 0; i < n; ++i) ids[i] = static_cast<std::int32_t>(i);
+  auto at = [&](std::int32_t i) {
+    return std::vector<double>(p.begin() + static_cast<std::ptrdiff_t>(d * static_cast<std::size_t>(i)),
+                               p.begin() + static_cast<std::ptrdiff_t>(d * static_cast<std::size_t>(i) + d));
+  };
+  std::stable_sort(ids.begin(), ids.end(), [&](std::int32_t a, std::int32_t b) { return at(a) < at(b); });
+  ids.erase(std::unique(ids.begin(), ids.end(), [&](std::int32_t a, std::int32_t b) { return at(a) == at(b); }), ids.end());
+  tessera::front::InsertionOptions o;
+  o.threads = threads;
+  o.parallel_min = parallel_min;
+  o.stats = stats;
+  const auto flat = tessera::front::insertion_delaunay(ctx, ids, ctx.lo.data(), ctx.hi.data(), o);
+  const std::size_t k = d + 1;
+  std::vector<std::vector<std::int32_t>> rows(flat ? flat->size() / k : 0);
+  for (std::size_t r = 0; r < rows.size(); ++r) rows[r].assign(flat->data() + k * r, flat->data() + k * (r + 1));
+  return rows;
+}
