@@ -262,12 +262,15 @@ std::vector<std::uint8_t> choose_skipped(const front::Pass<D>& pass, double frac
 /// nearly linearly, the phases defer more as their slabs thin), not a
 /// measurement.
 ///
-/// In 2D the insertion is serial (insertion_2d.cpp) and cheap: 0.87 s for
-/// 1M uniform points, 0.15 s for 200k, about the same on curves, blobs and
-/// segments. The cells take 1.13 s on one thread and 0.58 s on two at 1M
-/// uniform points, 0.125 s on two at 200k, and on 200k clustered points
-/// (ratios 6-7) 0.29-0.34 s on two: about ratio^0.55. Level on two threads
-/// at a ratio of ~1.4 (1M) to 1 (200k): 1.4 on two threads, as sqrt(threads).
+/// In 2D the insertion is cheap, and since stop 38 it has the parallel
+/// phases too: 1M uniform points 0.80 s on one thread and 0.50 s on two,
+/// 200k 0.073 s on two, about the same on curves, blobs and segments. The
+/// cells take 1.13 s on one thread and 0.60 s on two at 1M uniform points,
+/// 0.11 s on two at 200k, and on 200k clustered points (ratios 6-7)
+/// 0.29-0.34 s on two. Lattices (ratio 0.6-1.2), whose every in-circle
+/// test is a tie, take 0.10-0.14 s by the cells and 0.15-0.16 s by
+/// insertion at 250k points; they stay with the cells below 1.4 on two
+/// threads, as sqrt(threads) beyond.
 template <int D>
 double insertion_ratio(int threads) {
   return (D == 3 ? 1.6 : 1.4) * std::sqrt(std::max(threads, 1) / 2.0);
@@ -352,11 +355,11 @@ Delaunay run(std::span<const double> input, std::span<const std::int32_t> labels
     // lattice rotated, or scaled by 0.1, is off any grid, its near-ties
     // settled by the extended filter: 1.29 s and 2.54 s by insertion,
     // minutes and 4.49 s by the cells. Beyond two threads the cells scale
-    // better (a model; this machine has two cores). In 2D only on one
-    // thread (1M uniform points: 0.87 against 1.13 s; on two the cells
-    // take 0.58 s, the serial insertion 0.71).
+    // better (a model; this machine has two cores). In 2D likewise (1M
+    // uniform points: 0.80 against 1.13 s on one thread, 0.50 against 0.60
+    // s on two; a rotated 300^2 lattice 0.042 against 0.075 s).
     const bool ties = estimate.exact_per_cell >= clean_exact_per_cell && pass.exact.grid != nullptr;
-    const bool clean = !ties && pass.engine_options.threads <= (D == 3 ? 2 : 1);
+    const bool clean = !ties && pass.engine_options.threads <= 2;
     const bool insert = opt.method == DelaunayMethod::insertion || small ||
                         (may_insert && pilot && (estimate.ratio >= insert_from || clean));
     if (insert && complete && attempt == 0) return by_insertion(pass, std::move(out));

@@ -3,9 +3,9 @@
 // (lattices, co-circular and collinear points, where the symbolic
 // perturbation chooses), the same duplicates, a valid triangulation; the
 // automatic choice takes it for small inputs, costly cells (points on a
-// circle, along curves) and one thread, and leaves lattices and uniform
-// points on two threads to the cells. Its parallel phases give the serial
-// rows for any thread count.
+// circle, along curves) and inputs without ties on one or two threads, and
+// leaves lattices, and uniform points on more threads, to the cells. Its
+// parallel phases give the serial rows for any thread count.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -200,16 +200,22 @@ TEST(Insertion2D, AutomaticChoice) {
   const auto ring = circle(30000, 71);
   const tessera::Delaunay on_ring = automatic(ring, 2);
   EXPECT_EQ(on_ring.from_insertion, on_ring.n_simplices());
-  // Uniform points: the cells on two threads, insertion on one.
+  // Uniform points: insertion on one and two threads, the cells on four
+  // (a model: the cells scale better).
   const auto uniform = uniform_points(30000, 2, 72);
   const tessera::Delaunay two = automatic(uniform, 2);
-  EXPECT_EQ(two.from_insertion, 0u);
+  EXPECT_EQ(two.from_insertion, two.n_simplices());
   const tessera::Delaunay one = automatic(uniform, 1);
   EXPECT_EQ(one.from_insertion, one.n_simplices());
   EXPECT_EQ(one.simplices, two.simplices);
-  // A lattice's ties make insertion slower: the cells, on one thread too.
-  const tessera::Delaunay ties = automatic(grid2(200), 1);
-  EXPECT_EQ(ties.from_insertion, 0u);
+  const tessera::Delaunay four = automatic(uniform, 4);
+  EXPECT_EQ(four.from_insertion, 0u);
+  EXPECT_EQ(four.simplices, two.simplices);
+  // A lattice's ties make insertion slower: the cells, on one and two threads.
+  for (const int threads : {1, 2}) {
+    const tessera::Delaunay ties = automatic(grid2(200), threads);
+    EXPECT_EQ(ties.from_insertion, 0u);
+  }
 }
 
 TEST(Insertion2D, ProgressAndCancellation) {
