@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <bit>
 #include <cmath>
 #include <cstring>
@@ -70,6 +71,7 @@ struct Worker : insertion::Worker {
   };
   std::vector<Facet> boundary;
   std::vector<Edge> edges;  // 3D: new tetrahedra by the edge they share
+  std::int32_t pending_infinite = -1;  // 2D: pending_'s entry for the infinite vertex
   std::vector<std::uint64_t> used;
 };
 
@@ -91,7 +93,7 @@ class Triangulation {
     coords_.resize(D * n);
     for (std::size_t k = 0; k < n; ++k)
       for (std::size_t e = 0; e < D; ++e) coords_[D * k + e] = ctx.points[static_cast<std::size_t>(global_[k]) * D + e];
-    if constexpr (D == 2) pending_.assign(n + 1, -1);
+    if constexpr (D == 2) pending_.assign(n, -1);
     // A Delaunay tetrahedralisation has about 6.5 tetrahedra per point, a
     // triangulation 2 triangles.
     store_.reserve((D == 3 ? 7 : 3) * n + 64);
@@ -201,14 +203,16 @@ class Triangulation {
   ///   each among its four vertices, with one of every face's three left
   ///   out: no such tetrahedron exists (the infinite vertex belongs to
   ///   everyone).
-  /// * 2D: the same holds for a triangle with an edge all of A's and one all
-  ///   of B's, but only for edges of two finite vertices: a ghost (a, b, ∞)
-  ///   with a in A's slab and b in B's lies across (a, ∞) from a ghost A
-  ///   could own and across (b, ∞) from one B could. So in 2D no worker
-  ///   owns a ghost: every owned triangle is finite, every edge it meets
-  ///   others by has two finite vertices. A point whose cavity holds a
-  ///   ghost (it lies outside the hull so far) is deferred; after the first
-  ///   rounds there are few.
+  /// * 2D: likewise no triangle has an edge of two finite vertices all of
+  ///   A's and one all of B's. The exception is a ghost (a, b, ∞) with a in
+  ///   A's slab and b in B's: it lies across (a, ∞) from a ghost A may own
+  ///   and across (b, ∞) from one B may. Neither owns it, so neither
+  ///   changes its vertices; each may test it, mark it (the marks are
+  ///   relaxed atomics, and one worker's epochs never match another's) and
+  ///   rewrite its own link slot (opposite b, or opposite a: different
+  ///   words). The link across (a, b), which a test of it reads, only
+  ///   changes serially. Points on a circle are all on the hull: a first
+  ///   version that let no worker own a ghost deferred every one of them.
   /// The triangulation stays the Delaunay triangulation of the points
   /// inserted so far; it is unique (perturbed predicates), so the order of
   /// insertion, and with it the thread count, does not change the result.
@@ -296,12 +300,16 @@ class Triangulation {
       }
       for (int k = 0; k < K; ++k) {
         const std::int32_t u = simplex_of(ss[t].n[k]);
+        // Relaxed atomics (plain moves on x86): in 2D two workers may mark
+        // the same ghost (see phase).
+        std::atomic_ref<std::uint32_t> mark(state[u]);
+        const std::uint32_t m = mark.load(std::memory_order_relaxed);
         bool in;
-        if ((state[u] | 1) == mark_in) {
-          in = state[u] & 1;
+        if ((m | 1) == mark_in) {
+          in = m & 1;
         } else {
           in = conflicts(u, q);
-          state[u] = in ? mark_in : mark_out;
+          mark.store(in ? mark_in : mark_out, std::memory_order_relaxed);
           if (in) {
             if (Check && !owned(ss[u], w.part)) return false;
             w.stack.push_back(u);
@@ -331,9 +339,9 @@ class Triangulation {
     // The new simplices fan around q; two of them meet across each facet
     // through q, found by the facet's other vertices. 3D: a hash by the
     // boundary edge they share. 2D: an array by the one boundary vertex
-    // they share (pending_, by vertex + 1 so the infinite vertex has a
-    // place); in a phase a worker's vertices are its own, so no two workers
-    // use the same entry.
+    // they share (pending_; the infinite vertex's entry is the worker's
+    // own); in a phase a worker's finite vertices are its own, so no two
+    // workers use the same entry.
     std::uint64_t mask = 0;
     int shift = 0;
     if constexpr (D == 3) {
@@ -357,7 +365,8 @@ class Triangulation {
       for (int j = 0; j < K; ++j) {
         if (j == f.k) continue;
         if constexpr (D == 2) {
-          std::int32_t& p = pending_[static_cast<std::size_t>(f.v[3 - j - f.k] + 1)];
+          const std::int32_t v = f.v[3 - j - f.k];
+          std::int32_t& p = v == infinite ? w.pending_infinite : pending_[static_cast<std::size_t>(v)];
           if (p < 0) {
             p = across(nt, j);
           } else {
@@ -425,15 +434,10 @@ class Triangulation {
   }
 
   /// Whether worker `part` may change t: its finite vertices all lie in its
-  /// partition; in 2D it is also finite (see phase).
+  /// partition.
   bool owned(const S& t, std::uint8_t part) const {
-    for (int k = 0; k < K; ++k) {
-      if (t.v[k] == infinite) {
-        if constexpr (D == 2) return false;
-        continue;
-      }
-      if (part_[static_cast<std::size_t>(t.v[k])] != part) return false;
-    }
+    for (int k = 0; k < K; ++k)
+      if (t.v[k] != infinite && part_[static_cast<std::size_t>(t.v[k])] != part) return false;
     return true;
   }
 
@@ -530,7 +534,7 @@ class Triangulation {
   std::vector<std::int32_t> guide_;     // vertex -> an earlier round's vertex near it, or -1 (walk_start)
   std::vector<std::int32_t> vsimplex_;  // inserted vertex -> a live simplex of it
   std::vector<double> coords_;          // vertex -> coordinates (D each)
-  std::vector<std::int32_t> pending_;   // 2D: vertex + 1 -> a new triangle's link awaiting its partner, or -1
+  std::vector<std::int32_t> pending_;   // 2D: vertex -> a new triangle's link awaiting its partner, or -1
   insertion::SimplexStore<S> store_{D == 3 ? "tessera: insertion: more tetrahedra than Simplex::n can number (about 75 million points)"
                                            : "tessera: insertion: more triangles than Simplex::n can number (about 250 million points)"};
   std::vector<W> workers_;

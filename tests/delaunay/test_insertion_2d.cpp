@@ -143,9 +143,9 @@ TEST(Insertion2D, GivesTheRowsOfTheCellsPass) {
 
 TEST(Insertion2D, ParallelPhasesGiveTheSerialRows) {
   // As Insertion.ParallelPhasesGiveTheSerialRows: rounds from 8 points per
-  // thread on go through the parallel phases, cut across both axes. In 2D
-  // no worker owns a ghost triangle, so points outside the hull so far are
-  // deferred too: the circles defer most of theirs.
+  // thread on go through the parallel phases, cut across both axes. On a
+  // circle every point is on the hull: its cavity holds ghost triangles,
+  // and the ghosts across a cut are tested and marked by two workers.
   auto in = inputs2();
   in.emplace_back("uniform 20k", uniform_points(20000, 2, 74));
   in.emplace_back("circle 20k", circle(20000, 75));
@@ -155,12 +155,16 @@ TEST(Insertion2D, ParallelPhasesGiveTheSerialRows) {
     for (const int threads : {2, 3, 4}) EXPECT_EQ(insert_points(p, 2, threads, 8), serial) << what << ", threads " << threads;
   }
   // The phases did run and inserted most of their points: on uniform points
-  // they defer only those along the cuts and outside the hull.
+  // they defer only those along the cuts.
   tessera::front::InsertionStats stats;
   insert_points(uniform_points(20000, 2, 74), 2, 2, 8, &stats);
   EXPECT_GE(stats.phases, 8u);
   EXPECT_LT(4 * stats.deferred, stats.phase_points) << stats.deferred << " of " << stats.phase_points;
   EXPECT_GT(stats.guided, 100u);
+  // On a circle too: only the points whose cavity reaches across a cut wait.
+  insert_points(circle(20000, 75), 2, 2, 8, &stats);
+  EXPECT_GE(stats.phases, 8u);
+  EXPECT_LT(4 * stats.deferred, stats.phase_points) << stats.deferred << " of " << stats.phase_points;
   insert_points(uniform_points(20000, 2, 74), 2, 1, 8, &stats);
   EXPECT_EQ(stats.phases, 0u);
 }
