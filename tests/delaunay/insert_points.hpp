@@ -3,8 +3,12 @@
 // coincident ones), dim coordinates per point. Rows of dim + 1 ids.
 #pragma once
 
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <cstdint>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include "front/insertion.hpp"
@@ -40,4 +44,24 @@ inline std::vector<std::vector<std::int32_t>> insert_points(const std::vector<do
   std::vector<std::vector<std::int32_t>> rows(flat ? flat->size() / k : 0);
   for (std::size_t r = 0; r < rows.size(); ++r) rows[r].assign(flat->data() + k * r, flat->data() + k * (r + 1));
   return rows;
+}
+
+/// Each input's rows on 2, 3 and 4 workers, with phases from 8 points per
+/// thread, equal its serial rows.
+inline void expect_phases_give_the_serial_rows(const std::vector<std::pair<std::string, std::vector<double>>>& inputs,
+                                               int dim) {
+  for (const auto& [what, p] : inputs) {
+    const auto serial = insert_points(p, dim, 1, 8);
+    EXPECT_FALSE(serial.empty()) << what;
+    for (const int threads : {2, 3, 4}) EXPECT_EQ(insert_points(p, dim, threads, 8), serial) << what << ", threads " << threads;
+  }
+}
+
+/// Phases ran on p, 2 workers, and deferred under a quarter of their points.
+inline tessera::front::InsertionStats expect_phases_insert_most(const std::vector<double>& p, int dim) {
+  tessera::front::InsertionStats stats;
+  insert_points(p, dim, 2, 8, &stats);
+  EXPECT_GE(stats.phases, 8u);
+  EXPECT_LT(4 * stats.deferred, stats.phase_points) << stats.deferred << " of " << stats.phase_points;
+  return stats;
 }

@@ -158,17 +158,10 @@ TEST(Insertion, ParallelPhasesGiveTheSerialRows) {
   // run on whatever cores there are: the partition does not depend on them.
   auto in = inputs();
   in.emplace_back("uniform 20k", uniform_points(20000, 3, 47));
-  for (const auto& [what, p] : in) {
-    const auto serial = insert_points(p, 3, 1, 8);
-    EXPECT_FALSE(serial.empty()) << what;
-    for (const int threads : {2, 3, 4}) EXPECT_EQ(insert_points(p, 3, threads, 8), serial) << what << ", threads " << threads;
-  }
+  expect_phases_give_the_serial_rows(in, 3);
   // The phases did run and inserted most of their points: on uniform points
   // they defer only those along the cuts.
-  tessera::front::InsertionStats stats;
-  insert_points(uniform_points(20000, 3, 47), 3, 2, 8, &stats);
-  EXPECT_GE(stats.phases, 8u);
-  EXPECT_LT(4 * stats.deferred, stats.phase_points) << stats.deferred << " of " << stats.phase_points;
+  tessera::front::InsertionStats stats = expect_phases_insert_most(uniform_points(20000, 3, 47), 3);
   // Some walks start from their guide vertex, in the phases too (the rows
   // above are the same whichever start a walk takes).
   EXPECT_GT(stats.guided, 100u);

@@ -149,22 +149,13 @@ TEST(Insertion2D, ParallelPhasesGiveTheSerialRows) {
   auto in = inputs2();
   in.emplace_back("uniform 20k", uniform_points(20000, 2, 74));
   in.emplace_back("circle 20k", circle(20000, 75));
-  for (const auto& [what, p] : in) {
-    const auto serial = insert_points(p, 2, 1, 8);
-    EXPECT_FALSE(serial.empty()) << what;
-    for (const int threads : {2, 3, 4}) EXPECT_EQ(insert_points(p, 2, threads, 8), serial) << what << ", threads " << threads;
-  }
+  expect_phases_give_the_serial_rows(in, 2);
   // The phases did run and inserted most of their points: on uniform points
   // they defer only those along the cuts.
-  tessera::front::InsertionStats stats;
-  insert_points(uniform_points(20000, 2, 74), 2, 2, 8, &stats);
-  EXPECT_GE(stats.phases, 8u);
-  EXPECT_LT(4 * stats.deferred, stats.phase_points) << stats.deferred << " of " << stats.phase_points;
+  tessera::front::InsertionStats stats = expect_phases_insert_most(uniform_points(20000, 2, 74), 2);
   EXPECT_GT(stats.guided, 100u);
   // On a circle too: only the points whose cavity reaches across a cut wait.
-  insert_points(circle(20000, 75), 2, 2, 8, &stats);
-  EXPECT_GE(stats.phases, 8u);
-  EXPECT_LT(4 * stats.deferred, stats.phase_points) << stats.deferred << " of " << stats.phase_points;
+  expect_phases_insert_most(circle(20000, 75), 2);
   insert_points(uniform_points(20000, 2, 74), 2, 1, 8, &stats);
   EXPECT_EQ(stats.phases, 0u);
 }
