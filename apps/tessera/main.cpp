@@ -168,9 +168,9 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0.0, 0.99));
   del->add_option("--method", dla.method,
                   "cells: the cells pass and hull completion; insertion: incremental insertion (without labels; "
-                  "3D parallel by phases, 2D serial); auto (without labels or --skip-cells): insertion below 20,000 "
+                  "parallel by phases); auto (without labels or --skip-cells): insertion below 20,000 "
                   "points, and from there where a sample of cells costs far more than it finds (surface samples, "
-                  "2D curves and circles) or meets no ties on 1-2 threads in 3D, 1 in 2D (uniform points), or "
+                  "2D curves and circles) or meets no ties on 1-2 threads (uniform points), or "
                   "where 3D hull completion stalls; else the cells (lattices). Same result")
       ->check(CLI::IsMember({"auto", "cells", "insertion"}))
       ->capture_default_str();

@@ -28,7 +28,7 @@ enum class DelaunayMethod {
   /// hundred cells; insertion is chosen where they cost far more than the
   /// simplices they find (surface samples, clustered volumes, points nearly
   /// on a sphere; in 2D points on a circle or along curves) and, on one or
-  /// two threads in 3D and one in 2D, where they met no exact ties
+  /// two threads, where they met no exact ties
   /// (uniform, jittered, rotated points: ties need coordinates on a grid).
   /// The rest (lattices, whose ties make insertion slower) goes to the
   /// cells pass, which in 3D hands
@@ -37,7 +37,7 @@ enum class DelaunayMethod {
   /// pass. Every path gives the same rows.
   automatic,
   cells,      ///< the cells pass (and hull completion)
-  /// Incremental insertion (3D: parallel by phases; 2D: serial); without
+  /// Incremental insertion (parallel by phases); without
   /// labels and with complete_hull only.
   insertion,
 };

@@ -256,11 +256,11 @@ def delaunay(
     method : {"auto", "cells", "insertion"}
         How the simplices are built; the result is the same. ``"cells"``: the
         parallel cells pass and hull completion. ``"insertion"``: incremental
-        insertion (no labels, ``complete_hull``; 3D parallel by phases, 2D
-        serial). ``"auto"`` (no labels): insertion below 20,000 points, and
+        insertion (no labels, ``complete_hull``; parallel by phases).
+        ``"auto"`` (no labels): insertion below 20,000 points, and
         from there where a sample of cells costs far more than it finds
         (surface samples, 2D curves and circles) or meets no ties on one or
-        two threads in 3D, one in 2D (uniform points), or where 3D hull
+        two threads (uniform points), or where 3D hull
         completion stalls (rotated lattices); else the cells (lattices).
 
     Exact predicates and a symbolic perturbation decide every simplex, so
