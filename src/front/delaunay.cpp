@@ -263,7 +263,7 @@ std::vector<std::uint8_t> choose_skipped(const front::Pass<D>& pass, double frac
 /// measurement.
 ///
 /// In 2D the insertion is cheap, and since stop 38 it has the parallel
-/// phases too: 1M uniform points 0.80 s on one thread and 0.50 s on two,
+/// phases too: 1M uniform points 0.80 s on one thread and 0.47 s on two,
 /// 200k 0.073 s on two, about the same on curves, blobs and segments. The
 /// cells take 1.13 s on one thread and 0.60 s on two at 1M uniform points,
 /// 0.11 s on two at 200k, and on 200k clustered points (ratios 6-7)
@@ -356,7 +356,7 @@ Delaunay run(std::span<const double> input, std::span<const std::int32_t> labels
     // settled by the extended filter: 1.29 s and 2.54 s by insertion,
     // minutes and 4.49 s by the cells. Beyond two threads the cells scale
     // better (a model; this machine has two cores). In 2D likewise (1M
-    // uniform points: 0.80 against 1.13 s on one thread, 0.50 against 0.60
+    // uniform points: 0.80 against 1.13 s on one thread, 0.47 against 0.60
     // s on two; a rotated 300^2 lattice 0.042 against 0.075 s).
     const bool ties = estimate.exact_per_cell >= clean_exact_per_cell && pass.exact.grid != nullptr;
     const bool clean = !ties && pass.engine_options.threads <= 2;

@@ -3,15 +3,14 @@
 // (its slot across from a vertex) K - 1. What differs by dimension is the
 // float filters (insertion_filters.hpp), how the new simplices around a
 // point find their partners (3D: a hash by the edge they share, 2D: an array
-// by the vertex) and which simplices a worker of a parallel phase may own.
+// by the vertex), and in 2D the ghosts that two workers of a parallel phase
+// may both mark (Triangulation::phase).
 #include "insertion.hpp"
 
 #include <algorithm>
 #include <array>
 #include <atomic>
 #include <bit>
-#include <cmath>
-#include <cstring>
 #include <optional>
 #include <stdexcept>
 #include <utility>
@@ -70,9 +69,9 @@ struct Worker : insertion::Worker {
     int slot = 0;
   };
   std::vector<Facet> boundary;
-  std::vector<Edge> edges;  // 3D: new tetrahedra by the edge they share
+  std::vector<Edge> edges;          // 3D: new tetrahedra by the edge they share
+  std::vector<std::uint64_t> used;  // 3D: the entries of edges in use
   std::int32_t pending_infinite = -1;  // 2D: pending_'s entry for the infinite vertex
-  std::vector<std::uint64_t> used;
 };
 
 template <int D>
