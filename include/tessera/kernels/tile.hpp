@@ -111,12 +111,16 @@ class Tile {
     //   vertex 0 removed: b [k0 .. k1] a               (kept run k0 .. k1)
     const std::size_t kept = nv - removed;
     // The new vertices are built in their slots (see reset on why not copied in).
-    auto make = [&](std::size_t t, std::uint16_t p0, std::uint16_t p1) {
-      Vertex& v = verts_[t];
-      v.p[0] = p0;
-      v.p[1] = p1;
-      solve(v);
-      lanes_.set(t, v);
+    auto make = [&](std::size_t ta, std::uint16_t a0, std::size_t tb, std::uint16_t b1) {
+      Vertex& va = verts_[ta];
+      Vertex& vb = verts_[tb];
+      va.p[0] = a0;
+      va.p[1] = pn;
+      vb.p[0] = pn;
+      vb.p[1] = b1;
+      solve_pair(va, vb);
+      lanes_.set(ta, va);
+      lanes_.set(tb, vb);
     };
     if (removed == 1) grow(kept + 2);  // one vertex out, two in
     if (sign_[0] > 0) {
@@ -129,8 +133,7 @@ class Tile {
         filter::shift(verts_.data(), r0 + 2, e1, tail);
         lanes_.move(r0 + 2, e1, tail);
       }
-      make(r0, a0, pn);
-      make(r0 + 1, pn, b1);
+      make(r0, a0, r0 + 1, b1);
     } else {
       std::size_t k0 = 1;
       while (sign_[k0] < 0) ++k0;
@@ -139,8 +142,7 @@ class Tile {
         filter::shift(verts_.data(), 1, k0, kept);
         lanes_.move(1, k0, kept);
       }
-      make(0, pn, b1);
-      make(kept + 1, a0, pn);
+      make(kept + 1, a0, 0, b1);
     }
     verts_.resize(kept + 2);
     lanes_.resize(kept + 2);
@@ -173,6 +175,49 @@ class Tile {
       verts_.resize(n);
       lanes_.resize(n);
     }
+  }
+
+  // solve() for two vertices at once, in the two lanes of SSE2 registers:
+  // the same operations in the same order, so the same doubles, with one
+  // division for both. The rare cases (ill-conditioned, possible underflow)
+  // take the scalar path.
+  void solve_pair(Vertex& va, Vertex& vb) const {
+    using L = filter::detail::Lane;
+    const Plane& A0 = planes_[va.p[0]];
+    const Plane& B0 = planes_[va.p[1]];
+    const Plane& A1 = planes_[vb.p[0]];
+    const Plane& B1 = planes_[vb.p[1]];
+    const L an0 = {A0.n[0], A1.n[0]}, an1 = {A0.n[1], A1.n[1]};
+    const L bn0 = {B0.n[0], B1.n[0]}, bn1 = {B0.n[1], B1.n[1]};
+    const L ad = {A0.d, A1.d}, bd = {B0.d, B1.d};
+    const L an = {A0.n1, A1.n1}, bn = {B0.n1, B1.n1};
+    const L det = an0 * bn1 - an1 * bn0;
+    const L inv = L{1.0, 1.0} / det;
+    const L y0 = (bn1 * ad - an1 * bd) * inv;
+    const L y1 = (an0 * bd - bn0 * ad) * inv;
+    auto abs = [](L x) { return x < 0 ? -x : x; };  // x < 0 is false on -0 and NaN, as fabs keeps them
+    auto max = [](L a, L b) { return a < b ? b : a; };  // std::max, lane by lane
+    const L ymax = max(abs(y0), abs(y1));
+    const L inv_norm = (an + bn) * abs(inv);
+    const L amax = max(an, bn);
+    const L bmax = max(abs(ad), abs(bd));
+    const L cond = inv_norm * amax;
+    const bool ok = !may_underflow_ && cond[0] < filter::exact_vertex_condition && cond[1] < filter::exact_vertex_condition &&
+                    std::isfinite(ymax[0]) && std::isfinite(ymax[1]);
+    if (!ok) [[unlikely]] {
+      solve(va);
+      solve(vb);
+      return;
+    }
+    const L err = L{filter::vertex_eps, filter::vertex_eps} * inv_norm * (amax * ymax + bmax);
+    const L e = err + L{filter::plane_eps, filter::plane_eps} * ymax;
+    const L a = y0 * y0 + y1 * y1;
+    const L l1 = abs(y0) + abs(y1);
+    const L r2 = (a + L{4.0, 4.0} * err * (l1 + err)) * L{1.0 + 1e-12, 1.0 + 1e-12} + L{filter::abs_eps, filter::abs_eps};
+    va.y[0] = y0[0]; va.y[1] = y1[0]; va.e = e[0];
+    vb.y[0] = y0[1]; vb.y[1] = y1[1]; vb.e = e[1];
+    va.r2 = r2[0] < std::numeric_limits<double>::infinity() ? r2[0] : std::numeric_limits<double>::infinity();
+    vb.r2 = r2[1] < std::numeric_limits<double>::infinity() ? r2[1] : std::numeric_limits<double>::infinity();
   }
 
   void solve(Vertex& v) const {
