@@ -82,16 +82,14 @@ class Triangulation {
   using W = Worker<K>;
 
   /// Vertices are numbered by `global`, the insertion order: vertex k is
-  /// point global[k] of ctx, and its coordinates are copied in that order, so
-  /// the points a walk and a cavity meet lie close in memory too.
-  Triangulation(const ExactContext& ctx, std::vector<std::int32_t> global, std::vector<std::int32_t> guide, int threads)
-      : ctx_(ctx), global_(std::move(global)), guide_(std::move(guide)),
+  /// point global[k] of ctx, with its coordinates at coords[D k], so the
+  /// points a walk and a cavity meet lie close in memory too.
+  Triangulation(const ExactContext& ctx, std::vector<std::int32_t> global, Buffer<double> coords,
+                std::vector<std::int32_t> guide, int threads)
+      : ctx_(ctx), global_(std::move(global)), guide_(std::move(guide)), coords_(std::move(coords)),
         workers_(insertion::make_workers<W>(threads)) {
     const std::size_t n = global_.size();
     vsimplex_.resize(n);  // written for each vertex as it is inserted
-    coords_.resize(D * n);
-    for (std::size_t k = 0; k < n; ++k)
-      for (std::size_t e = 0; e < D; ++e) coords_[D * k + e] = ctx.points[static_cast<std::size_t>(global_[k]) * D + e];
     if constexpr (D == 2) pending_.assign(n, -1);
     // A Delaunay tetrahedralisation has about 6.5 tetrahedra per point, a
     // triangulation 2 triangles.
@@ -532,7 +530,7 @@ class Triangulation {
   std::vector<std::int32_t> global_;    // vertex -> input id
   std::vector<std::int32_t> guide_;     // vertex -> an earlier round's vertex near it, or -1 (walk_start)
   std::vector<std::int32_t> vsimplex_;  // inserted vertex -> a live simplex of it
-  std::vector<double> coords_;          // vertex -> coordinates (D each)
+  Buffer<double> coords_;               // vertex -> coordinates (D each)
   std::vector<std::int32_t> pending_;   // 2D: vertex -> a new triangle's link awaiting its partner, or -1
   insertion::SimplexStore<S> store_{D == 3 ? "tessera: insertion: more tetrahedra than Simplex::n can number (about 75 million points)"
                                            : "tessera: insertion: more triangles than Simplex::n can number (about 250 million points)"};
@@ -575,8 +573,9 @@ std::optional<std::array<std::int32_t, D + 1>> first_simplex(const ExactContext&
 
 template <int D>
 std::optional<Buffer<std::int32_t>> insert_all(const ExactContext& ctx, std::span<const std::int32_t> ids,
-                                               const double* lo, const double* hi, const InsertionOptions& options) {
-  BrioOrder order = brio_order(ctx, ids, lo, hi);
+                                               const double* coords, const double* lo, const double* hi,
+                                               const InsertionOptions& options) {
+  BrioOrder order = brio_order(ctx, ids, coords, lo, hi);
   const std::optional<std::array<std::int32_t, D + 1>> first = first_simplex<D>(ctx, order);
   if (!first) return std::nullopt;
   // Positions 0 and 1 start the first round; the simplex's later points
@@ -589,9 +588,9 @@ std::optional<Buffer<std::int32_t>> insert_all(const ExactContext& ctx, std::spa
       end_min = std::max(end_min, static_cast<std::size_t>(v) + 1);
     }
   const std::size_t m = order.ids.size();
-  std::vector<std::int32_t> guide = brio_guides(ctx, order);
+  std::vector<std::int32_t> guide = brio_guides(D, order);
   order.codes = {};
-  Triangulation<D> tri(ctx, std::move(order.ids), std::move(guide), options.threads);
+  Triangulation<D> tri(ctx, std::move(order.ids), std::move(order.coords), std::move(guide), options.threads);
   tri.start(*first);
   for (std::size_t r = 0; r + 1 < order.rounds.size(); ++r) {
     const std::size_t a = order.rounds[r], b = order.rounds[r + 1];
@@ -613,10 +612,10 @@ std::optional<Buffer<std::int32_t>> insert_all(const ExactContext& ctx, std::spa
 }  // namespace
 
 std::optional<Buffer<std::int32_t>> insertion_delaunay(const ExactContext& ctx, std::span<const std::int32_t> ids,
-                                                       const double* lo, const double* hi,
+                                                       const double* coords, const double* lo, const double* hi,
                                                        const InsertionOptions& options) {
-  if (ctx.dim == 2) return insert_all<2>(ctx, ids, lo, hi, options);
-  if (ctx.dim == 3) return insert_all<3>(ctx, ids, lo, hi, options);
+  if (ctx.dim == 2) return insert_all<2>(ctx, ids, coords, lo, hi, options);
+  if (ctx.dim == 3) return insert_all<3>(ctx, ids, coords, lo, hi, options);
   throw std::logic_error("tessera: insertion_delaunay: dimension must be 2 or 3");
 }
 
@@ -631,10 +630,20 @@ LocatedInsertion insert_located(const Pass<D>& pass, const std::function<void(do
   distinct.reserve(loc.size());
   for (std::size_t k = 0; k < loc.size(); ++k)
     if (out.lowest[k] < 0) distinct.push_back(loc.id(k));
+  // Their coordinates in the same (slot) order: the locator's own, or a
+  // copy without the duplicates.
+  const double* coords = loc.size() == 0 ? nullptr : loc.point(0).data();
+  Buffer<double> kept;
+  if (distinct.size() != loc.size()) {
+    kept.reserve(distinct.size() * D);
+    for (std::size_t k = 0; k < loc.size(); ++k)
+      if (out.lowest[k] < 0) kept.insert(kept.end(), loc.point(k).begin(), loc.point(k).end());
+    coords = kept.data();
+  }
   InsertionOptions io;
   io.threads = pass.engine_options.threads;
   io.progress = progress;
-  out.rows = insertion_delaunay(pass.exact, distinct, pass.gens.lo.data(), pass.gens.hi.data(), io);
+  out.rows = insertion_delaunay(pass.exact, distinct, coords, pass.gens.lo.data(), pass.gens.hi.data(), io);
   return out;
 }
 

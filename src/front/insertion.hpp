@@ -64,11 +64,15 @@ struct InsertionOptions {
 /// are swapped where that order is negatively oriented (2D: clockwise); rows
 /// are in ascending order of their sorted ids (the layout of
 /// tessera::Delaunay::simplices: D + 1 ids per row, flat). nullopt when the
-/// points are all on one plane (2D: line), so no simplex exists. `lo`/`hi`
+/// points are all on one plane (2D: line), so no simplex exists. `coords`,
+/// when not null, holds the points of `ids` in that order (ctx.dim each; the
+/// same values as ctx.points): read in place of ctx.points by id, which
+/// misses the cache per point where ids are not in space order. `lo`/`hi`
 /// bound the points (for the insertion order only).
 std::optional<Buffer<std::int32_t>> insertion_delaunay(const kernels::ExactContext& ctx,
-                                                       std::span<const std::int32_t> ids, const double* lo,
-                                                       const double* hi, const InsertionOptions& options = {});
+                                                       std::span<const std::int32_t> ids, const double* coords,
+                                                       const double* lo, const double* hi,
+                                                       const InsertionOptions& options = {});
 
 template <int D>
 struct Pass;

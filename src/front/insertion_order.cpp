@@ -39,15 +39,21 @@ std::uint64_t spread2(std::uint64_t x) {
 
 }  // namespace
 
-BrioOrder brio_order(const kernels::ExactContext& ctx, std::span<const std::int32_t> ids, const double* lo, const double* hi) {
+BrioOrder brio_order(const kernels::ExactContext& ctx, std::span<const std::int32_t> ids, const double* coords,
+                     const double* lo, const double* hi) {
   // One 64-bit key per point: the round in the top bits (smallest rounds
   // first), then a Morton code of 19 bits per axis in 3D, 28 in 2D; ties go
-  // by id.
+  // by id. `at` is the point's place in ids, for its coordinates.
   struct Key {
     std::uint64_t key;
     std::int32_t id;
+    std::uint32_t at;
   };
   const int D = ctx.dim;
+  const auto uD = static_cast<std::size_t>(D);
+  auto point = [&](std::size_t i) {
+    return coords != nullptr ? coords + i * uD : ctx.points + static_cast<std::size_t>(ids[i]) * uD;
+  };
   constexpr int max_round = 24;
   const int bits = D == 3 ? 19 : 28, code_bits = D * bits;
   const double top = static_cast<double>((std::uint64_t{1} << bits) - 1);
@@ -56,14 +62,14 @@ BrioOrder brio_order(const kernels::ExactContext& ctx, std::span<const std::int3
   for (int d = 0; d < D; ++d) scale[d] = hi[d] > lo[d] ? top / (hi[d] - lo[d]) : 0.0;
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, ids.size(), 1 << 14), [&](const tbb::blocked_range<std::size_t>& r) {
     for (std::size_t i = r.begin(); i != r.end(); ++i) {
-      const double* p = ctx.points + static_cast<std::size_t>(ids[i]) * static_cast<std::size_t>(D);
+      const double* p = point(i);
       std::uint64_t code = 0;
       for (int d = 0; d < D; ++d) {
         const auto c = static_cast<std::uint64_t>(std::clamp((p[d] - lo[d]) * scale[d], 0.0, top));
         code |= (D == 3 ? spread3(c) : spread2(c)) << d;
       }
       const int round = std::min(std::countl_zero(id_hash(ids[i])), max_round);
-      keys[i] = {static_cast<std::uint64_t>(max_round - round) << code_bits | code, ids[i]};
+      keys[i] = {static_cast<std::uint64_t>(max_round - round) << code_bits | code, ids[i], static_cast<std::uint32_t>(i)};
     }
   });
   tbb::parallel_sort(keys.begin(), keys.end(),
@@ -71,11 +77,14 @@ BrioOrder brio_order(const kernels::ExactContext& ctx, std::span<const std::int3
   BrioOrder order;
   order.ids.resize(ids.size());
   order.codes.resize(ids.size());
+  order.coords.resize(ids.size() * uD);  // every one written below
   const std::uint64_t code_mask = (std::uint64_t{1} << code_bits) - 1;
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, keys.size(), 1 << 14), [&](const tbb::blocked_range<std::size_t>& r) {
     for (std::size_t i = r.begin(); i != r.end(); ++i) {
       order.ids[i] = keys[i].id;
       order.codes[i] = keys[i].key & code_mask;
+      const double* p = point(keys[i].at);
+      for (std::size_t d = 0; d < uD; ++d) order.coords[i * uD + d] = p[d];
     }
   });
   for (std::size_t i = 0; i < keys.size(); ++i) {
@@ -85,9 +94,9 @@ BrioOrder brio_order(const kernels::ExactContext& ctx, std::span<const std::int3
   return order;
 }
 
-std::vector<std::int32_t> brio_guides(const kernels::ExactContext& ctx, const BrioOrder& order) {
-  const auto D = static_cast<std::size_t>(ctx.dim);
-  auto at = [&](std::size_t k) { return ctx.points + static_cast<std::size_t>(order.ids[k]) * D; };
+std::vector<std::int32_t> brio_guides(int dim, const BrioOrder& order) {
+  const auto D = static_cast<std::size_t>(dim);
+  auto at = [&](std::size_t k) { return order.coords.data() + k * D; };
   std::vector<std::int32_t> guide(order.ids.size(), -1);
   for (std::size_t r = 1; r + 1 < order.rounds.size(); ++r) {
     const std::size_t pa = order.rounds[r - 1], a = order.rounds[r], b = order.rounds[r + 1];

@@ -39,7 +39,7 @@ inline std::vector<std::vector<std::int32_t>> insert_points(const std::vector<do
   o.threads = threads;
   o.parallel_min = parallel_min;
   o.stats = stats;
-  const auto flat = tessera::front::insertion_delaunay(ctx, ids, ctx.lo.data(), ctx.hi.data(), o);
+  const auto flat = tessera::front::insertion_delaunay(ctx, ids, nullptr, ctx.lo.data(), ctx.hi.data(), o);
   const std::size_t k = d + 1;
   std::vector<std::vector<std::int32_t>> rows(flat ? flat->size() / k : 0);
   for (std::size_t r = 0; r < rows.size(); ++r) rows[r].assign(flat->data() + k * r, flat->data() + k * (r + 1));
