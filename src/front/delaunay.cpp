@@ -263,7 +263,8 @@ std::vector<std::uint8_t> choose_skipped(const front::Pass<D>& pass, double frac
 /// measurement.
 ///
 /// In 2D the insertion is cheap, and since stop 38 it has the parallel
-/// phases too: 1M uniform points 0.80 s on one thread and 0.47 s on two,
+/// phases too: 1M uniform points 0.70 s on one thread and 0.42 s on two
+/// (stop 39; 0.80 / 0.47 s in stop 38),
 /// 200k 0.073 s on two, about the same on curves, blobs and segments. The
 /// cells take 1.13 s on one thread and 0.60 s on two at 1M uniform points,
 /// 0.11 s on two at 200k, and on 200k clustered points (ratios 6-7)
