@@ -195,7 +195,8 @@ class Tile {
     const L inv = L{1.0, 1.0} / det;
     const L y0 = (bn1 * ad - an1 * bd) * inv;
     const L y1 = (an0 * bd - bn0 * ad) * inv;
-    auto abs = [](L x) { return x < 0 ? -x : x; };  // x < 0 is false on -0 and NaN, as fabs keeps them
+    using M = filter::detail::LaneMask;
+    auto abs = [](L x) { return reinterpret_cast<L>(reinterpret_cast<M>(x) & M{INT64_MAX, INT64_MAX}); };  // fabs: the sign bit cleared
     auto max = [](L a, L b) { return a < b ? b : a; };  // std::max, lane by lane
     const L ymax = max(abs(y0), abs(y1));
     const L inv_norm = (an + bn) * abs(inv);
