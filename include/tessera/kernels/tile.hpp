@@ -177,69 +177,86 @@ class Tile {
     }
   }
 
-  // solve() for two vertices at once, in the two lanes of SSE2 registers:
-  // the same operations in the same order, so the same doubles, with one
-  // division for both. The rare cases (ill-conditioned, possible underflow)
-  // take the scalar path.
+  // A vertex's solve by Cramer's rule and its error bound, written once for
+  // one vertex (T = double) and for two in the lanes of SSE2 registers
+  // (T = filter::detail::Lane): the same operations in the same order, so
+  // the same doubles either way.
+  using Lane = filter::detail::Lane;
+  static double magnitude(double x) { return std::fabs(x); }
+  static Lane magnitude(Lane x) {  // fabs per lane: the sign bit cleared
+    using M = filter::detail::LaneMask;
+    return reinterpret_cast<Lane>(reinterpret_cast<M>(x) & M{INT64_MAX, INT64_MAX});
+  }
+  template <class T>
+  static T larger(T a, T b) { return a < b ? b : a; }  // std::max (per lane)
+  template <class T>
+  struct Cramer {
+    T y0, y1, inv, ymax, inv_norm, amax, bmax, cond;
+    // Planes A (n = (an0, an1), d = ad, |n|_1 = an) and B.
+    Cramer(T an0, T an1, T ad, T an, T bn0, T bn1, T bd, T bn) {
+      const T det = an0 * bn1 - an1 * bn0;
+      inv = 1.0 / det;
+      y0 = (bn1 * ad - an1 * bd) * inv;
+      y1 = (an0 * bd - bn0 * ad) * inv;
+      ymax = larger(magnitude(y0), magnitude(y1));
+      inv_norm = (an + bn) * magnitude(inv);  // sum of |adj| entries / |det|
+      amax = larger(an, bn);
+      bmax = larger(magnitude(ad), magnitude(bd));
+      cond = inv_norm * amax;
+    }
+    T err() const { return filter::vertex_eps * inv_norm * (amax * ymax + bmax); }
+  };
+  // The bound on |y|^2 before set_radius's clamp to infinity.
+  template <class T>
+  static T radius2(T y0, T y1, T err) {
+    const T a = y0 * y0 + y1 * y1;
+    const T l1 = magnitude(y0) + magnitude(y1);
+    return (a + 4.0 * err * (l1 + err)) * (1.0 + 1e-12) + filter::abs_eps;
+  }
+
+  // solve() for the two new vertices of a clip at once, one division for
+  // both. The rare cases (ill-conditioned, possible underflow) take the
+  // scalar path.
   void solve_pair(Vertex& va, Vertex& vb) const {
-    using L = filter::detail::Lane;
     const Plane& A0 = planes_[va.p[0]];
     const Plane& B0 = planes_[va.p[1]];
     const Plane& A1 = planes_[vb.p[0]];
     const Plane& B1 = planes_[vb.p[1]];
-    const L an0 = {A0.n[0], A1.n[0]}, an1 = {A0.n[1], A1.n[1]};
-    const L bn0 = {B0.n[0], B1.n[0]}, bn1 = {B0.n[1], B1.n[1]};
-    const L ad = {A0.d, A1.d}, bd = {B0.d, B1.d};
-    const L an = {A0.n1, A1.n1}, bn = {B0.n1, B1.n1};
-    const L det = an0 * bn1 - an1 * bn0;
-    const L inv = L{1.0, 1.0} / det;
-    const L y0 = (bn1 * ad - an1 * bd) * inv;
-    const L y1 = (an0 * bd - bn0 * ad) * inv;
-    using M = filter::detail::LaneMask;
-    auto abs = [](L x) { return reinterpret_cast<L>(reinterpret_cast<M>(x) & M{INT64_MAX, INT64_MAX}); };  // fabs: the sign bit cleared
-    auto max = [](L a, L b) { return a < b ? b : a; };  // std::max, lane by lane
-    const L ymax = max(abs(y0), abs(y1));
-    const L inv_norm = (an + bn) * abs(inv);
-    const L amax = max(an, bn);
-    const L bmax = max(abs(ad), abs(bd));
-    const L cond = inv_norm * amax;
-    const bool ok = !may_underflow_ && cond[0] < filter::exact_vertex_condition && cond[1] < filter::exact_vertex_condition &&
-                    std::isfinite(ymax[0]) && std::isfinite(ymax[1]);
+    const Cramer<Lane> c(Lane{A0.n[0], A1.n[0]}, Lane{A0.n[1], A1.n[1]}, Lane{A0.d, A1.d}, Lane{A0.n1, A1.n1},
+                         Lane{B0.n[0], B1.n[0]}, Lane{B0.n[1], B1.n[1]}, Lane{B0.d, B1.d}, Lane{B0.n1, B1.n1});
+    const bool ok = !may_underflow_ && c.cond[0] < filter::exact_vertex_condition &&
+                    c.cond[1] < filter::exact_vertex_condition && std::isfinite(c.ymax[0]) && std::isfinite(c.ymax[1]);
     if (!ok) [[unlikely]] {
       solve(va);
       solve(vb);
       return;
     }
-    const L err = L{filter::vertex_eps, filter::vertex_eps} * inv_norm * (amax * ymax + bmax);
-    const L e = err + L{filter::plane_eps, filter::plane_eps} * ymax;
-    const L a = y0 * y0 + y1 * y1;
-    const L l1 = abs(y0) + abs(y1);
-    const L r2 = (a + L{4.0, 4.0} * err * (l1 + err)) * L{1.0 + 1e-12, 1.0 + 1e-12} + L{filter::abs_eps, filter::abs_eps};
-    va.y[0] = y0[0]; va.y[1] = y1[0]; va.e = e[0];
-    vb.y[0] = y0[1]; vb.y[1] = y1[1]; vb.e = e[1];
-    va.r2 = r2[0] < std::numeric_limits<double>::infinity() ? r2[0] : std::numeric_limits<double>::infinity();
-    vb.r2 = r2[1] < std::numeric_limits<double>::infinity() ? r2[1] : std::numeric_limits<double>::infinity();
+    const Lane err = c.err();
+    const Lane e = err + filter::plane_eps * c.ymax;
+    const Lane r2 = radius2(c.y0, c.y1, err);
+    Vertex* const v[2] = {&va, &vb};
+    for (int k = 0; k < 2; ++k) {
+      v[k]->y[0] = c.y0[k];
+      v[k]->y[1] = c.y1[k];
+      v[k]->e = e[k];
+      v[k]->r2 = clamp_radius(r2[k]);
+    }
   }
 
   void solve(Vertex& v) const {
     const Plane& A = planes_[v.p[0]];
     const Plane& B = planes_[v.p[1]];
-    double det = A.n[0] * B.n[1] - A.n[1] * B.n[0];
-    double inv = 1.0 / det;
-    v.y[0] = (B.n[1] * A.d - A.n[1] * B.d) * inv;
-    v.y[1] = (A.n[0] * B.d - B.n[0] * A.d) * inv;
-    double ymax = std::max(std::fabs(v.y[0]), std::fabs(v.y[1]));
-    double inv_norm = (A.n1 + B.n1) * std::fabs(inv);  // sum of |adj| entries / |det|
-    double amax = std::max(A.n1, B.n1);
-    double bmax = std::max(std::fabs(A.d), std::fabs(B.d));
-    double cond = inv_norm * amax;
+    const Cramer<double> c(A.n[0], A.n[1], A.d, A.n1, B.n[0], B.n[1], B.d, B.n1);
+    v.y[0] = c.y0;
+    v.y[1] = c.y1;
+    double ymax = c.ymax;
     // Extreme input only (front/pass.cpp): products that may have underflowed.
-    const double slack = may_underflow_ ? filter::underflow_slack(inv, amax, bmax, A.n1 + B.n1, ymax) : 0.0;
+    const double slack = may_underflow_ ? filter::underflow_slack(c.inv, c.amax, c.bmax, A.n1 + B.n1, ymax) : 0.0;
     double err;
-    if (cond < filter::exact_vertex_condition && std::isfinite(ymax))
-      err = filter::vertex_eps * inv_norm * (amax * ymax + bmax) + slack;
+    if (c.cond < filter::exact_vertex_condition && std::isfinite(ymax))
+      err = c.err() + slack;
     else
-      std::tie(err, ymax) = ill_conditioned(v, inv, ymax, slack);
+      std::tie(err, ymax) = ill_conditioned(v, c.inv, ymax, slack);
     v.e = err + filter::plane_eps * ymax;
     set_radius(v, err);
   }
@@ -264,12 +281,10 @@ class Tile {
     return {4 * filter::u * ymax, ymax};
   }
 
-  static void set_radius(Vertex& v, double err) {
-    double a = v.y[0] * v.y[0] + v.y[1] * v.y[1];
-    double l1 = std::fabs(v.y[0]) + std::fabs(v.y[1]);
-    v.r2 = (a + 4.0 * err * (l1 + err)) * (1.0 + 1e-12) + filter::abs_eps;
-    if (!(v.r2 < std::numeric_limits<double>::infinity())) v.r2 = std::numeric_limits<double>::infinity();  // NaN too
+  static double clamp_radius(double r2) {
+    return r2 < std::numeric_limits<double>::infinity() ? r2 : std::numeric_limits<double>::infinity();  // NaN too
   }
+  static void set_radius(Vertex& v, double err) { v.r2 = clamp_radius(radius2(v.y[0], v.y[1], err)); }
 
   void update_radius() {
     security2_ = 4.0 * lanes_.max_r2() * (1 + 1e-12);
