@@ -280,6 +280,17 @@ class Triangulation {
     std::uint32_t* state = store_.state();
     if (!conflicts(t0, q)) throw std::logic_error("tessera: insertion: the located simplex is not in conflict");
     state[t0] = mark_in;
+    // A simplex's four neighbours' marks and vertices are read one after
+    // the other once it leaves the stack: ask for them as it enters, so
+    // their misses overlap with the work in between.
+    auto prefetch_around = [&](std::int32_t t) {
+      if constexpr (D == 3)
+        for (int k = 0; k < K; ++k) {
+          __builtin_prefetch(state + simplex_of(ss[t].n[k]));
+          __builtin_prefetch(ss + simplex_of(ss[t].n[k]));
+        }
+    };
+    prefetch_around(t0);
     w.stack.assign(1, t0);
     w.cavity.clear();
     w.boundary.clear();
@@ -287,14 +298,6 @@ class Triangulation {
       const std::int32_t t = w.stack.back();
       w.stack.pop_back();
       w.cavity.push_back(t);
-      if constexpr (D == 3) {
-        // The four neighbours' marks and vertices are read below one after
-        // the other: ask for all of them first, so their misses overlap.
-        for (int k = 0; k < K; ++k) {
-          __builtin_prefetch(state + simplex_of(ss[t].n[k]));
-          __builtin_prefetch(ss + simplex_of(ss[t].n[k]));
-        }
-      }
       for (int k = 0; k < K; ++k) {
         const std::int32_t u = simplex_of(ss[t].n[k]);
         // Relaxed atomics (plain moves on x86): in 2D two workers may mark
@@ -309,6 +312,7 @@ class Triangulation {
           mark.store(in ? mark_in : mark_out, std::memory_order_relaxed);
           if (in) {
             if (Check && !owned(ss[u], w.part)) return false;
+            prefetch_around(u);
             w.stack.push_back(u);
           }
         }
@@ -505,6 +509,10 @@ class Triangulation {
     for (;;) {
       const S& tt = ss[t];
       if (infinite_slot(tt) != K) return t;
+      // The next step is into one of these: ask for them while the
+      // orientation tests run (3D surface samples walk ~28 steps a point).
+      if constexpr (D == 3)
+        for (int k = 0; k < K; ++k) __builtin_prefetch(ss + simplex_of(tt.n[k]));
       w.rng = w.rng * 6364136223846793005ull + 1442695040888963407ull;
       const unsigned first = D == 3 ? static_cast<unsigned>(w.rng >> 62) : static_cast<unsigned>((w.rng >> 32) % 3);
       std::int32_t next = -1;
