@@ -43,6 +43,8 @@ class SimplexStore {
   const S* simplices() const { return simplices_.get(); }
   std::uint32_t* state() { return state_.get(); }
   std::size_t size() const { return size_.load(std::memory_order_relaxed); }
+  /// Slots reserved; it changes only serially, so phases read it freely.
+  std::size_t capacity() const { return cap_; }
 
   /// Room for `extra` more slots without growing (serial only).
   void reserve(std::size_t extra) {

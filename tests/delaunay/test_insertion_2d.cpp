@@ -231,4 +231,47 @@ TEST(Insertion2D, ProgressAndCancellation) {
   EXPECT_THROW(tessera::delaunay(ring, 2, {}, o), tessera::Cancelled);
 }
 
+TEST(Insertion2D, InconsistentCoordinatesEndInAnError) {
+  // The float filters read `coords`, the exact stages the context's points
+  // by id. Coordinates out of step with the ids (here every point's, where
+  // ids leave out the exact duplicates, so each after the first duplicate
+  // is read one or more slots off) break the predicates' consistency, on
+  // points whose subnormal offsets send many tests to the exact stages.
+  // Then a walk can circle for ever: it must stop with an error instead
+  // (locate's step bound). Seeds 7 and 8 circle; the others end one way or
+  // another, never in a hang.
+  for (std::uint64_t seed = 1; seed <= 12; ++seed) {
+    const std::vector<double> p = subnormal_offset_points(40, 2, seed);
+    tessera::kernels::ExactContext ctx;
+    ctx.points = p.data();
+    ctx.dim = 2;
+    for (std::size_t a = 0; a < 2; ++a) {
+      ctx.lo[a] = ctx.hi[a] = p[a];
+      for (std::size_t i = 0; i < 40; ++i) {
+        ctx.lo[a] = std::min(ctx.lo[a], p[2 * i + a]);
+        ctx.hi[a] = std::max(ctx.hi[a], p[2 * i + a]);
+      }
+    }
+    std::vector<std::int32_t> ids;
+    for (std::size_t i = 0; i < 40; ++i) {
+      bool repeat = false;
+      for (std::size_t j = 0; j < i; ++j) repeat = repeat || (p[2 * i] == p[2 * j] && p[2 * i + 1] == p[2 * j + 1]);
+      if (!repeat) ids.push_back(static_cast<std::int32_t>(i));
+    }
+    for (const int threads : {1, 2}) {
+      tessera::front::InsertionOptions o;
+      o.threads = threads;
+      o.parallel_min = 8;
+      std::string error;
+      try {
+        tessera::front::insertion_delaunay(ctx, ids, p.data(), ctx.lo.data(), ctx.hi.data(), o);
+      } catch (const std::logic_error& e) {
+        error = e.what();
+      }
+      if (seed == 7 || seed == 8)
+        EXPECT_NE(error.find("walk did not end"), std::string::npos) << "seed " << seed << ", threads " << threads << ": " << error;
+    }
+  }
+}
+
 }  // namespace
