@@ -285,8 +285,10 @@ class Triangulation {
     std::uint32_t* state = store_.state();
     if (!conflicts(t0, q)) throw std::logic_error("tessera: insertion: the located simplex is not in conflict");
     state[t0] = mark_in;
-    // A simplex's four neighbours' marks and vertices are read one after
-    // the other once it leaves the stack: ask for them as it enters, so
+    // The cavity grows breadth first: w.cavity is both the simplices found
+    // in conflict and the queue of those whose neighbours are still to be
+    // tested. A simplex's four neighbours' marks and vertices are read one
+    // after the other when its turn comes: ask for them as it joins, so
     // their misses overlap with the work in between. 3D only: 2D's smaller
     // triangulations gained nothing.
     auto prefetch_around = [&](std::int32_t t) {
@@ -297,13 +299,10 @@ class Triangulation {
         }
     };
     prefetch_around(t0);
-    w.stack.assign(1, t0);
-    w.cavity.clear();
+    w.cavity.assign(1, t0);
     w.boundary.clear();
-    while (!w.stack.empty()) {
-      const std::int32_t t = w.stack.back();
-      w.stack.pop_back();
-      w.cavity.push_back(t);
+    for (std::size_t c = 0; c < w.cavity.size(); ++c) {
+      const std::int32_t t = w.cavity[c];
       for (int k = 0; k < K; ++k) {
         const std::int32_t u = simplex_of(ss[t].n[k]);
         // Relaxed atomics (plain moves on x86): in 2D two workers may mark
@@ -319,7 +318,7 @@ class Triangulation {
           if (in) {
             if (Check && !owned(ss[u], w.part)) return false;
             prefetch_around(u);
-            w.stack.push_back(u);
+            w.cavity.push_back(u);
           }
         }
         if (in) continue;
@@ -342,7 +341,7 @@ class Triangulation {
       ss = store_.simplices();  // a serial claim may have moved the arrays
       state = store_.state();
     }
-    for (const std::int32_t t : w.cavity) w.free.push_back(t);
+    w.free.insert(w.free.end(), w.cavity.begin(), w.cavity.end());
     // The new simplices fan around q; two of them meet across each facet
     // through q, found by the facet's other vertices. 3D: a hash by the
     // boundary edge they share. 2D: an array by the one boundary vertex

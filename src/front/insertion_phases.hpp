@@ -93,7 +93,7 @@ struct Worker {
   std::vector<std::int32_t> free;        // slots of simplices it removed
   std::size_t fresh = 0, fresh_end = 0;  // claimed slots never used
   std::vector<std::int32_t> deferred;    // points a parallel phase left for later
-  std::vector<std::int32_t> stack, cavity;
+  std::vector<std::int32_t> cavity;      // the simplices in conflict with the point being inserted
 
   /// At least `count` more fresh slots. Serially the store grows; in a
   /// parallel phase a spent capacity is a refusal (false).
