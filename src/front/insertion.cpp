@@ -287,16 +287,14 @@ class Triangulation {
     state[t0] = mark_in;
     // The cavity grows breadth first: w.cavity is both the simplices found
     // in conflict and the queue of those whose neighbours are still to be
-    // tested. A simplex's four neighbours' marks and vertices are read one
-    // after the other when its turn comes: ask for them as it joins, so
-    // their misses overlap with the work in between. 3D only: 2D's smaller
-    // triangulations gained nothing.
+    // tested. A simplex's neighbours' marks and vertices are read one after
+    // the other when its turn comes: ask for them as it joins, so their
+    // misses overlap with the work in between.
     auto prefetch_around = [&](std::int32_t t) {
-      if constexpr (D == 3)
-        for (int k = 0; k < K; ++k) {
-          __builtin_prefetch(state + simplex_of(ss[t].n[k]));
-          __builtin_prefetch(ss + simplex_of(ss[t].n[k]));
-        }
+      for (int k = 0; k < K; ++k) {
+        __builtin_prefetch(state + simplex_of(ss[t].n[k]));
+        __builtin_prefetch(ss + simplex_of(ss[t].n[k]));
+      }
     };
     prefetch_around(t0);
     w.cavity.assign(1, t0);
@@ -522,8 +520,7 @@ class Triangulation {
       if (infinite_slot(tt) != K) return t;
       // The next step is into one of these: ask for them while the
       // orientation tests run (3D surface samples walk ~28 steps a point).
-      if constexpr (D == 3)
-        for (int k = 0; k < K; ++k) __builtin_prefetch(ss + simplex_of(tt.n[k]));
+      for (int k = 0; k < K; ++k) __builtin_prefetch(ss + simplex_of(tt.n[k]));
       w.rng = w.rng * 6364136223846793005ull + 1442695040888963407ull;
       const unsigned first = D == 3 ? static_cast<unsigned>(w.rng >> 62) : static_cast<unsigned>((w.rng >> 32) % 3);
       std::int32_t next = -1;
