@@ -5,7 +5,8 @@
 // automatic choice takes it for small inputs, costly cells (points on a
 // circle, along curves) and inputs without ties on one or two threads, and
 // leaves lattices, and uniform points on more threads, to the cells. Its
-// parallel phases give the serial rows for any thread count.
+// parallel phases give the serial rows for any thread count. Coordinates
+// inconsistent with the exact stages' points end in an error, not a hang.
 #include <gtest/gtest.h>
 
 #include <algorithm>
