@@ -13,9 +13,8 @@
 
 #include "front/insertion.hpp"
 
-inline std::vector<std::vector<std::int32_t>> insert_points(const std::vector<double>& p, int dim, int threads,
-                                                            std::size_t parallel_min,
-                                                            tessera::front::InsertionStats* stats = nullptr) {
+/// The exact context of p (dim coordinates per point), its box the points' bounding box.
+inline tessera::kernels::ExactContext exact_context(const std::vector<double>& p, int dim) {
   const std::size_t d = static_cast<std::size_t>(dim), n = p.size() / d;
   tessera::kernels::ExactContext ctx;
   ctx.points = p.data();
@@ -27,6 +26,13 @@ inline std::vector<std::vector<std::int32_t>> insert_points(const std::vector<do
       ctx.hi[a] = std::max(ctx.hi[a], p[d * i + a]);
     }
   }
+  return ctx;
+}
+
+/// The ids of p's distinct points (the lowest id of each set of coincident
+/// ones), ascending.
+inline std::vector<std::int32_t> distinct_ids(const std::vector<double>& p, int dim) {
+  const std::size_t d = static_cast<std::size_t>(dim), n = p.size() / d;
   std::vector<std::int32_t> ids(n);
   for (std::size_t i = 0; i < n; ++i) ids[i] = static_cast<std::int32_t>(i);
   auto at = [&](std::int32_t i) {
@@ -35,6 +41,16 @@ inline std::vector<std::vector<std::int32_t>> insert_points(const std::vector<do
   };
   std::stable_sort(ids.begin(), ids.end(), [&](std::int32_t a, std::int32_t b) { return at(a) < at(b); });
   ids.erase(std::unique(ids.begin(), ids.end(), [&](std::int32_t a, std::int32_t b) { return at(a) == at(b); }), ids.end());
+  std::sort(ids.begin(), ids.end());
+  return ids;
+}
+
+inline std::vector<std::vector<std::int32_t>> insert_points(const std::vector<double>& p, int dim, int threads,
+                                                            std::size_t parallel_min,
+                                                            tessera::front::InsertionStats* stats = nullptr) {
+  const std::size_t d = static_cast<std::size_t>(dim);
+  const tessera::kernels::ExactContext ctx = exact_context(p, dim);
+  const std::vector<std::int32_t> ids = distinct_ids(p, dim);
   tessera::front::InsertionOptions o;
   o.threads = threads;
   o.parallel_min = parallel_min;

@@ -243,22 +243,8 @@ TEST(Insertion2D, InconsistentCoordinatesEndInAnError) {
   // another, never in a hang.
   for (std::uint64_t seed = 1; seed <= 12; ++seed) {
     const std::vector<double> p = subnormal_offset_points(40, 2, seed);
-    tessera::kernels::ExactContext ctx;
-    ctx.points = p.data();
-    ctx.dim = 2;
-    for (std::size_t a = 0; a < 2; ++a) {
-      ctx.lo[a] = ctx.hi[a] = p[a];
-      for (std::size_t i = 0; i < 40; ++i) {
-        ctx.lo[a] = std::min(ctx.lo[a], p[2 * i + a]);
-        ctx.hi[a] = std::max(ctx.hi[a], p[2 * i + a]);
-      }
-    }
-    std::vector<std::int32_t> ids;
-    for (std::size_t i = 0; i < 40; ++i) {
-      bool repeat = false;
-      for (std::size_t j = 0; j < i; ++j) repeat = repeat || (p[2 * i] == p[2 * j] && p[2 * i + 1] == p[2 * j + 1]);
-      if (!repeat) ids.push_back(static_cast<std::int32_t>(i));
-    }
+    const tessera::kernels::ExactContext ctx = exact_context(p, 2);
+    const std::vector<std::int32_t> ids = distinct_ids(p, 2);
     for (const int threads : {1, 2}) {
       tessera::front::InsertionOptions o;
       o.threads = threads;
