@@ -12,7 +12,7 @@
 #include <tbb/info.h>
 
 #include "cells_compositor.hpp"
-#include "delaunay_neighbours.hpp"
+#include "delaunay_stars.hpp"
 #include "pass.hpp"
 #include "pilot.hpp"
 #include "tessera/engine/tessellate.hpp"
@@ -76,7 +76,7 @@ Cells run(std::span<const double> input, std::span<const std::int32_t> labels, c
   // circle, along curves, in blobs) are clipped by their Delaunay
   // neighbours instead: the same cells (docs/design.md, "Cells from
   // Delaunay neighbours").
-  std::optional<engine::NeighbourLists> neighbours;
+  std::optional<engine::DelaunayStars> stars;
   {
     bool insert = opt.cell_method == CellMethod::insertion;
     if (opt.cell_method == CellMethod::automatic) {
@@ -88,10 +88,10 @@ Cells run(std::span<const double> input, std::span<const std::int32_t> labels, c
       // second (about their shares of the time on 1M clustered points).
       std::function<void(double)> half;
       if (opt.progress) half = [&opt](double f) { opt.progress(0.5 * f); };
-      neighbours = front::delaunay_neighbours(pass, half);
+      stars = front::delaunay_stars(pass, half);
     }
-    if (neighbours) {
-      pass.gens.neighbours = &*neighbours;
+    if (stars) {
+      pass.gens.stars = &*stars;
       out.from_insertion = true;
       if (opt.progress) pass.engine_options.progress = [&opt](double f) { opt.progress(0.5 + 0.5 * f); };
     }

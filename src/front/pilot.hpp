@@ -1,7 +1,7 @@
 // The pilot: what a sample of cells costs to search per Delaunay simplex it
 // finds, relative to uniform input. tessera::delaunay sizes its skipped
 // cells by it and turns to insertion where cells are costly; tessera::voronoi
-// turns to cells from Delaunay neighbours (delaunay_neighbours.hpp).
+// turns to cells from Delaunay neighbours (delaunay_stars.hpp).
 #pragma once
 
 #include <algorithm>

@@ -14,6 +14,7 @@
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
+#include "tessera/buffer.hpp"
 #include "tessera/engine/concepts.hpp"
 #include "tessera/kernels/cell_builder.hpp"
 #include "tessera/kernels/exact_predicates.hpp"
@@ -21,16 +22,18 @@
 
 namespace tessera::engine {
 
-/// Every located point's clipping neighbours, known in advance (the
-/// Delaunay neighbours: front/delaunay_neighbours.hpp), by locator slot: slot
-/// s's neighbours are the slots `slots[offsets[s] .. offsets[s + 1])`, in an
-/// order independent of the thread count. `duplicate_of[s]` is the lowest
-/// id at exactly s's coordinates when that is another point's (s then has
-/// no cell), else -1. Slots, not ids: the cells run in slot order, and the
-/// locator's copies of ids and coordinates are in it too.
-struct NeighbourLists {
-  std::vector<std::int64_t> offsets;
-  std::vector<std::uint32_t> slots;
+/// Every located point's Delaunay star (front/delaunay_neighbours.hpp), by
+/// locator slot: `rows` holds the simplices, D + 1 slots each, positively
+/// oriented (2D counter-clockwise, 3D det > 0); slot s's simplices are
+/// `simplices[first[s] .. first[s + 1])`, ascending, so in an order
+/// independent of the thread count. `duplicate_of[s]` is the lowest id at
+/// exactly s's coordinates when that is another point's (s then has no cell
+/// and no simplex), else -1. Slots, not ids: the cells run in slot order, and
+/// the locator's copies of ids and coordinates are in it too.
+struct DelaunayStars {
+  Buffer<std::int32_t> rows;  ///< slots (below 2^31), as the insertion's rows were ids
+  std::vector<std::uint32_t> first;
+  std::vector<std::uint32_t> simplices;
   std::vector<std::int32_t> duplicate_of;
 };
 
@@ -50,9 +53,9 @@ struct Generators {
   const kernels::ExactContext* exact = nullptr;
   /// The points' k-d tree, for cells of overfull bins and long cells (CellBuilder).
   const kernels::SharedKdTree<D>* tree = nullptr;
-  /// Optional: then each cell is the box clipped by its list alone
-  /// (CellBuilder::build_from), with no search. Needs `slots`.
-  const NeighbourLists* neighbours = nullptr;
+  /// Optional: then each cell comes from its Delaunay star
+  /// (CellBuilder::build_from_star), with no search. Needs `slots`.
+  const DelaunayStars* stars = nullptr;
 };
 
 struct EngineOptions {
@@ -71,8 +74,8 @@ std::uint64_t tessellate(const Generators<CellT::dim>& gens, Comp& comp, const E
   const std::size_t n = gens.order.size();
   if (!gens.slots.empty() && gens.slots.size() != n)
     throw std::invalid_argument("tessera: Generators::slots must be empty or as long as Generators::order");
-  if (gens.neighbours != nullptr && gens.slots.size() != n)
-    throw std::invalid_argument("tessera: Generators::neighbours needs Generators::slots");
+  if (gens.stars != nullptr && gens.slots.size() != n)
+    throw std::invalid_argument("tessera: Generators::stars needs Generators::slots");
   const std::size_t bs = std::max<std::size_t>(1, opt.batch_size);
   const std::size_t nb = (n + bs - 1) / bs;
   std::vector<typename Comp::Batch> batches(nb);
@@ -90,6 +93,7 @@ std::uint64_t tessellate(const Generators<CellT::dim>& gens, Comp& comp, const E
     return ws;
   });
 
+  constexpr std::size_t star_ahead = 4;  // cells whose star rows are prefetched ahead of their turn
   auto run_batch = [&](std::size_t k) {
     Workspace& ws = workspaces.local();
     auto& batch = batches[k];
@@ -99,16 +103,24 @@ std::uint64_t tessellate(const Generators<CellT::dim>& gens, Comp& comp, const E
       const double* p = gens.slots.empty() ? gens.coords + static_cast<std::size_t>(gen) * CellT::dim
                                            : gens.locator->point(gens.slots[g]).data();
       kernels::BuildStatus st;
-      if (const NeighbourLists* nl = gens.neighbours) {
-        const std::size_t at = gens.slots[g];
-        if (const std::int32_t owner = nl->duplicate_of[at]; owner >= 0) {
+      if (const DelaunayStars* ds = gens.stars) {
+        const std::uint32_t at = gens.slots[g];
+        if (const std::int32_t owner = ds->duplicate_of[at]; owner >= 0) {
           st.has_cell = false;
           st.duplicate_of = owner;
           comp.add(batch, gen, st, ws.cell);  // no cell built: its exact calls are not this one's
           continue;
         }
-        const auto a = static_cast<std::size_t>(nl->offsets[at]), e = static_cast<std::size_t>(nl->offsets[at + 1]);
-        st = ws.builder.build_from(gen, p, std::span<const std::uint32_t>(nl->slots.data() + a, e - a), ws.cell);
+        // A star's simplices lie all over the rows (they are in id order):
+        // ask for those of a later cell now.
+        if (g + star_ahead < end) {
+          const std::uint32_t later = gens.slots[g + star_ahead];
+          for (std::uint32_t t = ds->first[later]; t < ds->first[later + 1]; ++t)
+            __builtin_prefetch(ds->rows.data() + (CellT::dim + 1) * static_cast<std::size_t>(ds->simplices[t]));
+        }
+        const std::uint32_t a = ds->first[at], e = ds->first[at + 1];
+        st = ws.builder.build_from_star(gen, p, at, reinterpret_cast<const std::uint32_t*>(ds->rows.data()),
+                                        std::span<const std::uint32_t>(ds->simplices.data() + a, e - a), ws.cell);
       } else {
         st = ws.builder.build_any(gen, p, ws.cell);
       }

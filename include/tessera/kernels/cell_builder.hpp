@@ -151,7 +151,129 @@ class CellBuilder {
     return status;
   }
 
+  /// The cell of generator i, at locator slot s, from its Delaunay star:
+  /// the simplices `star` (indices of rows of D + 1 locator slots each in
+  /// `rows`, positively oriented: 2D counter-clockwise, 3D det > 0) that
+  /// have s as a vertex, in an order independent of the thread count. Its
+  /// Voronoi vertices are those simplices' circumcentres and its faces the
+  /// bisectors with their other vertices, so a point inside the hull (a
+  /// closed star) whose vertices all lie inside the domain box has its cell
+  /// assembled from them (Hull/Tile::assemble) with no clip and no sign
+  /// pass. The rest — points on the hull, cells the box cuts — are clipped by
+  /// the star's vertices (build_from), in the order they first appear.
+  /// The cell is the one build_from gives either way (the same exact
+  /// predicate decided the triangulation), up to the last bits of its
+  /// geometry.
+  BuildStatus build_from_star(std::int32_t i, const double* p, std::uint32_t s, const std::uint32_t* rows,
+                              std::span<const std::uint32_t> star, CellT& cell) {
+    constexpr int W = D + 1;
+    const std::size_t nt = star.size();
+    nn_ = 0;
+    if (nbr_.size() < 8) nbr_.resize(16);
+    std::fill_n(nbr_.begin(), 4, -1);
+    if (corners_.size() < D * nt) corners_.resize(D * nt);
+    std::uint16_t* const corners = corners_.data();
+    // Each simplex's other vertices as local indices into nbr_ (their order
+    // of first appearance), in the kernel's orientation: 2D (next, after
+    // next) counter-clockwise; 3D an even permutation of the row that
+    // starts with s.
+    bool fits = true;
+    for (std::size_t t = 0; t < nt; ++t) {
+      const std::uint32_t* row = rows + W * static_cast<std::size_t>(star[t]);
+      int c = 0;
+      while (c < D && row[c] != s) ++c;
+      // Local indices in row order (the order build_from's list has always
+      // had), then placed in the kernel's.
+      std::size_t at[W];
+      for (int r = 0; r < W; ++r)
+        if (r != c) at[r] = local_index(row[r]);
+      at[c] = 0;
+      static constexpr int order2[3][2] = {{1, 2}, {2, 0}, {0, 1}};
+      static constexpr int order3[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
+      const int* order;
+      if constexpr (D == 2) order = order2[c];
+      else order = order3[c];
+      for (int k = 0; k < D; ++k) {
+        const std::size_t a = at[order[k]];
+        fits &= a < 0xFFF0;
+        corners[D * t + static_cast<std::size_t>(k)] = static_cast<std::uint16_t>(a);
+      }
+    }
+    const std::size_t m = nn_;
+    // Closed star: in 2D a cycle through every neighbour (m == nt), in 3D a
+    // triangulated sphere (nt == 2m - 4; a hull point's link is a disk with
+    // a boundary of at least three edges, so nt <= 2m - 5 there).
+    bool closed = fits && nt >= D + 1;
+    if constexpr (D == 2) {
+      closed &= m == nt;
+      if (closed) {
+        // Chain the pairs (arriving, leaving) into the counter-clockwise cycle.
+        if (succ_.size() < m) succ_.resize(m);
+        std::fill(succ_.begin(), succ_.begin() + static_cast<std::ptrdiff_t>(m), std::uint32_t{0xFFFFFFFF});
+        for (std::size_t t = 0; t < nt; ++t) succ_[corners[2 * t]] = static_cast<std::uint32_t>(t);
+        if (cycle_.size() < 2 * m) cycle_.resize(2 * m);
+        std::uint32_t t = 0;
+        for (std::size_t k = 0; k < m && closed; ++k) {
+          cycle_[2 * k] = corners[2 * t];
+          cycle_[2 * k + 1] = corners[2 * t + 1];
+          t = succ_[corners[2 * t + 1]];
+          closed &= t < nt && (t == 0) == (k + 1 == m);
+        }
+      }
+    } else {
+      closed &= nt == 2 * m - 4;
+    }
+    if (closed) {
+      if (ids_.size() < m) {
+        ids_.resize(2 * m);
+        qs_.resize(2 * m * D);
+      }
+      for (std::size_t k = 0; k < m; ++k) {
+        const auto& pj = loc_.point(static_cast<std::uint32_t>(nbr_[k]));
+        for (int d = 0; d < D; ++d) qs_[D * k + static_cast<std::size_t>(d)] = pj[d] - p[d];
+        ids_[k] = loc_.id(static_cast<std::uint32_t>(nbr_[k]));
+      }
+      const std::uint16_t* vc = D == 2 ? cycle_.data() : corners;
+      if (cell.assemble(i, p, lo_, hi_, exact_, ids_.data(), qs_.data(), m, vc, nt)) {
+        BuildStatus status;
+        status.work = 4 * m;
+        return status;
+      }
+    }
+    return build_from(i, p, std::span<const std::uint32_t>(reinterpret_cast<const std::uint32_t*>(nbr_.data()), m), cell);
+  }
+
  private:
+  /// nbr_'s index of slot v, appended if new. A star has ~15 vertices in 3D
+  /// (~6 in 2D): compared four at a time, branch-free but for the loop
+  /// (nbr_ is padded with -1, no slot, to whole quads; its entries are
+  /// distinct, so at most one lane matches).
+  std::size_t local_index(std::uint32_t v) {
+    using Quad = std::int32_t __attribute__((vector_size(16)));
+    const std::int32_t sv = static_cast<std::int32_t>(v);  // slots are below 2^31
+    const Quad vv = {sv, sv, sv, sv};
+    Quad hit = {}, place = {1, 2, 3, 4};
+    for (std::size_t g = 0; g < nn_; g += 4) {
+      Quad h;
+      std::memcpy(&h, nbr_.data() + g, sizeof h);
+      hit |= (h == vv) & place;
+      place += 4;
+    }
+    if (const std::int32_t at = hit[0] | hit[1] | hit[2] | hit[3]; at != 0) return static_cast<std::size_t>(at - 1);
+    if (nbr_.size() < nn_ + 8) nbr_.resize(2 * nn_ + 16);
+    nbr_[nn_++] = sv;
+    if (nn_ % 4 == 0) std::fill_n(nbr_.begin() + static_cast<std::ptrdiff_t>(nn_), 4, -1);
+    return nn_ - 1;
+  }
+
+  std::vector<std::int32_t> nbr_;  // build_from_star: the star's vertices (slots), first appearance
+  std::size_t nn_ = 0;              // how many nbr_ holds
+  std::vector<std::uint16_t> corners_;  // D per simplex: indices into nbr_
+  std::vector<std::uint16_t> cycle_;  // 2D: corners in counter-clockwise order
+  std::vector<std::uint32_t> succ_;   // 2D: per neighbour, the simplex whose first corner it is
+  std::vector<std::int32_t> ids_;
+  std::vector<double> qs_;
+
   /// build(): the shell walk.
   BuildStatus walk_shells(std::int32_t i, const double* p, CellT& cell) {
     cell.reset(i, p, lo_, hi_, exact_);

@@ -54,25 +54,7 @@ class Hull {
   /// Start the cell of generator `gen` at p as the domain box [lo, hi].
   void reset(std::int32_t gen, const double* p, const double* lo, const double* hi,
              const ExactContext* exact) {
-    gen_ = gen;
-    for (int a = 0; a < 3; ++a) site_[a] = p[a];
-    exact_ = exact;
-    may_underflow_ = exact != nullptr && exact->may_underflow;
-    signs_.start_cell();
-    // Planes and corners are written in place: a local struct copied in
-    // would be read back wider than it was written (a store-forwarding stall).
-    planes_.resize(box_planes);
-    for (int k = 0; k < box_planes; ++k) {
-      const int axis = k / 2;
-      const bool upper = k & 1;
-      Plane& pl = planes_[static_cast<std::size_t>(k)];
-      for (int a = 0; a < 3; ++a) pl.n[a] = 0.0;
-      pl.n[axis] = upper ? 1.0 : -1.0;
-      pl.d = upper ? hi[axis] - p[axis] : p[axis] - lo[axis];
-      pl.n1 = 1.0;
-      pl.id = box_plane_id(axis, upper);
-    }
-    resize_vertices(0);  // nothing stale for ensure_table to link
+    start(gen, p, lo, hi, exact);
     ensure_table(64);
     resize_vertices(8);
     for (int c = 0; c < 8; ++c) {
@@ -177,6 +159,55 @@ class Hull {
     return ClipResult::clipped;
   }
 
+  /// Start the cell of generator `gen` at p as the polyhedron known whole in
+  /// advance (its Delaunay star: CellBuilder::build_from_star), without
+  /// clipping: its faces lie on the bisectors with the m points q (relative
+  /// to p, q[3k..3k+3)) of generator ids `ids`, and its nt vertices are the
+  /// triangles `corners` (three indices into those m each, counter-clockwise
+  /// from outside: det(q_a, q_b, q_c) > 0). Each vertex is solved as a clip
+  /// would solve it. Returns false when a vertex may lie outside the domain
+  /// box [lo, hi] (the box would cut the cell), when the faces do not fit the
+  /// 16-bit plane indices, or on extreme input (may_underflow): the cell is
+  /// then unfinished, and must be built again (reset and clipped).
+  bool assemble(std::int32_t gen, const double* p, const double* lo, const double* hi, const ExactContext* exact,
+                const std::int32_t* ids, const double* q, std::size_t m, const std::uint16_t* corners,
+                std::size_t nt) {
+    start(gen, p, lo, hi, exact);
+    if (may_underflow_ || m + box_planes + 1 >= 0xFFFF) return false;
+    planes_.resize(box_planes + m);
+    for (std::size_t k = 0; k < m; ++k) {
+      Plane& pl = planes_[box_planes + k];  // written in place (see reset)
+      const double* n = q + 3 * k;
+      pl.n[0] = n[0]; pl.n[1] = n[1]; pl.n[2] = n[2];
+      pl.d = 0.5 * (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+      pl.n1 = std::fabs(n[0]) + std::fabs(n[1]) + std::fabs(n[2]);
+      pl.id = ids[k];
+    }
+    if (planes_.size() > cap_ || edge_tri_.empty()) ensure_table(2 * planes_.size());
+    resize_vertices(nt);
+    // Inside the box by more than every rounding: the vertex's error bound
+    // err is below e - plane_eps |y|_inf, which covers the rounding of y + e;
+    // the margin covers that of hi - p.
+    double room_hi[3], room_lo[3];
+    for (int a = 0; a < 3; ++a) {
+      room_hi[a] = (hi[a] - p[a]) * (1 - 1e-10);
+      room_lo[a] = (p[a] - lo[a]) * (1 - 1e-10);
+    }
+    bool inside = true;
+    for (std::size_t t = 0; t < nt; ++t) {
+      Vertex& v = verts_[t];
+      const std::uint16_t* c = corners + 3 * t;
+      v.p[0] = static_cast<std::uint16_t>(box_planes + c[0]);
+      v.p[1] = static_cast<std::uint16_t>(box_planes + c[1]);
+      v.p[2] = static_cast<std::uint16_t>(box_planes + c[2]);
+      solve(v);
+      settle(static_cast<std::uint32_t>(t));
+      for (int a = 0; a < 3; ++a) inside &= (v.y[a] + v.e < room_hi[a]) & (v.e - v.y[a] < room_lo[a]);  // false on NaN
+    }
+    update_radius();
+    return inside;
+  }
+
   /// Upper bound on (2R)^2, R = the largest distance from the generator to a
   /// vertex: a neighbour farther than 2R cannot clip (security radius).
   double security_radius2() const { return security2_; }
@@ -261,6 +292,30 @@ class Hull {
   }
 
  private:
+  // The cell's generator and the domain box's planes (always its first
+  // local planes), with no vertices yet.
+  void start(std::int32_t gen, const double* p, const double* lo, const double* hi, const ExactContext* exact) {
+    gen_ = gen;
+    for (int a = 0; a < 3; ++a) site_[a] = p[a];
+    exact_ = exact;
+    may_underflow_ = exact != nullptr && exact->may_underflow;
+    signs_.start_cell();
+    // Planes and corners are written in place: a local struct copied in
+    // would be read back wider than it was written (a store-forwarding stall).
+    planes_.resize(box_planes);
+    for (int k = 0; k < box_planes; ++k) {
+      const int axis = k / 2;
+      const bool upper = k & 1;
+      Plane& pl = planes_[static_cast<std::size_t>(k)];
+      for (int a = 0; a < 3; ++a) pl.n[a] = 0.0;
+      pl.n[axis] = upper ? 1.0 : -1.0;
+      pl.d = upper ? hi[axis] - p[axis] : p[axis] - lo[axis];
+      pl.n1 = 1.0;
+      pl.id = box_plane_id(axis, upper);
+    }
+    resize_vertices(0);  // nothing stale for ensure_table to link
+  }
+
   // The exact sign of vertex slot t against j (prepared_signs.hpp).
   int exact_sign(std::size_t t, std::int32_t j) {
     const Vertex& v = verts_[t];

@@ -45,24 +45,7 @@ class Tile {
 
   void reset(std::int32_t gen, const double* p, const double* lo, const double* hi,
              const ExactContext* exact) {
-    gen_ = gen;
-    for (int a = 0; a < 2; ++a) site_[a] = p[a];
-    exact_ = exact;
-    may_underflow_ = exact != nullptr && exact->may_underflow;
-    signs_.start_cell();
-    // Planes and corners are written in place: a local struct copied in
-    // would be read back wider than it was written (a store-forwarding stall).
-    planes_.resize(box_planes);
-    for (int k = 0; k < box_planes; ++k) {
-      const int axis = k / 2;
-      const bool upper = k & 1;
-      Plane& pl = planes_[static_cast<std::size_t>(k)];
-      pl.n[axis] = upper ? 1.0 : -1.0;
-      pl.n[1 - axis] = 0.0;
-      pl.d = upper ? hi[axis] - p[axis] : p[axis] - lo[axis];
-      pl.n1 = 1.0;
-      pl.id = box_plane_id(axis, upper);
-    }
+    start(gen, p, lo, hi, exact);
     // Corners counter-clockwise from (lo, lo); local planes x0=0, x1=1, y0=2, y1=3.
     const std::uint16_t in[4] = {0, 2, 1, 3}, out[4] = {2, 1, 3, 0};
     const int cx[4] = {0, 1, 1, 0}, cy[4] = {0, 0, 1, 1};
@@ -150,6 +133,52 @@ class Tile {
     return ClipResult::clipped;
   }
 
+  /// Start the cell of generator `gen` at p as the polygon known whole in
+  /// advance (its Delaunay star: CellBuilder::build_from_star), without
+  /// clipping: its edges lie on the bisectors with the m points q (relative
+  /// to p, q[2k..2k+2)) of generator ids `ids`, and its nt vertices,
+  /// counter-clockwise, are the pairs `corners` (indices into those m: the
+  /// plane of the edge arriving, then of the edge leaving). Each vertex is
+  /// solved as a clip would solve it. Returns false when a vertex may lie
+  /// outside the domain box [lo, hi] (the box would cut the cell), when the
+  /// edges do not fit the 16-bit plane indices, or on extreme input
+  /// (may_underflow): the tile is then unfinished, and must be built again
+  /// (reset and clipped).
+  bool assemble(std::int32_t gen, const double* p, const double* lo, const double* hi, const ExactContext* exact,
+                const std::int32_t* ids, const double* q, std::size_t m, const std::uint16_t* corners,
+                std::size_t nt) {
+    start(gen, p, lo, hi, exact);
+    if (may_underflow_ || m + box_planes + 1 >= 0xFFFF) return false;
+    planes_.resize(box_planes + m);
+    for (std::size_t k = 0; k < m; ++k) {
+      Plane& pl = planes_[box_planes + k];  // written in place (see reset)
+      const double* n = q + 2 * k;
+      pl.n[0] = n[0]; pl.n[1] = n[1];
+      pl.d = 0.5 * (n[0] * n[0] + n[1] * n[1]);
+      pl.n1 = std::fabs(n[0]) + std::fabs(n[1]);
+      pl.id = ids[k];
+    }
+    verts_.resize(nt);
+    for (std::size_t t = 0; t < nt; ++t) {
+      verts_[t].p[0] = static_cast<std::uint16_t>(box_planes + corners[2 * t]);
+      verts_[t].p[1] = static_cast<std::uint16_t>(box_planes + corners[2 * t + 1]);
+    }
+    for (std::size_t t = 0; t + 1 < nt; t += 2) solve_pair(verts_[t], verts_[t + 1]);
+    if (nt % 2 != 0) solve(verts_[nt - 1]);
+    // Inside the box by more than every rounding (as Hull::assemble).
+    double room_hi[2], room_lo[2];
+    for (int a = 0; a < 2; ++a) {
+      room_hi[a] = (hi[a] - p[a]) * (1 - 1e-10);
+      room_lo[a] = (p[a] - lo[a]) * (1 - 1e-10);
+    }
+    bool inside = true;
+    for (const Vertex& v : verts_)
+      for (int a = 0; a < 2; ++a) inside &= (v.y[a] + v.e < room_hi[a]) & (v.e - v.y[a] < room_lo[a]);  // false on NaN
+    lanes_.assign(verts_);
+    update_radius();
+    return inside;
+  }
+
   double security_radius2() const { return security2_; }
   std::int32_t generator() const { return gen_; }
   /// The generator's coordinates: vertices are relative to them.
@@ -162,6 +191,29 @@ class Tile {
   const ExactContext* exact_context() const { return exact_; }
 
  private:
+  // The cell's generator and the domain box's planes (always its first
+  // local planes), with no vertices yet.
+  void start(std::int32_t gen, const double* p, const double* lo, const double* hi, const ExactContext* exact) {
+    gen_ = gen;
+    for (int a = 0; a < 2; ++a) site_[a] = p[a];
+    exact_ = exact;
+    may_underflow_ = exact != nullptr && exact->may_underflow;
+    signs_.start_cell();
+    // Planes and corners are written in place: a local struct copied in
+    // would be read back wider than it was written (a store-forwarding stall).
+    planes_.resize(box_planes);
+    for (int k = 0; k < box_planes; ++k) {
+      const int axis = k / 2;
+      const bool upper = k & 1;
+      Plane& pl = planes_[static_cast<std::size_t>(k)];
+      pl.n[axis] = upper ? 1.0 : -1.0;
+      pl.n[1 - axis] = 0.0;
+      pl.d = upper ? hi[axis] - p[axis] : p[axis] - lo[axis];
+      pl.n1 = 1.0;
+      pl.id = box_plane_id(axis, upper);
+    }
+  }
+
   // The exact sign of vertex slot t against j (prepared_signs.hpp).
   int exact_sign(std::size_t t, std::int32_t j) {
     const Vertex& v = verts_[t];
