@@ -102,7 +102,14 @@ class Hull {
     pl.n1 = n1;
     pl.id = j;
     if (planes_.size() > cap_) ensure_table(2 * cap_);
+    cut(pn, nv);
+    return ClipResult::clipped;
+  }
 
+ private:
+  // Replace the vertices sign_ marks removed (-1; some, not all, of the nv)
+  // by the new face on local plane pn: a clip's work after its sign pass.
+  void cut(std::uint16_t pn, std::size_t nv) {
     // The removed slots, ascending: holes_[0, nh) (never shrunk, so growing
     // it value-initializes nothing per clip).
     if (holes_.size() < nv) holes_.resize(nv);
@@ -156,8 +163,9 @@ class Hull {
       resize_vertices(end);
     }
     update_radius();
-    return ClipResult::clipped;
   }
+
+ public:
 
   /// Start the cell of generator `gen` at p as the polyhedron known whole in
   /// advance (its Delaunay star: CellBuilder::build_from_star), without
@@ -165,10 +173,14 @@ class Hull {
   /// to p, q[3k..3k+3)) of generator ids `ids`, and its nt vertices are the
   /// triangles `corners` (three indices into those m each, counter-clockwise
   /// from outside: det(q_a, q_b, q_c) > 0). Each vertex is solved as a clip
-  /// would solve it. Returns false when a vertex may lie outside the domain
-  /// box [lo, hi] (the box would cut the cell), when the faces do not fit the
-  /// 16-bit plane indices, or on extreme input (may_underflow): the cell is
-  /// then unfinished, and must be built again (reset and clipped).
+  /// would solve it. Where vertices lie outside the domain box [lo, hi], the
+  /// box planes then cut the cell (clip_to_box). Returns false when that
+  /// cannot be decided in floating point (a vertex within rounding of a box
+  /// plane), when a vertex is too ill-conditioned for its float solve (a
+  /// flat simplex, whose circumcentre lies far out: surface samples), when
+  /// the faces do not fit the 16-bit plane indices, or on extreme input
+  /// (may_underflow): the cell is then unfinished, and must be built again
+  /// (reset and clipped), which never solves vertices the box cuts away.
   bool assemble(std::int32_t gen, const double* p, const double* lo, const double* hi, const ExactContext* exact,
                 const std::int32_t* ids, const double* q, std::size_t m, const std::uint16_t* corners,
                 std::size_t nt) {
@@ -200,12 +212,13 @@ class Hull {
       v.p[0] = static_cast<std::uint16_t>(box_planes + c[0]);
       v.p[1] = static_cast<std::uint16_t>(box_planes + c[1]);
       v.p[2] = static_cast<std::uint16_t>(box_planes + c[2]);
-      solve(v);
+      solve(v, false);
+      if (!(v.e <= std::numeric_limits<double>::max())) return false;  // needs the exact solve: clip instead
       settle(static_cast<std::uint32_t>(t));
-      for (int a = 0; a < 3; ++a) inside &= (v.y[a] + v.e < room_hi[a]) & (v.e - v.y[a] < room_lo[a]);  // false on NaN
+      for (int a = 0; a < 3; ++a) inside &= (v.y[a] + v.e < room_hi[a]) & (v.e - v.y[a] < room_lo[a]);
     }
     update_radius();
-    return inside;
+    return inside || clip_to_box();
   }
 
   /// Upper bound on (2R)^2, R = the largest distance from the generator to a
@@ -292,6 +305,32 @@ class Hull {
   }
 
  private:
+  // The assembled cell cut by the domain box's planes, each decided by the
+  // float filter alone (the clip's test with the box plane's d): false,
+  // leaving the cell unfinished, where a vertex lies within its error bound
+  // of a box plane. Otherwise every decision is certain, so the cell is the
+  // one the exact clips build from the box: a vertex exactly on a box plane
+  // is the only case whose answer the perturbation would choose.
+  bool clip_to_box() {
+    for (std::uint16_t k = 0; k < box_planes; ++k) {
+      const int axis = k / 2;
+      const double s = (k & 1) ? 1.0 : -1.0, h = planes_[k].d;
+      const double de = filter::plane_eps * std::fabs(h) + filter::abs_eps;
+      const std::size_t nv = verts_.size();
+      if (sign_.size() < nv) sign_.resize(nv);
+      std::size_t removed = 0;
+      for (std::size_t t = 0; t < nv; ++t) {
+        const double P = h - s * verts_[t].y[axis], e = verts_[t].e + de;
+        if (!(P > e || P < -e)) return false;  // NaN too
+        sign_[t] = P > e ? filter::Sign{1} : filter::Sign{-1};
+        removed += P < -e;
+      }
+      if (removed == nv) return false;
+      if (removed != 0) cut(k, nv);
+    }
+    return true;
+  }
+
   // The cell's generator and the domain box's planes (always its first
   // local planes), with no vertices yet.
   void start(std::int32_t gen, const double* p, const double* lo, const double* hi, const ExactContext* exact) {
@@ -355,7 +394,9 @@ class Hull {
   }
 
   // The vertex where planes p[0], p[1], p[2] meet (Cramer's rule) and its error bound.
-  void solve(Vertex& v) const {
+  // exact_ok false (assemble): a vertex that would need the exact solve
+  // gets NaN for its bound instead, which sends its cell back to the clips.
+  void solve(Vertex& v, bool exact_ok = true) const {
     const Plane& A = planes_[v.p[0]];
     const Plane& B = planes_[v.p[1]];
     const Plane& C = planes_[v.p[2]];
@@ -379,7 +420,7 @@ class Hull {
     if (cond < filter::exact_vertex_condition && std::isfinite(ymax))
       err = filter::vertex_eps * inv_norm * (amax * ymax + bmax) + slack;
     else
-      std::tie(err, ymax) = ill_conditioned(v, inv, ymax, slack);
+      std::tie(err, ymax) = ill_conditioned(v, inv, ymax, slack, exact_ok);
     v.e = err + filter::plane_eps * ymax;
     set_radius(v, err);
   }
@@ -396,7 +437,7 @@ class Hull {
   // vertex is too ill-conditioned for a trustworthy float position (it
   // exists: the exact predicates created it) and is solved exactly. Out of
   // line: inline, the extra code cost ordinary input 2%.
-  [[gnu::noinline, gnu::cold]] std::pair<double, double> ill_conditioned(Vertex& v, double inv, double ymax, double slack) const {
+  [[gnu::noinline, gnu::cold]] std::pair<double, double> ill_conditioned(Vertex& v, double inv, double ymax, double slack, bool exact_ok) const {
     const Plane& A = planes_[v.p[0]];
     const Plane& B = planes_[v.p[1]];
     const Plane& C = planes_[v.p[2]];
@@ -410,6 +451,7 @@ class Hull {
     const double bmax = std::max({std::fabs(A.d) * sa, std::fabs(B.d) * sb, std::fabs(C.d) * sc});
     if (inv_norm * amax < filter::exact_vertex_condition && std::isfinite(ymax))  // false on NaN
       return {filter::vertex_eps * inv_norm * (amax * ymax + bmax) + slack, ymax};
+    if (!exact_ok) return {std::numeric_limits<double>::quiet_NaN(), ymax};
     std::int32_t ids[3] = {A.id, B.id, C.id};
     exact_vertex(*exact_, gen_, ids, v.y);
     ymax = std::max({std::fabs(v.y[0]), std::fabs(v.y[1]), std::fabs(v.y[2])});

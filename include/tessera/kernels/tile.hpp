@@ -85,6 +85,14 @@ class Tile {
     pl.d = d;
     pl.n1 = n1;
     pl.id = j;
+    cut(pn, nv, removed);
+    return ClipResult::clipped;
+  }
+
+ private:
+  // Replace the run of vertices sign_ marks removed (-1; `removed` of the
+  // nv, not all) by two on local plane pn: a clip's work after its sign pass.
+  void cut(std::uint16_t pn, std::size_t nv, std::size_t removed) {
     // The removed vertices form one cyclic run (the polygon is convex). It is
     // replaced in place by a (leaving: the edge plane of the last kept vertex,
     // then the new plane) and b (entering: the new plane, then the edge plane
@@ -130,8 +138,9 @@ class Tile {
     verts_.resize(kept + 2);
     lanes_.resize(kept + 2);
     update_radius();
-    return ClipResult::clipped;
   }
+
+ public:
 
   /// Start the cell of generator `gen` at p as the polygon known whole in
   /// advance (its Delaunay star: CellBuilder::build_from_star), without
@@ -139,11 +148,13 @@ class Tile {
   /// to p, q[2k..2k+2)) of generator ids `ids`, and its nt vertices,
   /// counter-clockwise, are the pairs `corners` (indices into those m: the
   /// plane of the edge arriving, then of the edge leaving). Each vertex is
-  /// solved as a clip would solve it. Returns false when a vertex may lie
-  /// outside the domain box [lo, hi] (the box would cut the cell), when the
-  /// edges do not fit the 16-bit plane indices, or on extreme input
-  /// (may_underflow): the tile is then unfinished, and must be built again
-  /// (reset and clipped).
+  /// solved as a clip would solve it. Where vertices lie outside the domain
+  /// box [lo, hi], the box planes then cut the tile (clip_to_box). Returns
+  /// false when that cannot be decided in floating point (a vertex within
+  /// rounding of a box plane), when a vertex is too ill-conditioned for its
+  /// float solve, when the edges do not fit the 16-bit plane indices, or on
+  /// extreme input (may_underflow): the tile is then unfinished, and must
+  /// be built again (reset and clipped).
   bool assemble(std::int32_t gen, const double* p, const double* lo, const double* hi, const ExactContext* exact,
                 const std::int32_t* ids, const double* q, std::size_t m, const std::uint16_t* corners,
                 std::size_t nt) {
@@ -163,8 +174,8 @@ class Tile {
       verts_[t].p[0] = static_cast<std::uint16_t>(box_planes + corners[2 * t]);
       verts_[t].p[1] = static_cast<std::uint16_t>(box_planes + corners[2 * t + 1]);
     }
-    for (std::size_t t = 0; t + 1 < nt; t += 2) solve_pair(verts_[t], verts_[t + 1]);
-    if (nt % 2 != 0) solve(verts_[nt - 1]);
+    for (std::size_t t = 0; t + 1 < nt; t += 2) solve_pair(verts_[t], verts_[t + 1], false);
+    if (nt % 2 != 0) solve(verts_[nt - 1], false);
     // Inside the box by more than every rounding (as Hull::assemble).
     double room_hi[2], room_lo[2];
     for (int a = 0; a < 2; ++a) {
@@ -172,11 +183,13 @@ class Tile {
       room_lo[a] = (p[a] - lo[a]) * (1 - 1e-10);
     }
     bool inside = true;
-    for (const Vertex& v : verts_)
-      for (int a = 0; a < 2; ++a) inside &= (v.y[a] + v.e < room_hi[a]) & (v.e - v.y[a] < room_lo[a]);  // false on NaN
+    for (const Vertex& v : verts_) {
+      if (!(v.e <= std::numeric_limits<double>::max())) return false;  // needs the exact solve: clip instead
+      for (int a = 0; a < 2; ++a) inside &= (v.y[a] + v.e < room_hi[a]) & (v.e - v.y[a] < room_lo[a]);
+    }
     lanes_.assign(verts_);
     update_radius();
-    return inside;
+    return inside || clip_to_box();
   }
 
   double security_radius2() const { return security2_; }
@@ -191,6 +204,28 @@ class Tile {
   const ExactContext* exact_context() const { return exact_; }
 
  private:
+  // The assembled tile cut by the domain box's planes, each decided by the
+  // float filter alone (as Hull::clip_to_box).
+  bool clip_to_box() {
+    for (std::uint16_t k = 0; k < box_planes; ++k) {
+      const int axis = k / 2;
+      const double s = (k & 1) ? 1.0 : -1.0, h = planes_[k].d;
+      const double de = filter::plane_eps * std::fabs(h) + filter::abs_eps;
+      const std::size_t nv = verts_.size();
+      if (sign_.size() < nv + 1) sign_.resize(nv + 1);
+      std::size_t removed = 0;
+      for (std::size_t t = 0; t < nv; ++t) {
+        const double P = h - s * verts_[t].y[axis], e = verts_[t].e + de;
+        if (!(P > e || P < -e)) return false;  // NaN too
+        sign_[t] = P > e ? filter::Sign{1} : filter::Sign{-1};
+        removed += P < -e;
+      }
+      if (removed == nv) return false;
+      if (removed != 0) cut(k, nv, removed);
+    }
+    return true;
+  }
+
   // The cell's generator and the domain box's planes (always its first
   // local planes), with no vertices yet.
   void start(std::int32_t gen, const double* p, const double* lo, const double* hi, const ExactContext* exact) {
@@ -269,7 +304,7 @@ class Tile {
   // solve() for the two new vertices of a clip at once, one division for
   // both. The rare cases (ill-conditioned, possible underflow) take the
   // scalar path.
-  void solve_pair(Vertex& va, Vertex& vb) const {
+  void solve_pair(Vertex& va, Vertex& vb, bool exact_ok = true) const {
     const Plane& A0 = planes_[va.p[0]];
     const Plane& B0 = planes_[va.p[1]];
     const Plane& A1 = planes_[vb.p[0]];
@@ -279,8 +314,8 @@ class Tile {
     const bool ok = !may_underflow_ && c.cond[0] < filter::exact_vertex_condition &&
                     c.cond[1] < filter::exact_vertex_condition && std::isfinite(c.ymax[0]) && std::isfinite(c.ymax[1]);
     if (!ok) [[unlikely]] {
-      solve(va);
-      solve(vb);
+      solve(va, exact_ok);
+      solve(vb, exact_ok);
       return;
     }
     const Lane err = c.err();
@@ -295,7 +330,9 @@ class Tile {
     }
   }
 
-  void solve(Vertex& v) const {
+  // exact_ok false (assemble): a vertex that would need the exact solve
+  // gets NaN for its bound instead, which sends its cell back to the clips.
+  void solve(Vertex& v, bool exact_ok = true) const {
     const Plane& A = planes_[v.p[0]];
     const Plane& B = planes_[v.p[1]];
     const Cramer<double> c(A.n[0], A.n[1], A.d, A.n1, B.n[0], B.n[1], B.d, B.n1);
@@ -308,7 +345,7 @@ class Tile {
     if (c.cond < filter::exact_vertex_condition && std::isfinite(ymax))
       err = c.err() + slack;
     else
-      std::tie(err, ymax) = ill_conditioned(v, c.inv, ymax, slack);
+      std::tie(err, ymax) = ill_conditioned(v, c.inv, ymax, slack, exact_ok);
     v.e = err + filter::plane_eps * ymax;
     set_radius(v, err);
   }
@@ -316,7 +353,7 @@ class Tile {
   // As Hull::ill_conditioned: the bound on the rows scaled to |n|_1 in
   // [1, 2) (the same y, a bound blind to the rows' magnitudes), else the
   // exact solve. Returns err and ymax.
-  [[gnu::noinline, gnu::cold]] std::pair<double, double> ill_conditioned(Vertex& v, double inv, double ymax, double slack) const {
+  [[gnu::noinline, gnu::cold]] std::pair<double, double> ill_conditioned(Vertex& v, double inv, double ymax, double slack, bool exact_ok) const {
     const Plane& A = planes_[v.p[0]];
     const Plane& B = planes_[v.p[1]];
     const std::int32_t ea = filter::binary_exponent(A.n1), eb = filter::binary_exponent(B.n1);
@@ -327,6 +364,7 @@ class Tile {
     const double bmax = std::max(std::fabs(A.d) * sa, std::fabs(B.d) * sb);
     if (inv_norm * amax < filter::exact_vertex_condition && std::isfinite(ymax))  // false on NaN
       return {filter::vertex_eps * inv_norm * (amax * ymax + bmax) + slack, ymax};
+    if (!exact_ok) return {std::numeric_limits<double>::quiet_NaN(), ymax};
     std::int32_t ids[2] = {A.id, B.id};
     exact_vertex(*exact_, gen_, ids, v.y);
     ymax = std::max(std::fabs(v.y[0]), std::fabs(v.y[1]));
