@@ -259,7 +259,9 @@ void print_summary(const VoronoiArgs& a, const io::PointCloud& pc, const Cells& 
   std::printf("  %-18s %.3f s on %d thread%s (read %.3f s, write %.3f s)\n", "compute", compute_s,
               c.threads_used, c.threads_used == 1 ? "" : "s", read_s, write_s);
   if (c.from_insertion)
-    std::printf("  %-18s %s\n", "method", "insertion (each cell clipped by its Delaunay neighbours)");
+    std::printf("  %-18s insertion (%zu cells assembled from their Delaunay stars, %zu clipped by their Delaunay "
+                "neighbours)\n",
+                "method", c.assembled_from_stars, c.n_cells() - c.assembled_from_stars);
   // Lattices tie often but cheaply (tens of exact calls per cell, on the
   // integer path); thousands per cell mean a many-fold near-degenerate vertex
   // (points on one sphere, searched with --method search: docs/design.md,
@@ -382,10 +384,10 @@ int run_bench_voronoi(const BenchArgs& a) {
     std::printf(
         "{\"tool\":\"tessera\",\"op\":\"%s\",\"n\":%zu,\"threads\":%d,\"seconds\":%.6f,\"simplices\":%zu,"
         "\"extra\":{\"cpu_user_s\":%.6f,\"cpu_sys_s\":%.6f,\"minflt\":%lld,\"peak_rss_bytes\":%lld,"
-        "\"neighbors\":%zu,\"from_insertion\":%s,\"exact_calls\":%llu,\"volume_sum\":%.17g,\"repeat\":%d}}\n",
+        "\"neighbors\":%zu,\"from_insertion\":%s,\"assembled\":%zu,\"exact_calls\":%llu,\"volume_sum\":%.17g,\"repeat\":%d}}\n",
         op, pc.n, cells.threads_used, secs, cells.n_cells(), u1.user_s - u0.user_s, u1.sys_s - u0.sys_s,
         u1.minflt - u0.minflt, u1.maxrss_bytes, cells.neighbors.size(), cells.from_insertion ? "true" : "false",
-        static_cast<unsigned long long>(cells.exact_predicate_calls), accurate_sum(cells.volume), rep);
+        cells.assembled_from_stars, static_cast<unsigned long long>(cells.exact_predicate_calls), accurate_sum(cells.volume), rep);
     std::fflush(stdout);
   }
   return kExitOk;

@@ -250,7 +250,7 @@ int main(int argc, char** argv) {
       "voronoi",
       "Time tessera::voronoi (cells, volumes and neighbour lists; no mesh, no output files) K times. "
       "Each run prints {\"tool\":\"tessera\",\"op\":\"voronoi3\"|\"voronoi2\",\"n\",\"threads\",\"seconds\","
-      "\"simplices\" (= cells),\"extra\":{cpu_user_s,cpu_sys_s,minflt,peak_rss_bytes,neighbors,from_insertion,exact_calls,"
+      "\"simplices\" (= cells),\"extra\":{cpu_user_s,cpu_sys_s,minflt,peak_rss_bytes,neighbors,from_insertion,assembled,exact_calls,"
       "volume_sum,repeat}}; seconds is wall time of the computation only");
   add_compute_options(bench_vor, ba.compute, bench_bounds);
   add_cell_method_option(bench_vor, ba.compute);

@@ -127,6 +127,10 @@ struct Cells {
   int threads_used = 1;
   /// The cells were clipped by Delaunay neighbours from insertion (CellMethod).
   bool from_insertion = false;
+  /// Of those, the cells assembled from their Delaunay stars with no clip;
+  /// the rest (points on the hull, cells within rounding of the box) were
+  /// clipped by their stars' vertices.
+  std::size_t assembled_from_stars = 0;
 
   std::size_t n_cells() const { return generator.size(); }
   std::size_t n_vertices() const { return vertex_keys.size() / (dim + 1); }

@@ -80,6 +80,7 @@ void bind_voronoi(py::module_& m) {
       .def_readonly("exact_predicate_calls", &Cells::exact_predicate_calls)
       .def_readonly("threads_used", &Cells::threads_used)
       .def_readonly("from_insertion", &Cells::from_insertion)
+      .def_readonly("assembled_from_stars", &Cells::assembled_from_stars)
       // per cell
       .def_property_readonly("generator", [](py::object s) { return view_flat(s.cast<const Cells&>().generator, s); })
       .def_property_readonly("region", [](py::object s) { return view_flat(s.cast<const Cells&>().region, s); })

@@ -201,8 +201,15 @@ class Voronoi:
 
     @property
     def from_insertion(self) -> bool:
-        """The cells were clipped by Delaunay neighbours from insertion (``method``)."""
+        """The cells came from the Delaunay triangulation by insertion (``method``)."""
         return self._cells.from_insertion
+
+    @property
+    def assembled_from_stars(self) -> int:
+        """Of the cells from insertion, those assembled from their Delaunay stars
+        with no clip (the rest, on the hull or within rounding of the box, were
+        clipped by their Delaunay neighbours)."""
+        return self._cells.assembled_from_stars
 
     # ---- checks, views, files ---------------------------------------------
     def validate(self) -> "_core.ValidationReport":

@@ -142,6 +142,13 @@ def test_method_insertion_gives_the_searched_cells():
     np.testing.assert_allclose(searched.volumes, auto.volumes, rtol=1e-12)
     assert auto.validate()
     assert not tessera.voronoi(random_points(500, 3)).from_insertion
+    # Points on a sphere are all on the hull: no cell is assembled from a
+    # closed star. Inside points' cells are, except where the box cuts them.
+    assert auto.assembled_from_stars == 0
+    p = random_points(500, 3)
+    ins = tessera.voronoi(p, method="insertion")
+    assert 0 < ins.assembled_from_stars < 500
+    assert np.array_equal(ins.neighbors, tessera.voronoi(p, method="search").neighbors)
     # 2D: points on a circle, whose searched cells each test every point.
     t = np.random.default_rng(5).random(1500) * 2 * np.pi
     c = np.c_[np.cos(t), np.sin(t)]

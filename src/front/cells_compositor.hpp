@@ -45,6 +45,7 @@ class CellsCompositor {
     std::vector<std::int32_t> face_nbr;
     std::vector<std::uint32_t> face_vend;   // running end into fverts, per face
     std::vector<std::uint32_t> fverts;      // local vertex index (within the cell)
+    std::size_t assembled = 0;              // cells assembled from their stars
   };
 
   /// `owners_known`: no two generators coincide, so a merged vertex's owner
@@ -56,6 +57,7 @@ class CellsCompositor {
       : out_(out), labels_(labels), classify_(labels), mesh_(mesh), owners_known_(owners_known) {}
 
   void add(Batch& b, std::int32_t gen, const kernels::BuildStatus& st, CellT& cell) {
+    b.assembled += st.assembled;
     b.gen.push_back(gen);
     b.dup_of.push_back(st.has_cell ? -1 : st.duplicate_of);
     if (!st.has_cell) {
@@ -127,7 +129,10 @@ class CellsCompositor {
     // outside labels, none ignored) and none is a duplicate, cell g is
     // generator g.
     std::size_t generators = 0;
-    for (const Batch& b : batches) generators += b.gen.size();
+    for (const Batch& b : batches) {
+      generators += b.gen.size();
+      o.assembled_from_stars += b.assembled;
+    }
     dense_ = o.duplicates.empty() && generators == n;
     const bool dense = dense_;
     o.cell_of.assign(n, dense ? 1 : 0);

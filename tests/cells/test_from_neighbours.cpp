@@ -155,6 +155,19 @@ TEST(FromNeighbours, SameCellsAsTheSearch) {
   for (std::uint64_t seed = 1; seed <= 4; ++seed)
     same_as_search(subnormal_offset_points(60, 3, seed + 100), "subnormal offsets seed " + std::to_string(seed), {},
                    std::nullopt, false, {}, true);
+  // A terrain's samples: flat tetrahedra along the surface, whose far
+  // circumcentres are too ill-conditioned to assemble (those cells clip),
+  // and cells the box cuts.
+  {
+    std::vector<double> p;
+    std::mt19937_64 rng(908);
+    std::uniform_real_distribution<double> u(0, 1);
+    for (int k = 0; k < 2000; ++k) {
+      const double x = u(rng), y = u(rng);
+      p.insert(p.end(), {x, y, 0.2 * std::sin(5 * x) * std::cos(4 * y)});
+    }
+    same_as_search(p, "terrain samples 2000");
+  }
   // Extreme scales: the pass computes in a rescaled frame.
   {
     auto p = random_points(300, 3, 907);
@@ -217,6 +230,31 @@ TEST(FromNeighbours, SameCellsAsTheSearch2D) {
     same2(p, "labelled with outside points and duplicates", labels, std::nullopt, false, inv);
     same2(p, "bounds with points outside", {}, make_bounds({0.1, 0.2}, {0.9, 0.7}), true);
   }
+}
+
+// Cells from insertion are assembled from their Delaunay stars where the star
+// is closed (the point is inside the hull) and the box does not need the
+// exact clips; the rest are clipped by their Delaunay neighbours. Either way
+// the cells are the search's (above); here, that both ways are taken.
+TEST(FromNeighbours, InsidePointsAreAssembledFromTheirStars) {
+  for (const int dim : {2, 3}) {
+    SCOPED_TRACE(dim);
+    const auto p = random_points(3000, dim, 930);
+    const auto c = run_method(p, dim, tessera::CellMethod::insertion);
+    ASSERT_TRUE(c.from_insertion);
+    EXPECT_GT(c.assembled_from_stars, 2400u);  // the hull's points (a few %) are clipped
+    EXPECT_LT(c.assembled_from_stars, 3000u);
+    const auto s = run_method(p, dim, tessera::CellMethod::search);
+    EXPECT_EQ(s.assembled_from_stars, 0u);
+  }
+  // Every point on a sphere is on the hull: no closed star.
+  const auto on_sphere = run_method(sphere_points(400, 931), 3, tessera::CellMethod::insertion);
+  EXPECT_EQ(on_sphere.assembled_from_stars, 0u);
+  // Bounds that cut through the points: the cells they cut are cut by the
+  // box planes after assembly, or clipped.
+  const auto p = random_points(2000, 3, 932);
+  const auto cut = run_method(p, 3, tessera::CellMethod::insertion, {}, 1, make_bounds({0.1, 0.2, 0.0}, {0.9, 0.7, 0.8}), true);
+  EXPECT_GT(cut.assembled_from_stars, cut.n_cells() / 2);
 }
 
 /// Cells by insertion on 1 and 2 threads: every output vector identical.

@@ -354,7 +354,8 @@ class Voronoi3D(TempDirCase):
         self.assertNotIn("Delaunay neighbours", r.stdout)
         r = self.ok(["voronoi", sph, "-o", self.p("a.vtu"), "--neighbors", self.p("a.npy")])
         self.assertNotIn("over 1000 per cell", r.stdout)
-        self.assertIn("method             insertion (each cell clipped by its Delaunay neighbours)", r.stdout)
+        self.assertIn("method             insertion (0 cells assembled from their Delaunay stars, 200 clipped by "
+                      "their Delaunay neighbours)", r.stdout)  # all 200 sphere points lie on the hull
         self.assertTrue(np.array_equal(np.load(self.p("s.npy")), np.load(self.p("a.npy"))))
         r = self.ok(["voronoi", self.inp, "-o", self.p("u.vtu")])
         self.assertNotIn("over 1000 per cell", r.stdout)

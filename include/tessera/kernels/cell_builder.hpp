@@ -50,6 +50,9 @@ struct BuildStatus {
   /// The search passed the builder's work cap (set_work_cap) and was
   /// abandoned: no cell (has_cell is false, duplicate_of -1).
   bool capped = false;
+  /// The cell was assembled from its Delaunay star, with no clip
+  /// (build_from_star).
+  bool assembled = false;
 };
 
 template <class CellT>
@@ -237,6 +240,7 @@ class CellBuilder {
       if (cell.assemble(i, p, lo_, hi_, exact_, ids_.data(), qs_.data(), m, vc, nt)) {
         BuildStatus status;
         status.work = 4 * m;
+        status.assembled = true;
         return status;
       }
     }
