@@ -22,7 +22,7 @@
 
 namespace tessera::engine {
 
-/// Every located point's Delaunay star (front/delaunay_neighbours.hpp), by
+/// Every located point's Delaunay star (front/delaunay_stars.hpp), by
 /// locator slot: `rows` holds the simplices, D + 1 slots each, positively
 /// oriented (2D counter-clockwise, 3D det > 0); slot s's simplices are
 /// `simplices[first[s] .. first[s + 1])`, ascending, so in an order

@@ -117,7 +117,7 @@ class CellBuilder {
   /// alone, nearest first, with no search: for a caller that knows every
   /// point that clips (the Delaunay neighbours, from incremental insertion,
   /// whose perturbed in-sphere test is this clip predicate:
-  /// front/delaunay_neighbours.hpp). The points are distinct, exclude i and
+  /// front/delaunay_stars.hpp). The points are distinct, exclude i and
   /// its coincident points, and come in an order that does not depend on the
   /// thread count (the clip order follows it among near-ties, and with it
   /// the last bits of the cell's geometry).
