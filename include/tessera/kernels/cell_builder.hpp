@@ -160,10 +160,12 @@ class CellBuilder {
   /// have s as a vertex, in an order independent of the thread count. Its
   /// Voronoi vertices are those simplices' circumcentres and its faces the
   /// bisectors with their other vertices, so a point inside the hull (a
-  /// closed star) whose vertices all lie inside the domain box has its cell
-  /// assembled from them (Hull/Tile::assemble) with no clip and no sign
-  /// pass. The rest — points on the hull, cells the box cuts — are clipped by
-  /// the star's vertices (build_from), in the order they first appear.
+  /// closed star) has its cell assembled from them (Hull/Tile::assemble),
+  /// then cut by the domain box where vertices lie outside it, with no
+  /// clip by a neighbour and no sign pass. The rest — points on the hull,
+  /// cells with a vertex within rounding of the box or too ill-conditioned
+  /// for the float solve — are clipped by the star's vertices (build_from),
+  /// in the order they first appear.
   /// The cell is the one build_from gives either way (the same exact
   /// predicate decided the triangulation), up to the last bits of its
   /// geometry.

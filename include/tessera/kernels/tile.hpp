@@ -141,7 +141,6 @@ class Tile {
   }
 
  public:
-
   /// Start the cell of generator `gen` at p as the polygon known whole in
   /// advance (its Delaunay star: CellBuilder::build_from_star), without
   /// clipping: its edges lie on the bisectors with the m points q (relative
@@ -304,7 +303,7 @@ class Tile {
   // solve() for the two new vertices of a clip at once, one division for
   // both. The rare cases (ill-conditioned, possible underflow) take the
   // scalar path.
-  void solve_pair(Vertex& va, Vertex& vb, bool exact_ok = true) const {
+  [[gnu::always_inline]] void solve_pair(Vertex& va, Vertex& vb, bool exact_ok = true) const {  // as Hull::solve
     const Plane& A0 = planes_[va.p[0]];
     const Plane& B0 = planes_[va.p[1]];
     const Plane& A1 = planes_[vb.p[0]];
