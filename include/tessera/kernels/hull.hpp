@@ -25,6 +25,7 @@
 #include <utility>
 #include <vector>
 
+#include "tessera/kernels/assembly.hpp"
 #include "tessera/kernels/exact_predicates.hpp"
 #include "tessera/kernels/filter.hpp"
 #include "tessera/kernels/prepared_signs.hpp"
@@ -185,25 +186,10 @@ class Hull {
                 std::size_t nt) {
     start(gen, p, lo, hi, exact);
     if (may_underflow_ || m + box_planes + 1 >= 0xFFFF) return false;
-    planes_.resize(box_planes + m);
-    for (std::size_t k = 0; k < m; ++k) {
-      Plane& pl = planes_[box_planes + k];  // written in place (see reset)
-      const double* n = q + 3 * k;
-      pl.n[0] = n[0]; pl.n[1] = n[1]; pl.n[2] = n[2];
-      pl.d = 0.5 * (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-      pl.n1 = std::fabs(n[0]) + std::fabs(n[1]) + std::fabs(n[2]);
-      pl.id = ids[k];
-    }
+    assembly::bisector_planes<3>(planes_, box_planes, ids, q, m);
     if (planes_.size() > cap_ || edge_tri_.empty()) ensure_table(2 * planes_.size());
     resize_vertices(nt);
-    // Inside the box by more than every rounding: the vertex's error bound
-    // err is below e - plane_eps |y|_inf, which covers the rounding of y + e;
-    // the margin covers that of hi - p.
-    double room_hi[3], room_lo[3];
-    for (int a = 0; a < 3; ++a) {
-      room_hi[a] = (hi[a] - p[a]) * (1 - 1e-10);
-      room_lo[a] = (p[a] - lo[a]) * (1 - 1e-10);
-    }
+    const assembly::BoxRoom<3> room(p, lo, hi);
     bool inside = true;
     for (std::size_t t = 0; t < nt; ++t) {
       Vertex& v = verts_[t];
@@ -214,7 +200,7 @@ class Hull {
       solve(v, false);
       if (!(v.e <= std::numeric_limits<double>::max())) return false;  // needs the exact solve: clip instead
       settle(static_cast<std::uint32_t>(t));
-      for (int a = 0; a < 3; ++a) inside &= (v.y[a] + v.e < room_hi[a]) & (v.e - v.y[a] < room_lo[a]);
+      inside &= room.holds(v);
     }
     update_radius();
     return inside || clip_to_box();
@@ -312,19 +298,9 @@ class Hull {
   // is the only case whose answer the perturbation would choose.
   bool clip_to_box() {
     for (std::uint16_t k = 0; k < box_planes; ++k) {
-      const int axis = k / 2;
-      const double s = (k & 1) ? 1.0 : -1.0, h = planes_[k].d;
-      const double de = filter::plane_eps * std::fabs(h) + filter::abs_eps;
       const std::size_t nv = verts_.size();
-      if (sign_.size() < nv) sign_.resize(nv);
-      std::size_t removed = 0;
-      for (std::size_t t = 0; t < nv; ++t) {
-        const double P = h - s * verts_[t].y[axis], e = verts_[t].e + de;
-        if (!(P > e || P < -e)) return false;  // NaN too
-        sign_[t] = P > e ? filter::Sign{1} : filter::Sign{-1};
-        removed += P < -e;
-      }
-      if (removed == nv) return false;
+      const std::size_t removed = assembly::box_signs(verts_.data(), nv, k, planes_[k].d, sign_);
+      if (removed == assembly::undecided || removed == nv) return false;
       if (removed != 0) cut(k, nv);
     }
     return true;

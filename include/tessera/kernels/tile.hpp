@@ -18,6 +18,7 @@
 #include <utility>
 #include <vector>
 
+#include "tessera/kernels/assembly.hpp"
 #include "tessera/kernels/exact_predicates.hpp"
 #include "tessera/kernels/filter.hpp"
 #include "tessera/kernels/hull.hpp"  // ClipResult
@@ -141,33 +142,17 @@ class Tile {
   }
 
  public:
-  /// Start the cell of generator `gen` at p as the polygon known whole in
-  /// advance (its Delaunay star: CellBuilder::build_from_star), without
-  /// clipping: its edges lie on the bisectors with the m points q (relative
-  /// to p, q[2k..2k+2)) of generator ids `ids`, and its nt vertices,
-  /// counter-clockwise, are the pairs `corners` (indices into those m: the
-  /// plane of the edge arriving, then of the edge leaving). Each vertex is
-  /// solved as a clip would solve it. Where vertices lie outside the domain
-  /// box [lo, hi], the box planes then cut the tile (clip_to_box). Returns
-  /// false when that cannot be decided in floating point (a vertex within
-  /// rounding of a box plane), when a vertex is too ill-conditioned for its
-  /// float solve, when the edges do not fit the 16-bit plane indices, or on
-  /// extreme input (may_underflow): the tile is then unfinished, and must
-  /// be built again (reset and clipped).
+  /// Hull::assemble for the polygon: edges on the bisectors with the m
+  /// points q (q[2k..2k+2)), and nt vertices, counter-clockwise, given as
+  /// `corners` pairs (the plane of the edge arriving, then of the edge
+  /// leaving), solved two at a time as a clip solves them. False, leaving
+  /// the tile to be reset and clipped, in the same cases.
   bool assemble(std::int32_t gen, const double* p, const double* lo, const double* hi, const ExactContext* exact,
                 const std::int32_t* ids, const double* q, std::size_t m, const std::uint16_t* corners,
                 std::size_t nt) {
     start(gen, p, lo, hi, exact);
     if (may_underflow_ || m + box_planes + 1 >= 0xFFFF) return false;
-    planes_.resize(box_planes + m);
-    for (std::size_t k = 0; k < m; ++k) {
-      Plane& pl = planes_[box_planes + k];  // written in place (see reset)
-      const double* n = q + 2 * k;
-      pl.n[0] = n[0]; pl.n[1] = n[1];
-      pl.d = 0.5 * (n[0] * n[0] + n[1] * n[1]);
-      pl.n1 = std::fabs(n[0]) + std::fabs(n[1]);
-      pl.id = ids[k];
-    }
+    assembly::bisector_planes<2>(planes_, box_planes, ids, q, m);
     verts_.resize(nt);
     for (std::size_t t = 0; t < nt; ++t) {
       verts_[t].p[0] = static_cast<std::uint16_t>(box_planes + corners[2 * t]);
@@ -175,16 +160,11 @@ class Tile {
     }
     for (std::size_t t = 0; t + 1 < nt; t += 2) solve_pair(verts_[t], verts_[t + 1], false);
     if (nt % 2 != 0) solve(verts_[nt - 1], false);
-    // Inside the box by more than every rounding (as Hull::assemble).
-    double room_hi[2], room_lo[2];
-    for (int a = 0; a < 2; ++a) {
-      room_hi[a] = (hi[a] - p[a]) * (1 - 1e-10);
-      room_lo[a] = (p[a] - lo[a]) * (1 - 1e-10);
-    }
+    const assembly::BoxRoom<2> room(p, lo, hi);
     bool inside = true;
     for (const Vertex& v : verts_) {
       if (!(v.e <= std::numeric_limits<double>::max())) return false;  // needs the exact solve: clip instead
-      for (int a = 0; a < 2; ++a) inside &= (v.y[a] + v.e < room_hi[a]) & (v.e - v.y[a] < room_lo[a]);
+      inside &= room.holds(v);
     }
     lanes_.assign(verts_);
     update_radius();
@@ -207,19 +187,9 @@ class Tile {
   // float filter alone (as Hull::clip_to_box).
   bool clip_to_box() {
     for (std::uint16_t k = 0; k < box_planes; ++k) {
-      const int axis = k / 2;
-      const double s = (k & 1) ? 1.0 : -1.0, h = planes_[k].d;
-      const double de = filter::plane_eps * std::fabs(h) + filter::abs_eps;
       const std::size_t nv = verts_.size();
-      if (sign_.size() < nv + 1) sign_.resize(nv + 1);
-      std::size_t removed = 0;
-      for (std::size_t t = 0; t < nv; ++t) {
-        const double P = h - s * verts_[t].y[axis], e = verts_[t].e + de;
-        if (!(P > e || P < -e)) return false;  // NaN too
-        sign_[t] = P > e ? filter::Sign{1} : filter::Sign{-1};
-        removed += P < -e;
-      }
-      if (removed == nv) return false;
+      const std::size_t removed = assembly::box_signs(verts_.data(), nv, k, planes_[k].d, sign_);
+      if (removed == assembly::undecided || removed == nv) return false;
       if (removed != 0) cut(k, nv, removed);
     }
     return true;
