@@ -73,9 +73,10 @@ Cells run(std::span<const double> input, std::span<const std::int32_t> labels, c
   const bool owners_known = opt.build_mesh && !pass.locator->may_have_coincident();
   // Cells whose search would cost far more than on uniform points (points
   // nearly on a sphere, surface samples, dense clusters; in 2D points on a
-  // circle, along curves, in blobs) are clipped by their Delaunay
-  // neighbours instead: the same cells (docs/design.md, "Cells from
-  // Delaunay neighbours").
+  // circle, along curves, in blobs) come from the Delaunay triangulation
+  // instead, assembled from their stars or clipped by their Delaunay
+  // neighbours: the same cells (docs/design.md, "Cells from Delaunay
+  // neighbours", "Cells assembled from their stars").
   std::optional<engine::DelaunayStars> stars;
   {
     bool insert = opt.cell_method == CellMethod::insertion;

@@ -189,8 +189,6 @@ class Hull {
     assembly::bisector_planes<3>(planes_, box_planes, ids, q, m);
     if (planes_.size() > cap_ || edge_tri_.empty()) ensure_table(2 * planes_.size());
     resize_vertices(nt);
-    const assembly::BoxRoom<3> room(p, lo, hi);
-    bool inside = true;
     for (std::size_t t = 0; t < nt; ++t) {
       Vertex& v = verts_[t];
       const std::uint16_t* c = corners + 3 * t;
@@ -200,10 +198,9 @@ class Hull {
       solve(v, false);
       if (!(v.e <= std::numeric_limits<double>::max())) return false;  // needs the exact solve: clip instead
       settle(static_cast<std::uint32_t>(t));
-      inside &= room.holds(v);
     }
     update_radius();
-    return inside || clip_to_box();
+    return clip_to_box();
   }
 
   /// Upper bound on (2R)^2, R = the largest distance from the generator to a
