@@ -125,7 +125,7 @@ struct Cells {
   std::vector<std::int32_t> ignored_outside_bounds;  ///< with ignore_outside_points
   std::uint64_t exact_predicate_calls = 0;          ///< filter failures resolved exactly
   int threads_used = 1;
-  /// The cells were clipped by Delaunay neighbours from insertion (CellMethod).
+  /// The cells came from the Delaunay triangulation by insertion (CellMethod).
   bool from_insertion = false;
   /// Of those, the cells assembled from their Delaunay stars with no clip;
   /// the rest (points on the hull, cells within rounding of the box) were

@@ -42,7 +42,7 @@ namespace {
 
 /// From this pilot ratio on (front/pilot.hpp: the cells' search work per
 /// Delaunay simplex they find, relative to uniform input), cells are
-/// clipped by their Delaunay neighbours (CellMethod::insertion). The same
+/// taken from the Delaunay triangulation (CellMethod::insertion). The same
 /// for every thread count: the two methods' cells differ in the last bits of
 /// their volumes and centroids (the clip order differs), and the output must
 /// not depend on the thread count. In 3D the two methods are level at about
