@@ -131,7 +131,7 @@ def test_duplicates_are_reported_and_own_no_cell():
 
 def test_method_insertion_gives_the_searched_cells():
     # Points nearly on one sphere: searched, every cell tests every point at
-    # the centre; "auto" clips them by their Delaunay neighbours instead.
+    # the centre; "auto" builds them from the Delaunay triangulation instead.
     v = np.random.default_rng(4).normal(size=(600, 3))
     v /= np.linalg.norm(v, axis=1)[:, None]
     searched = tessera.voronoi(v, method="search")
@@ -142,12 +142,13 @@ def test_method_insertion_gives_the_searched_cells():
     np.testing.assert_allclose(searched.volumes, auto.volumes, rtol=1e-12)
     assert auto.validate()
     assert not tessera.voronoi(random_points(500, 3)).from_insertion
-    # Points on a sphere are all on the hull: no cell is assembled from a
-    # closed star. Inside points' cells are, except where the box cuts them.
-    assert auto.assembled_from_stars == 0
+    # Points on a sphere are all on the hull: their cells are assembled from
+    # open stars, closed by a far plane that the box cuts away. So are
+    # uniform points' cells, inside the hull and on it.
+    assert auto.assembled_from_stars == 600
     p = random_points(500, 3)
     ins = tessera.voronoi(p, method="insertion")
-    assert 0 < ins.assembled_from_stars < 500
+    assert 490 < ins.assembled_from_stars <= 500
     assert np.array_equal(ins.neighbors, tessera.voronoi(p, method="search").neighbors)
     # 2D: points on a circle, whose searched cells each test every point.
     t = np.random.default_rng(5).random(1500) * 2 * np.pi

@@ -91,6 +91,24 @@ std::vector<double> sphere_points(std::size_t n, std::uint64_t seed) {
   return p;
 }
 
+/// D + 1 points at distance 5 from the origin (one Delaunay simplex, whose
+/// circumcentre, a Voronoi vertex, is the origin), then random points with
+/// y in [6, 10], outside that circumsphere. With the box's lower y plane
+/// at 0 (vertex_on_box_plane_bounds), the vertex lies exactly on it.
+std::vector<double> vertex_on_box_plane(int dim) {
+  std::vector<double> p = dim == 2 ? std::vector<double>{-3, 4, 3, 4, 0, 5}
+                                   : std::vector<double>{-3, 4, 0, 3, 4, 0, 0, 4, 3, 0, 5, 0};
+  std::mt19937_64 rng(static_cast<std::uint64_t>(940 + dim));
+  std::uniform_real_distribution<double> u(0, 1);
+  for (int k = 0; k < 200; ++k) {
+    p.push_back(-10 + 20 * u(rng));
+    p.push_back(6 + 4 * u(rng));
+    if (dim == 3) p.push_back(-10 + 20 * u(rng));
+  }
+  return p;
+}
+tessera::Bounds vertex_on_box_plane_bounds() { return make_bounds({-10, 0, -10}, {10, 10, 10}); }
+
 TEST(FromNeighbours, SameCellsAsTheSearch) {
   same_as_search(random_points(3000, 3, 901), "uniform 3000");
   same_as_search(grid_points(8, 3), "integer grid 8^3");
@@ -168,6 +186,7 @@ TEST(FromNeighbours, SameCellsAsTheSearch) {
     }
     same_as_search(p, "terrain samples 2000");
   }
+  same_as_search(vertex_on_box_plane(3), "a Voronoi vertex on a box plane", {}, vertex_on_box_plane_bounds());
   // Extreme scales: the pass computes in a rescaled frame.
   {
     auto p = random_points(300, 3, 907);
@@ -230,26 +249,53 @@ TEST(FromNeighbours, SameCellsAsTheSearch2D) {
     same2(p, "labelled with outside points and duplicates", labels, std::nullopt, false, inv);
     same2(p, "bounds with points outside", {}, make_bounds({0.1, 0.2}, {0.9, 0.7}), true);
   }
+  same2(vertex_on_box_plane(2), "a Voronoi vertex on a box plane", {}, vertex_on_box_plane_bounds());
 }
 
-// Cells from insertion are assembled from their Delaunay stars where the star
-// is closed (the point is inside the hull) and the box does not need the
-// exact clips; the rest are clipped by their Delaunay neighbours. Either way
-// the cells are the search's (above); here, that both ways are taken.
-TEST(FromNeighbours, InsidePointsAreAssembledFromTheirStars) {
+// Cells from insertion are assembled from their Delaunay stars: closed
+// stars (points inside the hull) and open ones (points on it, whose
+// unbounded cells a far plane closes before the box cuts them), unless the
+// box needs the exact clips or a vertex is too ill-conditioned for the float
+// solve; those are clipped by their Delaunay neighbours. Either way the cells
+// are the search's (above); here, that both ways are taken.
+TEST(FromNeighbours, CellsAreAssembledFromTheirStars) {
   for (const int dim : {2, 3}) {
     SCOPED_TRACE(dim);
     const auto p = random_points(3000, dim, 930);
     const auto c = run_method(p, dim, tessera::CellMethod::insertion);
     ASSERT_TRUE(c.from_insertion);
-    EXPECT_GT(c.assembled_from_stars, 2400u);  // the hull's points (a few %) are clipped
-    EXPECT_LT(c.assembled_from_stars, 3000u);
+    EXPECT_GT(c.assembled_from_stars, 2950u);  // the hull's points too
     const auto s = run_method(p, dim, tessera::CellMethod::search);
     EXPECT_EQ(s.assembled_from_stars, 0u);
   }
-  // Every point on a sphere is on the hull: no closed star.
-  const auto on_sphere = run_method(sphere_points(400, 931), 3, tessera::CellMethod::insertion);
-  EXPECT_EQ(on_sphere.assembled_from_stars, 0u);
+  // Every point on a sphere (a circle) is on the hull: all open stars.
+  EXPECT_EQ(run_method(sphere_points(400, 931), 3, tessera::CellMethod::insertion).assembled_from_stars, 400u);
+  EXPECT_EQ(run_method(circle_points(700, 933), 2, tessera::CellMethod::insertion).assembled_from_stars, 700u);
+  // A Voronoi vertex exactly on a box plane, where the perturbation
+  // decides: the cells that share it are clipped, the rest assembled.
+  for (const int dim : {2, 3}) {
+    SCOPED_TRACE(dim);
+    const auto p = vertex_on_box_plane(dim);
+    const auto c = run_method(p, dim, tessera::CellMethod::insertion, {}, 1, vertex_on_box_plane_bounds());
+    const std::size_t n = p.size() / static_cast<std::size_t>(dim), shared = static_cast<std::size_t>(dim + 1);
+    EXPECT_LE(c.assembled_from_stars, n - shared);
+    EXPECT_GE(c.assembled_from_stars, n - shared - 4);  // (in 3D one more clips: a far ill-conditioned vertex)
+  }
+  // A terrain's samples: flat tetrahedra along the surface, whose
+  // circumcentres lie far outside the box and need the exact solve: those
+  // cells are clipped, which never makes such a vertex.
+  {
+    std::vector<double> p;
+    std::mt19937_64 rng(934);
+    std::uniform_real_distribution<double> u(0, 1);
+    for (int k = 0; k < 2000; ++k) {
+      const double x = u(rng), y = u(rng);
+      p.insert(p.end(), {x, y, 0.2 * std::sin(5 * x) * std::cos(4 * y)});
+    }
+    const auto t = run_method(p, 3, tessera::CellMethod::insertion);
+    EXPECT_GT(t.assembled_from_stars, 1000u);
+    EXPECT_LT(t.assembled_from_stars, 2000u);
+  }
   // Bounds that cut through the points: the cells they cut are cut by the
   // box planes after assembly, or clipped.
   const auto p = random_points(2000, 3, 932);

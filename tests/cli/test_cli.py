@@ -342,8 +342,8 @@ class Voronoi3D(TempDirCase):
         # Points normalized onto one sphere tie (to rounding) at its centre:
         # searched, thousands of exact calls per cell, which the summary
         # points out along with the remedies; ordinary input gets no such
-        # remark. The automatic method clips them by their Delaunay
-        # neighbours instead (and says so), with the same cells.
+        # remark. The automatic method builds them from the Delaunay
+        # triangulation instead (and says so), with the same cells.
         v = np.random.default_rng(5).normal(size=(200, 3))
         v /= np.linalg.norm(v, axis=1)[:, None]
         sph = self.save("sphere.npy", v)
@@ -354,8 +354,9 @@ class Voronoi3D(TempDirCase):
         self.assertNotIn("Delaunay neighbours", r.stdout)
         r = self.ok(["voronoi", sph, "-o", self.p("a.vtu"), "--neighbors", self.p("a.npy")])
         self.assertNotIn("over 1000 per cell", r.stdout)
-        self.assertIn("method             insertion (0 cells assembled from their Delaunay stars, 200 clipped by "
-                      "their Delaunay neighbours)", r.stdout)  # all 200 sphere points lie on the hull
+        # All 200 sphere points lie on the hull: open stars, assembled too.
+        self.assertIn("method             insertion (200 cells assembled from their Delaunay stars, 0 clipped by "
+                      "their Delaunay neighbours)", r.stdout)
         self.assertTrue(np.array_equal(np.load(self.p("s.npy")), np.load(self.p("a.npy"))))
         r = self.ok(["voronoi", self.inp, "-o", self.p("u.vtu")])
         self.assertNotIn("over 1000 per cell", r.stdout)

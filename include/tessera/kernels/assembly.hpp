@@ -1,7 +1,8 @@
 // What the 2D tile and the 3D hull share in assembling a cell known whole
 // in advance (its Delaunay star: CellBuilder::build_from_star) rather than
-// clipping it from the box: its bisector planes, and the signs of its
-// vertices against the domain box's planes (the box cuts what lies outside).
+// clipping it from the box: its bisector planes, the far plane that closes
+// a hull point's unbounded cell, and the signs of its vertices against the
+// domain box's planes (the box cuts what lies outside).
 #pragma once
 
 #include <algorithm>
@@ -36,6 +37,85 @@ void bisector_planes(std::vector<Plane>& planes, std::size_t first, const std::i
     pl.n1 = n1;
     pl.id = ids[k];
   }
+}
+
+/// The id of the far plane that closes a hull point's cell (far_plane): no
+/// generator's and no box plane's. It never reaches a finished cell: the box
+/// cuts away every vertex on it, and the kernels then drop it.
+inline constexpr std::int32_t far_plane_id = std::numeric_limits<std::int32_t>::min();
+
+/// The plane that closes the cell of a point on the convex hull, whose
+/// Voronoi cell is unbounded: its star's simplices give the bounded
+/// vertices, and each hull facet at the point one unbounded edge, a ray in
+/// the facet's outward normal direction. A plane P = {y : n.y = c} that every
+/// such ray crosses, with the domain box and every bounded vertex strictly
+/// inside, turns the cell into the polytope cell ∩ {n.y <= c}, whose
+/// vertices are the bounded ones and one per ray (where it crosses P), all
+/// known from the star; the box then cuts P away whole, as it lies outside.
+///
+/// `dirs`: the k rays' unit directions (D each, from the rounded
+/// differences q; the callers reject directions whose rounding could tilt
+/// them). n is their sum; every ray must make an angle with n well short of
+/// a right angle (n.dir >= 1e-3 |n|, far beyond rounding), else false (a
+/// hull vertex whose normal cone is wider than that sum covers: the cell is
+/// clipped instead). c lies beyond the box's corners and the vertices [0,
+/// nv) (each widened by its error bound) by half the box's extent along n,
+/// so every vertex on P is certainly outside the box (box_signs).
+/// `box`: the kernel's first 2D planes (box_planes), n = -+e_axis, d = the
+/// offset from the generator.
+template <int D, class Plane, class Vertex>
+bool far_plane(const double* dirs, std::size_t k, const Plane* box, const Vertex* verts, std::size_t nv, Plane& out) {
+  double n[D] = {};
+  for (std::size_t r = 0; r < k; ++r)
+    for (int a = 0; a < D; ++a) n[a] += dirs[D * r + static_cast<std::size_t>(a)];
+  double len2 = 0, n1 = 0;
+  for (int a = 0; a < D; ++a) {
+    len2 += n[a] * n[a];
+    n1 += std::fabs(n[a]);
+  }
+  const double min_dot = 1e-3 * std::sqrt(len2);
+  for (std::size_t r = 0; r < k; ++r) {
+    double dot = 0;
+    for (int a = 0; a < D; ++a) dot += n[a] * dirs[D * r + static_cast<std::size_t>(a)];
+    if (!(dot >= min_dot)) return false;  // NaN too
+  }
+  double cmax = 0, extent = 0;  // over the box's corners: sum over axes of the larger end
+  for (int a = 0; a < D; ++a) {
+    const double lo = -box[2 * a].d, hi = box[2 * a + 1].d;
+    cmax += std::max(n[a] * lo, n[a] * hi);
+    extent += std::fabs(n[a]) * (hi - lo);
+  }
+  for (std::size_t t = 0; t < nv; ++t) {
+    double dot = 0;
+    for (int a = 0; a < D; ++a) dot += n[a] * verts[t].y[a];
+    cmax = std::max(cmax, dot + n1 * verts[t].e);
+  }
+  const double c = cmax + 0.5 * extent;
+  if (!(c < std::numeric_limits<double>::max() && extent > 0)) return false;
+  for (int a = 0; a < D; ++a) out.n[a] = n[a];
+  out.d = c;
+  out.n1 = n1;
+  out.id = far_plane_id;
+  return true;
+}
+
+/// Whether an assembled vertex too ill-conditioned for the float solve is
+/// worth its exact solve: its float estimate y lies in the domain box grown
+/// by a quarter of its size per axis (`box`: the kernel's first 2D planes).
+/// Farther out the box most likely cuts it away, and an exact solve there is
+/// wasted (a terrain's flat simplices, whose circumcentres lie far above and
+/// below it: 7% of its run when every one was solved); such a vertex gets a
+/// NaN bound and its cell is clipped, which never makes it. Points on a
+/// circle need the ones inside (their cells' shared corner at the centre:
+/// clipping those cells cost them 7%). Either way the cell is exact.
+template <int D, class Plane>
+bool worth_exact_solve(const double* y, const Plane* box) {
+  bool in = true;
+  for (int a = 0; a < D; ++a) {
+    const double lo = box[2 * a].d, hi = box[2 * a + 1].d, grow = 0.25 * (lo + hi);
+    in &= y[a] >= -lo - grow && y[a] <= hi + grow;  // false on NaN
+  }
+  return in;
 }
 
 /// No vertex can be placed against a box plane in floating point (box_signs).

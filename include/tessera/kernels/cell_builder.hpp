@@ -159,13 +159,15 @@ class CellBuilder {
   /// `rows`, positively oriented: 2D counter-clockwise, 3D det > 0) that
   /// have s as a vertex, in an order independent of the thread count. Its
   /// Voronoi vertices are those simplices' circumcentres and its faces the
-  /// bisectors with their other vertices, so a point inside the hull (a
-  /// closed star) has its cell assembled from them (Hull/Tile::assemble),
-  /// then cut by the domain box where vertices lie outside it, with no
-  /// clip by a neighbour and no sign pass. The rest — points on the hull,
-  /// cells with a vertex within rounding of the box or too ill-conditioned
-  /// for the float solve — are clipped by the star's vertices (build_from),
-  /// in the order they first appear.
+  /// bisectors with their other vertices, so the cell is assembled from
+  /// them (Hull/Tile::assemble), then cut by the domain box where vertices
+  /// lie outside it, with no clip by a neighbour and no sign pass. A point
+  /// on the hull (an open star) has an unbounded cell: its hull facets' rays
+  /// are closed by a far plane beyond the box, which the box cuts away. The
+  /// rest — cells with a vertex within rounding of the box or too
+  /// ill-conditioned for the float solve, hull points whose far plane
+  /// cannot be placed — are clipped by the star's vertices (build_from), in
+  /// the order they first appear.
   /// The cell is the one build_from gives either way (the same exact
   /// predicate decided the triangulation), up to the last bits of its
   /// geometry.
@@ -206,29 +208,46 @@ class CellBuilder {
     }
     const std::size_t m = nn_;
     // Closed star: in 2D a cycle through every neighbour (m == nt), in 3D a
-    // triangulated sphere (nt == 2m - 4; a hull point's link is a disk with
-    // a boundary of at least three edges, so nt <= 2m - 5 there).
-    bool closed = fits && nt >= D + 1;
+    // triangulated sphere (nt == 2m - 4). A point on the hull has an open
+    // star: in 2D a chain (m == nt + 1), in 3D a disk, whose boundary of at
+    // least three edges makes nt <= 2m - 5 (the kernel checks the disk).
+    bool ok = fits && nt >= 1 && m <= CellT::max_assembled_planes;
+    bool open = false;
     if constexpr (D == 2) {
-      closed &= m == nt;
-      if (closed) {
-        // Chain the pairs (arriving, leaving) into the counter-clockwise cycle.
+      open = m == nt + 1;
+      ok &= (m == nt && nt >= 3) || open;
+      if (ok) {
+        // Chain the pairs (arriving, leaving) into the counter-clockwise
+        // cycle, or the chain from the one neighbour that leaves no simplex.
         if (succ_.size() < m) succ_.resize(m);
         std::fill(succ_.begin(), succ_.begin() + static_cast<std::ptrdiff_t>(m), std::uint32_t{0xFFFFFFFF});
         for (std::size_t t = 0; t < nt; ++t) succ_[corners[2 * t]] = static_cast<std::uint32_t>(t);
-        if (cycle_.size() < 2 * m) cycle_.resize(2 * m);
         std::uint32_t t = 0;
-        for (std::size_t k = 0; k < m && closed; ++k) {
+        if (open) {
+          // The chain's first simplex: its arriving neighbour is no
+          // simplex's leaving one.
+          for (std::size_t k = 0; k < nt; ++k) succ_[corners[2 * k + 1]] |= 0x80000000u;
+          std::size_t k = 0;
+          while (k < nt && (succ_[corners[2 * k]] & 0x80000000u) != 0) ++k;
+          for (std::size_t j = 0; j < m; ++j)
+            if (succ_[j] != 0xFFFFFFFF) succ_[j] &= 0x7FFFFFFFu;
+          t = static_cast<std::uint32_t>(k);
+          ok = k < nt;
+        }
+        if (cycle_.size() < 2 * m) cycle_.resize(2 * m);
+        for (std::size_t k = 0; k < nt && ok; ++k) {
           cycle_[2 * k] = corners[2 * t];
           cycle_[2 * k + 1] = corners[2 * t + 1];
           t = succ_[corners[2 * t + 1]];
-          closed &= t < nt && (t == 0) == (k + 1 == m);
+          // A cycle returns to its start after nt steps; a chain ends there.
+          ok &= open ? (t == 0xFFFFFFFF) == (k + 1 == nt) : t < nt && (t == 0) == (k + 1 == nt);
         }
       }
     } else {
-      closed &= nt == 2 * m - 4;
+      open = nt + 5 <= 2 * m;
+      ok &= (nt + 4 == 2 * m && nt >= 4) || open;
     }
-    if (closed) {
+    if (ok) {
       if (ids_.size() < m) {
         ids_.resize(2 * m);
         qs_.resize(2 * m * D);
@@ -239,7 +258,7 @@ class CellBuilder {
         ids_[k] = loc_.id(nbr_[k]);
       }
       const std::uint16_t* vc = D == 2 ? cycle_.data() : corners;
-      if (cell.assemble(i, p, lo_, hi_, exact_, ids_.data(), qs_.data(), m, vc, nt)) {
+      if (cell.assemble(i, p, lo_, hi_, exact_, ids_.data(), qs_.data(), m, vc, nt, open)) {
         BuildStatus status;
         status.work = 4 * m;
         status.assembled = true;

@@ -39,6 +39,11 @@ class Hull {
   static constexpr int dim = 3;
   /// The domain box's planes are always the cell's first local planes.
   static constexpr std::uint16_t box_planes = 6;
+  /// The most bisectors assemble() takes (more: the cell is clipped). Its
+  /// edge table holds (2 x planes)^2 entries; a hull point of a terrain's
+  /// samples has thousands of neighbours (flat tetrahedra reach across the
+  /// surface), whose table took gigabytes to zero.
+  static constexpr std::size_t max_assembled_planes = 500;
   struct Plane {
     double n[3];
     double d;
@@ -181,13 +186,20 @@ class Hull {
   /// the faces do not fit the 16-bit plane indices, or on extreme input
   /// (may_underflow): the cell is then unfinished, and must be built again
   /// (reset and clipped), which never solves vertices the box cuts away.
+  ///
+  /// `open`: the generator lies on the convex hull, and the triangles form
+  /// a disk (its star's link), whose boundary edges (a -> b) are its hull
+  /// facets. The cell is unbounded; each facet adds a vertex where its ray
+  /// crosses a far plane (assembly::far_plane), the triangle (b, a, far),
+  /// and the box cuts them all away. False too where the triangles are not
+  /// such a disk or the far plane cannot be placed.
   bool assemble(std::int32_t gen, const double* p, const double* lo, const double* hi, const ExactContext* exact,
                 const std::int32_t* ids, const double* q, std::size_t m, const std::uint16_t* corners,
-                std::size_t nt) {
+                std::size_t nt, bool open = false) {
     start(gen, p, lo, hi, exact);
-    if (may_underflow_ || m + box_planes + 1 >= 0xFFFF) return false;
+    if (may_underflow_ || m > max_assembled_planes) return false;
     assembly::bisector_planes<3>(planes_, box_planes, ids, q, m);
-    if (planes_.size() > cap_ || edge_tri_.empty()) ensure_table(2 * planes_.size());
+    if (planes_.size() + 1 > cap_ || edge_tri_.empty()) ensure_table(2 * (planes_.size() + 1));
     resize_vertices(nt);
     for (std::size_t t = 0; t < nt; ++t) {
       Vertex& v = verts_[t];
@@ -199,8 +211,18 @@ class Hull {
       if (!(v.e <= std::numeric_limits<double>::max())) return false;  // needs the exact solve: clip instead
       settle(static_cast<std::uint32_t>(t));
     }
+    if (open && !close_far(q, m)) return false;
     update_radius();
-    return clip_to_box();
+    if (!clip_to_box()) return false;
+    if (open) {
+      // The box removed every vertex on the far plane (it lies outside the
+      // box, and each decision was certain); checked, then the plane dropped.
+      const std::uint16_t far = static_cast<std::uint16_t>(planes_.size() - 1);
+      for (const Vertex& v : verts_)
+        if (v.p[0] == far || v.p[1] == far || v.p[2] == far) return false;
+      planes_.pop_back();
+    }
+    return true;
   }
 
   /// Upper bound on (2R)^2, R = the largest distance from the generator to a
@@ -303,6 +325,78 @@ class Hull {
     return true;
   }
 
+  // assemble() of a hull point: the link's nt = verts_.size() triangles
+  // are solved and linked; find its boundary edges (a -> b: no triangle
+  // holds b -> a), add the far plane and the triangles (b, a, far), and
+  // check that the surface is now a sphere. q: the bisectors' points, as
+  // assemble's.
+  bool close_far(const double* q, std::size_t m) {
+    const std::size_t nt = verts_.size();
+    const std::size_t cap = cap_;
+    const std::uint16_t far = static_cast<std::uint16_t>(planes_.size());
+    border_.clear();  // here: the boundary edges, as (b, a)
+    for (std::size_t t = 0; t < nt; ++t) {
+      const Vertex& v = verts_[t];
+      for (int k = 0; k < 3; ++k) {
+        const std::uint16_t a = v.p[k], b = v.p[k == 2 ? 0 : k + 1];
+        // The table is not cleared between cells: an entry is this cell's
+        // only if its triangle holds the edge.
+        const std::uint32_t u = edge_tri_[static_cast<std::size_t>(b) * cap + a];
+        if (u < nt && holds(verts_[u], b, a)) continue;
+        border_.push_back({b, a});
+      }
+    }
+    const std::size_t nb = border_.size();
+    // A disk closed by a cone over its boundary is a sphere: its triangles
+    // number twice its vertices (the m bisectors and the far plane) less 4.
+    if (nt + nb != 2 * (m + 1) - 4) return false;
+    // Facet (p, a, b) of the hull, with the link triangle (a, b, c): c lies
+    // inside, det(q_a, q_b, q_c) > 0, so the outward normal, the ray's
+    // direction, is q_b x q_a.
+    dirs_.resize(3 * nb);
+    for (std::size_t k = 0; k < nb; ++k) {
+      const double* qb = q + 3 * (border_[k].a - box_planes);
+      const double* qa = q + 3 * (border_[k].b - box_planes);
+      double* d = dirs_.data() + 3 * k;
+      cross(qb, qa, d);
+      const double len = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+      // A facet so thin that the cross product's rounding (~1e-16 of
+      // |q_a| |q_b|) could tilt its normal: not closed here.
+      const double na = std::sqrt(qa[0] * qa[0] + qa[1] * qa[1] + qa[2] * qa[2]);
+      const double nbl = std::sqrt(qb[0] * qb[0] + qb[1] * qb[1] + qb[2] * qb[2]);
+      if (!(len > 1e-8 * na * nbl)) return false;
+      for (int a = 0; a < 3; ++a) d[a] /= len;
+    }
+    Plane& pf = planes_.emplace_back();
+    if (!assembly::far_plane<3>(dirs_.data(), nb, planes_.data(), verts_.data(), nt, pf)) return false;
+    resize_vertices(nt + nb);
+    for (std::size_t k = 0; k < nb; ++k) {
+      Vertex& v = verts_[nt + k];
+      v.p[0] = border_[k].a;
+      v.p[1] = border_[k].b;
+      v.p[2] = far;
+      solve(v, false);  // never exact: on the far plane
+      if (!(v.e <= std::numeric_limits<double>::max())) return false;
+      settle(static_cast<std::uint32_t>(nt + k));
+    }
+    // Each boundary vertex starts and ends one boundary edge: then the
+    // triangles around the far plane chain into one cycle, and every edge
+    // (a -> far), (far -> b) has its twin.
+    for (std::size_t k = 0; k < nb; ++k) {
+      const std::uint16_t b = border_[k].a, a = border_[k].b;
+      const std::uint32_t u = edge_tri_[static_cast<std::size_t>(far) * cap + a];
+      const std::uint32_t w = edge_tri_[static_cast<std::size_t>(b) * cap + far];
+      if (!(u >= nt && u < nt + nb && verts_[u].p[0] == a) || !(w >= nt && w < nt + nb && verts_[w].p[1] == b))
+        return false;
+    }
+    return true;
+  }
+
+  // Whether triangle v holds the directed edge (a -> b).
+  static bool holds(const Vertex& v, std::uint16_t a, std::uint16_t b) {
+    return (v.p[0] == a && v.p[1] == b) || (v.p[1] == a && v.p[2] == b) || (v.p[2] == a && v.p[0] == b);
+  }
+
   // The cell's generator and the domain box's planes (always its first
   // local planes), with no vertices yet.
   void start(std::int32_t gen, const double* p, const double* lo, const double* hi, const ExactContext* exact) {
@@ -367,7 +461,8 @@ class Hull {
 
   // The vertex where planes p[0], p[1], p[2] meet (Cramer's rule) and its error bound.
   // exact_ok false (assemble): a vertex that would need the exact solve
-  // gets NaN for its bound instead, which sends its cell back to the clips.
+  // may get NaN for its bound instead (ill_conditioned), which sends its
+  // cell back to the clips.
   // Inlined in both callers: out of line (it has two), the clip's calls
   // cost the search 4%.
   [[gnu::always_inline]] void solve(Vertex& v, bool exact_ok = true) const {
@@ -425,7 +520,13 @@ class Hull {
     const double bmax = std::max({std::fabs(A.d) * sa, std::fabs(B.d) * sb, std::fabs(C.d) * sc});
     if (inv_norm * amax < filter::exact_vertex_condition && std::isfinite(ymax))  // false on NaN
       return {filter::vertex_eps * inv_norm * (amax * ymax + bmax) + slack, ymax};
-    if (!exact_ok) return {std::numeric_limits<double>::quiet_NaN(), ymax};
+    // assemble(): the exact solve only where the float estimate lies near
+    // the box (assembly::worth_exact_solve), never on a hull point's far
+    // plane (no bisector: it has no exact form); else NaN, and the cell is
+    // clipped instead (or, for a vertex the box cut made on the far plane,
+    // the box test gives the cell up).
+    if ((!exact_ok && !assembly::worth_exact_solve<3>(v.y, planes_.data())) || A.id == assembly::far_plane_id || B.id == assembly::far_plane_id || C.id == assembly::far_plane_id)
+      return {std::numeric_limits<double>::quiet_NaN(), ymax};
     std::int32_t ids[3] = {A.id, B.id, C.id};
     exact_vertex(*exact_, gen_, ids, v.y);
     ymax = std::max({std::fabs(v.y[0]), std::fabs(v.y[1]), std::fabs(v.y[2])});
@@ -468,6 +569,7 @@ class Hull {
   std::vector<std::uint8_t> seen_;
   std::vector<std::uint32_t> loop_;
   std::vector<std::uint32_t> next_;  // for_each_face's successor links
+  std::vector<double> dirs_;         // close_far: the rays' unit directions
   PreparedSigns<3> signs_;  // the exact stages, prepared per vertex slot
 };
 

@@ -31,6 +31,8 @@ class Tile {
   static constexpr int dim = 2;
   /// The domain box's planes are always the tile's first local planes.
   static constexpr std::uint16_t box_planes = 4;
+  /// The most bisectors assemble() takes (as Hull's: 16-bit plane indices).
+  static constexpr std::size_t max_assembled_planes = 0xFFF0;
   struct Plane {
     double n[2];
     double d;
@@ -147,22 +149,59 @@ class Tile {
   /// `corners` pairs (the plane of the edge arriving, then of the edge
   /// leaving), solved two at a time as a clip solves them. False, leaving
   /// the tile to be reset and clipped, in the same cases.
+  ///
+  /// `open`: the generator lies on the convex hull, and the corners are a
+  /// chain, not a cycle (its fan of triangles, counter-clockwise), from
+  /// hull edge (p, first corner's arriving plane) to hull edge (p, last
+  /// corner's leaving plane). Each of those two edges adds a vertex where
+  /// its ray crosses a far line (assembly::far_plane), which closes the
+  /// cycle, and the box cuts them away.
   bool assemble(std::int32_t gen, const double* p, const double* lo, const double* hi, const ExactContext* exact,
                 const std::int32_t* ids, const double* q, std::size_t m, const std::uint16_t* corners,
-                std::size_t nt) {
+                std::size_t nt, bool open = false) {
     start(gen, p, lo, hi, exact);
-    if (may_underflow_ || m + box_planes + 1 >= 0xFFFF) return false;
+    if (may_underflow_ || m > max_assembled_planes) return false;
     assembly::bisector_planes<2>(planes_, box_planes, ids, q, m);
-    verts_.resize(nt);
+    verts_.resize(open ? nt + 2 : nt);
     for (std::size_t t = 0; t < nt; ++t) {
       verts_[t].p[0] = static_cast<std::uint16_t>(box_planes + corners[2 * t]);
       verts_[t].p[1] = static_cast<std::uint16_t>(box_planes + corners[2 * t + 1]);
     }
     for (std::size_t t = 0; t + 1 < nt; t += 2) solve_pair(verts_[t], verts_[t + 1], false);
     if (nt % 2 != 0) solve(verts_[nt - 1], false);
+    if (open) {
+      // Hull edges (p, s) at the chain's start and (p, e) at its end: the
+      // fan lies counter-clockwise from s to e, the outside beyond them, so
+      // their outward normals are q_s turned clockwise and q_e
+      // counter-clockwise (exact turns), the rays' directions.
+      const std::uint16_t s = corners[0], e = corners[2 * nt - 1];
+      const double* qs = q + 2 * s;
+      const double* qe = q + 2 * e;
+      const double ls = std::hypot(qs[0], qs[1]), le = std::hypot(qe[0], qe[1]);
+      const double dirs[4] = {qs[1] / ls, -qs[0] / ls, -qe[1] / le, qe[0] / le};
+      const std::uint16_t far = static_cast<std::uint16_t>(planes_.size());
+      Plane& pf = planes_.emplace_back();
+      if (!assembly::far_plane<2>(dirs, 2, planes_.data(), verts_.data(), nt, pf)) return false;
+      Vertex& ve = verts_[nt];  // leaving along e's ray, arriving on the far line
+      Vertex& vs = verts_[nt + 1];
+      ve.p[0] = static_cast<std::uint16_t>(box_planes + e);
+      ve.p[1] = far;
+      vs.p[0] = far;
+      vs.p[1] = static_cast<std::uint16_t>(box_planes + s);
+      solve_pair(ve, vs, false);  // never exact: on the far line
+    }
     lanes_.assign(verts_);
     update_radius();
-    return clip_to_box();  // false too where a vertex needed the exact solve (its bound is NaN)
+    if (!clip_to_box()) return false;  // false too where a vertex needed the exact solve (its bound is NaN)
+    if (open) {
+      // The box removed both vertices on the far line (it lies outside the
+      // box, and each decision was certain); checked, then the line dropped.
+      const std::uint16_t far = static_cast<std::uint16_t>(planes_.size() - 1);
+      for (const Vertex& v : verts_)
+        if (v.p[0] == far || v.p[1] == far) return false;
+      planes_.pop_back();
+    }
+    return true;
   }
 
   double security_radius2() const { return security2_; }
@@ -294,7 +333,8 @@ class Tile {
   }
 
   // exact_ok false (assemble): a vertex that would need the exact solve
-  // gets NaN for its bound instead, which sends its cell back to the clips.
+  // may get NaN for its bound instead (ill_conditioned), which sends its
+  // cell back to the clips.
   void solve(Vertex& v, bool exact_ok = true) const {
     const Plane& A = planes_[v.p[0]];
     const Plane& B = planes_[v.p[1]];
@@ -327,7 +367,13 @@ class Tile {
     const double bmax = std::max(std::fabs(A.d) * sa, std::fabs(B.d) * sb);
     if (inv_norm * amax < filter::exact_vertex_condition && std::isfinite(ymax))  // false on NaN
       return {filter::vertex_eps * inv_norm * (amax * ymax + bmax) + slack, ymax};
-    if (!exact_ok) return {std::numeric_limits<double>::quiet_NaN(), ymax};
+    // assemble(): the exact solve only where the float estimate lies near
+    // the box (assembly::worth_exact_solve), never on a hull point's far
+    // plane (no bisector: it has no exact form); else NaN, and the cell is
+    // clipped instead (or, for a vertex the box cut made on the far plane,
+    // the box test gives the cell up).
+    if ((!exact_ok && !assembly::worth_exact_solve<2>(v.y, planes_.data())) || A.id == assembly::far_plane_id || B.id == assembly::far_plane_id)
+      return {std::numeric_limits<double>::quiet_NaN(), ymax};
     std::int32_t ids[2] = {A.id, B.id};
     exact_vertex(*exact_, gen_, ids, v.y);
     ymax = std::max(std::fabs(v.y[0]), std::fabs(v.y[1]));
