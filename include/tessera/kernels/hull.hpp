@@ -379,15 +379,18 @@ class Hull {
       if (!(v.e <= std::numeric_limits<double>::max())) return false;
       settle(static_cast<std::uint32_t>(nt + k));
     }
-    // Each boundary vertex starts and ends one boundary edge: then the
-    // triangles around the far plane chain into one cycle, and every edge
-    // (a -> far), (far -> b) has its twin.
-    for (std::size_t k = 0; k < nb; ++k) {
-      const std::uint16_t b = border_[k].a, a = border_[k].b;
-      const std::uint32_t u = edge_tri_[static_cast<std::size_t>(far) * cap + a];
-      const std::uint32_t w = edge_tri_[static_cast<std::size_t>(b) * cap + far];
-      if (!(u >= nt && u < nt + nb && verts_[u].p[0] == a) || !(w >= nt && w < nt + nb && verts_[w].p[1] == b))
-        return false;
+    // Closed and consistently oriented: every directed edge is held by one
+    // triangle only, and its twin by another. (The disk's edges were
+    // checked above, but a vertex with two boundary edges leaving it would
+    // give the far plane's triangles a repeated edge.)
+    for (std::size_t t = 0; t < nt + nb; ++t) {
+      const Vertex& v = verts_[t];
+      for (int k = 0; k < 3; ++k) {
+        const std::uint16_t a = v.p[k], b = v.p[k == 2 ? 0 : k + 1];
+        const std::uint32_t u = edge_tri_[static_cast<std::size_t>(b) * cap + a];
+        if (edge_tri_[static_cast<std::size_t>(a) * cap + b] != t || !(u < nt + nb && holds(verts_[u], b, a)))
+          return false;
+      }
     }
     return true;
   }
