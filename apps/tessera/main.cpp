@@ -80,8 +80,9 @@ void add_cell_method_option(CLI::App* app, ComputeArgs& c) {
   app->add_option("--method", c.cell_method,
                   "How each cell finds the points that clip it. search: the bins around it (the meshless "
                   "method); insertion: the Delaunay triangulation by incremental insertion, each cell assembled "
-                  "from its Delaunay star or, on the hull, clipped by its Delaunay neighbours (faster where cells "
-                  "reach far: points nearly on a sphere or circle, surface samples, dense clusters, 2D curves); "
+                  "from its Delaunay star, or clipped by its Delaunay neighbours where the box or an "
+                  "ill-conditioned vertex needs the exact clips; faster where cells reach far (points nearly "
+                  "on a sphere or circle, surface samples, dense clusters, 2D curves); "
                   "auto: insertion where a sample of cells costs far more than on uniform points, else search. "
                   "Same cells")
       ->check(CLI::IsMember({"auto", "search", "insertion"}))

@@ -127,9 +127,11 @@ struct Cells {
   int threads_used = 1;
   /// The cells came from the Delaunay triangulation by insertion (CellMethod).
   bool from_insertion = false;
-  /// Of those, the cells assembled from their Delaunay stars with no clip;
-  /// the rest (points on the hull, cells within rounding of the box) were
-  /// clipped by their stars' vertices.
+  /// Of those, the cells assembled from their Delaunay stars with no clip
+  /// (points on the hull too); the rest (cells with a vertex within
+  /// rounding of the box, or one too ill-conditioned for the float solve
+  /// and far out, or stars of over 500 neighbours in 3D) were clipped by
+  /// their stars' vertices.
   std::size_t assembled_from_stars = 0;
 
   std::size_t n_cells() const { return generator.size(); }

@@ -207,8 +207,9 @@ class Voronoi:
     @property
     def assembled_from_stars(self) -> int:
         """Of the cells from insertion, those assembled from their Delaunay stars
-        with no clip (the rest, on the hull or within rounding of the box, were
-        clipped by their Delaunay neighbours)."""
+        with no clip, on the hull too (the rest, with a vertex within rounding
+        of the box or too ill-conditioned and far out, were clipped by their
+        Delaunay neighbours)."""
         return self._cells.assembled_from_stars
 
     # ---- checks, views, files ---------------------------------------------
