@@ -91,6 +91,19 @@ std::vector<double> sphere_points(std::size_t n, std::uint64_t seed) {
   return p;
 }
 
+/// n samples of a terrain, z = 0.2 sin(5x) cos(4y) over the unit square:
+/// flat tetrahedra along the surface, whose circumcentres lie far out.
+std::vector<double> terrain_points(int n, std::uint64_t seed) {
+  std::vector<double> p;
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(0, 1);
+  for (int k = 0; k < n; ++k) {
+    const double x = u(rng), y = u(rng);
+    p.insert(p.end(), {x, y, 0.2 * std::sin(5 * x) * std::cos(4 * y)});
+  }
+  return p;
+}
+
 /// D + 1 points at distance 5 from the origin (one Delaunay simplex, whose
 /// circumcentre, a Voronoi vertex, is the origin), then random points with
 /// y in [6, 10], outside that circumsphere. With the box's lower y plane
@@ -176,16 +189,7 @@ TEST(FromNeighbours, SameCellsAsTheSearch) {
   // A terrain's samples: flat tetrahedra along the surface, whose far
   // circumcentres are too ill-conditioned to assemble (those cells clip),
   // and cells the box cuts.
-  {
-    std::vector<double> p;
-    std::mt19937_64 rng(908);
-    std::uniform_real_distribution<double> u(0, 1);
-    for (int k = 0; k < 2000; ++k) {
-      const double x = u(rng), y = u(rng);
-      p.insert(p.end(), {x, y, 0.2 * std::sin(5 * x) * std::cos(4 * y)});
-    }
-    same_as_search(p, "terrain samples 2000");
-  }
+  same_as_search(terrain_points(2000, 908), "terrain samples 2000");
   same_as_search(vertex_on_box_plane(3), "a Voronoi vertex on a box plane", {}, vertex_on_box_plane_bounds());
   // Extreme scales: the pass computes in a rescaled frame.
   {
@@ -285,14 +289,7 @@ TEST(FromNeighbours, CellsAreAssembledFromTheirStars) {
   // circumcentres lie far outside the box and need the exact solve: those
   // cells are clipped, which never makes such a vertex.
   {
-    std::vector<double> p;
-    std::mt19937_64 rng(934);
-    std::uniform_real_distribution<double> u(0, 1);
-    for (int k = 0; k < 2000; ++k) {
-      const double x = u(rng), y = u(rng);
-      p.insert(p.end(), {x, y, 0.2 * std::sin(5 * x) * std::cos(4 * y)});
-    }
-    const auto t = run_method(p, 3, tessera::CellMethod::insertion);
+    const auto t = run_method(terrain_points(2000, 934), 3, tessera::CellMethod::insertion);
     EXPECT_GT(t.assembled_from_stars, 1000u);
     EXPECT_LT(t.assembled_from_stars, 2000u);
   }

@@ -104,10 +104,11 @@ bool far_plane(const double* dirs, std::size_t k, const Plane* box, const Vertex
 /// by a quarter of its size per axis (`box`: the kernel's first 2D planes).
 /// Farther out the box most likely cuts it away, and an exact solve there is
 /// wasted (a terrain's flat simplices, whose circumcentres lie far above and
-/// below it: 7% of its run when every one was solved); such a vertex gets a
-/// NaN bound and its cell is clipped, which never makes it. Points on a
-/// circle need the ones inside (their cells' shared corner at the centre:
-/// clipping those cells cost them 7%). Either way the cell is exact.
+/// below it: its run took 13% longer when every one was solved); such a
+/// vertex gets a NaN bound and its cell is clipped, which never makes it.
+/// Points on a circle need the ones inside (their cells' shared corner at
+/// the centre: clipping those cells cost them 7%). Either way the cell is
+/// exact.
 template <int D, class Plane>
 bool worth_exact_solve(const double* y, const Plane* box) {
   bool in = true;

@@ -183,7 +183,7 @@ class Hull {
   /// cannot be decided in floating point (a vertex within rounding of a box
   /// plane), when a vertex is too ill-conditioned for its float solve (a
   /// flat simplex, whose circumcentre lies far out: surface samples), when
-  /// the faces do not fit the 16-bit plane indices, or on extreme input
+  /// the star has more than max_assembled_planes neighbours, or on extreme input
   /// (may_underflow): the cell is then unfinished, and must be built again
   /// (reset and clipped), which never solves vertices the box cuts away.
   ///
