@@ -99,6 +99,20 @@ bool far_plane(const double* dirs, std::size_t k, const Plane* box, const Vertex
   return true;
 }
 
+/// After the box cut of a hull point's cell: false if a vertex still lies
+/// on the far plane (the last of `planes`; the box removes every vertex on
+/// it, as it lies outside the box and each decision was certain, so this is
+/// a check), else the plane is dropped and true.
+template <int D, class Plane, class Vertex>
+bool drop_far_plane(std::vector<Plane>& planes, const std::vector<Vertex>& verts) {
+  const auto far = static_cast<std::uint16_t>(planes.size() - 1);
+  for (const Vertex& v : verts)
+    for (int k = 0; k < D; ++k)
+      if (v.p[k] == far) return false;
+  planes.pop_back();
+  return true;
+}
+
 /// Whether an assembled vertex too ill-conditioned for the float solve is
 /// worth its exact solve: its float estimate y lies in the domain box grown
 /// by a quarter of its size per axis (`box`: the kernel's first 2D planes).
@@ -117,6 +131,19 @@ bool worth_exact_solve(const double* y, const Plane* box) {
     in &= y[a] >= -lo - grow && y[a] <= hi + grow;  // false on NaN
   }
   return in;
+}
+
+/// Whether a vertex (its D local planes `p`) too ill-conditioned for the
+/// float solve must not take the exact one: on a hull point's far plane,
+/// which is no bisector and has no exact form, or, for an assembled vertex
+/// (exact_ok false), where it is not worth it (worth_exact_solve). It then
+/// gets a NaN bound, and its cell is clipped instead (or, for a vertex the
+/// box cut made on the far plane, the box test gives the cell up).
+template <int D, class Plane>
+bool refuse_exact_solve(bool exact_ok, const double* y, const Plane* planes, const std::uint16_t* p) {
+  for (int k = 0; k < D; ++k)
+    if (planes[p[k]].id == far_plane_id) return true;
+  return !exact_ok && !worth_exact_solve<D>(y, planes);
 }
 
 /// No vertex can be placed against a box plane in floating point (box_signs).

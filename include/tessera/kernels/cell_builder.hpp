@@ -226,11 +226,11 @@ class CellBuilder {
         if (open) {
           // The chain's first simplex: its arriving neighbour is no
           // simplex's leaving one.
-          for (std::size_t k = 0; k < nt; ++k) succ_[corners[2 * k + 1]] |= 0x80000000u;
+          if (leaving_.size() < m) leaving_.resize(m);
+          std::fill(leaving_.begin(), leaving_.begin() + static_cast<std::ptrdiff_t>(m), std::uint8_t{0});
+          for (std::size_t k = 0; k < nt; ++k) leaving_[corners[2 * k + 1]] = 1;
           std::size_t k = 0;
-          while (k < nt && (succ_[corners[2 * k]] & 0x80000000u) != 0) ++k;
-          for (std::size_t j = 0; j < m; ++j)
-            if (succ_[j] != 0xFFFFFFFF) succ_[j] &= 0x7FFFFFFFu;
+          while (k < nt && leaving_[corners[2 * k]] != 0) ++k;
           t = static_cast<std::uint32_t>(k);
           ok = k < nt;
         }
@@ -291,6 +291,7 @@ class CellBuilder {
   std::vector<std::uint16_t> corners_;  // D per simplex: indices into nbr_
   std::vector<std::uint16_t> cycle_;  // 2D: corners in counter-clockwise order
   std::vector<std::uint32_t> succ_;   // 2D: per neighbour, the simplex whose first corner it is
+  std::vector<std::uint8_t> leaving_;  // 2D open star: per neighbour, some simplex's second corner
   std::vector<std::int32_t> ids_;
   std::vector<double> qs_;
 

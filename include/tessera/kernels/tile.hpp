@@ -192,16 +192,8 @@ class Tile {
     }
     lanes_.assign(verts_);
     update_radius();
-    if (!clip_to_box()) return false;  // false too where a vertex needed the exact solve (its bound is NaN)
-    if (open) {
-      // The box removed both vertices on the far line (it lies outside the
-      // box, and each decision was certain); checked, then the line dropped.
-      const std::uint16_t far = static_cast<std::uint16_t>(planes_.size() - 1);
-      for (const Vertex& v : verts_)
-        if (v.p[0] == far || v.p[1] == far) return false;
-      planes_.pop_back();
-    }
-    return true;
+    // false too where a vertex needed the exact solve (its bound is NaN)
+    return clip_to_box() && (!open || assembly::drop_far_plane<2>(planes_, verts_));
   }
 
   double security_radius2() const { return security2_; }
@@ -367,12 +359,7 @@ class Tile {
     const double bmax = std::max(std::fabs(A.d) * sa, std::fabs(B.d) * sb);
     if (inv_norm * amax < filter::exact_vertex_condition && std::isfinite(ymax))  // false on NaN
       return {filter::vertex_eps * inv_norm * (amax * ymax + bmax) + slack, ymax};
-    // assemble(): the exact solve only where the float estimate lies near
-    // the box (assembly::worth_exact_solve), never on a hull point's far
-    // plane (no bisector: it has no exact form); else NaN, and the cell is
-    // clipped instead (or, for a vertex the box cut made on the far plane,
-    // the box test gives the cell up).
-    if ((!exact_ok && !assembly::worth_exact_solve<2>(v.y, planes_.data())) || A.id == assembly::far_plane_id || B.id == assembly::far_plane_id)
+    if (assembly::refuse_exact_solve<2>(exact_ok, v.y, planes_.data(), v.p))
       return {std::numeric_limits<double>::quiet_NaN(), ymax};
     std::int32_t ids[2] = {A.id, B.id};
     exact_vertex(*exact_, gen_, ids, v.y);
