@@ -493,7 +493,7 @@ class Triangulation {
     if (s != 0) return s > 0;
     std::int32_t planes[D];
     for (int k = 0; k < D; ++k) planes[k] = global(t.v[k + 1]);
-    return kernels::in_sphere(ctx_, global(t.v[0]), planes, global(q));
+    return kernels::in_sphere_past_filter(ctx_, global(t.v[0]), planes, global(q));
   }
 
   /// A simplex whose closure holds q, or a ghost whose facet q lies strictly

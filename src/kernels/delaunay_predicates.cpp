@@ -17,13 +17,6 @@ const double* pt(const ExactContext& ctx, std::int32_t id) {
   return ctx.points + static_cast<std::size_t>(id) * static_cast<std::size_t>(ctx.dim);
 }
 
-// Rows r_k = p_k - p_0 (rounded) of the orientation matrix.
-struct Rows {
-  double r[3][3];
-};
-
-using detail::det_perm;
-
 // Exact orientation in 128-bit integers when every coordinate is a 25-bit
 // integer times one common power of two (lattices, voxel centres, integer and
 // dyadic grids — where exact zeros are common and GMP would dominate).
@@ -153,42 +146,97 @@ int orientation_exact(int D, const double* const* pts) {
 // The in-sphere filter on the Schur form of the clip predicate: with rows
 // r_k = p_k - p_a, s_k = |r_k|^2 for the planes and for q (last row of p),
 // det[[R, s], [r_q, s_q]] = det R * (pow_q(v) - pow_a(v)) (exact_predicates.hpp),
-// and q is inside iff that power difference is negative. Evaluated in T,
-// whose operations err by a relative `unit` at most (eps: an absolute floor
-// for underflow); +1 when q is surely inside, -1 surely outside, 0 undecided.
-template <class T>
-int in_sphere_filter(int D, const double* pa, const double* const* p, T unit, T eps) {
-  T r[4][3] = {}, s[4];
+// and q is inside iff that power difference is negative. The determinants
+// are evaluated in T, whose operations err by a relative `unit` at most; the
+// permanents of the error bounds in double (eps: an absolute floor for
+// underflow); +1 when q is surely inside, -1 surely outside, 0 undecided.
+//
+// Near-co-spherical input (a sampled sphere, whose every test is nearly a
+// tie) leaves most tests to the long double evaluation (x87), where a
+// generic evaluation of each minor took two fifths of the run. So:
+//  * the D + 1 minors of R's rows share their 2x2 minors of the first two
+//    columns (3D: six, each in three of the four minors), computed once;
+//  * the permanents are summed in double whatever T is (SSE, beside the x87
+//    stack): from differences rounded to double they are within 2^-47 of
+//    those of the differences rounded to T, which the bounds' margin (64
+//    units where Shewchuk's analysis needs 16) absorbs; a permanent that
+//    overflows double leaves the test undecided.
+// A permanent does not depend on the order of its sum, and the bounds hold
+// for any order of evaluation, so these are the quantities and bounds of a
+// separate evaluation per minor.
+template <int D, class T>
+int in_sphere_filter(const double* pa, const double* const* p, T unit, double eps) {
+  using std::fabs;
+  T r[D + 1][D], s[D + 1];
+  double rd[D + 1][D], sd[D + 1];
   for (int k = 0; k <= D; ++k) {
     s[k] = 0;
+    sd[k] = 0;
     for (int d = 0; d < D; ++d) {
       r[k][d] = static_cast<T>(p[k][d]) - static_cast<T>(pa[d]);
+      rd[k][d] = p[k][d] - pa[d];  // the same as r when T is double
       s[k] += r[k][d] * r[k][d];
+      sd[k] += rd[k][d] * rd[k][d];
     }
   }
-  // det R (rows 0..D-1) and the full determinant by expansion along the s column.
-  T det_r = 0, perm_r = 0, det_m = 0, perm_m = 0;
+  // xy(i, j) = the 2x2 minor of rows i < j in the first two columns.
+  T xy[D + 1][D + 1];
+  double axy[D + 1][D + 1];
+  for (int i = 0; i <= D; ++i)
+    for (int j = i + 1; j <= D; ++j) {
+      xy[i][j] = r[i][0] * r[j][1] - r[i][1] * r[j][0];
+      axy[i][j] = fabs(rd[i][0] * rd[j][1]) + fabs(rd[i][1] * rd[j][0]);
+    }
+  // m[k], pm[k]: the minor of the rows other than k (in increasing order),
+  // and its permanent; 3D minors expanded along the third column.
+  T m[D + 1];
+  double pm[D + 1];
+  if constexpr (D == 2) {
+    m[0] = xy[1][2], pm[0] = axy[1][2];
+    m[1] = xy[0][2], pm[1] = axy[0][2];
+    m[2] = xy[0][1], pm[2] = axy[0][1];
+  } else {
+    auto minor = [&](int i, int j, int k, double& perm) {
+      perm = fabs(rd[i][2]) * axy[j][k] + fabs(rd[j][2]) * axy[i][k] + fabs(rd[k][2]) * axy[i][j];
+      return r[i][2] * xy[j][k] - r[j][2] * xy[i][k] + r[k][2] * xy[i][j];
+    };
+    m[0] = minor(1, 2, 3, pm[0]);
+    m[1] = minor(0, 2, 3, pm[1]);
+    m[2] = minor(0, 1, 3, pm[2]);
+    m[3] = minor(0, 1, 2, pm[3]);
+  }
+  // The full determinant by expansion along the s column; the cofactor sign
+  // of (row k, column D) is (-1)^(k + D).
+  T det_m = 0;
+  double perm_m = 0;
   for (int k = 0; k <= D; ++k) {
-    int rows[3] = {0, 0, 0};
-    for (int j = 0, m = 0; j <= D; ++j)
-      if (j != k) rows[m++] = j;
-    T pm;
-    const T dm = det_perm(r[rows[0]], r[rows[1]], r[rows[2]], D, pm);
-    if (k == D) {
-      det_r = dm;
-      perm_r = pm;
-    }
-    // Cofactor sign of (row k, column D) in a (D+1) x (D+1) matrix.
-    det_m += ((k + D) % 2 == 0 ? s[k] : -s[k]) * dm;
-    perm_m += s[k] * pm;
+    det_m += ((k + D) % 2 == 0 ? s[k] : -s[k]) * m[k];
+    perm_m += sd[k] * pm[k];
   }
+  const T det_r = m[D];
+  const double perm_r = pm[D];
+  if (!(perm_m < std::numeric_limits<double>::infinity())) return 0;
   const T bound_r = 16 * unit * perm_r + eps;
   // The lifted column is itself rounded (relative 3 units per entry): 64
   // units cover the classic 11 of Shewchuk's insphere bound with a wide margin.
   const T bound_m = 64 * unit * perm_m + eps;
-  if (std::fabs(det_r) > bound_r && std::fabs(det_m) > bound_m)
+  if (fabs(det_r) > bound_r && fabs(det_m) > bound_m)
     return (det_m > 0) != (det_r > 0) ? 1 : -1;  // P = det M / det R; inside iff P < 0
   return 0;
+}
+
+// in_sphere past its double filter: the long double filter, then the exact sign.
+template <int D>
+bool in_sphere_extended(const ExactContext& ctx, const double* pa, const double* const* p, std::int32_t a,
+                        const std::int32_t* planes, std::int32_t q) {
+  // Near-degenerate input (a rotated lattice, points nearly on one sphere)
+  // leaves a tenth of the tests or more to this stage, where the 64-bit
+  // mantissa settles most of what double rounding could not.
+  if constexpr (std::numeric_limits<long double>::digits >= 64)
+    // The floor covers the permanents' underflow in double (at most a few
+    // units of 2^-1074 each; long double itself does not underflow here).
+    if (const int s = in_sphere_filter<D, long double>(pa, p, 0x1p-64L, 0x1p-1000)) return s > 0;
+  return exact_clip_sign(ctx, a, planes, q) < 0;
 }
 
 }  // namespace
@@ -216,17 +264,23 @@ int orientation(const ExactContext& ctx, const std::int32_t* ids) {
 }
 
 bool in_sphere(const ExactContext& ctx, std::int32_t a, const std::int32_t* planes, std::int32_t q) {
-  const int D = ctx.dim;
   const double* p[4] = {};
-  for (int k = 0; k <= D; ++k) p[k] = pt(ctx, k < D ? planes[k] : q);
+  for (int k = 0; k <= ctx.dim; ++k) p[k] = pt(ctx, k < ctx.dim ? planes[k] : q);
   const double* pa = pt(ctx, a);
-  if (const int s = in_sphere_filter<double>(D, pa, p, filter::u, filter::abs_eps)) return s > 0;
-  // Near-degenerate input (a rotated lattice, points nearly on one sphere)
-  // leaves a tenth of the tests or more to this stage, where the 64-bit
-  // mantissa settles most of what double rounding could not.
-  if constexpr (std::numeric_limits<long double>::digits >= 64)
-    if (const int s = in_sphere_filter<long double>(D, pa, p, 0x1p-64L, 0.0L)) return s > 0;
-  return exact_clip_sign(ctx, a, planes, q) < 0;
+  if (ctx.dim == 2) {
+    if (const int s = in_sphere_filter<2, double>(pa, p, filter::u, filter::abs_eps)) return s > 0;
+    return in_sphere_extended<2>(ctx, pa, p, a, planes, q);
+  }
+  if (const int s = in_sphere_filter<3, double>(pa, p, filter::u, filter::abs_eps)) return s > 0;
+  return in_sphere_extended<3>(ctx, pa, p, a, planes, q);
+}
+
+bool in_sphere_past_filter(const ExactContext& ctx, std::int32_t a, const std::int32_t* planes, std::int32_t q) {
+  const double* p[4] = {};
+  for (int k = 0; k <= ctx.dim; ++k) p[k] = pt(ctx, k < ctx.dim ? planes[k] : q);
+  const double* pa = pt(ctx, a);
+  if (ctx.dim == 2) return in_sphere_extended<2>(ctx, pa, p, a, planes, q);
+  return in_sphere_extended<3>(ctx, pa, p, a, planes, q);
 }
 
 }  // namespace tessera::kernels

@@ -20,8 +20,7 @@ namespace tessera::kernels {
 
 namespace detail {
 /// det of the D x D matrix of rows r0, r1 (and r2 in 3D) and its permanent
-/// (for the error bound), in the arithmetic T of the rows (double, or long
-/// double for the in-sphere test's second filter).
+/// (for the error bound), in the arithmetic T of the rows.
 template <class T>
 inline T det_perm(const T* r0, const T* r1, const T* r2, int dim, T& perm) {
   using std::fabs;
@@ -83,5 +82,11 @@ inline bool collinear3(const double* a, const double* b, const double* c) {
 /// the perturbed sense of the clip predicate? Never undecided. Precondition: a
 /// and the planes are affinely independent, q is none of them.
 bool in_sphere(const ExactContext& ctx, std::int32_t a, const std::int32_t* planes, std::int32_t q);
+
+/// The same answer, for a caller whose own double filter (the quantities and
+/// bound of in_sphere's, evaluated in any order: insertion_filters.hpp) was
+/// undecided: starts at the long double stage, as in_sphere's double filter
+/// would almost surely be undecided again. Correct whatever the caller did.
+bool in_sphere_past_filter(const ExactContext& ctx, std::int32_t a, const std::int32_t* planes, std::int32_t q);
 
 }  // namespace tessera::kernels
