@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 #include <cstdint>
+#include <type_traits>
 
 #include "tessera/kernels/expansion.hpp"
 #include "tessera/kernels/filter.hpp"
@@ -148,40 +149,46 @@ int orientation_exact(int D, const double* const* pts) {
 // det[[R, s], [r_q, s_q]] = det R * (pow_q(v) - pow_a(v)) (exact_predicates.hpp),
 // and q is inside iff that power difference is negative. The determinants
 // are evaluated in T, whose operations err by a relative `unit` at most; the
-// permanents of the error bounds in double (eps: an absolute floor for
-// underflow); +1 when q is surely inside, -1 surely outside, 0 undecided.
+// permanents of the error bounds in P (eps: an absolute floor for underflow);
+// +1 when q is surely inside, -1 surely outside, 0 undecided, and
+// permanents_out_of_range (undecided too) when P is narrower than T and a
+// permanent lies outside [2^-900, P's overflow).
 //
 // Near-co-spherical input (a sampled sphere, whose every test is nearly a
 // tie) leaves most tests to the long double evaluation (x87), where a
 // generic evaluation of each minor took two fifths of the run. So:
 //  * the D + 1 minors of R's rows share their 2x2 minors of the first two
 //    columns (3D: six, each in three of the four minors), computed once;
-//  * the permanents are summed in double whatever T is (SSE, beside the x87
-//    stack): from differences rounded to double they are within 2^-47 of
+//  * the permanents are summed in double (P) whatever T is (SSE, beside the
+//    x87 stack): from differences rounded to double they are within 2^-47 of
 //    those of the differences rounded to T, which the bounds' margin (64
-//    units where Shewchuk's analysis needs 16) absorbs; a permanent that
-//    overflows double leaves the test undecided.
+//    units where Shewchuk's analysis needs 16) absorbs. Below 2^-900 their
+//    terms' underflow would count, past double's range (coordinates past
+//    ~2^200) they overflow: the long double stage then sums them again in
+//    long double, whose exponent range holds any product of five doubles.
 // A permanent does not depend on the order of its sum, and the bounds hold
 // for any order of evaluation, so these are the quantities and bounds of a
 // separate evaluation per minor.
-template <int D, class T>
-int in_sphere_filter(const double* pa, const double* const* p, T unit, double eps) {
+constexpr int permanents_out_of_range = 2;  // in_sphere_filter: undecided, sum them in T
+
+template <int D, class T, class P = double>
+int in_sphere_filter(const double* pa, const double* const* p, T unit, P eps) {
   using std::fabs;
   T r[D + 1][D], s[D + 1];
-  double rd[D + 1][D], sd[D + 1];
+  P rd[D + 1][D], sd[D + 1];
   for (int k = 0; k <= D; ++k) {
     s[k] = 0;
     sd[k] = 0;
     for (int d = 0; d < D; ++d) {
       r[k][d] = static_cast<T>(p[k][d]) - static_cast<T>(pa[d]);
-      rd[k][d] = p[k][d] - pa[d];  // the same as r when T is double
+      rd[k][d] = static_cast<P>(p[k][d]) - static_cast<P>(pa[d]);  // r itself when P is T
       s[k] += r[k][d] * r[k][d];
       sd[k] += rd[k][d] * rd[k][d];
     }
   }
   // xy(i, j) = the 2x2 minor of rows i < j in the first two columns.
   T xy[D + 1][D + 1];
-  double axy[D + 1][D + 1];
+  P axy[D + 1][D + 1];
   for (int i = 0; i <= D; ++i)
     for (int j = i + 1; j <= D; ++j) {
       xy[i][j] = r[i][0] * r[j][1] - r[i][1] * r[j][0];
@@ -190,13 +197,13 @@ int in_sphere_filter(const double* pa, const double* const* p, T unit, double ep
   // m[k], pm[k]: the minor of the rows other than k (in increasing order),
   // and its permanent; 3D minors expanded along the third column.
   T m[D + 1];
-  double pm[D + 1];
+  P pm[D + 1];
   if constexpr (D == 2) {
     m[0] = xy[1][2], pm[0] = axy[1][2];
     m[1] = xy[0][2], pm[1] = axy[0][2];
     m[2] = xy[0][1], pm[2] = axy[0][1];
   } else {
-    auto minor = [&](int i, int j, int k, double& perm) {
+    auto minor = [&](int i, int j, int k, P& perm) {
       perm = fabs(rd[i][2]) * axy[j][k] + fabs(rd[j][2]) * axy[i][k] + fabs(rd[k][2]) * axy[i][j];
       return r[i][2] * xy[j][k] - r[j][2] * xy[i][k] + r[k][2] * xy[i][j];
     };
@@ -208,18 +215,22 @@ int in_sphere_filter(const double* pa, const double* const* p, T unit, double ep
   // The full determinant by expansion along the s column; the cofactor sign
   // of (row k, column D) is (-1)^(k + D).
   T det_m = 0;
-  double perm_m = 0;
+  P perm_m = 0;
   for (int k = 0; k <= D; ++k) {
     det_m += ((k + D) % 2 == 0 ? s[k] : -s[k]) * m[k];
     perm_m += sd[k] * pm[k];
   }
   const T det_r = m[D];
-  const double perm_r = pm[D];
-  if (!(perm_m < std::numeric_limits<double>::infinity())) return 0;
-  const T bound_r = 16 * unit * perm_r + eps;
+  const P perm_r = pm[D];
+  if constexpr (!std::is_same_v<P, T>) {
+    constexpr P inf = std::numeric_limits<P>::infinity();
+    if (!(perm_m >= P(0x1p-900) && perm_m < inf && perm_r >= P(0x1p-900) && perm_r < inf))
+      return permanents_out_of_range;
+  }
+  const T bound_r = 16 * unit * static_cast<T>(perm_r) + static_cast<T>(eps);
   // The lifted column is itself rounded (relative 3 units per entry): 64
   // units cover the classic 11 of Shewchuk's insphere bound with a wide margin.
-  const T bound_m = 64 * unit * perm_m + eps;
+  const T bound_m = 64 * unit * static_cast<T>(perm_m) + static_cast<T>(eps);
   if (fabs(det_r) > bound_r && fabs(det_m) > bound_m)
     return (det_m > 0) != (det_r > 0) ? 1 : -1;  // P = det M / det R; inside iff P < 0
   return 0;
@@ -233,9 +244,10 @@ bool in_sphere_extended(const ExactContext& ctx, const double* pa, const double*
   // leaves a tenth of the tests or more to this stage, where the 64-bit
   // mantissa settles most of what double rounding could not.
   if constexpr (std::numeric_limits<long double>::digits >= 64)
-    // The floor covers the permanents' underflow in double (at most a few
-    // units of 2^-1074 each; long double itself does not underflow here).
-    if (const int s = in_sphere_filter<D, long double>(pa, p, 0x1p-64L, 0x1p-1000)) return s > 0;
+    if (int s = in_sphere_filter<D, long double>(pa, p, 0x1p-64L, 0.0); s != 0) {
+      if (s == permanents_out_of_range) s = in_sphere_filter<D, long double, long double>(pa, p, 0x1p-64L, 0.0L);
+      if (s == 1 || s == -1) return s > 0;
+    }
   return exact_clip_sign(ctx, a, planes, q) < 0;
 }
 
@@ -268,10 +280,10 @@ bool in_sphere(const ExactContext& ctx, std::int32_t a, const std::int32_t* plan
   for (int k = 0; k <= ctx.dim; ++k) p[k] = pt(ctx, k < ctx.dim ? planes[k] : q);
   const double* pa = pt(ctx, a);
   if (ctx.dim == 2) {
-    if (const int s = in_sphere_filter<2, double>(pa, p, filter::u, filter::abs_eps)) return s > 0;
+    if (const int s = in_sphere_filter<2, double>(pa, p, filter::u, filter::abs_eps); s == 1 || s == -1) return s > 0;
     return in_sphere_extended<2>(ctx, pa, p, a, planes, q);
   }
-  if (const int s = in_sphere_filter<3, double>(pa, p, filter::u, filter::abs_eps)) return s > 0;
+  if (const int s = in_sphere_filter<3, double>(pa, p, filter::u, filter::abs_eps); s == 1 || s == -1) return s > 0;
   return in_sphere_extended<3>(ctx, pa, p, a, planes, q);
 }
 

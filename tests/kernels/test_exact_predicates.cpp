@@ -32,6 +32,7 @@
 #include <string>
 #include <vector>
 
+#include "tessera/kernels/delaunay_predicates.hpp"
 #include "tessera/kernels/exact_predicates.hpp"
 #include "tessera/kernels/prepared_signs.hpp"
 
@@ -486,6 +487,56 @@ void extended_on_sphere_points(int dim, std::uint64_t seed) {
 
 TEST(ExactPredicates, ExtendedStageOnSpherePoints) { extended_on_sphere_points(3, 41); }
 TEST(ExactPredicates, ExtendedStageOnCirclePoints) { extended_on_sphere_points(2, 42); }
+
+// The Delaunay side's in-sphere test (kernels::in_sphere: its double and
+// long double filters, then the exact sign) and in_sphere_past_filter (the
+// insertion's entry, from the long double filter on) against the oracle, on
+// points normalized onto a sphere, so every query is a near-tie, at scales
+// 2^-400 to 2^400: past ~2^200 the long double filter's permanents overflow
+// double and are summed again in long double. q is inside iff it clips.
+void in_sphere_near_ties(int dim, std::uint64_t seed) {
+  Rng r(seed);
+  int asked = 0;
+  for (const int e : {-400, -60, 0, 60, 250, 400}) {
+    const double scale = std::ldexp(1.0, e), offset = std::ldexp(0.75, e);
+    Problem p;
+    p.dim = dim;
+    for (int d = 0; d < 3; ++d) {
+      p.lo[d] = offset - 2 * scale;
+      p.hi[d] = offset + 2 * scale;
+    }
+    std::normal_distribution<double> gauss;
+    for (int k = 0; k < 40; ++k) {
+      double v[3] = {gauss(r.g), gauss(r.g), dim == 3 ? gauss(r.g) : 0.0};
+      const double len = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+      p.add({offset + scale * (v[0] / len), offset + scale * (v[1] / len), offset + scale * (v[2] / len)});
+    }
+    const auto c = p.ctx();
+    for (int t = 0; t < 150; ++t) {
+      std::int32_t ids[5];
+      for (int k = 0; k < dim + 2; ++k) {
+        bool fresh;
+        do {
+          ids[k] = r.index(p.size());
+          fresh = std::find(ids, ids + k, ids[k]) == ids + k;
+        } while (!fresh);
+      }
+      Ids planes{};
+      for (int k = 0; k < dim; ++k) planes[k] = ids[1 + k];
+      if (!independent(c, ids[0], planes.data())) continue;
+      ++asked;
+      const bool inside = oracle_sign(c, ids[0], planes.data(), ids[dim + 1]) < 0;
+      EXPECT_EQ(tessera::kernels::in_sphere(c, ids[0], planes.data(), ids[dim + 1]), inside)
+          << "scale 2^" << e << ": " << describe(c, ids[0], planes.data(), ids[dim + 1]);
+      EXPECT_EQ(tessera::kernels::in_sphere_past_filter(c, ids[0], planes.data(), ids[dim + 1]), inside)
+          << "scale 2^" << e << ": " << describe(c, ids[0], planes.data(), ids[dim + 1]);
+    }
+  }
+  EXPECT_GT(asked, 800);
+}
+
+TEST(ExactPredicates, DelaunayInSphereOnSpherePointsAtAllScales) { in_sphere_near_ties(3, 43); }
+TEST(ExactPredicates, DelaunayInCircleOnCirclePointsAtAllScales) { in_sphere_near_ties(2, 44); }
 
 TEST(ExactPredicates, ExtendedStageDefersOnExactTies) {
   // Exactly cospherical: (0,0,0), e_x, e_y, e_z and (1,1,1) lie on one sphere.
