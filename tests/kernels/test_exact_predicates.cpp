@@ -441,6 +441,41 @@ void near_ties(int dim, std::uint64_t seed) {
   (void)zero;
 }
 
+// n points normalized onto the sphere (circle in 2D) of radius `scale`
+// centred at (offset, offset, offset): cospherical up to rounding, so every
+// query among them is a near-tie. The box reaches `scale` past the sphere.
+Problem sphere_sample(int dim, Rng& r, double scale, double offset, int n) {
+  Problem p;
+  p.dim = dim;
+  for (int d = 0; d < 3; ++d) {
+    p.lo[d] = offset - 2 * scale;
+    p.hi[d] = offset + 2 * scale;
+  }
+  std::normal_distribution<double> gauss;
+  for (int k = 0; k < n; ++k) {
+    double v[3] = {gauss(r.g), gauss(r.g), dim == 3 ? gauss(r.g) : 0.0};
+    const double len = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+    p.add({offset + scale * (v[0] / len), offset + scale * (v[1] / len), offset + scale * (v[2] / len)});
+  }
+  return p;
+}
+
+// A random query of p: the cell ids[0], its vertex's planes, the candidate
+// ids[dim + 1], all distinct; false when the planes meet in no vertex.
+bool random_query(const Problem& p, Rng& r, std::int32_t* ids, Ids& planes) {
+  const int dim = p.dim;
+  for (int k = 0; k < dim + 2; ++k) {
+    bool fresh;
+    do {
+      ids[k] = r.index(p.size());
+      fresh = std::find(ids, ids + k, ids[k]) == ids + k;
+    } while (!fresh);
+  }
+  planes = {};
+  for (int k = 0; k < dim; ++k) planes[k] = ids[1 + k];
+  return independent(p.ctx(), ids[0], planes.data());
+}
+
 // Points normalized onto the unit sphere (cospherical up to rounding), at
 // two scales and offsets: every query is a near-tie the float filter cannot
 // decide. The extended stage must agree with the rational oracle whenever it
@@ -451,31 +486,12 @@ void extended_on_sphere_points(int dim, std::uint64_t seed) {
   const double setups[][2] = {{1, 0}, {1e-3, 1e3}, {1e5, -3e5}};
   int asked = 0, decided_before = extended_decided;
   for (const auto& st : setups) {
-    Problem p;
-    p.dim = dim;
-    for (int d = 0; d < 3; ++d) {
-      p.lo[d] = st[1] - 2 * st[0];
-      p.hi[d] = st[1] + 2 * st[0];
-    }
-    std::normal_distribution<double> gauss;
-    for (int k = 0; k < 60; ++k) {
-      double v[3] = {gauss(r.g), gauss(r.g), dim == 3 ? gauss(r.g) : 0.0};
-      const double len = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
-      p.add({st[1] + st[0] * (v[0] / len), st[1] + st[0] * (v[1] / len), st[1] + st[0] * (v[2] / len)});
-    }
+    const Problem p = sphere_sample(dim, r, st[0], st[1], 60);
     const auto c = p.ctx();
     for (int t = 0; t < 400; ++t) {
       std::int32_t ids[5];
-      for (int k = 0; k < dim + 2; ++k) {
-        bool fresh;
-        do {
-          ids[k] = r.index(p.size());
-          fresh = std::find(ids, ids + k, ids[k]) == ids + k;
-        } while (!fresh);
-      }
-      Ids planes{};
-      for (int k = 0; k < dim; ++k) planes[k] = ids[1 + k];
-      if (!independent(c, ids[0], planes.data())) continue;
+      Ids planes;
+      if (!random_query(p, r, ids, planes)) continue;
       ++asked;
       check_sign(c, ids[0], planes.data(), ids[dim + 1]);
     }
@@ -498,32 +514,12 @@ void in_sphere_near_ties(int dim, std::uint64_t seed) {
   Rng r(seed);
   int asked = 0;
   for (const int e : {-400, -60, 0, 60, 250, 400}) {
-    const double scale = std::ldexp(1.0, e), offset = std::ldexp(0.75, e);
-    Problem p;
-    p.dim = dim;
-    for (int d = 0; d < 3; ++d) {
-      p.lo[d] = offset - 2 * scale;
-      p.hi[d] = offset + 2 * scale;
-    }
-    std::normal_distribution<double> gauss;
-    for (int k = 0; k < 40; ++k) {
-      double v[3] = {gauss(r.g), gauss(r.g), dim == 3 ? gauss(r.g) : 0.0};
-      const double len = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
-      p.add({offset + scale * (v[0] / len), offset + scale * (v[1] / len), offset + scale * (v[2] / len)});
-    }
+    const Problem p = sphere_sample(dim, r, std::ldexp(1.0, e), std::ldexp(0.75, e), 40);
     const auto c = p.ctx();
     for (int t = 0; t < 150; ++t) {
       std::int32_t ids[5];
-      for (int k = 0; k < dim + 2; ++k) {
-        bool fresh;
-        do {
-          ids[k] = r.index(p.size());
-          fresh = std::find(ids, ids + k, ids[k]) == ids + k;
-        } while (!fresh);
-      }
-      Ids planes{};
-      for (int k = 0; k < dim; ++k) planes[k] = ids[1 + k];
-      if (!independent(c, ids[0], planes.data())) continue;
+      Ids planes;
+      if (!random_query(p, r, ids, planes)) continue;
       ++asked;
       const bool inside = oracle_sign(c, ids[0], planes.data(), ids[dim + 1]) < 0;
       EXPECT_EQ(tessera::kernels::in_sphere(c, ids[0], planes.data(), ids[dim + 1]), inside)
