@@ -259,6 +259,19 @@ bool in_sphere_extended(const ExactContext& ctx, const double* pa, const double*
   return exact_clip_sign(ctx, a, planes, q) < 0;
 }
 
+// in_sphere's stages for dimension D: the double filter (unless the caller
+// ran its own: in_sphere_past_filter), then in_sphere_extended.
+template <int D>
+bool in_sphere_staged(const ExactContext& ctx, std::int32_t a, const std::int32_t* planes, std::int32_t q,
+                      bool double_filter) {
+  const double* p[D + 1];
+  for (int k = 0; k <= D; ++k) p[k] = pt(ctx, k < D ? planes[k] : q);
+  const double* pa = pt(ctx, a);
+  if (double_filter)
+    if (const int s = in_sphere_filter<D, double>(pa, p, filter::u, filter::abs_eps); s == 1 || s == -1) return s > 0;
+  return in_sphere_extended<D>(ctx, pa, p, a, planes, q);
+}
+
 }  // namespace
 
 int orientation(int D, const double* const* pts) {
@@ -284,23 +297,11 @@ int orientation(const ExactContext& ctx, const std::int32_t* ids) {
 }
 
 bool in_sphere(const ExactContext& ctx, std::int32_t a, const std::int32_t* planes, std::int32_t q) {
-  const double* p[4] = {};
-  for (int k = 0; k <= ctx.dim; ++k) p[k] = pt(ctx, k < ctx.dim ? planes[k] : q);
-  const double* pa = pt(ctx, a);
-  if (ctx.dim == 2) {
-    if (const int s = in_sphere_filter<2, double>(pa, p, filter::u, filter::abs_eps); s == 1 || s == -1) return s > 0;
-    return in_sphere_extended<2>(ctx, pa, p, a, planes, q);
-  }
-  if (const int s = in_sphere_filter<3, double>(pa, p, filter::u, filter::abs_eps); s == 1 || s == -1) return s > 0;
-  return in_sphere_extended<3>(ctx, pa, p, a, planes, q);
+  return ctx.dim == 2 ? in_sphere_staged<2>(ctx, a, planes, q, true) : in_sphere_staged<3>(ctx, a, planes, q, true);
 }
 
 bool in_sphere_past_filter(const ExactContext& ctx, std::int32_t a, const std::int32_t* planes, std::int32_t q) {
-  const double* p[4] = {};
-  for (int k = 0; k <= ctx.dim; ++k) p[k] = pt(ctx, k < ctx.dim ? planes[k] : q);
-  const double* pa = pt(ctx, a);
-  if (ctx.dim == 2) return in_sphere_extended<2>(ctx, pa, p, a, planes, q);
-  return in_sphere_extended<3>(ctx, pa, p, a, planes, q);
+  return ctx.dim == 2 ? in_sphere_staged<2>(ctx, a, planes, q, false) : in_sphere_staged<3>(ctx, a, planes, q, false);
 }
 
 }  // namespace tessera::kernels
