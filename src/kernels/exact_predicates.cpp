@@ -363,9 +363,11 @@ bool VertexPredicate::prepare(const ExactContext& ctx, std::int32_t i, const std
   i_ = i;
   if (dim_ != 2 && dim_ != 3) return false;
   for (int r = 0; r < dim_; ++r) gen_[r] = planes[r];
+  narrow_ = false;
   if (ctx.grid != nullptr) {
     // The whole input is on one grid: read it.
     shift_ = ctx.grid_shift;
+    if (prepare_narrow(ctx)) return det_a_sign_ != 0;
     const std::int32_t* gi = ctx.grid + static_cast<std::size_t>(i) * dim_;
     ci2_ = 0;
     for (int d = 0; d < dim_; ++d) {
@@ -444,9 +446,100 @@ void VertexPredicate::set_cofactors(const std::int64_t (*a)[3]) {
   terms_.set(i_, gen_, dim_);  // the perturbation's terms other than j's
 }
 
+// The narrow form's bounds, with |q| < 2^10 per coordinate for the vertex's
+// bisector rows and the candidate: a = 2q < 2^11; A's cofactors (3D: a
+// difference of two products of a's) < 2^23; det A and a_j . C_r (three
+// products) < 2^36; a bisector row's b = |q|^2 < 2^22, a box row's
+// b = c - p_i,axis < 2^23 (grid integers lie below 2^22); det M0, four
+// products of a b with one of those, < 2^61; w_i's coefficient < 2^38. 2D
+// stays smaller. Everything fits in int64, so each candidate costs a dozen
+// multiplications instead of 128-bit ones.
+namespace {
+constexpr std::int64_t kNarrowLimit = std::int64_t{1} << 10;
+bool narrow_coordinate(std::int64_t q) { return q > -kNarrowLimit && q < kNarrowLimit; }
+}  // namespace
+
+bool VertexPredicate::prepare_narrow(const ExactContext& ctx) {
+  return dim_ == 3 ? prepare_narrow<3>(ctx) : prepare_narrow<2>(ctx);
+}
+
+template <int D>
+bool VertexPredicate::prepare_narrow(const ExactContext& ctx) {
+  const std::int32_t* gi = ctx.grid + static_cast<std::size_t>(i_) * D;
+  for (int d = 0; d < D; ++d) ci_[d] = gi[d];
+  std::int64_t a[D][D] = {};
+  for (int r = 0; r < D; ++r) {
+    if (gen_[r] >= 0) {
+      const std::int32_t* gk = ctx.grid + static_cast<std::size_t>(gen_[r]) * D;
+      std::int64_t sq = 0;
+      bool near = true;
+      for (int d = 0; d < D; ++d) {
+        const std::int64_t q = std::int64_t{gk[d]} - ci_[d];
+        near &= narrow_coordinate(q);
+        a[r][d] = 2 * q;
+        sq += q * q;
+      }
+      if (!near) return false;
+      nb_[r] = sq;
+    } else {
+      const int axis = box_plane_axis(gen_[r]);
+      a[r][axis] = 1;
+      const auto ax = static_cast<std::size_t>(axis);
+      nb_[r] = (box_plane_upper(gen_[r]) ? ctx.grid_hi[ax] : ctx.grid_lo[ax]) - ci_[axis];
+    }
+  }
+  // A's cofactors and det A (translation leaves them as they are).
+  if constexpr (D == 2) {
+    cof_[0][0] = a[1][1]; cof_[0][1] = -a[1][0];
+    cof_[1][0] = -a[0][1]; cof_[1][1] = a[0][0];
+  } else {
+    cof_[0][0] = a[1][1] * a[2][2] - a[1][2] * a[2][1];
+    cof_[0][1] = a[1][2] * a[2][0] - a[1][0] * a[2][2];
+    cof_[0][2] = a[1][0] * a[2][1] - a[1][1] * a[2][0];
+    cof_[1][0] = a[2][1] * a[0][2] - a[2][2] * a[0][1];
+    cof_[1][1] = a[2][2] * a[0][0] - a[2][0] * a[0][2];
+    cof_[1][2] = a[2][0] * a[0][1] - a[2][1] * a[0][0];
+    cof_[2][0] = a[0][1] * a[1][2] - a[0][2] * a[1][1];
+    cof_[2][1] = a[0][2] * a[1][0] - a[0][0] * a[1][2];
+    cof_[2][2] = a[0][0] * a[1][1] - a[0][1] * a[1][0];
+  }
+  ndet_a_ = 0;
+  for (int d = 0; d < D; ++d) ndet_a_ += a[0][d] * cof_[0][d];
+  det_a_sign_ = sign_of(ndet_a_);
+  terms_.set(i_, gen_, D);
+  narrow_ = true;
+  return true;
+}
+
+template <int D>
+int VertexPredicate::sign_narrow(const ExactContext& ctx, std::int32_t j) const {
+  const std::int32_t* gj = ctx.grid + static_cast<std::size_t>(j) * D;
+  std::int64_t aj[D], bj = 0;
+  bool near = true;
+  for (int d = 0; d < D; ++d) {
+    const std::int64_t q = std::int64_t{gj[d]} - ci_[d];
+    near &= narrow_coordinate(q);
+    aj[d] = 2 * q;
+    bj += q * q;
+  }
+  if (!near) return exact_clip_sign(ctx, i_, gen_, j);  // a candidate 2^10 steps away
+  std::int64_t m0 = bj * ndet_a_, wi = ndet_a_, dr[D];
+  for (int r = 0; r < D; ++r) {
+    dr[r] = 0;
+    for (int d = 0; d < D; ++d) dr[r] += aj[d] * cof_[r][d];
+    m0 -= nb_[r] * dr[r];
+    if (gen_[r] >= 0) wi -= dr[r];
+  }
+  int sign_m = sign_of(m0);
+  if (sign_m == 0)  // as in sign()
+    sign_m = terms_.decide(j, -det_a_sign_, [&](int row) { return row < 0 ? sign_of(wi) : sign_of(dr[row]); });
+  return sign_m * det_a_sign_ > 0 ? +1 : -1;
+}
+
 int VertexPredicate::sign(const ExactContext& ctx, std::int32_t j) const {
   using I = __int128;
   constexpr int kBits = kGridBits;
+  if (narrow_) return dim_ == 3 ? sign_narrow<3>(ctx, j) : sign_narrow<2>(ctx, j);
   // p_j on the vertex's grid, within the bounds; else the general path.
   const double* pj = ctx.points + static_cast<std::size_t>(j) * dim_;
   std::int64_t xj[Scratch::kMaxDim];

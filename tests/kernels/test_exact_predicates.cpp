@@ -1026,6 +1026,79 @@ TEST(ExactPredicates, GridContext) {
   }
 }
 
+// On a global grid the prepared form takes 64-bit integers, rows relative to
+// p_i, while the vertex's bisector rows lie within 2^10 grid steps of the
+// generator; a farther row takes the 128-bit form, and a candidate farther
+// than that goes to exact_clip_sign. A small lattice (exact ties at nearly
+// every vertex) beside points 2^19 to 2^21 steps away, the box at the 22-bit
+// limit: every answer equals exact_clip_sign's and the oracle's, whichever
+// form serves it.
+TEST(ExactPredicates, GridContextNearAndFarRows) {
+  using tessera::kernels::make_grid;
+  for (int dim : {2, 3}) {
+    Rng r(83 + static_cast<std::uint64_t>(dim));
+    Problem p;
+    p.dim = dim;
+    for (int d = 0; d < 3; ++d) { p.lo[d] = -0x1p21; p.hi[d] = 0x1p21; }
+    const int side = dim == 3 ? 4 : 8;
+    for (int k = 0; k < (dim == 3 ? side * side * side : side * side); ++k) {
+      std::array<double, 3> x{};
+      for (int d = 0, m = k; d < dim; ++d, m /= side) x[d] = m % side - side / 2;
+      p.add(x);
+    }
+    const std::int32_t lattice = p.size();
+    // Rows near the narrow form's limit, along each axis: their vertices'
+    // products are large enough that a far candidate would overflow 64 bits.
+    for (int d = 0; d < dim; ++d)
+      for (double at : {1020.0, -1021.0}) {
+        std::array<double, 3> x{};
+        x[d] = at;
+        p.add(x);
+      }
+    const std::int32_t mid = p.size();
+    for (double far : {1023.0, 1024.0, -1025.0, 0x1p19 + 3, -0x1p20, 0x1p21 - 1}) {
+      std::array<double, 3> x{};
+      for (int d = 0; d < dim; ++d) x[d] = d == 0 ? far : static_cast<double>(static_cast<int>(r.index(5)) - 2);
+      p.add(x);
+    }
+    const ExactContext plain = p.ctx();
+    ExactContext gc = plain;
+    std::vector<std::int32_t> grid;
+    ASSERT_TRUE(make_grid(gc, static_cast<std::size_t>(p.size()), grid));
+    int checked = 0, ties = 0;
+    for (int t = 0; t < 250; ++t) {
+      Ids planes{};
+      // Mostly lattice rows (the narrow form), sometimes a far row or a box
+      // plane; every fourth vertex on the rows near the limit.
+      const std::int32_t i = r.index(8) == 0 ? lattice + r.index(p.size() - lattice) : r.index(lattice);
+      for (int k = 0; k < dim; ++k) {
+        const std::uint64_t kind = t % 4 == 0 ? 2 : r.index(8);
+        planes[k] = kind == 0   ? box_plane_id(static_cast<int>(r.index(dim)), r.index(2) == 1)
+                    : kind == 1 ? lattice + r.index(p.size() - lattice)
+                    : kind == 2 ? lattice + r.index(mid - lattice)
+                                : r.index(lattice);
+      }
+      bool distinct = true;
+      for (int k = 0; k < dim; ++k) {
+        distinct &= planes[k] != i;
+        for (int m = 0; m < k; ++m) distinct &= planes[k] != planes[m];
+      }
+      if (!distinct || !independent(plain, i, planes.data())) continue;
+      tessera::kernels::VertexPredicate vp;
+      ASSERT_TRUE(vp.prepare(gc, i, planes.data()));
+      for (std::int32_t j = 0; j < p.size(); ++j) {
+        if (j == i || std::find(planes.begin(), planes.begin() + dim, j) != planes.begin() + dim) continue;
+        const int want = check_sign(plain, i, planes.data(), j);
+        EXPECT_EQ(vp.sign(gc, j), want) << "grid: " << describe(plain, i, planes.data(), j);
+        ties += power_diff(plain, i, planes.data(), j) == 0;
+        ++checked;
+      }
+    }
+    EXPECT_GT(checked, 5000) << "dim " << dim;
+    EXPECT_GT(ties, 80) << "dim " << dim << ": too few exact ties to test the tie-break";
+  }
+}
+
 // StageGate: open for 64 failures in a row, then once in 64, and open again
 // after a success.
 TEST(ExactPredicates, StageGateClosesAfterRepeatedFailures) {

@@ -157,29 +157,36 @@ class PerturbationTerms {
  public:
   /// The terms of generator i and the rows' generators gen[0, dim) (box ids < 0 carry no weight).
   void set(std::int32_t i, const std::int32_t* gen, int dim) {
-    n_ = 0;
-    terms_[n_++] = {i, -1};
-    for (int r = 0; r < dim; ++r)
-      if (gen[r] >= 0) terms_[n_++] = {gen[r], r};
-    for (int a = 1; a < n_; ++a)  // insertion sort by id (at most 4 terms)
-      for (int b = a; b > 0 && terms_[b].id < terms_[b - 1].id; --b) std::swap(terms_[b], terms_[b - 1]);
+    // Each term packed as (id << 8 | row + 1), ascending with the id; absent
+    // ones (box planes, the missing row in 2D) as the largest key, so a
+    // sorting network of four orders them without a branch: on lattices
+    // every vertex sets its terms, and a branching sort mispredicted.
+    constexpr std::int64_t absent = INT64_MAX;
+    std::int64_t k[4] = {pack(i, -1), absent, absent, absent};
+    for (int r = 0; r < dim; ++r) k[r + 1] = gen[r] >= 0 ? pack(gen[r], r) : absent;
+    auto order = [&](int x, int y) {
+      const std::int64_t lo = std::min(k[x], k[y]), hi = std::max(k[x], k[y]);
+      k[x] = lo;
+      k[y] = hi;
+    };
+    order(0, 1), order(2, 3), order(0, 2), order(1, 3), order(1, 2);
+    for (int t = 0; t < 4; ++t) keys_[t] = k[t];
   }
   /// sign(det M) on a tie: coef(row) gives each term's coefficient sign
   /// (row -1: w_i's), j_coef the query's.
   template <class Coef>
   int decide(std::int32_t j, int j_coef, Coef&& coef) const {
-    for (int t = 0; t < n_ && terms_[t].id < j; ++t)
-      if (const int c = coef(terms_[t].row); c != 0) return c;
+    // Terms below j in id: keys below j's smallest packed key (absent ones
+    // are above every id).
+    const std::int64_t below = pack(j, -1);
+    for (int t = 0; t < 4 && keys_[t] < below; ++t)
+      if (const int c = coef(static_cast<int>(keys_[t] & 0xff) - 1); c != 0) return c;
     return j_coef;
   }
 
  private:
-  struct Term {
-    std::int32_t id;
-    int row;
-  };
-  Term terms_[4] = {};  // by ascending id
-  int n_ = 0;
+  static std::int64_t pack(std::int32_t id, int row) { return (std::int64_t{id} << 8) | (row + 1); }
+  std::int64_t keys_[4] = {INT64_MAX, INT64_MAX, INT64_MAX, INT64_MAX};  // ascending
 };
 
 /// exact_clip_sign for one vertex asked against many candidates. What
@@ -199,6 +206,18 @@ class VertexPredicate {
 
  private:
   void set_cofactors(const std::int64_t (*a)[3]);  // cof_ and det_a_ from A's rows
+  bool prepare_narrow(const ExactContext& ctx);     // the narrow form, or false
+  template <int D>
+  bool prepare_narrow(const ExactContext& ctx);
+  template <int D>
+  int sign_narrow(const ExactContext& ctx, std::int32_t j) const;
+  // The narrow form: on a global grid (ExactContext::grid) with every
+  // bisector row's q_r = p_r - p_i below 2^10 grid steps per coordinate, the
+  // rows are taken relative to p_i and every quantity fits in 64 bits (bounds
+  // at prepare_narrow). Lattices and voxel centres, where nearly every vertex
+  // ties, take it.
+  bool narrow_ = false;
+  std::int64_t ncof_[3][3] = {}, nb_[3] = {0, 0, 0}, ndet_a_ = 0;
   int dim_ = 3, shift_ = 0;
   std::int32_t i_ = -1, gen_[3] = {0, 0, 0};
   std::int64_t ci_[3] = {0, 0, 0};   // p_i on the grid
