@@ -195,6 +195,46 @@ void signs_gmp(const ExactContext& ctx, std::int32_t i, const std::int32_t* gen,
   out.weight_i = mpz_sgn(s.t2);
 }
 
+// The signs from M's integer rows: a (|a| < 2^24) and b, det M0 below
+// 2^127 (the callers' bounds). The minors in 64 bits when `small` (|a| <
+// 2^19), else in 128.
+void signs_from_rows(const std::int64_t (*a)[Scratch::kMaxDim], const __int128* b, const std::int32_t* gen, int dim,
+                     bool small, ClipSigns& out) {
+  using I = __int128;
+  const int rows = dim + 1;
+  I minor[Scratch::kRows];
+  auto minors = [&]<class T>(T) {
+    for (int r = 0; r < rows; ++r) {
+      int sel[Scratch::kMaxDim] = {0, 0, 0};
+      int k = 0;
+      for (int q = 0; q < rows; ++q) if (q != r) sel[k++] = q;
+      const std::int64_t* r0 = a[sel[0]];
+      const std::int64_t* r1 = a[sel[1]];
+      T m;
+      if (dim == 2) {
+        m = static_cast<T>(r0[0]) * r1[1] - static_cast<T>(r0[1]) * r1[0];
+      } else {
+        const std::int64_t* r2 = a[sel[2]];
+        m = r0[0] * (static_cast<T>(r1[1]) * r2[2] - static_cast<T>(r1[2]) * r2[1]) +
+            r0[1] * (static_cast<T>(r1[2]) * r2[0] - static_cast<T>(r1[0]) * r2[2]) +
+            r0[2] * (static_cast<T>(r1[0]) * r2[1] - static_cast<T>(r1[1]) * r2[0]);
+      }
+      minor[r] = m;
+      out.minor[r] = (m > 0) - (m < 0);
+    }
+  };
+  if (small) minors(std::int64_t{});
+  else minors(I{});
+  I m0 = 0, wi = 0;
+  for (int r = 0; r < rows; ++r) {
+    I cof = cofactor_sign(r, dim) * minor[r];
+    m0 += b[r] * cof;
+    if (gen[r] >= 0) wi += cof;
+  }
+  out.det_m0 = (m0 > 0) - (m0 < 0);
+  out.weight_i = (wi > 0) - (wi < 0);
+}
+
 // The same in 128-bit integers when every scaled coordinate has at most 22
 // bits (lattices, voxel centres, integer and dyadic grids: where ties are
 // common). Bounds: |a| < 2^24, |b| < 2^46, 3x3 minors < 2^(3*24+3), det M0 <
@@ -234,41 +274,69 @@ bool signs_int128(const ExactContext& ctx, std::int32_t i, const std::int32_t* g
       b[r] = scaled_p(pv[r][0]);
     }
   }
-  // The minors in T: 64-bit when the coordinates have at most 17 bits
-  // (|a| < 2^19, a 3x3 minor < 6 * 2^57 < 2^60: small lattices and voxel
-  // grids, where this path runs for most clips), else 128-bit.
-  I minor[Scratch::kRows];
-  auto minors = [&]<class T>(T) {
-    for (int r = 0; r < rows; ++r) {
-      int sel[Scratch::kMaxDim] = {0, 0, 0};
-      int k = 0;
-      for (int q = 0; q < rows; ++q) if (q != r) sel[k++] = q;
-      const std::int64_t* r0 = a[sel[0]];
-      const std::int64_t* r1 = a[sel[1]];
-      T m;
-      if (dim == 2) {
-        m = static_cast<T>(r0[0]) * r1[1] - static_cast<T>(r0[1]) * r1[0];
-      } else {
-        const std::int64_t* r2 = a[sel[2]];
-        m = r0[0] * (static_cast<T>(r1[1]) * r2[2] - static_cast<T>(r1[2]) * r2[1]) +
-            r0[1] * (static_cast<T>(r1[2]) * r2[0] - static_cast<T>(r1[0]) * r2[2]) +
-            r0[2] * (static_cast<T>(r1[0]) * r2[1] - static_cast<T>(r1[1]) * r2[0]);
-      }
-      minor[r] = m;
-      out.minor[r] = (m > 0) - (m < 0);
+  // The minors in 64 bits when the coordinates have at most 17 bits (|a| <
+  // 2^19, a 3x3 minor < 6 * 2^57 < 2^60: small lattices and voxel grids,
+  // where this path runs for most clips), else in 128.
+  signs_from_rows(a, b, gen, dim, span.fits(17), out);
+  return true;
+}
+
+// signs_int128 on the global grid (ExactContext::grid): the rows read as
+// integers instead of decoded from the doubles, relative to p_i (translating
+// the vertex leaves det M and its minors as they are). Grid integers lie
+// below 2^22, so |q| < 2^23, |a| < 2^24 and |b| < 3 * 2^46 (a box row's
+// below 2^23): 3x3 minors < 6 * 2^72, det M0 < 4 * 2^48 * 2^75 < 2^126, in
+// 128 bits. Where every |q| is below 2^10 (a lattice's neighbours), |a| <
+// 2^11, minors < 6 * 2^33, |b| < 2^23 and det M0 < 2^61: all in 64 bits.
+template <int D, class T>
+void signs_from_grid_rows(const std::int64_t (*a)[3], const std::int64_t* b, const std::int32_t* gen, ClipSigns& out) {
+  T minor[D + 1], m0 = 0, wi = 0;
+  for (int r = 0; r <= D; ++r) {
+    // The rows other than r, in order.
+    const std::int64_t* u = a[r == 0 ? 1 : 0];
+    const std::int64_t* v = a[r <= 1 ? 2 : 1];
+    if constexpr (D == 2) {
+      minor[r] = static_cast<T>(u[0]) * v[1] - static_cast<T>(u[1]) * v[0];
+    } else {
+      const std::int64_t* w = a[r <= 2 ? 3 : 2];
+      minor[r] = u[0] * (static_cast<T>(v[1]) * w[2] - static_cast<T>(v[2]) * w[1]) +
+                 u[1] * (static_cast<T>(v[2]) * w[0] - static_cast<T>(v[0]) * w[2]) +
+                 u[2] * (static_cast<T>(v[0]) * w[1] - static_cast<T>(v[1]) * w[0]);
     }
-  };
-  if (span.fits(17)) minors(std::int64_t{});
-  else minors(I{});
-  I m0 = 0, wi = 0;
-  for (int r = 0; r < rows; ++r) {
-    I cof = cofactor_sign(r, dim) * minor[r];
+    out.minor[r] = (minor[r] > 0) - (minor[r] < 0);
+    const T cof = ((r + D) & 1) == 0 ? minor[r] : -minor[r];  // cofactor_sign(r, D)
     m0 += b[r] * cof;
     if (gen[r] >= 0) wi += cof;
   }
   out.det_m0 = (m0 > 0) - (m0 < 0);
   out.weight_i = (wi > 0) - (wi < 0);
-  return true;
+}
+
+template <int D>
+void signs_on_grid(const ExactContext& ctx, std::int32_t i, const std::int32_t* gen, ClipSigns& out) {
+  const std::int32_t* gi = ctx.grid + static_cast<std::size_t>(i) * D;
+  std::int64_t a[D + 1][3] = {}, b[D + 1];
+  std::int64_t reach = 0;  // max |q| over the bisector rows
+  for (int r = 0; r <= D; ++r) {
+    if (gen[r] >= 0) {
+      const std::int32_t* gk = ctx.grid + static_cast<std::size_t>(gen[r]) * D;
+      std::int64_t sq = 0;
+      for (int d = 0; d < D; ++d) {
+        const std::int64_t q = std::int64_t{gk[d]} - gi[d];
+        reach = std::max(reach, q < 0 ? -q : q);
+        a[r][d] = 2 * q;
+        sq += q * q;
+      }
+      b[r] = sq;
+    } else {
+      const int axis = box_plane_axis(gen[r]);
+      const auto ax = static_cast<std::size_t>(axis);
+      a[r][axis] = 1;
+      b[r] = (box_plane_upper(gen[r]) ? ctx.grid_hi[ax] : ctx.grid_lo[ax]) - gi[axis];
+    }
+  }
+  if (reach < (std::int64_t{1} << 10)) signs_from_grid_rows<D, std::int64_t>(a, b, gen, out);
+  else signs_from_grid_rows<D, __int128>(a, b, gen, out);
 }
 
 }  // namespace
@@ -311,6 +379,11 @@ int exact_clip_sign(const ExactContext& ctx, std::int32_t i, const std::int32_t*
   for (int r = 0; r < dim; ++r) gen[r] = planes[r];
   gen[dim] = j;
   ClipSigns sg;
+  if (ctx.grid != nullptr) {
+    if (dim == 3) signs_on_grid<3>(ctx, i, gen, sg);
+    else signs_on_grid<2>(ctx, i, gen, sg);
+    return decide(sg, i, gen, dim);
+  }
   if (signs_int128(ctx, i, gen, sg)) return decide(sg, i, gen, dim);
   WidePredicate wide;
   int s;

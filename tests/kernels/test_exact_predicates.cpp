@@ -1007,6 +1007,7 @@ TEST(ExactPredicates, GridContext) {
         if (j == i || std::find(planes.begin(), planes.begin() + dim, j) != planes.begin() + dim) continue;
         const int want = check_sign(plain, i, planes.data(), j);
         EXPECT_EQ(vp.sign(gc, j), want) << "grid: " << describe(plain, i, planes.data(), j);
+        EXPECT_EQ(exact_clip_sign(gc, i, planes.data(), j), want) << "grid, unprepared: " << describe(plain, i, planes.data(), j);
         ++checked;
       }
     }
@@ -1031,8 +1032,9 @@ TEST(ExactPredicates, GridContext) {
 // generator; a farther row takes the 128-bit form, and a candidate farther
 // than that goes to exact_clip_sign. A small lattice (exact ties at nearly
 // every vertex) beside points 2^19 to 2^21 steps away, the box at the 22-bit
-// limit: every answer equals exact_clip_sign's and the oracle's, whichever
-// form serves it.
+// limit: every answer equals exact_clip_sign's on the plain context and the
+// oracle's, whichever form serves it; so does exact_clip_sign's on the grid
+// (64-bit for a lattice's rows, 128-bit for far ones).
 TEST(ExactPredicates, GridContextNearAndFarRows) {
   using tessera::kernels::make_grid;
   for (int dim : {2, 3}) {
@@ -1090,6 +1092,7 @@ TEST(ExactPredicates, GridContextNearAndFarRows) {
         if (j == i || std::find(planes.begin(), planes.begin() + dim, j) != planes.begin() + dim) continue;
         const int want = check_sign(plain, i, planes.data(), j);
         EXPECT_EQ(vp.sign(gc, j), want) << "grid: " << describe(plain, i, planes.data(), j);
+        EXPECT_EQ(exact_clip_sign(gc, i, planes.data(), j), want) << "grid, unprepared: " << describe(plain, i, planes.data(), j);
         ties += power_diff(plain, i, planes.data(), j) == 0;
         ++checked;
       }
