@@ -217,7 +217,7 @@ class VertexPredicate {
   // at prepare_narrow). Lattices and voxel centres, where nearly every vertex
   // ties, take it.
   bool narrow_ = false;
-  std::int64_t ncof_[3][3] = {}, nb_[3] = {0, 0, 0}, ndet_a_ = 0;
+  std::int64_t nb_[3] = {0, 0, 0}, ndet_a_ = 0;  // b relative to p_i, det A (cofactors in cof_)
   int dim_ = 3, shift_ = 0;
   std::int32_t i_ = -1, gen_[3] = {0, 0, 0};
   std::int64_t ci_[3] = {0, 0, 0};   // p_i on the grid
