@@ -967,6 +967,34 @@ TEST(ExactPredicates, PreparedVertexOnAndOffGrid) {
 
 namespace {
 
+// The vertex of cell i on `planes`, when they are distinct from i and each
+// other and independent, asked against every other point: the prepared form
+// and exact_clip_sign on the grid context gc must answer as exact_clip_sign
+// on the plain context and the oracle (check_sign). Returns the queries
+// checked (0 for an unusable vertex) and adds the exact ties to *ties.
+int check_on_grid(const ExactContext& plain, const ExactContext& gc, std::int32_t n, std::int32_t i, const Ids& planes,
+                  int* ties = nullptr) {
+  const int dim = plain.dim;
+  bool distinct = true;
+  for (int k = 0; k < dim; ++k) {
+    distinct &= planes[k] != i;
+    for (int m = 0; m < k; ++m) distinct &= planes[k] != planes[m];
+  }
+  if (!distinct || !independent(plain, i, planes.data())) return 0;
+  tessera::kernels::VertexPredicate vp;
+  EXPECT_TRUE(vp.prepare(gc, i, planes.data())) << describe(plain, i, planes.data(), i);
+  int checked = 0;
+  for (std::int32_t j = 0; j < n; ++j) {
+    if (j == i || std::find(planes.begin(), planes.begin() + dim, j) != planes.begin() + dim) continue;
+    const int want = check_sign(plain, i, planes.data(), j);
+    EXPECT_EQ(vp.sign(gc, j), want) << "grid: " << describe(plain, i, planes.data(), j);
+    EXPECT_EQ(exact_clip_sign(gc, i, planes.data(), j), want) << "grid, unprepared: " << describe(plain, i, planes.data(), j);
+    if (ties != nullptr) *ties += power_diff(plain, i, planes.data(), j) == 0;
+    ++checked;
+  }
+  return checked;
+}
+
 // make_grid: the input and box on one grid of at most 22 bits, or nothing.
 // With the grid in the context, prepared predicates read integers; their
 // answers equal exact_clip_sign's on the plain context and the oracle's.
@@ -995,21 +1023,7 @@ TEST(ExactPredicates, GridContext) {
       const std::int32_t i = r.index(p.size());
       for (int k = 0; k < dim; ++k)
         planes[k] = r.index(5) == 0 ? box_plane_id(static_cast<int>(r.index(dim)), r.index(2) == 1) : r.index(p.size());
-      bool distinct = true;
-      for (int k = 0; k < dim; ++k) {
-        distinct &= planes[k] != i;
-        for (int m = 0; m < k; ++m) distinct &= planes[k] != planes[m];
-      }
-      if (!distinct || !independent(plain, i, planes.data())) continue;
-      tessera::kernels::VertexPredicate vp;
-      ASSERT_TRUE(vp.prepare(gc, i, planes.data()));
-      for (std::int32_t j = 0; j < p.size(); ++j) {
-        if (j == i || std::find(planes.begin(), planes.begin() + dim, j) != planes.begin() + dim) continue;
-        const int want = check_sign(plain, i, planes.data(), j);
-        EXPECT_EQ(vp.sign(gc, j), want) << "grid: " << describe(plain, i, planes.data(), j);
-        EXPECT_EQ(exact_clip_sign(gc, i, planes.data(), j), want) << "grid, unprepared: " << describe(plain, i, planes.data(), j);
-        ++checked;
-      }
+      checked += check_on_grid(plain, gc, p.size(), i, planes);
     }
     EXPECT_GT(checked, 3000) << "dim " << dim;
 
@@ -1080,22 +1094,7 @@ TEST(ExactPredicates, GridContextNearAndFarRows) {
                     : kind == 2 ? lattice + r.index(mid - lattice)
                                 : r.index(lattice);
       }
-      bool distinct = true;
-      for (int k = 0; k < dim; ++k) {
-        distinct &= planes[k] != i;
-        for (int m = 0; m < k; ++m) distinct &= planes[k] != planes[m];
-      }
-      if (!distinct || !independent(plain, i, planes.data())) continue;
-      tessera::kernels::VertexPredicate vp;
-      ASSERT_TRUE(vp.prepare(gc, i, planes.data()));
-      for (std::int32_t j = 0; j < p.size(); ++j) {
-        if (j == i || std::find(planes.begin(), planes.begin() + dim, j) != planes.begin() + dim) continue;
-        const int want = check_sign(plain, i, planes.data(), j);
-        EXPECT_EQ(vp.sign(gc, j), want) << "grid: " << describe(plain, i, planes.data(), j);
-        EXPECT_EQ(exact_clip_sign(gc, i, planes.data(), j), want) << "grid, unprepared: " << describe(plain, i, planes.data(), j);
-        ties += power_diff(plain, i, planes.data(), j) == 0;
-        ++checked;
-      }
+      checked += check_on_grid(plain, gc, p.size(), i, planes, &ties);
     }
     EXPECT_GT(checked, 5000) << "dim " << dim;
     EXPECT_GT(ties, 80) << "dim " << dim << ": too few exact ties to test the tie-break";
