@@ -195,39 +195,27 @@ void signs_gmp(const ExactContext& ctx, std::int32_t i, const std::int32_t* gen,
   out.weight_i = mpz_sgn(s.t2);
 }
 
-// The signs from M's integer rows: a (|a| < 2^24) and b, det M0 below
-// 2^127 (the callers' bounds). The minors in 64 bits when `small` (|a| <
-// 2^19), else in 128.
-void signs_from_rows(const std::int64_t (*a)[Scratch::kMaxDim], const __int128* b, const std::int32_t* gen, int dim,
-                     bool small, ClipSigns& out) {
-  using I = __int128;
-  const int rows = dim + 1;
-  I minor[Scratch::kRows];
-  auto minors = [&]<class T>(T) {
-    for (int r = 0; r < rows; ++r) {
-      int sel[Scratch::kMaxDim] = {0, 0, 0};
-      int k = 0;
-      for (int q = 0; q < rows; ++q) if (q != r) sel[k++] = q;
-      const std::int64_t* r0 = a[sel[0]];
-      const std::int64_t* r1 = a[sel[1]];
-      T m;
-      if (dim == 2) {
-        m = static_cast<T>(r0[0]) * r1[1] - static_cast<T>(r0[1]) * r1[0];
-      } else {
-        const std::int64_t* r2 = a[sel[2]];
-        m = r0[0] * (static_cast<T>(r1[1]) * r2[2] - static_cast<T>(r1[2]) * r2[1]) +
-            r0[1] * (static_cast<T>(r1[2]) * r2[0] - static_cast<T>(r1[0]) * r2[2]) +
-            r0[2] * (static_cast<T>(r1[0]) * r2[1] - static_cast<T>(r1[1]) * r2[0]);
-      }
-      minor[r] = m;
-      out.minor[r] = (m > 0) - (m < 0);
+// The signs from M's integer rows a (D + 1 rows of D entries) and b: the
+// minors in Minor, det M0 and w_i's coefficient in Sum, each wide enough for
+// the caller's bounds.
+template <int D, class Minor, class Sum>
+void signs_from_rows(const std::int64_t (*a)[3], const std::int64_t* b, const std::int32_t* gen, ClipSigns& out) {
+  Sum m0 = 0, wi = 0;
+  for (int r = 0; r <= D; ++r) {
+    // The rows other than r, in order.
+    const std::int64_t* u = a[r == 0 ? 1 : 0];
+    const std::int64_t* v = a[r <= 1 ? 2 : 1];
+    Minor minor;
+    if constexpr (D == 2) {
+      minor = static_cast<Minor>(u[0]) * v[1] - static_cast<Minor>(u[1]) * v[0];
+    } else {
+      const std::int64_t* w = a[r <= 2 ? 3 : 2];
+      minor = u[0] * (static_cast<Minor>(v[1]) * w[2] - static_cast<Minor>(v[2]) * w[1]) +
+              u[1] * (static_cast<Minor>(v[2]) * w[0] - static_cast<Minor>(v[0]) * w[2]) +
+              u[2] * (static_cast<Minor>(v[0]) * w[1] - static_cast<Minor>(v[1]) * w[0]);
     }
-  };
-  if (small) minors(std::int64_t{});
-  else minors(I{});
-  I m0 = 0, wi = 0;
-  for (int r = 0; r < rows; ++r) {
-    I cof = cofactor_sign(r, dim) * minor[r];
+    out.minor[r] = (minor > 0) - (minor < 0);
+    const Sum cof = cofactor_sign(r, D) * static_cast<Sum>(minor);
     m0 += b[r] * cof;
     if (gen[r] >= 0) wi += cof;
   }
@@ -257,8 +245,7 @@ bool signs_int128(const ExactContext& ctx, std::int32_t i, const std::int32_t* g
     ci[d] = scaled_p(pv[rows][d]);
     ci2 += static_cast<I>(ci[d]) * ci[d];
   }
-  std::int64_t a[Scratch::kRows][Scratch::kMaxDim];
-  I b[Scratch::kRows];
+  std::int64_t a[Scratch::kRows][Scratch::kMaxDim], b[Scratch::kRows];
   for (int r = 0; r < rows; ++r) {
     if (gen[r] >= 0) {
       I sq = 0;
@@ -267,7 +254,7 @@ bool signs_int128(const ExactContext& ctx, std::int32_t i, const std::int32_t* g
         a[r][d] = 2 * (x - ci[d]);
         sq += static_cast<I>(x) * x;
       }
-      b[r] = sq - ci2;
+      b[r] = static_cast<std::int64_t>(sq - ci2);
     } else {
       int axis = box_plane_axis(gen[r]);
       for (int d = 0; d < dim; ++d) a[r][d] = d == axis ? 1 : 0;
@@ -277,66 +264,59 @@ bool signs_int128(const ExactContext& ctx, std::int32_t i, const std::int32_t* g
   // The minors in 64 bits when the coordinates have at most 17 bits (|a| <
   // 2^19, a 3x3 minor < 6 * 2^57 < 2^60: small lattices and voxel grids,
   // where this path runs for most clips), else in 128.
-  signs_from_rows(a, b, gen, dim, span.fits(17), out);
+  const bool small = span.fits(17);
+  if (dim == 3) small ? signs_from_rows<3, std::int64_t, I>(a, b, gen, out) : signs_from_rows<3, I, I>(a, b, gen, out);
+  else small ? signs_from_rows<2, std::int64_t, I>(a, b, gen, out) : signs_from_rows<2, I, I>(a, b, gen, out);
   return true;
 }
 
-// signs_int128 on the global grid (ExactContext::grid): the rows read as
-// integers instead of decoded from the doubles, relative to p_i (translating
-// the vertex leaves det M and its minors as they are). Grid integers lie
-// below 2^22, so |q| < 2^23, |a| < 2^24 and |b| < 3 * 2^46 (a box row's
-// below 2^23): 3x3 minors < 6 * 2^72, det M0 < 4 * 2^48 * 2^75 < 2^126, in
-// 128 bits. Where every |q| is below 2^10 (a lattice's neighbours), |a| <
-// 2^11, minors < 6 * 2^33, |b| < 2^23 and det M0 < 2^61: all in 64 bits.
-template <int D, class T>
-void signs_from_grid_rows(const std::int64_t (*a)[3], const std::int64_t* b, const std::int32_t* gen, ClipSigns& out) {
-  T minor[D + 1], m0 = 0, wi = 0;
-  for (int r = 0; r <= D; ++r) {
-    // The rows other than r, in order.
-    const std::int64_t* u = a[r == 0 ? 1 : 0];
-    const std::int64_t* v = a[r <= 1 ? 2 : 1];
-    if constexpr (D == 2) {
-      minor[r] = static_cast<T>(u[0]) * v[1] - static_cast<T>(u[1]) * v[0];
-    } else {
-      const std::int64_t* w = a[r <= 2 ? 3 : 2];
-      minor[r] = u[0] * (static_cast<T>(v[1]) * w[2] - static_cast<T>(v[2]) * w[1]) +
-                 u[1] * (static_cast<T>(v[2]) * w[0] - static_cast<T>(v[0]) * w[2]) +
-                 u[2] * (static_cast<T>(v[0]) * w[1] - static_cast<T>(v[1]) * w[0]);
-    }
-    out.minor[r] = (minor[r] > 0) - (minor[r] < 0);
-    const T cof = ((r + D) & 1) == 0 ? minor[r] : -minor[r];  // cofactor_sign(r, D)
-    m0 += b[r] * cof;
-    if (gen[r] >= 0) wi += cof;
+// Below this many grid steps from p_i in every coordinate, a vertex's rows
+// and a candidate's fit the 64-bit forms: |a| < 2^11, 3x3 minors and A's
+// cofactors along a row < 6 * 2^33, a bisector row's b < 2^22, a box row's
+// < 2^23, so det M0 (four products of a b with a minor) < 2^61.
+constexpr std::int64_t kNarrowLimit = std::int64_t{1} << 10;
+
+// Row (a, b) of a vertex's system for generator or box id `id` on the global
+// grid (ExactContext::grid), relative to p_i at grid point c (translating the
+// vertex leaves det M and its minors as they are): a bisector row (2q, |q|^2)
+// with q = p_id - p_i, a box row (e_axis, c_box - p_i). Grid integers lie
+// below 2^22, so |q| < 2^23 and |b| < 3 * 2^46. Returns whether every |q_d|
+// is below kNarrowLimit (a box row: true). Inlined: as a call, the lattice
+// cells' queries ran 6% slower.
+template <int D>
+[[gnu::always_inline]] inline bool grid_row(const ExactContext& ctx, const std::int64_t* c, std::int32_t id, std::int64_t* a,
+                                             std::int64_t& b) {
+  if (id < 0) {
+    const int axis = box_plane_axis(id);
+    const auto ax = static_cast<std::size_t>(axis);
+    for (int d = 0; d < D; ++d) a[d] = d == axis;
+    b = (box_plane_upper(id) ? ctx.grid_hi[ax] : ctx.grid_lo[ax]) - c[axis];
+    return true;
   }
-  out.det_m0 = (m0 > 0) - (m0 < 0);
-  out.weight_i = (wi > 0) - (wi < 0);
+  const std::int32_t* g = ctx.grid + static_cast<std::size_t>(id) * D;
+  bool near = true;
+  b = 0;
+  for (int d = 0; d < D; ++d) {
+    const std::int64_t q = std::int64_t{g[d]} - c[d];
+    near &= q > -kNarrowLimit && q < kNarrowLimit;
+    a[d] = 2 * q;
+    b += q * q;
+  }
+  return near;
 }
 
+// signs_int128 on the global grid: the rows read as integers instead of
+// decoded from the doubles (grid_row). 3x3 minors < 6 * 2^72 and det M0 <
+// 4 * 2^48 * 2^75 < 2^126 in 128 bits; within kNarrowLimit, all in 64.
 template <int D>
 void signs_on_grid(const ExactContext& ctx, std::int32_t i, const std::int32_t* gen, ClipSigns& out) {
   const std::int32_t* gi = ctx.grid + static_cast<std::size_t>(i) * D;
-  std::int64_t a[D + 1][3] = {}, b[D + 1];
-  std::int64_t reach = 0;  // max |q| over the bisector rows
-  for (int r = 0; r <= D; ++r) {
-    if (gen[r] >= 0) {
-      const std::int32_t* gk = ctx.grid + static_cast<std::size_t>(gen[r]) * D;
-      std::int64_t sq = 0;
-      for (int d = 0; d < D; ++d) {
-        const std::int64_t q = std::int64_t{gk[d]} - gi[d];
-        reach = std::max(reach, q < 0 ? -q : q);
-        a[r][d] = 2 * q;
-        sq += q * q;
-      }
-      b[r] = sq;
-    } else {
-      const int axis = box_plane_axis(gen[r]);
-      const auto ax = static_cast<std::size_t>(axis);
-      a[r][axis] = 1;
-      b[r] = (box_plane_upper(gen[r]) ? ctx.grid_hi[ax] : ctx.grid_lo[ax]) - gi[axis];
-    }
-  }
-  if (reach < (std::int64_t{1} << 10)) signs_from_grid_rows<D, std::int64_t>(a, b, gen, out);
-  else signs_from_grid_rows<D, __int128>(a, b, gen, out);
+  std::int64_t c[D], a[D + 1][3], b[D + 1];
+  for (int d = 0; d < D; ++d) c[d] = gi[d];
+  bool near = true;
+  for (int r = 0; r <= D; ++r) near &= grid_row<D>(ctx, c, gen[r], a[r], b[r]);
+  if (near) signs_from_rows<D, std::int64_t, std::int64_t>(a, b, gen, out);
+  else signs_from_rows<D, __int128, __int128>(a, b, gen, out);
 }
 
 }  // namespace
@@ -440,7 +420,7 @@ bool VertexPredicate::prepare(const ExactContext& ctx, std::int32_t i, const std
   if (ctx.grid != nullptr) {
     // The whole input is on one grid: read it.
     shift_ = ctx.grid_shift;
-    if (prepare_narrow(ctx)) return det_a_sign_ != 0;
+    if (dim_ == 3 ? prepare_narrow<3>(ctx) : prepare_narrow<2>(ctx)) return det_a_sign_ != 0;
     const std::int32_t* gi = ctx.grid + static_cast<std::size_t>(i) * dim_;
     ci2_ = 0;
     for (int d = 0; d < dim_; ++d) {
@@ -519,83 +499,26 @@ void VertexPredicate::set_cofactors(const std::int64_t (*a)[3]) {
   terms_.set(i_, gen_, dim_);  // the perturbation's terms other than j's
 }
 
-// The narrow form's bounds, with |q| < 2^10 per coordinate for the vertex's
-// bisector rows and the candidate: a = 2q < 2^11; A's cofactors (3D: a
-// difference of two products of a's) < 2^23; det A and a_j . C_r (three
-// products) < 2^36; a bisector row's b = |q|^2 < 2^22, a box row's
-// b = c - p_i,axis < 2^23 (grid integers lie below 2^22); det M0, four
-// products of a b with one of those, < 2^61; w_i's coefficient < 2^38. 2D
-// stays smaller. Everything fits in int64, so each candidate costs a dozen
-// multiplications instead of 128-bit ones.
-namespace {
-constexpr std::int64_t kNarrowLimit = std::int64_t{1} << 10;
-bool narrow_coordinate(std::int64_t q) { return q > -kNarrowLimit && q < kNarrowLimit; }
-}  // namespace
-
-bool VertexPredicate::prepare_narrow(const ExactContext& ctx) {
-  return dim_ == 3 ? prepare_narrow<3>(ctx) : prepare_narrow<2>(ctx);
-}
-
+// The narrow form (kNarrowLimit's bounds, with the candidate's row as the
+// fourth): each candidate costs a dozen 64-bit multiplications instead of
+// 128-bit ones.
 template <int D>
 bool VertexPredicate::prepare_narrow(const ExactContext& ctx) {
   const std::int32_t* gi = ctx.grid + static_cast<std::size_t>(i_) * D;
   for (int d = 0; d < D; ++d) ci_[d] = gi[d];
-  std::int64_t a[D][D] = {};
-  for (int r = 0; r < D; ++r) {
-    if (gen_[r] >= 0) {
-      const std::int32_t* gk = ctx.grid + static_cast<std::size_t>(gen_[r]) * D;
-      std::int64_t sq = 0;
-      bool near = true;
-      for (int d = 0; d < D; ++d) {
-        const std::int64_t q = std::int64_t{gk[d]} - ci_[d];
-        near &= narrow_coordinate(q);
-        a[r][d] = 2 * q;
-        sq += q * q;
-      }
-      if (!near) return false;
-      nb_[r] = sq;
-    } else {
-      const int axis = box_plane_axis(gen_[r]);
-      a[r][axis] = 1;
-      const auto ax = static_cast<std::size_t>(axis);
-      nb_[r] = (box_plane_upper(gen_[r]) ? ctx.grid_hi[ax] : ctx.grid_lo[ax]) - ci_[axis];
-    }
-  }
-  // A's cofactors and det A (translation leaves them as they are).
-  if constexpr (D == 2) {
-    cof_[0][0] = a[1][1]; cof_[0][1] = -a[1][0];
-    cof_[1][0] = -a[0][1]; cof_[1][1] = a[0][0];
-  } else {
-    cof_[0][0] = a[1][1] * a[2][2] - a[1][2] * a[2][1];
-    cof_[0][1] = a[1][2] * a[2][0] - a[1][0] * a[2][2];
-    cof_[0][2] = a[1][0] * a[2][1] - a[1][1] * a[2][0];
-    cof_[1][0] = a[2][1] * a[0][2] - a[2][2] * a[0][1];
-    cof_[1][1] = a[2][2] * a[0][0] - a[2][0] * a[0][2];
-    cof_[1][2] = a[2][0] * a[0][1] - a[2][1] * a[0][0];
-    cof_[2][0] = a[0][1] * a[1][2] - a[0][2] * a[1][1];
-    cof_[2][1] = a[0][2] * a[1][0] - a[0][0] * a[1][2];
-    cof_[2][2] = a[0][0] * a[1][1] - a[0][1] * a[1][0];
-  }
-  ndet_a_ = 0;
-  for (int d = 0; d < D; ++d) ndet_a_ += a[0][d] * cof_[0][d];
-  det_a_sign_ = sign_of(ndet_a_);
-  terms_.set(i_, gen_, D);
+  std::int64_t a[D][3];
+  for (int r = 0; r < D; ++r)
+    if (!grid_row<D>(ctx, ci_, gen_[r], a[r], nb_[r])) return false;
+  set_cofactors(a);  // translation leaves A's cofactors and det A as they are
+  ndet_a_ = static_cast<std::int64_t>(det_a_);
   narrow_ = true;
   return true;
 }
 
 template <int D>
 int VertexPredicate::sign_narrow(const ExactContext& ctx, std::int32_t j) const {
-  const std::int32_t* gj = ctx.grid + static_cast<std::size_t>(j) * D;
-  std::int64_t aj[D], bj = 0;
-  bool near = true;
-  for (int d = 0; d < D; ++d) {
-    const std::int64_t q = std::int64_t{gj[d]} - ci_[d];
-    near &= narrow_coordinate(q);
-    aj[d] = 2 * q;
-    bj += q * q;
-  }
-  if (!near) return exact_clip_sign(ctx, i_, gen_, j);  // a candidate 2^10 steps away
+  std::int64_t aj[3], bj;
+  if (!grid_row<D>(ctx, ci_, j, aj, bj)) return exact_clip_sign(ctx, i_, gen_, j);  // a far candidate
   std::int64_t m0 = bj * ndet_a_, wi = ndet_a_, dr[D];
   for (int r = 0; r < D; ++r) {
     dr[r] = 0;

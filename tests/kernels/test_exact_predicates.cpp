@@ -151,6 +151,17 @@ bool independent(const ExactContext& c, std::int32_t i, const std::int32_t* plan
   return solve_vertex(c, i, planes).has_value();
 }
 
+/// A real vertex of cell i: its planes differ from i and from each other,
+/// and are independent.
+bool usable_vertex(const ExactContext& c, std::int32_t i, const Ids& planes) {
+  for (int k = 0; k < c.dim; ++k) {
+    if (planes[k] == i) return false;
+    for (int m = 0; m < k; ++m)
+      if (planes[k] == planes[m]) return false;
+  }
+  return independent(c, i, planes.data());
+}
+
 std::string describe(const ExactContext& c, std::int32_t i, const std::int32_t* planes, std::int32_t j) {
   std::ostringstream s;
   s.precision(17);
@@ -241,6 +252,18 @@ int check_sign(const ExactContext& c, std::int32_t i, const std::int32_t* planes
   EXPECT_NE(want, 0) << "oracle: every perturbation coefficient vanished for " << describe(c, i, planes, j);
   EXPECT_EQ(got, want) << describe(c, i, planes, j) << "  P0 = " << power_diff(c, i, planes, j).get_d();
   return got;
+}
+
+/// check_sign for the vertex of cell i on `planes` against every other of
+/// the n points; returns how many were checked.
+int check_vertex(const ExactContext& c, std::int32_t n, std::int32_t i, const Ids& planes) {
+  int checked = 0;
+  for (std::int32_t j = 0; j < n; ++j) {
+    if (j == i || std::find(planes.begin(), planes.begin() + c.dim, j) != planes.begin() + c.dim) continue;
+    check_sign(c, i, planes.data(), j);
+    ++checked;
+  }
+  return checked;
 }
 
 /// A vertex defined by `defs[0..dim]` (generators and box planes, at least
@@ -946,17 +969,7 @@ TEST(ExactPredicates, PreparedVertexOnAndOffGrid) {
         if (r.index(4) == 0) planes[k] = box_plane_id(static_cast<int>(r.index(dim)), r.index(2) == 1);
         else planes[k] = r.index(on_grid);
       }
-      bool distinct = true;
-      for (int k = 0; k < dim; ++k) {
-        distinct &= planes[k] != i;
-        for (int m = 0; m < k; ++m) distinct &= planes[k] != planes[m];
-      }
-      if (!distinct || !independent(c, i, planes.data())) continue;
-      for (std::int32_t j = 0; j < p.size(); ++j) {
-        if (j == i || std::find(planes.begin(), planes.begin() + dim, j) != planes.begin() + dim) continue;
-        check_sign(c, i, planes.data(), j);
-        ++checked;
-      }
+      if (usable_vertex(c, i, planes)) checked += check_vertex(c, p.size(), i, planes);
     }
     EXPECT_GT(checked, 5000) << "dim " << dim;
     EXPECT_GT(prepared_used - before, 5000) << "dim " << dim << ": the prepared path hardly ran";
@@ -975,12 +988,7 @@ namespace {
 int check_on_grid(const ExactContext& plain, const ExactContext& gc, std::int32_t n, std::int32_t i, const Ids& planes,
                   int* ties = nullptr) {
   const int dim = plain.dim;
-  bool distinct = true;
-  for (int k = 0; k < dim; ++k) {
-    distinct &= planes[k] != i;
-    for (int m = 0; m < k; ++m) distinct &= planes[k] != planes[m];
-  }
-  if (!distinct || !independent(plain, i, planes.data())) return 0;
+  if (!usable_vertex(plain, i, planes)) return 0;
   tessera::kernels::VertexPredicate vp;
   EXPECT_TRUE(vp.prepare(gc, i, planes.data())) << describe(plain, i, planes.data(), i);
   int checked = 0;
@@ -1098,6 +1106,34 @@ TEST(ExactPredicates, GridContextNearAndFarRows) {
     }
     EXPECT_GT(checked, 5000) << "dim " << dim;
     EXPECT_GT(ties, 80) << "dim " << dim << ": too few exact ties to test the tie-break";
+  }
+}
+
+// The 128-bit path of exact_clip_sign off a global grid (signs_int128) at
+// its limit: integer points spanning 21 bits, so the vertices' minors need
+// more than 64 bits (the path keeps them in 64 only below 17 bits). Every
+// answer equals the oracle's.
+TEST(ExactPredicates, IntegerPathAtItsLimit) {
+  for (int dim : {2, 3}) {
+    Rng r(97 + static_cast<std::uint64_t>(dim));
+    Problem p;
+    p.dim = dim;
+    for (int d = 0; d < 3; ++d) { p.lo[d] = -0x1p20; p.hi[d] = 0x1p20; }
+    for (int k = 0; k < 30; ++k) {
+      std::array<double, 3> x{};
+      for (int d = 0; d < dim; ++d) x[d] = static_cast<double>(static_cast<std::int64_t>(r.index(1 << 21)) - (1 << 20));
+      p.add(x);
+    }
+    const auto c = p.ctx();
+    int checked = 0;
+    for (int t = 0; t < 60; ++t) {
+      Ids planes{};
+      const std::int32_t i = r.index(p.size());
+      for (int k = 0; k < dim; ++k)
+        planes[k] = r.index(6) == 0 ? box_plane_id(static_cast<int>(r.index(dim)), r.index(2) == 1) : r.index(p.size());
+      if (usable_vertex(c, i, planes)) checked += check_vertex(c, p.size(), i, planes);
+    }
+    EXPECT_GT(checked, 800) << "dim " << dim;
   }
 }
 

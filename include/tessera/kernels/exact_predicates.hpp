@@ -206,16 +206,15 @@ class VertexPredicate {
 
  private:
   void set_cofactors(const std::int64_t (*a)[3]);  // cof_ and det_a_ from A's rows
-  bool prepare_narrow(const ExactContext& ctx);     // the narrow form, or false
   template <int D>
-  bool prepare_narrow(const ExactContext& ctx);
+  bool prepare_narrow(const ExactContext& ctx);  // the narrow form, or false
   template <int D>
   int sign_narrow(const ExactContext& ctx, std::int32_t j) const;
   // The narrow form: on a global grid (ExactContext::grid) with every
   // bisector row's q_r = p_r - p_i below 2^10 grid steps per coordinate, the
   // rows are taken relative to p_i and every quantity fits in 64 bits (bounds
-  // at prepare_narrow). Lattices and voxel centres, where nearly every vertex
-  // ties, take it.
+  // at kNarrowLimit in exact_predicates.cpp). Lattices and voxel centres,
+  // where nearly every vertex ties, take it.
   bool narrow_ = false;
   std::int64_t nb_[3] = {0, 0, 0}, ndet_a_ = 0;  // b relative to p_i, det A (cofactors in cof_)
   int dim_ = 3, shift_ = 0;
