@@ -98,6 +98,25 @@ bool is_junction_edge(const FaceSet& mesh, std::span<const std::int32_t> labels,
   return n >= 3 && distinct(r, n) >= 3;
 }
 
+std::vector<double> petal_radii(const FaceSet& mesh, std::span<const double> points) {
+  const std::size_t dn = static_cast<std::size_t>(mesh.dim), kn = dn + 1;
+  std::vector<double> petal(mesh.n_vertices(), 0.0);
+  parallel_range(petal.size(), 4096, [&](std::size_t v) {
+    const std::int32_t* key = &mesh.vertex_keys[v * kn];
+    std::size_t a = 0;
+    while (a < kn && key[a] < 0) ++a;  // box planes come first; a vertex has a generator
+    if (a == kn) return;
+    const double* g = &points[static_cast<std::size_t>(key[a]) * dn];
+    double d2 = 0;
+    for (std::size_t c = 0; c < dn; ++c) {
+      const double d = mesh.vertices[v * dn + c] - g[c];
+      d2 += d * d;
+    }
+    petal[v] = std::sqrt(d2);
+  });
+  return petal;
+}
+
 NetStencils build_stencils(const FaceSet& mesh, std::span<const std::int32_t> labels) {
   const int D = mesh.dim;
   const std::size_t kn = static_cast<std::size_t>(D) + 1;
@@ -209,27 +228,16 @@ std::vector<NetVertexKind> smooth_surface_net(FaceSet& mesh, std::span<const dou
 
   // Per vertex: the constraint radius and the axes pinned to a box plane.
   const std::vector<double> x0 = mesh.vertices;
+  const std::vector<double> petal = front::petal_radii(mesh, points);
   std::vector<double> radius(nv);
   std::vector<std::uint8_t> pinned(nv, 0);
   front::parallel_range(nv, 4096, [&](std::size_t v) {
     const std::int32_t* key = &mesh.vertex_keys[v * kn];
     std::uint8_t pin = 0;
-    std::int32_t gen = -1;
-    for (std::size_t a = 0; a < kn; ++a) {
+    for (std::size_t a = 0; a < kn; ++a)
       if (key[a] < 0) pin |= static_cast<std::uint8_t>(1u << ((-key[a] - 1) / 2));
-      else if (gen < 0) gen = key[a];
-    }
     pinned[v] = pin;
-    double r = options.constraint;
-    if (!options.constraint_is_absolute) {
-      double d2 = 0;
-      for (std::size_t a = 0; a < dn; ++a) {
-        const double d = x0[v * dn + a] - points[static_cast<std::size_t>(gen) * dn + a];
-        d2 += d * d;
-      }
-      r *= std::sqrt(d2);  // the petal radius: distance to each of its generators
-    }
-    radius[v] = r;
+    radius[v] = options.constraint_is_absolute ? options.constraint : options.constraint * petal[v];
   });
 
   // The guard: after each Jacobi step every polygon must still have a ladder
@@ -244,13 +252,7 @@ std::vector<NetVertexKind> smooth_surface_net(FaceSet& mesh, std::span<const dou
   std::vector<std::uint32_t> rotation(nf, 0);  // last valid ladder rotation
   front::parallel_range(nf, 1024, [&](std::size_t f) {
     const auto b = static_cast<std::size_t>(mesh.face_offsets[f]), e = static_cast<std::size_t>(mesh.face_offsets[f + 1]);
-    if (D == 2) {
-      for (std::size_t a = 0; a < 2; ++a)
-        ref[f * 2 + a] = x0[static_cast<std::size_t>(mesh.face_vertices[b + 1]) * 2 + a] -
-                         x0[static_cast<std::size_t>(mesh.face_vertices[b]) * 2 + a];
-      return;
-    }
-    front::newell(x0.data(), &mesh.face_vertices[b], e - b, &ref[3 * f]);
+    front::reference_orientation(D, x0.data(), petal.data(), &mesh.face_vertices[b], e - b, &ref[dn * f]);
   });
 
   std::vector<double> cur = x0, nxt(x0.size());

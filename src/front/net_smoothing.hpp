@@ -51,6 +51,49 @@ inline void newell(const double* xyz, const std::int32_t* loop, std::size_t n, d
   }
 }
 
+/// Per mesh vertex, its distance to its generators (a Voronoi vertex is
+/// equidistant from all of them; box planes in its key are skipped): the
+/// radius of its petal, the local spacing there. Runs in the caller's task
+/// arena.
+std::vector<double> petal_radii(const FaceSet& mesh, std::span<const double> points);
+
+/// Below this fraction of the local spacing (lengths; areas: its square) a
+/// polygon counts as degenerate, with no orientation to keep.
+inline constexpr double degenerate_fraction = 1e-10;
+
+/// The orientation the smoothing guard keeps for polygon `loop` (n corners)
+/// at positions x: in 3D Newell's vector, in 2D the segment's direction —
+/// zero where the polygon is degenerate: its area (length) below
+/// degenerate_fraction of the square of (of) its corners' largest petal
+/// radius. Exact ties on a lattice (8 cospherical voxel centres) split a
+/// Voronoi vertex into coincident ones, and the faces among them have zero
+/// area. With a spacing such as 0.7 the voxel centres round off the lattice
+/// and those faces keep an area of ~1e-13 of the spacing squared, whose
+/// normal is rounding noise: kept as an orientation, the first smoothing step
+/// "flipped" it and froze its corners, and the freeze spread in rounds (a
+/// 256^3 volume: 84 rounds instead of 20, smoothing 3x slower, its corners
+/// held back where the dyadic lattice's moved).
+inline void reference_orientation(int dim, const double* x, const double* petal, const std::int32_t* loop,
+                                  std::size_t n, double* out) {
+  double scale = 0;
+  for (std::size_t q = 0; q < n; ++q) scale = std::max(scale, petal[static_cast<std::size_t>(loop[q])]);
+  double norm2 = 0;
+  if (dim == 2) {
+    const double* a = &x[2 * static_cast<std::size_t>(loop[0])];
+    const double* b = &x[2 * static_cast<std::size_t>(loop[1])];
+    out[0] = b[0] - a[0];
+    out[1] = b[1] - a[1];
+    norm2 = out[0] * out[0] + out[1] * out[1];
+    scale *= degenerate_fraction;
+  } else {
+    newell(x, loop, n, out);
+    norm2 = out[0] * out[0] + out[1] * out[1] + out[2] * out[2];
+    scale *= scale * degenerate_fraction;
+  }
+  if (norm2 <= scale * scale)
+    for (int a = 0; a < dim; ++a) out[a] = 0;
+}
+
 /// The "ladder" of a loop of n corners starting at corner `start`: a strip
 /// zig-zagging between the two ends of the loop instead of a fan, so no
 /// vertex collects many thin triangles: (p0,p1,p(n-1)), (p1,p(n-2),p(n-1)),

@@ -56,8 +56,11 @@ std::vector<std::int32_t> resolve_selection(std::span<const std::int32_t> labels
 /// all face the polygon's original (unsmoothed, `before`) normal — the
 /// smoothing guard made sure one such rotation exists — and its worst
 /// triangle is the best shaped. A fixed ladder would make slivers of three
-/// corners along a straightened junction curve, which flip.
-void triangulate_ladder(FaceSet& m, const std::vector<double>& before, std::vector<std::int64_t>& polygon_of_face) {
+/// corners along a straightened junction curve, which flip. A polygon
+/// degenerate before smoothing (front::reference_orientation, with its
+/// vertices' petal radii `petal`) is measured against its smoothed normal.
+void triangulate_ladder(FaceSet& m, const std::vector<double>& before, const std::vector<double>& petal,
+                        std::vector<std::int64_t>& polygon_of_face) {
   const std::size_t np = m.n_faces();
   // Polygon p starts at triangle offset[p] - 2p: n - 2 triangles per n corners.
   const std::size_t nt = np == 0 ? 0 : static_cast<std::size_t>(m.face_offsets[np]) - 2 * np;
@@ -71,15 +74,21 @@ void triangulate_ladder(FaceSet& m, const std::vector<double>& before, std::vect
       const auto n = static_cast<std::size_t>(m.face_offsets[p + 1]) - b;
       const std::int32_t* loop = &m.face_vertices[b];
       double ref[3];
-      front::newell(before.data(), loop, n, ref);
+      front::reference_orientation(3, before.data(), petal.data(), loop, n, ref);
       if (ref[0] == 0 && ref[1] == 0 && ref[2] == 0) front::newell(m.vertices.data(), loop, n, ref);
       auto pos = [&](std::int32_t v) { return &m.vertices[3 * static_cast<std::size_t>(v)]; };
+      // A rotation replaces an earlier one only if it scores better by more
+      // than rounding (1e-9 relative): rotations that tie exactly on a
+      // lattice differ by noise off it, which must not choose the triangles.
+      auto better = [](double score, double best) {
+        return score > best && !(score <= best + 1e-9 * std::fabs(best));  // best = -inf: NaN bound, better
+      };
       std::size_t best = 0;
       if (n > 3) {
         double best_score = -std::numeric_limits<double>::infinity();
         for (std::size_t start = 0; start < n; ++start) {
           const double score = front::ladder_score(pos, before.data(), loop, n, start, ref);
-          if (score > best_score) {
+          if (better(score, best_score)) {
             best_score = score;
             best = start;
           }
@@ -162,8 +171,11 @@ SurfaceNet surface_nets(std::span<const double> points, std::span<const std::int
 
   t0 = Clock::now();
   const bool triangulate = options.triangles && D == 3;
-  std::vector<double> before;
-  if (triangulate) before = out.mesh.vertices;
+  std::vector<double> before, petal;
+  if (triangulate) {
+    before = out.mesh.vertices;
+    arena.execute([&] { petal = front::petal_radii(out.mesh, points); });
+  }
   arena.execute([&] {
     out.vertex_kind = smooth_surface_net(out.mesh, points, labels, options.smoothing, out.max_displacement);
   });
@@ -172,7 +184,7 @@ SurfaceNet surface_nets(std::span<const double> points, std::span<const std::int
 
   t0 = Clock::now();
   if (triangulate) {
-    arena.execute([&] { triangulate_ladder(out.mesh, before, out.polygon_of_face); });
+    arena.execute([&] { triangulate_ladder(out.mesh, before, petal, out.polygon_of_face); });
   } else {
     out.polygon_of_face.resize(out.mesh.n_faces());
     for (std::size_t f = 0; f < out.polygon_of_face.size(); ++f)
