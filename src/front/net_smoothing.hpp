@@ -57,40 +57,42 @@ inline void newell(const double* xyz, const std::int32_t* loop, std::size_t n, d
 /// arena.
 std::vector<double> petal_radii(const FaceSet& mesh, std::span<const double> points);
 
-/// Below this fraction of the local spacing (lengths; areas: its square) a
-/// polygon counts as degenerate, with no orientation to keep.
+/// A polygon counts as degenerate, with no orientation to keep, when its
+/// area vector's length is at most this fraction of the square of its local
+/// spacing (2D: the segment's length, of the spacing itself).
 inline constexpr double degenerate_fraction = 1e-10;
 
 /// The orientation the smoothing guard keeps for polygon `loop` (n corners)
 /// at positions x: in 3D Newell's vector, in 2D the segment's direction —
-/// zero where the polygon is degenerate: its area (length) below
-/// degenerate_fraction of the square of (of) its corners' largest petal
-/// radius. Exact ties on a lattice (8 cospherical voxel centres) split a
-/// Voronoi vertex into coincident ones, and the faces among them have zero
-/// area. With a spacing such as 0.7 the voxel centres round off the lattice
-/// and those faces keep an area of ~1e-13 of the spacing squared, whose
-/// normal is rounding noise: kept as an orientation, the first smoothing step
-/// "flipped" it and froze its corners, and the freeze spread in rounds (a
-/// 256^3 volume: 84 rounds instead of 20, smoothing 3x slower, its corners
-/// held back where the dyadic lattice's moved).
+/// zero where the polygon is degenerate (degenerate_fraction, the local
+/// spacing being its corners' largest petal radius). Exact ties on a lattice
+/// (8 cospherical voxel centres) split a Voronoi vertex into coincident ones,
+/// and the faces among them have zero area. With a spacing such as 0.7 the
+/// voxel centres round off the lattice and those faces keep an area of
+/// ~1e-13 of the spacing squared, whose normal is rounding noise: kept as an
+/// orientation, the first smoothing step "flipped" it and froze its corners,
+/// and the freeze spread in rounds (a 256^3 volume: 84 rounds instead of 20,
+/// smoothing 3x slower, its corners held back where the binary lattice's
+/// moved). Lengths are compared, not their squares, which would overflow or
+/// underflow first.
 inline void reference_orientation(int dim, const double* x, const double* petal, const std::int32_t* loop,
                                   std::size_t n, double* out) {
-  double scale = 0;
-  for (std::size_t q = 0; q < n; ++q) scale = std::max(scale, petal[static_cast<std::size_t>(loop[q])]);
-  double norm2 = 0;
+  double spacing = 0;
+  for (std::size_t q = 0; q < n; ++q) spacing = std::max(spacing, petal[static_cast<std::size_t>(loop[q])]);
+  double norm2 = 0, limit = 0;
   if (dim == 2) {
     const double* a = &x[2 * static_cast<std::size_t>(loop[0])];
     const double* b = &x[2 * static_cast<std::size_t>(loop[1])];
     out[0] = b[0] - a[0];
     out[1] = b[1] - a[1];
     norm2 = out[0] * out[0] + out[1] * out[1];
-    scale *= degenerate_fraction;
+    limit = degenerate_fraction * spacing;
   } else {
     newell(x, loop, n, out);
     norm2 = out[0] * out[0] + out[1] * out[1] + out[2] * out[2];
-    scale *= scale * degenerate_fraction;
+    limit = degenerate_fraction * spacing * spacing;
   }
-  if (norm2 <= scale * scale)
+  if (std::sqrt(norm2) <= limit)
     for (int a = 0; a < dim; ++a) out[a] = 0;
 }
 

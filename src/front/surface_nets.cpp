@@ -81,7 +81,8 @@ void triangulate_ladder(FaceSet& m, const std::vector<double>& before, const std
       // than rounding (1e-9 relative): rotations that tie exactly on a
       // lattice differ by noise off it, which must not choose the triangles.
       auto better = [](double score, double best) {
-        return score > best && !(score <= best + 1e-9 * std::fabs(best));  // best = -inf: NaN bound, better
+        // (best = -inf makes the bound NaN: then any larger score is better)
+        return score > best && !(score <= best + 1e-9 * std::fabs(best));
       };
       std::size_t best = 0;
       if (n > 3) {
