@@ -98,7 +98,7 @@ bool is_junction_edge(const FaceSet& mesh, std::span<const std::int32_t> labels,
   return n >= 3 && distinct(r, n) >= 3;
 }
 
-std::vector<double> petal_radii(const FaceSet& mesh, std::span<const double> points) {
+std::vector<double> petal_radii(const FaceSet& mesh, std::span<const double> positions, std::span<const double> points) {
   const std::size_t dn = static_cast<std::size_t>(mesh.dim), kn = dn + 1;
   std::vector<double> petal(mesh.n_vertices(), 0.0);
   parallel_range(petal.size(), 4096, [&](std::size_t v) {
@@ -109,7 +109,7 @@ std::vector<double> petal_radii(const FaceSet& mesh, std::span<const double> poi
     const double* g = &points[static_cast<std::size_t>(key[a]) * dn];
     double d2 = 0;
     for (std::size_t c = 0; c < dn; ++c) {
-      const double d = mesh.vertices[v * dn + c] - g[c];
+      const double d = positions[v * dn + c] - g[c];
       d2 += d * d;
     }
     petal[v] = std::sqrt(d2);
@@ -228,7 +228,7 @@ std::vector<NetVertexKind> smooth_surface_net(FaceSet& mesh, std::span<const dou
 
   // Per vertex: the constraint radius and the axes pinned to a box plane.
   const std::vector<double> x0 = mesh.vertices;
-  const std::vector<double> petal = front::petal_radii(mesh, points);
+  const std::vector<double> petal = front::petal_radii(mesh, x0, points);
   std::vector<double> radius(nv);
   std::vector<std::uint8_t> pinned(nv, 0);
   front::parallel_range(nv, 4096, [&](std::size_t v) {

@@ -51,11 +51,12 @@ inline void newell(const double* xyz, const std::int32_t* loop, std::size_t n, d
   }
 }
 
-/// Per mesh vertex, its distance to its generators (a Voronoi vertex is
-/// equidistant from all of them; box planes in its key are skipped): the
-/// radius of its petal, the local spacing there. Runs in the caller's task
-/// arena.
-std::vector<double> petal_radii(const FaceSet& mesh, std::span<const double> points);
+/// Per mesh vertex at `positions` (mesh.vertices' layout: the vertices
+/// where the cells left them), its distance to its generators (a Voronoi
+/// vertex is equidistant from all of them; box planes in its key are
+/// skipped): the radius of its petal, the local spacing there. Runs in the
+/// caller's task arena.
+std::vector<double> petal_radii(const FaceSet& mesh, std::span<const double> positions, std::span<const double> points);
 
 /// A polygon counts as degenerate, with no orientation to keep, when its
 /// area vector's length is at most this fraction of the square of its local

@@ -57,10 +57,11 @@ std::vector<std::int32_t> resolve_selection(std::span<const std::int32_t> labels
 /// smoothing guard made sure one such rotation exists — and its worst
 /// triangle is the best shaped. A fixed ladder would make slivers of three
 /// corners along a straightened junction curve, which flip. A polygon
-/// degenerate before smoothing (front::reference_orientation, with its
-/// vertices' petal radii `petal`) is measured against its smoothed normal.
-void triangulate_ladder(FaceSet& m, const std::vector<double>& before, const std::vector<double>& petal,
+/// degenerate before smoothing (front::reference_orientation; the cells'
+/// `points` give its local spacing) is measured against its smoothed normal.
+void triangulate_ladder(FaceSet& m, const std::vector<double>& before, std::span<const double> points,
                         std::vector<std::int64_t>& polygon_of_face) {
+  const std::vector<double> petal = front::petal_radii(m, before, points);
   const std::size_t np = m.n_faces();
   // Polygon p starts at triangle offset[p] - 2p: n - 2 triangles per n corners.
   const std::size_t nt = np == 0 ? 0 : static_cast<std::size_t>(m.face_offsets[np]) - 2 * np;
@@ -172,11 +173,8 @@ SurfaceNet surface_nets(std::span<const double> points, std::span<const std::int
 
   t0 = Clock::now();
   const bool triangulate = options.triangles && D == 3;
-  std::vector<double> before, petal;
-  if (triangulate) {
-    before = out.mesh.vertices;
-    arena.execute([&] { petal = front::petal_radii(out.mesh, points); });
-  }
+  std::vector<double> before;
+  if (triangulate) before = out.mesh.vertices;
   arena.execute([&] {
     out.vertex_kind = smooth_surface_net(out.mesh, points, labels, options.smoothing, out.max_displacement);
   });
@@ -185,7 +183,7 @@ SurfaceNet surface_nets(std::span<const double> points, std::span<const std::int
 
   t0 = Clock::now();
   if (triangulate) {
-    arena.execute([&] { triangulate_ladder(out.mesh, before, petal, out.polygon_of_face); });
+    arena.execute([&] { triangulate_ladder(out.mesh, before, points, out.polygon_of_face); });
   } else {
     out.polygon_of_face.resize(out.mesh.n_faces());
     for (std::size_t f = 0; f < out.polygon_of_face.size(); ++f)
