@@ -113,7 +113,7 @@ inline void measure(const kernels::Tile& tile, double& area, std::array<double, 
 /// Sort a key's ids ascending by a sorting network (branch-free min/max;
 /// std::sort's call and branches cost more on 3 or 4 ids).
 template <std::size_t N>
-void sort_key(std::array<std::int32_t, N>& k) {
+[[gnu::always_inline]] inline void sort_key(std::array<std::int32_t, N>& k) {
   auto order = [&](std::size_t a, std::size_t b) {
     const std::int32_t lo = std::min(k[a], k[b]), hi = std::max(k[a], k[b]);
     k[a] = lo;
@@ -143,38 +143,27 @@ inline Key<2> vertex_key(const kernels::Tile& tile, std::size_t t) {
   return k;
 }
 
-/// Visit faces as f(neighbour id, local vertex indices, count). In 2D a face is
-/// the edge leaving vertex k, so the polygon order is preserved.
+/// Visit each face once as f(local plane index, neighbour id) (box planes
+/// negative), in the order the mesh numbers a cell's faces: 3D by plane
+/// index, 2D counter-clockwise (the edge leaving vertex k is face k).
 template <class F>
-void for_each_face(kernels::Hull& hull, F&& f) {
+void for_each_face_plane(kernels::Hull& hull, F&& f) {
   const auto& pl = hull.planes();
-  hull.for_each_face([&](std::uint16_t p, const std::uint32_t* loop, std::size_t m) { f(pl[p].id, loop, m); });
-}
-
-/// Visit each face's neighbour id once, f(id) (box planes negative), without
-/// the vertex loops: what a cell's spokes need.
-template <class F>
-void for_each_spoke(kernels::Hull& hull, F&& f) {
-  const auto& pl = hull.planes();
-  hull.for_each_face_plane([&](std::uint16_t p) { f(pl[p].id); });
+  hull.for_each_face_plane([&](std::uint16_t p) { f(p, pl[p].id); });
 }
 
 template <class F>
-void for_each_spoke(kernels::Tile& tile, F&& f) {
+void for_each_face_plane(kernels::Tile& tile, F&& f) {
   const auto& v = tile.vertices();
   const auto& pl = tile.planes();
-  for (std::size_t k = 0; k < v.size(); ++k) f(pl[v[k].p[1]].id);
+  for (std::size_t k = 0; k < v.size(); ++k) f(v[k].p[1], pl[v[k].p[1]].id);
 }
 
-template <class F>
-void for_each_face(kernels::Tile& tile, F&& f) {
-  const auto& v = tile.vertices();
-  const auto& pl = tile.planes();
-  const std::size_t m = v.size();
-  for (std::size_t k = 0; k < m; ++k) {
-    std::uint32_t e[2] = {static_cast<std::uint32_t>(k), static_cast<std::uint32_t>((k + 1) % m)};
-    f(pl[v[k].p[1]].id, e, std::size_t{2});
-  }
+/// Visit each face's neighbour id once, f(id), without the vertex loops:
+/// what a cell's spokes need.
+template <class CellT, class F>
+void for_each_spoke(CellT& cell, F&& f) {
+  for_each_face_plane(cell, [&](std::uint16_t, std::int32_t id) { f(id); });
 }
 
 }  // namespace tessera::front

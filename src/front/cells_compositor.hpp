@@ -20,6 +20,7 @@
 #include "tessera/cells.hpp"
 #include "tessera/engine/classifier.hpp"
 #include "tessera/kernels/cell_builder.hpp"
+#include "tessera/kernels/dual_faces.hpp"
 
 namespace tessera::front {
 
@@ -35,24 +36,25 @@ class CellsCompositor {
     std::vector<std::int32_t> num_faces;
     std::vector<std::uint32_t> nbr_end;     // running end into nbrs, per generator
     std::vector<std::int32_t> nbrs;
-    // mesh
-    std::vector<std::uint32_t> vert_end;    // running end into keys/pos, per generator
-    Buffer<Key<D>> keys;                    // (Buffers: resized, then written)
+    // mesh: each cell in dual form (kernels/dual_faces.hpp), its faces numbered
+    // within the cell: a vertex is its D faces, a face its neighbour id
+    std::vector<std::uint32_t> vert_end;    // running end into corners, per generator
+    Buffer<kernels::Corners<D>> corners;    // (Buffers: resized, then written)
     Buffer<double> pos;                     // absolute coordinates: every vertex's, or the owned ones'
     std::vector<std::uint32_t> pos_end;     // running end into pos (in vertices), per generator
-    Buffer<std::int32_t> vglobal;           // merged vertex id per local vertex
-    std::vector<std::uint32_t> face_end;    // running end into faces, per generator
+    std::vector<std::uint32_t> face_end;    // running end into face_nbr, per generator
     std::vector<std::int32_t> face_nbr;
-    std::vector<std::uint32_t> face_vend;   // running end into fverts, per face
-    std::vector<std::uint32_t> fverts;      // local vertex index (within the cell)
+    std::vector<std::uint16_t> face_of;     // add()'s scratch: a local plane's face number
     std::size_t assembled = 0;              // cells assembled from their stars
   };
 
   /// `owners_known`: no two generators coincide, so a merged vertex's owner
   /// (the lowest generator of its key that owns a cell) is the lowest inside
-  /// generator of its key, known when the cell is added; only the owner then
-  /// keeps the vertex's position (a quarter of them: 3D vertices are shared
-  /// by four cells). Otherwise every cell keeps all its positions.
+  /// generator of its key, known when the cell is added. A cell then lists
+  /// its owned vertices first (a quarter of them: 3D vertices are shared by
+  /// four cells) and keeps only their positions, and the mesh numbers them
+  /// without finding their owners again. Otherwise every cell keeps all its
+  /// positions, in the cell's own vertex order.
   CellsCompositor(Cells& out, std::span<const std::int32_t> labels, bool mesh, bool owners_known = false)
       : out_(out), labels_(labels), classify_(labels), mesh_(mesh), owners_known_(owners_known) {}
 
@@ -66,7 +68,7 @@ class CellsCompositor {
       b.num_faces.push_back(0);
       b.nbr_end.push_back(static_cast<std::uint32_t>(b.nbrs.size()));
       if (mesh_) {
-        b.vert_end.push_back(static_cast<std::uint32_t>(b.keys.size()));
+        b.vert_end.push_back(static_cast<std::uint32_t>(b.corners.size()));
         b.pos_end.push_back(static_cast<std::uint32_t>(b.pos.size() / D));
         b.face_end.push_back(static_cast<std::uint32_t>(b.face_nbr.size()));
       }
@@ -75,15 +77,16 @@ class CellsCompositor {
     const double* p = cell.site();
     const std::size_t nb0 = b.nbrs.size();
     std::int32_t nf = 0;
-    // Spokes from the face planes; the face loops are walked only for the mesh.
+    // Spokes from the face planes; the mesh numbers the faces too.
     if (mesh_) {
-      for_each_face(cell, [&](std::int32_t id, const std::uint32_t* loop, std::size_t count) {
-        ++nf;
+      if (b.face_of.size() < cell.planes().size()) b.face_of.resize(cell.planes().size());
+      for_each_face_plane(cell, [&](std::uint16_t pl, std::int32_t id) {
+        b.face_of[pl] = static_cast<std::uint16_t>(nf++);
         if (id >= 0) b.nbrs.push_back(id);
         b.face_nbr.push_back(id);
-        b.fverts.insert(b.fverts.end(), loop, loop + count);
-        b.face_vend.push_back(static_cast<std::uint32_t>(b.fverts.size()));
       });
+      b.face_end.push_back(static_cast<std::uint32_t>(b.face_nbr.size()));
+      add_vertices(b, gen, cell);
     } else {
       for_each_spoke(cell, [&](std::int32_t id) {
         ++nf;
@@ -98,24 +101,6 @@ class CellsCompositor {
     std::sort(b.nbrs.begin() + static_cast<std::ptrdiff_t>(nb0), b.nbrs.end());
     b.num_faces.push_back(nf);
     b.nbr_end.push_back(static_cast<std::uint32_t>(b.nbrs.size()));
-    if (mesh_) {
-      const auto& v = cell.vertices();
-      const std::size_t nv = v.size(), k0 = b.keys.size(), p0 = b.pos.size() / D;
-      b.keys.resize(k0 + nv);
-      b.pos.resize((p0 + nv) * D);  // at most; trimmed below
-      Key<D>* key = b.keys.data() + k0;
-      double* pos = b.pos.data() + p0 * D;
-      std::size_t kept = 0;
-      for (std::size_t t = 0; t < nv; ++t) {
-        key[t] = vertex_key(cell, t);
-        for (int d = 0; d < D; ++d) pos[kept * D + d] = v[t].y[d] + p[d];
-        kept += !owners_known_ || first_inside(key[t]) == gen;
-      }
-      b.pos.resize((p0 + kept) * D);
-      b.vert_end.push_back(static_cast<std::uint32_t>(b.keys.size()));
-      b.pos_end.push_back(static_cast<std::uint32_t>(p0 + kept));
-      b.face_end.push_back(static_cast<std::uint32_t>(b.face_nbr.size()));
-    }
   }
 
   void finish(std::span<Batch> batches) {
@@ -146,17 +131,7 @@ class CellsCompositor {
     std::int32_t nc = 0;
     for (std::size_t g = 0; g < n; ++g) o.cell_of[g] = o.cell_of[g] ? nc++ : -1;
     const std::size_t ncell = static_cast<std::size_t>(nc);
-    // Generators come in bin order, so their cells' fields land all over
-    // the output: the loops below fetch a cell's destinations some
-    // generators ahead (and, with duplicates, its cell index before that).
-    auto ahead = [&](const Batch& b, std::size_t t, auto&& fetch) {
-      if (!dense && t + 2 * prefetch_ahead < b.gen.size())
-        __builtin_prefetch(&o.cell_of[static_cast<std::size_t>(b.gen[t + 2 * prefetch_ahead])]);
-      if (t + prefetch_ahead < b.gen.size()) {
-        const std::int32_t c = cell_at(b.gen[t + prefetch_ahead]);
-        if (c >= 0) fetch(static_cast<std::size_t>(c));
-      }
-    };
+    auto ahead = [&](const Batch& b, std::size_t t, auto&& fetch) { fetch_ahead(b, t, fetch); };
     // Output Buffers are sized, not zeroed: pass 1 writes every cell's
     // fields, the neighbour copy every entry.
     o.generator.resize(ncell);
@@ -208,9 +183,9 @@ class CellsCompositor {
         if (mesh_) {
           auto [f0, f1] = range_of(b.face_end, t);
           o.cell_face_offsets[cu + 1] = f1 - f0;
-          std::uint32_t v0 = f0 == 0 ? 0 : b.face_vend[f0 - 1];
-          std::uint32_t v1 = f1 == 0 ? 0 : b.face_vend[f1 - 1];
-          face_count_vertices[cu + 1] = v1 - v0;
+          // Each vertex lies on D faces (a 2D face is an edge, two vertices).
+          auto [v0, v1] = range_of(b.vert_end, t);
+          face_count_vertices[cu + 1] = D * static_cast<std::int64_t>(v1 - v0);
         }
       }
     });
@@ -236,6 +211,56 @@ class CellsCompositor {
 
  private:
   static constexpr std::size_t prefetch_ahead = 8;  // generators (finish)
+
+  // Generators come in bin order, so their cells' fields lie all over the
+  // cell-ordered arrays: the loops over a batch fetch a cell's entries some
+  // generators ahead, fetch(its cell index) (and, with duplicates, its cell
+  // index before that).
+  template <class Fetch>
+  void fetch_ahead(const Batch& b, std::size_t t, Fetch&& fetch) const {
+    if (!dense_ && t + 2 * prefetch_ahead < b.gen.size())
+      __builtin_prefetch(&out_.cell_of[static_cast<std::size_t>(b.gen[t + 2 * prefetch_ahead])]);
+    if (t + prefetch_ahead < b.gen.size()) {
+      const std::int32_t c = cell_at(b.gen[t + prefetch_ahead]);
+      if (c >= 0) fetch(static_cast<std::size_t>(c));
+    }
+  }
+
+  // The cell's vertices in dual form (faces numbered by b.face_of) and their
+  // positions: with owners known, the owned vertices first and only their
+  // positions; otherwise all of them, in the cell's order.
+  void add_vertices(Batch& b, std::int32_t gen, CellT& cell) {
+    const auto& v = cell.vertices();
+    const double* p = cell.site();
+    const std::size_t nv = v.size(), v0 = b.corners.size(), p0 = b.pos.size() / D;
+    b.corners.resize(v0 + nv);
+    b.pos.resize((p0 + nv) * D);  // at most; trimmed below
+    kernels::Corners<D>* corners = b.corners.data() + v0;
+    double* pos = b.pos.data() + p0 * D;
+    const std::uint16_t* face_of = b.face_of.data();
+    std::size_t kept = 0, back = nv;
+    for (std::size_t t = 0; t < nv; ++t) {
+      const bool owned = !owners_known_ || first_inside(vertex_key(cell, t)) == gen;
+      const std::size_t at = owned ? kept : --back;
+      for (int k = 0; k < D; ++k) corners[at][static_cast<std::size_t>(k)] = face_of[v[t].p[k]];
+      for (int d = 0; d < D; ++d) pos[kept * D + d] = v[t].y[d] + p[d];  // dropped unless owned
+      kept += owned;
+    }
+    b.pos.resize((p0 + kept) * D);
+    b.vert_end.push_back(static_cast<std::uint32_t>(b.corners.size()));
+    b.pos_end.push_back(static_cast<std::uint32_t>(p0 + kept));
+  }
+
+  // Vertex v's key (the generator and its faces' neighbour ids, ascending),
+  // from batch entry t's dual form.
+  Key<D> key_of(const Batch& b, std::size_t t, std::uint32_t v) const {
+    const std::int32_t* nbr = b.face_nbr.data() + (t == 0 ? 0 : b.face_end[t - 1]);
+    Key<D> k;
+    k[0] = b.gen[t];
+    for (int j = 0; j < D; ++j) k[static_cast<std::size_t>(j) + 1] = nbr[b.corners[v][static_cast<std::size_t>(j)]];
+    sort_key(k);
+    return k;
+  }
 
   // Generator g's cell index (-1: none); read without a lookup when dense_.
   std::int32_t cell_at(std::int32_t g) const { return dense_ ? g : out_.cell_of[static_cast<std::size_t>(g)]; }
@@ -281,17 +306,26 @@ class CellsCompositor {
   void build_mesh(std::span<Batch> batches, std::vector<std::int64_t>& fcv) {
     Cells& o = out_;
     const std::size_t ncell = o.n_cells();
-    // Owned vertices per cell -> global numbering in cell order.
+    auto range_of = [](const std::vector<std::uint32_t>& ends, std::size_t t) {
+      return std::pair<std::uint32_t, std::uint32_t>(t == 0 ? 0 : ends[t - 1], ends[t]);
+    };
+    // Owned vertices per cell -> global numbering in cell order. With owners
+    // known, a cell's owned vertices are its first ones, as many as the
+    // positions it kept (add_vertices); otherwise each key's owner is found.
     std::vector<std::int64_t> owned(ncell + 1, 0);
     tbb::parallel_for(std::size_t(0), batches.size(), [&](std::size_t k) {
-      Batch& b = batches[k];
-      b.vglobal.assign(b.keys.size(), -1);
+      const Batch& b = batches[k];
       for (std::size_t t = 0; t < b.gen.size(); ++t) {
-        std::int32_t c = cell_at(b.gen[t]);
+        const std::int32_t c = cell_at(b.gen[t]);
         if (c < 0) continue;
-        std::uint32_t v0 = t == 0 ? 0 : b.vert_end[t - 1], v1 = b.vert_end[t];
+        auto [v0, v1] = range_of(b.vert_end, t);
         std::int64_t cnt = 0;
-        for (std::uint32_t v = v0; v < v1; ++v) cnt += owner(b.keys[v]) == b.gen[t];
+        if (owners_known_) {
+          auto [p0, p1] = range_of(b.pos_end, t);
+          cnt = p1 - p0;
+        } else {
+          for (std::uint32_t v = v0; v < v1; ++v) cnt += owner(key_of(b, t, v)) == b.gen[t];
+        }
         owned[static_cast<std::size_t>(c) + 1] = cnt;
       }
     });
@@ -305,82 +339,40 @@ class CellsCompositor {
     tbb::parallel_for(std::size_t(0), batches.size(), [&](std::size_t k) {
       Batch& b = batches[k];
       for (std::size_t t = 0; t < b.gen.size(); ++t) {
-        std::int32_t c = cell_at(b.gen[t]);
+        fetch_ahead(b, t, [&](std::size_t c) { __builtin_prefetch(&owned[c]); });
+        const std::int32_t c = cell_at(b.gen[t]);
         if (c < 0) continue;
-        std::uint32_t v0 = t == 0 ? 0 : b.vert_end[t - 1], v1 = b.vert_end[t];
-        std::uint32_t pv = t == 0 ? 0 : b.pos_end[t - 1];  // the owned positions, in vertex order
-        std::int64_t next = owned[static_cast<std::size_t>(c)];
-        for (std::uint32_t v = v0; v < v1; ++v) {
-          if (owner(b.keys[v]) != b.gen[t]) continue;
-          std::size_t gid = static_cast<std::size_t>(next++);
-          b.vglobal[v] = static_cast<std::int32_t>(gid);
-          const std::size_t src = owners_known_ ? pv++ : v;
-          if (src >= b.pos.size() / D) break;  // (reported below)
-          for (int d = 0; d < D; ++d) o.vertices[gid * D + d] = b.pos[src * D + d];
-          for (int d = 0; d <= D; ++d) o.vertex_keys[gid * (D + 1) + d] = b.keys[v][static_cast<std::size_t>(d)];
+        auto [v0, v1] = range_of(b.vert_end, t);
+        std::size_t gid = static_cast<std::size_t>(owned[static_cast<std::size_t>(c)]);
+        const std::size_t end = static_cast<std::size_t>(owned[static_cast<std::size_t>(c) + 1]);
+        std::uint32_t src = range_of(b.pos_end, t).first;  // with owners known: the owned positions, in order
+        for (std::uint32_t v = v0; v < v1 && gid < end; ++v) {
+          const Key<D> key = key_of(b, t, v);
+          if (owner(key) != b.gen[t]) {
+            // With owners known, the owned vertices come first.
+            if (owners_known_) unowned.store(true, std::memory_order_relaxed);
+            continue;
+          }
+          const std::size_t from = owners_known_ ? src++ : v;
+          for (int d = 0; d < D; ++d) o.vertices[gid * D + d] = b.pos[from * D + d];
+          // Id by id: the sorted key leaves its registers as 4-byte stores,
+          // which a wider copy would have to wait for.
+          for (int d = 0; d <= D; ++d) o.vertex_keys[gid * (D + 1) + d] = key[static_cast<std::size_t>(d)];
+          ++gid;
         }
-        if (owners_known_ && pv != b.pos_end[t]) unowned.store(true, std::memory_order_relaxed);
+        if (gid != end) unowned.store(true, std::memory_order_relaxed);
       }
       Buffer<double>().swap(b.pos);  // copied out: freed before the face arrays are allocated
     });
     if (unowned.load())
       throw std::logic_error("tessera: a cell kept positions for other than its owned vertices");
-    // Vertices owned elsewhere: found by key among the owner's owned
-    // vertices, which the loop above wrote contiguously (global ids
-    // owned[c] .. owned[c + 1] of the owner's cell c, keys in vertex_keys):
-    // a quarter of the owner's vertices, found from its cell index alone. A
-    // miss means two cells disagree about a vertex, which exact predicates
-    // rule out.
-    std::atomic<std::size_t> misses{0};
-    tbb::parallel_for(std::size_t(0), batches.size(), [&](std::size_t k) {
-      Batch& b = batches[k];
-      const std::int32_t* const keys = o.vertex_keys.data();
-      // A cell's lookups are independent, and each is two dependent cache
-      // misses (the owner's range, then its keys): they run in three
-      // sweeps, so that the misses of one sweep overlap.
-      std::vector<std::uint32_t> slot;
-      std::vector<std::size_t> at;
-      for (std::size_t t = 0; t < b.gen.size(); ++t) {
-        if (cell_at(b.gen[t]) < 0) continue;
-        std::uint32_t v0 = t == 0 ? 0 : b.vert_end[t - 1], v1 = b.vert_end[t];
-        slot.clear();
-        at.clear();
-        for (std::uint32_t v = v0; v < v1; ++v) {
-          if (b.vglobal[v] >= 0) continue;
-          const std::int32_t own = owner(b.keys[v]);
-          const std::size_t oc = static_cast<std::size_t>(cell_at(own));
-          __builtin_prefetch(&owned[oc]);
-          slot.push_back(v);
-          at.push_back(oc);
-        }
-        for (const std::size_t oc : at) __builtin_prefetch(keys + static_cast<std::size_t>(owned[oc]) * (D + 1));
-        for (std::size_t m = 0; m < slot.size(); ++m) {
-          const std::uint32_t v = slot[m];
-          const std::size_t oc = at[m];
-          const std::int64_t g1 = owned[oc + 1];
-          std::int32_t found = -1;
-          for (std::int64_t g = owned[oc]; g < g1; ++g) {
-            Key<D> kg;
-            std::memcpy(kg.data(), keys + static_cast<std::size_t>(g) * (D + 1), sizeof kg);
-            if (same_key(kg, b.keys[v])) { found = static_cast<std::int32_t>(g); break; }
-          }
-          if (found < 0) misses.fetch_add(1, std::memory_order_relaxed);
-          b.vglobal[v] = found;
-        }
-      }
-      Buffer<Key<D>>().swap(b.keys);  // no longer read: lookups use vertex_keys
-    });
-    if (misses.load() != 0)
-      throw std::logic_error("tessera: " + std::to_string(misses.load()) +
-                             " cell vertices have no match in their owner cell (inconsistent topology)");
-    // Faces.
-    std::partial_sum(o.cell_face_offsets.begin(), o.cell_face_offsets.end(), o.cell_face_offsets.begin());
-    // The batches' keys and positions, freed above, lie in malloc's arenas
-    // (many allocations of a few MB each, below glibc's adaptive mmap
-    // threshold), which keep them from the system; the face arrays below are
-    // fresh mappings. Trimming hands those pages back first, so the peak
-    // holds one of the two, not both (1M 3D cells: ~0.5 GB less).
+    // The batches' positions, freed above, lie in malloc's arenas (many
+    // allocations of a few MB each, below glibc's adaptive mmap threshold),
+    // which keep them from the system; the face arrays below are fresh
+    // mappings. Trimming hands those pages back first, so that the peak
+    // holds one of the two, not both.
     release_free_memory();
+    std::partial_sum(o.cell_face_offsets.begin(), o.cell_face_offsets.end(), o.cell_face_offsets.begin());
     std::partial_sum(fcv.begin(), fcv.end(), fcv.begin());
     const std::size_t nfaces = static_cast<std::size_t>(o.cell_face_offsets.back());
     // Buffers: sized, not zeroed; the loop below writes every element
@@ -391,25 +383,93 @@ class CellsCompositor {
     o.face_vertices.resize(static_cast<std::size_t>(fcv.back()));
     o.face_neighbor.resize(nfaces);
     o.face_class.resize(nfaces);
+    // Each cell's vertex ids, then its faces. A vertex owned elsewhere is
+    // found by key among its owner's owned vertices, which the loop above
+    // wrote contiguously (global ids owned[c] .. owned[c + 1] of the owner's
+    // cell c, keys in vertex_keys): a quarter of the owner's vertices, found
+    // from its cell index alone. A miss means two cells disagree about a
+    // vertex, which exact predicates rule out.
+    std::atomic<std::size_t> misses{0};
     tbb::parallel_for(std::size_t(0), batches.size(), [&](std::size_t k) {
       const Batch& b = batches[k];
+      const std::int32_t* const keys = o.vertex_keys.data();
+      // A cell's lookups are independent, and each is two dependent cache
+      // misses (the owner's range, then its keys): they run in three
+      // sweeps, so that the misses of one sweep overlap.
+      std::vector<std::int32_t> gid;  // per vertex of the cell
+      std::vector<std::uint32_t> slot;
+      std::vector<std::size_t> at;
+      std::vector<Key<D>> sought;
+      kernels::FaceLoopScratch walk;
       for (std::size_t t = 0; t < b.gen.size(); ++t) {
-        std::int32_t c = cell_at(b.gen[t]);
+        fetch_ahead(b, t, [&](std::size_t c) {
+          __builtin_prefetch(&owned[c]);
+          __builtin_prefetch(&o.cell_face_offsets[c]);
+          __builtin_prefetch(&fcv[c]);
+        });
+        const std::int32_t c = cell_at(b.gen[t]);
         if (c < 0) continue;
-        std::size_t cu = static_cast<std::size_t>(c);
-        std::uint32_t f0 = t == 0 ? 0 : b.face_end[t - 1], f1 = b.face_end[t];
-        std::uint32_t vbase = t == 0 ? 0 : b.vert_end[t - 1];
+        const std::size_t cu = static_cast<std::size_t>(c);
+        auto [v0, v1] = range_of(b.vert_end, t);
+        gid.resize(v1 - v0);
+        if (sought.size() < v1 - v0) sought.resize(v1 - v0);
+        slot.clear();
+        at.clear();
+        std::int32_t next = static_cast<std::int32_t>(owned[cu]);
+        for (std::uint32_t v = v0; v < v1; ++v) {
+          if (owners_known_ && next < owned[cu + 1]) {
+            gid[v - v0] = next++;
+            continue;
+          }
+          // Built in place: copied from a temporary, the key's 4-byte stores
+          // stalled the copy's wider loads (2D: a quarter of this loop).
+          Key<D>& key = sought[slot.size()];
+          key = key_of(b, t, v);
+          const std::int32_t own = owner(key);
+          if (own == b.gen[t]) {
+            gid[v - v0] = next++;
+            continue;
+          }
+          const std::size_t oc = static_cast<std::size_t>(cell_at(own));
+          __builtin_prefetch(&owned[oc]);
+          slot.push_back(v);
+          at.push_back(oc);
+        }
+        for (const std::size_t oc : at) __builtin_prefetch(keys + static_cast<std::size_t>(owned[oc]) * (D + 1));
+        for (std::size_t m = 0; m < slot.size(); ++m) {
+          const std::size_t oc = at[m];
+          const std::int64_t g1 = owned[oc + 1];
+          const Key<D>& key = sought[m];
+          std::int32_t found = -1;
+          for (std::int64_t g = owned[oc]; g < g1; ++g) {
+            Key<D> kg;
+            std::memcpy(kg.data(), keys + static_cast<std::size_t>(g) * (D + 1), sizeof kg);
+            if (same_key(kg, key)) { found = static_cast<std::int32_t>(g); break; }
+          }
+          if (found < 0) misses.fetch_add(1, std::memory_order_relaxed);
+          gid[slot[m] - v0] = found;
+        }
+        auto [f0, f1] = range_of(b.face_end, t);
+        const std::int32_t* nbr = b.face_nbr.data() + f0;
         std::size_t fo = static_cast<std::size_t>(o.cell_face_offsets[cu]);
         std::size_t vo = static_cast<std::size_t>(fcv[cu]);
-        for (std::uint32_t f = f0; f < f1; ++f, ++fo) {
-          std::uint32_t a = f == 0 ? 0 : b.face_vend[f - 1], e = b.face_vend[f];
-          o.face_neighbor[fo] = b.face_nbr[f];
-          o.face_class[fo] = classify_(b.gen[t], b.face_nbr[f]);
-          for (std::uint32_t q = a; q < e; ++q) o.face_vertices[vo++] = b.vglobal[vbase + b.fverts[q]];
-          o.face_vertex_offsets[fo + 1] = static_cast<std::int64_t>(vo);
-        }
+        const std::size_t fend = static_cast<std::size_t>(o.cell_face_offsets[cu + 1]);
+        const std::size_t vend = static_cast<std::size_t>(fcv[cu + 1]);
+        kernels::for_each_face_loop(std::span<const kernels::Corners<D>>(b.corners.data() + v0, v1 - v0), f1 - f0, walk,
+                           [&](std::size_t f, const std::uint32_t* loop, std::size_t count) {
+                             if (fo == fend || count > vend - vo) return;  // (reported below)
+                             o.face_neighbor[fo] = nbr[f];
+                             o.face_class[fo] = classify_(b.gen[t], nbr[f]);
+                             for (std::size_t q = 0; q < count; ++q) o.face_vertices[vo++] = gid[loop[q]];
+                             o.face_vertex_offsets[++fo] = static_cast<std::int64_t>(vo);
+                           });
+        if (fo != fend || vo != vend) misses.fetch_add(1, std::memory_order_relaxed);  // faces that do not close
       }
     });
+    if (misses.load() != 0)
+      throw std::logic_error("tessera: " + std::to_string(misses.load()) +
+                             " cell vertices have no match in their owner cell, or cells' faces do not close"
+                             " (inconsistent topology)");
   }
 
   Cells& out_;

@@ -26,6 +26,7 @@
 #include <vector>
 
 #include "tessera/kernels/assembly.hpp"
+#include "tessera/kernels/dual_faces.hpp"
 #include "tessera/kernels/exact_predicates.hpp"
 #include "tessera/kernels/filter.hpp"
 #include "tessera/kernels/prepared_signs.hpp"
@@ -247,56 +248,16 @@ class Hull {
       if (seen[p]) f(static_cast<std::uint16_t>(p));
   }
 
-  /// Visit each face once: f(plane index, vertex indices counter-clockwise
-  /// from outside as pointer + count). The walk buffers are members, reused.
-  ///
-  /// Around plane p, the triangle after (p, x, y) is the one holding the
-  /// directed edge p -> y. Those successors are looked up first, for every
-  /// (triangle, corner) at once: independent loads. Each face walk then
-  /// follows one link per step; walking through the edge table itself was
-  /// a chain of dependent loads, ~30 cycles a step.
+  /// Visit each face once, by ascending plane index: f(plane index, vertex
+  /// indices counter-clockwise from outside as pointer + count), by the
+  /// walk of a cell's dual form (dual_faces.hpp). The walk's buffers are
+  /// members, reused.
   template <class F>
   void for_each_face(F&& f) {
-    const std::size_t nv = verts_.size();
-    seen_.assign(planes_.size(), 0);
-    loop_.resize(nv + 1);
-    if (next_.size() < 3 * nv) next_.resize(3 * nv);
-    // Raw pointers held in locals: the stores below (the loop, the seen
-    // flags) would otherwise make the compiler reload every member vector's
-    // data pointer at each step of the walk.
     const Vertex* const verts = verts_.data();
-    const std::uint32_t* const table = edge_tri_.data();
-    const std::size_t cap = cap_;
-    std::uint8_t* const seen = seen_.data();
-    std::uint32_t* const loop = loop_.data();
-    std::uint32_t* const next = next_.data();
-    // next[3 t + k] = 3 u + j: around plane p = t.p[k], triangle u follows
-    // t and holds p as its corner j.
-    for (std::size_t t = 0; t < nv; ++t) {
-      const Vertex& v = verts[t];
-      for (int k = 0; k < 3; ++k) {
-        const std::uint16_t p = v.p[k];
-        const std::uint32_t u = table[static_cast<std::size_t>(p) * cap + v.p[(k + 2) % 3]];
-        const Vertex& w = verts[u];
-        const std::uint32_t j = static_cast<std::uint32_t>(w.p[1] == p) + 2 * static_cast<std::uint32_t>(w.p[2] == p);
-        next[3 * t + static_cast<std::size_t>(k)] = 3 * u + j;
-      }
-    }
-    for (std::size_t t = 0; t < nv; ++t) {
-      for (int k = 0; k < 3; ++k) {
-        const std::uint16_t p = verts[t].p[k];
-        if (seen[p]) continue;
-        seen[p] = 1;
-        std::size_t m = 0;
-        const std::uint32_t start = 3 * static_cast<std::uint32_t>(t) + static_cast<std::uint32_t>(k);
-        std::uint32_t at = start;
-        do {
-          loop[m++] = at / 3;
-          at = next[at];
-        } while (at != start && m <= nv);
-        f(p, static_cast<const std::uint32_t*>(loop), m);
-      }
-    }
+    for_each_face_loop(
+        verts_.size(), planes_.size(), [verts](std::size_t t, int k) { return verts[t].p[k]; }, walk_,
+        std::forward<F>(f));
   }
 
  private:
@@ -556,8 +517,7 @@ class Hull {
   std::size_t cap_ = 0;
   double security2_ = 0;
   std::vector<std::uint8_t> seen_;
-  std::vector<std::uint32_t> loop_;
-  std::vector<std::uint32_t> next_;  // for_each_face's successor links
+  FaceLoopScratch walk_;  // for_each_face's
   std::vector<double> dirs_;         // close_far: the rays' unit directions
   PreparedSigns<3> signs_;  // the exact stages, prepared per vertex slot
 };
