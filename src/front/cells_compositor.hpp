@@ -11,6 +11,7 @@
 #include <numeric>
 #include <span>
 #include <stdexcept>
+#include <utility>
 #include <vector>
 
 #include <tbb/parallel_for.h>
@@ -131,7 +132,6 @@ class CellsCompositor {
     std::int32_t nc = 0;
     for (std::size_t g = 0; g < n; ++g) o.cell_of[g] = o.cell_of[g] ? nc++ : -1;
     const std::size_t ncell = static_cast<std::size_t>(nc);
-    auto ahead = [&](const Batch& b, std::size_t t, auto&& fetch) { fetch_ahead(b, t, fetch); };
     // Output Buffers are sized, not zeroed: pass 1 writes every cell's
     // fields, the neighbour copy every entry.
     o.generator.resize(ncell);
@@ -144,10 +144,6 @@ class CellsCompositor {
     std::vector<std::int64_t> face_count_vertices;  // per cell: total face-vertex entries
     if (mesh_) face_count_vertices.assign(ncell + 1, 0);
 
-    auto range_of = [](const std::vector<std::uint32_t>& ends, std::size_t t) {
-      std::uint32_t lo = t == 0 ? 0 : ends[t - 1];
-      return std::pair<std::uint32_t, std::uint32_t>(lo, ends[t]);
-    };
 
     // Pass 1: fixed-size fields and counts. Without duplicates the
     // generator and region columns are the identity and the labels, in order.
@@ -161,7 +157,7 @@ class CellsCompositor {
     tbb::parallel_for(std::size_t(0), batches.size(), [&](std::size_t k) {
       const Batch& b = batches[k];
       for (std::size_t t = 0; t < b.gen.size(); ++t) {
-        ahead(b, t, [&](std::size_t c) {
+        fetch_ahead(b, t, [&](std::size_t c) {
           __builtin_prefetch(&o.volume[c], 1);
           __builtin_prefetch(&o.centroid[c * D], 1);
           __builtin_prefetch(&o.num_faces[c], 1);
@@ -194,7 +190,7 @@ class CellsCompositor {
     tbb::parallel_for(std::size_t(0), batches.size(), [&](std::size_t k) {
       const Batch& b = batches[k];
       for (std::size_t t = 0; t < b.gen.size(); ++t) {
-        ahead(b, t, [&](std::size_t c) { __builtin_prefetch(&o.neighbor_offsets[c]); });
+        fetch_ahead(b, t, [&](std::size_t c) { __builtin_prefetch(&o.neighbor_offsets[c]); });
         std::int32_t c = cell_at(b.gen[t]);
         if (c < 0) continue;
         if (t + prefetch_ahead / 2 < b.gen.size()) {
@@ -211,6 +207,11 @@ class CellsCompositor {
 
  private:
   static constexpr std::size_t prefetch_ahead = 8;  // generators (finish)
+
+  // Entry t's range in a batch array of running ends.
+  static std::pair<std::uint32_t, std::uint32_t> range_of(const std::vector<std::uint32_t>& ends, std::size_t t) {
+    return {t == 0 ? 0 : ends[t - 1], ends[t]};
+  }
 
   // Generators come in bin order, so their cells' fields lie all over the
   // cell-ordered arrays: the loops over a batch fetch a cell's entries some
@@ -254,7 +255,7 @@ class CellsCompositor {
   // Vertex v's key (the generator and its faces' neighbour ids, ascending),
   // from batch entry t's dual form.
   Key<D> key_of(const Batch& b, std::size_t t, std::uint32_t v) const {
-    const std::int32_t* nbr = b.face_nbr.data() + (t == 0 ? 0 : b.face_end[t - 1]);
+    const std::int32_t* nbr = b.face_nbr.data() + range_of(b.face_end, t).first;
     Key<D> k;
     k[0] = b.gen[t];
     for (int j = 0; j < D; ++j) k[static_cast<std::size_t>(j) + 1] = nbr[b.corners[v][static_cast<std::size_t>(j)]];
@@ -306,9 +307,6 @@ class CellsCompositor {
   void build_mesh(std::span<Batch> batches, std::vector<std::int64_t>& fcv) {
     Cells& o = out_;
     const std::size_t ncell = o.n_cells();
-    auto range_of = [](const std::vector<std::uint32_t>& ends, std::size_t t) {
-      return std::pair<std::uint32_t, std::uint32_t>(t == 0 ? 0 : ends[t - 1], ends[t]);
-    };
     // Owned vertices per cell -> global numbering in cell order. With owners
     // known, a cell's owned vertices are its first ones, as many as the
     // positions it kept (add_vertices); otherwise each key's owner is found.
