@@ -376,16 +376,33 @@ class CellBuilder {
           loc_.for_each_shell_run(b, s, visit_run);
         }
       };
-      if constexpr (D == 3) {
+      std::size_t nr = 0, scanned = 0;
+      auto record = [&](std::uint32_t a, std::uint32_t e) {
+        if (runs_.size() == nr) [[unlikely]] runs_.resize(2 * nr + 16);
+        runs_[nr++] = {a, e};
+        scanned += e - a;
+      };
+      if (s == 2 && range == nullptr) {
+        // Shell 2 (nearly every cell reaches it: 99% in 3D, 68% in 2D on
+        // uniform points) is scanned whole, branch-free (gather_dense):
+        // pruning its bins by distance (for_each_shell_run_near) scanned
+        // fewer points (3D: 71 of ~190) but its per-shell gap tables, runs
+        // and the gather's unpredictable branch cost more (3D and 2D ~4.5%).
+        // A crowded shell (clustered points) is still pruned.
+        loc_.for_each_shell_run(b, s, record);
+        if (scanned <= dense_max) {
+          nc = gather_dense(p, nr, scanned, sec2);
+        } else {
+          nr = 0;
+          walk(record);
+          for (std::size_t r = 0; r < nr; ++r) gather(runs_[r].first, runs_[r].second);
+        }
+      } else if constexpr (D == 3) {
         // The walk only records the runs, and one loop gathers them: a 3D
         // shell has many short runs, and a call into the gather per run cost
         // more than their few points (2.5%). In 2D, with a few longer runs,
         // the detour cost 3%.
-        std::size_t nr = 0;
-        walk([&](std::uint32_t a, std::uint32_t e) {
-          if (runs_.size() == nr) [[unlikely]] runs_.resize(2 * nr + 16);
-          runs_[nr++] = {a, e};
-        });
+        walk(record);
         for (std::size_t r = 0; r < nr; ++r) gather(runs_[r].first, runs_[r].second);
       } else {
         walk(gather);
@@ -450,6 +467,51 @@ class CellBuilder {
       if (next == Next::no_cell) return status;
     }
     return status;
+  }
+
+  /// Shell 2's candidates, from the first nr runs_ (`scanned` slots, the
+  /// whole shell): every point's r2, the slot advancing only for those
+  /// within sec2 (branch-free), then their candidates and keys. The same
+  /// candidates, in the same order, as the pruned walk and gather.
+  std::size_t gather_dense(const double* p, std::size_t nr, std::size_t scanned, double sec2) {
+    work_ += scanned;
+    if (dense_slot_.size() < scanned) {
+      dense_slot_.resize(scanned);
+      dense_r2_.resize(scanned);
+    }
+    std::uint32_t* const slot = dense_slot_.data();
+    double* const rr = dense_r2_.data();
+    double c[D];
+    for (int d = 0; d < D; ++d) c[d] = p[d];
+    std::size_t n = 0;
+    for (std::size_t r = 0; r < nr; ++r) {
+      const std::uint32_t e = runs_[r].second;
+      for (std::uint32_t k = runs_[r].first; k < e; ++k) {
+        const auto& pj = loc_.point(k);
+        const double q0 = pj[0] - c[0];
+        double r2 = q0 * q0;
+        for (int d = 1; d < D; ++d) {
+          const double qd = pj[d] - c[d];
+          r2 += qd * qd;
+        }
+        slot[n] = k;
+        rr[n] = r2;
+        n += r2 <= sec2;
+      }
+    }
+    if (cand_.size() < n) [[unlikely]] {
+      cand_.resize(2 * n);
+      keys_.resize(cand_.size());
+    }
+    for (std::size_t t = 0; t < n; ++t) {
+      Candidate& cd = cand_[t];
+      const auto& pj = loc_.point(slot[t]);
+      for (int d = 0; d < D; ++d) cd.q[d] = pj[d] - c[d];
+      cd.r2 = rr[t];
+      cd.id = loc_.id(slot[t]);
+      keys_[t] = sort_key(rr[t], static_cast<std::uint32_t>(t));
+    }
+    return n;
   }
 
   /// build_nearest_first(): the k-d tree's search.
@@ -818,6 +880,11 @@ class CellBuilder {
   std::vector<double> gaps_;  // for_each_shell_run_near's scratch
   std::vector<std::pair<std::uint32_t, std::uint32_t>> runs_;  // a shell's slot runs
   std::vector<std::uint64_t> spill_;  // split_head's scratch
+  std::vector<std::uint32_t> dense_slot_;  // gather_dense's scratch
+  std::vector<double> dense_r2_;
+  /// The most points shell 2 may hold to be scanned whole (a uniform 3D
+  /// shell 2 holds ~196 at the default two points per bin).
+  static constexpr std::size_t dense_max = 512;
   SupportBound<D> support_;
   std::array<std::int32_t, D> flower_range_[2];  // flower_bins' result
   /// Above this squared security radius (nine squared smallest bin sizes)
