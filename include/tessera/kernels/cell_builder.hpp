@@ -45,7 +45,10 @@ struct BuildStatus {
   /// plus k-d tree nodes visited, plus four per candidate tested against the
   /// cell (a sign pass costs about four scanned points). Used to estimate
   /// what cells cost on an input (delaunay's skipped-cell fraction); the
-  /// same for any thread count.
+  /// same for any thread count. Scanned points are counted as the pruned
+  /// shell walk scans them only by a builder with a work cap (the pilot's,
+  /// whose rule was calibrated in those units); without one, shell 2 is
+  /// scanned whole and counted so.
   std::uint64_t work = 0;
   /// The search passed the builder's work cap (set_work_cap) and was
   /// abandoned: no cell (has_cell is false, duplicate_of -1).
@@ -79,7 +82,14 @@ class CellBuilder {
   /// exact_weight times, passes `cap` (BuildStatus::capped). For a pilot
   /// measuring what cells cost: on points nearly on one sphere every cell
   /// reaches its centre and tests every point there, most of them exactly.
-  void set_work_cap(std::uint64_t cap) { work_cap_ = cap; }
+  /// A capped builder also walks shell 2 pruned, as every shell was before
+  /// gather_dense, so that its work keeps the units the pilot's rule
+  /// (front/pilot.hpp) was calibrated in: the same cells, ~1.4 times the
+  /// scanned points on uniform 3D input otherwise.
+  void set_work_cap(std::uint64_t cap) {
+    work_cap_ = cap;
+    dense_shell2_ = cap == std::numeric_limits<std::uint64_t>::max();
+  }
   static constexpr std::uint64_t exact_weight = 32;
 
   /// How many cells this builder finished by certify_by_petals (the rest
@@ -382,13 +392,14 @@ class CellBuilder {
         runs_[nr++] = {a, e};
         scanned += e - a;
       };
-      if (s == 2 && range == nullptr) {
+      if (s == 2 && range == nullptr && dense_shell2_) {
         // Shell 2 (nearly every cell reaches it: 99% in 3D, 68% in 2D on
         // uniform points) is scanned whole, branch-free (gather_dense):
         // pruning its bins by distance (for_each_shell_run_near) scanned
         // fewer points (3D: 71 of ~190) but its per-shell gap tables, runs
         // and the gather's unpredictable branch cost more (3D and 2D ~4.5%).
-        // A crowded shell (clustered points) is still pruned.
+        // A crowded shell (clustered points) is still pruned, and so is
+        // every shell 2 of the pilot's capped builder (set_work_cap).
         loc_.for_each_shell_run(b, s, record);
         if (scanned <= dense_max) {
           nc = gather_dense(p, nr, scanned, sec2);
@@ -885,6 +896,7 @@ class CellBuilder {
   /// The most points shell 2 may hold to be scanned whole (a uniform 3D
   /// shell 2 holds ~196 at the default two points per bin).
   static constexpr std::size_t dense_max = 512;
+  bool dense_shell2_ = true;  // false for a capped builder (set_work_cap)
   SupportBound<D> support_;
   std::array<std::int32_t, D> flower_range_[2];  // flower_bins' result
   /// Above this squared security radius (nine squared smallest bin sizes)
