@@ -86,10 +86,7 @@ class CellBuilder {
   /// gather_dense, so that its work keeps the units the pilot's rule
   /// (front/pilot.hpp) was calibrated in: the same cells, ~1.4 times the
   /// scanned points on uniform 3D input otherwise.
-  void set_work_cap(std::uint64_t cap) {
-    work_cap_ = cap;
-    dense_shell2_ = cap == std::numeric_limits<std::uint64_t>::max();
-  }
+  void set_work_cap(std::uint64_t cap) { work_cap_ = cap; }
   static constexpr std::uint64_t exact_weight = 32;
 
   /// How many cells this builder finished by certify_by_petals (the rest
@@ -392,7 +389,7 @@ class CellBuilder {
         runs_[nr++] = {a, e};
         scanned += e - a;
       };
-      if (s == 2 && range == nullptr && dense_shell2_) {
+      if (s == 2 && range == nullptr && !capped_builder()) {
         // Shell 2 (nearly every cell reaches it: 99% in 3D, 68% in 2D on
         // uniform points) is scanned whole, branch-free (gather_dense):
         // pruning its bins by distance (for_each_shell_run_near) scanned
@@ -878,6 +875,7 @@ class CellBuilder {
   std::uint64_t work_ = 0;  // the current cell's BuildStatus::work
   std::uint64_t work_cap_ = std::numeric_limits<std::uint64_t>::max();  // set_work_cap
 
+  bool capped_builder() const { return work_cap_ != std::numeric_limits<std::uint64_t>::max(); }
   bool over_cap(const CellT& cell) const { return work_ + exact_weight * cell.exact_calls() > work_cap_; }
   static BuildStatus& capped(BuildStatus& status) {
     status.capped = true;
@@ -896,7 +894,6 @@ class CellBuilder {
   /// The most points shell 2 may hold to be scanned whole (a uniform 3D
   /// shell 2 holds ~196 at the default two points per bin).
   static constexpr std::size_t dense_max = 512;
-  bool dense_shell2_ = true;  // false for a capped builder (set_work_cap)
   SupportBound<D> support_;
   std::array<std::int32_t, D> flower_range_[2];  // flower_bins' result
   /// Above this squared security radius (nine squared smallest bin sizes)
