@@ -10,6 +10,7 @@
 #include <span>
 #include <vector>
 
+#include "tessera/buffer.hpp"
 #include "tessera/cells.hpp"
 #include "tessera/engine/tessellate.hpp"
 #include "tessera/kernels/exact_predicates.hpp"
@@ -56,8 +57,8 @@ struct Pass {
   std::vector<std::int32_t> ignored_outside; ///< points dropped (ignore_outside_points)
   std::optional<kernels::BinLocator<D>> locator;
   std::optional<kernels::SharedKdTree<D>> tree;  ///< of the located points (CellBuilder)
-  std::vector<std::int32_t> order;           ///< generators with cells wanted, bin order
-  std::vector<std::uint32_t> slots;          ///< their slots in the locator
+  Buffer<std::int32_t> order;                ///< generators with cells wanted, bin order
+  Buffer<std::uint32_t> slots;               ///< their slots in the locator
   kernels::ExactContext exact;
   std::vector<std::int32_t> grid;            ///< exact.grid's storage, when the input has one
   engine::Generators<D> gens;

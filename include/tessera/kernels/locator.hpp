@@ -19,6 +19,8 @@
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
+#include "tessera/buffer.hpp"
+
 namespace tessera::kernels {
 
 template <int D>
@@ -74,7 +76,7 @@ class BinLocator {
     // independent of the thread count. In parallel, in the caller's arena:
     // the ids are cut into contiguous chunks, each chunk counts its bins,
     // and chunk c's points of bin b go after those of bin b in chunks < c.
-    std::vector<std::uint32_t> bin_of(n);
+    Buffer<std::uint32_t> bin_of(n);  // (Buffers: on huge pages, not zeroed first)
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, std::size_t{1} << 14),
                       [&](const tbb::blocked_range<std::size_t>& r) {
                         for (std::size_t id = r.begin(); id != r.end(); ++id)
@@ -83,7 +85,7 @@ class BinLocator {
                       });
     const std::size_t chunks = std::clamp<std::size_t>(
         static_cast<std::size_t>(tbb::this_task_arena::max_concurrency()), 1, std::max<std::size_t>(1, n >> 16));
-    std::vector<std::vector<std::uint32_t>> count(chunks);
+    std::vector<Buffer<std::uint32_t>> count(chunks);
     auto chunk_range = [&](std::size_t c) { return std::pair{n * c / chunks, n * (c + 1) / chunks}; };
     tbb::parallel_for(std::size_t{0}, chunks, [&](std::size_t c) {
       auto [first, last] = chunk_range(c);
@@ -315,7 +317,7 @@ class BinLocator {
   double min_bin_size() const { return min_size_; }
   std::size_t size() const { return ids_.size(); }
   /// Points of bin k are slots offsets()[k] .. offsets()[k+1]).
-  const std::vector<std::uint32_t>& offsets() const { return offsets_; }
+  const Buffer<std::uint32_t>& offsets() const { return offsets_; }
   std::int32_t id(std::size_t slot) const { return ids_[slot]; }
   const Point& point(std::size_t slot) const { return sorted_[slot]; }
   const std::array<std::int32_t, D>& divisions() const { return divs_; }
@@ -369,9 +371,9 @@ class BinLocator {
   double min_size_ = 0;
   double slack_ = 0;  // a few ulp of the box coordinates
   std::array<std::int32_t, D> divs_{};
-  std::vector<std::uint32_t> offsets_;
-  std::vector<std::int32_t> ids_;   // point id per slot (bin order)
-  std::vector<Point> sorted_;       // coordinates per slot
+  Buffer<std::uint32_t> offsets_;
+  Buffer<std::int32_t> ids_;        // point id per slot (bin order)
+  Buffer<Point> sorted_;            // coordinates per slot
 };
 
 }  // namespace tessera::kernels
