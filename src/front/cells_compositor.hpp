@@ -33,8 +33,6 @@ class CellsCompositor {
   struct Batch {
     std::vector<std::int32_t> gen;          // every generator of the batch, in order
     std::vector<std::int32_t> dup_of;       // -1, or the owner it duplicates (no cell)
-    std::vector<double> volume, centroid;
-    std::vector<std::int32_t> num_faces;
     std::vector<std::uint32_t> nbr_end;     // running end into nbrs, per generator
     std::vector<std::int32_t> nbrs;
     // mesh: each cell in dual form (kernels/dual_faces.hpp), its faces numbered
@@ -56,17 +54,25 @@ class CellsCompositor {
   /// four cells) and keeps only their positions, and the mesh numbers them
   /// without finding their owners again. Otherwise every cell keeps all its
   /// positions, in the cell's own vertex order.
+  /// `out.n_points` must be set: the measures are kept by generator id.
   CellsCompositor(Cells& out, std::span<const std::int32_t> labels, bool mesh, bool owners_known = false)
-      : out_(out), labels_(labels), classify_(labels), mesh_(mesh), owners_known_(owners_known) {}
+      : out_(out), labels_(labels), classify_(labels), mesh_(mesh), owners_known_(owners_known) {
+    // Sized, not zeroed: add() writes every generator's entries, and finish
+    // reads only those of generators with cells.
+    volume_.resize(out.n_points);
+    centroid_.resize(out.n_points * D);
+    num_faces_.resize(out.n_points);
+  }
 
   void add(Batch& b, std::int32_t gen, const kernels::BuildStatus& st, CellT& cell) {
     b.assembled += st.assembled;
     b.gen.push_back(gen);
     b.dup_of.push_back(st.has_cell ? -1 : st.duplicate_of);
+    const std::size_t g = static_cast<std::size_t>(gen);
     if (!st.has_cell) {
-      b.volume.push_back(0);
-      for (int d = 0; d < D; ++d) b.centroid.push_back(0);
-      b.num_faces.push_back(0);
+      volume_[g] = 0;
+      for (int d = 0; d < D; ++d) centroid_[g * D + static_cast<std::size_t>(d)] = 0;
+      num_faces_[g] = 0;
       b.nbr_end.push_back(static_cast<std::uint32_t>(b.nbrs.size()));
       if (mesh_) {
         b.vert_end.push_back(static_cast<std::uint32_t>(b.corners.size()));
@@ -97,10 +103,10 @@ class CellsCompositor {
     double vol;
     std::array<double, D> c;
     measure(cell, vol, c);
-    b.volume.push_back(vol);
-    for (int d = 0; d < D; ++d) b.centroid.push_back(c[d] + p[d]);
+    volume_[g] = vol;
+    for (int d = 0; d < D; ++d) centroid_[g * D + static_cast<std::size_t>(d)] = c[d] + p[d];
     std::sort(b.nbrs.begin() + static_cast<std::ptrdiff_t>(nb0), b.nbrs.end());
-    b.num_faces.push_back(nf);
+    num_faces_[g] = nf;
     b.nbr_end.push_back(static_cast<std::uint32_t>(b.nbrs.size()));
   }
 
@@ -136,9 +142,17 @@ class CellsCompositor {
     // fields, the neighbour copy every entry.
     o.generator.resize(ncell);
     o.region.resize(ncell);
-    o.volume.resize(ncell);
-    o.centroid.resize(ncell * D);
-    o.num_faces.resize(ncell);
+    // The measures were written by generator id: when cell g is generator g
+    // they are the outputs as they stand; otherwise pass 1 gathers them.
+    if (dense) {
+      o.volume.swap(volume_);
+      o.centroid.swap(centroid_);
+      o.num_faces.swap(num_faces_);
+    } else {
+      o.volume.resize(ncell);
+      o.centroid.resize(ncell * D);
+      o.num_faces.resize(ncell);
+    }
     o.neighbor_offsets.assign(ncell + 1, 0);
     if (mesh_) o.cell_face_offsets.assign(ncell + 1, 0);
     std::vector<std::int64_t> face_count_vertices;  // per cell: total face-vertex entries
@@ -158,9 +172,11 @@ class CellsCompositor {
       const Batch& b = batches[k];
       for (std::size_t t = 0; t < b.gen.size(); ++t) {
         fetch_ahead(b, t, [&](std::size_t c) {
-          __builtin_prefetch(&o.volume[c], 1);
-          __builtin_prefetch(&o.centroid[c * D], 1);
-          __builtin_prefetch(&o.num_faces[c], 1);
+          if (!dense) {
+            __builtin_prefetch(&o.volume[c], 1);
+            __builtin_prefetch(&o.centroid[c * D], 1);
+            __builtin_prefetch(&o.num_faces[c], 1);
+          }
           __builtin_prefetch(&o.neighbor_offsets[c + 1], 1);
         });
         std::int32_t g = b.gen[t];
@@ -168,12 +184,13 @@ class CellsCompositor {
         if (c < 0) continue;
         std::size_t cu = static_cast<std::size_t>(c);
         if (!dense) {
+          const std::size_t gu = static_cast<std::size_t>(g);
           o.generator[cu] = g;
           o.region[cu] = labels_at(g);
+          o.volume[cu] = volume_[gu];
+          for (int d = 0; d < D; ++d) o.centroid[cu * D + d] = centroid_[gu * D + d];
+          o.num_faces[cu] = num_faces_[gu];
         }
-        o.volume[cu] = b.volume[t];
-        for (int d = 0; d < D; ++d) o.centroid[cu * D + d] = b.centroid[t * D + d];
-        o.num_faces[cu] = b.num_faces[t];
         auto [n0, n1] = range_of(b.nbr_end, t);
         o.neighbor_offsets[cu + 1] = n1 - n0;
         if (mesh_) {
@@ -476,6 +493,11 @@ class CellsCompositor {
   bool mesh_;
   bool owners_known_;
   bool dense_ = false;  // set by finish: every generator owns a cell, cell g = generator g
+  // Each cell's measures by generator id, written by add() from any thread
+  // (every generator lies in one batch, so no two threads write one entry),
+  // in place of per-batch copies: they become the outputs when dense_.
+  Buffer<double> volume_, centroid_;
+  Buffer<std::int32_t> num_faces_;
 };
 
 }  // namespace tessera::front

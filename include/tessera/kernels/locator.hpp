@@ -76,7 +76,7 @@ class BinLocator {
     // independent of the thread count. In parallel, in the caller's arena:
     // the ids are cut into contiguous chunks, each chunk counts its bins,
     // and chunk c's points of bin b go after those of bin b in chunks < c.
-    Buffer<std::uint32_t> bin_of(n);  // (Buffers: on huge pages, not zeroed first)
+    Buffer<std::uint32_t> bin_of(n);  // not zeroed first: every used id's bin is written
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, std::size_t{1} << 14),
                       [&](const tbb::blocked_range<std::size_t>& r) {
                         for (std::size_t id = r.begin(); id != r.end(); ++id)
