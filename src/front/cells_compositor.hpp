@@ -14,6 +14,7 @@
 #include <utility>
 #include <vector>
 
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
 #include "cell_geometry.hpp"
@@ -33,8 +34,13 @@ class CellsCompositor {
   struct Batch {
     std::vector<std::int32_t> gen;          // every generator of the batch, in order
     std::vector<std::int32_t> dup_of;       // -1, or the owner it duplicates (no cell)
-    std::vector<std::uint32_t> nbr_end;     // running end into nbrs, per generator
-    std::vector<std::int32_t> nbrs;
+    std::vector<std::uint32_t> nbr_end;     // running end into the batch's neighbour run, per generator
+    // The run: the neighbour ids of the batch's cells, contiguous in the
+    // store of the thread that built the batch, from nbr_base on. (One
+    // thread builds a whole batch, and no other batch in between: the
+    // engine's workspaces rely on the same.)
+    const Buffer<std::int32_t>* nbr_store = nullptr;
+    std::size_t nbr_base = 0;
     // mesh: each cell in dual form (kernels/dual_faces.hpp), its faces numbered
     // within the cell: a vertex is its D faces, a face its neighbour id
     std::vector<std::uint32_t> vert_end;    // running end into corners, per generator
@@ -65,6 +71,11 @@ class CellsCompositor {
   }
 
   void add(Batch& b, std::int32_t gen, const kernels::BuildStatus& st, CellT& cell) {
+    Buffer<std::int32_t>& nbrs = nbr_stores_.local();
+    if (b.gen.empty()) {
+      b.nbr_store = &nbrs;
+      b.nbr_base = nbrs.size();
+    }
     b.assembled += st.assembled;
     b.gen.push_back(gen);
     b.dup_of.push_back(st.has_cell ? -1 : st.duplicate_of);
@@ -73,7 +84,7 @@ class CellsCompositor {
       volume_[g] = 0;
       for (int d = 0; d < D; ++d) centroid_[g * D + static_cast<std::size_t>(d)] = 0;
       num_faces_[g] = 0;
-      b.nbr_end.push_back(static_cast<std::uint32_t>(b.nbrs.size()));
+      b.nbr_end.push_back(static_cast<std::uint32_t>(nbrs.size() - b.nbr_base));
       if (mesh_) {
         b.vert_end.push_back(static_cast<std::uint32_t>(b.corners.size()));
         b.pos_end.push_back(static_cast<std::uint32_t>(b.pos.size() / D));
@@ -82,14 +93,14 @@ class CellsCompositor {
       return;
     }
     const double* p = cell.site();
-    const std::size_t nb0 = b.nbrs.size();
+    const std::size_t nb0 = nbrs.size();
     std::int32_t nf = 0;
     // Spokes from the face planes; the mesh numbers the faces too.
     if (mesh_) {
       if (b.face_of.size() < cell.planes().size()) b.face_of.resize(cell.planes().size());
       for_each_face_plane(cell, [&](std::uint16_t pl, std::int32_t id) {
         b.face_of[pl] = static_cast<std::uint16_t>(nf++);
-        if (id >= 0) b.nbrs.push_back(id);
+        if (id >= 0) nbrs.push_back(id);
         b.face_nbr.push_back(id);
       });
       b.face_end.push_back(static_cast<std::uint32_t>(b.face_nbr.size()));
@@ -97,7 +108,7 @@ class CellsCompositor {
     } else {
       for_each_spoke(cell, [&](std::int32_t id) {
         ++nf;
-        if (id >= 0) b.nbrs.push_back(id);
+        if (id >= 0) nbrs.push_back(id);
       });
     }
     double vol;
@@ -105,9 +116,9 @@ class CellsCompositor {
     measure(cell, vol, c);
     volume_[g] = vol;
     for (int d = 0; d < D; ++d) centroid_[g * D + static_cast<std::size_t>(d)] = c[d] + p[d];
-    std::sort(b.nbrs.begin() + static_cast<std::ptrdiff_t>(nb0), b.nbrs.end());
+    std::sort(nbrs.begin() + static_cast<std::ptrdiff_t>(nb0), nbrs.end());
     num_faces_[g] = nf;
-    b.nbr_end.push_back(static_cast<std::uint32_t>(b.nbrs.size()));
+    b.nbr_end.push_back(static_cast<std::uint32_t>(nbrs.size() - b.nbr_base));
   }
 
   void finish(std::span<Batch> batches) {
@@ -215,10 +226,12 @@ class CellsCompositor {
           if (c2 >= 0) __builtin_prefetch(o.neighbors.data() + o.neighbor_offsets[static_cast<std::size_t>(c2)], 1);
         }
         auto [n0, n1] = range_of(b.nbr_end, t);
-        std::copy(b.nbrs.begin() + n0, b.nbrs.begin() + n1,
+        const std::int32_t* run = b.nbr_store->data() + b.nbr_base;
+        std::copy(run + n0, run + n1,
                   o.neighbors.begin() + o.neighbor_offsets[static_cast<std::size_t>(c)]);
       }
     });
+    nbr_stores_.clear();  // copied out: freed before the mesh's arrays (the batches' pointers are not read again)
     if (mesh_) build_mesh(batches, face_count_vertices);
   }
 
@@ -498,6 +511,10 @@ class CellsCompositor {
   // in place of per-batch copies: they become the outputs when dense_.
   Buffer<double> volume_, centroid_;
   Buffer<std::int32_t> num_faces_;
+  // Per thread, the neighbour runs of the batches it built, one after
+  // another: one growing Buffer (on huge pages once large) in place of a
+  // small vector per batch (2D 1M: ~6k fewer first-touch faults).
+  tbb::enumerable_thread_specific<Buffer<std::int32_t>> nbr_stores_;
 };
 
 }  // namespace tessera::front
