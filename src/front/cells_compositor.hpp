@@ -513,7 +513,7 @@ class CellsCompositor {
   Buffer<std::int32_t> num_faces_;
   // Per thread, the neighbour runs of the batches it built, one after
   // another: one growing Buffer (on huge pages once large) in place of a
-  // small vector per batch (2D 1M: ~6k fewer first-touch faults).
+  // small vector per batch (fewer first-touch faults: docs/design.md, stop 49).
   tbb::enumerable_thread_specific<Buffer<std::int32_t>> nbr_stores_;
 };
 

@@ -2,6 +2,7 @@
 // transparent huge pages (buffer.hpp, src/huge_pages.cpp).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
