@@ -16,6 +16,7 @@
 
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 #include "cell_geometry.hpp"
 #include "release_memory.hpp"
@@ -31,26 +32,38 @@ class CellsCompositor {
  public:
   static constexpr int D = CellT::dim;
 
+  /// A thread's variable-length output: the batches it built, one after
+  /// another, each a contiguous run in every array. One growing Buffer per
+  /// array (on huge pages once large) in place of small vectors per batch:
+  /// fewer first-touch page faults (docs/design.md, stop 49).
+  struct Store {
+    Buffer<std::int32_t> nbrs;             // neighbour ids, ascending per cell
+    // mesh: each cell in dual form (kernels/dual_faces.hpp), its faces numbered
+    // within the cell: a vertex is its D faces, a face its neighbour id
+    Buffer<kernels::Corners<D>> corners;   // (Buffers: resized, then written)
+    Buffer<double> pos;                    // absolute coordinates: every vertex's, or the owned ones'
+    Buffer<std::int32_t> face_nbr;
+  };
+
   struct Batch {
     std::vector<std::int32_t> gen;          // every generator of the batch, in order
     std::vector<std::int32_t> dup_of;       // -1, or the owner it duplicates (no cell)
-    std::vector<std::uint32_t> nbr_end;     // running end into the batch's neighbour run, per generator
-    // The run: the neighbour ids of the batch's cells, contiguous in the
-    // store of the thread that built the batch, from nbr_base on. (One
-    // thread builds a whole batch, and no other batch in between: the
-    // engine's workspaces rely on the same.)
-    const Buffer<std::int32_t>* nbr_store = nullptr;
-    std::size_t nbr_base = 0;
-    // mesh: each cell in dual form (kernels/dual_faces.hpp), its faces numbered
-    // within the cell: a vertex is its D faces, a face its neighbour id
-    std::vector<std::uint32_t> vert_end;    // running end into corners, per generator
-    Buffer<kernels::Corners<D>> corners;    // (Buffers: resized, then written)
-    Buffer<double> pos;                     // absolute coordinates: every vertex's, or the owned ones'
-    std::vector<std::uint32_t> pos_end;     // running end into pos (in vertices), per generator
-    std::vector<std::uint32_t> face_end;    // running end into face_nbr, per generator
-    std::vector<std::int32_t> face_nbr;
+    // Per generator, running ends into the batch's runs in its thread's
+    // store, which start at the bases. (One thread builds a whole batch, and
+    // no other batch in between: the engine's workspaces rely on the same.)
+    std::vector<std::uint32_t> nbr_end;
+    std::vector<std::uint32_t> vert_end;    // into corners
+    std::vector<std::uint32_t> pos_end;     // into pos, in vertices
+    std::vector<std::uint32_t> face_end;    // into face_nbr
+    Store* store = nullptr;
+    std::size_t nbr_base = 0, corner_base = 0, pos_base = 0, face_base = 0;
     std::vector<std::uint16_t> face_of;     // add()'s scratch: a local plane's face number
     std::size_t assembled = 0;              // cells assembled from their stars
+
+    const std::int32_t* nbrs() const { return store->nbrs.data() + nbr_base; }
+    const kernels::Corners<D>* corners() const { return store->corners.data() + corner_base; }
+    const double* pos() const { return store->pos.data() + pos_base * D; }
+    const std::int32_t* face_nbr() const { return store->face_nbr.data() + face_base; }
   };
 
   /// `owners_known`: no two generators coincide, so a merged vertex's owner
@@ -71,11 +84,9 @@ class CellsCompositor {
   }
 
   void add(Batch& b, std::int32_t gen, const kernels::BuildStatus& st, CellT& cell) {
-    Buffer<std::int32_t>& nbrs = nbr_stores_.local();
-    if (b.gen.empty()) {
-      b.nbr_store = &nbrs;
-      b.nbr_base = nbrs.size();
-    }
+    Store& s = stores_.local();
+    if (b.gen.empty()) start_batch(b, s);
+    Buffer<std::int32_t>& nbrs = s.nbrs;
     b.assembled += st.assembled;
     b.gen.push_back(gen);
     b.dup_of.push_back(st.has_cell ? -1 : st.duplicate_of);
@@ -86,9 +97,9 @@ class CellsCompositor {
       num_faces_[g] = 0;
       b.nbr_end.push_back(static_cast<std::uint32_t>(nbrs.size() - b.nbr_base));
       if (mesh_) {
-        b.vert_end.push_back(static_cast<std::uint32_t>(b.corners.size()));
-        b.pos_end.push_back(static_cast<std::uint32_t>(b.pos.size() / D));
-        b.face_end.push_back(static_cast<std::uint32_t>(b.face_nbr.size()));
+        b.vert_end.push_back(static_cast<std::uint32_t>(s.corners.size() - b.corner_base));
+        b.pos_end.push_back(static_cast<std::uint32_t>(s.pos.size() / D - b.pos_base));
+        b.face_end.push_back(static_cast<std::uint32_t>(s.face_nbr.size() - b.face_base));
       }
       return;
     }
@@ -101,10 +112,10 @@ class CellsCompositor {
       for_each_face_plane(cell, [&](std::uint16_t pl, std::int32_t id) {
         b.face_of[pl] = static_cast<std::uint16_t>(nf++);
         if (id >= 0) nbrs.push_back(id);
-        b.face_nbr.push_back(id);
+        s.face_nbr.push_back(id);
       });
-      b.face_end.push_back(static_cast<std::uint32_t>(b.face_nbr.size()));
-      add_vertices(b, gen, cell);
+      b.face_end.push_back(static_cast<std::uint32_t>(s.face_nbr.size() - b.face_base));
+      add_vertices(b, s, gen, cell);
     } else {
       for_each_spoke(cell, [&](std::int32_t id) {
         ++nf;
@@ -226,12 +237,11 @@ class CellsCompositor {
           if (c2 >= 0) __builtin_prefetch(o.neighbors.data() + o.neighbor_offsets[static_cast<std::size_t>(c2)], 1);
         }
         auto [n0, n1] = range_of(b.nbr_end, t);
-        const std::int32_t* run = b.nbr_store->data() + b.nbr_base;
-        std::copy(run + n0, run + n1,
+        std::copy(b.nbrs() + n0, b.nbrs() + n1,
                   o.neighbors.begin() + o.neighbor_offsets[static_cast<std::size_t>(c)]);
       }
     });
-    nbr_stores_.clear();  // copied out: freed before the mesh's arrays (the batches' pointers are not read again)
+    for (Store& s : stores_) Buffer<std::int32_t>().swap(s.nbrs);  // copied out: freed before the mesh's arrays
     if (mesh_) build_mesh(batches, face_count_vertices);
   }
 
@@ -257,17 +267,41 @@ class CellsCompositor {
     }
   }
 
+  // Batch b's runs start at the ends of thread store s. A store's first
+  // batch reserves room for its share of the cells and a half more (address
+  // space only: pages are touched as they fill), so that a store seldom
+  // doubles, whose copy would hold both sizes at once near the peak.
+  void start_batch(Batch& b, Store& s) {
+    if (s.nbrs.capacity() == 0) {
+      const auto threads = static_cast<std::size_t>(std::max(1, tbb::this_task_arena::max_concurrency()));
+      const std::size_t cells = out_.n_points / threads + out_.n_points / (2 * threads) + 64;
+      // Typical counts per uniform cell (3D: 15.5 faces, 27 vertices, a
+      // quarter of them owned; 2D: 6 of each), with room.
+      s.nbrs.reserve(cells * (D == 3 ? 17 : 7));
+      if (mesh_) {
+        s.corners.reserve(cells * (D == 3 ? 30 : 7));
+        s.pos.reserve(cells * D * (owners_known_ ? (D == 3 ? 8 : 3) : (D == 3 ? 30 : 7)));
+        s.face_nbr.reserve(cells * (D == 3 ? 17 : 7));
+      }
+    }
+    b.store = &s;
+    b.nbr_base = s.nbrs.size();
+    b.corner_base = s.corners.size();
+    b.pos_base = s.pos.size() / D;
+    b.face_base = s.face_nbr.size();
+  }
+
   // The cell's vertices in dual form (faces numbered by b.face_of) and their
   // positions: with owners known, the owned vertices first and only their
   // positions; otherwise all of them, in the cell's order.
-  void add_vertices(Batch& b, std::int32_t gen, CellT& cell) {
+  void add_vertices(Batch& b, Store& s, std::int32_t gen, CellT& cell) {
     const auto& v = cell.vertices();
     const double* p = cell.site();
-    const std::size_t nv = v.size(), v0 = b.corners.size(), p0 = b.pos.size() / D;
-    b.corners.resize(v0 + nv);
-    b.pos.resize((p0 + nv) * D);  // at most; trimmed below
-    kernels::Corners<D>* corners = b.corners.data() + v0;
-    double* pos = b.pos.data() + p0 * D;
+    const std::size_t nv = v.size(), v0 = s.corners.size(), p0 = s.pos.size() / D;
+    s.corners.resize(v0 + nv);
+    s.pos.resize((p0 + nv) * D);  // at most; trimmed below
+    kernels::Corners<D>* corners = s.corners.data() + v0;
+    double* pos = s.pos.data() + p0 * D;
     const std::uint16_t* face_of = b.face_of.data();
     std::size_t kept = 0, back = nv;
     for (std::size_t t = 0; t < nv; ++t) {
@@ -277,18 +311,19 @@ class CellsCompositor {
       for (int d = 0; d < D; ++d) pos[kept * D + d] = v[t].y[d] + p[d];  // dropped unless owned
       kept += owned;
     }
-    b.pos.resize((p0 + kept) * D);
-    b.vert_end.push_back(static_cast<std::uint32_t>(b.corners.size()));
-    b.pos_end.push_back(static_cast<std::uint32_t>(p0 + kept));
+    s.pos.resize((p0 + kept) * D);
+    b.vert_end.push_back(static_cast<std::uint32_t>(s.corners.size() - b.corner_base));
+    b.pos_end.push_back(static_cast<std::uint32_t>(p0 + kept - b.pos_base));
   }
 
   // Vertex v's key (the generator and its faces' neighbour ids, ascending),
   // from batch entry t's dual form.
   Key<D> key_of(const Batch& b, std::size_t t, std::uint32_t v) const {
-    const std::int32_t* nbr = b.face_nbr.data() + range_of(b.face_end, t).first;
+    const std::int32_t* nbr = b.face_nbr() + range_of(b.face_end, t).first;
+    const kernels::Corners<D>& corner = b.corners()[v];
     Key<D> k;
     k[0] = b.gen[t];
-    for (int j = 0; j < D; ++j) k[static_cast<std::size_t>(j) + 1] = nbr[b.corners[v][static_cast<std::size_t>(j)]];
+    for (int j = 0; j < D; ++j) k[static_cast<std::size_t>(j) + 1] = nbr[corner[static_cast<std::size_t>(j)]];
     sort_key(k);
     return k;
   }
@@ -382,7 +417,7 @@ class CellsCompositor {
             continue;
           }
           const std::size_t from = owners_known_ ? src++ : v;
-          for (int d = 0; d < D; ++d) o.vertices[gid * D + d] = b.pos[from * D + d];
+          for (int d = 0; d < D; ++d) o.vertices[gid * D + d] = b.pos()[from * D + d];
           // Id by id: the sorted key leaves its registers as 4-byte stores,
           // which a wider copy would have to wait for.
           for (int d = 0; d <= D; ++d) o.vertex_keys[gid * (D + 1) + d] = key[static_cast<std::size_t>(d)];
@@ -390,15 +425,14 @@ class CellsCompositor {
         }
         if (gid != end) unowned.store(true, std::memory_order_relaxed);
       }
-      Buffer<double>().swap(b.pos);  // copied out: freed before the face arrays are allocated
     });
+    for (Store& s : stores_) Buffer<double>().swap(s.pos);  // copied out: freed before the face arrays are allocated
     if (unowned.load())
       throw std::logic_error("tessera: a cell kept positions for other than its owned vertices");
-    // The batches' positions, freed above, lie in malloc's arenas (many
-    // allocations of a few MB each, below glibc's adaptive mmap threshold),
-    // which keep them from the system; the face arrays below are fresh
-    // mappings. Trimming hands those pages back first, so that the peak
-    // holds one of the two, not both.
+    // Memory freed above may lie in malloc's arenas (below glibc's adaptive
+    // mmap threshold), which keep it from the system; the face arrays below
+    // are fresh mappings. Trimming hands those pages back first, so that the
+    // peak holds one of the two, not both.
     release_free_memory();
     std::partial_sum(o.cell_face_offsets.begin(), o.cell_face_offsets.end(), o.cell_face_offsets.begin());
     std::partial_sum(fcv.begin(), fcv.end(), fcv.begin());
@@ -478,12 +512,12 @@ class CellsCompositor {
           gid[slot[m] - v0] = found;
         }
         auto [f0, f1] = range_of(b.face_end, t);
-        const std::int32_t* nbr = b.face_nbr.data() + f0;
+        const std::int32_t* nbr = b.face_nbr() + f0;
         std::size_t fo = static_cast<std::size_t>(o.cell_face_offsets[cu]);
         std::size_t vo = static_cast<std::size_t>(fcv[cu]);
         const std::size_t fend = static_cast<std::size_t>(o.cell_face_offsets[cu + 1]);
         const std::size_t vend = static_cast<std::size_t>(fcv[cu + 1]);
-        kernels::for_each_face_loop(std::span<const kernels::Corners<D>>(b.corners.data() + v0, v1 - v0), f1 - f0, walk,
+        kernels::for_each_face_loop(std::span<const kernels::Corners<D>>(b.corners() + v0, v1 - v0), f1 - f0, walk,
                            [&](std::size_t f, const std::uint32_t* loop, std::size_t count) {
                              if (fo == fend || count > vend - vo) return;  // (reported below)
                              o.face_neighbor[fo] = nbr[f];
@@ -511,10 +545,8 @@ class CellsCompositor {
   // in place of per-batch copies: they become the outputs when dense_.
   Buffer<double> volume_, centroid_;
   Buffer<std::int32_t> num_faces_;
-  // Per thread, the neighbour runs of the batches it built, one after
-  // another: one growing Buffer (on huge pages once large) in place of a
-  // small vector per batch (fewer first-touch faults: docs/design.md, stop 49).
-  tbb::enumerable_thread_specific<Buffer<std::int32_t>> nbr_stores_;
+  // Per thread (element references stay valid until the compositor dies).
+  tbb::enumerable_thread_specific<Store> stores_;
 };
 
 }  // namespace tessera::front
