@@ -12,6 +12,7 @@
 
 namespace tessera::detail {
 namespace {
+#if defined(__linux__)
 // TESSERA_HUGE_PAGES=0 turns the advice off (the storage stays aligned):
 // for comparing, or a system where huge pages cost more than they save.
 bool advise_enabled() {
@@ -27,6 +28,7 @@ bool advise_enabled() {
 std::size_t mapped_length(std::size_t bytes) {
   return (bytes + huge_page_bytes - 1) / huge_page_bytes * huge_page_bytes;
 }
+#endif
 }  // namespace
 
 #if defined(__linux__)
@@ -60,7 +62,6 @@ void* allocate_large(std::size_t bytes) {
 void deallocate_large(void* p, std::size_t bytes) noexcept { munmap(p, mapped_length(bytes)); }
 #else
 void* allocate_large(std::size_t bytes) {
-  (void)advise_enabled();
   return ::operator new(bytes, std::align_val_t{huge_page_bytes});
 }
 

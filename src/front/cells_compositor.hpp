@@ -84,8 +84,7 @@ class CellsCompositor {
   }
 
   void add(Batch& b, std::int32_t gen, const kernels::BuildStatus& st, CellT& cell) {
-    Store& s = stores_.local();
-    if (b.gen.empty()) start_batch(b, s);
+    Store& s = b.gen.empty() ? start_batch(b) : *b.store;
     Buffer<std::int32_t>& nbrs = s.nbrs;
     b.assembled += st.assembled;
     b.gen.push_back(gen);
@@ -95,12 +94,7 @@ class CellsCompositor {
       volume_[g] = 0;
       for (int d = 0; d < D; ++d) centroid_[g * D + static_cast<std::size_t>(d)] = 0;
       num_faces_[g] = 0;
-      b.nbr_end.push_back(static_cast<std::uint32_t>(nbrs.size() - b.nbr_base));
-      if (mesh_) {
-        b.vert_end.push_back(static_cast<std::uint32_t>(s.corners.size() - b.corner_base));
-        b.pos_end.push_back(static_cast<std::uint32_t>(s.pos.size() / D - b.pos_base));
-        b.face_end.push_back(static_cast<std::uint32_t>(s.face_nbr.size() - b.face_base));
-      }
+      close_cell(b, s);
       return;
     }
     const double* p = cell.site();
@@ -114,7 +108,6 @@ class CellsCompositor {
         if (id >= 0) nbrs.push_back(id);
         s.face_nbr.push_back(id);
       });
-      b.face_end.push_back(static_cast<std::uint32_t>(s.face_nbr.size() - b.face_base));
       add_vertices(b, s, gen, cell);
     } else {
       for_each_spoke(cell, [&](std::int32_t id) {
@@ -129,7 +122,7 @@ class CellsCompositor {
     for (int d = 0; d < D; ++d) centroid_[g * D + static_cast<std::size_t>(d)] = c[d] + p[d];
     std::sort(nbrs.begin() + static_cast<std::ptrdiff_t>(nb0), nbrs.end());
     num_faces_[g] = nf;
-    b.nbr_end.push_back(static_cast<std::uint32_t>(nbrs.size() - b.nbr_base));
+    close_cell(b, s);
   }
 
   void finish(std::span<Batch> batches) {
@@ -267,11 +260,13 @@ class CellsCompositor {
     }
   }
 
-  // Batch b's runs start at the ends of thread store s. A store's first
+  // Batch b's runs start at the ends of this thread's store, returned (the
+  // batch keeps it: no lookup per cell). A store's first
   // batch reserves room for its share of the cells and a half more (address
   // space only: pages are touched as they fill), so that a store seldom
   // doubles, whose copy would hold both sizes at once near the peak.
-  void start_batch(Batch& b, Store& s) {
+  Store& start_batch(Batch& b) {
+    Store& s = stores_.local();
     if (s.nbrs.capacity() == 0) {
       const auto threads = static_cast<std::size_t>(std::max(1, tbb::this_task_arena::max_concurrency()));
       const std::size_t cells = out_.n_points / threads + out_.n_points / (2 * threads) + 64;
@@ -289,12 +284,23 @@ class CellsCompositor {
     b.corner_base = s.corners.size();
     b.pos_base = s.pos.size() / D;
     b.face_base = s.face_nbr.size();
+    return s;
+  }
+
+  // The generator just added ends its runs here: each end relative to its
+  // run's base (the mesh's ends only with the mesh).
+  void close_cell(Batch& b, const Store& s) const {
+    b.nbr_end.push_back(static_cast<std::uint32_t>(s.nbrs.size() - b.nbr_base));
+    if (!mesh_) return;
+    b.vert_end.push_back(static_cast<std::uint32_t>(s.corners.size() - b.corner_base));
+    b.pos_end.push_back(static_cast<std::uint32_t>(s.pos.size() / D - b.pos_base));
+    b.face_end.push_back(static_cast<std::uint32_t>(s.face_nbr.size() - b.face_base));
   }
 
   // The cell's vertices in dual form (faces numbered by b.face_of) and their
   // positions: with owners known, the owned vertices first and only their
   // positions; otherwise all of them, in the cell's order.
-  void add_vertices(Batch& b, Store& s, std::int32_t gen, CellT& cell) {
+  void add_vertices(const Batch& b, Store& s, std::int32_t gen, CellT& cell) {
     const auto& v = cell.vertices();
     const double* p = cell.site();
     const std::size_t nv = v.size(), v0 = s.corners.size(), p0 = s.pos.size() / D;
@@ -312,8 +318,6 @@ class CellsCompositor {
       kept += owned;
     }
     s.pos.resize((p0 + kept) * D);
-    b.vert_end.push_back(static_cast<std::uint32_t>(s.corners.size() - b.corner_base));
-    b.pos_end.push_back(static_cast<std::uint32_t>(p0 + kept - b.pos_base));
   }
 
   // Vertex v's key (the generator and its faces' neighbour ids, ascending),
