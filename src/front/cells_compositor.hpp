@@ -120,7 +120,7 @@ class CellsCompositor {
     measure(cell, vol, c);
     volume_[g] = vol;
     for (int d = 0; d < D; ++d) centroid_[g * D + static_cast<std::size_t>(d)] = c[d] + p[d];
-    std::sort(nbrs.begin() + static_cast<std::ptrdiff_t>(nb0), nbrs.end());
+    sort_ids(nbrs.data() + nb0, nbrs.data() + nbrs.size());
     num_faces_[g] = nf;
     close_cell(b, s);
   }
@@ -285,6 +285,23 @@ class CellsCompositor {
     b.pos_base = s.pos.size() / D;
     b.face_base = s.face_nbr.size();
     return s;
+  }
+
+  // A cell's neighbour ids in ascending order. A cell has few (2D ~6, 3D
+  // ~15): an insertion sort in registers, where std::sort's own insertion
+  // step moved each new smallest id by a memmove call (2D cells ~7% of
+  // their time, stop 50). Long lists (clustered input) go to std::sort.
+  static void sort_ids(std::int32_t* first, std::int32_t* last) {
+    if (last - first > 48) {
+      std::sort(first, last);
+      return;
+    }
+    for (std::int32_t* i = first + (first != last); i < last; ++i) {
+      const std::int32_t v = *i;
+      std::int32_t* j = i;
+      for (; j > first && j[-1] > v; --j) *j = j[-1];
+      *j = v;
+    }
   }
 
   // The generator just added ends its runs here: each end relative to its
