@@ -165,10 +165,7 @@ std::vector<std::uint8_t> choose_skipped(const front::Pass<D>& pass, double frac
     for (std::size_t k = r.begin(); k != r.end(); ++k) rank_key[k] = static_cast<double>(id_hash(loc.id(k)) >> 11);
   });
   double bin_volume = 1;
-  for (int d = 0; d < D; ++d) {
-    const auto du = static_cast<std::size_t>(d);
-    bin_volume *= (pass.gens.hi[du] - pass.gens.lo[du]) / loc.divisions()[du];
-  }
+  for (int d = 0; d < D; ++d) bin_volume *= loc.bin_size(d);
   const double ball = spread_neighbours / (D == 3 ? 4.0 / 3.0 * std::numbers::pi : std::numbers::pi);
 
   // Bin k by the rank among neighbours; false (nothing decided) when the

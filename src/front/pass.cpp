@@ -214,7 +214,8 @@ Pass<D>::Pass(std::span<const double> input, std::span<const std::int32_t> label
   });
 
   // A bin far fuller than the grid was sized for (a cluster much smaller
-  // than a bin): its cells search a k-d tree of all the located points,
+  // than a bin), or points beyond the grid's box (outliers: BinLocator's
+  // grid_box): their cells search a k-d tree of all the located points,
   // built now. Otherwise the tree is built only if a long cell asks.
   // Long cells (CellBuilder::certify_by_petals) search it too, where most
   // bins are empty: points sampled on a surface. On volume-filling input
@@ -238,7 +239,7 @@ Pass<D>::Pass(std::span<const double> input, std::span<const std::int32_t> label
           for (std::size_t s = 0; s < ids.size(); ++s) ids[s] = loc.id(s);
           return ids;
         },
-        fullest > kernels::overfull_bin, 2 * empty > locator->num_bins());
+        fullest > kernels::overfull_bin || locator->outside_core() != 0, 2 * empty > locator->num_bins());
   });
 
   // Generators with cells, in bin order (neighbouring cells run together).

@@ -48,6 +48,7 @@ struct Case {
   bool wide = false;       // the points fill only the box's middle third on each axis
   double points_per_bin = 0;  // the locator's occupancy (0: automatic)
   std::size_t sparse_half = 0;  // > 0: the unit cube, one point in this many kept in its upper x half
+  bool outliers = false;   // the last three points moved 30 to 100 box widths out
 };
 
 /// Uniform points in the middle third of b on each axis: the cells of the
@@ -62,6 +63,22 @@ std::vector<double> middle_points(std::size_t n, int dim, std::uint64_t seed, co
     mid.hi[a] = b.hi[a] - w / 3;
   }
   return random_points(n, dim, seed, mid);
+}
+
+/// Uniform points in b, the last three then moved far out along different
+/// axes and directions: the default box is 30-100 times the bulk's extent,
+/// so the locator's grid spans the bulk alone (BinLocator's grid_box), the
+/// outliers lie beyond it in its edge bins, and their cells come from the
+/// k-d tree; the bulk's outer cells reach far out towards them.
+std::vector<double> outlier_points(std::size_t n, int dim, std::uint64_t seed, const tessera::Bounds& b) {
+  auto p = random_points(n, dim, seed, b);
+  const double out[3][3] = {{30, 0.5, 0.5}, {0.3, -100, 0.7}, {60, 0.4, -50}};
+  for (std::size_t k = 0; k < 3; ++k)
+    for (int a = 0; a < dim; ++a) {
+      const double w = b.hi[a] - b.lo[a];
+      p[(n - 3 + k) * dim + a] = b.lo[a] + out[k][a] * w;
+    }
+  return p;
 }
 
 /// Uniform points in b, all but the last 60 then squeezed into a blob of
@@ -109,12 +126,13 @@ void compare_with_oracle(const Case& cs) {
   SCOPED_TRACE(::testing::Message() << "dim " << cs.dim << " n " << cs.n << " seed " << cs.seed
                                     << (cs.explicit_bounds ? " explicit bounds" : " default bounds")
                                     << (cs.clustered ? " clustered" : "") << (cs.blob ? " blob" : "")
-                                    << (cs.wide ? " wide box" : "") << " points per bin " << cs.points_per_bin);
+                                    << (cs.wide ? " wide box" : "") << (cs.outliers ? " outliers" : "") << " points per bin " << cs.points_per_bin);
   const int dim = cs.dim;
   // An anisotropic, off-origin box so no axis or scale is special.
   const auto b = cs.sparse_half > 0 ? make_bounds({0, 0, 0}, {1, 1, 1}) : make_bounds({-3, 2, 10}, {7, 2.5, 11});
   const auto pts = cs.sparse_half > 0 ? half_sparse_points(cs.n, dim, cs.seed, b, cs.sparse_half)
                    : cs.blob      ? blob_points(cs.n, dim, cs.seed, b)
+                   : cs.outliers  ? outlier_points(cs.n, dim, cs.seed, b)
                    : cs.clustered ? clustered_points(cs.n, dim, cs.seed, b)
                    : cs.wide      ? middle_points(cs.n, dim, cs.seed, b)
                                   : random_points(cs.n, dim, cs.seed, b);
@@ -287,6 +305,22 @@ TEST(Oracle, CrowdedShells) {
   c3.points_per_bin = 8;
   c3.sparse_half = 30;
   for (const Case& cs : {c2, c3}) compare_with_oracle(cs);
+}
+
+// A few far outliers beside a bulk (default box, 30-100 times the bulk):
+// the grid spans the bulk and its edge bins reach out to the box.
+TEST(Oracle, FarOutliers) {
+  for (int dim : {2, 3}) {
+    Case cs{dim, 1000, 60 + static_cast<std::uint64_t>(dim), false};
+    cs.outliers = true;
+    compare_with_oracle(cs);
+    // One and two threads: the same bits (the tree path included).
+    const auto pts = outlier_points(cs.n, dim, cs.seed, make_bounds({-3, 2, 10}, {7, 2.5, 11}));
+    const tessera::Cells c1 = run(pts, dim), c2 = run(pts, dim, std::nullopt, {}, 2);
+    EXPECT_EQ(c1.volume, c2.volume) << "dim " << dim;
+    EXPECT_EQ(c1.centroid, c2.centroid) << "dim " << dim;
+    EXPECT_EQ(c1.neighbors, c2.neighbors) << "dim " << dim;
+  }
 }
 
 TEST(Oracle, Clustered) {

@@ -92,6 +92,22 @@ std::vector<Case<D>> cases() {
   add("thin far box", 800, t0, t1, 1.0, true);
   add("one bin", 40, z, one, 1000.0, false);
   add("dense", 200, a, b, 0.1, false);
+  // A bulk of tricky points in [0, 1] and a few far outliers in a box to
+  // 1000 (the lower faces close by): the grid spans the bulk (grid_box) and
+  // its edge bins reach out to the box's faces, holding the outliers (and
+  // the random queries beyond the bulk).
+  std::array<double, D> olo{}, ohi{};
+  for (int d = 0; d < D; ++d) {
+    olo[d] = -0.5;
+    ohi[d] = 1000;
+  }
+  add("outliers", 2400, z, one, 2.0, false);
+  Case<D>& o = out.back();
+  o.name = "outliers";
+  o.lo = olo;
+  o.hi = ohi;
+  for (int k = 0; k < 6; ++k)
+    for (int d = 0; d < D; ++d) o.coords.push_back(k == 5 ? -0.2 : (d == k % D ? 999.0 - k : 0.5 * k));
   return out;
 }
 
@@ -238,7 +254,7 @@ void check_shells(const Case<D>& c, std::uint64_t seed) {
       });
       EXPECT_EQ(slots_of_runs([&](auto&& f) { loc.for_each_shell_run(b, s, f); }), all) << "shell " << s;
       for (double r : {0.0, 0.3, 1.0, 1.7, 2.5, 4.0}) {
-        const double h = (c.hi[0] - c.lo[0]) / loc.divisions()[0];  // a bin edge
+        const double h = loc.bin_size(0);  // a bin edge
         const double r2max = r * r * h * h;
         std::vector<std::uint32_t> want;
         loc.for_each_shell_bin(b, s, [&](const std::array<std::int32_t, D>& cb, std::size_t bin) {
@@ -281,6 +297,25 @@ void check_bin_distance(const Case<D>& c, double slack) {
     }
   }
 }
+
+// The outlier case's grid spans the bulk alone: its bins are sized for the
+// bulk, and the outliers (and nothing else) lie beyond it.
+template <int D>
+void check_core_grid() {
+  for (const auto& c : cases<D>()) {
+    if (c.name != "outliers") continue;
+    BinLocator<D> loc(c.coords, c.use, c.lo, c.hi, c.ppb);
+    EXPECT_EQ(loc.outside_core(), 5u);  // the sixth lies just below the bulk, within its margin
+    for (int d = 0; d < D; ++d) EXPECT_LT(loc.bin_size(d), 0.25) << "axis " << d;
+    const std::size_t n = c.coords.size() / D;
+    for (std::size_t i = 0; i < n; ++i)
+      EXPECT_EQ(loc.beyond_core(&c.coords[i * D]), i >= n - 6 && i < n - 1) << "point " << i;
+    return;
+  }
+  ADD_FAILURE() << "no outlier case";
+}
+TEST(BinLocator, GridSpansTheBulkBesideOutliers2D) { check_core_grid<2>(); }
+TEST(BinLocator, GridSpansTheBulkBesideOutliers3D) { check_core_grid<3>(); }
 
 TEST(BinLocator, SortedStable2D) { for (const auto& c : cases<2>()) check_sorting(c); }
 TEST(BinLocator, SortedStable3D) { for (const auto& c : cases<3>()) check_sorting(c); }

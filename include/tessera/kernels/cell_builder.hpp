@@ -100,9 +100,13 @@ class CellBuilder {
   }
 
   /// Whether a generator at p lies in an overfull bin of a pass that built a
-  /// k-d tree: then build_nearest_first() is its cell's build (the engine asks).
+  /// k-d tree, or beyond the grid's box (an outlier, BinLocator::beyond_core,
+  /// whose cell reaches far and whose edge bin's bounds say little about its
+  /// distances): then build_nearest_first() is its cell's build (the engine
+  /// asks).
   bool in_overfull_bin(const double* p) const {
     if (tree_ == nullptr || !tree_->eager()) return false;
+    if (loc_.outside_core() != 0 && loc_.beyond_core(p)) return true;
     const std::size_t own = loc_.bin_index(loc_.bin_coords(p));
     return loc_.offsets()[own + 1] - loc_.offsets()[own] > overfull_bin;
   }

@@ -3,7 +3,16 @@
 // Points are sorted by bin (counting sort, stable in point id), with CSR
 // offsets per bin and a copy of the coordinates in bin order so the neighbour
 // search streams through memory. Bins are near-cubic: one target edge length,
-// rounded per axis to divide the box exactly.
+// rounded per axis to divide the grid's box exactly.
+//
+// The grid's box is the domain box, except along an axis where a few far
+// outliers stretch the box to more than four times the bulk of the points
+// (grid_box): there the grid spans the bulk alone, and its first and last
+// bins reach on to the box's faces. One stray point at x = 1000 beside a
+// million in the unit cube would otherwise leave the cube in one or two
+// bins, every cell scanning them. Edge bins are unbounded outward in every
+// bound below (bin_distance2, shell_lower_bound, the shells' gap tables):
+// a point in one may lie anywhere beyond its nominal face.
 #pragma once
 
 #include <algorithm>
@@ -13,6 +22,7 @@
 #include <cstdint>
 #include <limits>
 #include <span>
+#include <utility>
 #include <vector>
 
 #include <tbb/blocked_range.h>
@@ -36,6 +46,8 @@ class BinLocator {
     const std::size_t n = coords.size() / D;
     std::size_t used = use.empty() ? n : static_cast<std::size_t>(std::count(use.begin(), use.end(), 1));
     const double target_bins = std::max(1.0, static_cast<double>(used) / std::max(points_per_bin, 0.05));
+    Point glo = lo, ghi = hi;  // the grid's box
+    grid_box(coords, use, glo, ghi);
     // Cubic bins of the size that gives target_bins over the box. An axis
     // thinner than half that size gets one division, and the size is chosen
     // again over the other axes: a slab 1e-8 thick would otherwise get bins
@@ -48,20 +60,30 @@ class BinLocator {
       int wide = 0;
       for (int d = 0; d < D; ++d)
         if (!thin[d]) {
-          vol *= hi[d] - lo[d];
+          vol *= ghi[d] - glo[d];
           ++wide;
         }
       if (wide == 0) break;
       h = std::pow(vol / target_bins, 1.0 / wide);
+      if (!(vol >= std::numeric_limits<double>::min() && vol <= std::numeric_limits<double>::max())) {
+        // The product left double's range: a grid spanning the bulk of
+        // points whose outliers lie 1e200 away is scaled (front/pass.cpp)
+        // so that the bulk's volume underflows, and a zero h made
+        // 16k^3 bins. The same size by logarithms.
+        double log_vol = 0;
+        for (int d = 0; d < D; ++d)
+          if (!thin[d]) log_vol += std::log(ghi[d] - glo[d]);
+        h = std::exp((log_vol - std::log(target_bins)) / wide);
+      }
       bool again = false;
       for (int d = 0; d < D; ++d)
-        if (!thin[d] && std::round((hi[d] - lo[d]) / h) < 1) thin[d] = again = true;
+        if (!thin[d] && std::round((ghi[d] - glo[d]) / h) < 1) thin[d] = again = true;
       if (!again) break;
     }
     std::size_t total = 1;
     for (int d = 0; d < D; ++d) {
-      lo_[d] = lo[d];
-      double extent = hi[d] - lo[d];
+      lo_[d] = glo[d];
+      double extent = ghi[d] - glo[d];
       // Cap each axis so the grid stays proportionate to the point count.
       double divs = thin[d] ? 1.0 : std::clamp(std::round(extent / h), 1.0, 1.0 + 4.0 * static_cast<double>(used));
       divs_[d] = static_cast<std::int32_t>(std::min(divs, 1e6));
@@ -70,12 +92,15 @@ class BinLocator {
       total *= static_cast<std::size_t>(divs_[d]);
     }
     min_size_ = *std::min_element(size_.begin(), size_.end());
-    for (int d = 0; d < D; ++d) slack_ = std::max({slack_, std::fabs(lo[d]), std::fabs(hi[d])});
+    for (int d = 0; d < D; ++d) slack_ = std::max({slack_, std::fabs(glo[d]), std::fabs(ghi[d])});
     slack_ *= 8 * std::numeric_limits<double>::epsilon();
     // Counting sort by bin, stable in id, so the order is deterministic and
     // independent of the thread count. In parallel, in the caller's arena:
     // the ids are cut into contiguous chunks, each chunk counts its bins,
     // and chunk c's points of bin b go after those of bin b in chunks < c.
+    if (std::any_of(core_.begin(), core_.end(), [](bool c) { return c; }))
+      for (std::size_t id = 0; id < n; ++id)
+        outside_core_ += (use.empty() || use[id]) && beyond_core(&coords[id * D]);
     Buffer<std::uint32_t> bin_of(n);  // not zeroed first: every used id's bin is written
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, std::size_t{1} << 14),
                       [&](const tbb::blocked_range<std::size_t>& r) {
@@ -118,6 +143,17 @@ class BinLocator {
       }
     });
   }
+
+  /// Whether x lies beyond the grid's box along an axis where that box is
+  /// the bulk of the points, not the domain box (see grid_box): an outlier,
+  /// held by an edge bin that reaches out to it.
+  bool beyond_core(const double* x) const {
+    for (int d = 0; d < D; ++d)
+      if (core_[d] && !(x[d] >= core_lo_[d] && x[d] <= core_hi_[d])) return true;
+    return false;
+  }
+  /// How many located points lie beyond the grid's box (beyond_core).
+  std::size_t outside_core() const { return outside_core_; }
 
   std::array<std::int32_t, D> bin_coords(const double* x) const {
     std::array<std::int32_t, D> b;
@@ -170,10 +206,11 @@ class BinLocator {
   /// Never larger than the true value: bin faces are computed in floating
   /// point while points were binned by a rounded product, so each gap is
   /// shrunk by a few ulp of the box's coordinates.
+  /// Edge bins reach outward without bound (the file comment).
   double bin_distance2(const double* x, const std::array<std::int32_t, D>& b) const {
     double s = 0;
     for (int d = 0; d < D; ++d) {
-      double blo = lo_[d] + b[d] * size_[d], bhi = blo + size_[d];
+      const auto [blo, bhi] = faces(d, b[d]);
       double g = std::max({0.0, blo - x[d] - slack_, x[d] - bhi - slack_});
       s += g * g;
     }
@@ -181,12 +218,17 @@ class BinLocator {
   }
   /// Lower bound on the distance from x (in bin b) to any point in the shell of
   /// Chebyshev radius s >= 1 around b: it must cross s-1 whole bins plus the gap
-  /// from x to the nearest face of its own bin along some axis.
+  /// from x to the nearest face of its own bin along some axis. Only faces
+  /// with a bin beyond count: an edge bin's outer face has none (and x, held
+  /// there, may lie beyond it); a shell's bin differing from b by s along
+  /// axis d lies past b's inner face on that axis, with s-1 interior bins
+  /// between.
   double shell_lower_bound(const double* x, const std::array<std::int32_t, D>& b, int s) const {
     double gap = INFINITY;
     for (int d = 0; d < D; ++d) {
       double blo = lo_[d] + b[d] * size_[d];
-      gap = std::min({gap, x[d] - blo, blo + size_[d] - x[d]});
+      if (b[d] > 0) gap = std::min(gap, x[d] - blo);
+      if (b[d] < divs_[d] - 1) gap = std::min(gap, blo + size_[d] - x[d]);
     }
     return std::max(0.0, gap - slack_) + std::max(0.0, (s - 1) * min_size_ * (1 - 1e-12));
   }
@@ -243,7 +285,7 @@ class BinLocator {
     gaps.resize(D * w);
     for (int d = 0; d < D; ++d) {
       for (int o = -s; o <= s; ++o) {
-        const double blo = lo_[d] + (b[d] + o) * size_[d], bhi = blo + size_[d];
+        const auto [blo, bhi] = faces(d, b[d] + o);  // (outside the grid: never read)
         const double g = std::max(std::max(0.0, blo - x[d] - slack_), x[d] - bhi - slack_);
         const bool out = range != nullptr && (b[d] + o < range[0][d] || b[d] + o > range[1][d]);
         gaps[static_cast<std::size_t>(d) * w + static_cast<std::size_t>(o + s)] =
@@ -315,6 +357,8 @@ class BinLocator {
 
   std::size_t num_bins() const { return offsets_.size() - 1; }
   double min_bin_size() const { return min_size_; }
+  /// The bins' edge along axis d (edge bins: their nominal extent).
+  double bin_size(int d) const { return size_[d]; }
   std::size_t size() const { return ids_.size(); }
   /// Points of bin k are slots offsets()[k] .. offsets()[k+1]).
   const Buffer<std::uint32_t>& offsets() const { return offsets_; }
@@ -323,6 +367,49 @@ class BinLocator {
   const std::array<std::int32_t, D>& divisions() const { return divs_; }
 
  private:
+  // Bin c's faces along axis d: nominal inside the grid, unbounded outward
+  // at its edges (the file comment).
+  std::pair<double, double> faces(int d, std::int32_t c) const {
+    const double blo = lo_[d] + c * size_[d], bhi = blo + size_[d];
+    return {c <= 0 ? -std::numeric_limits<double>::infinity() : blo,
+            c >= divs_[d] - 1 ? std::numeric_limits<double>::infinity() : bhi};
+  }
+
+  // The grid's box, [glo, ghi] on entry the domain box (see the file
+  // comment). Per axis, the bulk of the points is the range from the k-th
+  // smallest to the k-th largest coordinate of a sample (every stride-th
+  // point, about 2^15 of them; k = a 256th of the sample), widened by a
+  // quarter on each side. It replaces the box's range where it still spans
+  // less than a quarter of it: a few points far away, whose cells the k-d
+  // tree serves (CellBuilder::in_overfull_bin). Uniform and Gaussian points
+  // never qualify (their box spans at most about twice their bulk), and
+  // heavy tails rarely reach the cells' search at all (the pass's pilot sends
+  // them to insertion). The sample is taken by id, so the grid does not
+  // depend on the thread count; any grid gives the same cells.
+  void grid_box(std::span<const double> coords, std::span<const std::uint8_t> use, Point& glo, Point& ghi) {
+    const std::size_t n = coords.size() / D;
+    const std::size_t stride = std::max<std::size_t>(1, n >> 15);
+    std::vector<double> x;
+    x.reserve(n / stride + 1);
+    for (int d = 0; d < D; ++d) {
+      x.clear();
+      for (std::size_t id = 0; id < n; id += stride)
+        if (use.empty() || use[id]) x.push_back(coords[id * D + static_cast<std::size_t>(d)]);
+      if (x.size() < 256) continue;  // too few to tell a bulk from outliers
+      const std::size_t k = x.size() / 256;
+      std::nth_element(x.begin(), x.begin() + static_cast<std::ptrdiff_t>(k), x.end());
+      const double a = x[k];
+      const auto top = x.end() - 1 - static_cast<std::ptrdiff_t>(k);
+      std::nth_element(x.begin(), top, x.end());
+      const double w = *top - a;
+      const double clo = std::max(glo[d], a - 0.25 * w), chi = std::min(ghi[d], *top + 0.25 * w);
+      if (!(w > 0) || !(chi - clo < 0.25 * (ghi[d] - glo[d]))) continue;
+      glo[d] = core_lo_[d] = clo;
+      ghi[d] = core_hi_[d] = chi;
+      core_[d] = true;
+    }
+  }
+
   // The slots of bins xa..xb of the row of c: contiguous, as bins are numbered x fastest.
   template <class F>
   void emit_run(std::array<std::int32_t, D> c, int xa, int xb, F&& f) const {
@@ -368,6 +455,9 @@ class BinLocator {
   }
 
   Point lo_{}, size_{}, inv_size_{};
+  std::array<bool, D> core_{};         // per axis: the grid spans the bulk, not the box
+  Point core_lo_{}, core_hi_{};        // that bulk's range, where core_
+  std::size_t outside_core_ = 0;
   double min_size_ = 0;
   double slack_ = 0;  // a few ulp of the box coordinates
   std::array<std::int32_t, D> divs_{};
