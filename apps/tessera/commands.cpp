@@ -251,6 +251,9 @@ void print_summary(const VoronoiArgs& a, const io::PointCloud& pc, const Cells& 
     std::printf("  %-18s %s\n", "ignored (outside)", ign.c_str());
   }
   std::printf("  %-18s %s\n", "domain", domain_string(c).c_str());
+  if (c.far_points != 0)
+    std::printf("  %-18s %zu (beyond the bulk of the points; they stretch the default domain: outliers?)\n",
+                "far points", c.far_points);
   const std::uint64_t faces = total_faces(c);
   std::printf("  %-18s %llu (%.2f per cell, box faces included)\n", d3 ? "faces" : "edges",
               static_cast<unsigned long long>(faces), c.n_cells() ? double(faces) / double(c.n_cells()) : 0.0);

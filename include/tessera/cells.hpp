@@ -124,6 +124,11 @@ struct Cells {
   std::vector<std::pair<std::int32_t, std::int32_t>> duplicates;
   std::vector<std::int32_t> ignored_outside_bounds;  ///< with ignore_outside_points
   std::uint64_t exact_predicate_calls = 0;          ///< filter failures resolved exactly
+  /// Points far beyond the bulk of the input along some axis (a few points
+  /// that stretch the default domain to over four times the bulk's extent:
+  /// likely outliers). The search grid spans the bulk, and their cells come
+  /// from a k-d tree; reported so that a user can spot them.
+  std::size_t far_points = 0;
   int threads_used = 1;
   /// The cells came from the Delaunay triangulation by insertion (CellMethod).
   bool from_insertion = false;

@@ -78,6 +78,7 @@ void bind_voronoi(py::module_& m) {
       .def_property_readonly("has_mesh", &has_mesh)
       .def_property_readonly("bounds", [](const Cells& c) { return bounds_tuple(c.bounds, c.dim); })
       .def_readonly("exact_predicate_calls", &Cells::exact_predicate_calls)
+      .def_readonly("far_points", &Cells::far_points)
       .def_readonly("threads_used", &Cells::threads_used)
       .def_readonly("from_insertion", &Cells::from_insertion)
       .def_readonly("assembled_from_stars", &Cells::assembled_from_stars)

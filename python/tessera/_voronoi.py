@@ -196,6 +196,12 @@ class Voronoi:
         return self._cells.exact_predicate_calls
 
     @property
+    def far_points(self) -> int:
+        """Points far beyond the bulk of the input (likely outliers: they
+        stretch the default domain to over four times the bulk's extent)."""
+        return self._cells.far_points
+
+    @property
     def threads_used(self) -> int:
         return self._cells.threads_used
 

@@ -37,6 +37,18 @@ def test_volumes_sum_to_the_padded_default_box(dim):
 
 
 @pytest.mark.parametrize("dim", [2, 3])
+def test_far_outliers_are_counted_and_cells_stay_whole(dim):
+    pts = random_points(3000, dim)
+    assert tessera.voronoi(pts, merge=False).far_points == 0
+    far = np.zeros((2, dim))
+    far[0, 0], far[1, -1] = 1e4, -1e6  # stretch the default box to ~1e6 the bulk
+    vor = tessera.voronoi(np.vstack([pts, far + 0.5]), merge=False)
+    assert vor.far_points == 2
+    assert vor.n_cells == 3002
+    assert vor.volumes.sum() == pytest.approx(box_volume(vor.bounds), rel=1e-9)
+
+
+@pytest.mark.parametrize("dim", [2, 3])
 def test_validate_passes_and_is_truthy(dim):
     report = tessera.voronoi(random_points(2000, dim)).validate()
     assert report.ok and bool(report), report.messages

@@ -67,6 +67,7 @@ Cells run(std::span<const double> input, std::span<const std::int32_t> labels, c
   out.bounds = pass.bounds;
   out.ignored_outside_bounds = pass.ignored_outside;
   out.threads_used = pass.engine_options.threads;
+  out.far_points = pass.locator->outside_core();
 
   // Without coincident points, a merged vertex's owner is known while its
   // cell is added, and only owners keep its position (CellsCompositor).

@@ -320,6 +320,10 @@ TEST(Oracle, FarOutliers) {
     EXPECT_EQ(c1.volume, c2.volume) << "dim " << dim;
     EXPECT_EQ(c1.centroid, c2.centroid) << "dim " << dim;
     EXPECT_EQ(c1.neighbors, c2.neighbors) << "dim " << dim;
+    EXPECT_EQ(c1.far_points, 3u) << "dim " << dim;
+    // Without the outliers, none.
+    const auto bulk = random_points(cs.n, dim, cs.seed, make_bounds({-3, 2, 10}, {7, 2.5, 11}));
+    EXPECT_EQ(run(bulk, dim).far_points, 0u) << "dim " << dim;
   }
 }
 

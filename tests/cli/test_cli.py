@@ -434,6 +434,15 @@ class Voronoi3D(TempDirCase):
             self.assertIn(word, r.stdout)
         self.assertEqual(read_vtu(out).GetNumberOfCells(), self.N)
 
+    def test_summary_names_far_points(self):
+        # Two points far beyond the bulk are reported (outliers?); none otherwise.
+        pts = np.vstack([self.pts, [[5e3, 0.5, 0.5], [0.5, -2e4, 0.5]]])
+        inp = self.save("far.npy", pts)
+        r = self.ok(["voronoi", inp, "-o", self.p("f.vtu")])
+        self.assertIn("far points         2", r.stdout)
+        r = self.ok(["voronoi", self.inp, "-o", self.p("g.vtu")])
+        self.assertNotIn("far points", r.stdout)
+
     def test_quiet(self):
         r = self.ok(["voronoi", self.inp, "-o", self.p("q.vtu"), "--quiet"])
         self.assertEqual(r.stdout, "")

@@ -17,9 +17,10 @@ lattices (coplanar hull faces up to rounding), near-duplicates, powers of ten
 from 1e-200 to 1e200 (float sort keys overflowed past 1e19; volumes
 underflow), clouds far from the origin (few significant bits), a tiny
 cluster in a huge cloud, nearly collinear and nearly coplanar points, points
-on a sphere with its centre, small integer grids, with random labels on a
-third of the cases. The only accepted failure is the input error for a zero
-extent (all points on an axis plane, or one point).
+on a sphere with its centre, small integer grids, a bulk with a few far
+outliers, with random labels on a third of the cases. The only accepted
+failure is the input error for a zero extent (all points on an axis plane,
+or one point).
 
 Prints "N passed, M failed" last; exits 1 if anything failed.
 """
@@ -47,7 +48,7 @@ def rotation(rng, d):
 
 KINDS = ["uniform", "lattice", "rotated_lattice", "rotated_lattice_scaled", "duplicates", "near_duplicates",
          "power_of_ten", "far_from_origin", "cluster_in_cloud", "nearly_collinear", "nearly_flat",
-         "sphere_and_centre", "grid_jitter", "small_integers"]
+         "sphere_and_centre", "grid_jitter", "small_integers", "far_outliers"]
 
 
 def generate(kind, rng, n, d):
@@ -89,6 +90,14 @@ def generate(kind, rng, n, d):
     if kind == "grid_jitter":
         g = lattice(int(rng.integers(2, 7)), d)
         return g + rng.normal(size=g.shape) * 1e-15
+    if kind == "far_outliers":
+        # A bulk large enough for the locator to tell it from its outliers
+        # (grid_box samples 256 points or more), and one to three points
+        # 10 to 1e30 bulk widths away in random directions.
+        p = rng.random((max(n, 300), d))
+        k = int(rng.integers(1, 4))
+        far = rng.normal(size=(k, d)) * 10.0 ** rng.integers(1, 31, size=(k, 1))
+        return np.vstack([p, far])
     if kind == "small_integers":
         return rng.integers(0, 4, size=(n, d)).astype(float)
     raise ValueError(kind)
