@@ -218,7 +218,8 @@ Pass<D>::Pass(std::span<const double> input, std::span<const std::int32_t> label
   // grid_box): their cells search a k-d tree of all the located points,
   // built now. Otherwise the tree is built only if a long cell asks.
   // Long cells (CellBuilder::certify_by_petals) search it too, where most
-  // bins are empty: points sampled on a surface. On volume-filling input
+  // bins are empty (points sampled on a surface) or outliers made it anyway
+  // (the bulk's hull cells reach out towards them). On volume-filling input
   // (about 14% of the bins empty when uniform) a few cells at the domain's
   // corners would ask for a tree the rest never use: the shell walk serves them.
   std::uint32_t fullest = 0;
@@ -239,7 +240,8 @@ Pass<D>::Pass(std::span<const double> input, std::span<const std::int32_t> label
           for (std::size_t s = 0; s < ids.size(); ++s) ids[s] = loc.id(s);
           return ids;
         },
-        fullest > kernels::overfull_bin || locator->outside_core() != 0, 2 * empty > locator->num_bins());
+        fullest > kernels::overfull_bin || locator->outside_core() != 0,
+        2 * empty > locator->num_bins() || locator->outside_core() != 0);
   });
 
   // Generators with cells, in bin order (neighbouring cells run together).
