@@ -201,7 +201,9 @@ double accurate_sum(std::span<const double> v) {
     c += std::fabs(s) >= std::fabs(x) ? (s - t) + x : (x - t) + s;
     s = t;
   }
-  return s + c;
+  // An infinite term (a cell whose volume overflows: an outlier near 1e200)
+  // makes the compensation inf - inf; the plain sum is then the answer.
+  return std::isfinite(s) ? s + c : s;
 }
 
 std::uint64_t total_faces(const Cells& c) {
