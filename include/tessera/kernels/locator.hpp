@@ -20,6 +20,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <limits>
 #include <span>
 #include <utility>
@@ -160,6 +161,15 @@ class BinLocator {
     for (int d = 0; d < D; ++d) {
       double f = std::floor((x[d] - lo_[d]) * inv_size_[d]);
       b[d] = static_cast<std::int32_t>(std::clamp(f, 0.0, static_cast<double>(divs_[d] - 1)));
+    }
+    if constexpr (D == 2) {
+      // One 8-byte store, not two of 4: GCC reads the pair back as one
+      // 8-byte vector (max_shell, vectorized), and a load spanning two
+      // narrower stores cannot be forwarded from them: a stall of ~7% of a
+      // 2D run on an Intel Xeon (stop 50).
+      const std::uint64_t packed =
+          static_cast<std::uint32_t>(b[0]) | static_cast<std::uint64_t>(static_cast<std::uint32_t>(b[1])) << 32;
+      std::memcpy(b.data(), &packed, sizeof packed);
     }
     return b;
   }
