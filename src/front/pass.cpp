@@ -230,6 +230,7 @@ Pass<D>::Pass(std::span<const double> input, std::span<const std::int32_t> label
     empty += count == 0;
   }
   const kernels::BinLocator<D>& loc = *locator;
+  const bool outliers = loc.outside_core() != 0;
   // In the arena: an eager tree's build runs parallel loops (its slabs),
   // which honour --threads there.
   tbb::task_arena(engine_options.threads).execute([&] {
@@ -240,8 +241,7 @@ Pass<D>::Pass(std::span<const double> input, std::span<const std::int32_t> label
           for (std::size_t s = 0; s < ids.size(); ++s) ids[s] = loc.id(s);
           return ids;
         },
-        fullest > kernels::overfull_bin || locator->outside_core() != 0,
-        2 * empty > locator->num_bins() || locator->outside_core() != 0);
+        fullest > kernels::overfull_bin || outliers, 2 * empty > locator->num_bins() || outliers);
   });
 
   // Generators with cells, in bin order (neighbouring cells run together).

@@ -93,18 +93,18 @@ class CellBuilder {
   /// of its long cells fell back to the shell walk): for tests and tuning.
   std::uint64_t petal_certified() const { return petal_certified_; }
 
-  /// The cell of generator i by the path its bin asks for: build(), or
-  /// build_nearest_first() in an overfull bin.
+  /// The cell of generator i by the path its place asks for: build(), or
+  /// build_nearest_first() in an overfull bin or beyond the grid (searches_tree).
   BuildStatus build_any(std::int32_t i, const double* p, CellT& cell) {
-    return in_overfull_bin(p) ? build_nearest_first(i, p, cell) : build(i, p, cell);
+    return searches_tree(p) ? build_nearest_first(i, p, cell) : build(i, p, cell);
   }
 
-  /// Whether a generator at p lies in an overfull bin of a pass that built a
-  /// k-d tree, or beyond the grid's box (an outlier, BinLocator::beyond_core,
-  /// whose cell reaches far and whose edge bin's bounds say little about its
-  /// distances): then build_nearest_first() is its cell's build (the engine
-  /// asks).
-  bool in_overfull_bin(const double* p) const {
+  /// Whether the cell of a generator at p is searched in the pass's eager
+  /// k-d tree (build_nearest_first) rather than the grid: it lies in an
+  /// overfull bin, or beyond the grid's box (an outlier, BinLocator::
+  /// beyond_core, whose cell reaches far and whose edge bin's bounds say
+  /// little about its distances).
+  bool searches_tree(const double* p) const {
     if (tree_ == nullptr || !tree_->eager()) return false;
     if (loc_.outside_core() != 0 && loc_.beyond_core(p)) return true;
     const std::size_t own = loc_.bin_index(loc_.bin_coords(p));

@@ -21,6 +21,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
+#include <functional>
 #include <limits>
 #include <span>
 #include <utility>
@@ -28,6 +29,7 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
 #include <tbb/task_arena.h>
 
 #include "tessera/buffer.hpp"
@@ -99,16 +101,21 @@ class BinLocator {
     // independent of the thread count. In parallel, in the caller's arena:
     // the ids are cut into contiguous chunks, each chunk counts its bins,
     // and chunk c's points of bin b go after those of bin b in chunks < c.
-    if (std::any_of(core_.begin(), core_.end(), [](bool c) { return c; }))
-      for (std::size_t id = 0; id < n; ++id)
-        outside_core_ += (use.empty() || use[id]) && beyond_core(&coords[id * D]);
+    // Each used point's bin, and (where the grid spans a bulk) how many lie
+    // beyond it, in the same parallel sweep.
+    const bool any_core = std::any_of(core_.begin(), core_.end(), [](bool c) { return c; });
     Buffer<std::uint32_t> bin_of(n);  // not zeroed first: every used id's bin is written
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, std::size_t{1} << 14),
-                      [&](const tbb::blocked_range<std::size_t>& r) {
-                        for (std::size_t id = r.begin(); id != r.end(); ++id)
-                          if (use.empty() || use[id])
-                            bin_of[id] = static_cast<std::uint32_t>(bin_index(bin_coords(&coords[id * D])));
-                      });
+    outside_core_ = tbb::parallel_reduce(
+        tbb::blocked_range<std::size_t>(0, n, std::size_t{1} << 14), std::size_t{0},
+        [&](const tbb::blocked_range<std::size_t>& r, std::size_t beyond) {
+          for (std::size_t id = r.begin(); id != r.end(); ++id)
+            if (use.empty() || use[id]) {
+              bin_of[id] = static_cast<std::uint32_t>(bin_index(bin_coords(&coords[id * D])));
+              beyond += any_core && beyond_core(&coords[id * D]);
+            }
+          return beyond;
+        },
+        std::plus<>());
     const std::size_t chunks = std::clamp<std::size_t>(
         static_cast<std::size_t>(tbb::this_task_arena::max_concurrency()), 1, std::max<std::size_t>(1, n >> 16));
     std::vector<Buffer<std::uint32_t>> count(chunks);
@@ -150,7 +157,7 @@ class BinLocator {
   /// held by an edge bin that reaches out to it.
   bool beyond_core(const double* x) const {
     for (int d = 0; d < D; ++d)
-      if (core_[d] && !(x[d] >= core_lo_[d] && x[d] <= core_hi_[d])) return true;
+      if (core_[d] && !(x[d] >= lo_[d] && x[d] <= core_hi_[d])) return true;
     return false;
   }
   /// How many located points lie beyond the grid's box (beyond_core).
@@ -391,7 +398,7 @@ class BinLocator {
   // point, at most 2^13 of them; k = a 256th of the sample), widened by a
   // quarter on each side. It replaces the box's range where it still spans
   // less than a quarter of it: a few points far away, whose cells the k-d
-  // tree serves (CellBuilder::in_overfull_bin). Uniform and Gaussian points
+  // tree serves (CellBuilder::searches_tree). Uniform and Gaussian points
   // never qualify (their box spans at most about twice their bulk), and
   // heavy tails rarely reach the cells' search at all (the pass's pilot sends
   // them to insertion). The sample is taken by id, so the grid does not
@@ -418,7 +425,7 @@ class BinLocator {
       const double w = *top - a;
       const double clo = std::max(glo[d], a - 0.25 * w), chi = std::min(ghi[d], *top + 0.25 * w);
       if (!(w > 0) || !(chi - clo < 0.25 * (ghi[d] - glo[d]))) continue;
-      glo[d] = core_lo_[d] = clo;
+      glo[d] = clo;  // becomes lo_
       ghi[d] = core_hi_[d] = chi;
       core_[d] = true;
     }
@@ -470,7 +477,7 @@ class BinLocator {
 
   Point lo_{}, size_{}, inv_size_{};
   std::array<bool, D> core_{};         // per axis: the grid spans the bulk, not the box
-  Point core_lo_{}, core_hi_{};        // that bulk's range, where core_
+  Point core_hi_{};                    // the bulk's upper end where core_ (its lower end is lo_)
   std::size_t outside_core_ = 0;
   double min_size_ = 0;
   double slack_ = 0;  // a few ulp of the box coordinates
