@@ -6,6 +6,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include "tessera/kernels/hull.hpp"
@@ -40,6 +41,9 @@ void measure_exactly(const Cell& cell, const std::vector<kernels::MeasureTerm>& 
 }
 
 /// Volume and centroid (relative to the generator) of a finished cell.
+/// Returns the volume's binary exponent: the volume is `volume` times
+/// 2^(D x the result), which is 0 unless the cell's sums left double's
+/// range (measure_shift; its volume alone may then over- or underflow).
 ///
 /// 3D, without walking the faces: the cell is the union of the tetrahedra
 /// (generator, c_f, y_a, y_b) over every edge a -> b of every face f's loop
@@ -52,25 +56,90 @@ void measure_exactly(const Cell& cell, const std::vector<kernels::MeasureTerm>& 
 /// its edge table: no face walk, no chain of dependent loads.
 /// 2D: the shoelace formula over the polygon's edges.
 /// Either falls back to exact arithmetic where the terms cancel (above).
-inline void measure(const kernels::Hull& hull, double& volume, std::array<double, 3>& centroid) {
+namespace detail {
+/// The k of a power of two 2^-k that brings the cell's largest |vertex
+/// coordinate| near 1: the measure of a cell whose sums overflowed or came
+/// near underflow (vertices beyond ~1e77 or below ~1e-150 in 3D, met only in
+/// input that no single frame fits, front/pass.cpp) is taken on vertices
+/// scaled by it, exactly.
+template <class Cell>
+std::int32_t measure_shift(const Cell& cell) {
+  double m = 0;
+  for (const auto& v : cell.vertices())
+    for (int d = 0; d < Cell::dim; ++d) m = std::max(m, std::fabs(v.y[d]));
+  return m > 0 && m <= std::numeric_limits<double>::max() ? kernels::filter::binary_exponent(m) + 1 : 0;
+}
+inline bool out_of_range(double mag, const double* c, int n) {
+  double t = mag;
+  for (int i = 0; i < n; ++i) t += std::fabs(c[i]);
+  return !(t <= std::numeric_limits<double>::max()) || mag < 0x1p-600;  // inf or NaN, or tiny terms
+}
+
+// The 3D measure's sums (below), of the vertices and feet scaled by `sc`
+// (a power of two; Scaled false: 1, without the multiplications).
+template <bool Scaled>
+void hull_sums(const kernels::Hull& hull, double sc, double& vol, double& mag, double* c) {
   const auto& verts = hull.vertices();
   const auto& planes = hull.planes();
-  double vol = 0, mag = 0, c[3] = {0, 0, 0};
+  vol = 0, mag = 0, c[0] = c[1] = c[2] = 0;
   for (std::size_t t = 0; t < verts.size(); ++t) {
     const auto& v = verts[t];
-    const double* a = v.y;
+    double as[3];
+    if constexpr (Scaled)
+      for (int i = 0; i < 3; ++i) as[i] = v.y[i] * sc;
+    const double* a = Scaled ? as : v.y;
     for (int k = 0; k < 3; ++k) {
       const auto& pl = planes[v.p[(k + 1) % 3]];
-      // The foot n d / |n|^2: d = |n|^2 / 2 on a bisector, |n| = 1 on a box plane.
-      const double w = pl.id >= 0 ? 0.5 : pl.d;
+      // The foot n d / |n|^2: d = |n|^2 / 2 on a bisector (2^scale times
+      // that on a scaled one), |n| = 1 on a box plane.
+      double w = pl.id < 0 ? pl.d : pl.scale == 0 ? 0.5 : std::ldexp(0.5, pl.scale);
+      if constexpr (Scaled) w *= sc;
       const double f[3] = {pl.n[0] * w, pl.n[1] * w, pl.n[2] * w};
-      const double* b = verts[hull.across(t, k)].y;
+      double bs[3];
+      const double* by = verts[hull.across(t, k)].y;
+      if constexpr (Scaled)
+        for (int i = 0; i < 3; ++i) bs[i] = by[i] * sc;
+      const double* b = Scaled ? bs : by;
       const double s = f[0] * (a[1] * b[2] - a[2] * b[1]) + f[1] * (a[2] * b[0] - a[0] * b[2]) +
                        f[2] * (a[0] * b[1] - a[1] * b[0]);
       vol += s;
       mag += std::fabs(s);
       for (int i = 0; i < 3; ++i) c[i] += s * (f[i] + a[i] + b[i]);
     }
+  }
+}
+
+template <bool Scaled>
+void tile_sums(const kernels::Tile& tile, double sc, double& s, double& mag, double* c) {
+  const auto& v = tile.vertices();
+  const std::size_t m = v.size();
+  s = 0, mag = 0, c[0] = c[1] = 0;
+  for (std::size_t k = 0; k < m; ++k) {
+    const double* ay = v[k].y;
+    const double* by = v[k + 1 == m ? 0 : k + 1].y;
+    double as[2], bs[2];
+    if constexpr (Scaled)
+      for (int i = 0; i < 2; ++i) as[i] = ay[i] * sc, bs[i] = by[i] * sc;
+    const double* a = Scaled ? as : ay;
+    const double* b = Scaled ? bs : by;
+    const double cr = a[0] * b[1] - a[1] * b[0];
+    s += cr;
+    mag += std::fabs(cr);
+    c[0] += (a[0] + b[0]) * cr;
+    c[1] += (a[1] + b[1]) * cr;
+  }
+}
+}  // namespace detail
+
+inline std::int32_t measure(const kernels::Hull& hull, double& volume, std::array<double, 3>& centroid) {
+  const auto& verts = hull.vertices();
+  const auto& planes = hull.planes();
+  double vol, mag, c[3];
+  detail::hull_sums<false>(hull, 1.0, vol, mag, c);
+  std::int32_t shift = 0;  // the sums are of coordinates scaled by 2^-shift
+  if (detail::out_of_range(mag, c, 3)) [[unlikely]] {
+    shift = detail::measure_shift(hull);
+    if (shift != 0) detail::hull_sums<true>(hull, kernels::filter::pow2(-shift), vol, mag, c);
   }
   if (measure_cancelled(vol, mag) && hull.exact_context() != nullptr && !verts.empty()) [[unlikely]] {
     thread_local std::vector<kernels::MeasureTerm> terms;
@@ -79,24 +148,24 @@ inline void measure(const kernels::Hull& hull, double& volume, std::array<double
       for (int k = 0; k < 3; ++k)
         terms.push_back({planes[verts[t].p[(k + 1) % 3]].id, static_cast<std::uint32_t>(t), hull.across(t, k)});
     measure_exactly(hull, terms, volume, centroid.data());
-    return;
+    return 0;
   }
   volume = vol / 6.0;
-  for (int i = 0; i < 3; ++i) centroid[static_cast<std::size_t>(i)] = vol != 0 ? c[i] / (4.0 * vol) : 0.0;
+  for (int i = 0; i < 3; ++i) {
+    const double ci = vol != 0 ? c[i] / (4.0 * vol) : 0.0;
+    centroid[static_cast<std::size_t>(i)] = shift == 0 ? ci : std::ldexp(ci, shift);
+  }
+  return shift;
 }
 
-inline void measure(const kernels::Tile& tile, double& area, std::array<double, 2>& centroid) {
-  const auto& v = tile.vertices();
-  const std::size_t m = v.size();
-  double s = 0, mag = 0, cx = 0, cy = 0;
-  for (std::size_t k = 0; k < m; ++k) {
-    const double* a = v[k].y;
-    const double* b = v[k + 1 == m ? 0 : k + 1].y;
-    const double cr = a[0] * b[1] - a[1] * b[0];
-    s += cr;
-    mag += std::fabs(cr);
-    cx += (a[0] + b[0]) * cr;
-    cy += (a[1] + b[1]) * cr;
+inline std::int32_t measure(const kernels::Tile& tile, double& area, std::array<double, 2>& centroid) {
+  const std::size_t m = tile.vertices().size();
+  double s, mag, c[2];
+  detail::tile_sums<false>(tile, 1.0, s, mag, c);
+  std::int32_t shift = 0;
+  if (detail::out_of_range(mag, c, 2)) [[unlikely]] {
+    shift = detail::measure_shift(tile);
+    if (shift != 0) detail::tile_sums<true>(tile, kernels::filter::pow2(-shift), s, mag, c);
   }
   if (measure_cancelled(s, mag) && tile.exact_context() != nullptr && m != 0) [[unlikely]] {
     thread_local std::vector<kernels::MeasureTerm> terms;
@@ -104,10 +173,14 @@ inline void measure(const kernels::Tile& tile, double& area, std::array<double, 
     for (std::size_t k = 0; k < m; ++k)
       terms.push_back({0, static_cast<std::uint32_t>(k), static_cast<std::uint32_t>(k + 1 == m ? 0 : k + 1)});
     measure_exactly(tile, terms, area, centroid.data());
-    return;
+    return 0;
   }
   area = 0.5 * s;
-  centroid = {s != 0 ? cx / (3 * s) : 0.0, s != 0 ? cy / (3 * s) : 0.0};
+  for (int i = 0; i < 2; ++i) {
+    const double ci = s != 0 ? c[i] / (3 * s) : 0.0;
+    centroid[static_cast<std::size_t>(i)] = shift == 0 ? ci : std::ldexp(ci, shift);
+  }
+  return shift;
 }
 
 /// Sort a key's ids ascending by a sorting network (branch-free min/max;

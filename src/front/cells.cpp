@@ -98,11 +98,11 @@ Cells run(std::span<const double> input, std::span<const std::int32_t> labels, c
       if (opt.progress) pass.engine_options.progress = [&opt](double f) { opt.progress(0.5 + 0.5 * f); };
     }
   }
-  front::CellsCompositor<CellT> comp(out, labels, opt.build_mesh, owners_known);
+  front::CellsCompositor<CellT> comp(out, labels, opt.build_mesh, owners_known, pass.k);
   out.exact_predicate_calls = engine::tessellate<CellT>(pass.gens, comp, pass.engine_options);
   std::sort(out.duplicates.begin(), out.duplicates.end());
   if (pass.k != 0) {
-    for (double& v : out.volume) v = std::ldexp(v, -pass.k * D);
+    // (volumes: already in the input's units, CellsCompositor)
     for (double& c : out.centroid) c = pass.unscale(c);
     for (double& c : out.vertices) c = pass.unscale(c);
   }

@@ -74,8 +74,12 @@ class CellsCompositor {
   /// without finding their owners again. Otherwise every cell keeps all its
   /// positions, in the cell's own vertex order.
   /// `out.n_points` must be set: the measures are kept by generator id.
-  CellsCompositor(Cells& out, std::span<const std::int32_t> labels, bool mesh, bool owners_known = false)
-      : out_(out), labels_(labels), classify_(labels), mesh_(mesh), owners_known_(owners_known) {
+  /// `frame_k`: the cells are computed on the input scaled by 2^frame_k
+  /// (front/pass.cpp); volumes are stored in the input's units, the rest in
+  /// the scaled frame.
+  CellsCompositor(Cells& out, std::span<const std::int32_t> labels, bool mesh, bool owners_known = false,
+                  int frame_k = 0)
+      : out_(out), labels_(labels), classify_(labels), mesh_(mesh), owners_known_(owners_known), frame_k_(frame_k) {
     // Sized, not zeroed: add() writes every generator's entries, and finish
     // reads only those of generators with cells.
     volume_.resize(out.n_points);
@@ -117,8 +121,10 @@ class CellsCompositor {
     }
     double vol;
     std::array<double, D> c;
-    measure(cell, vol, c);
-    volume_[g] = vol;
+    const std::int32_t shift = measure(cell, vol, c);
+    // In the input's units, rounded once (the frame's 2^-k and the measure's
+    // shift together: either alone may leave double's range).
+    volume_[g] = shift == 0 && frame_k_ == 0 ? vol : std::ldexp(vol, D * (shift - frame_k_));
     for (int d = 0; d < D; ++d) centroid_[g * D + static_cast<std::size_t>(d)] = c[d] + p[d];
     sort_ids(nbrs.data() + nb0, nbrs.data() + nbrs.size());
     num_faces_[g] = nf;
@@ -560,6 +566,7 @@ class CellsCompositor {
   engine::RegionClassifier classify_;
   bool mesh_;
   bool owners_known_;
+  int frame_k_;  // the scaled frame's 2^k (front/pass.cpp)
   bool dense_ = false;  // set by finish: every generator owns a cell, cell g = generator g
   // Each cell's measures by generator id, written by add() from any thread
   // (every generator lies in one batch, so no two threads write one entry),

@@ -36,6 +36,7 @@ void bisector_planes(std::vector<Plane>& planes, std::size_t first, const std::i
     pl.d = 0.5 * d;
     pl.n1 = n1;
     pl.id = ids[k];
+    pl.scale = 0;  // assemble() refuses extreme input (may_underflow), the only kind with huge bisectors
   }
 }
 
@@ -96,6 +97,7 @@ bool far_plane(const double* dirs, std::size_t k, const Plane* box, const Vertex
   out.d = c;
   out.n1 = n1;
   out.id = far_plane_id;
+  out.scale = 0;
   return true;
 }
 

@@ -36,6 +36,12 @@ inline constexpr double vertex_eps = 64 * u;
 /// (front/pass.cpp, choose_scaling), and this never matters on sane data.
 /// Vertex solves, which divide, need more: underflow_slack.
 inline constexpr double abs_eps = 0x1p-900;
+/// The same slack in a vertex's radius bound r2 (a sum of three squares
+/// errs by at most 3 x 2^-1075 below DBL_MIN), kept far below abs_eps: in a
+/// frame where the bulk of the points lies near 2^-465 (beside an outlier
+/// at 1e200, front/pass.cpp) their r2 are ~2^-940, and abs_eps made every
+/// security radius span the whole bulk.
+inline constexpr double radius_abs_eps = 0x1p-1000;
 /// The absolute error that underflow adds to a vertex solved by Cramer's
 /// rule (3D, or 2D with its smaller sums), beyond the relative bound. Each
 /// product that rounds below DBL_MIN errs by eta <= 2^-1075 (sums of
@@ -65,6 +71,43 @@ inline std::int32_t binary_exponent(double x) {
 
 /// 2^e for e in [-1022, 1023], built from the bits (no libm call).
 inline double pow2(std::int32_t e) { return std::bit_cast<double>(static_cast<std::uint64_t>(e + 1023) << 52); }
+
+/// Bisectors of points very far from, or very near to, the generator (|q|
+/// beyond about 2^200 or below about 2^-300) are stored scaled: n = q 2^-s,
+/// d = |n|^2 2^s / 2 and n1 = |n|_1, with s = floor(log2 |q|_1), the same
+/// plane n.y = d with |n|_1 in [1, 2). Such planes occur only in input that no
+/// single power-of-two frame fits (front/pass.cpp: a bulk of points and a far
+/// outlier, 1e-200 beside 1). Unscaled, d = |q|^2 / 2 overflows (from |q| ~
+/// 1.3e154) or its products with the cofactors do in the vertex solve; at the
+/// small end those products underflow, and the vertices came out as zeros.
+/// Either way every plane value and vertex went to the exact stage in
+/// rationals (4,000 points beside one at 1e200: 9.6 s, now 0.03 s). Scaling
+/// by a power of two is exact, and Cramer's rule gives the same vertex on
+/// rows scaled by powers of two, so the filter's relative bounds hold as for
+/// any plane. classify() takes the unscaled d for its radius test.
+inline constexpr double huge_bisector_d = 0x1p400, tiny_bisector_d = 0x1p-600;
+/// Whether the bisector with offset d = |q|^2 / 2 is stored as computed.
+inline bool ordinary_bisector(double d) { return d <= huge_bisector_d && d >= tiny_bisector_d; }
+/// For a bisector not ordinary_bisector: writes its scaled form into n, d,
+/// n1 (d: |q|^2 / 2 and n1: |q|_1 on entry) and returns s; returns 0 with
+/// n = q and d, n1 unchanged where q is 0 (a duplicate) or |q| itself
+/// overflowed, which the exact stage decides.
+template <int D>
+[[gnu::noinline, gnu::cold]] std::int32_t scale_bisector(const double* q, double* n, double& d, double& n1) {
+  for (int a = 0; a < D; ++a) n[a] = q[a];
+  if (!(n1 > 0 && n1 <= std::numeric_limits<double>::max())) return 0;
+  const std::int32_t s = binary_exponent(n1);
+  const double down = pow2(-s);
+  double nn = 0, l1 = 0;
+  for (int a = 0; a < D; ++a) {
+    n[a] = q[a] * down;
+    nn += n[a] * n[a];
+    l1 += std::fabs(n[a]);
+  }
+  d = 0.5 * nn * pow2(s);
+  n1 = l1;
+  return s;
+}
 
 /// memmove of `count` elements from base[src] to base[dst] (the ranges may
 /// overlap) as a plain loop: the moves are a few elements long, where a
@@ -206,13 +249,16 @@ inline Lane load(const double* p) {
 /// for term, as a scalar loop's (no contraction), so the signs do not depend on
 /// the vector width.
 template <int D, class Exact>
-std::size_t classify(const FilterLanes<D>& f, const double* n, double d, double n1,
+std::size_t classify(const FilterLanes<D>& f, const double* n, double d, double n1, double d_unscaled,
                      std::vector<Sign>& sign, Exact&& exact) {
   static_assert(FilterLanes<D>::lanes == 4, "two detail::Lanes per lane group");
   using detail::Lane;
   using detail::LaneMask;
   const std::size_t nv = f.size(), np = f.padded();
-  const double q2lo = 2.0 * d * (1.0 - 1e-12) - abs_eps;  // <= the exact |p_j - p_i|^2
+  // <= the exact |p_j - p_i|^2 (from the plane's d before scale_bisector:
+  // infinite only where the exact value exceeds every double, and so any
+  // finite 4 r2)
+  const double q2lo = 2.0 * d_unscaled * (1.0 - 1e-12) - abs_eps;
   const double de = plane_eps * std::fabs(d) + abs_eps;
   const double* E = f.e();
   const double* R = f.r2();

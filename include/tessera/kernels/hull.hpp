@@ -50,6 +50,7 @@ class Hull {
     double d;
     double n1;           // |n|_1, for the error bound
     std::int32_t id;     // generator id, or box-plane id < 0
+    std::int32_t scale;  // a bisector: n = q 2^-scale, 0 unless q is huge (filter::scale_bisector)
   };
   struct Vertex {
     double y[3];         // position relative to the generator
@@ -88,10 +89,18 @@ class Hull {
 
   /// Clip by the bisector with generator j, q = p_j - p_i (computed in double).
   ClipResult clip(std::int32_t j, const double* q) {
-    const double d = 0.5 * (q[0] * q[0] + q[1] * q[1] + q[2] * q[2]);
-    const double n1 = std::fabs(q[0]) + std::fabs(q[1]) + std::fabs(q[2]);
+    double d = 0.5 * (q[0] * q[0] + q[1] * q[1] + q[2] * q[2]);
+    double n1 = std::fabs(q[0]) + std::fabs(q[1]) + std::fabs(q[2]);
+    const double d_unscaled = d;
+    const double* n = q;
+    double scaled[3];
+    std::int32_t scale = 0;
+    if (!filter::ordinary_bisector(d)) [[unlikely]] {  // a far outlier's, in extreme input
+      scale = filter::scale_bisector<3>(q, scaled, d, n1);
+      n = scaled;
+    }
     const std::size_t nv = verts_.size();
-    const std::size_t removed = filter::classify<3>(lanes_, q, d, n1, sign_,
+    const std::size_t removed = filter::classify<3>(lanes_, n, d, n1, d_unscaled, sign_,
                                                      [&](std::size_t t) { return exact_sign(t, j); });
     if (removed == 0) return ClipResult::unchanged;
     if (removed == nv) {
@@ -104,10 +113,11 @@ class Hull {
     if (planes_.size() + 1 >= 0xFFFF)
       throw std::length_error("tessera: a cell has more than 65534 faces");
     Plane& pl = planes_.emplace_back();  // written in place (see reset)
-    pl.n[0] = q[0]; pl.n[1] = q[1]; pl.n[2] = q[2];
+    pl.n[0] = n[0]; pl.n[1] = n[1]; pl.n[2] = n[2];
     pl.d = d;
     pl.n1 = n1;
     pl.id = j;
+    pl.scale = scale;
     if (planes_.size() > cap_) ensure_table(2 * cap_);
     cut(pn, nv);
     return ClipResult::clipped;
@@ -372,6 +382,7 @@ class Hull {
       pl.d = upper ? hi[axis] - p[axis] : p[axis] - lo[axis];
       pl.n1 = 1.0;
       pl.id = box_plane_id(axis, upper);
+      pl.scale = 0;
     }
     resize_vertices(0);  // nothing stale for ensure_table to link
   }
@@ -488,7 +499,7 @@ class Hull {
   static void set_radius(Vertex& v, double err) {
     double a = v.y[0] * v.y[0] + v.y[1] * v.y[1] + v.y[2] * v.y[2];
     double l1 = std::fabs(v.y[0]) + std::fabs(v.y[1]) + std::fabs(v.y[2]);
-    v.r2 = (a + 4.0 * err * (l1 + err)) * (1.0 + 1e-12) + filter::abs_eps;
+    v.r2 = (a + 4.0 * err * (l1 + err)) * (1.0 + 1e-12) + filter::radius_abs_eps;
     if (!(v.r2 < std::numeric_limits<double>::infinity())) v.r2 = std::numeric_limits<double>::infinity();  // NaN too
   }
 

@@ -38,6 +38,7 @@ class Tile {
     double d;
     double n1;
     std::int32_t id;
+    std::int32_t scale;  // a bisector: n = q 2^-scale, 0 unless q is huge (filter::scale_bisector)
   };
   struct Vertex {
     double y[2];
@@ -69,10 +70,18 @@ class Tile {
   }
 
   ClipResult clip(std::int32_t j, const double* q) {
-    const double d = 0.5 * (q[0] * q[0] + q[1] * q[1]);
-    const double n1 = std::fabs(q[0]) + std::fabs(q[1]);
+    double d = 0.5 * (q[0] * q[0] + q[1] * q[1]);
+    double n1 = std::fabs(q[0]) + std::fabs(q[1]);
+    const double d_unscaled = d;
+    const double* n = q;
+    double scaled[2];
+    std::int32_t scale = 0;
+    if (!filter::ordinary_bisector(d)) [[unlikely]] {  // a far outlier's, in extreme input
+      scale = filter::scale_bisector<2>(q, scaled, d, n1);
+      n = scaled;
+    }
     const std::size_t nv = verts_.size();
-    const std::size_t removed = filter::classify<2>(lanes_, q, d, n1, sign_,
+    const std::size_t removed = filter::classify<2>(lanes_, n, d, n1, d_unscaled, sign_,
                                                      [&](std::size_t t) { return exact_sign(t, j); });
     if (removed == 0) return ClipResult::unchanged;
     if (removed == nv) {
@@ -84,10 +93,11 @@ class Tile {
     if (planes_.size() + 1 >= 0xFFFF) throw std::length_error("tessera: a tile has more than 65534 edges");
     const std::uint16_t pn = static_cast<std::uint16_t>(planes_.size());
     Plane& pl = planes_.emplace_back();  // written in place (see reset)
-    pl.n[0] = q[0]; pl.n[1] = q[1];
+    pl.n[0] = n[0]; pl.n[1] = n[1];
     pl.d = d;
     pl.n1 = n1;
     pl.id = j;
+    pl.scale = scale;
     cut(pn, nv, removed);
     return ClipResult::clipped;
   }
@@ -240,6 +250,7 @@ class Tile {
       pl.d = upper ? hi[axis] - p[axis] : p[axis] - lo[axis];
       pl.n1 = 1.0;
       pl.id = box_plane_id(axis, upper);
+      pl.scale = 0;
     }
   }
 
@@ -292,7 +303,7 @@ class Tile {
   static T radius2(T y0, T y1, T err) {
     const T a = y0 * y0 + y1 * y1;
     const T l1 = magnitude(y0) + magnitude(y1);
-    return (a + 4.0 * err * (l1 + err)) * (1.0 + 1e-12) + filter::abs_eps;
+    return (a + 4.0 * err * (l1 + err)) * (1.0 + 1e-12) + filter::radius_abs_eps;
   }
 
   // solve() for the two new vertices of a clip at once, one division for
