@@ -7,6 +7,8 @@
 // code or idea with tessera beyond the definition of a Voronoi cell.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 
 #include "helpers.hpp"
@@ -324,6 +326,74 @@ TEST(Oracle, FarOutliers) {
     // Without the outliers, none.
     const auto bulk = random_points(cs.n, dim, cs.seed, make_bounds({-3, 2, 10}, {7, 2.5, 11}));
     EXPECT_EQ(run(bulk, dim).far_points, 0u) << "dim " << dim;
+  }
+}
+
+// One outlier so far that no single power-of-two frame fits the input
+// (2^600 beside unit points, or unit points beside 2^-600: the kernels then
+// store its bisectors scaled, filter::scale_bisector, and rescale measures
+// that leave double's range). The bulk's interior cells (no box plane when
+// the bulk is alone in its own box) cannot see the outlier: the same
+// neighbours as the bulk alone, and the same volumes and centroids to
+// rounding; 1 and 2 threads give the same bits. Before the scaling, these
+// inputs took seconds, every bulk vertex underflowing to zero and every
+// measure going to rationals.
+TEST(Oracle, OutlierBeyondEveryFrame) {
+  for (int dim : {2, 3}) {
+    for (int e : {600, -600}) {
+      SCOPED_TRACE(testing::Message() << "dim " << dim << " exponent " << e);
+      const std::size_t n = dim == 2 ? 3000 : 2000;
+      const auto unit = make_bounds({0, 0, 0}, {1, 1, 1});
+      const auto bulk = random_points(n, dim, 70 + static_cast<std::uint64_t>(dim), unit);
+      // e > 0: the bulk at unit scale, the outlier at 2^e; e < 0: the bulk
+      // scaled by 2^e, the outlier at 1 on every axis.
+      const double s = e > 0 ? 1.0 : std::ldexp(1.0, e), far = e > 0 ? std::ldexp(1.0, e) : 1.0;
+      std::vector<double> pts(bulk);
+      for (double& x : pts) x *= s;
+      for (int a = 0; a < dim; ++a) pts.push_back(far);
+      // The search, and the clips by Delaunay neighbours: the same topology.
+      auto opt = options(dim, std::nullopt, 1);
+      opt.cell_method = tessera::CellMethod::search;
+      const tessera::Cells c = tessera::voronoi(pts, dim, {}, opt);
+      opt.threads = 2;
+      const tessera::Cells c2 = tessera::voronoi(pts, dim, {}, opt);
+      EXPECT_EQ(c.volume, c2.volume);
+      EXPECT_EQ(c.centroid, c2.centroid);
+      EXPECT_EQ(c.neighbors, c2.neighbors);
+      EXPECT_EQ(c.far_points, 1u);
+      opt.cell_method = tessera::CellMethod::insertion;
+      const tessera::Cells ci = tessera::voronoi(pts, dim, {}, opt);
+      EXPECT_EQ(c.neighbors, ci.neighbors);
+      EXPECT_EQ(c.neighbor_offsets, ci.neighbor_offsets);
+      const tessera::Cells alone = run(bulk, dim, unit);
+      std::size_t interior = 0;
+      for (std::size_t i = 0; i < n; ++i) {
+        const auto nb = neighbours_of(alone, i);
+        if (static_cast<std::size_t>(alone.num_faces[i]) != nb.size()) continue;  // touches the unit box
+        ++interior;
+        ASSERT_EQ(neighbours_of(c, i), nb) << "cell " << i;
+        // volume scales by s^dim: below double's range for e < 0 (then 0 or
+        // subnormal, as the exact value rounds)
+        const double v = std::ldexp(alone.volume[i], dim * (e > 0 ? 0 : e));
+        EXPECT_NEAR(c.volume[i], v, 1e-12 * v + 0x1p-1074) << "cell " << i;
+        for (int a = 0; a < dim; ++a) {
+          const double x = alone.centroid[i * dim + a] * s;
+          EXPECT_NEAR(c.centroid[i * dim + a], x, 1e-12 * s) << "cell " << i;
+        }
+      }
+      EXPECT_GT(interior, n / 2);
+      // The outlier's own cell and the bulk's hull cells are there too, with
+      // symmetric adjacency.
+      EXPECT_EQ(c.volume.size(), n + 1);
+      for (std::size_t i = 0; i <= n; ++i)
+        for (std::int32_t j : neighbours_of(c, i)) {
+          if (j < 0) continue;
+          const auto back = neighbours_of(c, static_cast<std::size_t>(j));
+          EXPECT_TRUE(std::binary_search(back.begin(), back.end(), static_cast<std::int32_t>(i)))
+              << i << " -> " << j;
+        }
+      EXPECT_FALSE(neighbours_of(c, n).empty());
+    }
   }
 }
 
