@@ -78,36 +78,59 @@ inline double pow2(std::int32_t e) { return std::bit_cast<double>(static_cast<st
 /// plane n.y = d with |n|_1 in [1, 2). Such planes occur only in input that no
 /// single power-of-two frame fits (front/pass.cpp: a bulk of points and a far
 /// outlier, 1e-200 beside 1). Unscaled, d = |q|^2 / 2 overflows (from |q| ~
-/// 1.3e154) or its products with the cofactors do in the vertex solve; at the
-/// small end those products underflow, and the vertices came out as zeros.
-/// Either way every plane value and vertex went to the exact stage in
-/// rationals (4,000 points beside one at 1e200: 9.6 s, now 0.03 s). Scaling
+/// 1.3e154) or its products with the cofactors do in the vertex solve, and
+/// every sign against it went to the exact stage; at the small end those
+/// products underflow, the vertices came out as zeros, and every cell was
+/// measured in rationals (4,000 points beside one at 1e200: 9.6 s, now
+/// 0.25 s; docs/design.md, "Bisectors beyond the frame"). Scaling
 /// by a power of two is exact, and Cramer's rule gives the same vertex on
 /// rows scaled by powers of two, so the filter's relative bounds hold as for
 /// any plane. classify() takes the unscaled d for its radius test.
 inline constexpr double huge_bisector_d = 0x1p400, tiny_bisector_d = 0x1p-600;
-/// Whether the bisector with offset d = |q|^2 / 2 is stored as computed.
-inline bool ordinary_bisector(double d) { return d <= huge_bisector_d && d >= tiny_bisector_d; }
-/// For a bisector not ordinary_bisector: writes its scaled form into n, d,
-/// n1 (d: |q|^2 / 2 and n1: |q|_1 on entry) and returns s; returns 0 with
-/// n = q and d, n1 unchanged where q is 0 (a duplicate) or |q| itself
-/// overflowed, which the exact stage decides.
+/// The bisector with q = p_j - p_i as a clip tests and stores it: n.y <= d,
+/// n = q and d = |q|^2 / 2 (both rounded once), n1 = |n|_1, or the scaled
+/// form above where d lies outside [tiny_bisector_d, huge_bisector_d] (scale
+/// != 0). Used in place: n may point into the object itself.
 template <int D>
-[[gnu::noinline, gnu::cold]] std::int32_t scale_bisector(const double* q, double* n, double& d, double& n1) {
-  for (int a = 0; a < D; ++a) n[a] = q[a];
-  if (!(n1 > 0 && n1 <= std::numeric_limits<double>::max())) return 0;
-  const std::int32_t s = binary_exponent(n1);
-  const double down = pow2(-s);
-  double nn = 0, l1 = 0;
-  for (int a = 0; a < D; ++a) {
-    n[a] = q[a] * down;
-    nn += n[a] * n[a];
-    l1 += std::fabs(n[a]);
+struct Bisector {
+  const double* n;
+  double d, n1;
+  double d_unscaled;      // |q|^2 / 2 as computed: classify's radius test
+  std::int32_t scale = 0;
+  double scaled[D];
+
+  explicit Bisector(const double* q) : n(q) {
+    d = 0, n1 = 0;
+    for (int a = 0; a < D; ++a) {
+      d += q[a] * q[a];
+      n1 += std::fabs(q[a]);
+    }
+    d *= 0.5;
+    d_unscaled = d;
+    if (!(d <= huge_bisector_d && d >= tiny_bisector_d)) [[unlikely]]  // a far outlier's, in extreme input
+      rescale(q);
   }
-  d = 0.5 * nn * pow2(s);
-  n1 = l1;
-  return s;
-}
+  Bisector(const Bisector&) = delete;
+  Bisector& operator=(const Bisector&) = delete;
+
+ private:
+  // Leaves q unscaled where it is 0 (a duplicate) or |q| itself overflowed:
+  // the exact stage decides those.
+  [[gnu::noinline, gnu::cold]] void rescale(const double* q) {
+    if (!(n1 > 0 && n1 <= std::numeric_limits<double>::max())) return;
+    scale = binary_exponent(n1);
+    const double down = pow2(-scale);
+    double nn = 0, l1 = 0;
+    for (int a = 0; a < D; ++a) {
+      scaled[a] = q[a] * down;
+      nn += scaled[a] * scaled[a];
+      l1 += std::fabs(scaled[a]);
+    }
+    n = scaled;
+    d = 0.5 * nn * pow2(scale);
+    n1 = l1;
+  }
+};
 
 /// memmove of `count` elements from base[src] to base[dst] (the ranges may
 /// overlap) as a plain loop: the moves are a few elements long, where a
@@ -255,7 +278,7 @@ std::size_t classify(const FilterLanes<D>& f, const double* n, double d, double 
   using detail::Lane;
   using detail::LaneMask;
   const std::size_t nv = f.size(), np = f.padded();
-  // <= the exact |p_j - p_i|^2 (from the plane's d before scale_bisector:
+  // <= the exact |p_j - p_i|^2 (from the plane's d before Bisector's scaling:
   // infinite only where the exact value exceeds every double, and so any
   // finite 4 r2)
   const double q2lo = 2.0 * d_unscaled * (1.0 - 1e-12) - abs_eps;

@@ -50,7 +50,7 @@ class Hull {
     double d;
     double n1;           // |n|_1, for the error bound
     std::int32_t id;     // generator id, or box-plane id < 0
-    std::int32_t scale;  // a bisector: n = q 2^-scale, 0 unless q is huge (filter::scale_bisector)
+    std::int32_t scale;  // a bisector: n = q 2^-scale, 0 unless q is huge (filter::Bisector)
   };
   struct Vertex {
     double y[3];         // position relative to the generator
@@ -89,18 +89,9 @@ class Hull {
 
   /// Clip by the bisector with generator j, q = p_j - p_i (computed in double).
   ClipResult clip(std::int32_t j, const double* q) {
-    double d = 0.5 * (q[0] * q[0] + q[1] * q[1] + q[2] * q[2]);
-    double n1 = std::fabs(q[0]) + std::fabs(q[1]) + std::fabs(q[2]);
-    const double d_unscaled = d;
-    const double* n = q;
-    double scaled[3];
-    std::int32_t scale = 0;
-    if (!filter::ordinary_bisector(d)) [[unlikely]] {  // a far outlier's, in extreme input
-      scale = filter::scale_bisector<3>(q, scaled, d, n1);
-      n = scaled;
-    }
+    const filter::Bisector<3> b(q);
     const std::size_t nv = verts_.size();
-    const std::size_t removed = filter::classify<3>(lanes_, n, d, n1, d_unscaled, sign_,
+    const std::size_t removed = filter::classify<3>(lanes_, b.n, b.d, b.n1, b.d_unscaled, sign_,
                                                      [&](std::size_t t) { return exact_sign(t, j); });
     if (removed == 0) return ClipResult::unchanged;
     if (removed == nv) {
@@ -113,11 +104,11 @@ class Hull {
     if (planes_.size() + 1 >= 0xFFFF)
       throw std::length_error("tessera: a cell has more than 65534 faces");
     Plane& pl = planes_.emplace_back();  // written in place (see reset)
-    pl.n[0] = n[0]; pl.n[1] = n[1]; pl.n[2] = n[2];
-    pl.d = d;
-    pl.n1 = n1;
+    pl.n[0] = b.n[0]; pl.n[1] = b.n[1]; pl.n[2] = b.n[2];
+    pl.d = b.d;
+    pl.n1 = b.n1;
     pl.id = j;
-    pl.scale = scale;
+    pl.scale = b.scale;
     if (planes_.size() > cap_) ensure_table(2 * cap_);
     cut(pn, nv);
     return ClipResult::clipped;

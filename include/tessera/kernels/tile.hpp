@@ -38,7 +38,7 @@ class Tile {
     double d;
     double n1;
     std::int32_t id;
-    std::int32_t scale;  // a bisector: n = q 2^-scale, 0 unless q is huge (filter::scale_bisector)
+    std::int32_t scale;  // a bisector: n = q 2^-scale, 0 unless q is huge (filter::Bisector)
   };
   struct Vertex {
     double y[2];
@@ -70,18 +70,9 @@ class Tile {
   }
 
   ClipResult clip(std::int32_t j, const double* q) {
-    double d = 0.5 * (q[0] * q[0] + q[1] * q[1]);
-    double n1 = std::fabs(q[0]) + std::fabs(q[1]);
-    const double d_unscaled = d;
-    const double* n = q;
-    double scaled[2];
-    std::int32_t scale = 0;
-    if (!filter::ordinary_bisector(d)) [[unlikely]] {  // a far outlier's, in extreme input
-      scale = filter::scale_bisector<2>(q, scaled, d, n1);
-      n = scaled;
-    }
+    const filter::Bisector<2> b(q);
     const std::size_t nv = verts_.size();
-    const std::size_t removed = filter::classify<2>(lanes_, n, d, n1, d_unscaled, sign_,
+    const std::size_t removed = filter::classify<2>(lanes_, b.n, b.d, b.n1, b.d_unscaled, sign_,
                                                      [&](std::size_t t) { return exact_sign(t, j); });
     if (removed == 0) return ClipResult::unchanged;
     if (removed == nv) {
@@ -93,11 +84,11 @@ class Tile {
     if (planes_.size() + 1 >= 0xFFFF) throw std::length_error("tessera: a tile has more than 65534 edges");
     const std::uint16_t pn = static_cast<std::uint16_t>(planes_.size());
     Plane& pl = planes_.emplace_back();  // written in place (see reset)
-    pl.n[0] = n[0]; pl.n[1] = n[1];
-    pl.d = d;
-    pl.n1 = n1;
+    pl.n[0] = b.n[0]; pl.n[1] = b.n[1];
+    pl.d = b.d;
+    pl.n1 = b.n1;
     pl.id = j;
-    pl.scale = scale;
+    pl.scale = b.scale;
     cut(pn, nv, removed);
     return ClipResult::clipped;
   }
