@@ -77,7 +77,9 @@ inline bool out_of_range(double mag, const double* c, int n) {
 
 // The 3D measure's sums (below), of the vertices and feet scaled by `sc`
 // (a power of two; Scaled false: 1, without the multiplications).
-template <bool Scaled>
+// ScaledPlanes: some bisector is stored scaled (Hull::has_scaled_planes);
+// otherwise every bisector's foot is n / 2 without reading Plane::scale.
+template <bool Scaled, bool ScaledPlanes>
 void hull_sums(const kernels::Hull& hull, double sc, double& vol, double& mag, double* c) {
   const auto& verts = hull.vertices();
   const auto& planes = hull.planes();
@@ -92,7 +94,9 @@ void hull_sums(const kernels::Hull& hull, double sc, double& vol, double& mag, d
       const auto& pl = planes[v.p[(k + 1) % 3]];
       // The foot n d / |n|^2: d = |n|^2 / 2 on a bisector (2^scale times
       // that on a scaled one), |n| = 1 on a box plane.
-      double w = pl.id < 0 ? pl.d : pl.scale == 0 ? 0.5 : std::ldexp(0.5, pl.scale);
+      double w = pl.id < 0 ? pl.d : 0.5;
+      if constexpr (ScaledPlanes)
+        if (pl.id >= 0 && pl.scale != 0) w = std::ldexp(0.5, pl.scale);
       if constexpr (Scaled) w *= sc;
       const double f[3] = {pl.n[0] * w, pl.n[1] * w, pl.n[2] * w};
       double bs[3];
@@ -135,11 +139,15 @@ inline std::int32_t measure(const kernels::Hull& hull, double& volume, std::arra
   const auto& verts = hull.vertices();
   const auto& planes = hull.planes();
   double vol, mag, c[3];
-  detail::hull_sums<false>(hull, 1.0, vol, mag, c);
+  const bool scaled_planes = hull.has_scaled_planes();
+  if (scaled_planes) [[unlikely]]
+    detail::hull_sums<false, true>(hull, 1.0, vol, mag, c);
+  else
+    detail::hull_sums<false, false>(hull, 1.0, vol, mag, c);
   std::int32_t shift = 0;  // the sums are of coordinates scaled by 2^-shift
   if (detail::out_of_range(mag, c, 3)) [[unlikely]] {
     shift = detail::measure_shift(hull);
-    if (shift != 0) detail::hull_sums<true>(hull, kernels::filter::pow2(-shift), vol, mag, c);
+    if (shift != 0) detail::hull_sums<true, true>(hull, kernels::filter::pow2(-shift), vol, mag, c);
   }
   if (measure_cancelled(vol, mag) && hull.exact_context() != nullptr && !verts.empty()) [[unlikely]] {
     thread_local std::vector<kernels::MeasureTerm> terms;

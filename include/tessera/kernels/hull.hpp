@@ -109,6 +109,7 @@ class Hull {
     pl.n1 = b.n1;
     pl.id = j;
     pl.scale = b.scale;
+    scaled_planes_ |= b.scale != 0;
     if (planes_.size() > cap_) ensure_table(2 * cap_);
     cut(pn, nv);
     return ClipResult::clipped;
@@ -223,6 +224,9 @@ class Hull {
   double security_radius2() const { return security2_; }
 
   std::int32_t generator() const { return gen_; }
+  /// Whether some plane is a scaled bisector (Plane::scale != 0): only in
+  /// input no frame fits; the measure reads every plane's scale only then.
+  bool has_scaled_planes() const { return scaled_planes_; }
   /// The generator's coordinates: vertices are relative to them.
   const double* site() const { return site_; }
   std::size_t num_vertices() const { return verts_.size(); }
@@ -360,6 +364,7 @@ class Hull {
     for (int a = 0; a < 3; ++a) site_[a] = p[a];
     exact_ = exact;
     may_underflow_ = exact != nullptr && exact->may_underflow;
+    scaled_planes_ = false;
     signs_.start_cell();
     // Planes and corners are written in place: a local struct copied in
     // would be read back wider than it was written (a store-forwarding stall).
@@ -508,6 +513,7 @@ class Hull {
   double site_[3] = {};  // the generator's coordinates
   const ExactContext* exact_ = nullptr;
   bool may_underflow_ = false;  // exact_->may_underflow: solve() adds filter::underflow_slack
+  bool scaled_planes_ = false;  // has_scaled_planes()
   std::vector<Plane> planes_;
   std::vector<Vertex> verts_;
   filter::FilterLanes<3> lanes_;  // verts_' filter data, for the sign pass
