@@ -50,7 +50,7 @@ class Hull {
     double d;
     double n1;           // |n|_1, for the error bound
     std::int32_t id;     // generator id, or box-plane id < 0
-    std::int32_t scale;  // a bisector: n = q 2^-scale, 0 unless q is huge (filter::Bisector)
+    std::int32_t scale;  // a bisector: n = q 2^-scale; 0 unless |q| is huge or tiny (filter::Bisector)
   };
   struct Vertex {
     double y[3];         // position relative to the generator

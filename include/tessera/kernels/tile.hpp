@@ -38,7 +38,7 @@ class Tile {
     double d;
     double n1;
     std::int32_t id;
-    std::int32_t scale;  // a bisector: n = q 2^-scale, 0 unless q is huge (filter::Bisector)
+    std::int32_t scale;  // a bisector: n = q 2^-scale; 0 unless |q| is huge or tiny (filter::Bisector)
   };
   struct Vertex {
     double y[2];
