@@ -135,13 +135,16 @@ class HullCompletion {
     std::optional<IntegerPlane> plane;
     std::uint64_t tested = 0;  // candidates considered, and exact side tests (set_budget)
     auto side_of = [&](const double* x, auto&& exact) {
-      double det = 0, perm = 0;
+      double det = 0, perm = 0, growth = 3;
       for (int d = 0; d < D; ++d) {
         const double r = x[d] - a[d];
         det += r * c[d];
         perm += std::fabs(r) * cp[d];
+        growth += 2 * std::fabs(r);
       }
-      const double bound = 16 * kernels::filter::u * perm + kernels::filter::abs_eps;
+      // Underflow: each c[d] errs by 2 eta at most, times |r|, and each
+      // product by eta (filter::underflow_bound).
+      const double bound = 16 * kernels::filter::u * perm + kernels::filter::underflow_bound(growth);
       if (det > bound) return 1;
       if (det < -bound) return -1;
       if (!plane) plane.emplace(f, *this);

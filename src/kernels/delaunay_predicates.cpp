@@ -92,6 +92,51 @@ bool in_exact_range(int D, const double* const* p, int count) {
   return true;
 }
 
+// Orientation in long double, for input out of the expansions' range (no
+// frame fits: 1e-155 beside 1e131, front/pass.cpp), where the double minors
+// underflow and every undecided test went to GMP rationals (2D: 100,000
+// points and one at 1e200 took 20.6 s by insertion, 0.85 s with this). Products of
+// up to three doubles neither underflow nor overflow in its 15-bit exponent,
+// so the bounds are relative only (7 and 11 units of the permanents after
+// Shewchuk; 16 to spare). Two forms, each certain where the other may not be:
+//  * det[p_k - p_0], as the double filter: for points close to each other;
+//  * the same value as the alternating sum of the D + 1 determinants of the
+//    points themselves (the lifted 1 column expanded): no differences, so
+//    for points of wildly different magnitudes near the origin (2^-167,
+//    2^-232, 2^-435: their differences lose the smaller ones' bits).
+// 0 when both are undecided.
+int orientation_long_double(int D, const double* const* p) {
+  if constexpr (std::numeric_limits<long double>::digits < 64) {
+    return 0;
+  } else {
+    using L = long double;
+    constexpr L unit16 = 16 * 0x1p-64L;
+    auto sign = [&](L det, L perm) { return det > unit16 * perm ? 1 : (det < -unit16 * perm ? -1 : 0); };
+    L r[3][3] = {};
+    for (int k = 0; k < D; ++k)
+      for (int d = 0; d < D; ++d) r[k][d] = static_cast<L>(p[k + 1][d]) - static_cast<L>(p[0][d]);
+    L perm;
+    L det = detail::det_perm(r[0], r[1], r[2], D, perm);
+    if (const int s = sign(det, perm)) return s;
+    L x[4][3] = {};
+    for (int k = 0; k <= D; ++k)
+      for (int d = 0; d < D; ++d) x[k][d] = static_cast<L>(p[k][d]);
+    // 2D: |p1 p2| - |p0 p2| + |p0 p1|; 3D: |p1 p2 p3| - |p0 p2 p3| + |p0 p1 p3| - |p0 p1 p2|.
+    det = 0;
+    perm = 0;
+    for (int skip = 0; skip <= D; ++skip) {
+      const L* rows[3] = {};
+      for (int k = 0, j = 0; k <= D; ++k)
+        if (k != skip) rows[j++] = x[k];
+      L pk;
+      const L dk = detail::det_perm(rows[0], rows[1], rows[2], D, pk);
+      det += skip % 2 == 0 ? dk : -dk;
+      perm += pk;
+    }
+    return sign(det, perm);
+  }
+}
+
 // Exact orientation by expansions; false when the input is outside their range.
 bool orientation_expansion(int D, const double* const* p, int& sign) {
   if (!in_exact_range(D, p, D + 1)) return false;
@@ -228,10 +273,25 @@ int in_sphere_filter(const double* pa, const double* const* p, T unit, P eps) {
     if (!(perm_m >= P(0x1p-900) && perm_m < inf && perm_r >= P(0x1p-900) && perm_r < inf))
       return permanents_out_of_range;
   }
-  const T bound_r = 16 * unit * static_cast<T>(perm_r) + static_cast<T>(eps);
+  // Underflow, in double only (a product of doubles never underflows in long
+  // double): a 2x2 minor errs by 2 eta, a 3x3 one by 2 eta Z + 3 eta (Z: the
+  // rows' sum of |z|), s[k] by D eta; det's products add s[k] times the
+  // minor's error, |m_k| times s[k]'s, and eta (filter::underflow_bound).
+  T abs_r = static_cast<T>(eps), abs_m = static_cast<T>(eps);
+  if constexpr (std::is_same_v<T, double>) {
+    double z = 0, s_sum = 0, m_sum = 0;
+    for (int k = 0; k <= D; ++k) {
+      if constexpr (D == 3) z += fabs(r[k][2]);
+      s_sum += s[k];
+      m_sum += fabs(m[k]);
+    }
+    abs_r = filter::underflow_bound(2 * z + 3);
+    abs_m = filter::underflow_bound(s_sum * (2 * z + 3) + 3 * m_sum + 4);
+  }
+  const T bound_r = 16 * unit * static_cast<T>(perm_r) + abs_r;
   // The lifted column is itself rounded (relative 3 units per entry): 64
   // units cover the classic 11 of Shewchuk's insphere bound with a wide margin.
-  const T bound_m = 64 * unit * static_cast<T>(perm_m) + static_cast<T>(eps);
+  const T bound_m = 64 * unit * static_cast<T>(perm_m) + abs_m;
   if (fabs(det_r) > bound_r && fabs(det_m) > bound_m)
     return (det_m > 0) != (det_r > 0) ? 1 : -1;  // P = det M / det R; inside iff P < 0
   return 0;
@@ -287,6 +347,8 @@ int orientation(int D, const double* const* pts) {
   int sign;
   if (orientation_int128(D, pts, sign)) return sign;
   if (orientation_expansion(D, pts, sign)) return sign;
+  // Out of the expansions' range (no frame fits): long double, then GMP.
+  if ((sign = orientation_long_double(D, pts)) != 0) return sign;
   return orientation_exact(D, pts);
 }
 

@@ -52,8 +52,10 @@ inline int orientation_filter(int D, const double* const* rows) {
   double perm;
   const double det = detail::det_perm(r, D, perm);
   // Shewchuk's bounds are 3u (2D) and 7u (3D) of the permanent including the
-  // rounded differences; 16u leaves room to spare.
-  const double bound = 16 * filter::u * perm + filter::abs_eps;
+  // rounded differences; 16u leaves room to spare. Underflow: each cofactor
+  // errs by 2 eta, times |r0[e]|, plus eta per product (filter::underflow_bound).
+  const double growth = 2 * (std::fabs(r[0][0]) + std::fabs(r[0][1]) + std::fabs(r[0][2])) + 3;
+  const double bound = 16 * filter::u * perm + filter::underflow_bound(growth);
   return det > bound ? 1 : (det < -bound ? -1 : 0);
 }
 

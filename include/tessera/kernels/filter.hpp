@@ -42,6 +42,21 @@ inline constexpr double abs_eps = 0x1p-900;
 /// at 1e200, front/pass.cpp) their r2 are ~2^-940, and abs_eps made every
 /// security radius span the whole bulk.
 inline constexpr double radius_abs_eps = 0x1p-1000;
+/// The absolute term of a determinant filter (orientation, in-sphere, a
+/// side test) whose products may round below DBL_MIN. Each such product
+/// errs by eta <= 2^-1075 in absolute terms (sums of subnormals are exact),
+/// and later products multiply that error: `growth` bounds the sum of those
+/// multipliers, so that underflow moves the determinant by at most
+/// eta * growth (each filter derives its own). Returns 8 eta growth, and at
+/// least 2^-1000: a normal double (subnormal arithmetic costs a microcode
+/// assist). Needed where no frame fits (ExactContext::may_underflow):
+/// 1e-155 beside 1e131, whose 2x2 minors underflow and are then multiplied
+/// by the large row; the insertion's walk went wrong on such input with
+/// abs_eps in its place. The floor lies below abs_eps (2^-900), which in
+/// such a frame (the bulk near 2^-465 beside an outlier at 2^200) exceeded
+/// every determinant of the bulk and sent each to the slower stages. NaN
+/// growth gives NaN, which leaves the filter undecided.
+inline double underflow_bound(double growth) { return (!(growth <= 0x1p72) ? growth : 0x1p72) * 0x1p-1072; }
 /// The absolute error that underflow adds to a vertex solved by Cramer's
 /// rule (3D, or 2D with its smaller sums), beyond the relative bound. Each
 /// product that rounds below DBL_MIN errs by eta <= 2^-1075 (sums of

@@ -86,6 +86,7 @@ class BinLocator {
     std::size_t total = 1;
     for (int d = 0; d < D; ++d) {
       lo_[d] = glo[d];
+      hi_[d] = ghi[d];
       double extent = ghi[d] - glo[d];
       // Cap each axis so the grid stays proportionate to the point count.
       double divs = thin[d] ? 1.0 : std::clamp(std::round(extent / h), 1.0, 1.0 + 4.0 * static_cast<double>(used));
@@ -160,6 +161,10 @@ class BinLocator {
       if (core_[d] && !(x[d] >= lo_[d] && x[d] <= core_hi_[d])) return true;
     return false;
   }
+  /// The grid's box: the domain box, or along an axis where a few points lie
+  /// far out, the bulk of the points (grid_box).
+  Point grid_lo() const { return lo_; }
+  Point grid_hi() const { return hi_; }
   /// How many located points lie beyond the grid's box (beyond_core).
   std::size_t outside_core() const { return outside_core_; }
 
@@ -475,7 +480,7 @@ class BinLocator {
     }
   }
 
-  Point lo_{}, size_{}, inv_size_{};
+  Point lo_{}, hi_{}, size_{}, inv_size_{};  // the grid's box, and its bins' size
   std::array<bool, D> core_{};         // per axis: the grid spans the bulk, not the box
   Point core_hi_{};                    // the bulk's upper end where core_ (its lower end is lo_)
   std::size_t outside_core_ = 0;
