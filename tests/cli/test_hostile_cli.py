@@ -18,7 +18,8 @@ from 1e-200 to 1e200 (float sort keys overflowed past 1e19; volumes
 underflow), clouds far from the origin (few significant bits), a tiny
 cluster in a huge cloud, nearly collinear and nearly coplanar points, points
 on a sphere with its centre, small integer grids, a bulk with a few far
-outliers, with random labels on a third of the cases. The only accepted
+outliers (up to 1e30 away, and 1e160 to 1e300), magnitudes spread
+log-uniformly over 1e-300..1e300, with random labels on a third of the cases. The only accepted
 failure is the input error for a zero extent (all points on an axis plane,
 or one point).
 
@@ -48,7 +49,8 @@ def rotation(rng, d):
 
 KINDS = ["uniform", "lattice", "rotated_lattice", "rotated_lattice_scaled", "duplicates", "near_duplicates",
          "power_of_ten", "far_from_origin", "cluster_in_cloud", "nearly_collinear", "nearly_flat",
-         "sphere_and_centre", "grid_jitter", "small_integers", "far_outliers"]
+         "sphere_and_centre", "grid_jitter", "small_integers", "far_outliers", "log_uniform",
+         "outliers_beyond_frame"]
 
 
 def generate(kind, rng, n, d):
@@ -98,6 +100,15 @@ def generate(kind, rng, n, d):
         k = int(rng.integers(1, 4))
         far = rng.normal(size=(k, d)) * 10.0 ** rng.integers(1, 31, size=(k, 1))
         return np.vstack([p, far])
+    if kind == "log_uniform":
+        # Magnitudes spread over 600 decades in random directions: no
+        # power-of-two frame fits (the insertion failed here, stop 52).
+        return 10.0 ** rng.uniform(-300, 300, size=(n, 1)) * rng.normal(size=(n, d))
+    if kind == "outliers_beyond_frame":
+        # A unit bulk beside points 1e160 to 1e300 away: no frame fits either.
+        p = rng.random((max(n, 300), d))
+        k = int(rng.integers(1, 4))
+        return np.vstack([p, rng.normal(size=(k, d)) * 10.0 ** rng.uniform(160, 300, size=(k, 1))])
     if kind == "small_integers":
         return rng.integers(0, 4, size=(n, d)).astype(float)
     raise ValueError(kind)

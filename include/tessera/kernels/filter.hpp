@@ -286,7 +286,18 @@ inline Lane load(const double* p) {
 /// vertices) at a time, branch-free within it; the arithmetic is the same, term
 /// for term, as a scalar loop's (no contraction), so the signs do not depend on
 /// the vector width.
-template <int D, class Exact>
+///
+/// Overflow: in a frame that fits (front/pass.cpp) coordinates stay below
+/// 2^200 and no product overflows. Where none fits (may_underflow) a cell
+/// reaching the box has vertices near 2^970, and n.y overflows: a sum with
+/// one term at +inf is +inf whatever the others, so P came out -inf (a
+/// certain "remove") for a vertex the plane keeps, or +inf (proved kept in
+/// the first pass) for one it cuts. Found by the hostile fuzz (points spread
+/// log-uniformly over 1e-300..1e300: a neighbour lost, wrong topology, and a
+/// crash in the exact measure of the malformed cell). With `Unbounded`, a
+/// lane whose P is not finite (an overflow in it, as inf never returns to a
+/// finite value) is undecided in both passes.
+template <int D, bool Unbounded = false, class Exact>
 std::size_t classify(const FilterLanes<D>& f, const double* n, double d, double n1, double d_unscaled,
                      std::vector<Sign>& sign, Exact&& exact) {
   static_assert(FilterLanes<D>::lanes == 4, "two detail::Lanes per lane group");
@@ -309,7 +320,11 @@ std::size_t classify(const FilterLanes<D>& f, const double* n, double d, double 
   std::size_t first = 0;  // the first lane group holding a vertex that may be cut
   for (; first < np; first += 4) {
     LaneMask hit{};
-    for (std::size_t h = first; h < first + 4; h += 2) hit |= ~(plane_value(h) > n1 * detail::load(E + h) + de);
+    for (std::size_t h = first; h < first + 4; h += 2) {
+      const Lane P = plane_value(h);
+      if constexpr (Unbounded) hit |= ~((P > n1 * detail::load(E + h) + de) & (P - P == 0));
+      else hit |= ~(P > n1 * detail::load(E + h) + de);
+    }
     if (hit[0] | hit[1]) break;
   }
   if (first >= np) return 0;
@@ -320,7 +335,8 @@ std::size_t classify(const FilterLanes<D>& f, const double* n, double d, double 
     const Lane P = plane_value(t);
     const Lane e = n1 * detail::load(E + t) + de;
     const LaneMask near = 4.0 * detail::load(R + t) < q2lo;  // never cut
-    const LaneMask s = near ? LaneMask{1, 1} : (P < -e) - (P > e);
+    LaneMask s = near ? LaneMask{1, 1} : (P < -e) - (P > e);
+    if constexpr (Unbounded) s = near | (P - P == 0) ? s : LaneMask{0, 0};
     for (int k = 0; k < 2; ++k) {
       sign[t + static_cast<std::size_t>(k)] = static_cast<Sign>(s[k]);
       removed += s[k] < 0;

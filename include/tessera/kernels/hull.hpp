@@ -91,8 +91,10 @@ class Hull {
   ClipResult clip(std::int32_t j, const double* q) {
     const filter::Bisector<3> b(q);
     const std::size_t nv = verts_.size();
-    const std::size_t removed = filter::classify<3>(lanes_, b.n, b.d, b.n1, b.d_unscaled, sign_,
-                                                     [&](std::size_t t) { return exact_sign(t, j); });
+    auto exact = [&](std::size_t t) { return exact_sign(t, j); };
+    // Input no frame fits may overflow n.y (filter::classify).
+    const std::size_t removed = may_underflow_ ? filter::classify<3, true>(lanes_, b.n, b.d, b.n1, b.d_unscaled, sign_, exact)
+                                               : filter::classify<3>(lanes_, b.n, b.d, b.n1, b.d_unscaled, sign_, exact);
     if (removed == 0) return ClipResult::unchanged;
     if (removed == nv) {
       resize_vertices(0);
