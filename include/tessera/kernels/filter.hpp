@@ -359,4 +359,13 @@ std::size_t classify(const FilterLanes<D>& f, const double* n, double d, double 
   return static_cast<std::size_t>(removed);
 }
 
+/// classify<D, true> for bisector b, out of line and cold: the cells of input
+/// no frame fits (may_underflow) take it, and the ordinary clip's code keeps
+/// its one hot instantiation.
+template <int D, class Exact>
+[[gnu::noinline, gnu::cold]] std::size_t classify_unbounded(const FilterLanes<D>& f, const Bisector<D>& b,
+                                                            std::vector<Sign>& sign, Exact&& exact) {
+  return classify<D, true>(f, b.n, b.d, b.n1, b.d_unscaled, sign, exact);
+}
+
 }  // namespace tessera::kernels::filter

@@ -72,12 +72,10 @@ class Tile {
   ClipResult clip(std::int32_t j, const double* q) {
     const filter::Bisector<2> b(q);
     const std::size_t nv = verts_.size();
-    std::size_t removed;
-    if (may_underflow_) [[unlikely]]
-      removed = classify_unbounded(b, j);  // n.y may overflow (filter::classify)
-    else
-      removed = filter::classify<2>(lanes_, b.n, b.d, b.n1, b.d_unscaled, sign_,
-                                     [&](std::size_t t) { return exact_sign(t, j); });
+    auto exact = [&](std::size_t t) { return exact_sign(t, j); };
+    // Where no frame fits, n.y may overflow (filter::classify).
+    const std::size_t removed = may_underflow_ ? filter::classify_unbounded<2>(lanes_, b, sign_, exact)
+                                               : filter::classify<2>(lanes_, b.n, b.d, b.n1, b.d_unscaled, sign_, exact);
     if (removed == 0) return ClipResult::unchanged;
     if (removed == nv) {
       verts_.clear();
@@ -98,13 +96,6 @@ class Tile {
   }
 
  private:
-  // The sign pass where no frame fits the input (may_underflow_): kept out of
-  // line, so the ordinary clip's code stays as it was (inlined beside it,
-  // the choice cost uniform cells 3%).
-  [[gnu::noinline, gnu::cold]] std::size_t classify_unbounded(const filter::Bisector<2>& b, std::int32_t j) {
-    return filter::classify<2, true>(lanes_, b.n, b.d, b.n1, b.d_unscaled, sign_,
-                                       [&](std::size_t t) { return exact_sign(t, j); });
-  }
   // Replace the run of vertices sign_ marks removed (-1; `removed` of the
   // nv, not all) by two on local plane pn: a clip's work after its sign pass.
   void cut(std::uint16_t pn, std::size_t nv, std::size_t removed) {
