@@ -383,6 +383,12 @@ Delaunay run(std::span<const double> input, std::span<const std::int32_t> labels
   // the automatic method may switch.
   const bool fall_back = D == 3 && complete && opt.method == DelaunayMethod::automatic && attempt == 0;
   const Delaunay before_cells = fall_back ? out : Delaunay{};
+  // Progress never restarts: where an insertion may take over, the cells
+  // report the bar's first 80% and the insertion the rest (it restarted the
+  // bar at 0 after the cells had filled it).
+  constexpr double cells_share = 0.8;
+  if (fall_back && opt.progress)
+    pass.engine_options.progress = [&opt](double f) { opt.progress(cells_share * f); };
   front::DelaunayPassResult<D> found;
   front::DelaunayCompositor<CellT> comp(found, n, labels, complete, skipped);
   out.exact_predicate_calls = engine::tessellate<CellT>(pass.gens, comp, pass.engine_options);
@@ -476,7 +482,11 @@ Delaunay run(std::span<const double> input, std::span<const std::int32_t> labels
       added = hc.run_from(*seed, pass.engine_options.threads);
     }
     if constexpr (D == 3)
-      if (hc.over_budget()) return by_insertion(pass, std::move(before_cells));
+      if (hc.over_budget()) {
+        if (opt.progress)
+          pass.engine_options.progress = [&opt](double f) { opt.progress(cells_share + (1 - cells_share) * f); };
+        return by_insertion(pass, std::move(before_cells));
+      }
   }
   out.from_hull_completion = added.size();
 

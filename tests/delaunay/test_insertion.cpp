@@ -284,6 +284,17 @@ TEST(Insertion, AutomaticChoiceTakesItWhereTheCellsPassWouldStall) {
   EXPECT_EQ(rotated.from_cells, 0u);
   expect_valid(rotated, lattice, "rotated lattice");
   EXPECT_EQ(triangulate(lattice, tessera::DelaunayMethod::automatic, 2).simplices, rotated.simplices);
+  // The progress of that hand-over never decreases (the insertion restarted
+  // the bar at 0 after the cells had filled it) and ends at 1.
+  tessera::DelaunayOptions o;
+  o.dim = 3;
+  o.threads = 4;
+  std::vector<double> seen;
+  o.progress = [&](double f) { seen.push_back(f); };
+  EXPECT_EQ(tessera::delaunay(lattice, 3, {}, o).simplices, rotated.simplices);
+  ASSERT_GE(seen.size(), 5u);
+  EXPECT_TRUE(std::is_sorted(seen.begin(), seen.end()));
+  EXPECT_EQ(seen.back(), 1.0);
 }
 
 }  // namespace
