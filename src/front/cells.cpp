@@ -82,14 +82,22 @@ Cells run(std::span<const double> input, std::span<const std::int32_t> labels, c
   {
     bool insert = opt.cell_method == CellMethod::insertion;
     // Input no frame fits (a far outlier beyond ~1e154, points spread
-    // log-uniformly over 1e-300..1e300: ExactContext::may_underflow) goes by
-    // the pilot too: the insertion serves it since stop 52 (long double
-    // orientations, the Morton order over the grid's box), and the search's
-    // cells at the bulk's edge reach the far points (200k 3D beside one at
-    // 1e200: 49 s by search, 2.2 s by insertion).
+    // log-uniformly over 1e-300..1e300: ExactContext::may_underflow) goes to
+    // the insertion without a pilot. The insertion serves it since stop 52
+    // (long double orientations, the Morton order over the grid's box),
+    // while the search's cells at the bulk's edge reach the far points
+    // (200k 3D beside one at 1e200: 49 s by search, 2.2 s by insertion). The
+    // pilot chose the insertion on each of the ten such inputs measured
+    // (docs/design.md, "Delaunay beyond the frame"), where its own sample of
+    // searched cells cost up to 0.4 s (2,003 log-uniform points: 0.6 s, 0.17 s
+    // without it).
     if (opt.cell_method == CellMethod::automatic) {
-      const front::PilotEstimate e = front::pilot_estimate<CellT>(pass, neighbours_ratio, pilot_share);
-      insert = e.ratio >= neighbours_ratio;
+      if (pass.exact.may_underflow) {
+        insert = true;
+      } else {
+        const front::PilotEstimate e = front::pilot_estimate<CellT>(pass, neighbours_ratio, pilot_share);
+        insert = e.ratio >= neighbours_ratio;
+      }
     }
     if (insert) {
       // The progress bar gives the insertion its first half, the cells the
