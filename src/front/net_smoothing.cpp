@@ -44,6 +44,17 @@ namespace {
 
 constexpr std::int64_t kNoRegion = std::numeric_limits<std::int64_t>::min();
 
+/// |d| (dn = 2 or 3 components) from d2, its sum of squares as computed:
+/// sqrt(d2) where no square under- or overflowed, else std::hypot, which
+/// scales. Coordinates beyond ~1e154 (or spacings below ~1e-154) made d2
+/// infinite (or zero): a vertex of points scaled by 2^600 then moved without
+/// its constraint, and the net was not the unit points' net scaled (it is
+/// now, to rounding).
+double length(const double* d, std::size_t dn, double d2) {
+  if (d2 >= 0x1p-900 && d2 <= 0x1p900) return std::sqrt(d2);
+  return std::hypot(d[0], d[1], dn == 3 ? d[2] : 0.0);
+}
+
 /// The region of a generator id of a topological coordinate: a point's label,
 /// or, for a domain-box plane (negative id), a code of its own that no label
 /// can take (labels are int32).
@@ -107,12 +118,12 @@ std::vector<double> petal_radii(const FaceSet& mesh, std::span<const double> pos
     while (a < kn && key[a] < 0) ++a;  // box planes come first; a vertex has a generator
     if (a == kn) return;
     const double* g = &points[static_cast<std::size_t>(key[a]) * dn];
-    double d2 = 0;
+    double d[3] = {0, 0, 0}, d2 = 0;
     for (std::size_t c = 0; c < dn; ++c) {
-      const double d = positions[v * dn + c] - g[c];
-      d2 += d * d;
+      d[c] = positions[v * dn + c] - g[c];
+      d2 += d[c] * d[c];
     }
-    petal[v] = std::sqrt(d2);
+    petal[v] = length(d, dn, d2);
   });
   return petal;
 }
@@ -279,8 +290,13 @@ std::vector<NetVertexKind> smooth_surface_net(FaceSet& mesh, std::span<const dou
         d[a] = p - x0[v * dn + a];
         d2 += d[a] * d[a];
       }
-      const double r = radius[v];
-      const double scale = d2 > r * r ? r / std::sqrt(d2) : 1.0;
+      const double r = radius[v], r2 = r * r;
+      double scale = 1.0;
+      if (d2 >= 0x1p-900 && d2 <= 0x1p900 && r2 >= 0x1p-900 && r2 <= 0x1p900) {
+        if (d2 > r2) scale = r / std::sqrt(d2);
+      } else if (const double dl = front::length(d, dn, d2); dl > r) {
+        scale = r / dl;  // squares out of range (length)
+      }
       for (std::size_t a = 0; a < dn; ++a)
         out[a] = (pinned[v] >> a) & 1u ? x0[v * dn + a] : x0[v * dn + a] + scale * d[a];
     });
@@ -322,16 +338,15 @@ std::vector<NetVertexKind> smooth_surface_net(FaceSet& mesh, std::span<const dou
     cur.swap(nxt);
   }
 
-  double m2 = 0;
+  moved = 0;
   for (std::size_t v = 0; v < nv; ++v) {
-    double d2 = 0;
+    double d[3] = {0, 0, 0}, d2 = 0;
     for (std::size_t a = 0; a < dn; ++a) {
-      const double d = cur[v * dn + a] - x0[v * dn + a];
-      d2 += d * d;
+      d[a] = cur[v * dn + a] - x0[v * dn + a];
+      d2 += d[a] * d[a];
     }
-    m2 = std::max(m2, d2);
+    moved = std::max(moved, front::length(d, dn, d2));
   }
-  moved = std::sqrt(m2);
   mesh.vertices = std::move(cur);
   return st.kind;
 }

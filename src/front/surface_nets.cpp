@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdint>
 #include <limits>
 #include <string>
@@ -15,6 +16,7 @@
 #include <tbb/task_arena.h>
 
 #include "net_smoothing.hpp"
+#include "pass.hpp"
 
 namespace tessera {
 namespace {
@@ -156,8 +158,10 @@ SurfaceNet surface_nets(std::span<const double> points, std::span<const std::int
   auto t0 = Clock::now();
   VoronoiOptions vo = options.voronoi;
   vo.build_mesh = true;
+  Bounds domain;
   {
     const Cells cells = voronoi(points, D, cell_labels, vo);
+    domain = cells.bounds;
     out.n_cells = cells.n_cells();
     out.seconds.cells = since(t0);
     std::vector<std::int32_t>().swap(cell_labels);
@@ -172,19 +176,41 @@ SurfaceNet surface_nets(std::span<const double> points, std::span<const std::int
   if (vo.progress) vo.progress(1.0);  // lets the caller cancel between stages
 
   t0 = Clock::now();
+  // Smoothing and triangulation square lengths and multiply them (normals,
+  // areas): in the cells' frame (front::choose_scaling), a power of two away
+  // from the input's units, so that points at 1e200 or 1e-200 give the unit
+  // points' net scaled. In the input's units those squares overflowed or
+  // underflowed: vertices moved without their constraint, the guard froze
+  // others, and polygons were cut along other diagonals (stop 52).
+  const int k = front::choose_scaling(points, domain, D).k;
+  std::vector<double> scaled;
+  std::span<const double> pts = points;
+  SmoothingOptions smoothing = options.smoothing;
+  if (k != 0) {
+    scaled.resize(points.size());
+    for (std::size_t i = 0; i < points.size(); ++i) scaled[i] = std::ldexp(points[i], k);
+    pts = scaled;
+    for (double& x : out.mesh.vertices) x = std::ldexp(x, k);
+    if (smoothing.constraint_is_absolute) smoothing.constraint = std::ldexp(smoothing.constraint, k);
+  }
   const bool triangulate = options.triangles && D == 3;
   std::vector<double> before;
   if (triangulate) before = out.mesh.vertices;
   arena.execute([&] {
-    out.vertex_kind = smooth_surface_net(out.mesh, points, labels, options.smoothing, out.max_displacement);
+    out.vertex_kind = smooth_surface_net(out.mesh, pts, labels, smoothing, out.max_displacement);
   });
   out.seconds.smoothing = since(t0);
   if (vo.progress) vo.progress(1.0);
 
   t0 = Clock::now();
   if (triangulate) {
-    arena.execute([&] { triangulate_ladder(out.mesh, before, points, out.polygon_of_face); });
-  } else {
+    arena.execute([&] { triangulate_ladder(out.mesh, before, pts, out.polygon_of_face); });
+  }
+  if (k != 0) {
+    for (double& x : out.mesh.vertices) x = std::ldexp(x, -k);
+    out.max_displacement = std::ldexp(out.max_displacement, -k);
+  }
+  if (!triangulate) {
     out.polygon_of_face.resize(out.mesh.n_faces());
     for (std::size_t f = 0; f < out.polygon_of_face.size(); ++f)
       out.polygon_of_face[f] = static_cast<std::int64_t>(f);

@@ -284,6 +284,33 @@ TEST(SurfaceNets, SmoothingOfVoxelCentresDoesNotDependOnTheirSpacingBeingBinary)
   }
 }
 
+TEST(SurfaceNets, PowerOfTwoScalesGiveTheScaledNet) {
+  // Points scaled by 2^600 or 2^-600: the cells are the same (exact
+  // predicates, a power-of-two frame), so the net must be the unit points'
+  // net scaled. The smoothing's squared lengths overflowed (or underflowed)
+  // there, so vertices moved without their constraint (or not at all), and
+  // vertices ended up to 0.06 apart in unit terms (stop 52).
+  for (int dim : {2, 3}) {
+    const Labelled unit = grid_points(12, dim, 0.3, 52, nested(dim));
+    SurfaceNetsOptions o = opts(dim, 20, false, dim == 3);
+    const SurfaceNet want = run(unit, o);
+    for (int e : {600, -600}) {
+      Labelled in = unit;
+      for (double& x : in.points) x = std::ldexp(x, e);
+      SurfaceNetsOptions oe = o;
+      for (double& x : oe.voronoi.bounds->hi) x = std::ldexp(x, e);
+      const SurfaceNet got = run(in, oe);
+      ASSERT_EQ(got.mesh.vertex_keys, want.mesh.vertex_keys) << "dim " << dim << " 2^" << e;
+      EXPECT_EQ(got.mesh.face_vertices, want.mesh.face_vertices) << "dim " << dim << " 2^" << e;
+      EXPECT_NEAR(std::ldexp(got.max_displacement, -e), want.max_displacement, 1e-12) << "dim " << dim << " 2^" << e;
+      std::size_t off = 0;
+      for (std::size_t c = 0; c < want.mesh.vertices.size(); ++c)
+        off += !(std::fabs(std::ldexp(got.mesh.vertices[c], -e) - want.mesh.vertices[c]) < 1e-12);
+      EXPECT_EQ(off, 0u) << "dim " << dim << " 2^" << e << ": coordinates of " << want.mesh.vertices.size();
+    }
+  }
+}
+
 TEST(SurfaceNets, SmoothingRespectsConstraintCornersAndBox) {
   const Labelled in = grid_points(16, 3, 0.3, 4, touching_boxes);
   const SurfaceNet before = run(in, opts(3, 0, true));
