@@ -18,6 +18,7 @@
 #include <tbb/parallel_for.h>
 
 #include "net_smoothing.hpp"
+#include "pass.hpp"
 #include "tessera/surface_nets.hpp"
 
 namespace tessera {
@@ -46,10 +47,9 @@ constexpr std::int64_t kNoRegion = std::numeric_limits<std::int64_t>::min();
 
 /// |d| (dn = 2 or 3 components) from d2, its sum of squares as computed:
 /// sqrt(d2) where no square under- or overflowed, else std::hypot, which
-/// scales. Coordinates beyond ~1e154 (or spacings below ~1e-154) made d2
-/// infinite (or zero): a vertex of points scaled by 2^600 then moved without
-/// its constraint, and the net was not the unit points' net scaled (it is
-/// now, to rounding).
+/// scales. The net's frame (net_frame_shift) keeps squares in range unless
+/// no frame fits the input (1e-300 beside 1e300), where an infinite d2
+/// would let a vertex move without its constraint.
 double length(const double* d, std::size_t dn, double d2) {
   if (d2 >= 0x1p-900 && d2 <= 0x1p900) return std::sqrt(d2);
   return std::hypot(d[0], d[1], dn == 3 ? d[2] : 0.0);
@@ -126,6 +126,18 @@ std::vector<double> petal_radii(const FaceSet& mesh, std::span<const double> pos
     petal[v] = length(d, dn, d2);
   });
   return petal;
+}
+
+int net_frame_shift(std::span<const double> vertices, std::span<const double> points, int dim) {
+  const auto dn = static_cast<std::size_t>(dim);
+  Bounds extent;  // the vertices' (the box corners among them), zeros when there are none
+  for (std::size_t i = 0; i < vertices.size(); ++i) {
+    double& lo = extent.lo[i % dn];
+    double& hi = extent.hi[i % dn];
+    lo = i < dn ? vertices[i] : std::min(lo, vertices[i]);
+    hi = i < dn ? vertices[i] : std::max(hi, vertices[i]);
+  }
+  return choose_scaling(points, extent, dim).k;
 }
 
 NetStencils build_stencils(const FaceSet& mesh, std::span<const std::int32_t> labels) {
@@ -212,8 +224,9 @@ NetStencils build_stencils(const FaceSet& mesh, std::span<const std::int32_t> la
 }  // namespace front
 
 std::vector<NetVertexKind> smooth_surface_net(FaceSet& mesh, std::span<const double> points,
-                                              std::span<const std::int32_t> labels, const SmoothingOptions& options,
+                                              std::span<const std::int32_t> labels, const SmoothingOptions& given,
                                               double& moved) {
+  SmoothingOptions options = given;  // an absolute constraint is scaled into the frame below
   front::check_smoothing_options(options);
   moved = 0;
   const int D = mesh.dim;
@@ -236,6 +249,17 @@ std::vector<NetVertexKind> smooth_surface_net(FaceSet& mesh, std::span<const dou
 
   const front::NetStencils st = front::build_stencils(mesh, labels);
   if (options.iterations == 0 || nv == 0) return st.kind;
+
+  // In the net's frame (front::net_frame_shift), undone at the end.
+  const int k = front::net_frame_shift(mesh.vertices, points, D);
+  std::vector<double> scaled_points;
+  if (k != 0) {
+    scaled_points.assign(points.begin(), points.end());
+    front::scale_pow2(scaled_points, k);
+    points = scaled_points;
+    front::scale_pow2(mesh.vertices, k);
+    if (options.constraint_is_absolute) options.constraint = std::ldexp(options.constraint, k);
+  }
 
   // Per vertex: the constraint radius and the axes pinned to a box plane.
   const std::vector<double> x0 = mesh.vertices;
@@ -348,6 +372,10 @@ std::vector<NetVertexKind> smooth_surface_net(FaceSet& mesh, std::span<const dou
     moved = std::max(moved, front::length(d, dn, d2));
   }
   mesh.vertices = std::move(cur);
+  if (k != 0) {
+    front::scale_pow2(mesh.vertices, -k);
+    moved = std::ldexp(moved, -k);
+  }
   return st.kind;
 }
 

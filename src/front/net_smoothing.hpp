@@ -2,10 +2,10 @@
 // that surface_nets.cpp also needs.
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
-#include <cmath>
-#include <algorithm>
 #include <limits>
 #include <span>
 #include <vector>
@@ -57,6 +57,19 @@ inline void newell(const double* xyz, const std::int32_t* loop, std::size_t n, d
 /// skipped): the radius of its petal, the local spacing there. Runs in the
 /// caller's task arena.
 std::vector<double> petal_radii(const FaceSet& mesh, std::span<const double> positions, std::span<const double> points);
+
+/// The net's computation frame: smoothing and triangulation square lengths
+/// and multiply them (constraints, normals, areas), which overflowed for
+/// points at 1e200 and underflowed at 1e-200 in the input's units (vertices
+/// moved without their constraint, polygons were cut along other diagonals).
+/// They run on positions scaled by 2^k, the cells' own frame
+/// (choose_scaling over the points and the vertices' extent): exact, and
+/// k = 0 for input of ordinary range.
+int net_frame_shift(std::span<const double> vertices, std::span<const double> points, int dim);
+/// x scaled by 2^k, in place (exact while nothing becomes subnormal).
+inline void scale_pow2(std::vector<double>& x, int k) {
+  for (double& v : x) v = std::ldexp(v, k);
+}
 
 /// A polygon counts as degenerate, with no orientation to keep, when its
 /// area vector's length is at most this fraction of the square of its local

@@ -5,7 +5,6 @@
 
 #include <algorithm>
 #include <chrono>
-#include <cmath>
 #include <cstdint>
 #include <limits>
 #include <string>
@@ -16,7 +15,6 @@
 #include <tbb/task_arena.h>
 
 #include "net_smoothing.hpp"
-#include "pass.hpp"
 
 namespace tessera {
 namespace {
@@ -61,8 +59,22 @@ std::vector<std::int32_t> resolve_selection(std::span<const std::int32_t> labels
 /// corners along a straightened junction curve, which flip. A polygon
 /// degenerate before smoothing (front::reference_orientation; the cells'
 /// `points` give its local spacing) is measured against its smoothed normal.
-void triangulate_ladder(FaceSet& m, const std::vector<double>& before, std::span<const double> points,
+void triangulate_ladder(FaceSet& m, std::vector<double> before, std::span<const double> points,
                         std::vector<std::int64_t>& polygon_of_face) {
+  // Normals and areas in the net's frame (front::net_frame_shift): read from
+  // scaled copies, as the positions themselves stay.
+  const int k = front::net_frame_shift(m.vertices, points, 3);
+  std::vector<double> scaled_points, scaled_vertices;
+  const double* xyz = m.vertices.data();
+  if (k != 0) {
+    scaled_points.assign(points.begin(), points.end());
+    front::scale_pow2(scaled_points, k);
+    points = scaled_points;
+    scaled_vertices = m.vertices;
+    front::scale_pow2(scaled_vertices, k);
+    xyz = scaled_vertices.data();
+    front::scale_pow2(before, k);
+  }
   const std::vector<double> petal = front::petal_radii(m, before, points);
   const std::size_t np = m.n_faces();
   // Polygon p starts at triangle offset[p] - 2p: n - 2 triangles per n corners.
@@ -78,8 +90,8 @@ void triangulate_ladder(FaceSet& m, const std::vector<double>& before, std::span
       const std::int32_t* loop = &m.face_vertices[b];
       double ref[3];
       front::reference_orientation(3, before.data(), petal.data(), loop, n, ref);
-      if (ref[0] == 0 && ref[1] == 0 && ref[2] == 0) front::newell(m.vertices.data(), loop, n, ref);
-      auto pos = [&](std::int32_t v) { return &m.vertices[3 * static_cast<std::size_t>(v)]; };
+      if (ref[0] == 0 && ref[1] == 0 && ref[2] == 0) front::newell(xyz, loop, n, ref);
+      auto pos = [&](std::int32_t v) { return xyz + 3 * static_cast<std::size_t>(v); };
       // A rotation replaces an earlier one only if it scores better by more
       // than rounding (1e-9 relative): rotations that tie exactly on a
       // lattice differ by noise off it, which must not choose the triangles.
@@ -158,10 +170,8 @@ SurfaceNet surface_nets(std::span<const double> points, std::span<const std::int
   auto t0 = Clock::now();
   VoronoiOptions vo = options.voronoi;
   vo.build_mesh = true;
-  Bounds domain;
   {
     const Cells cells = voronoi(points, D, cell_labels, vo);
-    domain = cells.bounds;
     out.n_cells = cells.n_cells();
     out.seconds.cells = since(t0);
     std::vector<std::int32_t>().swap(cell_labels);
@@ -176,41 +186,19 @@ SurfaceNet surface_nets(std::span<const double> points, std::span<const std::int
   if (vo.progress) vo.progress(1.0);  // lets the caller cancel between stages
 
   t0 = Clock::now();
-  // Smoothing and triangulation square lengths and multiply them (normals,
-  // areas): in the cells' frame (front::choose_scaling), a power of two away
-  // from the input's units, so that points at 1e200 or 1e-200 give the unit
-  // points' net scaled. In the input's units those squares overflowed or
-  // underflowed: vertices moved without their constraint, the guard froze
-  // others, and polygons were cut along other diagonals (stop 52).
-  const int k = front::choose_scaling(points, domain, D).k;
-  std::vector<double> scaled;
-  std::span<const double> pts = points;
-  SmoothingOptions smoothing = options.smoothing;
-  if (k != 0) {
-    scaled.resize(points.size());
-    for (std::size_t i = 0; i < points.size(); ++i) scaled[i] = std::ldexp(points[i], k);
-    pts = scaled;
-    for (double& x : out.mesh.vertices) x = std::ldexp(x, k);
-    if (smoothing.constraint_is_absolute) smoothing.constraint = std::ldexp(smoothing.constraint, k);
-  }
   const bool triangulate = options.triangles && D == 3;
   std::vector<double> before;
   if (triangulate) before = out.mesh.vertices;
   arena.execute([&] {
-    out.vertex_kind = smooth_surface_net(out.mesh, pts, labels, smoothing, out.max_displacement);
+    out.vertex_kind = smooth_surface_net(out.mesh, points, labels, options.smoothing, out.max_displacement);
   });
   out.seconds.smoothing = since(t0);
   if (vo.progress) vo.progress(1.0);
 
   t0 = Clock::now();
   if (triangulate) {
-    arena.execute([&] { triangulate_ladder(out.mesh, before, pts, out.polygon_of_face); });
-  }
-  if (k != 0) {
-    for (double& x : out.mesh.vertices) x = std::ldexp(x, -k);
-    out.max_displacement = std::ldexp(out.max_displacement, -k);
-  }
-  if (!triangulate) {
+    arena.execute([&] { triangulate_ladder(out.mesh, std::move(before), points, out.polygon_of_face); });
+  } else {
     out.polygon_of_face.resize(out.mesh.n_faces());
     for (std::size_t f = 0; f < out.polygon_of_face.size(); ++f)
       out.polygon_of_face[f] = static_cast<std::int64_t>(f);
