@@ -15,7 +15,8 @@ folder named in the failure message, with the command that failed.
 Each kind reproduces an input that once broke Tessera or could: rotated
 lattices (coplanar hull faces up to rounding), near-duplicates, powers of ten
 from 1e-200 to 1e200 (float sort keys overflowed past 1e19; volumes
-underflow), clouds far from the origin (few significant bits), a tiny
+underflow), axes scaled up to 1e9 apart, points on a few parallel planes,
+a small integer grid offset by 2^50, concentric spheres, clouds far from the origin (few significant bits), a tiny
 cluster in a huge cloud, nearly collinear and nearly coplanar points, points
 on a sphere with its centre, small integer grids, a bulk with a few far
 outliers (up to 1e30 away, and 1e160 to 1e300), magnitudes spread
@@ -50,7 +51,7 @@ def rotation(rng, d):
 KINDS = ["uniform", "lattice", "rotated_lattice", "rotated_lattice_scaled", "duplicates", "near_duplicates",
          "power_of_ten", "far_from_origin", "cluster_in_cloud", "nearly_collinear", "nearly_flat",
          "sphere_and_centre", "grid_jitter", "small_integers", "far_outliers", "log_uniform",
-         "outliers_beyond_frame"]
+         "outliers_beyond_frame", "anisotropic", "layers", "big_integers", "concentric_spheres"]
 
 
 def generate(kind, rng, n, d):
@@ -111,6 +112,27 @@ def generate(kind, rng, n, d):
         return np.vstack([p, rng.normal(size=(k, d)) * 10.0 ** rng.uniform(160, 300, size=(k, 1))])
     if kind == "small_integers":
         return rng.integers(0, 4, size=(n, d)).astype(float)
+    if kind == "anisotropic":
+        # Each axis scaled by its own power of ten, up to 1e9 apart (a core
+        # sample, a wire, a slab of voxels 1e-8 thick).
+        return rng.random((n, d)) * 10.0 ** rng.integers(-9, 10, size=d)
+    if kind == "layers":
+        # Points on a few parallel lines or planes (CT slices, scan lines,
+        # stacked contours): the last coordinate takes one of a few exact
+        # values, the others are random.
+        p = rng.random((n, d))
+        p[:, -1] = rng.integers(0, int(rng.integers(2, 6)), n) * 0.1
+        return p
+    if kind == "big_integers":
+        # A small integer grid offset by 2^50 (cell ties where a double has
+        # two fractional bits left).
+        return rng.integers(0, 5, size=(n, d)).astype(float) + 2.0 ** 50
+    if kind == "concentric_spheres":
+        # Points on two to four spheres about one centre (shells of a
+        # simulation): every sphere cospherical up to rounding.
+        v = rng.normal(size=(min(n, 200), d))
+        v /= np.linalg.norm(v, axis=1)[:, None]
+        return v * rng.integers(1, 5, size=(len(v), 1))
     raise ValueError(kind)
 
 
