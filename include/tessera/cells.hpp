@@ -179,7 +179,12 @@ inline bool volumes_representable(double domain_volume, std::size_t cells) {
          domain_volume / static_cast<double>(cells > 0 ? cells : 1) >= 1e-290;
 }
 
-/// Resolved thread count for an option value (0 -> TESSERA_NUM_THREADS or hardware).
+/// The most threads a call may ask for: more than cores runs oversubscribed
+/// (engine::ThreadArena), and each thread costs a stack and a workspace.
+inline constexpr int max_threads = 4096;
+
+/// Resolved thread count for an option value (0 -> TESSERA_NUM_THREADS or
+/// hardware). InputError above max_threads, or for a malformed variable.
 int resolve_threads(int requested);
 
 }  // namespace tessera

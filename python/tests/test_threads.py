@@ -32,6 +32,19 @@ def test_threads_1_and_2_give_identical_results():
     assert d1.simplices.tobytes() == d2.simplices.tobytes()
 
 
+def test_more_threads_than_cores_run_as_asked(capfd):
+    pts = random_points(3000, 3, seed=8)
+    many = len(os.sched_getaffinity(0)) + 2
+    one = tessera.voronoi(pts, threads=1)
+    lots = tessera.voronoi(pts, threads=many)
+    assert lots.threads_used == many
+    assert np.array(one.neighbors).tobytes() == np.array(lots.neighbors).tobytes()
+    assert np.array(one.vertices).tobytes() == np.array(lots.vertices).tobytes()
+    assert "TBB" not in capfd.readouterr().err  # oneTBB's "number of workers is limited" warning
+    with pytest.raises(ValueError, match="threads must be at most 4096, got 5000"):
+        tessera.voronoi(pts, threads=5000)
+
+
 def test_tessera_num_threads_is_respected(monkeypatch):
     pts = random_points(2000, 2)
     monkeypatch.setenv("TESSERA_NUM_THREADS", "1")
@@ -41,7 +54,7 @@ def test_tessera_num_threads_is_respected(monkeypatch):
     assert tessera.delaunay(pts).threads_used == 2
     assert tessera.voronoi(pts, threads=1).threads_used == 1  # the argument wins
     monkeypatch.setenv("TESSERA_NUM_THREADS", "lots")
-    with pytest.raises(ValueError, match="TESSERA_NUM_THREADS must be a positive integer, got 'lots'"):
+    with pytest.raises(ValueError, match="TESSERA_NUM_THREADS must be an integer from 1 to 4096, got 'lots'"):
         tessera.voronoi(pts)
 
 

@@ -28,12 +28,15 @@ double Bounds::volume(int dim) const {
 }
 
 int resolve_threads(int requested) {
+  if (requested > max_threads)
+    throw InputError("threads must be at most " + std::to_string(max_threads) + ", got " + std::to_string(requested));
   if (requested > 0) return requested;
   if (const char* env = std::getenv("TESSERA_NUM_THREADS")) {
     char* end = nullptr;
     long v = std::strtol(env, &end, 10);
-    if (end != env && *end == '\0' && v > 0 && v < 4096) return static_cast<int>(v);
-    throw InputError(std::string("TESSERA_NUM_THREADS must be a positive integer, got '") + env + "'");
+    if (end != env && *end == '\0' && v > 0 && v <= max_threads) return static_cast<int>(v);
+    throw InputError(std::string("TESSERA_NUM_THREADS must be an integer from 1 to ") + std::to_string(max_threads) +
+                     ", got '" + env + "'");
   }
   return std::max(1, tbb::info::default_concurrency());
 }

@@ -46,7 +46,7 @@
 
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_sort.h>
-#include <tbb/task_arena.h>
+#include "tessera/engine/thread_arena.hpp"
 
 #include "delaunay_compositor.hpp"
 #include "tessera/kernels/delaunay_predicates.hpp"
@@ -249,7 +249,7 @@ class HullCompletion {
     // Facets on the current boundary and those closed by completion, with
     // the number of simplices holding each (found ones count once: the
     // other side of an open facet is what completion looks for).
-    tbb::task_arena arena(std::max(1, threads));
+    tessera::engine::ThreadArena arena(std::max(1, threads));
     FacetTable<D> facets(2 * open.size());
     std::vector<OpenFacet<D>> queue = open;
     std::vector<std::uint8_t> counts;

@@ -11,7 +11,7 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
+#include "tessera/engine/thread_arena.hpp"
 
 #include "tessera/cells.hpp"
 
@@ -65,7 +65,7 @@ inline double face_measure(const Cells& c, std::int64_t f) {
 /// on the schedule.
 template <class Body>
 void for_each_cell(const Cells& c, Body&& body) {
-  tbb::task_arena arena(c.threads_used > 0 ? c.threads_used : 1);
+  tessera::engine::ThreadArena arena(c.threads_used > 0 ? c.threads_used : 1);
   arena.execute([&] {
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, c.n_cells(), 256),
                       [&](const tbb::blocked_range<std::size_t>& r) {

@@ -12,7 +12,7 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
+#include "tessera/engine/thread_arena.hpp"
 
 #include "net_smoothing.hpp"
 
@@ -152,7 +152,7 @@ SurfaceNet surface_nets(std::span<const double> points, std::span<const std::int
   SurfaceNet out;
   out.selected = resolve_selection(labels, options.select);
   const auto& sel = out.selected;
-  tbb::task_arena arena(resolve_threads(options.voronoi.threads));
+  tessera::engine::ThreadArena arena(resolve_threads(options.voronoi.threads));
 
   // Unselected labels >= 0 become outside points for the cells (any negative
   // value will do); the faces get the original labels, so a capping face

@@ -25,7 +25,7 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
+#include "tessera/engine/thread_arena.hpp"
 
 #include "random.hpp"
 #include "tessera/image.hpp"
@@ -148,7 +148,7 @@ void parallel_range(std::size_t n, int threads, F&& body) {
     body(tbb::blocked_range<std::size_t>(0, n));
     return;
   }
-  tbb::task_arena arena(threads);
+  tessera::engine::ThreadArena arena(threads);
   arena.execute([&] { tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, kGrain), body); });
 }
 

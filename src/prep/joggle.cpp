@@ -12,7 +12,7 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
+#include "tessera/engine/thread_arena.hpp"
 
 #include "random.hpp"
 #include "tessera/cells.hpp"
@@ -104,7 +104,7 @@ std::vector<double> joggle(std::span<const double> coords, int dim, const Joggle
   if (threads == 1 || n <= kGrain) {
     body(tbb::blocked_range<std::size_t>(0, n));
   } else {
-    tbb::task_arena arena(threads);
+    tessera::engine::ThreadArena arena(threads);
     arena.execute([&] { tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, kGrain), body); });
   }
   for (std::size_t k = 0; k < out.size(); ++k)

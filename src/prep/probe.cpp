@@ -18,7 +18,7 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
+#include "tessera/engine/thread_arena.hpp"
 
 #include "tessera/cells.hpp"
 
@@ -91,7 +91,7 @@ ProbeResult probe(const ScalarImage& image, std::span<const double> coords, cons
   if (threads == 1 || n <= kGrain) {
     for (std::size_t p = 0; p < n; ++p) one(p);
   } else {
-    tbb::task_arena arena(threads);
+    tessera::engine::ThreadArena arena(threads);
     arena.execute([&] {
       tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, kGrain), [&](const tbb::blocked_range<std::size_t>& r) {
         for (std::size_t p = r.begin(); p != r.end(); ++p) one(p);

@@ -280,6 +280,15 @@ class Voronoi3D(TempDirCase):
         vtu = self.p("env.vtu")
         self.ok(["voronoi", inp, "-o", vtu, "-q"], env={"TESSERA_NUM_THREADS": "2"})
         self.assertTrue(read_bytes(vtu) == outs[1][0])
+        # More threads than cores run as asked (oversubscribed), with the same
+        # bytes and nothing from oneTBB on stderr ("TBB Warning: The number of
+        # workers is currently limited ...", while the summary claimed them).
+        many = len(os.sched_getaffinity(0)) + 2
+        vtu = self.p("many.vtu")
+        r = self.ok(["voronoi", inp, "-o", vtu, "--threads", many])
+        self.assertNotIn("TBB", r.stderr)
+        self.assertIn("on %d threads" % many, r.stdout)
+        self.assertTrue(read_bytes(vtu) == outs[1][0])
 
     def test_chunked_writers_read_back(self):
         # The .vtu's connectivity and faces, and the .csv's rows, are written
@@ -626,9 +635,9 @@ class BadInput(TempDirCase):
         self.good3 = self.save("good3.npy", np.random.default_rng(1).random((50, 3)))
         self.good2 = self.save("good2.npy", np.random.default_rng(1).random((50, 2)))
 
-    def fails(self, args, fragment=None, code=2, outputs=None):
+    def fails(self, args, fragment=None, code=2, outputs=None, env=None):
         before = set(os.listdir(self.dir))
-        r = run(args)
+        r = run(args, env=env)
         after = set(os.listdir(self.dir))
         cmd = "tessera " + " ".join(map(str, args))
         self.assertEqual(r.returncode, code, "%s: exit %d\nstdout: %s\nstderr: %s" %
@@ -755,6 +764,8 @@ class BadInput(TempDirCase):
         self.fails(["voronoi", self.good3])  # nothing to do
         self.fails(["voronoi", self.good3, "-o", self.out(), "--dim", "4"])
         self.fails(["voronoi", self.good3, "-o", self.out(), "--threads", "-1"])
+        self.fails(["voronoi", self.good3, "-o", self.out(), "--threads", "5000"], "threads must be at most 4096")
+        self.fails(["voronoi", self.good3, "-o", self.out()], "TESSERA_NUM_THREADS", env={"TESSERA_NUM_THREADS": "5000"})
         self.fails(["voronoi", self.good3, "-o", self.out(), "--padding", "-0.1"])
         # A padding that makes the domain overflow double (a segfault until
         # stop 17), in 3D and 2D, for cells and for surface nets.

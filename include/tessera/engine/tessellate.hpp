@@ -12,7 +12,7 @@
 
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
+#include "tessera/engine/thread_arena.hpp"
 
 #include "tessera/buffer.hpp"
 #include "tessera/engine/concepts.hpp"
@@ -129,7 +129,7 @@ std::uint64_t tessellate(const Generators<CellT::dim>& gens, Comp& comp, const E
     }
   };
 
-  tbb::task_arena arena(std::max(1, opt.threads));
+  ThreadArena arena(opt.threads);
   // Progress is reported (and cancellation honoured) between chunks of batches,
   // from the calling thread.
   const std::size_t chunk = opt.progress ? std::max<std::size_t>(1, nb / 100) : nb;
