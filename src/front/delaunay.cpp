@@ -17,7 +17,6 @@
 
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_sort.h>
-#include "tessera/engine/thread_arena.hpp"
 
 #include "delaunay_compositor.hpp"
 #include "hull_completion.hpp"
@@ -28,6 +27,7 @@
 #include "point_buckets.hpp"
 #include "simplex_facets.hpp"
 #include "tessera/engine/tessellate.hpp"
+#include "tessera/engine/thread_arena.hpp"
 #include "tessera/kernels/delaunay_predicates.hpp"
 #include "tessera/kernels/hull.hpp"
 #include "tessera/kernels/tile.hpp"

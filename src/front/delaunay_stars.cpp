@@ -6,9 +6,9 @@
 #include <vector>
 
 #include <tbb/parallel_for.h>
-#include "tessera/engine/thread_arena.hpp"
 
 #include "insertion.hpp"
+#include "tessera/engine/thread_arena.hpp"
 
 namespace tessera::front {
 

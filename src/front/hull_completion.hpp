@@ -46,9 +46,9 @@
 
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_sort.h>
-#include "tessera/engine/thread_arena.hpp"
 
 #include "delaunay_compositor.hpp"
+#include "tessera/engine/thread_arena.hpp"
 #include "tessera/kernels/delaunay_predicates.hpp"
 #include "candidate_tree.hpp"
 #include "facet_table.hpp"

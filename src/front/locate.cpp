@@ -11,8 +11,8 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
-#include "tessera/engine/thread_arena.hpp"
 
+#include "tessera/engine/thread_arena.hpp"
 #include "tessera/kernels/delaunay_predicates.hpp"
 
 namespace tessera {

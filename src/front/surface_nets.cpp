@@ -12,9 +12,9 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
-#include "tessera/engine/thread_arena.hpp"
 
 #include "net_smoothing.hpp"
+#include "tessera/engine/thread_arena.hpp"
 
 namespace tessera {
 namespace {

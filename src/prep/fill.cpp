@@ -25,9 +25,9 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
-#include "tessera/engine/thread_arena.hpp"
 
 #include "random.hpp"
+#include "tessera/engine/thread_arena.hpp"
 #include "tessera/image.hpp"
 #include "tessera/prep/sample_image.hpp"
 

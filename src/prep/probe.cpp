@@ -18,9 +18,9 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
-#include "tessera/engine/thread_arena.hpp"
 
 #include "tessera/cells.hpp"
+#include "tessera/engine/thread_arena.hpp"
 
 namespace tessera {
 

@@ -24,10 +24,10 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
-#include "tessera/engine/thread_arena.hpp"
 
 #include "random.hpp"
 #include "tessera/cells.hpp"
+#include "tessera/engine/thread_arena.hpp"
 
 namespace tessera {
 namespace {

@@ -12,10 +12,10 @@
 
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
-#include "tessera/engine/thread_arena.hpp"
 
 #include "tessera/buffer.hpp"
 #include "tessera/engine/concepts.hpp"
+#include "tessera/engine/thread_arena.hpp"
 #include "tessera/kernels/cell_builder.hpp"
 #include "tessera/kernels/exact_predicates.hpp"
 #include "tessera/kernels/locator.hpp"
