@@ -142,3 +142,38 @@ def test_calls_from_other_threads_run_concurrently():
     for t in threads:
         t.join()
     assert np.array_equal(results[0], results[1])
+
+
+def test_concurrent_calls_of_any_thread_count_give_the_serial_results():
+    # Python threads each running cells and Delaunay with 1, 2 or more threads
+    # than cores (each such call raises oneTBB's worker cap while it runs):
+    # every result equals the one-thread call's, bit for bit.
+    rng = np.random.default_rng(5)
+    inputs = [(rng.random((8000, 3)), None), (rng.random((12000, 2)), rng.integers(-1, 3, 12000)),
+              (rng.random((6000, 3)) ** 3, None)]
+    many = len(os.sched_getaffinity(0)) + 1
+
+    def run(i, threads):
+        pts, labels = inputs[i]
+        v = tessera.voronoi(pts, labels=labels, threads=threads)
+        out = [np.array(v.neighbors).tobytes(), np.array(v.volumes).tobytes(), np.array(v.vertices).tobytes()]
+        if labels is None:
+            out.append(np.array(tessera.delaunay(pts, threads=threads).simplices).tobytes())
+        return out
+
+    serial = [run(i, 1) for i in range(len(inputs))]
+    got = {}
+
+    def work(k):
+        for rep in range(2):
+            i = (k + rep) % len(inputs)
+            got[(k, rep)] = (i, run(i, (1, 2, many)[k % 3]))
+
+    threads = [threading.Thread(target=work, args=(k,)) for k in range(6)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert len(got) == 12
+    for (k, rep), (i, r) in got.items():
+        assert r == serial[i], (k, rep, i)
