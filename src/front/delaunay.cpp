@@ -291,7 +291,7 @@ inline constexpr double clean_exact_per_cell = 1.0;
 // The triangulation by insertion of the located points (front::insert_located).
 template <int D>
 Delaunay by_insertion(const front::Pass<D>& pass, Delaunay out) {
-  tessera::engine::ThreadArena(pass.engine_options.threads).execute([&] {
+  engine::ThreadArena(pass.engine_options.threads).execute([&] {
     front::LocatedInsertion ins = front::insert_located(pass, pass.engine_options.progress);
     const auto& loc = *pass.locator;
     for (std::size_t k = 0; k < loc.size(); ++k)
@@ -367,7 +367,7 @@ Delaunay run(std::span<const double> input, std::span<const std::int32_t> labels
   std::vector<std::int32_t> built_order;
   std::vector<std::uint32_t> built_slots;
   if (skip > 0) {
-    tessera::engine::ThreadArena(pass.engine_options.threads).execute([&] { skipped = choose_skipped<D>(pass, skip, n); });
+    engine::ThreadArena(pass.engine_options.threads).execute([&] { skipped = choose_skipped<D>(pass, skip, n); });
     for (std::size_t g = 0; g < pass.order.size(); ++g)
       if (!skipped[static_cast<std::size_t>(pass.order[g])]) {
         built_order.push_back(pass.order[g]);
@@ -453,7 +453,7 @@ Delaunay run(std::span<const double> input, std::span<const std::int32_t> labels
     if (!skipped.empty())
       for (std::size_t i = 0; i < n; ++i) found.touches_box[i] |= skipped[i];
     std::optional<front::CandidateTree<D>> tree;
-    tessera::engine::ThreadArena(pass.engine_options.threads).execute([&] { tree.emplace(pass.points, found.touches_box); });
+    engine::ThreadArena(pass.engine_options.threads).execute([&] { tree.emplace(pass.points, found.touches_box); });
     const front::CandidateTree<D>& candidates = *tree;
     double diam2 = 0;
     for (int d = 0; d < D; ++d) {
@@ -495,7 +495,7 @@ Delaunay run(std::span<const double> input, std::span<const std::int32_t> labels
   // them, and write() lays out the found rows and these extra ones in one
   // pass.
   std::atomic<std::size_t> flat = 0;
-  tessera::engine::ThreadArena(pass.engine_options.threads).execute([&] {
+  engine::ThreadArena(pass.engine_options.threads).execute([&] {
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, added.size(), 4096), [&](const tbb::blocked_range<std::size_t>& r) {
       for (std::size_t i = r.begin(); i != r.end(); ++i) {
         auto& row = added[i];
@@ -510,7 +510,7 @@ Delaunay run(std::span<const double> input, std::span<const std::int32_t> labels
   if (added.size() < found.foreign.size()) added.swap(found.foreign);  // append the shorter list
   added.insert(added.end(), found.foreign.begin(), found.foreign.end());
   std::vector<std::array<std::int32_t, D + 1>>().swap(found.foreign);
-  tessera::engine::ThreadArena(pass.engine_options.threads).execute([&] { comp.write(added, out.simplices); });
+  engine::ThreadArena(pass.engine_options.threads).execute([&] { comp.write(added, out.simplices); });
   std::sort(out.duplicates.begin(), out.duplicates.end());
   return out;
 }
@@ -573,7 +573,7 @@ std::vector<std::int32_t> simplex_neighbors(const Delaunay& dt) {
   // entry of nb is written by one point, so points run at once. Records of
   // one facet pair up in ascending simplex order; a third (a non-conforming
   // triangulation) stays -1.
-  tessera::engine::ThreadArena(dt.threads_used > 0 ? dt.threads_used : 1).execute([&] {
+  engine::ThreadArena(dt.threads_used > 0 ? dt.threads_used : 1).execute([&] {
     const front::FacetBuckets buckets(dt);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, dt.n_points, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
       std::vector<front::FacetRecord> recs;
@@ -610,7 +610,7 @@ VertexNeighbors vertex_neighbors(const Delaunay& dt) {
     for (std::size_t j = i + 1; j < w; ++j) edge[edges++] = {i, j};
   const std::int32_t* const rows = dt.simplices.data();
   VertexNeighbors out;
-  tessera::engine::ThreadArena(dt.threads_used > 0 ? dt.threads_used : 1).execute([&] {
+  engine::ThreadArena(dt.threads_used > 0 ? dt.threads_used : 1).execute([&] {
     // Every simplex edge {u, v} goes to its lower end as the higher one
     // (bucket_by_point); each point keeps the distinct values of its bucket
     // in place (distinct_ascending): its higher neighbours H, ascending.

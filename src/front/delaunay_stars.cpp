@@ -19,7 +19,7 @@ std::optional<engine::DelaunayStars> delaunay_stars(const Pass<D>& pass, const s
   const std::size_t n = pass.points.size() / D, located = loc.size();
   engine::DelaunayStars out;
   bool flat = false;
-  tessera::engine::ThreadArena(pass.engine_options.threads).execute([&] {
+  engine::ThreadArena(pass.engine_options.threads).execute([&] {
     LocatedInsertion ins = insert_located(pass, progress);
     out.duplicate_of = std::move(ins.lowest);
     if (!ins.rows) {

@@ -69,7 +69,7 @@ SimplexLocator::SimplexLocator(const Delaunay& dt, std::span<const double> point
   if (n_simplices_ == 0) return;
 
   // The box of every simplex vertex: both methods bin it.
-  tessera::engine::ThreadArena arena(resolve_threads(threads));
+  engine::ThreadArena arena(resolve_threads(threads));
   struct Box {
     double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
   };
@@ -124,7 +124,7 @@ void SimplexLocator::build_grid(const Delaunay& dt, std::span<const double> poin
   const int D = dim_;
   const std::size_t w = static_cast<std::size_t>(D + 1);
   const std::size_t m = n_simplices_;
-  tessera::engine::ThreadArena arena(resolve_threads(threads));
+  engine::ThreadArena arena(resolve_threads(threads));
   // Bins near cubes of the volume that holds simplices_per_bin simplices each.
   size_bins(simplices_per_bin, static_cast<double>(m));
   auto total_bins = [&] { return bins_[0] * bins_[1] * bins_[2]; };
@@ -347,7 +347,7 @@ std::vector<std::int32_t> SimplexLocator::locate(const Delaunay& dt, std::span<c
   const std::size_t nq = queries.size() / du;
   std::vector<std::int32_t> found(nq, -1);
   if (n_simplices_ == 0) return found;
-  tessera::engine::ThreadArena(resolve_threads(threads)).execute([&] {
+  engine::ThreadArena(resolve_threads(threads)).execute([&] {
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nq, 1024), [&](const tbb::blocked_range<std::size_t>& r) {
       for (std::size_t q = r.begin(); q != r.end(); ++q) {
         const double* x = queries.data() + q * du;

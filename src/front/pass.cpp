@@ -208,7 +208,7 @@ Pass<D>::Pass(std::span<const double> input, std::span<const std::int32_t> label
   }
   const double ppb = opt.points_per_bin > 0 ? opt.points_per_bin : 2.0;
   engine_options.threads = resolve_threads(opt.threads);
-  tessera::engine::ThreadArena(engine_options.threads).execute([&] {
+  engine::ThreadArena(engine_options.threads).execute([&] {
     locator.emplace(points, n_in == n ? std::span<const std::uint8_t>() : std::span<const std::uint8_t>(in_box), lo,
                     hi, ppb);
   });
@@ -233,7 +233,7 @@ Pass<D>::Pass(std::span<const double> input, std::span<const std::int32_t> label
   const bool outliers = loc.outside_core() != 0;
   // In the arena: an eager tree's build runs parallel loops (its slabs),
   // which honour --threads there.
-  tessera::engine::ThreadArena(engine_options.threads).execute([&] {
+  engine::ThreadArena(engine_options.threads).execute([&] {
     tree.emplace(
         points,
         [&loc] {

@@ -152,7 +152,7 @@ SurfaceNet surface_nets(std::span<const double> points, std::span<const std::int
   SurfaceNet out;
   out.selected = resolve_selection(labels, options.select);
   const auto& sel = out.selected;
-  tessera::engine::ThreadArena arena(resolve_threads(options.voronoi.threads));
+  engine::ThreadArena arena(resolve_threads(options.voronoi.threads));
 
   // Unselected labels >= 0 become outside points for the cells (any negative
   // value will do); the faces get the original labels, so a capping face

@@ -148,7 +148,7 @@ void parallel_range(std::size_t n, int threads, F&& body) {
     body(tbb::blocked_range<std::size_t>(0, n));
     return;
   }
-  tessera::engine::ThreadArena arena(threads);
+  engine::ThreadArena arena(threads);
   arena.execute([&] { tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, kGrain), body); });
 }
 

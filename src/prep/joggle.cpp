@@ -104,7 +104,7 @@ std::vector<double> joggle(std::span<const double> coords, int dim, const Joggle
   if (threads == 1 || n <= kGrain) {
     body(tbb::blocked_range<std::size_t>(0, n));
   } else {
-    tessera::engine::ThreadArena arena(threads);
+    engine::ThreadArena arena(threads);
     arena.execute([&] { tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, kGrain), body); });
   }
   for (std::size_t k = 0; k < out.size(); ++k)

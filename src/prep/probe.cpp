@@ -91,7 +91,7 @@ ProbeResult probe(const ScalarImage& image, std::span<const double> coords, cons
   if (threads == 1 || n <= kGrain) {
     for (std::size_t p = 0; p < n; ++p) one(p);
   } else {
-    tessera::engine::ThreadArena arena(threads);
+    engine::ThreadArena arena(threads);
     arena.execute([&] {
       tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, kGrain), [&](const tbb::blocked_range<std::size_t>& r) {
         for (std::size_t p = r.begin(); p != r.end(); ++p) one(p);

@@ -195,7 +195,7 @@ inline bool is_power(std::int32_t d, std::int32_t n) {
 
 std::vector<std::int32_t> boundary_distance(const LabelImage& image, const std::vector<std::int32_t>& select) {
   check_image(image);
-  tessera::engine::ThreadArena arena(resolve_threads(0));
+  engine::ThreadArena arena(resolve_threads(0));
   std::vector<std::int32_t> out;
   arena.execute([&] {
     const Selection sel = make_selection(image, select);
@@ -236,7 +236,7 @@ LabelledPoints sample_image(const LabelImage& image, const SampleImageOptions& o
 
   LabelledPoints out;
   out.dim = dim;
-  tessera::engine::ThreadArena arena(resolve_threads(o.threads));
+  engine::ThreadArena arena(resolve_threads(o.threads));
   arena.execute([&] {
     const Selection sel = make_selection(image, o.select);
     for (std::size_t i = 0; i < sel.labels.size(); ++i)
