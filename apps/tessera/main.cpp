@@ -67,8 +67,9 @@ void add_compute_options(CLI::App* app, ComputeArgs& c, std::vector<std::string>
   app->add_flag("--ignore-outside", c.ignore_outside,
                 "With --bounds: drop points outside the box (listed in the summary) instead of failing");
   app->add_option("--threads", c.threads,
-                  "Worker threads (default 0: $TESSERA_NUM_THREADS, else all cores; at most 4096, more than the "
-                  "cores run oversubscribed). Results are identical for any thread count")
+                  "Worker threads (default 0: $TESSERA_NUM_THREADS, else all cores; at most " +
+                      std::to_string(tessera::max_threads) +
+                      ", more than the cores run oversubscribed). Results are identical for any thread count")
       ->check(NonNegative);
   app->add_option("--bin-points", c.bin_points,
                   "Tuning: mean points per bin of the point locator (default 0: automatic)")

@@ -573,7 +573,7 @@ std::vector<std::int32_t> simplex_neighbors(const Delaunay& dt) {
   // entry of nb is written by one point, so points run at once. Records of
   // one facet pair up in ascending simplex order; a third (a non-conforming
   // triangulation) stays -1.
-  engine::ThreadArena(dt.threads_used > 0 ? dt.threads_used : 1).execute([&] {
+  engine::ThreadArena(dt.threads_used).execute([&] {
     const front::FacetBuckets buckets(dt);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, dt.n_points, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
       std::vector<front::FacetRecord> recs;
@@ -610,7 +610,7 @@ VertexNeighbors vertex_neighbors(const Delaunay& dt) {
     for (std::size_t j = i + 1; j < w; ++j) edge[edges++] = {i, j};
   const std::int32_t* const rows = dt.simplices.data();
   VertexNeighbors out;
-  engine::ThreadArena(dt.threads_used > 0 ? dt.threads_used : 1).execute([&] {
+  engine::ThreadArena(dt.threads_used).execute([&] {
     // Every simplex edge {u, v} goes to its lower end as the higher one
     // (bucket_by_point); each point keeps the distinct values of its bucket
     // in place (distinct_ascending): its higher neighbours H, ascending.

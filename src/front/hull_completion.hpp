@@ -249,7 +249,7 @@ class HullCompletion {
     // Facets on the current boundary and those closed by completion, with
     // the number of simplices holding each (found ones count once: the
     // other side of an open facet is what completion looks for).
-    engine::ThreadArena arena(std::max(1, threads));
+    engine::ThreadArena arena(threads);  // below 1: one thread
     FacetTable<D> facets(2 * open.size());
     std::vector<OpenFacet<D>> queue = open;
     std::vector<std::uint8_t> counts;

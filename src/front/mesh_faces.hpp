@@ -65,7 +65,7 @@ inline double face_measure(const Cells& c, std::int64_t f) {
 /// on the schedule.
 template <class Body>
 void for_each_cell(const Cells& c, Body&& body) {
-  engine::ThreadArena arena(c.threads_used > 0 ? c.threads_used : 1);
+  engine::ThreadArena arena(c.threads_used);  // 0 (never computed): one thread
   arena.execute([&] {
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, c.n_cells(), 256),
                       [&](const tbb::blocked_range<std::size_t>& r) {

@@ -1,4 +1,4 @@
-// engine::ThreadArena runs the thread count it is given, beyond the machine's
+// engine::ThreadArena runs the thread count it is given (no more), beyond the machine's
 // cores too (a plain tbb::task_arena ran on the cores alone there, and oneTBB
 // warned on stderr); the cap it raises is back when it ends, and an
 // application's lower cap still wins. resolve_threads bounds the request.
@@ -52,7 +52,7 @@ TEST(ThreadArena, RunsMoreThreadsThanCoresAtOnce) {
   EXPECT_EQ(cap(), before);  // raised only while the arena lives
 }
 
-TEST(ThreadArena, RunsExactlyItsCount) {
+TEST(ThreadArena, RunsNoMoreThanItsCount) {
   ThreadArena arena(2);
   std::set<std::thread::id> ids;
   std::mutex m;
