@@ -119,10 +119,10 @@ int run_delaunay(const DelaunayArgs& a) {
       std::fprintf(stderr,
                    "tessera: validation %s: %zu simplices, %zu flat/inverted, %zu non-manifold facets, %zu boundary "
                    "facets, %zu open ridges, %zu non-convex ridges, %zu missing points, %zu non-Delaunay facets, "
-                   "volume %.17g (boundary encloses %.17g)\n",
+                   "volume %.17g (boundary encloses %.17g; they agree within %.3g)\n",
                    r.ok ? "passed" : "FAILED", r.simplices, r.flat_or_inverted, r.nonmanifold_facets,
                    r.boundary_facets, r.open_boundary_ridges, r.nonconvex_boundary, r.missing_points,
-                   r.local_delaunay_violations, r.volume_sum, r.enclosed_volume);
+                   r.local_delaunay_violations, r.volume_sum, r.enclosed_volume, r.volume_tolerance);
       for (const auto& m : r.messages) std::fprintf(stderr, "tessera: validation: %s\n", m.c_str());
     }
     if (!r.ok) {

@@ -118,6 +118,10 @@ struct DelaunayReport {
   std::size_t local_delaunay_violations = 0;  ///< interior facets whose opposite vertex is in the circumsphere
   double volume_sum = 0;                   ///< sum of simplex volumes (areas in 2D)
   double enclosed_volume = 0;              ///< volume enclosed by the boundary facets
+  /// How far the two volumes may differ and still agree: their float
+  /// rounding (bounded from each determinant) plus 1e-9 relative. On nearly
+  /// flat input both are at this noise level, and either may be negative.
+  double volume_tolerance = 0;
   std::vector<std::string> messages;       ///< one line each
 };
 DelaunayReport validate(const Delaunay& dt, std::span<const double> points, std::span<const std::int32_t> labels);

@@ -94,6 +94,7 @@ void bind_delaunay(py::module_& m) {
       .def_readonly("local_delaunay_violations", &DelaunayReport::local_delaunay_violations)
       .def_readonly("volume_sum", &DelaunayReport::volume_sum)
       .def_readonly("enclosed_volume", &DelaunayReport::enclosed_volume)
+      .def_readonly("volume_tolerance", &DelaunayReport::volume_tolerance)
       .def_readonly("messages", &DelaunayReport::messages)
       .def("__bool__", [](const DelaunayReport& r) { return r.ok; })
       .def("__repr__", [](const DelaunayReport& r) {

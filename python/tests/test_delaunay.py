@@ -26,6 +26,21 @@ def test_validate_orientation_and_hull(dim):
     assert (dt.simplices[:, 0] == dt.simplices.min(axis=1)).all()  # lowest id first
     assert dt.hull_completed and dt.from_cells + dt.from_hull_completion + dt.from_insertion == dt.nsimplex
     assert set(np.unique(dt.simplices).tolist()) == set(range(3000))  # every point used
+    assert 0 < report.volume_tolerance < 1e-6 * report.volume_sum
+    assert abs(report.volume_sum - report.enclosed_volume) <= report.volume_tolerance
+
+
+def test_validate_near_line_volumes_agree_within_tolerance():
+    # 3D points within 1e-17 of a line: both volumes are rounding noise (either
+    # may be negative); the report says how far they may differ.
+    rng = np.random.default_rng(3)
+    t = rng.random(1000)
+    pts = np.outer(t, [0.3, 0.5, 0.7]) + rng.normal(scale=1e-17, size=(1000, 3))
+    report = tessera.delaunay(pts).validate()
+    assert report.ok, report.messages
+    assert report.volume_tolerance > 0
+    assert abs(report.volume_sum - report.enclosed_volume) <= report.volume_tolerance
+    assert abs(report.enclosed_volume) <= report.volume_tolerance
 
 
 def test_neighbors_are_symmetric():

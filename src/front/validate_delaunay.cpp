@@ -279,6 +279,7 @@ DelaunayReport validate(const Delaunay& dt, std::span<const double> points, std:
   rep.volume_sum = std::ldexp(volume_sum, unit_exp_sum);
   rep.enclosed_volume = std::ldexp(enclosed_volume, unit_exp_sum);
   const double tol = 1e-9 * std::max(std::fabs(volume_sum), std::fabs(enclosed_volume)) + volume_err;
+  rep.volume_tolerance = std::ldexp(tol, unit_exp_sum);
   if (!(std::fabs(volume_sum - enclosed_volume) <= tol)) {  // NaN fails too
     rep.ok = false;
     std::ostringstream s;
