@@ -93,13 +93,18 @@ int run_delaunay(const DelaunayArgs& a) {
   const double write_s = seconds_since(t0);
 
   if (!a.quiet) {
+    // With labels, the counts by method are of the whole triangulation.
+    const std::string outside =
+        pc.labels.empty() || a.no_hull_completion
+            ? std::string()
+            : "; " + std::to_string(dt.outside_simplices) + " with an outside vertex left out";
     if (dt.from_insertion > 0)
-      std::fprintf(stderr, "tessera: %zu points (%dD) -> %zu %s (by incremental insertion)\n", pc.n, pc.dim,
-                   dt.n_simplices(), pc.dim == 3 ? "tetrahedra" : "triangles");
+      std::fprintf(stderr, "tessera: %zu points (%dD) -> %zu %s (by incremental insertion%s)\n", pc.n, pc.dim,
+                   dt.n_simplices(), pc.dim == 3 ? "tetrahedra" : "triangles", outside.c_str());
     else
-      std::fprintf(stderr, "tessera: %zu points (%dD) -> %zu %s (%zu from the cells, %zu by hull completion%s)\n",
+      std::fprintf(stderr, "tessera: %zu points (%dD) -> %zu %s (%zu from the cells, %zu by hull completion%s%s)\n",
                    pc.n, pc.dim, dt.n_simplices(), pc.dim == 3 ? "tetrahedra" : "triangles", dt.from_cells,
-                   dt.from_hull_completion, dt.hull_completed ? "" : ": off");
+                   dt.from_hull_completion, a.no_hull_completion ? ": off" : "", outside.c_str());
     if (dt.n_simplices() == 0)
       std::fprintf(stderr, "tessera: no simplices: the points are %s%s\n",
                    pc.dim == 3 ? "coplanar (for a 2D triangulation use --dim 2 on in-plane coordinates)" : "collinear",

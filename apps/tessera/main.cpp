@@ -167,11 +167,11 @@ int main(int argc, char** argv) {
                   "built: their simplices come from their neighbours' cells, and gift wrapping closes the cavities "
                   "between skipped points. Same result. Default from 20,000 points, by what a sample of cells costs: "
                   "in 3D 0.35 to 0.9 (more on surface samples, whose cells are needles), in 2D 0 on uniform points "
-                  "and 0.3 to 0.6 on clustered ones; else 0. Ignored with labels or --no-hull-completion")
+                  "and 0.3 to 0.6 on clustered ones; else 0. Ignored with --no-hull-completion")
       ->check(CLI::Range(0.0, 0.99));
   del->add_option("--method", dla.method,
-                  "cells: the cells pass and hull completion; insertion: incremental insertion (without labels; "
-                  "parallel by phases); auto (without labels or --skip-cells): insertion below 20,000 "
+                  "cells: the cells pass and hull completion; insertion: incremental insertion (with hull "
+                  "completion; parallel by phases); auto (without --skip-cells): insertion below 20,000 "
                   "points, and from there where a sample of cells costs far more than it finds (surface samples, "
                   "2D curves and circles) or meets no ties on 1-2 threads (uniform points), or "
                   "where 3D hull completion stalls; else the cells (lattices). Same result")
@@ -183,8 +183,9 @@ int main(int argc, char** argv) {
   del->add_flag("-q,--quiet", dla.quiet, "No summary and no progress bar");
   del->footer(
       "Without labels the triangulation covers the convex hull (CGAL's on points in general position; a valid\n"
-      "one chosen by symbolic perturbation on degenerate input). With --labels: the simplices whose vertices\n"
-      "all have labels >= 0 (concave results allowed).\n"
+      "one chosen by symbolic perturbation on degenerate input). With --labels: that triangulation's simplices\n"
+      "whose vertices all have labels >= 0 (concave results allowed; with --no-hull-completion, only those\n"
+      "whose circumcentre lies in the domain box).\n"
       "Examples:\n"
       "  tessera delaunay points.npy -o tets.vtu --simplices tets.npy\n"
       "  tessera delaunay points.csv --dim 2 -o triangles.vtp --validate");

@@ -1,13 +1,14 @@
 // Front end: the Delaunay triangulation of a point set, the dual of the cells.
 //
-// Every Voronoi vertex of the (symbolically perturbed) diagram with D+1 inside
-// generators is one Delaunay simplex. The cells pass finds those whose
-// circumcentre lies in the domain box; without labels, hull completion then
-// adds the thin simplices near the convex hull whose circumcentres lie outside
-// it, so the result covers the convex hull of the input exactly (docs/design.md,
-// "Delaunay and hull completion"). Where a pilot finds the cells far costlier
-// than what they find (points sampled on surfaces), 3D points go to
-// incremental insertion instead, which builds the same simplices.
+// Every Voronoi vertex of the (symbolically perturbed) diagram is one Delaunay
+// simplex. The cells pass finds those whose circumcentre lies in the domain
+// box; hull completion then adds the thin simplices near the convex hull whose
+// circumcentres lie outside it, so the result covers the convex hull of the
+// input exactly (docs/design.md, "Delaunay and hull completion"). Where a
+// pilot finds the cells far costlier than what they find (points sampled on
+// surfaces), points go to incremental insertion instead, which builds the same
+// simplices. With labels, the result is the simplices of that whole
+// triangulation whose vertices are all inside points (label >= 0).
 #pragma once
 
 #include <cstddef>
@@ -23,7 +24,7 @@ namespace tessera {
 
 /// How tessera::delaunay builds the triangulation (the result is the same).
 enum class DelaunayMethod {
-  /// Without labels, with complete_hull and automatic skip_cells:
+  /// With complete_hull and automatic skip_cells:
   /// insertion below 20,000 points. From there a pilot builds a few
   /// hundred cells; insertion is chosen where they cost far more than the
   /// simplices they find (surface samples, clustered volumes, points nearly
@@ -37,15 +38,17 @@ enum class DelaunayMethod {
   /// pass. Every path gives the same rows.
   automatic,
   cells,      ///< the cells pass (and hull completion)
-  /// Incremental insertion (parallel by phases); without
-  /// labels and with complete_hull only.
+  /// Incremental insertion (parallel by phases); with complete_hull only.
   insertion,
 };
 
 struct DelaunayOptions : VoronoiOptions {
-  /// Without labels: close the triangulation up to the convex hull (simplices
-  /// whose circumcentre lies outside the domain box). Ignored with labels,
-  /// where the result is the simplices whose generators are all inside points.
+  /// Close the triangulation up to the convex hull (simplices whose
+  /// circumcentre lies outside the domain box). With labels, the result is
+  /// then the whole triangulation's simplices whose vertices are all inside
+  /// points, whatever the box; without completion, those of the inside
+  /// points' cells (circumcentre in the box, every vertex inside), as the
+  /// cells pass finds them.
   bool complete_hull = true;
   /// With hull completion: the fraction of the points, in [0, 1), whose
   /// cells are not built (picked by a hash of their id; points with an exact
@@ -55,7 +58,7 @@ struct DelaunayOptions : VoronoiOptions {
   /// is the same, row for row. Negative: automatic (from 20,000 points, by
   /// what a cell costs per simplex it finds, measured on a sample of cells
   /// first: in 3D 0.35 to 0.9; in 2D 0 on uniform points, 0.3 to 0.6 on
-  /// clustered ones; else 0). Ignored with labels or without hull completion.
+  /// clustered ones; else 0). Ignored without hull completion.
   double skip_cells = -1;
   DelaunayMethod method = DelaunayMethod::automatic;
 };
@@ -74,8 +77,15 @@ struct Delaunay {
   std::size_t from_hull_completion = 0;    ///< simplices added by hull completion (and skipped cells' cavities)
   std::size_t skipped_cells = 0;           ///< generators whose cells were not built (DelaunayOptions::skip_cells)
   std::size_t from_insertion = 0;          ///< simplices built by incremental insertion (DelaunayOptions::method)
-  bool hull_completed = false;             ///< hull completion ran (no labels, complete_hull)
-  std::vector<std::pair<std::int32_t, std::int32_t>> duplicates;  ///< (duplicate, owner): not vertices
+  /// The simplices cover the convex hull of the points: hull completion ran
+  /// and no labels left simplices out (locate() may walk).
+  bool hull_completed = false;
+  /// With labels and complete_hull: the whole triangulation's simplices left
+  /// out for an outside vertex. The from_* counts are of the whole
+  /// triangulation, so they sum to n_simplices() plus this.
+  std::size_t outside_simplices = 0;
+  /// (duplicate, owner): not vertices. With labels, only inside duplicates.
+  std::vector<std::pair<std::int32_t, std::int32_t>> duplicates;
   std::vector<std::int32_t> ignored_outside_bounds;
   std::uint64_t exact_predicate_calls = 0;
   int threads_used = 1;

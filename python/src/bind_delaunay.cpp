@@ -121,6 +121,7 @@ void bind_delaunay(py::module_& m) {
       .def_property_readonly("from_hull_completion", [](const DelaunayResult& r) { return r.dt.from_hull_completion; })
       .def_property_readonly("from_insertion", [](const DelaunayResult& r) { return r.dt.from_insertion; })
       .def_property_readonly("hull_completed", [](const DelaunayResult& r) { return r.dt.hull_completed; })
+      .def_property_readonly("outside_simplices", [](const DelaunayResult& r) { return r.dt.outside_simplices; })
       .def_property_readonly("duplicates", [](const DelaunayResult& r) { return pairs_copy(r.dt.duplicates); })
       .def_property_readonly("ignored_outside_bounds",
                              [](py::object s) {

@@ -25,8 +25,8 @@ class Delaunay:
     computed on first use and kept.
 
     Without labels the simplices cover the convex hull of the points exactly
-    (hull completion); with labels they are the simplices whose points are all
-    inside points (label >= 0).
+    (hull completion); with labels they are those of that whole triangulation
+    whose points are all inside points (label >= 0).
     """
 
     def __init__(self, dt: Any, points: np.ndarray, labels: Optional[np.ndarray]):
@@ -189,6 +189,14 @@ class Delaunay:
         return self._dt.hull_completed
 
     @property
+    def outside_simplices(self) -> int:
+        """With labels (and hull completion): simplices of the whole triangulation left
+        out for an outside vertex. ``from_cells``, ``from_hull_completion`` and
+        ``from_insertion`` count the whole triangulation, so they sum to ``nsimplex``
+        plus this."""
+        return self._dt.outside_simplices
+
+    @property
     def duplicates(self) -> np.ndarray:
         """int32 (k, 2): (duplicate id, owner id); duplicates are in no simplex."""
         return self._dt.duplicates
@@ -250,14 +258,16 @@ def delaunay(
     set the domain of the cells pass), plus:
 
     complete_hull : bool
-        Without labels, add the thin simplices near the convex hull whose
-        circumcentres lie outside the domain box, so the simplices cover the
-        hull exactly (as scipy's). Ignored with labels.
+        Add the thin simplices near the convex hull whose circumcentres lie
+        outside the domain box, so the simplices cover the hull exactly (as
+        scipy's). With labels the result is then the whole triangulation's
+        simplices whose points are all inside, whatever the box; without it,
+        only those whose circumcentres lie in the box.
     method : {"auto", "cells", "insertion"}
         How the simplices are built; the result is the same. ``"cells"``: the
         parallel cells pass and hull completion. ``"insertion"``: incremental
-        insertion (no labels, ``complete_hull``; parallel by phases).
-        ``"auto"`` (no labels): insertion below 20,000 points, and
+        insertion (``complete_hull`` only; parallel by phases).
+        ``"auto"``: insertion below 20,000 points, and
         from there where a sample of cells costs far more than it finds
         (surface samples, 2D curves and circles) or meets no ties on one or
         two threads (uniform points), or where 3D hull

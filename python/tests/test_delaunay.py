@@ -79,9 +79,15 @@ def test_labels_keep_the_simplices_of_inside_points():
     pts = random_points(2000, 2, seed=9)
     labels = np.where(np.linalg.norm(pts - 0.5, axis=1) < 0.25, -1, 0)
     dt = tessera.delaunay(pts, labels=labels)
-    assert not dt.hull_completed
+    assert not dt.hull_completed  # a region with a hole, not the convex hull
     assert (labels[dt.simplices] >= 0).all()
     assert dt.validate().ok, dt.validate().messages
+    # The whole triangulation's inside simplices, in its row order.
+    whole = tessera.delaunay(pts)
+    inside = (labels[whole.simplices] >= 0).all(axis=1)
+    assert np.array_equal(dt.simplices, whole.simplices[inside])
+    assert dt.outside_simplices == whole.nsimplex - dt.nsimplex
+    assert np.array_equal(tessera.delaunay(pts, labels=labels, method="insertion").simplices, dt.simplices)
 
 
 def test_duplicates_are_in_no_simplex():
@@ -121,4 +127,4 @@ def test_insertion_method_gives_the_same_simplices():
         assert np.array_equal(by_cells.simplices, by_insertion.simplices)
         assert by_insertion.from_insertion == by_insertion.nsimplex and by_cells.from_insertion == 0
     with pytest.raises(ValueError, match="whole convex hull"):
-        tessera.delaunay(random_points(100, 2, seed=1), method="insertion", labels=np.zeros(100, np.int32))
+        tessera.delaunay(random_points(100, 2, seed=1), method="insertion", complete_hull=False)

@@ -551,18 +551,48 @@ std::int32_t* distinct_ascending(std::int32_t* first, std::int32_t* last) {
   return std::copy(kept, kept + m, first);
 }
 
+// The labelled triangulation from the whole one (hull completed): its
+// simplices whose vertices are all inside points, rows in their order (so
+// still ascending), and the duplicates that are inside points. The same
+// simplices as the labelled cells pass finds where their circumcentres lie
+// in the box (there, outside generators build no cell and a simplex with an
+// outside vertex is dropped), and besides them the thin hull simplices
+// beyond the box, which that pass cannot reach: the result no longer
+// depends on the box, and the insertion can build it.
+void keep_inside(Delaunay& dt, std::span<const std::int32_t> labels) {
+  const std::size_t w = static_cast<std::size_t>(dt.dim + 1), n = dt.n_simplices();
+  std::int32_t* const rows = dt.simplices.data();
+  std::size_t kept = 0;
+  for (std::size_t r = 0; r < n; ++r) {
+    const std::int32_t* row = rows + r * w;
+    bool inside = true;
+    for (std::size_t k = 0; k < w; ++k) inside &= labels[static_cast<std::size_t>(row[k])] >= 0;
+    if (!inside) continue;
+    if (kept != r) std::copy(row, row + w, rows + kept * w);
+    ++kept;
+  }
+  dt.simplices.resize(kept * w);
+  dt.outside_simplices = n - kept;
+  dt.hull_completed = false;  // a region, not the convex hull: locate() must not walk
+  std::erase_if(dt.duplicates, [&](const auto& d) { return labels[static_cast<std::size_t>(d.first)] < 0; });
+}
+
 }  // namespace
 
 Delaunay delaunay(std::span<const double> points, int dim, std::span<const std::int32_t> labels,
                   const DelaunayOptions& options) {
   front::check_input(points, dim, labels);
-  if (options.method == DelaunayMethod::insertion) {
-    if (!labels.empty() || !options.complete_hull)
-      throw InputError("the insertion method triangulates the whole convex hull: no labels, hull completion on");
-  }
+  if (options.method == DelaunayMethod::insertion && !options.complete_hull)
+    throw InputError("the insertion method triangulates the whole convex hull: it needs hull completion");
   if (!(options.skip_cells < 1))
     throw InputError("skip_cells must be below 1 (a fraction of the points; negative: automatic), got " +
                      std::to_string(options.skip_cells));
+  if (!labels.empty() && options.complete_hull) {
+    // The whole triangulation, then its inside simplices (keep_inside).
+    Delaunay dt = dim == 3 ? run<kernels::Hull>(points, {}, options) : run<kernels::Tile>(points, {}, options);
+    keep_inside(dt, labels);
+    return dt;
+  }
   return dim == 3 ? run<kernels::Hull>(points, labels, options) : run<kernels::Tile>(points, labels, options);
 }
 

@@ -808,6 +808,66 @@ TEST(Delaunay, LabelsKeepInsideSimplicesOnly) {
   expect_valid(dt, p, labels);
 }
 
+// With labels (and hull completion) the result is the whole triangulation's
+// simplices whose vertices are all inside, rows in its order, whatever the
+// method and the box: here the inside points reach the hull on five sides,
+// where thin simplices have circumcentres beyond the box.
+TEST(Delaunay, LabelsKeepTheWholeTriangulationsInsideSimplices) {
+  for (int dim : {2, 3}) {
+    auto p = random_points(3000, dim, 57);
+    const std::size_t n = 3000;
+    // Exact duplicates: of an inside point (12), of an outside one (an x < 0.3 point).
+    std::size_t out_id = 0;
+    while (p[static_cast<std::size_t>(dim) * out_id] >= 0.3) ++out_id;
+    std::size_t in_id = 12;
+    while (p[static_cast<std::size_t>(dim) * in_id] < 0.3) ++in_id;
+    for (std::size_t src : {in_id, out_id})
+      for (int d = 0; d < dim; ++d) p.push_back(p[static_cast<std::size_t>(dim) * src + static_cast<std::size_t>(d)]);
+    std::vector<std::int32_t> labels(n + 2);
+    for (std::size_t i = 0; i < n + 2; ++i) labels[i] = p[static_cast<std::size_t>(dim) * i] < 0.3 ? -1 : static_cast<std::int32_t>(i % 3);
+    tessera::DelaunayOptions o;
+    o.dim = dim;
+    const tessera::Delaunay whole = tessera::delaunay(p, dim, {}, o);
+    ASSERT_TRUE(whole.hull_completed);
+    std::vector<std::int32_t> expected;
+    const std::size_t w = static_cast<std::size_t>(dim + 1);
+    for (std::size_t r = 0; r < whole.n_simplices(); ++r) {
+      const auto row = whole.simplices.begin() + static_cast<std::ptrdiff_t>(r * w);
+      if (std::all_of(row, row + static_cast<std::ptrdiff_t>(w), [&](std::int32_t id) { return labels[static_cast<std::size_t>(id)] >= 0; }))
+        expected.insert(expected.end(), row, row + static_cast<std::ptrdiff_t>(w));
+    }
+    for (auto method : {tessera::DelaunayMethod::automatic, tessera::DelaunayMethod::cells, tessera::DelaunayMethod::insertion}) {
+      for (int threads : {1, 2}) {
+        o.method = method;
+        o.threads = threads;
+        const tessera::Delaunay dt = tessera::delaunay(p, dim, labels, o);
+        EXPECT_EQ(std::vector<std::int32_t>(dt.simplices.begin(), dt.simplices.end()), expected) << dim << "D";
+        EXPECT_EQ(dt.n_simplices() + dt.outside_simplices, whole.n_simplices());
+        EXPECT_FALSE(dt.hull_completed) << "a region: locate() must not walk";
+        // Only the inside duplicate is reported (the outside one owns no simplex either way).
+        ASSERT_EQ(dt.duplicates.size(), 1u);
+        EXPECT_EQ(dt.duplicates[0], (std::pair<std::int32_t, std::int32_t>(static_cast<std::int32_t>(n), static_cast<std::int32_t>(in_id))));
+        expect_valid(dt, p, labels);
+      }
+    }
+    // Without completion: the simplices of the inside cells, circumcentres in
+    // the box; here fewer (the hull's thin ones are missing), none extra.
+    o.method = tessera::DelaunayMethod::cells;
+    o.complete_hull = false;
+    const tessera::Delaunay boxed = tessera::delaunay(p, dim, labels, o);
+    SimplexSet all = as_set(tessera::delaunay(p, dim, labels, [&] { auto c = o; c.complete_hull = true; return c; }()));
+    SimplexSet part = as_set(boxed);
+    EXPECT_LT(part.size(), all.size());
+    EXPECT_TRUE(std::includes(all.begin(), all.end(), part.begin(), part.end()));
+    EXPECT_EQ(boxed.outside_simplices, 0u);
+    o.complete_hull = true;
+    // Every point inside: the whole triangulation.
+    const std::vector<std::int32_t> zeros(n + 2, 0);
+    o.method = tessera::DelaunayMethod::automatic;
+    EXPECT_EQ(tessera::delaunay(p, dim, zeros, o).simplices, whole.simplices);
+  }
+}
+
 TEST(Delaunay, NeighborsAreMutual) {
   auto p = random_points(3000, 3, 41);
   tessera::Delaunay dt = run(p, 3);

@@ -198,10 +198,13 @@ TEST(Insertion, BadRequestsAreInputErrors) {
   o.method = tessera::DelaunayMethod::insertion;
   const auto p3 = uniform_points(100, 3, 1);
   o.dim = 3;
+  // Labels are served (the whole triangulation's inside simplices); without
+  // hull completion the insertion has nothing to build.
   const std::vector<std::int32_t> labels(100, 1);
-  EXPECT_THROW(tessera::delaunay(p3, 3, labels, o), tessera::InputError);
+  EXPECT_EQ(tessera::delaunay(p3, 3, labels, o).simplices, tessera::delaunay(p3, 3, {}, o).simplices);
   o.complete_hull = false;
   EXPECT_THROW(tessera::delaunay(p3, 3, {}, o), tessera::InputError);
+  EXPECT_THROW(tessera::delaunay(p3, 3, labels, o), tessera::InputError);
 }
 
 TEST(Insertion, AutomaticChoiceFollowsThePilot) {

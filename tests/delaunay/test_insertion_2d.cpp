@@ -172,15 +172,17 @@ TEST(Insertion2D, FewAndCollinearPoints) {
   const tessera::Delaunay dt = triangulate2({0, 0, 0, 1, 1, 0}, tessera::DelaunayMethod::insertion);
   ASSERT_EQ(dt.n_simplices(), 1u);
   EXPECT_EQ(std::vector<std::int32_t>(dt.simplices.begin(), dt.simplices.end()), (std::vector<std::int32_t>{0, 2, 1}));
-  // Labels or no hull completion: the insertion triangulates the whole hull only.
+  // Without hull completion: the insertion triangulates the whole hull only
+  // (with labels, that triangulation's inside simplices).
   tessera::DelaunayOptions o;
   o.dim = 2;
   o.method = tessera::DelaunayMethod::insertion;
   const auto p = uniform_points(100, 2, 68);
   const std::vector<std::int32_t> labels(100, 1);
-  EXPECT_THROW(tessera::delaunay(p, 2, labels, o), tessera::InputError);
+  EXPECT_EQ(tessera::delaunay(p, 2, labels, o).simplices, tessera::delaunay(p, 2, {}, o).simplices);
   o.complete_hull = false;
   EXPECT_THROW(tessera::delaunay(p, 2, {}, o), tessera::InputError);
+  EXPECT_THROW(tessera::delaunay(p, 2, labels, o), tessera::InputError);
 }
 
 TEST(Insertion2D, AutomaticChoice) {
