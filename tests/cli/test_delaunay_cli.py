@@ -138,6 +138,22 @@ class DelaunayCommand(unittest.TestCase):
                  "--validate"])
         s = np.load(self.path("t.npy"))
         self.assertTrue((labels[s] >= 0).all())
+        # Inside points on the hull (x > 0.6): the whole triangulation's inside
+        # simplices, hull slivers included; without completion, only those
+        # whose circumcentres lie in the box.
+        labels = np.where(self.p3[:, 0] > 0.6, 0, -1).astype(np.int32)
+        np.save(self.path("l.npy"), labels)
+        self.ok(["delaunay", self.path("p3.npy"), "--simplices", self.path("whole.npy")])
+        r = self.ok(["delaunay", self.path("p3.npy"), "--labels", self.path("l.npy"), "--simplices", self.path("t.npy")])
+        whole = np.load(self.path("whole.npy"))
+        inside = (labels[whole] >= 0).all(axis=1)
+        self.assertTrue(np.array_equal(np.load(self.path("t.npy")), whole[inside]))
+        self.assertIn("%d with an outside vertex left out" % (~inside).sum(), r.stderr)
+        self.ok(["delaunay", self.path("p3.npy"), "--labels", self.path("l.npy"), "--simplices", self.path("b.npy"),
+                 "--no-hull-completion"])
+        boxed = {tuple(sorted(x)) for x in np.load(self.path("b.npy")).tolist()}
+        full = {tuple(sorted(x)) for x in whole[inside].tolist()}
+        self.assertTrue(boxed < full)
 
     def test_bench_line(self):
         r = self.ok(["bench", "delaunay", self.path("p2.npy"), "--repeat", "2", "--threads", "1"])
