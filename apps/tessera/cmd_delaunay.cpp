@@ -93,11 +93,11 @@ int run_delaunay(const DelaunayArgs& a) {
   const double write_s = seconds_since(t0);
 
   if (!a.quiet) {
-    // With labels, the counts by method are of the whole triangulation.
+    // With labels, where the whole triangulation was built, the counts by
+    // method are of it (Delaunay::outside_simplices).
     const std::string outside =
-        pc.labels.empty() || a.no_hull_completion
-            ? std::string()
-            : "; " + std::to_string(dt.outside_simplices) + " with an outside vertex left out";
+        dt.outside_simplices == 0 ? std::string()
+                                  : "; " + std::to_string(dt.outside_simplices) + " with an outside vertex left out";
     if (dt.from_insertion > 0)
       std::fprintf(stderr, "tessera: %zu points (%dD) -> %zu %s (by incremental insertion%s)\n", pc.n, pc.dim,
                    dt.n_simplices(), pc.dim == 3 ? "tetrahedra" : "triangles", outside.c_str());

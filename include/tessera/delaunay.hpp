@@ -80,9 +80,12 @@ struct Delaunay {
   /// The simplices cover the convex hull of the points: hull completion ran
   /// and no labels left simplices out (locate() may walk).
   bool hull_completed = false;
-  /// With labels and complete_hull: the whole triangulation's simplices left
-  /// out for an outside vertex. The from_* counts are of the whole
-  /// triangulation, so they sum to n_simplices() plus this.
+  /// With labels and complete_hull, where some inside point's cell reaches
+  /// the domain box (so the whole triangulation was built): its simplices
+  /// left out for an outside vertex; the from_* counts are then of the whole
+  /// triangulation, and sum to n_simplices() plus this. 0 where no inside
+  /// cell reaches the box: the labelled cells pass found every inside
+  /// simplex, building the inside cells only.
   std::size_t outside_simplices = 0;
   /// (duplicate, owner): not vertices. With labels, only inside duplicates.
   std::vector<std::pair<std::int32_t, std::int32_t>> duplicates;

@@ -307,7 +307,7 @@ Delaunay by_insertion(const front::Pass<D>& pass, Delaunay out) {
 
 template <class CellT>
 Delaunay run(std::span<const double> input, std::span<const std::int32_t> labels, const DelaunayOptions& opt,
-             int attempt = 0) {
+             int attempt = 0, bool* labelled_cell_touches_box = nullptr) {
   constexpr int D = CellT::dim;
   const std::size_t n = input.size() / D;
   const bool complete = opt.complete_hull && labels.empty();
@@ -401,6 +401,7 @@ Delaunay run(std::span<const double> input, std::span<const std::int32_t> labels
   }
   out.duplicates = std::move(found.duplicates);
   out.from_cells = found.found;
+  if (labelled_cell_touches_box != nullptr) *labelled_cell_touches_box = found.labelled_cell_touches_box;
   out.skipped_cells = skip > 0 ? pass.order.size() - built_order.size() : 0;
 
   if (complete && out.from_cells == 0 && exactly_flat<D>(pass.points, pass.in_box)) {
@@ -557,8 +558,7 @@ std::int32_t* distinct_ascending(std::int32_t* first, std::int32_t* last) {
 // simplices as the labelled cells pass finds where their circumcentres lie
 // in the box (there, outside generators build no cell and a simplex with an
 // outside vertex is dropped), and besides them the thin hull simplices
-// beyond the box, which that pass cannot reach: the result no longer
-// depends on the box, and the insertion can build it.
+// beyond the box, which that pass cannot reach.
 void keep_inside(Delaunay& dt, std::span<const std::int32_t> labels) {
   const std::size_t w = static_cast<std::size_t>(dt.dim + 1), n = dt.n_simplices();
   std::int32_t* const rows = dt.simplices.data();
@@ -577,6 +577,34 @@ void keep_inside(Delaunay& dt, std::span<const std::int32_t> labels) {
   std::erase_if(dt.duplicates, [&](const auto& d) { return labels[static_cast<std::size_t>(d.first)] < 0; });
 }
 
+// Whether the inside points come within 5% of the points' extent of the
+// points' bounding box on some side (an inside point on the hull does).
+bool inside_reaches_out(std::span<const double> points, int dim, std::span<const std::int32_t> labels) {
+  const std::size_t d = static_cast<std::size_t>(dim), n = points.size() / d;
+  std::array<double, 3> lo, hi, in_lo, in_hi;
+  lo.fill(std::numeric_limits<double>::infinity());
+  hi.fill(-std::numeric_limits<double>::infinity());
+  in_lo = lo;
+  in_hi = hi;
+  for (std::size_t i = 0; i < n; ++i) {
+    const bool inside = labels[i] >= 0;
+    for (std::size_t a = 0; a < d; ++a) {
+      const double x = points[i * d + a];
+      lo[a] = std::min(lo[a], x);
+      hi[a] = std::max(hi[a], x);
+      if (inside) {
+        in_lo[a] = std::min(in_lo[a], x);
+        in_hi[a] = std::max(in_hi[a], x);
+      }
+    }
+  }
+  for (std::size_t a = 0; a < d; ++a) {
+    const double margin = 0.05 * (hi[a] - lo[a]);
+    if (!(in_lo[a] - lo[a] > margin && hi[a] - in_hi[a] > margin)) return true;  // NaN (overflowed extent) too
+  }
+  return false;
+}
+
 }  // namespace
 
 Delaunay delaunay(std::span<const double> points, int dim, std::span<const std::int32_t> labels,
@@ -588,7 +616,27 @@ Delaunay delaunay(std::span<const double> points, int dim, std::span<const std::
     throw InputError("skip_cells must be below 1 (a fraction of the points; negative: automatic), got " +
                      std::to_string(options.skip_cells));
   if (!labels.empty() && options.complete_hull) {
-    // The whole triangulation, then its inside simplices (keep_inside).
+    // The whole triangulation's inside simplices. An inside simplex whose
+    // circumcentre v lies beyond the box has each vertex's cell holding v
+    // and the vertex, so the segment between them, which crosses the box:
+    // each of those inside cells has a face on the box. Where no inside cell
+    // has one, the labelled cells pass (inside cells only, circumcentres in
+    // the box) therefore finds them all, and outside cells need not be
+    // built (a ball of inside points in a cloud of outside ones). Otherwise
+    // the whole triangulation is built, by any method, and filtered. The
+    // pass is not tried where inside points come near the points' bounding
+    // box (inside_reaches_out): there their cells nearly always reach the
+    // domain box, and the pass would be thrown away (speed only; either
+    // way gives the same rows).
+    if (options.method != DelaunayMethod::insertion && !inside_reaches_out(points, dim, labels)) {
+      DelaunayOptions boxed = options;
+      boxed.complete_hull = false;
+      boxed.method = DelaunayMethod::cells;
+      bool touches = true;
+      Delaunay dt = dim == 3 ? run<kernels::Hull>(points, labels, boxed, 0, &touches)
+                             : run<kernels::Tile>(points, labels, boxed, 0, &touches);
+      if (!touches) return dt;
+    }
     Delaunay dt = dim == 3 ? run<kernels::Hull>(points, {}, options) : run<kernels::Tile>(points, {}, options);
     keep_inside(dt, labels);
     return dt;

@@ -63,6 +63,9 @@ struct DelaunayPassResult {
   std::size_t found = 0;                   ///< simplices the cells found
   std::vector<OpenFacet<D>> open;          ///< ascending
   std::vector<std::uint8_t> touches_box;   ///< per point (hull info only)
+  /// With labels: some inside cell has a face on the domain box (it reaches
+  /// beyond the box: hull simplices may have circumcentres there).
+  bool labelled_cell_touches_box = false;
   std::vector<std::pair<std::int32_t, std::int32_t>> duplicates;
   /// Simplices whose lowest id is a skipped point (oriented rows, their
   /// lowest id first: that point has no cell to lay them out under).
@@ -85,6 +88,7 @@ class DelaunayCompositor {
     std::vector<Simplex> simplices;
     std::vector<OpenFacet<D>> open;
     std::vector<std::int32_t> touches_box;
+    bool labelled_touch = false;             // labels: a cell of this batch has a box face
     std::vector<Simplex> foreign;            // rows whose lowest id is skipped
     std::vector<OpenFacet<D>> skipped_facets;  // facets of skipped points only, apex the generator
     std::vector<Pending> pending;  // scratch of add()
@@ -118,9 +122,10 @@ class DelaunayCompositor {
       // Only a cell with a vertex on the box can hold an open facet: nearly
       // every cell of a large input has none and skips that search.
       bool touches = false;
-      if (hull_info_)
+      if (hull_info_ || !labels_.empty())
         for (const auto& v : verts)
           for (int k = 0; k < D; ++k) touches |= v.p[k] < CellT::box_planes;
+      b.labelled_touch |= touches && !labels_.empty();
       b.pending.clear();
       // Per plane: whether its generator is skipped (one lookup per
       // neighbour, not one per vertex and id).
@@ -174,6 +179,7 @@ class DelaunayCompositor {
     for (std::size_t k = 0; k < batches.size(); ++k) {
       Batch& b = batches[k];
       out_.found += b.simplices.size();
+      out_.labelled_cell_touches_box |= b.labelled_touch;
       for (std::size_t t = 0; t < b.gen.size(); ++t)
         if (b.dup_of[t] >= 0) out_.duplicates.emplace_back(b.gen[t], b.dup_of[t]);
       kept_[k].gen = std::move(b.gen);

@@ -806,6 +806,38 @@ TEST(Delaunay, LabelsKeepInsideSimplicesOnly) {
   // Every all-inside simplex of a ball well inside the box has its circumcentre in the box.
   EXPECT_EQ(as_set(dt), expected);
   expect_valid(dt, p, labels);
+  // With hull completion too: no inside cell reaches the box, so the
+  // labelled cells pass serves it, outside cells unbuilt.
+  tessera::DelaunayOptions o;
+  const tessera::Delaunay completed = tessera::delaunay(p, 3, labels, o);
+  EXPECT_EQ(completed.simplices, dt.simplices);
+  EXPECT_EQ(completed.outside_simplices, 0u) << "the whole triangulation was built";
+}
+
+// A ball of inside points with eight outside points far around it: the
+// inside bounds lie well within the points' (so the labelled cells pass is
+// tried), yet the inside cells reach the box, and the whole triangulation
+// is built after all. The rows are its inside ones either way.
+TEST(Delaunay, LabelledCellsReachingTheBoxFallBackToTheWholeTriangulation) {
+  auto p = random_points(2000, 3, 58);
+  for (double& x : p) x = 0.4 + 0.2 * x;
+  for (int c = 0; c < 8; ++c)
+    for (int a = 0; a < 3; ++a) p.push_back((c >> a) & 1 ? 1.0 : 0.0);
+  std::vector<std::int32_t> labels(2008, 0);
+  for (std::size_t i = 2000; i < 2008; ++i) labels[i] = -1;
+  tessera::DelaunayOptions o;
+  const tessera::Delaunay whole = tessera::delaunay(p, 3, {}, o);
+  std::vector<std::int32_t> expected;
+  for (std::size_t r = 0; r < whole.n_simplices(); ++r) {
+    const auto row = whole.simplices.begin() + static_cast<std::ptrdiff_t>(4 * r);
+    if (std::all_of(row, row + 4, [&](std::int32_t id) { return labels[static_cast<std::size_t>(id)] >= 0; }))
+      expected.insert(expected.end(), row, row + 4);
+  }
+  const tessera::Delaunay dt = tessera::delaunay(p, 3, labels, o);
+  EXPECT_EQ(std::vector<std::int32_t>(dt.simplices.begin(), dt.simplices.end()), expected);
+  EXPECT_GT(dt.outside_simplices, 0u) << "the whole triangulation was built";
+  o.complete_hull = false;
+  EXPECT_LT(tessera::delaunay(p, 3, labels, o).n_simplices(), dt.n_simplices());
 }
 
 // With labels (and hull completion) the result is the whole triangulation's
