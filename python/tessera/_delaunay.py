@@ -190,10 +190,11 @@ class Delaunay:
 
     @property
     def outside_simplices(self) -> int:
-        """With labels (and hull completion): simplices of the whole triangulation left
-        out for an outside vertex. ``from_cells``, ``from_hull_completion`` and
-        ``from_insertion`` count the whole triangulation, so they sum to ``nsimplex``
-        plus this."""
+        """With labels (and hull completion), where some inside point's cell reaches
+        the domain box so that the whole triangulation was built: its simplices left
+        out for an outside vertex (``from_cells``, ``from_hull_completion`` and
+        ``from_insertion`` then count the whole triangulation, and sum to
+        ``nsimplex`` plus this). 0 where the inside cells alone found every simplex."""
         return self._dt.outside_simplices
 
     @property
