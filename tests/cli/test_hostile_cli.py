@@ -176,7 +176,18 @@ class Hostile(base.TempDirCase):
             out = self.p("c.vtu" if d == 3 else "c.vtp")
             if not self.check(["voronoi"] + common + ["-o", out, "--validate"], inp, labels, kind, d, case):
                 continue  # a zero extent: every product refuses it alike
-            self.check(["delaunay"] + common + ["-o", self.p("t.vtu"), "--validate"], inp, labels, kind, d, case)
+            tri = self.p("t.npy")
+            if self.check(["delaunay"] + common + ["-o", self.p("t.vtu"), "--simplices", tri, "--validate"],
+                          inp, labels, kind, d, case) and labels:
+                # Labelled: the whole triangulation's inside rows, whichever way it came.
+                whole = self.p("whole.npy")
+                unlabelled = [inp, "--threads", threads, "--quiet"]
+                if self.check(["delaunay"] + unlabelled + ["--simplices", whole], inp, None, kind, d, case):
+                    w = np.load(whole)
+                    inside = (lab[w] >= 0).all(axis=1) if len(w) else np.zeros(0, bool)
+                    self.assertTrue(np.array_equal(np.load(tri), w[inside]),
+                                    "case %d (%s): labelled simplices are not the whole triangulation's inside ones"
+                                    % (case, kind))
             # The cells from the Delaunay triangulation are the searched ones.
             nb = {}
             for method in ("search", "insertion"):
