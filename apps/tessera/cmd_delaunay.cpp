@@ -105,10 +105,25 @@ int run_delaunay(const DelaunayArgs& a) {
       std::fprintf(stderr, "tessera: %zu points (%dD) -> %zu %s (%zu from the cells, %zu by hull completion%s%s)\n",
                    pc.n, pc.dim, dt.n_simplices(), pc.dim == 3 ? "tetrahedra" : "triangles", dt.from_cells,
                    dt.from_hull_completion, a.no_hull_completion ? ": off" : "", outside.c_str());
-    if (dt.n_simplices() == 0)
-      std::fprintf(stderr, "tessera: no simplices: the points are %s%s\n",
-                   pc.dim == 3 ? "coplanar (for a 2D triangulation use --dim 2 on in-plane coordinates)" : "collinear",
-                   pc.labels.empty() ? "" : ", or too few are inside");
+    if (dt.n_simplices() == 0) {
+      // Only with hull completion and no labels does an empty result mean
+      // flat input; otherwise say what else leaves none.
+      const char* flat =
+          pc.dim == 3 ? "coplanar (for a 2D triangulation use --dim 2 on in-plane coordinates)" : "collinear";
+      if (a.no_hull_completion)
+        std::fprintf(stderr,
+                     "tessera: no simplices: none has its circumcentre in the domain box (hull completion is off), "
+                     "or the points are %s\n",
+                     flat);
+      else if (dt.outside_simplices > 0)
+        std::fprintf(stderr, "tessera: no simplices: each of the triangulation's %zu has an outside vertex (label < 0)\n",
+                     dt.outside_simplices);
+      else if (!pc.labels.empty())
+        std::fprintf(stderr, "tessera: no simplices: none has all its vertices inside (label >= 0), or the points are %s\n",
+                     flat);
+      else
+        std::fprintf(stderr, "tessera: no simplices: the points are %s\n", flat);
+    }
     if (!dt.duplicates.empty())
       std::fprintf(stderr, "tessera: %zu duplicate points are not vertices (first: %d = %d)\n", dt.duplicates.size(),
                    dt.duplicates.front().first, dt.duplicates.front().second);

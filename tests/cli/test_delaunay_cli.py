@@ -155,6 +155,22 @@ class DelaunayCommand(unittest.TestCase):
         full = {tuple(sorted(x)) for x in whole[inside].tolist()}
         self.assertTrue(boxed < full)
 
+    def test_empty_results_say_why(self):
+        # One tetrahedron whose circumcentre lies outside the box: without hull
+        # completion none is found, which is not flat input; with an outside
+        # vertex the one simplex is left out.
+        p = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0.1, 0.1, 0.1]])
+        np.save(self.path("tet.npy"), p)
+        r = self.ok(["delaunay", self.path("tet.npy"), "--simplices", self.path("t.npy")])
+        self.assertEqual(np.load(self.path("t.npy")).shape, (1, 4))
+        r = self.ok(["delaunay", self.path("tet.npy"), "--simplices", self.path("t.npy"), "--no-hull-completion"])
+        self.assertEqual(len(np.load(self.path("t.npy"))), 0)
+        self.assertIn("none has its circumcentre in the domain box (hull completion is off)", r.stderr)
+        np.save(self.path("l4.npy"), np.array([0, 0, 0, -1], np.int32))
+        r = self.ok(["delaunay", self.path("tet.npy"), "--labels", self.path("l4.npy"), "--simplices", self.path("t.npy")])
+        self.assertEqual(len(np.load(self.path("t.npy"))), 0)
+        self.assertIn("each of the triangulation's 1 has an outside vertex", r.stderr)
+
     def test_bench_line(self):
         r = self.ok(["bench", "delaunay", self.path("p2.npy"), "--repeat", "2", "--threads", "1"])
         lines = [json.loads(x) for x in r.stdout.splitlines()]
