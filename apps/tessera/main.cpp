@@ -136,7 +136,8 @@ int main(int argc, char** argv) {
                   "neighbors; 2D: id,region,area,cx,cy,edges,neighbors) or .npy (float64, same columns)");
   vor->add_option("--neighbors", va.neighbors,
                   "Neighbour lists as one int64 .npy array: [n_cells, offsets (n_cells+1), ids...]; the "
-                  "neighbours of cell c are ids[offsets[c]:offsets[c+1]] (point ids)");
+                  "neighbours of cell c are ids[offsets[c]:offsets[c+1]] (point ids). Cells are numbered as the "
+                  "--cell-table rows (point order; outside points and duplicates own none)");
   vor->add_flag("--validate", va.validate,
                 "Check the result (volume sum, neighbour symmetry, vertex degrees, Euler characteristic), "
                 "print the report, exit 1 if a check fails");
