@@ -8,6 +8,7 @@
 // walks its own vertices by the same code.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -29,9 +30,39 @@ struct FaceLoopScratch {
   std::vector<std::uint32_t> last;   // 2D, per face: the vertex its edge arrives at
   std::vector<std::uint32_t> next;   // 3D, per corner 3t + k: the corner after it around its face
   std::vector<std::uint32_t> loop;
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> sorted;  // 3D, a huge cell: (a * nfaces + b, corner), sorted
 };
 
+/// Above this many faces a 3D cell's face pairs are sorted instead of
+/// tabled: the table's nfaces^2 entries took 1.6 GB for one point inside a
+/// shell of 20,000 points.
+inline constexpr std::size_t dense_face_pairs = 1024;
+
 inline constexpr std::uint32_t no_corner = std::numeric_limits<std::uint32_t>::max();
+
+/// for_each_face_loop's first and next for a cell of more than
+/// dense_face_pairs faces: the directed edges sorted by face pair and found
+/// by binary search, nv log nv, where the table would hold nfaces^2.
+template <class Corner>
+void face_successors_sorted(std::size_t nv, std::size_t nfaces, Corner& corner, FaceLoopScratch& w) {
+  auto& s = w.sorted;
+  s.resize(3 * nv);
+  for (std::size_t t = nv; t-- > 0;)
+    for (int k = 3; k-- > 0;) {
+      const std::size_t a = corner(t, k);
+      const std::uint32_t at = static_cast<std::uint32_t>(3 * t + static_cast<std::size_t>(k));
+      s[at] = {static_cast<std::uint64_t>(a) * nfaces + corner(t, (k + 1) % 3), at};
+      w.first[a] = at;
+    }
+  std::sort(s.begin(), s.end());
+  for (std::size_t t = 0; t < nv; ++t)
+    for (int k = 0; k < 3; ++k) {
+      const std::uint64_t key = static_cast<std::uint64_t>(corner(t, k)) * nfaces + corner(t, (k + 2) % 3);
+      const auto it = std::lower_bound(s.begin(), s.end(), std::pair<std::uint64_t, std::uint32_t>{key, 0});
+      // In a closed surface the edge is there; otherwise the walk's step bound ends the loop.
+      w.next[3 * t + static_cast<std::size_t>(k)] = it != s.end() && it->first == key ? it->second : 3 * static_cast<std::uint32_t>(t) + static_cast<std::uint32_t>(k);
+    }
+}
 
 /// Visit the faces of a closed 3D cell of nv vertices in face order, as
 /// f(face, vertex indices, count): each face's vertices counter-clockwise
@@ -48,25 +79,29 @@ inline constexpr std::uint32_t no_corner = std::numeric_limits<std::uint32_t>::m
 /// so that each step of a walk is a single load.
 template <class Corner, class F>
 void for_each_face_loop(std::size_t nv, std::size_t nfaces, Corner&& corner, FaceLoopScratch& w, F&& f) {
-  if (w.edge.size() < nfaces * nfaces) w.edge.resize(nfaces * nfaces);
   w.first.assign(nfaces, no_corner);
   if (w.next.size() < 3 * nv) w.next.resize(3 * nv);
   if (w.loop.size() < nv + 1) w.loop.resize(nv + 1);
-  std::uint32_t* const edge = w.edge.data();
   std::uint32_t* const first = w.first.data();
   std::uint32_t* const next = w.next.data();
   std::uint32_t* const loop = w.loop.data();
-  // Backwards, so that each face's first corner is written last (no branch).
-  for (std::size_t t = nv; t-- > 0;)
-    for (int k = 3; k-- > 0;) {
-      const std::size_t a = corner(t, k);
-      const std::uint32_t at = static_cast<std::uint32_t>(3 * t + static_cast<std::size_t>(k));
-      edge[a * nfaces + corner(t, (k + 1) % 3)] = at;
-      first[a] = at;
-    }
-  for (std::size_t t = 0; t < nv; ++t)
-    for (int k = 0; k < 3; ++k)
-      next[3 * t + static_cast<std::size_t>(k)] = edge[std::size_t{corner(t, k)} * nfaces + corner(t, (k + 2) % 3)];
+  if (nfaces > dense_face_pairs) [[unlikely]] {
+    face_successors_sorted(nv, nfaces, corner, w);
+  } else {
+    if (w.edge.size() < nfaces * nfaces) w.edge.resize(nfaces * nfaces);
+    std::uint32_t* const edge = w.edge.data();
+    // Backwards, so that each face's first corner is written last (no branch).
+    for (std::size_t t = nv; t-- > 0;)
+      for (int k = 3; k-- > 0;) {
+        const std::size_t a = corner(t, k);
+        const std::uint32_t at = static_cast<std::uint32_t>(3 * t + static_cast<std::size_t>(k));
+        edge[a * nfaces + corner(t, (k + 1) % 3)] = at;
+        first[a] = at;
+      }
+    for (std::size_t t = 0; t < nv; ++t)
+      for (int k = 0; k < 3; ++k)
+        next[3 * t + static_cast<std::size_t>(k)] = edge[std::size_t{corner(t, k)} * nfaces + corner(t, (k + 2) % 3)];
+  }
   for (std::size_t p = 0; p < nfaces; ++p) {
     const std::uint32_t start = first[p];
     if (start == no_corner) continue;

@@ -17,6 +17,7 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -104,7 +105,7 @@ class Hull {
 
     const std::uint16_t pn = static_cast<std::uint16_t>(planes_.size());
     if (planes_.size() + 1 >= 0xFFFF)
-      throw std::length_error("tessera: a cell has more than 65534 faces");
+      throw std::length_error("a cell has more than 65534 faces (one point with that many neighbours)");
     Plane& pl = planes_.emplace_back();  // written in place (see reset)
     pl.n[0] = b.n[0]; pl.n[1] = b.n[1]; pl.n[2] = b.n[2];
     pl.d = b.d;
@@ -112,14 +113,20 @@ class Hull {
     pl.id = j;
     pl.scale = b.scale;
     scaled_planes_ |= b.scale != 0;
-    if (planes_.size() > cap_) ensure_table(2 * cap_);
-    cut(pn, nv);
+    if (planes_.size() > cap_) [[unlikely]] grow_table();
+    if (hashed_) [[unlikely]]
+      cut_hashed(pn, nv);
+    else
+      cut<false>(pn, nv);
     return ClipResult::clipped;
   }
 
  private:
   // Replace the vertices sign_ marks removed (-1; some, not all, of the nv)
   // by the new face on local plane pn: a clip's work after its sign pass.
+  // Hashed: the edge map is the hash (grow_table), in a huge cell only; the
+  // ordinary instantiation has no test of it.
+  template <bool Hashed>
   [[gnu::always_inline]] void cut(std::uint16_t pn, std::size_t nv) {
     // The removed slots, ascending: holes_[0, nh) (never shrunk, so growing
     // it value-initializes nothing per clip).
@@ -135,7 +142,7 @@ class Hull {
     // a coin flip the branch predictor loses), then solved in a plain loop.
     if (border_.size() < 3 * nh) border_.resize(3 * nh);
     std::size_t nb = 0;
-    {
+    if constexpr (!Hashed) {
       Edge* const edges = border_.data();
       const std::uint32_t* const table = edge_tri_.data();
       const filter::Sign* const sign = sign_.data();
@@ -148,6 +155,8 @@ class Hull {
           nb += sign[table[static_cast<std::size_t>(b) * cap + a]] >= 0;
         }
       }
+    } else {
+      nb = border_hashed(nh);
     }
     // The new triangles go straight into the removed slots (the border is
     // collected, so those may be overwritten), the rest after the last slot;
@@ -160,7 +169,7 @@ class Hull {
       v.p[0] = border_[k].a; v.p[1] = border_[k].b; v.p[2] = pn;
       solve(v);
       if (k < nh) sign_[t] = 1;  // kept from now on
-      settle(t);
+      settle<Hashed>(t);
     }
     if (nb < nh) {
       std::size_t end = nv;
@@ -168,7 +177,7 @@ class Hull {
         const std::uint32_t t = holes_[k];
         while (end > t && sign_[end - 1] < 0) --end;  // drop trailing holes
         if (end <= t) break;                          // this hole and the rest lie beyond
-        place(t, verts_[end - 1]);
+        place<Hashed>(t, verts_[end - 1]);
         --end;
       }
       resize_vertices(end);
@@ -241,7 +250,7 @@ class Hull {
   /// plane pair (p[k] -> p[k+1]) seen from the other side.
   std::uint32_t across(std::size_t t, int k) const {
     const Vertex& v = verts_[t];
-    return edge_tri_[static_cast<std::size_t>(v.p[(k + 1) % 3]) * cap_ + v.p[k]];
+    return edge(v.p[(k + 1) % 3], v.p[k]);
   }
 
   /// Visit each face's plane index once, ascending: the planes that still
@@ -279,7 +288,7 @@ class Hull {
       const std::size_t nv = verts_.size();
       const std::size_t removed = assembly::box_signs(verts_.data(), nv, k, planes_[k].d, sign_);
       if (removed == assembly::undecided || removed == nv) return false;
-      if (removed != 0) cut(k, nv);
+      if (removed != 0) cut<false>(k, nv);  // assembled: at most max_assembled_planes, a dense map
     }
     return true;
   }
@@ -367,6 +376,7 @@ class Hull {
     exact_ = exact;
     may_underflow_ = exact != nullptr && exact->may_underflow;
     scaled_planes_ = false;
+    if (hashed_) [[unlikely]] leave_hash();
     signs_.start_cell();
     // Planes and corners are written in place: a local struct copied in
     // would be read back wider than it was written (a store-forwarding stall).
@@ -394,10 +404,11 @@ class Hull {
 
   // Every change to the vertex list goes through these, which keep the sign
   // pass's mirror (lanes_) and the edge table in step with verts_.
+  template <bool Hashed = false>
   void place(std::uint32_t t, const Vertex& v) {  // into an existing slot, kept from now on
     verts_[t] = v;
     sign_[t] = 1;
-    settle(t);
+    settle<Hashed>(t);
   }
   /// Keep the first n vertices, or make room for slots to be written in place
   /// and then settled.
@@ -405,15 +416,37 @@ class Hull {
     verts_.resize(n);
     lanes_.resize(n);
   }
+  template <bool Hashed = false>
   void settle(std::uint32_t t) {  // slot t was written in place
     lanes_.set(t, verts_[t]);
-    link(t);
+    link<Hashed>(t);
   }
 
+  template <bool Hashed = false>
   void link(std::uint32_t t) {
     const Vertex& v = verts_[t];
-    for (int k = 0; k < 3; ++k)
-      edge_tri_[static_cast<std::size_t>(v.p[k]) * cap_ + v.p[(k + 1) % 3]] = t;
+    if constexpr (Hashed) {
+      for (int k = 0; k < 3; ++k) hash_link(v.p[k], v.p[(k + 1) % 3], t);
+    } else {
+      for (int k = 0; k < 3; ++k)
+        edge_tri_[static_cast<std::size_t>(v.p[k]) * cap_ + v.p[(k + 1) % 3]] = t;
+    }
+  }
+
+  // The edge map: directed plane pair (a -> b) -> the triangle holding it.
+  // Entries of triangles since removed stay (the dense table is not cleared
+  // between cells either); a lookup only asks for an edge of a current
+  // triangle, which was linked last. While the cell has at most dense_planes
+  // planes (every ordinary cell) it is a dense cap x cap table, a lookup one
+  // load. Beyond, it is an open-addressing hash of the pairs linked, so
+  // memory follows the triangles, not the square of the planes: one point
+  // inside a shell of 20,000 points made a 4.3 GB table (5.3 GB peak for 20k
+  // points), and 70,000 one of 17 GB before its face limit stopped it.
+  static constexpr std::size_t dense_planes = 1024;  // a 4 MB table
+
+  std::uint32_t edge(std::uint16_t a, std::uint16_t b) const {
+    if (!hashed_) [[likely]] return edge_tri_[static_cast<std::size_t>(a) * cap_ + b];
+    return hash_find(a, b);
   }
 
   void ensure_table(std::size_t cap) {
@@ -421,6 +454,79 @@ class Hull {
     cap_ = std::max<std::size_t>(cap, 64);
     edge_tri_.assign(cap_ * cap_, 0);
     for (std::size_t t = 0; t < verts_.size(); ++t) link(static_cast<std::uint32_t>(t));
+  }
+
+  // More planes than the dense table holds: double it, or past dense_planes
+  // switch to the hash (kept until the next cell starts).
+  [[gnu::noinline, gnu::cold]] void grow_table() {
+    if (hashed_) return;
+    if (2 * cap_ <= dense_planes) {
+      ensure_table(2 * cap_);
+      return;
+    }
+    hashed_ = true;
+    hash_.assign(std::max<std::size_t>(1024, std::bit_ceil(8 * verts_.size())), 0);
+    hash_used_ = 0;
+    for (std::size_t t = 0; t < verts_.size(); ++t) link<true>(static_cast<std::uint32_t>(t));
+  }
+
+  // A new cell: back to the dense table (its size kept), the hash dropped.
+  void leave_hash() {
+    hashed_ = false;
+    std::vector<std::uint64_t>().swap(hash_);
+    hash_used_ = 0;
+  }
+
+  // Hash slots hold (key << 32 | triangle), key = (a << 16 | b) + 1 (0: empty).
+  static std::uint64_t hash_key(std::uint16_t a, std::uint16_t b) {
+    return ((static_cast<std::uint64_t>(a) << 16) | b) + 1;
+  }
+  std::size_t hash_slot(std::uint64_t key) const {  // Fibonacci hashing: the product's top bits
+    return static_cast<std::size_t>((key * 0x9E3779B97F4A7C15ull) >> (64 - std::countr_zero(hash_.size())));
+  }
+  std::uint32_t hash_find(std::uint16_t a, std::uint16_t b) const {
+    const std::uint64_t key = hash_key(a, b);
+    for (std::size_t s = hash_slot(key);; s = (s + 1) & (hash_.size() - 1)) {
+      const std::uint64_t e = hash_[s];
+      if ((e >> 32) == key) return static_cast<std::uint32_t>(e);
+      if (e == 0) return 0;  // never linked (not asked for by a consistent cell)
+    }
+  }
+  void hash_link(std::uint16_t a, std::uint16_t b, std::uint32_t t) {
+    if (2 * (hash_used_ + 1) > hash_.size()) rehash();
+    const std::uint64_t key = hash_key(a, b);
+    for (std::size_t s = hash_slot(key);; s = (s + 1) & (hash_.size() - 1)) {
+      std::uint64_t& e = hash_[s];
+      if (e == 0) ++hash_used_;
+      if (e == 0 || (e >> 32) == key) {
+        e = (key << 32) | t;
+        return;
+      }
+    }
+  }
+  void rehash() {
+    std::vector<std::uint64_t> old(2 * hash_.size(), 0);
+    old.swap(hash_);
+    hash_used_ = 0;
+    for (const std::uint64_t e : old)
+      if (e != 0) hash_link(static_cast<std::uint16_t>(((e >> 32) - 1) >> 16), static_cast<std::uint16_t>((e >> 32) - 1),
+                            static_cast<std::uint32_t>(e));
+  }
+
+  [[gnu::noinline, gnu::cold]] void cut_hashed(std::uint16_t pn, std::size_t nv) { cut<true>(pn, nv); }
+
+  // cut()'s border collection in hashed mode (see there).
+  [[gnu::noinline]] std::size_t border_hashed(std::size_t nh) {
+    std::size_t nb = 0;
+    for (std::size_t h = 0; h < nh; ++h) {
+      const Vertex& v = verts_[holes_[h]];
+      for (int k = 0; k < 3; ++k) {
+        const std::uint16_t a = v.p[k], b = v.p[k == 2 ? 0 : k + 1];
+        border_[nb] = {a, b};
+        nb += sign_[hash_find(b, a)] >= 0;
+      }
+    }
+    return nb;
   }
 
   // The vertex where planes p[0], p[1], p[2] meet (Cramer's rule) and its error bound.
@@ -523,8 +629,11 @@ class Hull {
   std::vector<Edge> border_;   // a clip's boundary edges (its first slots)
   std::vector<std::uint32_t> holes_;
   std::vector<filter::Sign> sign_;
-  std::vector<std::uint32_t> edge_tri_;  // cap_ x cap_: directed plane pair -> triangle
+  std::vector<std::uint32_t> edge_tri_;  // cap_ x cap_: directed plane pair -> triangle (edge())
   std::size_t cap_ = 0;
+  bool hashed_ = false;                  // the edge map is hash_ (grow_table)
+  std::vector<std::uint64_t> hash_;
+  std::size_t hash_used_ = 0;
   double security2_ = 0;
   std::vector<std::uint8_t> seen_;
   FaceLoopScratch walk_;  // for_each_face's

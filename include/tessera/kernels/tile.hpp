@@ -83,7 +83,7 @@ class Tile {
       security2_ = 0;
       return ClipResult::emptied;
     }
-    if (planes_.size() + 1 >= 0xFFFF) throw std::length_error("tessera: a tile has more than 65534 edges");
+    if (planes_.size() + 1 >= 0xFFFF) throw std::length_error("a tile has more than 65534 edges (one point with that many neighbours)");
     const std::uint16_t pn = static_cast<std::uint16_t>(planes_.size());
     Plane& pl = planes_.emplace_back();  // written in place (see reset)
     pl.n[0] = b.n[0]; pl.n[1] = b.n[1];
