@@ -350,7 +350,8 @@ def probe(
     spacing, origin : as in :func:`sample_image`.
     outside_value : float
         The value at points outside the box of the voxel centres (a point on
-        its far face is inside).
+        its far face is inside, and so is one within 1e-9 voxel spacings of
+        it, which takes the face's value).
 
     Returns
     -------
