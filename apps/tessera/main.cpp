@@ -32,7 +32,7 @@ void print_error(const std::string& msg) {
 }
 
 constexpr const char* kExitCodes =
-    "Exit status: 0 success; 1 failure (internal error, or --validate found a problem);\n"
+    "Exit status: 0 success; 1 failure (an internal error, or a failed --validate where the command has one);\n"
     "2 bad command line or bad input; 130 interrupted (Ctrl-C).\n"
     "Environment: TESSERA_NUM_THREADS sets the thread count when --threads is not given.";
 
