@@ -580,27 +580,10 @@ void keep_inside(Delaunay& dt, std::span<const std::int32_t> labels) {
 // Whether the inside points come within 5% of the points' extent of the
 // points' bounding box on some side (an inside point on the hull does).
 bool inside_reaches_out(std::span<const double> points, int dim, std::span<const std::int32_t> labels) {
-  const std::size_t d = static_cast<std::size_t>(dim), n = points.size() / d;
-  std::array<double, 3> lo, hi, in_lo, in_hi;
-  lo.fill(std::numeric_limits<double>::infinity());
-  hi.fill(-std::numeric_limits<double>::infinity());
-  in_lo = lo;
-  in_hi = hi;
-  for (std::size_t i = 0; i < n; ++i) {
-    const bool inside = labels[i] >= 0;
-    for (std::size_t a = 0; a < d; ++a) {
-      const double x = points[i * d + a];
-      lo[a] = std::min(lo[a], x);
-      hi[a] = std::max(hi[a], x);
-      if (inside) {
-        in_lo[a] = std::min(in_lo[a], x);
-        in_hi[a] = std::max(in_hi[a], x);
-      }
-    }
-  }
-  for (std::size_t a = 0; a < d; ++a) {
-    const double margin = 0.05 * (hi[a] - lo[a]);
-    if (!(in_lo[a] - lo[a] > margin && hi[a] - in_hi[a] > margin)) return true;  // NaN (overflowed extent) too
+  const Bounds all = front::bounding_box(points, dim), inside = front::bounding_box(points, dim, labels);
+  for (std::size_t a = 0; a < static_cast<std::size_t>(dim); ++a) {
+    const double margin = 0.05 * (all.hi[a] - all.lo[a]);
+    if (!(inside.lo[a] - all.lo[a] > margin && all.hi[a] - inside.hi[a] > margin)) return true;  // NaN (overflowed extent) too
   }
   return false;
 }

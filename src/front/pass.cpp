@@ -31,6 +31,24 @@ void check_input(std::span<const double> points, int dim, std::span<const std::i
     throw InputError("labels: every point is outside (label < 0); nothing to tessellate");
 }
 
+Bounds bounding_box(std::span<const double> points, int dim, std::span<const std::int32_t> labels) {
+  const std::size_t d = static_cast<std::size_t>(dim), n = points.size() / d;
+  Bounds b;
+  for (std::size_t a = 0; a < d; ++a) {
+    b.lo[a] = INFINITY;
+    b.hi[a] = -INFINITY;
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!labels.empty() && labels[i] < 0) continue;
+    for (std::size_t a = 0; a < d; ++a) {
+      const double x = points[i * d + a];
+      b.lo[a] = std::min(b.lo[a], x);
+      b.hi[a] = std::max(b.hi[a], x);
+    }
+  }
+  return b;
+}
+
 Bounds make_domain(std::span<const double> pts, int dim, const VoronoiOptions& opt) {
   const std::size_t n = pts.size() / static_cast<std::size_t>(dim);
   if (opt.bounds) {
@@ -47,17 +65,7 @@ Bounds make_domain(std::span<const double> pts, int dim, const VoronoiOptions& o
   }
   if (!(opt.padding >= 0) || !std::isfinite(opt.padding))
     throw InputError("padding must be a finite number >= 0");
-  Bounds b;
-  for (int d = 0; d < dim; ++d) {
-    b.lo[static_cast<std::size_t>(d)] = INFINITY;
-    b.hi[static_cast<std::size_t>(d)] = -INFINITY;
-  }
-  for (std::size_t i = 0; i < n; ++i)
-    for (int d = 0; d < dim; ++d) {
-      double x = pts[i * static_cast<std::size_t>(dim) + static_cast<std::size_t>(d)];
-      b.lo[static_cast<std::size_t>(d)] = std::min(b.lo[static_cast<std::size_t>(d)], x);
-      b.hi[static_cast<std::size_t>(d)] = std::max(b.hi[static_cast<std::size_t>(d)], x);
-    }
+  Bounds b = bounding_box(pts, dim);
   if (n == 1)
     throw InputError("a single point has no extent to make a domain from; give the domain with --bounds");
   // Half the largest extent: points spanning most of double's range have an

@@ -21,6 +21,10 @@ namespace tessera::front {
 /// Throws InputError unless points/labels are a valid input of dimension dim.
 void check_input(std::span<const double> points, int dim, std::span<const std::int32_t> labels);
 
+/// The bounding box of the points, or of the inside ones (label >= 0) when
+/// labels are given; +inf..-inf on an axis with none.
+Bounds bounding_box(std::span<const double> points, int dim, std::span<const std::int32_t> labels = {});
+
 /// The domain: explicit bounds checked, or the bounding box padded and rounded
 /// outward to a short binary fraction (see cells.cpp).
 Bounds make_domain(std::span<const double> points, int dim, const VoronoiOptions& opt);

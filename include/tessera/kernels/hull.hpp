@@ -515,7 +515,10 @@ class Hull {
 
   [[gnu::noinline, gnu::cold]] void cut_hashed(std::uint16_t pn, std::size_t nv) { cut<true>(pn, nv); }
 
-  // cut()'s border collection in hashed mode (see there).
+  // cut()'s border collection in hashed mode (see there). A copy with the
+  // hash lookup, not one loop with both: that loop (the lookup chosen by
+  // `if constexpr` in a lambda) cost the ordinary clip 2.5% (100k uniform 3D
+  // cells on one thread, four alternated rounds).
   [[gnu::noinline]] std::size_t border_hashed(std::size_t nh) {
     std::size_t nb = 0;
     for (std::size_t h = 0; h < nh; ++h) {
