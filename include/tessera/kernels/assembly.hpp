@@ -105,10 +105,10 @@ bool far_plane(const double* dirs, std::size_t k, const Plane* box, const Vertex
 /// on the far plane (the last of `planes`; the box removes every vertex on
 /// it, as it lies outside the box and each decision was certain, so this is
 /// a check), else the plane is dropped and true.
-template <int D, class Plane, class Vertex>
-bool drop_far_plane(std::vector<Plane>& planes, const std::vector<Vertex>& verts) {
+template <int D, class Plane, class Vertices>
+bool drop_far_plane(std::vector<Plane>& planes, const Vertices& verts) {
   const auto far = static_cast<std::uint16_t>(planes.size() - 1);
-  for (const Vertex& v : verts)
+  for (const auto& v : verts)
     for (int k = 0; k < D; ++k)
       if (v.p[k] == far) return false;
   planes.pop_back();
