@@ -473,6 +473,46 @@ TEST(Invariants, Labels) {
   labelled(2, grid_points(20, 2), 4, "2D grid labelled");
 }
 
+/// Duplicates whose labels differ: the lowest id of the group decides alone.
+/// An inside copy of an outside point owns no cell (and is reported); an
+/// outside copy of an inside point changes nothing. The result is the
+/// labelled run without the higher copies.
+TEST(Invariants, DuplicatesAcrossLabelsFollowTheLowestId) {
+  for (int dim : {2, 3}) {
+    SCOPED_TRACE("dim " + std::to_string(dim));
+    auto pts = random_points(500, dim, 410 + dim);
+    const std::size_t n = pts.size() / dim;
+    std::vector<std::int32_t> labels(n, 0);
+    for (std::size_t i = 0; i < n; i += 5) labels[i] = -1;
+    // Copies of points 0..19 at ids n..n+19, with the opposite side's label.
+    for (std::size_t i = 0; i < 20; ++i) {
+      for (int d = 0; d < dim; ++d) pts.push_back(pts[i * dim + d]);
+      labels.push_back(labels[i] < 0 ? 3 : -1);
+    }
+    const auto c = run(pts, dim, std::nullopt, labels);
+    const auto base = run(std::vector<double>(pts.begin(), pts.begin() + static_cast<std::ptrdiff_t>(n * dim)), dim,
+                          c.bounds, std::vector<std::int32_t>(labels.begin(), labels.begin() + static_cast<std::ptrdiff_t>(n)));
+    std::vector<std::pair<std::int32_t, std::int32_t>> want;
+    for (std::size_t i = 0; i < 20; ++i)
+      if (labels[i] < 0) want.emplace_back(static_cast<std::int32_t>(n + i), static_cast<std::int32_t>(i));
+    EXPECT_EQ(c.duplicates, want);  // only the inside copies are reported
+    ASSERT_EQ(c.n_cells(), base.n_cells());
+    for (std::size_t i = 0; i < 20; ++i) EXPECT_EQ(c.cell_of[n + i], -1) << "copy of point " << i;
+    for (std::size_t i = 0; i < n; ++i) {
+      ASSERT_EQ(c.cell_of[i], base.cell_of[i]) << "point " << i;
+      if (c.cell_of[i] < 0) continue;
+      EXPECT_EQ(c.volume[c.cell_of[i]], base.volume[base.cell_of[i]]) << "point " << i;
+      EXPECT_EQ(neighbours_of(c, c.cell_of[i]), neighbours_of(base, base.cell_of[i])) << "point " << i;
+    }
+    // The insertion's cells follow the same rule.
+    auto o = options(dim);
+    o.cell_method = tessera::CellMethod::insertion;
+    const auto ins = tessera::voronoi(std::span<const double>(pts), dim, std::span<const std::int32_t>(labels), o);
+    EXPECT_EQ(ins.duplicates, want);
+    EXPECT_EQ(ins.cell_of, c.cell_of);
+  }
+}
+
 // ------------------------------------------------------------------ threads
 
 /// The result is independent of the thread count: every vector is identical.
