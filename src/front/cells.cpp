@@ -72,9 +72,7 @@ Cells run(std::span<const double> input, std::span<const std::int32_t> labels, c
   out.threads_used = pass.engine_options.threads;
   out.far_points = pass.locator->outside_core();
 
-  // Without coincident points, a merged vertex's owner is known while its
-  // cell is added, and only owners keep its position (CellsCompositor).
-  const bool owners_known = opt.build_mesh && !pass.locator->may_have_coincident();
+  front::report_duplicates(pass, labels, out.duplicates);
   // Cells whose search would cost far more than on uniform points (points
   // nearly on a sphere, surface samples, dense clusters; in 2D points on a
   // circle, along curves, in blobs) come from the Delaunay triangulation
@@ -115,7 +113,7 @@ Cells run(std::span<const double> input, std::span<const std::int32_t> labels, c
       if (opt.progress) pass.engine_options.progress = [&opt](double f) { opt.progress(0.5 + 0.5 * f); };
     }
   }
-  front::CellsCompositor<CellT> comp(out, labels, opt.build_mesh, owners_known, pass.k);
+  front::CellsCompositor<CellT> comp(out, labels, opt.build_mesh, pass.k);
   out.exact_predicate_calls = engine::tessellate<CellT>(pass.gens, comp, pass.engine_options);
   std::sort(out.duplicates.begin(), out.duplicates.end());
   if (pass.k != 0) {

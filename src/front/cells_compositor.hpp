@@ -66,20 +66,19 @@ class CellsCompositor {
     const std::int32_t* face_nbr() const { return store->face_nbr.data() + face_base; }
   };
 
-  /// `owners_known`: no two generators coincide, so a merged vertex's owner
-  /// (the lowest generator of its key that owns a cell) is the lowest inside
-  /// generator of its key, known when the cell is added. A cell then lists
-  /// its owned vertices first (a quarter of them: 3D vertices are shared by
-  /// four cells) and keeps only their positions, and the mesh numbers them
-  /// without finding their owners again. Otherwise every cell keeps all its
-  /// positions, in the cell's own vertex order.
+  /// The mesh: no two located points coincide (front::Pass leaves
+  /// duplicates out), so a merged vertex's owner (the lowest generator of
+  /// its key that owns a cell) is the lowest inside generator of its key,
+  /// known when the cell is added. A cell lists its owned vertices first (a
+  /// quarter of them: 3D vertices are shared by four cells) and keeps only
+  /// their positions, and the mesh numbers them without finding their
+  /// owners again.
   /// `out.n_points` must be set: the measures are kept by generator id.
   /// `frame_k`: the cells are computed on the input scaled by 2^frame_k
   /// (front/pass.cpp); volumes are stored in the input's units, the rest in
   /// the scaled frame.
-  CellsCompositor(Cells& out, std::span<const std::int32_t> labels, bool mesh, bool owners_known = false,
-                  int frame_k = 0)
-      : out_(out), labels_(labels), classify_(labels), mesh_(mesh), owners_known_(owners_known), frame_k_(frame_k) {
+  CellsCompositor(Cells& out, std::span<const std::int32_t> labels, bool mesh, int frame_k = 0)
+      : out_(out), labels_(labels), classify_(labels), mesh_(mesh), frame_k_(frame_k) {
     // Sized, not zeroed: add() writes every generator's entries, and finish
     // reads only those of generators with cells.
     volume_.resize(out.n_points);
@@ -281,7 +280,7 @@ class CellsCompositor {
       s.nbrs.reserve(cells * (D == 3 ? 17 : 7));
       if (mesh_) {
         s.corners.reserve(cells * (D == 3 ? 30 : 7));
-        s.pos.reserve(cells * D * (owners_known_ ? (D == 3 ? 8 : 3) : (D == 3 ? 30 : 7)));
+        s.pos.reserve(cells * D * (D == 3 ? 8 : 3));
         s.face_nbr.reserve(cells * (D == 3 ? 17 : 7));
       }
     }
@@ -320,9 +319,8 @@ class CellsCompositor {
     b.face_end.push_back(static_cast<std::uint32_t>(s.face_nbr.size() - b.face_base));
   }
 
-  // The cell's vertices in dual form (faces numbered by b.face_of) and their
-  // positions: with owners known, the owned vertices first and only their
-  // positions; otherwise all of them, in the cell's order.
+  // The cell's vertices in dual form (faces numbered by b.face_of), the
+  // owned ones first, and the owned ones' positions.
   void add_vertices(const Batch& b, Store& s, std::int32_t gen, CellT& cell) {
     const auto& v = cell.vertices();
     const double* p = cell.site();
@@ -334,7 +332,7 @@ class CellsCompositor {
     const std::uint16_t* face_of = b.face_of.data();
     std::size_t kept = 0, back = nv;
     for (std::size_t t = 0; t < nv; ++t) {
-      const bool owned = !owners_known_ || first_inside(vertex_key(cell, t)) == gen;
+      const bool owned = first_inside(vertex_key(cell, t)) == gen;
       const std::size_t at = owned ? kept : --back;
       for (int k = 0; k < D; ++k) corners[at][static_cast<std::size_t>(k)] = face_of[v[t].p[k]];
       for (int d = 0; d < D; ++d) pos[kept * D + d] = v[t].y[d] + p[d];  // dropped unless owned
@@ -367,8 +365,8 @@ class CellsCompositor {
     return lowest_generator(key, [&](std::int32_t id) { return dense_ || out_.cell_of[static_cast<std::size_t>(id)] >= 0; });
   }
 
-  // The key's lowest inside generator (label >= 0): its owner when no
-  // generators coincide.
+  // The key's lowest inside generator (label >= 0): its owner, as no
+  // located points coincide.
   std::int32_t first_inside(const Key<D>& key) const {
     return lowest_generator(key, [&](std::int32_t id) { return labels_at(id) >= 0; });
   }
@@ -399,33 +397,24 @@ class CellsCompositor {
   void build_mesh(std::span<Batch> batches, std::vector<std::int64_t>& fcv) {
     Cells& o = out_;
     const std::size_t ncell = o.n_cells();
-    // Owned vertices per cell -> global numbering in cell order. With owners
-    // known, a cell's owned vertices are its first ones, as many as the
-    // positions it kept (add_vertices); otherwise each key's owner is found.
+    // Owned vertices per cell -> global numbering in cell order: a cell's
+    // owned vertices are its first ones, as many as the positions it kept
+    // (add_vertices).
     std::vector<std::int64_t> owned(ncell + 1, 0);
     tbb::parallel_for(std::size_t(0), batches.size(), [&](std::size_t k) {
       const Batch& b = batches[k];
       for (std::size_t t = 0; t < b.gen.size(); ++t) {
         const std::int32_t c = cell_at(b.gen[t]);
         if (c < 0) continue;
-        auto [v0, v1] = range_of(b.vert_end, t);
-        std::int64_t cnt = 0;
-        if (owners_known_) {
-          auto [p0, p1] = range_of(b.pos_end, t);
-          cnt = p1 - p0;
-        } else {
-          for (std::uint32_t v = v0; v < v1; ++v) cnt += owner(key_of(b, t, v)) == b.gen[t];
-        }
-        owned[static_cast<std::size_t>(c) + 1] = cnt;
+        auto [p0, p1] = range_of(b.pos_end, t);
+        owned[static_cast<std::size_t>(c) + 1] = p1 - p0;
       }
     });
     std::partial_sum(owned.begin(), owned.end(), owned.begin());
-    if (owners_known_ && !o.duplicates.empty())
-      throw std::logic_error("tessera: coincident generators were missed before the cells pass");
     const std::size_t nverts = static_cast<std::size_t>(owned.back());
     o.vertices.resize(nverts * D);
     o.vertex_keys.resize(nverts * (D + 1));
-    std::atomic<bool> unowned{false};  // owners_known_ was wrong about a vertex
+    std::atomic<bool> unowned{false};  // a cell's kept positions were not its owned vertices
     tbb::parallel_for(std::size_t(0), batches.size(), [&](std::size_t k) {
       Batch& b = batches[k];
       for (std::size_t t = 0; t < b.gen.size(); ++t) {
@@ -435,15 +424,14 @@ class CellsCompositor {
         auto [v0, v1] = range_of(b.vert_end, t);
         std::size_t gid = static_cast<std::size_t>(owned[static_cast<std::size_t>(c)]);
         const std::size_t end = static_cast<std::size_t>(owned[static_cast<std::size_t>(c) + 1]);
-        std::uint32_t src = range_of(b.pos_end, t).first;  // with owners known: the owned positions, in order
+        std::uint32_t src = range_of(b.pos_end, t).first;  // the owned positions, in order
         for (std::uint32_t v = v0; v < v1 && gid < end; ++v) {
           const Key<D> key = key_of(b, t, v);
-          if (owner(key) != b.gen[t]) {
-            // With owners known, the owned vertices come first.
-            if (owners_known_) unowned.store(true, std::memory_order_relaxed);
+          if (owner(key) != b.gen[t]) {  // the owned vertices come first
+            unowned.store(true, std::memory_order_relaxed);
             continue;
           }
-          const std::size_t from = owners_known_ ? src++ : v;
+          const std::size_t from = src++;
           for (int d = 0; d < D; ++d) o.vertices[gid * D + d] = b.pos()[from * D + d];
           // Id by id: the sorted key leaves its registers as 4-byte stores,
           // which a wider copy would have to wait for.
@@ -506,7 +494,7 @@ class CellsCompositor {
         at.clear();
         std::int32_t next = static_cast<std::int32_t>(owned[cu]);
         for (std::uint32_t v = v0; v < v1; ++v) {
-          if (owners_known_ && next < owned[cu + 1]) {
+          if (next < owned[cu + 1]) {
             gid[v - v0] = next++;
             continue;
           }
@@ -565,7 +553,6 @@ class CellsCompositor {
   std::span<const std::int32_t> labels_;
   engine::RegionClassifier classify_;
   bool mesh_;
-  bool owners_known_;
   int frame_k_;  // the scaled frame's 2^k (front/pass.cpp)
   bool dense_ = false;  // set by finish: every generator owns a cell, cell g = generator g
   // Each cell's measures by generator id, written by add() from any thread

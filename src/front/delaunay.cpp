@@ -296,6 +296,7 @@ Delaunay by_insertion(const front::Pass<D>& pass, Delaunay out) {
     const auto& loc = *pass.locator;
     for (std::size_t k = 0; k < loc.size(); ++k)
       if (ins.lowest[k] >= 0) out.duplicates.emplace_back(loc.id(k), ins.lowest[k]);
+    front::report_duplicates(pass, {}, out.duplicates);  // (no labels here: completion)
     std::sort(out.duplicates.begin(), out.duplicates.end());
     out.hull_completed = true;
     if (!ins.rows) return;  // all on one plane (2D: line): no simplex exists
@@ -399,7 +400,9 @@ Delaunay run(std::span<const double> input, std::span<const std::int32_t> labels
     all.skip_cells = 0;
     return run<CellT>(input, labels, all, attempt);
   }
+  const std::size_t found_duplicates = found.duplicates.size();
   out.duplicates = std::move(found.duplicates);
+  front::report_duplicates(pass, labels, out.duplicates);
   out.from_cells = found.found;
   if (labelled_cell_touches_box != nullptr) *labelled_cell_touches_box = found.labelled_cell_touches_box;
   out.skipped_cells = skip > 0 ? pass.order.size() - built_order.size() : 0;
@@ -412,7 +415,7 @@ Delaunay run(std::span<const double> input, std::span<const std::int32_t> labels
     std::sort(out.duplicates.begin(), out.duplicates.end());
     return out;
   }
-  const bool none_found = complete && out.from_cells == 0 && pass.locator->size() - out.duplicates.size() > D;
+  const bool none_found = complete && out.from_cells == 0 && pass.locator->size() - found_duplicates > D;
   if (none_found && attempt < 2) {
     // Every circumcentre lies outside the box (a handful of points, or nearly
     // flat input), so completion has no found simplex to start from. The

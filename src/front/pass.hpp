@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <optional>
 #include <span>
+#include <utility>
 #include <vector>
 
 #include "tessera/buffer.hpp"
@@ -59,7 +60,13 @@ struct Pass {
   std::span<const double> points;            ///< the computation's coordinates
   std::vector<std::uint8_t> in_box;          ///< per point: inside the domain
   std::vector<std::int32_t> ignored_outside; ///< points dropped (ignore_outside_points)
-  std::optional<kernels::BinLocator<D>> locator;
+  /// Located points at exactly the coordinates of a lower id: (id, the
+  /// group's lowest id), ascending. They are left out of the locator, so
+  /// no cell meets them and none is built for them: a copy's bisectors are
+  /// its group's, and the lowest id owns the cell (docs/design.md,
+  /// "Duplicates leave the locator"). Callers report them.
+  std::vector<std::pair<std::int32_t, std::int32_t>> duplicates;
+  std::optional<kernels::BinLocator<D>> locator;  ///< the located points but duplicates
   std::optional<kernels::SharedKdTree<D>> tree;  ///< of the located points (CellBuilder)
   Buffer<std::int32_t> order;                ///< generators with cells wanted, bin order
   Buffer<std::uint32_t> slots;               ///< their slots in the locator
@@ -68,6 +75,16 @@ struct Pass {
   engine::Generators<D> gens;
   engine::EngineOptions engine_options;
 };
+
+/// Appends the pass's duplicates that a result reports: those that would
+/// be generators (every one without labels, else label >= 0), whatever
+/// their group's lowest id is.
+template <int D>
+void report_duplicates(const Pass<D>& pass, std::span<const std::int32_t> labels,
+                       std::vector<std::pair<std::int32_t, std::int32_t>>& out) {
+  for (const auto& d : pass.duplicates)
+    if (labels.empty() || labels[static_cast<std::size_t>(d.first)] >= 0) out.push_back(d);
+}
 
 extern template struct Pass<2>;
 extern template struct Pass<3>;

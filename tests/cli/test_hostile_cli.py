@@ -51,7 +51,7 @@ def rotation(rng, d):
 KINDS = ["uniform", "lattice", "rotated_lattice", "rotated_lattice_scaled", "duplicates", "near_duplicates",
          "power_of_ten", "far_from_origin", "cluster_in_cloud", "nearly_collinear", "nearly_flat",
          "sphere_and_centre", "grid_jitter", "small_integers", "far_outliers", "log_uniform",
-         "outliers_beyond_frame", "anisotropic", "layers", "big_integers", "concentric_spheres"]
+         "outliers_beyond_frame", "anisotropic", "layers", "big_integers", "concentric_spheres", "piles"]
 
 
 def generate(kind, rng, n, d):
@@ -133,6 +133,14 @@ def generate(kind, rng, n, d):
         v = rng.normal(size=(min(n, 200), d))
         v /= np.linalg.norm(v, axis=1)[:, None]
         return v * rng.integers(1, 5, size=(len(v), 1))
+    if kind == "piles":
+        # One to three points each repeated ten times n, shuffled among the
+        # rest (a sensor stuck on one reading, a padded array): a pile of
+        # 60,000 copies took 97 s, 70,000 beside distinct points broke the
+        # face limit, before the pass left duplicates out of the locator.
+        p = rng.random((n, d))
+        piles = np.repeat(p[rng.integers(0, n, int(rng.integers(1, 4)))], 10 * n, axis=0)
+        return rng.permutation(np.vstack([p, piles]))
     raise ValueError(kind)
 
 

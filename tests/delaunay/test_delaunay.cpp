@@ -510,6 +510,33 @@ TEST(Delaunay, NearDuplicatesAndDuplicates) {
   expect_valid(dt, p);
 }
 
+// A pile of 50,000 copies of one point among 2,000 distinct points, in 2D
+// and 3D, by every method: the rows of the distinct points, every copy
+// reported (the pass leaves them out of the locator; kept, the cells beside
+// the pile clipped by copy after copy).
+TEST(Delaunay, PileOfCopies) {
+  for (int dim : {2, 3}) {
+    SCOPED_TRACE("dim " + std::to_string(dim));
+    const std::size_t copies = 50000, n0 = 2000;
+    auto p = random_points(n0, dim, 430 + static_cast<std::uint64_t>(dim));
+    const auto distinct = p;
+    for (std::size_t k = 1; k < copies; ++k)
+      for (int a = 0; a < dim; ++a) p.push_back(p[static_cast<std::size_t>(a)]);
+    const tessera::Delaunay base = run(distinct, dim);
+    for (auto method : {tessera::DelaunayMethod::cells, tessera::DelaunayMethod::insertion, tessera::DelaunayMethod::automatic}) {
+      tessera::DelaunayOptions o;
+      o.dim = dim;
+      o.threads = 2;
+      o.method = method;
+      const tessera::Delaunay dt = tessera::delaunay(p, dim, {}, o);
+      EXPECT_EQ(dt.simplices, base.simplices);
+      ASSERT_EQ(dt.duplicates.size(), copies - 1);
+      EXPECT_EQ(dt.duplicates.front(), std::make_pair(static_cast<std::int32_t>(n0), 0));
+      EXPECT_EQ(dt.duplicates.back(), std::make_pair(static_cast<std::int32_t>(n0 + copies - 2), 0));
+    }
+  }
+}
+
 // Skipped cells (DelaunayOptions::skip_cells): the simplices of skipped
 // points come from their neighbours' cells, and gift wrapping closes the
 // cavities of skipped points only; the rows must be those of every cell

@@ -412,10 +412,10 @@ TEST(BinLocator, GridShape) {
   }
 }
 
-// may_have_coincident: false on distinct points (including ones one ulp
-// apart, in one bin), true once any two coincide exactly, wherever they lie
-// in the input, and true (unchecked) for a bin more crowded than asked.
-TEST(BinLocator, MayHaveCoincident) {
+// has_coincident: false on distinct points (including ones one ulp apart,
+// in one bin), true once any two coincide exactly, wherever they lie in the
+// input, in ordinary bins and in a crowded one (sorted).
+TEST(BinLocator, HasCoincident) {
   std::mt19937_64 g(6);
   std::uniform_real_distribution<double> u(0, 1);
   std::vector<double> p(2000 * 3);
@@ -423,19 +423,19 @@ TEST(BinLocator, MayHaveCoincident) {
   p[3 * 7 + 0] = std::nextafter(p[3 * 1500 + 0], 2.0);  // one ulp from point 1500
   p[3 * 7 + 1] = p[3 * 1500 + 1];
   p[3 * 7 + 2] = p[3 * 1500 + 2];
-  EXPECT_FALSE((BinLocator<3>(p, {}, {0, 0, 0}, {1, 1, 1}, 2.0).may_have_coincident()));
+  EXPECT_FALSE((BinLocator<3>(p, {}, {0, 0, 0}, {1, 1, 1}, 2.0).has_coincident()));
   std::vector<double> q = p;
   for (int d = 0; d < 3; ++d) q[3 * 1999 + d] = q[3 * 3 + d];  // point 1999 copies point 3
-  EXPECT_TRUE((BinLocator<3>(q, {}, {0, 0, 0}, {1, 1, 1}, 2.0).may_have_coincident()));
+  EXPECT_TRUE((BinLocator<3>(q, {}, {0, 0, 0}, {1, 1, 1}, 2.0).has_coincident()));
   // An unused copy does not count: only located points can coincide.
   std::vector<std::uint8_t> use(2000, 1);
   use[1999] = 0;
-  EXPECT_FALSE((BinLocator<3>(q, use, {0, 0, 0}, {1, 1, 1}, 2.0).may_have_coincident()));
-  // One bin of 2000 points: more than `crowded`, so "may".
-  EXPECT_TRUE((BinLocator<3>(p, {}, {0, 0, 0}, {1, 1, 1}, 2000.0).may_have_coincident()));
-  EXPECT_FALSE((BinLocator<3>(p, {}, {0, 0, 0}, {1, 1, 1}, 2000.0).may_have_coincident(2000)));
+  EXPECT_FALSE((BinLocator<3>(q, use, {0, 0, 0}, {1, 1, 1}, 2.0).has_coincident()));
+  // One bin of 2000 points: sorted, and answered exactly.
+  EXPECT_FALSE((BinLocator<3>(p, {}, {0, 0, 0}, {1, 1, 1}, 2000.0).has_coincident()));
+  EXPECT_TRUE((BinLocator<3>(q, {}, {0, 0, 0}, {1, 1, 1}, 2000.0).has_coincident()));
   std::vector<double> r = {0.25, 0.5, 0.75, 0.5, 0.25, 0.5};  // 2D: points 0 and 2 coincide
-  EXPECT_TRUE((BinLocator<2>(r, {}, {0, 0}, {1, 1}, 2.0).may_have_coincident()));
+  EXPECT_TRUE((BinLocator<2>(r, {}, {0, 0}, {1, 1}, 2.0).has_coincident()));
 }
 
 // lowest_coincident against brute force: every slot maps to the lowest id
