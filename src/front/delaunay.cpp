@@ -293,11 +293,7 @@ template <int D>
 Delaunay by_insertion(const front::Pass<D>& pass, Delaunay out) {
   engine::ThreadArena(pass.engine_options.threads).execute([&] {
     front::LocatedInsertion ins = front::insert_located(pass, pass.engine_options.progress);
-    const auto& loc = *pass.locator;
-    for (std::size_t k = 0; k < loc.size(); ++k)
-      if (ins.lowest[k] >= 0) out.duplicates.emplace_back(loc.id(k), ins.lowest[k]);
     front::report_duplicates(pass, {}, out.duplicates);  // (no labels here: completion)
-    std::sort(out.duplicates.begin(), out.duplicates.end());
     out.hull_completed = true;
     if (!ins.rows) return;  // all on one plane (2D: line): no simplex exists
     out.from_insertion = ins.rows->size() / (D + 1);

@@ -21,7 +21,6 @@ std::optional<engine::DelaunayStars> delaunay_stars(const Pass<D>& pass, const s
   bool flat = false;
   engine::ThreadArena(pass.engine_options.threads).execute([&] {
     LocatedInsertion ins = insert_located(pass, progress);
-    out.duplicate_of = std::move(ins.lowest);
     if (!ins.rows) {
       flat = true;
       return;

@@ -640,25 +640,13 @@ std::optional<Buffer<std::int32_t>> insertion_delaunay(const ExactContext& ctx, 
 
 template <int D>
 LocatedInsertion insert_located(const Pass<D>& pass, const std::function<void(double)>& progress) {
-  // Exact duplicates, bin by bin (BinLocator::lowest_coincident): sorting
-  // every id by its coordinates gathered a cache line per comparison.
+  // The located points are distinct (the pass left exact duplicates out),
+  // in slot order with the locator's own coordinates.
   const auto& loc = *pass.locator;
   LocatedInsertion out;
-  out.lowest = loc.lowest_coincident();
-  std::vector<std::int32_t> distinct;
-  distinct.reserve(loc.size());
-  for (std::size_t k = 0; k < loc.size(); ++k)
-    if (out.lowest[k] < 0) distinct.push_back(loc.id(k));
-  // Their coordinates in the same (slot) order: the locator's own, or a
-  // copy without the duplicates.
+  std::vector<std::int32_t> ids(loc.size());
+  for (std::size_t k = 0; k < loc.size(); ++k) ids[k] = loc.id(k);
   const double* coords = loc.size() == 0 ? nullptr : loc.point(0).data();
-  Buffer<double> kept;
-  if (distinct.size() != loc.size()) {
-    kept.reserve(distinct.size() * D);
-    for (std::size_t k = 0; k < loc.size(); ++k)
-      if (out.lowest[k] < 0) kept.insert(kept.end(), loc.point(k).begin(), loc.point(k).end());
-    coords = kept.data();
-  }
   InsertionOptions io;
   io.threads = pass.engine_options.threads;
   io.progress = progress;
@@ -667,7 +655,7 @@ LocatedInsertion insert_located(const Pass<D>& pass, const std::function<void(do
   // box, 1M points beside one at 1e200 all had one code, were inserted in
   // random order, and every walk crossed the triangulation (2D: 52.9 s).
   const auto glo = loc.grid_lo(), ghi = loc.grid_hi();
-  out.rows = insertion_delaunay(pass.exact, distinct, coords, glo.data(), ghi.data(), io);
+  out.rows = insertion_delaunay(pass.exact, ids, coords, glo.data(), ghi.data(), io);
   return out;
 }
 

@@ -77,12 +77,11 @@ std::optional<Buffer<std::int32_t>> insertion_delaunay(const kernels::ExactConte
 template <int D>
 struct Pass;
 
-/// insertion_delaunay of a pass's located points, exact duplicates left out:
-/// of each set of coincident points the lowest id is the vertex, as the
-/// cells pass decides. For tessera::delaunay (its rows) and
+/// insertion_delaunay of a pass's located points (distinct: the pass left
+/// exact duplicates out, and of each set of coincident points the lowest id
+/// is the vertex, as the cells decide). For tessera::delaunay (its rows) and
 /// tessera::voronoi (the cells' neighbours). Call it in the pass's arena.
 struct LocatedInsertion {
-  std::vector<std::int32_t> lowest;          ///< per locator slot: BinLocator::lowest_coincident
   std::optional<Buffer<std::int32_t>> rows;  ///< nullopt when the points are all on one plane (2D: line)
 };
 /// `progress`, when set, as InsertionOptions::progress. D = 2 or 3.

@@ -26,15 +26,13 @@ namespace tessera::engine {
 /// locator slot: `rows` holds the simplices, D + 1 slots each, positively
 /// oriented (2D counter-clockwise, 3D det > 0); slot s's simplices are
 /// `simplices[first[s] .. first[s + 1])`, ascending, so in an order
-/// independent of the thread count. `duplicate_of[s]` is the lowest id at
-/// exactly s's coordinates when that is another point's (s then has no cell
-/// and no simplex), else -1. Slots, not ids: the cells run in slot order, and
-/// the locator's copies of ids and coordinates are in it too.
+/// independent of the thread count. Slots, not ids: the cells run in slot
+/// order, and the locator's copies of ids and coordinates are in it too.
+/// Located points are distinct (front::Pass leaves duplicates out).
 struct DelaunayStars {
   Buffer<std::int32_t> rows;  ///< slots (below 2^31), as the insertion's rows were ids
   std::vector<std::uint32_t> first;
   std::vector<std::uint32_t> simplices;
-  std::vector<std::int32_t> duplicate_of;
 };
 
 /// What the driver needs: input, domain, locator and the generators whose
@@ -105,12 +103,6 @@ std::uint64_t tessellate(const Generators<CellT::dim>& gens, Comp& comp, const E
       kernels::BuildStatus st;
       if (const DelaunayStars* ds = gens.stars) {
         const std::uint32_t at = gens.slots[g];
-        if (const std::int32_t owner = ds->duplicate_of[at]; owner >= 0) {
-          st.has_cell = false;
-          st.duplicate_of = owner;
-          comp.add(batch, gen, st, ws.cell);  // no cell built: its exact calls are not this one's
-          continue;
-        }
         // A star's simplices lie all over the rows (they are in id order):
         // ask for those of a later cell now.
         if (g + star_ahead < end) {
