@@ -42,11 +42,14 @@ class Hull {
   static constexpr int dim = 3;
   /// The domain box's planes are always the cell's first local planes.
   static constexpr std::uint16_t box_planes = 6;
-  /// The most bisectors assemble() takes (more: the cell is clipped). Its
-  /// edge table holds (2 x planes)^2 entries; a hull point of a terrain's
-  /// samples has thousands of neighbours (flat tetrahedra reach across the
-  /// surface), whose table took gigabytes to zero.
-  static constexpr std::size_t max_assembled_planes = 500;
+  /// The most bisectors assemble() takes (more: the cell is clipped), below
+  /// the local plane limit with the box's six and a far plane. Beyond
+  /// dense_planes the edge map is the hash, so memory follows the
+  /// triangles (until stop 55 the limit was 500: the dense table of a hull
+  /// point of a terrain's samples, thousands of neighbours, took gigabytes,
+  /// and the centre of 40,000 points on a sphere was clipped instead, in
+  /// time quadratic in its faces: 6 s).
+  static constexpr std::size_t max_assembled_planes = 0xFFF0;
   struct Plane {
     double n[3];
     double d;
@@ -214,7 +217,13 @@ class Hull {
     start(gen, p, lo, hi, exact);
     if (may_underflow_ || m > max_assembled_planes) return false;
     assembly::bisector_planes<3>(planes_, box_planes, ids, q, m);
-    if (planes_.size() + 1 > cap_ || edge_tri_.empty()) ensure_table(2 * (planes_.size() + 1));
+    // Room for the far plane too: dense up to dense_planes, else the hash.
+    const std::size_t need = planes_.size() + 1;
+    if (need <= dense_planes) {
+      if (need > cap_ || edge_tri_.empty()) ensure_table(std::min(2 * need, dense_planes));
+    } else {
+      enter_hash(2 * nt);
+    }
     resize_vertices(nt);
     for (std::size_t t = 0; t < nt; ++t) {
       Vertex& v = verts_[t];
@@ -224,7 +233,7 @@ class Hull {
       v.p[2] = static_cast<std::uint16_t>(box_planes + c[2]);
       solve(v, false);
       if (!(v.e <= std::numeric_limits<double>::max())) return false;  // needs the exact solve: clip instead
-      settle(static_cast<std::uint32_t>(t));
+      settle_any(static_cast<std::uint32_t>(t));
     }
     if (open && !close_far(q, m)) return false;
     update_radius();
@@ -292,7 +301,9 @@ class Hull {
       const std::size_t nv = verts_.size();
       const std::size_t removed = assembly::box_signs(verts_.data(), nv, k, planes_[k].d, sign_);
       if (removed == assembly::undecided || removed == nv) return false;
-      if (removed != 0) cut<false>(k, nv);  // assembled: at most max_assembled_planes, a dense map
+      if (removed == 0) continue;
+      if (hashed_) cut_hashed(k, nv);  // a star of more than dense_planes neighbours
+      else cut<false>(k, nv);
     }
     return true;
   }
@@ -304,7 +315,6 @@ class Hull {
   // assemble's.
   bool close_far(const double* q, std::size_t m) {
     const std::size_t nt = verts_.size();
-    const std::size_t cap = cap_;
     const std::uint16_t far = static_cast<std::uint16_t>(planes_.size());
     border_.clear();  // here: the boundary edges, as (b, a)
     for (std::size_t t = 0; t < nt; ++t) {
@@ -313,7 +323,7 @@ class Hull {
         const std::uint16_t a = v.p[k], b = v.p[k == 2 ? 0 : k + 1];
         // The table is not cleared between cells: an entry is this cell's
         // only if its triangle holds the edge.
-        const std::uint32_t u = edge_tri_[static_cast<std::size_t>(b) * cap + a];
+        const std::uint32_t u = edge(b, a);
         if (u < nt && holds(verts_[u], b, a)) continue;
         border_.push_back({b, a});
       }
@@ -349,7 +359,7 @@ class Hull {
       v.p[2] = far;
       solve(v, false);  // never exact: on the far plane
       if (!(v.e <= std::numeric_limits<double>::max())) return false;
-      settle(static_cast<std::uint32_t>(nt + k));
+      settle_any(static_cast<std::uint32_t>(nt + k));
     }
     // Closed and consistently oriented: every directed edge is held by one
     // triangle only, and its twin by another. (The disk's edges were
@@ -359,9 +369,8 @@ class Hull {
       const Vertex& v = verts_[t];
       for (int k = 0; k < 3; ++k) {
         const std::uint16_t a = v.p[k], b = v.p[k == 2 ? 0 : k + 1];
-        const std::uint32_t u = edge_tri_[static_cast<std::size_t>(b) * cap + a];
-        if (edge_tri_[static_cast<std::size_t>(a) * cap + b] != t || !(u < nt + nb && holds(verts_[u], b, a)))
-          return false;
+        const std::uint32_t u = edge(b, a);
+        if (edge(a, b) != t || !(u < nt + nb && holds(verts_[u], b, a))) return false;
       }
     }
     return true;
@@ -426,6 +435,12 @@ class Hull {
     link<Hashed>(t);
   }
 
+  // settle() in whichever mode the edge map is (assembly: decided per cell).
+  void settle_any(std::uint32_t t) {
+    if (hashed_) settle<true>(t);
+    else settle<false>(t);
+  }
+
   template <bool Hashed = false>
   void link(std::uint32_t t) {
     const Vertex& v = verts_[t];
@@ -468,10 +483,16 @@ class Hull {
       ensure_table(2 * cap_);
       return;
     }
-    hashed_ = true;
-    hash_.assign(std::max<std::size_t>(1024, std::bit_ceil(8 * verts_.size())), 0);
-    hash_used_ = 0;
+    enter_hash(verts_.size());
     for (std::size_t t = 0; t < verts_.size(); ++t) link<true>(static_cast<std::uint32_t>(t));
+  }
+
+  // The hash as the edge map, empty, sized for about `triangles` (three
+  // edges each, at most half full; it grows by rehash()).
+  void enter_hash(std::size_t triangles) {
+    hashed_ = true;
+    hash_.assign(std::max<std::size_t>(1024, std::bit_ceil(8 * triangles)), 0);
+    hash_used_ = 0;
   }
 
   // A new cell: back to the dense table (its size kept), the hash dropped.
