@@ -288,6 +288,10 @@ inline constexpr std::uint64_t completion_budget = 64;
 /// speak of (PilotEstimate::exact_per_cell; lattices ~53).
 inline constexpr double clean_exact_per_cell = 1.0;
 
+/// The share of the inside generators the labelled pass's pilot may build
+/// (as the cells' pilot: few inside points are measured too).
+inline constexpr double labelled_pilot_share = 0.5;
+
 // The triangulation by insertion of the located points (front::insert_located).
 template <int D>
 Delaunay by_insertion(const front::Pass<D>& pass, Delaunay out) {
@@ -315,6 +319,20 @@ Delaunay run(std::span<const double> input, std::span<const std::int32_t> labels
   out.bounds = pass.user_bounds;
   out.ignored_outside_bounds = pass.ignored_outside;
   out.threads_used = pass.engine_options.threads;
+
+  // The labelled cells pass of delaunay()'s first way, with the automatic
+  // method: where a sample of its cells finds them costly, it gives way to
+  // the whole triangulation (the second way), which the automatic method
+  // builds by insertion on such input. The centre of 40,000 points on a
+  // sphere, alone inside, has every sphere point as a face, clipped one by
+  // one: 4 s, and past 65,534 points the face limit (0.2 s by insertion).
+  if (labelled_cell_touches_box != nullptr && opt.method == DelaunayMethod::automatic) {
+    const double insert_from = insertion_ratio<D>(pass.engine_options.threads);
+    if (pilot_estimate<CellT>(pass, insert_from, labelled_pilot_share).ratio >= insert_from) {
+      *labelled_cell_touches_box = true;
+      return out;
+    }
+  }
 
   // Skipped cells (docs/design.md, "Skipped cells"): only where completion
   // runs, as it closes their cavities. Automatically from 20,000 points, by
@@ -612,8 +630,7 @@ Delaunay delaunay(std::span<const double> points, int dim, std::span<const std::
     // way gives the same rows).
     if (options.method != DelaunayMethod::insertion && !inside_reaches_out(points, dim, labels)) {
       DelaunayOptions boxed = options;
-      boxed.complete_hull = false;
-      boxed.method = DelaunayMethod::cells;
+      boxed.complete_hull = false;  // (run() reads the method: automatic lets its pilot decline the pass)
       bool touches = true;
       Delaunay dt = dim == 3 ? run<kernels::Hull>(points, labels, boxed, 0, &touches)
                              : run<kernels::Tile>(points, labels, boxed, 0, &touches);

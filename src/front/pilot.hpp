@@ -135,8 +135,17 @@ PilotEstimate pilot_estimate(const Pass<CellT::dim>& pass, double enough, double
   const double cells = max_share > 0 ? std::clamp(share * static_cast<double>(pass.order.size()) / pilot_bands, 16.0,
                                                   static_cast<double>(pilot_band))
                                       : static_cast<double>(pilot_band);
-  const double band = cells / static_cast<double>(pass.order.size());
-  const std::size_t bands = std::min<std::size_t>(pilot_bands, static_cast<std::size_t>(share / band));
+  double band = cells / static_cast<double>(pass.order.size());
+  std::size_t bands = std::min<std::size_t>(pilot_bands, static_cast<std::size_t>(share / band));
+  if (bands == 0 && max_share > 0) {
+    // Fewer generators than two bands of 16 (a small input, or a few inside
+    // points among outside ones): one band of them all, each capped. One of
+    // them may be costly alone: the centre of 40,000 outside points on a
+    // sphere, the only inside point, was searched for 2.4 s (0.3 s from its
+    // Delaunay star), and past 65,534 points it failed.
+    band = 1.0;
+    bands = 1;
+  }
   if (bands == 0) return {1.0, unmeasured};
   // Every band's generators in one scan (bin order kept), with their band.
   const auto from = static_cast<std::uint64_t>(std::ldexp(1.0 - static_cast<double>(bands) * band, 64));
