@@ -321,14 +321,17 @@ Delaunay run(std::span<const double> input, std::span<const std::int32_t> labels
   out.threads_used = pass.engine_options.threads;
 
   // The labelled cells pass of delaunay()'s first way, with the automatic
-  // method: where a sample of its cells finds them costly, it gives way to
-  // the whole triangulation (the second way), which the automatic method
-  // builds by insertion on such input. The centre of 40,000 points on a
-  // sphere, alone inside, has every sphere point as a face, clipped one by
-  // one: 4 s, and past 65,534 points the face limit (0.2 s by insertion).
+  // method: where a sample of its cells finds them costly, and costlier in
+  // all than the whole triangulation (the second way, which the automatic
+  // method builds by insertion on such input; about a cell's cost per
+  // point), it gives way to that. The centre of 40,000 points on a sphere,
+  // alone inside, has every sphere point as a face, clipped one by one: 4 s,
+  // and past 65,534 points the face limit (0.2 s by insertion). A clustered
+  // ball inside a cloud ten times its size keeps the pass.
   if (labelled_cell_touches_box != nullptr && opt.method == DelaunayMethod::automatic) {
     const double insert_from = insertion_ratio<D>(pass.engine_options.threads);
-    if (pilot_estimate<CellT>(pass, insert_from, labelled_pilot_share).ratio >= insert_from) {
+    const double ratio = pilot_estimate<CellT>(pass, insert_from, labelled_pilot_share).ratio;
+    if (ratio >= insert_from && ratio * static_cast<double>(pass.order.size()) >= static_cast<double>(n)) {
       *labelled_cell_touches_box = true;
       return out;
     }
