@@ -215,6 +215,18 @@ TEST(Invariants, FibonacciSphere3D) {
   EXPECT_EQ(neighbours_of(c, c.cell_of[m]).size(), std::size_t(m)) << "the centre touches every sphere point";
 }
 
+/// m random points projected onto the unit sphere about the origin.
+std::vector<double> unit_sphere_points(int m, std::uint64_t seed) {
+  std::vector<double> pts = random_points(static_cast<std::size_t>(m), 3, seed);
+  for (int i = 0; i < m; ++i) {
+    double* p = pts.data() + 3 * i;
+    for (int a = 0; a < 3; ++a) p[a] -= 0.5;
+    const double len = std::sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
+    for (int a = 0; a < 3; ++a) p[a] /= len;
+  }
+  return pts;
+}
+
 TEST(Invariants, HugeCell3D) {
   // A point inside a shell of 3,000 random points: its cell has 3,000 faces,
   // past the dense edge maps (Hull's plane-pair table and the face walk's,
@@ -226,13 +238,7 @@ TEST(Invariants, HugeCell3D) {
   // vertices, which its neighbours find by key order (the mesh's crowded
   // owners; scanned, 40,000 sphere points took 1.7 s there).
   const int m = 3000;
-  std::vector<double> sphere = random_points(static_cast<std::size_t>(m), 3, 91);
-  for (int i = 0; i < m; ++i) {
-    double* p = sphere.data() + 3 * i;
-    for (int a = 0; a < 3; ++a) p[a] -= 0.5;
-    const double len = std::sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
-    for (int a = 0; a < 3; ++a) p[a] /= len;
-  }
+  const std::vector<double> sphere = unit_sphere_points(m, 91);
   for (bool centre_first : {false, true}) {
     SCOPED_TRACE(centre_first ? "centre first" : "centre last");
     std::vector<double> pts = sphere;
@@ -263,13 +269,7 @@ TEST(Invariants, HugeCell3D) {
 // more than the whole triangulation, filtered (outside_simplices counts it).
 TEST(Invariants, HugeCellAloneInsideComesFromItsStar) {
   const int m = 3000;
-  std::vector<double> pts = random_points(static_cast<std::size_t>(m), 3, 92);
-  for (int i = 0; i < m; ++i) {
-    double* p = pts.data() + 3 * i;
-    for (int a = 0; a < 3; ++a) p[a] -= 0.5;
-    const double len = std::sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
-    for (int a = 0; a < 3; ++a) p[a] /= len;
-  }
+  std::vector<double> pts = unit_sphere_points(m, 92);
   pts.insert(pts.begin(), {0.0, 0.0, 0.0});
   std::vector<std::int32_t> labels(static_cast<std::size_t>(m) + 1, -1);
   labels[0] = 0;
@@ -287,13 +287,7 @@ TEST(Invariants, HugeCellAloneInsideComesFromItsStar) {
   // The Delaunay's pass declines where the cells cost more in all than the
   // whole triangulation: 20,000 sphere points (its pilot's cell is capped).
   const int big = 20000;
-  std::vector<double> many = random_points(static_cast<std::size_t>(big), 3, 93);
-  for (int i = 0; i < big; ++i) {
-    double* p = many.data() + 3 * i;
-    for (int a = 0; a < 3; ++a) p[a] -= 0.5;
-    const double len = std::sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
-    for (int a = 0; a < 3; ++a) p[a] /= len;
-  }
+  std::vector<double> many = unit_sphere_points(big, 93);
   many.insert(many.begin(), {0.0, 0.0, 0.0});
   std::vector<std::int32_t> alone(static_cast<std::size_t>(big) + 1, -1);
   alone[0] = 0;
