@@ -66,7 +66,7 @@ struct Pass {
   /// its group's, and the lowest id owns the cell (docs/design.md,
   /// "Duplicates leave the locator"). Callers report them.
   std::vector<std::pair<std::int32_t, std::int32_t>> duplicates;
-  std::optional<kernels::BinLocator<D>> locator;  ///< the located points but duplicates
+  std::optional<kernels::BinLocator<D>> locator;  ///< the located points, duplicates left out
   std::optional<kernels::SharedKdTree<D>> tree;  ///< of the located points (CellBuilder)
   Buffer<std::int32_t> order;                ///< generators with cells wanted, bin order
   Buffer<std::uint32_t> slots;               ///< their slots in the locator
