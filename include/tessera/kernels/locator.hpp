@@ -331,65 +331,33 @@ class BinLocator {
         });
   }
 
-  /// Whether two located points coincide exactly. Coincident points share
-  /// a bin, so each bin's points are compared pairwise, a bin of more than
-  /// `crowded` points sorted by coordinates; bins in parallel, stopping once
-  /// any thread found a pair. ~2-5 ms for 1M uniform points on two threads.
+  /// Whether two located points coincide exactly (coincident_in_bin over
+  /// the bins in parallel, stopping once any thread found a pair). ~2-5 ms
+  /// for 1M uniform points on two threads.
   bool has_coincident(std::uint32_t crowded = 32) const {
     std::atomic<bool> found{false};
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, num_bins(), 1 << 12), [&](const tbb::blocked_range<std::size_t>& r) {
-      if (found.load(std::memory_order_relaxed)) return;
       std::vector<std::uint32_t> crowd;
-      for (std::size_t k = r.begin(); k != r.end(); ++k) {
-        const std::uint32_t a = offsets_[k], e = offsets_[k + 1];
-        bool pair = false;
-        if (e - a <= crowded) {
-          for (std::uint32_t i = a + 1; i < e && !pair; ++i)
-            for (std::uint32_t j = a; j < i; ++j) pair |= sorted_[j] == sorted_[i];
-        } else {
-          crowd.resize(e - a);
-          for (std::uint32_t i = a; i < e; ++i) crowd[i - a] = i;
-          std::sort(crowd.begin(), crowd.end(), [&](std::uint32_t x, std::uint32_t y) { return sorted_[x] < sorted_[y]; });
-          for (std::size_t m = 1; m < crowd.size() && !pair; ++m) pair = sorted_[crowd[m]] == sorted_[crowd[m - 1]];
-        }
-        if (pair) {
+      for (std::size_t k = r.begin(); k != r.end() && !found.load(std::memory_order_relaxed); ++k)
+        if (!coincident_in_bin(k, crowded, crowd, [](std::uint32_t, std::uint32_t) { return false; }))
           found.store(true, std::memory_order_relaxed);
-          return;
-        }
-      }
     });
     return found.load();
   }
 
   /// Per slot, the lowest id among the located points at exactly its
   /// coordinates when that is another point's, else -1: each group of
-  /// coincident points (which share a bin, whose slots keep id order)
-  /// maps to its first member. A bin of up to `crowded` points is compared
-  /// pairwise, a fuller one sorted by coordinates; bins in parallel.
+  /// coincident points maps to its first member (coincident_in_bin, bins in
+  /// parallel).
   std::vector<std::int32_t> lowest_coincident(std::uint32_t crowded = 32) const {
     std::vector<std::int32_t> lowest(ids_.size(), -1);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, num_bins(), 1 << 10), [&](const tbb::blocked_range<std::size_t>& r) {
       std::vector<std::uint32_t> crowd;
-      for (std::size_t k = r.begin(); k != r.end(); ++k) {
-        const std::uint32_t a = offsets_[k], e = offsets_[k + 1];
-        if (e - a <= crowded) {
-          for (std::uint32_t i = a + 1; i < e; ++i)
-            for (std::uint32_t j = a; j < i; ++j)
-              if (sorted_[j] == sorted_[i]) {
-                lowest[i] = ids_[j];
-                break;
-              }
-          continue;
-        }
-        crowd.resize(e - a);
-        for (std::uint32_t i = a; i < e; ++i) crowd[i - a] = i;
-        std::sort(crowd.begin(), crowd.end(), [&](std::uint32_t x, std::uint32_t y) {
-          return sorted_[x] != sorted_[y] ? sorted_[x] < sorted_[y] : x < y;
+      for (std::size_t k = r.begin(); k != r.end(); ++k)
+        coincident_in_bin(k, crowded, crowd, [&](std::uint32_t slot, std::uint32_t first) {
+          lowest[slot] = ids_[first];
+          return true;
         });
-        for (std::size_t m = 1; m < crowd.size(); ++m)
-          if (sorted_[crowd[m]] == sorted_[crowd[m - 1]])
-            lowest[crowd[m]] = lowest[crowd[m - 1]] >= 0 ? lowest[crowd[m - 1]] : ids_[crowd[m - 1]];
-      }
     });
     return lowest;
   }
@@ -406,6 +374,40 @@ class BinLocator {
   const std::array<std::int32_t, D>& divisions() const { return divs_; }
 
  private:
+  // Bin k's slots that coincide with an earlier slot (coincident points
+  // share a bin): f(slot, the group's first slot, which holds its lowest id,
+  // as a bin's slots keep id order), which returns false to stop; returns
+  // false when f stopped. A bin of up to `crowded` points is compared
+  // pairwise, a fuller one sorted by coordinates, then slot (`crowd`: its
+  // scratch).
+  template <class F>
+  bool coincident_in_bin(std::size_t k, std::uint32_t crowded, std::vector<std::uint32_t>& crowd, F&& f) const {
+    const std::uint32_t a = offsets_[k], e = offsets_[k + 1];
+    if (e - a <= crowded) {
+      for (std::uint32_t i = a + 1; i < e; ++i)
+        for (std::uint32_t j = a; j < i; ++j)
+          if (sorted_[j] == sorted_[i]) {
+            if (!f(i, j)) return false;
+            break;
+          }
+      return true;
+    }
+    crowd.resize(e - a);
+    for (std::uint32_t i = a; i < e; ++i) crowd[i - a] = i;
+    std::sort(crowd.begin(), crowd.end(), [&](std::uint32_t x, std::uint32_t y) {
+      return sorted_[x] != sorted_[y] ? sorted_[x] < sorted_[y] : x < y;
+    });
+    std::uint32_t first = crowd[0];
+    for (std::size_t m = 1; m < crowd.size(); ++m) {
+      if (sorted_[crowd[m]] != sorted_[crowd[m - 1]]) {
+        first = crowd[m];
+        continue;
+      }
+      if (!f(crowd[m], first)) return false;
+    }
+    return true;
+  }
+
   // Bin c's faces along axis d: nominal inside the grid, unbounded outward
   // at its edges (the file comment).
   std::pair<double, double> faces(int d, std::int32_t c) const {
