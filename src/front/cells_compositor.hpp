@@ -394,6 +394,14 @@ class CellsCompositor {
     }
   }
 
+  // Merged vertex g's key, from the mesh's vertex_keys (a copy: a
+  // std::array compare on it is two wide loads, see same_key).
+  static Key<D> key_at(const std::int32_t* keys, std::int64_t g) {
+    Key<D> k;
+    std::memcpy(k.data(), keys + static_cast<std::size_t>(g) * (D + 1), sizeof k);
+    return k;
+  }
+
   // Owners searched by key order (build_mesh): above this many owned
   // vertices (a uniform 3D cell owns ~7).
   static constexpr std::int64_t crowded_owner = 256;
@@ -408,15 +416,10 @@ class CellsCompositor {
     std::int32_t find(std::size_t cell, const Key<D>& key, const std::int32_t* keys) const {
       const std::size_t i = static_cast<std::size_t>(std::lower_bound(cells.begin(), cells.end(), cell) - cells.begin());
       if (i == cells.size() || cells[i] != cell) return -1;
-      auto key_at = [keys](std::int32_t g) {
-        Key<D> k;
-        std::memcpy(k.data(), keys + static_cast<std::size_t>(g) * (D + 1), sizeof k);
-        return k;
-      };
       const auto first = ids.begin() + static_cast<std::ptrdiff_t>(start[i]);
       const auto last = ids.begin() + static_cast<std::ptrdiff_t>(start[i + 1]);
-      const auto it = std::lower_bound(first, last, key, [&](std::int32_t g, const Key<D>& k) { return key_at(g) < k; });
-      return it != last && same_key(key_at(*it), key) ? *it : -1;
+      const auto it = std::lower_bound(first, last, key, [&](std::int32_t g, const Key<D>& k) { return key_at(keys, g) < k; });
+      return it != last && same_key(key_at(keys, *it), key) ? *it : -1;
     }
   };
 
@@ -433,10 +436,7 @@ class CellsCompositor {
     const std::int32_t* keys = out_.vertex_keys.data();
     tbb::parallel_for(std::size_t(0), c.cells.size(), [&](std::size_t i) {
       std::sort(c.ids.begin() + static_cast<std::ptrdiff_t>(c.start[i]), c.ids.begin() + static_cast<std::ptrdiff_t>(c.start[i + 1]),
-                [keys](std::int32_t a, std::int32_t b) {
-                  return std::lexicographical_compare(keys + static_cast<std::size_t>(a) * (D + 1), keys + static_cast<std::size_t>(a + 1) * (D + 1),
-                                                      keys + static_cast<std::size_t>(b) * (D + 1), keys + static_cast<std::size_t>(b + 1) * (D + 1));
-                });
+                [keys](std::int32_t a, std::int32_t b) { return key_at(keys, a) < key_at(keys, b); });
     });
     return c;
   }
@@ -574,11 +574,8 @@ class CellsCompositor {
           if (g1 - owned[oc] > crowded_owner) [[unlikely]] {
             found = crowded.find(oc, key, keys);
           } else {
-            for (std::int64_t g = owned[oc]; g < g1; ++g) {
-              Key<D> kg;
-              std::memcpy(kg.data(), keys + static_cast<std::size_t>(g) * (D + 1), sizeof kg);
-              if (same_key(kg, key)) { found = static_cast<std::int32_t>(g); break; }
-            }
+            for (std::int64_t g = owned[oc]; g < g1; ++g)
+              if (same_key(key_at(keys, g), key)) { found = static_cast<std::int32_t>(g); break; }
           }
           if (found < 0) misses.fetch_add(1, std::memory_order_relaxed);
           gid[slot[m] - v0] = found;
