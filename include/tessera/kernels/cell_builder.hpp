@@ -42,7 +42,9 @@ struct BuildStatus {
   bool has_cell = true;          ///< false: an exact duplicate of `duplicate_of`
   std::int32_t duplicate_of = -1;
   /// The search's work in deterministic units: points scanned in the bins,
-  /// plus k-d tree nodes visited, plus four per candidate tested against the
+  /// plus the k-d tree's own effort (a unit per node or leaf point it
+  /// measures, two per entry it queues: KdTree::nearest_first; a unit per
+  /// node of KdTree::nearest), plus four per candidate tested against the
   /// cell (a sign pass costs about four scanned points). Used to estimate
   /// what cells cost on an input (delaunay's skipped-cell fraction); the
   /// same for any thread count. Scanned points are counted as the pruned
@@ -570,7 +572,7 @@ class CellBuilder {
         return false;
       }
       return true;
-    }, prune);
+    }, prune, work_);
     return status;
   }
 

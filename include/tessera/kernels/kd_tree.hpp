@@ -97,12 +97,17 @@ class KdTree {
   /// continues while the next key is at most r2max() (re-read each step, it
   /// may shrink) and f returns true. A node for which prune(lo, hi) (its
   /// box, absolute) holds is skipped with all its points. `heap` is the
-  /// caller's scratch.
+  /// caller's scratch. `work` grows by the search's own effort: one per
+  /// node or leaf point whose distance it computes, two more per entry it
+  /// queues (a heap push and pop, O(log heap) each); the cell builder's
+  /// BuildStatus::work, which the pilot weighs against the grid's scans.
   template <class Radius, class F, class Prune>
-  void nearest_first(const double* x, std::int32_t self, std::vector<Entry>& heap, Radius&& r2max, F&& f, Prune&& prune) const {
+  void nearest_first(const double* x, std::int32_t self, std::vector<Entry>& heap, Radius&& r2max, F&& f, Prune&& prune,
+                     std::uint64_t& work) const {
     heap.clear();
     if (nodes_.empty()) return;
     auto push = [&](Entry e) {
+      work += 2;
       heap.push_back(e);
       std::push_heap(heap.begin(), heap.end(), std::greater<>{});
     };
@@ -121,6 +126,7 @@ class KdTree {
       const double bound = r2max();
       const Node& nd = nodes_[static_cast<std::size_t>(-1 - e.id)];
       if (nd.left < 0) {
+        work += nd.end - nd.begin;
         for (std::uint32_t k = nd.begin; k < nd.end; ++k) {
           const std::int32_t j = ids_[k];
           if (j == self) continue;
@@ -133,6 +139,7 @@ class KdTree {
           if (r2 <= bound) push({r2, j});
         }
       } else {
+        work += 2;
         for (const std::int32_t c : {nd.left, nd.right}) {
           const double b2 = box_distance2(static_cast<std::size_t>(c), x);
           const Node& child = nodes_[static_cast<std::size_t>(c)];
