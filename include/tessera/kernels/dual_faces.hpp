@@ -30,10 +30,14 @@ struct FaceLoopScratch {
   std::vector<std::uint32_t> last;   // 2D, per face: the vertex its edge arrives at
   std::vector<std::uint32_t> next;   // 3D, per corner 3t + k: the corner after it around its face
   std::vector<std::uint32_t> loop;
-  std::vector<std::pair<std::uint64_t, std::uint32_t>> sorted;  // 3D, a huge cell: (a * nfaces + b, corner), sorted
+  // 3D, a huge cell (face_successors_bucketed): the corners bucketed by face,
+  // and per face b the stamp and corner of the edge (a -> b) of the face a
+  // being matched.
+  std::vector<std::uint32_t> offset, bucket, mark, holder;
+  std::uint32_t mark_epoch = 0;
 };
 
-/// Above this many faces a 3D cell's face pairs are sorted instead of
+/// Above this many faces a 3D cell's face pairs are bucketed instead of
 /// tabled: the table's nfaces^2 entries took 1.6 GB for one point inside a
 /// shell of 20,000 points.
 inline constexpr std::size_t dense_face_pairs = 1024;
@@ -41,27 +45,63 @@ inline constexpr std::size_t dense_face_pairs = 1024;
 inline constexpr std::uint32_t no_corner = std::numeric_limits<std::uint32_t>::max();
 
 /// for_each_face_loop's first and next for a cell of more than
-/// dense_face_pairs faces: the directed edges sorted by face pair and found
-/// by binary search, nv log nv, where the table would hold nfaces^2.
+/// dense_face_pairs faces, in time linear in its corners, where the table
+/// would hold nfaces^2 entries: the directed edges are bucketed by their
+/// first face (a counting sort), and each face's successors are matched
+/// within its bucket through a per-face mark (stamped, so never cleared).
+/// Until stop 56 the edges were sorted and each found by binary search: a
+/// third of the mesh's time where every cell has ~2,000 faces (a circle of
+/// points and its axis).
 template <class Corner>
-void face_successors_sorted(std::size_t nv, std::size_t nfaces, Corner& corner, FaceLoopScratch& w) {
-  auto& s = w.sorted;
-  s.resize(3 * nv);
+void face_successors_bucketed(std::size_t nv, std::size_t nfaces, Corner& corner, FaceLoopScratch& w) {
+  w.offset.assign(nfaces + 1, 0);
+  std::uint32_t* const offset = w.offset.data();
+  for (std::size_t t = 0; t < nv; ++t)
+    for (int k = 0; k < 3; ++k) ++offset[corner(t, k) + 1];
+  for (std::size_t a = 0; a < nfaces; ++a) offset[a + 1] += offset[a];
+  // Backwards, so that each face's first corner is written last (as the
+  // dense table's are).
+  if (w.bucket.size() < 3 * nv) w.bucket.resize(3 * nv);
+  std::uint32_t* const bucket = w.bucket.data();
+  std::uint32_t* const first = w.first.data();
   for (std::size_t t = nv; t-- > 0;)
     for (int k = 3; k-- > 0;) {
       const std::size_t a = corner(t, k);
       const std::uint32_t at = static_cast<std::uint32_t>(3 * t + static_cast<std::size_t>(k));
-      s[at] = {static_cast<std::uint64_t>(a) * nfaces + corner(t, (k + 1) % 3), at};
-      w.first[a] = at;
+      bucket[--offset[a + 1]] = at;
+      first[a] = at;
     }
-  std::sort(s.begin(), s.end());
-  for (std::size_t t = 0; t < nv; ++t)
-    for (int k = 0; k < 3; ++k) {
-      const std::uint64_t key = static_cast<std::uint64_t>(corner(t, k)) * nfaces + corner(t, (k + 2) % 3);
-      const auto it = std::lower_bound(s.begin(), s.end(), std::pair<std::uint64_t, std::uint32_t>{key, 0});
+  // offset[a + 1] counted down from bucket a's end to its start: bucket a
+  // is [offset[a + 1], offset[a + 2]), the last one ending at 3 nv.
+  if (w.mark.size() < nfaces) w.mark.resize(nfaces);  // new marks are 0, no face's stamp
+  if (w.holder.size() < nfaces) w.holder.resize(nfaces);
+  std::uint32_t* const mark = w.mark.data();
+  std::uint32_t* const holder = w.holder.data();
+  std::uint32_t* const next = w.next.data();
+  for (std::size_t a = 0; a < nfaces; ++a) {
+    const std::uint32_t b0 = offset[a + 1], b1 = a + 2 <= nfaces ? offset[a + 2] : static_cast<std::uint32_t>(3 * nv);
+    if (b0 == b1) continue;
+    if (++w.mark_epoch == 0) {  // wrapped: stale marks could read as this face's
+      std::fill(w.mark.begin(), w.mark.end(), 0);
+      w.mark_epoch = 1;
+    }
+    const std::uint32_t stamp = w.mark_epoch;
+    // Face a's edges a -> b, b the corner after a in its triangle.
+    for (std::uint32_t e = b0; e < b1; ++e) {
+      const std::uint32_t at = bucket[e];
+      const std::size_t b = corner(at / 3, static_cast<int>((at % 3 + 1) % 3));
+      mark[b] = stamp;
+      holder[b] = at;
+    }
+    // Around face a, the corner after `at` holds the edge a -> c, c the
+    // corner before a in at's triangle.
+    for (std::uint32_t e = b0; e < b1; ++e) {
+      const std::uint32_t at = bucket[e];
+      const std::size_t c = corner(at / 3, static_cast<int>((at % 3 + 2) % 3));
       // In a closed surface the edge is there; otherwise the walk's step bound ends the loop.
-      w.next[3 * t + static_cast<std::size_t>(k)] = it != s.end() && it->first == key ? it->second : 3 * static_cast<std::uint32_t>(t) + static_cast<std::uint32_t>(k);
+      next[at] = mark[c] == stamp ? holder[c] : at;
     }
+  }
 }
 
 /// Visit the faces of a closed 3D cell of nv vertices in face order, as
@@ -86,7 +126,7 @@ void for_each_face_loop(std::size_t nv, std::size_t nfaces, Corner&& corner, Fac
   std::uint32_t* const next = w.next.data();
   std::uint32_t* const loop = w.loop.data();
   if (nfaces > dense_face_pairs) [[unlikely]] {
-    face_successors_sorted(nv, nfaces, corner, w);
+    face_successors_bucketed(nv, nfaces, corner, w);
   } else {
     if (w.edge.size() < nfaces * nfaces) w.edge.resize(nfaces * nfaces);
     std::uint32_t* const edge = w.edge.data();
