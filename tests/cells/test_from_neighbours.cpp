@@ -104,6 +104,20 @@ std::vector<double> terrain_points(int n, std::uint64_t seed) {
   return p;
 }
 
+/// Points on a helix of ten turns: every point on the hull, and a Delaunay
+/// triangulation quadratic in the points (1,000 of them: ~190 neighbours
+/// each), whose flat tetrahedra put a few of each cell's vertices far out.
+std::vector<double> helix_points(int n, std::uint64_t seed) {
+  std::vector<double> p;
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(0, 20 * std::numbers::pi);
+  for (int k = 0; k < n; ++k) {
+    const double t = u(rng);
+    p.insert(p.end(), {std::cos(t), std::sin(t), t / (20 * std::numbers::pi)});
+  }
+  return p;
+}
+
 /// D + 1 points at distance 5 from the origin (one Delaunay simplex, whose
 /// circumcentre, a Voronoi vertex, is the origin), then random points with
 /// y in [6, 10], outside that circumsphere. With the box's lower y plane
@@ -292,6 +306,14 @@ TEST(FromNeighbours, CellsAreAssembledFromTheirStars) {
     const auto t = run_method(terrain_points(2000, 934), 3, tessera::CellMethod::insertion);
     EXPECT_GT(t.assembled_from_stars, 1000u);
     EXPECT_LT(t.assembled_from_stars, 2000u);
+  }
+  // A helix's stars have hundreds of neighbours and a few far vertices
+  // each, which are solved exactly rather than the cell clipped (before stop
+  // 56 half of these cells were clipped, quadratic in their neighbours).
+  {
+    const auto h = helix_points(1000, 935);
+    EXPECT_GT(run_method(h, 3, tessera::CellMethod::insertion).assembled_from_stars, 990u);
+    same_as_search(h, "helix");
   }
   // Bounds that cut through the points: the cells they cut are cut by the
   // box planes after assembly, or clipped.

@@ -135,6 +135,22 @@ bool worth_exact_solve(const double* y, const Plane* box) {
   return in;
 }
 
+/// How many of an assembled cell's vertices that worth_exact_solve turned
+/// down (far out, where the box most likely cuts them) are solved exactly
+/// after all rather than the cell clipped by its m neighbours (nt
+/// vertices): as many as that clipping would cost. Clipping costs about m
+/// sign passes over the cell's vertices, ~1 ns per vertex, plus ~100 ns per
+/// clip (points on a helix: ~0.8 ms for a cell of 760 neighbours and 1,500
+/// vertices); an exact solve, in rationals where no grid holds the input,
+/// ~15 µs (a terrain's 10,000 cells with one such vertex each, ~20
+/// neighbours, took 7 µs more each solved than clipped). So a small star
+/// is clipped, as before stop 56, and a star of hundreds of neighbours
+/// (points on a helix, whose Delaunay triangulation is quadratic: 2,000 of
+/// them have ~380 neighbours each, and three vertices in a thousand spoiled
+/// four cells in five) solves its few far vertices rather than clip
+/// quadratically.
+inline std::size_t exact_solves_paid(std::size_t m, std::size_t nt) { return m * (nt + 100) / 16000; }
+
 /// Whether a vertex (its D local planes `p`) too ill-conditioned for the
 /// float solve must not take the exact one: on a hull point's far plane,
 /// which is no bisector and has no exact form, or, for an assembled vertex

@@ -225,6 +225,8 @@ class Hull {
       enter_hash(2 * nt);
     }
     resize_vertices(nt);
+    refused_.clear();
+    const std::size_t may_refuse = assembly::exact_solves_paid(m, nt);
     for (std::size_t t = 0; t < nt; ++t) {
       Vertex& v = verts_[t];
       const std::uint16_t* c = corners + 3 * t;
@@ -232,8 +234,18 @@ class Hull {
       v.p[1] = static_cast<std::uint16_t>(box_planes + c[1]);
       v.p[2] = static_cast<std::uint16_t>(box_planes + c[2]);
       solve(v, false);
-      if (!(v.e <= std::numeric_limits<double>::max())) return false;  // needs the exact solve: clip instead
+      if (!(v.e <= std::numeric_limits<double>::max())) {  // would need the exact solve
+        if (refused_.size() == may_refuse) return false;          // clip instead
+        refused_.push_back(static_cast<std::uint32_t>(t));
+        continue;
+      }
       settle_any(static_cast<std::uint32_t>(t));
+    }
+    if (!refused_.empty()) {
+      for (const std::uint32_t t : refused_) {
+        solve(verts_[t], true);
+        settle_any(t);
+      }
     }
     if (open && !close_far(q, m)) return false;
     update_radius();
@@ -666,6 +678,7 @@ class Hull {
   std::vector<std::uint8_t> seen_;
   FaceLoopScratch walk_;  // for_each_face's
   std::vector<double> dirs_;         // close_far: the rays' unit directions
+  std::vector<std::uint32_t> refused_;  // assemble: the vertices refused the exact solve
   PreparedSigns<3> signs_;  // the exact stages, prepared per vertex slot
 };
 
