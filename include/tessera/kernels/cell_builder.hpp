@@ -45,7 +45,8 @@ struct BuildStatus {
   /// plus the k-d tree's own effort (a unit per node or leaf point it
   /// measures, two per entry it queues: KdTree::nearest_first; a unit per
   /// node of KdTree::nearest), plus four per candidate tested against the
-  /// cell (a sign pass costs about four scanned points). Used to estimate
+  /// cell (a sign pass costs about four scanned points), plus
+  /// off_grid_weight per exact evaluation that no small integer grid served. Used to estimate
   /// what cells cost on an input (delaunay's skipped-cell fraction); the
   /// same for any thread count. Scanned points are counted as the pruned
   /// shell walk scans them only by a builder with a work cap (the pilot's,
@@ -76,7 +77,7 @@ class CellBuilder {
   BuildStatus build(std::int32_t i, const double* p, CellT& cell) {
     work_ = 0;
     BuildStatus status = walk_shells(i, p, cell);
-    status.work = work_;
+    status.work = work_ + off_grid_weight * cell.off_grid_exact_calls();
     return status;
   }
 
@@ -90,6 +91,9 @@ class CellBuilder {
   /// scanned points on uniform 3D input otherwise.
   void set_work_cap(std::uint64_t cap) { work_cap_ = cap; }
   static constexpr std::uint64_t exact_weight = 32;
+  /// BuildStatus::work's units per exact evaluation no small grid served
+  /// (PreparedSigns::off_grid_calls: ~120 ns each, a work unit ~15 ns).
+  static constexpr std::uint64_t off_grid_weight = 8;
 
   /// How many cells this builder finished by certify_by_petals (the rest
   /// of its long cells fell back to the shell walk): for tests and tuning.
@@ -122,7 +126,7 @@ class CellBuilder {
   [[gnu::noinline]] BuildStatus build_nearest_first(std::int32_t i, const double* p, CellT& cell) {
     work_ = 0;
     BuildStatus status = search_nearest_first(i, p, cell);
-    status.work = work_;
+    status.work = work_ + off_grid_weight * cell.off_grid_exact_calls();
     return status;
   }
 

@@ -269,6 +269,7 @@ class Hull {
   const VertexList& vertices() const { return verts_; }
   const std::vector<Plane>& planes() const { return planes_; }
   std::uint64_t exact_calls() const { return signs_.calls(); }
+  std::uint64_t off_grid_exact_calls() const { return signs_.off_grid_calls(); }
   /// The input's exact context (null in bare kernel tests).
   const ExactContext* exact_context() const { return exact_; }
   /// The triangle (vertex) sharing edge k of triangle t, i.e. the directed

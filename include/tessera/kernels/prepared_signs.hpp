@@ -50,6 +50,7 @@ class PreparedSigns {
   void start_cell() {
     ++cell_;
     calls_ = 0;
+    off_grid_ = 0;
   }
 
   /// exact_clip_sign(ctx, gen, ids, j) for the vertex in slot t, whose local
@@ -75,6 +76,7 @@ class PreparedSigns {
       s.wide = Wide::untried;
     }
     if (s.grid) return s.pred.sign(ctx, j);
+    ++off_grid_;
     if (s.extended) {
       const int r = s.ext.sign(ctx, j);
       extended_gate_.record(r != 0);
@@ -87,6 +89,10 @@ class PreparedSigns {
 
   /// Exact evaluations since start_cell.
   std::uint64_t calls() const { return calls_; }
+  /// Those of them no small integer grid served (stages 2-4): on lattices
+  /// nearly none, where every call is a few integer products; off any grid
+  /// (a cylindrical grid's cos and sin, a rotated lattice) ~100-150 ns each.
+  std::uint64_t off_grid_calls() const { return off_grid_; }
 
  private:
   enum class Wide : std::uint8_t { untried, usable, unusable };
@@ -102,7 +108,7 @@ class PreparedSigns {
   };
   std::vector<Slot> slots_;
   std::uint64_t cell_ = 0;  // cells started (the slots' epoch)
-  std::uint64_t calls_ = 0;
+  std::uint64_t calls_ = 0, off_grid_ = 0;
   StageGate grid_gate_;      // whether a slot tries VertexPredicate (off a global grid)
   StageGate extended_gate_;  // whether a slot prepares ExtendedPredicate
 };

@@ -207,6 +207,7 @@ class Tile {
   const std::vector<Vertex>& vertices() const { return verts_; }
   const std::vector<Plane>& planes() const { return planes_; }
   std::uint64_t exact_calls() const { return signs_.calls(); }
+  std::uint64_t off_grid_exact_calls() const { return signs_.off_grid_calls(); }
   /// The input's exact context (null in bare kernel tests).
   const ExactContext* exact_context() const { return exact_; }
 
