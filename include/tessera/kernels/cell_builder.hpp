@@ -77,7 +77,7 @@ class CellBuilder {
   BuildStatus build(std::int32_t i, const double* p, CellT& cell) {
     work_ = 0;
     BuildStatus status = walk_shells(i, p, cell);
-    status.work = work_ + off_grid_weight * cell.off_grid_exact_calls();
+    status.work = work_ + off_grid_weight * cell.off_grid_exact_calls() + exact_solve_weight * cell.exact_solves();
     return status;
   }
 
@@ -94,6 +94,8 @@ class CellBuilder {
   /// BuildStatus::work's units per exact evaluation no small grid served
   /// (PreparedSigns::off_grid_calls: ~120 ns each, a work unit ~15 ns).
   static constexpr std::uint64_t off_grid_weight = 8;
+  /// BuildStatus::work's units per vertex solved exactly (rationals).
+  static constexpr std::uint64_t exact_solve_weight = 64;
 
   /// How many cells this builder finished by certify_by_petals (the rest
   /// of its long cells fell back to the shell walk): for tests and tuning.
@@ -126,7 +128,7 @@ class CellBuilder {
   [[gnu::noinline]] BuildStatus build_nearest_first(std::int32_t i, const double* p, CellT& cell) {
     work_ = 0;
     BuildStatus status = search_nearest_first(i, p, cell);
-    status.work = work_ + off_grid_weight * cell.off_grid_exact_calls();
+    status.work = work_ + off_grid_weight * cell.off_grid_exact_calls() + exact_solve_weight * cell.exact_solves();
     return status;
   }
 

@@ -270,6 +270,8 @@ class Hull {
   const std::vector<Plane>& planes() const { return planes_; }
   std::uint64_t exact_calls() const { return signs_.calls(); }
   std::uint64_t off_grid_exact_calls() const { return signs_.off_grid_calls(); }
+  /// Vertices of this cell solved exactly (too ill-conditioned for the float solve).
+  std::uint64_t exact_solves() const { return exact_solves_; }
   /// The input's exact context (null in bare kernel tests).
   const ExactContext* exact_context() const { return exact_; }
   /// The triangle (vertex) sharing edge k of triangle t, i.e. the directed
@@ -404,6 +406,7 @@ class Hull {
     scaled_planes_ = false;
     if (hashed_) [[unlikely]] leave_hash();
     signs_.start_cell();
+    exact_solves_ = 0;
     // Planes and corners are written in place: a local struct copied in
     // would be read back wider than it was written (a store-forwarding stall).
     planes_.resize(box_planes);
@@ -635,6 +638,7 @@ class Hull {
       return {std::numeric_limits<double>::quiet_NaN(), ymax};
     std::int32_t ids[3] = {A.id, B.id, C.id};
     exact_vertex(*exact_, gen_, ids, v.y);
+    ++exact_solves_;
     ymax = std::max({std::fabs(v.y[0]), std::fabs(v.y[1]), std::fabs(v.y[2])});
     return {4 * filter::u * ymax, ymax};
   }
@@ -663,6 +667,7 @@ class Hull {
   const ExactContext* exact_ = nullptr;
   bool may_underflow_ = false;  // exact_->may_underflow: solve() adds filter::underflow_slack
   bool scaled_planes_ = false;  // has_scaled_planes()
+  mutable std::uint64_t exact_solves_ = 0;  // exact_solves(); counted by the const solve
   std::vector<Plane> planes_;
   VertexList verts_;
   filter::FilterLanes<3> lanes_;  // verts_' filter data, for the sign pass

@@ -208,6 +208,8 @@ class Tile {
   const std::vector<Plane>& planes() const { return planes_; }
   std::uint64_t exact_calls() const { return signs_.calls(); }
   std::uint64_t off_grid_exact_calls() const { return signs_.off_grid_calls(); }
+  /// Vertices of this cell solved exactly (too ill-conditioned for the float solve).
+  std::uint64_t exact_solves() const { return exact_solves_; }
   /// The input's exact context (null in bare kernel tests).
   const ExactContext* exact_context() const { return exact_; }
 
@@ -232,6 +234,7 @@ class Tile {
     exact_ = exact;
     may_underflow_ = exact != nullptr && exact->may_underflow;
     signs_.start_cell();
+    exact_solves_ = 0;
     // Planes and corners are written in place: a local struct copied in
     // would be read back wider than it was written (a store-forwarding stall).
     planes_.resize(box_planes);
@@ -368,6 +371,7 @@ class Tile {
       return {std::numeric_limits<double>::quiet_NaN(), ymax};
     std::int32_t ids[2] = {A.id, B.id};
     exact_vertex(*exact_, gen_, ids, v.y);
+    ++exact_solves_;
     ymax = std::max(std::fabs(v.y[0]), std::fabs(v.y[1]));
     return {4 * filter::u * ymax, ymax};
   }
@@ -385,6 +389,7 @@ class Tile {
   double site_[2] = {};  // the generator's coordinates
   const ExactContext* exact_ = nullptr;
   bool may_underflow_ = false;  // exact_->may_underflow: solve() adds filter::underflow_slack
+  mutable std::uint64_t exact_solves_ = 0;  // exact_solves(); counted by the const solve
   std::vector<Plane> planes_;
   std::vector<Vertex> verts_;
   filter::FilterLanes<2> lanes_;  // verts_' filter data, for the sign pass
