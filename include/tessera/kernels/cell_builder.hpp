@@ -45,8 +45,9 @@ struct BuildStatus {
   /// plus the k-d tree's own effort (a unit per node or leaf point it
   /// measures, two per entry it queues: KdTree::nearest_first; a unit per
   /// node of KdTree::nearest), plus four per candidate tested against the
-  /// cell (a sign pass costs about four scanned points), plus
-  /// off_grid_weight per exact evaluation that no small integer grid served. Used to estimate
+  /// cell (a sign pass costs about four scanned points), plus off_grid_weight
+  /// per exact evaluation no small integer grid served and exact_solve_weight
+  /// per vertex solved exactly. Used to estimate
   /// what cells cost on an input (delaunay's skipped-cell fraction); the
   /// same for any thread count. Scanned points are counted as the pruned
   /// shell walk scans them only by a builder with a work cap (the pilot's,

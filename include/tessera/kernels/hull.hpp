@@ -199,8 +199,9 @@ class Hull {
   /// would solve it. Where vertices lie outside the domain box [lo, hi], the
   /// box planes then cut the cell (clip_to_box). Returns false when that
   /// cannot be decided in floating point (a vertex within rounding of a box
-  /// plane), when a vertex is too ill-conditioned for its float solve (a
-  /// flat simplex, whose circumcentre lies far out: surface samples), when
+  /// plane), when more vertices are too ill-conditioned for their float
+  /// solve (flat simplices, whose circumcentres lie far out: surface
+  /// samples) than assembly::exact_solves_paid lets it solve exactly, when
   /// the star has more than max_assembled_planes neighbours, or on extreme input
   /// (may_underflow): the cell is then unfinished, and must be built again
   /// (reset and clipped), which never solves vertices the box cuts away.
@@ -241,11 +242,9 @@ class Hull {
       }
       settle_any(static_cast<std::uint32_t>(t));
     }
-    if (!refused_.empty()) {
-      for (const std::uint32_t t : refused_) {
-        solve(verts_[t], true);
-        settle_any(t);
-      }
+    for (const std::uint32_t t : refused_) {  // few enough to pay for their exact solves
+      solve(verts_[t], true);
+      settle_any(t);
     }
     if (open && !close_far(q, m)) return false;
     update_radius();
