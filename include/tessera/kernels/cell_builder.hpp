@@ -78,7 +78,7 @@ class CellBuilder {
   BuildStatus build(std::int32_t i, const double* p, CellT& cell) {
     work_ = 0;
     BuildStatus status = walk_shells(i, p, cell);
-    status.work = work_ + off_grid_weight * cell.off_grid_exact_calls() + exact_solve_weight * cell.exact_solves();
+    status.work = cell_work(cell);
     return status;
   }
 
@@ -129,7 +129,7 @@ class CellBuilder {
   [[gnu::noinline]] BuildStatus build_nearest_first(std::int32_t i, const double* p, CellT& cell) {
     work_ = 0;
     BuildStatus status = search_nearest_first(i, p, cell);
-    status.work = work_ + off_grid_weight * cell.off_grid_exact_calls() + exact_solve_weight * cell.exact_solves();
+    status.work = cell_work(cell);
     return status;
   }
 
@@ -888,6 +888,10 @@ class CellBuilder {
   std::uint64_t work_ = 0;  // the current cell's BuildStatus::work
   std::uint64_t work_cap_ = std::numeric_limits<std::uint64_t>::max();  // set_work_cap
 
+  // BuildStatus::work of the cell just built: the search's count and its exact work.
+  std::uint64_t cell_work(const CellT& cell) const {
+    return work_ + off_grid_weight * cell.off_grid_exact_calls() + exact_solve_weight * cell.exact_solves();
+  }
   bool capped_builder() const { return work_cap_ != std::numeric_limits<std::uint64_t>::max(); }
   bool over_cap(const CellT& cell) const { return work_ + exact_weight * cell.exact_calls() > work_cap_; }
   static BuildStatus& capped(BuildStatus& status) {
