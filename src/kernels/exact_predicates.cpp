@@ -1,5 +1,6 @@
 // Exact evaluation of the clip predicate; see exact_predicates.hpp for the math.
 #include "tessera/kernels/exact_predicates.hpp"
+#include "exact_rows.hpp"
 
 #include <gmp.h>
 
@@ -43,36 +44,12 @@ void row_parts(const ExactContext& ctx, std::int32_t i, const std::int32_t* gen,
   }
 }
 
-// Scratch integers reused across calls on one thread: the exact path is rare on
-// random input but common on lattices, and GMP allocation would dominate it.
-struct Scratch {
-  static constexpr int kMaxDim = 3;
-  static constexpr int kRows = kMaxDim + 1;
-  mpz_t coord[kRows + 1][kMaxDim];  // scaled coordinates of i, the plane generators and j
-  mpz_t box[kRows];                 // scaled box constant for box rows
-  mpz_t a[kRows][kMaxDim];          // first dim columns of M
-  mpz_t b[kRows];                   // last column of M without weights
-  mpz_t minor[kRows];               // minors of M without its last column
-  mpz_t t0, t1, t2, acc;
-  Scratch() {
-    for (auto& r : coord) for (auto& c : r) mpz_init(c);
-    for (auto& c : box) mpz_init(c);
-    for (auto& r : a) for (auto& c : r) mpz_init(c);
-    for (auto& c : b) mpz_init(c);
-    for (auto& c : minor) mpz_init(c);
-    mpz_init(t0); mpz_init(t1); mpz_init(t2); mpz_init(acc);
-  }
-  ~Scratch() {
-    for (auto& r : coord) for (auto& c : r) mpz_clear(c);
-    for (auto& c : box) mpz_clear(c);
-    for (auto& r : a) for (auto& c : r) mpz_clear(c);
-    for (auto& c : b) mpz_clear(c);
-    for (auto& c : minor) mpz_clear(c);
-    mpz_clear(t0); mpz_clear(t1); mpz_clear(t2); mpz_clear(acc);
-  }
-};
+}  // namespace
 
-// out = x * 2^(-shift), exactly an integer because shift <= lowest_bit_exponent(x).
+namespace exact_rows {
+
+// The integer rows (contracts in exact_rows.hpp).
+
 void set_scaled(mpz_t out, double x, int shift) {
   if (x == 0) { mpz_set_ui(out, 0); return; }
   int e;
@@ -84,7 +61,6 @@ void set_scaled(mpz_t out, double x, int shift) {
   else if (s < 0) mpz_tdiv_q_2exp(out, out, static_cast<mp_bitcnt_t>(-s));  // exact: those bits are zero
 }
 
-// det of the k x k matrix formed by rows `rows` of a (k = 2 or 3).
 void det_rows(mpz_t out, mpz_t (*a)[Scratch::kMaxDim], const int* rows, int k, Scratch& s) {
   if (k == 2) {
     mpz_mul(s.t0, a[rows[0]][0], a[rows[1]][1]);
@@ -103,9 +79,6 @@ void det_rows(mpz_t out, mpz_t (*a)[Scratch::kMaxDim], const int* rows, int k, S
   mpz_set(out, s.acc);
 }
 
-// Fill s.a / s.b with the rows of gen[0..rows) (see the header) on the input
-// scaled to integers; returns the scale exponent (coordinates = ints * 2^shift)
-// and leaves the scaled p_i in s.coord[kRows].
 int build_rows(const ExactContext& ctx, std::int32_t i, const std::int32_t* gen, int rows, Scratch& s) {
   const int dim = ctx.dim;
 
@@ -152,7 +125,12 @@ int build_rows(const ExactContext& ctx, std::int32_t i, const std::int32_t* gen,
   return shift;
 }
 
-}  // namespace
+
+}  // namespace exact_rows
+
+using exact_rows::Scratch;
+using exact_rows::build_rows;
+using exact_rows::det_rows;
 
 namespace {
 
@@ -673,177 +651,6 @@ bool WidePredicate::sign_on_grid(const ExactContext& ctx, std::int32_t j, int& o
 int WidePredicate::sign(const ExactContext& ctx, std::int32_t j) const {
   int s;
   return sign_on_grid(ctx, j, s) ? s : exact_clip_sign(ctx, i_, gen_, j);
-}
-
-namespace {
-// q as a double, keeping values below DBL_MIN: mpq_get_d returns 0 for them
-// (GMP leaves it system dependent), while a sliver's exact volume, or a
-// vertex coordinate, can be a subnormal. Scaled up by 2^1100 first, then
-// down by ldexp, which rounds into the subnormals. Modifies q.
-double rational_to_double(mpq_ptr q) {
-  const long e = static_cast<long>(mpz_sizeinbase(mpq_numref(q), 2)) - static_cast<long>(mpz_sizeinbase(mpq_denref(q), 2));
-  if (mpq_sgn(q) == 0 || e > -1000) return mpq_get_d(q);
-  mpq_mul_2exp(q, q, 1100);
-  return std::ldexp(mpq_get_d(q), -1100);
-}
-
-// The vertex of cell i where planes[0..dim) meet, relative to p_i, as
-// integers: y[d] = minor[d] / minor[dim] * 2^shift (returned), for d < dim.
-// Cramer's rule on the integer rows (build_rows): det A, then numerator
-// d = det(A with column d replaced by b), less det times p_i. Weights are
-// infinitesimal and do not move the vertex in the limit.
-int vertex_numerators(const ExactContext& ctx, std::int32_t i, const std::int32_t* planes, Scratch& s) {
-  const int dim = ctx.dim;
-  const int shift = build_rows(ctx, i, planes, dim, s);
-  int sel[Scratch::kMaxDim] = {0, 1, 2};
-  det_rows(s.minor[dim], s.a, sel, dim, s);
-  if (mpz_sgn(s.minor[dim]) == 0)
-    throw std::logic_error("exact_vertex: vertex planes are dependent (corrupt cell)");
-  for (int d = 0; d < dim; ++d) {
-    // Swap column d with b, take the determinant, swap back.
-    for (int r = 0; r < dim; ++r) mpz_swap(s.a[r][d], s.b[r]);
-    det_rows(s.minor[d], s.a, sel, dim, s);
-    for (int r = 0; r < dim; ++r) mpz_swap(s.a[r][d], s.b[r]);
-    mpz_submul(s.minor[d], s.minor[dim], s.coord[Scratch::kRows][d]);
-  }
-  return shift;
-}
-
-// The same vertex as rationals (canonical, as GMP's rational arithmetic needs).
-void solve_vertex_exactly(const ExactContext& ctx, std::int32_t i, const std::int32_t* planes, Scratch& s,
-                          mpq_ptr* y) {
-  const int shift = vertex_numerators(ctx, i, planes, s);
-  for (int d = 0; d < ctx.dim; ++d) {
-    mpq_set_num(y[d], s.minor[d]);
-    mpq_set_den(y[d], s.minor[ctx.dim]);
-    mpq_canonicalize(y[d]);
-    if (shift > 0) mpq_mul_2exp(y[d], y[d], static_cast<mp_bitcnt_t>(shift));
-    else if (shift < 0) mpq_div_2exp(y[d], y[d], static_cast<mp_bitcnt_t>(-shift));
-  }
-}
-
-// num / den * 2^shift rounded toward zero to 66 bits, then to double (within
-// 2 ulp): an integer division, where the rational's canonical form cost two
-// gcds per coordinate (a lattice jittered by 1e-9 solves a few vertices per
-// cell exactly, and those gcds were a fifth of its run). `q` is scratch.
-double quotient_to_double(mpz_srcptr num, mpz_srcptr den, long shift, mpz_ptr q) {
-  if (mpz_sgn(num) == 0) return 0.0;
-  const long k = 66 - (static_cast<long>(mpz_sizeinbase(num, 2)) - static_cast<long>(mpz_sizeinbase(den, 2)));
-  if (k >= 0) {
-    mpz_mul_2exp(q, num, static_cast<mp_bitcnt_t>(k));
-    mpz_tdiv_q(q, q, den);
-  } else {
-    // trunc(trunc(num / 2^-k) / den) = trunc(num / (2^-k den)): nothing lost.
-    mpz_tdiv_q_2exp(q, num, static_cast<mp_bitcnt_t>(-k));
-    mpz_tdiv_q(q, q, den);
-  }
-  // q holds 65 to 67 bits, below the exact quotient by less than one unit
-  // of them; mpz_get_d truncates it to 53 (together under 2 ulp), and ldexp
-  // scales, rounding once where the result is subnormal (as mpq_get_d did).
-  const long e = shift - k;
-  const double m = mpz_get_d(q);
-  if (e > 2100) return std::copysign(std::numeric_limits<double>::infinity(), m);
-  if (e < -2300) return std::copysign(0.0, m);
-  return std::ldexp(m, static_cast<int>(e));
-}
-}  // namespace
-
-void exact_vertex(const ExactContext& ctx, std::int32_t i, const std::int32_t* planes, double* y) {
-  thread_local Scratch s;
-  const int shift = vertex_numerators(ctx, i, planes, s);
-  for (int d = 0; d < ctx.dim; ++d) y[d] = quotient_to_double(s.minor[d], s.minor[ctx.dim], shift, s.t0);
-}
-
-double exact_cell_measure(const ExactContext& ctx, std::int32_t i, std::span<const std::int32_t> vertex_planes,
-                          std::span<const MeasureTerm> terms, double* centroid) {
-  thread_local Scratch s;
-  const int dim = ctx.dim;
-  const auto du = static_cast<std::size_t>(dim);
-  const std::size_t nv = vertex_planes.size() / du;
-  // Rationals with RAII: this path is rare (a few cells of hostile input).
-  struct Rationals {
-    std::vector<__mpq_struct> q;
-    explicit Rationals(std::size_t n) : q(n) {
-      for (auto& x : q) mpq_init(&x);
-    }
-    ~Rationals() {
-      for (auto& x : q) mpq_clear(&x);
-    }
-  };
-  // The vertices (dim each), then a foot, the weight sum, the moments and
-  // three temporaries.
-  const std::size_t base = nv * du;
-  Rationals r(base + 10);
-  auto y = [&](std::size_t v, int d) { return &r.q[v * du + static_cast<std::size_t>(d)]; };
-  mpq_ptr foot[3] = {&r.q[base], &r.q[base + 1], &r.q[base + 2]};
-  mpq_ptr moment[3] = {&r.q[base + 3], &r.q[base + 4], &r.q[base + 5]};
-  mpq_ptr sum = &r.q[base + 6], w = &r.q[base + 7], t0 = &r.q[base + 8], t1 = &r.q[base + 9];
-  for (std::size_t v = 0; v < nv; ++v) {
-    mpq_ptr yv[Scratch::kMaxDim] = {y(v, 0), y(v, 1), dim == 3 ? y(v, 2) : nullptr};
-    solve_vertex_exactly(ctx, i, vertex_planes.data() + v * du, s, yv);
-  }
-  const double* pi = ctx.points + static_cast<std::size_t>(i) * du;
-  // As measure() in front/cell_geometry.hpp: each term's weight w, summed,
-  // and w times the sum of its points (foot and both vertices in 3D, both
-  // vertices in 2D) for the centroid.
-  mpq_set_ui(sum, 0, 1);
-  for (int d = 0; d < dim; ++d) mpq_set_ui(moment[d], 0, 1);
-  for (const MeasureTerm& term : terms) {
-    for (int d = 0; d < 3; ++d) mpq_set_ui(foot[d], 0, 1);
-    if (dim == 2) {  // w = det(y_a, y_b)
-      mpq_mul(w, y(term.a, 0), y(term.b, 1));
-      mpq_mul(t0, y(term.a, 1), y(term.b, 0));
-      mpq_sub(w, w, t0);
-    } else {
-      // The foot of the plane from p_i: (p_j - p_i) / 2 on a bisector,
-      // (bound - p_i) along the axis on a box plane.
-      if (term.plane >= 0) {
-        const double* pj = ctx.points + static_cast<std::size_t>(term.plane) * 3;
-        for (int d = 0; d < 3; ++d) {
-          mpq_set_d(foot[d], pj[d]);
-          mpq_set_d(t0, pi[d]);
-          mpq_sub(foot[d], foot[d], t0);
-          mpq_div_2exp(foot[d], foot[d], 1);
-        }
-      } else {
-        const auto axis = static_cast<std::size_t>(box_plane_axis(term.plane));
-        mpq_set_d(foot[axis], box_plane_upper(term.plane) ? ctx.hi[axis] : ctx.lo[axis]);
-        mpq_set_d(t0, pi[axis]);
-        mpq_sub(foot[axis], foot[axis], t0);
-      }
-      mpq_set_ui(w, 0, 1);  // w = foot . (y_a x y_b)
-      for (int d = 0; d < 3; ++d) {
-        const int d1 = (d + 1) % 3, d2 = (d + 2) % 3;
-        mpq_mul(t0, y(term.a, d1), y(term.b, d2));
-        mpq_mul(t1, y(term.a, d2), y(term.b, d1));
-        mpq_sub(t0, t0, t1);
-        mpq_mul(t0, t0, foot[d]);
-        mpq_add(w, w, t0);
-      }
-    }
-    mpq_add(sum, sum, w);
-    for (int d = 0; d < dim; ++d) {
-      mpq_add(t0, y(term.a, d), y(term.b, d));
-      mpq_add(t0, t0, foot[d]);  // zero in 2D
-      mpq_mul(t0, t0, w);
-      mpq_add(moment[d], moment[d], t0);
-    }
-  }
-  // Centroid: moment / (4 sum) in 3D (a tetrahedron's is the mean of its
-  // corners, one at the origin), moment / (3 sum) in 2D.
-  for (int d = 0; d < dim; ++d) {
-    if (mpq_sgn(sum) == 0) {
-      centroid[d] = 0;
-      continue;
-    }
-    mpq_div(t0, moment[d], sum);
-    mpq_set_ui(t1, dim == 2 ? 3 : 4, 1);
-    mpq_div(t0, t0, t1);
-    centroid[d] = rational_to_double(t0);
-  }
-  mpq_set_ui(t0, dim == 2 ? 2 : 6, 1);
-  mpq_div(sum, sum, t0);
-  return rational_to_double(sum);
 }
 
 int lowest_bit_exponent(double x) {

@@ -463,28 +463,38 @@ TEST(Tile, LatticeTessellation) {
 // is exact, rounded once). Terms as measure() forms them: 3D, the cone from
 // the generator over each triangle edge (t, k) with its face's foot; 2D, the
 // shoelace over the polygon.
+/// A finished cell's vertices by their planes and its measure terms, as
+/// front/cell_geometry.hpp's measure_exactly passes them.
+template <class CellT>
+void measure_input(const CellT& c, std::vector<std::int32_t>& vp, std::vector<tessera::kernels::MeasureTerm>& terms) {
+  constexpr int D = CellT::dim;
+  const auto& v = c.vertices();
+  vp.clear();
+  terms.clear();
+  for (const auto& x : v)
+    for (int k = 0; k < D; ++k) vp.push_back(c.planes()[x.p[k]].id);
+  for (std::size_t t = 0; t < v.size(); ++t) {
+    if constexpr (D == 3) {
+      for (int k = 0; k < 3; ++k)
+        terms.push_back({c.planes()[v[t].p[(k + 1) % 3]].id, static_cast<std::uint32_t>(t), c.across(t, k)});
+    } else {
+      terms.push_back({0, static_cast<std::uint32_t>(t), static_cast<std::uint32_t>(t + 1 == v.size() ? 0 : t + 1)});
+    }
+  }
+}
+
 template <class CellT>
 void exact_measure_test(const Scene<CellT::dim>& s) {
   constexpr int D = CellT::dim;
   double volume = 0, moment[D] = {}, box_moment[D];
+  std::vector<std::int32_t> vp;
+  std::vector<tessera::kernels::MeasureTerm> terms;
   for (std::int32_t i = 0; i < s.size(); ++i) {
     CellT c;
     s.reset(c, i);
     for (std::int32_t j = 0; j < s.size(); ++j)
       if (j != i) s.clip(c, j);
-    const auto& v = c.vertices();
-    std::vector<std::int32_t> vp;
-    for (const auto& x : v)
-      for (int k = 0; k < D; ++k) vp.push_back(c.planes()[x.p[k]].id);
-    std::vector<tessera::kernels::MeasureTerm> terms;
-    for (std::size_t t = 0; t < v.size(); ++t) {
-      if constexpr (D == 3) {
-        for (int k = 0; k < 3; ++k)
-          terms.push_back({c.planes()[v[t].p[(k + 1) % 3]].id, static_cast<std::uint32_t>(t), c.across(t, k)});
-      } else {
-        terms.push_back({0, static_cast<std::uint32_t>(t), static_cast<std::uint32_t>(t + 1 == v.size() ? 0 : t + 1)});
-      }
-    }
+    measure_input(c, vp, terms);
     double centroid[D];
     const double vol = tessera::kernels::exact_cell_measure(s.ctx, i, vp, terms, centroid);
     EXPECT_GT(vol, 0) << "cell " << i;
@@ -508,6 +518,84 @@ TEST(Hull, ExactMeasureSumsToTheBox) {
 TEST(Tile, ExactMeasureSumsToTheBox) {
   Scene<2> s(random_points<2>(60, 17), {0, 0}, {1, 1});
   exact_measure_test<Tile>(s);
+}
+
+/// Points each with `copies - 1` near copies along a random direction,
+/// `step` apart: the cells between copies are slabs thinner than their
+/// float vertices' rounding, the cells measure_exactly exists for.
+template <int D>
+std::vector<double> near_copy_chains(int bases, int copies, double step, std::uint64_t seed) {
+  std::mt19937_64 g(seed);
+  std::uniform_real_distribution<double> u(0, 1);
+  std::normal_distribution<double> n(0, 1);
+  std::vector<double> p;
+  for (int b = 0; b < bases; ++b) {
+    double base[D], dir[D];
+    for (int d = 0; d < D; ++d) base[d] = u(g), dir[d] = n(g) * step;
+    for (int k = 0; k < copies; ++k)
+      for (int d = 0; d < D; ++d) p.push_back(base[d] + k * dir[d]);
+  }
+  return p;
+}
+
+/// exact_cell_measure's fixed-point tier gives rational_cell_measure's
+/// doubles, bit for bit, wherever it certifies them; `certified` is the
+/// share of cells it must certify at 200 bits.
+template <class CellT>
+void fixed_point_tier_test(const Scene<CellT::dim>& s, double certified) {
+  constexpr int D = CellT::dim;
+  std::vector<std::int32_t> vp;
+  std::vector<tessera::kernels::MeasureTerm> terms;
+  int sure = 0;
+  for (std::int32_t i = 0; i < s.size(); ++i) {
+    CellT c;
+    s.reset(c, i);
+    for (std::int32_t j = 0; j < s.size(); ++j)
+      if (j != i) s.clip(c, j);
+    measure_input(c, vp, terms);
+    double exact_centroid[D], fixed_centroid[D], centroid[D];
+    const double exact = tessera::kernels::rational_cell_measure(s.ctx, i, vp, terms, exact_centroid);
+    double fixed = 0;
+    if (tessera::kernels::fixed_point_cell_measure(s.ctx, i, vp, terms, 200, fixed, fixed_centroid)) {
+      ++sure;
+      EXPECT_EQ(fixed, exact) << "cell " << i;
+      for (int d = 0; d < D; ++d) EXPECT_EQ(fixed_centroid[d], exact_centroid[d]) << "cell " << i << " axis " << d;
+    }
+    EXPECT_EQ(tessera::kernels::exact_cell_measure(s.ctx, i, vp, terms, centroid), exact) << "cell " << i;
+    for (int d = 0; d < D; ++d) EXPECT_EQ(centroid[d], exact_centroid[d]) << "cell " << i << " axis " << d;
+  }
+  EXPECT_GE(sure, certified * s.size());
+}
+
+TEST(Hull, ExactMeasureFixedPointMatchesRationals) {
+  // Slabs between copies 1e-11 and 1e-13 apart, ordinary cells, and the
+  // same at scales far from 1 (the units follow the cell).
+  for (const double step : {1e-11, 1e-13}) {
+    Scene<3> s(near_copy_chains<3>(12, 4, step, 5), {0, 0, 0}, {1, 1, 1});
+    fixed_point_tier_test<Hull>(s, 0.95);
+  }
+  for (const double scale : {0x1p-300, 0x1p+300}) {
+    auto p = near_copy_chains<3>(10, 3, 1e-12, 6);
+    for (auto& x : p) x *= scale;
+    Scene<3> s(std::move(p), {0, 0, 0}, {scale, scale, scale});
+    fixed_point_tier_test<Hull>(s, 0.95);
+  }
+  Scene<3> r(random_points<3>(40, 8), {0, 0, 0}, {1, 1, 1});
+  fixed_point_tier_test<Hull>(r, 0.95);
+  // A lattice's cells are cubes about their generators: every centroid
+  // coordinate is zero, which no error bound certifies, so the rational
+  // tier serves them, and gives the same doubles.
+  Scene<3> l(lattice<3>(3), {0, 0, 0}, {3, 3, 3});
+  fixed_point_tier_test<Hull>(l, 0);
+}
+
+TEST(Tile, ExactMeasureFixedPointMatchesRationals) {
+  for (const double step : {1e-11, 1e-14}) {
+    Scene<2> s(near_copy_chains<2>(20, 4, step, 7), {0, 0}, {1, 1});
+    fixed_point_tier_test<Tile>(s, 0.95);
+  }
+  Scene<2> r(random_points<2>(60, 17), {0, 0}, {1, 1});
+  fixed_point_tier_test<Tile>(r, 0.95);
 }
 
 }  // namespace

@@ -1,0 +1,425 @@
+// Vertices solved exactly, and the exact measure of a cell (volume or area,
+// and centroid) for cells whose float measure cancels. See
+// exact_predicates.hpp for the contracts.
+#include <gmp.h>
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <cstdint>
+#include <deque>
+#include <limits>
+#include <span>
+#include <stdexcept>
+#include <vector>
+
+#include "exact_rows.hpp"
+#include "tessera/kernels/exact_predicates.hpp"
+
+namespace tessera::kernels {
+
+using exact_rows::build_rows;
+using exact_rows::det_rows;
+using exact_rows::Scratch;
+
+// ---- Vertices ----
+
+namespace {
+// q as a double, keeping values below DBL_MIN: mpq_get_d returns 0 for them
+// (GMP leaves it system dependent), while a sliver's exact volume, or a
+// vertex coordinate, can be a subnormal. Scaled up by 2^1100 first, then
+// down by ldexp, which rounds into the subnormals. Modifies q.
+double rational_to_double(mpq_ptr q) {
+  const long e = static_cast<long>(mpz_sizeinbase(mpq_numref(q), 2)) - static_cast<long>(mpz_sizeinbase(mpq_denref(q), 2));
+  if (mpq_sgn(q) == 0 || e > -1000) return mpq_get_d(q);
+  mpq_mul_2exp(q, q, 1100);
+  return std::ldexp(mpq_get_d(q), -1100);
+}
+
+// The vertex of cell i where planes[0..dim) meet, relative to p_i, as
+// integers: y[d] = minor[d] / minor[dim] * 2^shift (returned), for d < dim.
+// Cramer's rule on the integer rows (build_rows): det A, then numerator
+// d = det(A with column d replaced by b), less det times p_i. Weights are
+// infinitesimal and do not move the vertex in the limit.
+int vertex_numerators(const ExactContext& ctx, std::int32_t i, const std::int32_t* planes, Scratch& s) {
+  const int dim = ctx.dim;
+  const int shift = build_rows(ctx, i, planes, dim, s);
+  int sel[Scratch::kMaxDim] = {0, 1, 2};
+  det_rows(s.minor[dim], s.a, sel, dim, s);
+  if (mpz_sgn(s.minor[dim]) == 0)
+    throw std::logic_error("exact_vertex: vertex planes are dependent (corrupt cell)");
+  for (int d = 0; d < dim; ++d) {
+    // Swap column d with b, take the determinant, swap back.
+    for (int r = 0; r < dim; ++r) mpz_swap(s.a[r][d], s.b[r]);
+    det_rows(s.minor[d], s.a, sel, dim, s);
+    for (int r = 0; r < dim; ++r) mpz_swap(s.a[r][d], s.b[r]);
+    mpz_submul(s.minor[d], s.minor[dim], s.coord[Scratch::kRows][d]);
+  }
+  return shift;
+}
+
+// The same vertex as rationals (canonical, as GMP's rational arithmetic needs).
+void solve_vertex_exactly(const ExactContext& ctx, std::int32_t i, const std::int32_t* planes, Scratch& s,
+                          mpq_ptr* y) {
+  const int shift = vertex_numerators(ctx, i, planes, s);
+  for (int d = 0; d < ctx.dim; ++d) {
+    mpq_set_num(y[d], s.minor[d]);
+    mpq_set_den(y[d], s.minor[ctx.dim]);
+    mpq_canonicalize(y[d]);
+    if (shift > 0) mpq_mul_2exp(y[d], y[d], static_cast<mp_bitcnt_t>(shift));
+    else if (shift < 0) mpq_div_2exp(y[d], y[d], static_cast<mp_bitcnt_t>(-shift));
+  }
+}
+
+// num / den * 2^shift rounded toward zero to 66 bits, then to double (within
+// 2 ulp): an integer division, where the rational's canonical form cost two
+// gcds per coordinate (a lattice jittered by 1e-9 solves a few vertices per
+// cell exactly, and those gcds were a fifth of its run). `q` is scratch.
+double quotient_to_double(mpz_srcptr num, mpz_srcptr den, long shift, mpz_ptr q) {
+  if (mpz_sgn(num) == 0) return 0.0;
+  const long k = 66 - (static_cast<long>(mpz_sizeinbase(num, 2)) - static_cast<long>(mpz_sizeinbase(den, 2)));
+  if (k >= 0) {
+    mpz_mul_2exp(q, num, static_cast<mp_bitcnt_t>(k));
+    mpz_tdiv_q(q, q, den);
+  } else {
+    // trunc(trunc(num / 2^-k) / den) = trunc(num / (2^-k den)): nothing lost.
+    mpz_tdiv_q_2exp(q, num, static_cast<mp_bitcnt_t>(-k));
+    mpz_tdiv_q(q, q, den);
+  }
+  // q holds 65 to 67 bits, below the exact quotient by less than one unit
+  // of them; mpz_get_d truncates it to 53 (together under 2 ulp), and ldexp
+  // scales, rounding once where the result is subnormal (as mpq_get_d did).
+  const long e = shift - k;
+  const double m = mpz_get_d(q);
+  if (e > 2100) return std::copysign(std::numeric_limits<double>::infinity(), m);
+  if (e < -2300) return std::copysign(0.0, m);
+  return std::ldexp(m, static_cast<int>(e));
+}
+}  // namespace
+
+void exact_vertex(const ExactContext& ctx, std::int32_t i, const std::int32_t* planes, double* y) {
+  thread_local Scratch s;
+  const int shift = vertex_numerators(ctx, i, planes, s);
+  for (int d = 0; d < ctx.dim; ++d) y[d] = quotient_to_double(s.minor[d], s.minor[ctx.dim], shift, s.t0);
+}
+
+// ---- The cell measure ----
+
+// In canonical rationals (GMP's mpq): every vertex, term and sum exact, then
+// truncated to double. Slow: each operation takes gcds, and the sum's
+// denominator grows towards the product of the vertices' determinants (a
+// slab cell of 22 vertices and 67 terms: ~2 ms).
+double rational_cell_measure(const ExactContext& ctx, std::int32_t i, std::span<const std::int32_t> vertex_planes,
+                             std::span<const MeasureTerm> terms, double* centroid) {
+  thread_local Scratch s;
+  const int dim = ctx.dim;
+  const auto du = static_cast<std::size_t>(dim);
+  const std::size_t nv = vertex_planes.size() / du;
+  // Rationals with RAII: this path is rare (cells the fixed-point tier cannot certify).
+  struct Rationals {
+    std::vector<__mpq_struct> q;
+    explicit Rationals(std::size_t n) : q(n) {
+      for (auto& x : q) mpq_init(&x);
+    }
+    ~Rationals() {
+      for (auto& x : q) mpq_clear(&x);
+    }
+  };
+  // The vertices (dim each), then a foot, the weight sum, the moments and
+  // three temporaries.
+  const std::size_t base = nv * du;
+  Rationals r(base + 10);
+  auto y = [&](std::size_t v, int d) { return &r.q[v * du + static_cast<std::size_t>(d)]; };
+  mpq_ptr foot[3] = {&r.q[base], &r.q[base + 1], &r.q[base + 2]};
+  mpq_ptr moment[3] = {&r.q[base + 3], &r.q[base + 4], &r.q[base + 5]};
+  mpq_ptr sum = &r.q[base + 6], w = &r.q[base + 7], t0 = &r.q[base + 8], t1 = &r.q[base + 9];
+  for (std::size_t v = 0; v < nv; ++v) {
+    mpq_ptr yv[Scratch::kMaxDim] = {y(v, 0), y(v, 1), dim == 3 ? y(v, 2) : nullptr};
+    solve_vertex_exactly(ctx, i, vertex_planes.data() + v * du, s, yv);
+  }
+  const double* pi = ctx.points + static_cast<std::size_t>(i) * du;
+  // As measure() in front/cell_geometry.hpp: each term's weight w, summed,
+  // and w times the sum of its points (foot and both vertices in 3D, both
+  // vertices in 2D) for the centroid.
+  mpq_set_ui(sum, 0, 1);
+  for (int d = 0; d < dim; ++d) mpq_set_ui(moment[d], 0, 1);
+  for (const MeasureTerm& term : terms) {
+    for (int d = 0; d < 3; ++d) mpq_set_ui(foot[d], 0, 1);
+    if (dim == 2) {  // w = det(y_a, y_b)
+      mpq_mul(w, y(term.a, 0), y(term.b, 1));
+      mpq_mul(t0, y(term.a, 1), y(term.b, 0));
+      mpq_sub(w, w, t0);
+    } else {
+      // The foot of the plane from p_i: (p_j - p_i) / 2 on a bisector,
+      // (bound - p_i) along the axis on a box plane.
+      if (term.plane >= 0) {
+        const double* pj = ctx.points + static_cast<std::size_t>(term.plane) * 3;
+        for (int d = 0; d < 3; ++d) {
+          mpq_set_d(foot[d], pj[d]);
+          mpq_set_d(t0, pi[d]);
+          mpq_sub(foot[d], foot[d], t0);
+          mpq_div_2exp(foot[d], foot[d], 1);
+        }
+      } else {
+        const auto axis = static_cast<std::size_t>(box_plane_axis(term.plane));
+        mpq_set_d(foot[axis], box_plane_upper(term.plane) ? ctx.hi[axis] : ctx.lo[axis]);
+        mpq_set_d(t0, pi[axis]);
+        mpq_sub(foot[axis], foot[axis], t0);
+      }
+      mpq_set_ui(w, 0, 1);  // w = foot . (y_a x y_b)
+      for (int d = 0; d < 3; ++d) {
+        const int d1 = (d + 1) % 3, d2 = (d + 2) % 3;
+        mpq_mul(t0, y(term.a, d1), y(term.b, d2));
+        mpq_mul(t1, y(term.a, d2), y(term.b, d1));
+        mpq_sub(t0, t0, t1);
+        mpq_mul(t0, t0, foot[d]);
+        mpq_add(w, w, t0);
+      }
+    }
+    mpq_add(sum, sum, w);
+    for (int d = 0; d < dim; ++d) {
+      mpq_add(t0, y(term.a, d), y(term.b, d));
+      mpq_add(t0, t0, foot[d]);  // zero in 2D
+      mpq_mul(t0, t0, w);
+      mpq_add(moment[d], moment[d], t0);
+    }
+  }
+  // Centroid: moment / (4 sum) in 3D (a tetrahedron's is the mean of its
+  // corners, one at the origin), moment / (3 sum) in 2D.
+  for (int d = 0; d < dim; ++d) {
+    if (mpq_sgn(sum) == 0) {
+      centroid[d] = 0;
+      continue;
+    }
+    mpq_div(t0, moment[d], sum);
+    mpq_set_ui(t1, dim == 2 ? 3 : 4, 1);
+    mpq_div(t0, t0, t1);
+    centroid[d] = rational_to_double(t0);
+  }
+  mpq_set_ui(t0, dim == 2 ? 2 : 6, 1);
+  mpq_div(sum, sum, t0);
+  return rational_to_double(sum);
+}
+
+namespace {
+
+// mpz integers reused on one thread across cells (grown, never shrunk): the
+// fixed-point measure takes a few per vertex and per term, and GMP's
+// allocations would otherwise dominate it.
+class IntegerPool {
+ public:
+  IntegerPool() = default;
+  IntegerPool(const IntegerPool&) = delete;
+  IntegerPool& operator=(const IntegerPool&) = delete;
+  ~IntegerPool() {
+    for (auto& x : z_) mpz_clear(&x);
+  }
+  void reserve(std::size_t n) {
+    while (z_.size() < n) {
+      z_.emplace_back();
+      mpz_init(&z_.back());
+    }
+  }
+  mpz_ptr operator[](std::size_t k) { return &z_[k]; }
+
+ private:
+  std::deque<__mpz_struct> z_;  // a deque: growing it never moves an integer
+};
+
+long bit_length(mpz_srcptr x) { return static_cast<long>(mpz_sizeinbase(x, 2)); }
+
+// out = trunc(x 2^k).
+void scale_truncated(mpz_ptr out, mpz_srcptr x, long k) {
+  if (k >= 0) mpz_mul_2exp(out, x, static_cast<mp_bitcnt_t>(k));
+  else mpz_tdiv_q_2exp(out, x, static_cast<mp_bitcnt_t>(-k));
+}
+
+// out = trunc((a - b) 2^k / 2^g) for doubles a, b: their difference exactly
+// on their common grid, then truncated to the unit 2^g.
+void difference_truncated(mpz_ptr out, double a, double b, long k, long g, Scratch& s) {
+  const int grid = a == 0 ? lowest_bit_exponent(b)
+                   : b == 0 ? lowest_bit_exponent(a)
+                            : std::min(lowest_bit_exponent(a), lowest_bit_exponent(b));
+  exact_rows::set_scaled(s.t0, a, grid);
+  exact_rows::set_scaled(s.t1, b, grid);
+  mpz_sub(s.t0, s.t0, s.t1);
+  scale_truncated(out, s.t0, grid + k - g);
+}
+
+// The double that x = n / d * 2^exp truncates to (towards zero, as
+// mpq_get_d), where n is known only to lie within 2^hn of `num`, and d is c
+// times a number within 2^hd of `den` (den null: d = c exactly). False where
+// those intervals leave that double undetermined (they hold zero, or two
+// doubles) or it lies outside [2^-1000, 2^1000] (the rational path then
+// rounds subnormals as it always did). Truncation is monotone, so when both
+// ends of x's interval truncate alike, x does too. `z[at..at+5)` is scratch.
+bool certain_quotient(mpz_srcptr num, long hn, mpz_srcptr den, long hd, unsigned long c, long exp, IntegerPool& z,
+                      std::size_t at, double& out) {
+  mpz_ptr lo = z[at], hi = z[at + 1], dlo = z[at + 2], dhi = z[at + 3], h = z[at + 4];
+  mpz_set_ui(h, 1);
+  mpz_mul_2exp(h, h, static_cast<mp_bitcnt_t>(hn));
+  mpz_sub(lo, num, h);
+  mpz_add(hi, num, h);
+  const int sign = mpz_sgn(lo);
+  if (sign == 0 || mpz_sgn(hi) != sign) return false;  // n may be zero
+  if (den != nullptr) {
+    mpz_set_ui(h, 1);
+    mpz_mul_2exp(h, h, static_cast<mp_bitcnt_t>(hd));
+    mpz_sub(dlo, den, h);
+    mpz_add(dhi, den, h);
+    if (mpz_sgn(dlo) <= 0) return false;
+    mpz_mul_ui(dlo, dlo, c);
+    mpz_mul_ui(dhi, dhi, c);
+  } else {
+    mpz_set_ui(dlo, c);
+    mpz_set_ui(dhi, c);
+  }
+  // Quotients of some 72 bits: enough for truncation to 53 to agree at both
+  // ends whenever x's interval is narrow.
+  const long k = 72 + bit_length(dhi) - bit_length(num);
+  if (k > 0) {
+    mpz_mul_2exp(lo, lo, static_cast<mp_bitcnt_t>(k));
+    mpz_mul_2exp(hi, hi, static_cast<mp_bitcnt_t>(k));
+  } else if (k < 0) {
+    mpz_mul_2exp(dlo, dlo, static_cast<mp_bitcnt_t>(-k));
+    mpz_mul_2exp(dhi, dhi, static_cast<mp_bitcnt_t>(-k));
+  }
+  // x 2^(k - exp) lies in [floor(lo / d_far), ceil(hi / d_near)], the
+  // denominators' ends taken by the numerator's sign.
+  if (sign > 0) {
+    mpz_fdiv_q(lo, lo, dhi);
+    mpz_cdiv_q(hi, hi, dlo);
+  } else {
+    mpz_fdiv_q(lo, lo, dlo);
+    mpz_cdiv_q(hi, hi, dhi);
+  }
+  const double low = mpz_get_d(lo), high = mpz_get_d(hi);  // truncated to 53 bits
+  if (low != high || low == 0) return false;
+  int e;
+  std::frexp(low, &e);
+  const long scale = exp - k;
+  if (e + scale < -1000 || e + scale > 1000) return false;
+  out = std::ldexp(low, static_cast<int>(scale));
+  return true;
+}
+
+}  // namespace
+
+// Every vertex solved exactly (Cramer's numerators and determinant,
+// vertex_numerators), then truncated to an integer multiple of a unit 2^g
+// set `bits` bits below the largest coordinate; the feet likewise; the
+// terms and moments of measure() (front/cell_geometry.hpp) summed in
+// integers, exactly. Each truncation is off by under one unit, which bounds
+// the sums' errors (the derivation at the bounds below); certain_quotient
+// then certifies the doubles, or finds them undetermined. A slab cell's
+// measure, 22 vertices and 67 terms, takes ~0.1 ms here against ~2 ms in
+// rationals, whose gcds on ever-larger denominators were the whole cost of
+// a chain of near copies (5,000 points: 6 s).
+bool fixed_point_cell_measure(const ExactContext& ctx, std::int32_t i, std::span<const std::int32_t> vertex_planes,
+                              std::span<const MeasureTerm> terms, long bits, double& volume, double* centroid) {
+  thread_local Scratch s;
+  thread_local IntegerPool z;
+  thread_local std::vector<long> shift;
+  const int dim = ctx.dim;
+  const auto du = static_cast<std::size_t>(dim);
+  const std::size_t nv = vertex_planes.size() / du;
+  if (nv == 0) return false;
+  // Per vertex: its Cramer numerators and determinant, then its fixed-point
+  // coordinates. After them: a foot, a term, the sums and the scratch.
+  const std::size_t per = 2 * du + 1;
+  const std::size_t base = nv * per;
+  z.reserve(base + 16);
+  auto num = [&](std::size_t v, std::size_t d) { return z[v * per + d]; };  // d = dim: the determinant
+  auto fixed = [&](std::size_t v, std::size_t d) { return z[v * per + du + 1 + d]; };
+  mpz_ptr foot[3] = {z[base], z[base + 1], z[base + 2]};
+  mpz_ptr w = z[base + 3], sum = z[base + 4], t0 = z[base + 5];
+  mpz_ptr moment[3] = {z[base + 6], z[base + 7], z[base + 8]};
+  const std::size_t spare = base + 9;  // certain_quotient's five
+
+  shift.resize(nv);
+  long top = std::numeric_limits<long>::min();  // |every coordinate| < 2^top
+  for (std::size_t v = 0; v < nv; ++v) {
+    shift[v] = vertex_numerators(ctx, i, vertex_planes.data() + v * du, s);
+    const long det_bits = bit_length(s.minor[dim]);
+    for (std::size_t d = 0; d <= du; ++d) mpz_set(num(v, d), s.minor[d]);
+    for (std::size_t d = 0; d < du; ++d) top = std::max(top, bit_length(s.minor[d]) - det_bits + 1 + shift[v]);
+  }
+  // The unit. A foot lies no farther from p_i than the vertices of its face,
+  // so its coordinates stay below sqrt(3) 2^top.
+  const long g = top - bits;
+  for (std::size_t v = 0; v < nv; ++v)
+    for (std::size_t d = 0; d < du; ++d) {
+      // trunc(trunc(n 2^k) / det) = trunc(n 2^k / det) for k < 0 as well.
+      scale_truncated(fixed(v, d), num(v, d), shift[v] - g);
+      mpz_tdiv_q(fixed(v, d), fixed(v, d), num(v, du));
+    }
+
+  const double* pi = ctx.points + static_cast<std::size_t>(i) * du;
+  mpz_set_ui(sum, 0);
+  for (std::size_t d = 0; d < du; ++d) mpz_set_ui(moment[d], 0);
+  for (const MeasureTerm& term : terms) {
+    if (dim == 2) {  // w = det(y_a, y_b)
+      mpz_mul(w, fixed(term.a, 0), fixed(term.b, 1));
+      mpz_submul(w, fixed(term.a, 1), fixed(term.b, 0));
+    } else {
+      // The foot: (p_j - p_i) / 2 on a bisector, (bound - p_i) along the
+      // axis on a box plane.
+      if (term.plane >= 0) {
+        const double* pj = ctx.points + static_cast<std::size_t>(term.plane) * 3;
+        for (int d = 0; d < 3; ++d) difference_truncated(foot[d], pj[d], pi[d], -1, g, s);
+      } else {
+        const int axis = box_plane_axis(term.plane);
+        for (int d = 0; d < 3; ++d) mpz_set_ui(foot[d], 0);
+        difference_truncated(foot[axis], box_plane_upper(term.plane) ? ctx.hi[axis] : ctx.lo[axis], pi[axis], 0, g, s);
+      }
+      mpz_set_ui(w, 0);  // w = foot . (y_a x y_b)
+      for (int d = 0; d < 3; ++d) {
+        const std::size_t d1 = static_cast<std::size_t>((d + 1) % 3), d2 = static_cast<std::size_t>((d + 2) % 3);
+        mpz_mul(t0, fixed(term.a, d1), fixed(term.b, d2));
+        mpz_submul(t0, fixed(term.a, d2), fixed(term.b, d1));
+        mpz_addmul(w, t0, foot[d]);
+      }
+    }
+    mpz_add(sum, sum, w);
+    for (std::size_t d = 0; d < du; ++d) {
+      mpz_add(t0, fixed(term.a, d), fixed(term.b, d));
+      if (dim == 3) mpz_add(t0, t0, foot[d]);
+      mpz_addmul(moment[d], t0, w);
+    }
+  }
+
+  // Error bounds, in units 2^(D g) for the sum and 2^((D + 1) g) for the
+  // moments. Every fixed coordinate and foot is below 2^(bits + 1), and its
+  // true value within one unit, so both lie within M = 2^(bits + 2). With
+  // a, b perturbed by under 1 each, a b moves by under 2M + 1. In 3D a
+  // cross product's coordinate moves by under 4M + 2 and is at most 2M^2,
+  // so a term (the foot's dot product) moves by under 3 (2M^2 + M (4M + 2)
+  // + 4M + 2) <= 32 M^2 and is at most 6 M^3; its moment (the term times a
+  // sum s of three coordinates, |s| <= 3M, moved by under 3) by under
+  // 6M^3 3 + 32M^2 3M + 32M^2 3 <= 128 M^3. In 2D a term moves by under
+  // 2 (2M + 1) <= 8M and is at most 2M^2; its moment (s of two) by under
+  // 2M^2 2 + 8M 2M + 8M 2 <= 32 M^2. Summed over n terms.
+  const long terms_bits = static_cast<long>(std::bit_width(terms.size()));  // n <= 2^terms_bits
+  const long m = bits + 2;
+  const long sum_error = dim == 3 ? terms_bits + 5 + 2 * m : terms_bits + 3 + m;
+  const long moment_error = dim == 3 ? terms_bits + 7 + 3 * m : terms_bits + 5 + 2 * m;
+  // Volume = sum 2^(D g) / (6 or 2); centroid = moment 2^((D + 1) g) / ((4
+  // or 3) sum 2^(D g)), as in rational_measure.
+  if (!certain_quotient(sum, sum_error, nullptr, 0, dim == 3 ? 6 : 2, dim * g, z, spare, volume)) return false;
+  for (std::size_t d = 0; d < du; ++d)
+    if (!certain_quotient(moment[d], moment_error, sum, sum_error, dim == 3 ? 4 : 3, g, z, spare, centroid[d]))
+      return false;
+  return true;
+}
+
+double exact_cell_measure(const ExactContext& ctx, std::int32_t i, std::span<const std::int32_t> vertex_planes,
+                          std::span<const MeasureTerm> terms, double* centroid) {
+  // 200 bits certify cells whose volume is down to ~2^-80 of their largest
+  // coordinate cubed; 640 bits, to ~2^-500; the rational path, any.
+  double volume;
+  for (const long bits : {200L, 640L})
+    if (fixed_point_cell_measure(ctx, i, vertex_planes, terms, bits, volume, centroid)) return volume;
+  return rational_cell_measure(ctx, i, vertex_planes, terms, centroid);
+}
+
+}  // namespace tessera::kernels
