@@ -14,37 +14,6 @@
 #include <vector>
 
 namespace tessera::kernels {
-namespace {
-
-// x / 2^shift for x = pt on a grid of step 2^shift (its bits below 2^shift
-// are zero, so the arithmetic right shift is exact, negative or not; C++20
-// defines it).
-std::int64_t on_grid(const DoubleParts& pt, int shift) {
-  if (pt.mant == 0) return 0;
-  const int k = pt.e2 - shift;
-  return k >= 0 ? pt.mant * (std::int64_t{1} << k) : pt.mant >> -k;
-}
-
-// The doubles of a vertex's rows by their bits, and their common grid: p_i
-// into pv[rows], each generator row's point into pv[r], a box row's constant
-// into pv[r][0]. For the integer paths, which go on to put them on the grid.
-void row_parts(const ExactContext& ctx, std::int32_t i, const std::int32_t* gen, int rows, DoubleParts (*pv)[3],
-               GridScale& span) {
-  const int dim = ctx.dim;
-  const double* pi = ctx.points + static_cast<std::size_t>(i) * dim;
-  for (int d = 0; d < dim; ++d) pv[rows][d] = span.see(pi[d]);
-  for (int r = 0; r < rows; ++r) {
-    if (gen[r] >= 0) {
-      const double* pk = ctx.points + static_cast<std::size_t>(gen[r]) * dim;
-      for (int d = 0; d < dim; ++d) pv[r][d] = span.see(pk[d]);
-    } else {
-      const int axis = box_plane_axis(gen[r]);
-      pv[r][0] = span.see(box_plane_upper(gen[r]) ? ctx.hi[axis] : ctx.lo[axis]);
-    }
-  }
-}
-
-}  // namespace
 
 namespace exact_rows {
 
@@ -126,8 +95,26 @@ int build_rows(const ExactContext& ctx, std::int32_t i, const std::int32_t* gen,
 }
 
 
+void row_parts(const ExactContext& ctx, std::int32_t i, const std::int32_t* gen, int rows, DoubleParts (*pv)[3],
+               GridScale& span) {
+  const int dim = ctx.dim;
+  const double* pi = ctx.points + static_cast<std::size_t>(i) * dim;
+  for (int d = 0; d < dim; ++d) pv[rows][d] = span.see(pi[d]);
+  for (int r = 0; r < rows; ++r) {
+    if (gen[r] >= 0) {
+      const double* pk = ctx.points + static_cast<std::size_t>(gen[r]) * dim;
+      for (int d = 0; d < dim; ++d) pv[r][d] = span.see(pk[d]);
+    } else {
+      const int axis = box_plane_axis(gen[r]);
+      pv[r][0] = span.see(box_plane_upper(gen[r]) ? ctx.hi[axis] : ctx.lo[axis]);
+    }
+  }
+}
+
 }  // namespace exact_rows
 
+using exact_rows::on_grid;
+using exact_rows::row_parts;
 using exact_rows::Scratch;
 using exact_rows::build_rows;
 using exact_rows::det_rows;

@@ -44,6 +44,21 @@ struct Scratch {
 // out = x * 2^(-shift), exactly an integer because shift <= lowest_bit_exponent(x).
 void set_scaled(mpz_t out, double x, int shift);
 
+// x / 2^shift for x = pt on a grid of step 2^shift (its bits below 2^shift
+// are zero, so the arithmetic right shift is exact, negative or not; C++20
+// defines it).
+inline std::int64_t on_grid(const DoubleParts& pt, int shift) {
+  if (pt.mant == 0) return 0;
+  const int k = pt.e2 - shift;
+  return k >= 0 ? pt.mant * (std::int64_t{1} << k) : pt.mant >> -k;
+}
+
+// The doubles of a vertex's rows by their bits, and their common grid: p_i
+// into pv[rows], each generator row's point into pv[r], a box row's constant
+// into pv[r][0]. For the integer paths, which go on to put them on the grid.
+void row_parts(const ExactContext& ctx, std::int32_t i, const std::int32_t* gen, int rows, DoubleParts (*pv)[3],
+               GridScale& span);
+
 // det of the k x k matrix formed by rows `rows` of a (k = 2 or 3).
 void det_rows(mpz_t out, mpz_t (*a)[Scratch::kMaxDim], const int* rows, int k, Scratch& s);
 

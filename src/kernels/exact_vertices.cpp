@@ -15,6 +15,7 @@
 
 #include "exact_rows.hpp"
 #include "tessera/kernels/exact_predicates.hpp"
+#include "tessera/kernels/wide_int.hpp"
 
 namespace tessera::kernels {
 
@@ -36,14 +37,91 @@ double rational_to_double(mpq_ptr q) {
   return std::ldexp(mpq_get_d(q), -1100);
 }
 
+// A signed fixed-width integer into GMP (two's complement limbs, least
+// significant first).
+template <int N>
+void set_wide(mpz_ptr out, WideInt<N> x) {
+  const bool negative = x.negative();
+  if (negative) x = WideInt<N>::from_int64(0) - x;
+  mpz_import(out, N, -1, sizeof(std::uint64_t), 0, 0, x.limb);
+  if (negative) mpz_neg(out, out);
+}
+
+// vertex_numerators in 64- to 256-bit integers, where p_i and the planes'
+// points and bounds lie on one grid of at most 60 bits (every input whose
+// coordinates share a scale): the rows relative to p_i, a = 2 q with
+// |q| < 2^61 and b = |q|^2 < 2^124 (a box row: the unit axis, b its
+// bound less p_i), so the cofactors (a x a) stay below 2^125, det A below
+// 2^189 and the numerators (b times cofactors) below 2^251. The same
+// rationals as in GMP throughout (build_rows, det_rows), which cost 40% of a
+// chain of near copies' cells (4 determinants, each a few dozen GMP calls).
+// False off such a grid.
+bool vertex_numerators_narrow(const ExactContext& ctx, std::int32_t i, const std::int32_t* planes, Scratch& s,
+                              int& shift) {
+  using I = __int128;
+  const int dim = ctx.dim;
+  if (dim != 2 && dim != 3) return false;
+  DoubleParts pv[Scratch::kRows][Scratch::kMaxDim];
+  GridScale span;
+  exact_rows::row_parts(ctx, i, planes, dim, pv, span);
+  if (span.all_zero() || !span.fits(60)) return false;
+  shift = span.scale();
+  std::int64_t ci[3], a[3][3] = {};
+  I b[3];
+  for (int d = 0; d < dim; ++d) ci[d] = exact_rows::on_grid(pv[dim][d], shift);
+  for (int r = 0; r < dim; ++r) {
+    if (planes[r] >= 0) {
+      I sq = 0;
+      for (int d = 0; d < dim; ++d) {
+        const std::int64_t q = exact_rows::on_grid(pv[r][d], shift) - ci[d];
+        a[r][d] = 2 * q;
+        sq += static_cast<I>(q) * q;
+      }
+      b[r] = sq;
+    } else {
+      const int axis = box_plane_axis(planes[r]);
+      a[r][axis] = 1;
+      b[r] = exact_rows::on_grid(pv[r][0], shift) - ci[axis];
+    }
+  }
+  // cof[r][d]: the cofactor of a[r][d]. det A = sum_d a[0][d] cof[0][d];
+  // Cramer's numerator d = sum_r b[r] cof[r][d].
+  I cof[3][3];
+  if (dim == 2) {
+    cof[0][0] = a[1][1], cof[0][1] = -a[1][0];
+    cof[1][0] = -a[0][1], cof[1][1] = a[0][0];
+  } else {
+    for (int r = 0; r < 3; ++r) {
+      const std::int64_t* u = a[(r + 1) % 3];
+      const std::int64_t* w = a[(r + 2) % 3];
+      cof[r][0] = static_cast<I>(u[1]) * w[2] - static_cast<I>(u[2]) * w[1];
+      cof[r][1] = static_cast<I>(u[2]) * w[0] - static_cast<I>(u[0]) * w[2];
+      cof[r][2] = static_cast<I>(u[0]) * w[1] - static_cast<I>(u[1]) * w[0];
+    }
+  }
+  WideInt<3> det = WideInt<3>::from(0);
+  for (int d = 0; d < dim; ++d) det = det + multiply(WideInt<1>::from_int64(a[0][d]), WideInt<2>::from(cof[0][d]));
+  if (det.sign() == 0) throw std::logic_error("exact_vertex: vertex planes are dependent (corrupt cell)");
+  set_wide(s.minor[dim], det);
+  for (int d = 0; d < dim; ++d) {
+    WideInt<4> n = WideInt<4>::from(0);
+    for (int r = 0; r < dim; ++r) n = n + multiply(WideInt<2>::from(b[r]), WideInt<2>::from(cof[r][d]));
+    set_wide(s.minor[d], n);
+  }
+  return true;
+}
+
 // The vertex of cell i where planes[0..dim) meet, relative to p_i, as
 // integers: y[d] = minor[d] / minor[dim] * 2^shift (returned), for d < dim.
 // Cramer's rule on the integer rows (build_rows): det A, then numerator
 // d = det(A with column d replaced by b), less det times p_i. Weights are
-// infinitesimal and do not move the vertex in the limit.
+// infinitesimal and do not move the vertex in the limit. On 64-bit rows
+// where the input allows (vertex_numerators_narrow), else in GMP.
 int vertex_numerators(const ExactContext& ctx, std::int32_t i, const std::int32_t* planes, Scratch& s) {
   const int dim = ctx.dim;
-  const int shift = build_rows(ctx, i, planes, dim, s);
+  int shift;
+  if (vertex_numerators_narrow(ctx, i, planes, s, shift)) return shift;
+  shift = build_rows(ctx, i, planes, dim, s);
   int sel[Scratch::kMaxDim] = {0, 1, 2};
   det_rows(s.minor[dim], s.a, sel, dim, s);
   if (mpz_sgn(s.minor[dim]) == 0)
