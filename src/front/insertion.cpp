@@ -179,7 +179,10 @@ class Triangulation {
   Buffer<std::int32_t> take_rows() { return insertion::take_rows<K>(store_, global_, workers_); }
   InsertionStats stats() const {
     InsertionStats s = stats_;
-    for (const W& w : workers_) s.guided += w.guided;
+    for (const W& w : workers_) {
+      s.guided += w.guided;
+      s.created += w.created;
+    }
     return s;
   }
 
@@ -340,6 +343,7 @@ class Triangulation {
       state = store_.state();
     }
     w.free.insert(w.free.end(), w.cavity.begin(), w.cavity.end());
+    w.created += w.boundary.size();
     // The new simplices fan around q; two of them meet across each facet
     // through q, found by the facet's other vertices. 3D: a hash by the
     // boundary edge they share. 2D: an array by the one boundary vertex

@@ -58,14 +58,20 @@ BrioOrder brio_order(const kernels::ExactContext& ctx, std::span<const std::int3
   const int bits = D == 3 ? 19 : 28, code_bits = D * bits;
   const double top = static_cast<double>((std::uint64_t{1} << bits) - 1);
   Buffer<Key> keys(ids.size());  // every one written below
-  double scale[3] = {};
-  for (int d = 0; d < D; ++d) scale[d] = hi[d] > lo[d] ? top / (hi[d] - lo[d]) : 0.0;
+  // One scale for every axis, so that the curve's cells are cubes (squares):
+  // scaled per axis, a box 1e4 times longer on one axis had its points
+  // inserted in long thin columns, whose skinny tetrahedra's circumspheres
+  // reached far along it, and the conflicts of the next column were large
+  // (400k points: 5.5 s, against 1.3 s for a cube).
+  double extent = 0;
+  for (int d = 0; d < D; ++d) extent = std::max(extent, hi[d] - lo[d]);
+  const double scale = extent > 0 ? top / extent : 0.0;
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, ids.size(), 1 << 14), [&](const tbb::blocked_range<std::size_t>& r) {
     for (std::size_t i = r.begin(); i != r.end(); ++i) {
       const double* p = point(i);
       std::uint64_t code = 0;
       for (int d = 0; d < D; ++d) {
-        const auto c = static_cast<std::uint64_t>(std::clamp((p[d] - lo[d]) * scale[d], 0.0, top));
+        const auto c = static_cast<std::uint64_t>(std::clamp((p[d] - lo[d]) * scale, 0.0, top));
         code |= (D == 3 ? spread3(c) : spread2(c)) << d;
       }
       const int round = std::min(std::countl_zero(id_hash(ids[i])), max_round);

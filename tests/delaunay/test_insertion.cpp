@@ -171,6 +171,23 @@ TEST(Insertion, ParallelPhasesGiveTheSerialRows) {
   EXPECT_GT(stats.guided, 100u);
 }
 
+TEST(Insertion, ALongBoxIsInsertedInCubes) {
+  // The same points in a unit cube and stretched 1e4 times along x (2D: a
+  // square and a strip): the insertion order's curve cells are cubes
+  // (squares) either way, so the stretched points' conflicts create about
+  // as many simplices per point. Scaled per axis, the curve inserted the
+  // strip in long thin columns, whose skinny simplices' circumspheres
+  // reached far along it (3D: 2.6 times the cube's simplices; 2D: 1.5).
+  for (const int dim : {2, 3}) {
+    std::vector<double> cube = uniform_points(20000, dim, 51), box = cube;
+    for (std::size_t i = 0; i < box.size(); i += static_cast<std::size_t>(dim)) box[i] *= 1e4;
+    tessera::front::InsertionStats in_cube, in_box;
+    insert_points(cube, dim, 1, 1024, &in_cube);
+    insert_points(box, dim, 1, 1024, &in_box);
+    EXPECT_LT(static_cast<double>(in_box.created), 1.2 * static_cast<double>(in_cube.created)) << dim << "D";
+  }
+}
+
 TEST(Insertion, FewAndFlatPoints) {
   // Fewer than four points, and coplanar points (on the tilted plane z = x + y,
   // so the box has extent): no tetrahedron, no error.
