@@ -181,7 +181,7 @@ class Triangulation {
     InsertionStats s = stats_;
     for (const W& w : workers_) {
       s.guided += w.guided;
-      s.created += w.created;
+      s.steps += w.steps;
     }
     return s;
   }
@@ -343,7 +343,6 @@ class Triangulation {
       state = store_.state();
     }
     w.free.insert(w.free.end(), w.cavity.begin(), w.cavity.end());
-    w.created += w.boundary.size();
     // The new simplices fan around q; two of them meet across each facet
     // through q, found by the facet's other vertices. 3D: a hash by the
     // boundary edge they share. 2D: an array by the one boundary vertex
@@ -543,6 +542,7 @@ class Triangulation {
       if (Check && !owned(ss[next], w.part)) return -1;
       if (--steps_left == 0) [[unlikely]]
         walk_did_not_end();
+      ++w.steps;
       came_from = t;
       t = next;
     }

@@ -45,9 +45,9 @@ struct InsertionStats {
   std::size_t phase_points = 0;  ///< points they were given
   std::size_t deferred = 0;      ///< of those, points they left for later
   std::size_t guided = 0;        ///< walks started from a guide vertex rather than the last insertion
-  /// Simplices the insertions created (one per facet of each cavity's
-  /// boundary): the work of the conflicts, which a poor order inflates.
-  std::size_t created = 0;
+  /// Steps the walks took from one simplex to the next: the work of point
+  /// location, which an order without locality inflates.
+  std::size_t steps = 0;
 };
 
 struct InsertionOptions {

@@ -89,7 +89,7 @@ struct Worker {
   std::int32_t last = -1;     // a simplex of its last insertion (the next walk's start), or -1
   std::int32_t prev = -1;     // the vertex it inserted last, or -1
   std::size_t guided = 0;     // walks it started by a guide (walk_start)
-  std::size_t created = 0;    // simplices its insertions created
+  std::size_t steps = 0;      // steps its walks took (locate)
   std::uint64_t rng = 0x2545F4914F6CDD1Dull;
   std::vector<std::int32_t> free;        // slots of simplices it removed
   std::size_t fresh = 0, fresh_end = 0;  // claimed slots never used
