@@ -394,7 +394,8 @@ bool certain_quotient(mpz_srcptr num, long hn, mpz_srcptr den, long hd, unsigned
 // rationals, whose gcds on ever-larger denominators were the whole cost of
 // a chain of near copies (5,000 points: 6 s).
 bool fixed_point_cell_measure(const ExactContext& ctx, std::int32_t i, std::span<const std::int32_t> vertex_planes,
-                              std::span<const MeasureTerm> terms, long bits, double& volume, double* centroid) {
+                              std::span<const MeasureTerm> terms, long bits, double& volume, double* centroid,
+                              long* wanted) {
   thread_local Scratch s;
   thread_local IntegerPool z;
   thread_local std::vector<long> shift;
@@ -403,16 +404,15 @@ bool fixed_point_cell_measure(const ExactContext& ctx, std::int32_t i, std::span
   const std::size_t nv = vertex_planes.size() / du;
   if (nv == 0) return false;
   // Per vertex: its Cramer numerators and determinant, then its fixed-point
-  // coordinates. After them: a foot, a term, the sums and the scratch.
+  // coordinates. After them: a term, the sums, certain_quotient's five
+  // scratch integers, then the feet (3D: three per plane, as met).
   const std::size_t per = 2 * du + 1;
-  const std::size_t base = nv * per;
-  z.reserve(base + 16);
+  const std::size_t base = nv * per, spare = base + 6, feet = base + 11;
+  z.reserve(feet + (dim == 3 ? 3 * terms.size() : 0));
   auto num = [&](std::size_t v, std::size_t d) { return z[v * per + d]; };  // d = dim: the determinant
   auto fixed = [&](std::size_t v, std::size_t d) { return z[v * per + du + 1 + d]; };
-  mpz_ptr foot[3] = {z[base], z[base + 1], z[base + 2]};
-  mpz_ptr w = z[base + 3], sum = z[base + 4], t0 = z[base + 5];
-  mpz_ptr moment[3] = {z[base + 6], z[base + 7], z[base + 8]};
-  const std::size_t spare = base + 9;  // certain_quotient's five
+  mpz_ptr w = z[base], sum = z[base + 1], t0 = z[base + 2];
+  mpz_ptr moment[3] = {z[base + 3], z[base + 4], z[base + 5]};
 
   shift.resize(nv);
   long top = std::numeric_limits<long>::min();  // |every coordinate| < 2^top
@@ -433,23 +433,38 @@ bool fixed_point_cell_measure(const ExactContext& ctx, std::int32_t i, std::span
     }
 
   const double* pi = ctx.points + static_cast<std::size_t>(i) * du;
+  // A plane's foot in fixed point, computed once per plane: (p_j - p_i) / 2
+  // on a bisector, (bound - p_i) along the axis on a box plane. A cell has
+  // a few dozen planes, each in many terms.
+  thread_local std::vector<std::int32_t> foot_plane;
+  foot_plane.clear();
+  auto foot_of = [&](std::int32_t plane) {
+    std::size_t k = 0;
+    while (k < foot_plane.size() && foot_plane[k] != plane) ++k;
+    mpz_ptr f[3] = {z[feet + 3 * k], z[feet + 3 * k + 1], z[feet + 3 * k + 2]};
+    if (k == foot_plane.size()) {
+      foot_plane.push_back(plane);
+      if (plane >= 0) {
+        const double* pj = ctx.points + static_cast<std::size_t>(plane) * 3;
+        for (int d = 0; d < 3; ++d) difference_truncated(f[d], pj[d], pi[d], -1, g, s);
+      } else {
+        const int axis = box_plane_axis(plane);
+        for (int d = 0; d < 3; ++d) mpz_set_ui(f[d], 0);
+        difference_truncated(f[axis], box_plane_upper(plane) ? ctx.hi[axis] : ctx.lo[axis], pi[axis], 0, g, s);
+      }
+    }
+    return feet + 3 * k;
+  };
   mpz_set_ui(sum, 0);
   for (std::size_t d = 0; d < du; ++d) mpz_set_ui(moment[d], 0);
+  mpz_ptr foot[3] = {};
   for (const MeasureTerm& term : terms) {
     if (dim == 2) {  // w = det(y_a, y_b)
       mpz_mul(w, fixed(term.a, 0), fixed(term.b, 1));
       mpz_submul(w, fixed(term.a, 1), fixed(term.b, 0));
     } else {
-      // The foot: (p_j - p_i) / 2 on a bisector, (bound - p_i) along the
-      // axis on a box plane.
-      if (term.plane >= 0) {
-        const double* pj = ctx.points + static_cast<std::size_t>(term.plane) * 3;
-        for (int d = 0; d < 3; ++d) difference_truncated(foot[d], pj[d], pi[d], -1, g, s);
-      } else {
-        const int axis = box_plane_axis(term.plane);
-        for (int d = 0; d < 3; ++d) mpz_set_ui(foot[d], 0);
-        difference_truncated(foot[axis], box_plane_upper(term.plane) ? ctx.hi[axis] : ctx.lo[axis], pi[axis], 0, g, s);
-      }
+      const std::size_t f = foot_of(term.plane);
+      for (std::size_t d = 0; d < 3; ++d) foot[d] = z[f + d];
       mpz_set_ui(w, 0);  // w = foot . (y_a x y_b)
       for (int d = 0; d < 3; ++d) {
         const std::size_t d1 = static_cast<std::size_t>((d + 1) % 3), d2 = static_cast<std::size_t>((d + 2) % 3);
@@ -483,20 +498,48 @@ bool fixed_point_cell_measure(const ExactContext& ctx, std::int32_t i, std::span
   const long moment_error = dim == 3 ? terms_bits + 7 + 3 * m : terms_bits + 5 + 2 * m;
   // Volume = sum 2^(D g) / (6 or 2); centroid = moment 2^((D + 1) g) / ((4
   // or 3) sum 2^(D g)), as in rational_measure.
-  if (!certain_quotient(sum, sum_error, nullptr, 0, dim == 3 ? 6 : 2, dim * g, z, spare, volume)) return false;
-  for (std::size_t d = 0; d < du; ++d)
-    if (!certain_quotient(moment[d], moment_error, sum, sum_error, dim == 3 ? 4 : 3, g, z, spare, centroid[d]))
-      return false;
-  return true;
+  bool sure = certain_quotient(sum, sum_error, nullptr, 0, dim == 3 ? 6 : 2, dim * g, z, spare, volume);
+  for (std::size_t d = 0; sure && d < du; ++d)
+    sure = certain_quotient(moment[d], moment_error, sum, sum_error, dim == 3 ? 4 : 3, g, z, spare, centroid[d]);
+  if (!sure && wanted != nullptr) {
+    // The bits that should certify them: each bit more adds one to every
+    // margin (the sum grows by 2^D, its error bound by 2^(D - 1); the
+    // moments by 2^(D + 1) and 2^D), and a margin of 80 bits leaves the
+    // interval under 2^-79 of its value. A sum or moment that came out
+    // zero gives no measure of what it lacks: twice the bits.
+    long deficit = 80 - (bit_length(sum) - sum_error);
+    bool zero = mpz_sgn(sum) == 0;
+    for (std::size_t d = 0; d < du; ++d) {
+      deficit = std::max(deficit, 80 - (bit_length(moment[d]) - moment_error));
+      zero |= mpz_sgn(moment[d]) == 0;
+    }
+    *wanted = zero ? 2 * bits : bits + std::max(deficit, 16L);
+  }
+  return sure;
 }
 
 double exact_cell_measure(const ExactContext& ctx, std::int32_t i, std::span<const std::int32_t> vertex_planes,
                           std::span<const MeasureTerm> terms, double* centroid) {
-  // 200 bits certify cells whose volume is down to ~2^-80 of their largest
-  // coordinate cubed; 640 bits, to ~2^-500; the rational path, any.
+  // 200 bits certify a cell whose volume is down to ~2^-80 of its largest
+  // coordinate cubed and whose centroid is not far nearer its generator
+  // than that. A cell that needs more gets a second try with the bits the
+  // first found wanting (a slab in a cluster of points a few ulps apart:
+  // ~250), and the thread's next cell starts from those (its neighbours
+  // are alike), drifting back towards 200 while they suffice; the doubles
+  // are the same whatever the bits. The rational path serves zero centroid
+  // coordinates and cancellation beyond 4,000 bits.
+  constexpr long least = 200, most = 4000;
+  thread_local long start = least;
   double volume;
-  for (const long bits : {200L, 640L})
-    if (fixed_point_cell_measure(ctx, i, vertex_planes, terms, bits, volume, centroid)) return volume;
+  long wanted = 0;
+  if (fixed_point_cell_measure(ctx, i, vertex_planes, terms, start, volume, centroid, &wanted)) {
+    start = std::max(least, start - 8);
+    return volume;
+  }
+  if (wanted > 0 && wanted <= most) {
+    start = wanted;
+    if (fixed_point_cell_measure(ctx, i, vertex_planes, terms, wanted, volume, centroid)) return volume;
+  }
   return rational_cell_measure(ctx, i, vertex_planes, terms, centroid);
 }
 

@@ -344,8 +344,11 @@ double rational_cell_measure(const ExactContext& ctx, std::int32_t i, std::span<
 /// doubles certified by error bounds. True with `volume` and `centroid` set
 /// (then the doubles rational_cell_measure gives); false where the bounds
 /// leave them undetermined (cancellation deeper than the bits kept, an
-/// exactly zero centroid coordinate, or results outside [2^-1000, 2^1000]).
+/// exactly zero centroid coordinate, or results outside [2^-1000, 2^1000]),
+/// with `*wanted` (if given) the bits likely to certify them, or 0 where
+/// no number would (a zero sum or moment).
 bool fixed_point_cell_measure(const ExactContext& ctx, std::int32_t i, std::span<const std::int32_t> vertex_planes,
-                              std::span<const MeasureTerm> terms, long bits, double& volume, double* centroid);
+                              std::span<const MeasureTerm> terms, long bits, double& volume, double* centroid,
+                              long* wanted = nullptr);
 
 }  // namespace tessera::kernels
