@@ -94,7 +94,6 @@ int build_rows(const ExactContext& ctx, std::int32_t i, const std::int32_t* gen,
   return shift;
 }
 
-
 void row_parts(const ExactContext& ctx, std::int32_t i, const std::int32_t* gen, int rows, DoubleParts (*pv)[3],
                GridScale& span) {
   const int dim = ctx.dim;
