@@ -21,6 +21,7 @@
 #include <string>
 #include <vector>
 
+#include "tessera/kernels/assembly.hpp"
 #include "tessera/kernels/exact_predicates.hpp"
 #include "tessera/kernels/hull.hpp"
 #include "tessera/kernels/tile.hpp"
@@ -513,6 +514,58 @@ TEST(Hull, ExactMeasureSumsToTheBox) {
   exact_measure_test<Hull>(s);
   Scene<3> l(lattice<3>(3), {0, 0, 0}, {3, 3, 3});
   exact_measure_test<Hull>(l);
+}
+
+/// The far plane that closes a hull point's cell (assembly::far_plane) when
+/// its rays crowd one side of a wide cone: a thousand rays 80 degrees below
+/// the x axis and one 80 degrees above it (the end of a thin band: many
+/// rays across the band, one along it). Their sum leans 160 degrees away
+/// from the lone ray; a direction near the x axis serves them all. A cone
+/// that is a whole half space (rays up and down) has none.
+TEST(Assembly, FarPlaneCoversAWideCone) {
+  struct P { double n[3]; double d, n1; std::int32_t id; int scale; };
+  struct V { double y[3]; double e; };
+  for (const int dim : {2, 3}) {
+    SCOPED_TRACE(dim);
+    const double down = -80 * M_PI / 180, up = 80 * M_PI / 180;
+    const int k = 1001;
+    std::vector<double> dirs;
+    for (int r = 0; r < k; ++r) {
+      const double a = r + 1 < k ? down : up;
+      if (dim == 2) dirs.insert(dirs.end(), {std::cos(a), std::sin(a)});
+      else dirs.insert(dirs.end(), {std::cos(a), 0.0, std::sin(a)});
+    }
+    P box[6];
+    for (int q = 0; q < 2 * dim; ++q) box[q].d = 1.0;  // the box [-1, 1]^D about the generator
+    const V verts[1] = {{{0.25, -0.5, 0.125}, 1e-12}};
+    P far{};
+    bool ok = false;
+    if (dim == 2) ok = tessera::kernels::assembly::far_plane<2>(dirs.data(), k, box, verts, 1, far);
+    else ok = tessera::kernels::assembly::far_plane<3>(dirs.data(), k, box, verts, 1, far);
+    ASSERT_TRUE(ok);
+    double len = 0;
+    for (int a = 0; a < dim; ++a) len += far.n[a] * far.n[a];
+    len = std::sqrt(len);
+    for (int r = 0; r < k; ++r) {
+      double dot = 0;
+      for (int a = 0; a < dim; ++a) dot += far.n[a] * dirs[static_cast<std::size_t>(dim * r + a)];
+      EXPECT_GE(dot, 1e-3 * len) << "ray " << r;
+    }
+    // Beyond every box corner and the vertex.
+    for (int corner = 0; corner < (1 << dim); ++corner) {
+      double dot = 0;
+      for (int a = 0; a < dim; ++a) dot += far.n[a] * ((corner >> a) & 1 ? 1.0 : -1.0);
+      EXPECT_GT(far.d, dot);
+    }
+    double dot = 0;
+    for (int a = 0; a < dim; ++a) dot += far.n[a] * verts[0].y[a];
+    EXPECT_GT(far.d, dot);
+    // Up and down: no plane crosses both rays.
+    std::vector<double> opposite = dim == 2 ? std::vector<double>{0, 1, 0, -1} : std::vector<double>{0, 0, 1, 0, 0, -1};
+    const bool none = dim == 2 ? tessera::kernels::assembly::far_plane<2>(opposite.data(), 2, box, verts, 1, far)
+                               : tessera::kernels::assembly::far_plane<3>(opposite.data(), 2, box, verts, 1, far);
+    EXPECT_FALSE(none);
+  }
 }
 
 TEST(Tile, ExactMeasureSumsToTheBox) {

@@ -56,10 +56,11 @@ inline constexpr std::int32_t far_plane_id = std::numeric_limits<std::int32_t>::
 ///
 /// `dirs`: the k rays' unit directions (D each, from the rounded
 /// differences q; the callers reject directions whose rounding could tilt
-/// them). n is their sum; every ray must make an angle with n well short of
-/// a right angle (n.dir >= 1e-3 |n|, far beyond rounding), else false (a
-/// hull vertex whose normal cone is wider than that sum covers: the cell is
-/// clipped instead). c lies beyond the box's corners and the vertices [0,
+/// them). n is their sum, or where that leaves a ray short, a direction
+/// found by stepping towards the worst ray (below); every ray must make an
+/// angle with n well short of a right angle (n.dir >= 1e-3 |n|, far beyond
+/// rounding), else false (a hull vertex whose normal cone is nearly a half
+/// space: the cell is clipped instead). c lies beyond the box's corners and the vertices [0,
 /// nv) (each widened by its error bound) by half the box's extent along n,
 /// so every vertex on P is certainly outside the box (box_signs).
 /// `box`: the kernel's first 2D planes (box_planes), n = -+e_axis, d = the
@@ -69,17 +70,33 @@ bool far_plane(const double* dirs, std::size_t k, const Plane* box, const Vertex
   double n[D] = {};
   for (std::size_t r = 0; r < k; ++r)
     for (int a = 0; a < D; ++a) n[a] += dirs[D * r + static_cast<std::size_t>(a)];
-  double len2 = 0, n1 = 0;
-  for (int a = 0; a < D; ++a) {
-    len2 += n[a] * n[a];
-    n1 += std::fabs(n[a]);
+  // Where the rays crowd one side of a wide cone (a hull point at the end of
+  // a thin band: thousands of rays across the band, a few along it), their
+  // sum leans towards the crowd and the rest fall short of it. Then n steps
+  // towards the worst ray (halfway, as unit vectors), up to 64 times: a
+  // perceptron's steps, which find a direction for any cone that admits one
+  // by the margin.
+  for (int step = 0;; ++step) {
+    double len2 = 0;
+    for (int a = 0; a < D; ++a) len2 += n[a] * n[a];
+    const double len = std::sqrt(len2), min_dot = 1e-3 * len;
+    std::size_t worst = k;
+    double least = min_dot;
+    for (std::size_t r = 0; r < k; ++r) {
+      double dot = 0;
+      for (int a = 0; a < D; ++a) dot += n[a] * dirs[D * r + static_cast<std::size_t>(a)];
+      if (!(dot >= least)) {
+        if (!(dot == dot)) return false;  // NaN
+        least = dot;
+        worst = r;
+      }
+    }
+    if (worst == k) break;  // every ray crosses n's planes at 1e-3 of a right angle or more
+    if (step == 64 || !(len > 0)) return false;
+    for (int a = 0; a < D; ++a) n[a] = n[a] / len + dirs[D * worst + static_cast<std::size_t>(a)];
   }
-  const double min_dot = 1e-3 * std::sqrt(len2);
-  for (std::size_t r = 0; r < k; ++r) {
-    double dot = 0;
-    for (int a = 0; a < D; ++a) dot += n[a] * dirs[D * r + static_cast<std::size_t>(a)];
-    if (!(dot >= min_dot)) return false;  // NaN too
-  }
+  double n1 = 0;
+  for (int a = 0; a < D; ++a) n1 += std::fabs(n[a]);
   double cmax = 0, extent = 0;  // over the box's corners: sum over axes of the larger end
   for (int a = 0; a < D; ++a) {
     const double lo = -box[2 * a].d, hi = box[2 * a + 1].d;
