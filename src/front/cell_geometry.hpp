@@ -244,7 +244,7 @@ void for_each_face_plane(kernels::Tile& tile, F&& f) {
 /// what a cell's spokes need.
 template <class CellT, class F>
 void for_each_spoke(CellT& cell, F&& f) {
-  for_each_face_plane(cell, [&](std::uint16_t, std::int32_t id) { f(id); });
+  for_each_face_plane(cell, [&](auto, std::int32_t id) { f(id); });
 }
 
 }  // namespace tessera::front

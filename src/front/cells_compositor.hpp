@@ -57,7 +57,7 @@ class CellsCompositor {
     std::vector<std::uint32_t> face_end;    // into face_nbr
     Store* store = nullptr;
     std::size_t nbr_base = 0, corner_base = 0, pos_base = 0, face_base = 0;
-    std::vector<std::uint16_t> face_of;     // add()'s scratch: a local plane's face number
+    std::vector<std::uint32_t> face_of;     // add()'s scratch: a local plane's face number
     std::size_t assembled = 0;              // cells assembled from their stars
 
     const std::int32_t* nbrs() const { return store->nbrs.data() + nbr_base; }
@@ -106,8 +106,8 @@ class CellsCompositor {
     // Spokes from the face planes; the mesh numbers the faces too.
     if (mesh_) {
       if (b.face_of.size() < cell.planes().size()) b.face_of.resize(cell.planes().size());
-      for_each_face_plane(cell, [&](std::uint16_t pl, std::int32_t id) {
-        b.face_of[pl] = static_cast<std::uint16_t>(nf++);
+      for_each_face_plane(cell, [&](auto pl, std::int32_t id) {
+        b.face_of[pl] = static_cast<std::uint32_t>(nf++);
         if (id >= 0) nbrs.push_back(id);
         s.face_nbr.push_back(id);
       });
@@ -329,7 +329,7 @@ class CellsCompositor {
     s.pos.resize((p0 + nv) * D);  // at most; trimmed below
     kernels::Corners<D>* corners = s.corners.data() + v0;
     double* pos = s.pos.data() + p0 * D;
-    const std::uint16_t* face_of = b.face_of.data();
+    const std::uint32_t* face_of = b.face_of.data();
     std::size_t kept = 0, back = nv;
     for (std::size_t t = 0; t < nv; ++t) {
       const bool owned = first_inside(vertex_key(cell, t)) == gen;

@@ -261,6 +261,49 @@ TEST(Invariants, HugeCell3D) {
   }
 }
 
+TEST(Invariants, HugeCell2D) {
+  // Polygons past 65,534 edges: a tile's local plane indices are 32-bit
+  // since stop 57 (before, these failed with a length error). The centre of
+  // 70,000 points on a circle, its cell assembled from its star, with the
+  // mesh, on 1 and 2 threads. (By the search its clips are quadratic in its
+  // edges; the insertion is the automatic method's choice there.)
+  const int m = 70000;
+  std::vector<double> pts = random_points(static_cast<std::size_t>(m), 2, 94);
+  for (int i = 0; i < m; ++i) {
+    const double a = 2 * std::numbers::pi * pts[2 * i];
+    pts[2 * i] = std::cos(a);
+    pts[2 * i + 1] = std::sin(a);
+  }
+  pts.insert(pts.end(), {0.0, 0.0});
+  for (int threads : {1, 2}) {
+    tessera::VoronoiOptions o = options(2, std::nullopt, threads);
+    o.cell_method = tessera::CellMethod::insertion;
+    const tessera::Cells c = tessera::voronoi(pts, 2, {}, o);
+    check_invariants(c, pts, {}, "70,000 circle points + centre");
+    EXPECT_EQ(c.assembled_from_stars, c.n_cells());
+    EXPECT_EQ(c.num_faces[c.cell_of[m]], m);
+  }
+  // Points on a parabola (t, t^2): the triangulation fans from the end at
+  // t = 0, whose star holds every point (past the 16-bit indices' 65,520),
+  // and thousands of its vertices are far out and ill-conditioned. It is
+  // assembled, those vertices solved exactly (Hull::assemble's rule): clipped
+  // by its 80,000 neighbours it took seconds, quadratic in them. (Not
+  // check_invariants: the needle cells' areas from the merged mesh differ
+  // from their own by up to ~1e-6, past its 1e-9, as before stop 57 at any
+  // size; the library's validation and the area sum hold.)
+  std::vector<double> curve = random_points(80000, 1, 95);
+  std::vector<double> parabola;
+  for (const double t : curve) parabola.insert(parabola.end(), {t, t * t});
+  const tessera::Cells c = tessera::voronoi(parabola, 2, {}, options(2));
+  EXPECT_TRUE(c.from_insertion);
+  EXPECT_EQ(c.n_cells(), curve.size());
+  EXPECT_EQ(c.assembled_from_stars, c.n_cells());
+  EXPECT_TRUE(tessera::validate(c, {}).ok);
+  double area = 0;
+  for (const double v : c.volume) area += v;
+  EXPECT_NEAR(area, box_volume(c.bounds, 2), 1e-12 * box_volume(c.bounds, 2));
+}
+
 // The centre of 3,000 points on a sphere, the only inside point: the pilot
 // measures so few generators too (one band of them all, capped), finds the
 // cell costly and takes it from its Delaunay star. Searched, its clips cost

@@ -10,6 +10,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <limits>
+#include <type_traits>
 #include <vector>
 
 #include "tessera/kernels/filter.hpp"
@@ -124,7 +125,7 @@ bool far_plane(const double* dirs, std::size_t k, const Plane* box, const Vertex
 /// a check), else the plane is dropped and true.
 template <int D, class Plane, class Vertices>
 bool drop_far_plane(std::vector<Plane>& planes, const Vertices& verts) {
-  const auto far = static_cast<std::uint16_t>(planes.size() - 1);
+  const auto far = static_cast<std::remove_cvref_t<decltype(verts.front().p[0])>>(planes.size() - 1);
   for (const auto& v : verts)
     for (int k = 0; k < D; ++k)
       if (v.p[k] == far) return false;
@@ -174,8 +175,8 @@ inline std::size_t exact_solves_paid(std::size_t m, std::size_t nt) { return m *
 /// (exact_ok false), where it is not worth it (worth_exact_solve). It then
 /// gets a NaN bound, and its cell is clipped instead (or, for a vertex the
 /// box cut made on the far plane, the box test gives the cell up).
-template <int D, class Plane>
-bool refuse_exact_solve(bool exact_ok, const double* y, const Plane* planes, const std::uint16_t* p) {
+template <int D, class Plane, class Index>
+bool refuse_exact_solve(bool exact_ok, const double* y, const Plane* planes, const Index* p) {
   for (int k = 0; k < D; ++k)
     if (planes[p[k]].id == far_plane_id) return true;
   return !exact_ok && !worth_exact_solve<D>(y, planes);

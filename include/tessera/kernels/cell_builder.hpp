@@ -66,6 +66,7 @@ template <class CellT>
 class CellBuilder {
  public:
   static constexpr int D = CellT::dim;
+  using Index = typename CellT::Index;  // the kernel's local plane index
 
   /// `tree`, when given, serves the cells of overfull bins (see KdTree) and
   /// long cells (certify_by_petals).
@@ -197,9 +198,12 @@ class CellBuilder {
     const std::size_t nt = star.size();
     nn_ = 0;
     if (slot_mark_.size() < loc_.size()) slot_mark_.assign(loc_.size(), 0);
-    ++mark_epoch_;  // from 1: no mark matches before its first cell
+    if (++mark_epoch_ == std::uint64_t{1} << 32) {  // wrapped: stale marks could read as this cell's
+      std::fill(slot_mark_.begin(), slot_mark_.end(), 0);
+      mark_epoch_ = 1;
+    }  // from 1: no mark matches before its first cell
     if (corners_.size() < D * nt) corners_.resize(D * nt);
-    std::uint16_t* const corners = corners_.data();
+    Index* const corners = corners_.data();
     // Each simplex's other vertices as local indices into nbr_ (their order
     // of first appearance), in the kernel's orientation: 2D (next, after
     // next) counter-clockwise; 3D an even permutation of the row that
@@ -222,8 +226,8 @@ class CellBuilder {
       else order = order3[c];
       for (int k = 0; k < D; ++k) {
         const std::size_t a = at[order[k]];
-        fits &= a < 0xFFF0;
-        corners[D * t + static_cast<std::size_t>(k)] = static_cast<std::uint16_t>(a);
+        fits &= a < CellT::max_assembled_planes;
+        corners[D * t + static_cast<std::size_t>(k)] = static_cast<Index>(a);
       }
     }
     const std::size_t m = nn_;
@@ -277,7 +281,7 @@ class CellBuilder {
         for (int d = 0; d < D; ++d) qs_[D * k + static_cast<std::size_t>(d)] = pj[d] - p[d];
         ids_[k] = loc_.id(nbr_[k]);
       }
-      const std::uint16_t* vc = D == 2 ? cycle_.data() : corners;
+      const Index* vc = D == 2 ? cycle_.data() : corners;
       if (cell.assemble(i, p, lo_, hi_, exact_, ids_.data(), qs_.data(), m, vc, nt, open)) {
         BuildStatus status;
         status.work = 4 * m;
@@ -295,21 +299,21 @@ class CellBuilder {
   /// generator's spatial neighbours, so their marks lie near in slot order.
   std::size_t local_index(std::uint32_t v) {
     std::uint64_t& mark = slot_mark_[v];
-    if ((mark >> 16) == mark_epoch_) return static_cast<std::size_t>(mark & 0xFFFF);
+    if ((mark >> 32) == mark_epoch_) return static_cast<std::size_t>(mark & 0xFFFFFFFF);
     const std::size_t k = nn_;
     if (nbr_.size() <= k) nbr_.resize(2 * k + 16);
     nbr_[k] = v;
     ++nn_;
-    mark = (mark_epoch_ << 16) | std::min<std::size_t>(k, 0xFFFF);
+    mark = (mark_epoch_ << 32) | std::min<std::size_t>(k, 0xFFFFFFFF);
     return k;
   }
 
   std::vector<std::uint32_t> nbr_;  // build_from_star: the star's vertices (slots), first appearance
-  std::vector<std::uint64_t> slot_mark_;  // per slot: (epoch << 16) | its index in nbr_
+  std::vector<std::uint64_t> slot_mark_;  // per slot: (epoch << 32) | its index in nbr_
   std::uint64_t mark_epoch_ = 0;
   std::size_t nn_ = 0;              // how many nbr_ holds
-  std::vector<std::uint16_t> corners_;  // D per simplex: indices into nbr_
-  std::vector<std::uint16_t> cycle_;  // 2D: corners in counter-clockwise order
+  std::vector<Index> corners_;  // D per simplex: indices into nbr_
+  std::vector<Index> cycle_;  // 2D: corners in counter-clockwise order
   std::vector<std::uint32_t> succ_;   // 2D: per neighbour, the simplex whose first corner it is
   std::vector<std::uint8_t> leaving_;  // 2D open star: per neighbour, some simplex's second corner
   std::vector<std::int32_t> ids_;

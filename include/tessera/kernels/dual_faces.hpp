@@ -14,14 +14,17 @@
 #include <cstdint>
 #include <limits>
 #include <span>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
 namespace tessera::kernels {
 
-/// A vertex of a cell in dual form: the indices of the D faces meeting there.
+/// A vertex of a cell in dual form: the indices of the D faces meeting there,
+/// as wide as the kernel's local plane index (Hull::Index 16 bits, Tile::Index
+/// 32: a polygon may have any number of edges).
 template <int D>
-using Corners = std::array<std::uint16_t, static_cast<std::size_t>(D)>;
+using Corners = std::array<std::conditional_t<D == 2, std::uint32_t, std::uint16_t>, static_cast<std::size_t>(D)>;
 
 /// Scratch of for_each_face_loop, reused across cells (one per thread).
 struct FaceLoopScratch {

@@ -43,7 +43,8 @@ class StageGate {
   std::uint64_t misses_ = 0, skipped_ = 0;
 };
 
-template <int D>
+/// `Index`: the kernel's local plane index (Hull::Index, Tile::Index).
+template <int D, class Index>
 class PreparedSigns {
  public:
   /// A new cell: every slot's preparation is stale.
@@ -57,7 +58,7 @@ class PreparedSigns {
   /// plane indices are p[0..D) and their ids ids[0..D). A slot's preparation
   /// stays valid while it holds the same local planes in the same cell (a
   /// cell's local plane indices only grow, and a removed vertex never returns).
-  int sign(const ExactContext& ctx, std::int32_t gen, std::size_t t, const std::uint16_t* p, const std::int32_t* ids,
+  int sign(const ExactContext& ctx, std::int32_t gen, std::size_t t, const Index* p, const std::int32_t* ids,
            std::int32_t j) {
     ++calls_;
     if (slots_.size() <= t) slots_.resize(t + 1);
@@ -98,7 +99,7 @@ class PreparedSigns {
   enum class Wide : std::uint8_t { untried, usable, unusable };
   struct Slot {
     std::uint64_t cell = 0;
-    std::uint16_t p[D] = {};
+    Index p[D] = {};
     bool grid = false;      // pred serves the vertex
     bool extended = false;  // ext prepared
     Wide wide = Wide::untried;

@@ -29,10 +29,19 @@ namespace tessera::kernels {
 class Tile {
  public:
   static constexpr int dim = 2;
+  /// A local plane's index (vertices hold two): 32 bits cost the tile
+  /// nothing (its vertex is 40 bytes either way, in padding), so a polygon
+  /// may have any number of edges, where the hull's are 16-bit. Before stop
+  /// 57 they were 16-bit too: the centre of 65,535 points on a circle, or
+  /// the end of 400k points on a parabola (whose triangulation fans from
+  /// it), failed with a length error, and past 65,520 neighbours a star
+  /// could not be assembled and was clipped, quadratic in them.
+  using Index = std::uint32_t;
   /// The domain box's planes are always the tile's first local planes.
-  static constexpr std::uint16_t box_planes = 4;
-  /// The most bisectors assemble() takes (as Hull's: 16-bit plane indices).
-  static constexpr std::size_t max_assembled_planes = 0xFFF0;
+  static constexpr Index box_planes = 4;
+  /// The most bisectors assemble() takes: any star (its neighbours are
+  /// input points, fewer than 2^31).
+  static constexpr std::size_t max_assembled_planes = 0xFFFFFFF0;
   struct Plane {
     double n[2];
     double d;
@@ -44,14 +53,15 @@ class Tile {
     double y[2];
     double e;            // err + plane_eps * |y|_inf (see hull.hpp)
     double r2;           // upper bound on the exact |y|^2
-    std::uint16_t p[2];  // [0] = plane of the edge arriving, [1] = of the edge leaving
+    Index p[2];  // [0] = plane of the edge arriving, [1] = of the edge leaving
   };
+  static_assert(sizeof(Vertex) == 40, "32-bit plane indices fill what was padding");
 
   void reset(std::int32_t gen, const double* p, const double* lo, const double* hi,
              const ExactContext* exact) {
     start(gen, p, lo, hi, exact);
     // Corners counter-clockwise from (lo, lo); local planes x0=0, x1=1, y0=2, y1=3.
-    const std::uint16_t in[4] = {0, 2, 1, 3}, out[4] = {2, 1, 3, 0};
+    const Index in[4] = {0, 2, 1, 3}, out[4] = {2, 1, 3, 0};
     const int cx[4] = {0, 1, 1, 0}, cy[4] = {0, 0, 1, 1};
     verts_.resize(4);
     for (int c = 0; c < 4; ++c) {
@@ -83,8 +93,7 @@ class Tile {
       security2_ = 0;
       return ClipResult::emptied;
     }
-    if (planes_.size() + 1 >= 0xFFFF) throw std::length_error("a tile has more than 65534 edges (one point with that many neighbours)");
-    const std::uint16_t pn = static_cast<std::uint16_t>(planes_.size());
+    const Index pn = static_cast<Index>(planes_.size());
     Plane& pl = planes_.emplace_back();  // written in place (see reset)
     pl.n[0] = b.n[0]; pl.n[1] = b.n[1];
     pl.d = b.d;
@@ -98,7 +107,7 @@ class Tile {
  private:
   // Replace the run of vertices sign_ marks removed (-1; `removed` of the
   // nv, not all) by two on local plane pn: a clip's work after its sign pass.
-  void cut(std::uint16_t pn, std::size_t nv, std::size_t removed) {
+  void cut(Index pn, std::size_t nv, std::size_t removed) {
     // The removed vertices form one cyclic run (the polygon is convex). It is
     // replaced in place by a (leaving: the edge plane of the last kept vertex,
     // then the new plane) and b (entering: the new plane, then the edge plane
@@ -108,7 +117,7 @@ class Tile {
     //   vertex 0 removed: b [k0 .. k1] a               (kept run k0 .. k1)
     const std::size_t kept = nv - removed;
     // The new vertices are built in their slots (see reset on why not copied in).
-    auto make = [&](std::size_t ta, std::uint16_t a0, std::size_t tb, std::uint16_t b1) {
+    auto make = [&](std::size_t ta, Index a0, std::size_t tb, Index b1) {
       Vertex& va = verts_[ta];
       Vertex& vb = verts_[tb];
       va.p[0] = a0;
@@ -124,7 +133,7 @@ class Tile {
       std::size_t r0 = 1;
       while (sign_[r0] > 0) ++r0;
       const std::size_t e1 = r0 + removed;  // first slot after the run (nv: none)
-      const std::uint16_t a0 = verts_[r0 - 1].p[1], b1 = verts_[e1 % nv].p[0];
+      const Index a0 = verts_[r0 - 1].p[1], b1 = verts_[e1 % nv].p[0];
       const std::size_t tail = nv - e1;
       if (removed != 2) {
         filter::shift(verts_.data(), r0 + 2, e1, tail);
@@ -134,7 +143,7 @@ class Tile {
     } else {
       std::size_t k0 = 1;
       while (sign_[k0] < 0) ++k0;
-      const std::uint16_t b1 = verts_[k0].p[0], a0 = verts_[k0 + kept - 1].p[1];
+      const Index b1 = verts_[k0].p[0], a0 = verts_[k0 + kept - 1].p[1];
       if (k0 != 1) {
         filter::shift(verts_.data(), 1, k0, kept);
         lanes_.move(1, k0, kept);
@@ -160,37 +169,49 @@ class Tile {
   /// its ray crosses a far line (assembly::far_plane), which closes the
   /// cycle, and the box cuts them away.
   bool assemble(std::int32_t gen, const double* p, const double* lo, const double* hi, const ExactContext* exact,
-                const std::int32_t* ids, const double* q, std::size_t m, const std::uint16_t* corners,
+                const std::int32_t* ids, const double* q, std::size_t m, const Index* corners,
                 std::size_t nt, bool open = false) {
     start(gen, p, lo, hi, exact);
     if (may_underflow_ || m > max_assembled_planes) return false;
     assembly::bisector_planes<2>(planes_, box_planes, ids, q, m);
     verts_.resize(open ? nt + 2 : nt);
     for (std::size_t t = 0; t < nt; ++t) {
-      verts_[t].p[0] = static_cast<std::uint16_t>(box_planes + corners[2 * t]);
-      verts_[t].p[1] = static_cast<std::uint16_t>(box_planes + corners[2 * t + 1]);
+      verts_[t].p[0] = box_planes + corners[2 * t];
+      verts_[t].p[1] = box_planes + corners[2 * t + 1];
     }
     for (std::size_t t = 0; t + 1 < nt; t += 2) solve_pair(verts_[t], verts_[t + 1], false);
     if (nt % 2 != 0) solve(verts_[nt - 1], false);
+    // Vertices too ill-conditioned for the float solve that lie far out
+    // (refuse_exact_solve) are solved exactly after all, as long as that
+    // costs less than clipping the cell (Hull::assemble's rule): the end
+    // of points on a parabola, whose star holds nearly every point, has
+    // thousands of them, and clipping it was quadratic (100k points: 1.0 s).
+    const std::size_t may_refuse = assembly::exact_solves_paid(m, nt);
+    std::size_t refused = 0;
+    for (std::size_t t = 0; t < nt; ++t)
+      if (!(verts_[t].e <= std::numeric_limits<double>::max())) {
+        if (++refused > may_refuse) return false;
+        solve(verts_[t], true);
+      }
     if (open) {
       // Hull edges (p, s) at the chain's start and (p, e) at its end: the
       // fan lies counter-clockwise from s to e, the outside beyond them, so
       // their outward normals are q_s turned clockwise and q_e
       // counter-clockwise (exact turns), the rays' directions.
-      const std::uint16_t s = corners[0], e = corners[2 * nt - 1];
+      const Index s = corners[0], e = corners[2 * nt - 1];
       const double* qs = q + 2 * s;
       const double* qe = q + 2 * e;
       const double ls = std::hypot(qs[0], qs[1]), le = std::hypot(qe[0], qe[1]);
       const double dirs[4] = {qs[1] / ls, -qs[0] / ls, -qe[1] / le, qe[0] / le};
-      const std::uint16_t far = static_cast<std::uint16_t>(planes_.size());
+      const Index far = static_cast<Index>(planes_.size());
       Plane& pf = planes_.emplace_back();
       if (!assembly::far_plane<2>(dirs, 2, planes_.data(), verts_.data(), nt, pf)) return false;
       Vertex& ve = verts_[nt];  // leaving along e's ray, arriving on the far line
       Vertex& vs = verts_[nt + 1];
-      ve.p[0] = static_cast<std::uint16_t>(box_planes + e);
+      ve.p[0] = box_planes + e;
       ve.p[1] = far;
       vs.p[0] = far;
-      vs.p[1] = static_cast<std::uint16_t>(box_planes + s);
+      vs.p[1] = box_planes + s;
       solve_pair(ve, vs, false);  // never exact: on the far line
     }
     lanes_.assign(verts_);
@@ -217,7 +238,7 @@ class Tile {
   // The assembled tile cut by the domain box's planes, each decided by the
   // float filter alone (as Hull::clip_to_box).
   bool clip_to_box() {
-    for (std::uint16_t k = 0; k < box_planes; ++k) {
+    for (Index k = 0; k < box_planes; ++k) {
       const std::size_t nv = verts_.size();
       const std::size_t removed = assembly::box_signs(verts_.data(), nv, k, planes_[k].d, sign_);
       if (removed == assembly::undecided || removed == nv) return false;
@@ -238,7 +259,7 @@ class Tile {
     // Planes and corners are written in place: a local struct copied in
     // would be read back wider than it was written (a store-forwarding stall).
     planes_.resize(box_planes);
-    for (int k = 0; k < box_planes; ++k) {
+    for (int k = 0; k < static_cast<int>(box_planes); ++k) {
       const int axis = k / 2;
       const bool upper = k & 1;
       Plane& pl = planes_[static_cast<std::size_t>(k)];
@@ -395,7 +416,7 @@ class Tile {
   filter::FilterLanes<2> lanes_;  // verts_' filter data, for the sign pass
   std::vector<filter::Sign> sign_;
   double security2_ = 0;
-  PreparedSigns<2> signs_;  // the exact stages, prepared per vertex slot
+  PreparedSigns<2, Index> signs_;  // the exact stages, prepared per vertex slot
 };
 
 }  // namespace tessera::kernels
