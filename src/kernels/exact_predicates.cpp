@@ -536,7 +536,6 @@ int VertexPredicate::sign(const ExactContext& ctx, std::int32_t j) const {
 // ---- WidePredicate (see the header for the bounds) ----
 
 bool WidePredicate::prepare(const ExactContext& ctx, std::int32_t i, const std::int32_t* planes, std::int32_t also) {
-  using I = __int128;
   dim_ = ctx.dim;
   i_ = i;
   if (dim_ != 2 && dim_ != 3) return false;
@@ -551,35 +550,9 @@ bool WidePredicate::prepare(const ExactContext& ctx, std::int32_t i, const std::
   // The grid as fine as the bound allows, up to two bits of headroom above:
   // candidates near the vertex may reach a binade lower or higher.
   shift_ = std::min(span.shift, span.top + 2 - bits);
-  for (int d = 0; d < dim_; ++d) ci_[d] = on_grid(pv[dim_][d], shift_);
-  std::int64_t a[Scratch::kMaxDim][Scratch::kMaxDim] = {};
-  for (int r = 0; r < dim_; ++r) {
-    if (gen_[r] >= 0) {
-      I sq = 0;
-      for (int d = 0; d < dim_; ++d) {
-        const std::int64_t q = on_grid(pv[r][d], shift_) - ci_[d];
-        a[r][d] = 2 * q;
-        sq += static_cast<I>(q) * q;
-      }
-      b_[r] = sq;
-    } else {
-      const int axis = box_plane_axis(gen_[r]);
-      a[r][axis] = 1;
-      b_[r] = on_grid(pv[r][0], shift_) - ci_[axis];
-    }
-  }
-  if (dim_ == 2) {
-    cof_[0][0] = a[1][1]; cof_[0][1] = -a[1][0];
-    cof_[1][0] = -a[0][1]; cof_[1][1] = a[0][0];
-  } else {
-    for (int r = 0; r < 3; ++r) {
-      const std::int64_t* u = a[(r + 1) % 3];
-      const std::int64_t* w = a[(r + 2) % 3];
-      cof_[r][0] = static_cast<I>(u[1]) * w[2] - static_cast<I>(u[2]) * w[1];
-      cof_[r][1] = static_cast<I>(u[2]) * w[0] - static_cast<I>(u[0]) * w[2];
-      cof_[r][2] = static_cast<I>(u[0]) * w[1] - static_cast<I>(u[1]) * w[0];
-    }
-  }
+  std::int64_t a[Scratch::kMaxDim][Scratch::kMaxDim];
+  exact_rows::relative_rows(pv, gen_, dim_, shift_, ci_, a, b_);
+  exact_rows::cofactors(a, dim_, cof_);
   det_a_ = WideInt<3>::from(0);
   for (int d = 0; d < dim_; ++d)
     det_a_ = det_a_ + multiply(WideInt<1>::from_int64(a[0][d]), WideInt<2>::from(cof_[0][d]));

@@ -59,6 +59,51 @@ inline std::int64_t on_grid(const DoubleParts& pt, int shift) {
 void row_parts(const ExactContext& ctx, std::int32_t i, const std::int32_t* gen, int rows, DoubleParts (*pv)[3],
                GridScale& span);
 
+// A vertex's rows relative to p_i on the grid of step 2^shift, from the
+// doubles' parts as row_parts leaves them (p_i in pv[dim]): a bisector's row
+// a = 2 q, b = |q|^2 with q = p_k - p_i; a box plane's the unit axis and
+// its bound less p_i; ci = p_i on the grid. Every value must lie on the
+// grid below 2^61: |a| < 2^62, b < 3 2^122.
+inline void relative_rows(const DoubleParts (*pv)[3], const std::int32_t* planes, int dim, int shift,
+                          std::int64_t* ci, std::int64_t (*a)[3], __int128* b) {
+  for (int d = 0; d < dim; ++d) ci[d] = on_grid(pv[dim][d], shift);
+  for (int r = 0; r < dim; ++r) {
+    for (int d = 0; d < 3; ++d) a[r][d] = 0;
+    if (planes[r] >= 0) {
+      __int128 sq = 0;
+      for (int d = 0; d < dim; ++d) {
+        const std::int64_t q = on_grid(pv[r][d], shift) - ci[d];
+        a[r][d] = 2 * q;
+        sq += static_cast<__int128>(q) * q;
+      }
+      b[r] = sq;
+    } else {
+      const int axis = box_plane_axis(planes[r]);
+      a[r][axis] = 1;
+      b[r] = on_grid(pv[r][0], shift) - ci[axis];
+    }
+  }
+}
+
+// cof[r][d]: the cofactor of a[r][d] (2D or 3D; below 2^125 for |a| < 2^62),
+// so that det A = sum_d a[0][d] cof[0][d] and Cramer's numerator d is
+// sum_r b[r] cof[r][d].
+inline void cofactors(const std::int64_t (*a)[3], int dim, __int128 (*cof)[3]) {
+  using I = __int128;
+  if (dim == 2) {
+    cof[0][0] = a[1][1], cof[0][1] = -a[1][0];
+    cof[1][0] = -a[0][1], cof[1][1] = a[0][0];
+    return;
+  }
+  for (int r = 0; r < 3; ++r) {
+    const std::int64_t* u = a[(r + 1) % 3];
+    const std::int64_t* w = a[(r + 2) % 3];
+    cof[r][0] = static_cast<I>(u[1]) * w[2] - static_cast<I>(u[2]) * w[1];
+    cof[r][1] = static_cast<I>(u[2]) * w[0] - static_cast<I>(u[0]) * w[2];
+    cof[r][2] = static_cast<I>(u[0]) * w[1] - static_cast<I>(u[1]) * w[0];
+  }
+}
+
 // det of the k x k matrix formed by rows `rows` of a (k = 2 or 3).
 void det_rows(mpz_t out, mpz_t (*a)[Scratch::kMaxDim], const int* rows, int k, Scratch& s);
 

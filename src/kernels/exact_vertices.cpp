@@ -66,39 +66,10 @@ bool vertex_numerators_narrow(const ExactContext& ctx, std::int32_t i, const std
   exact_rows::row_parts(ctx, i, planes, dim, pv, span);
   if (span.all_zero() || !span.fits(60)) return false;
   shift = span.scale();
-  std::int64_t ci[3], a[3][3] = {};
-  I b[3];
-  for (int d = 0; d < dim; ++d) ci[d] = exact_rows::on_grid(pv[dim][d], shift);
-  for (int r = 0; r < dim; ++r) {
-    if (planes[r] >= 0) {
-      I sq = 0;
-      for (int d = 0; d < dim; ++d) {
-        const std::int64_t q = exact_rows::on_grid(pv[r][d], shift) - ci[d];
-        a[r][d] = 2 * q;
-        sq += static_cast<I>(q) * q;
-      }
-      b[r] = sq;
-    } else {
-      const int axis = box_plane_axis(planes[r]);
-      a[r][axis] = 1;
-      b[r] = exact_rows::on_grid(pv[r][0], shift) - ci[axis];
-    }
-  }
-  // cof[r][d]: the cofactor of a[r][d]. det A = sum_d a[0][d] cof[0][d];
-  // Cramer's numerator d = sum_r b[r] cof[r][d].
-  I cof[3][3];
-  if (dim == 2) {
-    cof[0][0] = a[1][1], cof[0][1] = -a[1][0];
-    cof[1][0] = -a[0][1], cof[1][1] = a[0][0];
-  } else {
-    for (int r = 0; r < 3; ++r) {
-      const std::int64_t* u = a[(r + 1) % 3];
-      const std::int64_t* w = a[(r + 2) % 3];
-      cof[r][0] = static_cast<I>(u[1]) * w[2] - static_cast<I>(u[2]) * w[1];
-      cof[r][1] = static_cast<I>(u[2]) * w[0] - static_cast<I>(u[0]) * w[2];
-      cof[r][2] = static_cast<I>(u[0]) * w[1] - static_cast<I>(u[1]) * w[0];
-    }
-  }
+  std::int64_t ci[3], a[3][3];
+  I b[3], cof[3][3];
+  exact_rows::relative_rows(pv, planes, dim, shift, ci, a, b);
+  exact_rows::cofactors(a, dim, cof);
   WideInt<3> det = WideInt<3>::from(0);
   for (int d = 0; d < dim; ++d) det = det + multiply(WideInt<1>::from_int64(a[0][d]), WideInt<2>::from(cof[0][d]));
   if (det.sign() == 0) throw std::logic_error("exact_vertex: vertex planes are dependent (corrupt cell)");

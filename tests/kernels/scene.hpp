@@ -45,6 +45,13 @@ struct Scene {
   }
   template <class CellT>
   void reset(CellT& c, std::int32_t i) const { c.reset(i, p(i), lo.data(), hi.data(), &ctx); }
+  /// Point i's cell clipped by every other point: the brute-force oracle.
+  template <class CellT>
+  void clip_by_all(CellT& c, std::int32_t i) const {
+    reset(c, i);
+    for (std::int32_t j = 0; j < size(); ++j)
+      if (j != i) clip(c, j);
+  }
   template <class CellT>
   ClipResult clip(CellT& c, std::int32_t j) const {
     double q[D];

@@ -492,9 +492,7 @@ void exact_measure_test(const Scene<CellT::dim>& s) {
   std::vector<tessera::kernels::MeasureTerm> terms;
   for (std::int32_t i = 0; i < s.size(); ++i) {
     CellT c;
-    s.reset(c, i);
-    for (std::int32_t j = 0; j < s.size(); ++j)
-      if (j != i) s.clip(c, j);
+    s.clip_by_all(c, i);
     measure_input(c, vp, terms);
     double centroid[D];
     const double vol = tessera::kernels::exact_cell_measure(s.ctx, i, vp, terms, centroid);
@@ -602,9 +600,7 @@ void fixed_point_tier_test(const Scene<CellT::dim>& s, double certified) {
   int sure = 0;
   for (std::int32_t i = 0; i < s.size(); ++i) {
     CellT c;
-    s.reset(c, i);
-    for (std::int32_t j = 0; j < s.size(); ++j)
-      if (j != i) s.clip(c, j);
+    s.clip_by_all(c, i);
     measure_input(c, vp, terms);
     double exact_centroid[D], fixed_centroid[D], centroid[D];
     const double exact = tessera::kernels::rational_cell_measure(s.ctx, i, vp, terms, exact_centroid);
