@@ -345,8 +345,8 @@ double rational_cell_measure(const ExactContext& ctx, std::int32_t i, std::span<
 /// (then the doubles rational_cell_measure gives); false where the bounds
 /// leave them undetermined (cancellation deeper than the bits kept, an
 /// exactly zero centroid coordinate, or results outside [2^-1000, 2^1000]),
-/// with `*wanted` (if given) the bits likely to certify them, or 0 where
-/// no number would (a zero sum or moment).
+/// with `*wanted` (if given) the bits likely to certify them (twice `bits`
+/// where a sum or moment came out zero, which gives no measure).
 bool fixed_point_cell_measure(const ExactContext& ctx, std::int32_t i, std::span<const std::int32_t> vertex_planes,
                               std::span<const MeasureTerm> terms, long bits, double& volume, double* centroid,
                               long* wanted = nullptr);
