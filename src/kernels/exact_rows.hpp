@@ -23,21 +23,21 @@ struct Scratch {
   mpz_t b[kRows];                   // last column of M without weights
   mpz_t minor[kRows];               // minors of M without its last column
   mpz_t t0, t1, t2, acc;
-  Scratch() {
-    for (auto& r : coord) for (auto& c : r) mpz_init(c);
-    for (auto& c : box) mpz_init(c);
-    for (auto& r : a) for (auto& c : r) mpz_init(c);
-    for (auto& c : b) mpz_init(c);
-    for (auto& c : minor) mpz_init(c);
-    mpz_init(t0); mpz_init(t1); mpz_init(t2); mpz_init(acc);
-  }
-  ~Scratch() {
-    for (auto& r : coord) for (auto& c : r) mpz_clear(c);
-    for (auto& c : box) mpz_clear(c);
-    for (auto& r : a) for (auto& c : r) mpz_clear(c);
-    for (auto& c : b) mpz_clear(c);
-    for (auto& c : minor) mpz_clear(c);
-    mpz_clear(t0); mpz_clear(t1); mpz_clear(t2); mpz_clear(acc);
+  Scratch() { each(mpz_init); }
+  ~Scratch() { each(mpz_clear); }
+  Scratch(const Scratch&) = delete;
+  Scratch& operator=(const Scratch&) = delete;
+
+ private:
+  // f on every integer above: the one list that init and clear share.
+  template <class F>
+  void each(F f) {
+    for (auto& r : coord) for (auto& c : r) f(c);
+    for (auto& c : box) f(c);
+    for (auto& r : a) for (auto& c : r) f(c);
+    for (auto& c : b) f(c);
+    for (auto& c : minor) f(c);
+    for (mpz_ptr c : {t0, t1, t2, acc}) f(c);
   }
 };
 
