@@ -143,6 +143,7 @@ class Triangulation {
   void insert_round(std::vector<std::int32_t> pts, std::size_t end, std::size_t parallel_min, Placed&& placed) {
     const std::size_t total = pts.size();
     const std::size_t threads = workers_.size();
+    if (!pts.empty()) update_centre(static_cast<std::size_t>(pts.front()));
     int cut_axis = -1;
     for (int k = 0; k < 2 && parallel_ && threads > 1 && pts.size() >= parallel_min * threads; ++k) {
       const std::size_t tried = pts.size();
@@ -162,6 +163,7 @@ class Triangulation {
     W& w = workers_[0];
     w.last = hint_;
     w.prev = -1;
+    w.hull_ghost = -1;
     const std::size_t before = total - pts.size();
     for (std::size_t k = 0; k < pts.size(); ++k) {
       if (w.epoch >= insertion::epoch_limit) insertion::reset_marks(store_, workers_);
@@ -241,6 +243,7 @@ class Triangulation {
       w.deferred.clear();
       w.last = -1;
       w.prev = -1;
+      w.hull_ghost = -1;
       const std::size_t tries = std::min<std::size_t>(mine[t].size(), 64);
       for (std::size_t k = 0; k < tries && w.last < 0; ++k) {
         const std::int32_t t0 = locate<false>(w, mine[t][k * mine[t].size() / tries], walk_from);
@@ -280,7 +283,12 @@ class Triangulation {
   /// fresh slot is left: nothing has been changed then.
   template <bool Check>
   bool insert(W& w, std::int32_t q) {
-    const std::int32_t t0 = locate<Check>(w, q, walk_start<Check>(w, q));
+    const bool after_hull = w.hull_ghost >= 0;
+    const bool by_hull = after_hull && w.prefers_hull_walk();
+    const std::size_t steps_before = w.steps;
+    std::int32_t t0 = by_hull ? hull_walk<Check>(w, q, w.hull_ghost) : -1;
+    if (t0 < 0) t0 = locate<Check>(w, q, walk_start<Check>(w, q));
+    if (after_hull) w.walked(by_hull, w.steps - steps_before);
     if (t0 < 0) return false;
     w.epoch += static_cast<std::uint32_t>(workers_.size());
     const std::uint32_t mark_out = w.epoch << 1, mark_in = mark_out | 1;
@@ -358,6 +366,7 @@ class Triangulation {
       shift = 64 - std::countr_zero(w.edges.size());
       w.used.clear();
     }
+    w.hull_ghost = -1;
     for (const Facet& f : w.boundary) {
       const std::int32_t nt = w.allocate(store_);
       S& t = ss[nt];
@@ -366,6 +375,7 @@ class Triangulation {
         // Every vertex of a removed simplex lies on the cavity's boundary,
         // so each keeps a live one.
         if (f.v[m] != infinite) vsimplex_[static_cast<std::size_t>(f.v[m])] = nt;
+        else w.hull_ghost = nt;  // q lay outside the hull: the next walk may go along it
       }
       t.n[f.k] = across(f.outside, f.back);
       ss[f.outside].n[f.back] = across(nt, f.k);
@@ -499,6 +509,76 @@ class Triangulation {
     return kernels::in_sphere_past_filter(ctx_, global(t.v[0]), planes, global(q));
   }
 
+  /// The walk for a point q after one that lay outside the hull: from ghost
+  /// g (that point's), over the hull's ghosts, to the one whose facet the
+  /// ray from centre_ through q crosses. Such a facet is the one a point
+  /// outside the hull sees first, so where that ghost is in conflict with
+  /// q (the exact test: q beyond its facet, or on its plane within the
+  /// circumcircle), it is returned, as insert needs no more than a simplex
+  /// in conflict. Otherwise (q inside the hull, or the walk took too long) -1,
+  /// and locate walks as ever; with Check also -1 where the walk would
+  /// leave w's ghosts. For surface samples, where every point lies on the
+  /// hull when inserted: locate's straight walk between consecutive points
+  /// crosses the needle tetrahedra along the chord, 417 steps a point on a
+  /// thin cylindrical band (71 on a tall cylinder), where the hull's facets
+  /// between them are a few. The steps' sides are float tests, each
+  /// against a plane through centre_ and the facet's vertices but one: a
+  /// wrong sign only lengthens the walk, as the answer is checked exactly.
+  /// (The facets' cones from a point inside the hull tile space, so this is
+  /// a visibility walk in a central projection of the hull.)
+  template <bool Check>
+  std::int32_t hull_walk(W& w, std::int32_t q, std::int32_t g) {
+    constexpr int step_limit = 256;
+    const S* const ss = store_.simplices();
+    const double* const x = at(q);
+    for (int step = 0; step < step_limit; ++step) {
+      const S& t = ss[g];
+      const int inf = infinite_slot(t);
+      w.rng = w.rng * 6364136223846793005ull + 1442695040888963407ull;
+      const unsigned first = static_cast<unsigned>(w.rng >> 33) % K;
+      std::int32_t next = -1;
+      for (unsigned i = 0; i < K && next < 0; ++i) {
+        const int k = static_cast<int>((first + i) % K);
+        if (k == inf) continue;
+        // The plane through centre_ and the facet's vertices but v[k]:
+        // crossing it away from v[k] leads to the ghost across from v[k].
+        const double* e[D - 1] = {};
+        for (int m = 0, c = 0; m < K; ++m)
+          if (m != k && m != inf) e[c++] = at(t.v[m]);
+        const double sv = side_of_centre_plane(e, at(t.v[k])), sq = side_of_centre_plane(e, x);
+        if ((sv > 0 && sq < 0) || (sv < 0 && sq > 0)) next = simplex_of(t.n[k]);
+      }
+      if (next < 0) return conflicts(g, q) ? g : -1;
+      if (Check && !owned(ss[next], w.part)) return -1;
+      ++w.steps;
+      g = next;
+    }
+    return -1;
+  }
+
+  // The sign (in floats) of x against the plane (2D: line) through
+  // centre_ and e[0..D-1): det(e - centre, ..., x - centre).
+  double side_of_centre_plane(const double* const* e, const double* x) const {
+    const double* c = centre_;
+    if constexpr (D == 2) {
+      return (e[0][0] - c[0]) * (x[1] - c[1]) - (e[0][1] - c[1]) * (x[0] - c[0]);
+    } else {
+      const double a0 = e[0][0] - c[0], a1 = e[0][1] - c[1], a2 = e[0][2] - c[2];
+      const double b0 = e[1][0] - c[0], b1 = e[1][1] - c[1], b2 = e[1][2] - c[2];
+      const double x0 = x[0] - c[0], x1 = x[1] - c[1], x2 = x[2] - c[2];
+      return a0 * (b1 * x2 - b2 * x1) - a1 * (b0 * x2 - b2 * x0) + a2 * (b0 * x1 - b1 * x0);
+    }
+  }
+
+  // centre_: the mean of vertices [0, end), all inserted, so it lies in
+  // their hull (hull_walk's centre of projection), which only grows.
+  void update_centre(std::size_t end) {
+    for (; centre_count_ < end; ++centre_count_)
+      for (int d = 0; d < D; ++d) centre_sum_[d] += at(static_cast<std::int32_t>(centre_count_))[d];
+    if (centre_count_ > 0)
+      for (int d = 0; d < D; ++d) centre_[d] = centre_sum_[d] / static_cast<double>(centre_count_);
+  }
+
   /// A simplex whose closure holds q, or a ghost whose facet q lies strictly
   /// beyond: a visibility walk from `from`, which tries the facets from a
   /// varying first one (a stochastic walk terminates; Devillers, Pion &
@@ -560,6 +640,9 @@ class Triangulation {
   std::vector<W> workers_;
   std::vector<std::uint8_t> part_;  // vertex -> partition, in a parallel phase
   std::int32_t hint_ = 0;           // a live simplex: the serial walk's start
+  double centre_[D] = {};            // hull_walk's centre of projection (update_centre)
+  double centre_sum_[D] = {};
+  std::size_t centre_count_ = 0;
   bool parallel_ = true;            // whether rounds still try parallel phases
   InsertionStats stats_;
 };

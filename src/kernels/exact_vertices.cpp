@@ -47,6 +47,14 @@ void set_wide(mpz_ptr out, WideInt<N> x) {
   if (negative) mpz_neg(out, out);
 }
 
+// A vertex's Cramer numerators and determinant in fixed-width integers:
+// y[d] = num[d] / det * 2^shift relative to p_i (vertex_numerators).
+struct GridNumerators {
+  WideInt<8> num[3];
+  WideInt<6> det;
+  int shift = 0;
+};
+
 // vertex_numerators in 64- to 256-bit integers, where p_i and the planes'
 // points and bounds lie on one grid of at most 60 bits (every input whose
 // coordinates share a scale): the rows relative to p_i, a = 2 q with
@@ -55,17 +63,11 @@ void set_wide(mpz_ptr out, WideInt<N> x) {
 // 2^189 and the numerators (b times cofactors) below 2^251. The same
 // rationals as in GMP throughout (build_rows, det_rows), which cost 40% of a
 // chain of near copies' cells (4 determinants, each a few dozen GMP calls).
-// False off such a grid.
-bool vertex_numerators_narrow(const ExactContext& ctx, std::int32_t i, const std::int32_t* planes, Scratch& s,
-                              int& shift) {
+// pv: the rows' doubles as row_parts leaves them, on the grid of step
+// 2^shift.
+void vertex_numerators_narrow(const DoubleParts (*pv)[Scratch::kMaxDim], const std::int32_t* planes, int dim,
+                              int shift, GridNumerators& g) {
   using I = __int128;
-  const int dim = ctx.dim;
-  if (dim != 2 && dim != 3) return false;
-  DoubleParts pv[Scratch::kRows][Scratch::kMaxDim];
-  GridScale span;
-  exact_rows::row_parts(ctx, i, planes, dim, pv, span);
-  if (span.all_zero() || !span.fits(60)) return false;
-  shift = span.scale();
   std::int64_t ci[3], a[3][3];
   I b[3], cof[3][3];
   exact_rows::relative_rows(pv, planes, dim, shift, ci, a, b);
@@ -73,13 +75,135 @@ bool vertex_numerators_narrow(const ExactContext& ctx, std::int32_t i, const std
   WideInt<3> det = WideInt<3>::from(0);
   for (int d = 0; d < dim; ++d) det = det + multiply(WideInt<1>::from_int64(a[0][d]), WideInt<2>::from(cof[0][d]));
   if (det.sign() == 0) throw std::logic_error("exact_vertex: vertex planes are dependent (corrupt cell)");
-  set_wide(s.minor[dim], det);
+  g.det = det.widen<6>();
   for (int d = 0; d < dim; ++d) {
     WideInt<4> n = WideInt<4>::from(0);
     for (int r = 0; r < dim; ++r) n = n + multiply(WideInt<2>::from(b[r]), WideInt<2>::from(cof[r][d]));
-    set_wide(s.minor[d], n);
+    g.num[d] = n.widen<8>();
   }
+}
+
+// x / 2^shift for x = pt on a grid of step 2^shift, below 2^124 (as
+// exact_rows::on_grid, in 128 bits).
+__int128 on_wide_grid(const DoubleParts& pt, int shift) {
+  if (pt.mant == 0) return 0;
+  const int k = pt.e2 - shift;
+  return k >= 0 ? static_cast<__int128>(pt.mant) * (static_cast<__int128>(1) << k) : pt.mant >> -k;
+}
+
+// vertex_numerators_narrow for a grid of 61 to 124 bits: random doubles in
+// [0, 1) whose smallest coordinate is ~1e-3 already need 64 (points on a
+// thin cylindrical band solve ~40 vertices of each cell exactly, with
+// grids of 60 to 76 bits). Rows relative to p_i: |q| < 2^125, a = 2 q
+// below 2^126, b = |q|^2 below 3 2^250 (a box row's b below 2^125); the
+// cofactors (differences of products of a) below 2^253, det A below
+// 3 2^126 2^253 < 2^381 and the numerators below 3 (3 2^250) 2^253 < 2^507:
+// 2, 4, 4, 6 and 8 limbs, each a signed value within its width.
+void vertex_numerators_wide(const DoubleParts (*pv)[Scratch::kMaxDim], const std::int32_t* planes, int dim,
+                            int shift, GridNumerators& g) {
+  using I = __int128;
+  using W2 = WideInt<2>;
+  using W4 = WideInt<4>;
+  I ci[3] = {0, 0, 0}, a[3][3] = {};
+  W4 b[3];
+  for (int d = 0; d < dim; ++d) ci[d] = on_wide_grid(pv[dim][d], shift);
+  for (int r = 0; r < dim; ++r) {
+    if (planes[r] >= 0) {
+      W4 sq = W4::from(0);
+      for (int d = 0; d < dim; ++d) {
+        const I q = on_wide_grid(pv[r][d], shift) - ci[d];
+        a[r][d] = 2 * q;
+        sq = sq + multiply(W2::from(q), W2::from(q));
+      }
+      b[r] = sq;
+    } else {
+      const int axis = box_plane_axis(planes[r]);
+      a[r][axis] = 1;
+      b[r] = W4::from(on_wide_grid(pv[r][0], shift) - ci[axis]);
+    }
+  }
+  // cof[r][d]: the cofactor of a[r][d] (exact_rows::cofactors, wider).
+  W4 cof[3][3];
+  if (dim == 2) {
+    cof[0][0] = W4::from(a[1][1]), cof[0][1] = W4::from(-a[1][0]);
+    cof[1][0] = W4::from(-a[0][1]), cof[1][1] = W4::from(a[0][0]);
+  } else {
+    for (int r = 0; r < 3; ++r) {
+      const I* u = a[(r + 1) % 3];
+      const I* w = a[(r + 2) % 3];
+      for (int d = 0; d < 3; ++d) {
+        const int x = (d + 1) % 3, y = (d + 2) % 3;
+        cof[r][d] = multiply(W2::from(u[x]), W2::from(w[y])) - multiply(W2::from(u[y]), W2::from(w[x]));
+      }
+    }
+  }
+  g.det = WideInt<6>::from(0);
+  for (int d = 0; d < dim; ++d) g.det = g.det + multiply(W2::from(a[0][d]), cof[0][d]);
+  if (g.det.sign() == 0) throw std::logic_error("exact_vertex: vertex planes are dependent (corrupt cell)");
+  for (int d = 0; d < dim; ++d) {
+    g.num[d] = WideInt<8>::from(0);
+    for (int r = 0; r < dim; ++r) g.num[d] = g.num[d] + multiply(b[r], cof[r][d]);
+  }
+}
+
+// The numerators on the input's grid where it spans at most 124 bits
+// (narrow up to 60, else wide); false otherwise (GMP's turn).
+bool grid_numerators(const ExactContext& ctx, std::int32_t i, const std::int32_t* planes, GridNumerators& g) {
+  const int dim = ctx.dim;
+  if (dim != 2 && dim != 3) return false;
+  DoubleParts pv[Scratch::kRows][Scratch::kMaxDim];
+  GridScale span;
+  exact_rows::row_parts(ctx, i, planes, dim, pv, span);
+  if (span.all_zero() || !span.fits(124)) return false;
+  g.shift = span.scale();
+  if (span.fits(60)) vertex_numerators_narrow(pv, planes, dim, g.shift, g);
+  else vertex_numerators_wide(pv, planes, dim, g.shift, g);
   return true;
+}
+
+// The bit length of m >= 0.
+template <int N>
+int bit_length(const WideInt<N>& m) {
+  for (int k = N - 1; k >= 0; --k)
+    if (m.limb[k] != 0) return 64 * k + 64 - std::countl_zero(m.limb[k]);
+  return 0;
+}
+
+// The top `want` <= 128 bits of m >= 0 of bit length len: floor(m /
+// 2^(len - want)), or m * 2^(want - len) when shorter.
+template <int N>
+unsigned __int128 top_bits(const WideInt<N>& m, int len, int want) {
+  const int s = std::max(len - want, 0);
+  const int w = s / 64, b = s % 64;
+  auto limb = [&m](int k) { return k < N ? m.limb[k] : std::uint64_t{0}; };
+  std::uint64_t lo = limb(w), mid = limb(w + 1);
+  if (b != 0) {
+    lo = (lo >> b) | (mid << (64 - b));
+    mid = (mid >> b) | (limb(w + 2) << (64 - b));
+  }
+  const unsigned __int128 t = (static_cast<unsigned __int128>(mid) << 64) | lo;
+  return len >= want ? t : t << (want - len);
+}
+
+// num / den * 2^shift as a double within 0.51 ulp (den != 0), with no GMP:
+// the top 128 bits of |num| over the top 64 of |den| (each truncated,
+// relatively by under 2^-63) give a 64- or 65-bit quotient q >= 2^63 (its
+// truncation: under 2^-63 more), so q times its power of two lies within
+// 2^-61 of the exact value, and the conversion to double rounds once
+// (twice for a subnormal result: under 2 ulp either way, as the GMP
+// path's).
+double grid_quotient(WideInt<8> num, WideInt<6> den, int shift) {
+  const bool negative = num.negative() != den.negative();
+  if (num.negative()) num = WideInt<8>::from_int64(0) - num;
+  if (den.negative()) den = WideInt<6>::from_int64(0) - den;
+  const int ln = bit_length(num), ld = bit_length(den);
+  if (ln == 0) return 0.0;
+  const unsigned __int128 n = top_bits(num, ln, 128);
+  const auto d = static_cast<std::uint64_t>(top_bits(den, ld, 64));
+  const double q = static_cast<double>(n / d);
+  // |num| / |den| ~ (n 2^(ln - 128)) / (d 2^(ld - 64)).
+  const double r = std::ldexp(q, ln - ld - 64 + shift);
+  return negative ? -r : r;
 }
 
 // The vertex of cell i where planes[0..dim) meet, relative to p_i, as
@@ -87,12 +211,17 @@ bool vertex_numerators_narrow(const ExactContext& ctx, std::int32_t i, const std
 // Cramer's rule on the integer rows (build_rows): det A, then numerator
 // d = det(A with column d replaced by b), less det times p_i. Weights are
 // infinitesimal and do not move the vertex in the limit. On 64-bit rows
-// where the input allows (vertex_numerators_narrow), else in GMP.
+// where the input allows (vertex_numerators_narrow), else on 128-bit ones
+// (vertex_numerators_wide), else in GMP.
 int vertex_numerators(const ExactContext& ctx, std::int32_t i, const std::int32_t* planes, Scratch& s) {
   const int dim = ctx.dim;
-  int shift;
-  if (vertex_numerators_narrow(ctx, i, planes, s, shift)) return shift;
-  shift = build_rows(ctx, i, planes, dim, s);
+  GridNumerators g;
+  if (grid_numerators(ctx, i, planes, g)) {
+    set_wide(s.minor[dim], g.det);
+    for (int d = 0; d < dim; ++d) set_wide(s.minor[d], g.num[d]);
+    return g.shift;
+  }
+  const int shift = build_rows(ctx, i, planes, dim, s);
   int sel[Scratch::kMaxDim] = {0, 1, 2};
   det_rows(s.minor[dim], s.a, sel, dim, s);
   if (mpz_sgn(s.minor[dim]) == 0)
@@ -147,6 +276,11 @@ double quotient_to_double(mpz_srcptr num, mpz_srcptr den, long shift, mpz_ptr q)
 }  // namespace
 
 void exact_vertex(const ExactContext& ctx, std::int32_t i, const std::int32_t* planes, double* y) {
+  GridNumerators g;
+  if (grid_numerators(ctx, i, planes, g)) {
+    for (int d = 0; d < ctx.dim; ++d) y[d] = grid_quotient(g.num[d], g.det, g.shift);
+    return;
+  }
   thread_local Scratch s;
   const int shift = vertex_numerators(ctx, i, planes, s);
   for (int d = 0; d < ctx.dim; ++d) y[d] = quotient_to_double(s.minor[d], s.minor[ctx.dim], shift, s.t0);

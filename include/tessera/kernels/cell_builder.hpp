@@ -80,6 +80,7 @@ class CellBuilder {
     work_ = 0;
     BuildStatus status = walk_shells(i, p, cell);
     status.work = cell_work(cell);
+    cell.solve_deferred();
     return status;
   }
 
@@ -131,6 +132,7 @@ class CellBuilder {
     work_ = 0;
     BuildStatus status = search_nearest_first(i, p, cell);
     status.work = cell_work(cell);
+    cell.solve_deferred();
     return status;
   }
 
@@ -172,6 +174,7 @@ class CellBuilder {
         break;
       }
     }
+    cell.solve_deferred();
     return status;
   }
 
@@ -283,6 +286,7 @@ class CellBuilder {
       }
       const Index* vc = D == 2 ? cycle_.data() : corners;
       if (cell.assemble(i, p, lo_, hi_, exact_, ids_.data(), qs_.data(), m, vc, nt, open)) {
+        cell.solve_deferred();  // the box's cuts may have deferred some
         BuildStatus status;
         status.work = 4 * m;
         status.assembled = true;

@@ -77,6 +77,22 @@ inline double underflow_slack(double inv, double amax, double bmax, double s, do
 /// for geometry (volumes, merged coordinates): the vertex is solved exactly.
 inline constexpr double exact_vertex_condition = 1e6;
 
+/// A clip's vertex whose condition number lies in [exact_vertex_condition,
+/// deferred_vertex_condition) keeps its float position and bound while the
+/// cell is built; only if it survives every clip is it solved exactly
+/// (Hull/Tile::solve_deferred). Its bound stays first order: the computed
+/// determinant errs relatively by about cond * 4u < 1e-6 here, which the
+/// bound's factor of two covers. Most such vertices are cut away again (a
+/// thin band of points on a cylinder: ~100 per cell, where the cell keeps
+/// a few), and each exact solve costs about a microsecond in GMP.
+inline constexpr double deferred_vertex_condition = 1e9;
+
+/// How solve() treats a vertex too ill-conditioned for its float bound
+/// (Hull/Tile::ill_conditioned): the assembly's first pass may refuse it
+/// (a NaN bound sends the cell to the clips), the assembly's refused
+/// vertices are solved exactly at once, and a clip's may be deferred.
+enum class SolveMode : std::uint8_t { float_only, exact_now, deferrable };
+
 /// floor(log2(x)) for a finite x > 0, clamped to [-1022, 1022] (subnormals
 /// give -1022), read from the bits.
 inline std::int32_t binary_exponent(double x) {

@@ -174,7 +174,7 @@ class Hull {
       const std::uint32_t t = k < nh ? holes_[k] : static_cast<std::uint32_t>(nv + k - nh);
       Vertex& v = verts_[t];  // built in place (see reset)
       v.p[0] = border_[k].a; v.p[1] = border_[k].b; v.p[2] = pn;
-      solve(v);
+      solve(v, filter::SolveMode::deferrable);
       if (k < nh) sign_[t] = 1;  // kept from now on
       settle<Hashed>(t);
     }
@@ -237,7 +237,7 @@ class Hull {
       v.p[0] = static_cast<std::uint16_t>(box_planes + c[0]);
       v.p[1] = static_cast<std::uint16_t>(box_planes + c[1]);
       v.p[2] = static_cast<std::uint16_t>(box_planes + c[2]);
-      solve(v, false);
+      solve(v, filter::SolveMode::float_only);
       if (!(v.e <= std::numeric_limits<double>::max())) {  // would need the exact solve
         if (refused_.size() == may_refuse) return false;          // clip instead
         refused_.push_back(static_cast<std::uint32_t>(t));
@@ -246,7 +246,7 @@ class Hull {
       settle_any(static_cast<std::uint32_t>(t));
     }
     for (const std::uint32_t t : refused_) {  // few enough to pay for their exact solves
-      solve(verts_[t], true);
+      solve(verts_[t], filter::SolveMode::exact_now);
       settle_any(t);
     }
     if (open && !close_far(q, m)) return false;
@@ -274,6 +274,28 @@ class Hull {
   std::uint64_t off_grid_exact_calls() const { return signs_.off_grid_calls(); }
   /// Vertices of this cell solved exactly (too ill-conditioned for the float solve).
   std::uint64_t exact_solves() const { return exact_solves_; }
+
+  /// The cell's last step once no clip is to come: the vertices whose exact
+  /// solve a clip deferred (filter::deferred_vertex_condition), and that
+  /// are still there, are solved exactly now, so every vertex of a built
+  /// cell is as accurate as if they had been solved at once (the same
+  /// doubles: the clips' decisions are exact either way). CellBuilder calls
+  /// it for every cell it returns.
+  void solve_deferred() {
+    if (deferred_.empty()) return;
+    std::sort(deferred_.begin(), deferred_.end());
+    for (std::size_t t = 0; t < verts_.size(); ++t) {
+      Vertex& v = verts_[t];
+      if (!std::binary_search(deferred_.begin(), deferred_.end(), triple_key(v))) continue;
+      const double ymax = solve_exactly(v);
+      const double err = 4 * filter::u * ymax;
+      v.e = err + filter::plane_eps * ymax;
+      set_radius(v, err);
+      lanes_.set(static_cast<std::uint32_t>(t), v);
+    }
+    deferred_.clear();
+    update_radius();
+  }
   /// The input's exact context (null in bare kernel tests).
   const ExactContext* exact_context() const { return exact_; }
   /// The triangle (vertex) sharing edge k of triangle t, i.e. the directed
@@ -374,7 +396,7 @@ class Hull {
       v.p[0] = border_[k].a;
       v.p[1] = border_[k].b;
       v.p[2] = far;
-      solve(v, false);  // never exact: on the far plane
+      solve(v, filter::SolveMode::float_only);  // never exact: on the far plane
       if (!(v.e <= std::numeric_limits<double>::max())) return false;
       settle_any(static_cast<std::uint32_t>(nt + k));
     }
@@ -409,6 +431,7 @@ class Hull {
     if (hashed_) [[unlikely]] leave_hash();
     signs_.start_cell();
     exact_solves_ = 0;
+    deferred_.clear();
     // Planes and corners are written in place: a local struct copied in
     // would be read back wider than it was written (a store-forwarding stall).
     planes_.resize(box_planes);
@@ -575,13 +598,15 @@ class Hull {
     return nb;
   }
 
-  // The vertex where planes p[0], p[1], p[2] meet (Cramer's rule) and its error bound.
-  // exact_ok false (assemble): a vertex that would need the exact solve
-  // may get NaN for its bound instead (ill_conditioned), which sends its
-  // cell back to the clips.
+  // The vertex where planes p[0], p[1], p[2] meet (Cramer's rule) and its
+  // error bound. A vertex too ill-conditioned for that bound is solved
+  // exactly, or as `mode` allows (filter::SolveMode, ill_conditioned):
+  // float_only (assemble) may leave NaN for its bound, which sends its cell
+  // back to the clips; deferrable (a clip) may keep the float position with
+  // a wider bound until solve_deferred.
   // Inlined in both callers: out of line (it has two), the clip's calls
   // cost the search 4%.
-  [[gnu::always_inline]] void solve(Vertex& v, bool exact_ok = true) const {
+  [[gnu::always_inline]] void solve(Vertex& v, filter::SolveMode mode) const {
     const Plane& A = planes_[v.p[0]];
     const Plane& B = planes_[v.p[1]];
     const Plane& C = planes_[v.p[2]];
@@ -605,7 +630,7 @@ class Hull {
     if (cond < filter::exact_vertex_condition && std::isfinite(ymax))
       err = filter::vertex_eps * inv_norm * (amax * ymax + bmax) + slack;
     else
-      std::tie(err, ymax) = ill_conditioned(v, inv, ymax, slack, exact_ok);
+      std::tie(err, ymax) = ill_conditioned(v, inv, ymax, slack, mode);
     v.e = err + filter::plane_eps * ymax;
     set_radius(v, err);
   }
@@ -620,9 +645,12 @@ class Hull {
   // anisotropically (a slab of voxel centres 1e-8 apart across and 1 along:
   // unscaled, every vertex there went to the exact solve). Failing that, the
   // vertex is too ill-conditioned for a trustworthy float position (it
-  // exists: the exact predicates created it) and is solved exactly. Out of
-  // line: inline, the extra code cost ordinary input 2%.
-  [[gnu::noinline, gnu::cold]] std::pair<double, double> ill_conditioned(Vertex& v, double inv, double ymax, double slack, bool exact_ok) const {
+  // exists: the exact predicates created it) and is solved exactly, unless
+  // a clip made it with a condition below deferred_vertex_condition: then
+  // the bound stands, and solve_deferred solves it if it is still there
+  // when the cell is built. Out of line: inline, the extra code cost
+  // ordinary input 2%.
+  [[gnu::noinline, gnu::cold]] std::pair<double, double> ill_conditioned(Vertex& v, double inv, double ymax, double slack, filter::SolveMode mode) const {
     const Plane& A = planes_[v.p[0]];
     const Plane& B = planes_[v.p[1]];
     const Plane& C = planes_[v.p[2]];
@@ -634,15 +662,35 @@ class Hull {
         (nb * nc + nc * na + na * nb) * (std::fabs(inv) * filter::pow2(ea) * filter::pow2(eb) * filter::pow2(ec));
     const double amax = std::max({na, nb, nc});
     const double bmax = std::max({std::fabs(A.d) * sa, std::fabs(B.d) * sb, std::fabs(C.d) * sc});
-    if (inv_norm * amax < filter::exact_vertex_condition && std::isfinite(ymax))  // false on NaN
-      return {filter::vertex_eps * inv_norm * (amax * ymax + bmax) + slack, ymax};
-    if (assembly::refuse_exact_solve<3>(exact_ok, v.y, planes_.data(), v.p))
+    const double cond = inv_norm * amax;
+    const double err = filter::vertex_eps * inv_norm * (amax * ymax + bmax) + slack;
+    if (cond < filter::exact_vertex_condition && std::isfinite(ymax))  // false on NaN
+      return {err, ymax};
+    if (assembly::refuse_exact_solve<3>(mode != filter::SolveMode::float_only, v.y, planes_.data(), v.p))
       return {std::numeric_limits<double>::quiet_NaN(), ymax};
-    std::int32_t ids[3] = {A.id, B.id, C.id};
+    if (mode == filter::SolveMode::deferrable && cond < filter::deferred_vertex_condition && std::isfinite(err)) {
+      deferred_.push_back(triple_key(v));
+      return {err, ymax};
+    }
+    ymax = solve_exactly(v);
+    return {4 * filter::u * ymax, ymax};
+  }
+
+  // v's position solved exactly and rounded (exact_vertex); returns |y|_inf.
+  double solve_exactly(Vertex& v) const {
+    const std::int32_t ids[3] = {planes_[v.p[0]].id, planes_[v.p[1]].id, planes_[v.p[2]].id};
     exact_vertex(*exact_, gen_, ids, v.y);
     ++exact_solves_;
-    ymax = std::max({std::fabs(v.y[0]), std::fabs(v.y[1]), std::fabs(v.y[2])});
-    return {4 * filter::u * ymax, ymax};
+    return std::max({std::fabs(v.y[0]), std::fabs(v.y[1]), std::fabs(v.y[2])});
+  }
+
+  // A vertex's planes as a set (its rotation in p varies with the clip that made it).
+  static std::uint64_t triple_key(const Vertex& v) {
+    std::uint64_t a = v.p[0], b = v.p[1], c = v.p[2];
+    if (a > b) std::swap(a, b);
+    if (b > c) std::swap(b, c);
+    if (a > b) std::swap(a, b);
+    return (a << 32) | (b << 16) | c;
   }
 
   // |y_exact| <= |y| + sqrt(3) err, so |y_exact|^2 <= |y|^2 + 4 err |y|_1 + 4 err^2
@@ -670,6 +718,7 @@ class Hull {
   bool may_underflow_ = false;  // exact_->may_underflow: solve() adds filter::underflow_slack
   bool scaled_planes_ = false;  // has_scaled_planes()
   mutable std::uint64_t exact_solves_ = 0;  // exact_solves(); counted by the const solve
+  mutable std::vector<std::uint64_t> deferred_;  // triple_keys of vertices whose exact solve waits (solve_deferred)
   std::vector<Plane> planes_;
   VertexList verts_;
   filter::FilterLanes<3> lanes_;  // verts_' filter data, for the sign pass

@@ -124,7 +124,7 @@ class Tile {
       va.p[1] = pn;
       vb.p[0] = pn;
       vb.p[1] = b1;
-      solve_pair(va, vb);
+      solve_pair(va, vb, filter::SolveMode::deferrable);
       lanes_.set(ta, va);
       lanes_.set(tb, vb);
     };
@@ -179,8 +179,8 @@ class Tile {
       verts_[t].p[0] = box_planes + corners[2 * t];
       verts_[t].p[1] = box_planes + corners[2 * t + 1];
     }
-    for (std::size_t t = 0; t + 1 < nt; t += 2) solve_pair(verts_[t], verts_[t + 1], false);
-    if (nt % 2 != 0) solve(verts_[nt - 1], false);
+    for (std::size_t t = 0; t + 1 < nt; t += 2) solve_pair(verts_[t], verts_[t + 1], filter::SolveMode::float_only);
+    if (nt % 2 != 0) solve(verts_[nt - 1], filter::SolveMode::float_only);
     // Vertices too ill-conditioned for the float solve that lie far out
     // (refuse_exact_solve) are solved exactly after all, as long as that
     // costs less than clipping the cell (Hull::assemble's rule): the end
@@ -191,7 +191,7 @@ class Tile {
     for (std::size_t t = 0; t < nt; ++t)
       if (!(verts_[t].e <= std::numeric_limits<double>::max())) {
         if (++refused > may_refuse) return false;
-        solve(verts_[t], true);
+        solve(verts_[t], filter::SolveMode::exact_now);
       }
     if (open) {
       // Hull edges (p, s) at the chain's start and (p, e) at its end: the
@@ -212,7 +212,7 @@ class Tile {
       ve.p[1] = far;
       vs.p[0] = far;
       vs.p[1] = box_planes + s;
-      solve_pair(ve, vs, false);  // never exact: on the far line
+      solve_pair(ve, vs, filter::SolveMode::float_only);  // never exact: on the far line
     }
     lanes_.assign(verts_);
     update_radius();
@@ -231,6 +231,24 @@ class Tile {
   std::uint64_t off_grid_exact_calls() const { return signs_.off_grid_calls(); }
   /// Vertices of this cell solved exactly (too ill-conditioned for the float solve).
   std::uint64_t exact_solves() const { return exact_solves_; }
+
+  /// As Hull::solve_deferred: the surviving vertices whose exact solve a
+  /// clip deferred are solved now.
+  void solve_deferred() {
+    if (deferred_.empty()) return;
+    std::sort(deferred_.begin(), deferred_.end());
+    for (std::size_t t = 0; t < verts_.size(); ++t) {
+      Vertex& v = verts_[t];
+      if (!std::binary_search(deferred_.begin(), deferred_.end(), pair_key(v))) continue;
+      const double ymax = solve_exactly(v);
+      const double err = 4 * filter::u * ymax;
+      v.e = err + filter::plane_eps * ymax;
+      set_radius(v, err);
+      lanes_.set(t, v);
+    }
+    deferred_.clear();
+    update_radius();
+  }
   /// The input's exact context (null in bare kernel tests).
   const ExactContext* exact_context() const { return exact_; }
 
@@ -256,6 +274,7 @@ class Tile {
     may_underflow_ = exact != nullptr && exact->may_underflow;
     signs_.start_cell();
     exact_solves_ = 0;
+    deferred_.clear();
     // Planes and corners are written in place: a local struct copied in
     // would be read back wider than it was written (a store-forwarding stall).
     planes_.resize(box_planes);
@@ -327,7 +346,7 @@ class Tile {
   // solve() for the two new vertices of a clip at once, one division for
   // both. The rare cases (ill-conditioned, possible underflow) take the
   // scalar path.
-  [[gnu::always_inline]] void solve_pair(Vertex& va, Vertex& vb, bool exact_ok = true) const {  // as Hull::solve
+  [[gnu::always_inline]] void solve_pair(Vertex& va, Vertex& vb, filter::SolveMode mode) const {  // as Hull::solve
     const Plane& A0 = planes_[va.p[0]];
     const Plane& B0 = planes_[va.p[1]];
     const Plane& A1 = planes_[vb.p[0]];
@@ -337,8 +356,8 @@ class Tile {
     const bool ok = !may_underflow_ && c.cond[0] < filter::exact_vertex_condition &&
                     c.cond[1] < filter::exact_vertex_condition && std::isfinite(c.ymax[0]) && std::isfinite(c.ymax[1]);
     if (!ok) [[unlikely]] {
-      solve(va, exact_ok);
-      solve(vb, exact_ok);
+      solve(va, mode);
+      solve(vb, mode);
       return;
     }
     const Lane err = c.err();
@@ -353,10 +372,8 @@ class Tile {
     }
   }
 
-  // exact_ok false (assemble): a vertex that would need the exact solve
-  // may get NaN for its bound instead (ill_conditioned), which sends its
-  // cell back to the clips.
-  void solve(Vertex& v, bool exact_ok = true) const {
+  // As Hull::solve, by `mode`.
+  void solve(Vertex& v, filter::SolveMode mode) const {
     const Plane& A = planes_[v.p[0]];
     const Plane& B = planes_[v.p[1]];
     const Cramer<double> c(A.n[0], A.n[1], A.d, A.n1, B.n[0], B.n[1], B.d, B.n1);
@@ -369,15 +386,16 @@ class Tile {
     if (c.cond < filter::exact_vertex_condition && std::isfinite(ymax))
       err = c.err() + slack;
     else
-      std::tie(err, ymax) = ill_conditioned(v, c.inv, ymax, slack, exact_ok);
+      std::tie(err, ymax) = ill_conditioned(v, c.inv, ymax, slack, mode);
     v.e = err + filter::plane_eps * ymax;
     set_radius(v, err);
   }
 
   // As Hull::ill_conditioned: the bound on the rows scaled to |n|_1 in
   // [1, 2) (the same y, a bound blind to the rows' magnitudes), else the
-  // exact solve. Returns err and ymax.
-  [[gnu::noinline, gnu::cold]] std::pair<double, double> ill_conditioned(Vertex& v, double inv, double ymax, double slack, bool exact_ok) const {
+  // exact solve, now or (a clip's, below deferred_vertex_condition)
+  // deferred. Returns err and ymax.
+  [[gnu::noinline, gnu::cold]] std::pair<double, double> ill_conditioned(Vertex& v, double inv, double ymax, double slack, filter::SolveMode mode) const {
     const Plane& A = planes_[v.p[0]];
     const Plane& B = planes_[v.p[1]];
     const std::int32_t ea = filter::binary_exponent(A.n1), eb = filter::binary_exponent(B.n1);
@@ -386,16 +404,30 @@ class Tile {
     const double inv_norm = (na + nb) * (std::fabs(inv) * filter::pow2(ea) * filter::pow2(eb));
     const double amax = std::max(na, nb);
     const double bmax = std::max(std::fabs(A.d) * sa, std::fabs(B.d) * sb);
-    if (inv_norm * amax < filter::exact_vertex_condition && std::isfinite(ymax))  // false on NaN
-      return {filter::vertex_eps * inv_norm * (amax * ymax + bmax) + slack, ymax};
-    if (assembly::refuse_exact_solve<2>(exact_ok, v.y, planes_.data(), v.p))
+    const double cond = inv_norm * amax;
+    const double err = filter::vertex_eps * inv_norm * (amax * ymax + bmax) + slack;
+    if (cond < filter::exact_vertex_condition && std::isfinite(ymax))  // false on NaN
+      return {err, ymax};
+    if (assembly::refuse_exact_solve<2>(mode != filter::SolveMode::float_only, v.y, planes_.data(), v.p))
       return {std::numeric_limits<double>::quiet_NaN(), ymax};
-    std::int32_t ids[2] = {A.id, B.id};
-    exact_vertex(*exact_, gen_, ids, v.y);
-    ++exact_solves_;
-    ymax = std::max(std::fabs(v.y[0]), std::fabs(v.y[1]));
+    if (mode == filter::SolveMode::deferrable && cond < filter::deferred_vertex_condition && std::isfinite(err)) {
+      deferred_.push_back(pair_key(v));
+      return {err, ymax};
+    }
+    ymax = solve_exactly(v);
     return {4 * filter::u * ymax, ymax};
   }
+
+  // v's position solved exactly and rounded (exact_vertex); returns |y|_inf.
+  double solve_exactly(Vertex& v) const {
+    const std::int32_t ids[2] = {planes_[v.p[0]].id, planes_[v.p[1]].id};
+    exact_vertex(*exact_, gen_, ids, v.y);
+    ++exact_solves_;
+    return std::max(std::fabs(v.y[0]), std::fabs(v.y[1]));
+  }
+
+  // A vertex's two lines, in order (one vertex per ordered pair in a tile).
+  static std::uint64_t pair_key(const Vertex& v) { return (std::uint64_t{v.p[0]} << 32) | v.p[1]; }
 
   static double clamp_radius(double r2) {
     return r2 < std::numeric_limits<double>::infinity() ? r2 : std::numeric_limits<double>::infinity();  // NaN too
@@ -411,6 +443,7 @@ class Tile {
   const ExactContext* exact_ = nullptr;
   bool may_underflow_ = false;  // exact_->may_underflow: solve() adds filter::underflow_slack
   mutable std::uint64_t exact_solves_ = 0;  // exact_solves(); counted by the const solve
+  mutable std::vector<std::uint64_t> deferred_;  // pair_keys of vertices whose exact solve waits (solve_deferred)
   std::vector<Plane> planes_;
   std::vector<Vertex> verts_;
   filter::FilterLanes<2> lanes_;  // verts_' filter data, for the sign pass

@@ -70,6 +70,16 @@ struct WideInt {
   }
 
   bool negative() const { return static_cast<std::int64_t>(limb[N - 1]) < 0; }
+
+  /// The same value in M >= N limbs (sign-extended).
+  template <int M>
+  WideInt<M> widen() const {
+    static_assert(M >= N);
+    WideInt<M> r;
+    for (int k = 0; k < N; ++k) r.limb[k] = limb[k];
+    for (int k = N; k < M; ++k) r.limb[k] = negative() ? ~std::uint64_t{0} : 0;
+    return r;
+  }
 };
 
 /// a * b exactly, in A + B limbs (always fits): A * B word products (the
