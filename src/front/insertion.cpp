@@ -366,7 +366,7 @@ class Triangulation {
       shift = 64 - std::countr_zero(w.edges.size());
       w.used.clear();
     }
-    w.hull_ghost = -1;
+    std::int32_t ghost = -1;  // a new ghost: q lay outside the hull (the next walk may go along it)
     for (const Facet& f : w.boundary) {
       const std::int32_t nt = w.allocate(store_);
       S& t = ss[nt];
@@ -375,7 +375,7 @@ class Triangulation {
         // Every vertex of a removed simplex lies on the cavity's boundary,
         // so each keeps a live one.
         if (f.v[m] != infinite) vsimplex_[static_cast<std::size_t>(f.v[m])] = nt;
-        else w.hull_ghost = nt;  // q lay outside the hull: the next walk may go along it
+        else ghost = nt;
       }
       t.n[f.k] = across(f.outside, f.back);
       ss[f.outside].n[f.back] = across(nt, f.k);
@@ -424,6 +424,7 @@ class Triangulation {
     if constexpr (D == 3)
       for (const std::uint64_t h : w.used) w.edges[h] = Edge{};
     w.prev = q;
+    w.hull_ghost = ghost;
     return true;
   }
 
@@ -527,7 +528,7 @@ class Triangulation {
   /// (The facets' cones from a point inside the hull tile space, so this is
   /// a visibility walk in a central projection of the hull.)
   template <bool Check>
-  std::int32_t hull_walk(W& w, std::int32_t q, std::int32_t g) {
+  [[gnu::noinline]] std::int32_t hull_walk(W& w, std::int32_t q, std::int32_t g) {
     constexpr int step_limit = 256;
     const S* const ss = store_.simplices();
     const double* const x = at(q);

@@ -126,6 +126,19 @@ std::vector<std::pair<std::string, std::vector<double>>> inputs() {
     }
     in.emplace_back("crowded duplicates", std::move(p));
   }
+  {
+    // Points on a cylinder, all on the hull as they come: a thin band
+    // (located by the hull walk) and a tall one.
+    std::uniform_real_distribution<double> u;
+    std::vector<double> band, tall;
+    for (int i = 0; i < 1500; ++i) {
+      const double t = 1.5 * u(rng), z = u(rng);
+      band.insert(band.end(), {std::cos(t), std::sin(t), 1e-3 * z});
+      tall.insert(tall.end(), {std::cos(4 * t), std::sin(4 * t), z});
+    }
+    in.emplace_back("thin cylindrical band", std::move(band));
+    in.emplace_back("cylinder", std::move(tall));
+  }
   in.emplace_back("subnormal offsets", subnormal_offset_points(300, 3, 7));
   {
     auto far = uniform_points(2000, 3, 44);  // far from the origin: large, rounded differences
@@ -185,6 +198,28 @@ TEST(Insertion, ALongBoxIsInsertedInCubes) {
     insert_points(cube, dim, 1, 1024, &in_cube);
     insert_points(box, dim, 1, 1024, &in_box);
     EXPECT_LT(static_cast<double>(in_box.steps), 2.0 * static_cast<double>(in_cube.steps)) << dim << "D";
+  }
+}
+
+TEST(Insertion, HullPointsAreLocatedAlongTheHull) {
+  // Points on a thin band of a cylinder (3D) and on a circle's arc (2D),
+  // each outside the hull of those before it. The plain walk from the last
+  // point crosses the needle simplices along the chord between them (3D:
+  // 417 steps a point on 50,000); the walk over the hull's facets takes a
+  // few, and is chosen for taking fewer.
+  std::mt19937_64 rng(58);
+  std::uniform_real_distribution<double> u;
+  for (const int dim : {2, 3}) {
+    std::vector<double> p, cube = uniform_points(20000, dim, 52);
+    for (int i = 0; i < 20000; ++i) {
+      const double t = 1.5 * u(rng);
+      p.insert(p.end(), {std::cos(t), std::sin(t)});
+      if (dim == 3) p.push_back(1e-3 * u(rng));
+    }
+    tessera::front::InsertionStats on_band, in_cube;
+    insert_points(p, dim, 1, 1024, &on_band);
+    insert_points(cube, dim, 1, 1024, &in_cube);
+    EXPECT_LT(static_cast<double>(on_band.steps), 4.0 * static_cast<double>(in_cube.steps)) << dim << "D";
   }
 }
 

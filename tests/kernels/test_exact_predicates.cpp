@@ -817,6 +817,53 @@ TEST(ExactPredicates, ExactVertexMatchesRational) {
   EXPECT_GT(checked, 1500);
 }
 
+// exact_vertex on inputs whose common grid spans 60 to 130 bits: unit
+// coordinates with one axis in [0, 2^-j), so a vertex's rows need about
+// 54 + j bits (64-bit rows up to 60, 128-bit rows up to 124, GMP beyond).
+// On the integer rows the quotient is rounded once: within 0.51 ulp, where
+// GMP's truncations allow 2. Ill-conditioned vertices too: each point has
+// a twin a few ulp away, as on a thin cylindrical band whose cells solve
+// half their vertices exactly.
+TEST(ExactPredicates, ExactVertexOnWideGrids) {
+  Rng r(57);
+  int checked = 0;
+  for (int dim : {2, 3})
+    for (int j : {0, 8, 20, 40, 60, 69, 75}) {
+      Problem p;
+      p.dim = dim;
+      for (int d = 0; d < 3; ++d) { p.lo[d] = -0.5; p.hi[d] = 1.5; }
+      for (int k = 0; k < 8; ++k) {
+        std::array<double, 3> x{};
+        for (int d = 0; d < dim; ++d) x[d] = r.uniform(0, 1);
+        x[dim - 1] = std::ldexp(r.uniform(0, 1), -j);
+        p.add(x);
+        for (int d = 0; d < dim; ++d)
+          for (int u = r.index(3); u >= 0; --u) x[d] = std::nextafter(x[d], r.coin() ? INFINITY : -INFINITY);
+        p.add(x);
+      }
+      const ExactContext c = p.ctx();
+      for (int t = 0; t < 120; ++t) {
+        std::int32_t i, k;
+        Ids planes;
+        if (!random_query(p, r, dim - 1, i, planes, k)) continue;
+        check_exact_vertex(c, i, planes.data());
+        ++checked;
+        if (j > 40) continue;  // maybe past 124 bits (the smallest values set the grid): GMP's rounding
+        auto v = solve_vertex(c, i, planes.data());
+        double y[3];
+        exact_vertex(c, i, planes.data(), y);
+        for (int d = 0; d < dim; ++d) {
+          const Q exact = (*v)[d] - coord(c, i, d);
+          const double a = std::fabs(exact.get_d());  // truncated: the same binade
+          if (a == 0) continue;
+          EXPECT_LE(abs(Q(y[d]) - exact), Q(0.51 * (std::nextafter(a, INFINITY) - a)))
+              << "coordinate " << d << " of " << describe(c, i, planes.data(), i);
+        }
+      }
+    }
+  EXPECT_GT(checked, 1400);
+}
+
 // Mixed magnitudes: the input coordinates and the box differ by hundreds of
 // binary orders (a unit cloud in a 1e300 box, a 1e-300 cloud in a unit box),
 // so the common integer scale of the exact computation is far from the
