@@ -169,17 +169,25 @@ bool worth_exact_solve(const double* y, const Plane* box) {
 /// quadratically.
 inline std::size_t exact_solves_paid(std::size_t m, std::size_t nt) { return m * (nt + 100) / 16000; }
 
-/// Whether a vertex (its D local planes `p`) too ill-conditioned for the
-/// float solve must not take the exact one: on a hull point's far plane,
-/// which is no bisector and has no exact form, or, for an assembled vertex
-/// (exact_ok false), where it is not worth it (worth_exact_solve). It then
-/// gets a NaN bound, and its cell is clipped instead (or, for a vertex the
-/// box cut made on the far plane, the box test gives the cell up).
+/// Whether a vertex (its D local planes `p`) lies on a hull point's far
+/// plane, which is no bisector and has no exact form: too ill-conditioned
+/// for the float solve, it gets a NaN bound, and the box test gives its
+/// cell up.
 template <int D, class Plane, class Index>
-bool refuse_exact_solve(bool exact_ok, const double* y, const Plane* planes, const Index* p) {
+bool on_far_plane(const Plane* planes, const Index* p) {
   for (int k = 0; k < D; ++k)
     if (planes[p[k]].id == far_plane_id) return true;
-  return !exact_ok && !worth_exact_solve<D>(y, planes);
+  return false;
+}
+
+/// Whether a vertex too ill-conditioned for the float solve, and for the
+/// deferred one (filter::deferred_vertex_condition), must not take the
+/// exact one: on the far plane, or, for an assembled vertex (exact_ok
+/// false), where it is not worth it (worth_exact_solve). It then gets a
+/// NaN bound, and its cell is clipped instead.
+template <int D, class Plane, class Index>
+bool refuse_exact_solve(bool exact_ok, const double* y, const Plane* planes, const Index* p) {
+  return on_far_plane<D>(planes, p) || (!exact_ok && !worth_exact_solve<D>(y, planes));
 }
 
 /// No vertex can be placed against a box plane in floating point (box_signs).

@@ -65,7 +65,9 @@ class Hull {
     double e;            // err + plane_eps * |y|_inf, err bounding |y - exact|_inf (filter.hpp)
     double r2;           // upper bound on the exact |y|^2
     std::uint16_t p[3];  // local plane indices, counter-clockwise from outside
+    std::uint16_t deferred;  // 1: its exact solve waits for solve_deferred (in what was padding)
   };
+  static_assert(sizeof(Vertex) == 48, "the deferral flag fills padding");
 
   /// Start the cell of generator `gen` at p as the domain box [lo, hi].
   void reset(std::int32_t gen, const double* p, const double* lo, const double* hi,
@@ -83,6 +85,7 @@ class Hull {
       double err = filter::u * ymax;  // each coordinate rounded once
       v.e = err + filter::plane_eps * ymax;
       set_radius(v, err);
+      v.deferred = 0;
       const std::uint16_t a = static_cast<std::uint16_t>(sx), b = static_cast<std::uint16_t>(2 + sy),
                           cc = static_cast<std::uint16_t>(4 + sz);
       // det(±e_x, ±e_y, ±e_z) = product of the signs; swap to make it positive.
@@ -282,18 +285,18 @@ class Hull {
   /// doubles: the clips' decisions are exact either way). CellBuilder calls
   /// it for every cell it returns.
   void solve_deferred() {
-    if (deferred_.empty()) return;
-    std::sort(deferred_.begin(), deferred_.end());
+    if (deferred_ == 0) return;
     for (std::size_t t = 0; t < verts_.size(); ++t) {
       Vertex& v = verts_[t];
-      if (!std::binary_search(deferred_.begin(), deferred_.end(), triple_key(v))) continue;
+      if (v.deferred == 0) continue;
+      v.deferred = 0;
       const double ymax = solve_exactly(v);
       const double err = 4 * filter::u * ymax;
       v.e = err + filter::plane_eps * ymax;
       set_radius(v, err);
       lanes_.set(static_cast<std::uint32_t>(t), v);
     }
-    deferred_.clear();
+    deferred_ = 0;
     update_radius();
   }
   /// The input's exact context (null in bare kernel tests).
@@ -431,7 +434,7 @@ class Hull {
     if (hashed_) [[unlikely]] leave_hash();
     signs_.start_cell();
     exact_solves_ = 0;
-    deferred_.clear();
+    deferred_ = 0;
     // Planes and corners are written in place: a local struct copied in
     // would be read back wider than it was written (a store-forwarding stall).
     planes_.resize(box_planes);
@@ -618,6 +621,7 @@ class Hull {
     double inv = 1.0 / det;
     for (int k = 0; k < 3; ++k) v.y[k] = (A.d * c1[k] + B.d * c2[k] + C.d * c3[k]) * inv;
     double ymax = std::max({std::fabs(v.y[0]), std::fabs(v.y[1]), std::fabs(v.y[2])});
+    v.deferred = 0;  // ill_conditioned may defer it
     // |a x b|_1 <= |a|_1 |b|_1, so the adjugate's entries sum to at most s.
     double s = B.n1 * C.n1 + C.n1 * A.n1 + A.n1 * B.n1;
     double inv_norm = s * std::fabs(inv);             // >= |A^-1|_inf
@@ -666,12 +670,14 @@ class Hull {
     const double err = filter::vertex_eps * inv_norm * (amax * ymax + bmax) + slack;
     if (cond < filter::exact_vertex_condition && std::isfinite(ymax))  // false on NaN
       return {err, ymax};
-    if (assembly::refuse_exact_solve<3>(mode != filter::SolveMode::float_only, v.y, planes_.data(), v.p))
-      return {std::numeric_limits<double>::quiet_NaN(), ymax};
-    if (mode == filter::SolveMode::deferrable && cond < filter::deferred_vertex_condition && std::isfinite(err)) {
-      deferred_.push_back(triple_key(v));
+    if (assembly::on_far_plane<3>(planes_.data(), v.p)) return {std::numeric_limits<double>::quiet_NaN(), ymax};
+    if (mode != filter::SolveMode::exact_now && cond < filter::deferred_vertex_condition && std::isfinite(err)) {
+      v.deferred = 1;
+      ++deferred_;
       return {err, ymax};
     }
+    if (assembly::refuse_exact_solve<3>(mode != filter::SolveMode::float_only, v.y, planes_.data(), v.p))
+      return {std::numeric_limits<double>::quiet_NaN(), ymax};
     ymax = solve_exactly(v);
     return {4 * filter::u * ymax, ymax};
   }
@@ -684,14 +690,6 @@ class Hull {
     return std::max({std::fabs(v.y[0]), std::fabs(v.y[1]), std::fabs(v.y[2])});
   }
 
-  // A vertex's planes as a set (its rotation in p varies with the clip that made it).
-  static std::uint64_t triple_key(const Vertex& v) {
-    std::uint64_t a = v.p[0], b = v.p[1], c = v.p[2];
-    if (a > b) std::swap(a, b);
-    if (b > c) std::swap(b, c);
-    if (a > b) std::swap(a, b);
-    return (a << 32) | (b << 16) | c;
-  }
 
   // |y_exact| <= |y| + sqrt(3) err, so |y_exact|^2 <= |y|^2 + 4 err |y|_1 + 4 err^2
   // (|y| <= |y|_1), with a relative margin for the rounding of this sum.
@@ -718,7 +716,7 @@ class Hull {
   bool may_underflow_ = false;  // exact_->may_underflow: solve() adds filter::underflow_slack
   bool scaled_planes_ = false;  // has_scaled_planes()
   mutable std::uint64_t exact_solves_ = 0;  // exact_solves(); counted by the const solve
-  mutable std::vector<std::uint64_t> deferred_;  // triple_keys of vertices whose exact solve waits (solve_deferred)
+  mutable std::size_t deferred_ = 0;  // vertices deferred (Vertex::deferred) since the cell started
   std::vector<Plane> planes_;
   VertexList verts_;
   filter::FilterLanes<3> lanes_;  // verts_' filter data, for the sign pass

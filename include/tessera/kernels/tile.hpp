@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "tessera/kernels/assembly.hpp"
+#include "tessera/kernels/deferred_solves.hpp"
 #include "tessera/kernels/exact_predicates.hpp"
 #include "tessera/kernels/filter.hpp"
 #include "tessera/kernels/hull.hpp"  // ClipResult
@@ -236,10 +237,10 @@ class Tile {
   /// clip deferred are solved now.
   void solve_deferred() {
     if (deferred_.empty()) return;
-    std::sort(deferred_.begin(), deferred_.end());
+    deferred_.seal();
     for (std::size_t t = 0; t < verts_.size(); ++t) {
       Vertex& v = verts_[t];
-      if (!std::binary_search(deferred_.begin(), deferred_.end(), pair_key(v))) continue;
+      if (!deferred_.contains(pair_key(v))) continue;
       const double ymax = solve_exactly(v);
       const double err = 4 * filter::u * ymax;
       v.e = err + filter::plane_eps * ymax;
@@ -408,12 +409,13 @@ class Tile {
     const double err = filter::vertex_eps * inv_norm * (amax * ymax + bmax) + slack;
     if (cond < filter::exact_vertex_condition && std::isfinite(ymax))  // false on NaN
       return {err, ymax};
-    if (assembly::refuse_exact_solve<2>(mode != filter::SolveMode::float_only, v.y, planes_.data(), v.p))
-      return {std::numeric_limits<double>::quiet_NaN(), ymax};
-    if (mode == filter::SolveMode::deferrable && cond < filter::deferred_vertex_condition && std::isfinite(err)) {
-      deferred_.push_back(pair_key(v));
+    if (assembly::on_far_plane<2>(planes_.data(), v.p)) return {std::numeric_limits<double>::quiet_NaN(), ymax};
+    if (mode != filter::SolveMode::exact_now && cond < filter::deferred_vertex_condition && std::isfinite(err)) {
+      deferred_.add(pair_key(v));
       return {err, ymax};
     }
+    if (assembly::refuse_exact_solve<2>(mode != filter::SolveMode::float_only, v.y, planes_.data(), v.p))
+      return {std::numeric_limits<double>::quiet_NaN(), ymax};
     ymax = solve_exactly(v);
     return {4 * filter::u * ymax, ymax};
   }
@@ -443,7 +445,7 @@ class Tile {
   const ExactContext* exact_ = nullptr;
   bool may_underflow_ = false;  // exact_->may_underflow: solve() adds filter::underflow_slack
   mutable std::uint64_t exact_solves_ = 0;  // exact_solves(); counted by the const solve
-  mutable std::vector<std::uint64_t> deferred_;  // pair_keys of vertices whose exact solve waits (solve_deferred)
+  mutable DeferredSolves deferred_;  // pair_keys of vertices whose exact solve waits (solve_deferred)
   std::vector<Plane> planes_;
   std::vector<Vertex> verts_;
   filter::FilterLanes<2> lanes_;  // verts_' filter data, for the sign pass
