@@ -169,25 +169,36 @@ bool worth_exact_solve(const double* y, const Plane* box) {
 /// quadratically.
 inline std::size_t exact_solves_paid(std::size_t m, std::size_t nt) { return m * (nt + 100) / 16000; }
 
-/// Whether a vertex (its D local planes `p`) lies on a hull point's far
-/// plane, which is no bisector and has no exact form: too ill-conditioned
-/// for the float solve, it gets a NaN bound, and the box test gives its
-/// cell up.
+/// What becomes of a vertex too ill-conditioned for its float bound
+/// (Hull/Tile::ill_conditioned; its D local planes `p`, its float estimate
+/// y, its condition `cond`, whether its first-order bound is finite):
+///   refuse: a NaN bound. On a hull point's far plane, which is no bisector
+///     and has no exact form (the box test then gives the cell up); or, in
+///     the assembly (float_only), one far out beyond the deferred bound:
+///     the assembly solves as many of those as it can pay for
+///     (exact_solves_paid), else the cell is clipped;
+///   defer: it keeps its float position and bound (filter::
+///     deferred_vertex_condition) until the cell is built. A clip's, and in
+///     the assembly one far out (not worth_exact_solve): the box cuts it
+///     with certainty, never solved (a thin cylindrical band's stars all have
+///     such vertices, and were clipped for them);
+///   solve: exactly, now. exact_now, a clip's beyond the deferred bound,
+///     and in the assembly one near the box, which most likely survives its
+///     cut: deferred, its wide bound near a box plane would give the cell up
+///     (the end of a 2D parabola, whose star holds most points and has
+///     thousands of such vertices, was then clipped by all of them: 400k
+///     points 0.85 → 16 s).
+enum class IllConditioned { solve, defer, refuse };
 template <int D, class Plane, class Index>
-bool on_far_plane(const Plane* planes, const Index* p) {
+IllConditioned ill_conditioned_fate(filter::SolveMode mode, double cond, bool bounded, const double* y,
+                                    const Plane* planes, const Index* p) {
   for (int k = 0; k < D; ++k)
-    if (planes[p[k]].id == far_plane_id) return true;
-  return false;
-}
-
-/// Whether a vertex too ill-conditioned for the float solve, and for the
-/// deferred one (filter::deferred_vertex_condition), must not take the
-/// exact one: on the far plane, or, for an assembled vertex (exact_ok
-/// false), where it is not worth it (worth_exact_solve). It then gets a
-/// NaN bound, and its cell is clipped instead.
-template <int D, class Plane, class Index>
-bool refuse_exact_solve(bool exact_ok, const double* y, const Plane* planes, const Index* p) {
-  return on_far_plane<D>(planes, p) || (!exact_ok && !worth_exact_solve<D>(y, planes));
+    if (planes[p[k]].id == far_plane_id) return IllConditioned::refuse;
+  if (mode == filter::SolveMode::exact_now) return IllConditioned::solve;
+  const bool deferrable = cond < filter::deferred_vertex_condition && bounded;
+  if (mode == filter::SolveMode::deferrable) return deferrable ? IllConditioned::defer : IllConditioned::solve;
+  if (worth_exact_solve<D>(y, planes)) return IllConditioned::solve;
+  return deferrable ? IllConditioned::defer : IllConditioned::refuse;
 }
 
 /// No vertex can be placed against a box plane in floating point (box_signs).

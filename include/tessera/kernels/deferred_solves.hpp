@@ -1,4 +1,4 @@
-// The vertices of a 2D cell whose exact solve a clip deferred (Tile::
+// The vertices of a 2D cell whose exact solve was deferred (Tile::
 // solve_deferred, filter::deferred_vertex_condition), by the key of their
 // lines: the tile's slots move as clips fill holes, the lines do not. (The
 // hull flags its vertices instead, in what was padding; the tile's vertex

@@ -279,8 +279,8 @@ class Hull {
   std::uint64_t exact_solves() const { return exact_solves_; }
 
   /// The cell's last step once no clip is to come: the vertices whose exact
-  /// solve a clip deferred (filter::deferred_vertex_condition), and that
-  /// are still there, are solved exactly now, so every vertex of a built
+  /// solve a clip or the assembly deferred (filter::deferred_vertex_
+  /// condition), and that are still there, are solved exactly now, so every vertex of a built
   /// cell is as accurate as if they had been solved at once (the same
   /// doubles: the clips' decisions are exact either way). CellBuilder calls
   /// it for every cell it returns.
@@ -603,10 +603,10 @@ class Hull {
 
   // The vertex where planes p[0], p[1], p[2] meet (Cramer's rule) and its
   // error bound. A vertex too ill-conditioned for that bound is solved
-  // exactly, or as `mode` allows (filter::SolveMode, ill_conditioned):
-  // float_only (assemble) may leave NaN for its bound, which sends its cell
-  // back to the clips; deferrable (a clip) may keep the float position with
-  // a wider bound until solve_deferred.
+  // exactly, or as `mode` allows (filter::SolveMode, ill_conditioned): it
+  // may keep its float position with a wider bound until solve_deferred,
+  // or (float_only: assemble) get NaN for its bound, which sends its cell
+  // back to the clips.
   // Inlined in both callers: out of line (it has two), the clip's calls
   // cost the search 4%.
   [[gnu::always_inline]] void solve(Vertex& v, filter::SolveMode mode) const {
@@ -650,10 +650,10 @@ class Hull {
   // unscaled, every vertex there went to the exact solve). Failing that, the
   // vertex is too ill-conditioned for a trustworthy float position (it
   // exists: the exact predicates created it) and is solved exactly, unless
-  // a clip made it with a condition below deferred_vertex_condition: then
-  // the bound stands, and solve_deferred solves it if it is still there
-  // when the cell is built. Out of line: inline, the extra code cost
-  // ordinary input 2%.
+  // its condition is below deferred_vertex_condition and `mode` is not
+  // exact_now: then the bound stands, and solve_deferred solves it if it is
+  // still there when the cell is built. Out of line: inline, the extra code
+  // cost ordinary input 2%.
   [[gnu::noinline, gnu::cold]] std::pair<double, double> ill_conditioned(Vertex& v, double inv, double ymax, double slack, filter::SolveMode mode) const {
     const Plane& A = planes_[v.p[0]];
     const Plane& B = planes_[v.p[1]];
@@ -670,14 +670,16 @@ class Hull {
     const double err = filter::vertex_eps * inv_norm * (amax * ymax + bmax) + slack;
     if (cond < filter::exact_vertex_condition && std::isfinite(ymax))  // false on NaN
       return {err, ymax};
-    if (assembly::on_far_plane<3>(planes_.data(), v.p)) return {std::numeric_limits<double>::quiet_NaN(), ymax};
-    if (mode != filter::SolveMode::exact_now && cond < filter::deferred_vertex_condition && std::isfinite(err)) {
-      v.deferred = 1;
-      ++deferred_;
-      return {err, ymax};
+    switch (assembly::ill_conditioned_fate<3>(mode, cond, std::isfinite(err), v.y, planes_.data(), v.p)) {
+      case assembly::IllConditioned::refuse:
+        return {std::numeric_limits<double>::quiet_NaN(), ymax};
+      case assembly::IllConditioned::defer:
+        v.deferred = 1;
+        ++deferred_;
+        return {err, ymax};
+      case assembly::IllConditioned::solve:
+        break;
     }
-    if (assembly::refuse_exact_solve<3>(mode != filter::SolveMode::float_only, v.y, planes_.data(), v.p))
-      return {std::numeric_limits<double>::quiet_NaN(), ymax};
     ymax = solve_exactly(v);
     return {4 * filter::u * ymax, ymax};
   }
@@ -689,7 +691,6 @@ class Hull {
     ++exact_solves_;
     return std::max({std::fabs(v.y[0]), std::fabs(v.y[1]), std::fabs(v.y[2])});
   }
-
 
   // |y_exact| <= |y| + sqrt(3) err, so |y_exact|^2 <= |y|^2 + 4 err |y|_1 + 4 err^2
   // (|y| <= |y|_1), with a relative margin for the rounding of this sum.

@@ -183,7 +183,7 @@ class Tile {
     for (std::size_t t = 0; t + 1 < nt; t += 2) solve_pair(verts_[t], verts_[t + 1], filter::SolveMode::float_only);
     if (nt % 2 != 0) solve(verts_[nt - 1], filter::SolveMode::float_only);
     // Vertices too ill-conditioned for the float solve that lie far out
-    // (refuse_exact_solve) are solved exactly after all, as long as that
+    // (assembly::ill_conditioned_fate) are solved exactly after all, as long as that
     // costs less than clipping the cell (Hull::assemble's rule): the end
     // of points on a parabola, whose star holds nearly every point, has
     // thousands of them, and clipping it was quadratic (100k points: 1.0 s).
@@ -233,8 +233,8 @@ class Tile {
   /// Vertices of this cell solved exactly (too ill-conditioned for the float solve).
   std::uint64_t exact_solves() const { return exact_solves_; }
 
-  /// As Hull::solve_deferred: the surviving vertices whose exact solve a
-  /// clip deferred are solved now.
+  /// As Hull::solve_deferred: the surviving vertices whose exact solve was
+  /// deferred are solved now.
   void solve_deferred() {
     if (deferred_.empty()) return;
     deferred_.seal();
@@ -394,8 +394,8 @@ class Tile {
 
   // As Hull::ill_conditioned: the bound on the rows scaled to |n|_1 in
   // [1, 2) (the same y, a bound blind to the rows' magnitudes), else the
-  // exact solve, now or (a clip's, below deferred_vertex_condition)
-  // deferred. Returns err and ymax.
+  // exact solve, now or (below deferred_vertex_condition, unless `mode` is
+  // exact_now) deferred. Returns err and ymax.
   [[gnu::noinline, gnu::cold]] std::pair<double, double> ill_conditioned(Vertex& v, double inv, double ymax, double slack, filter::SolveMode mode) const {
     const Plane& A = planes_[v.p[0]];
     const Plane& B = planes_[v.p[1]];
@@ -409,13 +409,15 @@ class Tile {
     const double err = filter::vertex_eps * inv_norm * (amax * ymax + bmax) + slack;
     if (cond < filter::exact_vertex_condition && std::isfinite(ymax))  // false on NaN
       return {err, ymax};
-    if (assembly::on_far_plane<2>(planes_.data(), v.p)) return {std::numeric_limits<double>::quiet_NaN(), ymax};
-    if (mode != filter::SolveMode::exact_now && cond < filter::deferred_vertex_condition && std::isfinite(err)) {
-      deferred_.add(pair_key(v));
-      return {err, ymax};
+    switch (assembly::ill_conditioned_fate<2>(mode, cond, std::isfinite(err), v.y, planes_.data(), v.p)) {
+      case assembly::IllConditioned::refuse:
+        return {std::numeric_limits<double>::quiet_NaN(), ymax};
+      case assembly::IllConditioned::defer:
+        deferred_.add(pair_key(v));
+        return {err, ymax};
+      case assembly::IllConditioned::solve:
+        break;
     }
-    if (assembly::refuse_exact_solve<2>(mode != filter::SolveMode::float_only, v.y, planes_.data(), v.p))
-      return {std::numeric_limits<double>::quiet_NaN(), ymax};
     ymax = solve_exactly(v);
     return {4 * filter::u * ymax, ymax};
   }
