@@ -78,10 +78,10 @@ inline double underflow_slack(double inv, double amax, double bmax, double s, do
 inline constexpr double exact_vertex_condition = 1e6;
 
 /// A vertex whose condition number lies in [exact_vertex_condition,
-/// deferred_vertex_condition), made by a clip or by an assembly, keeps its
-/// float position and bound while the cell is built; only if it survives
-/// every clip (the box's, for an assembled cell) is it solved exactly
-/// (Hull/Tile::solve_deferred). Its bound stays first order: the computed
+/// deferred_vertex_condition), made by a clip or far out in an assembly,
+/// keeps its float position and bound while the cell is built; only if it
+/// survives every clip (the box's, for an assembled cell) is it solved
+/// exactly (Hull/Tile::solve_deferred). Its bound stays first order: the computed
 /// determinant errs relatively by about cond * 4u < 1e-6 here, which the
 /// bound's factor of two covers. Most such vertices are cut away again (a
 /// thin band of points on a cylinder: ~100 per cell, where the cell keeps
@@ -89,11 +89,13 @@ inline constexpr double exact_vertex_condition = 1e6;
 inline constexpr double deferred_vertex_condition = 1e9;
 
 /// How solve() treats a vertex too ill-conditioned for its float bound
-/// (Hull/Tile::ill_conditioned). Below deferred_vertex_condition every mode
-/// but exact_now defers its exact solve; beyond it, float_only (the
-/// assembly's first pass, and the far plane's vertices) may refuse it (a
+/// (Hull/Tile::ill_conditioned, assembly::ill_conditioned_fate): exact_now
+/// solves it at once; deferrable (a clip) defers it below
+/// deferred_vertex_condition, else solves it; float_only (the assembly's
+/// first pass, and the far plane's vertices) solves one near the box at
+/// once, defers one far out below that condition, and refuses the rest (a
 /// NaN bound: the assembly solves those it can pay for with exact_now, or
-/// sends the cell to the clips), and deferrable (a clip) solves it at once.
+/// sends the cell to the clips).
 enum class SolveMode : std::uint8_t { float_only, exact_now, deferrable };
 
 /// floor(log2(x)) for a finite x > 0, clamped to [-1022, 1022] (subnormals
