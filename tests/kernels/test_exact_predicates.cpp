@@ -778,6 +778,13 @@ TEST(ExactPredicates, DuplicatesLowerIdKeeps) {
   EXPECT_GT(checked, 1000);
 }
 
+/// x with each coordinate moved 1 to 3 ulps either way: a near twin.
+std::array<double, 3> twin(std::array<double, 3> x, int dim, Rng& r) {
+  for (int d = 0; d < dim; ++d)
+    for (int u = r.index(3); u >= 0; --u) x[d] = std::nextafter(x[d], r.coin() ? INFINITY : -INFINITY);
+  return x;
+}
+
 // exact_vertex within 2 ulp of the rational vertex, on random input (every
 // magnitude) and on ill-conditioned pairs: a generator one ulp from p_i, seen
 // with the other planes (the case the kernels call it for).
@@ -791,11 +798,8 @@ TEST(ExactPredicates, ExactVertexMatchesRational) {
       // Near-duplicates: points 0..3 get a partner a few ulp away.
       for (int k = 0; k < 4; ++k) {
         std::array<double, 3> x{};
-        for (int d = 0; d < dim; ++d) {
-          x[d] = p.pts[static_cast<std::size_t>(k) * dim + d];
-          for (int u = r.index(3); u >= 0; --u) x[d] = std::nextafter(x[d], r.coin() ? INFINITY : -INFINITY);
-        }
-        p.add(x);
+        for (int d = 0; d < dim; ++d) x[d] = p.pts[static_cast<std::size_t>(k) * dim + d];
+        p.add(twin(x, dim, r));
       }
       const auto c = p.ctx();
       for (int t = 0; t < 150; ++t) {
@@ -837,9 +841,7 @@ TEST(ExactPredicates, ExactVertexOnWideGrids) {
         for (int d = 0; d < dim; ++d) x[d] = r.uniform(0, 1);
         x[dim - 1] = std::ldexp(r.uniform(0, 1), -j);
         p.add(x);
-        for (int d = 0; d < dim; ++d)
-          for (int u = r.index(3); u >= 0; --u) x[d] = std::nextafter(x[d], r.coin() ? INFINITY : -INFINITY);
-        p.add(x);
+        p.add(twin(x, dim, r));
       }
       const ExactContext c = p.ctx();
       for (int t = 0; t < 120; ++t) {

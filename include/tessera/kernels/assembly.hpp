@@ -212,7 +212,7 @@ inline constexpr std::size_t undecided = std::numeric_limits<std::size_t>::max()
 /// `undecided` where a vertex lies within its error bound of
 /// the plane: the exact clip, whose perturbation decides such a tie, must
 /// build that cell. Also where a vertex's bound is NaN (Hull/Tile::solve
-/// with exact_ok false: it needed the exact solve).
+/// refused it the exact solve: assembly::ill_conditioned_fate).
 template <class Vertex>
 std::size_t box_signs(const Vertex* verts, std::size_t nv, int k, double h, std::vector<filter::Sign>& sign) {
   const int axis = k / 2;
