@@ -230,7 +230,7 @@ inline Key<2> vertex_key(const kernels::Tile& tile, std::size_t t) {
 template <class F>
 void for_each_face_plane(kernels::Hull& hull, F&& f) {
   const auto& pl = hull.planes();
-  hull.for_each_face_plane([&](std::uint16_t p) { f(p, pl[p].id); });
+  hull.for_each_face_plane([&](kernels::Hull::Index p) { f(p, pl[p].id); });
 }
 
 template <class F>

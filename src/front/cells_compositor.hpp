@@ -8,6 +8,7 @@
 #include <string>
 #include <cstdint>
 #include <cstring>
+#include <limits>
 #include <numeric>
 #include <span>
 #include <stdexcept>
@@ -59,11 +60,25 @@ class CellsCompositor {
     std::size_t nbr_base = 0, corner_base = 0, pos_base = 0, face_base = 0;
     std::vector<std::uint32_t> face_of;     // add()'s scratch: a local plane's face number
     std::size_t assembled = 0;              // cells assembled from their stars
+    // 3D cells of more than 65,535 faces (the centre of a sphere's points):
+    // their corners keep the low 16 bits of each face number, and
+    // high_corners the high ones, from wide[i].second for entry
+    // wide[i].first (ascending). Corners of 32 bits for every vertex would
+    // take 1M uniform cells' mesh 160 MB more.
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> wide;
+    std::vector<kernels::Corners<D>> high_corners;
 
     const std::int32_t* nbrs() const { return store->nbrs.data() + nbr_base; }
     const kernels::Corners<D>* corners() const { return store->corners.data() + corner_base; }
     const double* pos() const { return store->pos.data() + pos_base * D; }
     const std::int32_t* face_nbr() const { return store->face_nbr.data() + face_base; }
+    /// Entry t's high corner halves (its first vertex's), or null: not a wide cell.
+    const kernels::Corners<D>* high_of(std::size_t t) const {
+      if (wide.empty()) [[likely]] return nullptr;
+      const auto at = std::lower_bound(wide.begin(), wide.end(), std::pair<std::uint32_t, std::uint32_t>{
+                                                                     static_cast<std::uint32_t>(t), 0});
+      return at != wide.end() && at->first == t ? high_corners.data() + at->second : nullptr;
+    }
   };
 
   /// The mesh: no two located points coincide (front::Pass leaves
@@ -111,7 +126,7 @@ class CellsCompositor {
         if (id >= 0) nbrs.push_back(id);
         s.face_nbr.push_back(id);
       });
-      add_vertices(b, s, gen, cell);
+      add_vertices(b, s, gen, cell, static_cast<std::size_t>(nf));
     } else {
       for_each_spoke(cell, [&](std::int32_t id) {
         ++nf;
@@ -320,8 +335,9 @@ class CellsCompositor {
   }
 
   // The cell's vertices in dual form (faces numbered by b.face_of), the
-  // owned ones first, and the owned ones' positions.
-  void add_vertices(const Batch& b, Store& s, std::int32_t gen, CellT& cell) {
+  // owned ones first, and the owned ones' positions. A cell of more than
+  // 65,535 faces (3D) is wide (Batch::wide).
+  void add_vertices(Batch& b, Store& s, std::int32_t gen, CellT& cell, std::size_t nfaces) {
     const auto& v = cell.vertices();
     const double* p = cell.site();
     const std::size_t nv = v.size(), v0 = s.corners.size(), p0 = s.pos.size() / D;
@@ -330,24 +346,52 @@ class CellsCompositor {
     kernels::Corners<D>* corners = s.corners.data() + v0;
     double* pos = s.pos.data() + p0 * D;
     const std::uint32_t* face_of = b.face_of.data();
+    using Half = typename kernels::Corners<D>::value_type;
+    constexpr bool may_be_wide = sizeof(Half) < sizeof(std::uint32_t);
+    kernels::Corners<D>* high = nullptr;
+    if (may_be_wide && nfaces > std::numeric_limits<Half>::max()) [[unlikely]] {
+      b.wide.emplace_back(static_cast<std::uint32_t>(b.gen.size() - 1), static_cast<std::uint32_t>(b.high_corners.size()));
+      b.high_corners.resize(b.high_corners.size() + nv);
+      high = b.high_corners.data() + b.wide.back().second;
+    }
     std::size_t kept = 0, back = nv;
     for (std::size_t t = 0; t < nv; ++t) {
       const bool owned = first_inside(vertex_key(cell, t)) == gen;
       const std::size_t at = owned ? kept : --back;
-      for (int k = 0; k < D; ++k) corners[at][static_cast<std::size_t>(k)] = face_of[v[t].p[k]];
+      for (int k = 0; k < D; ++k) {
+        const std::uint32_t f = face_of[v[t].p[k]];
+        corners[at][static_cast<std::size_t>(k)] = static_cast<Half>(f);
+        if constexpr (may_be_wide)
+          if (high) [[unlikely]] high[at][static_cast<std::size_t>(k)] = static_cast<Half>(f >> 16);
+      }
       for (int d = 0; d < D; ++d) pos[kept * D + d] = v[t].y[d] + p[d];  // dropped unless owned
       kept += owned;
     }
     s.pos.resize((p0 + kept) * D);
   }
 
+  // Face k of batch vertex v, the vertex of entry t whose high halves are
+  // `high` (Batch::high_of) and whose first vertex is v0.
+  static std::uint32_t corner_of(const Batch& b, const kernels::Corners<D>* high, std::uint32_t v0, std::uint32_t v, int k) {
+    const std::uint32_t lo = b.corners()[v][static_cast<std::size_t>(k)];
+    if (high == nullptr) [[likely]] return lo;
+    return lo | static_cast<std::uint32_t>(high[v - v0][static_cast<std::size_t>(k)]) << 16;
+  }
+
   // Vertex v's key (the generator and its faces' neighbour ids, ascending),
   // from batch entry t's dual form.
   Key<D> key_of(const Batch& b, std::size_t t, std::uint32_t v) const {
     const std::int32_t* nbr = b.face_nbr() + range_of(b.face_end, t).first;
-    const kernels::Corners<D>& corner = b.corners()[v];
     Key<D> k;
     k[0] = b.gen[t];
+    if (!b.wide.empty()) [[unlikely]] {
+      const auto* high = b.high_of(t);
+      const std::uint32_t v0 = range_of(b.vert_end, t).first;
+      for (int j = 0; j < D; ++j) k[static_cast<std::size_t>(j) + 1] = nbr[corner_of(b, high, v0, v, j)];
+      sort_key(k);
+      return k;
+    }
+    const kernels::Corners<D>& corner = b.corners()[v];
     for (int j = 0; j < D; ++j) k[static_cast<std::size_t>(j) + 1] = nbr[corner[static_cast<std::size_t>(j)]];
     sort_key(k);
     return k;
@@ -586,14 +630,25 @@ class CellsCompositor {
         std::size_t vo = static_cast<std::size_t>(fcv[cu]);
         const std::size_t fend = static_cast<std::size_t>(o.cell_face_offsets[cu + 1]);
         const std::size_t vend = static_cast<std::size_t>(fcv[cu + 1]);
-        kernels::for_each_face_loop(std::span<const kernels::Corners<D>>(b.corners() + v0, v1 - v0), f1 - f0, walk,
-                           [&](std::size_t f, const std::uint32_t* loop, std::size_t count) {
-                             if (fo == fend || count > vend - vo) return;  // (reported below)
-                             o.face_neighbor[fo] = nbr[f];
-                             o.face_class[fo] = classify_(b.gen[t], nbr[f]);
-                             for (std::size_t q = 0; q < count; ++q) o.face_vertices[vo++] = gid[loop[q]];
-                             o.face_vertex_offsets[++fo] = static_cast<std::int64_t>(vo);
-                           });
+        auto face = [&](std::size_t f, const std::uint32_t* loop, std::size_t count) {
+          if (fo == fend || count > vend - vo) return;  // (reported below)
+          o.face_neighbor[fo] = nbr[f];
+          o.face_class[fo] = classify_(b.gen[t], nbr[f]);
+          for (std::size_t q = 0; q < count; ++q) o.face_vertices[vo++] = gid[loop[q]];
+          o.face_vertex_offsets[++fo] = static_cast<std::int64_t>(vo);
+        };
+        const std::span<const kernels::Corners<D>> cell_corners(b.corners() + v0, v1 - v0);
+        if constexpr (D == 3) {
+          if (const kernels::Corners<D>* high = b.high_of(t)) [[unlikely]]
+            kernels::for_each_face_loop(
+                v1 - v0, f1 - f0,
+                [&](std::size_t u, int k) { return corner_of(b, high, v0, v0 + static_cast<std::uint32_t>(u), k); },
+                walk, face);
+          else
+            kernels::for_each_face_loop(cell_corners, f1 - f0, walk, face);
+        } else {
+          kernels::for_each_face_loop(cell_corners, f1 - f0, walk, face);
+        }
         if (fo != fend || vo != vend) misses.fetch_add(1, std::memory_order_relaxed);  // faces that do not close
       }
     });

@@ -326,7 +326,7 @@ Delaunay run(std::span<const double> input, std::span<const std::int32_t> labels
   // method builds by insertion on such input; about a cell's cost per
   // point), it gives way to that. The centre of 40,000 points on a sphere,
   // alone inside, has every sphere point as a face, clipped one by one: 4 s,
-  // and past 65,534 points the face limit (0.2 s by insertion). A clustered
+  // and past 65,534 points (until stop 59) the face limit (0.2 s by insertion). A clustered
   // ball inside a cloud ten times its size keeps the pass.
   if (labelled_cell_touches_box != nullptr && opt.method == DelaunayMethod::automatic) {
     const double insert_from = insertion_ratio<D>(pass.engine_options.threads);

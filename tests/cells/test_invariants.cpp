@@ -261,6 +261,43 @@ TEST(Invariants, HugeCell3D) {
   }
 }
 
+TEST(Invariants, HugeCell3DPastSixteenBits) {
+  // Cells past 65,535 faces: the hull's local plane indices are 32-bit since
+  // stop 59 (before, the centre of these points stopped the run with a
+  // length error), and the mesh keeps such a cell's face numbers in two
+  // 16-bit halves (CellsCompositor::Batch::wide). The centre of 70,000
+  // points on a sphere, last (one thread) and first (two threads; its
+  // ~140,000 vertices then owned by the lowest id), assembled from its star
+  // in the hashed edge map, with the mesh. (By the search its clips are quadratic in its
+  // faces: 11 s.) A mesh that read only the low halves would give its faces
+  // the wrong neighbours and vertices: check_invariants integrates every
+  // cell's faces from the mesh.
+  const int m = 70000;
+  const std::vector<double> sphere = unit_sphere_points(m, 93);
+  for (bool centre_first : {false, true}) {
+    SCOPED_TRACE(centre_first ? "centre first" : "centre last");
+    std::vector<double> pts = sphere;
+    pts.insert(centre_first ? pts.begin() : pts.end(), {0.0, 0.0, 0.0});
+    const int centre = centre_first ? 0 : m;
+    {
+      const int threads = centre_first ? 2 : 1;
+      tessera::VoronoiOptions o = options(3, std::nullopt, threads);
+      o.cell_method = tessera::CellMethod::insertion;
+      const tessera::Cells c = tessera::voronoi(pts, 3, {}, o);
+      check_invariants(c, pts, {}, "70,000 sphere points + centre");
+      EXPECT_EQ(c.assembled_from_stars, c.n_cells());
+      const std::size_t cell = static_cast<std::size_t>(c.cell_of[centre]);
+      EXPECT_EQ(c.num_faces[cell], m);
+      EXPECT_EQ(neighbours_of(c, c.cell_of[centre]).size(), std::size_t(m));
+      // Its faces in the mesh: one per sphere point, each naming it.
+      std::vector<char> named(static_cast<std::size_t>(m) + 1, 0);
+      for (std::int64_t f = c.cell_face_offsets[cell]; f < c.cell_face_offsets[cell + 1]; ++f)
+        named[static_cast<std::size_t>(c.face_neighbor[static_cast<std::size_t>(f)])] = 1;
+      EXPECT_EQ(std::count(named.begin(), named.end(), 1), m);
+    }
+  }
+}
+
 TEST(Invariants, HugeCell2D) {
   // Polygons past 65,534 edges: a tile's local plane indices are 32-bit
   // since stop 57 (before, these failed with a length error). The centre of

@@ -20,9 +20,11 @@
 
 namespace tessera::kernels {
 
-/// A vertex of a cell in dual form: the indices of the D faces meeting there,
-/// as wide as the kernel's local plane index (Hull::Index 16 bits, Tile::Index
-/// 32: a polygon may have any number of edges).
+/// A vertex of a cell in dual form: the indices of the D faces meeting there.
+/// 32 bits in 2D (free: a polygon may have any number of edges); 16 in 3D,
+/// where a cell has 27 vertices on average: the mesh's store of a cell of
+/// more than 65,535 faces adds their high halves aside
+/// (front::CellsCompositor::Batch::wide), not 6 bytes to every vertex.
 template <int D>
 using Corners = std::array<std::conditional_t<D == 2, std::uint32_t, std::uint16_t>, static_cast<std::size_t>(D)>;
 

@@ -40,11 +40,12 @@ enum class ClipResult { unchanged, clipped, emptied };
 class Hull {
  public:
   static constexpr int dim = 3;
-  /// A local plane's index (vertices hold three): 16 bits keep a vertex at
-  /// 48 bytes in the hot loops, and limit a cell to 65,534 faces.
-  using Index = std::uint16_t;
+  /// A local plane's index (vertices hold three). 32 bits since stop 59: a
+  /// cell may have any number of faces (16 bits stopped the centre of 70,000
+  /// points on a sphere with an error).
+  using Index = std::uint32_t;
   /// The domain box's planes are always the cell's first local planes.
-  static constexpr std::uint16_t box_planes = 6;
+  static constexpr Index box_planes = 6;
   /// The most bisectors assemble() takes (more: the cell is clipped), below
   /// the local plane limit with the box's six and a far plane. Beyond
   /// dense_planes the edge map is the hash, so memory follows the
@@ -52,7 +53,10 @@ class Hull {
   /// point of a terrain's samples, thousands of neighbours, took gigabytes,
   /// and the centre of 40,000 points on a sphere was clipped instead, in
   /// time quadratic in its faces: 6 s).
-  static constexpr std::size_t max_assembled_planes = 0xFFF0;
+  static constexpr std::size_t max_assembled_planes = 0xFFFFFFF0;
+  /// A cell's local planes stay below this (Index's range; clip() throws
+  /// beyond, which no input of fewer than 2^32 points reaches).
+  static constexpr std::size_t max_planes = 0xFFFFFFFF;
   struct Plane {
     double n[3];
     double d;
@@ -64,10 +68,10 @@ class Hull {
     double y[3];         // position relative to the generator
     double e;            // err + plane_eps * |y|_inf, err bounding |y - exact|_inf (filter.hpp)
     double r2;           // upper bound on the exact |y|^2
-    std::uint16_t p[3];  // local plane indices, counter-clockwise from outside
-    std::uint16_t deferred;  // 1: its exact solve waits for solve_deferred (in what was padding)
+    Index p[3];              // local plane indices, counter-clockwise from outside
+    std::uint32_t deferred;  // 1: its exact solve waits for solve_deferred
   };
-  static_assert(sizeof(Vertex) == 48, "the deferral flag fills padding");
+  static_assert(sizeof(Vertex) == 56, "three 32-bit plane indices and the deferral flag");
 
   /// Start the cell of generator `gen` at p as the domain box [lo, hi].
   void reset(std::int32_t gen, const double* p, const double* lo, const double* hi,
@@ -86,8 +90,8 @@ class Hull {
       v.e = err + filter::plane_eps * ymax;
       set_radius(v, err);
       v.deferred = 0;
-      const std::uint16_t a = static_cast<std::uint16_t>(sx), b = static_cast<std::uint16_t>(2 + sy),
-                          cc = static_cast<std::uint16_t>(4 + sz);
+      const Index a = static_cast<Index>(sx), b = static_cast<Index>(2 + sy),
+                          cc = static_cast<Index>(4 + sz);
       // det(±e_x, ±e_y, ±e_z) = product of the signs; swap to make it positive.
       const bool positive = ((sx + sy + sz) % 2) == 1;  // signs: upper=+, lower=-
       v.p[0] = a;
@@ -113,9 +117,9 @@ class Hull {
       return ClipResult::emptied;
     }
 
-    const std::uint16_t pn = static_cast<std::uint16_t>(planes_.size());
-    if (planes_.size() + 1 >= 0xFFFF)
-      throw std::length_error("a cell has more than 65534 faces (one point with that many neighbours)");
+    const Index pn = static_cast<Index>(planes_.size());
+    if (planes_.size() + 1 >= max_planes) [[unlikely]]
+      throw std::length_error("a cell has more than 4294967294 faces (one point with that many neighbours)");
     Plane& pl = planes_.emplace_back();  // written in place (see reset)
     pl.n[0] = b.n[0]; pl.n[1] = b.n[1]; pl.n[2] = b.n[2];
     pl.d = b.d;
@@ -137,7 +141,7 @@ class Hull {
   // Hashed: the edge map is the hash (grow_table), in a huge cell only; the
   // ordinary instantiation has no test of it.
   template <bool Hashed>
-  [[gnu::always_inline]] void cut(std::uint16_t pn, std::size_t nv) {
+  [[gnu::always_inline]] void cut(Index pn, std::size_t nv) {
     // The removed slots, ascending: holes_[0, nh) (never shrunk, so growing
     // it value-initializes nothing per clip).
     if (holes_.size() < nv) holes_.resize(nv);
@@ -160,7 +164,7 @@ class Hull {
       for (std::size_t h = 0; h < nh; ++h) {
         const Vertex& v = verts_[holes_[h]];
         for (int k = 0; k < 3; ++k) {
-          const std::uint16_t a = v.p[k], b = v.p[k == 2 ? 0 : k + 1];
+          const Index a = v.p[k], b = v.p[k == 2 ? 0 : k + 1];
           edges[nb] = {a, b};
           nb += sign[table[static_cast<std::size_t>(b) * cap + a]] >= 0;
         }
@@ -219,7 +223,7 @@ class Hull {
   /// and the box cuts them all away. False too where the triangles are not
   /// such a disk or the far plane cannot be placed.
   bool assemble(std::int32_t gen, const double* p, const double* lo, const double* hi, const ExactContext* exact,
-                const std::int32_t* ids, const double* q, std::size_t m, const std::uint16_t* corners,
+                const std::int32_t* ids, const double* q, std::size_t m, const Index* corners,
                 std::size_t nt, bool open = false) {
     start(gen, p, lo, hi, exact);
     if (may_underflow_ || m > max_assembled_planes) return false;
@@ -229,17 +233,17 @@ class Hull {
     if (need <= dense_planes) {
       if (need > cap_ || edge_tri_.empty()) ensure_table(std::min(2 * need, dense_planes));
     } else {
-      enter_hash(2 * nt);
+      enter_hash(nt);  // (rehash() grows it if the far plane and the box add more)
     }
     resize_vertices(nt);
     refused_.clear();
     const std::size_t may_refuse = assembly::exact_solves_paid(m, nt);
     for (std::size_t t = 0; t < nt; ++t) {
       Vertex& v = verts_[t];
-      const std::uint16_t* c = corners + 3 * t;
-      v.p[0] = static_cast<std::uint16_t>(box_planes + c[0]);
-      v.p[1] = static_cast<std::uint16_t>(box_planes + c[1]);
-      v.p[2] = static_cast<std::uint16_t>(box_planes + c[2]);
+      const Index* c = corners + 3 * t;
+      v.p[0] = static_cast<Index>(box_planes + c[0]);
+      v.p[1] = static_cast<Index>(box_planes + c[1]);
+      v.p[2] = static_cast<Index>(box_planes + c[2]);
       solve(v, filter::SolveMode::float_only);
       if (!(v.e <= std::numeric_limits<double>::max())) {  // would need the exact solve
         if (refused_.size() == may_refuse) return false;          // clip instead
@@ -316,7 +320,7 @@ class Hull {
     std::uint8_t* const seen = seen_.data();
     for (const Vertex& v : verts_) seen[v.p[0]] = seen[v.p[1]] = seen[v.p[2]] = 1;
     for (std::size_t p = 0; p < planes_.size(); ++p)
-      if (seen[p]) f(static_cast<std::uint16_t>(p));
+      if (seen[p]) f(static_cast<Index>(p));
   }
 
   /// Visit each face once, by ascending plane index: f(plane index, vertex
@@ -339,7 +343,7 @@ class Hull {
   // one the exact clips build from the box: a vertex exactly on a box plane
   // is the only case whose answer the perturbation would choose.
   bool clip_to_box() {
-    for (std::uint16_t k = 0; k < box_planes; ++k) {
+    for (Index k = 0; k < box_planes; ++k) {
       const std::size_t nv = verts_.size();
       const std::size_t removed = assembly::box_signs(verts_.data(), nv, k, planes_[k].d, sign_);
       if (removed == assembly::undecided || removed == nv) return false;
@@ -357,12 +361,12 @@ class Hull {
   // assemble's.
   bool close_far(const double* q, std::size_t m) {
     const std::size_t nt = verts_.size();
-    const std::uint16_t far = static_cast<std::uint16_t>(planes_.size());
+    const Index far = static_cast<Index>(planes_.size());
     border_.clear();  // here: the boundary edges, as (b, a)
     for (std::size_t t = 0; t < nt; ++t) {
       const Vertex& v = verts_[t];
       for (int k = 0; k < 3; ++k) {
-        const std::uint16_t a = v.p[k], b = v.p[k == 2 ? 0 : k + 1];
+        const Index a = v.p[k], b = v.p[k == 2 ? 0 : k + 1];
         // The table is not cleared between cells: an entry is this cell's
         // only if its triangle holds the edge.
         const std::uint32_t u = edge(b, a);
@@ -410,7 +414,7 @@ class Hull {
     for (std::size_t t = 0; t < nt + nb; ++t) {
       const Vertex& v = verts_[t];
       for (int k = 0; k < 3; ++k) {
-        const std::uint16_t a = v.p[k], b = v.p[k == 2 ? 0 : k + 1];
+        const Index a = v.p[k], b = v.p[k == 2 ? 0 : k + 1];
         const std::uint32_t u = edge(b, a);
         if (edge(a, b) != t || !(u < nt + nb && holds(verts_[u], b, a))) return false;
       }
@@ -419,7 +423,7 @@ class Hull {
   }
 
   // Whether triangle v holds the directed edge (a -> b).
-  static bool holds(const Vertex& v, std::uint16_t a, std::uint16_t b) {
+  static bool holds(const Vertex& v, Index a, Index b) {
     return (v.p[0] == a && v.p[1] == b) || (v.p[1] == a && v.p[2] == b) || (v.p[2] == a && v.p[0] == b);
   }
 
@@ -438,7 +442,7 @@ class Hull {
     // Planes and corners are written in place: a local struct copied in
     // would be read back wider than it was written (a store-forwarding stall).
     planes_.resize(box_planes);
-    for (int k = 0; k < box_planes; ++k) {
+    for (int k = 0; k < static_cast<int>(box_planes); ++k) {
       const int axis = k / 2;
       const bool upper = k & 1;
       Plane& pl = planes_[static_cast<std::size_t>(k)];
@@ -507,7 +511,7 @@ class Hull {
   // points), and 70,000 one of 17 GB before its face limit stopped it.
   static constexpr std::size_t dense_planes = 1024;  // a 4 MB table
 
-  std::uint32_t edge(std::uint16_t a, std::uint16_t b) const {
+  std::uint32_t edge(Index a, Index b) const {
     if (!hashed_) [[likely]] return edge_tri_[static_cast<std::size_t>(a) * cap_ + b];
     return hash_find(a, b);
   }
@@ -535,54 +539,55 @@ class Hull {
   // edges each, at most half full; it grows by rehash()).
   void enter_hash(std::size_t triangles) {
     hashed_ = true;
-    hash_.assign(std::max<std::size_t>(1024, std::bit_ceil(8 * triangles)), 0);
+    hash_.assign(std::max<std::size_t>(1024, std::bit_ceil(8 * triangles)), HashSlot{});
     hash_used_ = 0;
   }
 
   // A new cell: back to the dense table (its size kept), the hash dropped.
   void leave_hash() {
     hashed_ = false;
-    std::vector<std::uint64_t>().swap(hash_);
+    std::vector<HashSlot>().swap(hash_);
     hash_used_ = 0;
   }
 
-  // Hash slots hold (key << 32 | triangle), key = (a << 16 | b) + 1 (0: empty).
-  static std::uint64_t hash_key(std::uint16_t a, std::uint16_t b) {
-    return ((static_cast<std::uint64_t>(a) << 16) | b) + 1;
-  }
-  std::size_t hash_slot(std::uint64_t key) const {  // Fibonacci hashing: the product's top bits
+  // A hash slot: the directed edge (a -> b) and the triangle holding it;
+  // a = no_plane: empty. 12 bytes (a huge cell's map holds millions).
+  static constexpr Index no_plane = std::numeric_limits<Index>::max();
+  struct HashSlot {
+    Index a = no_plane, b = 0;
+    std::uint32_t tri = 0;
+  };
+  std::size_t hash_slot(Index a, Index b) const {  // Fibonacci hashing: the product's top bits
+    const std::uint64_t key = (static_cast<std::uint64_t>(a) << 32) | b;
     return static_cast<std::size_t>((key * 0x9E3779B97F4A7C15ull) >> (64 - std::countr_zero(hash_.size())));
   }
-  std::uint32_t hash_find(std::uint16_t a, std::uint16_t b) const {
-    const std::uint64_t key = hash_key(a, b);
-    for (std::size_t s = hash_slot(key);; s = (s + 1) & (hash_.size() - 1)) {
-      const std::uint64_t e = hash_[s];
-      if ((e >> 32) == key) return static_cast<std::uint32_t>(e);
-      if (e == 0) return 0;  // never linked (not asked for by a consistent cell)
+  std::uint32_t hash_find(Index a, Index b) const {
+    for (std::size_t s = hash_slot(a, b);; s = (s + 1) & (hash_.size() - 1)) {
+      const HashSlot& e = hash_[s];
+      if (e.a == a && e.b == b) return e.tri;
+      if (e.a == no_plane) return 0;  // never linked (not asked for by a consistent cell)
     }
   }
-  void hash_link(std::uint16_t a, std::uint16_t b, std::uint32_t t) {
+  void hash_link(Index a, Index b, std::uint32_t t) {
     if (2 * (hash_used_ + 1) > hash_.size()) rehash();
-    const std::uint64_t key = hash_key(a, b);
-    for (std::size_t s = hash_slot(key);; s = (s + 1) & (hash_.size() - 1)) {
-      std::uint64_t& e = hash_[s];
-      if (e == 0) ++hash_used_;
-      if (e == 0 || (e >> 32) == key) {
-        e = (key << 32) | t;
+    for (std::size_t s = hash_slot(a, b);; s = (s + 1) & (hash_.size() - 1)) {
+      HashSlot& e = hash_[s];
+      if (e.a == no_plane) ++hash_used_;
+      if (e.a == no_plane || (e.a == a && e.b == b)) {
+        e = {a, b, t};
         return;
       }
     }
   }
   void rehash() {
-    std::vector<std::uint64_t> old(2 * hash_.size(), 0);
+    std::vector<HashSlot> old(2 * hash_.size());
     old.swap(hash_);
     hash_used_ = 0;
-    for (const std::uint64_t e : old)
-      if (e != 0) hash_link(static_cast<std::uint16_t>(((e >> 32) - 1) >> 16), static_cast<std::uint16_t>((e >> 32) - 1),
-                            static_cast<std::uint32_t>(e));
+    for (const HashSlot& e : old)
+      if (e.a != no_plane) hash_link(e.a, e.b, e.tri);
   }
 
-  [[gnu::noinline, gnu::cold]] void cut_hashed(std::uint16_t pn, std::size_t nv) { cut<true>(pn, nv); }
+  [[gnu::noinline, gnu::cold]] void cut_hashed(Index pn, std::size_t nv) { cut<true>(pn, nv); }
 
   // cut()'s border collection in hashed mode (see there). A copy with the
   // hash lookup, not one loop with both: that loop (the lookup chosen by
@@ -593,7 +598,7 @@ class Hull {
     for (std::size_t h = 0; h < nh; ++h) {
       const Vertex& v = verts_[holes_[h]];
       for (int k = 0; k < 3; ++k) {
-        const std::uint16_t a = v.p[k], b = v.p[k == 2 ? 0 : k + 1];
+        const Index a = v.p[k], b = v.p[k == 2 ? 0 : k + 1];
         border_[nb] = {a, b};
         nb += sign_[hash_find(b, a)] >= 0;
       }
@@ -721,14 +726,14 @@ class Hull {
   std::vector<Plane> planes_;
   VertexList verts_;
   filter::FilterLanes<3> lanes_;  // verts_' filter data, for the sign pass
-  struct Edge { std::uint16_t a, b; };
+  struct Edge { Index a, b; };
   std::vector<Edge> border_;   // a clip's boundary edges (its first slots)
   std::vector<std::uint32_t> holes_;
   std::vector<filter::Sign> sign_;
   std::vector<std::uint32_t> edge_tri_;  // cap_ x cap_: directed plane pair -> triangle (edge())
   std::size_t cap_ = 0;
   bool hashed_ = false;                  // the edge map is hash_ (grow_table)
-  std::vector<std::uint64_t> hash_;
+  std::vector<HashSlot> hash_;
   std::size_t hash_used_ = 0;
   double security2_ = 0;
   std::vector<std::uint8_t> seen_;

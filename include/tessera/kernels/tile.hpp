@@ -32,7 +32,7 @@ class Tile {
   static constexpr int dim = 2;
   /// A local plane's index (vertices hold two): 32 bits cost the tile
   /// nothing (its vertex is 40 bytes either way, in padding), so a polygon
-  /// may have any number of edges, where the hull's are 16-bit. Before stop
+  /// may have any number of edges (the hull's are 32-bit since stop 59). Before stop
   /// 57 they were 16-bit too: the centre of 65,535 points on a circle, or
   /// the end of 400k points on a parabola (whose triangulation fans from
   /// it), failed with a length error, and past 65,520 neighbours a star
