@@ -645,7 +645,7 @@ class CellBuilder {
     auto skip = [&](std::int32_t j) {
       return tried_[static_cast<std::size_t>(j)] == epoch_ || exactly_equal(p, j);
     };
-    certified_.assign(cell.vertices().size(), ~std::uint64_t{0});
+    certified_.assign(cell.vertices().size(), uncertified);
     for (std::size_t t = 0; t < cell.vertices().size(); ++t) {
       const auto& v = cell.vertices()[t];
       if (4 * v.r2 * (1 + 1e-12) < near2) certified_[t] = vertex_key(v);
@@ -653,7 +653,7 @@ class CellBuilder {
     std::size_t nodes = 0, searches = 0, afford = 0;
     for (;;) {
       const auto& verts = cell.vertices();
-      if (certified_.size() < verts.size()) certified_.resize(verts.size(), ~std::uint64_t{0});
+      if (certified_.size() < verts.size()) certified_.resize(verts.size(), uncertified);
       std::size_t widest = verts.size(), open = 0;
       for (std::size_t t = 0; t < verts.size(); ++t) {
         if (certified_[t] == vertex_key(verts[t])) continue;
@@ -701,11 +701,19 @@ class CellBuilder {
     }
   }
 
-  /// A vertex's local planes packed (identifies it within one cell: a new
-  /// vertex always holds the newest plane).
-  static std::uint64_t vertex_key(const typename CellT::Vertex& v) {
-    std::uint64_t k = 0;
-    for (int d = 0; d < D; ++d) k = (k << 16) | v.p[d];
+  /// A vertex's local planes (identify it within one cell: a new vertex
+  /// always holds the newest plane). Whole indices: packed 16 bits apiece
+  /// (until stop 59), the keys of a cell past 65,535 planes (2D since stop
+  /// 57, 3D since 59) could collide, and a vertex pass for certified.
+  using VertexKey = std::array<Index, D>;
+  static constexpr VertexKey uncertified = [] {
+    VertexKey k{};
+    k.fill(std::numeric_limits<Index>::max());  // no vertex's: its planes differ
+    return k;
+  }();
+  static VertexKey vertex_key(const typename CellT::Vertex& v) {
+    VertexKey k;
+    for (int d = 0; d < D; ++d) k[static_cast<std::size_t>(d)] = v.p[d];
     return k;
   }
 
@@ -907,7 +915,7 @@ class CellBuilder {
     status.has_cell = false;
     return status;
   }
-  std::vector<std::uint64_t> certified_;  // per vertex slot: the key it was certified with
+  std::vector<VertexKey> certified_;  // per vertex slot: the key it was certified with
   PetalCover<D> petals_;  // build_nearest_first's
   std::vector<Candidate> cand_;
   std::vector<std::uint64_t> keys_;
