@@ -66,9 +66,9 @@ inline constexpr std::int32_t far_plane_id = std::numeric_limits<std::int32_t>::
 /// so every vertex on P is certainly outside the box (box_signs).
 /// `box`: the kernel's first 2D planes (box_planes), n = -+e_axis, d = the
 /// offset from the generator.
-template <int D, class Plane, class Vertex>
-bool far_plane(const double* dirs, std::size_t k, const Plane* box, const Vertex* verts, std::size_t nv, Plane& out) {
-  double n[D] = {};
+template <int D>
+bool far_direction(const double* dirs, std::size_t k, double* n) {
+  for (int a = 0; a < D; ++a) n[a] = 0;
   for (std::size_t r = 0; r < k; ++r)
     for (int a = 0; a < D; ++a) n[a] += dirs[D * r + static_cast<std::size_t>(a)];
   // Where the rays crowd one side of a wide cone (a hull point at the end of
@@ -92,10 +92,16 @@ bool far_plane(const double* dirs, std::size_t k, const Plane* box, const Vertex
         worst = r;
       }
     }
-    if (worst == k) break;  // every ray crosses n's planes at 1e-3 of a right angle or more
+    if (worst == k) return true;  // every ray crosses n's planes at 1e-3 of a right angle or more
     if (step == 64 || !(len > 0)) return false;
     for (int a = 0; a < D; ++a) n[a] = n[a] / len + dirs[D * worst + static_cast<std::size_t>(a)];
   }
+}
+
+/// far_plane's second half: the plane of normal n (from far_direction)
+/// beyond the box and the vertices, as far_plane describes.
+template <int D, class Plane, class Vertex>
+bool far_offset(const double* n, const Plane* box, const Vertex* verts, std::size_t nv, Plane& out) {
   double n1 = 0;
   for (int a = 0; a < D; ++a) n1 += std::fabs(n[a]);
   double cmax = 0, extent = 0;  // over the box's corners: sum over axes of the larger end
@@ -117,6 +123,14 @@ bool far_plane(const double* dirs, std::size_t k, const Plane* box, const Vertex
   out.id = far_plane_id;
   out.scale = 0;
   return true;
+}
+
+/// The direction (far_direction: where the rays allow none, false before
+/// any vertex is read), then the offset (far_offset).
+template <int D, class Plane, class Vertex>
+bool far_plane(const double* dirs, std::size_t k, const Plane* box, const Vertex* verts, std::size_t nv, Plane& out) {
+  double n[D];
+  return far_direction<D>(dirs, k, n) && far_offset<D>(n, box, verts, nv, out);
 }
 
 /// After the box cut of a hull point's cell: false if a vertex still lies

@@ -236,14 +236,32 @@ class Hull {
       enter_hash(nt);  // (rehash() grows it if the far plane and the box add more)
     }
     resize_vertices(nt);
-    refused_.clear();
-    const std::size_t may_refuse = assembly::exact_solves_paid(m, nt);
-    for (std::size_t t = 0; t < nt; ++t) {
-      Vertex& v = verts_[t];
+    auto set_planes = [&](Vertex& v, std::size_t t) {
       const Index* c = corners + 3 * t;
       v.p[0] = static_cast<Index>(box_planes + c[0]);
       v.p[1] = static_cast<Index>(box_planes + c[1]);
       v.p[2] = static_cast<Index>(box_planes + c[2]);
+    };
+    // A hull point: its link's boundary, the far plane's direction and its
+    // vertices' conditions come from the triangles alone, so a large star
+    // that cannot be closed (the end of a thin band, whose star holds
+    // 160,000 neighbours, and whose far vertices are too ill-conditioned
+    // for floats) gives up before its vertices are solved, some thousands
+    // exactly. A small one is checked after them, as before: checked first,
+    // the extra pass cost points on a sphere 2.5%.
+    const bool boundary_first = open && nt >= boundary_first_from;
+    if (boundary_first) {
+      for (std::size_t t = 0; t < nt; ++t) {
+        set_planes(verts_[t], t);
+        link_any(static_cast<std::uint32_t>(t));
+      }
+      if (!link_boundary(q, m, true)) return false;
+    }
+    refused_.clear();
+    const std::size_t may_refuse = assembly::exact_solves_paid(m, nt);
+    for (std::size_t t = 0; t < nt; ++t) {
+      Vertex& v = verts_[t];
+      set_planes(v, t);
       solve(v, filter::SolveMode::float_only);
       if (!(v.e <= std::numeric_limits<double>::max())) {  // would need the exact solve
         if (refused_.size() == may_refuse) return false;          // clip instead
@@ -256,7 +274,7 @@ class Hull {
       solve(verts_[t], filter::SolveMode::exact_now);
       settle_any(t);
     }
-    if (open && !close_far(q, m)) return false;
+    if (open && !((boundary_first || link_boundary(q, m, false)) && close_far())) return false;
     update_radius();
     return clip_to_box() && (!open || assembly::drop_far_plane<3>(planes_, verts_));
   }
@@ -354,15 +372,17 @@ class Hull {
     return true;
   }
 
-  // assemble() of a hull point: the link's nt = verts_.size() triangles
-  // are solved and linked; find its boundary edges (a -> b: no triangle
-  // holds b -> a), add the far plane and the triangles (b, a, far), and
-  // check that the surface is now a sphere. q: the bisectors' points, as
-  // assemble's.
-  bool close_far(const double* q, std::size_t m) {
+  // assemble() of a hull point, before its vertices are solved: the link's
+  // nt = verts_.size() triangles are linked (their planes written). Find
+  // its boundary edges (a -> b: no triangle holds b -> a) into border_ as
+  // (b, a), check that a cone over them closes the disk into a sphere, and
+  // find the far plane's direction (far_n_) from the hull facets' outward
+  // normals (dirs_); with `probe`, check too that the far vertices are
+  // well enough conditioned for close_far's float solves. q: the
+  // bisectors' points, as assemble's.
+  bool link_boundary(const double* q, std::size_t m, bool probe) {
     const std::size_t nt = verts_.size();
-    const Index far = static_cast<Index>(planes_.size());
-    border_.clear();  // here: the boundary edges, as (b, a)
+    border_.clear();
     for (std::size_t t = 0; t < nt; ++t) {
       const Vertex& v = verts_[t];
       for (int k = 0; k < 3; ++k) {
@@ -395,8 +415,42 @@ class Hull {
       if (!(len > 1e-8 * na * nbl)) return false;
       for (int a = 0; a < 3; ++a) d[a] /= len;
     }
+    if (!assembly::far_direction<3>(dirs_.data(), nb, far_n_)) return false;
+    if (!probe) return true;
+    // Whether a far vertex is well enough conditioned for its float solve
+    // (close_far gives up otherwise) depends on the planes' normals alone:
+    // found here with the far plane at any offset, before the link's
+    // vertices are solved (the end of a thin band: thousands of them
+    // exactly, for nothing).
     Plane& pf = planes_.emplace_back();
-    if (!assembly::far_plane<3>(dirs_.data(), nb, planes_.data(), verts_.data(), nt, pf)) return false;
+    for (int a = 0; a < 3; ++a) pf.n[a] = far_n_[a];
+    pf.d = 0;
+    pf.n1 = std::fabs(far_n_[0]) + std::fabs(far_n_[1]) + std::fabs(far_n_[2]);
+    pf.id = assembly::far_plane_id;
+    pf.scale = 0;
+    const Index far = static_cast<Index>(planes_.size() - 1);
+    bool solvable = true;
+    for (std::size_t k = 0; solvable && k < nb; ++k) {
+      Vertex probe;
+      probe.p[0] = border_[k].a;
+      probe.p[1] = border_[k].b;
+      probe.p[2] = far;
+      solve(probe, filter::SolveMode::float_only);
+      solvable = probe.e <= std::numeric_limits<double>::max();
+    }
+    planes_.pop_back();
+    return solvable;
+  }
+
+  // link_boundary's second half, once the link's vertices are solved and
+  // settled: the far plane (its offset beyond them and the box) and the
+  // triangles (b, a, far) over the boundary; false unless the surface is
+  // then closed.
+  bool close_far() {
+    const std::size_t nt = verts_.size(), nb = border_.size();
+    const Index far = static_cast<Index>(planes_.size());
+    Plane& pf = planes_.emplace_back();
+    if (!assembly::far_offset<3>(far_n_, planes_.data(), verts_.data(), nt, pf)) return false;
     resize_vertices(nt + nb);
     for (std::size_t k = 0; k < nb; ++k) {
       Vertex& v = verts_[nt + k];
@@ -483,10 +537,14 @@ class Hull {
     link<Hashed>(t);
   }
 
-  // settle() in whichever mode the edge map is (assembly: decided per cell).
+  // settle() and link() in whichever mode the edge map is (assembly: decided per cell).
   void settle_any(std::uint32_t t) {
     if (hashed_) settle<true>(t);
     else settle<false>(t);
+  }
+  void link_any(std::uint32_t t) {
+    if (hashed_) link<true>(t);
+    else link<false>(t);
   }
 
   template <bool Hashed = false>
@@ -510,6 +568,9 @@ class Hull {
   // inside a shell of 20,000 points made a 4.3 GB table (5.3 GB peak for 20k
   // points), and 70,000 one of 17 GB before its face limit stopped it.
   static constexpr std::size_t dense_planes = 1024;  // a 4 MB table
+  // assemble(): a hull point's star of this many triangles or more is
+  // checked for closing before its vertices are solved (link_boundary).
+  static constexpr std::size_t boundary_first_from = 4096;
 
   std::uint32_t edge(Index a, Index b) const {
     if (!hashed_) [[likely]] return edge_tri_[static_cast<std::size_t>(a) * cap_ + b];
@@ -738,7 +799,8 @@ class Hull {
   double security2_ = 0;
   std::vector<std::uint8_t> seen_;
   FaceLoopScratch walk_;  // for_each_face's
-  std::vector<double> dirs_;         // close_far: the rays' unit directions
+  std::vector<double> dirs_;         // link_boundary: the rays' unit directions
+  double far_n_[3] = {};             // link_boundary: the far plane's normal
   std::vector<std::uint32_t> refused_;  // assemble: the vertices refused the exact solve
   PreparedSigns<3, Index> signs_;  // the exact stages, prepared per vertex slot
 };
