@@ -75,8 +75,8 @@ class CellsCompositor {
     /// Entry t's high corner halves (its first vertex's), or null: not a wide cell.
     const kernels::Corners<D>* high_of(std::size_t t) const {
       if (wide.empty()) [[likely]] return nullptr;
-      const auto at = std::lower_bound(wide.begin(), wide.end(), std::pair<std::uint32_t, std::uint32_t>{
-                                                                     static_cast<std::uint32_t>(t), 0});
+      const std::pair<std::uint32_t, std::uint32_t> sought{static_cast<std::uint32_t>(t), 0};
+      const auto at = std::lower_bound(wide.begin(), wide.end(), sought);
       return at != wide.end() && at->first == t ? high_corners.data() + at->second : nullptr;
     }
   };
@@ -350,7 +350,9 @@ class CellsCompositor {
     constexpr bool may_be_wide = sizeof(Half) < sizeof(std::uint32_t);
     kernels::Corners<D>* high = nullptr;
     if (may_be_wide && nfaces > std::numeric_limits<Half>::max()) [[unlikely]] {
-      b.wide.emplace_back(static_cast<std::uint32_t>(b.gen.size() - 1), static_cast<std::uint32_t>(b.high_corners.size()));
+      // This cell is the batch's last entry (add() listed its generator).
+      b.wide.emplace_back(static_cast<std::uint32_t>(b.gen.size() - 1),
+                          static_cast<std::uint32_t>(b.high_corners.size()));
       b.high_corners.resize(b.high_corners.size() + nv);
       high = b.high_corners.data() + b.wide.back().second;
     }
@@ -372,7 +374,8 @@ class CellsCompositor {
 
   // Face k of batch vertex v, the vertex of entry t whose high halves are
   // `high` (Batch::high_of) and whose first vertex is v0.
-  static std::uint32_t corner_of(const Batch& b, const kernels::Corners<D>* high, std::uint32_t v0, std::uint32_t v, int k) {
+  static std::uint32_t corner_of(const Batch& b, const kernels::Corners<D>* high, std::uint32_t v0, std::uint32_t v,
+                                 int k) {
     const std::uint32_t lo = b.corners()[v][static_cast<std::size_t>(k)];
     if (high == nullptr) [[likely]] return lo;
     return lo | static_cast<std::uint32_t>(high[v - v0][static_cast<std::size_t>(k)]) << 16;

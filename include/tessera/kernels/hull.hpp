@@ -90,8 +90,7 @@ class Hull {
       v.e = err + filter::plane_eps * ymax;
       set_radius(v, err);
       v.deferred = 0;
-      const Index a = static_cast<Index>(sx), b = static_cast<Index>(2 + sy),
-                          cc = static_cast<Index>(4 + sz);
+      const Index a = static_cast<Index>(sx), b = static_cast<Index>(2 + sy), cc = static_cast<Index>(4 + sz);
       // det(±e_x, ±e_y, ±e_z) = product of the signs; swap to make it positive.
       const bool positive = ((sx + sy + sz) % 2) == 1;  // signs: upper=+, lower=-
       v.p[0] = a;
