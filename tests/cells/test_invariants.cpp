@@ -227,6 +227,13 @@ std::vector<double> unit_sphere_points(int m, std::uint64_t seed) {
   return pts;
 }
 
+/// `sphere`'s points with the origin added first or last, and its index.
+std::pair<std::vector<double>, int> with_centre(const std::vector<double>& sphere, bool first) {
+  std::vector<double> pts = sphere;
+  pts.insert(first ? pts.begin() : pts.end(), {0.0, 0.0, 0.0});
+  return {pts, first ? 0 : static_cast<int>(sphere.size() / 3)};
+}
+
 TEST(Invariants, HugeCell3D) {
   // A point inside a shell of 3,000 random points: its cell has 3,000 faces,
   // past the dense edge maps (Hull's plane-pair table and the face walk's,
@@ -241,9 +248,7 @@ TEST(Invariants, HugeCell3D) {
   const std::vector<double> sphere = unit_sphere_points(m, 91);
   for (bool centre_first : {false, true}) {
     SCOPED_TRACE(centre_first ? "centre first" : "centre last");
-    std::vector<double> pts = sphere;
-    pts.insert(centre_first ? pts.begin() : pts.end(), {0.0, 0.0, 0.0});
-    const int centre = centre_first ? 0 : m;
+    const auto [pts, centre] = with_centre(sphere, centre_first);
     std::vector<std::int32_t> first;
     for (auto method : {tessera::CellMethod::search, tessera::CellMethod::insertion})
       for (int threads : {1, 2}) {
@@ -276,9 +281,7 @@ TEST(Invariants, HugeCell3DPastSixteenBits) {
   const std::vector<double> sphere = unit_sphere_points(m, 93);
   for (bool centre_first : {false, true}) {
     SCOPED_TRACE(centre_first ? "centre first" : "centre last");
-    std::vector<double> pts = sphere;
-    pts.insert(centre_first ? pts.begin() : pts.end(), {0.0, 0.0, 0.0});
-    const int centre = centre_first ? 0 : m;
+    const auto [pts, centre] = with_centre(sphere, centre_first);
     {
       const int threads = centre_first ? 2 : 1;
       tessera::VoronoiOptions o = options(3, std::nullopt, threads);
