@@ -94,60 +94,74 @@ __int128 on_wide_grid(const DoubleParts& pt, int shift) {
 // vertex_numerators_narrow for a grid of 61 to 124 bits: random doubles in
 // [0, 1) whose smallest coordinate is ~1e-3 already need 64 (points on a
 // thin cylindrical band solve ~40 vertices of each cell exactly, with
-// grids of 60 to 76 bits). Rows relative to p_i: |q| < 2^125, a = 2 q
-// below 2^126, b = |q|^2 below 3 2^250 (a box row's b below 2^125); the
-// cofactors (differences of products of a) below 2^253, det A below
-// 3 2^126 2^253 < 2^381 and the numerators below 3 (3 2^250) 2^253 < 2^507:
-// 2, 4, 4, 6 and 8 limbs, each a signed value within its width.
+// grids of 60 to 76 bits). Rows relative to p_i, in L limbs for b and the
+// cofactors:
+// * L = 4, grids of up to 124 bits: |q| < 2^125, a = 2 q below 2^126,
+//   b = |q|^2 below 3 2^250 (a box row's b below 2^125); the cofactors
+//   (differences of products of a) below 2^253, det A below
+//   3 2^126 2^253 < 2^381 and the numerators below 3 (3 2^250) 2^253 <
+//   2^507: 2, 4, 4, 6 and 8 limbs;
+// * L = 3, grids of up to 92 bits (the band's): |q| < 2^93, a below 2^94,
+//   b below 3 2^186 < 2^188, the cofactors below 2^189, det A below
+//   3 2^94 2^189 < 2^285 and the numerators below 3 2^188 2^189 < 2^379:
+//   2, 3, 3, 5 and 6 limbs. The products of 3 limbs by 3 take 9 word
+//   products where 4 by 4 take 16: the band's cells (50k, one thread) 2.38-2.46
+//   -> 2.31-2.33 s, the same doubles.
+// Each value is signed within its width.
+template <int L>
 void vertex_numerators_wide(const DoubleParts (*pv)[Scratch::kMaxDim], const std::int32_t* planes, int dim,
                             int shift, GridNumerators& g) {
   using I = __int128;
   using W2 = WideInt<2>;
-  using W4 = WideInt<4>;
+  using WL = WideInt<L>;
   I ci[3] = {0, 0, 0}, a[3][3] = {};
-  W4 b[3];
+  WL b[3];
   for (int d = 0; d < dim; ++d) ci[d] = on_wide_grid(pv[dim][d], shift);
   for (int r = 0; r < dim; ++r) {
     if (planes[r] >= 0) {
-      W4 sq = W4::from(0);
+      WideInt<4> sq = WideInt<4>::from(0);
       for (int d = 0; d < dim; ++d) {
         const I q = on_wide_grid(pv[r][d], shift) - ci[d];
         a[r][d] = 2 * q;
         sq = sq + multiply(W2::from(q), W2::from(q));
       }
-      b[r] = sq;
+      b[r] = sq.template narrow<L>();
     } else {
       const int axis = box_plane_axis(planes[r]);
       a[r][axis] = 1;
-      b[r] = W4::from(on_wide_grid(pv[r][0], shift) - ci[axis]);
+      b[r] = WL::from(on_wide_grid(pv[r][0], shift) - ci[axis]);
     }
   }
   // cof[r][d]: the cofactor of a[r][d] (exact_rows::cofactors, wider).
-  W4 cof[3][3];
+  WL cof[3][3];
   if (dim == 2) {
-    cof[0][0] = W4::from(a[1][1]), cof[0][1] = W4::from(-a[1][0]);
-    cof[1][0] = W4::from(-a[0][1]), cof[1][1] = W4::from(a[0][0]);
+    cof[0][0] = WL::from(a[1][1]), cof[0][1] = WL::from(-a[1][0]);
+    cof[1][0] = WL::from(-a[0][1]), cof[1][1] = WL::from(a[0][0]);
   } else {
     for (int r = 0; r < 3; ++r) {
       const I* u = a[(r + 1) % 3];
       const I* w = a[(r + 2) % 3];
       for (int d = 0; d < 3; ++d) {
         const int x = (d + 1) % 3, y = (d + 2) % 3;
-        cof[r][d] = multiply(W2::from(u[x]), W2::from(w[y])) - multiply(W2::from(u[y]), W2::from(w[x]));
+        cof[r][d] = (multiply(W2::from(u[x]), W2::from(w[y])) - multiply(W2::from(u[y]), W2::from(w[x])))
+                        .template narrow<L>();
       }
     }
   }
-  g.det = WideInt<6>::from(0);
-  for (int d = 0; d < dim; ++d) g.det = g.det + multiply(W2::from(a[0][d]), cof[0][d]);
-  if (g.det.sign() == 0) throw std::logic_error("exact_vertex: vertex planes are dependent (corrupt cell)");
+  WideInt<2 + L> det = WideInt<2 + L>::from(0);
+  for (int d = 0; d < dim; ++d) det = det + multiply(W2::from(a[0][d]), cof[0][d]);
+  if (det.sign() == 0) throw std::logic_error("exact_vertex: vertex planes are dependent (corrupt cell)");
+  g.det = det.template widen<6>();
   for (int d = 0; d < dim; ++d) {
-    g.num[d] = WideInt<8>::from(0);
-    for (int r = 0; r < dim; ++r) g.num[d] = g.num[d] + multiply(b[r], cof[r][d]);
+    WideInt<2 * L> n = WideInt<2 * L>::from(0);
+    for (int r = 0; r < dim; ++r) n = n + multiply(b[r], cof[r][d]);
+    g.num[d] = n.template widen<8>();
   }
 }
 
 // The numerators on the input's grid where it spans at most 124 bits
-// (narrow up to 60, else wide); false otherwise (GMP's turn).
+// (narrow up to 60, wide in 3 limbs up to 92, else in 4); false otherwise
+// (GMP's turn).
 bool grid_numerators(const ExactContext& ctx, std::int32_t i, const std::int32_t* planes, GridNumerators& g) {
   const int dim = ctx.dim;
   if (dim != 2 && dim != 3) return false;
@@ -157,7 +171,8 @@ bool grid_numerators(const ExactContext& ctx, std::int32_t i, const std::int32_t
   if (span.all_zero() || !span.fits(124)) return false;
   g.shift = span.scale();
   if (span.fits(60)) vertex_numerators_narrow(pv, planes, dim, g.shift, g);
-  else vertex_numerators_wide(pv, planes, dim, g.shift, g);
+  else if (span.fits(92)) vertex_numerators_wide<3>(pv, planes, dim, g.shift, g);
+  else vertex_numerators_wide<4>(pv, planes, dim, g.shift, g);
   return true;
 }
 

@@ -71,6 +71,16 @@ struct WideInt {
 
   bool negative() const { return static_cast<std::int64_t>(limb[N - 1]) < 0; }
 
+  /// The same value in M <= N limbs: its low limbs, exact when the value
+  /// fits M limbs as a signed value (the caller's bound).
+  template <int M>
+  WideInt<M> narrow() const {
+    static_assert(M <= N);
+    WideInt<M> r;
+    for (int k = 0; k < M; ++k) r.limb[k] = limb[k];
+    return r;
+  }
+
   /// The same value in M >= N limbs (sign-extended).
   template <int M>
   WideInt<M> widen() const {
