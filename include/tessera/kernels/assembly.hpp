@@ -186,11 +186,21 @@ inline std::size_t exact_solves_paid(std::size_t m, std::size_t nt) { return m *
 /// What becomes of a vertex too ill-conditioned for its float bound
 /// (Hull/Tile::ill_conditioned; its D local planes `p`, its float estimate
 /// y, its condition `cond`, whether its first-order bound is finite):
-///   refuse: a NaN bound. On a hull point's far plane, which is no bisector
-///     and has no exact form (the box test then gives the cell up); or, in
-///     the assembly (float_only), one far out beyond the deferred bound:
-///     the assembly solves as many of those as it can pay for
-///     (exact_solves_paid), else the cell is clipped;
+///   refuse: a NaN bound. On a hull point's far plane beyond the deferred
+///     bound (the box test then gives the cell up); or, in the assembly
+///     (float_only), one far out beyond it: the assembly solves as many of
+///     those as it can pay for (exact_solves_paid), else the cell is
+///     clipped;
+///   keep: on a hull point's far plane, which is no bisector and has no
+///     exact form, below filter::deferred_vertex_condition: it keeps its
+///     float position and first-order bound for good. The far plane lies
+///     half the box's extent beyond it, so the box cuts every such vertex
+///     with certainty (drop_far_plane checks), and none is ever output.
+///     Until stop 59 these were refused: the ends of hull facets thin as
+///     seen from the point (two neighbours nearly in line with it: the end
+///     of a thin band, the apex of a cone over a circle) sent stars of
+///     tens of thousands of neighbours to the clips, quadratic (80,000
+///     circle points and the two apexes: 61 s);
 ///   defer: it keeps its float position and bound (filter::
 ///     deferred_vertex_condition) until the cell is built. A clip's, and in
 ///     the assembly one far out (not worth_exact_solve): the box cuts it
@@ -202,14 +212,14 @@ inline std::size_t exact_solves_paid(std::size_t m, std::size_t nt) { return m *
 ///     (the end of a 2D parabola, whose star holds most points and has
 ///     thousands of such vertices, was then clipped by all of them: 400k
 ///     points 0.85 → 16 s).
-enum class IllConditioned { solve, defer, refuse };
+enum class IllConditioned { solve, defer, refuse, keep };
 template <int D, class Plane, class Index>
 IllConditioned ill_conditioned_fate(filter::SolveMode mode, double cond, bool bounded, const double* y,
                                     const Plane* planes, const Index* p) {
-  for (int k = 0; k < D; ++k)
-    if (planes[p[k]].id == far_plane_id) return IllConditioned::refuse;
-  if (mode == filter::SolveMode::exact_now) return IllConditioned::solve;
   const bool deferrable = cond < filter::deferred_vertex_condition && bounded;
+  for (int k = 0; k < D; ++k)
+    if (planes[p[k]].id == far_plane_id) return deferrable ? IllConditioned::keep : IllConditioned::refuse;
+  if (mode == filter::SolveMode::exact_now) return IllConditioned::solve;
   if (mode == filter::SolveMode::deferrable) return deferrable ? IllConditioned::defer : IllConditioned::solve;
   if (worth_exact_solve<D>(y, planes)) return IllConditioned::solve;
   return deferrable ? IllConditioned::defer : IllConditioned::refuse;

@@ -92,10 +92,12 @@ inline constexpr double deferred_vertex_condition = 1e9;
 /// (Hull/Tile::ill_conditioned, assembly::ill_conditioned_fate): exact_now
 /// solves it at once; deferrable (a clip) defers it below
 /// deferred_vertex_condition, else solves it; float_only (the assembly's
-/// first pass, and the far plane's vertices) solves one near the box at
-/// once, defers one far out below that condition, and refuses the rest (a
-/// NaN bound: the assembly solves those it can pay for with exact_now, or
-/// sends the cell to the clips).
+/// first pass) solves one near the box at once, defers one far out below
+/// that condition, and refuses the rest (a NaN bound: the assembly solves
+/// those it can pay for with exact_now, or sends the cell to the clips). A
+/// vertex on a hull point's far plane is never solved exactly: below that
+/// condition it keeps its float bound, beyond it is refused
+/// (assembly::ill_conditioned_fate).
 enum class SolveMode : std::uint8_t { float_only, exact_now, deferrable };
 
 /// floor(log2(x)) for a finite x > 0, clamped to [-1022, 1022] (subnormals

@@ -742,6 +742,8 @@ class Hull {
         v.deferred = 1;
         ++deferred_;
         return {err, ymax};
+      case assembly::IllConditioned::keep:  // on the far plane: the box cuts it
+        return {err, ymax};
       case assembly::IllConditioned::solve:
         break;
     }

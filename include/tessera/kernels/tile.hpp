@@ -415,6 +415,8 @@ class Tile {
       case assembly::IllConditioned::defer:
         deferred_.add(pair_key(v));
         return {err, ymax};
+      case assembly::IllConditioned::keep:  // on the far plane: the box cuts it
+        return {err, ymax};
       case assembly::IllConditioned::solve:
         break;
     }
