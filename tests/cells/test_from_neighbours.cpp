@@ -355,6 +355,27 @@ TEST(FromNeighbours, CellsAreAssembledFromTheirStars) {
     EXPECT_EQ(run_method(cone, 3, tessera::CellMethod::insertion).assembled_from_stars, 1001u);
     same_as_search(cone, "cone over a circle");
   }
+  // The same with 8,000 circle points and apexes above and below (every
+  // point on the unit sphere). Each apex's cell is a polyhedral 45-degree
+  // cone, whose edges pass within ~1e-9 of the default box's edges: a vertex
+  // the box's x plane makes lies 7e-10 from its z plane, inside its float
+  // bound (1e-9 at a condition of 1e5). Such vertices are now solved exactly
+  // and the box decides them (Hull::solve_near); before, the two apexes
+  // were clipped by all 8,000 neighbours, with exact ties at the centre
+  // (80,000 points: 61 s).
+  {
+    std::mt19937_64 rng(3);
+    std::uniform_real_distribution<double> u(0, 2 * std::numbers::pi);
+    std::vector<double> cones;
+    for (int k = 0; k < 8000; ++k) {
+      const double t = u(rng);
+      cones.insert(cones.end(), {std::cos(t), std::sin(t), 0.0});
+    }
+    cones.insert(cones.end(), {0.0, 0.0, 1.0, 0.0, 0.0, -1.0});
+    const tessera::Cells c = run_method(cones, 3, tessera::CellMethod::insertion);
+    EXPECT_EQ(c.assembled_from_stars, 8002u);
+    EXPECT_TRUE(tessera::validate(c, {}).ok);
+  }
   // A thin cylindrical band: the far vertices, ill-conditioned beyond the
   // float bound but not beyond the deferred one, are cut by the box with
   // certainty and never solved exactly (stop 58; before, a star that had one
