@@ -121,6 +121,19 @@ std::vector<double> helix_points(int n, std::uint64_t seed) {
   return p;
 }
 
+/// n points on the unit circle in the plane z = 0 (3D), at angles uniform
+/// at random.
+std::vector<double> circle_at_random_angles(int n, std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(0, 2 * std::numbers::pi);
+  std::vector<double> p;
+  for (int k = 0; k < n; ++k) {
+    const double t = u(rng);
+    p.insert(p.end(), {std::cos(t), std::sin(t), 0.0});
+  }
+  return p;
+}
+
 /// Points exactly on a thin band of a cylinder (a quarter arc of radius 1,
 /// 1e-3 high): every point on the hull, and every cell a wedge reaching the
 /// axis, where half its vertices are too ill-conditioned for a float
@@ -344,13 +357,7 @@ TEST(FromNeighbours, CellsAreAssembledFromTheirStars) {
   // refused, and 977 of the 1,001 cells were assembled (the apex's among
   // the clipped: 0.08 against 0.012 s; with 8,000 points 1.34 against 0.11 s).
   {
-    std::mt19937_64 rng(937);
-    std::uniform_real_distribution<double> u(0, 2 * std::numbers::pi);
-    std::vector<double> cone;
-    for (int k = 0; k < 1000; ++k) {
-      const double t = u(rng);
-      cone.insert(cone.end(), {std::cos(t), std::sin(t), 0.0});
-    }
+    std::vector<double> cone = circle_at_random_angles(1000, 937);
     cone.insert(cone.end(), {0.0, 0.0, 1.0});
     EXPECT_EQ(run_method(cone, 3, tessera::CellMethod::insertion).assembled_from_stars, 1001u);
     same_as_search(cone, "cone over a circle");
@@ -364,13 +371,7 @@ TEST(FromNeighbours, CellsAreAssembledFromTheirStars) {
   // were clipped by all 8,000 neighbours, with exact ties at the centre
   // (80,000 points: 61 s).
   {
-    std::mt19937_64 rng(3);
-    std::uniform_real_distribution<double> u(0, 2 * std::numbers::pi);
-    std::vector<double> cones;
-    for (int k = 0; k < 8000; ++k) {
-      const double t = u(rng);
-      cones.insert(cones.end(), {std::cos(t), std::sin(t), 0.0});
-    }
+    std::vector<double> cones = circle_at_random_angles(8000, 3);
     cones.insert(cones.end(), {0.0, 0.0, 1.0, 0.0, 0.0, -1.0});
     const tessera::Cells c = run_method(cones, 3, tessera::CellMethod::insertion);
     EXPECT_EQ(c.assembled_from_stars, 8002u);
