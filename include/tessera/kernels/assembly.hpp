@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <limits>
 #include <type_traits>
+#include <utility>
 #include <vector>
 
 #include "tessera/kernels/filter.hpp"
@@ -223,6 +224,30 @@ IllConditioned ill_conditioned_fate(filter::SolveMode mode, double cond, bool bo
   if (mode == filter::SolveMode::deferrable) return deferrable ? IllConditioned::defer : IllConditioned::solve;
   if (worth_exact_solve<D>(y, planes)) return IllConditioned::solve;
   return deferrable ? IllConditioned::defer : IllConditioned::refuse;
+}
+
+/// A kernel's ill-conditioned vertex v (Hull/Tile::ill_conditioned) given
+/// its fate: its first-order bound `err` and |y|_inf `ymax` as they stand,
+/// `defer()` recording the deferral the kernel's own way (a flag in the
+/// hull's vertex, a key set in the tile), `solve()` solving v exactly and
+/// returning its new |y|_inf. Returns v's err and ymax: NaN for err where
+/// refused.
+template <int D, class Plane, class Vertex, class Defer, class Solve>
+std::pair<double, double> settle_ill_conditioned(filter::SolveMode mode, double cond, double err, double ymax,
+                                                 const Vertex& v, const Plane* planes, Defer&& defer, Solve&& solve) {
+  switch (ill_conditioned_fate<D>(mode, cond, std::isfinite(err), v.y, planes, v.p)) {
+    case IllConditioned::refuse:
+      return {std::numeric_limits<double>::quiet_NaN(), ymax};
+    case IllConditioned::defer:
+      defer();
+      return {err, ymax};
+    case IllConditioned::keep:  // on the far plane: the box cuts it
+      return {err, ymax};
+    case IllConditioned::solve:
+      break;
+  }
+  const double exact_ymax = solve();
+  return {4 * filter::u * exact_ymax, exact_ymax};
 }
 
 /// No vertex can be placed against a box plane in floating point (box_signs).

@@ -773,20 +773,13 @@ class Hull {
     const double err = filter::vertex_eps * inv_norm * (amax * ymax + bmax) + slack;
     if (cond < filter::exact_vertex_condition && std::isfinite(ymax))  // false on NaN
       return {err, ymax};
-    switch (assembly::ill_conditioned_fate<3>(mode, cond, std::isfinite(err), v.y, planes_.data(), v.p)) {
-      case assembly::IllConditioned::refuse:
-        return {std::numeric_limits<double>::quiet_NaN(), ymax};
-      case assembly::IllConditioned::defer:
-        v.deferred = 1;
-        ++deferred_;
-        return {err, ymax};
-      case assembly::IllConditioned::keep:  // on the far plane: the box cuts it
-        return {err, ymax};
-      case assembly::IllConditioned::solve:
-        break;
-    }
-    ymax = solve_exactly(v);
-    return {4 * filter::u * ymax, ymax};
+    return assembly::settle_ill_conditioned<3>(
+        mode, cond, err, ymax, v, planes_.data(),
+        [&] {
+          v.deferred = 1;
+          ++deferred_;
+        },
+        [&] { return solve_exactly(v); });
   }
 
   // v's position solved exactly and rounded (exact_vertex); returns |y|_inf.

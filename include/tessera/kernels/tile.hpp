@@ -409,19 +409,9 @@ class Tile {
     const double err = filter::vertex_eps * inv_norm * (amax * ymax + bmax) + slack;
     if (cond < filter::exact_vertex_condition && std::isfinite(ymax))  // false on NaN
       return {err, ymax};
-    switch (assembly::ill_conditioned_fate<2>(mode, cond, std::isfinite(err), v.y, planes_.data(), v.p)) {
-      case assembly::IllConditioned::refuse:
-        return {std::numeric_limits<double>::quiet_NaN(), ymax};
-      case assembly::IllConditioned::defer:
-        deferred_.add(pair_key(v));
-        return {err, ymax};
-      case assembly::IllConditioned::keep:  // on the far plane: the box cuts it
-        return {err, ymax};
-      case assembly::IllConditioned::solve:
-        break;
-    }
-    ymax = solve_exactly(v);
-    return {4 * filter::u * ymax, ymax};
+    return assembly::settle_ill_conditioned<2>(
+        mode, cond, err, ymax, v, planes_.data(), [&] { deferred_.add(pair_key(v)); },
+        [&] { return solve_exactly(v); });
   }
 
   // v's position solved exactly and rounded (exact_vertex); returns |y|_inf.
