@@ -320,6 +320,23 @@ TEST(FromNeighbours, CellsAreAssembledFromTheirStars) {
   // Every point on a sphere (a circle) is on the hull: all open stars.
   EXPECT_EQ(run_method(sphere_points(400, 931), 3, tessera::CellMethod::insertion).assembled_from_stars, 400u);
   EXPECT_EQ(run_method(circle_points(700, 933), 2, tessera::CellMethod::insertion).assembled_from_stars, 700u);
+  // 316 concentric circles of 316 equally spaced points (2D): some cells'
+  // vertices lie within their float bounds of a box plane but not on it.
+  // Solved exactly, the box places them (Tile::solve_near, the helper
+  // shared with Hull: assembly::solve_near_box_plane); before stop 59 those
+  // cells were clipped.
+  {
+    std::vector<double> rings;
+    const int nc = 316;
+    for (int j = 0; j < nc; ++j)
+      for (int i = 0; i < nc; ++i) {
+        const double th = i * 2.0 * std::numbers::pi / nc;
+        rings.insert(rings.end(), {std::cos(th) * (j + 1) / nc, std::sin(th) * (j + 1) / nc});
+      }
+    const tessera::Cells c = run_method(rings, 2, tessera::CellMethod::insertion);
+    EXPECT_GE(c.assembled_from_stars, 99850u);  // 99,848 without the exact solves
+    EXPECT_TRUE(tessera::validate(c, {}).ok);
+  }
   // A Voronoi vertex exactly on a box plane, where the perturbation
   // decides: the cells that share it are clipped, the rest assembled.
   for (const int dim : {2, 3}) {

@@ -134,6 +134,36 @@ bool far_plane(const double* dirs, std::size_t k, const Plane* box, const Vertex
   return far_direction<D>(dirs, k, n) && far_offset<D>(n, box, verts, nv, out);
 }
 
+/// The vertices of [0, nv) that box plane k (offset h, as box_signs)
+/// cannot place by their float bounds, and whose exact solve would narrow
+/// the bound (not one on the far plane, which has no exact form, nor one
+/// solved exactly already): each passed to solve(t). Returns whether there
+/// were any. A first-order bound is wide (1e-9 at a condition of 1e5,
+/// more for a deferred vertex) and may straddle a plane the exact vertex
+/// does not touch; solved, such a vertex lets box_signs decide.
+template <int D, class Vertex, class Plane, class Solve>
+bool solve_near_box_plane(const Vertex* verts, std::size_t nv, int k, double h, const Plane* planes, Solve&& solve) {
+  const int axis = k / 2;
+  const double s = (k & 1) ? 1.0 : -1.0;
+  const double de = filter::plane_eps * std::fabs(h) + filter::abs_eps;
+  bool solved = false;
+  for (std::size_t t = 0; t < nv; ++t) {
+    const Vertex& v = verts[t];
+    const double P = h - s * v.y[axis], e = v.e + de;
+    if (P > e || P < -e) continue;
+    double ymax = 0;
+    bool on_far = false;
+    for (int c = 0; c < D; ++c) {
+      ymax = std::max(ymax, std::fabs(v.y[c]));
+      on_far |= planes[v.p[c]].id == far_plane_id;
+    }
+    if (on_far || !(v.e > (4 * filter::u + filter::plane_eps) * ymax)) continue;  // no exact form, or exact already (or NaN)
+    solve(t);
+    solved = true;
+  }
+  return solved;
+}
+
 /// After the box cut of a hull point's cell: false if a vertex still lies
 /// on the far plane (the last of `planes`; the box removes every vertex on
 /// it, as it lies outside the box and each decision was certain, so this is

@@ -384,27 +384,12 @@ class Hull {
     lanes_.set(static_cast<std::uint32_t>(t), v);
   }
 
-  // The vertices that box plane k cannot place by their float bounds
-  // (box_signs' test) solved exactly, where that narrows the bound (not one
-  // on the far plane, which has no exact form, nor one solved already);
-  // whether there were any.
+  // The vertices box plane k cannot place, solved exactly
+  // (assembly::solve_near_box_plane); whether there were any.
   bool solve_near(Index k) {
-    const int axis = static_cast<int>(k) / 2;
-    const double s = (k & 1) ? 1.0 : -1.0, h = planes_[k].d;
-    const double de = filter::plane_eps * std::fabs(h) + filter::abs_eps;
-    bool solved = false;
-    for (std::size_t t = 0; t < verts_.size(); ++t) {
-      const Vertex& v = verts_[t];
-      const double P = h - s * v.y[axis], e = v.e + de;
-      if (P > e || P < -e) continue;
-      const double ymax = std::max({std::fabs(v.y[0]), std::fabs(v.y[1]), std::fabs(v.y[2])});
-      if (!(v.e > (4 * filter::u + filter::plane_eps) * ymax)) continue;  // exact already (or NaN)
-      bool on_far = false;
-      for (int c = 0; c < 3; ++c) on_far |= planes_[v.p[c]].id == assembly::far_plane_id;
-      if (on_far) continue;
-      solve_now(t);
-      solved = true;
-    }
+    const bool solved = assembly::solve_near_box_plane<3>(verts_.data(), verts_.size(), static_cast<int>(k),
+                                                          planes_[k].d, planes_.data(),
+                                                          [this](std::size_t t) { solve_now(t); });
     if (solved) update_radius();
     return solved;
   }

@@ -238,15 +238,8 @@ class Tile {
   void solve_deferred() {
     if (deferred_.empty()) return;
     deferred_.seal();
-    for (std::size_t t = 0; t < verts_.size(); ++t) {
-      Vertex& v = verts_[t];
-      if (!deferred_.contains(pair_key(v))) continue;
-      const double ymax = solve_exactly(v);
-      const double err = 4 * filter::u * ymax;
-      v.e = err + filter::plane_eps * ymax;
-      set_radius(v, err);
-      lanes_.set(t, v);
-    }
+    for (std::size_t t = 0; t < verts_.size(); ++t)
+      if (deferred_.contains(pair_key(verts_[t]))) solve_now(t);
     deferred_.clear();
     update_radius();
   }
@@ -255,15 +248,39 @@ class Tile {
 
  private:
   // The assembled tile cut by the domain box's planes, each decided by the
-  // float filter alone (as Hull::clip_to_box).
+  // float filter alone, after solving exactly the vertices a plane cannot
+  // place (as Hull::clip_to_box).
   bool clip_to_box() {
     for (Index k = 0; k < box_planes; ++k) {
       const std::size_t nv = verts_.size();
-      const std::size_t removed = assembly::box_signs(verts_.data(), nv, k, planes_[k].d, sign_);
+      std::size_t removed = assembly::box_signs(verts_.data(), nv, k, planes_[k].d, sign_);
+      if (removed == assembly::undecided && solve_near(k))
+        removed = assembly::box_signs(verts_.data(), nv, k, planes_[k].d, sign_);
       if (removed == assembly::undecided || removed == nv) return false;
       if (removed != 0) cut(k, nv, removed);
     }
     return true;
+  }
+
+  // Vertex t solved exactly now (solve_deferred's step, and solve_near's). A
+  // deferred one keeps its key: solve_deferred solves it again, to the same
+  // doubles (the set has no removal; this is rare).
+  void solve_now(std::size_t t) {
+    Vertex& v = verts_[t];
+    const double ymax = solve_exactly(v);
+    const double err = 4 * filter::u * ymax;
+    v.e = err + filter::plane_eps * ymax;
+    set_radius(v, err);
+    lanes_.set(t, v);
+  }
+
+  // As Hull::solve_near.
+  bool solve_near(Index k) {
+    const bool solved = assembly::solve_near_box_plane<2>(verts_.data(), verts_.size(), static_cast<int>(k),
+                                                          planes_[k].d, planes_.data(),
+                                                          [this](std::size_t t) { solve_now(t); });
+    if (solved) update_radius();
+    return solved;
   }
 
   // The cell's generator and the domain box's planes (always its first
