@@ -394,6 +394,21 @@ TEST(FromNeighbours, CellsAreAssembledFromTheirStars) {
     EXPECT_EQ(c.assembled_from_stars, 8002u);
     EXPECT_TRUE(tessera::validate(c, {}).ok);
   }
+  // The same with 1,000 circle points and two more 1e-10 rad apart: each
+  // apex's hull facet over that pair is 1e-10 thin, and its far vertex's
+  // condition ~2e11. Until stop 60 the facet failed the thin test (then
+  // 1e-8; now assembly::thin_facet) and such a vertex was refused (above
+  // 1e9; now assembly::far_vertex_condition), so both apexes were clipped
+  // by all their neighbours: 80,000 circle points at random angles, whose
+  // nearest pair lies ~1e-9 apart, took 34 s on two threads, now 0.9 s.
+  {
+    std::vector<double> cones = circle_at_random_angles(1000, 938);
+    const double t = 1.0;
+    cones.insert(cones.end(), {std::cos(t), std::sin(t), 0.0, std::cos(t + 1e-10), std::sin(t + 1e-10), 0.0});
+    cones.insert(cones.end(), {0.0, 0.0, 1.0, 0.0, 0.0, -1.0});
+    EXPECT_EQ(run_method(cones, 3, tessera::CellMethod::insertion).assembled_from_stars, 1004u);
+    same_as_search(cones, "cones over a circle with a thin facet");
+  }
   // A thin cylindrical band: the far vertices, ill-conditioned beyond the
   // float bound but not beyond the deferred one, are cut by the box with
   // certainty and never solved exactly (stop 58; before, a star that had one

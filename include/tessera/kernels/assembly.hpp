@@ -47,6 +47,39 @@ void bisector_planes(std::vector<Plane>& planes, std::size_t first, const std::i
 /// cuts away every vertex on it, and the kernels then drop it.
 inline constexpr std::int32_t far_plane_id = std::numeric_limits<std::int32_t>::min();
 
+/// The least angle far_direction leaves between the far plane and any ray,
+/// as n.dir >= far_margin |n| for unit directions.
+inline constexpr double far_margin = 1e-3;
+
+/// A ray's direction, the cross product of its hull facet's two differences
+/// q_a and q_b, is taken only where |q_a x q_b| > thin_facet |q_a| |q_b|.
+/// Its rounding, and the q's own (each component of q_a x q_b errs by at
+/// most ~4u |q_a| |q_b|, the exact q's cross product and the float one's
+/// differ by about as much), then tilt it by under 1.6e-15 / thin_facet =
+/// 1.6e-4 rad, a sixth of far_margin: every ray the far plane is chosen to
+/// cross, it crosses. Until stop 60 this was 1e-8: the hull facets of an
+/// apex over 8,000 points at random angles on a circle, some 1e-8 thin,
+/// sent both apexes' stars to the clips (2.6 s instead of 0.1).
+inline constexpr double thin_facet = 1e-11;
+
+/// A vertex on the far plane is never solved exactly (the plane has no
+/// exact form) and never output: only the box's cut reads it, and it lies
+/// outside the box by half the box's extent along the far plane's normal.
+/// It keeps its float position and first-order bound up to this condition
+/// number cond = |A^-1| |A| (Hull/Tile::solve), then is refused (the star
+/// goes to the clips). That bound, 64u |A^-1| (|A| |y| + |b|), is over six
+/// times the first-order error of the rounded planes (~u |A^-1| (|A| |y| +
+/// 5 |b|)) and of Cramer's rule (~u |A^-1| (6 |A| |y| + 5 |b|)). Beyond
+/// first order, the computed determinant errs relatively by delta ~ 5u cond
+/// (5.6e-3 here), which multiplies those errors by 1 / (1 - delta), and |y|
+/// may exceed the computed |y| by the bound itself, 64u cond (7%) of it:
+/// the margin covers both. (filter::deferred_vertex_condition stops at 1e9
+/// for another reason: a vertex that stays in a cell needs a bound narrow
+/// enough for the sign passes.) A thin_facet facet makes a far vertex of
+/// condition ~2e12 when the far plane meets its ray at 45 degrees. Until
+/// stop 60 far vertices were kept below 1e9 only.
+inline constexpr double far_vertex_condition = 1e13;
+
 /// The plane that closes the cell of a point on the convex hull, whose
 /// Voronoi cell is unbounded: its star's simplices give the bounded
 /// vertices, and each hull facet at the point one unbounded edge, a ray in
@@ -60,7 +93,7 @@ inline constexpr std::int32_t far_plane_id = std::numeric_limits<std::int32_t>::
 /// differences q; the callers reject directions whose rounding could tilt
 /// them). n is their sum, or where that leaves a ray short, a direction
 /// found by stepping towards the worst ray (below); every ray must make an
-/// angle with n well short of a right angle (n.dir >= 1e-3 |n|, far beyond
+/// angle with n well short of a right angle (n.dir >= far_margin |n|, far beyond
 /// rounding), else false (a hull vertex whose normal cone is nearly a half
 /// space: the cell is clipped instead). c lies beyond the box's corners and the vertices [0,
 /// nv) (each widened by its error bound) by half the box's extent along n,
@@ -81,7 +114,7 @@ bool far_direction(const double* dirs, std::size_t k, double* n) {
   for (int step = 0;; ++step) {
     double len2 = 0;
     for (int a = 0; a < D; ++a) len2 += n[a] * n[a];
-    const double len = std::sqrt(len2), min_dot = 1e-3 * len;
+    const double len = std::sqrt(len2), min_dot = far_margin * len;
     std::size_t worst = k;
     double least = min_dot;
     for (std::size_t r = 0; r < k; ++r) {
@@ -247,9 +280,10 @@ enum class IllConditioned { solve, defer, refuse, keep };
 template <int D, class Plane, class Index>
 IllConditioned ill_conditioned_fate(filter::SolveMode mode, double cond, bool bounded, const double* y,
                                     const Plane* planes, const Index* p) {
-  const bool deferrable = cond < filter::deferred_vertex_condition && bounded;
   for (int k = 0; k < D; ++k)
-    if (planes[p[k]].id == far_plane_id) return deferrable ? IllConditioned::keep : IllConditioned::refuse;
+    if (planes[p[k]].id == far_plane_id)
+      return cond < far_vertex_condition && bounded ? IllConditioned::keep : IllConditioned::refuse;
+  const bool deferrable = cond < filter::deferred_vertex_condition && bounded;
   if (mode == filter::SolveMode::exact_now) return IllConditioned::solve;
   if (mode == filter::SolveMode::deferrable) return deferrable ? IllConditioned::defer : IllConditioned::solve;
   if (worth_exact_solve<D>(y, planes)) return IllConditioned::solve;

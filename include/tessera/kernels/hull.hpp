@@ -430,11 +430,11 @@ class Hull {
       double* d = dirs_.data() + 3 * k;
       cross(qb, qa, d);
       const double len = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-      // A facet so thin that the cross product's rounding (~1e-16 of
-      // |q_a| |q_b|) could tilt its normal: not closed here.
+      // A facet so thin that rounding could tilt its normal past the far
+      // plane's margin: not closed here (assembly::thin_facet).
       const double na = std::sqrt(qa[0] * qa[0] + qa[1] * qa[1] + qa[2] * qa[2]);
       const double nbl = std::sqrt(qb[0] * qb[0] + qb[1] * qb[1] + qb[2] * qb[2]);
-      if (!(len > 1e-8 * na * nbl)) return false;
+      if (!(len > assembly::thin_facet * na * nbl)) return false;
       for (int a = 0; a < 3; ++a) d[a] /= len;
     }
     if (!assembly::far_direction<3>(dirs_.data(), nb, far_n_)) return false;
