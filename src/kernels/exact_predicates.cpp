@@ -336,6 +336,38 @@ int exact_clip_sign(const ExactContext& ctx, std::int32_t i, const std::int32_t*
   return decide(sg, i, gen, dim);
 }
 
+int exact_box_sign(const ExactContext& ctx, std::int32_t i, const std::int32_t* planes, std::int32_t box) {
+  const int dim = ctx.dim;
+  std::int32_t gen[Scratch::kRows];
+  for (int r = 0; r < dim; ++r) {
+    if (planes[r] == box) return 0;
+    gen[r] = planes[r];
+  }
+  gen[dim] = box;
+  // GMP alone: a tie with the box is rare (symmetric input whose bisectors
+  // pass through the box's edges), and only the vertices within rounding
+  // of a box plane ask.
+  ClipSigns sg;
+  signs_gmp(ctx, i, gen, sg);
+  const int sign_det_a = sg.minor[dim];
+  if (sign_det_a == 0) return 0;
+  int sign_m = sg.det_m0;
+  if (sign_m == 0) {
+    // As decide(), over every weighted term (the query row has none): an id
+    // above every generator's lets decide() read them all, and its
+    // coefficient, 0, is returned when none decides.
+    PerturbationTerms terms;
+    terms.set(i, gen, dim);
+    sign_m = terms.decide(std::numeric_limits<std::int32_t>::max(), 0, [&](int row) {
+      return row < 0 ? sg.weight_i : -cofactor_sign(row, dim) * sg.minor[row];
+    });
+    if (sign_m == 0) return 0;
+  }
+  // sign(c - v_axis); inside is v_axis <= c on an upper plane, >= c on a lower one.
+  const int side = sign_m * sign_det_a;
+  return box_plane_upper(box) ? side : -side;
+}
+
 // The prepared form (see VertexPredicate in the header). With the query row
 // q = (a_j, b_j) below A, the minor without row r < dim is A with row r
 // replaced by a_j, moved to the bottom: (-1)^(dim-1-r) a_j . C_r, C_r being

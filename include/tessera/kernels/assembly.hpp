@@ -14,6 +14,7 @@
 #include <utility>
 #include <vector>
 
+#include "tessera/kernels/exact_predicates.hpp"
 #include "tessera/kernels/filter.hpp"
 
 namespace tessera::kernels::assembly {
@@ -319,15 +320,16 @@ inline constexpr std::size_t undecided = std::numeric_limits<std::size_t>::max()
 
 /// The signs of vertices [0, nv) against the domain box's plane k (axis k / 2,
 /// the upper side when k is odd: n.y <= h, n = +-e_axis, h the plane's
-/// offset from the generator) by the clip's float test alone, +1 keep and
-/// -1 remove, into `sign` (grown to nv + 1 if shorter; untouched when every
+/// offset from the generator) by the clip's float test, +1 keep and -1
+/// remove, into `sign` (grown to nv + 1 if shorter; untouched when every
 /// vertex is kept, and then 0 returned); returns how many are removed, or
-/// `undecided` where a vertex lies within its error bound of
-/// the plane: the exact clip, whose perturbation decides such a tie, must
-/// build that cell. Also where a vertex's bound is NaN (Hull/Tile::solve
-/// refused it the exact solve: assembly::ill_conditioned_fate).
-template <class Vertex>
-std::size_t box_signs(const Vertex* verts, std::size_t nv, int k, double h, std::vector<filter::Sign>& sign) {
+/// `undecided`. A vertex within its error bound of the plane is passed to
+/// `decide(t)` (+1, -1, or 0: undecided; exact_box_side), and one whose
+/// bound is NaN (Hull/Tile::solve refused it the exact solve:
+/// ill_conditioned_fate) is undecided: the exact clips must build that cell.
+template <class Vertex, class Decide>
+std::size_t box_signs(const Vertex* verts, std::size_t nv, int k, double h, std::vector<filter::Sign>& sign,
+                      Decide&& decide) {
   const int axis = k / 2;
   const double s = (k & 1) ? 1.0 : -1.0;
   const double de = filter::plane_eps * std::fabs(h) + filter::abs_eps;
@@ -341,11 +343,42 @@ std::size_t box_signs(const Vertex* verts, std::size_t nv, int k, double h, std:
   std::size_t removed = 0;
   for (std::size_t t = first; t < nv; ++t) {
     const double P = h - s * verts[t].y[axis], e = verts[t].e + de;
-    if (!(P > e || P < -e)) return undecided;
-    sign[t] = P > e ? filter::Sign{1} : filter::Sign{-1};
-    removed += P < -e;
+    int side = P > e ? 1 : P < -e ? -1 : 0;
+    if (side == 0) {
+      if (!(e == e)) return undecided;  // NaN: refused its exact solve
+      side = decide(t);
+      if (side == 0) return undecided;
+    }
+    sign[t] = side > 0 ? filter::Sign{1} : filter::Sign{-1};
+    removed += side < 0;
   }
   return removed;
+}
+
+/// box_signs by the float test alone: undecided at any vertex within its
+/// bound of the plane.
+template <class Vertex>
+std::size_t box_signs(const Vertex* verts, std::size_t nv, int k, double h, std::vector<filter::Sign>& sign) {
+  return box_signs(verts, nv, k, h, sign, [](std::size_t) { return 0; });
+}
+
+/// Box plane k's side of a vertex on the planes p[0, D) (exact_box_sign):
+/// +1 keep, -1 remove, 0 undecided (a vertex on the far plane, which has
+/// no exact form, or no exact context). For the vertices the float test
+/// and solve_near_box_plane leave within rounding of a box plane: exact
+/// ties between a bisector and the box (an apex over points on a circle,
+/// one of them on a box plane's diagonal: the apex's bisector with it holds
+/// a box edge), which sent the cell to the clips, quadratic in a star of
+/// thousands.
+template <int D, class Plane, class Index>
+int exact_box_side(const ExactContext* exact, std::int32_t gen, const Plane* planes, const Index* p, int k) {
+  if (exact == nullptr) return 0;
+  std::int32_t ids[D];
+  for (int c = 0; c < D; ++c) {
+    ids[c] = planes[p[c]].id;
+    if (ids[c] == far_plane_id) return 0;
+  }
+  return exact_box_sign(*exact, gen, ids, planes[k].id);
 }
 
 }  // namespace tessera::kernels::assembly

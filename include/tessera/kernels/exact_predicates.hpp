@@ -148,6 +148,17 @@ bool make_grid(ExactContext& ctx, std::size_t n, std::vector<std::int32_t>& grid
 /// and j is not i nor one of the planes.
 int exact_clip_sign(const ExactContext& ctx, std::int32_t i, const std::int32_t* planes, std::int32_t j);
 
+/// The side of domain-box plane `box` (a box-plane id) on which the vertex
+/// of cell i where planes[0..dim) meet lies, in the perturbed sense of
+/// exact_clip_sign: +1 inside the box's half-space, -1 outside, 0 where the
+/// weights leave it on the plane (or the planes define no vertex, or
+/// include `box`). The assembly's box cut asks it of a vertex within
+/// rounding of the plane (Hull/Tile::clip_to_box): the same perturbed
+/// diagram the clips build, so an assembled cell is the clipped one.
+/// With the box row (e_axis, c) as M's last row, det M = det A (c - v_axis)
+/// (Schur complement), and the box row carries no weight.
+int exact_box_sign(const ExactContext& ctx, std::int32_t i, const std::int32_t* planes, std::int32_t box);
+
 /// The symbolic perturbation's tie-break (exact_clip_sign): when det M0 is
 /// exactly zero, the weights w_k (decreasing with id) decide, through the
 /// first term in ascending id whose coefficient is non-zero. The terms are

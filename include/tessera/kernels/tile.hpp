@@ -254,8 +254,14 @@ class Tile {
     for (Index k = 0; k < box_planes; ++k) {
       const std::size_t nv = verts_.size();
       std::size_t removed = assembly::box_signs(verts_.data(), nv, k, planes_[k].d, sign_);
-      if (removed == assembly::undecided && solve_near(k))
-        removed = assembly::box_signs(verts_.data(), nv, k, planes_[k].d, sign_);
+      if (removed == assembly::undecided) {
+        // Solve exactly the vertices the plane cannot place; those still
+        // within rounding of it tie with it, or nearly: the exact side.
+        solve_near(k);
+        removed = assembly::box_signs(verts_.data(), nv, k, planes_[k].d, sign_, [&](std::size_t t) {
+          return assembly::exact_box_side<2>(exact_, gen_, planes_.data(), verts_[t].p, static_cast<int>(k));
+        });
+      }
       if (removed == assembly::undecided || removed == nv) return false;
       if (removed != 0) cut(k, nv, removed);
     }
