@@ -345,7 +345,7 @@ std::size_t box_signs(const Vertex* verts, std::size_t nv, int k, double h, std:
     const double P = h - s * verts[t].y[axis], e = verts[t].e + de;
     int side = P > e ? 1 : P < -e ? -1 : 0;
     if (side == 0) {
-      if (!(e == e)) return undecided;  // NaN: refused its exact solve
+      if (!(P == P && e == e)) return undecided;  // NaN: refused its exact solve
       side = decide(t);
       if (side == 0) return undecided;
     }
