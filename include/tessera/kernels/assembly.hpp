@@ -102,35 +102,60 @@ inline constexpr double far_vertex_condition = 1e13;
 /// `box`: the kernel's first 2D planes (box_planes), n = -+e_axis, d = the
 /// offset from the generator.
 template <int D>
-bool far_direction(const double* dirs, std::size_t k, double* n) {
-  for (int a = 0; a < D; ++a) n[a] = 0;
-  for (std::size_t r = 0; r < k; ++r)
-    for (int a = 0; a < D; ++a) n[a] += dirs[D * r + static_cast<std::size_t>(a)];
-  // Where the rays crowd one side of a wide cone (a hull point at the end of
-  // a thin band: thousands of rays across the band, a few along it), their
-  // sum leans towards the crowd and the rest fall short of it. Then n steps
-  // towards the worst ray (halfway, as unit vectors), up to 64 times: a
-  // perceptron's steps, which find a direction for any cone that admits one
-  // by the margin.
-  for (int step = 0;; ++step) {
+bool far_direction(const double* dirs, std::size_t k, double* n, const double* hint = nullptr) {
+  // The ray m crosses at the least angle below far_margin (k: none; k + 1:
+  // NaN, or m = 0), and m.dir / |m| for it.
+  auto worst_ray = [&](const double* m, double& least) {
     double len2 = 0;
-    for (int a = 0; a < D; ++a) len2 += n[a] * n[a];
-    const double len = std::sqrt(len2), min_dot = far_margin * len;
+    for (int a = 0; a < D; ++a) len2 += m[a] * m[a];
+    const double len = std::sqrt(len2);
+    if (!(len > 0)) return k + 1;
     std::size_t worst = k;
-    double least = min_dot;
+    least = far_margin * len;
     for (std::size_t r = 0; r < k; ++r) {
       double dot = 0;
-      for (int a = 0; a < D; ++a) dot += n[a] * dirs[D * r + static_cast<std::size_t>(a)];
+      for (int a = 0; a < D; ++a) dot += m[a] * dirs[D * r + static_cast<std::size_t>(a)];
       if (!(dot >= least)) {
-        if (!(dot == dot)) return false;  // NaN
+        if (!(dot == dot)) return k + 1;
         least = dot;
         worst = r;
       }
     }
-    if (worst == k) return true;  // every ray crosses n's planes at 1e-3 of a right angle or more
-    if (step == 64 || !(len > 0)) return false;
-    for (int a = 0; a < D; ++a) n[a] = n[a] / len + dirs[D * worst + static_cast<std::size_t>(a)];
-  }
+    least /= len;
+    return worst;
+  };
+  // From n: while some ray falls short, step towards the worst (halfway,
+  // as unit vectors), up to 64 times. Where the rays crowd one side of a
+  // wide cone (a hull point at the end of a thin band: thousands of rays
+  // across the band, a few along it), their sum leans towards the crowd and
+  // the rest fall short of it; these are a perceptron's steps, which find a
+  // direction for any cone that admits one by the margin.
+  auto steps_from = [&]() {
+    double least = 0;
+    for (int step = 0;; ++step) {
+      const std::size_t worst = worst_ray(n, least);
+      if (worst == k) return true;  // every ray crosses n's planes at far_margin of a right angle or more
+      if (worst > k || step == 64) return false;
+      double len2 = 0;
+      for (int a = 0; a < D; ++a) len2 += n[a] * n[a];
+      const double len = std::sqrt(len2);
+      for (int a = 0; a < D; ++a) n[a] = n[a] / len + dirs[D * worst + static_cast<std::size_t>(a)];
+    }
+  };
+  for (int a = 0; a < D; ++a) n[a] = 0;
+  for (std::size_t r = 0; r < k; ++r)
+    for (int a = 0; a < D; ++a) n[a] += dirs[D * r + static_cast<std::size_t>(a)];
+  if (steps_from()) return true;
+  // Then from the caller's hint. A point far above a ring of points (an
+  // apex 50 radii over a circle) has rays all round the horizon, tilted up
+  // by 1/50: their sum is mostly the noise of their spacing, and steps of a
+  // degree or so do not reach the axis. The point less its hull neighbours'
+  // mean does. (Second: where the sum's steps succeed, the direction they
+  // find stays; from the hint, the end of a thin parabolic band closed
+  // fewer stars.)
+  if (hint == nullptr) return false;
+  for (int a = 0; a < D; ++a) n[a] = hint[a];
+  return steps_from();
 }
 
 /// far_plane's second half: the plane of normal n (from far_direction)

@@ -430,9 +430,11 @@ class Hull {
     // inside, det(q_a, q_b, q_c) > 0, so the outward normal, the ray's
     // direction, is q_b x q_a.
     dirs_.resize(3 * nb);
+    double hint[3] = {0, 0, 0};  // the point less its hull neighbours' mean (far_direction)
     for (std::size_t k = 0; k < nb; ++k) {
       const double* qb = q + 3 * (border_[k].a - box_planes);
       const double* qa = q + 3 * (border_[k].b - box_planes);
+      for (int a = 0; a < 3; ++a) hint[a] -= qb[a];  // each hull neighbour once, as an edge's start
       double* d = dirs_.data() + 3 * k;
       cross(qb, qa, d);
       const double len = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
@@ -443,7 +445,7 @@ class Hull {
       if (!(len > assembly::thin_facet * na * nbl)) return false;
       for (int a = 0; a < 3; ++a) d[a] /= len;
     }
-    if (!assembly::far_direction<3>(dirs_.data(), nb, far_n_)) return false;
+    if (!assembly::far_direction<3>(dirs_.data(), nb, far_n_, hint)) return false;
     if (!probe) return true;
     // Whether a far vertex is well enough conditioned for its float solve
     // (close_far gives up otherwise) depends on the planes' normals alone:
