@@ -52,11 +52,26 @@ inline constexpr std::int32_t far_plane_id = std::numeric_limits<std::int32_t>::
 /// as n.dir >= far_margin |n| for unit directions.
 inline constexpr double far_margin = 1e-3;
 
+/// Where no direction keeps far_margin from every ray (a hull point whose
+/// rays span nearly a half space: one point 1,000 radii above a ring of
+/// points, whose rays all lie within 1e-3 of the horizon; in 2D a point
+/// far above a row of points), far_direction tries again with each ray's
+/// own margin, six times the bound on its direction's tilt (3D:
+/// facet_tilt over its facet's thinness, thin_facet below; 2D, where a ray
+/// is q turned by a right angle, exactly, and normalised: ~2u), and at
+/// least far_margin_least. Such a ray meets the far plane nearly edge on,
+/// far out; its far vertex is then ill-conditioned, and far_vertex_condition
+/// decides whether it may be kept, as for any other.
+inline constexpr double far_margin_least = 1e-12;
+/// The bound on a 3D ray direction's tilt, times its facet's thinness
+/// |q_a x q_b| / (|q_a| |q_b|) (thin_facet).
+inline constexpr double facet_tilt = 1.6e-15;
+
 /// A ray's direction, the cross product of its hull facet's two differences
 /// q_a and q_b, is taken only where |q_a x q_b| > thin_facet |q_a| |q_b|.
 /// Its rounding, and the q's own (each component of q_a x q_b errs by at
 /// most ~4u |q_a| |q_b|, the exact q's cross product and the float one's
-/// differ by about as much), then tilt it by under 1.6e-15 / thin_facet =
+/// differ by about as much), then tilt it by under facet_tilt / thin_facet =
 /// 1.6e-4 rad, a sixth of far_margin: every ray the far plane is chosen to
 /// cross, it crosses. Until stop 60 this was 1e-8: the hull facets of an
 /// apex over 8,000 points at random angles on a circle, some 1e-8 thin,
@@ -102,26 +117,27 @@ inline constexpr double far_vertex_condition = 1e13;
 /// `box`: the kernel's first 2D planes (box_planes), n = -+e_axis, d = the
 /// offset from the generator.
 template <int D>
-bool far_direction(const double* dirs, std::size_t k, double* n, const double* hint = nullptr) {
-  // The ray m crosses at the least angle below far_margin (k: none; k + 1:
-  // NaN, or m = 0), and m.dir / |m| for it.
-  auto worst_ray = [&](const double* m, double& least) {
+bool far_direction(const double* dirs, std::size_t k, double* n, const double* hint = nullptr,
+                   const double* ray_margins = nullptr) {
+  const double* margins = nullptr;  // per ray; null: far_margin for every one
+  // The ray m falls shortest of its margin on (k: none; k + 1: NaN, or m = 0).
+  auto worst_ray = [&](const double* m) {
     double len2 = 0;
     for (int a = 0; a < D; ++a) len2 += m[a] * m[a];
     const double len = std::sqrt(len2);
     if (!(len > 0)) return k + 1;
     std::size_t worst = k;
-    least = far_margin * len;
+    double least = 0;  // the worst's dot less its margin, times |m|
     for (std::size_t r = 0; r < k; ++r) {
       double dot = 0;
       for (int a = 0; a < D; ++a) dot += m[a] * dirs[D * r + static_cast<std::size_t>(a)];
-      if (!(dot >= least)) {
-        if (!(dot == dot)) return k + 1;
-        least = dot;
+      const double short_by = dot - (margins != nullptr ? margins[r] : far_margin) * len;
+      if (!(short_by >= least)) {
+        if (!(short_by == short_by)) return k + 1;
+        least = short_by;
         worst = r;
       }
     }
-    least /= len;
     return worst;
   };
   // From n: while some ray falls short, step towards the worst (halfway,
@@ -131,9 +147,8 @@ bool far_direction(const double* dirs, std::size_t k, double* n, const double* h
   // the rest fall short of it; these are a perceptron's steps, which find a
   // direction for any cone that admits one by the margin.
   auto steps_from = [&]() {
-    double least = 0;
     for (int step = 0;; ++step) {
-      const std::size_t worst = worst_ray(n, least);
+      const std::size_t worst = worst_ray(n);
       if (worst == k) return true;  // every ray crosses n's planes at far_margin of a right angle or more
       if (worst > k || step == 64) return false;
       double len2 = 0;
@@ -142,20 +157,27 @@ bool far_direction(const double* dirs, std::size_t k, double* n, const double* h
       for (int a = 0; a < D; ++a) n[a] = n[a] / len + dirs[D * worst + static_cast<std::size_t>(a)];
     }
   };
-  for (int a = 0; a < D; ++a) n[a] = 0;
-  for (std::size_t r = 0; r < k; ++r)
-    for (int a = 0; a < D; ++a) n[a] += dirs[D * r + static_cast<std::size_t>(a)];
-  if (steps_from()) return true;
-  // Then from the caller's hint. A point far above a ring of points (an
-  // apex 50 radii over a circle) has rays all round the horizon, tilted up
-  // by 1/50: their sum is mostly the noise of their spacing, and steps of a
-  // degree or so do not reach the axis. The point less its hull neighbours'
-  // mean does. (Second: where the sum's steps succeed, the direction they
-  // find stays; from the hint, the end of a thin parabolic band closed
-  // fewer stars.)
-  if (hint == nullptr) return false;
-  for (int a = 0; a < D; ++a) n[a] = hint[a];
-  return steps_from();
+  // From the rays' sum, then from the caller's hint. A point far above a
+  // ring of points (an apex 50 radii over a circle) has rays all round the
+  // horizon, tilted up by 1/50: their sum is mostly the noise of their
+  // spacing, and steps of a degree or so do not reach the axis. The point
+  // less its hull neighbours' mean does. (The sum first: where its steps
+  // succeed, the direction they find stays; from the hint, the end of a
+  // thin parabolic band closed fewer stars.)
+  auto from_sum_or_hint = [&]() {
+    for (int a = 0; a < D; ++a) n[a] = 0;
+    for (std::size_t r = 0; r < k; ++r)
+      for (int a = 0; a < D; ++a) n[a] += dirs[D * r + static_cast<std::size_t>(a)];
+    if (steps_from()) return true;
+    if (hint == nullptr) return false;
+    for (int a = 0; a < D; ++a) n[a] = hint[a];
+    return steps_from();
+  };
+  if (from_sum_or_hint()) return true;
+  // Then with each ray's own margin (far_margin_least).
+  if (ray_margins == nullptr) return false;
+  margins = ray_margins;
+  return from_sum_or_hint();
 }
 
 /// far_plane's second half: the plane of normal n (from far_direction)
@@ -188,9 +210,10 @@ bool far_offset(const double* n, const Plane* box, const Vertex* verts, std::siz
 /// The direction (far_direction: where the rays allow none, false before
 /// any vertex is read), then the offset (far_offset).
 template <int D, class Plane, class Vertex>
-bool far_plane(const double* dirs, std::size_t k, const Plane* box, const Vertex* verts, std::size_t nv, Plane& out) {
+bool far_plane(const double* dirs, std::size_t k, const Plane* box, const Vertex* verts, std::size_t nv, Plane& out,
+               const double* ray_margins = nullptr) {
   double n[D];
-  return far_direction<D>(dirs, k, n) && far_offset<D>(n, box, verts, nv, out);
+  return far_direction<D>(dirs, k, n, nullptr, ray_margins) && far_offset<D>(n, box, verts, nv, out);
 }
 
 /// The vertices of [0, nv) that box plane k (offset h, as box_signs)

@@ -430,6 +430,7 @@ class Hull {
     // inside, det(q_a, q_b, q_c) > 0, so the outward normal, the ray's
     // direction, is q_b x q_a.
     dirs_.resize(3 * nb);
+    margins_.resize(nb);
     double hint[3] = {0, 0, 0};  // the point less its hull neighbours' mean (far_direction)
     for (std::size_t k = 0; k < nb; ++k) {
       const double* qb = q + 3 * (border_[k].a - box_planes);
@@ -444,8 +445,9 @@ class Hull {
       const double nbl = std::sqrt(qb[0] * qb[0] + qb[1] * qb[1] + qb[2] * qb[2]);
       if (!(len > assembly::thin_facet * na * nbl)) return false;
       for (int a = 0; a < 3; ++a) d[a] /= len;
+      margins_[k] = std::max(assembly::far_margin_least, 6 * assembly::facet_tilt * (na * nbl / len));
     }
-    if (!assembly::far_direction<3>(dirs_.data(), nb, far_n_, hint)) return false;
+    if (!assembly::far_direction<3>(dirs_.data(), nb, far_n_, hint, margins_.data())) return false;
     if (!probe) return true;
     // Whether a far vertex is well enough conditioned for its float solve
     // (close_far gives up otherwise) depends on the planes' normals alone:
@@ -825,6 +827,7 @@ class Hull {
   std::vector<std::uint8_t> seen_;
   FaceLoopScratch walk_;  // for_each_face's
   std::vector<double> dirs_;         // link_boundary: the rays' unit directions
+  std::vector<double> margins_;      // and their own margins (assembly::far_margin_least)
   double far_n_[3] = {};             // link_boundary: the far plane's normal
   std::vector<std::uint32_t> refused_;  // assemble: the vertices refused the exact solve
   PreparedSigns<3, Index> signs_;  // the exact stages, prepared per vertex slot

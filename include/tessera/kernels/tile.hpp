@@ -206,7 +206,8 @@ class Tile {
       const double dirs[4] = {qs[1] / ls, -qs[0] / ls, -qe[1] / le, qe[0] / le};
       const Index far = static_cast<Index>(planes_.size());
       Plane& pf = planes_.emplace_back();
-      if (!assembly::far_plane<2>(dirs, 2, planes_.data(), verts_.data(), nt, pf)) return false;
+      const double margins[2] = {assembly::far_margin_least, assembly::far_margin_least};  // tilts ~2u
+      if (!assembly::far_plane<2>(dirs, 2, planes_.data(), verts_.data(), nt, pf, margins)) return false;
       Vertex& ve = verts_[nt];  // leaving along e's ray, arriving on the far line
       Vertex& vs = verts_[nt + 1];
       ve.p[0] = box_planes + e;
