@@ -301,6 +301,60 @@ void exact_vertex(const ExactContext& ctx, std::int32_t i, const std::int32_t* p
   for (int d = 0; d < ctx.dim; ++d) y[d] = quotient_to_double(s.minor[d], s.minor[ctx.dim], shift, s.t0);
 }
 
+void exact_vertex_on_plane(const ExactContext& ctx, std::int32_t i, const std::int32_t* planes, int row,
+                           const double* n, double d, double* y) {
+  const int dim = ctx.dim;
+  thread_local Scratch s;
+  // The other rows as exact_vertex builds them; build_rows reads a box
+  // plane's constant in place of the given row, which is then overwritten.
+  std::int32_t ids[Scratch::kMaxDim];
+  for (int r = 0; r < dim; ++r) ids[r] = r == row ? box_plane_id(0, false) : planes[r];
+  const int shift = build_rows(ctx, i, ids, dim, s);
+  // The given row n.y = d, y relative to p_i, reads n.X = (d + n.p_i) 2^-shift
+  // in build_rows' integers (x = X 2^shift). Every double is a rational with
+  // a power of two below, so one power of two, the largest, clears them.
+  thread_local struct Rationals {
+    mpq_t v[Scratch::kMaxDim + 1], t, u;
+    Rationals() {
+      for (auto& q : v) mpq_init(q);
+      mpq_init(t);
+      mpq_init(u);
+    }
+    ~Rationals() {
+      for (auto& q : v) mpq_clear(q);
+      mpq_clear(t);
+      mpq_clear(u);
+    }
+  } r;
+  const double* pi = ctx.points + static_cast<std::size_t>(i) * static_cast<std::size_t>(dim);
+  mpq_set_d(r.v[dim], d);
+  for (int k = 0; k < dim; ++k) {
+    mpq_set_d(r.v[k], n[k]);
+    mpq_set_d(r.t, pi[k]);
+    mpq_mul(r.u, r.v[k], r.t);
+    mpq_add(r.v[dim], r.v[dim], r.u);
+  }
+  if (shift > 0) mpq_div_2exp(r.v[dim], r.v[dim], static_cast<mp_bitcnt_t>(shift));
+  else if (shift < 0) mpq_mul_2exp(r.v[dim], r.v[dim], static_cast<mp_bitcnt_t>(-shift));
+  std::size_t top = 0;  // the largest denominator's exponent (canonical: each a power of two)
+  for (int k = 0; k <= dim; ++k) top = std::max(top, mpz_sizeinbase(mpq_denref(r.v[k]), 2) - 1);
+  for (int k = 0; k <= dim; ++k) {
+    mpz_ptr out = k < dim ? s.a[row][k] : s.b[row];
+    mpz_mul_2exp(out, mpq_numref(r.v[k]), top - (mpz_sizeinbase(mpq_denref(r.v[k]), 2) - 1));
+  }
+  int sel[Scratch::kMaxDim] = {0, 1, 2};
+  det_rows(s.minor[dim], s.a, sel, dim, s);
+  if (mpz_sgn(s.minor[dim]) == 0)
+    throw std::logic_error("exact_vertex_on_plane: vertex planes are dependent (corrupt cell)");
+  for (int c = 0; c < dim; ++c) {
+    for (int q = 0; q < dim; ++q) mpz_swap(s.a[q][c], s.b[q]);
+    det_rows(s.minor[c], s.a, sel, dim, s);
+    for (int q = 0; q < dim; ++q) mpz_swap(s.a[q][c], s.b[q]);
+    mpz_submul(s.minor[c], s.minor[dim], s.coord[Scratch::kRows][c]);
+  }
+  for (int c = 0; c < dim; ++c) y[c] = quotient_to_double(s.minor[c], s.minor[dim], shift, s.t0);
+}
+
 // ---- The cell measure ----
 
 // In canonical rationals (GMP's mpq): every vertex, term and sum exact, then

@@ -460,6 +460,21 @@ TEST(FromNeighbours, CellsAreAssembledFromTheirStars) {
     EXPECT_TRUE(tessera::validate(c, {}).ok);
     EXPECT_EQ(run_method(row_and_far_point(), 2, tessera::CellMethod::insertion).assembled_from_stars, 1001u);
   }
+  // The same apexes at 50 radii, and a pair of circle points 2e-10 rad
+  // apart: the apexes' facets over the pair are 4e-12 thin (below the
+  // former thin_facet, 1e-11; their rays' margins now come from their
+  // tilt bounds), and their far vertices' conditions pass
+  // far_vertex_condition, so those are solved exactly
+  // (exact_vertex_on_plane). Before, both apexes were clipped by all their
+  // neighbours (1.3 s; 80,000 points at random angles, ~3 min).
+  {
+    std::vector<double> cones = circle_at_random_angles(2000, 942);
+    cones.insert(cones.end(), {std::cos(1.0), std::sin(1.0), 0.0, std::cos(1.0 + 2e-10), std::sin(1.0 + 2e-10), 0.0});
+    cones.insert(cones.end(), {0.0, 0.0, 50.0, 0.0, 0.0, -50.0});
+    const tessera::Cells c = run_method(cones, 3, tessera::CellMethod::insertion);
+    EXPECT_EQ(c.assembled_from_stars, 2004u);
+    EXPECT_TRUE(tessera::validate(c, {}).ok);
+  }
   // A thin cylindrical band: the far vertices, ill-conditioned beyond the
   // float bound but not beyond the deferred one, are cut by the box with
   // certainty and never solved exactly (stop 58; before, a star that had one

@@ -504,6 +504,77 @@ void box_sign_matches(int dim, std::uint64_t seed) {
   EXPECT_GE(ties, 200);
 }
 
+/// exact_vertex_on_plane (an assembled hull point's far vertex, past the
+/// float bound's condition limit) against the rational solve: row `row`
+/// is the plane n.y = d relative to p_i, the others bisectors or box
+/// planes; within 2 ulp per coordinate, as exact_vertex.
+void vertex_on_plane_matches(int dim, std::uint64_t seed) {
+  using tessera::kernels::exact_vertex_on_plane;
+  Rng r(seed);
+  int checked = 0;
+  const double scales[][2] = {{1, 0}, {1e-200, 0}, {1e200, 0}, {3.7e-5, 0}, {1, 1e15}};
+  for (const auto& sc : scales) {
+    const Problem p = random_problem(dim, 16, sc[0], sc[1], r);
+    const auto c = p.ctx();
+    for (int t = 0; t < 60; ++t) {
+      std::int32_t i, j;
+      Ids planes;
+      if (!random_query(p, r, dim - 1, i, planes, j)) continue;
+      const int row = r.index(dim);
+      double n[3] = {0, 0, 0};
+      for (int k = 0; k < dim; ++k) n[k] = full_mantissa(r) * std::ldexp(1.0, r.index(40) - 20);
+      const double d = full_mantissa(r) * sc[0] * std::ldexp(1.0, r.index(20));
+      // The rational system, relative to p_i: bisector 2 q.y = |q|^2, box
+      // y_axis = c - p_i, the plane n.y = d.
+      Q A[3][3], b[3];
+      for (int q = 0; q < dim; ++q) {
+        const std::int32_t k = planes[q];
+        if (q == row) {
+          for (int e = 0; e < dim; ++e) A[q][e] = n[e];
+          b[q] = d;
+        } else if (k >= 0) {
+          Q s2 = 0;
+          for (int e = 0; e < dim; ++e) {
+            const Q qe = coord(c, k, e) - coord(c, i, e);
+            A[q][e] = 2 * qe;
+            s2 += qe * qe;
+          }
+          b[q] = s2;
+        } else {
+          const int axis = box_plane_axis(k);
+          for (int e = 0; e < dim; ++e) A[q][e] = e == axis ? 1 : 0;
+          b[q] = (box_plane_upper(k) ? Q(c.hi[axis]) : Q(c.lo[axis])) - coord(c, i, axis);
+        }
+      }
+      auto det = [&](Q (*m)[3]) {
+        if (dim == 2) return Q(m[0][0] * m[1][1] - m[0][1] * m[1][0]);
+        return Q(m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
+                 m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]));
+      };
+      const Q da = det(A);
+      if (da == 0) continue;
+      double y[3] = {0, 0, 0};
+      exact_vertex_on_plane(c, i, planes.data(), row, n, d, y);
+      for (int e = 0; e < dim; ++e) {
+        Q m[3][3];
+        for (int q = 0; q < dim; ++q)
+          for (int f = 0; f < dim; ++f) m[q][f] = f == e ? b[q] : A[q][f];
+        const Q exact = det(m) / da;
+        const double mag = std::fabs(exact.get_d());
+        if (!(mag <= std::numeric_limits<double>::max()) || mag < 1e-290) continue;
+        const double ulp = std::nextafter(mag, INFINITY) - mag;
+        ASSERT_LE(abs(Q(y[e]) - exact), Q(2 * ulp)) << "coordinate " << e << " scale " << sc[0] << ": exact "
+                                                    << exact.get_d() << ", got " << y[e];
+      }
+      ++checked;
+    }
+  }
+  EXPECT_GT(checked, 250);
+}
+
+TEST(ExactPredicates, VertexOnPlaneMatchesRational2D) { vertex_on_plane_matches(2, 15); }
+TEST(ExactPredicates, VertexOnPlaneMatchesRational3D) { vertex_on_plane_matches(3, 16); }
+
 TEST(ExactPredicates, BoxSignMatchesRational2D) { box_sign_matches(2, 13); }
 TEST(ExactPredicates, BoxSignMatchesRational3D) { box_sign_matches(3, 14); }
 

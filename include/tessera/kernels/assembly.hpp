@@ -52,48 +52,46 @@ inline constexpr std::int32_t far_plane_id = std::numeric_limits<std::int32_t>::
 /// as n.dir >= far_margin |n| for unit directions.
 inline constexpr double far_margin = 1e-3;
 
-/// Where no direction keeps far_margin from every ray (a hull point whose
-/// rays span nearly a half space: one point 1,000 radii above a ring of
-/// points, whose rays all lie within 1e-3 of the horizon; in 2D a point
-/// far above a row of points), far_direction tries again with each ray's
-/// own margin, six times the bound on its direction's tilt (3D:
-/// facet_tilt over its facet's thinness, thin_facet below; 2D, where a ray
-/// is q turned by a right angle, exactly, and normalised: ~2u), and at
-/// least far_margin_least. Such a ray meets the far plane nearly edge on,
-/// far out; its far vertex is then ill-conditioned, and far_vertex_condition
-/// decides whether it may be kept, as for any other.
+/// Each ray's own margin: six times the bound on its direction's tilt. A
+/// 3D ray is the cross product of its hull facet's two differences q_a and
+/// q_b; its rounding and the q's own (each component errs by at most ~4u
+/// |q_a| |q_b|, and the exact q's cross product and the float one's differ
+/// by about as much) tilt it by under facet_tilt / t, t its facet's
+/// thinness |q_a x q_b| / (|q_a| |q_b|). A 2D ray is q turned by a right
+/// angle (exact) and normalised: ~2u. far_direction asks every ray for
+/// the larger of far_margin and its own margin; where no direction gives
+/// that (a hull point whose rays span nearly a half space: one 1,000 radii
+/// above a ring of points, whose rays lie within 1e-3 of the horizon; in 2D
+/// one far above a row), it asks again with far_margin_least in place of
+/// far_margin. So every ray the far plane is chosen to cross, it crosses.
+/// A ray met nearly edge on puts its far vertex far out, ill-conditioned
+/// (far_vertex_condition).
 inline constexpr double far_margin_least = 1e-12;
-/// The bound on a 3D ray direction's tilt, times its facet's thinness
-/// |q_a x q_b| / (|q_a| |q_b|) (thin_facet).
 inline constexpr double facet_tilt = 1.6e-15;
+/// Facets thinner than this are not closed: a tilt bound past 0.16 rad
+/// leaves no margin a direction could keep. Stop 59 refused facets below
+/// 1e-8 outright; the apexes over 8,000 points at random angles on a
+/// circle, some facets 1e-8 thin, went to the clips (2.6 s instead of 0.1),
+/// and over 80,000 (pairs 2.5e-10 rad apart, at 50 radii up 5e-12 thin) the
+/// run took minutes.
+inline constexpr double thin_facet = 1e-14;
 
-/// A ray's direction, the cross product of its hull facet's two differences
-/// q_a and q_b, is taken only where |q_a x q_b| > thin_facet |q_a| |q_b|.
-/// Its rounding, and the q's own (each component of q_a x q_b errs by at
-/// most ~4u |q_a| |q_b|, the exact q's cross product and the float one's
-/// differ by about as much), then tilt it by under facet_tilt / thin_facet =
-/// 1.6e-4 rad, a sixth of far_margin: every ray the far plane is chosen to
-/// cross, it crosses. Until stop 60 this was 1e-8: the hull facets of an
-/// apex over 8,000 points at random angles on a circle, some 1e-8 thin,
-/// sent both apexes' stars to the clips (2.6 s instead of 0.1).
-inline constexpr double thin_facet = 1e-11;
-
-/// A vertex on the far plane is never solved exactly (the plane has no
-/// exact form) and never output: only the box's cut reads it, and it lies
-/// outside the box by half the box's extent along the far plane's normal.
-/// It keeps its float position and first-order bound up to this condition
-/// number cond = |A^-1| |A| (Hull/Tile::solve), then is refused (the star
-/// goes to the clips). That bound, 64u |A^-1| (|A| |y| + |b|), is over six
-/// times the first-order error of the rounded planes (~u |A^-1| (|A| |y| +
-/// 5 |b|)) and of Cramer's rule (~u |A^-1| (6 |A| |y| + 5 |b|)). Beyond
-/// first order, the computed determinant errs relatively by delta ~ 5u cond
-/// (5.6e-3 here), which multiplies those errors by 1 / (1 - delta), and |y|
-/// may exceed the computed |y| by the bound itself, 64u cond (7%) of it:
-/// the margin covers both. (filter::deferred_vertex_condition stops at 1e9
-/// for another reason: a vertex that stays in a cell needs a bound narrow
-/// enough for the sign passes.) A thin_facet facet makes a far vertex of
-/// condition ~2e12 when the far plane meets its ray at 45 degrees. Until
-/// stop 60 far vertices were kept below 1e9 only.
+/// A vertex on the far plane is never output: only the box's cut reads it,
+/// and it lies outside the box by half the box's extent along the far
+/// plane's normal. It keeps its float position and first-order bound up to
+/// this condition number cond = |A^-1| |A| (Hull/Tile::solve), and beyond
+/// is solved exactly (exact_vertex_on_plane: the far plane's normal and
+/// offset are doubles, so exact rationals), as other vertices are; until
+/// stop 60 it was refused beyond 1e9, and the star went to the clips. The
+/// bound, 64u |A^-1| (|A| |y| + |b|), is over six times the first-order
+/// error of the rounded planes (~u |A^-1| (|A| |y| + 5 |b|)) and of
+/// Cramer's rule (~u |A^-1| (6 |A| |y| + 5 |b|)). Beyond first order, the
+/// computed determinant errs relatively by delta ~ 5u cond (5.6e-3 here),
+/// which multiplies those errors by 1 / (1 - delta), and |y| may exceed the
+/// computed |y| by the bound itself, 64u cond (7%) of it: the margin covers
+/// both. (filter::deferred_vertex_condition stops at 1e9 for another reason:
+/// a vertex that stays in a cell needs a bound narrow enough for the sign
+/// passes.)
 inline constexpr double far_vertex_condition = 1e13;
 
 /// The plane that closes the cell of a point on the convex hull, whose
@@ -106,12 +104,13 @@ inline constexpr double far_vertex_condition = 1e13;
 /// known from the star; the box then cuts P away whole, as it lies outside.
 ///
 /// `dirs`: the k rays' unit directions (D each, from the rounded
-/// differences q; the callers reject directions whose rounding could tilt
-/// them). n is their sum, or where that leaves a ray short, a direction
-/// found by stepping towards the worst ray (below); every ray must make an
-/// angle with n well short of a right angle (n.dir >= far_margin |n|, far beyond
-/// rounding), else false (a hull vertex whose normal cone is nearly a half
-/// space: the cell is clipped instead). c lies beyond the box's corners and the vertices [0,
+/// differences q), and `ray_margins` their own margins (far_margin_least;
+/// null: far_margin alone). n is their sum, or where that leaves a ray
+/// short, a direction found by stepping towards the worst ray, or the same
+/// from the caller's hint (below); every ray must make an angle with n
+/// short of a right angle by its margin (n.dir >= margin |n|, beyond its
+/// rounding), else false (a hull vertex whose normal cone is a half space
+/// to within the rounding: the cell is clipped instead). c lies beyond the box's corners and the vertices [0,
 /// nv) (each widened by its error bound) by half the box's extent along n,
 /// so every vertex on P is certainly outside the box (box_signs).
 /// `box`: the kernel's first 2D planes (box_planes), n = -+e_axis, d = the
@@ -119,7 +118,7 @@ inline constexpr double far_vertex_condition = 1e13;
 template <int D>
 bool far_direction(const double* dirs, std::size_t k, double* n, const double* hint = nullptr,
                    const double* ray_margins = nullptr) {
-  const double* margins = nullptr;  // per ray; null: far_margin for every one
+  bool relaxed = false;  // the second round: far_margin_least in place of far_margin
   // The ray m falls shortest of its margin on (k: none; k + 1: NaN, or m = 0).
   auto worst_ray = [&](const double* m) {
     double len2 = 0;
@@ -131,7 +130,9 @@ bool far_direction(const double* dirs, std::size_t k, double* n, const double* h
     for (std::size_t r = 0; r < k; ++r) {
       double dot = 0;
       for (int a = 0; a < D; ++a) dot += m[a] * dirs[D * r + static_cast<std::size_t>(a)];
-      const double short_by = dot - (margins != nullptr ? margins[r] : far_margin) * len;
+      const double margin = ray_margins == nullptr ? far_margin
+                            : std::max(relaxed ? far_margin_least : far_margin, ray_margins[r]);
+      const double short_by = dot - margin * len;
       if (!(short_by >= least)) {
         if (!(short_by == short_by)) return k + 1;
         least = short_by;
@@ -174,9 +175,9 @@ bool far_direction(const double* dirs, std::size_t k, double* n, const double* h
     return steps_from();
   };
   if (from_sum_or_hint()) return true;
-  // Then with each ray's own margin (far_margin_least).
+  // Then with far_margin_least in far_margin's place.
   if (ray_margins == nullptr) return false;
-  margins = ray_margins;
+  relaxed = true;
   return from_sum_or_hint();
 }
 
@@ -218,8 +219,8 @@ bool far_plane(const double* dirs, std::size_t k, const Plane* box, const Vertex
 
 /// The vertices of [0, nv) that box plane k (offset h, as box_signs)
 /// cannot place by their float bounds, and whose exact solve would narrow
-/// the bound (not one on the far plane, which has no exact form, nor one
-/// solved exactly already): each passed to solve(t). Returns whether there
+/// the bound (not one on the far plane, solved exactly only past
+/// far_vertex_condition, nor one solved exactly already): each passed to solve(t). Returns whether there
 /// were any. A first-order bound is wide (1e-9 at a condition of 1e5,
 /// more for a deferred vertex) and may straddle a plane the exact vertex
 /// does not touch; solved, such a vertex lets box_signs decide.
@@ -239,7 +240,7 @@ bool solve_near_box_plane(const Vertex* verts, std::size_t nv, int k, double h, 
       ymax = std::max(ymax, std::fabs(v.y[c]));
       on_far |= planes[v.p[c]].id == far_plane_id;
     }
-    if (on_far || !(v.e > (4 * filter::u + filter::plane_eps) * ymax)) continue;  // no exact form, or exact already (or NaN)
+    if (on_far || !(v.e > (4 * filter::u + filter::plane_eps) * ymax)) continue;  // far, or exact already (or NaN)
     solve(t);
     solved = true;
   }
@@ -331,7 +332,7 @@ IllConditioned ill_conditioned_fate(filter::SolveMode mode, double cond, bool bo
                                     const Plane* planes, const Index* p) {
   for (int k = 0; k < D; ++k)
     if (planes[p[k]].id == far_plane_id)
-      return cond < far_vertex_condition && bounded ? IllConditioned::keep : IllConditioned::refuse;
+      return cond < far_vertex_condition && bounded ? IllConditioned::keep : IllConditioned::solve;
   const bool deferrable = cond < filter::deferred_vertex_condition && bounded;
   if (mode == filter::SolveMode::exact_now) return IllConditioned::solve;
   if (mode == filter::SolveMode::deferrable) return deferrable ? IllConditioned::defer : IllConditioned::solve;
@@ -410,9 +411,27 @@ std::size_t box_signs(const Vertex* verts, std::size_t nv, int k, double h, std:
   return box_signs(verts, nv, k, h, sign, [](std::size_t) { return 0; });
 }
 
+/// The vertex on the planes p[0, D) of generator gen's cell, solved exactly
+/// into y (exact_vertex; exact_vertex_on_plane for one on the far plane).
+template <int D, class Plane, class Index>
+void exact_solve(const ExactContext& exact, std::int32_t gen, const Plane* planes, const Index* p, double* y) {
+  std::int32_t ids[D];
+  int far = -1;
+  for (int c = 0; c < D; ++c) {
+    ids[c] = planes[p[c]].id;
+    if (ids[c] == far_plane_id) far = c;
+  }
+  if (far < 0) {
+    exact_vertex(exact, gen, ids, y);
+  } else {
+    const Plane& f = planes[p[far]];
+    exact_vertex_on_plane(exact, gen, ids, far, f.n, f.d, y);
+  }
+}
+
 /// Box plane k's side of a vertex on the planes p[0, D) (exact_box_sign):
-/// +1 keep, -1 remove, 0 undecided (a vertex on the far plane, which has
-/// no exact form, or no exact context). For the vertices the float test
+/// +1 keep, -1 remove, 0 undecided (a vertex on the far plane, whose row
+/// exact_box_sign does not take, or no exact context). For the vertices the float test
 /// and solve_near_box_plane leave within rounding of a box plane: exact
 /// ties between a bisector and the box (an apex over points on a circle,
 /// one of them on a box plane's diagonal: the apex's bisector with it holds

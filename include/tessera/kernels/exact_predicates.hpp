@@ -324,6 +324,14 @@ class WidePredicate {
 /// near-duplicate pair's two bisectors seen from a third cell, say).
 void exact_vertex(const ExactContext& ctx, std::int32_t i, const std::int32_t* planes, double* y);
 
+/// exact_vertex where row `row` of the planes is no bisector or box plane
+/// but the plane n.y = d (y relative to p_i; n and d any finite doubles,
+/// each an exact rational): the far plane that closes a hull point's
+/// assembled cell (assembly::far_plane), whose vertices can be too
+/// ill-conditioned for a float bound (assembly::far_vertex_condition).
+void exact_vertex_on_plane(const ExactContext& ctx, std::int32_t i, const std::int32_t* planes, int row,
+                           const double* n, double d, double* y);
+
 /// One term of a cell's measure: det(foot of `plane`, y_a, y_b) in 3D (the
 /// cone over a triangle of a face, measure() in front/cell_geometry.hpp), or
 /// det(y_a, y_b) in 2D (the shoelace; `plane` unused).

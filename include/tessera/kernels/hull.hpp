@@ -241,20 +241,20 @@ class Hull {
       v.p[1] = static_cast<Index>(box_planes + c[1]);
       v.p[2] = static_cast<Index>(box_planes + c[2]);
     };
-    // A hull point: its link's boundary, the far plane's direction and its
-    // vertices' conditions come from the triangles alone, so a large star
-    // that cannot be closed (the end of a thin band, whose star holds
-    // 160,000 neighbours, and whose far vertices are too ill-conditioned
-    // for floats) gives up before its vertices are solved, some thousands
-    // exactly. A small one is checked after them, as before: checked first,
-    // the extra pass cost points on a sphere 2.5%.
+    // A hull point: its link's boundary and the far plane's direction come
+    // from the triangles alone, so a large star that cannot be closed gives
+    // up before its vertices are solved, some thousands exactly (the end of
+    // a thin band holds 160,000 neighbours; until stop 60 its far vertices'
+    // conditions were checked here too, when one past the float bound was
+    // refused). A small one is checked after them, as before: checked
+    // first, the extra pass cost points on a sphere 2.5%.
     const bool boundary_first = open && nt >= boundary_first_from;
     if (boundary_first) {
       for (std::size_t t = 0; t < nt; ++t) {
         set_planes(verts_[t], t);
         link_any(static_cast<std::uint32_t>(t));
       }
-      if (!link_boundary(q, m, true)) return false;
+      if (!link_boundary(q, m)) return false;
     }
     refused_.clear();
     const std::size_t may_refuse = assembly::exact_solves_paid(m, nt);
@@ -273,7 +273,7 @@ class Hull {
       solve(verts_[t], filter::SolveMode::exact_now);
       settle_any(t);
     }
-    if (open && !((boundary_first || link_boundary(q, m, false)) && close_far())) return false;
+    if (open && !((boundary_first || link_boundary(q, m)) && close_far())) return false;
     update_radius();
     return clip_to_box() && (!open || assembly::drop_far_plane<3>(planes_, verts_));
   }
@@ -405,10 +405,8 @@ class Hull {
   // its boundary edges (a -> b: no triangle holds b -> a) into border_ as
   // (b, a), check that a cone over them closes the disk into a sphere, and
   // find the far plane's direction (far_n_) from the hull facets' outward
-  // normals (dirs_); with `probe`, check too that the far vertices are
-  // well enough conditioned for close_far's float solves. q: the
-  // bisectors' points, as assemble's.
-  bool link_boundary(const double* q, std::size_t m, bool probe) {
+  // normals (dirs_). q: the bisectors' points, as assemble's.
+  bool link_boundary(const double* q, std::size_t m) {
     const std::size_t nt = verts_.size();
     border_.clear();
     for (std::size_t t = 0; t < nt; ++t) {
@@ -439,39 +437,16 @@ class Hull {
       double* d = dirs_.data() + 3 * k;
       cross(qb, qa, d);
       const double len = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-      // A facet so thin that rounding could tilt its normal past the far
-      // plane's margin: not closed here (assembly::thin_facet).
+      // A facet so thin that no far plane could keep its normal's margin:
+      // not closed here (assembly::thin_facet).
       const double na = std::sqrt(qa[0] * qa[0] + qa[1] * qa[1] + qa[2] * qa[2]);
       const double nbl = std::sqrt(qb[0] * qb[0] + qb[1] * qb[1] + qb[2] * qb[2]);
       if (!(len > assembly::thin_facet * na * nbl)) return false;
       for (int a = 0; a < 3; ++a) d[a] /= len;
-      margins_[k] = std::max(assembly::far_margin_least, 6 * assembly::facet_tilt * (na * nbl / len));
+      margins_[k] = 6 * assembly::facet_tilt * (na * nbl / len);
     }
     if (!assembly::far_direction<3>(dirs_.data(), nb, far_n_, hint, margins_.data())) return false;
-    if (!probe) return true;
-    // Whether a far vertex is well enough conditioned for its float solve
-    // (close_far gives up otherwise) depends on the planes' normals alone:
-    // found here with the far plane at any offset, before the link's
-    // vertices are solved (the end of a thin band: thousands of them
-    // exactly, for nothing).
-    Plane& pf = planes_.emplace_back();
-    for (int a = 0; a < 3; ++a) pf.n[a] = far_n_[a];
-    pf.d = 0;
-    pf.n1 = std::fabs(far_n_[0]) + std::fabs(far_n_[1]) + std::fabs(far_n_[2]);
-    pf.id = assembly::far_plane_id;
-    pf.scale = 0;
-    const Index far = static_cast<Index>(planes_.size() - 1);
-    bool solvable = true;
-    for (std::size_t k = 0; solvable && k < nb; ++k) {
-      Vertex probe;
-      probe.p[0] = border_[k].a;
-      probe.p[1] = border_[k].b;
-      probe.p[2] = far;
-      solve(probe, filter::SolveMode::float_only);
-      solvable = probe.e <= std::numeric_limits<double>::max();
-    }
-    planes_.pop_back();
-    return solvable;
+    return true;
   }
 
   // link_boundary's second half, once the link's vertices are solved and
@@ -779,8 +754,7 @@ class Hull {
 
   // v's position solved exactly and rounded (exact_vertex); returns |y|_inf.
   double solve_exactly(Vertex& v) const {
-    const std::int32_t ids[3] = {planes_[v.p[0]].id, planes_[v.p[1]].id, planes_[v.p[2]].id};
-    exact_vertex(*exact_, gen_, ids, v.y);
+    assembly::exact_solve<3>(*exact_, gen_, planes_.data(), v.p, v.y);
     ++exact_solves_;
     return std::max({std::fabs(v.y[0]), std::fabs(v.y[1]), std::fabs(v.y[2])});
   }
@@ -827,7 +801,7 @@ class Hull {
   std::vector<std::uint8_t> seen_;
   FaceLoopScratch walk_;  // for_each_face's
   std::vector<double> dirs_;         // link_boundary: the rays' unit directions
-  std::vector<double> margins_;      // and their own margins (assembly::far_margin_least)
+  std::vector<double> margins_;      // and their own margins (assembly::facet_tilt)
   double far_n_[3] = {};             // link_boundary: the far plane's normal
   std::vector<std::uint32_t> refused_;  // assemble: the vertices refused the exact solve
   PreparedSigns<3, Index> signs_;  // the exact stages, prepared per vertex slot

@@ -206,7 +206,7 @@ class Tile {
       const double dirs[4] = {qs[1] / ls, -qs[0] / ls, -qe[1] / le, qe[0] / le};
       const Index far = static_cast<Index>(planes_.size());
       Plane& pf = planes_.emplace_back();
-      const double margins[2] = {assembly::far_margin_least, assembly::far_margin_least};  // tilts ~2u
+      const double margins[2] = {0, 0};  // tilts ~2u: far_margin, then far_margin_least
       if (!assembly::far_plane<2>(dirs, 2, planes_.data(), verts_.data(), nt, pf, margins)) return false;
       Vertex& ve = verts_[nt];  // leaving along e's ray, arriving on the far line
       Vertex& vs = verts_[nt + 1];
@@ -440,8 +440,7 @@ class Tile {
 
   // v's position solved exactly and rounded (exact_vertex); returns |y|_inf.
   double solve_exactly(Vertex& v) const {
-    const std::int32_t ids[2] = {planes_[v.p[0]].id, planes_[v.p[1]].id};
-    exact_vertex(*exact_, gen_, ids, v.y);
+    assembly::exact_solve<2>(*exact_, gen_, planes_.data(), v.p, v.y);
     ++exact_solves_;
     return std::max(std::fabs(v.y[0]), std::fabs(v.y[1]));
   }
