@@ -221,6 +221,23 @@ double grid_quotient(WideInt<8> num, WideInt<6> den, int shift) {
   return negative ? -r : r;
 }
 
+// Cramer's rule on the rows in s.a / s.b (build_rows' frame): det A into
+// s.minor[dim], and into s.minor[d] the numerator of coordinate d less det A
+// times p_i's (the vertex relative to p_i). Throws where the rows are
+// dependent (a corrupt cell).
+void cramer_numerators(int dim, Scratch& s) {
+  int sel[Scratch::kMaxDim] = {0, 1, 2};
+  det_rows(s.minor[dim], s.a, sel, dim, s);
+  if (mpz_sgn(s.minor[dim]) == 0) throw std::logic_error("exact_vertex: vertex planes are dependent (corrupt cell)");
+  for (int d = 0; d < dim; ++d) {
+    // Swap column d with b, take the determinant, swap back.
+    for (int r = 0; r < dim; ++r) mpz_swap(s.a[r][d], s.b[r]);
+    det_rows(s.minor[d], s.a, sel, dim, s);
+    for (int r = 0; r < dim; ++r) mpz_swap(s.a[r][d], s.b[r]);
+    mpz_submul(s.minor[d], s.minor[dim], s.coord[Scratch::kRows][d]);
+  }
+}
+
 // The vertex of cell i where planes[0..dim) meet, relative to p_i, as
 // integers: y[d] = minor[d] / minor[dim] * 2^shift (returned), for d < dim.
 // Cramer's rule on the integer rows (build_rows): det A, then numerator
@@ -237,17 +254,7 @@ int vertex_numerators(const ExactContext& ctx, std::int32_t i, const std::int32_
     return g.shift;
   }
   const int shift = build_rows(ctx, i, planes, dim, s);
-  int sel[Scratch::kMaxDim] = {0, 1, 2};
-  det_rows(s.minor[dim], s.a, sel, dim, s);
-  if (mpz_sgn(s.minor[dim]) == 0)
-    throw std::logic_error("exact_vertex: vertex planes are dependent (corrupt cell)");
-  for (int d = 0; d < dim; ++d) {
-    // Swap column d with b, take the determinant, swap back.
-    for (int r = 0; r < dim; ++r) mpz_swap(s.a[r][d], s.b[r]);
-    det_rows(s.minor[d], s.a, sel, dim, s);
-    for (int r = 0; r < dim; ++r) mpz_swap(s.a[r][d], s.b[r]);
-    mpz_submul(s.minor[d], s.minor[dim], s.coord[Scratch::kRows][d]);
-  }
+  cramer_numerators(dim, s);
   return shift;
 }
 
@@ -342,16 +349,7 @@ void exact_vertex_on_plane(const ExactContext& ctx, std::int32_t i, const std::i
     mpz_ptr out = k < dim ? s.a[row][k] : s.b[row];
     mpz_mul_2exp(out, mpq_numref(r.v[k]), top - (mpz_sizeinbase(mpq_denref(r.v[k]), 2) - 1));
   }
-  int sel[Scratch::kMaxDim] = {0, 1, 2};
-  det_rows(s.minor[dim], s.a, sel, dim, s);
-  if (mpz_sgn(s.minor[dim]) == 0)
-    throw std::logic_error("exact_vertex_on_plane: vertex planes are dependent (corrupt cell)");
-  for (int c = 0; c < dim; ++c) {
-    for (int q = 0; q < dim; ++q) mpz_swap(s.a[q][c], s.b[q]);
-    det_rows(s.minor[c], s.a, sel, dim, s);
-    for (int q = 0; q < dim; ++q) mpz_swap(s.a[q][c], s.b[q]);
-    mpz_submul(s.minor[c], s.minor[dim], s.coord[Scratch::kRows][c]);
-  }
+  cramer_numerators(dim, s);
   for (int c = 0; c < dim; ++c) y[c] = quotient_to_double(s.minor[c], s.minor[dim], shift, s.t0);
 }
 

@@ -393,6 +393,22 @@ TEST(ExactPredicates, HandCheckedCases) {
   check_views(c3, {o, x, yy, z}, opp);
 }
 
+/// For each (scale, offset) in `scales`, a random problem of 16 points and
+/// `per_scale` random queries on it (random_query, up to dim - 1 box
+/// planes): f(context, scale, offset, i, planes, j) for each.
+template <std::size_t N, class F>
+void random_queries(int dim, const double (&scales)[N][2], int per_scale, Rng& r, F&& f) {
+  for (const auto& s : scales) {
+    const Problem p = random_problem(dim, 16, s[0], s[1], r);
+    const auto c = p.ctx();
+    for (int t = 0; t < per_scale; ++t) {
+      std::int32_t i, j;
+      Ids planes;
+      if (random_query(p, r, dim - 1, i, planes, j)) f(c, s[0], s[1], i, planes, j);
+    }
+  }
+}
+
 // Random input at every magnitude: the kernel's sign is sign(P0) (ties do not
 // occur), box planes mixed in.
 void random_matches(int dim, std::uint64_t seed) {
@@ -402,25 +418,19 @@ void random_matches(int dim, std::uint64_t seed) {
                               {0x1p-1000, 0}, {3.7e-5, 0}, {1e-6, 1e6}, {1, 1e15},   {1e-12, -0.3}};
   Rng r(seed);
   int checked = 0, nonzero = 0;
-  for (const auto& s : scales) {
-    const Problem p = random_problem(dim, 16, s[0], s[1], r);
-    const auto c = p.ctx();
-    for (int t = 0; t < 150; ++t) {
-      std::int32_t i, j;
-      Ids planes;
-      if (!random_query(p, r, dim - 1, i, planes, j)) continue;
-      const Q p0 = power_diff(c, i, planes.data(), j);
-      const int got = exact_clip_sign(c, i, planes.data(), j);
-      EXPECT_EQ(prepared_sign(c, i, planes.data(), j), got) << "prepared: " << describe(c, i, planes.data(), j);
-      if (p0 != 0) {
-        ++nonzero;
-        ASSERT_EQ(got, sgn(p0)) << "scale " << s[0] << " offset " << s[1] << ": " << describe(c, i, planes.data(), j);
-      } else {
-        check_sign(c, i, planes.data(), j);
-      }
-      ++checked;
+  random_queries(dim, scales, 150, r, [&](const ExactContext& c, double scale, double offset, std::int32_t i,
+                                          const Ids& planes, std::int32_t j) {
+    const Q p0 = power_diff(c, i, planes.data(), j);
+    const int got = exact_clip_sign(c, i, planes.data(), j);
+    EXPECT_EQ(prepared_sign(c, i, planes.data(), j), got) << "prepared: " << describe(c, i, planes.data(), j);
+    if (p0 != 0) {
+      ++nonzero;
+      ASSERT_EQ(got, sgn(p0)) << "scale " << scale << " offset " << offset << ": " << describe(c, i, planes.data(), j);
+    } else {
+      check_sign(c, i, planes.data(), j);
     }
-  }
+    ++checked;
+  });
   EXPECT_GT(checked, 1200);
   EXPECT_GT(nonzero, 1200);
 }
@@ -513,62 +523,56 @@ void vertex_on_plane_matches(int dim, std::uint64_t seed) {
   Rng r(seed);
   int checked = 0;
   const double scales[][2] = {{1, 0}, {1e-200, 0}, {1e200, 0}, {3.7e-5, 0}, {1, 1e15}};
-  for (const auto& sc : scales) {
-    const Problem p = random_problem(dim, 16, sc[0], sc[1], r);
-    const auto c = p.ctx();
-    for (int t = 0; t < 60; ++t) {
-      std::int32_t i, j;
-      Ids planes;
-      if (!random_query(p, r, dim - 1, i, planes, j)) continue;
-      const int row = r.index(dim);
-      double n[3] = {0, 0, 0};
-      for (int k = 0; k < dim; ++k) n[k] = full_mantissa(r) * std::ldexp(1.0, r.index(40) - 20);
-      const double d = full_mantissa(r) * sc[0] * std::ldexp(1.0, r.index(20));
-      // The rational system, relative to p_i: bisector 2 q.y = |q|^2, box
-      // y_axis = c - p_i, the plane n.y = d.
-      Q A[3][3], b[3];
-      for (int q = 0; q < dim; ++q) {
-        const std::int32_t k = planes[q];
-        if (q == row) {
-          for (int e = 0; e < dim; ++e) A[q][e] = n[e];
-          b[q] = d;
-        } else if (k >= 0) {
-          Q s2 = 0;
-          for (int e = 0; e < dim; ++e) {
-            const Q qe = coord(c, k, e) - coord(c, i, e);
-            A[q][e] = 2 * qe;
-            s2 += qe * qe;
-          }
-          b[q] = s2;
-        } else {
-          const int axis = box_plane_axis(k);
-          for (int e = 0; e < dim; ++e) A[q][e] = e == axis ? 1 : 0;
-          b[q] = (box_plane_upper(k) ? Q(c.hi[axis]) : Q(c.lo[axis])) - coord(c, i, axis);
+  random_queries(dim, scales, 60, r, [&](const ExactContext& c, double scale, double, std::int32_t i,
+                                         const Ids& planes, std::int32_t) {
+    const int row = r.index(dim);
+    double n[3] = {0, 0, 0};
+    for (int k = 0; k < dim; ++k) n[k] = full_mantissa(r) * std::ldexp(1.0, r.index(40) - 20);
+    const double d = full_mantissa(r) * scale * std::ldexp(1.0, r.index(20));
+    // The rational system, relative to p_i: bisector 2 q.y = |q|^2, box
+    // y_axis = c - p_i, the plane n.y = d.
+    Q A[3][3], b[3];
+    for (int q = 0; q < dim; ++q) {
+      const std::int32_t k = planes[q];
+      if (q == row) {
+        for (int e = 0; e < dim; ++e) A[q][e] = n[e];
+        b[q] = d;
+      } else if (k >= 0) {
+        Q s2 = 0;
+        for (int e = 0; e < dim; ++e) {
+          const Q qe = coord(c, k, e) - coord(c, i, e);
+          A[q][e] = 2 * qe;
+          s2 += qe * qe;
         }
+        b[q] = s2;
+      } else {
+        const int axis = box_plane_axis(k);
+        for (int e = 0; e < dim; ++e) A[q][e] = e == axis ? 1 : 0;
+        b[q] = (box_plane_upper(k) ? Q(c.hi[axis]) : Q(c.lo[axis])) - coord(c, i, axis);
       }
-      auto det = [&](Q (*m)[3]) {
-        if (dim == 2) return Q(m[0][0] * m[1][1] - m[0][1] * m[1][0]);
-        return Q(m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
-                 m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]));
-      };
-      const Q da = det(A);
-      if (da == 0) continue;
-      double y[3] = {0, 0, 0};
-      exact_vertex_on_plane(c, i, planes.data(), row, n, d, y);
-      for (int e = 0; e < dim; ++e) {
-        Q m[3][3];
-        for (int q = 0; q < dim; ++q)
-          for (int f = 0; f < dim; ++f) m[q][f] = f == e ? b[q] : A[q][f];
-        const Q exact = det(m) / da;
-        const double mag = std::fabs(exact.get_d());
-        if (!(mag <= std::numeric_limits<double>::max()) || mag < 1e-290) continue;
-        const double ulp = std::nextafter(mag, INFINITY) - mag;
-        ASSERT_LE(abs(Q(y[e]) - exact), Q(2 * ulp)) << "coordinate " << e << " scale " << sc[0] << ": exact "
-                                                    << exact.get_d() << ", got " << y[e];
-      }
-      ++checked;
     }
-  }
+    auto det = [&](Q (*m)[3]) {
+      if (dim == 2) return Q(m[0][0] * m[1][1] - m[0][1] * m[1][0]);
+      return Q(m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
+               m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]));
+    };
+    const Q da = det(A);
+    if (da == 0) return;
+    double y[3] = {0, 0, 0};
+    exact_vertex_on_plane(c, i, planes.data(), row, n, d, y);
+    for (int e = 0; e < dim; ++e) {
+      Q m[3][3];
+      for (int q = 0; q < dim; ++q)
+        for (int f = 0; f < dim; ++f) m[q][f] = f == e ? b[q] : A[q][f];
+      const Q exact = det(m) / da;
+      const double mag = std::fabs(exact.get_d());
+      if (!(mag <= std::numeric_limits<double>::max()) || mag < 1e-290) continue;
+      const double ulp = std::nextafter(mag, INFINITY) - mag;
+      ASSERT_LE(abs(Q(y[e]) - exact), Q(2 * ulp)) << "coordinate " << e << " scale " << scale << ": exact "
+                                                  << exact.get_d() << ", got " << y[e];
+    }
+    ++checked;
+  });
   EXPECT_GT(checked, 250);
 }
 
