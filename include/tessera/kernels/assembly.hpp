@@ -448,4 +448,21 @@ int exact_box_side(const ExactContext* exact, std::int32_t gen, const Plane* pla
   return exact_box_sign(*exact, gen, ids, planes[k].id);
 }
 
+/// Box plane k's signs for an assembled cell's box cut (box_signs), as
+/// both kernels' clip_to_box take them: by the float bounds; where a vertex
+/// lies within its bound of the plane, again after `solve_near()` has
+/// solved such vertices exactly (the kernel's step around
+/// solve_near_box_plane), with the exact, perturbed side (exact_box_side)
+/// for any still within rounding. Returns box_signs' count or undecided.
+template <int D, class Vertex, class Plane, class SolveNear>
+std::size_t box_cut_signs(const Vertex* verts, std::size_t nv, int k, const Plane* planes,
+                          std::vector<filter::Sign>& sign, const ExactContext* exact, std::int32_t gen,
+                          SolveNear&& solve_near) {
+  const std::size_t removed = box_signs(verts, nv, k, planes[k].d, sign);
+  if (removed != undecided) return removed;
+  solve_near();
+  return box_signs(verts, nv, k, planes[k].d, sign,
+                   [&](std::size_t t) { return exact_box_side<D>(exact, gen, planes, verts[t].p, k); });
+}
+
 }  // namespace tessera::kernels::assembly

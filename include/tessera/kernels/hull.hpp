@@ -361,15 +361,8 @@ class Hull {
   bool clip_to_box() {
     for (Index k = 0; k < box_planes; ++k) {
       const std::size_t nv = verts_.size();
-      std::size_t removed = assembly::box_signs(verts_.data(), nv, k, planes_[k].d, sign_);
-      if (removed == assembly::undecided) {
-        // Solve exactly the vertices the plane cannot place; those still
-        // within rounding of it tie with it, or nearly: the exact side.
-        solve_near(k);
-        removed = assembly::box_signs(verts_.data(), nv, k, planes_[k].d, sign_, [&](std::size_t t) {
-          return assembly::exact_box_side<3>(exact_, gen_, planes_.data(), verts_[t].p, static_cast<int>(k));
-        });
-      }
+      const std::size_t removed = assembly::box_cut_signs<3>(verts_.data(), nv, static_cast<int>(k), planes_.data(),
+                                                             sign_, exact_, gen_, [&] { solve_near(k); });
       if (removed == assembly::undecided || removed == nv) return false;
       if (removed == 0) continue;
       if (hashed_) cut_hashed(k, nv);  // a star of more than dense_planes neighbours
@@ -391,13 +384,12 @@ class Hull {
   }
 
   // The vertices box plane k cannot place, solved exactly
-  // (assembly::solve_near_box_plane); whether there were any.
-  bool solve_near(Index k) {
+  // (assembly::solve_near_box_plane), and the radius updated if any were.
+  void solve_near(Index k) {
     const bool solved = assembly::solve_near_box_plane<3>(verts_.data(), verts_.size(), static_cast<int>(k),
                                                           planes_[k].d, planes_.data(),
                                                           [this](std::size_t t) { solve_now(t); });
     if (solved) update_radius();
-    return solved;
   }
 
   // assemble() of a hull point, before its vertices are solved: the link's

@@ -254,15 +254,8 @@ class Tile {
   bool clip_to_box() {
     for (Index k = 0; k < box_planes; ++k) {
       const std::size_t nv = verts_.size();
-      std::size_t removed = assembly::box_signs(verts_.data(), nv, k, planes_[k].d, sign_);
-      if (removed == assembly::undecided) {
-        // Solve exactly the vertices the plane cannot place; those still
-        // within rounding of it tie with it, or nearly: the exact side.
-        solve_near(k);
-        removed = assembly::box_signs(verts_.data(), nv, k, planes_[k].d, sign_, [&](std::size_t t) {
-          return assembly::exact_box_side<2>(exact_, gen_, planes_.data(), verts_[t].p, static_cast<int>(k));
-        });
-      }
+      const std::size_t removed = assembly::box_cut_signs<2>(verts_.data(), nv, static_cast<int>(k), planes_.data(),
+                                                             sign_, exact_, gen_, [&] { solve_near(k); });
       if (removed == assembly::undecided || removed == nv) return false;
       if (removed != 0) cut(k, nv, removed);
     }
@@ -282,12 +275,11 @@ class Tile {
   }
 
   // As Hull::solve_near.
-  bool solve_near(Index k) {
+  void solve_near(Index k) {
     const bool solved = assembly::solve_near_box_plane<2>(verts_.data(), verts_.size(), static_cast<int>(k),
                                                           planes_[k].d, planes_.data(),
                                                           [this](std::size_t t) { solve_now(t); });
     if (solved) update_radius();
-    return solved;
   }
 
   // The cell's generator and the domain box's planes (always its first
