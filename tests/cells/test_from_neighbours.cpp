@@ -475,6 +475,24 @@ TEST(FromNeighbours, CellsAreAssembledFromTheirStars) {
     EXPECT_EQ(c.assembled_from_stars, 2004u);
     EXPECT_TRUE(tessera::validate(c, {}).ok);
   }
+  // Apexes 1e5 radii above and below a circle (stop 61): their rays are
+  // tilted 1e-5 from the horizon, and the isotropic bound on a thin facet's
+  // ray (6 facet_tilt / thinness, ~1e-9 / the circle points' gap) exceeds
+  // that, so no far plane was found; the bound along the far plane's normal
+  // itself (far_direction's ray_axis_errors: the cross product's z is made
+  // of the q's horizontal parts alone) is ~1e-20 / gap. The far vertices
+  // then lie ~1e10 out, with float bounds too wide to place against the box's
+  // side planes; they are solved exactly there (solve_near_box_plane, which
+  // skipped vertices on the far plane until then). Before, both apexes were
+  // clipped by all their neighbours, most tests exact ties (1,000 points and
+  // the two apexes: 1.7 s on one thread; 0.05 s now).
+  {
+    std::vector<double> cones = circle_at_random_angles(1000, 943);
+    cones.insert(cones.end(), {0.0, 0.0, 1e5, 0.3, -0.2, -1e6});
+    const tessera::Cells c = run_method(cones, 3, tessera::CellMethod::insertion);
+    EXPECT_EQ(c.assembled_from_stars, 1002u);
+    EXPECT_TRUE(tessera::validate(c, {}).ok);
+  }
   // A thin cylindrical band: the far vertices, ill-conditioned beyond the
   // float bound but not beyond the deferred one, are cut by the box with
   // certainty and never solved exactly (stop 58; before, a star that had one

@@ -66,6 +66,8 @@ inline constexpr double far_margin = 1e-3;
 /// far_margin. So every ray the far plane is chosen to cross, it crosses.
 /// A ray met nearly edge on puts its far vertex far out, ill-conditioned
 /// (far_vertex_condition).
+/// (A 3D ray's error along a given direction can be much smaller than its
+/// tilt bound: far_direction's ray_axis_errors.)
 inline constexpr double far_margin_least = 1e-12;
 inline constexpr double facet_tilt = 1.6e-15;
 /// Facets thinner than this are not closed: a tilt bound past 0.16 rad
@@ -105,7 +107,15 @@ inline constexpr double far_vertex_condition = 1e13;
 ///
 /// `dirs`: the k rays' unit directions (D each, from the rounded
 /// differences q), and `ray_margins` their own margins (far_margin_least;
-/// null: far_margin alone). n is their sum, or where that leaves a ray
+/// null: far_margin alone). `ray_axis_errors` (optional, D per ray): bounds
+/// e on the error of each of a ray's components, so that a ray's error along
+/// a unit n is at most sum_a |n_a| e_a; where that is below its own margin
+/// it serves instead. (A 3D ray is the cross product of two nearly parallel
+/// q over a thin facet: its direction is uncertain by the margin, but only
+/// sideways; along the far plane's normal it may be known far better. An
+/// apex 1e5 radii above a circle: rays tilted 1e-5 up, margins up to 1e-3,
+/// their errors along the axis ~1e-20 / the circle points' gap.) n is
+/// their sum, or where that leaves a ray
 /// short, a direction found by stepping towards the worst ray, or the same
 /// from the caller's hint (below); every ray must make an angle with n
 /// short of a right angle by its margin (n.dir >= margin |n|, beyond its
@@ -117,12 +127,15 @@ inline constexpr double far_vertex_condition = 1e13;
 /// offset from the generator.
 template <int D>
 bool far_direction(const double* dirs, std::size_t k, double* n, const double* hint = nullptr,
-                   const double* ray_margins = nullptr) {
+                   const double* ray_margins = nullptr, const double* ray_axis_errors = nullptr) {
   bool relaxed = false;  // the second round: far_margin_least in place of far_margin
   // The ray m falls shortest of its margin on (k: none; k + 1: NaN, or m = 0).
   auto worst_ray = [&](const double* m) {
-    double len2 = 0;
-    for (int a = 0; a < D; ++a) len2 += m[a] * m[a];
+    double len2 = 0, mabs[D];
+    for (int a = 0; a < D; ++a) {
+      len2 += m[a] * m[a];
+      mabs[a] = std::fabs(m[a]);
+    }
     const double len = std::sqrt(len2);
     if (!(len > 0)) return k + 1;
     std::size_t worst = k;
@@ -130,9 +143,17 @@ bool far_direction(const double* dirs, std::size_t k, double* n, const double* h
     for (std::size_t r = 0; r < k; ++r) {
       double dot = 0;
       for (int a = 0; a < D; ++a) dot += m[a] * dirs[D * r + static_cast<std::size_t>(a)];
-      const double margin = ray_margins == nullptr ? far_margin
-                            : std::max(relaxed ? far_margin_least : far_margin, ray_margins[r]);
-      const double short_by = dot - margin * len;
+      double margin_len = far_margin * len;  // the ray's margin, times |m|
+      if (ray_margins != nullptr) {
+        double own = ray_margins[r] * len;
+        if (ray_axis_errors != nullptr) {  // the bound along m itself, where smaller
+          double along = 0;
+          for (int a = 0; a < D; ++a) along += mabs[a] * ray_axis_errors[D * r + static_cast<std::size_t>(a)];
+          own = std::min(own, along);
+        }
+        margin_len = std::max((relaxed ? far_margin_least : far_margin) * len, own);
+      }
+      const double short_by = dot - margin_len;
       if (!(short_by >= least)) {
         if (!(short_by == short_by)) return k + 1;
         least = short_by;
@@ -219,13 +240,17 @@ bool far_plane(const double* dirs, std::size_t k, const Plane* box, const Vertex
 
 /// The vertices of [0, nv) that box plane k (offset h, as box_signs)
 /// cannot place by their float bounds, and whose exact solve would narrow
-/// the bound (not one on the far plane, solved exactly only past
-/// far_vertex_condition, nor one solved exactly already): each passed to solve(t). Returns whether there
-/// were any. A first-order bound is wide (1e-9 at a condition of 1e5,
-/// more for a deferred vertex) and may straddle a plane the exact vertex
-/// does not touch; solved, such a vertex lets box_signs decide.
-template <int D, class Vertex, class Plane, class Solve>
-bool solve_near_box_plane(const Vertex* verts, std::size_t nv, int k, double h, const Plane* planes, Solve&& solve) {
+/// the bound (not one solved exactly already): each passed to solve(t).
+/// Returns whether there were any. A first-order bound is wide (1e-9 at a
+/// condition of 1e5, more for a deferred vertex) and may straddle a plane
+/// the exact vertex does not touch; solved, such a vertex lets box_signs
+/// decide. Vertices on the far plane too (exact_vertex_on_plane; until
+/// stop 61 they were left, and the cell clipped): one far out along a ray
+/// met nearly edge on (an apex 1e5 radii above a circle: 1e10 out, its
+/// bound 3e8) may be outside the box, yet not certainly on one side of a
+/// side plane.
+template <int D, class Vertex, class Solve>
+bool solve_near_box_plane(const Vertex* verts, std::size_t nv, int k, double h, Solve&& solve) {
   const int axis = k / 2;
   const double s = (k & 1) ? 1.0 : -1.0;
   const double de = filter::plane_eps * std::fabs(h) + filter::abs_eps;
@@ -235,12 +260,8 @@ bool solve_near_box_plane(const Vertex* verts, std::size_t nv, int k, double h, 
     const double P = h - s * v.y[axis], e = v.e + de;
     if (P > e || P < -e) continue;
     double ymax = 0;
-    bool on_far = false;
-    for (int c = 0; c < D; ++c) {
-      ymax = std::max(ymax, std::fabs(v.y[c]));
-      on_far |= planes[v.p[c]].id == far_plane_id;
-    }
-    if (on_far || !(v.e > (4 * filter::u + filter::plane_eps) * ymax)) continue;  // far, or exact already (or NaN)
+    for (int c = 0; c < D; ++c) ymax = std::max(ymax, std::fabs(v.y[c]));
+    if (!(v.e > (4 * filter::u + filter::plane_eps) * ymax)) continue;  // exact already (or NaN)
     solve(t);
     solved = true;
   }

@@ -387,8 +387,7 @@ class Hull {
   // (assembly::solve_near_box_plane), and the radius updated if any were.
   void solve_near(Index k) {
     const bool solved = assembly::solve_near_box_plane<3>(verts_.data(), verts_.size(), static_cast<int>(k),
-                                                          planes_[k].d, planes_.data(),
-                                                          [this](std::size_t t) { solve_now(t); });
+                                                          planes_[k].d, [this](std::size_t t) { solve_now(t); });
     if (solved) update_radius();
   }
 
@@ -421,6 +420,7 @@ class Hull {
     // direction, is q_b x q_a.
     dirs_.resize(3 * nb);
     margins_.resize(nb);
+    axis_errors_.resize(3 * nb);
     double hint[3] = {0, 0, 0};  // the point less its hull neighbours' mean (far_direction)
     for (std::size_t k = 0; k < nb; ++k) {
       const double* qb = q + 3 * (border_[k].a - box_planes);
@@ -435,9 +435,19 @@ class Hull {
       const double nbl = std::sqrt(qb[0] * qb[0] + qb[1] * qb[1] + qb[2] * qb[2]);
       if (!(len > assembly::thin_facet * na * nbl)) return false;
       for (int a = 0; a < 3; ++a) d[a] /= len;
-      margins_[k] = 6 * assembly::facet_tilt * (na * nbl / len);
+      const double scale = 6 * assembly::facet_tilt / len;
+      margins_[k] = scale * (na * nbl);
+      // Component a of the cross product (q_b,i q_a,j - q_b,j q_a,i) errs
+      // by ~4u (|q_b,i q_a,j| + |q_b,j q_a,i|): 2u from q's rounding, 2u
+      // from its own; facet_tilt (~7u) and the factor 6 as for the margin.
+      for (int a = 0; a < 3; ++a) {
+        const int i = a == 2 ? 0 : a + 1, j = a == 0 ? 2 : a - 1;
+        axis_errors_[3 * k + static_cast<std::size_t>(a)] =
+            scale * (std::fabs(qb[i] * qa[j]) + std::fabs(qb[j] * qa[i]));
+      }
     }
-    if (!assembly::far_direction<3>(dirs_.data(), nb, far_n_, hint, margins_.data())) return false;
+    if (!assembly::far_direction<3>(dirs_.data(), nb, far_n_, hint, margins_.data(), axis_errors_.data()))
+      return false;
     return true;
   }
 
@@ -794,6 +804,7 @@ class Hull {
   FaceLoopScratch walk_;  // for_each_face's
   std::vector<double> dirs_;         // link_boundary: the rays' unit directions
   std::vector<double> margins_;      // and their own margins (assembly::facet_tilt)
+  std::vector<double> axis_errors_;  // and the bounds on their components (far_direction)
   double far_n_[3] = {};             // link_boundary: the far plane's normal
   std::vector<std::uint32_t> refused_;  // assemble: the vertices refused the exact solve
   PreparedSigns<3, Index> signs_;  // the exact stages, prepared per vertex slot

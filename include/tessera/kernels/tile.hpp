@@ -277,8 +277,7 @@ class Tile {
   // As Hull::solve_near.
   void solve_near(Index k) {
     const bool solved = assembly::solve_near_box_plane<2>(verts_.data(), verts_.size(), static_cast<int>(k),
-                                                          planes_[k].d, planes_.data(),
-                                                          [this](std::size_t t) { solve_now(t); });
+                                                          planes_[k].d, [this](std::size_t t) { solve_now(t); });
     if (solved) update_radius();
   }
 
