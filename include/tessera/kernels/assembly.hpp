@@ -315,8 +315,16 @@ bool worth_exact_solve(const double* y, const Plane* box) {
 /// (points on a helix, whose Delaunay triangulation is quadratic: 2,000 of
 /// them have ~380 neighbours each, and three vertices in a thousand spoiled
 /// four cells in five) solves its few far vertices rather than clip
-/// quadratically.
-inline std::size_t exact_solves_paid(std::size_t m, std::size_t nt) { return m * (nt + 100) / 16000; }
+/// quadratically. Four more are paid for at any size (stop 61): that
+/// clipping cost holds for well-conditioned stars, but a star with a
+/// vertex too ill-conditioned for floats is near a degenerate one, and its
+/// clips' tests near that vertex go to the exact stages. The cylinder
+/// band's stars (~50 neighbours, ~100 vertices, paid none) made ~500 exact
+/// evaluations each when clipped: 100k band points 7.6-7.9 -> 6.3-6.6 s on
+/// one thread with all but 15 stars assembled, a 1-degree latitude-longitude
+/// grid on the sphere 0.67-0.82 -> 0.59 s; a terrain, a torus, an ellipsoid,
+/// a helix and the clustered benchmark level.
+inline std::size_t exact_solves_paid(std::size_t m, std::size_t nt) { return m * (nt + 100) / 16000 + 4; }
 
 /// What becomes of a vertex too ill-conditioned for its float bound
 /// (Hull/Tile::ill_conditioned; its D local planes `p`, its float estimate
