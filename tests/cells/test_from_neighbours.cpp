@@ -152,12 +152,12 @@ std::vector<double> band_points(int n, std::uint64_t seed) {
 /// 1,000 random points on a segment of the x axis (2D) and one a million
 /// times the segment's length above it: the far point's two rays lie within
 /// 1e-6 of the horizontal, on both sides.
-std::vector<double> row_and_far_point() {
+std::vector<double> row_and_far_point(double height = 1e6) {
   std::mt19937_64 rng(941);
   std::uniform_real_distribution<double> u(0, 1);
   std::vector<double> p;
   for (int k = 0; k < 1000; ++k) p.insert(p.end(), {u(rng), 0.0});
-  p.insert(p.end(), {0.5, 1e6});
+  p.insert(p.end(), {0.5, height});
   return p;
 }
 
@@ -312,6 +312,10 @@ TEST(FromNeighbours, SameCellsAsTheSearch2D) {
   }
   same2(vertex_on_box_plane(2), "a Voronoi vertex on a box plane", {}, vertex_on_box_plane_bounds());
   same2(row_and_far_point(), "a row of points and one far above it");
+  // 1e12 above: its rays lie 1e-12 from the horizon, at far_margin_least
+  // until stop 61 (then 1e-12, now 1e-14), and the point was clipped.
+  same2(row_and_far_point(1e12), "a row of points and one 1e12 above it");
+  EXPECT_EQ(run_method(row_and_far_point(1e12), 2, tessera::CellMethod::insertion).assembled_from_stars, 1001u);
 }
 
 // Cells from insertion are assembled from their Delaunay stars: closed

@@ -67,8 +67,12 @@ inline constexpr double far_margin = 1e-3;
 /// A ray met nearly edge on puts its far vertex far out, ill-conditioned
 /// (far_vertex_condition).
 /// (A 3D ray's error along a given direction can be much smaller than its
-/// tilt bound: far_direction's ray_axis_errors.)
-inline constexpr double far_margin_least = 1e-12;
+/// tilt bound: far_direction's ray_axis_errors.) far_margin_least is the
+/// floor under every margin: it covers the dot product n.dir's own rounding
+/// (~3u per term, under 7e-16 |n|) and a 2D ray's (~3u) some fifteen times.
+/// Stop 60 set it at 1e-12, which left a point 1e12 above a row (its rays
+/// 1e-12 from the horizon) to the clips; 1e-14 since stop 61.
+inline constexpr double far_margin_least = 1e-14;
 inline constexpr double facet_tilt = 1.6e-15;
 /// Facets thinner than this are not closed: a tilt bound past 0.16 rad
 /// leaves no margin a direction could keep. Stop 59 refused facets below
