@@ -118,10 +118,11 @@ inline constexpr double far_vertex_condition = 1e13;
 /// q over a thin facet: its direction is uncertain by the margin, but only
 /// sideways; along the far plane's normal it may be known far better. An
 /// apex 1e5 radii above a circle: rays tilted 1e-5 up, margins up to 1e-3,
-/// their errors along the axis ~1e-20 / the circle points' gap.) n is
-/// their sum, or where that leaves a ray
-/// short, a direction found by stepping towards the worst ray, or the same
-/// from the caller's hint (below); every ray must make an angle with n
+/// their errors along the axis ~1e-20 / the circle points' gap.)
+///
+/// n is their sum, or where that leaves a ray short, a direction found by
+/// stepping towards the worst ray, or the same from the caller's hint
+/// (below); every ray must make an angle with n
 /// short of a right angle by its margin (n.dir >= margin |n|, beyond its
 /// rounding), else false (a hull vertex whose normal cone is a half space
 /// to within the rounding: the cell is clipped instead). c lies beyond the box's corners and the vertices [0,
