@@ -149,9 +149,9 @@ std::vector<double> band_points(int n, std::uint64_t seed) {
   return p;
 }
 
-/// 1,000 random points on a segment of the x axis (2D) and one a million
-/// times the segment's length above it: the far point's two rays lie within
-/// 1e-6 of the horizontal, on both sides.
+/// 1,000 random points on a segment of the x axis (2D) and one `height`
+/// times the segment's length above it (a million by default): the far
+/// point's two rays lie within 1 / height of the horizontal, on both sides.
 std::vector<double> row_and_far_point(double height = 1e6) {
   std::mt19937_64 rng(941);
   std::uniform_real_distribution<double> u(0, 1);
@@ -488,8 +488,9 @@ TEST(FromNeighbours, CellsAreAssembledFromTheirStars) {
   // then lie ~1e10 out, with float bounds too wide to place against the box's
   // side planes; they are solved exactly there (solve_near_box_plane, which
   // skipped vertices on the far plane until then). Before, both apexes were
-  // clipped by all their neighbours, most tests exact ties (1,000 points and
-  // the two apexes: 1.7 s on one thread; 0.05 s now).
+  // clipped by all their neighbours, most tests exact ties (2,000 random
+  // circle points with apexes at +-1e5 on the axis: 7.6 s on one thread,
+  // 0.09 s now).
   {
     std::vector<double> cones = circle_at_random_angles(1000, 943);
     cones.insert(cones.end(), {0.0, 0.0, 1e5, 0.3, -0.2, -1e6});
@@ -512,8 +513,9 @@ TEST(FromNeighbours, CellsAreAssembledFromTheirStars) {
   // centres): every cell reaches the centre, and four grid neighbours are
   // co-circular, so many stars of ~10 neighbours have a vertex too
   // ill-conditioned for floats. Until stop 61 such small stars paid for no
-  // exact solve (assembly::exact_solves_paid) and 13,449 were assembled;
-  // clipping them cost ~75 exact evaluations each.
+  // exact solve (assembly::exact_solves_paid), and of the same grid built
+  // in numpy 13,449 were assembled; clipping them cost ~75 exact
+  // evaluations each. (With the budget as before, this test fails.)
   {
     std::vector<double> grid;
     for (int i = 0; i < 90; ++i)
