@@ -92,6 +92,11 @@ std::vector<Case<D>> cases() {
   add("thin far box", 800, t0, t1, 1.0, true);
   add("one bin", 40, z, one, 1000.0, false);
   add("dense", 200, a, b, 0.1, false);
+  // One bin across every axis but the last, which holds ~200: the shells
+  // there are far wider than the grid (walk_rows clips them to it).
+  std::array<double, D> c0{}, c1{};
+  for (int d = 0; d < D; ++d) c1[d] = d == D - 1 ? 100 : 0.01;
+  add("column", 400, c0, c1, 2.0, false);
   // A bulk of tricky points in [0, 1] and a few far outliers in a box to
   // 1000 (the lower faces close by): the grid spans the bulk (grid_box) and
   // its edge bins reach out to the box's faces, holding the outliers (and
@@ -363,6 +368,40 @@ TEST(BinLocator, ShellsPartitionAndBound3D) {
   std::uint64_t seed = 100;
   for (const auto& c : cases<3>()) check_shells(c, seed++);
 }
+// A plane (2D: a row) of points and one far off it: the grid is a column of
+// bins, one bin across the plane's axes. A shell's bins lie along the long
+// axis, so its lower bound grows by that axis's bin size per shell, not by
+// the thin axes' (which let every cell of such input walk the column to its
+// far end).
+template <int D>
+void shell_bound_follows_the_long_axis() {
+  std::mt19937_64 g(D * 31 + 5);
+  std::uniform_real_distribution<double> u(-1, 1);
+  std::vector<double> coords;
+  for (int i = 0; i < 700; ++i)
+    for (int d = 0; d < D; ++d) coords.push_back(d == D - 1 ? 0.0 : u(g));
+  for (int d = 0; d < D; ++d) coords.push_back(d == D - 1 ? 1e6 : 0.0);
+  std::array<double, D> lo{}, hi{};
+  for (int d = 0; d < D; ++d) {
+    lo[d] = d == D - 1 ? -0.01 : -1.01;
+    hi[d] = d == D - 1 ? 1e6 + 0.01 : 1.01;
+  }
+  BinLocator<D> loc(coords, {}, lo, hi, 2.0);
+  for (int d = 0; d + 1 < D; ++d) ASSERT_EQ(loc.divisions()[d], 1) << "axis " << d;
+  ASSERT_GT(loc.divisions()[D - 1], 100);
+  const double h = loc.bin_size(D - 1);
+  for (std::size_t i = 0; i < 700; i += 99) {
+    const double* x = &coords[i * D];
+    const auto b = loc.bin_coords(x);
+    const int last = loc.max_shell(b);
+    ASSERT_EQ(last, loc.divisions()[D - 1] - 1);
+    for (int s = 1; s <= last; s += 7)
+      EXPECT_GE(loc.shell_lower_bound(x, b, s), (s - 1) * h * (1 - 1e-9)) << "point " << i << ", shell " << s;
+  }
+}
+TEST(BinLocator, ShellBoundFollowsTheLongAxis2D) { shell_bound_follows_the_long_axis<2>(); }
+TEST(BinLocator, ShellBoundFollowsTheLongAxis3D) { shell_bound_follows_the_long_axis<3>(); }
+
 TEST(BinLocator, BinDistance2D) { for (const auto& c : cases<2>()) check_bin_distance(c, face_slack(c)); }
 TEST(BinLocator, BinDistance3D) { for (const auto& c : cases<3>()) check_bin_distance(c, face_slack(c)); }
 

@@ -240,20 +240,24 @@ class BinLocator {
     return s;
   }
   /// Lower bound on the distance from x (in bin b) to any point in the shell of
-  /// Chebyshev radius s >= 1 around b: it must cross s-1 whole bins plus the gap
-  /// from x to the nearest face of its own bin along some axis. Only faces
-  /// with a bin beyond count: an edge bin's outer face has none (and x, held
-  /// there, may lie beyond it); a shell's bin differing from b by s along
-  /// axis d lies past b's inner face on that axis, with s-1 interior bins
-  /// between.
+  /// Chebyshev radius s >= 1 around b. A bin of the shell differs from b by s
+  /// along some axis d, on a side where the grid has a bin s away: it lies
+  /// past b's face on that side, with s-1 whole bins of axis d between. So
+  /// the bound is the least, over such axes and sides, of the gap from x to
+  /// that face plus s-1 bin sizes of that axis. (An edge bin's outer face
+  /// has no bin beyond, and x, held there, may lie beyond it.) Per axis, not
+  /// with the smallest bin size of all: where one axis is a single bin wide
+  /// (a plane of points and one far off it), that size bounded nothing along
+  /// the long axis, and every cell walked the column of bins to its end.
   double shell_lower_bound(const double* x, const std::array<std::int32_t, D>& b, int s) const {
-    double gap = INFINITY;
+    double bound = INFINITY;
     for (int d = 0; d < D; ++d) {
-      double blo = lo_[d] + b[d] * size_[d];
-      if (b[d] > 0) gap = std::min(gap, x[d] - blo);
-      if (b[d] < divs_[d] - 1) gap = std::min(gap, blo + size_[d] - x[d]);
+      const double blo = lo_[d] + b[d] * size_[d];
+      const double across = std::max(0.0, (s - 1) * size_[d] * (1 - 1e-12));
+      if (b[d] - s >= 0) bound = std::min(bound, std::max(0.0, x[d] - blo - slack_) + across);
+      if (b[d] + s <= divs_[d] - 1) bound = std::min(bound, std::max(0.0, blo + size_[d] - x[d] - slack_) + across);
     }
-    return std::max(0.0, gap - slack_) + std::max(0.0, (s - 1) * min_size_ * (1 - 1e-12));
+    return bound;
   }
   /// The largest shell radius that still touches the grid from bin b.
   int max_shell(const std::array<std::int32_t, D>& b) const {
@@ -307,8 +311,10 @@ class BinLocator {
     const std::size_t w = static_cast<std::size_t>(2 * s + 1);
     gaps.resize(D * w);
     for (int d = 0; d < D; ++d) {
-      for (int o = -s; o <= s; ++o) {
-        const auto [blo, bhi] = faces(d, b[d] + o);  // (outside the grid: never read)
+      // Offsets outside the grid are never read (walk_rows clips to it).
+      const int olo = std::max(-s, -b[d]), ohi = std::min(s, divs_[d] - 1 - b[d]);
+      for (int o = olo; o <= ohi; ++o) {
+        const auto [blo, bhi] = faces(d, b[d] + o);
         const double g = std::max(std::max(0.0, blo - x[d] - slack_), x[d] - bhi - slack_);
         const bool out = range != nullptr && (b[d] + o < range[0][d] || b[d] + o > range[1][d]);
         gaps[static_cast<std::size_t>(d) * w + static_cast<std::size_t>(o + s)] =
@@ -482,17 +488,25 @@ class BinLocator {
       if (b[0] - s >= 0) f(c, b[0] - s, b[0] - s);
       if (b[0] + s < divs_[0]) f(c, b[0] + s, b[0] + s);
     };
+    // The offsets along z and y run over the grid only: a shell far wider
+    // than a thin axis of the grid (a column of bins, one wide across) then
+    // costs its bins, not s^2 empty rows. A plane of points and one far
+    // above it made every cell's security radius reach ~185 shells up
+    // such a column, and the rows outside the grid were the whole run:
+    // 742 points took 13 s.
     const int outer = D - 1;
-    for (int oo = -s; oo <= s; ++oo) {
+    const int oo_lo = std::max(-s, -b[outer]), oo_hi = std::min(s, divs_[outer] - 1 - b[outer]);
+    for (int oo = oo_lo; oo <= oo_hi; ++oo) {
       c[outer] = b[outer] + oo;
-      if (c[outer] < 0 || c[outer] >= divs_[outer] || !near_outer(oo)) continue;
+      if (!near_outer(oo)) continue;
       const bool outer_face = oo == -s || oo == s;
       if constexpr (D == 2) {
         walk_x(outer_face);
       } else {
-        for (int oy = -s; oy <= s; ++oy) {
+        const int oy_lo = std::max(-s, -b[1]), oy_hi = std::min(s, divs_[1] - 1 - b[1]);
+        for (int oy = oy_lo; oy <= oy_hi; ++oy) {
           c[1] = b[1] + oy;
-          if (c[1] < 0 || c[1] >= divs_[1] || !near_row(oy, oo)) continue;
+          if (!near_row(oy, oo)) continue;
           walk_x(outer_face || oy == -s || oy == s);
         }
       }
