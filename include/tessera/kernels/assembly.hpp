@@ -74,17 +74,18 @@ inline constexpr double far_margin = 1e-3;
 /// 1e-12 from the horizon) to the clips; 1e-14 since stop 61.
 inline constexpr double far_margin_least = 1e-14;
 inline constexpr double facet_tilt = 1.6e-15;
-/// Facets thinner than this are not closed: a tilt bound past 0.16 rad
-/// leaves no margin a direction could keep. (Since stop 61 a ray's error
-/// along the far plane's normal, ray_axis_errors, can be far below its
-/// tilt bound, so thinner facets might close; with this test removed, an
-/// apex 1e12 radii above a circle, whose facets are ~1e-15 thin, still went
-/// to the clips at a later step, not looked into, and the test stays.) Stop 59 refused facets below
-/// 1e-8 outright; the apexes over 8,000 points at random angles on a
-/// circle, some facets 1e-8 thin, went to the clips (2.6 s instead of 0.1),
-/// and over 80,000 (pairs 2.5e-10 rad apart, at 50 radii up 5e-12 thin) the
-/// run took minutes.
-inline constexpr double thin_facet = 1e-14;
+// No facet is too thin to close (stop 62; from stop 59 to 61 those below
+// `thin_facet`, last 1e-14, were refused). A thin facet's ray is uncertain
+// sideways by ~facet_tilt / thinness, past a right angle below ~1e-15, but
+// far_direction never relies on more than it knows: a ray's isotropic
+// margin is then above 1, which no direction meets, and its bound along
+// the normal (ray_axis_errors) bounds the cross product's own component
+// errors, divided by the computed length on both sides of the test, so
+// it holds at any thinness. Only a zero cross product (the facet's two
+// neighbours in line with the point, in floats) has no direction. The
+// test had left a point 1e12 below a plane of 2,000 points (facets
+// ~7e-15 thin) and an apex 1e12 radii above 2,000 circle points (~1e-18)
+// to the clips: 9 s and 4 s, quadratic; 0.07-0.09 s now.
 
 /// A vertex on the far plane is never output: only the box's cut reads it,
 /// and it lies outside the box by half the box's extent along the far
@@ -199,6 +200,20 @@ bool far_direction(const double* dirs, std::size_t k, double* n, const double* h
     for (int a = 0; a < D; ++a) n[a] = 0;
     for (std::size_t r = 0; r < k; ++r)
       for (int a = 0; a < D; ++a) n[a] += dirs[D * r + static_cast<std::size_t>(a)];
+    if constexpr (D == 2) {
+      // A 2D hull point has two rays, and their sum is their bisector. Where
+      // they are nearly opposite the sum cancels: a point 1e12 below the end
+      // of a row has rays (-1, 0) and (1, -3e-9), whose x parts sum to 0 in
+      // floats, and the perceptron's steps cannot find a direction within
+      // 1.5e-9 of the right angle to both (its cell was clipped by all its
+      // neighbours, quadratically). For unit rays the bisector is at right
+      // angles to their difference, which does not cancel there.
+      if (k == 2 && dirs[0] * dirs[2] + dirs[1] * dirs[3] < 0) {
+        n[0] = dirs[3] - dirs[1];
+        n[1] = dirs[0] - dirs[2];
+        if (n[0] * dirs[0] + n[1] * dirs[1] < 0) n[0] = -n[0], n[1] = -n[1];
+      }
+    }
     if (steps_from()) return true;
     if (hint == nullptr) return false;
     for (int a = 0; a < D; ++a) n[a] = hint[a];
@@ -300,13 +315,21 @@ bool drop_far_plane(std::vector<Plane>& planes, const Vertices& verts) {
 /// vertex gets a NaN bound and its cell is clipped, which never makes it.
 /// Points on a circle need the ones inside (their cells' shared corner at
 /// the centre: clipping those cells cost them 7%). Either way the cell is
-/// exact.
+/// exact. y is widened by `err`, its first-order bound (0 where that is not
+/// finite): a
+/// vertex whose planes are so nearly dependent that the float solve says
+/// nothing of where it lies (cond u near 1 or more) may well lie inside.
+/// An apex 1e10 radii above 2,000 points on a circle, all on one sphere:
+/// its star's vertices lie on the axis, inside the box, but their float
+/// estimates lay anywhere, most far out; refused, they were more than its
+/// exact solves paid for, and the star was clipped (3.9 s, 2M exact
+/// evaluations).
 template <int D, class Plane>
-bool worth_exact_solve(const double* y, const Plane* box) {
+bool worth_exact_solve(const double* y, double err, const Plane* box) {
   bool in = true;
   for (int a = 0; a < D; ++a) {
     const double lo = box[2 * a].d, hi = box[2 * a + 1].d, grow = 0.25 * (lo + hi);
-    in &= y[a] >= -lo - grow && y[a] <= hi + grow;  // false on NaN
+    in &= y[a] + err >= -lo - grow && y[a] - err <= hi + grow;  // false on NaN
   }
   return in;
 }
@@ -337,7 +360,8 @@ inline std::size_t exact_solves_paid(std::size_t m, std::size_t nt) { return m *
 
 /// What becomes of a vertex too ill-conditioned for its float bound
 /// (Hull/Tile::ill_conditioned; its D local planes `p`, its float estimate
-/// y, its condition `cond`, whether its first-order bound is finite):
+/// y, its condition `cond`, its first-order bound `err`, which may be
+/// infinite or NaN):
 ///   refuse: a NaN bound. On a hull point's far plane beyond the deferred
 ///     bound (the box test then gives the cell up); or, in the assembly
 ///     (float_only), one far out beyond it: the assembly solves as many of
@@ -366,15 +390,16 @@ inline std::size_t exact_solves_paid(std::size_t m, std::size_t nt) { return m *
 ///     points 0.85 → 16 s).
 enum class IllConditioned { solve, defer, refuse, keep };
 template <int D, class Plane, class Index>
-IllConditioned ill_conditioned_fate(filter::SolveMode mode, double cond, bool bounded, const double* y,
+IllConditioned ill_conditioned_fate(filter::SolveMode mode, double cond, double err, const double* y,
                                     const Plane* planes, const Index* p) {
+  const bool bounded = std::isfinite(err);
   for (int k = 0; k < D; ++k)
     if (planes[p[k]].id == far_plane_id)
       return cond < far_vertex_condition && bounded ? IllConditioned::keep : IllConditioned::solve;
   const bool deferrable = cond < filter::deferred_vertex_condition && bounded;
   if (mode == filter::SolveMode::exact_now) return IllConditioned::solve;
   if (mode == filter::SolveMode::deferrable) return deferrable ? IllConditioned::defer : IllConditioned::solve;
-  if (worth_exact_solve<D>(y, planes)) return IllConditioned::solve;
+  if (worth_exact_solve<D>(y, bounded ? err : 0.0, planes)) return IllConditioned::solve;
   return deferrable ? IllConditioned::defer : IllConditioned::refuse;
 }
 
@@ -387,7 +412,7 @@ IllConditioned ill_conditioned_fate(filter::SolveMode mode, double cond, bool bo
 template <int D, class Plane, class Vertex, class Defer, class Solve>
 std::pair<double, double> settle_ill_conditioned(filter::SolveMode mode, double cond, double err, double ymax,
                                                  const Vertex& v, const Plane* planes, Defer&& defer, Solve&& solve) {
-  switch (ill_conditioned_fate<D>(mode, cond, std::isfinite(err), v.y, planes, v.p)) {
+  switch (ill_conditioned_fate<D>(mode, cond, err, v.y, planes, v.p)) {
     case IllConditioned::refuse:
       return {std::numeric_limits<double>::quiet_NaN(), ymax};
     case IllConditioned::defer:

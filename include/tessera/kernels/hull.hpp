@@ -429,11 +429,11 @@ class Hull {
       double* d = dirs_.data() + 3 * k;
       cross(qb, qa, d);
       const double len = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-      // A facet so thin that no far plane could keep its normal's margin:
-      // not closed here (assembly::thin_facet).
+      // Any thinness will do (assembly::facet_tilt), but not none: q_a and
+      // q_b parallel in floats give no direction.
       const double na = std::sqrt(qa[0] * qa[0] + qa[1] * qa[1] + qa[2] * qa[2]);
       const double nbl = std::sqrt(qb[0] * qb[0] + qb[1] * qb[1] + qb[2] * qb[2]);
-      if (!(len > assembly::thin_facet * na * nbl)) return false;
+      if (!(len > 0)) return false;
       for (int a = 0; a < 3; ++a) d[a] /= len;
       const double scale = 6 * assembly::facet_tilt / len;
       margins_[k] = scale * (na * nbl);
