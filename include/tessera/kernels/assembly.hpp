@@ -316,14 +316,13 @@ bool drop_far_plane(std::vector<Plane>& planes, const Vertices& verts) {
 /// Points on a circle need the ones inside (their cells' shared corner at
 /// the centre: clipping those cells cost them 7%). Either way the cell is
 /// exact. y is widened by `err`, its first-order bound (0 where that is not
-/// finite): a
-/// vertex whose planes are so nearly dependent that the float solve says
-/// nothing of where it lies (cond u near 1 or more) may well lie inside.
-/// An apex 1e10 radii above 2,000 points on a circle, all on one sphere:
-/// its star's vertices lie on the axis, inside the box, but their float
-/// estimates lay anywhere, most far out; refused, they were more than its
-/// exact solves paid for, and the star was clipped (3.9 s, 2M exact
-/// evaluations).
+/// finite): a vertex whose planes are so nearly dependent that the float
+/// solve says nothing of where it lies (cond u near 1 or more) may well lie
+/// inside (stop 62). An apex 1e10 radii above 2,000 points on a circle, all
+/// on one sphere: its star's vertices lie on the axis, inside the box, but
+/// their float estimates lay anywhere, most far out; refused, they were
+/// more than its exact solves paid for, and the star was clipped (3.9 s,
+/// 2M exact evaluations).
 template <int D, class Plane>
 bool worth_exact_solve(const double* y, double err, const Plane* box) {
   bool in = true;
