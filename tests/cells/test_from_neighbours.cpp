@@ -529,6 +529,16 @@ TEST(FromNeighbours, CellsAreAssembledFromTheirStars) {
     const tessera::Cells a = run_method(cone, 3, tessera::CellMethod::insertion);
     EXPECT_EQ(a.assembled_from_stars, 1001u);
     EXPECT_TRUE(tessera::validate(a, {}).ok);
+    // At 1e14 radii the rays lie 1e-14 from the horizon, at
+    // far_margin_least, which far_direction no longer asks of 3D rays (their
+    // floor is the dot's rounding); and the far vertices, solved exactly,
+    // lie ~1e28 out, their bound (of the largest coordinate) too wide to
+    // place the others against the box's side planes, which now read each
+    // coordinate's own rounding (assembly::exactly_solved).
+    cone.back() = 1e14;
+    const tessera::Cells f = run_method(cone, 3, tessera::CellMethod::insertion);
+    EXPECT_EQ(f.assembled_from_stars, 1001u);
+    EXPECT_TRUE(tessera::validate(f, {}).ok);
   }
   // A thin cylindrical band: the far vertices, ill-conditioned beyond the
   // float bound but not beyond the deferred one, are cut by the box with

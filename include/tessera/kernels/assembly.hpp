@@ -156,12 +156,26 @@ bool far_direction(const double* dirs, std::size_t k, double* n, const double* h
       double margin_len = far_margin * len;  // the ray's margin, times |m|
       if (ray_margins != nullptr) {
         double own = ray_margins[r] * len;
+        double least_len = far_margin_least * len;
         if (ray_axis_errors != nullptr) {  // the bound along m itself, where smaller
-          double along = 0;
-          for (int a = 0; a < D; ++a) along += mabs[a] * ray_axis_errors[D * r + static_cast<std::size_t>(a)];
+          double along = 0, terms = 0;
+          for (int a = 0; a < D; ++a) {
+            along += mabs[a] * ray_axis_errors[D * r + static_cast<std::size_t>(a)];
+            terms += mabs[a] * std::fabs(dirs[D * r + static_cast<std::size_t>(a)]);
+          }
           own = std::min(own, along);
+          // The floor need only cover the dot's rounding and the ray's
+          // normalisation (each under 4u of its terms' sum; the ray's own
+          // error is in `own`), and products lost to underflow, but it must
+          // stay positive: where own and the terms are all zero (q_a and q_b
+          // with a common zero component, and m orthogonal to the ray in
+          // floats: a rotated lattice's hull edge), a zero dot would pass,
+          // and the far vertex's planes are then dependent. An apex 1e14
+          // radii above a circle has rays 1e-14 from the horizon, and
+          // far_margin_least alone left it to the clips.
+          least_len = 8 * filter::u * terms + 0x1p-1000 * len;
         }
-        margin_len = std::max((relaxed ? far_margin_least : far_margin) * len, own);
+        margin_len = std::max(relaxed ? least_len : far_margin * len, own);
       }
       const double short_by = dot - margin_len;
       if (!(short_by >= least)) {
@@ -262,6 +276,22 @@ bool far_plane(const double* dirs, std::size_t k, const Plane* box, const Vertex
   return far_direction<D>(dirs, k, n, nullptr, ray_margins) && far_offset<D>(n, box, verts, nv, out);
 }
 
+/// Whether v was solved exactly and rounded (exact_vertex: each coordinate
+/// within 2 ulp; Hull/Tile::solve_now and settle_ill_conditioned set its
+/// bound to 4u |y|_inf + plane_eps |y|_inf). A float solve's bound is at
+/// least vertex_eps |y|_inf (64u), so the two never meet. (The box's corners,
+/// each coordinate rounded once, pass too, rightly.) Such a vertex's error
+/// along one axis is its own coordinate's rounding, which can be far below
+/// its bound: a far vertex of an apex 1e14 radii above a circle lies 1e28 out
+/// along y with x = -1.1e12, 2.2e12 inside the box's plane x = x1, where the
+/// bound is 2.2e13, and the star went to the clips (box_signs).
+template <class Vertex>
+bool exactly_solved(const Vertex& v) {
+  double ymax = 0;
+  for (const double c : v.y) ymax = std::max(ymax, std::fabs(c));
+  return v.e <= (4 * filter::u + filter::plane_eps) * ymax;  // false on NaN
+}
+
 /// The vertices of [0, nv) that box plane k (offset h, as box_signs)
 /// cannot place by their float bounds, and whose exact solve would narrow
 /// the bound (not one solved exactly already): each passed to solve(t).
@@ -283,9 +313,7 @@ bool solve_near_box_plane(const Vertex* verts, std::size_t nv, int k, double h, 
     const Vertex& v = verts[t];
     const double P = h - s * v.y[axis], e = v.e + de;
     if (P > e || P < -e) continue;
-    double ymax = 0;
-    for (int c = 0; c < D; ++c) ymax = std::max(ymax, std::fabs(v.y[c]));
-    if (!(v.e > (4 * filter::u + filter::plane_eps) * ymax)) continue;  // exact already (or NaN)
+    if (!(v.e == v.e) || exactly_solved(v)) continue;  // NaN, or exact already
     solve(t);
     solved = true;
   }
@@ -457,7 +485,13 @@ std::size_t box_signs(const Vertex* verts, std::size_t nv, int k, double h, std:
     int side = P > e ? 1 : P < -e ? -1 : 0;
     if (side == 0) {
       if (!(P == P && e == e)) return undecided;  // NaN: refused its exact solve
-      side = decide(t);
+      if (exactly_solved(verts[t])) {
+        // Each coordinate is rounded on its own (within 2 ulp): its own
+        // error bounds this plane's test, not the largest coordinate's.
+        const double ea = 8 * filter::u * std::fabs(verts[t].y[axis]) + de;
+        side = P > ea ? 1 : P < -ea ? -1 : 0;
+      }
+      if (side == 0) side = decide(t);
       if (side == 0) return undecided;
     }
     sign[t] = side > 0 ? filter::Sign{1} : filter::Sign{-1};
