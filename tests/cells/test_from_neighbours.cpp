@@ -322,6 +322,11 @@ TEST(FromNeighbours, SameCellsAsTheSearch2D) {
   // bisector of nearly opposite rays), and the point was clipped.
   same2(row_and_far_point(-1e12, 0.0), "a row of points and one 1e12 below its end");
   EXPECT_EQ(run_method(row_and_far_point(-1e12, 0.0), 2, tessera::CellMethod::insertion).assembled_from_stars, 1001u);
+  // 1e15 above: its rays lie 1e-15 from the horizon, below the fixed floor
+  // (far_margin_least, 1e-14) that far_direction asked until stop 62; the
+  // floor is now the dot's own rounding.
+  same2(row_and_far_point(1e15), "a row of points and one 1e15 above it");
+  EXPECT_EQ(run_method(row_and_far_point(1e15), 2, tessera::CellMethod::insertion).assembled_from_stars, 1001u);
 }
 
 // Cells from insertion are assembled from their Delaunay stars: closed

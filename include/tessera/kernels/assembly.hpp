@@ -62,17 +62,18 @@ inline constexpr double far_margin = 1e-3;
 /// the larger of far_margin and its own margin; where no direction gives
 /// that (a hull point whose rays span nearly a half space: one 1,000 radii
 /// above a ring of points, whose rays lie within 1e-3 of the horizon; in 2D
-/// one far above a row), it asks again with far_margin_least in place of
+/// one far above a row), it asks again with that floor (below) in place of
 /// far_margin. So every ray the far plane is chosen to cross, it crosses.
 /// A ray met nearly edge on puts its far vertex far out, ill-conditioned
 /// (far_vertex_condition).
 /// (A 3D ray's error along a given direction can be much smaller than its
-/// tilt bound: far_direction's ray_axis_errors.) far_margin_least is the
-/// floor under every margin: it covers the dot product n.dir's own rounding
-/// (~3u per term, under 7e-16 |n|) and a 2D ray's (~3u) some fifteen times.
-/// Stop 60 set it at 1e-12, which left a point 1e12 above a row (its rays
-/// 1e-12 from the horizon) to the clips; 1e-14 since stop 61.
-inline constexpr double far_margin_least = 1e-14;
+/// tilt bound: far_direction's ray_axis_errors.) The floor under every
+/// margin in that second round covers only the dot product's rounding and
+/// the ray's normalisation (and a 2D ray's own error): 16u times the sum of
+/// |n_a dir_a|. Stop 60 set a fixed floor, far_margin_least, at 1e-12,
+/// which left a point 1e12 above a row (its rays 1e-12 from the horizon) to
+/// the clips; stop 61 1e-14, which left apexes 1e14 above circles and
+/// points 1e15 off rows; stop 62 the computed floor.
 inline constexpr double facet_tilt = 1.6e-15;
 // No facet is too thin to close (stop 62; from stop 59 to 61 those below
 // `thin_facet`, last 1e-14, were refused). A thin facet's ray is uncertain
@@ -115,7 +116,7 @@ inline constexpr double far_vertex_condition = 1e13;
 /// known from the star; the box then cuts P away whole, as it lies outside.
 ///
 /// `dirs`: the k rays' unit directions (D each, from the rounded
-/// differences q), and `ray_margins` their own margins (far_margin_least;
+/// differences q), and `ray_margins` their own margins (the floor;
 /// null: far_margin alone). `ray_axis_errors` (optional, D per ray): bounds
 /// e on the error of each of a ray's components, so that a ray's error along
 /// a unit n is at most sum_a |n_a| e_a; where that is below its own margin
@@ -138,7 +139,7 @@ inline constexpr double far_vertex_condition = 1e13;
 template <int D>
 bool far_direction(const double* dirs, std::size_t k, double* n, const double* hint = nullptr,
                    const double* ray_margins = nullptr, const double* ray_axis_errors = nullptr) {
-  bool relaxed = false;  // the second round: far_margin_least in place of far_margin
+  bool relaxed = false;  // the second round: the rounding floor in place of far_margin
   // The ray m falls shortest of its margin on (k: none; k + 1: NaN, or m = 0).
   auto worst_ray = [&](const double* m) {
     double len2 = 0, mabs[D];
@@ -155,26 +156,22 @@ bool far_direction(const double* dirs, std::size_t k, double* n, const double* h
       for (int a = 0; a < D; ++a) dot += m[a] * dirs[D * r + static_cast<std::size_t>(a)];
       double margin_len = far_margin * len;  // the ray's margin, times |m|
       if (ray_margins != nullptr) {
-        double own = ray_margins[r] * len;
-        double least_len = far_margin_least * len;
+        double own = ray_margins[r] * len, terms = 0;
+        for (int a = 0; a < D; ++a) terms += mabs[a] * std::fabs(dirs[D * r + static_cast<std::size_t>(a)]);
         if (ray_axis_errors != nullptr) {  // the bound along m itself, where smaller
-          double along = 0, terms = 0;
-          for (int a = 0; a < D; ++a) {
-            along += mabs[a] * ray_axis_errors[D * r + static_cast<std::size_t>(a)];
-            terms += mabs[a] * std::fabs(dirs[D * r + static_cast<std::size_t>(a)]);
-          }
+          double along = 0;
+          for (int a = 0; a < D; ++a) along += mabs[a] * ray_axis_errors[D * r + static_cast<std::size_t>(a)];
           own = std::min(own, along);
-          // The floor need only cover the dot's rounding and the ray's
-          // normalisation (each under 4u of its terms' sum; the ray's own
-          // error is in `own`), and products lost to underflow, but it must
-          // stay positive: where own and the terms are all zero (q_a and q_b
-          // with a common zero component, and m orthogonal to the ray in
-          // floats: a rotated lattice's hull edge), a zero dot would pass,
-          // and the far vertex's planes are then dependent. An apex 1e14
-          // radii above a circle has rays 1e-14 from the horizon, and
-          // far_margin_least alone left it to the clips.
-          least_len = 8 * filter::u * terms + 0x1p-1000 * len;
         }
+        // The floor (far_margin_least's place, stop 62): the dot's rounding
+        // and the ray's normalisation, each under 4u of the sum of
+        // |m_a dir_a|, and in 2D the ray's own error (q's rounding and the
+        // normalisation, each component within 3u of itself); and products
+        // lost to underflow. It must stay positive: where own and the terms
+        // are all zero (q_a and q_b with a common zero component, and m
+        // orthogonal to the ray in floats: a rotated lattice's hull edge), a
+        // zero dot would pass, and the far vertex's planes are dependent.
+        const double least_len = 16 * filter::u * terms + 0x1p-1000 * len;
         margin_len = std::max(relaxed ? least_len : far_margin * len, own);
       }
       const double short_by = dot - margin_len;
@@ -234,7 +231,7 @@ bool far_direction(const double* dirs, std::size_t k, double* n, const double* h
     return steps_from();
   };
   if (from_sum_or_hint()) return true;
-  // Then with far_margin_least in far_margin's place.
+  // Then with the rounding floor in far_margin's place.
   if (ray_margins == nullptr) return false;
   relaxed = true;
   return from_sum_or_hint();

@@ -206,7 +206,7 @@ class Tile {
       const double dirs[4] = {qs[1] / ls, -qs[0] / ls, -qe[1] / le, qe[0] / le};
       const Index far = static_cast<Index>(planes_.size());
       Plane& pf = planes_.emplace_back();
-      const double margins[2] = {0, 0};  // tilts ~2u: far_margin, then far_margin_least
+      const double margins[2] = {0, 0};  // tilts ~3u: far_margin, then far_direction's floor
       if (!assembly::far_plane<2>(dirs, 2, planes_.data(), verts_.data(), nt, pf, margins)) return false;
       Vertex& ve = verts_[nt];  // leaving along e's ray, arriving on the far line
       Vertex& vs = verts_[nt + 1];
