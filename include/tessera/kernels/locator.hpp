@@ -490,10 +490,10 @@ class BinLocator {
     };
     // The offsets along z and y run over the grid only: a shell far wider
     // than a thin axis of the grid (a column of bins, one wide across) then
-    // costs its bins, not s^2 empty rows. A plane of points and one far
-    // above it made every cell's security radius reach ~185 shells up
-    // such a column, and the rows outside the grid were the whole run:
-    // 742 points took 13 s.
+    // costs its bins, not s^2 empty rows. A plane of 741 points and one 1e6
+    // above it: every cell's security radius reaches ~185 shells up such a
+    // column; the search took 13 s, 0.75 s with this clipping alone, and
+    // 0.32 s with shell_lower_bound's per-axis bound too.
     const int outer = D - 1;
     const int oo_lo = std::max(-s, -b[outer]), oo_hi = std::min(s, divs_[outer] - 1 - b[outer]);
     for (int oo = oo_lo; oo <= oo_hi; ++oo) {
