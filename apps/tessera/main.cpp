@@ -16,6 +16,7 @@
 
 #include "commands.hpp"
 #include "option_checks.hpp"
+#include "progress.hpp"
 #include "tessera/cells.hpp"
 
 namespace {
@@ -33,7 +34,8 @@ void print_error(const std::string& msg) {
 
 constexpr const char* kExitCodes =
     "Exit status: 0 success; 1 failure (an internal error, or a failed --validate where the command has one);\n"
-    "2 bad command line or bad input; 130 interrupted (Ctrl-C).\n"
+    "2 bad command line or bad input; 130 interrupted (Ctrl-C). Killed by SIGTERM, SIGHUP or a second\n"
+    "Ctrl-C, it removes the outputs it was writing and ends by that signal.\n"
     "Environment: TESSERA_NUM_THREADS sets the thread count when --threads is not given.";
 
 /// Options shared by the commands that compute cells (`voronoi`, `bench voronoi`, `graph`, ...).
@@ -118,6 +120,7 @@ void finish_compute_args(ComputeArgs& c, const std::vector<std::string>& raw_bou
 }  // namespace
 
 int main(int argc, char** argv) {
+  install_fatal_signal_cleanup();
   CLI::App app{"tessera: Voronoi tessellations of 2D/3D point clouds, clipped to a box, with exact topology.",
                "tessera"};
   app.require_subcommand(1);

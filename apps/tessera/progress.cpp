@@ -5,6 +5,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
+
+#include "tessera/io/atomic_file.hpp"
 
 namespace tessera::cli {
 
@@ -56,16 +59,56 @@ void ProgressBar::finish() {
 }
 
 namespace {
+
+/// Only async-signal-safe calls below: unlink (inside
+/// remove_pending_temporaries), write, sigaction, raise.
+void write_stderr(const char* text) {
+  const ssize_t ignored = ::write(STDERR_FILENO, text, std::strlen(text));
+  (void)ignored;  // nothing to do about a failed error message
+}
+
+void on_fatal_signal(int sig) {
+  const int removed = io::remove_pending_temporaries();
+  write_stderr(sig == SIGINT    ? "tessera: error: interrupted"
+               : sig == SIGTERM ? "tessera: error: terminated (SIGTERM)"
+                                : "tessera: error: hung up (SIGHUP)");
+  write_stderr(removed > 0 ? "; unfinished output removed\n" : "\n");
+  // SA_RESETHAND has restored the default action: re-raise so the parent sees
+  // the process end by this signal, as it would have without the handler.
+  ::raise(sig);
+}
+
 volatile std::sig_atomic_t g_interrupted = 0;
-void on_sigint(int) { g_interrupted = 1; }
+struct sigaction g_before_guard {};  // the handler an InterruptGuard replaced
+
+void on_sigint(int) {
+  g_interrupted = 1;
+  ::sigaction(SIGINT, &g_before_guard, nullptr);  // the next Ctrl-C ends the run
+}
+
 }  // namespace
+
+void install_fatal_signal_cleanup() {
+  struct sigaction sa {};
+  sa.sa_handler = on_fatal_signal;
+  sigemptyset(&sa.sa_mask);
+  sa.sa_flags = SA_RESETHAND;
+  for (const int sig : {SIGINT, SIGTERM, SIGHUP}) {
+    struct sigaction old {};
+    // A signal ignored by whoever started us (nohup, a shell's background job)
+    // stays ignored.
+    if (::sigaction(sig, nullptr, &old) == 0 && old.sa_handler == SIG_IGN) continue;
+    ::sigaction(sig, &sa, nullptr);
+  }
+}
 
 InterruptGuard::InterruptGuard() {
   g_interrupted = 0;
   struct sigaction sa {};
   sa.sa_handler = on_sigint;
   sigemptyset(&sa.sa_mask);
-  sa.sa_flags = SA_RESETHAND;  // the next Ctrl-C gets the default action (terminate)
+  // g_before_guard is set before on_sigint can run, so it never reads it half-written.
+  if (::sigaction(SIGINT, nullptr, &g_before_guard) != 0) return;
   installed_ = ::sigaction(SIGINT, &sa, &previous_) == 0;
 }
 

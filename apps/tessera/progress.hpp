@@ -41,8 +41,16 @@ class ProgressBar {
 
 /// While alive, the first SIGINT (Ctrl-C) only sets a flag, which the progress
 /// callback turns into tessera::Cancelled so the run stops between batches and
-/// no output is written; a second SIGINT kills the process as usual
-/// (SA_RESETHAND). The previous handler is restored on destruction.
+/// no output is written; a second SIGINT goes to the handler that was there
+/// before (normally the one of install_fatal_signal_cleanup, which ends the
+/// process). The previous handler is restored on destruction.
+/// Install, for the whole run, handlers of SIGINT, SIGTERM and SIGHUP that
+/// remove the temporaries of the outputs being written
+/// (io::remove_pending_temporaries), print one error line and end the process
+/// by the same signal (exit status 128 + signal to a shell). Without them a run
+/// killed while writing, e.g. by `timeout`, left its `OUTPUT.tmp-XXXXXX` behind.
+void install_fatal_signal_cleanup();
+
 class InterruptGuard {
  public:
   InterruptGuard();

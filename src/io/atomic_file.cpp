@@ -82,9 +82,66 @@ class FdBuf : public std::streambuf {
   int err_ = 0;
 };
 
+/// The temporaries of the writes in progress, kept where a signal handler may
+/// read them: fixed slots of plain characters, no allocation and no locks (an
+/// async-signal-safe reader can take neither). A writer claims a free slot,
+/// copies its temporary's name in and arms it; the handler claims an armed slot
+/// before reading it, so a writer never reuses a name that is being read.
+class PendingTemporaries {
+ public:
+  static constexpr int kSlots = 64;
+
+  /// Arm a slot with `name`; returns its index, or -1 when none is free or the
+  /// name does not fit (the write then goes untracked; nothing else changes).
+  int arm(const std::string& name) noexcept {
+    if (name.size() >= sizeof(Slot::name)) return -1;
+    for (int i = 0; i < kSlots; ++i) {
+      int expected = kFree;
+      if (!slots_[i].state.compare_exchange_strong(expected, kFilling, std::memory_order_acquire)) continue;
+      std::memcpy(slots_[i].name, name.c_str(), name.size() + 1);
+      slots_[i].state.store(kArmed, std::memory_order_release);
+      return i;
+    }
+    return -1;
+  }
+
+  /// Give the slot back once its temporary is renamed or removed. A slot that
+  /// a handler is removing stays taken: the process is about to die.
+  void disarm(int i) noexcept {
+    if (i < 0) return;
+    int expected = kArmed;
+    slots_[i].state.compare_exchange_strong(expected, kFree, std::memory_order_release);
+  }
+
+  int remove_all() noexcept {
+    int removed = 0;
+    for (Slot& slot : slots_) {
+      int expected = kArmed;
+      if (slot.state.compare_exchange_strong(expected, kRemoving, std::memory_order_acquire))
+        removed += ::unlink(slot.name) == 0;
+    }
+    return removed;
+  }
+
+ private:
+  enum : int { kFree, kFilling, kArmed, kRemoving };
+  struct Slot {
+    std::atomic<int> state{kFree};
+    char name[4096]{};  // PATH_MAX on Linux
+  };
+  static_assert(std::atomic<int>::is_always_lock_free, "a signal handler may only use lock-free atomics");
+  Slot slots_[kSlots];
+};
+
+// constinit: no guard variable, which a signal handler could not take.
+constinit PendingTemporaries g_pending;
+PendingTemporaries& pending() { return g_pending; }
+
 /// Create `path.tmp-XXXXXX` exclusively (mode 0666 less the umask, like a
-/// plain new file). Returns its fd and sets `tmp`; throws on failure.
-int create_temp(const std::string& path, std::string& tmp) {
+/// plain new file). Returns its fd, sets `tmp` and arms `slot` with it; throws
+/// on failure. The name is armed before the file exists, so no moment of the
+/// file's life is hidden from remove_pending_temporaries().
+int create_temp(const std::string& path, std::string& tmp, int& slot) {
   static std::atomic<unsigned> counter{0};
   static const char kAlnum[] = "abcdefghijklmnopqrstuvwxyz0123456789";
   std::random_device rd;
@@ -92,9 +149,13 @@ int create_temp(const std::string& path, std::string& tmp) {
   for (int attempt = 0; attempt < 100; ++attempt) {
     tmp = path + ".tmp-";
     for (int k = 0; k < 6; ++k) tmp += kAlnum[gen() % (sizeof kAlnum - 1)];
+    slot = pending().arm(tmp);
     const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
     if (fd >= 0) return fd;
-    if (errno != EEXIST) cannot_write(path, std::strerror(errno));
+    const int err = errno;
+    pending().disarm(slot);
+    slot = -1;
+    if (err != EEXIST) cannot_write(path, std::strerror(err));
   }
   cannot_write(path, "could not create a unique temporary file");
 }
@@ -107,11 +168,14 @@ void write_file_atomic(const std::string& path, const std::function<void(std::os
   if (fs::is_directory(path, ec)) cannot_write(path, "is a directory");
 
   std::string tmp;
-  const int fd = create_temp(path, tmp);
-  // From here on every exit path must close fd and remove tmp unless renamed.
+  int slot = -1;
+  const int fd = create_temp(path, tmp, slot);
+  // From here on every exit path must close fd and remove tmp unless renamed,
+  // and disarm the slot after the file is gone (renamed or unlinked).
   auto discard = [&](int open_fd) {
     if (open_fd >= 0) ::close(open_fd);
     ::unlink(tmp.c_str());
+    pending().disarm(slot);
   };
   int write_error = 0;
   bool stream_bad = false;
@@ -146,6 +210,7 @@ void write_file_atomic(const std::string& path, const std::function<void(std::os
     discard(-1);
     cannot_write(path, ec.message());
   }
+  pending().disarm(slot);
 }
 
 void write_file_atomic(const std::string& path, std::string_view bytes) {
@@ -153,6 +218,8 @@ void write_file_atomic(const std::string& path, std::string_view bytes) {
     os.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
   });
 }
+
+int remove_pending_temporaries() noexcept { return pending().remove_all(); }
 
 void check_writable(const std::string& path) {
   if (path.empty()) throw InputError("cannot write an empty path");

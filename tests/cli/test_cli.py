@@ -554,6 +554,35 @@ class Interrupt(TempDirCase):
         self.assertIn(b"tessera: error: interrupted", text)
         self.assertEqual(sorted(os.listdir(self.dir)), ["p.npy"])
 
+    def kill_while_writing(self, sig, message):
+        """Signal `sig` once the output's temporary exists: the run ends by that
+        signal, prints one error line, and leaves neither the output nor its
+        temporary (a killed run used to leave OUTPUT.tmp-XXXXXX behind)."""
+        import time
+        inp = self.save("p.npy", np.random.default_rng(5).random((200000, 3)))
+        out = self.p("c.vtu")
+        proc = subprocess.Popen([TESSERA, "voronoi", inp, "-o", out, "-q"], stderr=subprocess.PIPE)
+        deadline = time.monotonic() + 120
+        while proc.poll() is None and time.monotonic() < deadline:
+            if any(".tmp-" in name for name in os.listdir(self.dir)):
+                proc.send_signal(sig)
+                break
+            time.sleep(0.001)
+        err = proc.communicate(timeout=120)[1]
+        if proc.returncode == 0:
+            self.skipTest("the write finished before the signal")
+        self.assertEqual(proc.returncode, -sig, err)
+        self.assertEqual(err.decode().strip().splitlines(), ["tessera: error: " + message + "; unfinished output removed"])
+        self.assertEqual(sorted(os.listdir(self.dir)), ["p.npy"])
+
+    def test_sigterm_while_writing_removes_the_temporary(self):
+        import signal
+        self.kill_while_writing(signal.SIGTERM, "terminated (SIGTERM)")
+
+    def test_ctrl_c_while_writing_removes_the_temporary(self):
+        import signal
+        self.kill_while_writing(signal.SIGINT, "interrupted")
+
 
 class Bench(TempDirCase):
     KEYS = {"tool", "op", "n", "threads", "seconds", "simplices", "extra"}

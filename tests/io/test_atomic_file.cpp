@@ -1,6 +1,9 @@
 // Atomic writes: success, overwrite, and failures that leave nothing behind.
 #include <gtest/gtest.h>
+#include <sys/wait.h>
 #include <unistd.h>
+
+#include <csignal>
 
 #include <stdexcept>
 #include <string>
@@ -10,6 +13,7 @@
 
 using namespace tessera_test;
 using tessera::io::check_writable;
+using tessera::io::remove_pending_temporaries;
 using tessera::io::write_file_atomic;
 
 TEST(AtomicFile, WritesAndOverwrites) {
@@ -98,4 +102,41 @@ TEST(AtomicFile, CheckWritable) {
     fs::permissions(dir.path() / "ro", fs::perms::owner_all);
     EXPECT_TRUE(fs::is_empty(dir.path() / "ro"));
   }
+}
+
+// A process killed while writing: its signal handler calls
+// remove_pending_temporaries(), which must find the temporary of the write in
+// progress (armed before the file was created) and unlink it. The child raises
+// SIGTERM from inside `fill`, after 1 MB has reached the temporary.
+namespace {
+extern "C" void remove_and_exit(int) {
+  _exit(remove_pending_temporaries() == 1 ? 3 : 4);
+}
+}  // namespace
+
+TEST(AtomicFile, SignalHandlerRemovesTheTemporary) {
+  TempDir dir;
+  const std::string done = dir.file("done.txt"), killed = dir.file("killed.bin");
+  write_file_atomic(done, std::string_view("complete"));  // finished writes stay untouched
+  const pid_t pid = ::fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    std::signal(SIGTERM, remove_and_exit);
+    try {
+      write_file_atomic(killed, [](std::ostream& os) {
+        os << std::string(1 << 20, 'k');
+        os.flush();
+        std::raise(SIGTERM);
+      });
+    } catch (...) {
+    }
+    _exit(5);  // the handler did not run
+  }
+  int status = 0;
+  ASSERT_EQ(::waitpid(pid, &status, 0), pid);
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 3) << "4: the handler found no temporary; 5: it did not run";
+  EXPECT_EQ(dir.entries(), std::vector<std::string>{"done.txt"});
+  EXPECT_EQ(read_all(done), "complete");
+  EXPECT_EQ(remove_pending_temporaries(), 0);  // this process has no write in progress
 }

@@ -19,4 +19,14 @@ void write_file_atomic(const std::string& path, std::string_view bytes);
 /// its directory must exist and be writable. Throws InputError.
 void check_writable(const std::string& path);
 
+/// Unlink the temporary of every write_file_atomic now in progress, in any
+/// thread. Async-signal-safe (it calls only unlink(2)), so a program's handler
+/// for SIGTERM or SIGINT can call it before the process dies: a run killed while
+/// writing then leaves neither a partial file nor its temporary. The library
+/// installs no signal handler itself; the tessera command does (main.cpp).
+/// Best effort: up to 64 concurrent writes are tracked, and a write completing
+/// at the same moment may lose its temporary name's unlink to ENOENT, harmlessly.
+/// Returns how many temporaries it unlinked.
+int remove_pending_temporaries() noexcept;
+
 }  // namespace tessera::io
