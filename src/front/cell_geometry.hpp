@@ -50,7 +50,9 @@ void measure_exactly(const Cell& cell, const std::vector<kernels::MeasureTerm>& 
 /// (counter-clockwise from outside), c_f being the foot of the perpendicular
 /// from the generator to f's plane: q/2 for a bisector, n d for a box plane.
 /// Each tetrahedron's signed volume is det(c_f, y_a, y_b) / 6, and those of
-/// one face sum to its cone's volume whatever the polygon's shape. The edge
+/// one face sum to its cone's volume whatever the polygon's shape. Where
+/// those terms may cancel (a cell far longer than wide), each face is
+/// fanned from one of its vertices instead (hull_sums, Fan). The edge
 /// leaving triangle t within face p[k+1] is t's edge k, whose twin triangle is
 /// across(t, k) (hull.hpp), so every term comes straight from a triangle and
 /// its edge table: no face walk, no chain of dependent loads.
@@ -79,10 +81,30 @@ inline bool out_of_range(double mag, const double* c, int n) {
 // (a power of two; Scaled false: 1, without the multiplications).
 // ScaledPlanes: some bisector is stored scaled (Hull::has_scaled_planes);
 // otherwise every bisector's foot is n / 2 without reading Plane::scale.
-template <bool Scaled, bool ScaledPlanes>
+//
+// Fan false: each term is det(c_f, a, b), the cone over the triangle
+// (c_f, a, b), c_f the foot of f's plane. Its rounding error is up to
+// ~u |c_f| |a| |b| (sums_uncertain bounds it by the cell's radius): small
+// for a cell about its generator, but a face far off and small, or far
+// beside its plane's foot, cancels. A column cell 5e7 long and 0.07 wide
+// (points far off a slanted plane), whose end on a box plane lies 3e5
+// beside that plane's foot 1e6 away, had terms worth 1e5 with errors of
+// ~1e7, and until stop 63 its volume came out wrong by up to 100%.
+// Fan true: each face is fanned from one of its own vertices r (the last
+// triangle to name its plane: `face_vertex`), each term det(r, a, b) =
+// det(c_f, a - r, b - r), whose error is u |c_f| times the face's diameter
+// squared. An extra pass and six subtractions a term, so only for the
+// cells that need it (measure()).
+template <bool Scaled, bool ScaledPlanes, bool Fan>
 void hull_sums(const kernels::Hull& hull, double sc, double& vol, double& mag, double* c) {
   const auto& verts = hull.vertices();
   const auto& planes = hull.planes();
+  thread_local std::vector<std::uint32_t> face_vertex;
+  if constexpr (Fan) {
+    face_vertex.resize(planes.size());  // every entry read below is written first
+    for (std::size_t t = 0; t < verts.size(); ++t)
+      for (int k = 0; k < 3; ++k) face_vertex[verts[t].p[k]] = static_cast<std::uint32_t>(t);
+  }
   vol = 0, mag = 0, c[0] = c[1] = c[2] = 0;
   for (std::size_t t = 0; t < verts.size(); ++t) {
     const auto& v = verts[t];
@@ -91,7 +113,8 @@ void hull_sums(const kernels::Hull& hull, double sc, double& vol, double& mag, d
       for (int i = 0; i < 3; ++i) as[i] = v.y[i] * sc;
     const double* a = Scaled ? as : v.y;
     for (int k = 0; k < 3; ++k) {
-      const auto& pl = planes[v.p[(k + 1) % 3]];
+      const auto face = v.p[(k + 1) % 3];
+      const auto& pl = planes[face];
       // The foot n d / |n|^2: d = |n|^2 / 2 on a bisector (2^scale times
       // that on a scaled one), |n| = 1 on a box plane.
       double w = pl.id < 0 ? pl.d : 0.5;
@@ -104,13 +127,39 @@ void hull_sums(const kernels::Hull& hull, double sc, double& vol, double& mag, d
       if constexpr (Scaled)
         for (int i = 0; i < 3; ++i) bs[i] = by[i] * sc;
       const double* b = Scaled ? bs : by;
-      const double s = f[0] * (a[1] * b[2] - a[2] * b[1]) + f[1] * (a[2] * b[0] - a[0] * b[2]) +
-                       f[2] * (a[0] * b[1] - a[1] * b[0]);
-      vol += s;
-      mag += std::fabs(s);
-      for (int i = 0; i < 3; ++i) c[i] += s * (f[i] + a[i] + b[i]);
+      if constexpr (Fan) {
+        double rs[3];
+        const double* ry = verts[face_vertex[face]].y;
+        if constexpr (Scaled)
+          for (int i = 0; i < 3; ++i) rs[i] = ry[i] * sc;
+        const double* r = Scaled ? rs : ry;
+        const double ar[3] = {a[0] - r[0], a[1] - r[1], a[2] - r[2]};
+        const double br[3] = {b[0] - r[0], b[1] - r[1], b[2] - r[2]};
+        const double s = f[0] * (ar[1] * br[2] - ar[2] * br[1]) + f[1] * (ar[2] * br[0] - ar[0] * br[2]) +
+                         f[2] * (ar[0] * br[1] - ar[1] * br[0]);
+        vol += s;
+        mag += std::fabs(s);
+        for (int i = 0; i < 3; ++i) c[i] += s * (r[i] + a[i] + b[i]);
+      } else {
+        const double s = f[0] * (a[1] * b[2] - a[2] * b[1]) + f[1] * (a[2] * b[0] - a[0] * b[2]) +
+                         f[2] * (a[0] * b[1] - a[1] * b[0]);
+        vol += s;
+        mag += std::fabs(s);
+        for (int i = 0; i < 3; ++i) c[i] += s * (f[i] + a[i] + b[i]);
+      }
     }
   }
+}
+
+// Whether the foot's sums (Fan false) may have lost more than ~20 bits:
+// each of the 3 nv terms errs by at most ~21u R^3 (the three vectors within
+// R, the cell's radius, of the generator: a determinant's absolute terms sum
+// to at most (sqrt(3) R)^3, and four roundings each), bounded by 32u R^3.
+// An ordinary cell's volume is a fair fraction of R^3 (uniform points:
+// ~0.3), far above the bound; a column 5e7 long and 0.07 wide is 1e-11 of it.
+inline bool sums_uncertain(double vol, std::size_t nv, double radius) {
+  const double bound = 32 * kernels::filter::u * static_cast<double>(3 * nv) * radius * radius * radius;
+  return !(std::fabs(vol) > 0x1p20 * bound);  // NaN and inf too
 }
 
 template <bool Scaled>
@@ -141,13 +190,20 @@ inline std::int32_t measure(const kernels::Hull& hull, double& volume, std::arra
   double vol, mag, c[3];
   const bool scaled_planes = hull.has_scaled_planes();
   if (scaled_planes) [[unlikely]]
-    detail::hull_sums<false, true>(hull, 1.0, vol, mag, c);
+    detail::hull_sums<false, true, false>(hull, 1.0, vol, mag, c);
   else
-    detail::hull_sums<false, false>(hull, 1.0, vol, mag, c);
+    detail::hull_sums<false, false, false>(hull, 1.0, vol, mag, c);
   std::int32_t shift = 0;  // the sums are of coordinates scaled by 2^-shift
   if (detail::out_of_range(mag, c, 3)) [[unlikely]] {
     shift = detail::measure_shift(hull);
-    if (shift != 0) detail::hull_sums<true, true>(hull, kernels::filter::pow2(-shift), vol, mag, c);
+    if (shift != 0) detail::hull_sums<true, true, false>(hull, kernels::filter::pow2(-shift), vol, mag, c);
+  }
+  // The cell's radius, an upper bound (half the security radius), in the
+  // sums' scale.
+  const double radius = std::ldexp(0.5 * std::sqrt(hull.security_radius2()), -shift);
+  if (detail::sums_uncertain(vol, verts.size(), radius)) [[unlikely]] {
+    if (shift == 0) detail::hull_sums<false, true, true>(hull, 1.0, vol, mag, c);
+    else detail::hull_sums<true, true, true>(hull, kernels::filter::pow2(-shift), vol, mag, c);
   }
   if (measure_cancelled(vol, mag) && hull.exact_context() != nullptr && !verts.empty()) [[unlikely]] {
     thread_local std::vector<kernels::MeasureTerm> terms;
