@@ -117,6 +117,7 @@ using exact_rows::row_parts;
 using exact_rows::Scratch;
 using exact_rows::build_rows;
 using exact_rows::det_rows;
+using exact_rows::set_scaled;
 
 namespace {
 
@@ -334,6 +335,21 @@ int exact_clip_sign(const ExactContext& ctx, std::int32_t i, const std::int32_t*
   if (wide.prepare(ctx, i, planes, j) && wide.sign_on_grid(ctx, j, s)) return s;
   signs_gmp(ctx, i, gen, sg);
   return decide(sg, i, gen, dim);
+}
+
+int exact_ray_side(const ExactContext& ctx, std::int32_t i, std::int32_t a, std::int32_t b, const double* n) {
+  thread_local Scratch s;
+  // Rows 0 and 1: 2 (p_a - p_i) and 2 (p_b - p_i) on their common grid. n on
+  // its own grid as row 2: a positive scale changes no sign.
+  const std::int32_t gen[2] = {a, b};
+  build_rows(ctx, i, gen, 2, s);
+  GridScale grid;
+  for (int d = 0; d < 3; ++d) grid.see(n[d]);
+  const int shift = grid.scale();
+  for (int d = 0; d < 3; ++d) set_scaled(s.a[2][d], n[d], shift);
+  const int rows[3] = {2, 0, 1};
+  det_rows(s.t1, s.a, rows, 3, s);  // det[n; q_a; q_b] = n . (q_a x q_b)
+  return mpz_sgn(s.t1);
 }
 
 int exact_box_sign(const ExactContext& ctx, std::int32_t i, const std::int32_t* planes, std::int32_t box) {

@@ -159,6 +159,14 @@ int exact_clip_sign(const ExactContext& ctx, std::int32_t i, const std::int32_t*
 /// (Schur complement), and the box row carries no weight.
 int exact_box_sign(const ExactContext& ctx, std::int32_t i, const std::int32_t* planes, std::int32_t box);
 
+/// The exact sign of n . ((p_a - p_i) x (p_b - p_i)) in 3D (n any finite
+/// doubles): whether a plane of normal n crosses, going outwards, the ray of
+/// cell i's unbounded edge dual to its hull facet (i, a, b), whose direction
+/// is that cross product (the facet's outward normal when a, b run
+/// clockwise seen from outside). The assembly asks it where the float rays
+/// are too uncertain to place a far plane (Hull::link_boundary).
+int exact_ray_side(const ExactContext& ctx, std::int32_t i, std::int32_t a, std::int32_t b, const double* n);
+
 /// The symbolic perturbation's tie-break (exact_clip_sign): when det M0 is
 /// exactly zero, the weights w_k (decreasing with id) decide, through the
 /// first term in ascending id whose coefficient is non-zero. The terms are
