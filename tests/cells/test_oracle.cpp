@@ -439,46 +439,50 @@ TEST(Oracle, OverflowingPlaneValues) {
 // (exactly coplanar: spacing s = 1/16, so every sum is exact), whose cells
 // in the plane are the hexagons of a triangular lattice (its vectors
 // (s, 0, s) and (0, s, s) meet at 60 degrees), of area s^2 sqrt 3; and one
-// point 1e8 off the plane along its normal. Each inner grid point's cell is
+// point h = 1e8 (1e12) off the plane along its normal. Each inner grid point's cell is
 // a prism of that cross-section running along the normal from the box (one
-// end, 1e6 off) to its bisector with the far point (the other, 5e7 off):
+// end, 1e6 off) to its bisector with the far point (the other, h/2 off):
 // its volume is the cross-section times the length of its axis, which
 // passes through the point (the centre of its hexagon), whatever the slant
 // of either end. Until stop 63 the volumes came out up to 100% wrong, by
 // both methods: the measure's terms, read from the generator, cancelled to
 // ~1e7 of error in terms worth ~1e5 (front/cell_geometry.hpp, hull_sums).
-// The vertices lie ~5e7 from their generator, rounded by ~1e-8 against a
-// cell 0.06 wide: 1e-6 relative.
+// Fanned from the faces' own vertices they are within ~1e-8 (the vertices,
+// 5e7 from their generator, err by ~1e-8 against a cell 0.06 wide; at 1e12,
+// by 1e-4); such cells are now measured exactly (vertices_blur): 1e-9.
 TEST(Oracle, LongColumnsKeepTheirVolumes) {
-  const double s = 1.0 / 16, h = 1e8, r3 = 1 / std::sqrt(3.0);
-  std::vector<double> p;
-  for (int i = 0; i < 16; ++i)
-    for (int j = 0; j < 16; ++j) p.insert(p.end(), {i * s, j * s, i * s + j * s});
-  // The grid's centre less h times the unit normal (-1, -1, 1) / sqrt 3.
-  const double apex[3] = {0.5 + h * r3, 0.5 + h * r3, 1.0 - h * r3};
-  p.insert(p.end(), apex, apex + 3);
-  const double far_side = 1e6;
-  const tessera::Bounds box = make_bounds({-far_side, -far_side, -h}, {h, h, far_side});
-  for (const auto method : {tessera::CellMethod::search, tessera::CellMethod::insertion}) {
-    SCOPED_TRACE(method == tessera::CellMethod::search ? "search" : "insertion");
-    auto opt = options(3, box);
-    opt.cell_method = method;
-    const tessera::Cells c = tessera::voronoi(p, 3, {}, opt);
-    ASSERT_EQ(c.n_cells(), 257u);
-    for (int i = 1; i < 15; ++i)
-      for (int j = 1; j < 15; ++j) {
-        const std::size_t k = static_cast<std::size_t>(16 * i + j);
-        const double* q = p.data() + 3 * k;
-        // Towards the far point, along u = (1, 1, -1) / sqrt 3: its
-        // bisector at t = |A - q|^2 / (2 (A - q) . u). Away from it, along
-        // -u: the box's first plane of x = -1e6, y = -1e6, z = 1e6.
-        double d2 = 0;
-        for (int a = 0; a < 3; ++a) d2 += (apex[a] - q[a]) * (apex[a] - q[a]);
-        const double du = ((apex[0] - q[0]) + (apex[1] - q[1]) - (apex[2] - q[2])) * r3;
-        const double away = std::min({q[0] + far_side, q[1] + far_side, far_side - q[2]}) / r3;
-        const double want = s * s * std::sqrt(3.0) * (d2 / (2 * du) + away);
-        EXPECT_NEAR(c.volume[k], want, 1e-6 * want) << "point " << k;
-      }
+  for (const double h : {1e8, 1e12}) {
+    SCOPED_TRACE(h);
+    const double s = 1.0 / 16, r3 = 1 / std::sqrt(3.0);
+    std::vector<double> p;
+    for (int i = 0; i < 16; ++i)
+      for (int j = 0; j < 16; ++j) p.insert(p.end(), {i * s, j * s, i * s + j * s});
+    // The grid's centre less h times the unit normal (-1, -1, 1) / sqrt 3.
+    const double apex[3] = {0.5 + h * r3, 0.5 + h * r3, 1.0 - h * r3};
+    p.insert(p.end(), apex, apex + 3);
+    const double far_side = 1e6;
+    const tessera::Bounds box = make_bounds({-far_side, -far_side, -h}, {h, h, far_side});
+    for (const auto method : {tessera::CellMethod::search, tessera::CellMethod::insertion}) {
+      SCOPED_TRACE(method == tessera::CellMethod::search ? "search" : "insertion");
+      auto opt = options(3, box);
+      opt.cell_method = method;
+      const tessera::Cells c = tessera::voronoi(p, 3, {}, opt);
+      ASSERT_EQ(c.n_cells(), 257u);
+      for (int i = 1; i < 15; ++i)
+        for (int j = 1; j < 15; ++j) {
+          const std::size_t k = static_cast<std::size_t>(16 * i + j);
+          const double* q = p.data() + 3 * k;
+          // Towards the far point, along u = (1, 1, -1) / sqrt 3: its
+          // bisector at t = |A - q|^2 / (2 (A - q) . u). Away from it, along
+          // -u: the box's first plane of x = -1e6, y = -1e6, z = 1e6.
+          double d2 = 0;
+          for (int a = 0; a < 3; ++a) d2 += (apex[a] - q[a]) * (apex[a] - q[a]);
+          const double du = ((apex[0] - q[0]) + (apex[1] - q[1]) - (apex[2] - q[2])) * r3;
+          const double away = std::min({q[0] + far_side, q[1] + far_side, far_side - q[2]}) / r3;
+          const double want = s * s * std::sqrt(3.0) * (d2 / (2 * du) + away);
+          EXPECT_NEAR(c.volume[k], want, 1e-9 * want) << "point " << k;
+        }
+    }
   }
 }
 
