@@ -94,10 +94,26 @@ inline bool out_of_range(double mag, const double* c, int n) {
 // triangle to name its plane: `face_vertex`), each term det(r, a, b) =
 // det(c_f, a - r, b - r), whose error is u |c_f| times the face's diameter
 // squared. An extra pass and six subtractions a term, so only for the
-// cells that need it (measure()). It also sums the faces' areas into
-// `area` (Fan false leaves it alone).
+// cells that need it (measure()). It also bounds, into `blur`, how far the
+// vertices' own errors may move the volume (Fan false leaves it alone): to
+// first order, each face's area times how far its vertices may lie off its
+// plane (off_plane). A vertex solved from nearly parallel planes may err far
+// along them, but it satisfies each of its planes closely, and only the
+// distance off them moves the volume.
+// A bound on how far vertex y (unscaled) lies off plane pl: its computed
+// residual n.y - d plus that residual's rounding, over |n| >= |n|_1 / sqrt 3.
+// (A scaled bisector's n and d carry the same power of two: the ratio holds.)
+inline double off_plane(const kernels::Hull::Plane& pl, const double* y) {
+  double dot = -pl.d, terms = std::fabs(pl.d);
+  for (int a = 0; a < 3; ++a) {
+    dot += pl.n[a] * y[a];
+    terms += std::fabs(pl.n[a] * y[a]);
+  }
+  return 1.75 * (std::fabs(dot) + 4 * kernels::filter::u * terms) / pl.n1;
+}
+
 template <bool Scaled, bool ScaledPlanes, bool Fan>
-void hull_sums(const kernels::Hull& hull, double sc, double& vol, double& mag, double* c, double& area) {
+void hull_sums(const kernels::Hull& hull, double sc, double& vol, double& mag, double* c, double& blur) {
   const auto& verts = hull.vertices();
   const auto& planes = hull.planes();
   thread_local std::vector<std::uint32_t> face_vertex;
@@ -107,7 +123,7 @@ void hull_sums(const kernels::Hull& hull, double sc, double& vol, double& mag, d
       for (int k = 0; k < 3; ++k) face_vertex[verts[t].p[k]] = static_cast<std::uint32_t>(t);
   }
   vol = 0, mag = 0, c[0] = c[1] = c[2] = 0;
-  if constexpr (Fan) area = 0;
+  if constexpr (Fan) blur = 0;
   for (std::size_t t = 0; t < verts.size(); ++t) {
     const auto& v = verts[t];
     double as[3];
@@ -140,7 +156,8 @@ void hull_sums(const kernels::Hull& hull, double sc, double& vol, double& mag, d
         const double n[3] = {ar[1] * br[2] - ar[2] * br[1], ar[2] * br[0] - ar[0] * br[2],
                              ar[0] * br[1] - ar[1] * br[0]};
         const double s = f[0] * n[0] + f[1] * n[1] + f[2] * n[2];
-        area += 0.5 * std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        const double off = std::max({off_plane(pl, v.y), off_plane(pl, by), off_plane(pl, ry)});
+        blur += 0.5 * std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]) * off * sc;
         vol += s;
         mag += std::fabs(s);
         for (int i = 0; i < 3; ++i) c[i] += s * (r[i] + a[i] + b[i]);
@@ -166,26 +183,6 @@ inline bool sums_uncertain(double vol, std::size_t nv, double radius) {
   return !(std::fabs(vol) > 0x1p20 * bound);  // NaN and inf too
 }
 
-// Whether the vertices' positions may blur the volume by more than 2^-20
-// of it: a vertex y solved in floats errs by at least its rounding, u |y|,
-// and a well-conditioned one by up to 64u |y| (filter::vertex_eps), each
-// coordinate; moved by that, the vertices move the volume by up to that
-// times the cell's surface `area` (both in the sums' scale, sc). A column
-// cell 5e7 long and 0.07 wide (points 1e8 off a slanted plane) has its
-// vertices ~1e-8 off against that width: volumes within ~1e-8, by this
-// bound 3e-5; at 5e12 (1e13 off), 1e-3. There the float measure is given
-// up for the exact one (from the vertices' planes). For the cells the fan
-// sums (sums_uncertain) only. The bound is ~64 times the errors seen, so a
-// lower limit asks it of ordinary thin cells: at 2^-30 a thin band's
-// (su_band, 100,000 points) took 15% longer, and with the vertices' own
-// bounds (Vertex::e, wide where kept ill-conditioned) 2.2 times, for
-// volumes within 3e-9 already.
-inline bool vertices_blur(const kernels::Hull& hull, double vol, double area, double sc) {
-  double ymax = 0;
-  for (const auto& v : hull.vertices())
-    ymax = std::max({ymax, std::fabs(v.y[0]), std::fabs(v.y[1]), std::fabs(v.y[2])});
-  return !(1.75 * kernels::filter::vertex_eps * ymax * sc * area <= 0x1p-20 * std::fabs(vol));  // NaN too
-}
 
 template <bool Scaled>
 void tile_sums(const kernels::Tile& tile, double sc, double& s, double& mag, double* c) {
@@ -212,16 +209,16 @@ void tile_sums(const kernels::Tile& tile, double sc, double& s, double& mag, dou
 inline std::int32_t measure(const kernels::Hull& hull, double& volume, std::array<double, 3>& centroid) {
   const auto& verts = hull.vertices();
   const auto& planes = hull.planes();
-  double vol, mag, c[3], area = 0;
+  double vol, mag, c[3], blur = 0;
   const bool scaled_planes = hull.has_scaled_planes();
   if (scaled_planes) [[unlikely]]
-    detail::hull_sums<false, true, false>(hull, 1.0, vol, mag, c, area);
+    detail::hull_sums<false, true, false>(hull, 1.0, vol, mag, c, blur);
   else
-    detail::hull_sums<false, false, false>(hull, 1.0, vol, mag, c, area);
+    detail::hull_sums<false, false, false>(hull, 1.0, vol, mag, c, blur);
   std::int32_t shift = 0;  // the sums are of coordinates scaled by 2^-shift
   if (detail::out_of_range(mag, c, 3)) [[unlikely]] {
     shift = detail::measure_shift(hull);
-    if (shift != 0) detail::hull_sums<true, true, false>(hull, kernels::filter::pow2(-shift), vol, mag, c, area);
+    if (shift != 0) detail::hull_sums<true, true, false>(hull, kernels::filter::pow2(-shift), vol, mag, c, blur);
   }
   bool exact = measure_cancelled(vol, mag);
   // The cell's radius, an upper bound (half the security radius), in the
@@ -229,9 +226,19 @@ inline std::int32_t measure(const kernels::Hull& hull, double& volume, std::arra
   const double sc = kernels::filter::pow2(-shift);
   if (!exact && detail::sums_uncertain(vol, verts.size(), 0.5 * std::sqrt(hull.security_radius2()) * sc))
       [[unlikely]] {
-    if (shift == 0) detail::hull_sums<false, true, true>(hull, 1.0, vol, mag, c, area);
-    else detail::hull_sums<true, true, true>(hull, sc, vol, mag, c, area);
-    exact = measure_cancelled(vol, mag) || detail::vertices_blur(hull, vol / 6, area, sc);
+    if (shift == 0) detail::hull_sums<false, true, true>(hull, 1.0, vol, mag, c, blur);
+    else detail::hull_sums<true, true, true>(hull, sc, vol, mag, c, blur);
+    // Where the vertices' errors may move the volume by 2^-30 of it, it is
+    // measured exactly from their planes: a column 5e7 long and 0.07 wide,
+    // slanted (points 1e8 off a slanted plane), has vertices ~1e-8 off its
+    // walls, and its volume blurred by ~1e-7 (at 1e12 off, 1e-3).
+    // Axis-aligned, the walls' residuals leave out the long coordinate, and
+    // such columns keep their float measure. (A bound by 64u |y|max, the
+    // vertices' isotropic error, sent those too, and a thin band's cells,
+    // to the exact measure: 3,000 points between two 1e9 off a plane 0.17 ->
+    // 4.8 s; by the vertices' own bounds, Vertex::e, wide where kept
+    // ill-conditioned, 100,000 band points took 2.2 times as long.)
+    exact = measure_cancelled(vol, mag) || !(blur <= 0x1p-30 * std::fabs(vol / 6));  // NaN too
   }
   if (exact && hull.exact_context() != nullptr && !verts.empty()) [[unlikely]] {
     thread_local std::vector<kernels::MeasureTerm> terms;
