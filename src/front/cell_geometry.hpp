@@ -77,6 +77,18 @@ inline bool out_of_range(double mag, const double* c, int n) {
   return !(t <= std::numeric_limits<double>::max()) || mag < 0x1p-600;  // inf or NaN, or tiny terms
 }
 
+// A bound on how far vertex y (unscaled) lies off plane pl: its computed
+// residual n.y - d plus that residual's rounding, over |n| >= |n|_1 / sqrt 3.
+// (A scaled bisector's n and d carry the same power of two: the ratio holds.)
+inline double off_plane(const kernels::Hull::Plane& pl, const double* y) {
+  double dot = -pl.d, terms = std::fabs(pl.d);
+  for (int a = 0; a < 3; ++a) {
+    dot += pl.n[a] * y[a];
+    terms += std::fabs(pl.n[a] * y[a]);
+  }
+  return 1.75 * (std::fabs(dot) + 4 * kernels::filter::u * terms) / pl.n1;
+}
+
 // The 3D measure's sums (below), of the vertices and feet scaled by `sc`
 // (a power of two; Scaled false: 1, without the multiplications).
 // ScaledPlanes: some bisector is stored scaled (Hull::has_scaled_planes);
@@ -100,27 +112,17 @@ inline bool out_of_range(double mag, const double* c, int n) {
 // plane (off_plane). A vertex solved from nearly parallel planes may err far
 // along them, but it satisfies each of its planes closely, and only the
 // distance off them moves the volume.
-// A bound on how far vertex y (unscaled) lies off plane pl: its computed
-// residual n.y - d plus that residual's rounding, over |n| >= |n|_1 / sqrt 3.
-// (A scaled bisector's n and d carry the same power of two: the ratio holds.)
-inline double off_plane(const kernels::Hull::Plane& pl, const double* y) {
-  double dot = -pl.d, terms = std::fabs(pl.d);
-  for (int a = 0; a < 3; ++a) {
-    dot += pl.n[a] * y[a];
-    terms += std::fabs(pl.n[a] * y[a]);
-  }
-  return 1.75 * (std::fabs(dot) + 4 * kernels::filter::u * terms) / pl.n1;
-}
-
 template <bool Scaled, bool ScaledPlanes, bool Fan>
 void hull_sums(const kernels::Hull& hull, double sc, double& vol, double& mag, double* c, double& blur) {
   const auto& verts = hull.vertices();
   const auto& planes = hull.planes();
-  thread_local std::vector<std::uint32_t> face_vertex;
+  const std::uint32_t* face_vertex = nullptr;
   if constexpr (Fan) {
-    face_vertex.resize(planes.size());  // every entry read below is written first
+    thread_local std::vector<std::uint32_t> table;
+    table.resize(planes.size());  // every entry read below is written first
     for (std::size_t t = 0; t < verts.size(); ++t)
-      for (int k = 0; k < 3; ++k) face_vertex[verts[t].p[k]] = static_cast<std::uint32_t>(t);
+      for (int k = 0; k < 3; ++k) table[verts[t].p[k]] = static_cast<std::uint32_t>(t);
+    face_vertex = table.data();
   }
   vol = 0, mag = 0, c[0] = c[1] = c[2] = 0;
   if constexpr (Fan) blur = 0;
@@ -182,7 +184,6 @@ inline bool sums_uncertain(double vol, std::size_t nv, double radius) {
   const double bound = 32 * kernels::filter::u * static_cast<double>(3 * nv) * radius * radius * radius;
   return !(std::fabs(vol) > 0x1p20 * bound);  // NaN and inf too
 }
-
 
 template <bool Scaled>
 void tile_sums(const kernels::Tile& tile, double sc, double& s, double& mag, double* c) {
