@@ -39,4 +39,31 @@ TEST(Pilot, UniformPointsReadAboutOne) {
   std::printf("[ pilot ] uniform ratio 3D %.3f 2D %.3f\n", r3, r2);
 }
 
+// A plane of 3,000 random points and one 1e12 off it: every sample cell is a
+// column, searched through the plane's points nearly all exactly, and
+// capped. The first part of the first band already has the work that puts
+// the band past `enough` (2, the automatic method's threshold), so the pilot
+// stops there (stop 63; before, all 256 cells of the band: 0.17 s, where the
+// insertion then took 0.035 s). Without `enough` it builds the band whole and
+// reads a ratio past 2 too: the same choice.
+TEST(Pilot, StopsOnceItsBandIsSettled) {
+  std::vector<double> pts = uniform_points(3000, 2, 7);
+  std::vector<double> p3;
+  for (std::size_t i = 0; i < 3000; ++i) p3.insert(p3.end(), {pts[2 * i], pts[2 * i + 1], 0.0});
+  p3.insert(p3.end(), {0.5, 0.5, 1e12});
+  tessera::VoronoiOptions opt;
+  opt.dim = 3;
+  opt.threads = 2;
+  const tessera::front::Pass<3> pass(p3, {}, opt);
+  const auto early = tessera::front::pilot_estimate<tessera::kernels::Hull>(pass, 2.0, 0.5);
+  const auto whole = tessera::front::pilot_estimate<tessera::kernels::Hull>(pass, 1e9, 0.5);
+  EXPECT_GE(early.ratio, 2.0);
+  EXPECT_GE(whole.ratio, 2.0);
+  EXPECT_LE(early.cells, 64u);
+  EXPECT_GE(whole.cells, 256u);
+  std::printf("[ pilot ] plane and far point: %llu cells, ratio %.1f (whole band: %llu, %.1f)\n",
+              static_cast<unsigned long long>(early.cells), early.ratio,
+              static_cast<unsigned long long>(whole.cells), whole.ratio);
+}
+
 }  // namespace
