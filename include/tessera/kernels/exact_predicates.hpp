@@ -162,9 +162,10 @@ int exact_box_sign(const ExactContext& ctx, std::int32_t i, const std::int32_t* 
 /// The exact sign of n . ((p_a - p_i) x (p_b - p_i)) in 3D (n any finite
 /// doubles): whether a plane of normal n crosses, going outwards, the ray of
 /// cell i's unbounded edge dual to its hull facet (i, a, b), whose direction
-/// is that cross product (the facet's outward normal when a, b run
-/// clockwise seen from outside). The assembly asks it where the float rays
-/// are too uncertain to place a far plane (Hull::link_boundary).
+/// is that cross product (the facet's outward normal, for a and b in the
+/// order Hull::link_boundary takes them from its link's boundary edge). The
+/// assembly asks it where the float rays are too uncertain to place a far
+/// plane.
 int exact_ray_side(const ExactContext& ctx, std::int32_t i, std::int32_t a, std::int32_t b, const double* n);
 
 /// The symbolic perturbation's tie-break (exact_clip_sign): when det M0 is
