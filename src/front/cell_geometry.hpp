@@ -147,8 +147,11 @@ void hull_sums(const kernels::Hull& hull, double sc, double& vol, double& mag, d
       if constexpr (Scaled)
         for (int i = 0; i < 3; ++i) bs[i] = by[i] * sc;
       const double* b = Scaled ? bs : by;
+      // The term's tetrahedron is (generator, o, a, b): o the foot, or the
+      // fan's vertex.
+      double s, rs[3];
+      const double* o = f;
       if constexpr (Fan) {
-        double rs[3];
         const double* ry = verts[face_vertex[face]].y;
         if constexpr (Scaled)
           for (int i = 0; i < 3; ++i) rs[i] = ry[i] * sc;
@@ -157,19 +160,17 @@ void hull_sums(const kernels::Hull& hull, double sc, double& vol, double& mag, d
         const double br[3] = {b[0] - r[0], b[1] - r[1], b[2] - r[2]};
         const double n[3] = {ar[1] * br[2] - ar[2] * br[1], ar[2] * br[0] - ar[0] * br[2],
                              ar[0] * br[1] - ar[1] * br[0]};
-        const double s = f[0] * n[0] + f[1] * n[1] + f[2] * n[2];
+        s = f[0] * n[0] + f[1] * n[1] + f[2] * n[2];
         const double off = std::max({off_plane(pl, v.y), off_plane(pl, by), off_plane(pl, ry)});
         blur += 0.5 * std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]) * off * sc;
-        vol += s;
-        mag += std::fabs(s);
-        for (int i = 0; i < 3; ++i) c[i] += s * (r[i] + a[i] + b[i]);
+        o = r;
       } else {
-        const double s = f[0] * (a[1] * b[2] - a[2] * b[1]) + f[1] * (a[2] * b[0] - a[0] * b[2]) +
-                         f[2] * (a[0] * b[1] - a[1] * b[0]);
-        vol += s;
-        mag += std::fabs(s);
-        for (int i = 0; i < 3; ++i) c[i] += s * (f[i] + a[i] + b[i]);
+        s = f[0] * (a[1] * b[2] - a[2] * b[1]) + f[1] * (a[2] * b[0] - a[0] * b[2]) +
+            f[2] * (a[0] * b[1] - a[1] * b[0]);
       }
+      vol += s;
+      mag += std::fabs(s);
+      for (int i = 0; i < 3; ++i) c[i] += s * (o[i] + a[i] + b[i]);
     }
   }
 }

@@ -458,23 +458,25 @@ inline void check_invariants(const tessera::Cells& c, const std::vector<double>&
     // of points far off a slanted plane (FromNeighbours) differ by up to 40
     // times the volume's slack times reach / volume; 128 is allowed.
     double volume_slack = 0, centroid_slack = 0;
-    auto measures_agree = [&] {
-      bool agree = std::abs(vol - c.volume[k]) <= 1e-9 * c.volume[k] + volume_slack;
-      for (int q = 0; q < dim; ++q)
-        agree = agree && std::abs(cen[q] / vol - c.centroid[k * dim + q]) <= 1e-9 * L + centroid_slack;
+    auto volume_agrees = [&] { return std::abs(vol - c.volume[k]) <= 1e-9 * c.volume[k] + volume_slack; };
+    auto centroid_agrees = [&](int q) {
+      return std::abs(cen[q] / vol - c.centroid[k * dim + q]) <= 1e-9 * L + centroid_slack;
+    };
+    auto all_agree = [&] {
+      bool agree = volume_agrees();
+      for (int q = 0; q < dim; ++q) agree = agree && centroid_agrees(q);
       return agree;
     };
-    if (dim == 3 && !measures_agree()) {
+    if (dim == 3 && !all_agree()) {
       mesh_measure_quad(c, k, gp, vol, cen, volume_slack);
       double reach = 0;
       for (auto v : cell_vertices) reach = std::max(reach, std::sqrt(norm(sub(mesh_vertex(c, v), gp))));
       centroid_slack = 128 * volume_slack / std::abs(vol) * reach;
     }
-    if (!(std::abs(vol - c.volume[k]) <= 1e-9 * c.volume[k] + volume_slack))
+    if (!volume_agrees())
       fail.add("cell ", k, " (gen ", g, ") mesh volume ", vol, " != volume ", c.volume[k], " (negative = wrong orientation)");
     for (int q = 0; q < dim; ++q)
-      if (!(std::abs(cen[q] / vol - c.centroid[k * dim + q]) <= 1e-9 * L + centroid_slack))
-        fail.add("cell ", k, " mesh centroid differs on axis ", q);
+      if (!centroid_agrees(q)) fail.add("cell ", k, " mesh centroid differs on axis ", q);
   }
 
   // -- each merged vertex is used by exactly the cells of its non-negative key
