@@ -56,8 +56,10 @@ void measure_exactly(const Cell& cell, const std::vector<kernels::MeasureTerm>& 
 /// leaving triangle t within face p[k+1] is t's edge k, whose twin triangle is
 /// across(t, k) (hull.hpp), so every term comes straight from a triangle and
 /// its edge table: no face walk, no chain of dependent loads.
-/// 2D: the shoelace formula over the polygon's edges.
-/// Either falls back to exact arithmetic where the terms cancel (above).
+/// 2D: the shoelace formula over the polygon's edges, bounded edge by edge
+/// where a strip far longer than wide may lose bits (tile_sums).
+/// Either falls back to exact arithmetic where the terms cancel (above) or
+/// where those bounds allow an error past 2^-30 of the measure.
 namespace detail {
 /// The k of a power of two 2^-k that brings the cell's largest |vertex
 /// coordinate| near 1: the measure of a cell whose sums overflowed or came
@@ -78,15 +80,17 @@ inline bool out_of_range(double mag, const double* c, int n) {
 }
 
 // A bound on how far vertex y (unscaled) lies off plane pl: its computed
-// residual n.y - d plus that residual's rounding, over |n| >= |n|_1 / sqrt 3.
-// (A scaled bisector's n and d carry the same power of two: the ratio holds.)
-inline double off_plane(const kernels::Hull::Plane& pl, const double* y) {
+// residual n.y - d plus that residual's rounding, over |n| >= |n|_1 / sqrt D
+// (a factor 1.75 in 3D, 1.5 in 2D). (A scaled bisector's n and d carry the
+// same power of two: the ratio holds.)
+template <class Plane, int D = static_cast<int>(sizeof(Plane::n) / sizeof(double))>
+inline double off_plane(const Plane& pl, const double* y) {
   double dot = -pl.d, terms = std::fabs(pl.d);
-  for (int a = 0; a < 3; ++a) {
+  for (int a = 0; a < D; ++a) {
     dot += pl.n[a] * y[a];
     terms += std::fabs(pl.n[a] * y[a]);
   }
-  return 1.75 * (std::fabs(dot) + 4 * kernels::filter::u * terms) / pl.n1;
+  return (D == 3 ? 1.75 : 1.5) * (std::fabs(dot) + 4 * kernels::filter::u * terms) / pl.n1;
 }
 
 // The 3D measure's sums (below), of the vertices and feet scaled by `sc`
@@ -186,11 +190,31 @@ inline bool sums_uncertain(double vol, std::size_t nv, double radius) {
   return !(std::fabs(vol) > 0x1p20 * bound);  // NaN and inf too
 }
 
-template <bool Scaled>
-void tile_sums(const kernels::Tile& tile, double sc, double& s, double& mag, double* c) {
+// The 2D measure's sums (the shoelace formula), of the vertices scaled by
+// `sc` (a power of two; Scaled false: 1).
+//
+// Bounded true: they also bound, into `err`, how far the computed s may lie
+// from twice the area of the exact cell. Two sources, each to first order:
+// * the terms' rounding: a cross product a0 b1 - a1 b0 errs by up to
+//   3u (|a0 b1| + |a1 b0|), and the sum of m terms by (m - 1)u times their
+//   magnitudes. In a strip 5e11 long and 0.07 wide, slanted (points on a
+//   slanted row and one 1e12 off it), each cross of two vertices along it
+//   cancels from products of ~1e23 to ~1e10: 1e-5 of the area was lost.
+//   Taking the terms about one of the strip's own vertices (the 3D fan's
+//   remedy) leaves the same products: only exact arithmetic helps there.
+// * the vertices' own errors: moving vertex v by delta changes the area by
+//   half delta x (next - prev); a delta along one of v's edges leaves v on
+//   that edge's line and moves it off the other's by the same cross, so each
+//   edge's length times how far its ends may lie off its line (off_plane),
+//   summed, bounds what all of them move it (twice that in s).
+// An extra pass over the edges, so only for the cells that need it (measure()).
+template <bool Scaled, bool Bounded>
+void tile_sums(const kernels::Tile& tile, double sc, double& s, double& mag, double* c, double& err) {
   const auto& v = tile.vertices();
+  const auto& planes = tile.planes();
   const std::size_t m = v.size();
   s = 0, mag = 0, c[0] = c[1] = 0;
+  double rounding = 0, moved = 0;
   for (std::size_t k = 0; k < m; ++k) {
     const double* ay = v[k].y;
     const double* by = v[k + 1 == m ? 0 : k + 1].y;
@@ -204,7 +228,29 @@ void tile_sums(const kernels::Tile& tile, double sc, double& s, double& mag, dou
     mag += std::fabs(cr);
     c[0] += (a[0] + b[0]) * cr;
     c[1] += (a[1] + b[1]) * cr;
+    if constexpr (Bounded) {
+      rounding += std::fabs(a[0] * b[1]) + std::fabs(a[1] * b[0]);
+      const auto& line = planes[v[k].p[1]];  // edge k's (Tile: vertex k's leaving plane)
+      moved += std::hypot(b[0] - a[0], b[1] - a[1]) * std::max(off_plane(line, ay), off_plane(line, by)) * sc;
+    }
   }
+  if constexpr (Bounded)
+    err = 3 * kernels::filter::u * rounding + static_cast<double>(m) * kernels::filter::u * mag + 2 * moved;
+}
+
+// Whether the 2D sums (Bounded false) may fall short of ~30 correct bits,
+// from bounds alone, without a pass over the edges: R, the cell's radius,
+// bounds every vertex's distance from the generator, so each cross's
+// rounding is at most 3u R^2 and the sum's (m - 1)u m R^2; and e, the
+// largest Vertex::e, bounds each vertex's error, so the area moves by at
+// most e sqrt 2 times the perimeter, itself at most 2 pi R. An ordinary
+// cell's area is a fair fraction of R^2, far above both; a strip far longer
+// than wide, or a cell with an ill-conditioned vertex kept, may not be, and
+// its edges are then bounded one by one (tile_sums, Bounded).
+inline bool tile_sums_uncertain(double s, std::size_t m, double radius, double emax) {
+  const double md = static_cast<double>(m);
+  const double bound = kernels::filter::u * md * (md + 2) * radius * radius + 18 * emax * radius;  // in s
+  return !(std::fabs(s) > 0x1p30 * bound);  // NaN and inf too
 }
 }  // namespace detail
 
@@ -260,15 +306,31 @@ inline std::int32_t measure(const kernels::Hull& hull, double& volume, std::arra
 }
 
 inline std::int32_t measure(const kernels::Tile& tile, double& area, std::array<double, 2>& centroid) {
-  const std::size_t m = tile.vertices().size();
-  double s, mag, c[2];
-  detail::tile_sums<false>(tile, 1.0, s, mag, c);
+  const auto& verts = tile.vertices();
+  const std::size_t m = verts.size();
+  double s, mag, c[2], err = 0;
+  detail::tile_sums<false, false>(tile, 1.0, s, mag, c, err);
   std::int32_t shift = 0;
   if (detail::out_of_range(mag, c, 2)) [[unlikely]] {
     shift = detail::measure_shift(tile);
-    if (shift != 0) detail::tile_sums<true>(tile, kernels::filter::pow2(-shift), s, mag, c);
+    if (shift != 0) detail::tile_sums<true, false>(tile, kernels::filter::pow2(-shift), s, mag, c, err);
   }
-  if (measure_cancelled(s, mag) && tile.exact_context() != nullptr && m != 0) [[unlikely]] {
+  bool exact = measure_cancelled(s, mag);
+  const double sc = kernels::filter::pow2(-shift);
+  if (!exact) {
+    double emax = 0;
+    for (const auto& v : verts) emax = std::max(emax, v.e);
+    if (detail::tile_sums_uncertain(s, m, 0.5 * std::sqrt(tile.security_radius2()) * sc, emax * sc)) [[unlikely]] {
+      // Where the terms' rounding or the vertices' errors may move the area
+      // by 2^-30 of it, it is measured exactly from their lines (stop 64: a
+      // strip of points on a slanted row, one point 1e12 off it, had areas
+      // off by 4.5e-5; an axis-aligned strip keeps its float measure).
+      if (shift == 0) detail::tile_sums<false, true>(tile, 1.0, s, mag, c, err);
+      else detail::tile_sums<true, true>(tile, sc, s, mag, c, err);
+      exact = measure_cancelled(s, mag) || !(err <= 0x1p-30 * std::fabs(s));  // NaN too
+    }
+  }
+  if (exact && tile.exact_context() != nullptr && m != 0) [[unlikely]] {
     thread_local std::vector<kernels::MeasureTerm> terms;
     terms.clear();
     for (std::size_t k = 0; k < m; ++k)
