@@ -15,6 +15,7 @@
 #include "delaunay_result.hpp"
 #include "dual_result.hpp"
 #include "interrupt.hpp"
+#include "signal_cleanup.hpp"
 #include "tessera/cells.hpp"
 #include "tessera/io/dual.hpp"
 #include "tessera/io/vtk_polydata.hpp"
@@ -28,6 +29,7 @@ namespace {
 /// Run a writer without the GIL; its InputError becomes OSError (see above).
 template <class Write>
 void write_or_oserror(Write&& write) {
+  const SignalCleanupDuringWrite cleanup;  // taken with the GIL held
   try {
     without_gil(std::forward<Write>(write));
   } catch (const InputError& e) {

@@ -169,3 +169,69 @@ def test_save_errors_leave_nothing_behind(tmp_path):
     with pytest.raises(OSError, match="cannot write"):
         dt.save(tmp_path / "missing" / "x.vtu")
     assert os.listdir(tmp_path) == []
+
+
+# A script killed while saving: it ends by the signal, as by default, but
+# leaves neither the file nor its temporary (OUTPUT.tmp-XXXXXX), which it
+# used to leave behind (python/src/signal_cleanup.hpp).
+KILLED_WHILE_SAVING = """
+import signal, sys
+import numpy as np
+import tessera
+if sys.argv[2] == "handled":
+    signal.signal(signal.SIGTERM, lambda *_: sys.exit(7))
+vor = tessera.voronoi(np.random.default_rng(5).random((200000, 3)))
+print("saving", flush=True)
+vor.save(sys.argv[1])
+vor.save(sys.argv[1] + ".again.vtu")
+"""
+
+
+def save_and_signal(tmp_path, sig, mode):
+    """Run KILLED_WHILE_SAVING, send `sig` once the first file's temporary
+    appears; returns the exit code and the directory's names (None: the
+    write finished before the signal could be sent)."""
+    import signal
+    import subprocess
+    import sys
+    import time
+    out = tmp_path / "c.vtu"
+    proc = subprocess.Popen([sys.executable, "-c", KILLED_WHILE_SAVING, str(out), mode],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    assert proc.stdout.readline() == b"saving\n"
+    deadline = time.monotonic() + 120
+    sent = False
+    while proc.poll() is None and time.monotonic() < deadline:
+        if any(".tmp-" in name for name in os.listdir(tmp_path)):
+            proc.send_signal(sig)
+            sent = True
+            break
+        time.sleep(0.0005)
+    proc.communicate(timeout=120)
+    if not sent:
+        return None, None
+    return proc.returncode, sorted(os.listdir(tmp_path))
+
+
+@pytest.mark.parametrize("signame", ["SIGTERM", "SIGHUP"])
+def test_a_script_killed_while_saving_leaves_nothing(tmp_path, signame):
+    import signal
+    sig = getattr(signal, signame)
+    code, names = save_and_signal(tmp_path, sig, "default")
+    if code is None:
+        pytest.skip("the save finished before the signal")
+    assert code == -sig
+    assert names == []
+
+
+def test_a_scripts_own_handler_is_kept_and_the_file_completed(tmp_path):
+    """With a handler of its own, SIGTERM is the script's: Python runs it once
+    the save returns, so the file is complete and the second save never
+    starts."""
+    import signal
+    code, names = save_and_signal(tmp_path, signal.SIGTERM, "handled")
+    if code is None:
+        pytest.skip("the save finished before the signal")
+    assert code == 7
+    assert names == ["c.vtu"]
+    assert read_vtk(tmp_path / "c.vtu").GetNumberOfCells() == 200000
