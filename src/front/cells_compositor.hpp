@@ -33,10 +33,6 @@ class CellsCompositor {
  public:
   static constexpr int D = CellT::dim;
 
-  /// A thread's variable-length output: the batches it built, one after
-  /// another, each a contiguous run in every array. One growing Buffer per
-  /// array (on huge pages once large) in place of small vectors per batch:
-  /// fewer first-touch page faults (docs/design.md, stop 49).
   /// A cell's measures. add() appends them to its thread's store, in batch
   /// order, and finish() places them by cell: written by generator id from
   /// the cell loop (until stop 64), they landed all over three arrays, on
@@ -48,6 +44,10 @@ class CellsCompositor {
     std::int32_t faces;
   };
 
+  /// A thread's variable-length output: the batches it built, one after
+  /// another, each a contiguous run in every array. One growing Buffer per
+  /// array (on huge pages once large) in place of small vectors per batch:
+  /// fewer first-touch page faults (docs/design.md, stop 49).
   struct Store {
     Buffer<std::int32_t> nbrs;             // neighbour ids, ascending per cell
     Buffer<Measures> measures;             // one per generator (zero: no cell)
