@@ -2,6 +2,7 @@
 #include "signal_cleanup.hpp"
 
 #include <csignal>
+#include <iterator>  // std::size
 #include <mutex>
 
 #include <signal.h>
