@@ -191,7 +191,9 @@ inline bool sums_uncertain(double vol, std::size_t nv, double radius) {
 }
 
 // The 2D measure's sums (the shoelace formula), of the vertices scaled by
-// `sc` (a power of two; Scaled false: 1).
+// `sc` (a power of two; Scaled false: 1): s (twice the area), mag (the sum
+// of the terms' magnitudes), c (the centroid's sums), and emax, the largest
+// Vertex::e (unscaled), for tile_sums_uncertain.
 //
 // Bounded true: they also bound, into `err`, how far the computed s may lie
 // from twice the area of the exact cell. Two sources, each to first order:
@@ -208,14 +210,22 @@ inline bool sums_uncertain(double vol, std::size_t nv, double radius) {
 //   edge's length times how far its ends may lie off its line (off_plane),
 //   summed, bounds what all of them move it (twice that in s).
 // An extra pass over the edges, so only for the cells that need it (measure()).
+struct TileSums {
+  double s = 0, mag = 0, c[2] = {0, 0}, emax = 0;
+  double err = 0;  // Bounded only
+};
 template <bool Scaled, bool Bounded>
-void tile_sums(const kernels::Tile& tile, double sc, double& s, double& mag, double* c, double& err) {
+TileSums tile_sums(const kernels::Tile& tile, double sc) {
   const auto& v = tile.vertices();
   const auto& planes = tile.planes();
   const std::size_t m = v.size();
-  s = 0, mag = 0, c[0] = c[1] = 0;
+  TileSums r;
+  double& s = r.s;
+  double& mag = r.mag;
+  double* c = r.c;
   double rounding = 0, moved = 0;
   for (std::size_t k = 0; k < m; ++k) {
+    r.emax = std::max(r.emax, v[k].e);
     const double* ay = v[k].y;
     const double* by = v[k + 1 == m ? 0 : k + 1].y;
     double as[2], bs[2];
@@ -235,7 +245,8 @@ void tile_sums(const kernels::Tile& tile, double sc, double& s, double& mag, dou
     }
   }
   if constexpr (Bounded)
-    err = 3 * kernels::filter::u * rounding + static_cast<double>(m) * kernels::filter::u * mag + 2 * moved;
+    r.err = 3 * kernels::filter::u * rounding + static_cast<double>(m) * kernels::filter::u * mag + 2 * moved;
+  return r;
 }
 
 // Whether the 2D sums (Bounded false) may fall short of ~30 correct bits,
@@ -306,29 +317,23 @@ inline std::int32_t measure(const kernels::Hull& hull, double& volume, std::arra
 }
 
 inline std::int32_t measure(const kernels::Tile& tile, double& area, std::array<double, 2>& centroid) {
-  const auto& verts = tile.vertices();
-  const std::size_t m = verts.size();
-  double s, mag, c[2], err = 0;
-  detail::tile_sums<false, false>(tile, 1.0, s, mag, c, err);
+  const std::size_t m = tile.vertices().size();
+  detail::TileSums t = detail::tile_sums<false, false>(tile, 1.0);
   std::int32_t shift = 0;
-  if (detail::out_of_range(mag, c, 2)) [[unlikely]] {
+  if (detail::out_of_range(t.mag, t.c, 2)) [[unlikely]] {
     shift = detail::measure_shift(tile);
-    if (shift != 0) detail::tile_sums<true, false>(tile, kernels::filter::pow2(-shift), s, mag, c, err);
+    if (shift != 0) t = detail::tile_sums<true, false>(tile, kernels::filter::pow2(-shift));
   }
-  bool exact = measure_cancelled(s, mag);
+  bool exact = measure_cancelled(t.s, t.mag);
   const double sc = kernels::filter::pow2(-shift);
-  if (!exact) {
-    double emax = 0;
-    for (const auto& v : verts) emax = std::max(emax, v.e);
-    if (detail::tile_sums_uncertain(s, m, 0.5 * std::sqrt(tile.security_radius2()) * sc, emax * sc)) [[unlikely]] {
-      // Where the terms' rounding or the vertices' errors may move the area
-      // by 2^-30 of it, it is measured exactly from their lines (stop 64: a
-      // strip of points on a slanted row, one point 1e12 off it, had areas
-      // off by 4.5e-5; an axis-aligned strip keeps its float measure).
-      if (shift == 0) detail::tile_sums<false, true>(tile, 1.0, s, mag, c, err);
-      else detail::tile_sums<true, true>(tile, sc, s, mag, c, err);
-      exact = measure_cancelled(s, mag) || !(err <= 0x1p-30 * std::fabs(s));  // NaN too
-    }
+  if (!exact && detail::tile_sums_uncertain(t.s, m, 0.5 * std::sqrt(tile.security_radius2()) * sc, t.emax * sc))
+      [[unlikely]] {
+    // Where the terms' rounding or the vertices' errors may move the area by
+    // 2^-30 of it, it is measured exactly from their lines (stop 64: strips
+    // of points on a slanted row at random gaps, one point 1e12 off it, had
+    // areas off by up to 14%; an axis-aligned strip keeps its float measure).
+    t = shift == 0 ? detail::tile_sums<false, true>(tile, 1.0) : detail::tile_sums<true, true>(tile, sc);
+    exact = measure_cancelled(t.s, t.mag) || !(t.err <= 0x1p-30 * std::fabs(t.s));  // NaN too
   }
   if (exact && tile.exact_context() != nullptr && m != 0) [[unlikely]] {
     thread_local std::vector<kernels::MeasureTerm> terms;
@@ -338,9 +343,9 @@ inline std::int32_t measure(const kernels::Tile& tile, double& area, std::array<
     measure_exactly(tile, terms, area, centroid.data());
     return 0;
   }
-  area = 0.5 * s;
+  area = 0.5 * t.s;
   for (int i = 0; i < 2; ++i) {
-    const double ci = s != 0 ? c[i] / (3 * s) : 0.0;
+    const double ci = t.s != 0 ? t.c[i] / (3 * t.s) : 0.0;
     centroid[static_cast<std::size_t>(i)] = shift == 0 ? ci : std::ldexp(ci, shift);
   }
   return shift;
