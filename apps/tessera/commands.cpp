@@ -283,7 +283,7 @@ void print_summary(const VoronoiArgs& a, const io::PointCloud& pc, const Cells& 
 }
 
 bool report_validation(const Cells& c, const io::PointCloud& pc, bool quiet) {
-  const ValidationReport r = validate(c, pc.labels);
+  const ValidationReport r = validate(c, pc.labels, pc.coords);
   if (!quiet) {
     std::printf("validation: %s\n", r.ok ? "OK" : "FAILED");
     if (r.volumes_checked)
@@ -297,6 +297,10 @@ bool report_validation(const Cells& c, const io::PointCloud& pc, bool quiet) {
     if (c.dim == 3) std::printf("  %-18s %zu\n", "bad Euler", r.bad_euler);
     if (r.underflowed_volumes)
       std::printf("  %-18s %zu (below the smallest double, reported as 0)\n", "tiny cells", r.underflowed_volumes);
+    if (r.measures_checked)
+      std::printf("  %-18s %zu sampled cells against exact arithmetic: largest relative %s error %.2g (point %d)\n",
+                  "exact measures", r.measures_checked, c.dim == 3 ? "volume" : "area", r.measure_rel_error,
+                  r.measure_worst);
     for (const auto& m : r.messages) std::printf("  %s\n", m.c_str());
     std::fflush(stdout);
   }

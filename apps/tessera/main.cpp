@@ -142,8 +142,9 @@ int main(int argc, char** argv) {
                   "neighbours of cell c are ids[offsets[c]:offsets[c+1]] (point ids). Cells are numbered as the "
                   "--cell-table rows (point order; outside points and duplicates own none)");
   vor->add_flag("--validate", va.validate,
-                "Check the result (volume sum, neighbour symmetry, vertex degrees, Euler characteristic), "
-                "print the report, exit 1 if a check fails");
+                "Check the result (volume sum, neighbour symmetry, vertex degrees, Euler characteristic, and "
+                "the volumes and centroids of up to 128 sampled cells against exact arithmetic), print the report, "
+                "exit 1 if a check fails");
   vor->add_flag("-q,--quiet", va.quiet, "No summary and no progress bar");
   vor->footer(
       "At least one of -o, --cell-table, --neighbors or --validate is required. Output paths are checked\n"

@@ -165,9 +165,26 @@ struct ValidationReport {
   /// Cells whose exact volume is below the smallest double, reported as 0
   /// (points within ~1e-160 of each other): not a failure.
   std::size_t underflowed_volumes = 0;
+  /// Cells whose volume and centroid were compared with their exact values
+  /// (rational arithmetic from the input points and the merged vertices'
+  /// keys): a sample, the smallest, the most elongated and some spread over
+  /// the output (see validate). 0 where no points were given, without the
+  /// mesh, or where volumes are not checked.
+  std::size_t measures_checked = 0;
+  double measure_rel_error = 0;           ///< the largest relative volume error among them
+  std::int32_t measure_worst = -1;        ///< the generator of that cell (-1: none checked)
   std::vector<std::string> messages;      ///< one line each
 };
-ValidationReport validate(const Cells& cells, std::span<const std::int32_t> labels);
+/// The sampled exact check fails a cell whose volume errs by more than this,
+/// relatively (four times the 2^-30 the measure keeps: docs/design.md,
+/// "Strip areas"), or whose centroid errs by more than this times the
+/// cell's radius (plus the rounding of adding the generator's coordinates).
+inline constexpr double measure_tolerance = 0x1p-28;
+/// `points` (n_points x dim, the coordinates the cells were computed from)
+/// enables the exact check of sampled cells' measures; an empty span skips
+/// it. std::invalid_argument where its size is not n_points x dim.
+ValidationReport validate(const Cells& cells, std::span<const std::int32_t> labels,
+                          std::span<const double> points = {});
 
 /// Whether the cell volumes of a domain of volume `domain_volume` cut into
 /// `cells` cells are normal doubles (the rule behind volumes_checked): the

@@ -60,6 +60,11 @@ void bind_voronoi(py::module_& m) {
       .def_readonly("bad_euler", &ValidationReport::bad_euler)
       .def_readonly("underflowed_volumes", &ValidationReport::underflowed_volumes,
                     "cells whose exact volume is below the smallest double (reported as 0; not a failure)")
+      .def_readonly("measures_checked", &ValidationReport::measures_checked,
+                    "sampled cells whose volume and centroid were compared with exact arithmetic")
+      .def_readonly("measure_rel_error", &ValidationReport::measure_rel_error,
+                    "the largest relative volume (area) error among them")
+      .def_readonly("measure_worst", &ValidationReport::measure_worst, "that cell's generator (-1: none checked)")
       .def_readonly("messages", &ValidationReport::messages)
       .def("__bool__", [](const ValidationReport& r) { return r.ok; })
       .def("__repr__", [](const ValidationReport& r) {
@@ -138,11 +143,21 @@ void bind_voronoi(py::module_& m) {
 
   m.def(
       "validate_cells",
-      [](const Cells& c, const py::object& labels) {
+      [](const Cells& c, const py::object& labels, const py::object& points) {
         const auto lab = as_labels(labels);
-        return without_gil([&] { return validate(c, lab); });
+        std::span<const double> pts;
+        std::optional<Points> held;  // keeps the array alive while the GIL is released
+        if (!points.is_none()) {
+          held = points.cast<Points>();
+          if (checked_dim(*held) != c.dim || static_cast<std::size_t>(held->shape(0)) != c.n_points)
+            throw py::value_error("validate_cells: points are not the ones the cells were computed from");
+          pts = as_span(*held);
+        }
+        return without_gil([&] { return validate(c, lab, pts); });
       },
-      py::arg("cells"), py::arg("labels").none(true), "Invariant checks (the CLI's --validate).");
+      py::arg("cells"), py::arg("labels").none(true), py::arg("points").none(true) = py::none(),
+      "Invariant checks (the CLI's --validate); with the points, also a sample of cells' measures "
+      "against exact arithmetic.");
 }
 
 }  // namespace tessera::python

@@ -54,6 +54,18 @@ def test_validate_passes_and_is_truthy(dim):
     assert report.ok and bool(report), report.messages
     assert report.volume_rel_error < 1e-12
     assert "ok=True" in repr(report)
+    # a sample of cells measured exactly (the smallest, the longest, a spread)
+    assert report.measures_checked >= 64
+    assert report.measure_rel_error < 1e-13 and report.measure_worst >= 0
+
+
+def test_validate_cells_checks_measures_only_with_the_points():
+    pts = random_points(300, 3)
+    vor = tessera.voronoi(pts)
+    without = tessera._core.validate_cells(vor._cells, None)
+    assert without.ok and without.measures_checked == 0
+    with pytest.raises(ValueError, match="points are not the ones"):
+        tessera._core.validate_cells(vor._cells, None, pts[:-1])
 
 
 def test_shapes_dtypes_and_csr_consistency():

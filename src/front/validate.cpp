@@ -3,16 +3,22 @@
 #include <cmath>
 #include <map>
 #include <sstream>
+#include <stdexcept>
+#include <string>
 #include <unordered_map>
 
 #include "tessera/cells.hpp"
+#include "validate_measures.hpp"
 
 namespace tessera {
 
-ValidationReport validate(const Cells& c, std::span<const std::int32_t> labels) {
+ValidationReport validate(const Cells& c, std::span<const std::int32_t> labels, std::span<const double> points) {
   ValidationReport r;
   const std::size_t nc = c.n_cells();
   const int D = c.dim;
+  if (!points.empty() && points.size() != static_cast<std::size_t>(c.n_points) * static_cast<std::size_t>(D))
+    throw std::invalid_argument("validate: " + std::to_string(points.size()) + " coordinates given for " +
+                                std::to_string(c.n_points) + " points in " + std::to_string(D) + "D");
 
   // Volumes: with every point inside, the cells tile the domain exactly.
   // Checked only where the volumes are normal doubles (volumes_representable):
@@ -64,23 +70,48 @@ ValidationReport validate(const Cells& c, std::span<const std::int32_t> labels) 
 
   if (!c.vertex_keys.empty()) {
     // Each merged vertex is used by exactly the cells of its key's generators.
+    // With the points, the same pass takes each cell's radius (its farthest
+    // vertex from its generator, squared) for the exact check's sample. A
+    // vertex lies equally far from every generator of its key, so its
+    // distance is computed once, by the first cell that meets it, and kept
+    // beside its use counts: the merged vertices lie in no order a cell's
+    // corners follow, and reading them at every corner cost 1M cells ~1 s.
     const std::size_t nv = c.n_vertices();
-    std::vector<std::int32_t> users(nv, 0);
-    std::vector<std::int32_t> last_cell(nv, -1);
+    const bool measuring = !points.empty() && r.volumes_checked;
+    struct Use {
+      std::int32_t users = 0, last_cell = -1;
+      double dist2 = -1;  // from a generator of its key (measuring only)
+    };
+    std::vector<Use> use(nv);
+    std::vector<double> radius2(measuring ? nc : 0, 0.0);
     std::size_t bad_euler = 0;
     for (std::size_t k = 0; k < nc; ++k) {
       std::int64_t f0 = c.cell_face_offsets[k], f1 = c.cell_face_offsets[k + 1];
       std::size_t corners = 0;
       std::int64_t half_edges = 0;
+      const double* p = measuring ? points.data() + static_cast<std::size_t>(c.generator[k]) * static_cast<std::size_t>(D)
+                                  : nullptr;
       for (auto f = f0; f < f1; ++f) {
         for (auto q = c.face_vertex_offsets[static_cast<std::size_t>(f)];
              q < c.face_vertex_offsets[static_cast<std::size_t>(f) + 1]; ++q) {
           std::int32_t v = c.face_vertices[static_cast<std::size_t>(q)];
           if (v < 0 || static_cast<std::size_t>(v) >= nv) continue;
-          if (last_cell[static_cast<std::size_t>(v)] != static_cast<std::int32_t>(k)) {
-            last_cell[static_cast<std::size_t>(v)] = static_cast<std::int32_t>(k);
-            ++users[static_cast<std::size_t>(v)];
+          Use& u = use[static_cast<std::size_t>(v)];
+          if (u.last_cell != static_cast<std::int32_t>(k)) {
+            u.last_cell = static_cast<std::int32_t>(k);
+            ++u.users;
             ++corners;
+            if (measuring) {
+              if (u.dist2 < 0) {
+                u.dist2 = 0;
+                for (int d = 0; d < D; ++d) {
+                  const double x = c.vertices[static_cast<std::size_t>(v) * static_cast<std::size_t>(D) +
+                                              static_cast<std::size_t>(d)] - p[d];
+                  u.dist2 += x * x;
+                }
+              }
+              radius2[k] = std::max(radius2[k], u.dist2);
+            }
           }
           ++half_edges;
         }
@@ -96,7 +127,7 @@ ValidationReport validate(const Cells& c, std::span<const std::int32_t> labels) 
         std::int32_t id = c.vertex_keys[v * static_cast<std::size_t>(D + 1) + static_cast<std::size_t>(d)];
         if (id >= 0 && c.cell_of[static_cast<std::size_t>(id)] >= 0) ++expect;
       }
-      if (users[v] != expect) ++r.bad_vertex_degree;
+      if (use[v].users != expect) ++r.bad_vertex_degree;
     }
     r.bad_euler = bad_euler;
     if (r.bad_vertex_degree) {
@@ -114,6 +145,9 @@ ValidationReport validate(const Cells& c, std::span<const std::int32_t> labels) 
       r.messages.push_back(std::to_string(unresolved) + " face corners refer to no merged vertex");
       r.ok = false;
     }
+    // Each vertex's key names the cell's generator and the faces' corners
+    // are resolved: the mesh can be measured exactly.
+    if (measuring && r.bad_vertex_degree == 0 && unresolved == 0) front::check_measures(c, points, radius2, r);
   }
   return r;
 }

@@ -497,7 +497,8 @@ inline void check_invariants(const tessera::Cells& c, const std::vector<double>&
   }
 
   if (opt.check_validate) {
-    auto rep = tessera::validate(c, labels);
+    // With the points: also the exact check of sampled cells' measures.
+    auto rep = tessera::validate(c, labels, pts);
     if (!rep.ok) {
       std::string m;
       for (auto& s : rep.messages) m += s + "; ";

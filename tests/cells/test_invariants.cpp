@@ -80,6 +80,46 @@ TEST(Invariants, CheckerCatchesCorruption) {
   }
 }
 
+// validate()'s exact check of sampled measures (front/validate_measures.cpp):
+// a cell's volume or centroid off by far less than the volume sum can show is
+// caught, and named.
+TEST(Invariants, ValidateChecksSampledMeasuresExactly) {
+  for (const int dim : {2, 3}) {
+    SCOPED_TRACE(dim);
+    const auto pts = random_points(400, dim, 105);
+    const auto good = run(pts, dim, unit_box());
+    const tessera::ValidationReport r = tessera::validate(good, {}, pts);
+    EXPECT_TRUE(r.ok);
+    EXPECT_GE(r.measures_checked, 64u);  // the 64 spread cells at least; the smallest and longest overlap them
+    EXPECT_LE(r.measure_rel_error, 1e-13);
+    const std::size_t k = static_cast<std::size_t>(
+        std::min_element(good.volume.begin(), good.volume.end()) - good.volume.begin());  // always sampled
+    const std::string name = "cell of point " + std::to_string(good.generator[k]);
+    {
+      auto c = good;  // off by 1e-7: the sum moves by ~1e-11 relative
+      c.volume[k] *= 1 + 1e-7;
+      EXPECT_TRUE(tessera::validate(c, {}).ok);  // without the points, blind to it
+      const tessera::ValidationReport bad = tessera::validate(c, {}, pts);
+      EXPECT_FALSE(bad.ok);
+      EXPECT_EQ(bad.measure_worst, good.generator[k]);
+      EXPECT_NEAR(bad.measure_rel_error, 1e-7, 1e-9);
+      ASSERT_FALSE(bad.messages.empty());
+      EXPECT_NE(bad.messages.front().find(name), std::string::npos) << bad.messages.front();
+    }
+    {
+      auto c = good;  // a centroid moved by 1e-7 (the cells are ~0.05 across)
+      c.centroid[k * static_cast<std::size_t>(dim)] += 1e-7;
+      EXPECT_TRUE(tessera::validate(c, {}).ok);
+      const tessera::ValidationReport bad = tessera::validate(c, {}, pts);
+      EXPECT_FALSE(bad.ok);
+      ASSERT_FALSE(bad.messages.empty());
+      EXPECT_NE(bad.messages.front().find(name + ": centroid"), std::string::npos) << bad.messages.front();
+    }
+    const std::vector<double> fewer(pts.begin(), pts.end() - dim);
+    EXPECT_THROW(tessera::validate(good, {}, fewer), std::invalid_argument);
+  }
+}
+
 // ------------------------------------------------------------------ lattices
 
 /// Points on a lattice whose cells are all the same known box: checks each

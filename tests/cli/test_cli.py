@@ -320,6 +320,8 @@ class Voronoi3D(TempDirCase):
         out = self.p("cells.vtu")
         r = self.ok(["voronoi", self.inp, "-o", out, "--validate"])
         self.assertIn("validation: OK", r.stdout)
+        self.assertRegex(r.stdout, r"exact measures +\d+ sampled cells against exact arithmetic: "
+                                   r"largest relative volume error")
         g = read_vtu(out)
         self.assertEqual(g.GetNumberOfCells(), self.N)
         # default domain: bounding box padded by 1% of the largest extent, then
