@@ -75,8 +75,8 @@ void check_measures(const Cells& c, std::span<const double> points, const std::v
   take_first(eligible, sample_smallest, [&](std::uint32_t a, std::uint32_t b) {
     return c.volume[a] != c.volume[b] ? c.volume[a] < c.volume[b] : a < b;
   });
-  // Elongation radius^D / volume, compared in logarithms (radius^3 of a
-  // column 1e12 long would overflow nothing, but its ratio to a tiny volume may).
+  // Elongation radius^D / volume, compared in logarithms: the ratio itself
+  // may overflow (a radius of 1e120 over a volume of 1e-100).
   std::vector<double> elongation(nc, 0.0);
   for (const std::uint32_t k : eligible)
     elongation[k] = 0.5 * static_cast<double>(D) * std::log(radius2[k]) - std::log(c.volume[k]);
@@ -85,8 +85,11 @@ void check_measures(const Cells& c, std::span<const double> points, const std::v
   });
   const std::size_t spread = std::min(sample_spread, eligible.size());
   for (std::size_t s = 0; s < spread; ++s) pick.push_back(eligible[s * eligible.size() / spread]);
-  std::sort(pick.begin(), pick.end());
-  pick.erase(std::unique(pick.begin(), pick.end()), pick.end());
+  // Each cell once, in that order of priority (the corner budget below may
+  // leave the last ones out).
+  std::vector<std::uint32_t> sample;
+  for (const std::uint32_t k : pick)
+    if (std::find(sample.begin(), sample.end(), k) == sample.end()) sample.push_back(k);
 
   kernels::ExactContext ctx;
   ctx.points = points.data();
@@ -97,8 +100,8 @@ void check_measures(const Cells& c, std::span<const double> points, const std::v
   std::vector<std::int32_t> vertex_planes;
   std::vector<kernels::MeasureTerm> terms;
   std::size_t measured_corners = 0, failed = 0;
-  for (const std::uint32_t k : pick) {
-    if (measured_corners + corners(k) > max_total_corners) break;
+  for (const std::uint32_t k : sample) {
+    if (measured_corners + corners(k) > max_total_corners) continue;
     measured_corners += corners(k);
     const std::int32_t g = c.generator[k];
     local.clear();
@@ -123,8 +126,9 @@ void check_measures(const Cells& c, std::span<const double> points, const std::v
     for (auto f = c.cell_face_offsets[k]; f < c.cell_face_offsets[k + 1] && keyed; ++f) {
       const auto q0 = static_cast<std::size_t>(c.face_vertex_offsets[static_cast<std::size_t>(f)]);
       const auto q1 = static_cast<std::size_t>(c.face_vertex_offsets[static_cast<std::size_t>(f) + 1]);
-      for (std::size_t q = q0; q < q1 && keyed; ++q) keyed &= c.face_vertices[q] >= 0 &&
-                                                           static_cast<std::size_t>(c.face_vertices[q]) < nv;
+      keyed &= q1 >= q0 + (D == 3 ? 3 : 2);  // a polygon; in 2D an edge
+      for (std::size_t q = q0; q < q1 && keyed; ++q)
+        keyed &= c.face_vertices[q] >= 0 && static_cast<std::size_t>(c.face_vertices[q]) < nv;
       if (!keyed) break;
       // 3D: the cone over each edge a -> b of the face's loop
       // (counter-clockwise from outside) from the foot of its plane. 2D: a
@@ -138,7 +142,8 @@ void check_measures(const Cells& c, std::span<const double> points, const std::v
       }
     }
     if (!keyed) {
-      r.messages.push_back("cell of point " + std::to_string(g) + ": a face corner whose key does not name its generator");
+      r.messages.push_back("cell of point " + std::to_string(g) +
+                           ": a face too short, or a corner whose key does not name the generator");
       r.ok = false;
       continue;
     }
