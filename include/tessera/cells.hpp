@@ -166,7 +166,7 @@ struct ValidationReport {
   /// (points within ~1e-160 of each other): not a failure.
   std::size_t underflowed_volumes = 0;
   /// Cells whose volume and centroid were compared with their exact values
-  /// (rational arithmetic from the input points and the merged vertices'
+  /// (exact arithmetic from the input points and the merged vertices'
   /// keys): a sample, the smallest, the most elongated and some spread over
   /// the output (see validate). 0 where no points were given, without the
   /// mesh, or where volumes are not checked.

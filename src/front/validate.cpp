@@ -145,8 +145,9 @@ ValidationReport validate(const Cells& c, std::span<const std::int32_t> labels, 
       r.messages.push_back(std::to_string(unresolved) + " face corners refer to no merged vertex");
       r.ok = false;
     }
-    // Each vertex's key names the cell's generator and the faces' corners
-    // are resolved: the mesh can be measured exactly.
+    // Every vertex used by exactly the cells of its key (so each first
+    // meeting above measured its distance from a generator of its key) and
+    // every corner resolved: the mesh can be measured exactly.
     if (measuring && r.bad_vertex_degree == 0 && unresolved == 0) front::check_measures(c, points, radius2, r);
   }
   return r;
