@@ -94,7 +94,8 @@ inline double off_plane(const Plane& pl, const double* y) {
 }
 
 // The 3D measure's sums (below), of the vertices and feet scaled by `sc`
-// (a power of two; Scaled false: 1, without the multiplications).
+// (a power of two; Scaled false: 1, without the multiplications), and
+// emax, the largest Vertex::e (unscaled), for sums_uncertain.
 // ScaledPlanes: some bisector is stored scaled (Hull::has_scaled_planes);
 // otherwise every bisector's foot is n / 2 without reading Plane::scale.
 //
@@ -117,7 +118,7 @@ inline double off_plane(const Plane& pl, const double* y) {
 // along them, but it satisfies each of its planes closely, and only the
 // distance off them moves the volume.
 template <bool Scaled, bool ScaledPlanes, bool Fan>
-void hull_sums(const kernels::Hull& hull, double sc, double& vol, double& mag, double* c, double& blur) {
+void hull_sums(const kernels::Hull& hull, double sc, double& vol, double& mag, double* c, double& blur, double& emax) {
   const auto& verts = hull.vertices();
   const auto& planes = hull.planes();
   const std::uint32_t* face_vertex = nullptr;
@@ -128,10 +129,11 @@ void hull_sums(const kernels::Hull& hull, double sc, double& vol, double& mag, d
       for (int k = 0; k < 3; ++k) table[verts[t].p[k]] = static_cast<std::uint32_t>(t);
     face_vertex = table.data();
   }
-  vol = 0, mag = 0, c[0] = c[1] = c[2] = 0;
+  vol = 0, mag = 0, c[0] = c[1] = c[2] = 0, emax = 0;
   if constexpr (Fan) blur = 0;
   for (std::size_t t = 0; t < verts.size(); ++t) {
     const auto& v = verts[t];
+    emax = std::max(emax, v.e);
     double as[3];
     if constexpr (Scaled)
       for (int i = 0; i < 3; ++i) as[i] = v.y[i] * sc;
@@ -185,9 +187,21 @@ void hull_sums(const kernels::Hull& hull, double sc, double& vol, double& mag, d
 // to at most (sqrt(3) R)^3, and four roundings each), bounded by 32u R^3.
 // An ordinary cell's volume is a fair fraction of R^3 (uniform points:
 // ~0.3), far above the bound; a column 5e7 long and 0.07 wide is 1e-11 of it.
-inline bool sums_uncertain(double vol, std::size_t nv, double radius) {
+// Or whether the vertices' own errors may move the volume by 2^-30 of it:
+// each vertex lies within sqrt(3) e of its exact place (e, the largest
+// Vertex::e, bounds its error per coordinate), which moves the volume by at
+// most that times the cell's surface, itself at most 4 pi R^2: in the
+// sums' units (six times the volume) 131 e R^2. Until stop 65 the gate had
+// only the first test (the 2D gate has had both since stop 64): a cell of
+// nearly collinear points, with vertices of condition ~1e5 (e ~1e-11 of the
+// cell's size), kept a volume 7.9e-9 off (Oracle.VertexErrorsBoundTheVolume;
+// found by validate's exact check). Such a cell is now summed again by
+// faces (Fan), whose bound on the vertices' errors (blur, from the residuals)
+// is far tighter, and measured exactly if that bound passes 2^-30.
+inline bool sums_uncertain(double vol, std::size_t nv, double radius, double emax) {
   const double bound = 32 * kernels::filter::u * static_cast<double>(3 * nv) * radius * radius * radius;
-  return !(std::fabs(vol) > 0x1p20 * bound);  // NaN and inf too
+  const double moved = 132 * emax * radius * radius;  // 6 x 4 pi sqrt(3) = 130.6
+  return !(std::fabs(vol) > 0x1p20 * bound && std::fabs(vol) > 0x1p30 * moved);  // NaN and inf too
 }
 
 // The 2D measure's sums (the shoelace formula), of the vertices scaled by
@@ -268,25 +282,25 @@ inline bool tile_sums_uncertain(double s, std::size_t m, double radius, double e
 inline std::int32_t measure(const kernels::Hull& hull, double& volume, std::array<double, 3>& centroid) {
   const auto& verts = hull.vertices();
   const auto& planes = hull.planes();
-  double vol, mag, c[3], blur = 0;
+  double vol, mag, c[3], blur = 0, emax = 0;
   const bool scaled_planes = hull.has_scaled_planes();
   if (scaled_planes) [[unlikely]]
-    detail::hull_sums<false, true, false>(hull, 1.0, vol, mag, c, blur);
+    detail::hull_sums<false, true, false>(hull, 1.0, vol, mag, c, blur, emax);
   else
-    detail::hull_sums<false, false, false>(hull, 1.0, vol, mag, c, blur);
+    detail::hull_sums<false, false, false>(hull, 1.0, vol, mag, c, blur, emax);
   std::int32_t shift = 0;  // the sums are of coordinates scaled by 2^-shift
   if (detail::out_of_range(mag, c, 3)) [[unlikely]] {
     shift = detail::measure_shift(hull);
-    if (shift != 0) detail::hull_sums<true, true, false>(hull, kernels::filter::pow2(-shift), vol, mag, c, blur);
+    if (shift != 0) detail::hull_sums<true, true, false>(hull, kernels::filter::pow2(-shift), vol, mag, c, blur, emax);
   }
   bool exact = measure_cancelled(vol, mag);
   // The cell's radius, an upper bound (half the security radius), in the
   // sums' scale.
   const double sc = kernels::filter::pow2(-shift);
-  if (!exact && detail::sums_uncertain(vol, verts.size(), 0.5 * std::sqrt(hull.security_radius2()) * sc))
+  if (!exact && detail::sums_uncertain(vol, verts.size(), 0.5 * std::sqrt(hull.security_radius2()) * sc, emax * sc))
       [[unlikely]] {
-    if (shift == 0) detail::hull_sums<false, true, true>(hull, 1.0, vol, mag, c, blur);
-    else detail::hull_sums<true, true, true>(hull, sc, vol, mag, c, blur);
+    if (shift == 0) detail::hull_sums<false, true, true>(hull, 1.0, vol, mag, c, blur, emax);
+    else detail::hull_sums<true, true, true>(hull, sc, vol, mag, c, blur, emax);
     // Where the vertices' errors may move the volume by 2^-30 of it, it is
     // measured exactly from their planes: a column 5e7 long and 0.07 wide,
     // slanted (points 1e8 off a slanted plane), has vertices ~1e-8 off its
