@@ -92,6 +92,21 @@ TEST(Invariants, ValidateChecksSampledMeasuresExactly) {
     EXPECT_TRUE(r.ok);
     EXPECT_GE(r.measures_checked, 64u);  // the 64 spread cells at least; the smallest and longest overlap them
     EXPECT_LE(r.measure_rel_error, 1e-13);
+    {
+      auto four = good;  // validate runs in the cells' thread count: the same report in four
+      four.threads_used = 4;
+      four.neighbors.erase(four.neighbors.begin() + four.neighbor_offsets[1] - 1);  // and a one-sided spoke
+      for (std::size_t j = 1; j < four.neighbor_offsets.size(); ++j) --four.neighbor_offsets[j];
+      auto one = four;
+      one.threads_used = 1;
+      const tessera::ValidationReport r4 = tessera::validate(four, {}, pts), r1 = tessera::validate(one, {}, pts);
+      EXPECT_EQ(r4.asymmetric_spokes, 1u);
+      EXPECT_EQ(r4.asymmetric_spokes, r1.asymmetric_spokes);
+      EXPECT_EQ(r4.measures_checked, r1.measures_checked);
+      EXPECT_EQ(r4.measure_rel_error, r1.measure_rel_error);
+      EXPECT_EQ(r4.measure_worst, r1.measure_worst);
+      EXPECT_EQ(r4.messages, r1.messages);
+    }
     const std::size_t k = static_cast<std::size_t>(
         std::min_element(good.volume.begin(), good.volume.end()) - good.volume.begin());  // always sampled
     const std::string name = "cell of point " + std::to_string(good.generator[k]);
