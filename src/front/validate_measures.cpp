@@ -31,7 +31,8 @@ constexpr std::size_t sample_longest = 32;   // by radius^dim / volume
 constexpr std::size_t sample_spread = 64;    // evenly spaced in output order
 // A cell of more face corners than this is left out of the sample (the
 // centre of thousands of points on a sphere: its exact measure alone would
-// take seconds), and the check stops once it has measured this many in all.
+// take seconds); the sample is measured in order of priority, each cell
+// only while the corners measured in all stay within the second.
 constexpr std::size_t max_cell_corners = 20000;
 constexpr std::size_t max_total_corners = 400000;
 // Where the exact check reports failures by name, the first few.
