@@ -36,16 +36,19 @@ class CornerSet {
  public:
   /// Starts a cell of at most `corners` corners.
   void start(std::size_t corners) {
-    const std::size_t want = std::bit_ceil(std::max<std::size_t>(64, 2 * corners));
-    if (slots_.size() < want || ++stamp_ == 0) {
-      slots_.assign(std::max(want, slots_.size()), Slot{});
+    const std::size_t size = std::bit_ceil(std::max<std::size_t>(64, 2 * corners));
+    if (slots_.size() < size || ++stamp_ == 0) {
+      slots_.assign(std::max(size, slots_.size()), Slot{});
       stamp_ = 1;
     }
-    mask_ = std::bit_ceil(std::max<std::size_t>(64, 2 * corners)) - 1;
+    mask_ = size - 1;
+    shift_ = 64 - std::countr_zero(size);
   }
   /// True the first time v is met in this cell.
   bool insert(std::int32_t v) {
-    for (std::size_t s = (static_cast<std::uint32_t>(v) * 0x9E3779B1u) & mask_;; s = (s + 1) & mask_) {
+    // Fibonacci hashing: the product's top bits.
+    for (std::size_t s = (std::uint64_t{static_cast<std::uint32_t>(v)} * 0x9E3779B97F4A7C15ull) >> shift_;;
+         s = (s + 1) & mask_) {
       Slot& e = slots_[s];
       if (e.stamp != stamp_) {
         e = {v, stamp_};
@@ -62,6 +65,7 @@ class CornerSet {
   };
   std::vector<Slot> slots_;
   std::size_t mask_ = 0;
+  int shift_ = 64;
   std::uint32_t stamp_ = 0;
 };
 
