@@ -21,6 +21,8 @@
 #include <unordered_map>
 #include <vector>
 
+#include <tbb/parallel_for.h>
+
 #include "tessera/kernels/exact_predicates.hpp"
 
 namespace tessera::front {
@@ -45,15 +47,80 @@ std::string number(double x) {
   return s.str();
 }
 
+// One sampled cell against its exact measure.
+struct Outcome {
+  bool keyed = false;  // false: a face too short, or a corner whose key lacks the generator
+  double exact = 0, rel = 0;                 // the exact volume; the reported one's relative error
+  double off = 0, off_tolerance = 0, radius = 0;  // the centroid's error, its tolerance; the cell's radius
+};
+
+Outcome measure_cell(const Cells& c, const kernels::ExactContext& ctx, std::span<const double> points,
+                     const std::vector<double>& radius2, std::size_t k) {
+  const auto Du = static_cast<std::size_t>(c.dim);
+  const std::size_t nv = c.n_vertices();
+  const std::int32_t g = c.generator[k];
+  std::unordered_map<std::int32_t, std::uint32_t> local;  // merged vertex -> its index in the cell
+  std::vector<std::int32_t> vertex_planes;
+  std::vector<kernels::MeasureTerm> terms;
+  Outcome o;
+  o.keyed = true;
+  auto index_of = [&](std::int32_t v) {
+    const auto [it, fresh] = local.try_emplace(v, static_cast<std::uint32_t>(local.size()));
+    if (fresh) {
+      // The vertex's planes: its key without the generator (ascending,
+      // box planes negative, as exact_cell_measure takes them).
+      const std::int32_t* key = c.vertex_keys.data() + static_cast<std::size_t>(v) * (Du + 1);
+      std::size_t own = 0;
+      for (std::size_t d = 0; d <= Du; ++d) {
+        if (key[d] == g) ++own;
+        else vertex_planes.push_back(key[d]);
+      }
+      o.keyed &= own == 1;
+    }
+    return it->second;
+  };
+  for (auto f = c.cell_face_offsets[k]; f < c.cell_face_offsets[k + 1] && o.keyed; ++f) {
+    const auto q0 = static_cast<std::size_t>(c.face_vertex_offsets[static_cast<std::size_t>(f)]);
+    const auto q1 = static_cast<std::size_t>(c.face_vertex_offsets[static_cast<std::size_t>(f) + 1]);
+    o.keyed &= q1 >= q0 + (c.dim == 3 ? 3 : 2);  // a polygon; in 2D an edge
+    for (std::size_t q = q0; q < q1 && o.keyed; ++q)
+      o.keyed &= c.face_vertices[q] >= 0 && static_cast<std::size_t>(c.face_vertices[q]) < nv;
+    if (!o.keyed) return o;
+    // 3D: the cone over each edge a -> b of the face's loop
+    // (counter-clockwise from outside) from the foot of its plane. 2D: a
+    // face is an edge, its two vertices counter-clockwise (the shoelace term).
+    const std::int32_t plane = c.dim == 3 ? c.face_neighbor[static_cast<std::size_t>(f)] : 0;
+    const std::size_t m = q1 - q0;
+    for (std::size_t t = 0; t < (c.dim == 3 ? m : 1); ++t) {
+      const std::uint32_t a = index_of(c.face_vertices[q0 + t]);
+      const std::uint32_t b = index_of(c.face_vertices[q0 + (t + 1) % m]);
+      terms.push_back({plane, a, b});
+    }
+  }
+  if (!o.keyed) return o;
+  double centroid[3] = {0, 0, 0};
+  o.exact = kernels::exact_cell_measure(ctx, g, vertex_planes, terms, centroid);
+  o.rel = o.exact > 0 ? std::fabs(c.volume[k] - o.exact) / o.exact : std::numeric_limits<double>::infinity();
+  const double* p = points.data() + static_cast<std::size_t>(g) * Du;
+  o.radius = std::sqrt(radius2[k]);
+  double pmax = 0;
+  for (std::size_t d = 0; d < Du; ++d) {
+    o.off = std::max(o.off, std::fabs(c.centroid[k * Du + d] - (p[d] + centroid[d])));
+    pmax = std::max(pmax, std::fabs(p[d]));
+  }
+  // Both centroids add the generator's coordinates to one relative to it,
+  // each rounding once.
+  o.off_tolerance = measure_tolerance * o.radius + 8 * 0x1p-53 * (pmax + o.radius);
+  return o;
+}
+
 }  // namespace
 
 void check_measures(const Cells& c, std::span<const double> points, const std::vector<double>& radius2,
                     ValidationReport& r) {
   const int D = c.dim;
-  const auto Du = static_cast<std::size_t>(D);
   const std::size_t nc = c.n_cells();
   if (nc == 0 || c.vertex_keys.empty()) return;
-  const std::size_t nv = c.n_vertices();
   // Each cell's face corners: the exact measure's terms in 3D (twice them in 2D).
   auto corners = [&](std::size_t k) {
     return static_cast<std::size_t>(c.face_vertex_offsets[static_cast<std::size_t>(c.cell_face_offsets[k + 1])] -
@@ -92,92 +159,51 @@ void check_measures(const Cells& c, std::span<const double> points, const std::v
   for (const std::uint32_t k : pick)
     if (std::find(sample.begin(), sample.end(), k) == sample.end()) sample.push_back(k);
 
+  // The cells measured: the sample in order of priority, within the corner budget.
+  std::vector<std::uint32_t> measured;
+  std::size_t measured_corners = 0;
+  for (const std::uint32_t k : sample)
+    if (measured_corners + corners(k) <= max_total_corners) {
+      measured_corners += corners(k);
+      measured.push_back(k);
+    }
+
+  // Their exact measures, in parallel (each is independent; validate runs
+  // in the cells' arena), then reported in the order above.
   kernels::ExactContext ctx;
   ctx.points = points.data();
   ctx.dim = D;
   ctx.lo = c.bounds.lo;
   ctx.hi = c.bounds.hi;
-  std::unordered_map<std::int32_t, std::uint32_t> local;  // merged vertex -> its index in the cell
-  std::vector<std::int32_t> vertex_planes;
-  std::vector<kernels::MeasureTerm> terms;
-  std::size_t measured_corners = 0, failed = 0;
-  for (const std::uint32_t k : sample) {
-    if (measured_corners + corners(k) > max_total_corners) continue;
-    measured_corners += corners(k);
-    const std::int32_t g = c.generator[k];
-    local.clear();
-    vertex_planes.clear();
-    terms.clear();
-    bool keyed = true;
-    auto index_of = [&](std::int32_t v) {
-      const auto [it, fresh] = local.try_emplace(v, static_cast<std::uint32_t>(local.size()));
-      if (fresh) {
-        // The vertex's planes: its key without the generator (ascending,
-        // box planes negative, as exact_cell_measure takes them).
-        const std::int32_t* key = c.vertex_keys.data() + static_cast<std::size_t>(v) * (Du + 1);
-        std::size_t own = 0;
-        for (std::size_t d = 0; d <= Du; ++d) {
-          if (key[d] == g) ++own;
-          else vertex_planes.push_back(key[d]);
-        }
-        keyed &= own == 1;
-      }
-      return it->second;
-    };
-    for (auto f = c.cell_face_offsets[k]; f < c.cell_face_offsets[k + 1] && keyed; ++f) {
-      const auto q0 = static_cast<std::size_t>(c.face_vertex_offsets[static_cast<std::size_t>(f)]);
-      const auto q1 = static_cast<std::size_t>(c.face_vertex_offsets[static_cast<std::size_t>(f) + 1]);
-      keyed &= q1 >= q0 + (D == 3 ? 3 : 2);  // a polygon; in 2D an edge
-      for (std::size_t q = q0; q < q1 && keyed; ++q)
-        keyed &= c.face_vertices[q] >= 0 && static_cast<std::size_t>(c.face_vertices[q]) < nv;
-      if (!keyed) break;
-      // 3D: the cone over each edge a -> b of the face's loop
-      // (counter-clockwise from outside) from the foot of its plane. 2D: a
-      // face is an edge, its two vertices counter-clockwise (the shoelace term).
-      const std::int32_t plane = D == 3 ? c.face_neighbor[static_cast<std::size_t>(f)] : 0;
-      const std::size_t m = q1 - q0;
-      for (std::size_t t = 0; t < (D == 3 ? m : 1); ++t) {
-        const std::uint32_t a = index_of(c.face_vertices[q0 + t]);
-        const std::uint32_t b = index_of(c.face_vertices[q0 + (t + 1) % m]);
-        terms.push_back({plane, a, b});
-      }
-    }
-    if (!keyed) {
+  std::vector<Outcome> outcomes(measured.size());
+  tbb::parallel_for(std::size_t{0}, measured.size(),
+                    [&](std::size_t s) { outcomes[s] = measure_cell(c, ctx, points, radius2, measured[s]); });
+  std::size_t failed = 0;
+  for (std::size_t s = 0; s < measured.size(); ++s) {
+    const Outcome& o = outcomes[s];
+    const std::int32_t g = c.generator[measured[s]];
+    if (!o.keyed) {
       r.messages.push_back("cell of point " + std::to_string(g) +
                            ": a face too short, or a corner whose key does not name the generator");
       r.ok = false;
       continue;
     }
-    double centroid[3] = {0, 0, 0};
-    const double exact = kernels::exact_cell_measure(ctx, g, vertex_planes, terms, centroid);
     ++r.measures_checked;
-    const double v = c.volume[k];
-    const double rel = exact > 0 ? std::fabs(v - exact) / exact : std::numeric_limits<double>::infinity();
-    const double* p = points.data() + static_cast<std::size_t>(g) * Du;
-    const double radius = std::sqrt(radius2[k]);
-    double off = 0, pmax = 0;
-    for (std::size_t d = 0; d < Du; ++d) {
-      off = std::max(off, std::fabs(c.centroid[k * Du + d] - (p[d] + centroid[d])));
-      pmax = std::max(pmax, std::fabs(p[d]));
-    }
-    // Both centroids add the generator's coordinates to one relative to it,
-    // each rounding once.
-    const double off_tolerance = measure_tolerance * radius + 8 * 0x1p-53 * (pmax + radius);
-    if (r.measure_worst < 0 || rel > r.measure_rel_error) {
-      r.measure_rel_error = rel;
+    if (r.measure_worst < 0 || o.rel > r.measure_rel_error) {
+      r.measure_rel_error = o.rel;
       r.measure_worst = g;
     }
-    const bool volume_bad = !(rel <= measure_tolerance), centroid_bad = !(off <= off_tolerance);
+    const bool volume_bad = !(o.rel <= measure_tolerance), centroid_bad = !(o.off <= o.off_tolerance);
     if (!volume_bad && !centroid_bad) continue;
     r.ok = false;
     if (++failed > named_failures) continue;
     const char* what = D == 3 ? "volume " : "area ";
     if (volume_bad)
-      r.messages.push_back("cell of point " + std::to_string(g) + ": " + what + number(v) + ", exactly " +
-                           number(exact) + " (relative error " + number(rel) + ")");
+      r.messages.push_back("cell of point " + std::to_string(g) + ": " + what + number(c.volume[measured[s]]) +
+                           ", exactly " + number(o.exact) + " (relative error " + number(o.rel) + ")");
     else
-      r.messages.push_back("cell of point " + std::to_string(g) + ": centroid " + number(off) +
-                           " off its exact value (cell radius " + number(radius) + ")");
+      r.messages.push_back("cell of point " + std::to_string(g) + ": centroid " + number(o.off) +
+                           " off its exact value (cell radius " + number(o.radius) + ")");
   }
   if (failed > named_failures)
     r.messages.push_back(std::to_string(failed) + " of " + std::to_string(r.measures_checked) +
