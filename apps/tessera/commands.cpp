@@ -301,6 +301,9 @@ bool report_validation(const Cells& c, const io::PointCloud& pc, bool quiet) {
       std::printf("  %-18s %zu sampled cells against exact arithmetic: largest relative %s error %.2g (point %d)\n",
                   "exact measures", r.measures_checked, c.dim == 3 ? "volume" : "area", r.measure_rel_error,
                   r.measure_worst);
+    if (r.measures_checked)
+      std::printf("  %-18s their merged vertices against exact positions: largest offset %.2g of the cell radius (vertex %d)\n",
+                  "exact corners", r.vertex_rel_error, r.vertex_worst);
     for (const auto& m : r.messages) std::printf("  %s\n", m.c_str());
     std::fflush(stdout);
   }

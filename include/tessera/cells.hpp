@@ -173,12 +173,18 @@ struct ValidationReport {
   std::size_t measures_checked = 0;
   double measure_rel_error = 0;           ///< the largest relative volume error among them
   std::int32_t measure_worst = -1;        ///< the generator of that cell (-1: none checked)
+  /// The largest distance (max norm) of a corner of those cells from its
+  /// exact position (solved from its key), relative to its cell's radius,
+  /// and that merged vertex (-1: none checked).
+  double vertex_rel_error = 0;
+  std::int32_t vertex_worst = -1;
   std::vector<std::string> messages;      ///< one line each
 };
 /// The sampled exact check fails a cell whose volume errs by more than this,
 /// relatively (four times the 2^-30 the measure keeps: docs/design.md,
 /// "Strip areas"), or whose centroid errs by more than this times the
-/// cell's radius (plus the rounding of adding the generator's coordinates).
+/// cell's radius (plus the rounding of adding the generator's coordinates),
+/// or one of whose corners lies farther than that from its exact position.
 inline constexpr double measure_tolerance = 0x1p-28;
 /// `points` (n_points x dim, the coordinates the cells were computed from)
 /// enables the exact check of sampled cells' measures; an empty span skips

@@ -65,6 +65,10 @@ void bind_voronoi(py::module_& m) {
       .def_readonly("measure_rel_error", &ValidationReport::measure_rel_error,
                     "the largest relative volume (area) error among them")
       .def_readonly("measure_worst", &ValidationReport::measure_worst, "that cell's generator (-1: none checked)")
+      .def_readonly("vertex_rel_error", &ValidationReport::vertex_rel_error,
+                    "the largest distance of those cells' merged vertices from their exact positions, relative to "
+                    "the cell's radius")
+      .def_readonly("vertex_worst", &ValidationReport::vertex_worst, "that merged vertex (-1: none checked)")
       .def_readonly("messages", &ValidationReport::messages)
       .def("__bool__", [](const ValidationReport& r) { return r.ok; })
       .def("__repr__", [](const ValidationReport& r) {

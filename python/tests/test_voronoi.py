@@ -57,6 +57,7 @@ def test_validate_passes_and_is_truthy(dim):
     # a sample of cells measured exactly (the smallest, the longest, a spread)
     assert report.measures_checked >= 64
     assert report.measure_rel_error < 1e-13 and report.measure_worst >= 0
+    assert report.vertex_rel_error < 1e-12 and report.vertex_worst >= 0
 
 
 def test_validate_cells_checks_measures_only_with_the_points():

@@ -6,7 +6,8 @@
 // vertices exactly from the input points and sums the cell's cones exactly
 // (kernels::exact_cell_measure, the measure's own fallback, given terms
 // built here from the mesh). So a wrong float measure, or a cell whose
-// recorded measure belongs to different faces, shows up. The per-cell cost
+// recorded measure belongs to different faces, shows up. The merged
+// vertices' coordinates are compared with those exact positions too. The per-cell cost
 // is ~0.1 ms in fixed point, more where it falls back to rationals, so only
 // a sample is measured: the cells most likely to be wrong (the smallest,
 // and the most elongated, whose float terms cancel: stop 63's columns,
@@ -18,6 +19,7 @@
 #include <cstdint>
 #include <limits>
 #include <sstream>
+#include <stdexcept>
 #include <unordered_map>
 #include <vector>
 
@@ -50,8 +52,13 @@ std::string number(double x) {
 // One sampled cell against its exact measure.
 struct Outcome {
   bool keyed = false;  // false: a face too short, or a corner whose key lacks the generator
+  bool solvable = true;  // false: a corner's key names dependent planes (no such vertex exists)
   double exact = 0, rel = 0;                 // the exact volume; the reported one's relative error
   double off = 0, off_tolerance = 0, radius = 0;  // the centroid's error, its tolerance; the cell's radius
+  // The corner farthest from its exact position (by its key), and how far
+  // (|.|_inf); its tolerance is off_tolerance's.
+  double vertex_off = 0;
+  std::int32_t vertex_worst = -1;
 };
 
 Outcome measure_cell(const Cells& c, const kernels::ExactContext& ctx, std::span<const double> points,
@@ -60,6 +67,7 @@ Outcome measure_cell(const Cells& c, const kernels::ExactContext& ctx, std::span
   const std::size_t nv = c.n_vertices();
   const std::int32_t g = c.generator[k];
   std::unordered_map<std::int32_t, std::uint32_t> local;  // merged vertex -> its index in the cell
+  std::vector<std::int32_t> merged;                        // the inverse
   std::vector<std::int32_t> vertex_planes;
   std::vector<kernels::MeasureTerm> terms;
   Outcome o;
@@ -67,6 +75,7 @@ Outcome measure_cell(const Cells& c, const kernels::ExactContext& ctx, std::span
   auto index_of = [&](std::int32_t v) {
     const auto [it, fresh] = local.try_emplace(v, static_cast<std::uint32_t>(local.size()));
     if (fresh) {
+      merged.push_back(v);
       // The vertex's planes: its key without the generator (ascending,
       // box planes negative, as exact_cell_measure takes them).
       const std::int32_t* key = c.vertex_keys.data() + static_cast<std::size_t>(v) * (Du + 1);
@@ -99,7 +108,12 @@ Outcome measure_cell(const Cells& c, const kernels::ExactContext& ctx, std::span
   }
   if (!o.keyed) return o;
   double centroid[3] = {0, 0, 0};
-  o.exact = kernels::exact_cell_measure(ctx, g, vertex_planes, terms, centroid);
+  try {
+    o.exact = kernels::exact_cell_measure(ctx, g, vertex_planes, terms, centroid);
+  } catch (const std::logic_error&) {  // exact_vertex: the key's planes meet in no point
+    o.solvable = false;
+    return o;
+  }
   o.rel = o.exact > 0 ? std::fabs(c.volume[k] - o.exact) / o.exact : std::numeric_limits<double>::infinity();
   const double* p = points.data() + static_cast<std::size_t>(g) * Du;
   o.radius = std::sqrt(radius2[k]);
@@ -111,6 +125,23 @@ Outcome measure_cell(const Cells& c, const kernels::ExactContext& ctx, std::span
   // Both centroids add the generator's coordinates to one relative to it,
   // each rounding once.
   o.off_tolerance = measure_tolerance * o.radius + 8 * 0x1p-53 * (pmax + o.radius);
+  // The corners where the mesh puts them against their exact positions.
+  // A merged vertex was solved in its owner's frame (the lowest generator
+  // of its key), but it lies as far from every generator of its key, so its
+  // float error scales with |y| <= this cell's radius as here: below 1e-10
+  // of it for the float solves (condition under filter::exact_vertex_condition),
+  // the last bits for exact ones; the tolerance allows 2^-28.
+  for (std::size_t l = 0; l < merged.size(); ++l) {
+    double y[3] = {0, 0, 0};
+    kernels::exact_vertex(ctx, g, vertex_planes.data() + l * Du, y);
+    const double* v = c.vertices.data() + static_cast<std::size_t>(merged[l]) * Du;
+    double off = 0;
+    for (std::size_t d = 0; d < Du; ++d) off = std::max(off, std::fabs(v[d] - (p[d] + y[d])));
+    if (!(off <= o.vertex_off) || o.vertex_worst < 0) {  // NaN: the worst
+      o.vertex_off = off;
+      o.vertex_worst = merged[l];
+    }
+  }
   return o;
 }
 
@@ -182,9 +213,10 @@ void check_measures(const Cells& c, std::span<const double> points, const std::v
   for (std::size_t s = 0; s < measured.size(); ++s) {
     const Outcome& o = outcomes[s];
     const std::int32_t g = c.generator[measured[s]];
-    if (!o.keyed) {
+    if (!o.keyed || !o.solvable) {
       r.messages.push_back("cell of point " + std::to_string(g) +
-                           ": a face too short, or a corner whose key does not name the generator");
+                           (o.keyed ? ": a corner's key names planes that meet in no point"
+                                    : ": a face too short, or a corner whose key does not name the generator"));
       r.ok = false;
       continue;
     }
@@ -193,21 +225,31 @@ void check_measures(const Cells& c, std::span<const double> points, const std::v
       r.measure_rel_error = o.rel;
       r.measure_worst = g;
     }
-    const bool volume_bad = !(o.rel <= measure_tolerance), centroid_bad = !(o.off <= o.off_tolerance);
-    if (!volume_bad && !centroid_bad) continue;
+    const double vertex_rel = o.radius > 0 ? o.vertex_off / o.radius : std::numeric_limits<double>::infinity();
+    if (r.vertex_worst < 0 || !(vertex_rel <= r.vertex_rel_error)) {
+      r.vertex_rel_error = vertex_rel;
+      r.vertex_worst = o.vertex_worst;
+    }
+    const bool volume_bad = !(o.rel <= measure_tolerance), centroid_bad = !(o.off <= o.off_tolerance),
+               vertex_bad = !(o.vertex_off <= o.off_tolerance);
+    if (!volume_bad && !centroid_bad && !vertex_bad) continue;
     r.ok = false;
     if (++failed > named_failures) continue;
     const char* what = D == 3 ? "volume " : "area ";
     if (volume_bad)
       r.messages.push_back("cell of point " + std::to_string(g) + ": " + what + number(c.volume[measured[s]]) +
                            ", exactly " + number(o.exact) + " (relative error " + number(o.rel) + ")");
-    else
+    else if (centroid_bad)
       r.messages.push_back("cell of point " + std::to_string(g) + ": centroid " + number(o.off) +
                            " off its exact value (cell radius " + number(o.radius) + ")");
+    else
+      r.messages.push_back("cell of point " + std::to_string(g) + ": merged vertex " + std::to_string(o.vertex_worst) +
+                           " " + number(o.vertex_off) + " off its exact position (cell radius " +
+                           number(o.radius) + ")");
   }
   if (failed > named_failures)
     r.messages.push_back(std::to_string(failed) + " of " + std::to_string(r.measures_checked) +
-                         " sampled cells differ from their exact measures");
+                         " sampled cells differ from their exact measures or corners");
 }
 
 }  // namespace tessera::front

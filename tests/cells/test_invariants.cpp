@@ -81,8 +81,8 @@ TEST(Invariants, CheckerCatchesCorruption) {
 }
 
 // validate()'s exact check of sampled measures (front/validate_measures.cpp):
-// a cell's volume or centroid off by far less than the volume sum can show is
-// caught, and named.
+// a cell's volume, centroid or corner off by far less than the volume sum can
+// show is caught, and named; a corrupt key is reported.
 TEST(Invariants, ValidateChecksSampledMeasuresExactly) {
   for (const int dim : {2, 3}) {
     SCOPED_TRACE(dim);
@@ -105,6 +105,8 @@ TEST(Invariants, ValidateChecksSampledMeasuresExactly) {
       EXPECT_EQ(r4.measures_checked, r1.measures_checked);
       EXPECT_EQ(r4.measure_rel_error, r1.measure_rel_error);
       EXPECT_EQ(r4.measure_worst, r1.measure_worst);
+      EXPECT_EQ(r4.vertex_rel_error, r1.vertex_rel_error);
+      EXPECT_EQ(r4.vertex_worst, r1.vertex_worst);
       EXPECT_EQ(r4.messages, r1.messages);
     }
     const std::size_t k = static_cast<std::size_t>(
@@ -129,6 +131,40 @@ TEST(Invariants, ValidateChecksSampledMeasuresExactly) {
       EXPECT_FALSE(bad.ok);
       ASSERT_FALSE(bad.messages.empty());
       EXPECT_NE(bad.messages.front().find(name + ": centroid"), std::string::npos) << bad.messages.front();
+    }
+    EXPECT_LE(r.vertex_rel_error, 1e-12);
+    EXPECT_GE(r.vertex_worst, 0);
+    const auto Du = static_cast<std::size_t>(dim);
+    // A corner of cell k: the first vertex of its first face.
+    const std::int32_t v = good.face_vertices[static_cast<std::size_t>(
+        good.face_vertex_offsets[static_cast<std::size_t>(good.cell_face_offsets[k])])];
+    {
+      auto c = good;  // that corner moved by 1e-7: no measure changes
+      c.vertices[static_cast<std::size_t>(v) * Du] += 1e-7;
+      EXPECT_TRUE(tessera::validate(c, {}).ok);
+      const tessera::ValidationReport bad = tessera::validate(c, {}, pts);
+      EXPECT_FALSE(bad.ok);
+      EXPECT_EQ(bad.vertex_worst, v);
+      EXPECT_GT(bad.vertex_rel_error, 1e-7);
+      ASSERT_FALSE(bad.messages.empty());
+      EXPECT_NE(bad.messages.front().find("merged vertex " + std::to_string(v)), std::string::npos)
+          << bad.messages.front();
+    }
+    {
+      auto c = good;  // its key names one bisector twice: no such point, reported, not thrown
+      std::int32_t* key = c.vertex_keys.data() + static_cast<std::size_t>(v) * (Du + 1);
+      std::int32_t other = -1;
+      for (std::size_t d = 0; d <= Du; ++d)
+        if (key[d] != good.generator[k]) {
+          if (other < 0) other = key[d];
+          key[d] = other;
+        }
+      tessera::ValidationReport bad;
+      ASSERT_NO_THROW(bad = tessera::validate(c, {}, pts));
+      EXPECT_FALSE(bad.ok);
+      bool named = false;
+      for (const auto& m : bad.messages) named |= m.find(name + ": a corner's key names planes") != std::string::npos;
+      EXPECT_TRUE(named);
     }
     const std::vector<double> fewer(pts.begin(), pts.end() - dim);
     EXPECT_THROW(tessera::validate(good, {}, fewer), std::invalid_argument);

@@ -322,6 +322,8 @@ class Voronoi3D(TempDirCase):
         self.assertIn("validation: OK", r.stdout)
         self.assertRegex(r.stdout, r"exact measures +\d+ sampled cells against exact arithmetic: "
                                    r"largest relative volume error")
+        self.assertRegex(r.stdout, r"exact corners +their merged vertices against exact positions: "
+                                   r"largest offset \S+ of the cell radius \(vertex \d+\)")
         g = read_vtu(out)
         self.assertEqual(g.GetNumberOfCells(), self.N)
         # default domain: bounding box padded by 1% of the largest extent, then
