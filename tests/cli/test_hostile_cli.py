@@ -20,7 +20,8 @@ a small integer grid offset by 2^50, concentric spheres, clouds far from the ori
 cluster in a huge cloud, nearly collinear and nearly coplanar points, points
 on a sphere with its centre, small integer grids, a bulk with a few far
 outliers (up to 1e30 away, and 1e160 to 1e300), magnitudes spread
-log-uniformly over 1e-300..1e300, with random labels on a third of the cases. The only accepted
+log-uniformly over 1e-300..1e300, fcc, bcc and hexagonal packings, every point
+with a near twin, with random labels on a third of the cases. The only accepted
 failure is the input error for a zero extent (all points on an axis plane,
 or one point).
 
@@ -51,7 +52,8 @@ def rotation(rng, d):
 KINDS = ["uniform", "lattice", "rotated_lattice", "rotated_lattice_scaled", "duplicates", "near_duplicates",
          "power_of_ten", "far_from_origin", "cluster_in_cloud", "nearly_collinear", "nearly_flat",
          "sphere_and_centre", "grid_jitter", "small_integers", "far_outliers", "log_uniform",
-         "outliers_beyond_frame", "anisotropic", "layers", "big_integers", "concentric_spheres", "piles"]
+         "outliers_beyond_frame", "anisotropic", "layers", "big_integers", "concentric_spheres", "piles",
+         "packed_lattice", "twins"]
 
 
 def generate(kind, rng, n, d):
@@ -141,6 +143,24 @@ def generate(kind, rng, n, d):
         p = rng.random((n, d))
         piles = np.repeat(p[rng.integers(0, n, int(rng.integers(1, 4)))], 10 * n, axis=0)
         return rng.permutation(np.vstack([p, piles]))
+    if kind == "packed_lattice":
+        # Crystal packings (granular and materials inputs): fcc or bcc in
+        # 3D, hexagonal in 2D, whose cells meet in many cospherical
+        # (cocircular) sets at once; rotated half the time, so the ties hold
+        # only up to rounding.
+        m = int(rng.integers(2, 6)) if d == 3 else int(rng.integers(3, 16))
+        b = lattice(m, d)
+        if d == 3:
+            shifts = [[0.5, 0.5, 0], [0.5, 0, 0.5], [0, 0.5, 0.5]] if rng.integers(0, 2) else [[0.5, 0.5, 0.5]]
+            p = np.vstack([b] + [b + s for s in shifts])
+        else:
+            p = np.column_stack([b[:, 0] + 0.5 * (b[:, 1] % 2), b[:, 1] * np.sqrt(3) / 2])
+        return p @ rotation(rng, d).T if rng.integers(0, 2) else p
+    if kind == "twins":
+        # Every point with a twin 1e-15 to 1e-9 away (a merged pair of
+        # scans, a particle output written twice with noise).
+        p = rng.random((n, d))
+        return np.vstack([p, p + rng.normal(size=p.shape) * 10.0 ** int(rng.integers(-15, -8))])
     raise ValueError(kind)
 
 
