@@ -225,8 +225,9 @@ class Voronoi:
         its key, Euler characteristic (3D), and a sample of cells (the smallest,
         the most elongated and a spread over the rest) whose volume,
         centroid and corners are compared with exact arithmetic
-        (``measures_checked``, ``measure_rel_error``, ``vertex_rel_error``). The report is truthy when all pass;
-        ``report.messages`` says what failed."""
+        (``measures_checked``, ``measure_rel_error``, ``vertex_rel_error``).
+        The report is truthy when all pass; ``report.messages`` says what
+        failed."""
         return _core.validate_cells(self._cells, self._labels, self._points)
 
     @cached_property

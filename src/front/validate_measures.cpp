@@ -7,9 +7,9 @@
 // (kernels::exact_cell_measure, the measure's own fallback, given terms
 // built here from the mesh). So a wrong float measure, or a cell whose
 // recorded measure belongs to different faces, shows up. The merged
-// vertices' coordinates are compared with those exact positions too. The per-cell cost
-// is ~0.1 ms in fixed point, more where it falls back to rationals, so only
-// a sample is measured: the cells most likely to be wrong (the smallest,
+// vertices' coordinates are compared with those exact positions too. The
+// per-cell cost is ~0.1 ms in fixed point, more where it falls back to
+// rationals, so only a sample is measured: the cells most likely to be wrong (the smallest,
 // and the most elongated, whose float terms cancel: stop 63's columns,
 // stop 64's strips) and a spread over the rest.
 #include "validate_measures.hpp"
@@ -133,7 +133,7 @@ Outcome measure_cell(const Cells& c, const kernels::ExactContext& ctx, std::span
   // the last bits for exact ones; the tolerance allows 2^-28.
   for (std::size_t l = 0; l < merged.size(); ++l) {
     double y[3] = {0, 0, 0};
-    kernels::exact_vertex(ctx, g, vertex_planes.data() + l * Du, y);
+    kernels::exact_vertex(ctx, g, vertex_planes.data() + l * Du, y);  // solvable: the measure solved it
     const double* v = c.vertices.data() + static_cast<std::size_t>(merged[l]) * Du;
     double off = 0;
     for (std::size_t d = 0; d < Du; ++d) off = std::max(off, std::fabs(v[d] - (p[d] + y[d])));

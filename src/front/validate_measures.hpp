@@ -13,9 +13,10 @@ namespace tessera::front {
 /// merged vertices' keys, and the cells' merged vertices with their exact
 /// positions, and records the outcome in `r` (measures_checked,
 /// measure_rel_error, measure_worst, vertex_rel_error, vertex_worst; a
-/// message and ok = false for each cell past measure_tolerance). `radius2`: each cell's squared radius (its
-/// farthest vertex from its generator), which ranks the cells by elongation
-/// and scales the centroid's tolerance. Needs the mesh, every vertex used by
+/// message and ok = false for each cell past measure_tolerance).
+/// `radius2`: each cell's squared radius (its farthest vertex from its
+/// generator), which ranks the cells by elongation and scales the
+/// tolerances of the centroid and the corners. Needs the mesh, every vertex used by
 /// exactly the cells of its key; the caller checks that volumes are
 /// representable.
 ///
