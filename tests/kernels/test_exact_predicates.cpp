@@ -32,6 +32,7 @@
 #include <string>
 #include <vector>
 
+#include "tessera/kernels/box_ties.hpp"
 #include "tessera/kernels/delaunay_predicates.hpp"
 #include "tessera/kernels/exact_predicates.hpp"
 #include "tessera/kernels/prepared_signs.hpp"
@@ -241,6 +242,20 @@ int extended_sign(const ExactContext& c, std::int32_t i, const std::int32_t* pla
   return s;
 }
 
+/// How many queries BoxTiePredicate served (a tie at the corners of one
+/// axis-aligned box), over the whole test binary.
+int box_used = 0;
+
+/// BoxTiePredicate's sign where it serves (the vertex and the candidate at
+/// corners of one box), else 0.
+int box_sign(const ExactContext& c, std::int32_t i, const std::int32_t* planes, std::int32_t j) {
+  using tessera::kernels::box_tie_sign;
+  int s = 0;
+  if (!(c.dim == 3 ? box_tie_sign<3>(c, i, planes, j, s) : box_tie_sign<2>(c, i, planes, j, s))) return 0;
+  ++box_used;
+  return s;
+}
+
 /// Kernel vs oracle for one query; returns the kernel's sign. The extended
 /// stage, where it answers, must answer the same.
 int check_sign(const ExactContext& c, std::int32_t i, const std::int32_t* planes, std::int32_t j) {
@@ -248,6 +263,7 @@ int check_sign(const ExactContext& c, std::int32_t i, const std::int32_t* planes
   EXPECT_EQ(prepared_sign(c, i, planes, j), got) << "prepared: " << describe(c, i, planes, j);
   EXPECT_EQ(wide_sign(c, i, planes, j), got) << "wide: " << describe(c, i, planes, j);
   if (const int e = extended_sign(c, i, planes, j); e != 0) EXPECT_EQ(e, got) << "extended: " << describe(c, i, planes, j);
+  if (const int b = box_sign(c, i, planes, j); b != 0) EXPECT_EQ(b, got) << "box: " << describe(c, i, planes, j);
   const int want = oracle_sign(c, i, planes, j);
   EXPECT_NE(want, 0) << "oracle: every perturbation coefficient vanished for " << describe(c, i, planes, j);
   EXPECT_EQ(got, want) << describe(c, i, planes, j) << "  P0 = " << power_diff(c, i, planes, j).get_d();
@@ -285,6 +301,8 @@ int check_views(const ExactContext& c, const std::array<std::int32_t, 4>& defs, 
       EXPECT_EQ(wide_sign(c, defs[g], others.data(), j), s) << "wide: " << describe(c, defs[g], others.data(), j);
       if (const int e = extended_sign(c, defs[g], others.data(), j); e != 0)
         EXPECT_EQ(e, s) << "extended: " << describe(c, defs[g], others.data(), j);
+      if (const int b = box_sign(c, defs[g], others.data(), j); b != 0)
+        EXPECT_EQ(b, s) << "box: " << describe(c, defs[g], others.data(), j);
       EXPECT_TRUE(s == 1 || s == -1) << describe(c, defs[g], others.data(), j);
       EXPECT_EQ(s, want) << describe(c, defs[g], others.data(), j);
       if (first == 0) first = s;
@@ -899,6 +917,114 @@ TEST(ExactPredicates, FullMantissaCornerTies) {
     }
   }
   EXPECT_GT(wide_used - before, 1000) << "the fixed-width stage hardly ran";
+}
+
+// Tensor-product grids: each axis's coordinates from a list of its own (full
+// mantissas, any spacing: voxel centres of a 0.7 x 0.7 x 1.2 scan, a
+// rectilinear grid), at magnitudes from 1e-200 to 1e150. The corners of any
+// axis-aligned box are cospherical, so a vertex of dim + 1 corners ties with
+// every other corner of its box; BoxTiePredicate (through exact_clip_sign)
+// decides those from the coordinates' pattern, and must give the oracle's
+// sign from every view and order (check_views). Vertices on box planes are
+// drawn too: their generators on one face of the box, which the plane's axis
+// holds (the grid's boundary cells). Candidates off the vertex's box must be
+// refused and still be decided right by the later stages.
+TEST(ExactPredicates, BoxTiesOnTensorGrids) {
+  Rng r(101);
+  const int before = box_used;
+  int ties = 0, refused = 0;
+  for (int dim : {2, 3}) {
+    for (const double scale : {1.0, 0.7, 1e-200, 3e150}) {
+      for (const double offset : {0.0, -12.375, 1e6}) {
+        Problem p;
+        p.dim = dim;
+        constexpr int kValues = 4;
+        std::array<std::array<double, kValues>, 3> values{};
+        for (int d = 0; d < dim; ++d) {
+          for (int k = 0; k < kValues; ++k) values[d][k] = scale * (offset + k + 0.3 * full_mantissa(r));
+          if (r.coin()) std::reverse(values[d].begin(), values[d].end());  // descending lists too
+          p.lo[d] = -std::fabs(scale) * (std::fabs(offset) + 2 * kValues);
+          p.hi[d] = -p.lo[d];
+        }
+        const int n = dim == 3 ? kValues * kValues * kValues : kValues * kValues;
+        std::vector<std::array<int, 3>> index(static_cast<std::size_t>(n));
+        std::vector<std::int32_t> order(static_cast<std::size_t>(n));
+        for (int m = 0; m < n; ++m) order[static_cast<std::size_t>(m)] = m;
+        std::shuffle(order.begin(), order.end(), r.g);  // ids unrelated to the grid
+        for (int m : order) {
+          std::array<double, 3> x{};
+          std::array<int, 3> at{};
+          for (int d = 0, q = m; d < dim; ++d, q /= kValues) at[d] = q % kValues;
+          for (int d = 0; d < dim; ++d) x[d] = values[d][static_cast<std::size_t>(at[d])];
+          index[static_cast<std::size_t>(p.add(x))] = at;
+        }
+        auto id_of = [&](const std::array<int, 3>& at) {
+          for (std::int32_t k = 0; k < n; ++k)
+            if (index[static_cast<std::size_t>(k)] == at) return k;
+          return std::int32_t{-1};
+        };
+        const auto c = p.ctx();
+        for (int t = 0; t < 40; ++t) {
+          // A box: two of each axis's values. Held axes (box planes) keep
+          // the first; the vertex's generators and j are corners of that face.
+          std::array<std::array<int, 2>, 3> side{};
+          for (int d = 0; d < dim; ++d) {
+            side[d][0] = r.index(kValues);
+            do side[d][1] = r.index(kValues); while (side[d][1] == side[d][0]);
+          }
+          const int nheld = r.index(dim);  // 0 .. dim - 1
+          std::vector<std::array<int, 3>> corners;
+          for (int m = 0; m < (1 << dim); ++m) {
+            bool on_face = true;
+            for (int d = 0; d < nheld; ++d) on_face &= ((m >> d) & 1) == 0;
+            if (!on_face) continue;
+            std::array<int, 3> at{};
+            for (int d = 0; d < dim; ++d) at[d] = side[d][(m >> d) & 1];
+            corners.push_back(at);
+          }
+          std::shuffle(corners.begin(), corners.end(), r.g);
+          const int ngen = dim + 1 - nheld;
+          if (static_cast<int>(corners.size()) <= ngen) continue;
+          std::array<std::int32_t, 4> defs{};
+          for (int d = 0; d < nheld; ++d) defs[static_cast<std::size_t>(d)] = box_plane_id(d, r.coin());
+          for (int k = 0; k < ngen; ++k) defs[static_cast<std::size_t>(nheld + k)] = id_of(corners[static_cast<std::size_t>(k)]);
+          std::shuffle(defs.begin(), defs.begin() + dim + 1, r.g);
+          std::int32_t i = -1;
+          Ids planes{};
+          for (int q = 0, k = 0; q <= dim; ++q) {
+            if (i < 0 && defs[static_cast<std::size_t>(q)] >= 0) i = defs[static_cast<std::size_t>(q)];
+            else planes[static_cast<std::size_t>(k++)] = defs[static_cast<std::size_t>(q)];
+          }
+          if (!independent(c, i, planes.data())) continue;
+          const std::int32_t j = id_of(corners[static_cast<std::size_t>(ngen + r.index(static_cast<int>(corners.size()) - ngen))]);
+          ASSERT_EQ(power_diff(c, i, planes.data(), j), 0) << "not a tie: " << describe(c, i, planes.data(), j);
+          EXPECT_NE(box_sign(c, i, planes.data(), j), 0) << "a box tie not served: " << describe(c, i, planes.data(), j);
+          check_views(c, defs, j);
+          ++ties;
+          // Off the box: another value on some axis (a held one included).
+          std::array<int, 3> off = index[static_cast<std::size_t>(j)];
+          const int d = r.index(dim);
+          do off[static_cast<std::size_t>(d)] = r.index(kValues);
+          while (off[static_cast<std::size_t>(d)] == side[d][0] || off[static_cast<std::size_t>(d)] == side[d][1]);
+          const std::int32_t k = id_of(off);
+          EXPECT_EQ(box_sign(c, i, planes.data(), k), 0) << "off the box, yet served: " << describe(c, i, planes.data(), k);
+          check_sign(c, i, planes.data(), k);
+          ++refused;
+        }
+        // Any vertex of grid points and box planes, any candidate: the box
+        // stage must refuse what is no tie of its kind (generators off a box
+        // plane's axis, a third value on an axis) and serve only correctly.
+        for (int t = 0; t < 40; ++t) {
+          std::int32_t i, j;
+          Ids planes{};
+          if (random_query(p, r, dim - 1, i, planes, j)) check_sign(c, i, planes.data(), j);
+        }
+      }
+    }
+  }
+  EXPECT_GT(ties, 500);
+  EXPECT_GT(refused, 500);
+  EXPECT_GT(box_used - before, 2000) << "the box stage hardly ran";
 }
 
 // Exact duplicates p_j == p_i: the lower id keeps its vertices (+1 when i < j,

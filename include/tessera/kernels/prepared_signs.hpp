@@ -4,6 +4,10 @@
 // the sign is exact_clip_sign's. A vertex is asked against many candidates
 // (on lattices nearly every vertex ties with several), so what depends only
 // on the vertex is prepared once, in the first stage that can serve it:
+//   0. BoxTiePredicate: a tie at the corners of an axis-aligned box (any
+//      lattice or tensor-product grid, whatever its spacing), decided from
+//      the coordinates' pattern alone; a candidate off the vertex's box goes
+//      on to the stages below, which are prepared only then;
 //   1. VertexPredicate: the vertex's points on a small integer grid (lattices,
 //      voxel centres, integer and dyadic grids);
 //   2. ExtendedPredicate: x87 extended precision with a certified bound, for
@@ -21,6 +25,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "tessera/kernels/box_ties.hpp"
 #include "tessera/kernels/exact_predicates.hpp"
 
 namespace tessera::kernels {
@@ -68,6 +73,17 @@ class PreparedSigns {
     if (!same) {
       s.cell = cell_;
       for (int k = 0; k < D; ++k) s.p[k] = p[k];
+      const bool box_tried = box_gate_.open();
+      s.box = box_tried && s.box_pred.prepare(ctx, gen, ids);
+      if (box_tried) box_gate_.record(s.box);
+      s.staged = false;
+    }
+    if (s.box) {
+      int r;
+      if (s.box_pred.sign(ctx, j, r)) return r;
+    }
+    if (!s.staged) {
+      s.staged = true;
       // On a global grid (ExactContext::grid) VertexPredicate always serves.
       const bool global = ctx.grid != nullptr;
       const bool tried = global || grid_gate_.open();
@@ -100,9 +116,12 @@ class PreparedSigns {
   struct Slot {
     std::uint64_t cell = 0;
     Index p[D] = {};
+    bool box = false;       // box_pred prepared (a candidate may still be off its box)
+    bool staged = false;    // the stages below box_pred prepared
     bool grid = false;      // pred serves the vertex
     bool extended = false;  // ext prepared
     Wide wide = Wide::untried;
+    BoxTiePredicate<D> box_pred;
     VertexPredicate pred;
     ExtendedPredicate ext;
     WidePredicate wide_pred;
@@ -110,6 +129,7 @@ class PreparedSigns {
   std::vector<Slot> slots_;
   std::uint64_t cell_ = 0;  // cells started (the slots' epoch)
   std::uint64_t calls_ = 0, off_grid_ = 0;
+  StageGate box_gate_;       // whether a slot tries BoxTiePredicate
   StageGate grid_gate_;      // whether a slot tries VertexPredicate (off a global grid)
   StageGate extended_gate_;  // whether a slot prepares ExtendedPredicate
 };
