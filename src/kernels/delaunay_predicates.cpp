@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <type_traits>
 
+#include "tessera/kernels/box_ties.hpp"
 #include "tessera/kernels/expansion.hpp"
 #include "tessera/kernels/filter.hpp"
 #include "tessera/kernels/prepared_signs.hpp"
@@ -307,6 +308,10 @@ bool in_sphere_extended(const ExactContext& ctx, const double* pa, const double*
   // lattice's cospherical points, voxel centres) it can never settle: after
   // a run of such failures the gate lets only one test in 64 try it (speed
   // only; the exact sign is the same).
+  // Ties at the corners of an axis-aligned box (every in-sphere tie of a
+  // lattice or of voxel centres, whatever the spacing) first: decided from
+  // the coordinates' pattern, where the long double stage can only fail.
+  if (int s; box_tie_sign<D>(ctx, a, planes, q, s)) return s < 0;
   if constexpr (std::numeric_limits<long double>::digits >= 64) {
     thread_local StageGate gate;
     if (gate.open()) {
