@@ -53,7 +53,7 @@ KINDS = ["uniform", "lattice", "rotated_lattice", "rotated_lattice_scaled", "dup
          "power_of_ten", "far_from_origin", "cluster_in_cloud", "nearly_collinear", "nearly_flat",
          "sphere_and_centre", "grid_jitter", "small_integers", "far_outliers", "log_uniform",
          "outliers_beyond_frame", "anisotropic", "layers", "big_integers", "concentric_spheres", "piles",
-         "packed_lattice", "twins"]
+         "packed_lattice", "twins", "rectilinear"]
 
 
 def generate(kind, rng, n, d):
@@ -161,6 +161,18 @@ def generate(kind, rng, n, d):
         # scans, a particle output written twice with noise).
         p = rng.random((n, d))
         return np.vstack([p, p + rng.normal(size=p.shape) * 10.0 ** int(rng.integers(-15, -8))])
+    if kind == "rectilinear":
+        # Voxel centres and rectilinear grids: each axis's coordinates from a
+        # list of its own, with uneven full-mantissa steps (a scan at 0.7 x
+        # 0.7 x 1.2 mm, a stretched CFD grid), at a random scale and offset,
+        # some points dropped (a sampled label image). Every cell corner is a
+        # tie at the corners of an axis-aligned box.
+        m = int(rng.integers(2, 7)) if d == 3 else int(rng.integers(3, 20))
+        s = 10.0 ** int(rng.integers(-6, 7))
+        axes = [s * (rng.normal() * 1e3 + np.cumsum(rng.uniform(0.3, 1.7, m))) for _ in range(d)]
+        p = np.stack(np.meshgrid(*axes, indexing="ij"), -1).reshape(-1, d)
+        keep = rng.random(len(p)) < rng.uniform(0.5, 1.0)
+        return rng.permutation(p[keep] if keep.sum() > d + 1 else p)
     raise ValueError(kind)
 
 
