@@ -302,16 +302,16 @@ int in_sphere_filter(const double* pa, const double* const* p, T unit, P eps) {
 template <int D>
 bool in_sphere_extended(const ExactContext& ctx, const double* pa, const double* const* p, std::int32_t a,
                         const std::int32_t* planes, std::int32_t q) {
+  // Ties at the corners of an axis-aligned box (the in-sphere ties of
+  // lattices and voxel centres, whatever the spacing) first: decided from the
+  // coordinates' pattern, where the long double stage can only fail.
+  if (int s; box_tie_sign<D>(ctx, a, planes, q, s)) return s < 0;
   // Near-degenerate input (a rotated lattice, points nearly on one sphere)
   // leaves a tenth of the tests or more to this stage, where the 64-bit
   // mantissa settles most of what double rounding could not. Exact ties (a
   // lattice's cospherical points, voxel centres) it can never settle: after
   // a run of such failures the gate lets only one test in 64 try it (speed
   // only; the exact sign is the same).
-  // Ties at the corners of an axis-aligned box (every in-sphere tie of a
-  // lattice or of voxel centres, whatever the spacing) first: decided from
-  // the coordinates' pattern, where the long double stage can only fail.
-  if (int s; box_tie_sign<D>(ctx, a, planes, q, s)) return s < 0;
   if constexpr (std::numeric_limits<long double>::digits >= 64) {
     thread_local StageGate gate;
     if (gate.open()) {

@@ -121,11 +121,11 @@ class BoxTiePredicate {
       if (pj[d] != other_[d]) return false;
       ej[d] = 1;
     }
-    // det M0 = 0 (five corners of one box are cospherical); the weights'
-    // coefficients, as in VertexPredicate::sign, each a det(E') times
-    // 2^D prod Delta.
-    // A box row's dr is zero (e_j holds the row's axis at p_i's value, so
-    // that column of the replaced matrix is empty), so wi may sum every row.
+    // det M0 = 0 (corners of one box are cospherical), so the weights'
+    // coefficients decide, as in VertexPredicate::sign, each a det(E') times
+    // 2^D prod Delta. A box row's dr is zero (e_j holds the row's axis at
+    // p_i's value, so that column of the replaced matrix is empty), so wi
+    // may sum every row.
     int dr[3] = {0, 0, 0}, wi = det_e_;
     for (int r = 0; r < D; ++r) {
       for (int d = 0; d < D; ++d) dr[r] += ej[d] * cof_[r][d];

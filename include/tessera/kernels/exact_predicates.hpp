@@ -21,7 +21,9 @@
 // nothing beyond the determinant. All of it is evaluated on the input doubles
 // scaled to integers (every double is an integer times a power of two): in
 // 64/128-bit integers on a grid of at most 22 bits, in fixed-width integers
-// (WidePredicate) on one of at most 60, else in GMP.
+// (WidePredicate) on one of at most 60, else in GMP. A tie whose points all
+// sit at corners of one axis-aligned box is decided first, from the
+// coordinates' pattern alone (BoxTiePredicate, box_ties.hpp).
 #pragma once
 
 #include <algorithm>
