@@ -321,7 +321,7 @@ bool in_sphere_extended(const ExactContext& ctx, const double* pa, const double*
       if (s == 1 || s == -1) return s > 0;
     }
   }
-  return exact_clip_sign(ctx, a, planes, q) < 0;
+  return exact_clip_sign_by_arithmetic(ctx, a, planes, q) < 0;  // the box stage ran above
 }
 
 // in_sphere's stages for dimension D: the double filter (unless the caller

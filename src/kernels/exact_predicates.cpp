@@ -319,12 +319,15 @@ int sign_of(T x) { return (x > 0) - (x < 0); }
 }  // namespace
 
 int exact_clip_sign(const ExactContext& ctx, std::int32_t i, const std::int32_t* planes, std::int32_t j) {
-  const int dim = ctx.dim;
   // A tie at the corners of an axis-aligned box (lattices, voxel centres of
-  // any spacing: the insertion's in-sphere ties, the unprepared calls) is
-  // decided by the coordinates' pattern; anything else fails its test within
-  // a few comparisons.
-  if (int s; dim == 3 ? box_tie_sign<3>(ctx, i, planes, j, s) : box_tie_sign<2>(ctx, i, planes, j, s)) return s;
+  // any spacing) is decided by the coordinates' pattern; anything else fails
+  // that test within a few comparisons.
+  if (int s; ctx.dim == 3 ? box_tie_sign<3>(ctx, i, planes, j, s) : box_tie_sign<2>(ctx, i, planes, j, s)) return s;
+  return exact_clip_sign_by_arithmetic(ctx, i, planes, j);
+}
+
+int exact_clip_sign_by_arithmetic(const ExactContext& ctx, std::int32_t i, const std::int32_t* planes, std::int32_t j) {
+  const int dim = ctx.dim;
   // Row r's generator (or box id); the query row is last.
   std::int32_t gen[Scratch::kRows];
   for (int r = 0; r < dim; ++r) gen[r] = planes[r];

@@ -150,6 +150,12 @@ bool make_grid(ExactContext& ctx, std::size_t n, std::vector<std::int32_t>& grid
 /// and j is not i nor one of the planes.
 int exact_clip_sign(const ExactContext& ctx, std::int32_t i, const std::int32_t* planes, std::int32_t j);
 
+/// exact_clip_sign without its first stage (the tie at a box's corners,
+/// box_ties.hpp): the same sign by arithmetic on the coordinates. For
+/// callers that asked that stage already (its answer would be a refusal
+/// again), and for the tests of the arithmetic stages.
+int exact_clip_sign_by_arithmetic(const ExactContext& ctx, std::int32_t i, const std::int32_t* planes, std::int32_t j);
+
 /// The side of domain-box plane `box` (a box-plane id) on which the vertex
 /// of cell i where planes[0..dim) meet lies, in the perturbed sense of
 /// exact_clip_sign: +1 inside the box's half-space, -1 outside, 0 where the

@@ -73,9 +73,9 @@ class PreparedSigns {
     if (!same) {
       s.cell = cell_;
       for (int k = 0; k < D; ++k) s.p[k] = p[k];
-      const bool box_tried = box_gate_.open();
-      s.box = box_tried && s.box_pred.prepare(ctx, gen, ids);
-      if (box_tried) box_gate_.record(s.box);
+      s.box_tried = box_gate_.open();
+      s.box = s.box_tried && s.box_pred.prepare(ctx, gen, ids);
+      if (s.box_tried) box_gate_.record(s.box);
       s.staged = false;
     }
     if (s.box) {
@@ -101,7 +101,9 @@ class PreparedSigns {
     }
     if (s.wide == Wide::untried) s.wide = s.wide_pred.prepare(ctx, gen, ids) ? Wide::usable : Wide::unusable;
     if (s.wide == Wide::usable) return s.wide_pred.sign(ctx, j);
-    return exact_clip_sign(ctx, gen, ids, j);
+    // The box stage, where it was tried, refused this candidate: asking it
+    // again inside exact_clip_sign would only repeat the refusal.
+    return s.box_tried ? exact_clip_sign_by_arithmetic(ctx, gen, ids, j) : exact_clip_sign(ctx, gen, ids, j);
   }
 
   /// Exact evaluations since start_cell.
@@ -116,6 +118,7 @@ class PreparedSigns {
   struct Slot {
     std::uint64_t cell = 0;
     Index p[D] = {};
+    bool box_tried = false; // box_pred's prepare ran (its gate was open)
     bool box = false;       // box_pred prepared (a candidate may still be off its box)
     bool staged = false;    // the stages below box_pred prepared
     bool grid = false;      // pred serves the vertex
