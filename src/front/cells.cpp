@@ -48,15 +48,26 @@ namespace {
 /// taken from the Delaunay triangulation (CellMethod::insertion). The same
 /// for every thread count: the two methods' cells differ in the last bits of
 /// their volumes and centroids (the clip order differs), and the output must
-/// not depend on the thread count. In 3D the two methods are level at about
-/// 2 on two threads (docs/design.md, "Cells from Delaunay neighbours"). In
-/// 2D the insertion is serial: 200k uniform points take 0.23 s on one
-/// thread and 0.12 s on two by the search, 0.30 s and 0.20 s by insertion,
-/// which costs about the same on any input, while the search grows as
-/// ratio^0.7 (curves, segments and blobs of 200k points: ratios 6-7,
-/// 0.34-0.46 s on two threads, 0.20-0.23 s by insertion); level at ~1.45 on
-/// one thread and ~2.1 on two.
-inline constexpr double neighbours_ratio = 2.0;
+/// not depend on the thread count.
+///
+/// 3D: 1.75. On uniform points the search takes 0.64 of the insertion's time
+/// (100k, two threads), so where the insertion costs what it costs there
+/// per point the two are level at a ratio of ~1.55; where its in-sphere
+/// tests tie (lattices) or its walks are long it costs more. Measured on two
+/// threads (docs/design.md, "Sampled label images choose the insertion"):
+/// sampled label images at ratios 1.85-2.3 (119k-324k points) and a cube
+/// with a far outlier at 1.93 run 15-50% faster by insertion; a jittered
+/// lattice and a smooth 3-label image at 1.56-1.60 run 30-100% faster by the
+/// search. Until stop 68 the threshold was 2 (stop 35's measure), which
+/// kept the sampled images on the search.
+///
+/// 2D: 2. There 200k uniform points take 0.23 s on one thread and 0.12 s on
+/// two by the search, 0.30 s and 0.20 s by insertion, which costs about the
+/// same on any input, while the search grows as ratio^0.7 (curves, segments
+/// and blobs of 200k points: ratios 6-7, 0.34-0.46 s on two threads,
+/// 0.20-0.23 s by insertion); level at ~1.45 on one thread and ~2.1 on two.
+template <int D>
+inline constexpr double neighbours_ratio = D == 3 ? 1.75 : 2.0;
 /// The share of the generators the pilot may build: on small inputs too.
 inline constexpr double pilot_share = 0.5;
 
@@ -96,8 +107,8 @@ Cells run(std::span<const double> input, std::span<const std::int32_t> labels, c
       if (pass.exact.may_underflow) {
         insert = true;
       } else {
-        const front::PilotEstimate e = front::pilot_estimate<CellT>(pass, neighbours_ratio, pilot_share);
-        insert = e.ratio >= neighbours_ratio;
+        const front::PilotEstimate e = front::pilot_estimate<CellT>(pass, neighbours_ratio<D>, pilot_share);
+        insert = e.ratio >= neighbours_ratio<D>;
       }
     }
     if (insert) {
