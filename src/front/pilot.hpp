@@ -18,17 +18,20 @@
 namespace tessera::front {
 
 // The pilot's compositor: what the cells it is given cost to search
-// (BuildStatus::work) and how many of their vertices are Delaunay simplices
-// (no box plane). The cells themselves are not kept.
+// (BuildStatus::work, plus tie_weight units per exact evaluation a small
+// grid or the box-corner pattern served) and how many of their vertices
+// are Delaunay simplices (no box plane). The cells themselves are not kept.
 template <class CellT>
 struct PilotCompositor {
   struct Batch {
     std::uint64_t cells = 0, work = 0, vertices = 0, found = 0, capped = 0;
   };
   Batch total;
+  std::uint64_t tie_weight = 0;
   void add(Batch& b, std::int32_t, const kernels::BuildStatus& st, CellT& cell) {
     ++b.cells;
-    b.work += st.work;  // a capped cell's counts up to the cap: a lower bound
+    // (a capped cell's counts up to the cap: a lower bound)
+    b.work += st.work + tie_weight * (cell.exact_calls() - cell.off_grid_exact_calls());
     b.capped += st.capped;
     if (!st.has_cell) return;
     b.vertices += cell.vertices().size();
@@ -126,9 +129,14 @@ struct PilotEstimate {
 /// need the measure too: 500 points nearly on a sphere take 0.11 s by the
 /// search, 0.014 s from their Delaunay neighbours). 0: bands of pilot_band
 /// in the top hash range that skipped cells leave alone (1 - the highest
-/// skipped fraction).
+/// skipped fraction). `tie_weight`: work units per exact evaluation that a
+/// small grid or the box-corner pattern served (PilotCompositor), which
+/// BuildStatus::work leaves out: tessera::voronoi weighs them against its
+/// insertion (cells.cpp, tie_weight), tessera::delaunay does not, as its own
+/// insertion pays for the same ties in its in-sphere tests.
 template <class CellT>
-PilotEstimate pilot_estimate(const Pass<CellT::dim>& pass, double enough, double max_share = 0) {
+PilotEstimate pilot_estimate(const Pass<CellT::dim>& pass, double enough, double max_share = 0,
+                             std::uint64_t tie_weight = 0) {
   constexpr int D = CellT::dim;
   constexpr SkipRule rule = D == 3 ? skip_rule_3d : skip_rule_2d;
   constexpr double slope = rule.slope, lowest = rule.lowest, highest = rule.highest;
@@ -169,6 +177,7 @@ PilotEstimate pilot_estimate(const Pass<CellT::dim>& pass, double enough, double
       ++band_cells[k];
     }
   PilotCompositor<CellT> comp;
+  comp.tie_weight = tie_weight;
   double ratio = 1;
   std::uint64_t exact = 0;
   auto estimate = [&](double r, double fraction) {

@@ -728,12 +728,13 @@ TEST(FromNeighbours, AutomaticChoiceFollowsThePilot) {
   }
   // A label image sampled for surface nets (tessera::sample_image: every
   // voxel by a label boundary, fewer farther in) over the image's own box:
-  // ~30 ties per cell, most served by the box-corner pattern, which the
-  // pilot weighs (CellBuilder::on_grid_weight): a ratio of 1.82. Until
-  // stop 68 (weight 0, threshold 2) its ratio was 1.57 and it was searched,
-  // 1.3 times slower (0.28 s against 0.21 s on two threads). A
-  // voxel grid of the same spacing, ties everywhere but cells as cheap as
-  // uniform ones, stays on the search.
+  // ~34 ties per cell, served by the box-corner pattern or the small-grid
+  // stage (exact yet cheap: 25-55 ns each), which the cells' pilot weighs
+  // (cells.cpp, tie_weight): a ratio of 1.82. Until stop 68 (weight 0,
+  // threshold 2) its ratio was 1.57 and it was searched, 1.3 times slower
+  // (0.28 s against 0.21 s on two threads). A voxel grid of the same
+  // spacing, ties everywhere but cells as cheap as uniform ones, stays on
+  // the search.
   {
     tessera::LabelImage img;
     const std::int64_t n = 64;

@@ -97,13 +97,6 @@ class CellBuilder {
   /// BuildStatus::work's units per exact evaluation no small grid served
   /// (PreparedSigns::off_grid_calls: ~120 ns each, a work unit ~15 ns).
   static constexpr std::uint64_t off_grid_weight = 8;
-  /// ... and per exact evaluation a small grid or the box-corner pattern
-  /// served (a lattice's or a voxel grid's ties, ~53 per cell): 24-26 ns each
-  /// measured on the 50^3 lattice and on voxel centres, 55 ns on a sampled
-  /// label image, whose ties reach the narrow vertex stage more often. Until
-  /// stop 68 they weighed nothing, and the search of sampled label images
-  /// (about 30 of them per cell) looked ~12% cheaper than it was.
-  static constexpr std::uint64_t on_grid_weight = 2;
   /// BuildStatus::work's units per vertex solved exactly (rationals).
   static constexpr std::uint64_t exact_solve_weight = 64;
 
@@ -921,9 +914,7 @@ class CellBuilder {
 
   // BuildStatus::work of the cell just built: the search's count and its exact work.
   std::uint64_t cell_work(const CellT& cell) const {
-    const std::uint64_t off_grid = cell.off_grid_exact_calls();
-    return work_ + on_grid_weight * (cell.exact_calls() - off_grid) + off_grid_weight * off_grid +
-           exact_solve_weight * cell.exact_solves();
+    return work_ + off_grid_weight * cell.off_grid_exact_calls() + exact_solve_weight * cell.exact_solves();
   }
   bool capped_builder() const { return work_cap_ != std::numeric_limits<std::uint64_t>::max(); }
   bool over_cap(const CellT& cell) const { return work_ + exact_weight * cell.exact_calls() > work_cap_; }
