@@ -752,6 +752,9 @@ TEST(FromNeighbours, AutomaticChoiceFollowsThePilot) {
     const tessera::Cells s = run_method(sampled.coords, 3, tessera::CellMethod::automatic, sampled.labels, 2, box);
     EXPECT_TRUE(s.from_insertion) << "sampled label image";
     EXPECT_TRUE(tessera::validate(s, {}).ok) << "sampled label image";
+    // The choice, ties weighed, is the same on one thread: the same cells.
+    const tessera::Cells s1 = run_method(sampled.coords, 3, tessera::CellMethod::automatic, sampled.labels, 1, box);
+    EXPECT_TRUE(s1.volume == s.volume && s1.neighbors == s.neighbors) << "sampled label image, 1 thread";
     std::vector<double> voxels;
     for (int k = 0; k < 32; ++k)
       for (int j = 0; j < 32; ++j)
