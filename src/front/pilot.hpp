@@ -118,6 +118,12 @@ struct PilotEstimate {
   double exact_per_cell = std::numeric_limits<double>::infinity();
   /// The cells the pilot built.
   std::uint64_t cells = 0;
+  /// Of those, the cells abandoned at the work cap: where any was, the ratio
+  /// is a lower bound.
+  std::uint64_t capped = 0;
+  /// The vertices of the cells built (not abandoned), per such cell: ~27 on
+  /// uniform 3D input, ~6 in 2D.
+  double vertices_per_cell = 0;
 };
 
 /// `enough`: a ratio at which the caller's choice is made (insertion), so
@@ -134,9 +140,14 @@ struct PilotEstimate {
 /// BuildStatus::work leaves out: tessera::voronoi weighs them against its
 /// insertion (cells.cpp, tie_weight), tessera::delaunay does not, as its own
 /// insertion pays for the same ties in its in-sphere tests.
+/// `enough_if_capped` (default: `enough`): the ratio at which the choice is
+/// made once a cell was abandoned at the work cap (tessera::voronoi weighs
+/// its ratio by the share of generators among the points, except then).
 template <class CellT>
 PilotEstimate pilot_estimate(const Pass<CellT::dim>& pass, double enough, double max_share = 0,
-                             std::uint64_t tie_weight = 0) {
+                             std::uint64_t tie_weight = 0, double enough_if_capped = -1) {
+  if (enough_if_capped < 0) enough_if_capped = enough;
+  auto enough_now = [&](const auto& total) { return total.capped > 0 ? enough_if_capped : enough; };
   constexpr int D = CellT::dim;
   constexpr SkipRule rule = D == 3 ? skip_rule_3d : skip_rule_2d;
   constexpr double slope = rule.slope, lowest = rule.lowest, highest = rule.highest;
@@ -183,7 +194,9 @@ PilotEstimate pilot_estimate(const Pass<CellT::dim>& pass, double enough, double
   auto estimate = [&](double r, double fraction) {
     return PilotEstimate{r, fraction,
                          static_cast<double>(exact) / static_cast<double>(std::max<std::uint64_t>(comp.total.cells, 1)),
-                         comp.total.cells};
+                         comp.total.cells, comp.total.capped,
+                         static_cast<double>(comp.total.vertices) /
+                             static_cast<double>(std::max<std::uint64_t>(comp.total.cells - comp.total.capped, 1))};
   };
   std::size_t cells_to_band_end = 0;
   for (std::size_t k = 0; k < bands; ++k) {
@@ -217,7 +230,7 @@ PilotEstimate pilot_estimate(const Pass<CellT::dim>& pass, double enough, double
       // column, capped after ~600 exact evaluations) spent 0.17 s on the
       // band's 256 cells, and the insertion then 0.035 s.
       settled = static_cast<double>(comp.total.work) >=
-                enough * rule.uniform_work * static_cast<double>(cells_to_band_end);
+                enough_now(comp.total) * rule.uniform_work * static_cast<double>(cells_to_band_end);
     }
     const auto& t = comp.total;
     if (t.vertices == 0 && t.capped == 0) continue;  // no cell yet (duplicates only)
@@ -225,7 +238,7 @@ PilotEstimate pilot_estimate(const Pass<CellT::dim>& pass, double enough, double
     if (t.found == 0) return estimate(std::numeric_limits<double>::infinity(), highest);
     const double work = static_cast<double>(t.work) / static_cast<double>(t.cells) / rule.uniform_work;
     ratio = work / (static_cast<double>(t.found) / static_cast<double>(t.vertices));
-    if (slope * std::sqrt(ratio) > 2 * highest || ratio >= enough) break;
+    if (slope * std::sqrt(ratio) > 2 * highest || ratio >= enough_now(t)) break;
   }
   if (ratio < rule.off_below) return estimate(ratio, 0.0);
   return estimate(ratio, std::clamp(slope * std::sqrt(ratio), lowest, highest));

@@ -697,6 +697,31 @@ TEST(FromNeighbours, AutomaticChoiceFollowsThePilot) {
     EXPECT_TRUE(c.from_insertion) << dim << "D: two far clusters";
     EXPECT_TRUE(tessera::validate(c, {}).ok) << dim << "D: two far clusters";
   }
+  // The same clusters with one point in ten inside (label 0), the others
+  // outside points (-1): the insertion would triangulate all 20,000 to
+  // build 2,000 cells, so the ratio is weighed by the generators' share
+  // (until stop 68 these went to insertion: a clustered 100k with a tenth
+  // inside took 0.31 s, 0.11 s by the search). 60 points inside a sphere of
+  // 10,000 outside ones: the pilot's cells average 391 vertices, so its
+  // ratio (13.7) misses what their clips cost, and they still go to
+  // insertion (the threshold, weighed, would be 293).
+  {
+    auto two = random_points(20000, 3, 917);
+    for (std::size_t k = two.size() / 2; k < two.size(); k += 3) two[k] += 100;
+    std::vector<std::int32_t> labels(two.size() / 3, -1);
+    for (std::size_t i = 0; i < labels.size(); i += 10) labels[i] = 0;
+    const tessera::Cells c = run_method(two, 3, tessera::CellMethod::automatic, labels, 2);
+    EXPECT_FALSE(c.from_insertion) << "two far clusters, a tenth inside";
+    EXPECT_EQ(c.n_cells(), 2000u);
+    auto ball = sphere_points(10000, 941);
+    std::vector<std::int32_t> inside(10000, -1);
+    const auto centre = random_points(60, 3, 942);
+    for (const double x : centre) ball.push_back(0.05 * (x - 0.5));
+    inside.resize(10060, 0);
+    const tessera::Cells b = run_method(ball, 3, tessera::CellMethod::automatic, inside, 2);
+    EXPECT_TRUE(b.from_insertion) << "60 points inside a sphere of outside points";
+    EXPECT_TRUE(tessera::validate(b, inside).ok) << "60 points inside a sphere of outside points";
+  }
   // A cylindrical grid (rings of points at equal angles, stacked): ties
   // everywhere, as on a lattice, but its cos and sin lie on no small grid,
   // so each tie costs an exact stage beyond the grid's integer products. The
