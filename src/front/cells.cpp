@@ -55,12 +55,14 @@ namespace {
 /// (100k, two threads), so where the insertion costs what it costs there
 /// per point the two are level at a ratio of ~1.55; where its in-sphere
 /// tests tie (lattices) or its walks are long it costs more. Measured on two
-/// threads (docs/design.md, "Sampled label images choose the insertion"):
-/// sampled label images at ratios 1.85-2.3 (119k-324k points) and a cube
-/// with a far outlier at 1.93 run 15-50% faster by insertion; a jittered
-/// lattice and a smooth 3-label image at 1.56-1.60 run 30-100% faster by the
-/// search. Until stop 68 the threshold was 2 (stop 35's measure), which
-/// kept the sampled images on the search.
+/// threads (docs/design.md, "The cells' choice on sampled label images and
+/// outside points"): sampled label images at ratios 1.84-2.2 (118k-324k
+/// points) and a cube with a far outlier at 1.84 run 10-85% faster by
+/// insertion; a jittered lattice and a smooth 3-label image at 1.52-1.56
+/// run 30-100% faster by the search. Until stop 68 the threshold was 2
+/// (stop 35's measure), which kept the sampled images on the search. With
+/// outside points the threshold grows with the located points per
+/// generator (run(), below).
 ///
 /// 2D: 2. There 200k uniform points take 0.23 s on one thread and 0.12 s on
 /// two by the search, 0.30 s and 0.20 s by insertion, which costs about the
