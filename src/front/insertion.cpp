@@ -145,6 +145,11 @@ class Triangulation {
     const std::size_t threads = workers_.size();
     if (!pts.empty()) update_centre(static_cast<std::size_t>(pts.front()));
     int cut_axis = -1;
+    if (!parallel_ && retry_from_ != 0 && pts.size() >= retry_from_) {
+      parallel_ = true;  // the one retry (below)
+      retry_from_ = 0;
+      ++stats_.resumed;
+    }
     for (int k = 0; k < 2 && parallel_ && threads > 1 && pts.size() >= parallel_min * threads; ++k) {
       const std::size_t tried = pts.size();
       pts = phase(pts, end, cut_axis);
@@ -156,8 +161,16 @@ class Triangulation {
       // phase of 2048 points or more defers over a third, the later rounds
       // go serially (a failed walk costs about what its insertion would
       // have). Smaller phases defer many anyway, as their simplices are
-      // large next to the slabs.
-      if (tried >= 2048 && 3 * pts.size() > tried) parallel_ = false;
+      // large next to the slabs. Once, a round three times that phase's
+      // size tries again: where the early rounds were sparse (a sphere's
+      // first few thousand points, a label image sampled around a few
+      // labels) the later ones, denser, defer a few percent (200k points on
+      // a sphere: 60% of a 3k-point phase, then 5%).
+      if (tried >= 2048 && 3 * pts.size() > tried) {
+        parallel_ = false;
+        ++stats_.stopped;
+        if (retry_from_ != 0) retry_from_ = 3 * tried;
+      }
       placed(total - pts.size());
     }
     W& w = workers_[0];
@@ -645,6 +658,7 @@ class Triangulation {
   double centre_sum_[D] = {};
   std::size_t centre_count_ = 0;
   bool parallel_ = true;            // whether rounds still try parallel phases
+  std::size_t retry_from_ = 1;      // after phases failed: the round size that tries again (0: tried)
   InsertionStats stats_;
 };
 

@@ -44,6 +44,8 @@ struct InsertionStats {
   std::size_t phases = 0;        ///< parallel phases run
   std::size_t phase_points = 0;  ///< points they were given
   std::size_t deferred = 0;      ///< of those, points they left for later
+  std::size_t stopped = 0;       ///< phases that deferred so many that later rounds went serially
+  std::size_t resumed = 0;       ///< rounds that tried phases again after that (at most one)
   std::size_t guided = 0;        ///< walks started from a guide vertex rather than the last insertion
   /// Steps the walks took from one simplex to the next: the work of point
   /// location, which an order without locality inflates.
