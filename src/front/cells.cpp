@@ -71,10 +71,6 @@ namespace {
 /// 0.20-0.23 s by insertion); level at ~1.45 on one thread and ~2.1 on two.
 template <int D>
 inline constexpr double neighbours_ratio = D == 3 ? 1.75 : 2.0;
-/// Vertices of a cell of uniform input, on average (PilotEstimate::
-/// vertices_per_cell: 26-27 in 3D, 6 in 2D).
-template <int D>
-inline constexpr double uniform_vertices = D == 3 ? 27.0 : 6.0;
 /// The pilot's work units (~15-18 ns each) per exact evaluation that a small
 /// grid or the box-corner pattern served (a lattice's or a voxel grid's ties,
 /// ~53 per cell; ~30 on a sampled label image): 24-26 ns each measured on
@@ -126,21 +122,16 @@ Cells run(std::span<const double> input, std::span<const std::int32_t> labels, c
         // The insertion triangulates every located point, outside points
         // (label < 0) too, and the search builds the generators' cells only:
         // the threshold grows with the located points per generator (as the
-        // labelled Delaunay pass weighs its ratio, delaunay.cpp). Only where
-        // the pilot measured the cells' cost, though: not where one was
-        // abandoned at its cap (the ratio is then a lower bound), nor where
-        // its cells are large, as a clip classifies every vertex, a cost the
-        // work count (candidates) does not see: 60 points inside a sphere of
-        // 20,000 outside ones, cells of 107 vertices, measured 6.9 (~25 us a
-        // cell), were searched at 2.8 ms a cell (0.17 s; 0.07 s by insertion).
+        // labelled Delaunay pass weighs its ratio, delaunay.cpp), but only
+        // where the pilot measured the cells' cost (front::pilot_measured:
+        // none abandoned at its cap, none much larger than a uniform cell).
         const double located = static_cast<double>(pass.locator->size());
         const double generators = static_cast<double>(pass.order.size());
         const double from = generators > 0 ? neighbours_ratio<D> * std::max(1.0, located / generators)
                                             : std::numeric_limits<double>::infinity();
         const front::PilotEstimate e =
             front::pilot_estimate<CellT>(pass, from, pilot_share, tie_weight, neighbours_ratio<D>);
-        const bool measured = e.capped == 0 && e.vertices_per_cell <= 2 * uniform_vertices<D>;
-        insert = generators > 0 && e.ratio >= (measured ? from : neighbours_ratio<D>);
+        insert = generators > 0 && e.ratio >= (e.measured ? from : neighbours_ratio<D>);
       }
     }
     if (insert) {

@@ -145,9 +145,9 @@ class Triangulation {
     const std::size_t threads = workers_.size();
     if (!pts.empty()) update_centre(static_cast<std::size_t>(pts.front()));
     int cut_axis = -1;
-    if (!parallel_ && retry_from_ != 0 && pts.size() >= retry_from_) {
+    if (!parallel_ && retry_left_ && retry_from_ != 0 && pts.size() >= retry_from_) {
       parallel_ = true;  // the one retry (below)
-      retry_from_ = 0;
+      retry_left_ = false;
       ++stats_.resumed;
     }
     for (int k = 0; k < 2 && parallel_ && threads > 1 && pts.size() >= parallel_min * threads; ++k) {
@@ -169,7 +169,7 @@ class Triangulation {
       if (tried >= 2048 && 3 * pts.size() > tried) {
         parallel_ = false;
         ++stats_.stopped;
-        if (retry_from_ != 0) retry_from_ = 3 * tried;
+        retry_from_ = 3 * tried;
       }
       placed(total - pts.size());
     }
@@ -658,7 +658,8 @@ class Triangulation {
   double centre_sum_[D] = {};
   std::size_t centre_count_ = 0;
   bool parallel_ = true;            // whether rounds still try parallel phases
-  std::size_t retry_from_ = 1;      // after phases failed: the round size that tries again (0: tried)
+  bool retry_left_ = true;          // whether the phases may still try again once they stopped
+  std::size_t retry_from_ = 0;      // the round size that tries again, once they stopped
   InsertionStats stats_;
 };
 

@@ -100,11 +100,24 @@ struct SkipRule {
   /// points per bin (3D: 307 at 100k and at 1M points, 169 on the 50^3
   /// lattice; 2D: 81-83 at 200k and 1M).
   double uniform_work;
+  /// Vertices of a uniform cell, on average (3D 26-27, 2D 6).
+  double uniform_vertices;
   double off_below;  ///< no skipping below this ratio
   double slope, lowest, highest;
 };
-inline constexpr SkipRule skip_rule_3d{307.0, 0.0, 0.3, 0.35, 0.9};
-inline constexpr SkipRule skip_rule_2d{82.0, 2.0, 0.2, 0.3, 0.6};
+inline constexpr SkipRule skip_rule_3d{307.0, 27.0, 0.0, 0.3, 0.35, 0.9};
+inline constexpr SkipRule skip_rule_2d{82.0, 6.0, 2.0, 0.2, 0.3, 0.6};
+
+/// Whether the pilot's cells so far measure what the search costs: none was
+/// abandoned at the work cap (the ratio is then a lower bound), and they
+/// average at most twice a uniform cell's vertices. Larger cells cost more
+/// than the work count (candidates) sees, as every clip classifies every
+/// vertex: 60 points inside a sphere of 20,000 outside ones, cells of 107
+/// vertices, measured a ratio of 6.9 (~25 us a cell) and were searched at
+/// 2.8 ms a cell.
+inline bool pilot_measured(std::uint64_t cells, std::uint64_t capped, std::uint64_t vertices, const SkipRule& rule) {
+  return capped == 0 && static_cast<double>(vertices) <= 2 * rule.uniform_vertices * static_cast<double>(cells);
+}
 
 /// The pilot's measure: ratio, the cells' search work per simplex they find
 /// relative to uniform input (infinite when they find none; 1 when too few
@@ -118,12 +131,9 @@ struct PilotEstimate {
   double exact_per_cell = std::numeric_limits<double>::infinity();
   /// The cells the pilot built.
   std::uint64_t cells = 0;
-  /// Of those, the cells abandoned at the work cap: where any was, the ratio
-  /// is a lower bound.
-  std::uint64_t capped = 0;
-  /// The vertices of the cells built (not abandoned), per such cell: ~27 on
-  /// uniform 3D input, ~6 in 2D.
-  double vertices_per_cell = 0;
+  /// Whether the ratio measures the search's cost (pilot_measured); false
+  /// when not measured at all.
+  bool measured = false;
 };
 
 /// `enough`: a ratio at which the caller's choice is made (insertion), so
@@ -140,16 +150,17 @@ struct PilotEstimate {
 /// BuildStatus::work leaves out: tessera::voronoi weighs them against its
 /// insertion (cells.cpp, tie_weight), tessera::delaunay does not, as its own
 /// insertion pays for the same ties in its in-sphere tests.
-/// `enough_if_capped` (default: `enough`): the ratio at which the choice is
-/// made once a cell was abandoned at the work cap (tessera::voronoi weighs
-/// its ratio by the share of generators among the points, except then).
+/// `enough_unmeasured` (default: `enough`): the ratio at which the choice
+/// is made while the cells so far are not pilot_measured (tessera::voronoi
+/// weighs its threshold by the points per generator only where they are).
 template <class CellT>
 PilotEstimate pilot_estimate(const Pass<CellT::dim>& pass, double enough, double max_share = 0,
-                             std::uint64_t tie_weight = 0, double enough_if_capped = -1) {
-  if (enough_if_capped < 0) enough_if_capped = enough;
-  auto enough_now = [&](const auto& total) { return total.capped > 0 ? enough_if_capped : enough; };
+                             std::uint64_t tie_weight = 0, double enough_unmeasured = -1) {
   constexpr int D = CellT::dim;
   constexpr SkipRule rule = D == 3 ? skip_rule_3d : skip_rule_2d;
+  if (enough_unmeasured < 0) enough_unmeasured = enough;
+  auto measured = [&](const auto& t) { return pilot_measured(t.cells, t.capped, t.vertices, rule); };
+  auto enough_now = [&](const auto& t) { return measured(t) ? enough : enough_unmeasured; };
   constexpr double slope = rule.slope, lowest = rule.lowest, highest = rule.highest;
   constexpr double unmeasured = D == 3 ? lowest : 0.0;  // too few points for a pilot
   if (pass.order.empty()) return {1.0, unmeasured};
@@ -194,9 +205,7 @@ PilotEstimate pilot_estimate(const Pass<CellT::dim>& pass, double enough, double
   auto estimate = [&](double r, double fraction) {
     return PilotEstimate{r, fraction,
                          static_cast<double>(exact) / static_cast<double>(std::max<std::uint64_t>(comp.total.cells, 1)),
-                         comp.total.cells, comp.total.capped,
-                         static_cast<double>(comp.total.vertices) /
-                             static_cast<double>(std::max<std::uint64_t>(comp.total.cells - comp.total.capped, 1))};
+                         comp.total.cells, comp.total.cells > 0 && measured(comp.total)};
   };
   std::size_t cells_to_band_end = 0;
   for (std::size_t k = 0; k < bands; ++k) {
