@@ -96,9 +96,11 @@ class Triangulation {
     const std::size_t n = global_.size();
     vsimplex_.resize(n);  // written for each vertex as it is inserted
     if constexpr (D == 2) pending_.assign(n, -1);
-    // A Delaunay tetrahedralisation has about 6.5 tetrahedra per point, a
-    // triangulation 2 triangles.
-    store_.reserve((D == 3 ? 7 : 3) * n + 64);
+    // A Delaunay tetrahedralisation of uniform points has about 6.8
+    // tetrahedra per point, a triangulation 2 triangles. The capacity is
+    // address space until used (the arrays are not initialised), so it is
+    // sized for the last round's phases at that rate (reserve_round).
+    store_.grow(static_cast<std::size_t>((D == 3 ? 8.0 : 2.5) * static_cast<double>(n)) + 64);
   }
 
   /// Start from the positively oriented simplex s and its K ghosts.
@@ -143,6 +145,7 @@ class Triangulation {
   void insert_round(std::vector<std::int32_t> pts, std::size_t end, std::size_t parallel_min, Placed&& placed) {
     const std::size_t total = pts.size();
     const std::size_t threads = workers_.size();
+    reserve_round(total, end - std::min(end, total));
     if (!pts.empty()) update_centre(static_cast<std::size_t>(pts.front()));
     int cut_axis = -1;
     if (!parallel_ && retry_left_ && retry_from_ != 0 && pts.size() >= retry_from_) {
@@ -194,6 +197,7 @@ class Triangulation {
   Buffer<std::int32_t> take_rows() { return insertion::take_rows<K>(store_, global_, workers_); }
   InsertionStats stats() const {
     InsertionStats s = stats_;
+    s.store_growths = store_.growths();
     for (const W& w : workers_) {
       s.guided += w.guided;
       s.steps += w.steps;
@@ -266,8 +270,9 @@ class Triangulation {
       if (w.last < 0) w.deferred = mine[t];
     }
     // Room for every fresh slot the phase may claim (claims beyond it defer
-    // their points), and marks that cannot wrap within it.
-    store_.reserve((D == 3 ? 8 : 4) * pts.size() + threads * W::fresh_block);
+    // their points; reserve_round made room), and marks that cannot wrap
+    // within it.
+    store_.reserve(phase_slots(pts.size()));
     for (const W& w : workers_)
       if (w.epoch + threads * (pts.size() + 1) >= insertion::epoch_limit) insertion::reset_marks(store_, workers_);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, threads, 1), [&](const tbb::blocked_range<std::size_t>& r) {
@@ -642,13 +647,42 @@ class Triangulation {
     }
   }
 
+  /// Slots per point the store holds so far (its free slots included),
+  /// once enough points are in to measure it; before, a uniform input's.
+  double slots_per_point(std::size_t inserted) const {
+    if (inserted < 1024) return D == 3 ? 6.8 : 2.0;
+    return static_cast<double>(store_.size()) / static_cast<double>(inserted);
+  }
+  /// Fresh slots a parallel phase of `count` points may claim: its points'
+  /// share at the rate so far, a tenth more, and a block per worker.
+  std::size_t phase_slots(std::size_t count) const {
+    const std::size_t inserted = inserted_before_round_;
+    return static_cast<std::size_t>(1.1 * slots_per_point(inserted) * static_cast<double>(count)) +
+           workers_.size() * W::fresh_block;
+  }
+  /// Before a round of `count` points with `inserted` in: where its phases
+  /// could run out of room, grow the store to what all the points will need
+  /// at the rate measured so far, and a quarter more (the capacity costs
+  /// address space only), rather than doubling. Surface samples hold far
+  /// more simplices than uniform points (200k on a torus: 19 tetrahedra per
+  /// point), and their rate still rises as the rounds go (60k on a torus:
+  /// by a tenth after the first growth), so the growth's margin exceeds
+  /// the phases'; each growth copies the store.
+  void reserve_round(std::size_t count, std::size_t inserted) {
+    inserted_before_round_ = inserted;
+    if (store_.size() + phase_slots(count) <= store_.capacity()) return;
+    const double rest = static_cast<double>(global_.size() - std::min(global_.size(), inserted));
+    store_.grow(std::max(store_.size() + phase_slots(count),
+                         store_.size() + static_cast<std::size_t>(1.25 * slots_per_point(inserted) * rest)));
+  }
+
   const ExactContext& ctx_;
   const bool underflow_;                // ctx_.may_underflow, for the filters (insertion_filters.hpp)
   std::vector<std::int32_t> global_;    // vertex -> input id
   std::vector<std::int32_t> guide_;     // vertex -> an earlier round's vertex near it, or -1 (walk_start)
-  std::vector<std::int32_t> vsimplex_;  // inserted vertex -> a live simplex of it
+  Buffer<std::int32_t> vsimplex_;       // inserted vertex -> a live simplex of it
   Buffer<double> coords_;               // vertex -> coordinates (D each)
-  std::vector<std::int32_t> pending_;   // 2D: vertex -> a new triangle's link awaiting its partner, or -1
+  Buffer<std::int32_t> pending_;        // 2D: vertex -> a new triangle's link awaiting its partner, or -1
   insertion::SimplexStore<S> store_{D == 3 ? "tessera: insertion: more tetrahedra than Simplex::n can number (about 75 million points)"
                                            : "tessera: insertion: more triangles than Simplex::n can number (about 250 million points)"};
   std::vector<W> workers_;
@@ -660,6 +694,7 @@ class Triangulation {
   bool parallel_ = true;            // whether rounds still try parallel phases
   bool retry_left_ = true;          // whether the phases may still try again once they stopped
   std::size_t retry_from_ = 0;      // the round size that tries again, once they stopped
+  std::size_t inserted_before_round_ = 0;  // vertices in before the current round (reserve_round)
   InsertionStats stats_;
 };
 

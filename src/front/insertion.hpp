@@ -47,6 +47,9 @@ struct InsertionStats {
   std::size_t stopped = 0;       ///< phases that deferred so many that later rounds went serially
   std::size_t resumed = 0;       ///< rounds that tried phases again after that (at most one)
   std::size_t guided = 0;        ///< walks started from a guide vertex rather than the last insertion
+  /// Times the store of simplices grew past its first reservation (each
+  /// growth copies it).
+  std::size_t store_growths = 0;
   /// Steps the walks took from one simplex to the next: the work of point
   /// location, which an order without locality inflates.
   std::size_t steps = 0;

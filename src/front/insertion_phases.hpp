@@ -17,6 +17,8 @@
 #include <memory>
 #include <optional>
 #include <stdexcept>
+#include <type_traits>
+#include <utility>
 #include <vector>
 
 #include <tbb/blocked_range.h>
@@ -27,6 +29,32 @@
 namespace tessera::front::insertion {
 
 constexpr std::int32_t infinite = -1;  ///< the vertex every ghost simplex shares
+
+/// An array of `size` T, not initialised, from Buffer's allocator: from
+/// 2 MiB up a mapping of its own advised for transparent huge pages, as the
+/// outputs' (buffer.hpp), since its slots are filled front to back too.
+template <class T>
+class SlotArray {
+  static_assert(std::is_trivially_copyable_v<T> && std::is_trivially_default_constructible_v<T>);
+
+ public:
+  SlotArray() = default;
+  explicit SlotArray(std::size_t size) : p_(DefaultInitAllocator<T>().allocate(size)), size_(size) {}
+  SlotArray(SlotArray&& o) noexcept : p_(std::exchange(o.p_, nullptr)), size_(std::exchange(o.size_, 0)) {}
+  SlotArray& operator=(SlotArray&& o) noexcept {
+    std::swap(p_, o.p_);
+    std::swap(size_, o.size_);
+    return *this;
+  }
+  ~SlotArray() {
+    if (p_ != nullptr) DefaultInitAllocator<T>().deallocate(p_, size_);
+  }
+  T* get() const { return p_; }
+
+ private:
+  T* p_ = nullptr;
+  std::size_t size_ = 0;
+};
 
 /// The simplices and their conflict marks, in arrays whose slots are written
 /// before they are read (allocated without initialising: the capacity
@@ -46,14 +74,23 @@ class SimplexStore {
   /// Slots reserved; it changes only serially, so phases read it freely.
   std::size_t capacity() const { return cap_; }
 
-  /// Room for `extra` more slots without growing (serial only).
+  /// Room for `extra` more slots without growing (serial only); a growth
+  /// at least doubles the capacity.
   void reserve(std::size_t extra) {
     const std::size_t need = size() + extra;
     if (need <= cap_) return;
     if (need > max_slots) throw std::length_error(too_many_);
-    const std::size_t cap = std::min(std::max(need, 2 * cap_), max_slots);
-    std::unique_ptr<S[]> t(new S[cap]);
-    std::unique_ptr<std::uint32_t[]> s(new std::uint32_t[cap]);
+    grow(std::max(need, 2 * cap_));
+  }
+  /// A capacity of at least `cap` slots (at most the numbering's limit),
+  /// exactly that where it grows (serial only). Growing copies the slots in
+  /// use into new arrays, so the pages of both are touched: callers grow to
+  /// what they expect to need, once, rather than doubling again and again.
+  void grow(std::size_t cap) {
+    cap = std::min(cap, max_slots);
+    if (cap <= cap_) return;
+    SlotArray<S> t(cap);
+    SlotArray<std::uint32_t> s(cap);
     // memcpy: claimed slots not yet written hold indeterminate bytes.
     if (size() > 0) {
       std::memcpy(t.get(), simplices_.get(), size() * sizeof(S));
@@ -61,8 +98,11 @@ class SimplexStore {
     }
     simplices_ = std::move(t);
     state_ = std::move(s);
+    if (cap_ != 0) ++growths_;
     cap_ = cap;
   }
+  /// Times the capacity grew after the first allocation.
+  std::size_t growths() const { return growths_; }
   /// The first of `count` fresh slots, or nullopt when the capacity is spent.
   std::optional<std::size_t> claim(std::size_t count) {
     std::size_t s = size_.load(std::memory_order_relaxed);
@@ -75,9 +115,10 @@ class SimplexStore {
  private:
   static constexpr std::size_t max_slots = std::size_t{1} << 29;  // 4 u + m fits in int32
   const char* too_many_;
-  std::unique_ptr<S[]> simplices_;
-  std::unique_ptr<std::uint32_t[]> state_;  // (epoch << 1) | in conflict
+  SlotArray<S> simplices_;
+  SlotArray<std::uint32_t> state_;  // (epoch << 1) | in conflict
   std::size_t cap_ = 0;
+  std::size_t growths_ = 0;
   std::atomic<std::size_t> size_{0};
 };
 

@@ -207,6 +207,32 @@ TEST(Insertion, PhasesTryAgainAfterASparseRound) {
   EXPECT_EQ(rows, insert_points(sphere, 3, 1, 1024));
 }
 
+TEST(Insertion, TheStoreOfSimplicesIsSizedOnce) {
+  // Uniform points need about 6.8 tetrahedra (2 triangles) per point; the
+  // store reserves for that at the start and never grows, phases included
+  // (a growth copies it, and the old copy's pages were touched for
+  // nothing: stop 68 doubled the 3D store in the last round of every
+  // uniform input). Surface samples need far more (a torus ~19 per
+  // point), measured as the rounds go: one growth, to what all points need.
+  for (const int dim : {2, 3}) {
+    tessera::front::InsertionStats stats;
+    insert_points(uniform_points(dim == 3 ? 100000 : 200000, dim, 77), dim, 2, 1024, &stats);
+    EXPECT_GE(stats.phases, 4u) << dim << "D";
+    EXPECT_EQ(stats.store_growths, 0u) << dim << "D";
+  }
+  std::mt19937_64 rng(9);
+  std::uniform_real_distribution<double> angle(0.0, 2.0 * std::acos(-1.0));
+  std::vector<double> torus;
+  for (int i = 0; i < 60000; ++i) {
+    const double u = angle(rng), v = angle(rng), r = 1.0 + 0.35 * std::cos(v);
+    torus.insert(torus.end(), {r * std::cos(u), r * std::sin(u), 0.35 * std::sin(v)});
+  }
+  tessera::front::InsertionStats stats;
+  const auto rows = insert_points(torus, 3, 2, 1024, &stats);
+  EXPECT_GT(rows.size(), 12u * 60000u);
+  EXPECT_EQ(stats.store_growths, 1u);
+}
+
 TEST(Insertion, ALongBoxIsInsertedInCubes) {
   // The same points in a unit cube and stretched 1e4 times along x (2D: a
   // square and a strip): the insertion order's curve cells are cubes
