@@ -8,6 +8,7 @@
 #include <tbb/parallel_for.h>
 
 #include "insertion.hpp"
+#include "tessera/buffer.hpp"
 #include "tessera/engine/thread_arena.hpp"
 
 namespace tessera::front {
@@ -29,7 +30,9 @@ std::optional<engine::DelaunayStars> delaunay_stars(const Pass<D>& pass, const s
     // Rows of slots from here on: the cells run in slot order, where
     // neighbouring points share most of their simplices, and read the
     // locator's slot-ordered copies.
-    std::vector<std::uint32_t> slot_of(n, 0);
+    // Buffers: read and written at random over n entries, through huge
+    // pages (Buffer) rather than 4 KiB ones; only located ids are read.
+    Buffer<std::uint32_t> slot_of(n);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, located), [&](const tbb::blocked_range<std::size_t>& r) {
       for (std::size_t k = r.begin(); k != r.end(); ++k) slot_of[static_cast<std::size_t>(loc.id(k))] = static_cast<std::uint32_t>(k);
     });
@@ -44,7 +47,7 @@ std::optional<engine::DelaunayStars> delaunay_stars(const Pass<D>& pass, const s
     // entries per slot, and fills them after those of the parts before it,
     // so every slot's list is ascending whatever the number of parts.
     const std::size_t nparts = std::clamp<std::size_t>(static_cast<std::size_t>(pass.engine_options.threads), 1, 8);
-    std::vector<std::vector<std::uint32_t>> at(nparts, std::vector<std::uint32_t>(located, 0));
+    std::vector<Buffer<std::uint32_t>> at(nparts, Buffer<std::uint32_t>(located, 0));
     auto part_range = [&](std::size_t c) { return std::pair{m * c / nparts, m * (c + 1) / nparts}; };
     tbb::parallel_for(std::size_t{0}, nparts, [&](std::size_t c) {
       const auto [a, e] = part_range(c);

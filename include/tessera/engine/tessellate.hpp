@@ -31,8 +31,8 @@ namespace tessera::engine {
 /// Located points are distinct (front::Pass leaves duplicates out).
 struct DelaunayStars {
   Buffer<std::int32_t> rows;  ///< slots (below 2^31), as the insertion's rows were ids
-  std::vector<std::uint32_t> first;
-  std::vector<std::uint32_t> simplices;
+  Buffer<std::uint32_t> first;
+  Buffer<std::uint32_t> simplices;  ///< filled in scattered order: on huge pages (Buffer)
 };
 
 /// What the driver needs: input, domain, locator and the generators whose
