@@ -51,26 +51,32 @@ namespace {
 /// their volumes and centroids (the clip order differs), and the output must
 /// not depend on the thread count.
 ///
-/// 3D: 1.75. On uniform points the search takes 0.64 of the insertion's time
-/// (100k, two threads), so where the insertion costs what it costs there
-/// per point the two are level at a ratio of ~1.55; where its in-sphere
-/// tests tie (lattices) or its walks are long it costs more. Measured on two
-/// threads (docs/design.md, "The cells' choice on sampled label images and
-/// outside points"): sampled label images at ratios 1.84-2.2 (118k-324k
-/// points) and a cube with a far outlier at 1.84 run 10-85% faster by
-/// insertion; a jittered lattice and a smooth 3-label image at 1.52-1.56
-/// run 30-100% faster by the search. Until stop 68 the threshold was 2
-/// (stop 35's measure), which kept the sampled images on the search. With
-/// outside points the threshold grows with the located points per
-/// generator (run(), below).
+/// 3D: 1.75 (stop 68). On uniform points the search then took 0.64 of the
+/// insertion's time (100k, two threads). Measured on two threads (docs/
+/// design.md, "The cells' choice on sampled label images and outside
+/// points"): sampled label images at ratios 1.84-2.2 (118k-324k points) and a
+/// cube with a far outlier at 1.84 run 10-85% faster by insertion. Since
+/// stop 69 ("The store of simplices: sized once, on huge pages") the
+/// insertion's cells cost 1.09-1.21 times the search's on uniform points, and
+/// graded densities, thin slabs and sampled images at 1.56-1.69 run 5-27%
+/// faster by insertion; but inputs near ties do not follow the ratio: a
+/// lattice jittered by 1e-9 (1.56), a dyadic voxel grid (1.42) and a
+/// rectilinear grid (1.63) run 7-29% slower by insertion, whose in-sphere
+/// tests meet those ties, and the ratio of one input varies by ~0.1 from
+/// sample to sample. So 3D stays at 1.75 (stop 68 had it at 2 before).
 ///
-/// 2D: 2. There 200k uniform points take 0.23 s on one thread and 0.12 s on
-/// two by the search, 0.30 s and 0.20 s by insertion, which costs about the
-/// same on any input, while the search grows as ratio^0.7 (curves, segments
-/// and blobs of 200k points: ratios 6-7, 0.34-0.46 s on two threads,
-/// 0.20-0.23 s by insertion); level at ~1.45 on one thread and ~2.1 on two.
+/// 2D: 1.3 (stop 69; 2 since stop 35). Since stop 69 the insertion's cells
+/// take 1.04 times the search's time on 1M uniform points on two threads and
+/// 0.88 on one. From ratios 1.33-1.86 (blobs over a uniform background, a
+/// density gradient, thin strips, a rotated lattice, a 100k grid) they run
+/// level to 25% faster on two threads and 6-47% faster on one; a gradient at
+/// 1.22 stays 11% faster by the search on two threads. Lattices, exact or
+/// jittered by 1e-9, measure 0.53-0.73.
+///
+/// With outside points the threshold grows with the located points per
+/// generator (run(), below).
 template <int D>
-inline constexpr double neighbours_ratio = D == 3 ? 1.75 : 2.0;
+inline constexpr double neighbours_ratio = D == 3 ? 1.75 : 1.3;
 /// The pilot's work units (~15-18 ns each) per exact evaluation that a small
 /// grid or the box-corner pattern served (a lattice's or a voxel grid's ties,
 /// ~53 per cell; ~30 on a sampled label image): 24-26 ns each measured on

@@ -786,6 +786,18 @@ TEST(FromNeighbours, AutomaticChoiceFollowsThePilot) {
         for (int i = 0; i < 32; ++i) voxels.insert(voxels.end(), {i * 0.7, j * 0.7, k * 1.2});
     EXPECT_FALSE(automatic(voxels, 3).from_insertion) << "voxel centres";
   }
+  // A thin strip. Since stop 69 the 2D insertion's cells cost about what
+  // the search's cost on uniform points, and they win from a pilot ratio of
+  // ~1.3: 40k points in a strip 1/200 wide (ratios 1.59-1.69 over five
+  // samples) now go to the insertion, level on two threads and ~45% faster
+  // on one; the threshold before (2) kept them on the search.
+  {
+    auto strip = random_points(40000, 2, 944);
+    for (std::size_t k = 1; k < strip.size(); k += 2) strip[k] *= 0.005;
+    const tessera::Cells d = automatic(strip, 2);
+    EXPECT_TRUE(d.from_insertion) << "thin strip";
+    EXPECT_TRUE(tessera::validate(d, {}).ok) << "thin strip";
+  }
   // Insertion asked for on points all on one line (2D) or plane (3D): no
   // simplex exists, and the search serves them.
   std::vector<double> line;
