@@ -99,7 +99,10 @@ class Triangulation {
     // A Delaunay tetrahedralisation of uniform points has about 6.8
     // tetrahedra per point, a triangulation 2 triangles. The capacity is
     // address space until used (the arrays are not initialised), so it is
-    // sized for the last round's phases at that rate (reserve_round).
+    // sized for the last round's phases at that rate (reserve_round). Input
+    // whose simplices could not be numbered even at the uniform rate fails
+    // here, before any work.
+    store_.check_limit(static_cast<std::size_t>((D == 3 ? 6.8 : 2.0) * static_cast<double>(n)) + 64);
     store_.grow(static_cast<std::size_t>((D == 3 ? 8.0 : 2.5) * static_cast<double>(n)) + 64);
   }
 

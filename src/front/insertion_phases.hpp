@@ -16,7 +16,6 @@
 #include <cstring>
 #include <optional>
 #include <stdexcept>
-#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -29,57 +28,37 @@ namespace tessera::front::insertion {
 
 constexpr std::int32_t infinite = -1;  ///< the vertex every ghost simplex shares
 
-/// An array of `size` T, not initialised, from Buffer's allocator: from
-/// 2 MiB up a mapping of its own advised for transparent huge pages, as the
-/// outputs' (buffer.hpp), since its slots are filled front to back too.
-template <class T>
-class SlotArray {
-  static_assert(std::is_trivially_copyable_v<T> && std::is_trivially_default_constructible_v<T>);
-
- public:
-  SlotArray() = default;
-  explicit SlotArray(std::size_t size) : p_(DefaultInitAllocator<T>().allocate(size)), size_(size) {}
-  SlotArray(SlotArray&& o) noexcept : p_(std::exchange(o.p_, nullptr)), size_(std::exchange(o.size_, 0)) {}
-  SlotArray& operator=(SlotArray&& o) noexcept {
-    std::swap(p_, o.p_);
-    std::swap(size_, o.size_);
-    return *this;
-  }
-  ~SlotArray() {
-    if (p_ != nullptr) DefaultInitAllocator<T>().deallocate(p_, size_);
-  }
-  T* get() const { return p_; }
-
- private:
-  T* p_ = nullptr;
-  std::size_t size_ = 0;
-};
-
 /// The simplices and their conflict marks, in arrays whose slots are written
-/// before they are read (allocated without initialising: the capacity
-/// reserved ahead of a parallel phase costs no page until it is used). Fresh
-/// slots are claimed in blocks, atomically, so that the parallel phases can
-/// take them; only the serial code grows the arrays.
+/// before they are read (Buffers sized without initialising: the capacity
+/// reserved ahead of a parallel phase costs no page until it is used, and
+/// from 2 MiB up they lie on transparent huge pages, which the walks and
+/// cavities read at random). Fresh slots are claimed in blocks, atomically,
+/// so that the parallel phases can take them; only the serial code grows
+/// the arrays.
 template <class S>
 class SimplexStore {
  public:
   /// `too_many`: the error when the slots would not fit S::n's numbering.
   explicit SimplexStore(const char* too_many) : too_many_(too_many) {}
 
-  S* simplices() { return simplices_.get(); }
-  const S* simplices() const { return simplices_.get(); }
-  std::uint32_t* state() { return state_.get(); }
+  S* simplices() { return simplices_.data(); }
+  const S* simplices() const { return simplices_.data(); }
+  std::uint32_t* state() { return state_.data(); }
   std::size_t size() const { return size_.load(std::memory_order_relaxed); }
   /// Slots reserved; it changes only serially, so phases read it freely.
-  std::size_t capacity() const { return cap_; }
+  std::size_t capacity() const { return simplices_.size(); }
 
+  /// Throws the store's error where `slots` would not fit S::n's numbering.
+  void check_limit(std::size_t slots) const {
+    if (slots > max_slots) throw std::length_error(too_many_);
+  }
   /// Room for `extra` more slots without growing (serial only); a growth
   /// at least doubles the capacity.
   void reserve(std::size_t extra) {
     const std::size_t need = size() + extra;
-    if (need <= cap_) return;
-    if (need > max_slots) throw std::length_error(too_many_);
-    grow(std::max(need, 2 * cap_));
+    if (need <= capacity()) return;
+    check_limit(need);
+    grow(std::max(need, 2 * capacity()));
   }
   /// A capacity of at least `cap` slots (at most the numbering's limit),
   /// exactly that where it grows (serial only). Growing copies the slots in
@@ -87,18 +66,20 @@ class SimplexStore {
   /// what they expect to need, once, rather than doubling again and again.
   void grow(std::size_t cap) {
     cap = std::min(cap, max_slots);
-    if (cap <= cap_) return;
-    SlotArray<S> t(cap);
-    SlotArray<std::uint32_t> s(cap);
-    // memcpy: claimed slots not yet written hold indeterminate bytes.
+    if (cap <= capacity()) return;
+    Buffer<S> t;
+    Buffer<std::uint32_t> s;
+    t.resize(cap);  // not initialised (Buffer)
+    s.resize(cap);
+    // memcpy rather than the vectors' own growth: claimed slots not yet
+    // written hold indeterminate bytes.
     if (size() > 0) {
-      std::memcpy(t.get(), simplices_.get(), size() * sizeof(S));
-      std::memcpy(s.get(), state_.get(), size() * sizeof(std::uint32_t));
+      std::memcpy(t.data(), simplices_.data(), size() * sizeof(S));
+      std::memcpy(s.data(), state_.data(), size() * sizeof(std::uint32_t));
     }
+    if (capacity() != 0) ++growths_;
     simplices_ = std::move(t);
     state_ = std::move(s);
-    if (cap_ != 0) ++growths_;
-    cap_ = cap;
   }
   /// Times the capacity grew after the first allocation.
   std::size_t growths() const { return growths_; }
@@ -106,7 +87,7 @@ class SimplexStore {
   std::optional<std::size_t> claim(std::size_t count) {
     std::size_t s = size_.load(std::memory_order_relaxed);
     do {
-      if (s + count > cap_) return std::nullopt;
+      if (s + count > capacity()) return std::nullopt;
     } while (!size_.compare_exchange_weak(s, s + count, std::memory_order_relaxed));
     return s;
   }
@@ -114,9 +95,8 @@ class SimplexStore {
  private:
   static constexpr std::size_t max_slots = std::size_t{1} << 29;  // 4 u + m fits in int32
   const char* too_many_;
-  SlotArray<S> simplices_;
-  SlotArray<std::uint32_t> state_;  // (epoch << 1) | in conflict
-  std::size_t cap_ = 0;
+  Buffer<S> simplices_;
+  Buffer<std::uint32_t> state_;  // (epoch << 1) | in conflict
   std::size_t growths_ = 0;
   std::atomic<std::size_t> size_{0};
 };
