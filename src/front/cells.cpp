@@ -77,6 +77,26 @@ namespace {
 /// generator (run(), below).
 template <int D>
 inline constexpr double neighbours_ratio = D == 3 ? 1.75 : 1.3;
+/// 3D, where the domain box reaches far beyond the bulk of the points (a few
+/// far points, or explicit bounds many times the points' extent:
+/// BinLocator::spans_bulk), the insertion is taken from a ratio of 1.2
+/// (stop 70). The pilot's sample of cells cannot see what such input costs
+/// the search: the far points' own cells (one point 1e6 beyond 200k uniform
+/// ones: its bisectors with the bulk are nearly parallel, 836k exact
+/// evaluations and ~1.5 s for that one cell) and the bulk's hull cells, long
+/// cones out to the box, are a few cells among many. Their sampled neighbours
+/// measure 1.2-1.75 (uniform bulks), and on every such input measured but
+/// two small ones (10k-50k points, 4-5% slower) the insertion was level to
+/// 3.2 times faster on two threads (docs/design.md, "Far boxes: the cells'
+/// choice (stop 70)"). Not where the pilot met ties (far_box_tie_limit): a
+/// lattice or a voxel grid with one point 1e3 away measures 1.42-1.50 and
+/// runs 18-31% faster by the search, whose ties are cheap. Not in 2D, where
+/// such cells are cheap: uniform squares with far points run level by either
+/// method.
+inline constexpr double far_box_ratio = 1.2;
+/// Exact evaluations per pilot cell from which the input counts as tied
+/// (lattices ~53, sampled label images ~30; uniform points below 0.2).
+inline constexpr double far_box_tie_limit = 10;
 /// The pilot's work units (~15-18 ns each) per exact evaluation that a small
 /// grid or the box-corner pattern served (a lattice's or a voxel grid's ties,
 /// ~53 per cell; ~30 on a sampled label image): 24-26 ns each measured on
@@ -133,11 +153,13 @@ Cells run(std::span<const double> input, std::span<const std::int32_t> labels, c
         // none abandoned at its cap, none much larger than a uniform cell).
         const double located = static_cast<double>(pass.locator->size());
         const double generators = static_cast<double>(pass.order.size());
-        const double from = generators > 0 ? neighbours_ratio<D> * std::max(1.0, located / generators)
-                                            : std::numeric_limits<double>::infinity();
-        const front::PilotEstimate e =
-            front::pilot_estimate<CellT>(pass, from, pilot_share, tie_weight, neighbours_ratio<D>);
-        insert = generators > 0 && e.ratio >= (e.measured ? from : neighbours_ratio<D>);
+        const double per_generator = generators > 0 ? std::max(1.0, located / generators)
+                                                    : std::numeric_limits<double>::infinity();
+        const front::PilotEstimate e = front::pilot_estimate<CellT>(pass, neighbours_ratio<D> * per_generator,
+                                                                    pilot_share, tie_weight, neighbours_ratio<D>);
+        const bool far_box = D == 3 && pass.locator->spans_bulk() && e.exact_per_cell < far_box_tie_limit;
+        const double from = far_box ? far_box_ratio : neighbours_ratio<D>;
+        insert = generators > 0 && e.ratio >= (e.measured ? from * per_generator : from);
       }
     }
     if (insert) {

@@ -786,6 +786,30 @@ TEST(FromNeighbours, AutomaticChoiceFollowsThePilot) {
         for (int i = 0; i < 32; ++i) voxels.insert(voxels.end(), {i * 0.7, j * 0.7, k * 1.2});
     EXPECT_FALSE(automatic(voxels, 3).from_insertion) << "voxel centres";
   }
+  // 3D, a domain box far beyond the bulk of the points: one point 1e6 away
+  // from 20,000 uniform ones, or bounds twenty times their extent. The
+  // pilot's sample cannot see the far point's own cell (its bisectors with
+  // the bulk nearly parallel) or the bulk's hull cells, long cones out to the
+  // box, which cost the search most: it took twice the insertion's time on
+  // the first. From a ratio of 1.2 the insertion serves them (cells.cpp,
+  // far_box_ratio); until stop 70 they measured 1.4-1.5 and were searched.
+  // A lattice beside a far point (ties everywhere) stays on the search,
+  // which settles its ties cheaply: its pilot measures ~1.65, and so would
+  // go to the insertion without that exemption.
+  {
+    auto far = random_points(20000, 3, 945);
+    far.insert(far.end(), {1e6, 0.5, 0.5});
+    const tessera::Cells c = automatic(far, 3);
+    EXPECT_TRUE(c.from_insertion) << "a point 1e6 away";
+    EXPECT_TRUE(tessera::validate(c, {}).ok) << "a point 1e6 away";
+    const tessera::Cells w = run_method(random_points(20000, 3, 946), 3, tessera::CellMethod::automatic, {}, 2,
+                                        make_bounds({-10, -10, -10}, {11, 11, 11}));
+    EXPECT_TRUE(w.from_insertion) << "bounds twenty times the points' extent";
+    EXPECT_TRUE(tessera::validate(w, {}).ok) << "bounds twenty times the points' extent";
+    auto lattice = grid_points(36, 3);
+    lattice.insert(lattice.end(), {1e3, 18, 18});
+    EXPECT_FALSE(automatic(lattice, 3).from_insertion) << "a lattice and a point 1e3 away";
+  }
   // A thin strip. Since stop 69 the 2D insertion's cells cost about what
   // the search's cost on uniform points, and they win from a pilot ratio of
   // ~1.3: 40k points in a strip 1/200 wide (ratios 1.59-1.69 over five

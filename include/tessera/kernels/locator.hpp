@@ -168,6 +168,14 @@ class BinLocator {
   Point grid_hi() const { return hi_; }
   /// How many located points lie beyond the grid's box (beyond_core).
   std::size_t outside_core() const { return outside_core_; }
+  /// Whether the grid spans the bulk of the points, not the domain box,
+  /// along some axis (grid_box): the box reaches far beyond the bulk, set
+  /// by far points or by explicit bounds.
+  bool spans_bulk() const {
+    for (const bool c : core_)
+      if (c) return true;
+    return false;
+  }
 
   std::array<std::int32_t, D> bin_coords(const double* x) const {
     std::array<std::int32_t, D> b;
