@@ -331,6 +331,36 @@ TEST(Oracle, FarOutliers) {
   }
 }
 
+// A point far from the rest, its cell by the search: its bisectors with the
+// bulk are nearly parallel, and its clips leave vertices too ill-conditioned
+// for the float bound, whose exact solve is deferred (filter::deferred_
+// vertex_condition). Kept with their wide bounds while every point of the
+// bulk is tried, they sent each candidate to the exact stages: 836k exact
+// evaluations for one point 1e6 from 200k uniform ones (~1.5 s, that cell
+// alone). Since stop 70 a cell whose deferred vertices are asked 64 exact
+// questions solves them before its next clip (Hull/Tile::clip). The cells
+// are the same either way (the exact signs decide); the count of exact
+// evaluations shows the change, and the insertion's neighbours check the
+// cells.
+TEST(Oracle, FarPointSolvesItsDeferredVertices) {
+  for (int dim : {2, 3}) {
+    SCOPED_TRACE(testing::Message() << "dim " << dim);
+    const std::size_t n = 5000;
+    auto pts = random_points(n, dim, 80 + static_cast<std::uint64_t>(dim), make_bounds({0, 0, 0}, {1, 1, 1}));
+    pts.push_back(1e6);
+    for (int a = 1; a < dim; ++a) pts.push_back(0.5);
+    auto opt = options(dim, std::nullopt, 1);
+    opt.cell_method = tessera::CellMethod::search;
+    const tessera::Cells c = tessera::voronoi(pts, dim, {}, opt);
+    EXPECT_LT(c.exact_predicate_calls, n);  // 7,443 (2D) and 7,922 (3D) before
+    opt.cell_method = tessera::CellMethod::insertion;
+    const tessera::Cells ci = tessera::voronoi(pts, dim, {}, opt);
+    EXPECT_EQ(c.neighbors, ci.neighbors);
+    EXPECT_EQ(c.neighbor_offsets, ci.neighbor_offsets);
+    EXPECT_EQ(c.num_faces, ci.num_faces);
+  }
+}
+
 // One outlier so far that no single power-of-two frame fits the input
 // (2^600 beside unit points, or unit points beside 2^-600: the kernels then
 // store its bisectors scaled, filter::scale_bisector, and rescale measures

@@ -103,6 +103,10 @@ class Hull {
 
   /// Clip by the bisector with generator j, q = p_j - p_i (computed in double).
   ClipResult clip(std::int32_t j, const double* q) {
+    if (deferred_asks_ >= deferred_ask_limit) [[unlikely]] {
+      deferred_asks_ = 0;
+      solve_deferred();
+    }
     const filter::Bisector<3> b(q);
     const std::size_t nv = verts_.size();
     auto exact = [&](std::size_t t) { return exact_sign(t, j); };
@@ -519,6 +523,7 @@ class Hull {
     signs_.start_cell();
     exact_solves_ = 0;
     deferred_ = 0;
+    deferred_asks_ = 0;
     // Planes and corners are written in place: a local struct copied in
     // would be read back wider than it was written (a store-forwarding stall).
     planes_.resize(box_planes);
@@ -539,6 +544,7 @@ class Hull {
   // The exact sign of vertex slot t against j (prepared_signs.hpp).
   int exact_sign(std::size_t t, std::int32_t j) {
     const Vertex& v = verts_[t];
+    deferred_asks_ += v.deferred;
     const std::int32_t ids[3] = {planes_[v.p[0]].id, planes_[v.p[1]].id, planes_[v.p[2]].id};
     return signs_.sign(*exact_, gen_, t, v.p, ids, j);
   }
@@ -804,6 +810,12 @@ class Hull {
   bool scaled_planes_ = false;  // has_scaled_planes()
   mutable std::uint64_t exact_solves_ = 0;  // exact_solves(); counted by the const solve
   mutable std::size_t deferred_ = 0;  // vertices deferred (Vertex::deferred) since the cell started
+  // Exact evaluations asked of deferred vertices since the cell started or
+  // they were last solved: past deferred_ask_limit, the next clip solves
+  // them first (their wide bounds were sending every candidate to the
+  // exact stages).
+  std::uint32_t deferred_asks_ = 0;
+  static constexpr std::uint32_t deferred_ask_limit = 64;
   std::vector<Plane> planes_;
   VertexList verts_;
   filter::FilterLanes<3> lanes_;  // verts_' filter data, for the sign pass

@@ -81,6 +81,10 @@ class Tile {
   }
 
   ClipResult clip(std::int32_t j, const double* q) {
+    if (deferred_asks_ >= deferred_ask_limit) [[unlikely]] {
+      deferred_asks_ = 0;
+      solve_deferred();
+    }
     const filter::Bisector<2> b(q);
     const std::size_t nv = verts_.size();
     auto exact = [&](std::size_t t) { return exact_sign(t, j); };
@@ -291,6 +295,7 @@ class Tile {
     signs_.start_cell();
     exact_solves_ = 0;
     deferred_.clear();
+    deferred_asks_ = 0;
     // Planes and corners are written in place: a local struct copied in
     // would be read back wider than it was written (a store-forwarding stall).
     planes_.resize(box_planes);
@@ -310,6 +315,7 @@ class Tile {
   // The exact sign of vertex slot t against j (prepared_signs.hpp).
   int exact_sign(std::size_t t, std::int32_t j) {
     const Vertex& v = verts_[t];
+    deferred_asks_ += !deferred_.empty();
     const std::int32_t ids[2] = {planes_[v.p[0]].id, planes_[v.p[1]].id};
     return signs_.sign(*exact_, gen_, t, v.p, ids, j);
   }
@@ -454,6 +460,12 @@ class Tile {
   bool may_underflow_ = false;  // exact_->may_underflow: solve() adds filter::underflow_slack
   mutable std::uint64_t exact_solves_ = 0;  // exact_solves(); counted by the const solve
   mutable DeferredSolves deferred_;  // pair_keys of vertices whose exact solve waits (solve_deferred)
+  // Exact evaluations asked while some vertex is deferred (a tile cannot
+  // tell which without a lookup), since the cell started or they were last
+  // solved: past deferred_ask_limit the next clip solves them first, as
+  // Hull::clip does.
+  std::uint32_t deferred_asks_ = 0;
+  static constexpr std::uint32_t deferred_ask_limit = 64;
   std::vector<Plane> planes_;
   std::vector<Vertex> verts_;
   filter::FilterLanes<2> lanes_;  // verts_' filter data, for the sign pass
