@@ -81,16 +81,14 @@ inline constexpr double neighbours_ratio = D == 3 ? 1.75 : 1.3;
 /// far points, or explicit bounds many times the points' extent:
 /// BinLocator::spans_bulk), the insertion is taken from a ratio of 1.2
 /// (stop 70). The pilot's sample of cells cannot see what such input costs
-/// the search: the far points' own cells (one point 1e6 beyond 200k uniform
-/// ones: its bisectors with the bulk are nearly parallel, 836k exact
-/// evaluations and ~1.5 s for that one cell) and the bulk's hull cells, long
-/// cones out to the box, are a few cells among many. Their sampled neighbours
-/// measure 1.2-1.75 (uniform bulks), and on every such input measured but
-/// two small ones (10k-50k points, 4-5% slower) the insertion was level to
-/// 3.2 times faster on two threads (docs/design.md, "Far boxes: the cells'
-/// choice (stop 70)"). Not where the pilot met ties (far_box_tie_limit): a
-/// lattice or a voxel grid with one point 1e3 away measures 1.42-1.50 and
-/// runs 18-31% faster by the search, whose ties are cheap. Not in 2D, where
+/// the search: the far points' own cells (bisectors with the bulk nearly
+/// parallel) and the bulk's hull cells, long cones out to the box, are a few
+/// cells among many. Their sampled neighbours measure 1.2-1.75 (uniform
+/// bulks), and on every such input measured the insertion ran level (within
+/// 2%) to 2.7 times faster on two threads (docs/design.md, "Far boxes: the
+/// cells' choice (stop 70)"). Not where the pilot met ties (far_box_tie_limit):
+/// a lattice or a voxel grid with one point 1e3 away measures 1.42-1.50 and
+/// runs 2-8% faster by the search, whose ties are cheap. Not in 2D, where
 /// such cells are cheap: uniform squares with far points run level by either
 /// method.
 inline constexpr double far_box_ratio = 1.2;

@@ -308,7 +308,8 @@ class Hull {
   /// condition), and that are still there, are solved exactly now, so every vertex of a built
   /// cell is as accurate as if they had been solved at once (the same
   /// doubles: the clips' decisions are exact either way). CellBuilder calls
-  /// it for every cell it returns.
+  /// it for every cell it returns, and clip() sooner, once the deferred
+  /// vertices were asked deferred_ask_limit exact questions.
   void solve_deferred() {
     if (deferred_ == 0) return;
     for (std::size_t t = 0; t < verts_.size(); ++t)

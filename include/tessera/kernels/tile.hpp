@@ -239,7 +239,8 @@ class Tile {
   std::uint64_t exact_solves() const { return exact_solves_; }
 
   /// As Hull::solve_deferred: the surviving vertices whose exact solve was
-  /// deferred are solved now.
+  /// deferred are solved now (by CellBuilder for every cell it returns, and
+  /// by clip() once deferred_ask_limit exact questions were asked).
   void solve_deferred() {
     if (deferred_.empty()) return;
     deferred_.seal();
