@@ -339,9 +339,9 @@ TEST(Oracle, FarOutliers) {
 // evaluations for one point 1e6 from 200k uniform ones (~1.5 s, that cell
 // alone). Since stop 70 a cell whose deferred vertices are asked 64 exact
 // questions solves them before its next clip (Hull/Tile::clip). The cells
-// are the same either way (the exact signs decide); the count of exact
-// evaluations shows the change, and the insertion's neighbours check the
-// cells.
+// are the same either way (the exact signs decide; only the last bits of a
+// measure can move, with the clip order); the count of exact evaluations
+// shows the change, and the insertion's neighbours check the cells.
 TEST(Oracle, FarPointSolvesItsDeferredVertices) {
   for (int dim : {2, 3}) {
     SCOPED_TRACE(testing::Message() << "dim " << dim);
