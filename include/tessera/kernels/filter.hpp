@@ -88,6 +88,12 @@ inline constexpr double exact_vertex_condition = 1e6;
 /// a few), and each exact solve costs about a microsecond in GMP.
 inline constexpr double deferred_vertex_condition = 1e9;
 
+/// Exact evaluations a cell may ask of its deferred vertices before its next
+/// clip solves them (Hull/Tile::clip): kept with their wide bounds through a
+/// long search (a far point's cell tries every point of the bulk), they sent
+/// every candidate to the exact stages (stop 70).
+inline constexpr std::uint32_t deferred_ask_limit = 64;
+
 /// How solve() treats a vertex too ill-conditioned for its float bound
 /// (Hull/Tile::ill_conditioned, assembly::ill_conditioned_fate): exact_now
 /// solves it at once; deferrable (a clip) defers it below

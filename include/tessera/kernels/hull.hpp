@@ -103,7 +103,7 @@ class Hull {
 
   /// Clip by the bisector with generator j, q = p_j - p_i (computed in double).
   ClipResult clip(std::int32_t j, const double* q) {
-    if (deferred_asks_ >= deferred_ask_limit) [[unlikely]] {
+    if (deferred_asks_ >= filter::deferred_ask_limit) [[unlikely]] {
       deferred_asks_ = 0;
       solve_deferred();
     }
@@ -309,7 +309,7 @@ class Hull {
   /// cell is as accurate as if they had been solved at once (the same
   /// doubles: the clips' decisions are exact either way). CellBuilder calls
   /// it for every cell it returns, and clip() sooner, once the deferred
-  /// vertices were asked deferred_ask_limit exact questions.
+  /// vertices were asked filter::deferred_ask_limit exact questions.
   void solve_deferred() {
     if (deferred_ == 0) return;
     for (std::size_t t = 0; t < verts_.size(); ++t)
@@ -812,11 +812,8 @@ class Hull {
   mutable std::uint64_t exact_solves_ = 0;  // exact_solves(); counted by the const solve
   mutable std::size_t deferred_ = 0;  // vertices deferred (Vertex::deferred) since the cell started
   // Exact evaluations asked of deferred vertices since the cell started or
-  // they were last solved: past deferred_ask_limit, the next clip solves
-  // them first (their wide bounds were sending every candidate to the
-  // exact stages).
+  // they were last solved (filter::deferred_ask_limit).
   std::uint32_t deferred_asks_ = 0;
-  static constexpr std::uint32_t deferred_ask_limit = 64;
   std::vector<Plane> planes_;
   VertexList verts_;
   filter::FilterLanes<3> lanes_;  // verts_' filter data, for the sign pass

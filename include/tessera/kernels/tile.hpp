@@ -81,7 +81,7 @@ class Tile {
   }
 
   ClipResult clip(std::int32_t j, const double* q) {
-    if (deferred_asks_ >= deferred_ask_limit) [[unlikely]] {
+    if (deferred_asks_ >= filter::deferred_ask_limit) [[unlikely]] {
       deferred_asks_ = 0;
       solve_deferred();
     }
@@ -240,7 +240,7 @@ class Tile {
 
   /// As Hull::solve_deferred: the surviving vertices whose exact solve was
   /// deferred are solved now (by CellBuilder for every cell it returns, and
-  /// by clip() once deferred_ask_limit exact questions were asked).
+  /// by clip() once filter::deferred_ask_limit exact questions were asked).
   void solve_deferred() {
     if (deferred_.empty()) return;
     deferred_.seal();
@@ -463,10 +463,8 @@ class Tile {
   mutable DeferredSolves deferred_;  // pair_keys of vertices whose exact solve waits (solve_deferred)
   // Exact evaluations asked while some vertex is deferred (a tile cannot
   // tell which without a lookup), since the cell started or they were last
-  // solved: past deferred_ask_limit the next clip solves them first, as
-  // Hull::clip does.
+  // solved (filter::deferred_ask_limit).
   std::uint32_t deferred_asks_ = 0;
-  static constexpr std::uint32_t deferred_ask_limit = 64;
   std::vector<Plane> planes_;
   std::vector<Vertex> verts_;
   filter::FilterLanes<2> lanes_;  // verts_' filter data, for the sign pass
