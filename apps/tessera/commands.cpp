@@ -396,10 +396,11 @@ int run_bench_voronoi(const BenchArgs& a) {
     std::printf(
         "{\"tool\":\"tessera\",\"op\":\"%s\",\"n\":%zu,\"threads\":%d,\"seconds\":%.6f,\"simplices\":%zu,"
         "\"extra\":{\"cpu_user_s\":%.6f,\"cpu_sys_s\":%.6f,\"minflt\":%lld,\"peak_rss_bytes\":%lld,"
-        "\"neighbors\":%zu,\"from_insertion\":%s,\"assembled\":%zu,\"exact_calls\":%llu,\"volume_sum\":%.17g,\"repeat\":%d}}\n",
+        "\"neighbors\":%zu,\"from_insertion\":%s,\"assembled\":%zu,\"from_pilot\":%zu,\"exact_calls\":%llu,\"volume_sum\":%.17g,\"repeat\":%d}}\n",
         op, pc.n, cells.threads_used, secs, cells.n_cells(), u1.user_s - u0.user_s, u1.sys_s - u0.sys_s,
         u1.minflt - u0.minflt, u1.maxrss_bytes, cells.neighbors.size(), cells.from_insertion ? "true" : "false",
-        cells.assembled_from_stars, static_cast<unsigned long long>(cells.exact_predicate_calls), accurate_sum(cells.volume), rep);
+        cells.assembled_from_stars, cells.cells_from_pilot, static_cast<unsigned long long>(cells.exact_predicate_calls),
+        accurate_sum(cells.volume), rep);
     std::fflush(stdout);
   }
   return kExitOk;

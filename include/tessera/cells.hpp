@@ -138,6 +138,10 @@ struct Cells {
   /// and far out, or stars of over 500 neighbours in 3D) were clipped by
   /// their stars' vertices.
   std::size_t assembled_from_stars = 0;
+  /// Generators whose cells the automatic method's pilot built whole while
+  /// it sampled what the search costs, kept where the search was chosen
+  /// instead of being built again (the same cells).
+  std::size_t cells_from_pilot = 0;
 
   std::size_t n_cells() const { return generator.size(); }
   std::size_t n_vertices() const { return vertex_keys.size() / (dim + 1); }

@@ -127,6 +127,8 @@ Cells run(std::span<const double> input, std::span<const std::int32_t> labels, c
   // neighbours: the same cells (docs/design.md, "Cells from Delaunay
   // neighbours", "Cells assembled from their stars").
   std::optional<engine::DelaunayStars> stars;
+  front::CellsCompositor<CellT> comp(out, labels, opt.build_mesh, pass.k);
+  front::PilotKeep<front::CellsCompositor<CellT>> kept{comp, {}, 0};  // the pilot's whole cells
   {
     bool insert = opt.cell_method == CellMethod::insertion;
     // Input no frame fits (a far outlier beyond ~1e154, points spread
@@ -153,8 +155,8 @@ Cells run(std::span<const double> input, std::span<const std::int32_t> labels, c
         const double generators = static_cast<double>(pass.order.size());
         const double per_generator = generators > 0 ? std::max(1.0, located / generators)
                                                     : std::numeric_limits<double>::infinity();
-        const front::PilotEstimate e = front::pilot_estimate<CellT>(pass, neighbours_ratio<D> * per_generator,
-                                                                    pilot_share, tie_weight, neighbours_ratio<D>);
+        const front::PilotEstimate e = front::pilot_estimate<CellT>(
+            pass, neighbours_ratio<D> * per_generator, pilot_share, tie_weight, neighbours_ratio<D>, &kept);
         const bool far_box = D == 3 && pass.locator->spans_bulk() && e.exact_per_cell < far_box_tie_limit;
         const double from = far_box ? far_box_ratio : neighbours_ratio<D>;
         insert = generators > 0 && e.ratio >= (e.measured ? from * per_generator : from);
@@ -173,8 +175,29 @@ Cells run(std::span<const double> input, std::span<const std::int32_t> labels, c
       if (opt.progress) pass.engine_options.progress = [&opt](double f) { opt.progress(0.5 + 0.5 * f); };
     }
   }
-  front::CellsCompositor<CellT> comp(out, labels, opt.build_mesh, pass.k);
-  out.exact_predicate_calls = engine::tessellate<CellT>(pass.gens, comp, pass.engine_options);
+  // The search's pass leaves out the cells its pilot built whole.
+  std::vector<std::int32_t> rest_order;
+  std::vector<std::uint32_t> rest_slots;
+  if (stars || kept.batches.empty()) {
+    kept.batches.clear();
+    kept.exact_calls = 0;
+  } else {
+    std::vector<bool> built(out.n_points, false);
+    for (const auto& b : kept.batches) {
+      for (const std::int32_t g : b.gen) built[static_cast<std::size_t>(g)] = true;
+      out.cells_from_pilot += b.gen.size();
+    }
+    const bool with_slots = !pass.gens.slots.empty();
+    for (std::size_t i = 0; i < pass.gens.order.size(); ++i)
+      if (!built[static_cast<std::size_t>(pass.gens.order[i])]) {
+        rest_order.push_back(pass.gens.order[i]);
+        if (with_slots) rest_slots.push_back(pass.gens.slots[i]);
+      }
+    pass.gens.order = rest_order;
+    pass.gens.slots = rest_slots;
+  }
+  out.exact_predicate_calls =
+      engine::tessellate<CellT>(pass.gens, comp, pass.engine_options, std::move(kept.batches)) + kept.exact_calls;
   std::sort(out.duplicates.begin(), out.duplicates.end());
   if (pass.k != 0) {
     // (volumes: already in the input's units, CellsCompositor)

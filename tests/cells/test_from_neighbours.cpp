@@ -647,6 +647,61 @@ void same_for_threads(const std::vector<double>& p, int dim, const std::string& 
 #undef SAME
 }
 
+// The automatic method keeps the cells its pilot built whole where it
+// chooses the search (front/pilot.hpp, PilotKeep): the pass builds only the
+// rest, and the result is the search's, bit for bit, mesh included. Small
+// inputs, where the pilot builds up to half the cells; labels (outside
+// points) and duplicates, which the kept batches carry too.
+TEST(FromNeighbours, PilotCellsAreKept) {
+  auto same = [](const std::vector<double>& p, int dim, const std::vector<std::int32_t>& labels, int threads,
+                 const std::string& what) {
+    SCOPED_TRACE(what);
+    tessera::VoronoiOptions o = options(dim, std::nullopt, threads);
+    o.build_mesh = true;
+    auto run = [&](tessera::CellMethod m) {
+      o.cell_method = m;
+      return tessera::voronoi(std::span<const double>(p), dim, std::span<const std::int32_t>(labels), o);
+    };
+    const tessera::Cells a = run(tessera::CellMethod::automatic);
+    const tessera::Cells b = run(tessera::CellMethod::search);
+    EXPECT_FALSE(a.from_insertion);
+    EXPECT_GT(a.cells_from_pilot, 0u);
+    EXPECT_LT(a.cells_from_pilot, p.size() / static_cast<std::size_t>(dim));
+    EXPECT_EQ(b.cells_from_pilot, 0u);
+    EXPECT_EQ(a.exact_predicate_calls, b.exact_predicate_calls);
+#define SAME(f) EXPECT_TRUE(a.f == b.f) << #f " differs from the search's"
+    SAME(generator);
+    SAME(region);
+    SAME(volume);
+    SAME(centroid);
+    SAME(num_faces);
+    SAME(neighbor_offsets);
+    SAME(neighbors);
+    SAME(cell_of);
+    SAME(vertices);
+    SAME(vertex_keys);
+    SAME(cell_face_offsets);
+    SAME(face_vertex_offsets);
+    SAME(face_vertices);
+    SAME(face_neighbor);
+    SAME(face_class);
+    SAME(duplicates);
+#undef SAME
+  };
+  for (const int dim : {2, 3})
+    for (const int threads : {1, 2}) {
+      const std::string d = std::to_string(dim) + "D, " + std::to_string(threads) + " threads: ";
+      same(random_points(300, dim, 950), dim, {}, threads, d + "300 uniform points");
+      same(random_points(5000, dim, 951), dim, {}, threads, d + "5,000 uniform points");
+      same(grid_points(dim == 3 ? 9 : 30, dim), dim, {}, threads, d + "a lattice (ties)");
+      auto dup = random_points(2000, dim, 952);
+      dup.insert(dup.end(), dup.begin(), dup.begin() + 100 * dim);
+      std::vector<std::int32_t> labels(dup.size() / static_cast<std::size_t>(dim));
+      for (std::size_t i = 0; i < labels.size(); ++i) labels[i] = i % 7 == 3 ? -1 : static_cast<std::int32_t>(i % 3);
+      same(dup, dim, labels, threads, d + "duplicates and outside points");
+    }
+}
+
 TEST(FromNeighbours, ThreadCountDoesNotChangeResult) {
   auto p = sphere_points(1500, 908);
   const auto r = random_points(1500, 3, 909);

@@ -65,10 +65,15 @@ struct EngineOptions {
 };
 
 /// Build every cell of `gens.order` and hand each to the compositor; returns
-/// the number of exact predicate evaluations.
+/// the number of exact predicate evaluations. `earlier`: batches the same
+/// compositor was given before, by another loop over other generators (the
+/// pilot's sample, front/pilot.hpp), finished together with these (placed
+/// before them; the compositors order their output by generator, not by
+/// batch).
 template <class CellT, class Comp>
   requires Compositor<Comp, CellT>
-std::uint64_t tessellate(const Generators<CellT::dim>& gens, Comp& comp, const EngineOptions& opt) {
+std::uint64_t tessellate(const Generators<CellT::dim>& gens, Comp& comp, const EngineOptions& opt,
+                         std::vector<typename Comp::Batch> earlier = {}) {
   const std::size_t n = gens.order.size();
   if (!gens.slots.empty() && gens.slots.size() != n)
     throw std::invalid_argument("tessera: Generators::slots must be empty or as long as Generators::order");
@@ -76,7 +81,9 @@ std::uint64_t tessellate(const Generators<CellT::dim>& gens, Comp& comp, const E
     throw std::invalid_argument("tessera: Generators::stars needs Generators::slots");
   const std::size_t bs = std::max<std::size_t>(1, opt.batch_size);
   const std::size_t nb = (n + bs - 1) / bs;
-  std::vector<typename Comp::Batch> batches(nb);
+  const std::size_t first_own = earlier.size();
+  std::vector<typename Comp::Batch> batches = std::move(earlier);
+  batches.resize(first_own + nb);
 
   struct Workspace {
     kernels::CellBuilder<CellT> builder;
@@ -94,7 +101,7 @@ std::uint64_t tessellate(const Generators<CellT::dim>& gens, Comp& comp, const E
   constexpr std::size_t star_ahead = 4;  // cells whose star rows are prefetched ahead of their turn
   auto run_batch = [&](std::size_t k) {
     Workspace& ws = workspaces.local();
-    auto& batch = batches[k];
+    auto& batch = batches[first_own + k];
     const std::size_t end = std::min(n, (k + 1) * bs);
     for (std::size_t g = k * bs; g < end; ++g) {
       const std::int32_t gen = gens.order[g];
