@@ -259,6 +259,7 @@ PilotEstimate pilot_estimate(const Pass<CellT::dim>& pass, double enough, double
                          static_cast<double>(exact) / static_cast<double>(std::max<std::uint64_t>(comp.total.cells, 1)),
                          comp.total.cells, comp.total.cells > 0 && measured(comp.total)};
   };
+  engine::ThreadArena arena(pass.engine_options.threads);  // one for all the parts
   std::size_t cells_to_band_end = 0;
   for (std::size_t k = 0; k < bands; ++k) {
     cells_to_band_end += band_cells[k];
@@ -280,6 +281,7 @@ PilotEstimate pilot_estimate(const Pass<CellT::dim>& pass, double enough, double
       engine::EngineOptions eo = pass.engine_options;
       eo.progress = nullptr;
       eo.batch_size = 4;  // a part of 32 cells in 8 batches, shared among the threads
+      eo.arena = &arena;
       eo.work_cap = static_cast<std::uint64_t>(pilot_work_cap * rule.uniform_work);
       if constexpr (std::is_same_v<Kept, std::nullptr_t>) {
         exact += engine::tessellate<CellT>(gens, comp, eo);

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <functional>
 #include <limits>
+#include <optional>
 #include <span>
 #include <stdexcept>
 #include <vector>
@@ -62,6 +63,10 @@ struct EngineOptions {
   std::function<void(double)> progress;
   /// Cells whose search passes this are abandoned (CellBuilder::set_work_cap).
   std::uint64_t work_cap = std::numeric_limits<std::uint64_t>::max();
+  /// Optional: the arena to run in (of `threads` threads), kept by a caller
+  /// that runs many short loops (the pilot's parts). A fresh arena per call
+  /// lets a loop of a few dozen cells end before the second thread joins.
+  ThreadArena* arena = nullptr;
 };
 
 /// Build every cell of `gens.order` and hand each to the compositor; returns
@@ -128,7 +133,8 @@ std::uint64_t tessellate(const Generators<CellT::dim>& gens, Comp& comp, const E
     }
   };
 
-  ThreadArena arena(opt.threads);
+  std::optional<ThreadArena> own;
+  ThreadArena& arena = opt.arena != nullptr ? *opt.arena : own.emplace(opt.threads);
   // Progress is reported (and cancellation honoured) between chunks of batches,
   // from the calling thread.
   const std::size_t chunk = opt.progress ? std::max<std::size_t>(1, nb / 100) : nb;
