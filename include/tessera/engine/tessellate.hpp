@@ -84,7 +84,12 @@ std::uint64_t tessellate(const Generators<CellT::dim>& gens, Comp& comp, const E
     throw std::invalid_argument("tessera: Generators::slots must be empty or as long as Generators::order");
   if (gens.stars != nullptr && gens.slots.size() != n)
     throw std::invalid_argument("tessera: Generators::stars needs Generators::slots");
-  const std::size_t bs = std::max<std::size_t>(1, opt.batch_size);
+  std::size_t bs = std::max<std::size_t>(1, opt.batch_size);
+  // A short loop gets smaller batches (eight, of at least 128 cells), so
+  // that both threads get a share: the pass after the pilot's kept cells of
+  // 1,000 points was one batch of 512, on one thread. From the count alone,
+  // never the threads; no output depends on the batching.
+  bs = std::min(bs, std::max<std::size_t>(128, (n + 7) / 8));
   const std::size_t nb = (n + bs - 1) / bs;
   const std::size_t first_own = earlier.size();
   std::vector<typename Comp::Batch> batches = std::move(earlier);
