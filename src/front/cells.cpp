@@ -176,25 +176,17 @@ Cells run(std::span<const double> input, std::span<const std::int32_t> labels, c
     }
   }
   // The search's pass leaves out the cells its pilot built whole.
-  std::vector<std::int32_t> rest_order;
-  std::vector<std::uint32_t> rest_slots;
+  std::vector<std::uint64_t> built;
   if (stars || kept.batches.empty()) {
     kept.batches.clear();
     kept.exact_calls = 0;
   } else {
-    std::vector<bool> built(out.n_points, false);
+    built.assign((out.n_points + 63) / 64, 0);
     for (const auto& b : kept.batches) {
-      for (const std::int32_t g : b.gen) built[static_cast<std::size_t>(g)] = true;
+      for (const std::int32_t g : b.gen) built[static_cast<std::size_t>(g) >> 6] |= std::uint64_t{1} << (g & 63);
       out.cells_from_pilot += b.gen.size();
     }
-    const bool with_slots = !pass.gens.slots.empty();
-    for (std::size_t i = 0; i < pass.gens.order.size(); ++i)
-      if (!built[static_cast<std::size_t>(pass.gens.order[i])]) {
-        rest_order.push_back(pass.gens.order[i]);
-        if (with_slots) rest_slots.push_back(pass.gens.slots[i]);
-      }
-    pass.gens.order = rest_order;
-    pass.gens.slots = rest_slots;
+    pass.gens.skip = built;
   }
   out.exact_predicate_calls =
       engine::tessellate<CellT>(pass.gens, comp, pass.engine_options, std::move(kept.batches)) + kept.exact_calls;

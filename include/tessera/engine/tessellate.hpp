@@ -55,6 +55,10 @@ struct Generators {
   /// Optional: then each cell comes from its Delaunay star
   /// (CellBuilder::build_from_star), with no search. Needs `slots`.
   const DelaunayStars* stars = nullptr;
+  /// Optional: bit g set (skip[g / 64] >> g % 64) for a generator whose cell
+  /// is not built (the pilot built it already: front/pilot.hpp, PilotKeep).
+  /// A set of generator ids, so that `order` stays as it is.
+  std::span<const std::uint64_t> skip;
 };
 
 struct EngineOptions {
@@ -115,6 +119,7 @@ std::uint64_t tessellate(const Generators<CellT::dim>& gens, Comp& comp, const E
     const std::size_t end = std::min(n, (k + 1) * bs);
     for (std::size_t g = k * bs; g < end; ++g) {
       const std::int32_t gen = gens.order[g];
+      if (!gens.skip.empty() && (gens.skip[static_cast<std::size_t>(gen) >> 6] >> (gen & 63) & 1) != 0) continue;
       const double* p = gens.slots.empty() ? gens.coords + static_cast<std::size_t>(gen) * CellT::dim
                                            : gens.locator->point(gens.slots[g]).data();
       kernels::BuildStatus st;
