@@ -91,6 +91,7 @@ void bind_voronoi(py::module_& m) {
       .def_readonly("threads_used", &Cells::threads_used)
       .def_readonly("from_insertion", &Cells::from_insertion)
       .def_readonly("assembled_from_stars", &Cells::assembled_from_stars)
+      .def_readonly("cells_from_pilot", &Cells::cells_from_pilot)
       // per cell
       .def_property_readonly("generator", [](py::object s) { return view_flat(s.cast<const Cells&>().generator, s); })
       .def_property_readonly("region", [](py::object s) { return view_flat(s.cast<const Cells&>().region, s); })

@@ -218,6 +218,12 @@ class Voronoi:
         Delaunay neighbours)."""
         return self._cells.assembled_from_stars
 
+    @property
+    def cells_from_pilot(self) -> int:
+        """Cells the automatic method's pilot built while it sampled what the
+        search costs, kept (not built again) where it chose the search."""
+        return self._cells.cells_from_pilot
+
     # ---- checks, views, files ---------------------------------------------
     def validate(self) -> "_core.ValidationReport":
         """Invariant checks (the CLI's ``--validate``): volumes sum to the domain,

@@ -166,7 +166,15 @@ def test_method_insertion_gives_the_searched_cells():
     assert np.array_equal(searched.neighbor_offsets, auto.neighbor_offsets)
     np.testing.assert_allclose(searched.volumes, auto.volumes, rtol=1e-12)
     assert auto.validate()
-    assert not tessera.voronoi(random_points(500, 3)).from_insertion
+    small = tessera.voronoi(random_points(500, 3))
+    assert not small.from_insertion
+    # The pilot built up to half of these cells; they are kept, not built
+    # again, and the result is the search's.
+    assert 0 < small.cells_from_pilot < 500
+    assert auto.cells_from_pilot == 0 and searched.cells_from_pilot == 0
+    again = tessera.voronoi(random_points(500, 3), method="search")
+    assert np.array_equal(small.volumes, again.volumes)
+    assert np.array_equal(small.neighbors, again.neighbors)
     # Points on a sphere are all on the hull: their cells are assembled from
     # open stars, closed by a far plane that the box cuts away. So are
     # uniform points' cells, inside the hull and on it.
