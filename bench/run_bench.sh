@@ -77,6 +77,9 @@ has_op() { [[ " $ops " == *" $1 "* ]]; }
 has_op voronoi || has_op delaunay || die "OPS is empty"
 
 # ---- 1. peers -------------------------------------------------------------------------------
+# The peers' libraries (Voro++, CGAL, VTK, Qhull, Gmsh; idempotent). Without them a peer
+# is skipped with a note, and its columns stay empty.
+"$repo/scripts/install-deps.sh" --bench || die "installing the peers' packages failed (scripts/install-deps.sh --bench)"
 peer_build=$bench/build-peers
 peer_log=$peer_build/run_bench.log
 mkdir -p "$peer_build"
