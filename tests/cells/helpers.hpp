@@ -228,6 +228,35 @@ class Failures {
   std::size_t count_ = 0;
 };
 
+/// Expects two results to be the same bit for bit: every per-cell, per-generator
+/// and mesh array and the diagnostics' lists (not the counters, which say how
+/// the cells were found). `why`: how they were computed apart.
+inline void expect_same_cells(const tessera::Cells& a, const tessera::Cells& b, const std::string& why) {
+  EXPECT_EQ(a.dim, b.dim);
+  EXPECT_EQ(a.n_points, b.n_points);
+  EXPECT_EQ(a.bounds.lo, b.bounds.lo);
+  EXPECT_EQ(a.bounds.hi, b.bounds.hi);
+#define SAME(f) EXPECT_TRUE(a.f == b.f) << #f " differs: " << why
+  SAME(generator);
+  SAME(region);
+  SAME(volume);
+  SAME(centroid);
+  SAME(num_faces);
+  SAME(neighbor_offsets);
+  SAME(neighbors);
+  SAME(cell_of);
+  SAME(vertices);
+  SAME(vertex_keys);
+  SAME(cell_face_offsets);
+  SAME(face_vertex_offsets);
+  SAME(face_vertices);
+  SAME(face_neighbor);
+  SAME(face_class);
+  SAME(duplicates);
+  SAME(ignored_outside_bounds);
+#undef SAME
+}
+
 /// Checks every structural and geometric invariant of a result computed from
 /// `pts` (row-major, dim) and `labels`. What each block proves is stated inline.
 inline void check_invariants(const tessera::Cells& c, const std::vector<double>& pts,

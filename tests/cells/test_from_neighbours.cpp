@@ -669,24 +669,7 @@ TEST(FromNeighbours, PilotCellsAreKept) {
     EXPECT_LT(a.cells_from_pilot, p.size() / static_cast<std::size_t>(dim));
     EXPECT_EQ(b.cells_from_pilot, 0u);
     EXPECT_EQ(a.exact_predicate_calls, b.exact_predicate_calls);
-#define SAME(f) EXPECT_TRUE(a.f == b.f) << #f " differs from the search's"
-    SAME(generator);
-    SAME(region);
-    SAME(volume);
-    SAME(centroid);
-    SAME(num_faces);
-    SAME(neighbor_offsets);
-    SAME(neighbors);
-    SAME(cell_of);
-    SAME(vertices);
-    SAME(vertex_keys);
-    SAME(cell_face_offsets);
-    SAME(face_vertex_offsets);
-    SAME(face_vertices);
-    SAME(face_neighbor);
-    SAME(face_class);
-    SAME(duplicates);
-#undef SAME
+    expect_same_cells(a, b, "automatic (pilot's cells kept) against the search");
   };
   for (const int dim : {2, 3})
     for (const int threads : {1, 2}) {

@@ -874,29 +874,7 @@ void same_for_threads(int dim, const std::vector<double>& pts, const std::vector
   EXPECT_EQ(a.threads_used, 1);
   EXPECT_GE(b.threads_used, 1);
   EXPECT_LE(b.threads_used, 2);
-  EXPECT_EQ(a.dim, b.dim);
-  EXPECT_EQ(a.n_points, b.n_points);
-  EXPECT_EQ(a.bounds.lo, b.bounds.lo);
-  EXPECT_EQ(a.bounds.hi, b.bounds.hi);
-#define SAME(f) EXPECT_TRUE(a.f == b.f) << #f " differs between 1 and 2 threads"
-  SAME(generator);
-  SAME(region);
-  SAME(volume);
-  SAME(centroid);
-  SAME(num_faces);
-  SAME(neighbor_offsets);
-  SAME(neighbors);
-  SAME(cell_of);
-  SAME(vertices);
-  SAME(vertex_keys);
-  SAME(cell_face_offsets);
-  SAME(face_vertex_offsets);
-  SAME(face_vertices);
-  SAME(face_neighbor);
-  SAME(face_class);
-  SAME(duplicates);
-  SAME(ignored_outside_bounds);
-#undef SAME
+  expect_same_cells(a, b, "between 1 and 2 threads");
   if (a.exact_predicate_calls != b.exact_predicate_calls)
     std::printf("[ note ] %s: exact_predicate_calls %llu (1 thread) vs %llu (2 threads)\n", what.c_str(),
                 (unsigned long long)a.exact_predicate_calls, (unsigned long long)b.exact_predicate_calls);
