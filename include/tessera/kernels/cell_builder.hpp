@@ -107,6 +107,11 @@ class CellBuilder {
   /// The cell of generator i by the path its place asks for: build(), or
   /// build_nearest_first() in an overfull bin or beyond the grid (searches_tree).
   BuildStatus build_any(std::int32_t i, const double* p, CellT& cell) {
+    // A capped builder (the pilot's) counts off-grid evaluations, which the
+    // stage gates move: each of its cells starts with them open, so that its
+    // work depends on the cell alone (until stop 71 a mixed-tie input's
+    // pilot ratio varied from run to run on two threads, 2.984-3.002).
+    if (capped_builder()) cell.reset_stage_gates();
     return searches_tree(p) ? build_nearest_first(i, p, cell) : build(i, p, cell);
   }
 

@@ -300,6 +300,8 @@ class Hull {
   const std::vector<Plane>& planes() const { return planes_; }
   std::uint64_t exact_calls() const { return signs_.calls(); }
   std::uint64_t off_grid_exact_calls() const { return signs_.off_grid_calls(); }
+  /// The exact stages' gates open again (PreparedSigns::reset_gates).
+  void reset_stage_gates() { signs_.reset_gates(); }
   /// Vertices of this cell solved exactly (too ill-conditioned for the float solve).
   std::uint64_t exact_solves() const { return exact_solves_; }
 

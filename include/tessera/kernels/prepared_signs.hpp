@@ -106,6 +106,17 @@ class PreparedSigns {
     return s.box_tried ? exact_clip_sign_by_arithmetic(ctx, gen, ids, j) : exact_clip_sign(ctx, gen, ids, j);
   }
 
+  /// Every stage gate open again, as for the first cell. The gates carry
+  /// from cell to cell, and which cells a thread met first then moves which
+  /// evaluations count as off the grid; the pilot, whose counts choose the
+  /// method, starts each cell afresh so that they depend on the cell alone,
+  /// not on the threads' schedule (CellBuilder::build_any with a work cap).
+  void reset_gates() {
+    box_gate_ = {};
+    grid_gate_ = {};
+    extended_gate_ = {};
+  }
+
   /// Exact evaluations since start_cell.
   std::uint64_t calls() const { return calls_; }
   /// Those of them no small integer grid served (stages 2-4): on lattices
