@@ -631,20 +631,7 @@ void same_for_threads(const std::vector<double>& p, int dim, const std::string& 
   const auto b = run_method(p, dim, tessera::CellMethod::insertion, {}, 2);
   EXPECT_TRUE(a.from_insertion);
   EXPECT_EQ(b.threads_used, 2);
-#define SAME(f) EXPECT_TRUE(a.f == b.f) << #f " differs between 1 and 2 threads"
-  SAME(generator);
-  SAME(volume);
-  SAME(centroid);
-  SAME(num_faces);
-  SAME(neighbor_offsets);
-  SAME(neighbors);
-  SAME(vertices);
-  SAME(vertex_keys);
-  SAME(face_vertex_offsets);
-  SAME(face_vertices);
-  SAME(face_neighbor);
-  SAME(duplicates);
-#undef SAME
+  expect_same_cells(a, b, "between 1 and 2 threads");
 }
 
 // The automatic method keeps the cells its pilot built whole where it
