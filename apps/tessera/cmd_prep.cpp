@@ -136,7 +136,8 @@ void add_prep_commands(CLI::App& app, PrepCommands& c) {
   add_input_options(t, c.threshold.io, false);
   t->add_option("--scalars", c.threshold.scalars,
                 "S.npy (one number per point), or the name of a .ply vertex property / .csv column of INPUT "
-                "(with .csv, use --dim so that the column is not taken as a coordinate)")
+                "(with a .csv whose header does not name x,y[,z], use --dim so that the column is not taken "
+                "as a coordinate)")
       ->required();
   t->add_option("--interval", c.threshold.intervals,
                 "lo,hi,label: points with lo <= s < hi get label (repeat; lo may be -inf, hi inf; intervals must "

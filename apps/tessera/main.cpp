@@ -43,8 +43,9 @@ void add_compute_options(CLI::App* app, ComputeArgs& c, std::vector<std::string>
   // INPUT is checked after parsing (finish_compute_args), not ->required():
   // "--bounds 0 1 0 1 pts.npy" hands pts.npy to --bounds, which gives it back.
   app->add_option("INPUT", c.input,
-                  "Point file (required): .npy (float array, shape (N,2) or (N,3)), .csv/.xyz/.txt (2 or 3 "
-                  "numeric columns), or .ply (vertex x,y,z)");
+                  "Point file (required): .npy (float array, shape (N,2) or (N,3)), .csv/.xyz/.txt (the "
+                  "columns a header names x,y[,z], else the first 2 or 3 numeric columns), or .ply (vertex "
+                  "x,y,z)");
   app->add_option("--dim", c.dim,
                   "Dimension: 2 or 3 (default: the number of columns; .ply is 3D). --dim 2 on 3-column "
                   "input keeps x,y")

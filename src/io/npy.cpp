@@ -222,9 +222,41 @@ File open_npy(const std::string& path, Header& h) {
   if (std::fread(text.data(), 1, header_len, f.get()) != header_len)
     detail::fail(path, "truncated .npy header");
   h = HeaderParser(path, text).parse();
-  if (h.fortran_order)
-    detail::fail(path, "Fortran-order arrays are not supported (save with np.ascontiguousarray)");
   return f;
+}
+
+/// Reorder an array read in Fortran order (first index fastest) into C order
+/// (last index fastest), in place through one copy. NumPy saves any
+/// F-contiguous array so: a transposed array, or a pandas DataFrame's
+/// to_numpy(), whose columns are stored one after another. Fortran order of
+/// a 1-D array is C order.
+template <class T>
+void fortran_to_c_order(std::vector<T>& data, const std::vector<std::size_t>& shape) {
+  const std::size_t rank = shape.size();
+  if (rank < 2 || data.empty()) return;
+  const std::vector<T> f(data);
+  if (rank == 2) {  // (rows, columns): the points' case
+    const std::size_t rows = shape[0], cols = shape[1];
+    for (std::size_t c = 0; c < cols; ++c)
+      for (std::size_t r = 0; r < rows; ++r) data[r * cols + c] = f[c * rows + r];
+    return;
+  }
+  // C index walked in order; its Fortran offset kept by an odometer over
+  // the axes (Fortran stride of axis a: the product of the axes before it).
+  std::vector<std::size_t> stride(rank, 1), index(rank, 0);
+  for (std::size_t a = 1; a < rank; ++a) stride[a] = stride[a - 1] * shape[a - 1];
+  std::size_t off = 0;
+  for (std::size_t c = 0; c < data.size(); ++c) {
+    data[c] = f[off];
+    for (std::size_t a = rank; a-- > 0;) {
+      if (++index[a] < shape[a]) {
+        off += stride[a];
+        break;
+      }
+      off -= (shape[a] - 1) * stride[a];
+      index[a] = 0;
+    }
+  }
 }
 
 
@@ -368,6 +400,7 @@ NpyArray read_npy_double(const std::string& path) {
   File f = open_npy(path, h);
   NpyArray a = make_array(h);
   read_data(path, f.get(), h, a.as_double);
+  if (h.fortran_order) fortran_to_c_order(a.as_double, h.shape);
   return a;
 }
 
@@ -377,6 +410,7 @@ NpyArray read_npy_int(const std::string& path) {
   if (h.kind == 'f') detail::fail(path, "expected an integer array, found dtype '" + h.descr + "'");
   NpyArray a = make_array(h);
   read_data(path, f.get(), h, a.as_int);
+  if (h.fortran_order) fortran_to_c_order(a.as_int, h.shape);
   return a;
 }
 

@@ -5,8 +5,10 @@
 //    around fields are trimmed) or else by runs of spaces/tabs;
 //  - blank lines and lines starting with '#' are skipped; CRLF and a UTF-8 BOM are fine;
 //  - the first content line is a header when one of its fields is not a number;
-//  - the columns (other than a labels column) give the coordinates: 2 -> 2D,
-//    3 or more -> 3D (extras ignored), unless ReadOptions::dim forces it;
+//  - a header naming columns x and y (any case, in any position) takes the
+//    coordinates from them, and from z if named: 3D, else 2D;
+//  - otherwise the columns (other than a labels column) give the coordinates:
+//    2 -> 2D, 3 or more -> 3D (extras ignored); ReadOptions::dim forces either;
 //  - every data line must have the columns needed; errors name the line (1-based).
 // The whole file is read into memory and parsed with std::from_chars.
 #include <algorithm>
@@ -175,6 +177,32 @@ std::size_t find_column(const std::string& path, const TextLayout& t, const std:
   return static_cast<std::size_t>(it - t.names.begin());
 }
 
+/// The header's columns named x, y and z (any case; ncols where absent).
+/// found(): x and y are both named. A pandas frame saved with to_csv() leads
+/// with its unnamed index column, and tables often lead with an id: taking
+/// the first columns there would make the index a coordinate.
+struct NamedAxes {
+  std::size_t col[3];
+  std::size_t ncols;
+  bool found() const { return col[0] < ncols && col[1] < ncols; }
+};
+
+NamedAxes named_axes(const std::string& path, const TextLayout& t) {
+  NamedAxes a{{t.ncols, t.ncols, t.ncols}, t.ncols};
+  if (!t.header) return a;
+  for (std::size_t c = 0; c < t.names.size(); ++c) {
+    const std::string& n = t.names[c];
+    if (n.size() != 1) continue;
+    const char l = static_cast<char>(n[0] | 0x20);  // ASCII lower case
+    if (l < 'x' || l > 'z') continue;
+    std::size_t& at = a.col[l - 'x'];
+    if (at != t.ncols)
+      fail(path, "the header names coordinate '" + std::string(1, l) + "' twice (columns: " + quoted_list(t.names) + ")");
+    at = c;
+  }
+  return a;
+}
+
 }  // namespace
 
 PointCloud read_text_points(const std::string& path, const ReadOptions& options,
@@ -195,23 +223,37 @@ PointCloud read_text_points(const std::string& path, const ReadOptions& options,
   std::size_t label_col = ncols;  // ncols = none
   if (!label_column.empty()) label_col = find_column(path, layout, label_column, "labels");
 
-  // Coordinate columns: the first `dim` columns other than the labels column.
-  const std::size_t avail = ncols - (label_col < ncols ? 1 : 0);
+  // Coordinate columns: those a header names x, y (and z), or else the first
+  // `dim` columns other than the labels column.
+  const NamedAxes named = named_axes(path, layout);
   int dim = options.dim;
-  if (dim == 0) {
-    if (avail < 2)
-      fail(path, "line " + std::to_string(line_no) + " has " + std::to_string(avail) +
-                     " coordinate column(s); need 2 (x,y) or 3 (x,y,z)");
-    dim = avail >= 3 ? 3 : 2;
-  } else if (avail < static_cast<std::size_t>(dim)) {
-    fail(path, std::to_string(dim) + "D points asked but line " + std::to_string(line_no) + " has " +
-                   std::to_string(avail) + " coordinate column(s)");
-  }
   std::size_t coord_col[3] = {0, 0, 0};
-  for (std::size_t c = 0, k = 0; k < static_cast<std::size_t>(dim); ++c)
-    if (c != label_col) coord_col[k++] = c;
+  if (named.found()) {
+    if (dim == 0) dim = named.col[2] < ncols ? 3 : 2;
+    if (dim == 3 && named.col[2] == ncols)
+      fail(path, "3D points asked but the header names no 'z' column (columns: " + quoted_list(layout.names) + ")");
+    for (int k = 0; k < dim; ++k) {
+      coord_col[k] = named.col[k];
+      if (coord_col[k] == label_col)
+        fail(path, "column '" + label_column + "' cannot be both a coordinate and the labels");
+    }
+  } else {
+    const std::size_t avail = ncols - (label_col < ncols ? 1 : 0);
+    if (dim == 0) {
+      if (avail < 2)
+        fail(path, "line " + std::to_string(line_no) + " has " + std::to_string(avail) +
+                       " coordinate column(s); need 2 (x,y) or 3 (x,y,z)");
+      dim = avail >= 3 ? 3 : 2;
+    } else if (avail < static_cast<std::size_t>(dim)) {
+      fail(path, std::to_string(dim) + "D points asked but line " + std::to_string(line_no) + " has " +
+                     std::to_string(avail) + " coordinate column(s)");
+    }
+    for (std::size_t c = 0, k = 0; k < static_cast<std::size_t>(dim); ++c)
+      if (c != label_col) coord_col[k++] = c;
+  }
   // Field index -> slot: 0..dim-1 a coordinate, 3 the label, -1 ignored.
-  const std::size_t needed = std::max(coord_col[dim - 1], label_col < ncols ? label_col : 0) + 1;
+  std::size_t needed = (label_col < ncols ? label_col : 0) + 1;
+  for (int k = 0; k < dim; ++k) needed = std::max(needed, coord_col[k] + 1);
   std::vector<int> slot(needed, -1);
   for (int k = 0; k < dim; ++k) slot[coord_col[k]] = k;
   if (label_col < ncols) slot[label_col] = 3;

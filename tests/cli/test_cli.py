@@ -452,6 +452,28 @@ class Voronoi3D(TempDirCase):
             self.assertIn(word, r.stdout)
         self.assertEqual(read_vtu(out).GetNumberOfCells(), self.N)
 
+    def test_fortran_order_and_named_columns(self):
+        # The same points as a Fortran-order .npy (np.save of a transposed
+        # array, or of a pandas DataFrame's to_numpy()) and as a CSV led by an
+        # unnamed index column with the axes out of order (pandas' to_csv):
+        # the same cells as the C-order .npy.
+        ref = self.p("ref.csv")
+        self.ok(["voronoi", self.inp, "--cell-table", ref, "-q", "--bounds"] + BOX3)
+        f_npy = self.p("f.npy")
+        np.save(f_npy, np.asfortranarray(self.pts))
+        with open(f_npy, "rb") as f:
+            self.assertIn(b"'fortran_order': True", f.read(128))
+        csv_in = self.p("indexed.csv")
+        with open(csv_in, "w") as f:
+            f.write(",id,z,y,x\n")
+            for i, (x, y, z) in enumerate(self.pts):
+                f.write("%d,%d,%.17g,%.17g,%.17g\n" % (i, 1000 + i, z, y, x))
+        for k, inp in enumerate((f_npy, csv_in)):
+            t = self.p("t%d.csv" % k)
+            self.ok(["voronoi", inp, "--cell-table", t, "-q", "--bounds"] + BOX3)
+            with open(ref) as a, open(t) as b:
+                self.assertEqual(a.read(), b.read(), inp)
+
     def test_summary_names_far_points(self):
         # Two points far beyond the bulk are reported (outliers?); none otherwise.
         pts = np.vstack([self.pts, [[5e3, 0.5, 0.5], [0.5, -2e4, 0.5]]])

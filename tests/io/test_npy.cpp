@@ -1,5 +1,5 @@
 // .npy reader/writer: round trips, dtypes, byte order, header versions, and
-// the errors for Fortran order, bad shapes and truncated data.
+// Fortran order, and the errors for bad shapes and truncated data.
 #include <gtest/gtest.h>
 
 #include <cstdint>
@@ -166,13 +166,34 @@ TEST(Npy, IntegerPointsAreConverted) {
   EXPECT_EQ(pc.coords, (std::vector<double>{1, 2, -3, 4}));
 }
 
-TEST(Npy, FortranOrderRejected) {
+// NumPy saves an F-contiguous array (a transposed one, a pandas DataFrame's
+// to_numpy()) in Fortran order: read back in C order, as np.load gives it.
+TEST(Npy, FortranOrderIsReordered) {
   TempDir dir;
-  const std::vector<double> d{1, 2, 3, 4, 5, 6};
-  const std::string p = dir.write("f.npy", make_npy("<f8", "(2, 3)", raw_bytes(d), true));
-  auto msg = input_error([&] { read_points(p); });
-  EXPECT_EQ(msg.rfind(p, 0), 0u) << msg;
-  EXPECT_NE(msg.find("Fortran"), std::string::npos) << msg;
+  // Points (2, 3) stored column after column: x0 x1, y0 y1, z0 z1.
+  const std::vector<double> cols{1, 2, 3, 4, 5, 6};
+  auto pc = read_points(dir.write("f.npy", make_npy("<f8", "(2, 3)", raw_bytes(cols), true)));
+  EXPECT_EQ(pc.n, 2u);
+  EXPECT_EQ(pc.coords, (std::vector<double>{1, 3, 5, 2, 4, 6}));
+  // Converted dtypes and big-endian data go the same way.
+  auto pi = read_points(dir.write("fi.npy", make_npy(">i4", "(2, 2)", raw_bytes(std::vector<std::int32_t>{1, 2, 3, 4}, true), true)));
+  EXPECT_EQ(pi.coords, (std::vector<double>{1, 3, 2, 4}));
+  // Rank 3 (an image (nz, ny, nx)): element (i, j, k) lies at i + 2 (j + 3 k).
+  std::vector<std::int64_t> f(2 * 3 * 4);
+  for (std::size_t k = 0; k < 4; ++k)
+    for (std::size_t j = 0; j < 3; ++j)
+      for (std::size_t i = 0; i < 2; ++i) f[i + 2 * (j + 3 * k)] = static_cast<std::int64_t>(100 * i + 10 * j + k);
+  const auto a = read_npy_int(dir.write("f3.npy", make_npy("<i8", "(2, 3, 4)", raw_bytes(f), true)));
+  ASSERT_EQ(a.as_int.size(), f.size());
+  for (std::size_t i = 0; i < 2; ++i)
+    for (std::size_t j = 0; j < 3; ++j)
+      for (std::size_t k = 0; k < 4; ++k)
+        EXPECT_EQ(a.as_int[(i * 3 + j) * 4 + k], static_cast<std::int64_t>(100 * i + 10 * j + k)) << i << j << k;
+  const auto d = read_npy_double(dir.write("f3d.npy", make_npy("<i8", "(2, 3, 4)", raw_bytes(f), true)));
+  for (std::size_t c = 0; c < f.size(); ++c) EXPECT_EQ(d.as_double[c], static_cast<double>(a.as_int[c]));
+  // 1-D: Fortran order is C order.
+  const auto l = read_npy_int(dir.write("f1.npy", make_npy("<i4", "(3,)", raw_bytes(std::vector<std::int32_t>{7, 8, 9}), true)));
+  EXPECT_EQ(l.as_int, (std::vector<std::int64_t>{7, 8, 9}));
 }
 
 TEST(Npy, BadShapeNamesShape) {

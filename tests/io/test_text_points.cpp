@@ -71,6 +71,49 @@ TEST(TextPoints, ExtraColumnsIgnored) {
   EXPECT_EQ(pc3.coords, (std::vector<double>{4, 5, 6}));
 }
 
+// A header naming x and y (and z) picks those columns wherever they stand:
+// pandas' to_csv() writes its index first, under an empty name, and tables
+// often lead with an id. The first columns would have made those coordinates.
+TEST(TextPoints, CoordinatesByHeaderName) {
+  TempDir dir;
+  auto pd = read_points(dir.write("a.csv", ",x,y,z\n0,1,2,3\n1,4,5,6\n"));
+  EXPECT_EQ(pd.dim, 3);
+  EXPECT_EQ(pd.coords, (std::vector<double>{1, 2, 3, 4, 5, 6}));
+  auto id = read_points(dir.write("b.csv", "id,Z,\"Y\",X,mass\n7,3,2,1,9\n8,6,5,4,9\n"));
+  EXPECT_EQ(id.dim, 3);
+  EXPECT_EQ(id.coords, (std::vector<double>{1, 2, 3, 4, 5, 6}));
+  // x and y named, no z: 2D, however many columns.
+  auto p2 = read_points(dir.write("c.txt", "id x y t\n7 1 2 0.5\n8 3 4 0.5\n"));
+  EXPECT_EQ(p2.dim, 2);
+  EXPECT_EQ(p2.coords, (std::vector<double>{1, 2, 3, 4}));
+  // --dim 2 keeps x and y of named x, y, z.
+  ReadOptions two;
+  two.dim = 2;
+  auto k2 = read_points(dir.write("d.csv", "id,x,y,z\n7,1,2,3\n"), two);
+  EXPECT_EQ(k2.coords, (std::vector<double>{1, 2}));
+  // With a labels column.
+  ReadOptions lab;
+  lab.labels = "region";
+  auto pl = read_points(dir.write("e.csv", "id,region,y,x,z\n7,3,2,1,3\n8,-1,5,4,6\n"), lab);
+  EXPECT_EQ(pl.coords, (std::vector<double>{1, 2, 3, 4, 5, 6}));
+  EXPECT_EQ(pl.labels, (std::vector<std::int32_t>{3, -1}));
+  // Only one of x and y named: the first columns, as without names.
+  auto px = read_points(dir.write("f.csv", "x,b,c\n1,2,3\n"));
+  EXPECT_EQ(px.coords, (std::vector<double>{1, 2, 3}));
+  // Errors: --dim 3 without a z column; a coordinate named twice; labels
+  // from a coordinate column.
+  ReadOptions three;
+  three.dim = 3;
+  auto msg = input_error([&] { read_points(dir.write("g.csv", "id,x,y,w\n1,2,3,4\n"), three); });
+  EXPECT_NE(msg.find("no 'z' column"), std::string::npos) << msg;
+  msg = input_error([&] { read_points(dir.write("h.csv", "x,y,z,X\n1,2,3,4\n")); });
+  EXPECT_NE(msg.find("'x' twice"), std::string::npos) << msg;
+  ReadOptions lx;
+  lx.labels = "y";
+  msg = input_error([&] { read_points(dir.write("i.csv", "x,y,z\n1,2,3\n"), lx); });
+  EXPECT_NE(msg.find("both a coordinate and the labels"), std::string::npos) << msg;
+}
+
 TEST(TextPoints, Dim2FromThreeColumns) {
   TempDir dir;
   ReadOptions opt;

@@ -18,10 +18,11 @@ struct NpyArray {
   std::vector<std::int64_t> as_int;    ///< filled by read_npy_int
 };
 
-/// Read a C-order float32/float64 array (also accepts integer arrays, converted).
-/// Big-endian data is byte-swapped. Fortran order is rejected with InputError.
+/// Read a float32/float64 array (also accepts integer arrays, converted),
+/// returned in C order. Big-endian data is byte-swapped; a Fortran-order
+/// array is reordered.
 NpyArray read_npy_double(const std::string& path);
-/// Read a C-order integer array (any int/uint width, or bool).
+/// Read an integer array (any int/uint width, or bool), returned in C order.
 NpyArray read_npy_int(const std::string& path);
 
 /// Serialise arrays (C order, little-endian) to an .npy byte string; write the

@@ -22,7 +22,8 @@ struct PointCloud {
 
 struct ReadOptions {
   /// 2 or 3 to force the dimension (3-column input with dim 2 keeps x,y);
-  /// 0: take it from the file (2 or 3 columns; .ply is always 3D unless forced).
+  /// 0: take it from the file (2 or 3 columns, or a text header's named x, y
+  /// and z; .ply is always 3D unless forced).
   int dim = 0;
   /// Labels: empty = none; a path ending in .npy = an integer array of length n;
   /// otherwise the name of an integer .ply vertex property (or, for a .csv with
@@ -30,7 +31,8 @@ struct ReadOptions {
   std::string labels;
 };
 
-/// Read .npy, .csv/.xyz/.txt or .ply. Throws tessera::InputError (one line naming the
+/// Read .npy (C or Fortran order), .csv/.xyz/.txt (the columns a header names
+/// x, y and z in any case, else the first ones) or .ply. Throws tessera::InputError (one line naming the
 /// file and the problem) on a missing/unreadable file, unknown extension, wrong
 /// dtype/shape, empty input, NaN/Inf, or labels of the wrong length.
 PointCloud read_points(const std::string& path, const ReadOptions& options = {});
