@@ -1,5 +1,5 @@
-// PLY point reader: ascii and binary_little_endian (binary_big_endian is
-// refused). Only the `vertex` element is read: x, y (and z in 3D) plus an
+// PLY point reader: ascii, binary_little_endian and binary_big_endian. Only
+// the `vertex` element is read: x, y (and z in 3D) plus an
 // optional integer label property. Elements declared before `vertex` are
 // skipped properly (including `property list` rows); elements after it are
 // never looked at.
@@ -65,7 +65,7 @@ struct Element {
   std::vector<Property> props;
 };
 
-enum class Format { ascii, binary_le };
+enum class Format { ascii, binary_le, binary_be };
 
 struct Header {
   Format format = Format::ascii;
@@ -117,7 +117,7 @@ Header parse_header(const std::string& path, std::string_view bytes) {
       else if (tok[1] == "binary_little_endian")
         h.format = Format::binary_le;
       else if (tok[1] == "binary_big_endian")
-        fail(path, "binary_big_endian PLY is unsupported (convert it to binary_little_endian or ascii)");
+        h.format = Format::binary_be;
       else
         bad("unknown format '" + std::string(tok[1]) + "'");
       have_format = true;
@@ -154,40 +154,41 @@ Header parse_header(const std::string& path, std::string_view bytes) {
   return h;
 }
 
+/// A scalar stored big-endian (`big`) or little-endian at `p`.
 template <class T>
-T load_le(const unsigned char* p) {
+T load_binary(const unsigned char* p, bool big) {
   unsigned char b[sizeof(T)];
   std::memcpy(b, p, sizeof(T));
-  if constexpr (std::endian::native == std::endian::big) std::reverse(b, b + sizeof(T));
+  if (big != (std::endian::native == std::endian::big)) std::reverse(b, b + sizeof(T));
   T v;
   std::memcpy(&v, b, sizeof(T));
   return v;
 }
 
-/// A little-endian scalar of type `t` at `p`, as double (exact for all but
-/// 64-bit integers beyond 2^53, which are not coordinates or labels anyway).
-double load_value(const unsigned char* p, Scalar t) {
+/// A binary scalar of type `t` at `p`, as double (exact for all but 64-bit
+/// integers beyond 2^53, which are not coordinates or labels anyway).
+double load_value(const unsigned char* p, Scalar t, bool big) {
   switch (t) {
     case Scalar::i8:
       return static_cast<std::int8_t>(p[0]);
     case Scalar::u8:
       return p[0];
     case Scalar::i16:
-      return load_le<std::int16_t>(p);
+      return load_binary<std::int16_t>(p, big);
     case Scalar::u16:
-      return load_le<std::uint16_t>(p);
+      return load_binary<std::uint16_t>(p, big);
     case Scalar::i32:
-      return load_le<std::int32_t>(p);
+      return load_binary<std::int32_t>(p, big);
     case Scalar::u32:
-      return load_le<std::uint32_t>(p);
+      return load_binary<std::uint32_t>(p, big);
     case Scalar::i64:
-      return static_cast<double>(load_le<std::int64_t>(p));
+      return static_cast<double>(load_binary<std::int64_t>(p, big));
     case Scalar::u64:
-      return static_cast<double>(load_le<std::uint64_t>(p));
+      return static_cast<double>(load_binary<std::uint64_t>(p, big));
     case Scalar::f32:
-      return load_le<float>(p);
+      return load_binary<float>(p, big);
     case Scalar::f64:
-      return load_le<double>(p);
+      return load_binary<double>(p, big);
   }
   return 0;
 }
@@ -206,7 +207,7 @@ class DataReader {
 
   /// Skip every row of `e`.
   void skip(const Element& e) {
-    if (format_ == Format::binary_le) {
+    if (format_ != Format::ascii) {
       bool fixed = std::none_of(e.props.begin(), e.props.end(), [](const Property& p) { return p.is_list; });
       if (fixed) {
         std::size_t stride = 0;
@@ -254,9 +255,9 @@ class DataReader {
   }
 
   double value(const Element& e, std::size_t r, const Type& t) {
-    if (format_ == Format::binary_le) {
+    if (format_ != Format::ascii) {
       if (static_cast<std::size_t>(end_ - p_) < static_cast<std::size_t>(t.size)) truncated(e, r);
-      double v = load_value(p_, t.t);
+      double v = load_value(p_, t.t, format_ == Format::binary_be);
       p_ += t.size;
       return v;
     }
@@ -273,7 +274,7 @@ class DataReader {
   }
 
   void skip_values(const Element& e, std::size_t r, const Type& t, std::size_t n) {
-    if (format_ == Format::binary_le) {
+    if (format_ != Format::ascii) {
       if (n > static_cast<std::size_t>(end_ - p_) / static_cast<std::size_t>(t.size)) truncated(e, r);
       p_ += n * static_cast<std::size_t>(t.size);
       return;
