@@ -258,7 +258,7 @@ void add_image_commands(CLI::App& app, ImageCommands& c) {
       ->required();
   add_read_options(p, c.probe.read);
   p->add_option("--labels", c.probe.labels,
-                "Per-point integer labels carried to .ply/.vtp output: FILE.npy or a .ply property / .csv column");
+                "Per-point integer labels carried to .ply/.vtp output: FILE.npy or a .ply property / .csv column / structured .npy field");
   p->add_option("--outside-value", c.probe.outside_value,
                 "Value for points outside the box of voxel centres (a number, nan, inf or -inf)")
       ->capture_default_str();

@@ -135,7 +135,7 @@ void add_prep_commands(CLI::App& app, PrepCommands& c) {
   CLI::App* t = c.threshold_app;
   add_input_options(t, c.threshold.io, false);
   t->add_option("--scalars", c.threshold.scalars,
-                "S.npy (one number per point), or the name of a .ply vertex property / .csv column of INPUT "
+                "S.npy (one number per point), or the name of a .ply vertex property / .csv column / structured .npy field of INPUT "
                 "(with a .csv whose header does not name x,y[,z], use --dim so that the column is not taken "
                 "as a coordinate)")
       ->required();

@@ -43,7 +43,8 @@ void add_compute_options(CLI::App* app, ComputeArgs& c, std::vector<std::string>
   // INPUT is checked after parsing (finish_compute_args), not ->required():
   // "--bounds 0 1 0 1 pts.npy" hands pts.npy to --bounds, which gives it back.
   app->add_option("INPUT", c.input,
-                  "Point file (required): .npy (float array, shape (N,2) or (N,3)), .csv/.xyz/.txt (the "
+                  "Point file (required): .npy (float array, shape (N,2) or (N,3), or records with fields "
+                  "x,y[,z]), .csv/.xyz/.txt (the "
                   "columns a header names x,y[,z], else the first 2 or 3 numeric columns), or .ply (vertex "
                   "x,y,z)");
   app->add_option("--dim", c.dim,
@@ -52,7 +53,7 @@ void add_compute_options(CLI::App* app, ComputeArgs& c, std::vector<std::string>
       ->check(CLI::IsMember({2, 3}));
   app->add_option("--labels", c.labels,
                   "Per-point integer labels: FILE.npy (length N), or the name of an integer .ply vertex "
-                  "property / .csv column. Cells get their point's label as Region; points labelled < 0 "
+                  "property / .csv column / structured .npy field. Cells get their point's label as Region; points labelled < 0 "
                   "own no cell and clip their neighbours");
   // Collected as text: CLI11 cannot know whether 4 (2D) or 6 (3D) numbers
   // follow, so in 2D it also takes the next word; finish_compute_args sorts it out.

@@ -14,6 +14,7 @@
 #include <charconv>
 #include <cstdio>
 #include <cstring>
+#include <functional>
 #include <limits>
 #include <memory>
 #include <string_view>
@@ -44,6 +45,19 @@ struct Header {
   bool fortran_order = false;
   std::vector<std::size_t> shape;
   std::size_t count = 1;  ///< product of shape
+  /// A structured dtype's fields (descr a list), in record order; empty for
+  /// a plain array. item_size is then the record's size.
+  struct Field {
+    std::string name;
+    std::string descr;     ///< as written
+    char kind = 'V';       ///< 'f', 'i', 'u', 'b'; 'V' for void (padding, raw bytes)
+    int item_size = 0;
+    bool big_endian = false;
+    std::size_t count = 1;  ///< values per record (a sub-array field: more)
+    std::size_t offset = 0;
+  };
+  std::vector<Field> fields;
+  bool structured() const { return !fields.empty(); }
 };
 
 /// Parser for the subset of Python literals NumPy writes in the header:
@@ -64,8 +78,10 @@ class HeaderParser {
       expect(':');
       skip_ws();
       if (key == "descr") {
-        if (peek() != '\'' && peek() != '"') bad("structured dtypes are not supported");
-        h.descr = parse_string();
+        if (peek() == '[')
+          parse_fields(h);
+        else
+          h.descr = parse_string();
         have_descr = true;
       } else if (key == "fortran_order") {
         h.fortran_order = parse_bool();
@@ -143,20 +159,69 @@ class HeaderParser {
         bad("expected ',' or ')' in shape");
     }
   }
-  /// descr is byte order + kind + size, e.g. '<f8', '|u1', '>i4', '|b1'.
-  void decode_descr(Header& h) const {
-    const std::string& d = h.descr;
-    if (d.size() < 3) bad("unsupported dtype '" + d + "'");
+  /// A structured dtype: a list of fields (name, dtype[, shape]), packed as
+  /// numpy writes them (alignment padding appears as void fields named '').
+  void parse_fields(Header& h) {
+    expect('[');
+    std::size_t offset = 0;
+    h.descr = "structured";
+    for (;;) {
+      skip_ws();
+      if (peek() == ']') {
+        ++i_;
+        break;
+      }
+      expect('(');
+      skip_ws();
+      if (peek() == '(') bad("structured dtype with field titles is not supported");
+      Header::Field f;
+      f.name = parse_string();
+      expect(',');
+      skip_ws();
+      if (peek() == '[') bad("nested structured dtype (field '" + f.name + "') is not supported");
+      f.descr = parse_string();
+      skip_ws();
+      if (peek() == ',') {
+        ++i_;
+        skip_ws();
+        if (peek() == '(')
+          for (std::size_t d : parse_shape()) {
+            if (d != 0 && f.count > (std::size_t{1} << 32) / d) bad("field '" + f.name + "' too large");
+            f.count *= d;
+          }
+      }
+      expect(')');
+      if (f.descr.size() >= 3 && (f.descr[0] == '|' || f.descr[0] == '<' || f.descr[0] == '>') && f.descr[1] == 'V') {
+        auto [p, ec] = std::from_chars(f.descr.data() + 2, f.descr.data() + f.descr.size(), f.item_size);
+        if (ec != std::errc() || p != f.descr.data() + f.descr.size() || f.item_size < 0 || f.item_size > (1 << 20))
+          bad("unsupported dtype '" + f.descr + "' of field '" + f.name + "'");
+      } else {
+        decode_scalar(f.descr, f.kind, f.item_size, f.big_endian, "field '" + f.name + "': ");
+      }
+      f.offset = offset;
+      offset += f.count * static_cast<std::size_t>(f.item_size);
+      h.fields.push_back(std::move(f));
+      skip_ws();
+      if (peek() == ',') ++i_;
+    }
+    if (h.fields.empty()) bad("structured dtype without fields");
+    if (offset == 0 || offset > (std::size_t{1} << 24)) bad("implausible record size");
+  }
+
+  /// A scalar dtype: byte order + kind + size, e.g. '<f8', '|u1', '>i4', '|b1'.
+  void decode_scalar(const std::string& d, char& kind, int& item_size, bool& big_endian,
+                     const std::string& what = "") const {
+    if (d.size() < 3) bad(what + "unsupported dtype '" + d + "'");
     char order = d[0];
-    if (order != '<' && order != '>' && order != '|' && order != '=') bad("unsupported dtype '" + d + "'");
-    h.big_endian = order == '>' || (order == '=' && std::endian::native == std::endian::big);
-    h.kind = d[1];
+    if (order != '<' && order != '>' && order != '|' && order != '=') bad(what + "unsupported dtype '" + d + "'");
+    big_endian = order == '>' || (order == '=' && std::endian::native == std::endian::big);
+    kind = d[1];
     int size = 0;
     auto [p, ec] = std::from_chars(d.data() + 2, d.data() + d.size(), size);
-    if (ec != std::errc() || p != d.data() + d.size()) bad("unsupported dtype '" + d + "'");
-    h.item_size = size;
+    if (ec != std::errc() || p != d.data() + d.size()) bad(what + "unsupported dtype '" + d + "'");
+    item_size = size;
     bool ok = false;
-    switch (h.kind) {
+    switch (kind) {
       case 'f':
         ok = size == 4 || size == 8;
         break;
@@ -171,12 +236,24 @@ class HeaderParser {
         ok = false;
     }
     if (!ok)
-      bad("unsupported dtype '" + d + "' (expected float32/float64, int8..int64, uint8..uint64 or bool)");
+      bad(what + "unsupported dtype '" + d + "' (expected float32/float64, int8..int64, uint8..uint64 or bool)");
     // Single-byte data has no byte order.
-    if (size == 1) h.big_endian = false;
+    if (size == 1) big_endian = false;
+  }
+
+  void decode_descr(Header& h) const {
+    if (h.structured()) {
+      h.kind = 'V';
+      std::size_t record = 0;
+      for (const Header::Field& f : h.fields) record += f.count * static_cast<std::size_t>(f.item_size);
+      h.item_size = static_cast<int>(record);
+    } else {
+      decode_scalar(h.descr, h.kind, h.item_size, h.big_endian);
+    }
     h.count = 1;
     for (std::size_t dim : h.shape) {
-      if (dim != 0 && h.count > std::numeric_limits<std::size_t>::max() / dim / 8) bad("shape too large");
+      if (dim != 0 && h.count > std::numeric_limits<std::size_t>::max() / dim / static_cast<std::size_t>(std::max(8, h.item_size)))
+        bad("shape too large");
       h.count *= dim;
     }
   }
@@ -395,9 +472,83 @@ std::string npy_bytes_impl(const T* data, const std::vector<std::size_t>& shape,
 
 }  // namespace
 
+namespace {
+
+std::string field_list(const Header& h) {
+  std::string s;
+  for (const Header::Field& f : h.fields)
+    if (!f.name.empty()) s += (s.empty() ? "'" : ", '") + f.name + "'";
+  return s;
+}
+
+void refuse_structured(const std::string& path, const Header& h) {
+  if (h.structured())
+    detail::fail(path, "a structured array (fields " + field_list(h) + ") where a plain numeric array was expected");
+}
+
+}  // namespace
+
+NpyRecords read_npy_records(const std::string& path, const std::function<bool(const std::string&)>& take) {
+  Header h;
+  File f = open_npy(path, h);
+  NpyRecords r;
+  if (!h.structured()) return r;
+  r.structured = true;
+  if (h.shape.size() != 1)
+    detail::fail(path, "a structured array must be 1-D (one record per point), found shape " + shape_string(h.shape));
+  r.n = h.shape[0];
+  std::vector<std::size_t> taken;
+  for (const Header::Field& fd : h.fields) {
+    NpyRecords::Field out;
+    out.name = fd.name;
+    out.kind = fd.kind;
+    if (!fd.name.empty() && take(fd.name)) {
+      if (fd.kind == 'V' || fd.count != 1)
+        detail::fail(path, "field '" + fd.name + "' is not a number (dtype '" + fd.descr + "'" +
+                               (fd.count != 1 ? ", " + std::to_string(fd.count) + " values per record" : "") + ")");
+      out.taken = true;
+      out.values.resize(r.n);
+      taken.push_back(r.fields.size());
+    }
+    r.fields.push_back(std::move(out));
+  }
+  // Records in chunks; each taken field converted to double.
+  const std::size_t record = static_cast<std::size_t>(h.item_size);
+  struct stat st;
+  const long pos = std::ftell(f.get());
+  if (pos >= 0 && ::fstat(::fileno(f.get()), &st) == 0 && S_ISREG(st.st_mode)) {
+    const std::size_t avail = st.st_size > pos ? static_cast<std::size_t>(st.st_size - pos) : 0;
+    if (avail / record < r.n)
+      detail::fail(path, "truncated data: expected " + std::to_string(r.n) + " records of " + std::to_string(record) +
+                             " bytes, found " + std::to_string(avail) + " bytes");
+  }
+  const std::size_t chunk = std::max<std::size_t>(1, (std::size_t{1} << 22) / record);
+  std::vector<unsigned char> buf(chunk * record);
+  for (std::size_t done = 0; done < r.n;) {
+    const std::size_t items = std::min(chunk, r.n - done);
+    const std::size_t got = std::fread(buf.data(), 1, items * record, f.get());
+    if (got != items * record)
+      detail::fail(path, "truncated data: records end at record " + std::to_string(done + got / record) + " of " +
+                             std::to_string(r.n));
+    for (const std::size_t k : taken) {
+      const Header::Field& fd = h.fields[k];
+      Header one;
+      one.kind = fd.kind;
+      one.item_size = fd.item_size;
+      one.big_endian = fd.big_endian;
+      double* dst = r.fields[k].values.data() + done;
+      // One value at a time: the field's values are `record` bytes apart.
+      for (std::size_t i = 0; i < items; ++i) convert(path, one, buf.data() + i * record + fd.offset, 1, dst + i);
+    }
+    done += items;
+  }
+  return r;
+}
+
 NpyArray read_npy_double(const std::string& path) {
   Header h;
   File f = open_npy(path, h);
+  refuse_structured(path, h);
   NpyArray a = make_array(h);
   read_data(path, f.get(), h, a.as_double);
   if (h.fortran_order) fortran_to_c_order(a.as_double, h.shape);
@@ -407,6 +558,7 @@ NpyArray read_npy_double(const std::string& path) {
 NpyArray read_npy_int(const std::string& path) {
   Header h;
   File f = open_npy(path, h);
+  refuse_structured(path, h);
   if (h.kind == 'f') detail::fail(path, "expected an integer array, found dtype '" + h.descr + "'");
   NpyArray a = make_array(h);
   read_data(path, f.get(), h, a.as_int);

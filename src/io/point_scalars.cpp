@@ -1,5 +1,6 @@
 // io::read_point_scalars (include/tessera/io/points.hpp): a .npy array, or a
-// named .ply vertex property / text column of the points' own file.
+// named .ply vertex property / text column / structured .npy field of the
+// points' own file.
 #include <string>
 #include <vector>
 
@@ -23,7 +24,14 @@ std::vector<double> read_point_scalars(const std::string& points_path, const std
   const std::string ext = detail::lower_extension(points_path);
   if (ext == ".ply") return detail::read_ply_property(points_path, source);
   if (ext == ".csv" || ext == ".xyz" || ext == ".txt") return detail::read_text_column(points_path, source);
-  detail::fail(points_path, "scalars '" + source + "': name a .ply property or a .csv column, or give a .npy file");
+  if (ext == ".npy") {  // a field of a structured array
+    NpyRecords r = read_npy_records(points_path, [&](const std::string& name) { return name == source; });
+    for (auto& f : r.fields)
+      if (f.taken) return std::move(f.values);
+    if (r.structured) detail::fail(points_path, "no field '" + source + "' for scalars");
+  }
+  detail::fail(points_path, "scalars '" + source + "': name a .ply property, a .csv column or a field of a structured "
+                            ".npy, or give a .npy file");
 }
 
 }  // namespace tessera::io

@@ -452,11 +452,12 @@ class Voronoi3D(TempDirCase):
             self.assertIn(word, r.stdout)
         self.assertEqual(read_vtu(out).GetNumberOfCells(), self.N)
 
-    def test_fortran_order_and_named_columns(self):
+    def test_fortran_order_records_and_named_columns(self):
         # The same points as a Fortran-order .npy (np.save of a transposed
-        # array, or of a pandas DataFrame's to_numpy()) and as a CSV led by an
-        # unnamed index column with the axes out of order (pandas' to_csv):
-        # the same cells as the C-order .npy.
+        # array, or of a pandas DataFrame's to_numpy()), as a structured .npy
+        # (PDAL's arrays, to_records()) and as a CSV led by an unnamed index
+        # column with the axes out of order (pandas' to_csv): the same cells
+        # as the C-order .npy.
         ref = self.p("ref.csv")
         self.ok(["voronoi", self.inp, "--cell-table", ref, "-q", "--bounds"] + BOX3)
         f_npy = self.p("f.npy")
@@ -468,7 +469,12 @@ class Voronoi3D(TempDirCase):
             f.write(",id,z,y,x\n")
             for i, (x, y, z) in enumerate(self.pts):
                 f.write("%d,%d,%.17g,%.17g,%.17g\n" % (i, 1000 + i, z, y, x))
-        for k, inp in enumerate((f_npy, csv_in)):
+        rec = np.zeros(len(self.pts), dtype=[("Id", "<i8"), ("Z", "<f8"), ("Y", "<f8"), ("X", "<f8"), ("cls", "u1")])
+        rec["Id"] = np.arange(len(self.pts))
+        rec["X"], rec["Y"], rec["Z"] = self.pts.T
+        r_npy = self.p("records.npy")
+        np.save(r_npy, rec)
+        for k, inp in enumerate((f_npy, csv_in, r_npy)):
             t = self.p("t%d.csv" % k)
             self.ok(["voronoi", inp, "--cell-table", t, "-q", "--bounds"] + BOX3)
             with open(ref) as a, open(t) as b:

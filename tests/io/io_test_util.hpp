@@ -78,11 +78,14 @@ std::string raw_bytes(const std::vector<T>& v, bool big_endian = false) {
   return s;
 }
 
-/// An .npy file image with the given descr/shape text (e.g. "<f8", "(3, 2)"),
+/// An .npy file image with the given descr/shape text (e.g. "<f8", "(3, 2)";
+/// a structured descr as its list literal, "[('x', '<f8'), ...]"),
 /// header version `major`.0 and raw data.
 inline std::string make_npy(const std::string& descr, const std::string& shape, std::string_view data,
                             bool fortran = false, int major = 1) {
-  std::string dict = "{'descr': '" + descr + "', 'fortran_order': " + (fortran ? "True" : "False") +
+  // A structured dtype's descr is a list literal, written as given.
+  const std::string d = !descr.empty() && descr[0] == '[' ? descr : "'" + descr + "'";
+  std::string dict = "{'descr': " + d + ", 'fortran_order': " + (fortran ? "True" : "False") +
                      ", 'shape': " + shape + ", }";
   const std::size_t prefix = major == 1 ? 10 : 12;
   dict.append((64 - (prefix + dict.size() + 1) % 64) % 64, ' ');

@@ -196,6 +196,62 @@ TEST(Npy, FortranOrderIsReordered) {
   EXPECT_EQ(l.as_int, (std::vector<std::int64_t>{7, 8, 9}));
 }
 
+// A structured array (PDAL's point views, np.recarray, pandas'
+// to_records()): the points from its fields named x, y, z in any case and
+// position, labels from an integer field, numpy's padding skipped.
+TEST(Npy, StructuredRecords) {
+  TempDir dir;
+  // Records: id <i4, Z <f4, pad |V4, X >f8 (big-endian), Y <f8, cls |u1, rgb |u1 (3,) -> 32 bytes.
+  const std::string descr =
+      "[('id', '<i4'), ('Z', '<f4'), ('', '|V4'), ('X', '>f8'), ('Y', '<f8'), ('cls', '|u1'), ('rgb', '|u1', (3,))]";
+  std::string data;
+  const double xs[2] = {1.5, -2.0}, ys[2] = {0.25, 4.0};
+  const float zs[2] = {3.0f, -0.5f};
+  for (int i = 0; i < 2; ++i) {
+    data += raw_bytes(std::vector<std::int32_t>{100 + i});
+    data += raw_bytes(std::vector<float>{zs[i]});
+    data += std::string(4, '\x7f');
+    data += raw_bytes(std::vector<double>{xs[i]}, true);
+    data += raw_bytes(std::vector<double>{ys[i]});
+    data += static_cast<char>(i == 0 ? 5 : 200);
+    data += std::string(3, '\x01');
+  }
+  ASSERT_EQ(data.size(), 64u);
+  const std::string p = dir.write("rec.npy", make_npy(descr, "(2,)", data));
+  tessera::io::ReadOptions lab;
+  lab.labels = "cls";
+  auto pc = read_points(p, lab);
+  EXPECT_EQ(pc.dim, 3);
+  EXPECT_EQ(pc.coords, (std::vector<double>{1.5, 0.25, 3.0, -2.0, 4.0, -0.5}));
+  EXPECT_EQ(pc.labels, (std::vector<std::int32_t>{5, 200}));
+  tessera::io::ReadOptions two;
+  two.dim = 2;
+  EXPECT_EQ(read_points(p, two).coords, (std::vector<double>{1.5, 0.25, -2.0, 4.0}));
+  // Scalars by field name (threshold --scalars).
+  EXPECT_EQ(tessera::io::read_point_scalars(p, "id"), (std::vector<double>{100, 101}));
+  // Errors name the fields.
+  auto msg = input_error([&] { read_points(p, [] { tessera::io::ReadOptions o; o.labels = "rgb"; return o; }()); });
+  EXPECT_NE(msg.find("'rgb' is not a number"), std::string::npos) << msg;
+  msg = input_error([&] { read_points(p, [] { tessera::io::ReadOptions o; o.labels = "Z"; return o; }()); });
+  EXPECT_NE(msg.find("floating-point"), std::string::npos) << msg;
+  msg = input_error([&] { read_points(p, [] { tessera::io::ReadOptions o; o.labels = "none"; return o; }()); });
+  EXPECT_NE(msg.find("no field 'none'"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("'cls'"), std::string::npos) << msg;
+  // Without x and y fields; labels or scalars from a structured file where a plain array is expected.
+  const std::string q = dir.write("q.npy", make_npy("[('a', '<f8'), ('b', '<f8')]", "(1,)", raw_bytes(std::vector<double>{1, 2})));
+  msg = input_error([&] { read_points(q); });
+  EXPECT_NE(msg.find("fields x and y"), std::string::npos) << msg;
+  msg = input_error([&] { tessera::io::read_labels_npy(q); });
+  EXPECT_NE(msg.find("structured array (fields 'a', 'b')"), std::string::npos) << msg;
+  // Truncated records, nested dtypes and 2-D record arrays.
+  msg = input_error([&] { read_points(dir.write("t.npy", make_npy(descr, "(3,)", data))); });
+  EXPECT_NE(msg.find("truncated"), std::string::npos) << msg;
+  msg = input_error([&] { read_points(dir.write("n.npy", make_npy("[('p', [('x', '<f8')])]", "(1,)", std::string(8, '\0')))); });
+  EXPECT_NE(msg.find("nested"), std::string::npos) << msg;
+  msg = input_error([&] { read_points(dir.write("s.npy", make_npy("[('x', '<f8'), ('y', '<f8')]", "(1, 2)", std::string(32, '\0')))); });
+  EXPECT_NE(msg.find("1-D"), std::string::npos) << msg;
+}
+
 TEST(Npy, BadShapeNamesShape) {
   TempDir dir;
   const std::vector<double> d(20, 1.0);
