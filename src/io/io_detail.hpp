@@ -53,7 +53,7 @@ std::string lower_extension(const std::string& path);
 PointCloud read_text_points(const std::string& path, const ReadOptions& options,
                             const std::string& label_column);
 
-/// .ply files (ascii or binary_little_endian). `label_property` is empty, or
+/// .ply files (ascii or binary, either byte order). `label_property` is empty, or
 /// the name of an integer vertex property holding labels.
 PointCloud read_ply_points(const std::string& path, const ReadOptions& options,
                            const std::string& label_property);
@@ -65,5 +65,14 @@ std::vector<double> read_ply_property(const std::string& path, const std::string
 /// The values of the header column `name` of a text point file, one per data
 /// line (NaN and Inf allowed; the caller decides).
 std::vector<double> read_text_column(const std::string& path, const std::string& name);
+
+/// VTK XML point sets: .vtp (PolyData) and .vtu (UnstructuredGrid), the
+/// points of every piece (vtk_points.cpp). `label_array` is empty, or the
+/// name of an integer point data array holding labels.
+PointCloud read_vtk_points(const std::string& path, const ReadOptions& options, const std::string& label_array);
+
+/// The values of the one-component point data array `name` of a .vtp/.vtu
+/// file, in point order (NaN and Inf allowed; the caller decides).
+std::vector<double> read_vtk_point_array(const std::string& path, const std::string& name);
 
 }  // namespace tessera::io::detail

@@ -356,7 +356,10 @@ std::string VtkXmlFile::array_bytes(std::size_t da, std::size_t count, const std
   const std::size_t need = count * scalar_size(t);
   big = layout_.big_endian;
   const XmlElement& e = elements_[da];
-  const std::string_view content = std::string_view(text_).substr(e.content_begin, e.content_end - e.content_begin);
+  // The values are the element's text up to its first child: VTK writes
+  // <InformationKey> elements (a multi-component array's norm range) after them.
+  std::string_view content = std::string_view(text_).substr(e.content_begin, e.content_end - e.content_begin);
+  content = content.substr(0, std::min(content.size(), content.find('<')));
   if (format == "ascii") {
     big = std::endian::native == std::endian::big;
     return parse_ascii_values(path_, content, t, count);

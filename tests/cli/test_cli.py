@@ -24,7 +24,7 @@ import numpy as np
 
 try:
     import vtk
-    from vtk.util.numpy_support import vtk_to_numpy
+    from vtk.util.numpy_support import numpy_to_vtk, vtk_to_numpy
 except ImportError:  # pragma: no cover - reported as failures of the VTK tests
     vtk = None
 
@@ -479,6 +479,63 @@ class Voronoi3D(TempDirCase):
             self.ok(["voronoi", inp, "--cell-table", t, "-q", "--bounds"] + BOX3)
             with open(ref) as a, open(t) as b:
                 self.assertEqual(a.read(), b.read(), inp)
+
+    def test_vtk_point_files(self):
+        # Points saved by VTK's own XML writers (ParaView's "Save Data"), in
+        # every data mode, with and without zlib, 32- and 64-bit headers, in
+        # pieces, float32 in a .vtu; labels and scalars from point data: the
+        # same cells as the same points and labels from .npy files.
+        labels = np.random.default_rng(5).integers(-1, 3, self.N).astype(np.int32)
+        lab_npy = self.save("lab.npy", labels)
+
+        def dataset(kind, pts):
+            d = vtk.vtkPolyData() if kind == "vtp" else vtk.vtkUnstructuredGrid()
+            p = vtk.vtkPoints()
+            p.SetData(numpy_to_vtk(pts, deep=1))
+            d.SetPoints(p)
+            for name, values in (("RegionId", labels), ("temp", pts[:, 0] * 2)):
+                a = numpy_to_vtk(values, deep=1)
+                a.SetName(name)
+                d.GetPointData().AddArray(a)
+            return d
+
+        def table(inp, *extra):
+            t = self.p("t.csv")
+            self.ok(["voronoi", inp, "--cell-table", t, "-q", "--bounds"] + BOX3 + list(extra))
+            with open(t) as f:
+                return f.read()
+
+        ref = table(self.inp, "--labels", lab_npy)
+        ref32 = table(self.save("p32.npy", self.pts.astype(np.float32)), "--labels", lab_npy)
+        cases = [("vtp", mode, zlib, h64, pieces) for mode in ("Ascii", "Binary", "Appended")
+                 for zlib in (False, True) for h64 in (False, True) for pieces in (1, 3)
+                 if not (mode == "Ascii" and (zlib or h64))]
+        cases.append(("vtu", "Appended", True, False, 1))
+        for kind, mode, zlib, h64, pieces in cases:
+            name = self.p("%s_%s_%d_%d_%d.%s" % (kind, mode, zlib, h64, pieces, kind))
+            pts = self.pts if kind == "vtp" else self.pts.astype(np.float32)
+            w = vtk.vtkXMLPolyDataWriter() if kind == "vtp" else vtk.vtkXMLUnstructuredGridWriter()
+            w.SetFileName(name)
+            w.SetInputData(dataset(kind, pts))
+            getattr(w, "SetDataModeTo" + mode)()
+            if zlib:
+                w.SetCompressorTypeToZLib()
+            else:
+                w.SetCompressorTypeToNone()
+            if h64:
+                w.SetHeaderTypeToUInt64()
+            w.SetNumberOfPieces(pieces)
+            self.assertEqual(w.Write(), 1)
+            self.assertEqual(table(name, "--labels", "RegionId"), ref if kind == "vtp" else ref32, name)
+        # Scalars from point data (threshold), and the errors.
+        vtp = self.p("vtp_Appended_1_0_1.vtp")
+        out = self.p("th.npy")
+        self.ok(["threshold", vtp, "--scalars", "temp", "--interval", "0,1,1", "--interval", "1,inf,2", "-o", out, "-q"])
+        np.testing.assert_array_equal(np.load(self.p("th_labels.npy")), np.where(self.pts[:, 0] * 2 < 1, 1, 2))
+        r = run(["voronoi", vtp, "--labels", "temp", "-o", self.p("x.vtu")])
+        self.assertEqual(r.returncode, 2)
+        self.assertIn("floating-point", r.stderr)
+        self.assertFalse(os.path.exists(self.p("x.vtu")))
 
     def test_summary_names_far_points(self):
         # Two points far beyond the bulk are reported (outliers?); none otherwise.

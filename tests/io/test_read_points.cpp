@@ -16,12 +16,12 @@ TEST(ReadPoints, UnknownExtension) {
   TempDir dir;
   const std::string p = dir.write("points.foo", "1,2,3\n");
   auto msg = input_error([&] { read_points(p); });
-  EXPECT_EQ(msg, p + ": unknown input extension '.foo' (expected .npy, .csv, .xyz, .txt, .ply)");
+  EXPECT_EQ(msg, p + ": unknown input extension '.foo' (expected .npy, .csv, .xyz, .txt, .ply, .vtp, .vtu)");
 }
 
 TEST(ReadPoints, MissingFile) {
   TempDir dir;
-  for (const char* name : {"nope.csv", "nope.npy", "nope.ply"}) {
+  for (const char* name : {"nope.csv", "nope.npy", "nope.ply", "nope.vtp"}) {
     const std::string p = dir.file(name);
     auto msg = input_error([&] { read_points(p); });
     EXPECT_EQ(msg, "cannot open " + p + ": No such file or directory");
