@@ -23,12 +23,32 @@ namespace {
 
 using namespace tessera::cli;
 
-/// One line, whatever the message contains: control characters (a newline,
-/// or a form feed quoted from a file's header) become spaces.
+/// One line of valid UTF-8, whatever the message contains: control
+/// characters (a newline, or a form feed quoted from a file's header) become
+/// spaces, and bytes that are not UTF-8 (a corrupt file's header quoted) '?'.
+/// Valid multi-byte characters (a file name's) are kept.
 void print_error(const std::string& msg) {
-  std::string line = msg;
-  for (char& c : line)
-    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = ' ';
+  std::string line;
+  line.reserve(msg.size());
+  for (std::size_t i = 0; i < msg.size();) {
+    const auto c = static_cast<unsigned char>(msg[i]);
+    if (c < 0x80) {
+      line += c < 0x20 || c == 0x7f ? ' ' : static_cast<char>(c);
+      ++i;
+      continue;
+    }
+    // A lead byte and its continuation bytes (no overlong 2-byte forms).
+    const std::size_t len = c >= 0xc2 && c <= 0xdf ? 2 : c >= 0xe0 && c <= 0xef ? 3 : c >= 0xf0 && c <= 0xf4 ? 4 : 0;
+    bool ok = len != 0 && i + len <= msg.size();
+    for (std::size_t k = 1; ok && k < len; ++k) ok = (static_cast<unsigned char>(msg[i + k]) & 0xc0) == 0x80;
+    if (ok) {
+      line.append(msg, i, len);
+      i += len;
+    } else {
+      line += '?';
+      ++i;
+    }
+  }
   std::fprintf(stderr, "tessera: error: %s\n", line.c_str());
 }
 

@@ -776,6 +776,16 @@ class BadInput(TempDirCase):
     def test_missing_file(self):
         self.fails(["voronoi", self.p("nope.npy"), "-o", self.out()], "nope.npy")
 
+    def test_error_line_is_utf8(self):
+        # A corrupt file's bytes quoted in the message come out as '?' (run()
+        # decodes stderr as UTF-8 and would raise on them); a file name's
+        # UTF-8 stays.
+        bad = self.p("b\u00e9d.vtp")
+        with open(bad, "wb") as f:
+            f.write(b'<VTKFile type="Poly\xd7Data"></VTKFile>')
+        line = self.fails(["voronoi", bad, "-o", self.out()], "b\u00e9d.vtp")
+        self.assertIn("'Poly?Data'", line)
+
     def test_unknown_input_extension(self):
         path = self.p("pts.foo")
         with open(path, "w") as f:
