@@ -6,7 +6,7 @@
 set -euo pipefail
 
 pkgs=(build-essential cmake ninja-build ccache pkg-config
-      libtbb-dev libcli11-dev libgtest-dev libgmock-dev libbenchmark-dev libgmp-dev zlib1g-dev
+      libtbb-dev libcli11-dev libgtest-dev libgmock-dev libbenchmark-dev libgmp-dev zlib1g-dev liblzf-dev
       voro++-dev libvoro++1
       python3 python3-numpy python3-vtk9 qhull-bin
       # test oracles (CGAL's Delaunay, scipy) and the Python module (pybind11, pytest, meshio, matplotlib)

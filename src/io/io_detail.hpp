@@ -71,6 +71,13 @@ std::vector<double> read_text_column(const std::string& path, const std::string&
 /// name of an integer point data array holding labels.
 PointCloud read_vtk_points(const std::string& path, const ReadOptions& options, const std::string& label_array);
 
+/// PCD files (the Point Cloud Library's; ascii, binary, binary_compressed):
+/// the fields x, y (and z). `label_field` is empty, or an integer field.
+PointCloud read_pcd_points(const std::string& path, const ReadOptions& options, const std::string& label_field);
+
+/// The values of the one-value field `name` of a .pcd file, in point order.
+std::vector<double> read_pcd_field(const std::string& path, const std::string& name);
+
 /// The values of the one-component point data array `name` of a .vtp/.vtu
 /// file, in point order (NaN and Inf allowed; the caller decides).
 std::vector<double> read_vtk_point_array(const std::string& path, const std::string& name);

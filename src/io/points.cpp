@@ -211,8 +211,10 @@ PointCloud read_points(const std::string& path, const ReadOptions& options) {
     pc = detail::read_ply_points(path, options, label_name);
   } else if (ext == ".vtp" || ext == ".vtu") {
     pc = detail::read_vtk_points(path, options, label_name);
+  } else if (ext == ".pcd") {
+    pc = detail::read_pcd_points(path, options, label_name);
   } else {
-    detail::fail(path, "unknown input extension '" + ext + "' (expected .npy, .csv, .xyz, .txt, .ply, .vtp, .vtu)");
+    detail::fail(path, "unknown input extension '" + ext + "' (expected .npy, .csv, .xyz, .txt, .ply, .vtp, .vtu, .pcd)");
   }
 
   if (pc.n == 0) detail::fail(path, "no points");
