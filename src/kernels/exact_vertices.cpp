@@ -26,13 +26,21 @@ using exact_rows::Scratch;
 // ---- Vertices ----
 
 namespace {
-// q as a double, keeping values below DBL_MIN: mpq_get_d returns 0 for them
-// (GMP leaves it system dependent), while a sliver's exact volume, or a
-// vertex coordinate, can be a subnormal. Scaled up by 2^1100 first, then
-// down by ldexp, which rounds into the subnormals. Modifies q.
+// q as a double: truncated to 53 bits (mpq_get_d), then rounded once into
+// the subnormals below DBL_MIN, where mpq_get_d returns 0 (GMP leaves it
+// system dependent) while a sliver's exact volume, or a vertex coordinate,
+// can be a subnormal: scaled up by 2^1100 first, then down by ldexp.
+// Below 2^-1999 that rounding gives a zero of q's sign, and from 2^1024 on
+// (GMP: system dependent again) q is an infinity of its sign, as
+// certain_quotient decides them without rationals. Modifies q.
 double rational_to_double(mpq_ptr q) {
+  const int sign = mpq_sgn(q);
+  if (sign == 0) return 0.0;
+  // 2^(e - 1) < |q| < 2^(e + 1)
   const long e = static_cast<long>(mpz_sizeinbase(mpq_numref(q), 2)) - static_cast<long>(mpz_sizeinbase(mpq_denref(q), 2));
-  if (mpq_sgn(q) == 0 || e > -1000) return mpq_get_d(q);
+  if (e >= 1026) return sign > 0 ? std::numeric_limits<double>::infinity() : -std::numeric_limits<double>::infinity();
+  if (e <= -2000) return sign > 0 ? 0.0 : -0.0;
+  if (e > -1000) return mpq_get_d(q);
   mpq_mul_2exp(q, q, 1100);
   return std::ldexp(mpq_get_d(q), -1100);
 }
@@ -500,8 +508,11 @@ void difference_truncated(mpz_ptr out, double a, double b, long k, long g, Scrat
 // mpq_get_d), where n is known only to lie within 2^hn of `num`, and d is c
 // times a number within 2^hd of `den` (den null: d = c exactly). False where
 // those intervals leave that double undetermined (they hold zero, or two
-// doubles) or it lies outside [2^-1000, 2^1000] (the rational path then
-// rounds subnormals as it always did). Truncation is monotone, so when both
+// doubles). Out of double's range it is what rational_to_double makes of x:
+// an infinity from 2^1024 on, a zero below 2^-1999. (Until stop 72, false
+// outside [2^-1000, 2^1000], which sent every cell whose measure leaves
+// double's range to the rationals: 300 points spread over 1e-300..1e280
+// took 20 s, ~60 ms a cell.) Truncation is monotone, so when both
 // ends of x's interval truncate alike, x does too. `z[at..at+5)` is scratch.
 bool certain_quotient(mpz_srcptr num, long hn, mpz_srcptr den, long hd, unsigned long c, long exp, IntegerPool& z,
                       std::size_t at, double& out) {
@@ -548,7 +559,21 @@ bool certain_quotient(mpz_srcptr num, long hn, mpz_srcptr den, long hd, unsigned
   int e;
   std::frexp(low, &e);
   const long scale = exp - k;
-  if (e + scale < -1000 || e + scale > 1000) return false;
+  // |x| >= 2^(e - 1 + scale): from 2^1024 on it is beyond double's range,
+  // and truncates to an infinity, as mpq_get_d gives it (the volume and
+  // centroid of a cell reaching past 1e308, whose coordinates span from
+  // 1e-300 to 1e280: each such cell went to the rationals, ~60 ms apiece).
+  if (e + scale > 1024) {
+    out = low > 0 ? std::numeric_limits<double>::infinity() : -std::numeric_limits<double>::infinity();
+    return true;
+  }
+  // Below 2^-1022, ldexp rounds low 2^scale once into the subnormals, as
+  // rational_to_double rounds the same truncated mantissa; below 2^-1999 to
+  // a zero of x's sign, as it does.
+  if (e + scale < -1999) {
+    out = low > 0 ? 0.0 : -0.0;
+    return true;
+  }
   out = std::ldexp(low, static_cast<int>(scale));
   return true;
 }
@@ -699,7 +724,10 @@ double exact_cell_measure(const ExactContext& ctx, std::int32_t i, std::span<con
   // ~250), and the thread's next cell starts from those (its neighbours
   // are alike), drifting back towards 200 while they suffice; the doubles
   // are the same whatever the bits. The rational path serves zero centroid
-  // coordinates and cancellation beyond 4,000 bits.
+  // coordinates, quantities that are exactly doubles (the centroid of a
+  // prism spanning the box: no interval certifies them), and cancellation
+  // beyond 4,000 bits. (The start is kept even where the second try failed:
+  // tried in stop 72, restoring it made such inputs 10-40% slower.)
   constexpr long least = 200, most = 4000;
   thread_local long start = least;
   double volume;
