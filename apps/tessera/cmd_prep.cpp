@@ -29,14 +29,14 @@ constexpr const char* kOutputHelp =
     "int property 'label') or .vtp (VTK vertices, point data 'label'). 2D points get z = 0 in .ply/.vtp";
 
 void add_input_options(CLI::App* app, PrepInput& p, bool labels) {
-  app->add_option("INPUT", p.input, "Point file: .npy, .csv/.xyz/.txt, .ply or .vtp/.vtu (as for `voronoi`)")->required();
+  app->add_option("INPUT", p.input, "Point file: .npy, .csv/.xyz/.txt, .ply, .vtp/.vtu or .pcd (as for `voronoi`)")->required();
   app->add_option("-o,--output", p.output, kOutputHelp)->required();
-  app->add_option("--dim", p.dim, "Dimension: 2 or 3 (default: the number of columns; .ply, .vtp and .vtu are 3D)")
+  app->add_option("--dim", p.dim, "Dimension: 2 or 3 (default: the number of columns or fields; .ply, .vtp and .vtu are 3D)")
       ->check(CLI::IsMember({2, 3}));
   if (labels)
     app->add_option("--labels", p.labels,
                     "Per-point integer labels, carried to the output: FILE.npy, or the name of an integer .ply "
-                    "vertex property / .csv column / .vtp or .vtu point data array / structured .npy field");
+                    "vertex property / .csv column / .vtp or .vtu point data array / .pcd or structured .npy field");
   app->add_flag("-q,--quiet", p.quiet, "No summary line");
 }
 
@@ -136,7 +136,7 @@ void add_prep_commands(CLI::App& app, PrepCommands& c) {
   add_input_options(t, c.threshold.io, false);
   t->add_option("--scalars", c.threshold.scalars,
                 "S.npy (one number per point), or the name of a .ply vertex property / .csv column / .vtp or .vtu "
-                "point data array / structured .npy field of INPUT "
+                "point data array / .pcd or structured .npy field of INPUT "
                 "(with a .csv whose header does not name x,y[,z], use --dim so that the column is not taken "
                 "as a coordinate)")
       ->required();

@@ -126,7 +126,7 @@ NetInput read_net_input(const SurfaceNetsArgs& a) {
     in.coords = std::move(pc.coords);
     in.labels = std::move(pc.labels);
     if (in.labels.empty())
-      throw InputError("surface nets need region labels: give --labels FILE.npy or the name of a .ply/.csv/.vtp/.vtu/structured .npy label column");
+      throw InputError("surface nets need region labels: give --labels FILE.npy or the name of a .ply/.csv/.vtp/.vtu/.pcd/structured .npy label column");
   }
   return in;
 }

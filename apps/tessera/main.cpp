@@ -65,14 +65,15 @@ void add_compute_options(CLI::App* app, ComputeArgs& c, std::vector<std::string>
   app->add_option("INPUT", c.input,
                   "Point file (required): .npy (float array, shape (N,2) or (N,3), or records with fields "
                   "x,y[,z]), .csv/.xyz/.txt (the columns a header names x,y[,z], else the first 2 or 3 "
-                  "numeric columns), .ply (vertex x,y,z) or .vtp/.vtu (VTK XML points, as ParaView saves them)");
+                  "numeric columns), .ply (vertex x,y,z), .vtp/.vtu (VTK XML points, as ParaView saves them) or "
+                  ".pcd (PCL's point clouds)");
   app->add_option("--dim", c.dim,
-                  "Dimension: 2 or 3 (default: the number of columns; .ply, .vtp and .vtu are 3D). --dim 2 "
+                  "Dimension: 2 or 3 (default: the number of columns or fields; .ply, .vtp and .vtu are 3D). --dim 2 "
                   "on 3-column input keeps x,y")
       ->check(CLI::IsMember({2, 3}));
   app->add_option("--labels", c.labels,
                   "Per-point integer labels: FILE.npy (length N), or the name of an integer .ply vertex "
-                  "property / .csv column / .vtp or .vtu point data array / structured .npy field. Cells get "
+                  "property / .csv column / .vtp or .vtu point data array / .pcd or structured .npy field. Cells get "
                   "their point's label as Region; points labelled < 0 own no cell and clip their neighbours");
   // Collected as text: CLI11 cannot know whether 4 (2D) or 6 (3D) numbers
   // follow, so in 2D it also takes the next word; finish_compute_args sorts it out.
