@@ -22,6 +22,7 @@
 #include "options.hpp"
 #include "tessera/image.hpp"
 #include "tessera/io/image.hpp"
+#include "tessera/io/points.hpp"
 #include "tessera/labelled_points.hpp"
 #include "tessera/prep/fill.hpp"
 #include "tessera/prep/joggle.hpp"
@@ -295,6 +296,22 @@ void bind_prep(py::module_& m) {
       py::arg("points").noconvert(), py::arg("labels").none(true), py::arg("strategy"), py::arg("background_label"),
       py::arg("in_label"), py::arg("points_per_bin"), py::arg("bounds").none(true), py::arg("joggle"),
       py::arg("seed"), py::arg("threads"), "The points followed by background points in empty bins: (points, labels).");
+
+  // ---- read_points -----------------------------------------------------------
+  m.def(
+      "read_points",
+      [](const std::string& path, int dim, const std::string& labels) {
+        io::ReadOptions opt;
+        opt.dim = dim;
+        opt.labels = labels;
+        io::PointCloud pc = without_gil([&] { return io::read_points(path, opt); });
+        const auto n = static_cast<py::ssize_t>(pc.n);
+        py::object lab = py::none();
+        if (!labels.empty()) lab = adopt_flat(std::move(pc.labels));
+        return py::make_tuple(adopt(std::move(pc.coords), {n, static_cast<py::ssize_t>(pc.dim)}), lab);
+      },
+      py::arg("path"), py::arg("dim"), py::arg("labels"),
+      "A point file as the command line reads it: (points (n, dim), labels (n,) or None).");
 
   // ---- threshold --------------------------------------------------------------
   m.def(

@@ -4,7 +4,8 @@
 near the label boundaries; :func:`fill` adds background points where a cloud
 is empty; :func:`joggle` breaks exact ties; :func:`threshold` turns a scalar
 per point into labels; :func:`probe` samples an image's scalars at points;
-:func:`read_image` reads the image files the library reads.
+:func:`read_image` reads the image files the library reads, :func:`read_points`
+its point files.
 
 Images as numpy arrays are C-ordered, shape ``(ny, nx)`` or ``(nz, ny, nx)``:
 ``image[k, j, i]`` is voxel ``(i, j, k)``, x varies fastest (as in VTK, NRRD
@@ -107,6 +108,34 @@ def read_image(
         im = _inputs.call(_core.read_scalar_image, name, sp, org)
     geometry = (im.spacing, im.origin)
     return (im.release_array(),) + geometry
+
+
+# --------------------------------------------------------------- read_points
+
+def read_points(
+    path: PathLike, dim: Optional[int] = None, labels: Optional[PathLike] = None
+) -> Tuple[np.ndarray, Optional[np.ndarray]]:
+    """Read a point file as the ``tessera`` command reads it: ``.npy`` (an
+    (N, 2) or (N, 3) array in C or Fortran order, or a structured array with
+    fields x, y[, z]), ``.csv`` / ``.xyz`` / ``.txt`` (the columns a header
+    names x, y[, z], else the first ones), ``.ply``, ``.vtp`` / ``.vtu``
+    (VTK XML points) or ``.pcd`` (PCL's point clouds).
+
+    ``dim`` forces 2 or 3 (2 keeps x, y). ``labels``: a ``.npy`` file of N
+    integers, or the name of an integer column, property, point data array
+    or field of the file itself. Returns ``(points, labels)``: float64 of
+    shape (N, dim), and int32 of shape (N,) or None; both writable, taken
+    over from the library without a copy. ValueError
+    (:class:`tessera.InputError`) for a missing or malformed file.
+    """
+    if not _is_path(path):
+        raise ValueError(f"path: expected a file name, got {type(path).__name__}")
+    if dim not in (None, 2, 3):
+        raise ValueError(f"dim: expected 2, 3 or None, got {dim!r}")
+    if labels is not None and not _is_path(labels):
+        raise ValueError(f"labels: expected a file or field name, got {type(labels).__name__}")
+    lab = "" if labels is None else os.fsdecode(labels)
+    return _inputs.call(_core.read_points, os.fsdecode(path), dim or 0, lab)
 
 
 # -------------------------------------------------------------- sample_image

@@ -235,3 +235,34 @@ def test_a_scripts_own_handler_is_kept_and_the_file_completed(tmp_path):
     assert code == 7
     assert names == ["c.vtu"]
     assert read_vtk(tmp_path / "c.vtu").GetNumberOfCells() == 200000
+
+
+def test_read_points_reads_what_the_command_reads(tmp_path):
+    # The same points and labels from a Fortran-order .npy, a structured .npy
+    # and a CSV led by an index column.
+    pts = random_points(200, 3, seed=11)
+    lab = np.arange(200, dtype=np.int32) % 3
+    np.save(tmp_path / "f.npy", np.asfortranarray(pts))
+    rec = np.zeros(200, dtype=[("id", "<i8"), ("Z", "<f8"), ("X", "<f8"), ("Y", "<f8"), ("region", "<i2")])
+    rec["Z"], rec["X"], rec["Y"], rec["region"] = pts[:, 2], pts[:, 0], pts[:, 1], lab
+    np.save(tmp_path / "r.npy", rec)
+    with open(tmp_path / "p.csv", "w") as f:
+        f.write(",region,x,y,z\n")
+        for i, (p, l) in enumerate(zip(pts, lab)):
+            f.write("%d,%d,%r,%r,%r\n" % (i, l, p[0], p[1], p[2]))
+    np.save(tmp_path / "lab.npy", lab)
+    for name, labels in (("f.npy", tmp_path / "lab.npy"), ("r.npy", "region"), ("p.csv", "region")):
+        p, l = tessera.read_points(tmp_path / name, labels=labels)
+        assert p.shape == (200, 3) and p.dtype == np.float64 and p.flags.writeable
+        np.testing.assert_array_equal(p, pts)
+        np.testing.assert_array_equal(l, lab)
+        assert l.dtype == np.int32
+    p, l = tessera.read_points(tmp_path / "r.npy", dim=2)
+    np.testing.assert_array_equal(p, pts[:, :2])
+    assert l is None
+    with pytest.raises(ValueError, match="no field 'nope'"):
+        tessera.read_points(tmp_path / "r.npy", labels="nope")
+    with pytest.raises(ValueError, match="cannot open"):
+        tessera.read_points(tmp_path / "missing.pcd")
+    with pytest.raises(ValueError, match="dim"):
+        tessera.read_points(tmp_path / "r.npy", dim=4)
