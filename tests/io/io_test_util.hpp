@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "tessera/cells.hpp"
+#include "tessera/io/points.hpp"
 
 namespace tessera_test {
 
@@ -121,6 +122,13 @@ std::string input_error(F&& f) {
   }
   ADD_FAILURE() << "expected InputError, nothing thrown";
   return "";
+}
+
+/// Read options asking for labels from the column, property or field `name`.
+inline tessera::io::ReadOptions labels(const std::string& name) {
+  tessera::io::ReadOptions o;
+  o.labels = name;
+  return o;
 }
 
 }  // namespace tessera_test

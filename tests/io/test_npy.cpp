@@ -218,9 +218,7 @@ TEST(Npy, StructuredRecords) {
   }
   ASSERT_EQ(data.size(), 64u);
   const std::string p = dir.write("rec.npy", make_npy(descr, "(2,)", data));
-  tessera::io::ReadOptions lab;
-  lab.labels = "cls";
-  auto pc = read_points(p, lab);
+  auto pc = read_points(p, labels("cls"));
   EXPECT_EQ(pc.dim, 3);
   EXPECT_EQ(pc.coords, (std::vector<double>{1.5, 0.25, 3.0, -2.0, 4.0, -0.5}));
   EXPECT_EQ(pc.labels, (std::vector<std::int32_t>{5, 200}));
@@ -230,11 +228,11 @@ TEST(Npy, StructuredRecords) {
   // Scalars by field name (threshold --scalars).
   EXPECT_EQ(tessera::io::read_point_scalars(p, "id"), (std::vector<double>{100, 101}));
   // Errors name the fields.
-  auto msg = input_error([&] { read_points(p, [] { tessera::io::ReadOptions o; o.labels = "rgb"; return o; }()); });
+  auto msg = input_error([&] { read_points(p, labels("rgb")); });
   EXPECT_NE(msg.find("'rgb' is not a number"), std::string::npos) << msg;
-  msg = input_error([&] { read_points(p, [] { tessera::io::ReadOptions o; o.labels = "Z"; return o; }()); });
+  msg = input_error([&] { read_points(p, labels("Z")); });
   EXPECT_NE(msg.find("floating-point"), std::string::npos) << msg;
-  msg = input_error([&] { read_points(p, [] { tessera::io::ReadOptions o; o.labels = "none"; return o; }()); });
+  msg = input_error([&] { read_points(p, labels("none")); });
   EXPECT_NE(msg.find("no field 'none'"), std::string::npos) << msg;
   EXPECT_NE(msg.find("'cls'"), std::string::npos) << msg;
   // Without x and y fields; labels or scalars from a structured file where a plain array is expected.

@@ -78,12 +78,6 @@ std::string compressed() {
   return s + out.substr(0, c);
 }
 
-ReadOptions labels(const std::string& name) {
-  ReadOptions o;
-  o.labels = name;
-  return o;
-}
-
 }  // namespace
 
 TEST(Pcd, ThreeEncodings) {

@@ -15,12 +15,6 @@ using tessera::io::ReadOptions;
 
 namespace {
 
-ReadOptions labels(const std::string& name) {
-  ReadOptions o;
-  o.labels = name;
-  return o;
-}
-
 /// Append a scalar in little-endian (or big-endian) byte order.
 template <class T>
 void put(std::string& s, T v, bool big = false) {

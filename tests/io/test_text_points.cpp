@@ -92,9 +92,7 @@ TEST(TextPoints, CoordinatesByHeaderName) {
   auto k2 = read_points(dir.write("d.csv", "id,x,y,z\n7,1,2,3\n"), two);
   EXPECT_EQ(k2.coords, (std::vector<double>{1, 2}));
   // With a labels column.
-  ReadOptions lab;
-  lab.labels = "region";
-  auto pl = read_points(dir.write("e.csv", "id,region,y,x,z\n7,3,2,1,3\n8,-1,5,4,6\n"), lab);
+  auto pl = read_points(dir.write("e.csv", "id,region,y,x,z\n7,3,2,1,3\n8,-1,5,4,6\n"), labels("region"));
   EXPECT_EQ(pl.coords, (std::vector<double>{1, 2, 3, 4, 5, 6}));
   EXPECT_EQ(pl.labels, (std::vector<std::int32_t>{3, -1}));
   // Only one of x and y named: the first columns, as without names.
@@ -108,9 +106,7 @@ TEST(TextPoints, CoordinatesByHeaderName) {
   EXPECT_NE(msg.find("no 'z' column"), std::string::npos) << msg;
   msg = input_error([&] { read_points(dir.write("h.csv", "x,y,z,X\n1,2,3,4\n")); });
   EXPECT_NE(msg.find("'x' twice"), std::string::npos) << msg;
-  ReadOptions lx;
-  lx.labels = "y";
-  msg = input_error([&] { read_points(dir.write("i.csv", "x,y,z\n1,2,3\n"), lx); });
+  msg = input_error([&] { read_points(dir.write("i.csv", "x,y,z\n1,2,3\n"), labels("y")); });
   EXPECT_NE(msg.find("both a coordinate and the labels"), std::string::npos) << msg;
 }
 

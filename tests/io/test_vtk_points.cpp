@@ -52,12 +52,6 @@ const char* kTwoPieces = R"(<?xml version="1.0"?>
 </VTKFile>
 )";
 
-ReadOptions labels(const std::string& name) {
-  ReadOptions o;
-  o.labels = name;
-  return o;
-}
-
 }  // namespace
 
 TEST(VtkPoints, PiecesLabelsAndScalars) {
