@@ -181,6 +181,10 @@ bool parse_one(std::string_view tok, T& v) {
 
 template <class T>
 void parse_ascii_as(const std::string& path, std::string_view text, std::size_t count, std::string& out) {
+  // n values take at least 2n - 1 characters: a count the text cannot hold
+  // is refused before anything is sized by it.
+  if (count > text.size() / 2 + 1)
+    fail(path, "ascii data is shorter than the " + std::to_string(count) + " values the header gives");
   out.assign(count * sizeof(T), '\0');
   std::size_t pos = 0;
   for (std::size_t k = 0; k < count; ++k) {

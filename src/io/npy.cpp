@@ -497,6 +497,16 @@ NpyRecords read_npy_records(const std::string& path, const std::function<bool(co
   if (h.shape.size() != 1)
     detail::fail(path, "a structured array must be 1-D (one record per point), found shape " + shape_string(h.shape));
   r.n = h.shape[0];
+  // The file must hold the records before anything is sized by the header.
+  const std::size_t record = static_cast<std::size_t>(h.item_size);
+  struct stat st;
+  const long pos = std::ftell(f.get());
+  if (pos >= 0 && ::fstat(::fileno(f.get()), &st) == 0 && S_ISREG(st.st_mode)) {
+    const std::size_t avail = st.st_size > pos ? static_cast<std::size_t>(st.st_size - pos) : 0;
+    if (avail / record < r.n)
+      detail::fail(path, "truncated data: expected " + std::to_string(r.n) + " records of " + std::to_string(record) +
+                             " bytes, found " + std::to_string(avail) + " bytes");
+  }
   std::vector<std::size_t> taken;
   for (const Header::Field& fd : h.fields) {
     NpyRecords::Field out;
@@ -513,15 +523,6 @@ NpyRecords read_npy_records(const std::string& path, const std::function<bool(co
     r.fields.push_back(std::move(out));
   }
   // Records in chunks; each taken field converted to double.
-  const std::size_t record = static_cast<std::size_t>(h.item_size);
-  struct stat st;
-  const long pos = std::ftell(f.get());
-  if (pos >= 0 && ::fstat(::fileno(f.get()), &st) == 0 && S_ISREG(st.st_mode)) {
-    const std::size_t avail = st.st_size > pos ? static_cast<std::size_t>(st.st_size - pos) : 0;
-    if (avail / record < r.n)
-      detail::fail(path, "truncated data: expected " + std::to_string(r.n) + " records of " + std::to_string(record) +
-                             " bytes, found " + std::to_string(avail) + " bytes");
-  }
   const std::size_t chunk = std::max<std::size_t>(1, (std::size_t{1} << 22) / record);
   std::vector<unsigned char> buf(chunk * record);
   for (std::size_t done = 0; done < r.n;) {

@@ -193,8 +193,20 @@ double load(const unsigned char* p, const Field& f) {
 /// one column per wanted field.
 std::vector<std::vector<double>> read_columns(const std::string& path, std::string_view bytes, const PcdHeader& h,
                                               const std::vector<std::size_t>& want) {
-  std::vector<std::vector<double>> cols(want.size(), std::vector<double>(h.points));
   const std::string_view data = bytes.substr(std::min(h.data_start, bytes.size()));
+  // The data must be able to hold the points before anything is sized by
+  // the header: n ascii points take at least 2n - 1 characters, binary ones
+  // their records, LZF expands at most ~100 times.
+  const std::size_t need = h.points * h.record;
+  if (h.record != 0 && need / h.record != h.points) fail(path, "PCD POINTS too large");
+  if (h.encoding == Encoding::ascii && h.points > data.size() / 2 + 1)
+    fail(path, "PCD data ends before " + std::to_string(h.points) + " points");
+  if (h.encoding == Encoding::binary && data.size() < need)
+    fail(path, "PCD data ends after " + std::to_string(data.size()) + " of " + std::to_string(need) + " bytes (" +
+                   std::to_string(h.points) + " points)");
+  if (h.encoding == Encoding::binary_compressed && need / 128 > data.size())
+    fail(path, "PCD compressed data is shorter than " + std::to_string(h.points) + " points can compress to");
+  std::vector<std::vector<double>> cols(want.size(), std::vector<double>(h.points));
   std::vector<std::size_t> offset(h.fields.size());  // within a record
   for (std::size_t k = 1; k < h.fields.size(); ++k)
     offset[k] = offset[k - 1] + static_cast<std::size_t>(h.fields[k - 1].size) * h.fields[k - 1].count;
@@ -206,7 +218,7 @@ std::vector<std::vector<double>> read_columns(const std::string& path, std::stri
       at[k] = per;
       per += h.fields[k].count;
     }
-    std::size_t pos = 0, line = 0;
+    std::size_t pos = 0;
     std::vector<std::string_view> w;
     for (std::size_t i = 0; i < h.points;) {
       if (pos >= data.size())
@@ -214,7 +226,6 @@ std::vector<std::vector<double>> read_columns(const std::string& path, std::stri
       const std::size_t nl = data.find('\n', pos);
       const std::string_view l = data.substr(pos, (nl == std::string_view::npos ? data.size() : nl) - pos);
       pos = nl == std::string_view::npos ? data.size() : nl + 1;
-      ++line;
       w = words(l);
       if (w.empty()) continue;
       if (w.size() != per)
@@ -238,8 +249,6 @@ std::vector<std::vector<double>> read_columns(const std::string& path, std::stri
     }
     return cols;
   }
-  const std::size_t need = h.points * h.record;
-  if (h.record != 0 && need / h.record != h.points) fail(path, "PCD POINTS too large");
   const unsigned char* src = reinterpret_cast<const unsigned char*>(data.data());
   std::vector<unsigned char> plain;
   if (h.encoding == Encoding::binary_compressed) {
@@ -267,9 +276,6 @@ std::vector<std::vector<double>> read_columns(const std::string& path, std::stri
     }
     return cols;
   }
-  if (data.size() < need)
-    fail(path, "PCD data ends after " + std::to_string(data.size()) + " of " + std::to_string(need) + " bytes (" +
-                   std::to_string(h.points) + " points)");
   for (std::size_t c = 0; c < want.size(); ++c) {
     const Field& f = h.fields[want[c]];
     for (std::size_t i = 0; i < h.points; ++i) cols[c][i] = load(src + i * h.record + offset[want[c]], f);

@@ -51,8 +51,7 @@ std::size_t components(const VtkXmlFile& file, std::size_t da, const std::string
 /// The one-component point data array `name` over all pieces, and whether
 /// it holds floating-point values.
 std::vector<double> point_array(const VtkXmlFile& file, const Pieces& p, const std::string& name, bool& is_float) {
-  std::vector<double> out;
-  out.reserve(p.total);
+  std::vector<double> out;  // (grown with the data read, not sized by the header)
   for (std::size_t k = 0; k < p.piece.size(); ++k) {
     const std::size_t pd = file.child(p.piece[k], "PointData");
     std::size_t da = 0;
@@ -91,7 +90,6 @@ PointCloud read_vtk_points(const std::string& path, const ReadOptions& options, 
   PointCloud pc;
   pc.dim = dim;
   pc.n = p.total;
-  pc.coords.reserve(p.total * static_cast<std::size_t>(dim));
   for (std::size_t k = 0; k < p.piece.size(); ++k) {
     if (p.points[k] == 0) continue;
     const std::size_t pts = file.child(p.piece[k], "Points");

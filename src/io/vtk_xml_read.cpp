@@ -157,6 +157,11 @@ class Base64Source {
   Base64Source(const std::string& path, std::string_view text) : path_(path), s_(text) {}
 
   std::string read(std::size_t n) {
+    // Four characters give at most three bytes: a size the text cannot hold
+    // is refused before anything is sized by it.
+    if (n > (s_.size() - i_) / 4 * 3 + 3 + (pending_.size() - pend_pos_))
+      fail(path_, "base64 data ends before the " + std::to_string(n) +
+                      " bytes the header gives (data shorter than the header says)");
     std::string out;
     out.reserve(n);
     while (out.size() < n && pend_pos_ < pending_.size()) out += pending_[pend_pos_++];
@@ -261,6 +266,12 @@ std::string read_binary(const std::string& path, Source& src, const BinaryLayout
     fail(path, "array '" + array + "' has " + std::to_string(total) + " bytes of data, its size needs " +
                    std::to_string(need) + " (mismatched sizes)");
   const std::string sizes = src.read(static_cast<std::size_t>(nblocks) * l.header_size);
+  // zlib inflates at most ~1032 times: blocks claiming more are corrupt,
+  // and are refused before anything is sized by them.
+  std::uint64_t compressed = 0;
+  for (std::uint64_t b = 0; b < nblocks; ++b) compressed += std::min<std::uint64_t>(header_int(sizes, static_cast<std::size_t>(b), l), std::uint64_t(1) << 40);
+  if (need / 1100 > compressed + 64)
+    fail(path, "array '" + array + "': malformed compressed-data header (more data than its blocks can hold)");
   std::string out;
   out.reserve(need);
   for (std::uint64_t b = 0; b < nblocks; ++b) {

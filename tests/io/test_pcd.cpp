@@ -137,5 +137,11 @@ TEST(Pcd, Errors) {
   error("type.pcd", "FIELDS x y\nSIZE 4 4\nTYPE F Q\nPOINTS 0\nDATA ascii\n", "unknown TYPE 'Q'");
   error("size.pcd", "FIELDS x y\nSIZE 4\nTYPE F F\nPOINTS 0\nDATA ascii\n", "SIZE gives 1 values for 2 fields");
   error("nodata.pcd", "FIELDS x y\nSIZE 4 4\nTYPE F F\nPOINTS 1\n", "no DATA line");
+  // A header claiming far more points than its data: refused before
+  // anything is sized by the claim (it ran out of memory).
+  for (const char* enc : {"ascii", "binary", "binary_compressed"})
+    error(std::string("huge_") + enc + ".pcd",
+          std::string("FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nPOINTS 999999999999\nDATA ") + enc + "\n1 2 3\n",
+          "PCD");
   error("enc.pcd", "FIELDS x y\nSIZE 4 4\nTYPE F F\nPOINTS 1\nDATA zip\n", "unknown DATA 'zip'");
 }

@@ -98,6 +98,12 @@ TEST(VtkPoints, Errors) {
   comps.replace(comps.find("NumberOfComponents=\"3\" format=\"ascii\">-1"), 22, "NumberOfComponents=\"2\"");
   msg = input_error([&] { read_points(dir.write("comps.vtp", comps)); });
   EXPECT_NE(msg.find("2 components, expected 3"), std::string::npos) << msg;
+  // A piece claiming far more points than its data: refused before anything
+  // is sized by the claim (it ran out of memory).
+  std::string huge = s;
+  huge.replace(huge.find("NumberOfPoints=\"2\""), 18, "NumberOfPoints=\"999999999999\"");
+  msg = input_error([&] { read_points(dir.write("huge.vtp", huge)); });
+  EXPECT_NE(msg.find("shorter than"), std::string::npos) << msg;
   // No points array in a piece that has points.
   std::string nopts = s;
   const std::size_t a = nopts.rfind("<Points>"), b = nopts.rfind("</Points>") + 9;
