@@ -256,6 +256,19 @@ TEST(FromNeighbours, SameCellsAsTheSearch) {
     for (double& x : p) x = std::ldexp(x, 300);
     same_as_search(p, "uniform scaled by 2^300", {}, std::nullopt, false, {}, true);
   }
+  // A point 8.4e52 off four unit points, two of which share its z (found by
+  // stop 72's reader fuzz): the far point's hull rays come in opposite
+  // pairs, so their sum was 2^-175 long, far_direction's floor (2^-1000 of
+  // it) underflowed, a ray at right angles to the far plane passed, and the
+  // insertion stopped with "vertex planes are dependent" (exit 1).
+  {
+    const std::vector<double> p{0x1.690221d53d688p-1,  1.0,                  -0x1p-7,
+                                0x1.ee4f4a7a06498p-1,  1.0,                  0x1.02p+0,
+                                0x1.a05c1019af2a5p-1,  -0x1p-7,              -0x1p-7,
+                                0x1.c7a3bbc788363p-1,  -0x1p-7,              0x1.02p+0,
+                                -0x1.c26b8fd91de2p+175, 0x1.72ca25ccd8ab4p-3, 0x1.02p+0};
+    same_as_search(p, "a point 8.4e52 off four unit points with opposite rays", {}, std::nullopt, false, {}, true);
+  }
 }
 
 std::vector<double> circle_points(std::size_t n, std::uint64_t seed) {

@@ -136,12 +136,35 @@ inline constexpr double far_vertex_condition = 1e13;
 /// so every vertex on P is certainly outside the box (box_signs).
 /// `box`: the kernel's first 2D planes (box_planes), n = -+e_axis, d = the
 /// offset from the generator.
+/// v scaled by a power of two (exactly: the same direction, the same signs
+/// of its dot products) so that its largest component lies in [1, 2); left
+/// alone if zero or not finite. far_direction's n may be tiny: the rays'
+/// sum, or a step (n / |n| plus the worst ray), where unit rays cancel (a
+/// point 1e52 off unit points, whose rays come in opposite pairs: 2^-175
+/// long). Its floor, 2^-1000 of |n|, then underflowed to zero, a ray at
+/// right angles to n passed, and the far vertex's planes were dependent: an
+/// internal error, exit 1. So its tests read n scaled, and it returns n
+/// scaled.
+template <int D>
+void scale_to_unit(double* v) {
+  double m = 0;
+  for (int a = 0; a < D; ++a) m = std::max(m, std::fabs(v[a]));
+  if (!(m > 0 && m <= std::numeric_limits<double>::max())) return;
+  const int e = filter::binary_exponent(m);
+  for (int a = 0; a < D; ++a) v[a] = std::ldexp(v[a], -e);
+}
+
 template <int D>
 bool far_direction(const double* dirs, std::size_t k, double* n, const double* hint = nullptr,
                    const double* ray_margins = nullptr, const double* ray_axis_errors = nullptr) {
   bool relaxed = false;  // the second round: the rounding floor in place of far_margin
   // The ray m falls shortest of its margin on (k: none; k + 1: NaN, or m = 0).
-  auto worst_ray = [&](const double* m) {
+  auto worst_ray = [&](const double* m_in) {
+    // On n scaled to unit range (scale_to_unit): the same dots' signs, and
+    // a floor that does not underflow.
+    double m[D];
+    for (int a = 0; a < D; ++a) m[a] = m_in[a];
+    scale_to_unit<D>(m);
     double len2 = 0, mabs[D];
     for (int a = 0; a < D; ++a) {
       len2 += m[a] * m[a];
@@ -192,7 +215,10 @@ bool far_direction(const double* dirs, std::size_t k, double* n, const double* h
   auto steps_from = [&]() {
     for (int step = 0;; ++step) {
       const std::size_t worst = worst_ray(n);
-      if (worst == k) return true;  // every ray crosses n's planes at far_margin of a right angle or more
+      if (worst == k) {  // every ray crosses n's planes at far_margin of a right angle or more
+        scale_to_unit<D>(n);
+        return true;
+      }
       if (worst > k || step == 64) return false;
       double len2 = 0;
       for (int a = 0; a < D; ++a) len2 += n[a] * n[a];

@@ -469,6 +469,7 @@ class Hull {
     // beyond far_vertex_condition), and the box cut decides as for any.
     if (exact_ == nullptr) return false;
     for (int a = 0; a < 3; ++a) far_n_[a] = hint[a];
+    assembly::scale_to_unit<3>(far_n_);
     for (std::size_t k = 0; k < nb; ++k)
       if (exact_ray_side(*exact_, gen_, planes_[border_[k].a].id, planes_[border_[k].b].id, far_n_) <= 0)
         return false;
