@@ -106,6 +106,24 @@ inline constexpr double facet_tilt = 1.6e-15;
 /// passes.)
 inline constexpr double far_vertex_condition = 1e13;
 
+/// v scaled by a power of two (exactly: the same direction, the same signs
+/// of its dot products) so that its largest component lies in [1, 2); left
+/// alone if zero or not finite. far_direction's n may be tiny: the rays'
+/// sum, or a step (n / |n| plus the worst ray), where unit rays cancel (a
+/// point 1e52 off unit points, whose rays come in opposite pairs: 2^-175
+/// long). Its floor, 2^-1000 of |n|, then underflowed to zero, a ray at
+/// right angles to n passed, and the far vertex's planes were dependent: an
+/// internal error, exit 1. So its tests read n scaled, and it returns n
+/// scaled.
+template <int D>
+void scale_to_unit(double* v) {
+  double m = 0;
+  for (int a = 0; a < D; ++a) m = std::max(m, std::fabs(v[a]));
+  if (!(m > 0 && m <= std::numeric_limits<double>::max())) return;
+  const int e = filter::binary_exponent(m);
+  for (int a = 0; a < D; ++a) v[a] = std::ldexp(v[a], -e);
+}
+
 /// The plane that closes the cell of a point on the convex hull, whose
 /// Voronoi cell is unbounded: its star's simplices give the bounded
 /// vertices, and each hull facet at the point one unbounded edge, a ray in
@@ -136,24 +154,6 @@ inline constexpr double far_vertex_condition = 1e13;
 /// so every vertex on P is certainly outside the box (box_signs).
 /// `box`: the kernel's first 2D planes (box_planes), n = -+e_axis, d = the
 /// offset from the generator.
-/// v scaled by a power of two (exactly: the same direction, the same signs
-/// of its dot products) so that its largest component lies in [1, 2); left
-/// alone if zero or not finite. far_direction's n may be tiny: the rays'
-/// sum, or a step (n / |n| plus the worst ray), where unit rays cancel (a
-/// point 1e52 off unit points, whose rays come in opposite pairs: 2^-175
-/// long). Its floor, 2^-1000 of |n|, then underflowed to zero, a ray at
-/// right angles to n passed, and the far vertex's planes were dependent: an
-/// internal error, exit 1. So its tests read n scaled, and it returns n
-/// scaled.
-template <int D>
-void scale_to_unit(double* v) {
-  double m = 0;
-  for (int a = 0; a < D; ++a) m = std::max(m, std::fabs(v[a]));
-  if (!(m > 0 && m <= std::numeric_limits<double>::max())) return;
-  const int e = filter::binary_exponent(m);
-  for (int a = 0; a < D; ++a) v[a] = std::ldexp(v[a], -e);
-}
-
 template <int D>
 bool far_direction(const double* dirs, std::size_t k, double* n, const double* hint = nullptr,
                    const double* ray_margins = nullptr, const double* ray_axis_errors = nullptr) {
