@@ -47,6 +47,29 @@ T load_item(const void* p, bool swap) {
 /// The extension of `path`, lowercased, with its dot ("" when there is none).
 std::string lower_extension(const std::string& path);
 
+/// 'a', 'b', 'c' for error messages.
+std::string quoted_list(const std::vector<std::string>& names);
+
+/// The coordinates a file's column or field `names` give (named_points.cpp):
+/// those named x, y and z in any case and order. found: x and y are named;
+/// dim: `dim` (the option) or 3 where z is named, else 2; col: the columns
+/// of the dim coordinates. `what` ("column", "field") names them in the
+/// errors: a coordinate named twice, 3D asked without z, the `labels`
+/// column being a coordinate.
+struct NamedAxes {
+  bool found = false;
+  int dim = 0;
+  std::size_t col[3] = {0, 0, 0};
+};
+NamedAxes named_axes(const std::string& path, const std::vector<std::string>& names, const std::string& labels,
+                     int dim, const std::string& what);
+
+/// Labels from numeric values (a column's, a field's, a point data
+/// array's): integers that fit in int32, else InputError naming `name` and
+/// the point.
+std::vector<std::int32_t> labels_from_values(const std::string& path, const std::string& name,
+                                             const std::vector<double>& v);
+
 /// Text point files (.csv/.xyz/.txt). `label_column` is empty, or the header
 /// name of the column holding integer labels. Coordinates are checked finite
 /// (errors name the line). Returns the cloud with labels filled when asked.

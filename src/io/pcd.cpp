@@ -283,19 +283,19 @@ std::vector<std::vector<double>> read_columns(const std::string& path, std::stri
   return cols;
 }
 
-std::string field_names(const PcdHeader& h) {
-  std::string s;
-  for (const Field& f : h.fields) s += (s.empty() ? "'" : ", '") + f.name + "'";
-  return s;
+std::vector<std::string> field_names(const PcdHeader& h) {
+  std::vector<std::string> names;
+  for (const Field& f : h.fields) names.push_back(f.name);
+  return names;
 }
 
-/// Index of the one-value field `name` (compared as given, or in lower case
-/// with `any_case`); h.fields.size() when absent.
-std::size_t find_field(const std::string& path, const PcdHeader& h, const std::string& name, bool any_case) {
+/// Index of the field `name`, which must hold one value per point;
+/// h.fields.size() when absent.
+std::size_t find_field(const std::string& path, const PcdHeader& h, const std::string& name) {
   for (std::size_t k = 0; k < h.fields.size(); ++k)
-    if (any_case ? lower(h.fields[k].name) == name : h.fields[k].name == name) {
+    if (h.fields[k].name == name) {
       if (h.fields[k].count != 1)
-        fail(path, "field '" + h.fields[k].name + "' holds " + std::to_string(h.fields[k].count) + " values per point, expected 1");
+        fail(path, "field '" + name + "' holds " + std::to_string(h.fields[k].count) + " values per point, expected 1");
       return k;
     }
   return h.fields.size();
@@ -307,16 +307,19 @@ PointCloud read_pcd_points(const std::string& path, const ReadOptions& options, 
   const std::string bytes = read_file_bytes(path);
   const PcdHeader h = parse_header(path, bytes);
   const std::size_t none = h.fields.size();
-  const std::size_t x = find_field(path, h, "x", true), y = find_field(path, h, "y", true), z = find_field(path, h, "z", true);
-  if (x == none || y == none) fail(path, "PCD fields need x and y (fields: " + field_names(h) + ")");
-  const int dim = options.dim ? options.dim : z != none ? 3 : 2;
-  if (dim == 3 && z == none) fail(path, "3D points asked but the PCD has no field 'z' (fields: " + field_names(h) + ")");
-  std::vector<std::size_t> want{x, y};
-  if (dim == 3) want.push_back(z);
+  const NamedAxes axes = named_axes(path, field_names(h), label_field, options.dim, "field");
+  if (!axes.found) fail(path, "PCD fields need x and y (fields: " + quoted_list(field_names(h)) + ")");
+  const int dim = axes.dim;
+  std::vector<std::size_t> want(axes.col, axes.col + dim);
+  for (const std::size_t k : want)
+    if (h.fields[k].count != 1)
+      fail(path, "field '" + h.fields[k].name + "' holds " + std::to_string(h.fields[k].count) +
+                     " values per point, expected 1");
   std::size_t label = none;
   if (!label_field.empty()) {
-    label = find_field(path, h, label_field, false);
-    if (label == none) fail(path, "no field '" + label_field + "' for labels (fields: " + field_names(h) + ")");
+    label = find_field(path, h, label_field);
+    if (label == none)
+      fail(path, "no field '" + label_field + "' for labels (fields: " + quoted_list(field_names(h)) + ")");
     if (h.fields[label].type == 'F') fail(path, "labels field '" + label_field + "' holds floating-point values, not integers");
     want.push_back(label);
   }
@@ -333,23 +336,15 @@ PointCloud read_pcd_points(const std::string& path, const ReadOptions& options, 
                    "remove them first, e.g. pcl::removeNaNFromPointCloud)");
       pc.coords[i * static_cast<std::size_t>(dim) + static_cast<std::size_t>(d)] = v;
     }
-  if (label != none) {
-    const std::vector<double>& v = cols.back();
-    pc.labels.resize(h.points);
-    for (std::size_t i = 0; i < h.points; ++i) {
-      if (!(v[i] >= std::numeric_limits<std::int32_t>::min() && v[i] <= std::numeric_limits<std::int32_t>::max()))
-        fail(path, "label in field '" + label_field + "' at point " + std::to_string(i) + " does not fit in int32");
-      pc.labels[i] = static_cast<std::int32_t>(v[i]);
-    }
-  }
+  if (label != none) pc.labels = labels_from_values(path, label_field, cols.back());
   return pc;
 }
 
 std::vector<double> read_pcd_field(const std::string& path, const std::string& name) {
   const std::string bytes = read_file_bytes(path);
   const PcdHeader h = parse_header(path, bytes);
-  const std::size_t k = find_field(path, h, name, false);
-  if (k == h.fields.size()) fail(path, "no field '" + name + "' for scalars (fields: " + field_names(h) + ")");
+  const std::size_t k = find_field(path, h, name);
+  if (k == h.fields.size()) fail(path, "no field '" + name + "' for scalars (fields: " + quoted_list(field_names(h)) + ")");
   return std::move(read_columns(path, bytes, h, {k})[0]);
 }
 

@@ -77,60 +77,35 @@ std::string lower_extension(const std::string& path) {
 
 namespace {
 
-/// Labels from a numeric field's values: integers that fit in int32.
-std::vector<std::int32_t> labels_from_values(const std::string& path, const std::string& name,
-                                             const std::vector<double>& v) {
-  std::vector<std::int32_t> labels(v.size());
-  for (std::size_t i = 0; i < v.size(); ++i) {
-    if (!(v[i] >= std::numeric_limits<std::int32_t>::min() && v[i] <= std::numeric_limits<std::int32_t>::max()))
-      detail::fail(path, "label in field '" + name + "' at index " + std::to_string(i) + " does not fit in int32");
-    labels[i] = static_cast<std::int32_t>(v[i]);
-  }
-  return labels;
-}
-
 /// Points from a structured .npy array: its fields named x, y and z (any
 /// case), as a text file's header names them, and labels from the field
 /// `label_name`.
 PointCloud points_from_records(const std::string& path, NpyRecords& r, const ReadOptions& options,
                                const std::string& label_name) {
-  std::string names;
-  for (const auto& f : r.fields)
-    if (!f.name.empty()) names += (names.empty() ? "'" : ", '") + f.name + "'";
-  const std::size_t none = r.fields.size();
-  std::size_t axis[3] = {none, none, none}, label = none;
-  for (std::size_t k = 0; k < r.fields.size(); ++k) {
-    const std::string& n = r.fields[k].name;
-    if (!label_name.empty() && n == label_name) {
-      label = k;
-      continue;
-    }
-    const std::string l = detail::lower(n);
-    if (l.size() != 1 || l[0] < 'x' || l[0] > 'z') continue;
-    std::size_t& at = axis[l[0] - 'x'];
-    if (at != none) detail::fail(path, "the record names coordinate '" + l + "' twice (fields: " + names + ")");
-    at = k;
-  }
-  if (axis[0] == none || axis[1] == none)
-    detail::fail(path, "a structured array needs fields x and y (and z in 3D) for the points (fields: " + names + ")");
-  const int dim = options.dim ? options.dim : axis[2] != none ? 3 : 2;
-  if (dim == 3 && axis[2] == none)
-    detail::fail(path, "3D points asked but the record has no field 'z' (fields: " + names + ")");
-  if (!label_name.empty()) {
-    if (label == none) detail::fail(path, "no field '" + label_name + "' for labels (fields: " + names + ")");
-    if (r.fields[label].kind == 'f')
-      detail::fail(path, "labels field '" + label_name + "' holds floating-point values, not integers");
-  }
+  std::vector<std::string> names;
+  for (const auto& f : r.fields) names.push_back(f.name);
+  const detail::NamedAxes axes = detail::named_axes(path, names, label_name, options.dim, "field");
+  if (!axes.found)
+    detail::fail(path, "a structured array needs fields x and y (and z in 3D) for the points (fields: " +
+                           detail::quoted_list(names) + ")");
   PointCloud pc;
-  pc.dim = dim;
+  pc.dim = axes.dim;
   pc.n = r.n;
-  pc.coords.resize(r.n * static_cast<std::size_t>(dim));
-  for (int d = 0; d < dim; ++d) {
-    const std::vector<double>& v = r.fields[axis[d]].values;
-    for (std::size_t i = 0; i < r.n; ++i) pc.coords[i * static_cast<std::size_t>(dim) + static_cast<std::size_t>(d)] = v[i];
+  const auto dim = static_cast<std::size_t>(axes.dim);
+  pc.coords.resize(r.n * dim);
+  for (std::size_t d = 0; d < dim; ++d) {
+    const std::vector<double>& v = r.fields[axes.col[d]].values;
+    for (std::size_t i = 0; i < r.n; ++i) pc.coords[i * dim + d] = v[i];
   }
-  if (label != none) pc.labels = labels_from_values(path, label_name, r.fields[label].values);
-  return pc;
+  if (label_name.empty()) return pc;
+  for (const auto& f : r.fields)
+    if (f.name == label_name) {
+      if (f.kind == 'f')
+        detail::fail(path, "labels field '" + label_name + "' holds floating-point values, not integers");
+      pc.labels = detail::labels_from_values(path, label_name, f.values);
+      return pc;
+    }
+  detail::fail(path, "no field '" + label_name + "' for labels (fields: " + detail::quoted_list(names) + ")");
 }
 
 /// Points from an .npy array of shape (N, 2) or (N, 3), or a structured one

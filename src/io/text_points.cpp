@@ -128,11 +128,6 @@ class Lines {
   std::size_t line_no_ = 0;
 };
 
-std::string quoted_list(const std::vector<std::string>& names) {
-  std::string s;
-  for (std::size_t k = 0; k < names.size(); ++k) s += (k ? ", '" : "'") + names[k] + "'";
-  return s;
-}
 
 /// The layout read off a text file's first content line: delimiter (',', ';'
 /// or whitespace), whether it is a header (some field is not a number), the
@@ -177,32 +172,6 @@ std::size_t find_column(const std::string& path, const TextLayout& t, const std:
   return static_cast<std::size_t>(it - t.names.begin());
 }
 
-/// The header's columns named x, y and z (any case; ncols where absent).
-/// found(): x and y are both named. A pandas frame saved with to_csv() leads
-/// with its unnamed index column, and tables often lead with an id: taking
-/// the first columns there would make the index a coordinate.
-struct NamedAxes {
-  std::size_t col[3];
-  std::size_t ncols;
-  bool found() const { return col[0] < ncols && col[1] < ncols; }
-};
-
-NamedAxes named_axes(const std::string& path, const TextLayout& t) {
-  NamedAxes a{{t.ncols, t.ncols, t.ncols}, t.ncols};
-  if (!t.header) return a;
-  for (std::size_t c = 0; c < t.names.size(); ++c) {
-    const std::string& n = t.names[c];
-    if (n.size() != 1) continue;
-    const char l = static_cast<char>(n[0] | 0x20);  // ASCII lower case
-    if (l < 'x' || l > 'z') continue;
-    std::size_t& at = a.col[l - 'x'];
-    if (at != t.ncols)
-      fail(path, "the header names coordinate '" + std::string(1, l) + "' twice (columns: " + quoted_list(t.names) + ")");
-    at = c;
-  }
-  return a;
-}
-
 }  // namespace
 
 PointCloud read_text_points(const std::string& path, const ReadOptions& options,
@@ -225,18 +194,16 @@ PointCloud read_text_points(const std::string& path, const ReadOptions& options,
 
   // Coordinate columns: those a header names x, y (and z), or else the first
   // `dim` columns other than the labels column.
-  const NamedAxes named = named_axes(path, layout);
+  const NamedAxes named =
+      layout.header ? named_axes(path, layout.names, label_column, options.dim, "column") : NamedAxes{};
   int dim = options.dim;
   std::size_t coord_col[3] = {0, 0, 0};
-  if (named.found()) {
-    if (dim == 0) dim = named.col[2] < ncols ? 3 : 2;
-    if (dim == 3 && named.col[2] == ncols)
-      fail(path, "3D points asked but the header names no 'z' column (columns: " + quoted_list(layout.names) + ")");
-    for (int k = 0; k < dim; ++k) {
-      coord_col[k] = named.col[k];
-      if (coord_col[k] == label_col)
-        fail(path, "column '" + label_column + "' cannot be both a coordinate and the labels");
-    }
+  if (named.found) {
+    // (A pandas frame saved with to_csv() leads with its unnamed index
+    // column, and tables often lead with an id: the first columns would
+    // make the index a coordinate.)
+    dim = named.dim;
+    for (int k = 0; k < dim; ++k) coord_col[k] = named.col[k];
   } else {
     const std::size_t avail = ncols - (label_col < ncols ? 1 : 0);
     if (dim == 0) {

@@ -107,12 +107,7 @@ PointCloud read_vtk_points(const std::string& path, const ReadOptions& options, 
     bool is_float = false;
     const std::vector<double> v = point_array(file, p, label_array, is_float);
     if (is_float) fail(path, "labels array '" + label_array + "' holds floating-point values, not integers");
-    pc.labels.resize(v.size());
-    for (std::size_t i = 0; i < v.size(); ++i) {
-      if (!(v[i] >= std::numeric_limits<std::int32_t>::min() && v[i] <= std::numeric_limits<std::int32_t>::max()))
-        fail(path, "label in array '" + label_array + "' at point " + std::to_string(i) + " does not fit in int32");
-      pc.labels[i] = static_cast<std::int32_t>(v[i]);
-    }
+    pc.labels = labels_from_values(path, label_array, v);
   }
   return pc;
 }

@@ -103,7 +103,7 @@ TEST(TextPoints, CoordinatesByHeaderName) {
   ReadOptions three;
   three.dim = 3;
   auto msg = input_error([&] { read_points(dir.write("g.csv", "id,x,y,w\n1,2,3,4\n"), three); });
-  EXPECT_NE(msg.find("no 'z' column"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("no column is named 'z'"), std::string::npos) << msg;
   msg = input_error([&] { read_points(dir.write("h.csv", "x,y,z,X\n1,2,3,4\n")); });
   EXPECT_NE(msg.find("'x' twice"), std::string::npos) << msg;
   msg = input_error([&] { read_points(dir.write("i.csv", "x,y,z\n1,2,3\n"), labels("y")); });
