@@ -83,29 +83,29 @@ TEST(VtkPoints, Errors) {
   msg = input_error([&] { read_points(p, labels("Region")); });
   EXPECT_NE(msg.find("no point data array 'Region'"), std::string::npos) << msg;
   EXPECT_NE(msg.find("'RegionId'"), std::string::npos) << msg;  // lists the arrays
-  std::string s = kTwoPieces;
-  // An image is not a point set.
-  std::string img = s;
-  img.replace(img.find("type=\"PolyData\""), 15, "type=\"ImageData\"");
-  msg = input_error([&] { read_points(dir.write("img.vtp", img)); });
-  EXPECT_NE(msg.find("expected PolyData or UnstructuredGrid"), std::string::npos) << msg;
-  // Fewer values than the piece's points; two components.
-  std::string short_ = s;
-  short_.replace(short_.find("-1 -2 -3"), 8, "-1 -2");
-  msg = input_error([&] { read_points(dir.write("short.vtp", short_)); });
-  EXPECT_NE(msg.find("short.vtp"), std::string::npos) << msg;
-  std::string comps = s;
-  comps.replace(comps.find("NumberOfComponents=\"3\" format=\"ascii\">-1"), 22, "NumberOfComponents=\"2\"");
-  msg = input_error([&] { read_points(dir.write("comps.vtp", comps)); });
-  EXPECT_NE(msg.find("2 components, expected 3"), std::string::npos) << msg;
-  // A piece claiming far more points than its data: refused before anything
-  // is sized by the claim (it ran out of memory).
-  std::string huge = s;
-  huge.replace(huge.find("NumberOfPoints=\"2\""), 18, "NumberOfPoints=\"999999999999\"");
-  msg = input_error([&] { read_points(dir.write("huge.vtp", huge)); });
-  EXPECT_NE(msg.find("shorter than"), std::string::npos) << msg;
+  // The file with one edit each, and what the error must say: an image is
+  // not a point set; fewer values than the piece's points; two components;
+  // a piece claiming far more points than its data, refused before
+  // anything is sized by the claim (it ran out of memory).
+  struct Edit {
+    const char* file;
+    std::string from, to;
+    const char* says;
+  };
+  for (const Edit& e : {Edit{"img.vtp", "type=\"PolyData\"", "type=\"ImageData\"", "expected PolyData or UnstructuredGrid"},
+                        Edit{"short.vtp", "-1 -2 -3", "-1 -2", "ascii data has 2 values, shorter than the 3"},
+                        Edit{"comps.vtp", "NumberOfComponents=\"3\" format=\"ascii\">-1",
+                             "NumberOfComponents=\"2\" format=\"ascii\">-1", "2 components, expected 3"},
+                        Edit{"huge.vtp", "NumberOfPoints=\"2\"", "NumberOfPoints=\"999999999999\"", "shorter than"}}) {
+    std::string t = kTwoPieces;
+    const std::size_t at = t.find(e.from);
+    ASSERT_NE(at, std::string::npos) << e.file;
+    t.replace(at, e.from.size(), e.to);
+    msg = input_error([&] { read_points(dir.write(e.file, t)); });
+    EXPECT_NE(msg.find(e.says), std::string::npos) << e.file << ": " << msg;
+  }
   // No points array in a piece that has points.
-  std::string nopts = s;
+  std::string nopts = kTwoPieces;
   const std::size_t a = nopts.rfind("<Points>"), b = nopts.rfind("</Points>") + 9;
   nopts.erase(a, b - a);
   msg = input_error([&] { read_points(dir.write("nopts.vtp", nopts)); });
