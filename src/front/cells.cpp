@@ -8,7 +8,6 @@
 #include <functional>
 #include <limits>
 #include <optional>
-#include <stdexcept>
 #include <string>
 
 #include <tbb/info.h>
@@ -168,22 +167,7 @@ Cells run(std::span<const double> input, std::span<const std::int32_t> labels, c
       // second (about their shares of the time on 1M clustered points).
       std::function<void(double)> half;
       if (opt.progress) half = [&opt](double f) { opt.progress(0.5 * f); };
-      if (opt.cell_method == CellMethod::automatic) {
-        // The automatic method's choice falls back on the search where the
-        // insertion stops on a degenerate simplex: points far out (1e72 to
-        // 1e194) beside unit points of which three share two coordinates
-        // with each other and lie on the hull (stop 72's fuzz; docs/
-        // design.md, "The far plane's direction"), whose in-sphere test met
-        // a flat simplex ("vertex planes are dependent"). A defect of the
-        // insertion, not fixed; the search's cells are the same cells.
-        try {
-          stars = front::delaunay_stars(pass, half);
-        } catch (const std::logic_error&) {
-          stars.reset();
-        }
-      } else {
-        stars = front::delaunay_stars(pass, half);
-      }
+      stars = front::delaunay_stars(pass, half);
     }
     if (stars) {
       pass.gens.stars = &*stars;

@@ -608,27 +608,6 @@ bool inside_reaches_out(std::span<const double> points, int dim, std::span<const
   return false;
 }
 
-/// run() in the dimension; where the automatic method's insertion stops on a
-/// degenerate simplex (std::logic_error "vertex planes are dependent": far
-/// points, 1e72 to 1e194 out, beside unit points of which three lie on one
-/// hull edge; stop 72's fuzz), the cells pass and hull completion alone
-/// (DelaunayMethod::cells), which give the same rows. A defect of the
-/// insertion, not fixed (docs/design.md, "The far plane's direction").
-Delaunay run_in(std::span<const double> points, int dim, std::span<const std::int32_t> labels,
-                const DelaunayOptions& options) {
-  auto go = [&](const DelaunayOptions& o) {
-    return dim == 3 ? run<kernels::Hull>(points, labels, o) : run<kernels::Tile>(points, labels, o);
-  };
-  if (options.method != DelaunayMethod::automatic) return go(options);
-  try {
-    return go(options);
-  } catch (const std::logic_error&) {
-    DelaunayOptions cells = options;
-    cells.method = DelaunayMethod::cells;
-    return go(cells);
-  }
-}
-
 }  // namespace
 
 Delaunay delaunay(std::span<const double> points, int dim, std::span<const std::int32_t> labels,
@@ -660,11 +639,11 @@ Delaunay delaunay(std::span<const double> points, int dim, std::span<const std::
                              : run<kernels::Tile>(points, labels, boxed, 0, &touches);
       if (!touches) return dt;
     }
-    Delaunay dt = run_in(points, dim, {}, options);
+    Delaunay dt = dim == 3 ? run<kernels::Hull>(points, {}, options) : run<kernels::Tile>(points, {}, options);
     keep_inside(dt, labels);
     return dt;
   }
-  return run_in(points, dim, labels, options);
+  return dim == 3 ? run<kernels::Hull>(points, labels, options) : run<kernels::Tile>(points, labels, options);
 }
 
 std::vector<std::int32_t> simplex_neighbors(const Delaunay& dt) {

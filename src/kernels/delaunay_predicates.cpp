@@ -213,6 +213,14 @@ int orientation_exact(int D, const double* const* pts) {
 //    terms' underflow would count, past double's range (coordinates past
 //    ~2^200) they overflow: the long double stage then sums them again in
 //    long double, whose exponent range holds any product of five doubles.
+//    A permanent of 2^-900 or more can still have lost a term to underflow:
+//    a row 2^200 long times a minor of rows near 2^-170, which rounds to
+//    zero in double (stop 73: unit points beside points at 1e72 and 1e194;
+//    the double permanent was 1e49 times too small, the stage certified the
+//    wrong sign, and the insertion built a flat tetrahedron). So the terms
+//    underflow may have dropped are bounded as the double filter bounds
+//    them (filter::underflow_bound), and the double permanents serve only
+//    where that is below 2^-60 of them.
 // A permanent does not depend on the order of its sum, and the bounds hold
 // for any order of evaluation, so these are the quantities and bounds of a
 // separate evaluation per minor.
@@ -273,6 +281,19 @@ int in_sphere_filter(const double* pa, const double* const* p, T unit, P eps) {
     constexpr P inf = std::numeric_limits<P>::infinity();
     if (!(perm_m >= P(0x1p-900) && perm_m < inf && perm_r >= P(0x1p-900) && perm_r < inf))
       return permanents_out_of_range;
+    // Underflow's losses (P is double here): a 2x2 permanent's products lose
+    // eta each, a 3x3 one's 2 eta Z + 3 eta (Z: the rows' sum of |z|), the
+    // squared lengths D eta each; the lifted permanent's products multiply
+    // those by sd[k] and pm[k], and add eta each.
+    P z = 0, s_sum = 0, pm_sum = 0;
+    for (int k = 0; k <= D; ++k) {
+      z += fabs(rd[k][D - 1]);
+      s_sum += sd[k];
+      pm_sum += pm[k];
+    }
+    const P lost_r = filter::underflow_bound(2 * z + 3);
+    const P lost_m = filter::underflow_bound(s_sum * (2 * z + 3) + D * pm_sum + D + 1);
+    if (!(lost_r <= P(0x1p-60) * perm_r && lost_m <= P(0x1p-60) * perm_m)) return permanents_out_of_range;
   }
   // Underflow, in double only (a product of doubles never underflows in long
   // double): a 2x2 minor errs by 2 eta, a 3x3 one by 2 eta Z + 3 eta (Z: the
