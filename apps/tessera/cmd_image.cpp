@@ -15,6 +15,7 @@
 
 #include "commands.hpp"
 #include "option_checks.hpp"
+#include "stdin_input.hpp"
 #include "tessera/io/atomic_file.hpp"
 #include "tessera/io/image.hpp"
 #include "tessera/io/npy.hpp"
@@ -250,7 +251,7 @@ void add_image_commands(CLI::App& app, ImageCommands& c) {
   CLI::App* p = c.probe_app;
   p->add_option("IMAGE", c.probe.image, kImageHelp)->required();
   p->add_option("POINTS", c.probe.points,
-                "Point file: .npy, .csv/.xyz/.txt, .ply, .vtp/.vtu or .pcd (2D images take x,y of 3-column points)")
+                "Point file: .npy, .csv/.xyz/.txt (or Qhull's format), .ply, .vtp/.vtu or .pcd (2D images take x,y of 3-column points); - reads standard input")
       ->required();
   p->add_option("-o,--output", c.probe.output,
                 ".npy: the values, float64 of shape (N,); .ply/.vtp: the points with a double array 'scalars' "
@@ -315,7 +316,7 @@ int run_probe(const ProbeArgs& a) {
   io::ReadOptions pro;
   pro.dim = img.geometry.dim;
   pro.labels = a.labels;
-  const io::PointCloud pc = io::read_points(a.points, pro);
+  const io::PointCloud pc = io::read_points(input_path(a.points), pro);
   ProbeOptions po;
   po.outside_value = outside;
   po.threads = a.threads;

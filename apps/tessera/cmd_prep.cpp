@@ -13,6 +13,7 @@
 #include <CLI/CLI.hpp>
 
 #include "commands.hpp"
+#include "stdin_input.hpp"
 #include "option_checks.hpp"
 #include "tessera/io/atomic_file.hpp"
 #include "tessera/io/npy.hpp"
@@ -29,7 +30,7 @@ constexpr const char* kOutputHelp =
     "int property 'label') or .vtp (VTK vertices, point data 'label'). 2D points get z = 0 in .ply/.vtp";
 
 void add_input_options(CLI::App* app, PrepInput& p, bool labels) {
-  app->add_option("INPUT", p.input, "Point file: .npy, .csv/.xyz/.txt, .ply, .vtp/.vtu or .pcd (as for `voronoi`)")->required();
+  app->add_option("INPUT", p.input, "Point file: .npy, .csv/.xyz/.txt (or Qhull's format), .ply, .vtp/.vtu or .pcd (as for `voronoi`); - reads standard input")->required();
   app->add_option("-o,--output", p.output, kOutputHelp)->required();
   app->add_option("--dim", p.dim, "Dimension: 2 or 3 (default: the number of columns or fields; .ply, .vtp and .vtu are 3D)")
       ->check(CLI::IsMember({2, 3}));
@@ -52,7 +53,7 @@ io::PointCloud read_prep_input(const PrepInput& p, bool with_labels) {
   io::ReadOptions ro;
   ro.dim = p.dim;
   if (with_labels) ro.labels = p.labels;
-  return io::read_points(p.input, ro);
+  return io::read_points(input_path(p.input), ro);
 }
 
 std::int32_t parse_label(const std::string& word, const std::string& what) {
@@ -206,7 +207,7 @@ int run_joggle(const JoggleArgs& a) {
   if (!a.io.quiet)
     std::printf("tessera joggle: %zu points (%dD) from %s, %zu moved (%s, radius %g%s), largest displacement %.3g; "
                 "wrote %s\n",
-                pc.n, pc.dim, a.io.input.c_str(), moving, a.mode.c_str(), a.radius,
+                pc.n, pc.dim, shown_path(a.io.input).c_str(), moving, a.mode.c_str(), a.radius,
                 a.absolute ? "" : " of the bounding-box diagonal", largest, written_list(written).c_str());
   return kExitOk;
 }
@@ -252,7 +253,7 @@ int run_fill(const FillArgs& a) {
   const std::vector<std::string> written = io::write_points(a.io.output, out);
   if (!a.io.quiet)
     std::printf("tessera fill: %zu points (%dD) from %s, %zu background points added (%s, label %d); wrote %s\n",
-                pc.n, pc.dim, a.io.input.c_str(), out.size() - pc.n, a.strategy.c_str(),
+                pc.n, pc.dim, shown_path(a.io.input).c_str(), out.size() - pc.n, a.strategy.c_str(),
                 static_cast<int>(a.background_label), written_list(written).c_str());
   return kExitOk;
 }
@@ -278,7 +279,7 @@ int run_threshold(const ThresholdArgs& a) {
   check_output(a.io.output);
 
   const io::PointCloud pc = read_prep_input(a.io, false);
-  const std::vector<double> s = io::read_point_scalars(a.io.input, a.scalars);
+  const std::vector<double> s = io::read_point_scalars(input_path(a.io.input), a.scalars);
   if (s.size() != pc.n)
     throw InputError("--scalars " + a.scalars + ": " + std::to_string(s.size()) + " values for " +
                      std::to_string(pc.n) + " points");
@@ -297,7 +298,7 @@ int run_threshold(const ThresholdArgs& a) {
     for (const auto& [label, k] : count)
       parts += (parts.empty() ? "" : ", ") + std::string(label == a.background_label ? "background " : "label ") +
                std::to_string(label) + ": " + std::to_string(k);
-    std::printf("tessera threshold: %zu points (%dD) from %s (%s); wrote %s\n", pc.n, pc.dim, a.io.input.c_str(),
+    std::printf("tessera threshold: %zu points (%dD) from %s (%s); wrote %s\n", pc.n, pc.dim, shown_path(a.io.input).c_str(),
                 parts.c_str(), written_list(written).c_str());
   }
   return kExitOk;

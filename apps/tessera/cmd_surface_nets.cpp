@@ -16,6 +16,7 @@
 #include <CLI/CLI.hpp>
 
 #include "commands.hpp"
+#include "stdin_input.hpp"
 #include "option_checks.hpp"
 #include "progress.hpp"
 #include "tessera/io/atomic_file.hpp"
@@ -316,7 +317,7 @@ int run_surface_nets(const SurfaceNetsArgs& a) {
   pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
   const Watertight w = check_watertight(net);
 
-  std::printf("tessera surface-nets: %zu points (%dD) from %s%s\n", in.size(), in.dim, a.compute.input.c_str(),
+  std::printf("tessera surface-nets: %zu points (%dD) from %s%s\n", in.size(), in.dim, shown_path(a.compute.input).c_str(),
               in.from_image ? " (sampled image)" : "");
   if (in.from_image)
     std::printf("  %-18s %lldx%lld%s voxels\n", "image", static_cast<long long>(in.geometry.size[0]),

@@ -1,5 +1,6 @@
 // Implementation of the tessera subcommands (see commands.hpp).
 #include "commands.hpp"
+#include "stdin_input.hpp"
 
 #include <sys/resource.h>
 
@@ -234,7 +235,7 @@ void print_volume_line(const Cells& c, const char* name) {
 void print_summary(const VoronoiArgs& a, const io::PointCloud& pc, const Cells& c, double read_s,
                    double compute_s, double write_s, const std::vector<std::string>& written) {
   const bool d3 = c.dim == 3;
-  std::printf("tessera voronoi: %zu points (%dD) from %s\n", pc.n, c.dim, a.compute.input.c_str());
+  std::printf("tessera voronoi: %zu points (%dD) from %s\n", pc.n, c.dim, shown_path(a.compute.input).c_str());
   std::printf("  %-18s %zu\n", "cells", c.n_cells());
   if (!pc.labels.empty()) {
     const auto outside = std::count_if(pc.labels.begin(), pc.labels.end(), [](std::int32_t l) { return l < 0; });

@@ -17,6 +17,7 @@
 #include "commands.hpp"
 #include "option_checks.hpp"
 #include "progress.hpp"
+#include "stdin_input.hpp"
 #include "tessera/cells.hpp"
 
 namespace {
@@ -27,7 +28,8 @@ using namespace tessera::cli;
 /// characters (a newline, or a form feed quoted from a file's header) become
 /// spaces, and bytes that are not UTF-8 (a corrupt file's header quoted) '?'.
 /// Valid multi-byte characters (a file name's) are kept.
-void print_error(const std::string& msg) {
+void print_error(const std::string& message) {
+  const std::string msg = name_stdin(message);
   std::string line;
   line.reserve(msg.size());
   for (std::size_t i = 0; i < msg.size();) {
@@ -65,8 +67,9 @@ void add_compute_options(CLI::App* app, ComputeArgs& c, std::vector<std::string>
   app->add_option("INPUT", c.input,
                   "Point file (required): .npy (float array, shape (N,2) or (N,3), or records with fields "
                   "x,y[,z]), .csv/.xyz/.txt (the columns a header names x,y[,z], else the first 2 or 3 "
-                  "numeric columns), .ply (vertex x,y,z), .vtp/.vtu (VTK XML points, as ParaView saves them) or "
-                  ".pcd (PCL's point clouds)");
+                  "numeric columns; also Qhull's format, as rbox writes it), .ply (vertex x,y,z), .vtp/.vtu (VTK XML "
+                  "points, as ParaView saves them) or .pcd (PCL's point clouds); - reads standard input, in any of "
+                  "these formats (rbox 1000 D3 | tessera voronoi - ...)");
   app->add_option("--dim", c.dim,
                   "Dimension: 2 or 3 (default: the number of columns or fields; .ply, .vtp and .vtu are 3D). --dim 2 "
                   "on 3-column input keeps x,y")
@@ -137,6 +140,7 @@ void finish_compute_args(ComputeArgs& c, const std::vector<std::string>& raw_bou
                               (i >= 4 ? " (put INPUT before --bounds)" : ""));
   }
   if (c.input.empty()) throw tessera::InputError("INPUT is required (run with --help for usage)");
+  c.input = input_path(c.input);
 }
 
 }  // namespace

@@ -13,6 +13,7 @@
 
 #include <atomic>
 #include <cerrno>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <random>
@@ -137,11 +138,11 @@ class PendingTemporaries {
 constinit PendingTemporaries g_pending;
 PendingTemporaries& pending() { return g_pending; }
 
-/// Create `path.tmp-XXXXXX` exclusively (mode 0666 less the umask, like a
-/// plain new file). Returns its fd, sets `tmp` and arms `slot` with it; throws
-/// on failure. The name is armed before the file exists, so no moment of the
-/// file's life is hidden from remove_pending_temporaries().
-int create_temp(const std::string& path, std::string& tmp, int& slot) {
+/// Create `path.tmp-XXXXXX` (then `suffix`) exclusively (mode 0666 less the
+/// umask, like a plain new file). Returns its fd, sets `tmp` and arms `slot`
+/// with it; throws on failure. The name is armed before the file exists, so
+/// no moment of the file's life is hidden from remove_pending_temporaries().
+int create_temp(const std::string& path, std::string& tmp, int& slot, const std::string& suffix = {}) {
   static std::atomic<unsigned> counter{0};
   static const char kAlnum[] = "abcdefghijklmnopqrstuvwxyz0123456789";
   std::random_device rd;
@@ -149,6 +150,7 @@ int create_temp(const std::string& path, std::string& tmp, int& slot) {
   for (int attempt = 0; attempt < 100; ++attempt) {
     tmp = path + ".tmp-";
     for (int k = 0; k < 6; ++k) tmp += kAlnum[gen() % (sizeof kAlnum - 1)];
+    tmp += suffix;
     slot = pending().arm(tmp);
     const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
     if (fd >= 0) return fd;
@@ -220,6 +222,43 @@ void write_file_atomic(const std::string& path, std::string_view bytes) {
 }
 
 int remove_pending_temporaries() noexcept { return pending().remove_all(); }
+
+TemporaryFile::TemporaryFile(const std::string& name, const std::string& suffix,
+                             const std::function<void(std::ostream&)>& fill) {
+  const char* env = std::getenv("TMPDIR");
+  const fs::path dir = env != nullptr && *env != '\0' ? fs::path(env) : fs::path("/tmp");
+  const std::string base = (dir / ("tessera-" + name)).string();
+  const int fd = create_temp(base, path_, slot_, suffix);
+  int write_error = 0;
+  bool stream_bad = false;
+  try {
+    FdBuf buf(fd);
+    std::ostream os(&buf);
+    fill(os);
+    os.flush();
+    write_error = buf.error();
+    stream_bad = !os;
+  } catch (...) {
+    ::close(fd);
+    remove();
+    throw;
+  }
+  if (::close(fd) != 0 && write_error == 0) write_error = errno;
+  if (write_error != 0 || stream_bad) {
+    const std::string why = write_error ? std::strerror(write_error) : "stream error";
+    remove();
+    cannot_write(base + ".tmp-*" + suffix, why);
+  }
+}
+
+TemporaryFile::~TemporaryFile() { remove(); }
+
+void TemporaryFile::remove() noexcept {
+  if (path_.empty()) return;
+  ::unlink(path_.c_str());
+  pending().disarm(slot_);
+  path_.clear();
+}
 
 void check_writable(const std::string& path) {
   if (path.empty()) throw InputError("cannot write an empty path");

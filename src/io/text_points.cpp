@@ -10,6 +10,12 @@
 //  - otherwise the columns (other than a labels column) give the coordinates:
 //    2 -> 2D, 3 or more -> 3D (extras ignored); ReadOptions::dim forces either;
 //  - every data line must have the columns needed; errors name the line (1-based).
+// Qhull's input format (what `rbox` writes, `rbox 1000 D3 | qhull`) is read
+// as well: a first line holding the dimension (then, optionally, a comment
+// such as "rbox 1000 D3"), a second holding the number of points (qhull
+// takes the two either way round: the smaller is the dimension), then the
+// coordinates, whitespace-separated (qhull_points below). A plain point
+// file cannot start so: its first line would be a point of one coordinate.
 // The whole file is read into memory and parsed with std::from_chars.
 #include <algorithm>
 #include <charconv>
@@ -172,6 +178,70 @@ std::size_t find_column(const std::string& path, const TextLayout& t, const std:
   return static_cast<std::size_t>(it - t.names.begin());
 }
 
+/// A whole field as a non-negative integer.
+bool parse_count(std::string_view f, std::size_t& out) {
+  auto [p, ec] = std::from_chars(f.data(), f.data() + f.size(), out);
+  return ec == std::errc() && p == f.data() + f.size();
+}
+
+/// Whether `line` is an integer alone or before a comment (a field that is
+/// not a number: "3 rbox 1000 D3"); sets it. "3 10" is a 2D point.
+bool count_line(std::string_view line, std::size_t& out) {
+  Fields fs(line, ' ');
+  std::string_view x, y;
+  if (!fs.next(x) || !parse_count(x, out)) return false;
+  double v;
+  return !fs.next(y) || !parse_double(y, v);
+}
+
+/// Whether the file's first two content lines have the shape of Qhull's
+/// input header; sets their integers.
+bool qhull_header(std::string_view line1, std::string_view line2, std::size_t& a, std::size_t& b) {
+  return count_line(line1, a) && count_line(line2, b);
+}
+
+/// Points in Qhull's input format, whose header qhull_header read: `ndim`
+/// (at least 2) coordinates per point, `count` points, the numbers after the header in
+/// any layout (one point per line, as rbox writes them, or not). Labels can
+/// come only from a .npy file (the format names no columns).
+PointCloud qhull_points(const std::string& path, Lines& lines, std::size_t ndim, std::size_t count,
+                        const ReadOptions& options, const std::string& label_column) {
+  if (!label_column.empty())
+    fail(path, "labels '" + label_column + "': Qhull's point format names no columns (give labels as a .npy file)");
+  if (ndim > 3 && options.dim == 0)
+    fail(path, "Qhull point format of dimension " + std::to_string(ndim) +
+                   ": tessera computes 2D and 3D cells (--dim 2 or 3 keeps the first coordinates)");
+  const std::size_t dim = options.dim != 0 ? static_cast<std::size_t>(options.dim) : ndim;
+  if (dim > ndim) fail(path, "3D points asked but the file's points have " + std::to_string(ndim) + " coordinates");
+  // The numbers are checked against the header's count before any array is
+  // sized by it (a corrupt count must not allocate).
+  PointCloud pc;
+  pc.dim = static_cast<int>(dim);
+  std::size_t seen = 0;
+  std::string_view line, f;
+  std::size_t line_no = 0;
+  while (lines.next(line, line_no)) {
+    Fields fs(line, ' ');
+    while (fs.next(f)) {
+      double v;
+      if (!parse_double(f, v))
+        fail(path, "line " + std::to_string(line_no) + ": cannot parse '" + std::string(f) + "' as a number");
+      if (!std::isfinite(v)) fail(path, "line " + std::to_string(line_no) + ": non-finite coordinate '" + std::string(f) + "'");
+      if (seen / ndim >= count)
+        fail(path, "Qhull point format: more numbers than the " + std::to_string(count) + " points of dimension " +
+                       std::to_string(ndim) + " its header declares (line " + std::to_string(line_no) + ")");
+      if (seen % ndim < dim) pc.coords.push_back(v);
+      ++seen;
+    }
+  }
+  if (seen != count * ndim)
+    fail(path, "Qhull point format: its header declares " + std::to_string(count) + " points of dimension " +
+                   std::to_string(ndim) + " (" + std::to_string(count * ndim) + " numbers), the file holds " +
+                   std::to_string(seen));
+  pc.n = count;
+  return pc;
+}
+
 }  // namespace
 
 PointCloud read_text_points(const std::string& path, const ReadOptions& options,
@@ -181,6 +251,23 @@ PointCloud read_text_points(const std::string& path, const ReadOptions& options,
   std::string_view line;
   std::size_t line_no = 0;
   if (!lines.next(line, line_no)) fail(path, "no points");
+  {
+    // Qhull's header, unless what follows is a column of single numbers (a
+    // one-column file, whose error is the plain reader's).
+    Lines after = lines;
+    std::string_view second, third;
+    std::size_t no = 0, a = 0, b = 0;
+    if (after.next(second, no) && qhull_header(line, second, a, b) && std::min(a, b) >= 2) {
+      Lines rest = after;
+      std::size_t fields = 2;
+      if (rest.next(third, no)) {
+        Fields fs(third, ' ');
+        std::string_view f;
+        for (fields = 0; fields < 2 && fs.next(f);) ++fields;
+      }
+      if (fields >= 2) return qhull_points(path, after, std::min(a, b), std::max(a, b), options, label_column);
+    }
+  }
 
   // Layout from the first content line: delimiter, header, column count.
   const TextLayout layout = text_layout(line);

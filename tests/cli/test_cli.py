@@ -678,6 +678,126 @@ class Interrupt(TempDirCase):
         self.kill_while_writing(signal.SIGINT, "interrupted")
 
 
+class Stdin(TempDirCase):
+    """INPUT "-": standard input, spooled into a temporary in $TMPDIR named by
+    the format its first bytes show, which is gone after the run however it
+    ends; and Qhull's point format, which `rbox` writes."""
+    N = 300
+
+    def setUp(self):
+        super().setUp()
+        self.tmp = self.p("tmpdir")
+        os.mkdir(self.tmp)
+        self.pts = np.random.default_rng(11).random((self.N, 3))
+        self.ref = self.p("ref.csv")
+        self.ok(["voronoi", self.save("pts.npy", self.pts), "--cell-table", self.ref, "--bounds"] + BOX3)
+
+    def piped(self, args, data):
+        env = dict(os.environ, TMPDIR=self.tmp)
+        env.pop("TESSERA_NUM_THREADS", None)
+        r = subprocess.run([TESSERA] + args, input=data, capture_output=True, env=env, timeout=600)
+        self.assertEqual(os.listdir(self.tmp), [], "the spool of standard input is removed")
+        return r
+
+    def qhull_text(self, pts, comment="rbox 300 D3"):
+        lines = ["%d %s" % (pts.shape[1], comment), str(len(pts))]
+        lines += [" ".join("%.17g" % v for v in row) for row in pts]
+        return ("\n".join(lines) + "\n").encode()
+
+    def test_every_format_through_stdin(self):
+        import io
+        buf = io.BytesIO()
+        np.save(buf, self.pts)
+        csv = "x,y,z\n" + "".join("%.17g,%.17g,%.17g\n" % tuple(r) for r in self.pts)
+        ply = "ply\nformat ascii 1.0\nelement vertex %d\nproperty double x\nproperty double y\nproperty double z\nend_header\n" % self.N
+        ply += "".join("%.17g %.17g %.17g\n" % tuple(r) for r in self.pts)
+        inputs = {"npy": buf.getvalue(), "csv": csv.encode(), "ply": ply.encode(), "qhull": self.qhull_text(self.pts)}
+        if vtk is not None:
+            d = vtk.vtkPolyData()
+            p = vtk.vtkPoints()
+            p.SetData(numpy_to_vtk(self.pts, deep=1))
+            d.SetPoints(p)
+            w = vtk.vtkXMLPolyDataWriter()
+            w.SetInputData(d)
+            w.SetFileName(self.p("pts.vtp"))
+            w.Write()
+            with open(self.p("pts.vtp"), "rb") as f:
+                inputs["vtp"] = f.read()
+        with open(self.ref) as f:
+            want = f.read()
+        for kind, data in inputs.items():
+            t = self.p("t_%s.csv" % kind)
+            r = self.piped(["voronoi", "-", "--cell-table", t, "--bounds"] + BOX3, data)
+            self.assertEqual(r.returncode, 0, (kind, r.stderr))
+            self.assertIn(b"from stdin", r.stdout, kind)
+            with open(t) as f:
+                self.assertEqual(f.read(), want, kind)
+        # The same Qhull text from a file; and rbox's own output, through a pipe.
+        q = self.p("rbox.txt")
+        with open(q, "wb") as f:
+            f.write(inputs["qhull"])
+        t = self.p("t_file.csv")
+        self.ok(["voronoi", q, "--cell-table", t, "--bounds"] + BOX3)
+        with open(t) as f:
+            self.assertEqual(f.read(), want)
+        if shutil.which("rbox"):
+            data = subprocess.run(["rbox", "500", "D3"], capture_output=True, check=True).stdout
+            r = self.piped(["voronoi", "-", "--neighbors", self.p("nb.npy"), "--validate"], data)
+            self.assertEqual(r.returncode, 0, r.stderr)
+            self.assertIn(b"500 points (3D) from stdin", r.stdout)
+
+    def test_threshold_reads_stdin_twice(self):
+        # threshold reads INPUT for the points, then again for its scalars.
+        csv = "x,y,z,temp\n" + "".join("%.17g,%.17g,%.17g,%d\n" % (x, y, z, i % 3) for i, (x, y, z) in enumerate(self.pts))
+        out = self.p("lab.npy")
+        r = self.piped(["threshold", "-", "--scalars", "temp", "--interval", "1,2,7", "-o", out], csv.encode())
+        self.assertEqual(r.returncode, 0, r.stderr)
+        labels = np.load(self.p("lab_labels.npy"))
+        self.assertEqual(int((labels == 7).sum()), len([i for i in range(self.N) if i % 3 == 1]))
+
+    def test_errors_name_stdin(self):
+        for data, words in ((b"", "stdin: no points"), (b"1,2,3\n4,x,6\n", "stdin: line 2"),
+                            (self.qhull_text(self.pts[:5])[:-30], "stdin: Qhull point format"),
+                            (b"<?xml version='1.0'?>\n<Other/>\n", "stdin: XML, but not a VTK")):
+            r = self.piped(["voronoi", "-", "--cell-table", self.p("e.csv")], data)
+            self.assertEqual(r.returncode, 2, data)
+            lines = r.stderr.decode().splitlines()
+            self.assertEqual(len(lines), 1, r.stderr)
+            self.assertTrue(lines[0].startswith("tessera: error: " + words), lines[0])
+            self.assertNotIn(self.tmp, lines[0])
+            self.assertFalse(os.path.exists(self.p("e.csv")))
+
+    def test_terminal_is_refused(self):
+        import pty
+        master, slave = pty.openpty()
+        try:
+            env = dict(os.environ, TMPDIR=self.tmp)
+            r = subprocess.run([TESSERA, "voronoi", "-", "--cell-table", self.p("e.csv")], stdin=slave,
+                               capture_output=True, env=env, timeout=60)
+        finally:
+            os.close(master)
+            os.close(slave)
+        self.assertEqual(r.returncode, 2)
+        self.assertIn(b"standard input, which is a terminal", r.stderr)
+
+    def test_sigterm_while_reading_removes_the_spool(self):
+        import signal
+        import time
+        env = dict(os.environ, TMPDIR=self.tmp)
+        proc = subprocess.Popen([TESSERA, "voronoi", "-", "--cell-table", self.p("e.csv")], stdin=subprocess.PIPE,
+                                stderr=subprocess.PIPE, env=env)
+        proc.stdin.write(b"x,y,z\n" + b"0.5,0.5,0.5\n" * 20000)  # past the first 64 KiB: the spool exists
+        proc.stdin.flush()
+        deadline = time.monotonic() + 60
+        while not os.listdir(self.tmp) and time.monotonic() < deadline:
+            time.sleep(0.005)
+        self.assertTrue(os.listdir(self.tmp), "the spool appears while standard input is open")
+        proc.send_signal(signal.SIGTERM)
+        err = proc.communicate(timeout=60)[1]
+        self.assertEqual(proc.returncode, -signal.SIGTERM, err)
+        self.assertEqual(os.listdir(self.tmp), [])
+
+
 class Bench(TempDirCase):
     KEYS = {"tool", "op", "n", "threads", "seconds", "simplices", "extra"}
     EXTRA = {"cpu_user_s", "cpu_sys_s", "minflt", "peak_rss_bytes", "neighbors", "exact_calls", "volume_sum"}

@@ -131,7 +131,55 @@ TEST(TextPoints, Dim3FromTwoColumnsRejected) {
 
 TEST(TextPoints, OneColumnRejected) {
   TempDir dir;
-  input_error([&] { read_points(dir.write("a.txt", "1\n2\n")); });
+  for (const char* text : {"1\n2\n", "3\n5\n7\n"}) {  // the second is no Qhull header: single numbers follow
+    const auto msg = input_error([&] { read_points(dir.write("a.txt", text)); });
+    EXPECT_NE(msg.find("1 coordinate column"), std::string::npos) << msg;
+  }
+}
+
+// Qhull's input format, as `rbox` writes it: dimension (and a comment),
+// count, then the coordinates.
+TEST(TextPoints, QhullFormat) {
+  TempDir dir;
+  auto pc = read_points(dir.write("r.txt", "3 rbox 4 D3\n4\n0 0 0\n1 0 0\n0 1 -2.5e-1\n0 0 1\n"));
+  EXPECT_EQ(pc.dim, 3);
+  EXPECT_EQ(pc.n, 4u);
+  EXPECT_EQ(pc.coords, (std::vector<double>{0, 0, 0, 1, 0, 0, 0, 1, -0.25, 0, 0, 1}));
+  // Count first, then dimension (qhull takes the smaller as the dimension);
+  // points in any layout.
+  pc = read_points(dir.write("r2.txt", "3\n2 points\n1 2\n3 4 5\n6\n"));
+  EXPECT_EQ(pc.dim, 2);
+  EXPECT_EQ(pc.coords, (std::vector<double>{1, 2, 3, 4, 5, 6}));
+  // --dim 2 keeps x, y; a 4D file with --dim 3 its first three coordinates.
+  ReadOptions two;
+  two.dim = 2;
+  pc = read_points(dir.write("r3.txt", "3\n4\n1 2 3\n4 5 6\n7 8 9\n0 0 0\n"), two);
+  EXPECT_EQ(pc.coords, (std::vector<double>{1, 2, 4, 5, 7, 8, 0, 0}));
+  ReadOptions three;
+  three.dim = 3;
+  const std::string four = dir.write("r4.txt", "4 rbox 5 D4\n5\n1 2 3 4\n5 6 7 8\n0 0 0 0\n1 1 1 1\n2 2 2 2\n");
+  pc = read_points(four, three);
+  EXPECT_EQ(pc.n, 5u);
+  EXPECT_EQ(std::vector<double>(pc.coords.begin(), pc.coords.begin() + 6), (std::vector<double>{1, 2, 3, 5, 6, 7}));
+
+  auto msg = input_error([&] { read_points(four); });
+  EXPECT_NE(msg.find("dimension 4"), std::string::npos) << msg;
+  msg = input_error([&] { read_points(dir.write("s.txt", "3\n4\n1 2 3\n4 5 6\n")); });
+  EXPECT_NE(msg.find("declares 4 points of dimension 3 (12 numbers), the file holds 6"), std::string::npos) << msg;
+  msg = input_error([&] { read_points(dir.write("l.txt", "2\n2\n1 2\n3 4\n5 6\n")); });
+  EXPECT_NE(msg.find("more numbers than the 2 points"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("line 5"), std::string::npos) << msg;
+  msg = input_error([&] { read_points(dir.write("g.txt", "2\n2\n1 2\n3 x\n")); });
+  EXPECT_NE(msg.find("line 4: cannot parse 'x'"), std::string::npos) << msg;
+  msg = input_error([&] { read_points(dir.write("d.txt", "2\n3\n1 2\n3 4\n5 6\n"), three); });
+  EXPECT_NE(msg.find("3D points asked"), std::string::npos) << msg;
+  ReadOptions named;
+  named.labels = "label";
+  msg = input_error([&] { read_points(dir.write("n.txt", "2\n3\n1 2\n3 4\n5 6\n"), named); });
+  EXPECT_NE(msg.find("names no columns"), std::string::npos) << msg;
+  // "3 10" is a 2D point, not a header.
+  pc = read_points(dir.write("p.txt", "3 10\n4 11\n"));
+  EXPECT_EQ(pc.n, 2u);
 }
 
 TEST(TextPoints, NanRejectedWithLineNumber) {
