@@ -140,3 +140,31 @@ TEST(AtomicFile, SignalHandlerRemovesTheTemporary) {
   EXPECT_EQ(read_all(done), "complete");
   EXPECT_EQ(remove_pending_temporaries(), 0);  // this process has no write in progress
 }
+
+// A TemporaryFile lies in $TMPDIR under its name and suffix, holds what its
+// fill wrote, and is gone when the object dies, when its fill throws, and
+// when a signal handler calls remove_pending_temporaries().
+TEST(AtomicFile, TemporaryFile) {
+  TempDir dir;
+  const char* old = std::getenv("TMPDIR");
+  const std::string saved = old != nullptr ? old : "";
+  ::setenv("TMPDIR", dir.file("").c_str(), 1);
+  {
+    tessera::io::TemporaryFile t("stdin", ".csv", [](std::ostream& os) { os << "1,2\n"; });
+    EXPECT_EQ(t.path().rfind(dir.file("tessera-stdin.tmp-"), 0), 0u) << t.path();
+    EXPECT_EQ(t.path().substr(t.path().size() - 4), ".csv");
+    EXPECT_EQ(read_all(t.path()), "1,2\n");
+    EXPECT_EQ(dir.entries().size(), 1u);
+  }
+  EXPECT_TRUE(dir.entries().empty());
+  EXPECT_THROW(tessera::io::TemporaryFile("x", ".txt", [](std::ostream&) { throw std::runtime_error("no"); }),
+               std::runtime_error);
+  EXPECT_TRUE(dir.entries().empty());
+  {
+    tessera::io::TemporaryFile t("x", ".npy", [](std::ostream& os) { os << "data"; });
+    EXPECT_EQ(remove_pending_temporaries(), 1);
+    EXPECT_TRUE(dir.entries().empty());
+  }  // its own removal finds the file gone, harmlessly
+  if (old != nullptr) ::setenv("TMPDIR", saved.c_str(), 1);
+  else ::unsetenv("TMPDIR");
+}
