@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "exact_rows.hpp"
+#include "nearest_double.hpp"
 #include "tessera/kernels/exact_predicates.hpp"
 #include "tessera/kernels/wide_int.hpp"
 
@@ -23,16 +24,42 @@ using exact_rows::build_rows;
 using exact_rows::det_rows;
 using exact_rows::Scratch;
 
-// ---- Vertices ----
+// ---- Rounding to nearest (nearest_double.hpp) ----
 
-namespace {
-// q as a double: truncated to 53 bits (mpq_get_d), then rounded once into
-// the subnormals below DBL_MIN, where mpq_get_d returns 0 (GMP leaves it
-// system dependent) while a sliver's exact volume, or a vertex coordinate,
-// can be a subnormal: scaled up by 2^1100 first, then down by ldexp.
-// Below 2^-1999 that rounding gives a zero of q's sign, and from 2^1024 on
-// (GMP: system dependent again) q is an infinity of its sign, as
-// certain_quotient decides them without rationals. Modifies q.
+// Every measure of exact_cell_measure is rounded so,
+// whichever tier computes it: to nearest rather than truncated (mpq_get_d's
+// way, until stop 73), so that a measure that is exactly a double (the
+// centroid of a prism spanning the box lies halfway between two box planes;
+// its volume is often a short binary fraction) lies inside its rounding
+// interval, where an error bound can certify it, not on that interval's
+// edge.
+double nearest_double(mpz_srcptr m, bool sticky, long k, int sign, mpz_ptr q, mpz_ptr r) {
+  const long length = static_cast<long>(mpz_sizeinbase(m, 2));
+  const long e = length - 1 - k;  // 2^e <= (m + f) 2^-k < 2^(e + 1)
+  if (e >= 1024) return sign > 0 ? std::numeric_limits<double>::infinity() : -std::numeric_limits<double>::infinity();
+  // Bits of m below the result's last place: 53 significant bits, fewer
+  // below DBL_MIN (the last place is then 2^-1074).
+  long below = length - 53;
+  if (e < -1022) below += -1022 - e;
+  if (below > length) return sign > 0 ? 0.0 : -0.0;  // under half the smallest subnormal
+  mpz_tdiv_q_2exp(q, m, static_cast<mp_bitcnt_t>(below));
+  mpz_tdiv_r_2exp(r, m, static_cast<mp_bitcnt_t>(below));
+  // Compare the dropped bits (and f) with half a last place.
+  const long top = below - 1;  // the half's bit
+  const bool half_set = mpz_tstbit(r, static_cast<mp_bitcnt_t>(top)) != 0;
+  bool up = false;
+  if (half_set) {
+    mpz_clrbit(r, static_cast<mp_bitcnt_t>(top));
+    up = mpz_sgn(r) != 0 || sticky || mpz_odd_p(q);  // above half, or a tie to an odd mantissa
+  }
+  if (up) mpz_add_ui(q, q, 1);
+  // q <= 2^53 is exact as a double, and so is the scaled result unless it
+  // overflows to the infinity IEEE rounding gives.
+  const double v = std::ldexp(mpz_get_d(q), static_cast<int>(below - k));
+  return sign > 0 ? v : -v;
+}
+
+// Beyond 2^1026 an infinity, below 2^-2000 a zero, without dividing.
 double rational_to_double(mpq_ptr q) {
   const int sign = mpq_sgn(q);
   if (sign == 0) return 0.0;
@@ -40,10 +67,23 @@ double rational_to_double(mpq_ptr q) {
   const long e = static_cast<long>(mpz_sizeinbase(mpq_numref(q), 2)) - static_cast<long>(mpz_sizeinbase(mpq_denref(q), 2));
   if (e >= 1026) return sign > 0 ? std::numeric_limits<double>::infinity() : -std::numeric_limits<double>::infinity();
   if (e <= -2000) return sign > 0 ? 0.0 : -0.0;
-  if (e > -1000) return mpq_get_d(q);
-  mpq_mul_2exp(q, q, 1100);
-  return std::ldexp(mpq_get_d(q), -1100);
+  // m = floor(|q| 2^k) with at least 56 bits, and whether a remainder is left.
+  const long k = 57 - e;
+  mpz_t m, rem, t0, t1;
+  mpz_inits(m, rem, t0, t1, nullptr);
+  mpz_abs(t0, mpq_numref(q));
+  if (k >= 0) mpz_mul_2exp(t0, t0, static_cast<mp_bitcnt_t>(k));
+  mpz_set(t1, mpq_denref(q));
+  if (k < 0) mpz_mul_2exp(t1, t1, static_cast<mp_bitcnt_t>(-k));
+  mpz_tdiv_qr(m, rem, t0, t1);
+  const double v = nearest_double(m, mpz_sgn(rem) != 0, k, sign, t0, t1);
+  mpz_clears(m, rem, t0, t1, nullptr);
+  return v;
 }
+
+// ---- Vertices ----
+
+namespace {
 
 // A signed fixed-width integer into GMP (two's complement limbs, least
 // significant first).
@@ -487,36 +527,65 @@ class IntegerPool {
 long bit_length(mpz_srcptr x) { return static_cast<long>(mpz_sizeinbase(x, 2)); }
 
 // out = trunc(x 2^k).
-void scale_truncated(mpz_ptr out, mpz_srcptr x, long k) {
-  if (k >= 0) mpz_mul_2exp(out, x, static_cast<mp_bitcnt_t>(k));
-  else mpz_tdiv_q_2exp(out, x, static_cast<mp_bitcnt_t>(-k));
+void scale_truncated(mpz_ptr out, mpz_srcptr x, long k, bool& exact) {
+  if (k >= 0) {
+    mpz_mul_2exp(out, x, static_cast<mp_bitcnt_t>(k));
+    return;
+  }
+  // Bits dropped: x has a set bit below 2^-k.
+  if (mpz_sgn(x) != 0 && mpz_scan1(x, 0) < static_cast<mp_bitcnt_t>(-k)) exact = false;
+  mpz_tdiv_q_2exp(out, x, static_cast<mp_bitcnt_t>(-k));
 }
 
 // out = trunc((a - b) 2^k / 2^g) for doubles a, b: their difference exactly
 // on their common grid, then truncated to the unit 2^g.
-void difference_truncated(mpz_ptr out, double a, double b, long k, long g, Scratch& s) {
+void difference_truncated(mpz_ptr out, double a, double b, long k, long g, Scratch& s, bool& exact) {
   const int grid = a == 0 ? lowest_bit_exponent(b)
                    : b == 0 ? lowest_bit_exponent(a)
                             : std::min(lowest_bit_exponent(a), lowest_bit_exponent(b));
   exact_rows::set_scaled(s.t0, a, grid);
   exact_rows::set_scaled(s.t1, b, grid);
   mpz_sub(s.t0, s.t0, s.t1);
-  scale_truncated(out, s.t0, grid + k - g);
+  scale_truncated(out, s.t0, grid + k - g, exact);
 }
 
-// The double that x = n / d * 2^exp truncates to (towards zero, as
-// mpq_get_d), where n is known only to lie within 2^hn of `num`, and d is c
-// times a number within 2^hd of `den` (den null: d = c exactly). False where
-// those intervals leave that double undetermined (they hold zero, or two
-// doubles). Out of double's range it is what rational_to_double makes of x:
-// an infinity from 2^1024 on, a zero below 2^-1999. (Until stop 72, false
-// outside [2^-1000, 2^1000], which sent every cell whose measure leaves
-// double's range to the rationals: 300 points spread over 1e-300..1e280
-// took 20 s, ~60 ms a cell.) Truncation is monotone, so when both
-// ends of x's interval truncate alike, x does too. `z[at..at+5)` is scratch.
+// The double nearest to x = n / d * 2^exp (nearest_double: the doubles of
+// rational_to_double), where n is known only to lie within 2^hn of `num`,
+// and d is c times a number within 2^hd of `den` (den null: d = c exactly).
+// False where those intervals leave that double undetermined (they hold
+// zero, or straddle a rounding boundary). Out of double's range it is an
+// infinity or a signed zero, as rational_to_double gives. (Until stop 72,
+// false outside [2^-1000, 2^1000], which sent every cell whose measure
+// leaves double's range to the rationals: 300 points spread over
+// 1e-300..1e280 took 20 s, ~60 ms a cell. Until stop 73 the doubles were
+// truncated, and a measure that is exactly a double could never be
+// certified.) Rounding is monotone, so when both ends of x's interval round
+// alike, x does too. hn = -1 (and hd = -1, or den null) says n (and d) is
+// exact: x is then rounded exactly. `z[at..at+5)` is scratch.
 bool certain_quotient(mpz_srcptr num, long hn, mpz_srcptr den, long hd, unsigned long c, long exp, IntegerPool& z,
                       std::size_t at, double& out) {
   mpz_ptr lo = z[at], hi = z[at + 1], dlo = z[at + 2], dhi = z[at + 3], h = z[at + 4];
+  if (hn < 0 && (den == nullptr || hd < 0)) {
+    // Exact (hn, hd = -1: no truncation lost a bit): x rounded from its own
+    // quotient and remainder, a tie included (the averages that bisectors
+    // take make exact midpoints between doubles common: a cell bounded by
+    // the bisector of 0.3 and 0.7 has volume 0.5 - 2^-55).
+    if (den == nullptr) mpz_set_ui(dlo, c);
+    else mpz_mul_ui(dlo, den, c);
+    if (mpz_sgn(dlo) <= 0) return false;  // a zero sum: the rationals' convention
+    const int sign = mpz_sgn(num);
+    if (sign == 0) {
+      out = 0.0;
+      return true;
+    }
+    mpz_abs(lo, num);
+    const long k = 72 + bit_length(dlo) - bit_length(lo);
+    if (k > 0) mpz_mul_2exp(lo, lo, static_cast<mp_bitcnt_t>(k));
+    else if (k < 0) mpz_mul_2exp(dlo, dlo, static_cast<mp_bitcnt_t>(-k));
+    mpz_tdiv_qr(hi, dhi, lo, dlo);
+    out = nearest_double(hi, mpz_sgn(dhi) != 0, k - exp, sign, lo, h);
+    return true;
+  }
   mpz_set_ui(h, 1);
   mpz_mul_2exp(h, h, static_cast<mp_bitcnt_t>(hn));
   mpz_sub(lo, num, h);
@@ -535,7 +604,7 @@ bool certain_quotient(mpz_srcptr num, long hn, mpz_srcptr den, long hd, unsigned
     mpz_set_ui(dlo, c);
     mpz_set_ui(dhi, c);
   }
-  // Quotients of some 72 bits: enough for truncation to 53 to agree at both
+  // Quotients of some 72 bits: enough for rounding to 53 to agree at both
   // ends whenever x's interval is narrow.
   const long k = 72 + bit_length(dhi) - bit_length(num);
   if (k > 0) {
@@ -554,27 +623,18 @@ bool certain_quotient(mpz_srcptr num, long hn, mpz_srcptr den, long hd, unsigned
     mpz_fdiv_q(lo, lo, dlo);
     mpz_cdiv_q(hi, hi, dhi);
   }
-  const double low = mpz_get_d(lo), high = mpz_get_d(hi);  // truncated to 53 bits
-  if (low != high || low == 0) return false;
-  int e;
-  std::frexp(low, &e);
-  const long scale = exp - k;
-  // |x| >= 2^(e - 1 + scale): from 2^1024 on it is beyond double's range,
-  // and truncates to an infinity, as mpq_get_d gives it (the volume and
-  // centroid of a cell reaching past 1e308, whose coordinates span from
-  // 1e-300 to 1e280: each such cell went to the rationals, ~60 ms apiece).
-  if (e + scale > 1024) {
-    out = low > 0 ? std::numeric_limits<double>::infinity() : -std::numeric_limits<double>::infinity();
-    return true;
+  // |x| 2^(k - exp) lies in [mag_lo, mag_hi].
+  mpz_ptr mag_lo = lo, mag_hi = hi;
+  if (sign < 0) {
+    mpz_neg(lo, lo);
+    mpz_neg(hi, hi);
+    std::swap(mag_lo, mag_hi);
   }
-  // Below 2^-1022, ldexp rounds low 2^scale once into the subnormals, as
-  // rational_to_double rounds the same truncated mantissa; below 2^-1999 to
-  // a zero of x's sign, as it does.
-  if (e + scale < -1999) {
-    out = low > 0 ? 0.0 : -0.0;
-    return true;
-  }
-  out = std::ldexp(low, static_cast<int>(scale));
+  if (mpz_sizeinbase(mag_lo, 2) < 54 || mpz_sgn(mag_lo) <= 0) return false;  // an interval that wide decides nothing
+  const double low = nearest_double(mag_lo, false, k - exp, sign, dlo, h);
+  const double high = nearest_double(mag_hi, false, k - exp, sign, dhi, h);
+  if (low != high) return false;
+  out = low;
   return true;
 }
 
@@ -611,6 +671,10 @@ bool fixed_point_cell_measure(const ExactContext& ctx, std::int32_t i, std::span
   mpz_ptr w = z[base], sum = z[base + 1], t0 = z[base + 2];
   mpz_ptr moment[3] = {z[base + 3], z[base + 4], z[base + 5]};
 
+  // Whether every truncation to fixed point below was exact (a cell whose
+  // vertices and feet lie on the grid of 2^g: dyadic coordinates, such as
+  // the bisectors of doubles and box planes): the sums are then exact too.
+  bool exact = true;
   shift.resize(nv);
   long top = std::numeric_limits<long>::min();  // |every coordinate| < 2^top
   for (std::size_t v = 0; v < nv; ++v) {
@@ -625,8 +689,9 @@ bool fixed_point_cell_measure(const ExactContext& ctx, std::int32_t i, std::span
   for (std::size_t v = 0; v < nv; ++v)
     for (std::size_t d = 0; d < du; ++d) {
       // trunc(trunc(n 2^k) / det) = trunc(n 2^k / det) for k < 0 as well.
-      scale_truncated(fixed(v, d), num(v, d), shift[v] - g);
-      mpz_tdiv_q(fixed(v, d), fixed(v, d), num(v, du));
+      scale_truncated(fixed(v, d), num(v, d), shift[v] - g, exact);
+      mpz_tdiv_qr(fixed(v, d), t0, fixed(v, d), num(v, du));
+      if (mpz_sgn(t0) != 0) exact = false;
     }
 
   const double* pi = ctx.points + static_cast<std::size_t>(i) * du;
@@ -643,11 +708,11 @@ bool fixed_point_cell_measure(const ExactContext& ctx, std::int32_t i, std::span
       foot_plane.push_back(plane);
       if (plane >= 0) {
         const double* pj = ctx.points + static_cast<std::size_t>(plane) * 3;
-        for (int d = 0; d < 3; ++d) difference_truncated(f[d], pj[d], pi[d], -1, g, s);
+        for (int d = 0; d < 3; ++d) difference_truncated(f[d], pj[d], pi[d], -1, g, s, exact);
       } else {
         const int axis = box_plane_axis(plane);
         for (int d = 0; d < 3; ++d) mpz_set_ui(f[d], 0);
-        difference_truncated(f[axis], box_plane_upper(plane) ? ctx.hi[axis] : ctx.lo[axis], pi[axis], 0, g, s);
+        difference_truncated(f[axis], box_plane_upper(plane) ? ctx.hi[axis] : ctx.lo[axis], pi[axis], 0, g, s, exact);
       }
     }
     return feet + 3 * k;
@@ -695,9 +760,10 @@ bool fixed_point_cell_measure(const ExactContext& ctx, std::int32_t i, std::span
   const long moment_error = dim == 3 ? terms_bits + 7 + 3 * m : terms_bits + 5 + 2 * m;
   // Volume = sum 2^(D g) / (6 or 2); centroid = moment 2^((D + 1) g) / ((4
   // or 3) sum 2^(D g)), as in rational_measure.
-  bool sure = certain_quotient(sum, sum_error, nullptr, 0, dim == 3 ? 6 : 2, dim * g, z, spare, volume);
+  const long sum_h = exact ? -1 : sum_error, moment_h = exact ? -1 : moment_error;
+  bool sure = certain_quotient(sum, sum_h, nullptr, 0, dim == 3 ? 6 : 2, dim * g, z, spare, volume);
   for (std::size_t d = 0; sure && d < du; ++d)
-    sure = certain_quotient(moment[d], moment_error, sum, sum_error, dim == 3 ? 4 : 3, g, z, spare, centroid[d]);
+    sure = certain_quotient(moment[d], moment_h, sum, sum_h, dim == 3 ? 4 : 3, g, z, spare, centroid[d]);
   if (!sure && wanted != nullptr) {
     // The bits that should certify them: each bit more adds one to every
     // margin (the sum grows by 2^D, its error bound by 2^(D - 1); the

@@ -637,10 +637,11 @@ TEST(Hull, ExactMeasureFixedPointMatchesRationals) {
   Scene<3> r(random_points<3>(40, 8), {0, 0, 0}, {1, 1, 1});
   fixed_point_tier_test<Hull>(r, 0.95);
   // A lattice's cells are cubes about their generators: every centroid
-  // coordinate is zero, which no error bound certifies, so the rational
-  // tier serves them, and gives the same doubles.
+  // coordinate is zero, which no error bound certifies. Their vertices lie
+  // on the fixed-point grid, so the sums are exact (stop 73), and the
+  // fixed-point tier gives every cell the rationals' doubles.
   Scene<3> l(lattice<3>(3), {0, 0, 0}, {3, 3, 3});
-  fixed_point_tier_test<Hull>(l, 0);
+  fixed_point_tier_test<Hull>(l, 1.0);
 }
 
 // Measures beyond double's range: a jittered 3x3x3 lattice 1e-104 apart in
@@ -665,6 +666,19 @@ TEST(Hull, ExactMeasureBeyondDoubleRange) {
   // Certified without the rationals: most outer cells, and the inner ones.
   EXPECT_GE(infinite, 15);
   EXPECT_GE(subnormal, 1);
+}
+
+// Measures that are exactly doubles: cells that are prisms spanning the
+// box (volume 0.5 or 0.25, centroid coordinates such as 0.25 - 0.3, exact by
+// Sterbenz's lemma). Until stop 73 the measure truncated, an exact double
+// lay on the edge of its rounding interval, no error bound certified it,
+// and every such cell went to the rationals; rounded to nearest, the
+// fixed-point tier certifies them all.
+TEST(Hull, ExactMeasureOfExactDoublesInFixedPoint) {
+  Scene<3> s({0.3, 0.4, 0.45, 0.7, 0.4, 0.45}, {0, 0, 0}, {1, 1, 1});
+  fixed_point_tier_test<Hull>(s, 1.0);
+  Scene<3> four({0.3, 0.4, 0.45, 0.7, 0.4, 0.45, 0.3, 0.6, 0.45, 0.7, 0.6, 0.45}, {0, 0, 0}, {1, 1, 1});
+  for (const double v : fixed_point_tier_test<Hull>(four, 1.0)) EXPECT_EQ(v, 0.25);
 }
 
 TEST(Tile, ExactMeasureFixedPointMatchesRationals) {

@@ -357,9 +357,9 @@ struct MeasureTerm {
   std::uint32_t a, b;
 };
 
-/// The exact volume (area in 2D) of cell `i`, rounded once (truncated
-/// towards zero), and its centroid relative to p_i (dim doubles into
-/// `centroid`), likewise. The vertices are given by their planes (dim ids
+/// The exact volume (area in 2D) of cell `i`, rounded once (to nearest,
+/// ties to even; an infinity from 2^1024 on), and its centroid relative to
+/// p_i (dim doubles into `centroid`), likewise. The vertices are given by their planes (dim ids
 /// each, `vertex_planes`) and solved exactly; the terms are summed exactly
 /// (divided by 6, or 2 in 2D). For cells whose float measure cancels to no
 /// correct digits (slivers thinner than the rounding of their vertices:
@@ -380,7 +380,8 @@ double rational_cell_measure(const ExactContext& ctx, std::int32_t i, std::span<
 /// doubles certified by error bounds. True with `volume` and `centroid` set
 /// (then the doubles rational_cell_measure gives); false where the bounds
 /// leave them undetermined (cancellation deeper than the bits kept, an
-/// exactly zero centroid coordinate, or results outside [2^-1000, 2^1000]),
+/// exactly zero centroid coordinate, a result within the bounds' width of a
+/// midpoint between two doubles),
 /// with `*wanted` (if given) the bits likely to certify them (twice `bits`
 /// where a sum or moment came out zero, which gives no measure).
 bool fixed_point_cell_measure(const ExactContext& ctx, std::int32_t i, std::span<const std::int32_t> vertex_planes,
