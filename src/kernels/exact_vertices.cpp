@@ -26,13 +26,12 @@ using exact_rows::Scratch;
 
 // ---- Rounding to nearest (nearest_double.hpp) ----
 
-// Every measure of exact_cell_measure is rounded so,
-// whichever tier computes it: to nearest rather than truncated (mpq_get_d's
-// way, until stop 73), so that a measure that is exactly a double (the
-// centroid of a prism spanning the box lies halfway between two box planes;
-// its volume is often a short binary fraction) lies inside its rounding
-// interval, where an error bound can certify it, not on that interval's
-// edge.
+// Every measure of exact_cell_measure is rounded so, whichever tier
+// computes it: to nearest rather than truncated (mpq_get_d's way, until
+// stop 73), so that a measure that is exactly a double (the centroid of a
+// prism spanning the box lies halfway between two box planes; its volume is
+// often a short binary fraction) lies inside its rounding interval, where
+// an error bound can certify it, not on that interval's edge.
 double nearest_double(mpz_srcptr m, bool sticky, long k, int sign, mpz_ptr q, mpz_ptr r) {
   const long length = static_cast<long>(mpz_sizeinbase(m, 2));
   const long e = length - 1 - k;  // 2^e <= (m + f) 2^-k < 2^(e + 1)
@@ -526,7 +525,7 @@ class IntegerPool {
 
 long bit_length(mpz_srcptr x) { return static_cast<long>(mpz_sizeinbase(x, 2)); }
 
-// out = trunc(x 2^k).
+// out = trunc(x 2^k); `exact` cleared where that drops a set bit.
 void scale_truncated(mpz_ptr out, mpz_srcptr x, long k, bool& exact) {
   if (k >= 0) {
     mpz_mul_2exp(out, x, static_cast<mp_bitcnt_t>(k));
@@ -538,7 +537,7 @@ void scale_truncated(mpz_ptr out, mpz_srcptr x, long k, bool& exact) {
 }
 
 // out = trunc((a - b) 2^k / 2^g) for doubles a, b: their difference exactly
-// on their common grid, then truncated to the unit 2^g.
+// on their common grid, then truncated to the unit 2^g (`exact` as above).
 void difference_truncated(mpz_ptr out, double a, double b, long k, long g, Scratch& s, bool& exact) {
   const int grid = a == 0 ? lowest_bit_exponent(b)
                    : b == 0 ? lowest_bit_exponent(a)
