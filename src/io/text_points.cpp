@@ -211,6 +211,8 @@ PointCloud qhull_points(const std::string& path, Lines& lines, std::size_t ndim,
   if (ndim > 3 && options.dim == 0)
     fail(path, "Qhull point format of dimension " + std::to_string(ndim) +
                    ": tessera computes 2D and 3D cells (--dim 2 or 3 keeps the first coordinates)");
+  if (count > std::numeric_limits<std::size_t>::max() / ndim)
+    fail(path, "Qhull point format: its header declares " + std::to_string(count) + " points, more than can be held");
   const std::size_t dim = options.dim != 0 ? static_cast<std::size_t>(options.dim) : ndim;
   if (dim > ndim) fail(path, "3D points asked but the file's points have " + std::to_string(ndim) + " coordinates");
   // The numbers are checked against the header's count before any array is
