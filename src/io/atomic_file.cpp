@@ -138,6 +138,24 @@ class PendingTemporaries {
 constinit PendingTemporaries g_pending;
 PendingTemporaries& pending() { return g_pending; }
 
+/// What streaming into a file descriptor came to: the errno of the first
+/// failed write, or a stream left bad by `fill` itself.
+struct FillResult {
+  int error = 0;
+  bool stream_bad = false;
+  bool ok() const { return error == 0 && !stream_bad; }
+  std::string why() const { return error != 0 ? std::strerror(error) : "stream error"; }
+};
+
+/// Stream `fill` into `fd` (left open); exceptions from `fill` pass through.
+FillResult fill_fd(int fd, const std::function<void(std::ostream&)>& fill) {
+  FdBuf buf(fd);
+  std::ostream os(&buf);
+  fill(os);
+  os.flush();
+  return {buf.error(), !os};
+}
+
 /// Create `path.tmp-XXXXXX` (then `suffix`) exclusively (mode 0666 less the
 /// umask, like a plain new file). Returns its fd, sets `tmp` and arms `slot`
 /// with it; throws on failure. The name is armed before the file exists, so
@@ -179,15 +197,9 @@ void write_file_atomic(const std::string& path, const std::function<void(std::os
     ::unlink(tmp.c_str());
     pending().disarm(slot);
   };
-  int write_error = 0;
-  bool stream_bad = false;
+  FillResult written;
   try {
-    FdBuf buf(fd);
-    std::ostream os(&buf);
-    fill(os);
-    os.flush();
-    write_error = buf.error();
-    stream_bad = !os;
+    written = fill_fd(fd, fill);
   } catch (const Cancelled&) {
     discard(fd);
     throw;  // cancellation is not a write error; let it through as itself
@@ -198,9 +210,9 @@ void write_file_atomic(const std::string& path, const std::function<void(std::os
     discard(fd);
     throw;
   }
-  if (write_error || stream_bad) {
+  if (!written.ok()) {
     discard(fd);
-    cannot_write(path, write_error ? std::strerror(write_error) : "stream error");
+    cannot_write(path, written.why());
   }
   if (::close(fd) != 0) {
     const int err = errno;
@@ -229,25 +241,18 @@ TemporaryFile::TemporaryFile(const std::string& name, const std::string& suffix,
   const fs::path dir = env != nullptr && *env != '\0' ? fs::path(env) : fs::path("/tmp");
   const std::string base = (dir / ("tessera-" + name)).string();
   const int fd = create_temp(base, path_, slot_, suffix);
-  int write_error = 0;
-  bool stream_bad = false;
+  FillResult written;
   try {
-    FdBuf buf(fd);
-    std::ostream os(&buf);
-    fill(os);
-    os.flush();
-    write_error = buf.error();
-    stream_bad = !os;
+    written = fill_fd(fd, fill);
   } catch (...) {
     ::close(fd);
     remove();
     throw;
   }
-  if (::close(fd) != 0 && write_error == 0) write_error = errno;
-  if (write_error != 0 || stream_bad) {
-    const std::string why = write_error ? std::strerror(write_error) : "stream error";
+  if (::close(fd) != 0 && written.error == 0) written.error = errno;
+  if (!written.ok()) {
     remove();
-    cannot_write(base + ".tmp-*" + suffix, why);
+    cannot_write(base + ".tmp-*" + suffix, written.why());
   }
 }
 
