@@ -47,17 +47,19 @@ Delaunay triangulate(const io::PointCloud& pc, DelaunayOptions opt, bool show_pr
 }
 
 void check_delaunay_outputs(const DelaunayArgs& a) {
+  if (a.output == "-") throw InputError("-o: the triangulation is written to a .vtu or .vtp file, not to standard output");
   if (!a.output.empty()) {
     const std::string e = extension(a.output);
     if (e != ".vtu" && e != ".vtp")
       throw InputError("output " + a.output + ": unknown extension '" + e + "' (use .vtu, or .vtp for 2D)");
   }
-  if (!a.simplices.empty() && extension(a.simplices) != ".npy")
+  if (!a.simplices.empty() && a.simplices != "-" && extension(a.simplices) != ".npy")
     throw InputError("--simplices " + a.simplices + ": must be a .npy file");
   if (a.output.empty() && a.simplices.empty() && !a.validate)
     throw InputError("nothing to do: give -o OUTPUT.vtu|.vtp, --simplices FILE.npy or --validate");
   for (const std::string* p : {&a.output, &a.simplices})
     if (!p->empty()) io::check_writable(*p);
+  route_standard_output({&a.simplices});
 }
 
 }  // namespace
@@ -88,7 +90,7 @@ int run_delaunay(const DelaunayArgs& a) {
     // int64 (M, D+1), as scipy.spatial.Delaunay.simplices.
     std::vector<std::int64_t> s(dt.simplices.begin(), dt.simplices.end());
     io::write_file_atomic(a.simplices, io::npy_bytes(s.data(), {dt.n_simplices(), std::size_t(pc.dim + 1)}));
-    written.push_back(a.simplices);
+    written.push_back(shown_output(a.simplices));
   }
   const double write_s = seconds_since(t0);
 

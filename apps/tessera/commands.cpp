@@ -57,6 +57,17 @@ std::string extension(const std::string& path) {
   return ext;
 }
 
+void route_standard_output(std::initializer_list<const std::string*> outputs) {
+  int to_stdout = 0;
+  for (const std::string* p : outputs) to_stdout += *p == "-";
+  if (to_stdout > 1) throw InputError("only one output can go to standard output ('-')");
+  if (to_stdout == 0) return;
+  // glibc's stdout is a variable: the summaries' printf calls now write to
+  // standard error, while file descriptor 1 carries the output alone.
+  std::fflush(stdout);
+  stdout = stderr;
+}
+
 namespace {
 
 const char* axis_name(int axis) { return axis == 0 ? "x" : axis == 1 ? "y" : "z"; }
@@ -66,18 +77,19 @@ const char* axis_name(int axis) { return axis == 0 ? "x" : axis == 1 ? "y" : "z"
 /// Output names are checked before anything is read or computed, so a typo
 /// does not cost a long run.
 void check_output_names(const VoronoiArgs& a) {
+  if (a.output == "-") throw InputError("-o: cells are written to a .vtu or .vtp file, not to standard output");
   if (!a.output.empty()) {
     const std::string e = extension(a.output);
     if (e != ".vtu" && e != ".vtp")
       throw InputError("output " + a.output + ": unknown extension '" + e +
                        "' (use .vtu for 3D cells, .vtp for 2D cells)");
   }
-  if (!a.cell_table.empty()) {
+  if (!a.cell_table.empty() && a.cell_table != "-") {  // "-": the CSV on standard output
     const std::string e = extension(a.cell_table);
     if (e != ".csv" && e != ".npy")
       throw InputError("--cell-table " + a.cell_table + ": unknown extension '" + e + "' (use .csv or .npy)");
   }
-  if (!a.neighbors.empty() && extension(a.neighbors) != ".npy")
+  if (!a.neighbors.empty() && a.neighbors != "-" && extension(a.neighbors) != ".npy")
     throw InputError("--neighbors " + a.neighbors + ": must be a .npy file");
   if (a.output.empty() && a.cell_table.empty() && a.neighbors.empty() && !a.validate)
     throw InputError("nothing to do: give -o OUTPUT.vtu|.vtp, --cell-table, --neighbors or --validate");
@@ -336,6 +348,7 @@ int run_voronoi(const VoronoiArgs& a) {
   // Fail before the (possibly long) read and computation, not after.
   for (const std::string* p : {&a.output, &a.cell_table, &a.neighbors})
     if (!p->empty()) io::check_writable(*p);
+  route_standard_output({&a.cell_table, &a.neighbors});
 
   auto t0 = Clock::now();
   const io::PointCloud pc = read_input(a.compute);
@@ -364,11 +377,11 @@ int run_voronoi(const VoronoiArgs& a) {
   }
   if (!a.cell_table.empty()) {
     io::write_cell_table(a.cell_table, cells);
-    written.push_back(a.cell_table);
+    written.push_back(shown_output(a.cell_table));
   }
   if (!a.neighbors.empty()) {
     io::write_neighbors_npy(a.neighbors, cells);
-    written.push_back(a.neighbors);
+    written.push_back(shown_output(a.neighbors));
   }
   const double write_s = seconds_since(t0);
 

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <initializer_list>
 #include <string>
 #include <vector>
 
@@ -269,6 +270,15 @@ struct Usage {
 };
 Usage usage_now();
 std::string extension(const std::string& path);  ///< lower-cased, with the dot; "" if none
+
+/// Outputs named "-" go to standard output (io::write_file_atomic writes
+/// them in place): at most one per command (InputError otherwise), and the
+/// command's summary then goes to standard error instead.
+void route_standard_output(std::initializer_list<const std::string*> outputs);
+
+/// How to name output `path` in a summary: "stdout" for "-".
+inline std::string shown_output(const std::string& path) { return path == "-" ? "stdout" : path; }
+
 /// Whether `word` is one whole number in strtod's syntax (no leading space,
 /// nothing after it; "inf" and "nan" included), and its value. Every reader
 /// of a number from the command line goes through this.

@@ -162,11 +162,13 @@ int main(int argc, char** argv) {
                   "with cell data GeneratorId, Region, Volume/Area, NumberOfFaces/Edges, NumberOfNeighbors");
   vor->add_option("--cell-table", va.cell_table,
                   "Per-cell table, one row per cell in point order: .csv (id,region,volume,cx,cy,cz,faces,"
-                  "neighbors; 2D: id,region,area,cx,cy,edges,neighbors) or .npy (float64, same columns)");
+                  "neighbors; 2D: id,region,area,cx,cy,edges,neighbors) or .npy (float64, same columns); - writes "
+                  "the CSV to standard output (the summary then goes to standard error)");
   vor->add_option("--neighbors", va.neighbors,
                   "Neighbour lists as one int64 .npy array: [n_cells, offsets (n_cells+1), ids...]; the "
                   "neighbours of cell c are ids[offsets[c]:offsets[c+1]] (point ids). Cells are numbered as the "
-                  "--cell-table rows (point order; outside points and duplicates own none)");
+                  "--cell-table rows (point order; outside points and duplicates own none); - writes it to standard "
+                  "output");
   vor->add_flag("--validate", va.validate,
                 "Check the result (volume sum, neighbour symmetry, vertex degrees, Euler characteristic, and "
                 "the volumes and centroids of up to 128 sampled cells against exact arithmetic), print the report, "
@@ -189,7 +191,7 @@ int main(int argc, char** argv) {
                   "Triangulation as VTK: .vtu (VTK_TETRA / VTK_TRIANGLE over the input points) or, in 2D, .vtp");
   del->add_option("--simplices", dla.simplices,
                   "Simplices as an int64 .npy array of shape (M, D+1), point ids; tetrahedra positively oriented, "
-                  "triangles counter-clockwise");
+                  "triangles counter-clockwise; - writes it to standard output");
   del->add_flag("--no-hull-completion", dla.no_hull_completion,
                 "Keep only the simplices whose circumcentre lies in the domain box (skip closing the triangulation "
                 "up to the convex hull)");

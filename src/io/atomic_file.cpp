@@ -184,6 +184,19 @@ int create_temp(const std::string& path, std::string& tmp, int& slot, const std:
 
 void write_file_atomic(const std::string& path, const std::function<void(std::ostream&)>& fill) {
   if (path.empty()) throw InputError("cannot write an empty path");
+  if (path == "-") {
+    // Standard output: written in place (a pipe cannot be renamed over).
+    FillResult written;
+    try {
+      written = fill_fd(STDOUT_FILENO, fill);
+    } catch (const Cancelled&) {
+      throw;
+    } catch (const std::exception& e) {
+      cannot_write("standard output", e.what());
+    }
+    if (!written.ok()) cannot_write("standard output", written.why());
+    return;
+  }
   std::error_code ec;
   if (fs::is_directory(path, ec)) cannot_write(path, "is a directory");
 
@@ -267,6 +280,7 @@ void TemporaryFile::remove() noexcept {
 
 void check_writable(const std::string& path) {
   if (path.empty()) throw InputError("cannot write an empty path");
+  if (path == "-") return;  // standard output
   std::error_code ec;
   if (fs::is_directory(path, ec)) cannot_write(path, "is a directory");
   fs::path dir = fs::path(path).parent_path();

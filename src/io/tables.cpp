@@ -90,7 +90,7 @@ void write_table_npy(const std::string& path, const Cells& c) {
 }  // namespace
 
 void write_cell_table(const std::string& path, const Cells& cells) {
-  const std::string ext = detail::lower_extension(path);
+  const std::string ext = path == "-" ? ".csv" : detail::lower_extension(path);
   if (ext != ".csv" && ext != ".npy")
     detail::fail(path, "unknown table extension '" + ext + "' (expected .csv or .npy)");
   check_cells(cells);

@@ -42,6 +42,13 @@ def run(args, env=None, timeout=600):
                           env=full_env, timeout=timeout)
 
 
+def run_bytes(args, data=b"", timeout=600):
+    """`run` with bytes in and out (standard input `data`)."""
+    env = dict(os.environ)
+    env.pop("TESSERA_NUM_THREADS", None)
+    return subprocess.run([TESSERA] + [str(a) for a in args], input=data, capture_output=True, env=env, timeout=timeout)
+
+
 def read_vtu(path):
     r = vtk.vtkXMLUnstructuredGridReader()
     r.SetFileName(path)
@@ -745,6 +752,38 @@ class Stdin(TempDirCase):
             r = self.piped(["voronoi", "-", "--neighbors", self.p("nb.npy"), "--validate"], data)
             self.assertEqual(r.returncode, 0, r.stderr)
             self.assertIn(b"500 points (3D) from stdin", r.stdout)
+
+    def test_outputs_to_stdout(self):
+        # "-" as the table, the neighbours or the simplices: the file's bytes on
+        # standard output alone, the summary on standard error.
+        inp = self.save("pts.npy", self.pts)
+        with open(self.ref, "rb") as f:
+            want = f.read()
+        r = run_bytes(["voronoi", inp, "--cell-table", "-", "--bounds"] + BOX3)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertEqual(r.stdout, want)
+        self.assertIn(b"tessera voronoi: 300 points (3D)", r.stderr)
+        self.assertIn(b"wrote              stdout", r.stderr)
+        nb = self.p("nb.npy")
+        self.ok(["voronoi", inp, "--neighbors", nb, "--bounds"] + BOX3)
+        r = run_bytes(["voronoi", "-", "--neighbors", "-", "-q", "--bounds"] + BOX3, self.qhull_text(self.pts))
+        self.assertEqual(r.returncode, 0, r.stderr)
+        with open(nb, "rb") as f:
+            self.assertEqual(r.stdout, f.read())
+        sx = self.p("s.npy")
+        self.ok(["delaunay", inp, "--simplices", sx])
+        r = run_bytes(["delaunay", inp, "--simplices", "-", "--validate"])
+        self.assertEqual(r.returncode, 0, r.stderr)
+        with open(sx, "rb") as f:
+            self.assertEqual(r.stdout, f.read())
+        self.assertIn(b"valid", r.stderr.lower())
+        for args, words in ((["voronoi", inp, "--cell-table", "-", "--neighbors", "-"], "only one output"),
+                            (["voronoi", inp, "-o", "-"], "not to standard output"),
+                            (["delaunay", inp, "-o", "-"], "not to standard output")):
+            r = run_bytes(args)
+            self.assertEqual(r.returncode, 2, args)
+            self.assertEqual(r.stdout, b"")
+            self.assertIn(words, r.stderr.decode())
 
     def test_threshold_reads_stdin_twice(self):
         # threshold reads INPUT for the points, then again for its scalars.

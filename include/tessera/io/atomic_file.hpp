@@ -12,11 +12,14 @@ namespace tessera::io {
 /// renaming it over `path` once complete. On any failure (directory missing,
 /// not writable, disk full, exception from `fill`) the temporary is removed,
 /// `path` is untouched, and tessera::InputError("cannot write PATH: reason") is thrown.
+/// `-` is standard output, written in place: not atomically (a pipe cannot
+/// be renamed over), so a failure leaves what was written.
 void write_file_atomic(const std::string& path, const std::function<void(std::ostream&)>& fill);
 void write_file_atomic(const std::string& path, std::string_view bytes);
 
 /// Fail early (before a long computation) if `path` cannot be created:
-/// its directory must exist and be writable. Throws InputError.
+/// its directory must exist and be writable (`-`, standard output, passes).
+/// Throws InputError.
 void check_writable(const std::string& path);
 
 /// A file of this process's own in the temporary directory ($TMPDIR, else

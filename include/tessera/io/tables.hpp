@@ -11,6 +11,7 @@ namespace tessera::io {
 /// .csv: header `id,region,volume,cx,cy,cz,faces,neighbors` (2D:
 /// `id,region,area,cx,cy,edges,neighbors`), doubles with 17 significant digits.
 /// .npy: float64 array (n_cells, 8) (2D: (n_cells, 7)) with the same columns.
+/// `-`: the CSV on standard output (write_file_atomic).
 void write_cell_table(const std::string& path, const Cells& cells);
 
 /// Neighbour lists as one int64 .npy array in CSR layout:
