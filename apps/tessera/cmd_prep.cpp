@@ -27,7 +27,8 @@ namespace {
 
 constexpr const char* kOutputHelp =
     "Output points with labels: .npy (float64 (N, D); labels in OUT_labels.npy, int32), .ply (binary, double x y z, "
-    "int property 'label') or .vtp (VTK vertices, point data 'label'). 2D points get z = 0 in .ply/.vtp";
+    "int property 'label') or .vtp (VTK vertices, point data 'label'). 2D points get z = 0 in .ply/.vtp. - writes "
+    "the .ply to standard output (rbox 1000 D3 | tessera joggle - -o - | tessera voronoi - --cell-table -)";
 
 void add_input_options(CLI::App* app, PrepInput& p, bool labels) {
   app->add_option("INPUT", p.input, "Point file: .npy, .csv/.xyz/.txt (or Qhull's format), .ply, .vtp/.vtu or .pcd (as for `voronoi`); - reads standard input")->required();
@@ -41,8 +42,14 @@ void add_input_options(CLI::App* app, PrepInput& p, bool labels) {
   app->add_flag("-q,--quiet", p.quiet, "No summary line");
 }
 
-/// Checks the output path before any work: a points extension and a writable directory.
+/// Checks the output path before any work: a points extension and a
+/// writable directory, or "-" (binary .ply on standard output; the summary
+/// then goes to standard error).
 void check_output(const std::string& path) {
+  if (path == "-") {
+    route_standard_output({&path});
+    return;
+  }
   const std::string e = extension(path);
   if (e != ".npy" && e != ".ply" && e != ".vtp")
     throw InputError("output " + path + ": points are written as .npy, .ply or .vtp (got '" + e + "')");
@@ -67,7 +74,7 @@ std::int32_t parse_label(const std::string& word, const std::string& what) {
 
 std::string written_list(const std::vector<std::string>& written) {
   std::string s;
-  for (const auto& w : written) s += (s.empty() ? "" : ", ") + w;
+  for (const auto& w : written) s += (s.empty() ? "" : ", ") + shown_output(w);
   return s;
 }
 

@@ -122,7 +122,7 @@ std::vector<std::string> write_points(const std::string& path, const LabelledPoi
         throw InputError("cannot write " + path + ": two arrays named '" + name + "'");
   }
 
-  const std::string ext = detail::lower_extension(path);
+  const std::string ext = path == "-" ? ".ply" : detail::lower_extension(path);  // standard output: one stream
   std::vector<std::string> written;
   if (ext == ".npy") {
     // All paths first, so that a bad sidecar path stops the run before any write.

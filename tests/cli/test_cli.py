@@ -777,6 +777,18 @@ class Stdin(TempDirCase):
         with open(sx, "rb") as f:
             self.assertEqual(r.stdout, f.read())
         self.assertIn(b"valid", r.stderr.lower())
+        # The point tools write the binary .ply, which `voronoi -` reads back.
+        jp = self.p("j.ply")
+        self.ok(["joggle", inp, "-o", jp])
+        r = run_bytes(["joggle", inp, "-o", "-"])
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertIn(b"wrote stdout", r.stderr)
+        with open(jp, "rb") as f:
+            self.assertEqual(r.stdout, f.read())
+        filled = run_bytes(["fill", inp, "-o", "-", "-q"]).stdout
+        r = run_bytes(["voronoi", "-", "--labels", "label", "--cell-table", "-", "-q"], filled)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertEqual(r.stdout.count(b"\n"), self.N + 1, "the filled points own no cells")
         for args, words in ((["voronoi", inp, "--cell-table", "-", "--neighbors", "-"], "only one output"),
                             (["voronoi", inp, "-o", "-"], "not to standard output"),
                             (["delaunay", inp, "-o", "-"], "not to standard output")):

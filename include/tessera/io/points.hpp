@@ -64,7 +64,9 @@ struct WritePointsOptions {
 /// Write points with their labels by extension: .npy (float64 (n, dim)),
 /// .ply (binary little-endian, float64 x y z, int32 property "label"),
 /// .vtp (VTK XML PolyData, one vertex per point, int32 point data "label").
-/// Every file is written atomically (all or nothing). Returns the paths
+/// `-` is the .ply on standard output (one stream holds the points, labels
+/// and arrays; write_file_atomic). Every file is written atomically (all or
+/// nothing). Returns the paths
 /// written. Throws InputError on an unknown extension or arrays of the wrong
 /// length.
 std::vector<std::string> write_points(const std::string& path, const LabelledPoints& points,
