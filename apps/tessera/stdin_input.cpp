@@ -97,7 +97,8 @@ std::string shown_path(const std::string& path) {
 std::string name_stdin(std::string message) {
   if (!g_spool) return message;
   const std::string& p = g_spool->path();
-  for (std::size_t at = message.find(p); at != std::string::npos; at = message.find(p, at + 5)) message.replace(at, p.size(), "stdin");
+  for (std::size_t at = message.find(p); at != std::string::npos; at = message.find(p, at + 5))
+    message.replace(at, p.size(), "stdin");
   return message;
 }
 

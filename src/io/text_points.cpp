@@ -201,13 +201,14 @@ bool qhull_header(std::string_view line1, std::string_view line2, std::size_t& a
 }
 
 /// Points in Qhull's input format, whose header qhull_header read: `ndim`
-/// (at least 2) coordinates per point, `count` points, the numbers after the header in
-/// any layout (one point per line, as rbox writes them, or not). Labels can
-/// come only from a .npy file (the format names no columns).
+/// (at least 2) coordinates per point, `count` points, the numbers after
+/// the header in any layout (one point per line, as rbox writes them, or
+/// not). Labels can come only from a .npy file (the format names no columns).
 PointCloud qhull_points(const std::string& path, Lines& lines, std::size_t ndim, std::size_t count,
                         const ReadOptions& options, const std::string& label_column) {
   if (!label_column.empty())
-    fail(path, "labels '" + label_column + "': Qhull's point format names no columns (give labels as a .npy file)");
+    fail(path, "labels '" + label_column +
+                   "': Qhull's point format names no columns (give labels as a .npy file)");
   if (ndim > 3 && options.dim == 0)
     fail(path, "Qhull point format of dimension " + std::to_string(ndim) +
                    ": tessera computes 2D and 3D cells (--dim 2 or 3 keeps the first coordinates)");
@@ -228,7 +229,8 @@ PointCloud qhull_points(const std::string& path, Lines& lines, std::size_t ndim,
       double v;
       if (!parse_double(f, v))
         fail(path, "line " + std::to_string(line_no) + ": cannot parse '" + std::string(f) + "' as a number");
-      if (!std::isfinite(v)) fail(path, "line " + std::to_string(line_no) + ": non-finite coordinate '" + std::string(f) + "'");
+      if (!std::isfinite(v))
+        fail(path, "line " + std::to_string(line_no) + ": non-finite coordinate '" + std::string(f) + "'");
       if (seen / ndim >= count)
         fail(path, "Qhull point format: more numbers than the " + std::to_string(count) + " points of dimension " +
                        std::to_string(ndim) + " its header declares (line " + std::to_string(line_no) + ")");

@@ -63,7 +63,8 @@ double rational_to_double(mpq_ptr q) {
   const int sign = mpq_sgn(q);
   if (sign == 0) return 0.0;
   // 2^(e - 1) < |q| < 2^(e + 1)
-  const long e = static_cast<long>(mpz_sizeinbase(mpq_numref(q), 2)) - static_cast<long>(mpz_sizeinbase(mpq_denref(q), 2));
+  const long e = static_cast<long>(mpz_sizeinbase(mpq_numref(q), 2)) -
+                 static_cast<long>(mpz_sizeinbase(mpq_denref(q), 2));
   if (e >= 1026) return sign > 0 ? std::numeric_limits<double>::infinity() : -std::numeric_limits<double>::infinity();
   if (e <= -2000) return sign > 0 ? 0.0 : -0.0;
   // m = floor(|q| 2^k) with at least 56 bits, and whether a remainder is left.

@@ -62,7 +62,7 @@ TEST(NearestDouble, MatchesTheDefinition) {
   for (int t = 0; t < 20000; ++t) {
     const int e = exponent(g);
     const double a = std::ldexp(unit(g), std::max(e, -1074)) * (g() & 1 ? 1 : -1);
-    const double b = std::nextafter(a, a > 0 ? std::numeric_limits<double>::infinity() : -std::numeric_limits<double>::infinity());
+    const double b = std::nextafter(a, std::copysign(std::numeric_limits<double>::infinity(), a));
     mpq_class x;
     switch (kind(g)) {
       case 0: x = mpq_class(a); break;                                  // a double exactly
