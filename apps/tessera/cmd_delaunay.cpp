@@ -130,7 +130,8 @@ int run_delaunay(const DelaunayArgs& a) {
       std::fprintf(stderr, "tessera: %zu duplicate points are not vertices (first: %d = %d)\n", dt.duplicates.size(),
                    dt.duplicates.front().first, dt.duplicates.front().second);
     if (!dt.ignored_outside_bounds.empty())
-      std::fprintf(stderr, "tessera: %zu points outside --bounds ignored\n", dt.ignored_outside_bounds.size());
+      std::fprintf(stderr, "tessera: %zu points outside --bounds (or not finite) ignored\n",
+                   dt.ignored_outside_bounds.size());
     std::fprintf(stderr, "tessera: read %.3f s, triangulate %.3f s (%d threads), write %.3f s\n", read_s, compute_s,
                  dt.threads_used, write_s);
     for (const auto& w : written) std::fprintf(stderr, "tessera: wrote %s\n", w.c_str());

@@ -126,15 +126,23 @@ void check_against_input(const ComputeArgs& a, const io::PointCloud& pc) {
   }
   if (!a.bounds.empty() || pc.n == 0) return;  // the reader reports empty input
   const std::string box_hint = dim == 3 ? "--bounds X0 X1 Y0 Y1 Z0 Z1" : "--bounds X0 X1 Y0 Y1";
-  if (pc.n == 1) throw InputError("only one point: give " + box_hint + " to define the domain around it");
-  double lo[3], hi[3];
-  for (int d = 0; d < dim; ++d) lo[d] = hi[d] = pc.coords[d];
-  for (std::size_t i = 1; i < pc.n; ++i)
+  // Over the finite points: with --ignore-outside the others are set aside
+  // (the library says so where none is left).
+  double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+  std::size_t finite = 0;
+  for (std::size_t i = 0; i < pc.n; ++i) {
+    bool ok = true;
+    for (int d = 0; d < dim; ++d) ok = ok && std::isfinite(pc.coords[i * dim + d]);
+    if (!ok) continue;
+    ++finite;
     for (int d = 0; d < dim; ++d) {
       const double v = pc.coords[i * dim + d];
       lo[d] = std::min(lo[d], v);
       hi[d] = std::max(hi[d], v);
     }
+  }
+  if (finite == 0) return;
+  if (finite == 1) throw InputError("only one point: give " + box_hint + " to define the domain around it");
   int flat = 0, flat_axis = -1;
   for (int d = 0; d < dim; ++d)
     if (lo[d] == hi[d]) {
@@ -142,8 +150,8 @@ void check_against_input(const ComputeArgs& a, const io::PointCloud& pc) {
       if (flat_axis < 0) flat_axis = d;
     }
   if (flat == 0) return;
-  if (flat == dim) throw InputError(strf("all %zu points coincide: give %s", pc.n, box_hint.c_str()));
-  const std::string where = strf("all %zu points have %s = %.17g", pc.n, axis_name(flat_axis), lo[flat_axis]);
+  if (flat == dim) throw InputError(strf("all %zu points coincide: give %s", finite, box_hint.c_str()));
+  const std::string where = strf("all %zu points have %s = %.17g", finite, axis_name(flat_axis), lo[flat_axis]);
   if (dim == 2) throw InputError(where + " (collinear input): give " + box_hint + " for a 2D domain");
   if (flat_axis == 2)
     throw InputError(where + " (planar input): use --dim 2 to tessellate x,y, or give " + box_hint +
@@ -158,6 +166,7 @@ io::PointCloud read_input(const ComputeArgs& a) {
   io::ReadOptions ro;
   ro.dim = a.dim;
   ro.labels = a.labels;
+  ro.keep_non_finite = a.ignore_outside;  // set aside by the computation, as points outside --bounds
   io::PointCloud pc = io::read_points(a.input, ro);
   check_against_input(a, pc);
   return pc;
@@ -263,7 +272,7 @@ void print_summary(const VoronoiArgs& a, const io::PointCloud& pc, const Cells& 
     for (std::size_t i = 0; i < std::min<std::size_t>(c.ignored_outside_bounds.size(), 5); ++i)
       ign += strf("%s%d", i ? ", " : " (points ", c.ignored_outside_bounds[i]);
     if (!c.ignored_outside_bounds.empty()) ign += c.ignored_outside_bounds.size() > 5 ? ", ...)" : ")";
-    std::printf("  %-18s %s\n", "ignored (outside)", ign.c_str());
+    std::printf("  %-18s %s\n", "ignored (outside)", ign.c_str());  // (or not finite)
   }
   std::printf("  %-18s %s\n", "domain", domain_string(c).c_str());
   if (c.far_points != 0)

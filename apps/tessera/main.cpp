@@ -92,7 +92,9 @@ void add_compute_options(CLI::App* app, ComputeArgs& c, std::vector<std::string>
       ->check(NonNegative)
       ->capture_default_str();
   app->add_flag("--ignore-outside", c.ignore_outside,
-                "With --bounds: drop points outside the box (listed in the summary) instead of failing");
+                "Drop points outside --bounds (listed in the summary) instead of failing; also points with a NaN or "
+                "infinite coordinate (an organized point cloud's missing returns), with or without --bounds (the "
+                "default domain then comes from the others). Point ids stay those of the input");
   app->add_option("--threads", c.threads,
                   "Worker threads (default 0: $TESSERA_NUM_THREADS, else all cores; at most " +
                       std::to_string(tessera::max_threads) +

@@ -58,7 +58,11 @@ struct VoronoiOptions {
   int dim = 3;                          ///< 2 or 3
   std::optional<Bounds> bounds;         ///< explicit domain; default: padded bbox
   double padding = 0.01;                ///< relative margin of the default domain (fraction of the largest extent)
-  bool ignore_outside_points = false;   ///< with explicit bounds: drop points outside instead of failing
+  /// With explicit bounds: drop points outside instead of failing. Also,
+  /// with or without bounds, points with a NaN or infinite coordinate (the
+  /// default domain then comes from the others). Ids stay the input's; the
+  /// dropped points are listed in Cells::ignored_outside_bounds.
+  bool ignore_outside_points = false;
   int threads = 0;                      ///< 0: TESSERA_NUM_THREADS, else all cores
   double points_per_bin = 0;            ///< locator bin occupancy; 0 = automatic
   bool build_mesh = true;               ///< merged vertices + per-cell faces (needed for VTK output)

@@ -187,7 +187,7 @@ class Voronoi:
 
     @property
     def ignored_outside_bounds(self) -> np.ndarray:
-        """int32: points dropped outside the bounds (ignore_outside=True)."""
+        """int32: points dropped outside the bounds or not finite (ignore_outside=True)."""
         return self._cells.ignored_outside_bounds
 
     @property
@@ -307,7 +307,10 @@ def voronoi(
         per-cell measures and neighbours: faster and smaller.
     ignore_outside : bool
         With ``bounds``: drop points outside the box (listed in
-        ``ignored_outside_bounds``) instead of raising ValueError.
+        ``ignored_outside_bounds``) instead of raising ValueError. Also,
+        with or without ``bounds``, points with a NaN or infinite coordinate
+        (an organized cloud's missing returns); the default box then comes
+        from the others. Point ids stay the input's.
     method : {"auto", "search", "insertion"}
         How each cell finds the points that clip it; the cells are the
         same. ``"search"``: the bins around it (the meshless method).

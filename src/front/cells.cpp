@@ -202,10 +202,14 @@ Cells run(std::span<const double> input, std::span<const std::int32_t> labels, c
 
 }  // namespace
 
-Cells voronoi(std::span<const double> points, int dim, std::span<const std::int32_t> labels,
+Cells voronoi(std::span<const double> input, int dim, std::span<const std::int32_t> labels,
               const VoronoiOptions& options) {
+  std::span<const double> points = input;
+  VoronoiOptions opt = options;
+  std::vector<double> cleaned;
+  front::set_aside_non_finite(points, dim, opt, cleaned);
   front::check_input(points, dim, labels);
-  return dim == 3 ? run<kernels::Hull>(points, labels, options) : run<kernels::Tile>(points, labels, options);
+  return dim == 3 ? run<kernels::Hull>(points, labels, opt) : run<kernels::Tile>(points, labels, opt);
 }
 
 }  // namespace tessera

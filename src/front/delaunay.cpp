@@ -610,8 +610,12 @@ bool inside_reaches_out(std::span<const double> points, int dim, std::span<const
 
 }  // namespace
 
-Delaunay delaunay(std::span<const double> points, int dim, std::span<const std::int32_t> labels,
-                  const DelaunayOptions& options) {
+Delaunay delaunay(std::span<const double> input, int dim, std::span<const std::int32_t> labels,
+                  const DelaunayOptions& given) {
+  std::span<const double> points = input;
+  DelaunayOptions options = given;
+  std::vector<double> cleaned;
+  front::set_aside_non_finite(points, dim, options, cleaned);
   front::check_input(points, dim, labels);
   if (options.method == DelaunayMethod::insertion && !options.complete_hull)
     throw InputError("the insertion method triangulates the whole convex hull: it needs hull completion");

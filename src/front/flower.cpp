@@ -16,7 +16,7 @@ std::string no_cell_reason(const Cells& c, std::int32_t id) {
     if (dup == id) return "it duplicates point " + std::to_string(owner);
   if (std::find(c.ignored_outside_bounds.begin(), c.ignored_outside_bounds.end(), id) !=
       c.ignored_outside_bounds.end())
-    return "it lies outside the bounds";
+    return "it lies outside the bounds (or has a NaN or infinite coordinate)";
   return "it is an outside point (label < 0)";
 }
 

@@ -2,6 +2,7 @@
 #include "pass.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -24,11 +25,58 @@ void check_input(std::span<const double> points, int dim, std::span<const std::i
   if (n > static_cast<std::size_t>(INT32_MAX - 1)) throw InputError("too many points (ids are 32-bit)");
   for (std::size_t k = 0; k < points.size(); ++k)
     if (!std::isfinite(points[k]))
-      throw InputError("point " + std::to_string(k / static_cast<std::size_t>(dim)) + " has a NaN or infinite coordinate");
+      throw InputError("point " + std::to_string(k / static_cast<std::size_t>(dim)) +
+                       " has a NaN or infinite coordinate (ignore_outside sets such points aside)");
   if (!labels.empty() && labels.size() != n)
     throw InputError("labels: " + std::to_string(labels.size()) + " values for " + std::to_string(n) + " points");
   if (!labels.empty() && std::none_of(labels.begin(), labels.end(), [](std::int32_t l) { return l >= 0; }))
     throw InputError("labels: every point is outside (label < 0); nothing to tessellate");
+}
+
+void set_aside_non_finite(std::span<const double>& points, int dim, VoronoiOptions& options,
+                          std::vector<double>& cleaned) {
+  if (!options.ignore_outside_points || (dim != 2 && dim != 3) || points.size() % static_cast<std::size_t>(dim) != 0)
+    return;  // (check_input names what is wrong)
+  const auto d = static_cast<std::size_t>(dim);
+  const std::size_t n = points.size() / d;
+  auto finite = [&](std::size_t i) {
+    for (std::size_t a = 0; a < d; ++a)
+      if (!std::isfinite(points[i * d + a])) return false;
+    return true;
+  };
+  std::size_t kept = 0;
+  for (std::size_t i = 0; i < n; ++i) kept += finite(i);
+  if (kept == n) return;
+  if (kept == 0) throw InputError("every point has a NaN or infinite coordinate");
+  if (!options.bounds) {
+    std::vector<double> good;
+    good.reserve(kept * d);
+    for (std::size_t i = 0; i < n; ++i)
+      if (finite(i)) good.insert(good.end(), points.begin() + static_cast<std::ptrdiff_t>(i * d),
+                                 points.begin() + static_cast<std::ptrdiff_t>((i + 1) * d));
+    options.bounds = make_domain(good, dim, options);
+  }
+  const Bounds& b = *options.bounds;
+  // One ulp beyond a face of the box (the first whose neighbour is finite):
+  // as far outside as anything can be while keeping the magnitudes, and so
+  // the frame, of the box.
+  std::array<double, 3> away{};
+  bool placed = false;
+  for (std::size_t a = 0; a < d && !placed; ++a) {
+    for (std::size_t c = 0; c < d; ++c) away[c] = b.lo[c];
+    for (const double x : {std::nextafter(b.lo[a], -INFINITY), std::nextafter(b.hi[a], INFINITY)})
+      if (std::isfinite(x)) {
+        away[a] = x;
+        placed = true;
+        break;
+      }
+  }
+  if (!placed) throw InputError("points with a NaN or infinite coordinate: the domain leaves no room outside it");
+  cleaned.assign(points.begin(), points.end());
+  for (std::size_t i = 0; i < n; ++i)
+    if (!finite(i))
+      std::copy(away.begin(), away.begin() + static_cast<std::ptrdiff_t>(d), cleaned.begin() + static_cast<std::ptrdiff_t>(i * d));
+  points = cleaned;
 }
 
 Bounds bounding_box(std::span<const double> points, int dim, std::span<const std::int32_t> labels) {

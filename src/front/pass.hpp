@@ -22,6 +22,18 @@ namespace tessera::front {
 /// Throws InputError unless points/labels are a valid input of dimension dim.
 void check_input(std::span<const double> points, int dim, std::span<const std::int32_t> labels);
 
+/// Points with a NaN or infinite coordinate, where options.ignore_outside_points
+/// says to drop points outside the domain, lie outside every box (organized
+/// point clouds mark missing returns so). Where there are any, `cleaned`
+/// receives a copy of `points` with each of them moved just outside the
+/// domain (the given bounds, else the default domain of the finite points),
+/// `points` is pointed at it and `options.bounds` set to that domain: the
+/// pass then drops them as any point outside the bounds, keeping the ids
+/// and listing them as ignored. Otherwise nothing changes (and check_input
+/// refuses such points).
+void set_aside_non_finite(std::span<const double>& points, int dim, VoronoiOptions& options,
+                          std::vector<double>& cleaned);
+
 /// The bounding box of the points, or of the inside ones (label >= 0) when
 /// labels are given; +inf..-inf on an axis with none.
 Bounds bounding_box(std::span<const double> points, int dim, std::span<const std::int32_t> labels = {});

@@ -119,13 +119,18 @@ DelaunayReport validate(const Delaunay& dt, std::span<const double> points, std:
     const auto du = static_cast<std::size_t>(d);
     lo[d] = dt.bounds.lo[du];
     hi[d] = dt.bounds.hi[du];
-    if (dt.n_points > 0) {
-      lo[d] = hi[d] = points[du];
-      for (std::size_t i = 1; i < dt.n_points; ++i) {
-        const double x = points[i * static_cast<std::size_t>(D) + du];
-        lo[d] = std::min(lo[d], x);
-        hi[d] = std::max(hi[d], x);
-      }
+    // Over the finite points (those with a NaN or infinite coordinate were
+    // set aside: VoronoiOptions::ignore_outside_points).
+    double l = INFINITY, h = -INFINITY;
+    for (std::size_t i = 0; i < dt.n_points; ++i) {
+      const double x = points[i * static_cast<std::size_t>(D) + du];
+      if (!std::isfinite(x)) continue;
+      l = std::min(l, x);
+      h = std::max(h, x);
+    }
+    if (l <= h) {
+      lo[d] = l;
+      hi[d] = h;
     }
     double extent = hi[d] - lo[d];
     if (!std::isfinite(extent)) extent = 0.5 * hi[d] - 0.5 * lo[d];

@@ -193,12 +193,12 @@ PointCloud read_points(const std::string& path, const ReadOptions& options) {
   }
 
   if (pc.n == 0) detail::fail(path, "no points");
-  for (std::size_t k = 0; k < pc.coords.size(); ++k) {
+  for (std::size_t k = 0; k < pc.coords.size() && !options.keep_non_finite; ++k) {
     if (!std::isfinite(pc.coords[k])) {
       char buf[64];
       std::snprintf(buf, sizeof buf, "%g", pc.coords[k]);
-      detail::fail(path, "non-finite coordinate " + std::string(buf) + " in row " +
-                             std::to_string(k / pc.dim) + " (0-based)");
+      detail::fail(path, "non-finite coordinate " + std::string(buf) + " in row " + std::to_string(k / pc.dim) +
+                             " (0-based; --ignore-outside sets such points aside)");
     }
   }
 

@@ -229,7 +229,7 @@ PointCloud qhull_points(const std::string& path, Lines& lines, std::size_t ndim,
       double v;
       if (!parse_double(f, v))
         fail(path, "line " + std::to_string(line_no) + ": cannot parse '" + std::string(f) + "' as a number");
-      if (!std::isfinite(v))
+      if (!std::isfinite(v) && !options.keep_non_finite)
         fail(path, "line " + std::to_string(line_no) + ": non-finite coordinate '" + std::string(f) + "'");
       if (seen / ndim >= count)
         fail(path, "Qhull point format: more numbers than the " + std::to_string(count) + " points of dimension " +
@@ -347,7 +347,7 @@ PointCloud read_text_points(const std::string& path, const ReadOptions& options,
         fail(path, "line " + std::to_string(line_no) + ": cannot parse '" + std::string(f) +
                        "' as a number (column " + std::to_string(c + 1) + ")");
       }
-      if (!std::isfinite(xyz[s]))
+      if (!std::isfinite(xyz[s]) && !options.keep_non_finite)
         fail(path, "line " + std::to_string(line_no) + ": non-finite coordinate '" + std::string(f) + "'");
     }
     if (c < needed)

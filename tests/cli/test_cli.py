@@ -459,6 +459,33 @@ class Voronoi3D(TempDirCase):
             self.assertIn(word, r.stdout)
         self.assertEqual(read_vtu(out).GetNumberOfCells(), self.N)
 
+    def test_non_finite_points_set_aside(self):
+        # An organized cloud (PCL's .pcd) marks missing returns with NaN
+        # points: refused, or with --ignore-outside set aside by id, the
+        # default domain and the cells those of the other points.
+        pts = self.pts.copy()
+        missing = [0, 7, 123, self.N - 1]
+        pts[missing] = np.nan
+        pcd = self.p("organized.pcd")
+        with open(pcd, "w") as f:
+            f.write("VERSION .7\nFIELDS x y z\nSIZE 8 8 8\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 20\nHEIGHT %d\n"
+                    "POINTS %d\nDATA ascii\n" % (self.N // 20, self.N))
+            for p in pts:
+                f.write("%.17g %.17g %.17g\n" % tuple(p))
+        r = run(["voronoi", pcd, "--cell-table", self.p("x.csv")])
+        self.assertEqual(r.returncode, 2)
+        self.assertIn("--ignore-outside", r.stderr)
+        t = self.p("t.csv")
+        r = self.ok(["voronoi", pcd, "--cell-table", t, "--ignore-outside"])
+        self.assertIn("ignored (outside)  4 (points 0, 7, 123, %d)" % (self.N - 1), r.stdout)
+        kept = np.delete(np.arange(self.N), missing)
+        ref = self.p("ref.csv")
+        self.ok(["voronoi", self.save("kept.npy", self.pts[kept]), "--cell-table", ref])
+        a = np.loadtxt(t, delimiter=",", skiprows=1)
+        b = np.loadtxt(ref, delimiter=",", skiprows=1)
+        self.assertTrue(np.array_equal(a[:, 0], kept))  # the input's ids
+        self.assertTrue(np.array_equal(a[:, 1:], b[:, 1:]))
+
     def test_fortran_order_records_and_named_columns(self):
         # The same points as a Fortran-order .npy (np.save of a transposed
         # array, or of a pandas DataFrame's to_numpy()), as a structured .npy

@@ -122,6 +122,14 @@ TEST(Pcd, Errors) {
   // An organized cloud's missing return.
   error("nan.pcd", "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nWIDTH 2\nHEIGHT 1\nDATA ascii\n1 2 3\nnan nan nan\n",
         "point 1 has a NaN coordinate");
+  {  // kept where the computation is to set them aside (--ignore-outside)
+    tessera::io::ReadOptions keep;
+    keep.keep_non_finite = true;
+    const auto pc = read_points(dir.file("nan.pcd"), keep);
+    ASSERT_EQ(pc.n, 2u);
+    EXPECT_EQ(pc.coords[2], 3.0);
+    EXPECT_TRUE(std::isnan(pc.coords[3]));
+  }
   error("short.pcd", header("ascii") + "0.5 1 0 0 0 0.1 7\n", "ends after 1 of 3 points");
   error("cols.pcd", header("ascii") + "0.5 1 0 0 0 0.1\n", "has 6 values, expected 7");
   std::string b = binary();

@@ -29,6 +29,10 @@ struct ReadOptions {
   /// otherwise the name of an integer .ply vertex property (or, for a .csv with
   /// a header, a column name).
   std::string labels;
+  /// Keep points with a NaN or infinite coordinate (organized clouds' missing
+  /// returns) for the computation to set aside, as VoronoiOptions::
+  /// ignore_outside_points does; otherwise such a point is an input error.
+  bool keep_non_finite = false;
 };
 
 /// Read .npy (C or Fortran order), .csv/.xyz/.txt (the columns a header names
