@@ -204,12 +204,9 @@ Cells run(std::span<const double> input, std::span<const std::int32_t> labels, c
 
 Cells voronoi(std::span<const double> input, int dim, std::span<const std::int32_t> labels,
               const VoronoiOptions& options) {
-  std::span<const double> points = input;
-  VoronoiOptions opt = options;
-  std::vector<double> cleaned;
-  front::set_aside_non_finite(points, dim, opt, cleaned);
-  front::check_input(points, dim, labels);
-  return dim == 3 ? run<kernels::Hull>(points, labels, opt) : run<kernels::Tile>(points, labels, opt);
+  const front::CheckedInput<VoronoiOptions> in(input, dim, labels, options);
+  return dim == 3 ? run<kernels::Hull>(in.points, labels, in.options)
+                  : run<kernels::Tile>(in.points, labels, in.options);
 }
 
 }  // namespace tessera

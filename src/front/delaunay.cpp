@@ -612,11 +612,9 @@ bool inside_reaches_out(std::span<const double> points, int dim, std::span<const
 
 Delaunay delaunay(std::span<const double> input, int dim, std::span<const std::int32_t> labels,
                   const DelaunayOptions& given) {
-  std::span<const double> points = input;
-  DelaunayOptions options = given;
-  std::vector<double> cleaned;
-  front::set_aside_non_finite(points, dim, options, cleaned);
-  front::check_input(points, dim, labels);
+  const front::CheckedInput<DelaunayOptions> in(input, dim, labels, given);
+  const std::span<const double> points = in.points;
+  const DelaunayOptions& options = in.options;
   if (options.method == DelaunayMethod::insertion && !options.complete_hull)
     throw InputError("the insertion method triangulates the whole convex hull: it needs hull completion");
   if (!(options.skip_cells < 1))

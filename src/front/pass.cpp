@@ -75,7 +75,7 @@ void set_aside_non_finite(std::span<const double>& points, int dim, VoronoiOptio
   cleaned.assign(points.begin(), points.end());
   for (std::size_t i = 0; i < n; ++i)
     if (!finite(i))
-      std::copy(away.begin(), away.begin() + static_cast<std::ptrdiff_t>(d), cleaned.begin() + static_cast<std::ptrdiff_t>(i * d));
+      for (std::size_t a = 0; a < d; ++a) cleaned[i * d + a] = away[a];
   points = cleaned;
 }
 

@@ -34,6 +34,23 @@ void check_input(std::span<const double> points, int dim, std::span<const std::i
 void set_aside_non_finite(std::span<const double>& points, int dim, VoronoiOptions& options,
                           std::vector<double>& cleaned);
 
+/// What tessera::voronoi and tessera::delaunay compute on: the input after
+/// set_aside_non_finite and check_input. Neither copied nor moved (`points`
+/// may view `cleaned`).
+template <class Options>
+struct CheckedInput {
+  std::span<const double> points;
+  Options options;
+  std::vector<double> cleaned;
+  CheckedInput(std::span<const double> input, int dim, std::span<const std::int32_t> labels, const Options& given)
+      : points(input), options(given) {
+    set_aside_non_finite(points, dim, options, cleaned);
+    check_input(points, dim, labels);
+  }
+  CheckedInput(const CheckedInput&) = delete;
+  CheckedInput& operator=(const CheckedInput&) = delete;
+};
+
 /// The bounding box of the points, or of the inside ones (label >= 0) when
 /// labels are given; +inf..-inf on an axis with none.
 Bounds bounding_box(std::span<const double> points, int dim, std::span<const std::int32_t> labels = {});
