@@ -300,17 +300,18 @@ void bind_prep(py::module_& m) {
   // ---- read_points -----------------------------------------------------------
   m.def(
       "read_points",
-      [](const std::string& path, int dim, const std::string& labels) {
+      [](const std::string& path, int dim, const std::string& labels, bool keep_non_finite) {
         io::ReadOptions opt;
         opt.dim = dim;
         opt.labels = labels;
+        opt.keep_non_finite = keep_non_finite;
         io::PointCloud pc = without_gil([&] { return io::read_points(path, opt); });
         const auto n = static_cast<py::ssize_t>(pc.n);
         py::object lab = py::none();
         if (!labels.empty()) lab = adopt_flat(std::move(pc.labels));
         return py::make_tuple(adopt(std::move(pc.coords), {n, static_cast<py::ssize_t>(pc.dim)}), lab);
       },
-      py::arg("path"), py::arg("dim"), py::arg("labels"),
+      py::arg("path"), py::arg("dim"), py::arg("labels"), py::arg("keep_non_finite"),
       "A point file as the command line reads it: (points (n, dim), labels (n,) or None).");
 
   // ---- threshold --------------------------------------------------------------

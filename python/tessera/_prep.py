@@ -113,7 +113,10 @@ def read_image(
 # --------------------------------------------------------------- read_points
 
 def read_points(
-    path: PathLike, dim: Optional[int] = None, labels: Optional[PathLike] = None
+    path: PathLike,
+    dim: Optional[int] = None,
+    labels: Optional[PathLike] = None,
+    keep_non_finite: bool = False,
 ) -> Tuple[np.ndarray, Optional[np.ndarray]]:
     """Read a point file as the ``tessera`` command reads it: ``.npy`` (an
     (N, 2) or (N, 3) array in C or Fortran order, or a structured array with
@@ -127,6 +130,11 @@ def read_points(
     shape (N, dim), and int32 of shape (N,) or None; both writable, taken
     over from the library without a copy. ValueError
     (:class:`tessera.InputError`) for a missing or malformed file.
+
+    Points with a NaN or infinite coordinate (an organized cloud's missing
+    returns) are an error, unless ``keep_non_finite``: then they are kept,
+    for :func:`voronoi` and the others to set aside with
+    ``ignore_outside=True`` (ids unchanged).
     """
     if not _is_path(path):
         raise ValueError(f"path: expected a file name, got {type(path).__name__}")
@@ -135,7 +143,7 @@ def read_points(
     if labels is not None and not _is_path(labels):
         raise ValueError(f"labels: expected a file or field name, got {type(labels).__name__}")
     lab = "" if labels is None else os.fsdecode(labels)
-    return _inputs.call(_core.read_points, os.fsdecode(path), dim or 0, lab)
+    return _inputs.call(_core.read_points, os.fsdecode(path), dim or 0, lab, bool(keep_non_finite))
 
 
 # -------------------------------------------------------------- sample_image

@@ -266,3 +266,20 @@ def test_read_points_reads_what_the_command_reads(tmp_path):
         tessera.read_points(tmp_path / "missing.pcd")
     with pytest.raises(ValueError, match="dim"):
         tessera.read_points(tmp_path / "r.npy", dim=4)
+
+
+def test_non_finite_points_kept_and_set_aside(tmp_path):
+    # An organized cloud's missing returns: an error, or kept and then set
+    # aside by ignore_outside, ids unchanged.
+    pts = random_points(300, 3, seed=12)
+    pts[[4, 100]] = np.nan
+    np.save(tmp_path / "o.npy", pts)
+    with pytest.raises(tessera.InputError, match="non-finite"):
+        tessera.read_points(tmp_path / "o.npy")
+    p, _ = tessera.read_points(tmp_path / "o.npy", keep_non_finite=True)
+    assert np.isnan(p[4]).all() and np.isnan(p[100]).all()
+    vor = tessera.voronoi(p, ignore_outside=True)
+    np.testing.assert_array_equal(vor.ignored_outside_bounds, [4, 100])
+    assert vor.n_cells == 298
+    assert 4 not in vor.generators and 100 not in vor.generators
+    assert np.isfinite(vor.volumes).all()
