@@ -131,4 +131,13 @@ inline tessera::io::ReadOptions labels(const std::string& name) {
   return o;
 }
 
+/// A read cloud's dimension, coordinates and (where given) labels.
+inline void expect_cloud(const tessera::io::PointCloud& pc, int dim, const std::vector<double>& coords,
+                         const std::vector<std::int32_t>& labels = {}) {
+  EXPECT_EQ(pc.dim, dim);
+  EXPECT_EQ(pc.n, coords.size() / static_cast<std::size_t>(dim));
+  EXPECT_EQ(pc.coords, coords);
+  if (!labels.empty()) EXPECT_EQ(pc.labels, labels);
+}
+
 }  // namespace tessera_test

@@ -46,10 +46,7 @@ TEST(Ply, AsciiWithLabelsAndFaces) {
   TempDir dir;
   const std::string p = dir.write("a.ply", kAscii);
   auto pc = read_points(p, labels("region"));
-  EXPECT_EQ(pc.dim, 3);
-  EXPECT_EQ(pc.n, 4u);
-  EXPECT_EQ(pc.coords, (std::vector<double>{0, 0, 0, 1.5, 0, 0, 0, 1, -0.25, 0, 0, 1}));
-  EXPECT_EQ(pc.labels, (std::vector<std::int32_t>{1, 2, 1, 3}));
+  expect_cloud(pc, 3, {0, 0, 0, 1.5, 0, 0, 0, 1, -0.25, 0, 0, 1}, {1, 2, 1, 3});
   // Without labels, and forced 2D.
   auto plain = read_points(p);
   EXPECT_TRUE(plain.labels.empty());

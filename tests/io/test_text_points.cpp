@@ -60,9 +60,7 @@ TEST(TextPoints, TwoColumnsAre2D) {
 
 TEST(TextPoints, ExtraColumnsIgnored) {
   TempDir dir;
-  auto pc = read_points(dir.write("a.csv", "x,y,z,r,g,b\n1,2,3,9,9,9\n4,5,6,9,9,9\n"));
-  EXPECT_EQ(pc.dim, 3);
-  EXPECT_EQ(pc.coords, (std::vector<double>{1, 2, 3, 4, 5, 6}));
+  expect_cloud(read_points(dir.write("a.csv", "x,y,z,r,g,b\n1,2,3,9,9,9\n4,5,6,9,9,9\n")), 3, {1, 2, 3, 4, 5, 6});
   // Extra columns are not even parsed (the first line is data: all numeric).
   auto pc2 = read_points(dir.write("b.csv", "1,2,3,4\n4,5,6,more junk\n"));
   EXPECT_EQ(pc2.coords, (std::vector<double>{1, 2, 3, 4, 5, 6}));
@@ -76,12 +74,8 @@ TEST(TextPoints, ExtraColumnsIgnored) {
 // often lead with an id. The first columns would have made those coordinates.
 TEST(TextPoints, CoordinatesByHeaderName) {
   TempDir dir;
-  auto pd = read_points(dir.write("a.csv", ",x,y,z\n0,1,2,3\n1,4,5,6\n"));
-  EXPECT_EQ(pd.dim, 3);
-  EXPECT_EQ(pd.coords, (std::vector<double>{1, 2, 3, 4, 5, 6}));
-  auto id = read_points(dir.write("b.csv", "id,Z,\"Y\",X,mass\n7,3,2,1,9\n8,6,5,4,9\n"));
-  EXPECT_EQ(id.dim, 3);
-  EXPECT_EQ(id.coords, (std::vector<double>{1, 2, 3, 4, 5, 6}));
+  expect_cloud(read_points(dir.write("a.csv", ",x,y,z\n0,1,2,3\n1,4,5,6\n")), 3, {1, 2, 3, 4, 5, 6});
+  expect_cloud(read_points(dir.write("b.csv", "id,Z,\"Y\",X,mass\n7,3,2,1,9\n8,6,5,4,9\n")), 3, {1, 2, 3, 4, 5, 6});
   // x and y named, no z: 2D, however many columns.
   auto p2 = read_points(dir.write("c.txt", "id x y t\n7 1 2 0.5\n8 3 4 0.5\n"));
   EXPECT_EQ(p2.dim, 2);

@@ -58,10 +58,7 @@ TEST(VtkPoints, PiecesLabelsAndScalars) {
   TempDir dir;
   const std::string p = dir.write("two.vtp", kTwoPieces);
   auto pc = read_points(p, labels("RegionId"));
-  EXPECT_EQ(pc.dim, 3);
-  EXPECT_EQ(pc.n, 3u);
-  EXPECT_EQ(pc.coords, (std::vector<double>{0, 0.25, 1, 2, 3, 4, -1, -2, -3}));
-  EXPECT_EQ(pc.labels, (std::vector<std::int32_t>{3, -1, 7}));
+  expect_cloud(pc, 3, {0, 0.25, 1, 2, 3, 4, -1, -2, -3}, {3, -1, 7});
   ReadOptions two;
   two.dim = 2;
   EXPECT_EQ(read_points(p, two).coords, (std::vector<double>{0, 0.25, 2, 3, -1, -2}));
