@@ -265,6 +265,9 @@ void add_image_commands(CLI::App& app, ImageCommands& c) {
       ->capture_default_str();
   p->add_option("--threads", c.probe.threads, "Worker threads (default 0: $TESSERA_NUM_THREADS, else all cores)")
       ->check(NonNegative);
+  p->add_flag("--keep-non-finite", c.probe.keep_non_finite,
+              "Points with a NaN or infinite coordinate (an organized cloud's missing returns) are read and count as "
+              "outside (--outside-value) instead of refused");
   p->add_flag("-q,--quiet", c.probe.quiet, "No summary line");
   p->footer(
       "A point is inside when it lies in the box spanned by the voxel centres, far faces included, or\n"
@@ -316,10 +319,13 @@ int run_probe(const ProbeArgs& a) {
   io::ReadOptions pro;
   pro.dim = img.geometry.dim;
   pro.labels = a.labels;
+  pro.keep_non_finite = a.keep_non_finite;
+  pro.non_finite_hint = "--keep-non-finite counts such points as outside";
   const io::PointCloud pc = io::read_points(input_path(a.points), pro);
   ProbeOptions po;
   po.outside_value = outside;
   po.threads = a.threads;
+  po.keep_non_finite = a.keep_non_finite;
   ProbeResult r;
   try {
     r = probe(img, pc.coords, po);

@@ -30,7 +30,8 @@ constexpr const char* kOutputHelp =
     "int property 'label') or .vtp (VTK vertices, point data 'label'). 2D points get z = 0 in .ply/.vtp. - writes "
     "the .ply to standard output (rbox 1000 D3 | tessera joggle - -o - | tessera voronoi - --cell-table -)";
 
-void add_input_options(CLI::App* app, PrepInput& p, bool labels) {
+/// The flag's help, per command: what it does to those points there.
+void add_input_options(CLI::App* app, PrepInput& p, bool labels, const char* keep_help) {
   app->add_option("INPUT", p.input, "Point file: .npy, .csv/.xyz/.txt (or Qhull's format), .ply, .vtp/.vtu or .pcd (as for `voronoi`); - reads standard input")->required();
   app->add_option("-o,--output", p.output, kOutputHelp)->required();
   app->add_option("--dim", p.dim, "Dimension: 2 or 3 (default: the number of columns or fields; .ply, .vtp and .vtu are 3D)")
@@ -39,7 +40,27 @@ void add_input_options(CLI::App* app, PrepInput& p, bool labels) {
     app->add_option("--labels", p.labels,
                     "Per-point integer labels, carried to the output: FILE.npy, or the name of an integer .ply "
                     "vertex property / .csv column / .vtp or .vtu point data array / .pcd or structured .npy field");
+  app->add_flag("--keep-non-finite", p.keep_non_finite, keep_help);
   app->add_flag("-q,--quiet", p.quiet, "No summary line");
+}
+
+/// Whether point i has only finite coordinates.
+bool finite_point(const io::PointCloud& pc, std::size_t i) {
+  for (int d = 0; d < pc.dim; ++d)
+    if (!std::isfinite(pc.coords[i * static_cast<std::size_t>(pc.dim) + static_cast<std::size_t>(d)])) return false;
+  return true;
+}
+
+/// How many of the points have a NaN or infinite coordinate.
+std::size_t count_non_finite(const io::PointCloud& pc) {
+  std::size_t count = 0;
+  for (std::size_t i = 0; i < pc.n; ++i) count += !finite_point(pc, i);
+  return count;
+}
+
+/// The summary's note on kept non-finite points ("" when there are none).
+std::string non_finite_note(std::size_t count) {
+  return count == 0 ? std::string() : ", " + std::to_string(count) + " with a non-finite coordinate kept in place";
 }
 
 /// Checks the output path before any work: a points extension and a
@@ -59,6 +80,8 @@ void check_output(const std::string& path) {
 io::PointCloud read_prep_input(const PrepInput& p, bool with_labels) {
   io::ReadOptions ro;
   ro.dim = p.dim;
+  ro.keep_non_finite = p.keep_non_finite;
+  ro.non_finite_hint = "--keep-non-finite keeps such points in place";
   if (with_labels) ro.labels = p.labels;
   return io::read_points(input_path(p.input), ro);
 }
@@ -86,7 +109,10 @@ void add_prep_commands(CLI::App& app, PrepCommands& c) {
   c.joggle_app = app.add_subcommand(
       "joggle", "Move points by a small deterministic random displacement (seeded per point id)");
   CLI::App* j = c.joggle_app;
-  add_input_options(j, c.joggle.io, true);
+  add_input_options(j, c.joggle.io, true,
+                    "Points with a NaN or infinite coordinate (an organized cloud's missing returns) are copied "
+                    "through unmoved instead of refused, so ids stay; the diagonal is the finite points' box. "
+                    "`voronoi --ignore-outside` sets them aside");
   j->add_option("--radius", c.joggle.radius,
                 "Largest displacement: a fraction of the bounding-box diagonal, or a length with --absolute")
       ->check(NonNegative)
@@ -111,7 +137,10 @@ void add_prep_commands(CLI::App& app, PrepCommands& c) {
       "fill", "Add background points (label < 0) in the empty bins of a point cloud, so outside regions carve "
               "concave shapes");
   CLI::App* f = c.fill_app;
-  add_input_options(f, c.fill.io, true);
+  add_input_options(f, c.fill.io, true,
+                    "Points with a NaN or infinite coordinate (an organized cloud's missing returns) are kept in "
+                    "place with their labels instead of refused; they mark no bin, and the box is the finite "
+                    "points'. `voronoi --ignore-outside` sets them aside");
   f->add_option("--strategy", c.fill.strategy,
                 "uniform: one point at the centre of every empty bin; adaptive: every empty bin next to the "
                 "data, sparser (exponentially) further away")
@@ -141,7 +170,10 @@ void add_prep_commands(CLI::App& app, PrepCommands& c) {
       "threshold", "Label points by a scalar per point in half-open intervals [lo, hi); the rest get the "
                    "background label");
   CLI::App* t = c.threshold_app;
-  add_input_options(t, c.threshold.io, false);
+  add_input_options(t, c.threshold.io, false,
+                    "Points with a NaN or infinite coordinate (an organized cloud's missing returns) are read and "
+                    "labelled by their scalar as any other, instead of refused. `voronoi --ignore-outside` sets "
+                    "them aside");
   t->add_option("--scalars", c.threshold.scalars,
                 "S.npy (one number per point), or the name of a .ply vertex property / .csv column / .vtp or .vtu "
                 "point data array / .pcd or structured .npy field of INPUT "
@@ -181,6 +213,7 @@ int run_joggle(const JoggleArgs& a) {
                             : JoggleMode::ball;
   o.seed = a.seed;
   o.threads = a.threads;
+  o.keep_non_finite = a.io.keep_non_finite;
   check_output(a.io.output);
 
   const io::PointCloud pc = read_prep_input(a.io, true);
@@ -188,14 +221,19 @@ int run_joggle(const JoggleArgs& a) {
     throw InputError("--mode " + a.mode + " needs 3D points (2D points joggle in their plane: --mode ball)");
   std::vector<std::uint8_t> mask;
   std::size_t moving = pc.n;
+  const std::size_t non_finite = a.io.keep_non_finite ? count_non_finite(pc) : 0;
   if (!a.mask.empty()) {
     const io::NpyArray m = io::read_npy_int(a.mask);
     if (!(m.shape.size() == 1 || (m.shape.size() == 2 && m.shape[1] == 1)) || m.as_int.size() != pc.n)
       throw InputError(a.mask + ": mask must be a 1-D array of " + std::to_string(pc.n) + " values (one per point), "
                        "found " + std::to_string(m.as_int.size()));
     mask.resize(pc.n);
+    for (std::size_t i = 0; i < pc.n; ++i) mask[i] = m.as_int[i] != 0 ? 1 : 0;
+  }
+  if (!mask.empty() || non_finite != 0) {
+    // What joggle() moves: the masked points with finite coordinates.
     moving = 0;
-    for (std::size_t i = 0; i < pc.n; ++i) moving += (mask[i] = m.as_int[i] != 0 ? 1 : 0);
+    for (std::size_t i = 0; i < pc.n; ++i) moving += (mask.empty() || mask[i] != 0) && finite_point(pc, i);
   }
 
   LabelledPoints out;
@@ -207,15 +245,17 @@ int run_joggle(const JoggleArgs& a) {
     // std::hypot: squares of displacements below ~1e-154 underflow (the
     // summary said 0 for points that moved).
     double dx[3] = {0, 0, 0};
-    for (int d = 0; d < pc.dim; ++d) dx[d] = out.coords[i * pc.dim + d] - pc.coords[i * pc.dim + d];
+    for (int d = 0; d < pc.dim; ++d)
+      if (std::isfinite(pc.coords[i * pc.dim + d])) dx[d] = out.coords[i * pc.dim + d] - pc.coords[i * pc.dim + d];
     largest = std::max(largest, std::hypot(dx[0], dx[1], dx[2]));
   }
   const std::vector<std::string> written = io::write_points(a.io.output, out);
   if (!a.io.quiet)
-    std::printf("tessera joggle: %zu points (%dD) from %s, %zu moved (%s, radius %g%s), largest displacement %.3g; "
+    std::printf("tessera joggle: %zu points (%dD) from %s, %zu moved (%s, radius %g%s), largest displacement %.3g%s; "
                 "wrote %s\n",
                 pc.n, pc.dim, shown_path(a.io.input).c_str(), moving, a.mode.c_str(), a.radius,
-                a.absolute ? "" : " of the bounding-box diagonal", largest, written_list(written).c_str());
+                a.absolute ? "" : " of the bounding-box diagonal", largest, non_finite_note(non_finite).c_str(),
+                written_list(written).c_str());
   return kExitOk;
 }
 
@@ -235,6 +275,7 @@ int run_fill(const FillArgs& a) {
   o.joggle = a.joggle;
   o.seed = a.seed;
   o.threads = a.threads;
+  o.keep_non_finite = a.io.keep_non_finite;
   std::vector<double> bounds;
   if (!a.bounds.empty()) {
     for (const std::string& w : split_commas(a.bounds)) bounds.push_back(parse_number(w, "--bounds", false));
@@ -259,9 +300,10 @@ int run_fill(const FillArgs& a) {
   const LabelledPoints out = fill(pc.coords, pc.dim, pc.labels, o);
   const std::vector<std::string> written = io::write_points(a.io.output, out);
   if (!a.io.quiet)
-    std::printf("tessera fill: %zu points (%dD) from %s, %zu background points added (%s, label %d); wrote %s\n",
+    std::printf("tessera fill: %zu points (%dD) from %s, %zu background points added (%s, label %d)%s; wrote %s\n",
                 pc.n, pc.dim, shown_path(a.io.input).c_str(), out.size() - pc.n, a.strategy.c_str(),
-                static_cast<int>(a.background_label), written_list(written).c_str());
+                static_cast<int>(a.background_label),
+                non_finite_note(a.io.keep_non_finite ? count_non_finite(pc) : 0).c_str(), written_list(written).c_str());
   return kExitOk;
 }
 
@@ -305,8 +347,9 @@ int run_threshold(const ThresholdArgs& a) {
     for (const auto& [label, k] : count)
       parts += (parts.empty() ? "" : ", ") + std::string(label == a.background_label ? "background " : "label ") +
                std::to_string(label) + ": " + std::to_string(k);
-    std::printf("tessera threshold: %zu points (%dD) from %s (%s); wrote %s\n", pc.n, pc.dim, shown_path(a.io.input).c_str(),
-                parts.c_str(), written_list(written).c_str());
+    std::printf("tessera threshold: %zu points (%dD) from %s (%s)%s; wrote %s\n", pc.n, pc.dim,
+                shown_path(a.io.input).c_str(), parts.c_str(),
+                non_finite_note(a.io.keep_non_finite ? count_non_finite(pc) : 0).c_str(), written_list(written).c_str());
   }
   return kExitOk;
 }

@@ -167,6 +167,7 @@ io::PointCloud read_input(const ComputeArgs& a) {
   ro.dim = a.dim;
   ro.labels = a.labels;
   ro.keep_non_finite = a.ignore_outside;  // set aside by the computation, as points outside --bounds
+  ro.non_finite_hint = "--ignore-outside sets such points aside";
   io::PointCloud pc = io::read_points(a.input, ro);
   check_against_input(a, pc);
   return pc;

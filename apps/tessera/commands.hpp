@@ -111,6 +111,7 @@ struct PrepInput {
   int dim = 0;                 ///< 0: from the file
   std::string labels;          ///< "" | NAME | FILE.npy
   bool quiet = false;
+  bool keep_non_finite = false;  ///< points with a NaN or infinite coordinate kept, untouched
 };
 
 struct JoggleArgs {
@@ -207,6 +208,7 @@ struct ProbeArgs {
   std::string outside_value = "nan";  ///< a number, nan, inf, -inf
   int threads = 0;
   bool quiet = false;
+  bool keep_non_finite = false;       ///< points with a NaN coordinate are outside, not refused
 };
 
 struct ImageCommands {

@@ -248,10 +248,11 @@ void bind_prep(py::module_& m) {
   m.def(
       "joggle",
       [](const Points& points, double radius, bool absolute, const std::string& mode, const py::object& mask,
-         std::uint64_t seed, int threads) {
+         std::uint64_t seed, int threads, bool keep_non_finite) {
         const int dim = checked_dim(points);
         check_threads(threads);
         JoggleOptions opt;
+        opt.keep_non_finite = keep_non_finite;
         opt.radius = radius;
         opt.absolute = absolute;
         opt.mode = joggle_mode(mode);
@@ -270,17 +271,19 @@ void bind_prep(py::module_& m) {
         return adopt(std::move(out), {points.shape(0), dim});
       },
       py::arg("points").noconvert(), py::arg("radius"), py::arg("absolute"), py::arg("mode"),
-      py::arg("mask").none(true), py::arg("seed"), py::arg("threads"), "A joggled copy of the points.");
+      py::arg("mask").none(true), py::arg("seed"), py::arg("threads"), py::arg("keep_non_finite"),
+      "A joggled copy of the points.");
 
   // ---- fill -------------------------------------------------------------------
   m.def(
       "fill",
       [](const Points& points, const py::object& labels, const std::string& strategy, std::int32_t background_label,
          std::int32_t in_label, double points_per_bin, const std::optional<std::vector<double>>& bounds,
-         double joggle, std::uint64_t seed, int threads) {
+         double joggle, std::uint64_t seed, int threads, bool keep_non_finite) {
         const int dim = checked_dim(points);
         check_threads(threads);
         FillOptions opt;
+        opt.keep_non_finite = keep_non_finite;
         opt.strategy = strategy_of(strategy);
         opt.background_label = background_label;
         opt.in_label = in_label;
@@ -295,7 +298,8 @@ void bind_prep(py::module_& m) {
       },
       py::arg("points").noconvert(), py::arg("labels").none(true), py::arg("strategy"), py::arg("background_label"),
       py::arg("in_label"), py::arg("points_per_bin"), py::arg("bounds").none(true), py::arg("joggle"),
-      py::arg("seed"), py::arg("threads"), "The points followed by background points in empty bins: (points, labels).");
+      py::arg("seed"), py::arg("threads"), py::arg("keep_non_finite"),
+      "The points followed by background points in empty bins: (points, labels).");
 
   // ---- read_points -----------------------------------------------------------
   m.def(
@@ -305,6 +309,7 @@ void bind_prep(py::module_& m) {
         opt.dim = dim;
         opt.labels = labels;
         opt.keep_non_finite = keep_non_finite;
+        opt.non_finite_hint = "keep_non_finite=True keeps such points";
         io::PointCloud pc = without_gil([&] { return io::read_points(path, opt); });
         const auto n = static_cast<py::ssize_t>(pc.n);
         py::object lab = py::none();
@@ -332,7 +337,7 @@ void bind_prep(py::module_& m) {
   // ---- probe ------------------------------------------------------------------
   m.def(
       "probe",
-      [](const ScalarImage& image, const Points& points, double outside_value, int threads) {
+      [](const ScalarImage& image, const Points& points, double outside_value, int threads, bool keep_non_finite) {
         if (checked_dim(points) != image.geometry.dim)
           throw py::value_error("points: " + std::to_string(points.shape(1)) + "D points for a " +
                                 std::to_string(image.geometry.dim) + "D image");
@@ -340,11 +345,13 @@ void bind_prep(py::module_& m) {
         ProbeOptions opt;
         opt.outside_value = outside_value;
         opt.threads = threads;
+        opt.keep_non_finite = keep_non_finite;
         const auto pts = as_span(points);
         ProbeResult r = without_gil([&] { return tessera::probe(image, pts, opt); });
         return py::make_tuple(adopt_flat(std::move(r.values)), adopt_flat(std::move(r.valid)));
       },
       py::arg("image"), py::arg("points").noconvert(), py::arg("outside_value"), py::arg("threads"),
+      py::arg("keep_non_finite"),
       "Linear interpolation of the image at the points: (values float64, valid uint8).");
 }
 

@@ -419,6 +419,7 @@ def joggle(
     mask: Optional[npt.NDArray[np.uint8]],
     seed: int,
     threads: int,
+    keep_non_finite: bool,
 ) -> npt.NDArray[np.float64]: ...
 def fill(
     points: npt.NDArray[np.float64],
@@ -431,10 +432,15 @@ def fill(
     joggle: float,
     seed: int,
     threads: int,
+    keep_non_finite: bool,
 ) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.int32]]: ...
 def threshold(
     scalars: npt.NDArray[np.float64], intervals: Sequence[Tuple[float, float, int]], background_label: int
 ) -> npt.NDArray[np.int32]: ...
 def probe(
-    image: ScalarImage, points: npt.NDArray[np.float64], outside_value: float, threads: int
+    image: ScalarImage,
+    points: npt.NDArray[np.float64],
+    outside_value: float,
+    threads: int,
+    keep_non_finite: bool,
 ) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.uint8]]: ...

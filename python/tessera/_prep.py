@@ -239,6 +239,7 @@ def joggle(
     mask: Any = None,
     seed: int = 0,
     threads: Optional[int] = None,
+    keep_non_finite: bool = False,
 ) -> np.ndarray:
     """A joggled copy of the points: a small deterministic random displacement
     that breaks the exact ties of lattice-like input (tessera needs none for
@@ -257,6 +258,11 @@ def joggle(
     seed : int
         Each point's displacement depends only on (seed, point id): the same
         for any thread count and any mask.
+    keep_non_finite : bool
+        Points with a NaN or infinite coordinate (an organized cloud's missing
+        returns) are copied through unmoved instead of refused, so ids stay;
+        the relative radius then measures the finite points' box.
+        ``voronoi(..., ignore_outside=True)`` sets such points aside.
 
     Returns
     -------
@@ -271,7 +277,7 @@ def joggle(
         raise ValueError(f"mode: {m!r} needs 3D points; 2D points joggle in their plane (mode='ball')")
     mk = _inputs.as_mask(mask, pts.shape[0])
     return _inputs.call(_core.joggle, pts, r, bool(absolute), m, mk, _inputs.as_seed(seed),
-                        _inputs.as_threads(threads))
+                        _inputs.as_threads(threads), bool(keep_non_finite))
 
 
 # ---------------------------------------------------------------------- fill
@@ -290,6 +296,7 @@ def fill(
     joggle: float = 0.0,
     seed: int = 0,
     threads: Optional[int] = None,
+    keep_non_finite: bool = False,
 ) -> Tuple[np.ndarray, np.ndarray]:
     """Fill a point cloud's empty space with background points (label < 0),
     so the outside carves concave shapes and the cells' searches stay short.
@@ -311,6 +318,10 @@ def fill(
     joggle : float
         Offset of the added points as a fraction of the bin edge (at most 0.5).
     seed : int
+    keep_non_finite : bool
+        Points with a NaN or infinite coordinate are kept in place with their
+        labels instead of refused; they mark no bin and are not held to
+        ``bounds``, and the bounding box is the finite points'.
 
     Returns
     -------
@@ -330,7 +341,7 @@ def fill(
     if not 0 <= jog <= 0.5:
         raise ValueError(f"joggle: expected a number in [0, 0.5] (a fraction of the bin edge), got {joggle!r}")
     return _inputs.call(_core.fill, pts, lab, strat, bg, inl, ppb, _inputs.as_bounds(bounds, dim), jog,
-                        _inputs.as_seed(seed), _inputs.as_threads(threads))
+                        _inputs.as_seed(seed), _inputs.as_threads(threads), bool(keep_non_finite))
 
 
 # ----------------------------------------------------------------- threshold
@@ -374,6 +385,7 @@ def probe(
     origin: Any = None,
     outside_value: float = float("nan"),
     threads: Optional[int] = None,
+    keep_non_finite: bool = False,
 ) -> Tuple[np.ndarray, np.ndarray]:
     """Sample an image's scalars at points by linear interpolation between
     voxel centres (bilinear in 2D, trilinear in 3D).
@@ -389,6 +401,9 @@ def probe(
         The value at points outside the box of the voxel centres (a point on
         its far face is inside, and so is one within 1e-9 voxel spacings of
         it, which takes the face's value).
+    keep_non_finite : bool
+        A point with a NaN coordinate is outside instead of refused (one with
+        an infinite coordinate is outside either way).
 
     Returns
     -------
@@ -399,5 +414,5 @@ def probe(
     if pts.shape[1] != im.dim:
         raise ValueError(f"points: {pts.shape[1]}D points for a {im.dim}D image (shape {im.shape})")
     ov = _inputs.as_float(outside_value, "outside_value")
-    values, valid = _inputs.call(_core.probe, im, pts, ov, _inputs.as_threads(threads))
+    values, valid = _inputs.call(_core.probe, im, pts, ov, _inputs.as_threads(threads), bool(keep_non_finite))
     return values, valid.view(np.bool_)

@@ -283,3 +283,36 @@ def test_non_finite_points_kept_and_set_aside(tmp_path):
     assert vor.n_cells == 298
     assert 4 not in vor.generators and 100 not in vor.generators
     assert np.isfinite(vor.volumes).all()
+
+
+def test_non_finite_points_through_the_point_tools():
+    # joggle, fill and probe keep an organized cloud's missing returns in
+    # place with keep_non_finite (refused otherwise); voronoi then sets them
+    # aside, and the cells are those of the finite points' pipeline.
+    pts = random_points(500, 3, seed=13)
+    lost = np.zeros(500, bool)
+    lost[[3, 77, 250, 499]] = True
+    bad = pts.copy()
+    bad[lost] = np.nan
+    bad[77, 0] = np.inf
+    for tool in (tessera.joggle, tessera.fill):
+        with pytest.raises(ValueError, match="keep_non_finite"):
+            tool(bad)
+    j = tessera.joggle(bad, radius=1e-3, keep_non_finite=True)
+    np.testing.assert_array_equal(j[lost], bad[lost])
+    assert (j[~lost] != bad[~lost]).all()
+    f, lab = tessera.fill(j, keep_non_finite=True)
+    fk, labk = tessera.fill(j[~lost])
+    np.testing.assert_array_equal(f[:500], j)
+    np.testing.assert_array_equal(f[500:], fk[len(fk) - (len(f) - 500):])
+    vor = tessera.voronoi(f, labels=lab, ignore_outside=True)
+    ref = tessera.voronoi(fk, labels=labk)
+    np.testing.assert_array_equal(vor.ignored_outside_bounds, np.flatnonzero(lost))
+    np.testing.assert_array_equal(ref.generators, np.arange(496))  # the input points own the cells
+    np.testing.assert_array_equal(vor.generators, np.flatnonzero(~lost))
+    np.testing.assert_array_equal(vor.volumes, ref.volumes)
+    image = np.arange(27, dtype=float).reshape(3, 3, 3)
+    with pytest.raises(ValueError, match="NaN"):
+        tessera.probe(image, bad)
+    v, ok = tessera.probe(image, bad, outside_value=-1.0, keep_non_finite=True)
+    assert not ok[lost].any() and (v[lost] == -1).all() and ok[~lost].all()

@@ -330,7 +330,7 @@ PointCloud read_pcd_points(const std::string& path, const ReadOptions& options, 
       const double v = cols[static_cast<std::size_t>(d)][i];
       if (std::isnan(v) && !options.keep_non_finite)
         fail(path, "point " + std::to_string(i) + " has a NaN coordinate (organized clouds mark missing returns so: "
-                   "remove them first, e.g. pcl::removeNaNFromPointCloud, or give --ignore-outside)");
+                   "remove them first, e.g. pcl::removeNaNFromPointCloud; or " + non_finite_hint(options) + ")");
       pc.coords[i * static_cast<std::size_t>(dim) + static_cast<std::size_t>(d)] = v;
     }
   if (label != none) pc.labels = labels_from_values(path, label_field, cols.back());

@@ -168,6 +168,10 @@ std::vector<std::int32_t> read_labels_npy(const std::string& path) {
   return labels;
 }
 
+std::string non_finite_hint(const ReadOptions& options) {
+  return options.non_finite_hint.empty() ? "keep_non_finite keeps such points" : options.non_finite_hint;
+}
+
 PointCloud read_points(const std::string& path, const ReadOptions& options) {
   if (options.dim != 0 && options.dim != 2 && options.dim != 3)
     detail::fail(path, "dimension must be 2 or 3, not " + std::to_string(options.dim));
@@ -198,7 +202,7 @@ PointCloud read_points(const std::string& path, const ReadOptions& options) {
       char buf[64];
       std::snprintf(buf, sizeof buf, "%g", pc.coords[k]);
       detail::fail(path, "non-finite coordinate " + std::string(buf) + " in row " + std::to_string(k / pc.dim) +
-                             " (0-based; --ignore-outside sets such points aside)");
+                             " (0-based; " + non_finite_hint(options) + ")");
     }
   }
 

@@ -230,7 +230,8 @@ PointCloud qhull_points(const std::string& path, Lines& lines, std::size_t ndim,
       if (!parse_double(f, v))
         fail(path, "line " + std::to_string(line_no) + ": cannot parse '" + std::string(f) + "' as a number");
       if (!std::isfinite(v) && !options.keep_non_finite)
-        fail(path, "line " + std::to_string(line_no) + ": non-finite coordinate '" + std::string(f) + "'");
+        fail(path, "line " + std::to_string(line_no) + ": non-finite coordinate '" + std::string(f) + "' (" +
+                       non_finite_hint(options) + ")");
       if (seen / ndim >= count)
         fail(path, "Qhull point format: more numbers than the " + std::to_string(count) + " points of dimension " +
                        std::to_string(ndim) + " its header declares (line " + std::to_string(line_no) + ")");
@@ -348,7 +349,8 @@ PointCloud read_text_points(const std::string& path, const ReadOptions& options,
                        "' as a number (column " + std::to_string(c + 1) + ")");
       }
       if (!std::isfinite(xyz[s]) && !options.keep_non_finite)
-        fail(path, "line " + std::to_string(line_no) + ": non-finite coordinate '" + std::string(f) + "'");
+        fail(path, "line " + std::to_string(line_no) + ": non-finite coordinate '" + std::string(f) + "' (" +
+                       non_finite_hint(options) + ")");
     }
     if (c < needed)
       fail(path, "line " + std::to_string(line_no) + " has " + std::to_string(c) +

@@ -175,9 +175,22 @@ LabelledPoints fill(std::span<const double> coords, int dim, std::span<const std
                      num(options.joggle));
   if (options.strategy != FillStrategy::uniform && options.strategy != FillStrategy::adaptive)
     throw InputError("fill: unknown strategy");
-  for (std::size_t k = 0; k < coords.size(); ++k)
-    if (!std::isfinite(coords[k]))
-      throw InputError("fill: non-finite coordinate " + num(coords[k]) + " in point " + std::to_string(k / sdim));
+  // Points that take part: all, or with keep_non_finite the finite ones.
+  std::vector<std::uint8_t> finite;
+  if (options.keep_non_finite) {
+    finite.assign(n, 1);
+    for (std::size_t k = 0; k < coords.size(); ++k)
+      if (!std::isfinite(coords[k])) finite[k / sdim] = 0;
+  } else {
+    for (std::size_t k = 0; k < coords.size(); ++k)
+      if (!std::isfinite(coords[k]))
+        throw InputError("fill: non-finite coordinate " + num(coords[k]) + " in point " + std::to_string(k / sdim) +
+                         " (keep_non_finite keeps such points, unbinned)");
+  }
+  auto takes_part = [&](std::size_t i) { return finite.empty() || finite[i] != 0; };
+  const std::size_t taking =
+      finite.empty() ? n : static_cast<std::size_t>(std::count(finite.begin(), finite.end(), std::uint8_t{1}));
+  if (taking == 0) throw InputError("fill: all " + std::to_string(n) + " points have a NaN or infinite coordinate");
 
   // The region: the given bounds (containing every point) or the bounding box.
   double lo[3], hi[3];
@@ -190,35 +203,39 @@ LabelledPoints fill(std::span<const double> coords, int dim, std::span<const std
                          num(lo[d]) + ", " + num(hi[d]) + "]");
     }
     for (std::size_t i = 0; i < n; ++i)
-      for (int d = 0; d < dim; ++d) {
+      for (int d = 0; d < dim && takes_part(i); ++d) {
         const double v = coords[i * sdim + static_cast<std::size_t>(d)];
         if (v < lo[d] || v > hi[d])
           throw InputError("fill: point " + std::to_string(i) + " lies outside the bounds (" + axis_name(d) + " = " +
                            num(v) + " not in [" + num(lo[d]) + ", " + num(hi[d]) + "])");
       }
   } else {
-    for (int d = 0; d < dim; ++d) lo[d] = hi[d] = coords[static_cast<std::size_t>(d)];
-    for (std::size_t i = 1; i < n; ++i)
+    bool first = true;
+    for (std::size_t i = 0; i < n; ++i) {
+      if (!takes_part(i)) continue;
       for (int d = 0; d < dim; ++d) {
         const double v = coords[i * sdim + static_cast<std::size_t>(d)];
-        lo[d] = std::min(lo[d], v);
-        hi[d] = std::max(hi[d], v);
+        lo[d] = first ? v : std::min(lo[d], v);
+        hi[d] = first ? v : std::max(hi[d], v);
       }
+      first = false;
+    }
     for (int d = 0; d < dim; ++d)
       if (!(lo[d] < hi[d]))
-        throw InputError(std::string("fill: all ") + std::to_string(n) + " points have " + axis_name(d) + " = " +
-                         num(lo[d]) + ": give bounds for the region to fill" +
+        throw InputError(std::string("fill: all ") + std::to_string(taking) + (taking < n ? " finite" : "") +
+                         " points have " + axis_name(d) + " = " + num(lo[d]) + ": give bounds for the region to fill" +
                          (dim == 3 && d == 2 ? " (or use 2D points)" : ""));
   }
 
-  const Grid grid = make_grid(dim, lo, hi, n, options.points_per_bin);
+  const Grid grid = make_grid(dim, lo, hi, taking, options.points_per_bin);
   const int threads = resolve_threads(options.threads);
 
   // Occupancy, one byte per bin; concurrent stores of the same value.
   std::vector<std::uint8_t> occupied(grid.n_bins(), 0);
   parallel_range(n, threads, [&](const tbb::blocked_range<std::size_t>& r) {
     for (std::size_t i = r.begin(); i != r.end(); ++i)
-      std::atomic_ref<std::uint8_t>(occupied[grid.bin_of(&coords[i * sdim])]).store(1, std::memory_order_relaxed);
+      if (takes_part(i))
+        std::atomic_ref<std::uint8_t>(occupied[grid.bin_of(&coords[i * sdim])]).store(1, std::memory_order_relaxed);
   });
 
   LabelledPoints out;

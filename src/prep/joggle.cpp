@@ -29,17 +29,29 @@ std::string num(double v) {
   return std::string(buf, r.ptr);
 }
 
-/// `r` times the length of the diagonal of the bounding box of all points.
+/// Whether point i's coordinates are all finite.
+bool finite_point(std::span<const double> coords, std::size_t i, int dim) {
+  for (int d = 0; d < dim; ++d)
+    if (!std::isfinite(coords[i * static_cast<std::size_t>(dim) + static_cast<std::size_t>(d)])) return false;
+  return true;
+}
+
+/// `r` times the length of the diagonal of the bounding box of the finite
+/// points (every point, unless keep_non_finite let others in); 0 when none is.
 double times_diagonal(double r, std::span<const double> coords, int dim) {
   const std::size_t n = coords.size() / static_cast<std::size_t>(dim);
   double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
-  for (int d = 0; d < dim; ++d) lo[d] = hi[d] = coords[static_cast<std::size_t>(d)];
-  for (std::size_t i = 1; i < n; ++i)
+  bool any = false;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!finite_point(coords, i, dim)) continue;
     for (int d = 0; d < dim; ++d) {
       const double v = coords[i * static_cast<std::size_t>(dim) + static_cast<std::size_t>(d)];
-      lo[d] = std::min(lo[d], v);
-      hi[d] = std::max(hi[d], v);
+      lo[d] = any ? std::min(lo[d], v) : v;
+      hi[d] = any ? std::max(hi[d], v) : v;
     }
+    any = true;
+  }
+  if (!any) return 0;
   double s = 0;
   for (int d = 0; d < dim; ++d) s += (hi[d] - lo[d]) * (hi[d] - lo[d]);
   if (std::isfinite(s) && s > 1e-290) return r * std::sqrt(s);
@@ -69,10 +81,11 @@ std::vector<double> joggle(std::span<const double> coords, int dim, const Joggle
   if (!mask.empty() && mask.size() != n)
     throw InputError("joggle: mask has " + std::to_string(mask.size()) + " values for " + std::to_string(n) +
                      " points");
-  for (std::size_t k = 0; k < coords.size(); ++k)
+  for (std::size_t k = 0; k < coords.size() && !options.keep_non_finite; ++k)
     if (!std::isfinite(coords[k]))
       throw InputError("joggle: non-finite coordinate " + num(coords[k]) + " in point " +
-                       std::to_string(k / static_cast<std::size_t>(dim)));
+                       std::to_string(k / static_cast<std::size_t>(dim)) +
+                       " (keep_non_finite copies such points through unmoved)");
 
   std::vector<double> out(coords.begin(), coords.end());
   if (n == 0) return out;
@@ -95,6 +108,7 @@ std::vector<double> joggle(std::span<const double> coords, int dim, const Joggle
     double u[3];
     for (std::size_t i = r.begin(); i != r.end(); ++i) {
       if (!mask.empty() && mask[i] == 0) continue;
+      if (options.keep_non_finite && !finite_point(coords, i, dim)) continue;  // copied through
       detail::RandomStream rng(options.seed, i, detail::kStreamJoggle);
       rng.in_unit_ball(moving, u);
       for (int k = 0; k < moving; ++k) out[i * stride + static_cast<std::size_t>(axes[k])] += radius * u[k];
@@ -108,7 +122,7 @@ std::vector<double> joggle(std::span<const double> coords, int dim, const Joggle
     arena.execute([&] { tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, kGrain), body); });
   }
   for (std::size_t k = 0; k < out.size(); ++k)
-    if (!std::isfinite(out[k]))
+    if (!std::isfinite(out[k]) && std::isfinite(coords[k]))
       throw InputError("joggle: point " + std::to_string(k / stride) + " moved past double's range (radius " +
                        num(radius) + "); give a smaller radius");
   return out;

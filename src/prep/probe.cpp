@@ -42,9 +42,10 @@ ProbeResult probe(const ScalarImage& image, std::span<const double> coords, cons
     throw InputError("probe: " + std::to_string(coords.size()) + " coordinates is not a multiple of the image "
                      "dimension " + std::to_string(dim));
   const std::size_t n = coords.size() / static_cast<std::size_t>(dim);
-  for (std::size_t k = 0; k < coords.size(); ++k)
+  for (std::size_t k = 0; k < coords.size() && !options.keep_non_finite; ++k)
     if (std::isnan(coords[k]))
-      throw InputError("probe: point " + std::to_string(k / static_cast<std::size_t>(dim)) + " has a NaN coordinate");
+      throw InputError("probe: point " + std::to_string(k / static_cast<std::size_t>(dim)) +
+                       " has a NaN coordinate (keep_non_finite counts such points as outside)");
 
   ProbeResult res;
   res.values.assign(n, options.outside_value);
@@ -59,7 +60,7 @@ ProbeResult probe(const ScalarImage& image, std::span<const double> coords, cons
       const std::size_t au = static_cast<std::size_t>(a);
       const double hi = static_cast<double>(g.size[au] - 1);
       double t = (coords[p * static_cast<std::size_t>(dim) + au] - g.origin[au]) / g.spacing[au];
-      if (!(t >= -kSlack && t <= hi + kSlack)) return;  // outside (also +-inf)
+      if (!(t >= -kSlack && t <= hi + kSlack)) return;  // outside (also +-inf, and NaN)
       t = std::clamp(t, 0.0, hi);
       // Snap to a voxel index within the slack: (p - origin) / spacing at a
       // voxel centre is off by rounding, and exactness there matters more.

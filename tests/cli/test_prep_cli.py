@@ -211,6 +211,84 @@ class Threshold(Case):
         self.fails(["threshold", inp, "--scalars", s, "-o", out], "interval")
 
 
+class NonFinite(Case):
+    """An organized cloud (PCL's .pcd, NaN rows for missing returns) through
+    the point tools with --keep-non-finite, then `voronoi --ignore-outside`:
+    the missing points keep their ids and bits and take no part."""
+
+    def setUp(self):
+        super().setUp()
+        rng = np.random.default_rng(8)
+        self.pts = rng.random((1200, 3))
+        self.intensity = rng.random(1200)
+        self.missing = np.arange(5, 1200, 9)
+        pts = self.pts.copy()
+        pts[self.missing] = np.nan
+        pts[self.missing[::4], 1] = 0.5  # some rows only partly missing
+        self.pcd = self.p("organized.pcd")
+        with open(self.pcd, "w") as f:
+            f.write("VERSION .7\nFIELDS x y z intensity\nSIZE 8 8 8 8\nTYPE F F F F\nCOUNT 1 1 1 1\nWIDTH 40\n"
+                    "HEIGHT 30\nPOINTS 1200\nDATA ascii\n")
+            for p, s in zip(pts, self.intensity):
+                f.write("%.17g %.17g %.17g %.17g\n" % (p[0], p[1], p[2], s))
+        self.kept = np.setdiff1d(np.arange(1200), self.missing)
+
+    def test_refused_without_the_flag(self):
+        for cmd in (["joggle"], ["fill"], ["threshold", "--scalars", "intensity", "--interval", "0,1,1"]):
+            self.fails(cmd + [self.pcd, "-o", self.p("o.npy")], "--keep-non-finite")
+        img = self.save("img.npy", np.zeros((4, 4, 4)))
+        self.fails(["probe", img, self.pcd, "-o", self.p("v.npy")], "--keep-non-finite")
+
+    def test_joggle_fill_threshold_then_voronoi(self):
+        n_missing = len(self.missing)
+        r = self.ok(["joggle", self.pcd, "--keep-non-finite", "--radius", "1e-3", "-o", self.p("j.npy")])
+        self.assertIn("%d moved" % (1200 - n_missing), r.stdout)
+        self.assertIn("%d with a non-finite coordinate kept in place" % n_missing, r.stdout)
+        j = np.load(self.p("j.npy"))
+        raw = np.loadtxt(self.pcd, skiprows=9)[:, :3]
+        lost = ~np.all(np.isfinite(raw), axis=1)
+        self.assertTrue(np.array_equal(np.flatnonzero(lost), self.missing))
+        self.assertTrue(np.array_equal(j[lost], raw[lost], equal_nan=True))  # copied through
+        self.assertTrue(np.all(j[~lost] != raw[~lost]))
+
+        # fill: the points first, then the finite points' background points.
+        r = self.ok(["fill", self.p("j.npy"), "--keep-non-finite", "-o", self.p("f.npy")])
+        self.assertIn("%d with a non-finite coordinate kept in place" % n_missing, r.stdout)
+        f = np.load(self.p("f.npy"))
+        self.ok(["fill", self.save("jk.npy", j[~lost]), "-o", self.p("fk.npy"), "-q"])
+        fk = np.load(self.p("fk.npy"))
+        self.assertTrue(np.array_equal(f[:1200], j, equal_nan=True))
+        self.assertTrue(np.array_equal(f[1200:], fk[len(self.kept):]))
+
+        # threshold: labels from the scalars, every row kept.
+        self.ok(["threshold", self.pcd, "--keep-non-finite", "--scalars", "intensity", "--interval", "0,0.5,1",
+                 "--interval", "0.5,1,2", "-o", self.p("t.npy"), "-q"])
+        lab = np.load(self.p("t_labels.npy"))
+        self.assertTrue(np.array_equal(lab, np.where(self.intensity < 0.5, 1, 2)))
+
+        # voronoi of the filled cloud: the missing points set aside, the
+        # cells those of the finite pipeline, under the input's ids.
+        t = self.p("cells.csv")
+        r = self.ok(["voronoi", self.p("f.npy"), "--labels", self.p("f_labels.npy"), "--ignore-outside",
+                     "--cell-table", t])
+        self.assertIn("ignored (outside)  %d" % n_missing, r.stdout)
+        ref = self.p("ref.csv")
+        self.ok(["voronoi", self.p("fk.npy"), "--labels", self.p("fk_labels.npy"), "--cell-table", ref, "-q"])
+        a = np.loadtxt(t, delimiter=",", skiprows=1)
+        b = np.loadtxt(ref, delimiter=",", skiprows=1)
+        self.assertTrue(np.array_equal(a[:, 0], self.kept))
+        self.assertTrue(np.array_equal(a[:, 1:], b[:, 1:]))
+
+    def test_probe_counts_them_outside(self):
+        img = self.save("img.npy", np.arange(64, dtype=float).reshape(4, 4, 4))
+        r = self.ok(["probe", img, self.pcd, "--keep-non-finite", "--outside-value", "-1", "-o", self.p("v.npy")])
+        self.assertIn("(%d inside, %d outside)" % (len(self.kept), len(self.missing)), r.stdout)
+        v = np.load(self.p("v.npy"))
+        self.assertTrue(np.all(v[self.missing] == -1))
+        # The others lie in [0, 1]^3, inside the voxel-centre box [0, 3]^3.
+        self.assertTrue(np.all(v[self.kept] >= 0))
+
+
 def main():
     return base.cli_main("test_prep_cli.py", [(base.vtk is not None, "python3-vtk9 is required (run with /usr/bin/python3)")])
 

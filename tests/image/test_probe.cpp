@@ -159,4 +159,22 @@ TEST(image_probe, Errors) {
   EXPECT_EQ(probe(img, std::vector<double>{}).values.size(), 0u);
 }
 
+TEST(image_probe, NonFinitePointsAreOutsideWhenKept) {
+  // An organized cloud's missing returns (NaN points) are outside, as an
+  // infinite coordinate is; the other points' values are unchanged.
+  const ScalarImage img = linear_image(3, {0.3, 1.5, -2.0, 0.7});
+  const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
+  const std::vector<double> pts = {0, 3, 1, nan, 3, 1, 0.5, 2.5, 1.5, 0, nan, nan, -inf, 3, 1, 0, 3, inf};
+  ProbeOptions o;
+  o.keep_non_finite = true;
+  o.outside_value = -7;
+  const auto r = probe(img, pts, o);
+  const std::vector<std::uint8_t> valid = {1, 0, 1, 0, 0, 0};
+  EXPECT_EQ(r.valid, valid);
+  const auto finite = probe(img, std::vector<double>{0, 3, 1, 0.5, 2.5, 1.5});
+  EXPECT_EQ(r.values[0], finite.values[0]);
+  EXPECT_EQ(r.values[2], finite.values[1]);
+  for (std::size_t p : {1, 3, 4, 5}) EXPECT_EQ(r.values[p], -7.0) << p;
+}
+
 }  // namespace

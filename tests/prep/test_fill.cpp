@@ -238,6 +238,53 @@ TEST(PrepFill, BinsAtDoubleResolutionAreAnError) {
       EXPECT_FALSE(out.coords[a] == wide[b] && out.coords[a + 1] == wide[b + 1]) << "added point " << a / 2;
 }
 
+TEST(PrepFill, NonFinitePointsKeptUnbinnedWhenKept) {
+  // Missing returns between the points: kept in place with their labels,
+  // and the added points are those of the finite points alone (the same
+  // box, the same bin count), with or without bounds.
+  const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
+  for (const FillStrategy strategy : {FillStrategy::uniform, FillStrategy::adaptive})
+    for (int dim : {2, 3})
+      for (bool bounded : {false, true}) {
+        std::mt19937_64 rng(static_cast<unsigned>(dim));
+        std::uniform_real_distribution<double> u(0.2, 0.7);
+        std::vector<double> finite_pts, all;
+        std::vector<std::int32_t> finite_labels, all_labels;
+        for (int i = 0; i < 600; ++i) {
+          const bool lost = i % 5 == 2;
+          for (int d = 0; d < dim; ++d) {
+            const double v = lost ? (d == 0 ? (i % 2 ? nan : -inf) : u(rng)) : u(rng);
+            all.push_back(v);
+            if (!lost) finite_pts.push_back(v);
+          }
+          all_labels.push_back(i % 4);
+          if (!lost) finite_labels.push_back(i % 4);
+        }
+        FillOptions o;
+        o.strategy = strategy;
+        o.joggle = 0.25;
+        if (bounded) o.bounds = box(0, 1, -0.5, 1, 0, 2);
+        EXPECT_THROW(tessera::fill(all, dim, all_labels, o), tessera::InputError);
+        o.keep_non_finite = true;
+        const auto out = tessera::fill(all, dim, all_labels, o);
+        const auto want = tessera::fill(finite_pts, dim, finite_labels, o);
+        const std::size_t n = all_labels.size(), nf = finite_labels.size();
+        ASSERT_EQ(out.size() - n, want.size() - nf) << dim << bounded;
+        ASSERT_GT(out.size(), n);
+        for (std::size_t k = 0; k < all.size(); ++k)
+          ASSERT_EQ(std::memcmp(&out.coords[k], &all[k], sizeof(double)), 0) << k;
+        EXPECT_TRUE(std::equal(all_labels.begin(), all_labels.end(), out.labels.begin()));
+        EXPECT_TRUE(std::equal(out.coords.begin() + static_cast<std::ptrdiff_t>(all.size()), out.coords.end(),
+                               want.coords.begin() + static_cast<std::ptrdiff_t>(finite_pts.size())));
+        EXPECT_TRUE(std::equal(out.labels.begin() + static_cast<std::ptrdiff_t>(n), out.labels.end(),
+                               want.labels.begin() + static_cast<std::ptrdiff_t>(nf)));
+      }
+  // Only non-finite points: nothing to bin.
+  FillOptions o;
+  o.keep_non_finite = true;
+  EXPECT_THROW(tessera::fill(std::vector<double>{nan, 0, inf, 1}, 2, {}, o), tessera::InputError);
+}
+
 TEST(PrepFill, BadInput) {
   const std::vector<double> p = {0, 0, 1, 1};
   FillOptions o;

@@ -194,6 +194,52 @@ TEST(PrepJoggle, ZeroRadiusAndEmptyInput) {
   EXPECT_EQ(tessera::joggle(one, 3), one);
 }
 
+TEST(PrepJoggle, NonFinitePointsCopiedThroughWhenKept) {
+  // An organized cloud's missing returns keep their place and bits; the
+  // finite points move as a mask of them would move them where the
+  // missing ones are copies of a finite point (the same bounding box).
+  const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
+  for (int dim : {2, 3}) {
+    const std::size_t n = 3000;  // also the parallel path
+    auto p = random_points(n, dim, 11);
+    auto same_box = p;
+    std::vector<std::uint8_t> finite(n, 1);
+    for (std::size_t i = 3; i < n; i += 7) {
+      finite[i] = 0;
+      const double bad = i % 3 == 0 ? nan : (i % 3 == 1 ? inf : -inf);
+      p[i * dim + (i % static_cast<std::size_t>(dim))] = bad;  // one coordinate; the others stay finite
+      if (i % 2 == 0)
+        for (int d = 0; d < dim; ++d) p[i * dim + d] = nan;  // or all of them
+      for (int d = 0; d < dim; ++d) same_box[i * dim + d] = same_box[d];
+    }
+    JoggleOptions o;
+    o.radius = 0.01;
+    EXPECT_THROW(tessera::joggle(p, dim, o), tessera::InputError);
+    o.keep_non_finite = true;
+    const auto out = tessera::joggle(p, dim, o);
+    const auto want = tessera::joggle(same_box, dim, o, finite);
+    for (std::size_t i = 0; i < n; ++i)
+      for (int d = 0; d < dim; ++d) {
+        const std::size_t k = i * dim + static_cast<std::size_t>(d);
+        if (finite[i]) {
+          ASSERT_TRUE(bit_equal(out[k], want[k])) << dim << " " << i;
+          ASSERT_NE(out[k], p[k]);
+        } else {
+          ASSERT_TRUE(bit_equal(out[k], p[k])) << dim << " " << i;
+        }
+      }
+    // Absolute radius: the same displacements; only non-finite points: none moves.
+    o.absolute = true;
+    const auto abs_out = tessera::joggle(p, dim, o), abs_want = tessera::joggle(same_box, dim, o);
+    for (std::size_t i = 0; i < n; ++i)
+      if (finite[i]) ASSERT_TRUE(bit_equal(abs_out[i * dim], abs_want[i * dim])) << i;
+    o.absolute = false;
+    const std::vector<double> lost(static_cast<std::size_t>(2 * dim), nan);
+    const auto none = tessera::joggle(lost, dim, o);
+    for (double v : none) EXPECT_TRUE(std::isnan(v));
+  }
+}
+
 TEST(PrepJoggle, BadInput) {
   const auto p = random_points(10, 3, 8);
   JoggleOptions o;

@@ -33,7 +33,14 @@ struct ReadOptions {
   /// returns) for the computation to set aside, as VoronoiOptions::
   /// ignore_outside_points does; otherwise such a point is an input error.
   bool keep_non_finite = false;
+  /// How the error on such a point says to keep them: the caller's own
+  /// option ("--ignore-outside sets such points aside"); empty: this
+  /// struct's keep_non_finite.
+  std::string non_finite_hint;
 };
+
+/// ReadOptions::non_finite_hint, or its default when empty.
+std::string non_finite_hint(const ReadOptions& options);
 
 /// Read .npy (C or Fortran order), .csv/.xyz/.txt (the columns a header names
 /// x, y and z in any case, else the first ones) or .ply. Throws tessera::InputError (one line naming the

@@ -36,9 +36,15 @@ struct FillOptions {
   double joggle = 0.0;
   std::uint64_t seed = 0;
   int threads = 0;
+  /// Points with a NaN or infinite coordinate (an organized cloud's missing
+  /// returns) are kept in the output, in place with their labels, instead of
+  /// refused; they mark no bin and are not held to the bounds. The bounding
+  /// box is then the finite points', of which there must be one.
+  bool keep_non_finite = false;
 };
 
-/// Throws InputError on empty or NaN input, labels of the wrong length,
+/// Throws InputError on empty input, a NaN or infinite coordinate (unless
+/// keep_non_finite), labels of the wrong length,
 /// background_label >= 0, points outside the given bounds, bad options.
 LabelledPoints fill(std::span<const double> coords, int dim, std::span<const std::int32_t> labels,
                     const FillOptions& options = {});

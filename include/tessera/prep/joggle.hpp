@@ -26,12 +26,18 @@ struct JoggleOptions {
   JoggleMode mode = JoggleMode::ball;
   std::uint64_t seed = 0;
   int threads = 0;            ///< 0: TESSERA_NUM_THREADS, else all cores
+  /// Points with a NaN or infinite coordinate (an organized cloud's missing
+  /// returns) are copied through unmoved instead of refused, keeping every
+  /// point's id; the relative radius then measures the finite points' box.
+  /// VoronoiOptions::ignore_outside_points sets such points aside later.
+  bool keep_non_finite = false;
 };
 
 /// Joggled copy of `coords` (n * dim, dim 2 or 3). With a non-empty `mask`
 /// (one byte per point) only points with mask != 0 move; the others are
 /// copied through bit for bit. Throws InputError on a negative / non-finite
-/// radius, a plane mode with dim 2, a mask of the wrong length, or NaN input.
+/// radius, a plane mode with dim 2, a mask of the wrong length, or a NaN or
+/// infinite coordinate (unless options.keep_non_finite).
 std::vector<double> joggle(std::span<const double> coords, int dim, const JoggleOptions& options = {},
                            std::span<const std::uint8_t> mask = {});
 

@@ -18,6 +18,10 @@ struct ProbeOptions {
   /// 1e-9 voxel spacings from it: nearer, a point takes the face's value).
   double outside_value = std::numeric_limits<double>::quiet_NaN();
   int threads = 0;
+  /// A point with a NaN coordinate (an organized cloud's missing return) is
+  /// outside (outside_value, not valid) instead of refused. An infinite
+  /// coordinate is outside either way.
+  bool keep_non_finite = false;
 };
 
 struct ProbeResult {
@@ -26,7 +30,8 @@ struct ProbeResult {
 };
 
 /// `coords` has n * image.geometry.dim entries. A point exactly on the box's
-/// far face is inside. Throws InputError on NaN coordinates or an empty image.
+/// far face is inside. Throws InputError on NaN coordinates (unless
+/// keep_non_finite) or an empty image.
 ProbeResult probe(const ScalarImage& image, std::span<const double> coords, const ProbeOptions& options = {});
 
 }  // namespace tessera
