@@ -64,15 +64,18 @@ void print_written(const std::vector<std::string>& written) {
 // ------------------------------------------------------------------ graph
 
 int run_graph(const GraphArgs& a) {
-  if (a.output.empty() && a.csr.empty() && a.spoke_classes.empty())
-    throw InputError("nothing to do: give -o GRAPH.vtp, --csr FILE.npy or --spoke-classes FILE.npy");
+  if (a.output.empty() && a.csr.empty() && a.spoke_classes.empty() && a.spoke_measures.empty())
+    throw InputError(
+        "nothing to do: give -o GRAPH.vtp, --csr FILE.npy, --spoke-classes FILE.npy or --spoke-measures FILE.npy");
   if (!a.output.empty()) require_extension(a.output, ".vtp", "output", "the graph (lines)");
   if (!a.csr.empty()) require_extension(a.csr, ".npy", "--csr", "the wheels");
   if (!a.spoke_classes.empty()) require_extension(a.spoke_classes, ".npy", "--spoke-classes", "the spoke classes");
+  if (!a.spoke_measures.empty())
+    require_extension(a.spoke_measures, ".npy", "--spoke-measures", "the spoke measures");
   if (!(a.prune_tolerance >= 0) || !std::isfinite(a.prune_tolerance))
     throw InputError("--prune-tolerance must be a finite number >= 0");
   check_bounds_arg(a.compute.bounds);
-  for (const std::string* p : {&a.output, &a.csr, &a.spoke_classes})
+  for (const std::string* p : {&a.output, &a.csr, &a.spoke_classes, &a.spoke_measures})
     if (!p->empty()) io::check_writable(*p);
 
   const Computed r = read_and_compute(a.compute, a.quiet);
@@ -89,6 +92,10 @@ int run_graph(const GraphArgs& a) {
   if (!a.spoke_classes.empty()) {
     io::write_spoke_classes_npy(a.spoke_classes, g);
     written.push_back(a.spoke_classes);
+  }
+  if (!a.spoke_measures.empty()) {
+    io::write_spoke_measures_npy(a.spoke_measures, g);
+    written.push_back(a.spoke_measures);
   }
 
   if (!a.quiet) {

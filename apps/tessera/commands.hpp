@@ -71,6 +71,7 @@ struct GraphArgs {
   std::string output;          ///< .vtp lines, or empty
   std::string csr;             ///< .npy wheels (layout of --neighbors), or empty
   std::string spoke_classes;   ///< .npy uint8 class per spoke, or empty
+  std::string spoke_measures;  ///< .npy float64 face area (2D: length) per spoke, or empty
   double prune_tolerance = 0;
   bool quiet = false;
 };

@@ -240,6 +240,9 @@ int main(int argc, char** argv) {
   graph->add_option("--spoke-classes", ga.spoke_classes,
                     "Class of every spoke of --csr as a uint8 .npy array (0 same region, 1 region boundary, "
                     "2 domain boundary, 3 outside)");
+  graph->add_option("--spoke-measures", ga.spoke_measures,
+                    "Area (3D) or length (2D) of the face behind every spoke of --csr, as a float64 .npy array: "
+                    "face-area weights for neighbour statistics; both directions of a face get the same value");
   graph->add_option("--prune-tolerance", ga.prune_tolerance,
                     "Drop spokes whose face area (length in 2D) is below F * (mean cell volume)^((D-1)/D), both "
                     "directions together (VTK parity; default 0: keep all)")

@@ -70,6 +70,10 @@ void write_spoke_classes_npy(const std::string& path, const AdjacencyGraph& g) {
   write_file_atomic(path, npy_bytes(class_bytes(g.spoke_class).data(), {g.spoke_class.size()}));
 }
 
+void write_spoke_measures_npy(const std::string& path, const AdjacencyGraph& g) {
+  write_file_atomic(path, npy_bytes(g.spoke_measure.data(), {g.spoke_measure.size()}));
+}
+
 // ------------------------------------------------------------------ faces
 
 void write_faces_vtp(const std::string& path, const FaceSet& fs) {

@@ -163,13 +163,43 @@ class Graph(base.TempDirCase):
         self.check_graph(pts, pd, csr, cls)  # still symmetric
         self.assertLess(len(csr[2]), len(ids0))
 
+    def test_spoke_measures_are_the_faces_areas(self):
+        # Each cell's pyramids over its faces, apex at the generator, fill it:
+        # sum of measure x distance to the face's plane / D = the cell's volume
+        # (the table's). Both directions of a face carry one value.
+        for dim, box in ((3, BOX3), (2, BOX2)):
+            pts = np.random.default_rng(26 + dim).random((600, dim))
+            inp = self.save("m%d.npy" % dim, pts)
+            csr, meas, table = self.p("w.npy"), self.p("m.npy"), self.p("t.csv")
+            self.ok(["graph", inp, "--csr", csr, "--spoke-measures", meas, "-q", "--bounds"] + box)
+            self.ok(["voronoi", inp, "--cell-table", table, "-q", "--bounds"] + box)
+            n, off, ids = load_csr(csr)
+            m = np.load(meas)
+            self.assertEqual((m.dtype, m.shape), (np.float64, ids.shape))
+            self.assertTrue(np.all(m > 0))
+            vol = np.loadtxt(table, delimiter=",", skiprows=1)[:, 2]
+            at = {}
+            for i in range(n):
+                total = 0.0
+                for j, a in zip(ids[off[i]:off[i + 1]], m[off[i]:off[i + 1]]):
+                    if j >= 0:
+                        h = 0.5 * np.linalg.norm(pts[j] - pts[i])
+                        at[(i, int(j))] = a
+                    else:  # box plane -1 - 2 axis (lower), -2 - 2 axis (upper)
+                        axis, upper = (-1 - j) // 2, (-1 - j) % 2
+                        h = 1.0 - pts[i][axis] if upper else pts[i][axis]
+                    total += a * h / dim
+                self.assertAlmostEqual(total, vol[i], delta=1e-12 * vol[i] + 1e-15, msg="%dD cell %d" % (dim, i))
+            for (i, j), a in at.items():
+                self.assertEqual(a, at[(j, i)])
+
     def test_threads_byte_identical(self):
         inp = self.save("big.npy", np.random.default_rng(25).random((5000, 3)))
         outs = []
         for th in (1, 2):
-            files = [self.p("g%d.vtp" % th), self.p("g%d.npy" % th), self.p("c%d.npy" % th)]
+            files = [self.p("g%d.vtp" % th), self.p("g%d.npy" % th), self.p("c%d.npy" % th), self.p("m%d.npy" % th)]
             self.ok(["graph", inp, "-o", files[0], "--csr", files[1], "--spoke-classes", files[2],
-                     "--threads", th, "-q"])
+                     "--spoke-measures", files[3], "--threads", th, "-q"])
             outs.append([read_bytes(f) for f in files])
         self.assertTrue(outs[0] == outs[1])
 
@@ -303,7 +333,7 @@ class HelpAndSummary(base.TempDirCase):
         top = run(["--help"]).stdout
         for sub in ("graph", "faces", "flower"):
             self.assertIn(sub, top)
-        options = {"graph": ("--csr", "--spoke-classes", "--prune-tolerance"),
+        options = {"graph": ("--csr", "--spoke-classes", "--spoke-measures", "--prune-tolerance"),
                    "faces": ("--kind", "--capping"),
                    "flower": ("--point", "--glyphs")}
         for sub, own in options.items():
@@ -345,6 +375,7 @@ class BadDualInput(base.TempDirCase):
         self.fails(["graph", self.good3, "-o", self.p("g.vtu")], ".vtp")
         self.fails(["graph", self.good3, "--csr", self.p("g.csv")], ".npy")
         self.fails(["graph", self.good3, "--spoke-classes", self.p("c.txt")], ".npy")
+        self.fails(["graph", self.good3, "--spoke-measures", self.p("m.csv")], ".npy")
         self.fails(["graph", self.good3, "-o", out, "--prune-tolerance", "-1"])
         self.fails(["graph", self.good3, "-o", out, "--prune-tolerance", "nan"])
         self.fails(["graph", self.good3, "-o", out, "--csr", self.p("no/dir/g.npy")], "no/dir")

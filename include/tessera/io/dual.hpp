@@ -29,6 +29,9 @@ void write_graph_csr_npy(const std::string& path, const AdjacencyGraph& graph);
 
 /// The class of every spoke, uint8 .npy aligned with the spokes of the CSR file.
 void write_spoke_classes_npy(const std::string& path, const AdjacencyGraph& graph);
+/// AdjacencyGraph::spoke_measure, float64 (n_spokes,) in the order of the
+/// wheels (write_graph_csr_npy): each spoke's face area (3D) or length (2D).
+void write_spoke_measures_npy(const std::string& path, const AdjacencyGraph& graph);
 
 /// A face set: points are its vertices; 3D faces are polygons, 2D faces lines.
 /// Cell data: BoundaryLabels (Int32, 2 components: side 0, side 1), Sides
