@@ -19,6 +19,7 @@
 
 #include "progress.hpp"
 #include "tessera/io/atomic_file.hpp"
+#include "tessera/io/npy.hpp"
 #include "tessera/io/points.hpp"
 #include "tessera/io/tables.hpp"
 #include "tessera/io/vtk_xml.hpp"
@@ -91,7 +92,11 @@ void check_output_names(const VoronoiArgs& a) {
   }
   if (!a.neighbors.empty() && a.neighbors != "-" && extension(a.neighbors) != ".npy")
     throw InputError("--neighbors " + a.neighbors + ": must be a .npy file");
-  if (a.output.empty() && a.cell_table.empty() && a.neighbors.empty() && !a.validate)
+  if (!a.neighbor_shifts.empty() && extension(a.neighbor_shifts) != ".npy")
+    throw InputError("--neighbor-shifts " + a.neighbor_shifts + ": must be a .npy file");
+  if (!a.neighbor_shifts.empty() && a.compute.periodic.empty())
+    throw InputError("--neighbor-shifts: only with --periodic (without it every neighbour is the point itself)");
+  if (a.output.empty() && a.cell_table.empty() && a.neighbors.empty() && a.neighbor_shifts.empty() && !a.validate)
     throw InputError("nothing to do: give -o OUTPUT.vtu|.vtp, --cell-table, --neighbors or --validate");
 }
 
@@ -192,6 +197,15 @@ VoronoiOptions make_options(const ComputeArgs& a, int dim) {
   o.cell_method = a.cell_method == "search"      ? CellMethod::search
                   : a.cell_method == "insertion" ? CellMethod::insertion
                                                  : CellMethod::automatic;
+  for (const char axis : a.periodic) {
+    const std::size_t k = axis == 'x' ? 0 : axis == 'y' ? 1 : axis == 'z' ? 2 : 3;
+    if (k == 3 || o.periodic[k])
+      throw InputError("--periodic '" + a.periodic + "': expected axes x, y, z, each at most once (e.g. xyz)");
+    if (static_cast<int>(k) >= dim) throw InputError("--periodic " + a.periodic + ": 2D points have no z axis");
+    o.periodic[k] = true;
+  }
+  if (!a.periodic.empty() && a.bounds.empty())
+    throw InputError("--periodic needs --bounds: the box that repeats");
   return o;
 }
 
@@ -276,6 +290,16 @@ void print_summary(const VoronoiArgs& a, const io::PointCloud& pc, const Cells& 
     std::printf("  %-18s %s\n", "ignored (outside)", ign.c_str());  // (or not finite)
   }
   std::printf("  %-18s %s\n", "domain", domain_string(c).c_str());
+  if (c.is_periodic()) {
+    std::string axes, reach;
+    for (int a = 0; a < c.dim; ++a)
+      if (c.periodic[static_cast<std::size_t>(a)]) {
+        axes += "xyz"[a];
+        reach += strf("%s%.6g", reach.empty() ? "" : ", ", c.image_reach[static_cast<std::size_t>(a)]);
+      }
+    std::printf("  %-18s %s (%zu images of points, within %s beyond the box)\n", "periodic", axes.c_str(),
+                c.periodic_images, reach.c_str());
+  }
   if (c.far_points != 0)
     std::printf("  %-18s %zu (beyond the bulk of the points; they stretch the default domain: outliers?)\n",
                 "far points", c.far_points);
@@ -316,7 +340,11 @@ bool report_validation(const Cells& c, const io::PointCloud& pc, bool quiet) {
       std::printf("  %-18s not checked: the domain volume %.17g is outside double's range for %s at this scale\n",
                   "volume sum", r.domain_volume, c.dim == 3 ? "cell volumes" : "cell areas");
     std::printf("  %-18s %zu\n", "asymmetric spokes", r.asymmetric_spokes);
-    std::printf("  %-18s %zu\n", "bad vertex degree", r.bad_vertex_degree);
+    if (c.is_periodic())
+      std::printf("  %-18s not checked in a periodic box (keys name points without their images' shifts; "
+                  "nor are the exact measures)\n", "bad vertex degree");
+    else
+      std::printf("  %-18s %zu\n", "bad vertex degree", r.bad_vertex_degree);
     if (c.dim == 3) std::printf("  %-18s %zu\n", "bad Euler", r.bad_euler);
     if (r.underflowed_volumes)
       std::printf("  %-18s %zu (below the smallest double, reported as 0)\n", "tiny cells", r.underflowed_volumes);
@@ -356,7 +384,7 @@ int run_voronoi(const VoronoiArgs& a) {
     throw InputError(strf("--bounds has %zu numbers but --dim is %d (need %d)", a.compute.bounds.size(),
                           a.compute.dim, 2 * a.compute.dim));
   // Fail before the (possibly long) read and computation, not after.
-  for (const std::string* p : {&a.output, &a.cell_table, &a.neighbors})
+  for (const std::string* p : {&a.output, &a.cell_table, &a.neighbors, &a.neighbor_shifts})
     if (!p->empty()) io::check_writable(*p);
   route_standard_output({&a.cell_table, &a.neighbors});
 
@@ -392,6 +420,12 @@ int run_voronoi(const VoronoiArgs& a) {
   if (!a.neighbors.empty()) {
     io::write_neighbors_npy(a.neighbors, cells);
     written.push_back(shown_output(a.neighbors));
+  }
+  if (!a.neighbor_shifts.empty()) {
+    io::write_file_atomic(a.neighbor_shifts,
+                          io::npy_bytes(cells.neighbor_shifts.data(),
+                                        {cells.neighbors.size(), static_cast<std::size_t>(cells.dim)}));
+    written.push_back(a.neighbor_shifts);
   }
   const double write_s = seconds_since(t0);
 

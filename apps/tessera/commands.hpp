@@ -38,6 +38,7 @@ struct ComputeArgs {
   int threads = 0;              ///< 0: TESSERA_NUM_THREADS, else all cores
   double bin_points = 0;        ///< 0: automatic
   std::string cell_method = "auto";  ///< auto | search | insertion (voronoi only; add_cell_method_option)
+  std::string periodic;         ///< "" or periodic axes, e.g. "xyz" (voronoi only; add_periodic_option)
 };
 
 struct VoronoiArgs {
@@ -45,6 +46,7 @@ struct VoronoiArgs {
   std::string output;       ///< .vtu (3D) / .vtp (2D), or empty
   std::string cell_table;   ///< .csv / .npy, or empty
   std::string neighbors;    ///< .npy, or empty
+  std::string neighbor_shifts;  ///< .npy (periodic boxes), or empty
   bool validate = false;
   bool quiet = false;
 };

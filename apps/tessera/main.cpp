@@ -119,6 +119,17 @@ void add_cell_method_option(CLI::App* app, ComputeArgs& c) {
       ->capture_default_str();
 }
 
+/// --periodic of the commands whose product is the cells themselves.
+void add_periodic_option(CLI::App* app, ComputeArgs& c) {
+  app->add_option("--periodic", c.periodic,
+                  "Periodic axes, e.g. xyz (a simulation's or a crystal's periodic box), xy or x: --bounds is the "
+                  "box, which repeats along them, with no walls there; points outside it are wrapped in. The box "
+                  "and the coordinates along those axes are rounded to the spacing of doubles at a few box "
+                  "lengths (2^-51 for a unit box) so that every image is exact. Cells keep their shape across the "
+                  "box's faces; neighbours may be images (--neighbor-shifts)")
+      ->type_name("AXES");
+}
+
 /// Converts the --bounds words to numbers. A fifth word that is not a number
 /// is the INPUT that CLI11 attached to a 2D --bounds (when INPUT is otherwise
 /// missing). Throws InputError for anything else that is not a number.
@@ -159,6 +170,7 @@ int main(int argc, char** argv) {
   std::vector<std::string> vor_bounds, bench_bounds;
   add_compute_options(vor, va.compute, vor_bounds);
   add_cell_method_option(vor, va.compute);
+  add_periodic_option(vor, va.compute);
   vor->add_option("-o,--output", va.output,
                   "Cells as VTK XML: .vtu (3D, one polyhedron per cell) or .vtp (2D, one polygon per cell), "
                   "with cell data GeneratorId, Region, Volume/Area, NumberOfFaces/Edges, NumberOfNeighbors");
@@ -171,6 +183,10 @@ int main(int argc, char** argv) {
                   "neighbours of cell c are ids[offsets[c]:offsets[c+1]] (point ids). Cells are numbered as the "
                   "--cell-table rows (point order; outside points and duplicates own none); - writes it to standard "
                   "output");
+  vor->add_option("--neighbor-shifts", va.neighbor_shifts,
+                  "With --periodic: which image each --neighbors entry is, as an int8 .npy array of shape (entries, "
+                  "dim): the neighbour's point moved by that many box lengths along each axis (a point may be "
+                  "listed once per image that shares a face, itself included)");
   vor->add_flag("--validate", va.validate,
                 "Check the result (volume sum, neighbour symmetry, vertex degrees, Euler characteristic, and "
                 "the volumes and centroids of up to 128 sampled cells against exact arithmetic), print the report, "
@@ -296,6 +312,7 @@ int main(int argc, char** argv) {
       "volume_sum,repeat}}; seconds is wall time of the computation only");
   add_compute_options(bench_vor, ba.compute, bench_bounds);
   add_cell_method_option(bench_vor, ba.compute);
+  add_periodic_option(bench_vor, ba.compute);
   bench_vor->add_option("--repeat", ba.repeat, "Number of timed runs")
       ->check(Positive)
       ->capture_default_str();

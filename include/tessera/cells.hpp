@@ -67,6 +67,17 @@ struct VoronoiOptions {
   double points_per_bin = 0;            ///< locator bin occupancy; 0 = automatic
   bool build_mesh = true;               ///< merged vertices + per-cell faces (needed for VTK output)
   CellMethod cell_method = CellMethod::automatic;  ///< tessera::voronoi only (Delaunay has its own)
+  /// Periodic axes (tessera::voronoi only): the domain, `bounds`, which must
+  /// be given, repeats along them (a simulation's or a crystal's unit cell),
+  /// and each point's cell is its cell among all the images of all points.
+  /// Along a periodic axis the box has no walls; points outside it are
+  /// wrapped in, and the box and the coordinates along it are rounded to the
+  /// spacing of doubles at a few box lengths from the origin, so that every
+  /// image is exact (for a unit box 2^-51: each moves by at most 2^-52).
+  /// Cells straddle the box's faces where their points lie near them.
+  /// Cells::neighbor_shifts says which image each neighbour is. Delaunay,
+  /// graphs, face sets, flowers and surface nets refuse periodic input.
+  std::array<bool, 3> periodic{false, false, false};
   /// Called from the calling thread with the fraction done, in [0,1]; may throw
   /// Cancelled to stop the run (the engine stops between batches).
   std::function<void(double)> progress;
@@ -101,6 +112,13 @@ struct Cells {
   /// ascending; box faces are not listed (they are counted in num_faces).
   Buffer<std::int64_t> neighbor_offsets;  ///< n_cells + 1
   Buffer<std::int32_t> neighbors;
+  /// Periodic boxes only (VoronoiOptions::periodic), else empty: for each
+  /// entry of `neighbors`, dim shifts: the face is shared with the image of
+  /// that point moved by shift[a] box lengths along axis a (0 on axes that
+  /// are not periodic). A point may be listed more than once (several of
+  /// its images, in a box only a few cells wide), even as its own
+  /// neighbour; entries are ascending by id, then by shift.
+  Buffer<std::int8_t> neighbor_shifts;
 
   // ---- per generator (size n_points) ----
   std::vector<std::int32_t> cell_of;     ///< cell index or -1
@@ -110,6 +128,9 @@ struct Cells {
   Buffer<double> vertices;          ///< n_vertices * dim
   /// Topological coordinate of each vertex: dim+1 ids, ascending; domain-box
   /// planes are negative (-1-axis*2 for lo, -2-axis*2 for hi: x0=-1, x1=-2, y0=-3, ...).
+  /// In a periodic box the ids are those of the points whose images meet
+  /// there, without the shifts: a vertex shared by cells on opposite sides
+  /// of the box is listed once beside each, and keys need not be unique.
   Buffer<std::int32_t> vertex_keys; ///< n_vertices * (dim+1)
   /// 3D: faces of each cell: cell_face_offsets (n_cells+1) into faces; each face
   /// has face_vertex_offsets (n_faces_total+1) into face_vertices (global vertex
@@ -146,7 +167,14 @@ struct Cells {
   /// it sampled what the search costs, kept where the search was chosen
   /// instead of being built again (the same cells).
   std::size_t cells_from_pilot = 0;
+  /// Periodic boxes: the periodic axes (VoronoiOptions::periodic; `bounds`
+  /// is then the box as rounded), the images of points that took part, and
+  /// how far beyond the box they reached along each periodic axis.
+  std::array<bool, 3> periodic{false, false, false};
+  std::size_t periodic_images = 0;
+  std::array<double, 3> image_reach{0, 0, 0};
 
+  bool is_periodic() const { return periodic[0] || periodic[1] || periodic[2]; }
   std::size_t n_cells() const { return generator.size(); }
   std::size_t n_vertices() const { return vertex_keys.size() / (dim + 1); }
 };

@@ -1,5 +1,6 @@
 // tessera._core.Cells / voronoi() / validate_cells(): the cells front end
 // (include/tessera/cells.hpp) as a Python class whose arrays view its buffers.
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -21,10 +22,12 @@ namespace {
 using Points = py::array_t<double, py::array::c_style>;
 
 Cells run_voronoi(const Points& points, const py::object& labels, const std::optional<std::vector<double>>& bounds,
-                  double padding, bool ignore_outside, int threads, bool merge, const std::string& method) {
+                  double padding, bool ignore_outside, int threads, bool merge, const std::string& method,
+                  const std::array<bool, 3>& periodic) {
   const int dim = checked_dim(points);
   VoronoiOptions opt;
   fill_common(opt, dim, bounds, padding, ignore_outside, threads);
+  opt.periodic = periodic;
   opt.build_mesh = merge;
   if (method == "auto") opt.cell_method = CellMethod::automatic;
   else if (method == "search") opt.cell_method = CellMethod::search;
@@ -105,6 +108,24 @@ void bind_voronoi(py::module_& m) {
       .def_property_readonly("neighbor_offsets",
                              [](py::object s) { return view_flat(s.cast<const Cells&>().neighbor_offsets, s); })
       .def_property_readonly("neighbors", [](py::object s) { return view_flat(s.cast<const Cells&>().neighbors, s); })
+      .def_property_readonly("neighbor_shifts",
+                             [](py::object s) {
+                               const Cells& c = s.cast<const Cells&>();
+                               return view_rows(c.neighbor_shifts, static_cast<std::size_t>(c.dim), s);
+                             })
+      .def_property_readonly("periodic",
+                             [](const Cells& c) {
+                               py::tuple t(static_cast<std::size_t>(c.dim));
+                               for (int a = 0; a < c.dim; ++a) t[static_cast<std::size_t>(a)] = c.periodic[static_cast<std::size_t>(a)];
+                               return t;
+                             })
+      .def_readonly("periodic_images", &Cells::periodic_images)
+      .def_property_readonly("image_reach",
+                             [](const Cells& c) {
+                               py::tuple t(static_cast<std::size_t>(c.dim));
+                               for (int a = 0; a < c.dim; ++a) t[static_cast<std::size_t>(a)] = c.image_reach[static_cast<std::size_t>(a)];
+                               return t;
+                             })
       // per generator
       .def_property_readonly("cell_of", [](py::object s) { return view_flat(s.cast<const Cells&>().cell_of, s); })
       // merged mesh
@@ -144,7 +165,7 @@ void bind_voronoi(py::module_& m) {
 
   m.def("voronoi", &run_voronoi, py::arg("points").noconvert(), py::arg("labels").none(true), py::arg("bounds"),
         py::arg("padding"), py::arg("ignore_outside"), py::arg("threads"), py::arg("merge"),
-        py::arg("method"), "Cells of float64 C-ordered (N, D) points; labels None or int32 (N,). Runs without the GIL.");
+        py::arg("method"), py::arg("periodic"), "Cells of float64 C-ordered (N, D) points; labels None or int32 (N,). Runs without the GIL.");
 
   m.def(
       "validate_cells",

@@ -126,6 +126,25 @@ class Voronoi:
         ``neighbors[neighbor_offsets[c]:neighbor_offsets[c+1]]``."""
         return self._cells.neighbors
 
+    @property
+    def neighbor_shifts(self) -> np.ndarray:
+        """int8 (len(neighbors), D), periodic boxes only (empty otherwise): the
+        image each neighbour is, in box lengths along each axis. The face of
+        cell ``c`` at entry ``e`` is shared with point ``neighbors[e]`` moved
+        by ``neighbor_shifts[e] * box lengths``; a point may be listed once
+        per image (itself too, in a box a few cells wide)."""
+        return self._cells.neighbor_shifts
+
+    @property
+    def periodic(self) -> Tuple[bool, ...]:
+        """The periodic axes (all False for an ordinary box)."""
+        return self._cells.periodic
+
+    @property
+    def periodic_images(self) -> int:
+        """Images of points that took part in a periodic box's cells."""
+        return self._cells.periodic_images
+
     def cell_neighbors(self, c: int) -> np.ndarray:
         """The point ids across the faces of cell ``c`` (a view)."""
         off = self.neighbor_offsets
@@ -282,6 +301,7 @@ def voronoi(
     *,
     ignore_outside: bool = False,
     method: str = "auto",
+    periodic: Any = False,
 ) -> Voronoi:
     """Voronoi cells of 2D or 3D points, clipped to a box, with exact topology.
 
@@ -320,6 +340,14 @@ def voronoi(
         insertion where a sample of cells costs far more than on uniform
         points, else search (:attr:`Voronoi.from_insertion` says which
         ran).
+    periodic : bool, str or sequence of bool
+        Periodic axes: ``True`` (all), a string such as ``"xyz"`` or ``"x"``,
+        or one bool per axis. ``bounds`` is then the box, which repeats along
+        them (no walls there); points outside it are wrapped in. The box and
+        the coordinates along those axes are rounded to the spacing of
+        doubles at a few box lengths (2^-51 for a unit box), so that every
+        image is exact; cells keep their shape across the box's faces, and
+        :attr:`Voronoi.neighbor_shifts` says which image each neighbour is.
 
     Returns
     -------
@@ -339,6 +367,9 @@ def voronoi(
     pts = _inputs.as_points(points)
     dim = pts.shape[1]
     lab = _inputs.as_labels(labels, pts.shape[0])
+    per = _periodic_axes(periodic, dim)
+    if any(per) and bounds is None:
+        raise ValueError("periodic: give bounds, the box that repeats")
     cells = _inputs.call(
         _core.voronoi,
         pts,
@@ -349,5 +380,26 @@ def voronoi(
         _inputs.as_threads(threads),
         bool(merge),
         str(method),
+        per,
     )
     return Voronoi(cells, pts, lab)
+
+
+def _periodic_axes(periodic: Any, dim: int) -> Tuple[bool, bool, bool]:
+    """``voronoi``'s ``periodic`` as three flags."""
+    if periodic is None or periodic is False:
+        return (False, False, False)
+    if periodic is True:
+        return (True, True, dim == 3)
+    if isinstance(periodic, str):
+        axes = [False, False, False]
+        for ch in periodic:
+            k = "xyz".find(ch)
+            if k < 0 or axes[k] or k >= dim:
+                raise ValueError(f"periodic: expected axes among {'xyz'[:dim]!r}, each at most once, got {periodic!r}")
+            axes[k] = True
+        return (axes[0], axes[1], axes[2])
+    flags = [bool(f) for f in periodic]
+    if len(flags) != dim:
+        raise ValueError(f"periodic: expected {dim} flags (one per axis), got {len(flags)}")
+    return (flags[0], flags[1], flags[2] if dim == 3 else False)

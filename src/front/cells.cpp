@@ -3,6 +3,7 @@
 #include "tessera/cells.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdlib>
 #include <functional>
@@ -15,6 +16,7 @@
 #include "cells_compositor.hpp"
 #include "delaunay_stars.hpp"
 #include "pass.hpp"
+#include "periodic.hpp"
 #include "pilot.hpp"
 #include "tessera/engine/tessellate.hpp"
 #include "tessera/kernels/hull.hpp"
@@ -107,8 +109,11 @@ inline constexpr std::uint64_t tie_weight = 2;
 /// The share of the generators the pilot may build: on small inputs too.
 inline constexpr double pilot_share = 0.5;
 
+/// `reach`, when given (sized for every point, zeros): each built cell's
+/// security radius, in the input's units, at its generator's index.
 template <class CellT>
-Cells run(std::span<const double> input, std::span<const std::int32_t> labels, const VoronoiOptions& opt) {
+Cells run(std::span<const double> input, std::span<const std::int32_t> labels, const VoronoiOptions& opt,
+          std::vector<double>* reach = nullptr) {
   constexpr int D = CellT::dim;
   front::Pass<D> pass(input, labels, opt);
   Cells out;
@@ -128,6 +133,7 @@ Cells run(std::span<const double> input, std::span<const std::int32_t> labels, c
   // neighbours", "Cells assembled from their stars").
   std::optional<engine::DelaunayStars> stars;
   front::CellsCompositor<CellT> comp(out, labels, opt.build_mesh, pass.k);
+  comp.record_reach(reach);
   front::PilotKeep<front::CellsCompositor<CellT>> kept{comp, {}, 0};  // the pilot's whole cells
   {
     bool insert = opt.cell_method == CellMethod::insertion;
@@ -196,14 +202,49 @@ Cells run(std::span<const double> input, std::span<const std::int32_t> labels, c
     for (double& c : out.centroid) c = pass.unscale(c);
     for (double& c : out.vertices) c = pass.unscale(c);
   }
+  if (reach != nullptr)
+    for (double& r : *reach) r = pass.unscale(std::sqrt(r));
   out.bounds = pass.user_bounds;
   return out;
+}
+
+/// The cells of a periodic box (front/periodic.hpp): the points among their
+/// images in a layer around the box, widened once where some cell's
+/// security sphere reaches past it (then to what the cells asked for, which
+/// suffices: with more images no cell grows).
+template <class CellT>
+Cells run_periodic(std::span<const double> input, int dim, std::span<const std::int32_t> labels,
+                   const VoronoiOptions& opt) {
+  const front::PeriodicInput in = front::periodic_input(input, dim, labels, opt);
+  std::array<double, 3> width = front::initial_image_reach(in);
+  VoronoiOptions o = opt;
+  o.periodic = {false, false, false};
+  o.ignore_outside_points = false;  // set aside already; every image lies in the layer
+  for (int round = 0;; ++round) {
+    const front::PeriodicImages im = front::periodic_images(in, labels, width);
+    o.bounds = im.domain;
+    std::vector<double> reach(im.base.size(), 0.0);
+    Cells aug = run<CellT>(im.points, im.labels, o, &reach);
+    const std::array<double, 3> need = front::needed_image_reach(in, im, aug, reach);
+    bool enough = true;
+    for (std::size_t a = 0; a < 3; ++a)
+      if (in.periodic[a] && need[a] > std::min(width[a], in.reach_cap[a])) {
+        enough = false;
+        width[a] = std::min(need[a] * 1.0625, in.reach_cap[a]);
+      }
+    if (enough) return front::periodic_cells(std::move(aug), in, im, labels);
+    if (round == 2)  // the second layer covers what the first one's cells asked for
+      throw std::logic_error("tessera: periodic cells still reach past their images' layer after widening it");
+  }
 }
 
 }  // namespace
 
 Cells voronoi(std::span<const double> input, int dim, std::span<const std::int32_t> labels,
               const VoronoiOptions& options) {
+  if (options.periodic[0] || options.periodic[1] || options.periodic[2])
+    return dim == 3 ? run_periodic<kernels::Hull>(input, dim, labels, options)
+                    : run_periodic<kernels::Tile>(input, dim, labels, options);
   const front::CheckedInput<VoronoiOptions> in(input, dim, labels, options);
   return dim == 3 ? run<kernels::Hull>(in.points, labels, in.options)
                   : run<kernels::Tile>(in.points, labels, in.options);

@@ -107,6 +107,13 @@ class CellsCompositor {
   CellsCompositor(Cells& out, std::span<const std::int32_t> labels, bool mesh, int frame_k = 0)
       : out_(out), labels_(labels), classify_(labels), mesh_(mesh), frame_k_(frame_k) {}
 
+  /// Record each built cell's security radius, squared (in the pass's
+  /// frame), at its generator's index of `reach` (sized for every point):
+  /// no point farther than that from the generator can clip the cell. The
+  /// periodic driver (front/periodic.cpp) checks by it that the images it
+  /// placed reach far enough.
+  void record_reach(std::vector<double>* reach) { reach_ = reach; }
+
   void add(Batch& b, std::int32_t gen, const kernels::BuildStatus& st, CellT& cell) {
     Store& s = b.gen.empty() ? start_batch(b) : *b.store;
     Buffer<std::int32_t>& nbrs = s.nbrs;
@@ -118,6 +125,8 @@ class CellsCompositor {
       close_cell(b, s);
       return;
     }
+    if (reach_ != nullptr) [[unlikely]]
+      (*reach_)[static_cast<std::size_t>(gen)] = cell.security_radius2();
     const double* p = cell.site();
     const std::size_t nb0 = nbrs.size();
     std::int32_t nf = 0;
@@ -662,6 +671,7 @@ class CellsCompositor {
   std::span<const std::int32_t> labels_;
   engine::RegionClassifier classify_;
   bool mesh_;
+  std::vector<double>* reach_ = nullptr;  // record_reach
   int frame_k_;  // the scaled frame's 2^k (front/pass.cpp)
   bool dense_ = false;  // set by finish: every generator owns a cell, cell g = generator g
   // Per thread (element references stay valid until the compositor dies).

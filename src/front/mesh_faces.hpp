@@ -23,6 +23,9 @@ inline void require_mesh(const Cells& c, const char* who) {
   const std::size_t nc = c.n_cells();
   auto fail = [who](const char* what) { throw std::invalid_argument(std::string(who) + ": " + what); };
   if (c.dim != 2 && c.dim != 3) fail("dim must be 2 or 3");
+  // Their faces pair cells across the box's faces with images, whose
+  // shifts the mesh does not carry.
+  if (c.is_periodic()) throw InputError(std::string(who) + ": not available for cells in a periodic box");
   if (c.cell_face_offsets.size() != nc + 1)
     fail("cells have no mesh (compute them with VoronoiOptions::build_mesh = true)");
   const std::size_t nf = static_cast<std::size_t>(c.cell_face_offsets.back());

@@ -573,6 +573,9 @@ std::string npy_bytes(const double* data, const std::vector<std::size_t>& shape)
 std::string npy_bytes(const std::uint8_t* data, const std::vector<std::size_t>& shape) {
   return npy_bytes_impl(data, shape, "|u1");
 }
+std::string npy_bytes(const std::int8_t* data, const std::vector<std::size_t>& shape) {
+  return npy_bytes_impl(data, shape, "|i1");
+}
 std::string npy_bytes(const std::int32_t* data, const std::vector<std::size_t>& shape) {
   return npy_bytes_impl(data, shape, "<i4");
 }

@@ -102,6 +102,52 @@ TEST(VoroPlusPlus, Random1000) {
 
 TEST(VoroPlusPlus, Random20000) { compare_with_voro(20000, 603); }
 
+// A periodic box (Voro++'s container with its periodic flags; Tessera's
+// VoronoiOptions::periodic), fully and along x and z only: the same volumes
+// and the same sets of neighbour ids. Points on a grid of 2^-30 so that
+// Tessera's rounding to the box's grid leaves them as they are.
+TEST(VoroPlusPlus, PeriodicBox) {
+  const auto box = make_bounds({-1, 0, 2}, {1, 1.5, 3});
+  const std::size_t n = 3000;
+  auto pts = random_points(n, 3, 604, box);
+  for (double& x : pts) x = std::ldexp(std::floor(std::ldexp(x, 30)), -30);
+  for (const std::array<bool, 3> per : {std::array<bool, 3>{true, true, true}, std::array<bool, 3>{true, false, true}}) {
+    SCOPED_TRACE(::testing::Message() << "periodic " << per[0] << per[1] << per[2]);
+    voro::container con(box.lo[0], box.hi[0], box.lo[1], box.hi[1], box.lo[2], box.hi[2], 8, 8, 8, per[0], per[1],
+                        per[2], 8);
+    for (std::size_t i = 0; i < n; ++i) con.put(int(i), pts[3 * i], pts[3 * i + 1], pts[3 * i + 2]);
+    auto o = tessera::VoronoiOptions{};
+    o.dim = 3;
+    o.bounds = box;
+    o.threads = 2;
+    o.periodic = per;
+    const tessera::Cells c = tessera::voronoi(pts, 3, {}, o);
+    ASSERT_EQ(c.n_cells(), n);
+    voro::c_loop_all loop(con);
+    voro::voronoicell_neighbor cell;
+    std::vector<int> nb;
+    std::size_t computed = 0, bad_volume = 0, bad_neighbours = 0;
+    if (loop.start()) do {
+        ASSERT_TRUE(con.compute_cell(cell, loop));
+        ++computed;
+        const int i = loop.pid();
+        const auto k = static_cast<std::size_t>(c.cell_of[static_cast<std::size_t>(i)]);
+        if (!(std::abs(c.volume[k] - cell.volume()) <= 1e-9 * cell.volume()) && ++bad_volume <= 5)
+          ADD_FAILURE() << "point " << i << " volume " << c.volume[k] << " Voro++ " << cell.volume();
+        cell.neighbors(nb);
+        std::set<int> vn;
+        for (int j : nb)
+          if (j >= 0) vn.insert(j);  // walls (negative) along the axes that are not periodic
+        const auto t = neighbours_of(c, k);
+        const std::set<int> tn(t.begin(), t.end());
+        if (tn != vn && ++bad_neighbours <= 5) ADD_FAILURE() << "point " << i << ": neighbour ids differ";
+      } while (loop.inc());
+    EXPECT_EQ(computed, n);
+    EXPECT_EQ(bad_volume, 0u);
+    EXPECT_EQ(bad_neighbours, 0u);
+  }
+}
+
 }  // namespace
 
 #endif  // TESSERA_HAVE_VORO

@@ -48,6 +48,7 @@ NpyRecords read_npy_records(const std::string& path, const std::function<bool(co
 /// result with write_file_atomic. shape = {n} or {n, m}.
 std::string npy_bytes(const double* data, const std::vector<std::size_t>& shape);
 std::string npy_bytes(const std::uint8_t* data, const std::vector<std::size_t>& shape);
+std::string npy_bytes(const std::int8_t* data, const std::vector<std::size_t>& shape);
 std::string npy_bytes(const std::int32_t* data, const std::vector<std::size_t>& shape);
 std::string npy_bytes(const std::int64_t* data, const std::vector<std::size_t>& shape);
 

@@ -1,0 +1,94 @@
+// Periodic boxes (VoronoiOptions::periodic): the cells of points in a box
+// that repeats along some axes, computed as the cells of the points among
+// their images.
+//
+// The images are ordinary input to the pass: each point is followed, in the
+// augmented input, by its images within a layer of width w around the box
+// (PeriodicImages), and the images are outside points (label < 0: they clip,
+// own no cell). The cells of the points are then their periodic cells as
+// soon as each one's security sphere (the radius beyond which no point can
+// clip it) lies within that layer; the driver (cells.cpp) checks it and
+// widens the layer once where it does not.
+//
+// Exactness. Two things make the cells agree across the box's faces, ties
+// included, as they agree inside it:
+// * every image is exact: the box and the points' coordinates along a
+//   periodic axis are rounded to a grid of doubles on which x + k L is a
+//   double for every shift k used (PeriodicInput), so an image sits exactly
+//   a box length from its point and every predicate on translated points
+//   answers as on the points;
+// * the symbolic perturbation, which orders points by id, orders images as
+//   translation does not change: the augmented input lists each point's
+//   images together, in lexicographic order of their shift vectors, with the
+//   point itself among them at shift 0. Ordering by (point, shift)
+//   lexicographically is invariant under a common translation of the shifts,
+//   so a vertex seen from cell i (with an image of j) and from cell j (with
+//   an image of i) is the same perturbed configuration.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "tessera/cells.hpp"
+
+namespace tessera::front {
+
+/// The points as the periodic computation takes them.
+struct PeriodicInput {
+  int dim = 3;
+  std::array<bool, 3> periodic{};
+  Bounds box;                          ///< the user's box, rounded to the grid along periodic axes
+  std::array<double, 3> length{};      ///< box length along each axis (exact on periodic ones)
+  /// The most box lengths an image may lie from its point along each
+  /// periodic axis: enough for any cell (a priori_reach), and the grid is
+  /// chosen so that all those images are exact.
+  std::array<int, 3> max_shift{};
+  std::array<double, 3> grid{};        ///< the rounding grid's step along each periodic axis (a power of two)
+  /// The widest layer any cell needs along each periodic axis (its
+  /// security sphere's a-priori reach; max_shift box lengths at most).
+  std::array<double, 3> reach_cap{};
+  std::vector<double> points;          ///< n * dim: wrapped into the box and rounded (rows of dropped points as given)
+  std::vector<std::uint8_t> takes_part;  ///< per point
+  std::vector<std::int32_t> ignored;   ///< points set aside (non-finite, or outside a wall with ignore_outside)
+  std::size_t n = 0;
+};
+
+/// Checks the options (bounds given, periodic axes within dim), sets aside
+/// non-finite points and points outside the walls (with
+/// ignore_outside_points; otherwise an InputError), wraps and rounds the rest.
+PeriodicInput periodic_input(std::span<const double> points, int dim, std::span<const std::int32_t> labels,
+                             const VoronoiOptions& options);
+
+/// The augmented input for a layer of widths `width` (per periodic axis).
+struct PeriodicImages {
+  std::vector<double> points;          ///< augmented, m * dim
+  std::vector<std::int32_t> labels;    ///< the point's label (0 without labels) at shift 0; -1 for images
+  std::vector<std::int32_t> base;      ///< per augmented point: the input point it is an image of
+  std::vector<std::int8_t> shift;      ///< per augmented point: dim shifts, in box lengths
+  std::vector<std::int32_t> original;  ///< per input point: its augmented id at shift 0 (-1: takes no part)
+  Bounds domain;                       ///< the box widened by the layer along periodic axes
+  std::size_t images = 0;              ///< augmented points that are images
+};
+
+PeriodicImages periodic_images(const PeriodicInput& in, std::span<const std::int32_t> labels,
+                               const std::array<double, 3>& width);
+
+/// The layer's initial widths: a few mean spacings of the points (uniform
+/// cells' security spheres reach ~3-4), at most what any cell needs.
+std::array<double, 3> initial_image_reach(const PeriodicInput& in);
+
+/// The widths the cells need (each periodic axis: how far beyond the box
+/// the farthest security sphere reaches), from `reach` (per augmented
+/// point: the cell's security radius, 0 without a cell), capped at what
+/// any cell needs. A computation whose widths are at least these is final.
+std::array<double, 3> needed_image_reach(const PeriodicInput& in, const PeriodicImages& im, const Cells& cells,
+                                         std::span<const double> reach);
+
+/// The cells of the augmented input, as the cells of the input points: ids
+/// and keys mapped back, neighbour shifts, face classes by the user's labels.
+Cells periodic_cells(Cells&& augmented, const PeriodicInput& in, const PeriodicImages& im,
+                     std::span<const std::int32_t> labels);
+
+}  // namespace tessera::front

@@ -1,0 +1,306 @@
+// Periodic boxes (VoronoiOptions::periodic).
+//
+// What this proves:
+// * every cell equals the brute-force oracle's cell of the point among its
+//   explicit images (volume to 1e-12, and the same faces: neighbour and
+//   shift), fully and partly periodic, 2D and 3D, down to boxes of one to
+//   three points, whose cells need images several periods out;
+// * across the box's faces the cells agree as inside it, ties included: on
+//   lattices every neighbour entry (i, j, s) has its twin (j, i, -s), the
+//   volumes tile the box, and 1 and 2 threads give identical bytes;
+// * points outside the box along a periodic axis are wrapped in;
+// * what is refused: no bounds, a z axis in 2D, products other than cells.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <map>
+#include <tuple>
+#include <vector>
+
+#include "helpers.hpp"
+#include "oracle.hpp"
+#include "tessera/delaunay.hpp"
+#include "tessera/graph.hpp"
+
+namespace {
+
+using namespace cells_test;
+using Shift = std::array<int, 3>;
+using Entry = std::pair<std::int32_t, Shift>;
+
+/// Points on a grid of 2^-30 in the box (snapping leaves them as they are,
+/// so the test's explicit images are the library's).
+std::vector<double> grid_aligned(std::size_t n, int dim, std::uint64_t seed, const tessera::Bounds& b) {
+  auto p = random_points(n, dim, seed, b);
+  for (double& x : p) x = std::ldexp(std::floor(std::ldexp(x, 30)), -30);
+  return p;
+}
+
+tessera::VoronoiOptions periodic_options(int dim, const tessera::Bounds& box, std::array<bool, 3> periodic,
+                                         int threads = 1) {
+  auto o = options(dim, box, threads);
+  o.periodic = periodic;
+  return o;
+}
+
+tessera::Cells run_periodic(const std::vector<double>& pts, int dim, const tessera::Bounds& box,
+                            std::array<bool, 3> periodic, int threads = 1,
+                            const std::vector<std::int32_t>& labels = {}) {
+  return tessera::voronoi(pts, dim, labels, periodic_options(dim, box, periodic, threads));
+}
+
+/// Each cell's (neighbour, shift) entries.
+std::vector<std::vector<Entry>> entries(const tessera::Cells& c) {
+  std::vector<std::vector<Entry>> out(c.n_cells());
+  const auto du = static_cast<std::size_t>(c.dim);
+  EXPECT_EQ(c.neighbor_shifts.size(), c.neighbors.size() * du);
+  for (std::size_t k = 0; k < c.n_cells(); ++k)
+    for (auto e = c.neighbor_offsets[k]; e < c.neighbor_offsets[k + 1]; ++e) {
+      const auto eu = static_cast<std::size_t>(e);
+      Shift s{0, 0, 0};
+      for (std::size_t a = 0; a < du; ++a) s[a] = c.neighbor_shifts[eu * du + a];
+      out[k].push_back({c.neighbors[eu], s});
+    }
+  return out;
+}
+
+/// Entries (i, j, s) without as many twins (j, i, -s).
+std::size_t asymmetric_entries(const tessera::Cells& c) {
+  std::map<std::tuple<std::int32_t, std::int32_t, Shift>, int> count;
+  const auto e = entries(c);
+  for (std::size_t cell = 0; cell < e.size(); ++cell)
+    for (const auto& [j, s] : e[cell]) ++count[{c.generator[cell], j, s}];
+  std::size_t asymmetric = 0;
+  for (const auto& [key, m] : count) {
+    const auto& [i, j, s] = key;
+    const auto it = count.find({j, i, Shift{-s[0], -s[1], -s[2]}});
+    asymmetric += it == count.end() || it->second != m;
+  }
+  return asymmetric;
+}
+
+/// Each point's cell among its explicit images (shifts within `reach`
+/// periods on periodic axes), by the oracle, with its faces as entries.
+/// `ties`: a box of a few points, whose images form lattices: a cell that
+/// meets four images of one point on a rectangle has a tie there, which the
+/// symbolic perturbation settles with faces of no area that the oracle's
+/// plain doubles settle otherwise (with faces of rounding-noise area, or
+/// none). Then the oracle's faces of some area must be among the cell's.
+void compare_with_oracle(const std::vector<double>& pts, int dim, const tessera::Bounds& box,
+                         std::array<bool, 3> periodic, int reach, const std::string& what, bool ties = false) {
+  SCOPED_TRACE(what);
+  const auto du = static_cast<std::size_t>(dim);
+  const std::size_t n = pts.size() / du;
+  const tessera::Cells c = run_periodic(pts, dim, box, periodic);
+  ASSERT_EQ(c.n_cells(), n);
+  std::vector<double> all;
+  std::vector<Entry> label;
+  std::vector<std::size_t> original(n);
+  int k[3] = {0, 0, 0};
+  for (std::size_t a = 0; a < du; ++a) k[a] = periodic[a] ? reach : 0;
+  for (std::size_t i = 0; i < n; ++i)
+    for (int s0 = -k[0]; s0 <= k[0]; ++s0)
+      for (int s1 = -k[1]; s1 <= k[1]; ++s1)
+        for (int s2 = -k[2]; s2 <= k[2]; ++s2) {
+          const Shift s{s0, s1, s2};
+          if (s == Shift{0, 0, 0}) original[i] = label.size();
+          for (std::size_t a = 0; a < du; ++a) all.push_back(pts[i * du + a] + s[a] * (box.hi[a] - box.lo[a]));
+          label.push_back({static_cast<std::int32_t>(i), s});
+        }
+  std::array<double, 3> lo = box.lo, hi = box.hi;
+  for (std::size_t a = 0; a < du; ++a)
+    if (periodic[a]) {
+      lo[a] -= (reach + 1) * (box.hi[a] - box.lo[a]);
+      hi[a] += (reach + 1) * (box.hi[a] - box.lo[a]);
+    }
+  const auto got = entries(c);
+  double total = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const oracle::Cell o = oracle::cell(all, dim, original[i], lo, hi);
+    const auto cell = static_cast<std::size_t>(c.cell_of[i]);
+    total += c.volume[cell];
+    EXPECT_NEAR(c.volume[cell], o.volume, 1e-12 * o.volume) << "point " << i;
+    std::vector<Entry> want;
+    for (const auto& [lab, area] : o.face) {
+      if (lab < 0) {  // a wall: only along axes that are not periodic
+        ASSERT_FALSE(periodic[static_cast<std::size_t>((-lab - 1) / 2)])
+            << "point " << i << ": the oracle's cell reaches its box (widen `reach`)";
+        continue;
+      }
+      if (ties && area <= 1e-9 * std::pow(o.volume, (dim - 1.0) / dim)) continue;
+      want.push_back(label[static_cast<std::size_t>(lab)]);
+    }
+    std::sort(want.begin(), want.end());
+    if (ties)
+      EXPECT_TRUE(std::includes(got[cell].begin(), got[cell].end(), want.begin(), want.end())) << "point " << i;
+    else
+      EXPECT_EQ(got[cell], want) << "point " << i;
+  }
+  EXPECT_NEAR(total, box_volume(c.bounds, dim), 1e-12 * box_volume(c.bounds, dim));
+}
+
+TEST(Periodic, EqualsTheOracleAmongExplicitImages) {
+  const auto box3 = make_bounds({-1, 0, 2}, {1, 1.5, 3});
+  compare_with_oracle(grid_aligned(150, 3, 1, box3), 3, box3, {true, true, true}, 1, "3D xyz");
+  compare_with_oracle(grid_aligned(150, 3, 2, box3), 3, box3, {true, false, false}, 1, "3D x");
+  compare_with_oracle(grid_aligned(150, 3, 3, box3), 3, box3, {false, true, true}, 1, "3D yz");
+  const auto box2 = make_bounds({0.5, -2, 0}, {1.5, 0, 0});
+  compare_with_oracle(grid_aligned(300, 2, 4, box2), 2, box2, {true, true, false}, 1, "2D xy");
+  compare_with_oracle(grid_aligned(300, 2, 5, box2), 2, box2, {false, true, false}, 1, "2D y");
+}
+
+TEST(Periodic, BoxesOfAFewPointsReachSeveralPeriods) {
+  // One point's cell is the box about it; two or three meet their own
+  // images and each other's: the layer is widened to what they ask.
+  const auto box3 = make_bounds({0, 0, 0}, {1, 2, 1});
+  const auto box2 = make_bounds({0, 0, 0}, {3, 1, 0});
+  for (std::size_t n : {1, 2, 3, 5}) {
+    compare_with_oracle(grid_aligned(n, 3, 10 + n, box3), 3, box3, {true, true, true}, 2,
+                        "3D, " + std::to_string(n) + " points", true);
+    compare_with_oracle(grid_aligned(n, 2, 20 + n, box2), 2, box2, {true, true, false}, 3,
+                        "2D, " + std::to_string(n) + " points", true);
+  }
+  // One point: its cell is the box about it, bounded by its own images (a
+  // lattice: its corners are ties, each settled with faces of no area).
+  const tessera::Cells one = run_periodic({0.25, 0.5, 0.75}, 3, box3, {true, true, true});
+  EXPECT_EQ(one.volume[0], 2.0);
+  for (std::int32_t j : one.neighbors) EXPECT_EQ(j, 0);
+  const tessera::ValidationReport r = tessera::validate(one, {}, std::vector<double>{0.25, 0.5, 0.75});
+  EXPECT_TRUE(r.ok) << (r.messages.empty() ? "" : r.messages[0]);
+}
+
+TEST(Periodic, SparseFacesWidenTheImagesLayer) {
+  // A dense middle and a few points near the faces: the layer sized by the
+  // mean spacing is too thin for those few cells, and is widened once.
+  const auto box = make_bounds({0, 0, 0}, {1, 1, 1});
+  auto pts = grid_aligned(400, 3, 50, make_bounds({0.4, 0.4, 0.4}, {0.6, 0.6, 0.6}));
+  const auto sparse = grid_aligned(4, 3, 51, box);
+  pts.insert(pts.end(), sparse.begin(), sparse.end());
+  const double spacing = std::cbrt(1.0 / 404);
+  const tessera::Cells c = run_periodic(pts, 3, box, {true, true, true});
+  EXPECT_GT(c.image_reach[0], 4 * spacing * 1.01);  // widened past the initial 4 spacings
+  compare_with_oracle(pts, 3, box, {true, true, true}, 1, "sparse faces");
+}
+
+TEST(Periodic, LatticeTiesAgreeAcrossTheBox) {
+  // Every vertex of a lattice is a tie among 2^D points; the perturbation
+  // must settle it alike seen from either side of the box's faces.
+  for (int dim : {2, 3}) {
+    SCOPED_TRACE(dim);
+    const int k = dim == 3 ? 6 : 12;
+    const double h = 0.1;  // inexact: the box is rounded, the points with it
+    auto pts = grid_points(k, dim, h, 0.05);
+    const auto box = make_bounds({0, 0, 0}, {k * h, k * h, dim == 3 ? k * h : 0});
+    const std::array<bool, 3> all{true, true, dim == 3};
+    const tessera::Cells c = run_periodic(pts, dim, box, all);
+    const tessera::Cells c2 = run_periodic(pts, dim, box, all, 2);
+    expect_same_cells(c, c2, "1 vs 2 threads");
+    EXPECT_EQ(c.neighbor_shifts, c2.neighbor_shifts);
+    ASSERT_EQ(c.n_cells(), pts.size() / static_cast<std::size_t>(dim));
+    EXPECT_EQ(asymmetric_entries(c), 0u);
+    const double cell_volume = std::pow(h, dim);
+    for (double v : c.volume) EXPECT_NEAR(v, cell_volume, 1e-12 * cell_volume);
+    const tessera::ValidationReport r = tessera::validate(c, {}, pts);
+    EXPECT_TRUE(r.ok) << (r.messages.empty() ? "" : r.messages[0]);
+    EXPECT_EQ(r.asymmetric_spokes, 0u);
+  }
+}
+
+TEST(Periodic, ImagesAreExactSoTiesAgree) {
+  // Four points on a circle about the box's face x = 0, in the frame of A
+  // (x = a): the image of B (x = 1 - a) lies at exactly -a. In B's frame
+  // A's image, 1 + a, is not a double: without the rounding of the
+  // coordinates to the box's grid, B saw A a rounding inside the circle,
+  // while A's side settled the exact tie by the perturbation, and in 36 of
+  // these 48 orders the two sides disagreed (one-sided neighbours).
+  const double a = 0x1p-7 + 0x1p-53;
+  const std::array<std::array<double, 2>, 4> square{{{a, 0.5}, {1 - a, 0.5}, {0, 0.5 + a}, {0, 0.5 - a}}};
+  const auto box = make_bounds({0, 0, 0}, {1, 1, 0});
+  std::array<int, 4> order{0, 1, 2, 3};
+  do {
+    for (bool more : {false, true}) {
+      std::vector<double> pts;
+      for (int k : order) pts.insert(pts.end(), square[static_cast<std::size_t>(k)].begin(), square[static_cast<std::size_t>(k)].end());
+      if (more) pts.insert(pts.end(), {0.5, 0.1, 0.5, 0.9, 0.3, 0.3, 0.7, 0.7});
+      const tessera::Cells c = run_periodic(pts, 2, box, {true, true, false});
+      EXPECT_EQ(asymmetric_entries(c), 0u);
+    }
+  } while (std::next_permutation(order.begin(), order.end()));
+}
+
+TEST(Periodic, FewPointLatticesMeetSeveralImagesOfOnePoint) {
+  // Lattices of 1 to 3 points per period: a cell's ties involve several
+  // images of one point, which the perturbation orders by their shifts in
+  // the same way from either side of the box.
+  for (int dim : {2, 3})
+    for (int k : {1, 2, 3}) {
+      SCOPED_TRACE(::testing::Message() << dim << "D, " << k << " per period");
+      const auto pts = grid_points(k, dim, 0.25, 0.125);
+      const auto box = make_bounds({0, 0, 0}, {k * 0.25, k * 0.25, dim == 3 ? k * 0.25 : 0});
+      const tessera::Cells c = run_periodic(pts, dim, box, {true, true, dim == 3});
+      EXPECT_EQ(asymmetric_entries(c), 0u);
+      for (double v : c.volume) EXPECT_NEAR(v, std::pow(0.25, dim), 1e-15);
+    }
+}
+
+TEST(Periodic, RandomPointsThreadsAndValidation) {
+  const auto box = make_bounds({0, 0, 0}, {1, 1, 1});
+  const auto pts = random_points(20000, 3, 7, box);  // full mantissas: rounded to the box's grid
+  const tessera::Cells a = run_periodic(pts, 3, box, {true, true, true}, 1);
+  const tessera::Cells b = run_periodic(pts, 3, box, {true, true, true}, 2);
+  expect_same_cells(a, b, "1 vs 2 threads");
+  EXPECT_EQ(a.neighbor_shifts, b.neighbor_shifts);
+  EXPECT_GT(a.periodic_images, 0u);
+  const tessera::ValidationReport r = tessera::validate(a, {}, pts);
+  EXPECT_TRUE(r.ok) << (r.messages.empty() ? "" : r.messages[0]);
+  EXPECT_LT(r.volume_rel_error, 1e-12);
+  // Every point moved by at most half the grid's step (2^-51 here).
+  const tessera::Cells plain = run(pts, 3, box);
+  EXPECT_EQ(plain.n_cells(), a.n_cells());
+}
+
+TEST(Periodic, PointsOutsideArePeriodicallyWrapped) {
+  const auto box = make_bounds({-1, 0, 2}, {1, 1.5, 3});
+  const auto pts = grid_aligned(200, 3, 30, box);
+  auto moved = pts;
+  for (std::size_t i = 0; i < 200; ++i) {
+    moved[3 * i] += static_cast<double>(static_cast<int>(i % 5) - 2) * 2.0;  // x: -2..+2 periods
+    if (i % 7 == 0) moved[3 * i + 2] += 1.0;                              // z: one period up
+  }
+  moved[3 * 3] = 1.0;  // on the upper face: wraps to the lower one
+  auto at_lower = pts;
+  at_lower[3 * 3] = -1.0;
+  const tessera::Cells a = run_periodic(moved, 3, box, {true, false, true});
+  const tessera::Cells b = run_periodic(at_lower, 3, box, {true, false, true});
+  expect_same_cells(a, b, "wrapped");
+  EXPECT_EQ(a.neighbor_shifts, b.neighbor_shifts);
+}
+
+TEST(Periodic, Refused) {
+  const auto box = make_bounds({0, 0, 0}, {1, 1, 1});
+  const auto pts = random_points(50, 3, 40, box);
+  auto o = periodic_options(3, box, {true, true, true});
+  o.bounds.reset();
+  EXPECT_THROW(tessera::voronoi(pts, 3, {}, o), tessera::InputError);  // no box
+  const auto pts2 = random_points(50, 2, 41, box);
+  EXPECT_THROW(tessera::voronoi(pts2, 2, {}, periodic_options(2, box, {false, false, true})), tessera::InputError);
+  // Outside a wall (a non-periodic axis): refused, or dropped where asked.
+  auto out = pts;
+  out[1] = 1.5;
+  EXPECT_THROW(run_periodic(out, 3, box, {true, false, true}), tessera::InputError);
+  auto drop = periodic_options(3, box, {true, false, true});
+  drop.ignore_outside_points = true;
+  const tessera::Cells d = tessera::voronoi(out, 3, {}, drop);
+  EXPECT_EQ(d.ignored_outside_bounds, std::vector<std::int32_t>{0});
+  EXPECT_EQ(d.n_cells(), 49u);
+  // Products other than the cells.
+  tessera::DelaunayOptions dopt;
+  dopt.dim = 3;
+  dopt.bounds = box;
+  dopt.periodic = {true, true, true};
+  EXPECT_THROW(tessera::delaunay(pts, 3, {}, dopt), tessera::InputError);
+  const tessera::Cells c = run_periodic(pts, 3, box, {true, true, true});
+  EXPECT_THROW(tessera::adjacency_graph(c), tessera::InputError);
+}
+
+}  // namespace
