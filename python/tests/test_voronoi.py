@@ -244,3 +244,35 @@ def test_version_is_the_cmake_project_version():
 def test_repr():
     vor = tessera.voronoi(random_points(10, 2))
     assert repr(vor).startswith("<tessera.Voronoi 2D: 10 points, 10 cells")
+
+
+def test_periodic_box():
+    # A periodic box: the cells tile it, every neighbour entry (i, j, s) has
+    # its twin (j, i, -s), and the argument's forms agree.
+    pts = random_points(2000, 3, seed=31)
+    v = tessera.voronoi(pts, bounds=[0, 1, 0, 1, 0, 1], periodic=True)
+    assert v.periodic == (True, True, True) and v.periodic_images > 0
+    assert abs(v.volumes.sum() - 1.0) < 1e-12
+    shifts = v.neighbor_shifts
+    assert shifts.dtype == np.int8 and shifts.shape == (len(v.neighbors), 3)
+    off, ids = v.neighbor_offsets, v.neighbors
+    seen = {}
+    for c in range(v.n_cells):
+        g = int(v.generators[c])
+        for e in range(off[c], off[c + 1]):
+            key = (g, int(ids[e]), tuple(int(x) for x in shifts[e]))
+            seen[key] = seen.get(key, 0) + 1
+    for (i, j, s), m in seen.items():
+        assert seen.get((j, i, tuple(-x for x in s))) == m
+    assert v.validate()
+    w = tessera.voronoi(pts, bounds=[0, 1, 0, 1, 0, 1], periodic="xyz")
+    np.testing.assert_array_equal(w.volumes, v.volumes)
+    x = tessera.voronoi(pts, bounds=[0, 1, 0, 1, 0, 1], periodic=[True, False, False])
+    assert x.periodic == (True, False, False)
+    assert (x.neighbor_shifts[:, 1:] == 0).all()
+    plain = tessera.voronoi(pts, bounds=[0, 1, 0, 1, 0, 1])
+    assert plain.neighbor_shifts.size == 0 and plain.periodic == (False, False, False)
+    with pytest.raises(ValueError, match="bounds"):
+        tessera.voronoi(pts, periodic=True)
+    with pytest.raises(ValueError, match="periodic"):
+        tessera.voronoi(pts[:, :2].copy(), bounds=[0, 1, 0, 1], periodic="xz")

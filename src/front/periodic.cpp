@@ -200,10 +200,13 @@ std::array<double, 3> needed_image_reach(const PeriodicInput& in, const Periodic
     const auto g = static_cast<std::size_t>(cells.generator[c]);
     const double r = reach[g];
     const double* p = im.points.data() + g * du;
-    for (std::size_t a = 0; a < du; ++a)
-      if (in.periodic[a]) need[a] = std::max({need[a], in.box.lo[a] - (p[a] - r), (p[a] + r) - in.box.hi[a]});
+    for (std::size_t a = 0; a < du; ++a) {
+      if (!in.periodic[a]) continue;
+      const double beyond = std::max(in.box.lo[a] - (p[a] - r), (p[a] + r) - in.box.hi[a]);
+      need[a] = beyond <= need[a] ? need[a] : beyond;  // NaN too: then the cap, below
+    }
   }
-  for (std::size_t a = 0; a < 3; ++a) need[a] = std::min(need[a], in.reach_cap[a]);  // NaN: the cap
+  for (std::size_t a = 0; a < 3; ++a) need[a] = need[a] <= in.reach_cap[a] ? need[a] : in.reach_cap[a];
   return need;
 }
 

@@ -931,12 +931,74 @@ class RunDefault(TempDirCase):
         self.assertTrue(read_bytes(os.path.join(d, "cells.vtu")) == read_bytes(os.path.join(d2, "cells.vtu")))
 
 
+class Periodic(TempDirCase):
+    """--periodic: cells among the points' images, neighbour shifts, validation."""
+
+    def entries(self, nb, sh):
+        n, off, ids = load_neighbors(nb)
+        s = np.load(sh)
+        self.assertEqual(s.dtype, np.int8)
+        self.assertEqual(s.shape, (len(ids), 3 if s.ndim == 2 and s.shape[1] == 3 else 2))
+        out = {}
+        for c in range(n):
+            for e in range(off[c], off[c + 1]):
+                key = (c, int(ids[e]), tuple(int(x) for x in s[e]))
+                out[key] = out.get(key, 0) + 1
+        return out
+
+    def test_tiles_the_box_with_shifts_that_pair_up(self):
+        for dim, box, axes in ((3, ["-1", "1", "0", "1.5", "2", "3"], "xyz"), (3, BOX3, "xz"), (2, BOX2, "xy")):
+            pts = np.random.default_rng(dim).random((3000, dim))
+            lo = np.array([float(x) for x in box[0::2]])
+            hi = np.array([float(x) for x in box[1::2]])
+            pts = lo + pts * (hi - lo)
+            inp = self.save("p%d.npy" % dim, pts)
+            nb, sh, tab = self.p("n.npy"), self.p("s.npy"), self.p("t.csv")
+            out = self.p("c.vtu" if dim == 3 else "c.vtp")
+            r = self.ok(["voronoi", inp, "--bounds"] + box + ["--periodic", axes, "--neighbors", nb,
+                                                                "--neighbor-shifts", sh, "--cell-table", tab, "-o", out,
+                                                                "--validate"])
+            self.assertIn("periodic           %s (" % axes, r.stdout)
+            self.assertIn("validation: OK", r.stdout)
+            vol = np.loadtxt(tab, delimiter=",", skiprows=1)[:, 2]
+            self.assertAlmostEqual(vol.sum(), float(np.prod(hi - lo)), delta=1e-12 * float(np.prod(hi - lo)))
+            e = self.entries(nb, sh)
+            for (i, j, s), m in e.items():
+                self.assertEqual(e.get((j, i, tuple(-x for x in s))), m, "entry %d %d %s has no twin" % (i, j, s))
+                for a in range(dim):
+                    if "xyz"[a] not in axes:
+                        self.assertEqual(s[a], 0)
+            g = read_vtu(out) if dim == 3 else read_vtp(out)
+            self.assertEqual(g.GetNumberOfCells(), 3000)
+
+    def test_wrapped_points_and_threads(self):
+        pts = np.floor(np.random.default_rng(5).random((1000, 3)) * 2**30) / 2**30
+        moved = pts.copy()
+        moved[::3, 0] += 1.0
+        moved[1::3, 2] -= 2.0
+        tables = []
+        for p, th in ((pts, 1), (moved, 2)):
+            t = self.p("t%d.csv" % th)
+            self.ok(["voronoi", self.save("w%d.npy" % th, p), "--bounds"] + BOX3 +
+                    ["--periodic", "xyz", "--cell-table", t, "--threads", str(th), "-q"])
+            tables.append(read_bytes(t))
+        self.assertEqual(tables[0], tables[1])
+
+    def test_bench(self):
+        inp = self.save("b.npy", np.random.default_rng(6).random((2000, 3)))
+        r = self.ok(["bench", "voronoi", inp, "--bounds"] + BOX3 + ["--periodic", "xyz"])
+        j = json.loads(r.stdout.splitlines()[0])
+        self.assertEqual(j["simplices"], 2000)
+        self.assertAlmostEqual(j["extra"]["volume_sum"], 1.0, delta=1e-12)
+
+
 class Help(unittest.TestCase):
     def test_help_lists_everything(self):
         r = run(["voronoi", "--help"])
         self.assertEqual(r.returncode, 0)
         for opt in ("INPUT", "--output", "--dim", "--labels", "--bounds", "--padding", "--ignore-outside",
-                    "--threads", "--bin-points", "--cell-table", "--neighbors", "--validate", "--quiet"):
+                    "--threads", "--bin-points", "--cell-table", "--neighbors", "--validate", "--quiet",
+                    "--periodic", "--neighbor-shifts"):
             self.assertIn(opt, r.stdout)
         r = run(["--help"])
         self.assertEqual(r.returncode, 0)
@@ -1048,6 +1110,24 @@ class BadInput(TempDirCase):
                   ["0", "nan", "0", "1", "0", "1"], ["0", "1", "0", "1"]):
             self.fails(["voronoi", self.good3, "-o", self.out(), "--bounds"] + b)
         self.fails(["voronoi", self.good2, "-o", self.out("c.vtp"), "--bounds"] + BOX3)
+
+    def test_bad_periodic(self):
+        out = self.out()
+        self.fails(["voronoi", self.good3, "-o", out, "--periodic", "xyz"], "--bounds")
+        for axes in ("xx", "w", "x,y"):
+            self.fails(["voronoi", self.good3, "-o", out, "--bounds"] + BOX3 + ["--periodic", axes], "--periodic")
+        self.fails(["voronoi", self.good2, "-o", self.out("c.vtp"), "--bounds"] + BOX2 + ["--periodic", "xz"], "z")
+        self.fails(["voronoi", self.good3, "--neighbor-shifts", self.p("s.npy"), "--bounds"] + BOX3, "--periodic")
+        self.fails(["voronoi", self.good3, "--neighbor-shifts", self.p("s.csv"), "--bounds"] + BOX3 +
+                   ["--periodic", "x"], ".npy")
+        # Outside a wall (y is not periodic) stays an error.
+        pts = np.random.default_rng(2).random((50, 3))
+        pts[3, 1] = 1.5
+        self.fails(["voronoi", self.save("wall.npy", pts), "-o", out, "--bounds"] + BOX3 + ["--periodic", "xz"],
+                   "not periodic")
+        for cmd in (["graph", "-o", self.p("g.vtp")], ["delaunay", "-o", self.p("d.vtu")]):
+            r = run([cmd[0], self.good3] + cmd[1:] + ["--bounds"] + BOX3 + ["--periodic", "xyz"])
+            self.assertEqual(r.returncode, 2)  # no such option there
 
     def test_coplanar_3d_suggests_dim2(self):
         pts = np.random.default_rng(1).random((50, 3))
