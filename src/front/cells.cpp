@@ -227,11 +227,20 @@ Cells run_periodic(std::span<const double> input, int dim, std::span<const std::
     Cells aug = run<CellT>(im.points, im.labels, o, &reach);
     const std::array<double, 3> need = front::needed_image_reach(in, im, aug, reach);
     bool enough = true;
-    for (std::size_t a = 0; a < 3; ++a)
-      if (in.periodic[a] && need[a] > std::min(width[a], in.reach_cap[a])) {
-        enough = false;
-        width[a] = std::min(need[a] * 1.0625, in.reach_cap[a]);
+    for (std::size_t a = 0; a < 3; ++a) {
+      if (!in.periodic[a] || need[a] <= width[a]) continue;
+      if (width[a] >= in.reach_cap[a]) {
+        // At the a-priori bound every cell is final; held below it, some
+        // cell reaches farther than the images go.
+        if (in.reach_clamped[a])
+          throw InputError(std::string("periodic along ") + "xyz"[a] + ": some cell reaches past " +
+                           std::to_string(front::max_periodic_shift) +
+                           " box lengths (a few points in a box far longer along its walls than its period)");
+        continue;
       }
+      enough = false;
+      width[a] = std::min(need[a] * 1.0625, in.reach_cap[a]);
+    }
     if (enough) return front::periodic_cells(std::move(aug), in, im, labels);
     if (round == 2)  // the second layer covers what the first one's cells asked for
       throw std::logic_error("tessera: periodic cells still reach past their images' layer after widening it");

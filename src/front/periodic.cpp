@@ -68,12 +68,13 @@ PeriodicInput periodic_input(std::span<const double> points, int dim, std::span<
   for (int a = 0; a < dim; ++a) {
     const auto au = static_cast<std::size_t>(a);
     if (!in.periodic[au]) continue;
-    const double k = std::ceil(cap / in.length[au]);
-    if (!(k <= 1024))
-      throw InputError(std::string("periodic along ") + axis_name(a) + ": the box is more than 500 times longer " +
-                       "along its walls than its period (" + num(in.length[au]) + "); cells would reach past 1,000 periods");
+    // Shifts are int8 (Cells::neighbor_shifts). A box whose walls are more
+    // than ~60 periods long may ask for more than 127 only where its cells
+    // are that long (a few points): the driver then reports it.
+    const double k = std::min(std::ceil(cap / in.length[au]), double{max_periodic_shift});
     in.max_shift[au] = static_cast<int>(k);
-    in.reach_cap[au] = cap;
+    in.reach_cap[au] = std::min(cap, k * in.length[au]);
+    in.reach_clamped[au] = in.reach_cap[au] < cap;
     // The grid: multiples of g below 2^(e+1) are doubles, and every image
     // x + k L (|k| <= max_shift) stays below that.
     const double lo = in.box.lo[au], hi = in.box.hi[au];
@@ -118,7 +119,16 @@ PeriodicInput periodic_input(std::span<const double> points, int dim, std::span<
       // period or more out; then rounded to the grid, where the last steps
       // of a box length are exact.
       double x = p[a];
-      if (x < lo - len || x >= hi + len) x -= std::floor((x - lo) / len) * len;
+      if (x < lo - len || x >= hi + len) {
+        // fmod is exact: the error is only that of x - lo, the point's own
+        // imprecision at that distance.
+        const double off = x - lo;
+        if (!std::isfinite(off))
+          throw InputError("point " + std::to_string(i) + " lies too far from the periodic box to be wrapped into it");
+        double r = std::fmod(off, len);
+        if (r < 0) r += len;
+        x = lo + r;
+      }
       x = snap(x, in.grid[a]);
       while (x >= hi) x -= len;
       while (x < lo) x += len;
@@ -203,10 +213,10 @@ std::array<double, 3> needed_image_reach(const PeriodicInput& in, const Periodic
     for (std::size_t a = 0; a < du; ++a) {
       if (!in.periodic[a]) continue;
       const double beyond = std::max(in.box.lo[a] - (p[a] - r), (p[a] + r) - in.box.hi[a]);
-      need[a] = beyond <= need[a] ? need[a] : beyond;  // NaN too: then the cap, below
+      need[a] = beyond <= need[a] ? need[a] : beyond;  // NaN too: unbounded, below
     }
   }
-  for (std::size_t a = 0; a < 3; ++a) need[a] = need[a] <= in.reach_cap[a] ? need[a] : in.reach_cap[a];
+  for (double& n : need) n = n >= 0 ? n : std::numeric_limits<double>::infinity();  // NaN: unbounded
   return need;
 }
 

@@ -35,6 +35,9 @@
 
 namespace tessera::front {
 
+/// The most periods an image lies from its point (Cells::neighbor_shifts are int8).
+inline constexpr int max_periodic_shift = 127;
+
 /// The points as the periodic computation takes them.
 struct PeriodicInput {
   int dim = 3;
@@ -49,6 +52,9 @@ struct PeriodicInput {
   /// The widest layer any cell needs along each periodic axis (its
   /// security sphere's a-priori reach; max_shift box lengths at most).
   std::array<double, 3> reach_cap{};
+  /// reach_cap is below the a-priori bound, held to max_periodic_shift
+  /// periods: a cell that reaches past it is an error, not final.
+  std::array<bool, 3> reach_clamped{};
   std::vector<double> points;          ///< n * dim: wrapped into the box and rounded (rows of dropped points as given)
   std::vector<std::uint8_t> takes_part;  ///< per point
   std::vector<std::int32_t> ignored;   ///< points set aside (non-finite, or outside a wall with ignore_outside)
@@ -80,9 +86,10 @@ PeriodicImages periodic_images(const PeriodicInput& in, std::span<const std::int
 std::array<double, 3> initial_image_reach(const PeriodicInput& in);
 
 /// The widths the cells need (each periodic axis: how far beyond the box
-/// the farthest security sphere reaches), from `reach` (per augmented
-/// point: the cell's security radius, 0 without a cell), capped at what
-/// any cell needs. A computation whose widths are at least these is final.
+/// the farthest security sphere reaches; infinite where one is unbounded),
+/// from `reach` (per augmented point: the cell's security radius, 0 without
+/// a cell). A computation whose widths are at least these, or at an
+/// unclamped reach_cap, is final.
 std::array<double, 3> needed_image_reach(const PeriodicInput& in, const PeriodicImages& im, const Cells& cells,
                                          std::span<const double> reach);
 

@@ -268,6 +268,7 @@ TEST(Periodic, PointsOutsideArePeriodicallyWrapped) {
     if (i % 7 == 0) moved[3 * i + 2] += 1.0;                              // z: one period up
   }
   moved[3 * 3] = 1.0;  // on the upper face: wraps to the lower one
+  moved[3 * 5] += 1048576.0;  // 2^19 periods out: reduced by fmod, exactly here
   auto at_lower = pts;
   at_lower[3 * 3] = -1.0;
   const tessera::Cells a = run_periodic(moved, 3, box, {true, false, true});
@@ -284,6 +285,10 @@ TEST(Periodic, Refused) {
   EXPECT_THROW(tessera::voronoi(pts, 3, {}, o), tessera::InputError);  // no box
   const auto pts2 = random_points(50, 2, 41, box);
   EXPECT_THROW(tessera::voronoi(pts2, 2, {}, periodic_options(2, box, {false, false, true})), tessera::InputError);
+  auto far = pts;
+  far[0] = 1.7e308;  // beyond double's range from the box: not wrapped
+  const auto wide = make_bounds({-1.7e308, 0, 0}, {-1.6e308, 1, 1});
+  EXPECT_THROW(run_periodic(far, 3, wide, {true, false, false}), tessera::InputError);
   // Outside a wall (a non-periodic axis): refused, or dropped where asked.
   auto out = pts;
   out[1] = 1.5;
@@ -293,6 +298,12 @@ TEST(Periodic, Refused) {
   const tessera::Cells d = tessera::voronoi(out, 3, {}, drop);
   EXPECT_EQ(d.ignored_outside_bounds, std::vector<std::int32_t>{0});
   EXPECT_EQ(d.n_cells(), 49u);
+  // A period far shorter than the walls: with many points the cells are
+  // short and served; one point's cell is a strip 300 periods long, whose
+  // images would lie past int8 shifts.
+  const auto strip = make_bounds({0, 0, 0}, {1, 300, 0});
+  compare_with_oracle(grid_aligned(1000, 2, 42, strip), 2, strip, {true, false, false}, 1, "a short period");
+  EXPECT_THROW(run_periodic({0.5, 150}, 2, strip, {true, false, false}), tessera::InputError);
   // Products other than the cells.
   tessera::DelaunayOptions dopt;
   dopt.dim = 3;
