@@ -26,6 +26,10 @@ class ScipyVoronoi:
     def __init__(self, vor: "Voronoi"):
         if not vor.has_mesh:
             raise ValueError("the scipy view needs the mesh: compute with merge=True")
+        if any(vor.periodic):
+            # scipy has no periodic boxes: its ridges would pair points with
+            # images without saying which.
+            raise ValueError("the scipy view has no periodic boxes: use neighbors and neighbor_shifts")
         self._vor = vor
 
     @property

@@ -272,6 +272,8 @@ def test_periodic_box():
     assert (x.neighbor_shifts[:, 1:] == 0).all()
     plain = tessera.voronoi(pts, bounds=[0, 1, 0, 1, 0, 1])
     assert plain.neighbor_shifts.size == 0 and plain.periodic == (False, False, False)
+    with pytest.raises(ValueError, match="periodic"):
+        v.scipy
     with pytest.raises(ValueError, match="bounds"):
         tessera.voronoi(pts, periodic=True)
     with pytest.raises(ValueError, match="periodic"):
