@@ -252,7 +252,9 @@ class Voronoi:
         centroid and corners are compared with exact arithmetic
         (``measures_checked``, ``measure_rel_error``, ``vertex_rel_error``).
         The report is truthy when all pass; ``report.messages`` says what
-        failed."""
+        failed. In a periodic box neighbours must pair up with opposite
+        shifts, and the vertex and exact-measure checks are left out (the
+        keys name points without their images' shifts)."""
         return _core.validate_cells(self._cells, self._labels, self._points)
 
     @cached_property
