@@ -112,11 +112,20 @@ inline double off_plane(const Plane& pl, const double* y) {
 // det(c_f, a - r, b - r), whose error is u |c_f| times the face's diameter
 // squared. An extra pass and six subtractions a term, so only for the
 // cells that need it (measure()). It also bounds, into `blur`, how far the
-// vertices' own errors may move the volume (Fan false leaves it alone): to
-// first order, each face's area times how far its vertices may lie off its
-// plane (off_plane). A vertex solved from nearly parallel planes may err far
-// along them, but it satisfies each of its planes closely, and only the
-// distance off them moves the volume.
+// vertices' own errors, and the terms' rounding, may move the volume (Fan
+// false leaves it alone). The sum is (1/3) sum_f c_f . A_f, A_f the area
+// vector of f's loop, so a vertex moved along c_f (off f's plane) leaves
+// it; what moves it is a vertex sliding within f across one of its edges:
+// c_f . dA_f = 1/2 sum_edges (d_a + d_b) . ((b - a) x c_f), per edge |b - a|
+// |c_f| times the ends' moves within f perpendicular to the edge. The edge
+// lies on f and its other plane g, and a move m that way shows in the
+// residuals only as m sin(theta) off g (theta the angle between f and g),
+// so m <= (off_g + cos(theta) off_f) / sin(theta) (off_plane bounds each
+// residual). Until stop 74 the bound was each fan triangle's area times the
+// residuals alone: between nearly parallel faces (a dense cluster's cell
+// reaching 1e4 away to two far points' nearly parallel bisectors, theta
+// ~2e-5) a vertex 1e-12 off its planes slid 1e-7 along them, and a volume
+// passed with an error of 1.2e-8 where the bound said 1e-14.
 template <bool Scaled, bool ScaledPlanes, bool Fan>
 void hull_sums(const kernels::Hull& hull, double sc, double& vol, double& mag, double* c, double& blur, double& emax) {
   const auto& verts = hull.vertices();
@@ -167,8 +176,30 @@ void hull_sums(const kernels::Hull& hull, double sc, double& vol, double& mag, d
         const double n[3] = {ar[1] * br[2] - ar[2] * br[1], ar[2] * br[0] - ar[0] * br[2],
                              ar[0] * br[1] - ar[1] * br[0]};
         s = f[0] * n[0] + f[1] * n[1] + f[2] * n[2];
-        const double off = std::max({off_plane(pl, v.y), off_plane(pl, by), off_plane(pl, ry)});
-        blur += 0.5 * std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]) * off * sc;
+        const auto& pg = planes[v.p[k]];  // the edge's other plane (Hull::across: planes p[k], p[k+1])
+        const double nf = std::sqrt(pl.n[0] * pl.n[0] + pl.n[1] * pl.n[1] + pl.n[2] * pl.n[2]);
+        const double ng = std::sqrt(pg.n[0] * pg.n[0] + pg.n[1] * pg.n[1] + pg.n[2] * pg.n[2]);
+        const double x[3] = {pl.n[1] * pg.n[2] - pl.n[2] * pg.n[1], pl.n[2] * pg.n[0] - pl.n[0] * pg.n[2],
+                             pl.n[0] * pg.n[1] - pl.n[1] * pg.n[0]};
+        // sin and cos of the angle, the sine shaded down for its rounding.
+        const double sin_fg = std::sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]) / (nf * ng) * (1 - 0x1p-40) -
+                              8 * kernels::filter::u;
+        const double cos_fg = std::fabs(pl.n[0] * pg.n[0] + pl.n[1] * pg.n[1] + pl.n[2] * pg.n[2]) / (nf * ng);
+        auto slide = [&](const double* y) {
+          return (off_plane(pg, y) + cos_fg * off_plane(pl, y)) / sin_fg * sc;  // NaN, inf where sin_fg <= 0
+        };
+        const double ab[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+        const double edge = std::sqrt(ab[0] * ab[0] + ab[1] * ab[1] + ab[2] * ab[2]);
+        const double foot = std::sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
+        const double moved = sin_fg > 0 ? edge * foot * (slide(v.y) + slide(by)) : std::numeric_limits<double>::infinity();
+        // The term's rounding, by its products' magnitudes (a long edge
+        // times a short one, where a column's faces are long).
+        const double rounding =
+            8 * kernels::filter::u *
+            (std::fabs(f[0]) * (std::fabs(ar[1] * br[2]) + std::fabs(ar[2] * br[1])) +
+             std::fabs(f[1]) * (std::fabs(ar[2] * br[0]) + std::fabs(ar[0] * br[2])) +
+             std::fabs(f[2]) * (std::fabs(ar[0] * br[1]) + std::fabs(ar[1] * br[0])));
+        blur += (moved + rounding) / 6;  // in the volume's units (the sums are six times it)
         o = r;
       } else {
         s = f[0] * (a[1] * b[2] - a[2] * b[1]) + f[1] * (a[2] * b[0] - a[0] * b[2]) +
