@@ -220,9 +220,13 @@ void hull_sums(const kernels::Hull& hull, double sc, double& vol, double& mag, d
 // ~0.3), far above the bound; a column 5e7 long and 0.07 wide is 1e-11 of it.
 // Or whether the vertices' own errors may move the volume by 2^-30 of it:
 // each vertex lies within sqrt(3) e of its exact place (e, the largest
-// Vertex::e, bounds its error per coordinate), which moves the volume by at
-// most that times the cell's surface, itself at most 4 pi R^2: in the
-// sums' units (six times the volume) 131 e R^2. Until stop 65 the gate had
+// Vertex::e, bounds its error per coordinate). A move d of an edge's end
+// across the edge moves the sums (six times the volume) by |edge| |c_f| d
+// on each of the edge's two faces (hull_sums, Fan), each edge at most 2R
+// long and each foot within R: over the 3 nv / 2 edges, 12 sqrt(3) nv e R^2.
+// (Until stop 74 this was e times the surface, 4 pi R^2, sqrt(3) and six:
+// 131 e R^2; a vertex's slide along nearly parallel faces moves the volume
+// more than its surface says.) Until stop 65 the gate had
 // only the first test (the 2D gate has had both since stop 64): a cell of
 // nearly collinear points, with vertices of condition ~1e5 (e ~1e-11 of the
 // cell's size), kept a volume 7.9e-9 off (Oracle.VertexErrorsBoundTheVolume;
@@ -231,7 +235,7 @@ void hull_sums(const kernels::Hull& hull, double sc, double& vol, double& mag, d
 // is far tighter, and measured exactly if that bound passes 2^-30.
 inline bool sums_uncertain(double vol, std::size_t nv, double radius, double emax) {
   const double bound = 32 * kernels::filter::u * static_cast<double>(3 * nv) * radius * radius * radius;
-  const double moved = 132 * emax * radius * radius;  // 6 x 4 pi sqrt(3) = 130.6
+  const double moved = 21 * static_cast<double>(nv) * emax * radius * radius;  // 12 sqrt(3) = 20.8
   return !(std::fabs(vol) > 0x1p20 * bound && std::fabs(vol) > 0x1p30 * moved);  // NaN and inf too
 }
 
