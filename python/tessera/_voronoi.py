@@ -68,7 +68,8 @@ class Voronoi:
 
     @property
     def bounds(self) -> Tuple[float, ...]:
-        """The domain box, (x0, x1, y0, y1[, z0, z1]): the given bounds or the padded bounding box."""
+        """The domain box, (x0, x1, y0, y1[, z0, z1]): the given bounds (a periodic
+        box's as rounded to its grid) or the padded bounding box."""
         return self._cells.bounds
 
     @property
