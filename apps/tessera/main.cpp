@@ -198,7 +198,9 @@ int main(int argc, char** argv) {
       "Examples:\n"
       "  tessera voronoi points.npy -o cells.vtu --cell-table cells.csv\n"
       "  tessera voronoi points.csv --dim 2 --bounds 0 1 0 1 -o cells.vtp\n"
-      "  tessera voronoi grains.ply --labels grain --neighbors nb.npy --validate");
+      "  tessera voronoi grains.ply --labels grain --neighbors nb.npy --validate\n"
+      "  tessera voronoi frame.npy --bounds 0 10 0 10 0 10 --periodic xyz --cell-table cells.csv --neighbors nb.npy "
+      "--neighbor-shifts shifts.npy");
 
   DelaunayArgs dla;
   std::vector<std::string> del_bounds, bench_del_bounds;
