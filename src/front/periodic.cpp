@@ -193,9 +193,9 @@ std::array<double, 3> initial_image_reach(const PeriodicInput& in) {
   for (int a = 0; a < in.dim; ++a) volume *= in.length[static_cast<std::size_t>(a)];
   const double taking = static_cast<double>(in.n - in.ignored.size());
   const double spacing = std::pow(volume / taking, 1.0 / in.dim);
-  // A uniform cell's security sphere reaches ~2.5 spacings, and 1 in 10^4
-  // past 3.5 (3D) or 3 (2D): a layer of 4 / 3.5 spacings seldom needs widening.
-  const double w = (in.dim == 3 ? 4.0 : 3.5) * spacing;
+  // Four spacings: uniform points (20k, 200k and 1M, 2D and 3D) needed no
+  // wider layer; at 3.5 one 2D cell of 20k asked for 4.0.
+  const double w = 4.0 * spacing;
   std::array<double, 3> width{0, 0, 0};
   for (std::size_t a = 0; a < 3; ++a)
     if (in.periodic[a]) width[a] = std::isfinite(w) ? std::min(w, in.reach_cap[a]) : in.reach_cap[a];

@@ -81,8 +81,8 @@ struct PeriodicImages {
 PeriodicImages periodic_images(const PeriodicInput& in, std::span<const std::int32_t> labels,
                                const std::array<double, 3>& width);
 
-/// The layer's initial widths: a few mean spacings of the points (uniform
-/// cells' security spheres reach ~3-4), at most what any cell needs.
+/// The layer's initial widths: four mean spacings of the points, at most
+/// what any cell needs.
 std::array<double, 3> initial_image_reach(const PeriodicInput& in);
 
 /// The widths the cells need (each periodic axis: how far beyond the box
