@@ -93,6 +93,18 @@ inline double off_plane(const Plane& pl, const double* y) {
   return (D == 3 ? 1.75 : 1.5) * (std::fabs(dot) + 4 * kernels::filter::u * terms) / pl.n1;
 }
 
+// n / |n|, computed without under- or overflow (0 for n = 0).
+inline void unit_normal(const double* n, double* out) {
+  const double m = std::max({std::fabs(n[0]), std::fabs(n[1]), std::fabs(n[2])});
+  if (!(m > 0)) {
+    out[0] = out[1] = out[2] = 0;
+    return;
+  }
+  const double t[3] = {n[0] / m, n[1] / m, n[2] / m};
+  const double l = std::sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]);
+  for (int i = 0; i < 3; ++i) out[i] = t[i] / l;
+}
+
 // The 3D measure's sums (below), of the vertices and feet scaled by `sc`
 // (a power of two; Scaled false: 1, without the multiplications), and
 // emax, the largest Vertex::e (unscaled), for sums_uncertain.
@@ -131,12 +143,17 @@ void hull_sums(const kernels::Hull& hull, double sc, double& vol, double& mag, d
   const auto& verts = hull.vertices();
   const auto& planes = hull.planes();
   const std::uint32_t* face_vertex = nullptr;
+  const std::array<double, 3>* unit = nullptr;  // each plane's unit normal
   if constexpr (Fan) {
     thread_local std::vector<std::uint32_t> table;
+    thread_local std::vector<std::array<double, 3>> units;
     table.resize(planes.size());  // every entry read below is written first
+    units.resize(planes.size());
     for (std::size_t t = 0; t < verts.size(); ++t)
       for (int k = 0; k < 3; ++k) table[verts[t].p[k]] = static_cast<std::uint32_t>(t);
+    for (std::size_t q = 0; q < planes.size(); ++q) unit_normal(planes[q].n, units[q].data());
     face_vertex = table.data();
+    unit = units.data();
   }
   vol = 0, mag = 0, c[0] = c[1] = c[2] = 0, emax = 0;
   if constexpr (Fan) blur = 0;
@@ -177,18 +194,18 @@ void hull_sums(const kernels::Hull& hull, double sc, double& vol, double& mag, d
                              ar[0] * br[1] - ar[1] * br[0]};
         s = f[0] * n[0] + f[1] * n[1] + f[2] * n[2];
         const auto& pg = planes[v.p[k]];  // the edge's other plane (Hull::across: planes p[k], p[k+1])
-        const double nf = std::sqrt(pl.n[0] * pl.n[0] + pl.n[1] * pl.n[1] + pl.n[2] * pl.n[2]);
-        const double ng = std::sqrt(pg.n[0] * pg.n[0] + pg.n[1] * pg.n[1] + pg.n[2] * pg.n[2]);
-        const double x[3] = {pl.n[1] * pg.n[2] - pl.n[2] * pg.n[1], pl.n[2] * pg.n[0] - pl.n[0] * pg.n[2],
-                             pl.n[0] * pg.n[1] - pl.n[1] * pg.n[0]};
+        const double* uf = unit[face].data();
+        const double* ug = unit[v.p[k]].data();
+        const double x[3] = {uf[1] * ug[2] - uf[2] * ug[1], uf[2] * ug[0] - uf[0] * ug[2], uf[0] * ug[1] - uf[1] * ug[0]};
         // sin and cos of the angle, the sine shaded down for its rounding.
-        const double sin_fg = std::sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]) / (nf * ng) * (1 - 0x1p-40) -
-                              8 * kernels::filter::u;
-        const double cos_fg = std::fabs(pl.n[0] * pg.n[0] + pl.n[1] * pg.n[1] + pl.n[2] * pg.n[2]) / (nf * ng);
+        const double sin_fg = std::sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]) * (1 - 0x1p-40) - 8 * kernels::filter::u;
+        const double cos_fg = std::fabs(uf[0] * ug[0] + uf[1] * ug[1] + uf[2] * ug[2]);
         auto slide = [&](const double* y) {
           return (off_plane(pg, y) + cos_fg * off_plane(pl, y)) / sin_fg * sc;  // NaN, inf where sin_fg <= 0
         };
         const double ab[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+        // (In the sums' frame, where they stay in double's range; a square
+        // that overflows makes the bound infinite, and the cell exact.)
         const double edge = std::sqrt(ab[0] * ab[0] + ab[1] * ab[1] + ab[2] * ab[2]);
         const double foot = std::sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
         const double moved = sin_fg > 0 ? edge * foot * (slide(v.y) + slide(by)) : std::numeric_limits<double>::infinity();
