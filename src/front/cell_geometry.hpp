@@ -133,7 +133,8 @@ inline void unit_normal(const double* n, double* out) {
 // lies on f and its other plane g, and a move m that way shows in the
 // residuals only as m sin(theta) off g (theta the angle between f and g),
 // so m <= (off_g + cos(theta) off_f) / sin(theta) (off_plane bounds each
-// residual). Until stop 74 the bound was each fan triangle's area times the
+// residual); and m <= sqrt(3) e, the vertex's own bound: the smaller
+// counts. Until stop 74 the bound was each fan triangle's area times the
 // residuals alone: between nearly parallel faces (a dense cluster's cell
 // reaching 1e4 away to two far points' nearly parallel bisectors, theta
 // ~2e-5) a vertex 1e-12 off its planes slid 1e-7 along them, and a volume
@@ -200,15 +201,20 @@ void hull_sums(const kernels::Hull& hull, double sc, double& vol, double& mag, d
         // sin and cos of the angle, the sine shaded down for its rounding.
         const double sin_fg = std::sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]) * (1 - 0x1p-40) - 8 * kernels::filter::u;
         const double cos_fg = std::fabs(uf[0] * ug[0] + uf[1] * ug[1] + uf[2] * ug[2]);
-        auto slide = [&](const double* y) {
-          return (off_plane(pg, y) + cos_fg * off_plane(pl, y)) / sin_fg * sc;  // NaN, inf where sin_fg <= 0
+        // A vertex's own bound (Vertex::e per coordinate) bounds its slide
+        // too; the tighter of the two counts.
+        auto slide = [&](const auto& vx) {
+          const double by_residuals = sin_fg > 0 ? (off_plane(pg, vx.y) + cos_fg * off_plane(pl, vx.y)) / sin_fg
+                                                 : std::numeric_limits<double>::infinity();
+          const double by_bound = 1.7320508075688774 * vx.e;  // sqrt(3) e
+          return (by_residuals < by_bound ? by_residuals : by_bound) * sc;  // NaN residuals: the bound
         };
         const double ab[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
         // (In the sums' frame, where they stay in double's range; a square
         // that overflows makes the bound infinite, and the cell exact.)
         const double edge = std::sqrt(ab[0] * ab[0] + ab[1] * ab[1] + ab[2] * ab[2]);
         const double foot = std::sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
-        const double moved = sin_fg > 0 ? edge * foot * (slide(v.y) + slide(by)) : std::numeric_limits<double>::infinity();
+        const double moved = edge * foot * (slide(v) + slide(verts[hull.across(t, k)]));
         // The term's rounding, by its products' magnitudes (a long edge
         // times a short one, where a column's faces are long).
         const double rounding =
