@@ -15,6 +15,7 @@
 #include "commands.hpp"
 #include "stdin_input.hpp"
 #include "option_checks.hpp"
+#include "tessera/finite_points.hpp"
 #include "tessera/io/atomic_file.hpp"
 #include "tessera/io/npy.hpp"
 #include "tessera/io/points.hpp"
@@ -42,20 +43,6 @@ void add_input_options(CLI::App* app, PrepInput& p, bool labels, const char* kee
                     "vertex property / .csv column / .vtp or .vtu point data array / .pcd or structured .npy field");
   app->add_flag("--keep-non-finite", p.keep_non_finite, keep_help);
   app->add_flag("-q,--quiet", p.quiet, "No summary line");
-}
-
-/// Whether point i has only finite coordinates.
-bool finite_point(const io::PointCloud& pc, std::size_t i) {
-  for (int d = 0; d < pc.dim; ++d)
-    if (!std::isfinite(pc.coords[i * static_cast<std::size_t>(pc.dim) + static_cast<std::size_t>(d)])) return false;
-  return true;
-}
-
-/// How many of the points have a NaN or infinite coordinate.
-std::size_t count_non_finite(const io::PointCloud& pc) {
-  std::size_t count = 0;
-  for (std::size_t i = 0; i < pc.n; ++i) count += !finite_point(pc, i);
-  return count;
 }
 
 /// The summary's note on kept non-finite points ("" when there are none).
@@ -221,7 +208,7 @@ int run_joggle(const JoggleArgs& a) {
     throw InputError("--mode " + a.mode + " needs 3D points (2D points joggle in their plane: --mode ball)");
   std::vector<std::uint8_t> mask;
   std::size_t moving = pc.n;
-  const std::size_t non_finite = a.io.keep_non_finite ? count_non_finite(pc) : 0;
+  const std::size_t non_finite = a.io.keep_non_finite ? count_non_finite(pc.coords, pc.dim) : 0;
   if (!a.mask.empty()) {
     const io::NpyArray m = io::read_npy_int(a.mask);
     if (!(m.shape.size() == 1 || (m.shape.size() == 2 && m.shape[1] == 1)) || m.as_int.size() != pc.n)
@@ -233,7 +220,7 @@ int run_joggle(const JoggleArgs& a) {
   if (!mask.empty() || non_finite != 0) {
     // What joggle() moves: the masked points with finite coordinates.
     moving = 0;
-    for (std::size_t i = 0; i < pc.n; ++i) moving += (mask.empty() || mask[i] != 0) && finite_point(pc, i);
+    for (std::size_t i = 0; i < pc.n; ++i) moving += (mask.empty() || mask[i] != 0) && finite_point(pc.coords, i, pc.dim);
   }
 
   LabelledPoints out;
@@ -303,7 +290,7 @@ int run_fill(const FillArgs& a) {
     std::printf("tessera fill: %zu points (%dD) from %s, %zu background points added (%s, label %d)%s; wrote %s\n",
                 pc.n, pc.dim, shown_path(a.io.input).c_str(), out.size() - pc.n, a.strategy.c_str(),
                 static_cast<int>(a.background_label),
-                non_finite_note(a.io.keep_non_finite ? count_non_finite(pc) : 0).c_str(), written_list(written).c_str());
+                non_finite_note(a.io.keep_non_finite ? count_non_finite(pc.coords, pc.dim) : 0).c_str(), written_list(written).c_str());
   return kExitOk;
 }
 
@@ -349,7 +336,7 @@ int run_threshold(const ThresholdArgs& a) {
                std::to_string(label) + ": " + std::to_string(k);
     std::printf("tessera threshold: %zu points (%dD) from %s (%s)%s; wrote %s\n", pc.n, pc.dim,
                 shown_path(a.io.input).c_str(), parts.c_str(),
-                non_finite_note(a.io.keep_non_finite ? count_non_finite(pc) : 0).c_str(), written_list(written).c_str());
+                non_finite_note(a.io.keep_non_finite ? count_non_finite(pc.coords, pc.dim) : 0).c_str(), written_list(written).c_str());
   }
   return kExitOk;
 }

@@ -217,11 +217,12 @@ Cells run_periodic(std::span<const double> input, int dim, std::span<const std::
                    const VoronoiOptions& opt) {
   const front::PeriodicInput in = front::periodic_input(input, dim, labels, opt);
   std::array<double, 3> width = front::initial_image_reach(in);
+  const int threads = resolve_threads(opt.threads);
   VoronoiOptions o = opt;
   o.periodic = {false, false, false};
   o.ignore_outside_points = false;  // set aside already; every image lies in the layer
   for (int round = 0;; ++round) {
-    const front::PeriodicImages im = front::periodic_images(in, labels, width);
+    const front::PeriodicImages im = front::periodic_images(in, labels, width, threads);
     o.bounds = im.domain;
     std::vector<double> reach(im.base.size(), 0.0);
     Cells aug = run<CellT>(im.points, im.labels, o, &reach);
@@ -241,7 +242,7 @@ Cells run_periodic(std::span<const double> input, int dim, std::span<const std::
       enough = false;
       width[a] = std::min(need[a] * 1.0625, in.reach_cap[a]);
     }
-    if (enough) return front::periodic_cells(std::move(aug), in, im, labels);
+    if (enough) return front::periodic_cells(std::move(aug), in, im, labels, threads);
     if (round == 2)  // the second layer covers what the first one's cells asked for
       throw std::logic_error("tessera: periodic cells still reach past their images' layer after widening it");
   }

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "tessera/engine/thread_arena.hpp"
+#include "tessera/finite_points.hpp"
 
 namespace tessera::front {
 namespace {
@@ -39,11 +40,7 @@ void set_aside_non_finite(std::span<const double>& points, int dim, VoronoiOptio
     return;  // (check_input names what is wrong)
   const auto d = static_cast<std::size_t>(dim);
   const std::size_t n = points.size() / d;
-  auto finite = [&](std::size_t i) {
-    for (std::size_t a = 0; a < d; ++a)
-      if (!std::isfinite(points[i * d + a])) return false;
-    return true;
-  };
+  auto finite = [&](std::size_t i) { return finite_point(points, i, dim); };
   std::size_t kept = 0;
   for (std::size_t i = 0; i < n; ++i) kept += finite(i);
   if (kept == n) return;

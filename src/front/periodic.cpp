@@ -8,7 +8,12 @@
 #include <numeric>
 #include <string>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include "tessera/engine/classifier.hpp"
+#include "tessera/engine/thread_arena.hpp"
+#include "tessera/finite_points.hpp"
 
 namespace tessera::front {
 namespace {
@@ -92,9 +97,7 @@ PeriodicInput periodic_input(std::span<const double> points, int dim, std::span<
   in.takes_part.assign(in.n, 1);
   for (std::size_t i = 0; i < in.n; ++i) {
     double* p = in.points.data() + i * du;
-    bool finite = true;
-    for (std::size_t a = 0; a < du; ++a) finite = finite && std::isfinite(p[a]);
-    if (!finite) {
+    if (!finite_point(in.points, i, dim)) {
       if (!options.ignore_outside_points)
         throw InputError("point " + std::to_string(i) +
                          " has a NaN or infinite coordinate (ignore_outside sets such points aside)");
@@ -142,7 +145,7 @@ PeriodicInput periodic_input(std::span<const double> points, int dim, std::span<
 }
 
 PeriodicImages periodic_images(const PeriodicInput& in, std::span<const std::int32_t> labels,
-                               const std::array<double, 3>& width) {
+                               const std::array<double, 3>& width, int threads) {
   const int dim = in.dim;
   const auto du = static_cast<std::size_t>(dim);
   PeriodicImages im;
@@ -161,10 +164,9 @@ PeriodicImages periodic_images(const PeriodicInput& in, std::span<const std::int
   for (int s0 = -k[0]; s0 <= k[0]; ++s0)
     for (int s1 = -k[1]; s1 <= k[1]; ++s1)
       for (int s2 = -k[2]; s2 <= k[2]; ++s2) shifts.push_back({s0, s1, s2});
-  im.original.assign(in.n, -1);
-  const std::size_t limit = static_cast<std::size_t>(INT32_MAX - 1);
-  for (std::size_t i = 0; i < in.n; ++i) {
-    if (!in.takes_part[i]) continue;
+  // Point i's images in the layer, in shift order: f(shift, image).
+  auto for_each_image = [&](std::size_t i, auto&& f) {
+    if (!in.takes_part[i]) return;
     const double* p = in.points.data() + i * du;
     for (const auto& s : shifts) {
       double y[3] = {0, 0, 0};
@@ -173,18 +175,47 @@ PeriodicImages periodic_images(const PeriodicInput& in, std::span<const std::int
         y[a] = p[a] + s[a] * in.length[a];  // exact (PeriodicInput's grid)
         inside = y[a] >= im.domain.lo[a] && y[a] <= im.domain.hi[a];
       }
-      if (!inside) continue;
-      const bool zero = s[0] == 0 && s[1] == 0 && s[2] == 0;
-      if (im.base.size() == limit)
-        throw InputError("too many points with their periodic images (ids are 32-bit)");
-      if (zero) im.original[i] = static_cast<std::int32_t>(im.base.size());
-      im.base.push_back(static_cast<std::int32_t>(i));
-      im.points.insert(im.points.end(), y, y + du);
-      for (std::size_t a = 0; a < du; ++a) im.shift.push_back(static_cast<std::int8_t>(s[a]));
-      im.labels.push_back(zero ? (labels.empty() ? 0 : labels[i]) : -1);
-      im.images += !zero;
+      if (inside) f(s, y);
     }
-  }
+  };
+  // Counted, then written at their offsets, one block of points per task:
+  // the same array for any thread count.
+  std::vector<std::size_t> first(in.n + 1, 0);
+  engine::ThreadArena arena(threads);
+  arena.execute([&] {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, in.n, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
+      for (std::size_t i = r.begin(); i != r.end(); ++i)
+        for_each_image(i, [&](const std::array<int, 3>&, const double*) { ++first[i + 1]; });
+    });
+  });
+  std::partial_sum(first.begin(), first.end(), first.begin());
+  const std::size_t m = first.back();
+  if (m > static_cast<std::size_t>(INT32_MAX - 1))
+    throw InputError("too many points with their periodic images (ids are 32-bit)");
+  im.original.assign(in.n, -1);
+  im.base.resize(m);
+  im.points.resize(m * du);
+  im.shift.resize(m * du);
+  im.labels.resize(m);
+  im.images = m - (in.n - in.ignored.size());
+  arena.execute([&] {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, in.n, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
+      for (std::size_t i = r.begin(); i != r.end(); ++i) {
+        std::size_t at = first[i];
+        for_each_image(i, [&](const std::array<int, 3>& s, const double* y) {
+          const bool zero = s[0] == 0 && s[1] == 0 && s[2] == 0;
+          if (zero) im.original[i] = static_cast<std::int32_t>(at);
+          im.base[at] = static_cast<std::int32_t>(i);
+          for (std::size_t a = 0; a < du; ++a) {
+            im.points[at * du + a] = y[a];
+            im.shift[at * du + a] = static_cast<std::int8_t>(s[a]);
+          }
+          im.labels[at] = zero ? (labels.empty() ? 0 : labels[i]) : -1;
+          ++at;
+        });
+      }
+    });
+  });
   return im;
 }
 
@@ -221,7 +252,7 @@ std::array<double, 3> needed_image_reach(const PeriodicInput& in, const Periodic
 }
 
 Cells periodic_cells(Cells&& aug, const PeriodicInput& in, const PeriodicImages& im,
-                     std::span<const std::int32_t> labels) {
+                     std::span<const std::int32_t> labels, int threads) {
   const int dim = in.dim;
   const auto du = static_cast<std::size_t>(dim);
   Cells out;
@@ -234,11 +265,20 @@ Cells periodic_cells(Cells&& aug, const PeriodicInput& in, const PeriodicImages&
     if (in.periodic[a]) out.image_reach[a] = std::min(in.box.lo[a] - im.domain.lo[a], im.domain.hi[a] - in.box.hi[a]);
   auto base = [&](std::int32_t id) { return id < 0 ? id : im.base[static_cast<std::size_t>(id)]; };
   const std::size_t nc = aug.n_cells();
+  // Element-wise maps over the outputs, in blocks on the caller's threads.
+  engine::ThreadArena arena(threads);
+  auto each = [&](std::size_t n, auto&& f) {
+    arena.execute([&] {
+      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 16384), [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t k = r.begin(); k != r.end(); ++k) f(k);
+      });
+    });
+  };
 
   // Per cell: every cell is a point's own (images own none), in the order
   // of the points, as the augmented ids keep it.
   out.generator = std::move(aug.generator);
-  for (auto& g : out.generator) g = base(g);
+  each(nc, [&](std::size_t c) { out.generator[c] = base(out.generator[c]); });
   out.region = std::move(aug.region);
   out.volume = std::move(aug.volume);
   out.centroid = std::move(aug.centroid);
@@ -248,37 +288,38 @@ Cells periodic_cells(Cells&& aug, const PeriodicInput& in, const PeriodicImages&
 
   // Neighbours: (point, shift), ascending.
   out.neighbor_offsets = std::move(aug.neighbor_offsets);
-  out.neighbors.resize(aug.neighbors.size());
-  out.neighbor_shifts.resize(aug.neighbors.size() * du);
+  out.neighbors = std::move(aug.neighbors);
+  out.neighbor_shifts.resize(out.neighbors.size() * du);
   // Augmented ids list each point's images together, by shift, so their
   // ascending order is (point, shift): the order the entries keep.
-  for (std::size_t e = 0; e < aug.neighbors.size(); ++e) {
-    const auto j = static_cast<std::size_t>(aug.neighbors[e]);
+  each(out.neighbors.size(), [&](std::size_t e) {
+    const auto j = static_cast<std::size_t>(out.neighbors[e]);
     out.neighbors[e] = im.base[j];
     for (std::size_t a = 0; a < du; ++a) out.neighbor_shifts[e * du + a] = im.shift[j * du + a];
-  }
+  });
 
   // The mesh: keys and faces by the points' ids; classes by their labels.
   if (!aug.vertex_keys.empty() || !aug.cell_face_offsets.empty()) {
     out.vertices = std::move(aug.vertices);
     out.vertex_keys = std::move(aug.vertex_keys);
-    for (std::size_t v = 0; v < out.vertex_keys.size(); v += du + 1) {
-      std::int32_t* key = out.vertex_keys.data() + v;
+    each(out.vertex_keys.size() / (du + 1), [&](std::size_t v) {
+      std::int32_t* key = out.vertex_keys.data() + v * (du + 1);
       for (std::size_t d = 0; d <= du; ++d) key[d] = base(key[d]);
       std::sort(key, key + du + 1);
-    }
+    });
     out.cell_face_offsets = std::move(aug.cell_face_offsets);
     out.face_vertex_offsets = std::move(aug.face_vertex_offsets);
     out.face_vertices = std::move(aug.face_vertices);
     out.face_neighbor = std::move(aug.face_neighbor);
     out.face_class = std::move(aug.face_class);
     const engine::RegionClassifier classify(labels);
-    for (std::size_t c = 0; c < nc; ++c)
+    each(nc, [&](std::size_t c) {
       for (auto f = out.cell_face_offsets[c]; f < out.cell_face_offsets[c + 1]; ++f) {
         const auto fu = static_cast<std::size_t>(f);
         out.face_neighbor[fu] = base(out.face_neighbor[fu]);
         out.face_class[fu] = classify(out.generator[c], out.face_neighbor[fu]);
       }
+    });
   }
 
   // Duplicates among the points (the pass reports generators only, so not

@@ -78,8 +78,10 @@ struct PeriodicImages {
   std::size_t images = 0;              ///< augmented points that are images
 };
 
+/// `threads`: the computation's (resolved) thread count; the result is the
+/// same for any.
 PeriodicImages periodic_images(const PeriodicInput& in, std::span<const std::int32_t> labels,
-                               const std::array<double, 3>& width);
+                               const std::array<double, 3>& width, int threads);
 
 /// The layer's initial widths: four mean spacings of the points, at most
 /// what any cell needs.
@@ -96,6 +98,6 @@ std::array<double, 3> needed_image_reach(const PeriodicInput& in, const Periodic
 /// The cells of the augmented input, as the cells of the input points: ids
 /// and keys mapped back, neighbour shifts, face classes by the user's labels.
 Cells periodic_cells(Cells&& augmented, const PeriodicInput& in, const PeriodicImages& im,
-                     std::span<const std::int32_t> labels);
+                     std::span<const std::int32_t> labels, int threads);
 
 }  // namespace tessera::front

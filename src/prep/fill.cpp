@@ -28,6 +28,7 @@
 
 #include "random.hpp"
 #include "tessera/engine/thread_arena.hpp"
+#include "tessera/finite_points.hpp"
 #include "tessera/image.hpp"
 #include "tessera/prep/sample_image.hpp"
 
@@ -178,9 +179,8 @@ LabelledPoints fill(std::span<const double> coords, int dim, std::span<const std
   // Points that take part: all, or with keep_non_finite the finite ones.
   std::vector<std::uint8_t> finite;
   if (options.keep_non_finite) {
-    finite.assign(n, 1);
-    for (std::size_t k = 0; k < coords.size(); ++k)
-      if (!std::isfinite(coords[k])) finite[k / sdim] = 0;
+    finite.resize(n);
+    for (std::size_t i = 0; i < n; ++i) finite[i] = finite_point(coords, i, dim);
   } else {
     for (std::size_t k = 0; k < coords.size(); ++k)
       if (!std::isfinite(coords[k]))

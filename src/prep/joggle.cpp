@@ -16,6 +16,7 @@
 #include "random.hpp"
 #include "tessera/cells.hpp"
 #include "tessera/engine/thread_arena.hpp"
+#include "tessera/finite_points.hpp"
 
 namespace tessera {
 namespace {
@@ -27,13 +28,6 @@ std::string num(double v) {
   char buf[32];
   const auto r = std::to_chars(buf, buf + sizeof buf, v);
   return std::string(buf, r.ptr);
-}
-
-/// Whether point i's coordinates are all finite.
-bool finite_point(std::span<const double> coords, std::size_t i, int dim) {
-  for (int d = 0; d < dim; ++d)
-    if (!std::isfinite(coords[i * static_cast<std::size_t>(dim) + static_cast<std::size_t>(d)])) return false;
-  return true;
 }
 
 /// `r` times the length of the diagonal of the bounding box of the finite

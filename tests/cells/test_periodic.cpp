@@ -277,6 +277,21 @@ TEST(Periodic, PointsOutsideArePeriodicallyWrapped) {
   EXPECT_EQ(a.neighbor_shifts, b.neighbor_shifts);
 }
 
+TEST(Periodic, PointsFarOutAreWrappedIn) {
+  // 1e300 box lengths out: reduced by fmod (its position within the period
+  // is whatever the double 1e300 holds), then a cell like any other.
+  const auto box = make_bounds({0, 0, 0}, {1, 1, 1});
+  auto pts = random_points(200, 3, 43, box);
+  pts[0] = 1e300;
+  pts[4] = -3e299;
+  const tessera::Cells c = run_periodic(pts, 3, box, {true, true, true});
+  EXPECT_EQ(c.n_cells(), 200u);
+  double total = 0;
+  for (double v : c.volume) total += v;
+  EXPECT_NEAR(total, 1.0, 1e-12);
+  EXPECT_EQ(asymmetric_entries(c), 0u);
+}
+
 TEST(Periodic, Refused) {
   const auto box = make_bounds({0, 0, 0}, {1, 1, 1});
   const auto pts = random_points(50, 3, 40, box);
@@ -285,10 +300,10 @@ TEST(Periodic, Refused) {
   EXPECT_THROW(tessera::voronoi(pts, 3, {}, o), tessera::InputError);  // no box
   const auto pts2 = random_points(50, 2, 41, box);
   EXPECT_THROW(tessera::voronoi(pts2, 2, {}, periodic_options(2, box, {false, false, true})), tessera::InputError);
-  auto far = pts;
-  far[0] = 1.7e308;  // beyond double's range from the box: not wrapped
-  const auto wide = make_bounds({-1.7e308, 0, 0}, {-1.6e308, 1, 1});
-  EXPECT_THROW(run_periodic(far, 3, wide, {true, false, false}), tessera::InputError);
+  // A box whose images leave double's range is refused.
+  const auto huge = make_bounds({-1e308, 0, 0}, {-0.9e308, 1, 1});
+  EXPECT_THROW(run_periodic({-0.95e308, 0.5, 0.5, -0.92e308, 0.5, 0.5}, 3, huge, {true, false, false}),
+               tessera::InputError);
   // Outside a wall (a non-periodic axis): refused, or dropped where asked.
   auto out = pts;
   out[1] = 1.5;
