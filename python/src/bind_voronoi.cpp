@@ -38,6 +38,14 @@ Cells run_voronoi(const Points& points, const py::object& labels, const std::opt
   return without_gil([&] { return voronoi(pts, dim, lab, opt); });
 }
 
+/// The first dim values of a per-axis array, as a tuple.
+template <class T>
+py::tuple per_axis(const std::array<T, 3>& values, int dim) {
+  py::tuple t(static_cast<std::size_t>(dim));
+  for (std::size_t a = 0; a < static_cast<std::size_t>(dim); ++a) t[a] = values[a];
+  return t;
+}
+
 /// Per-face CSR and vertex arrays exist only when the cells were built with
 /// the merged mesh (build_mesh); without it cell_face_offsets stays empty
 /// (a result always has at least one cell).
@@ -113,19 +121,9 @@ void bind_voronoi(py::module_& m) {
                                const Cells& c = s.cast<const Cells&>();
                                return view_rows(c.neighbor_shifts, static_cast<std::size_t>(c.dim), s);
                              })
-      .def_property_readonly("periodic",
-                             [](const Cells& c) {
-                               py::tuple t(static_cast<std::size_t>(c.dim));
-                               for (int a = 0; a < c.dim; ++a) t[static_cast<std::size_t>(a)] = c.periodic[static_cast<std::size_t>(a)];
-                               return t;
-                             })
+      .def_property_readonly("periodic", [](const Cells& c) { return per_axis(c.periodic, c.dim); })
       .def_readonly("periodic_images", &Cells::periodic_images)
-      .def_property_readonly("image_reach",
-                             [](const Cells& c) {
-                               py::tuple t(static_cast<std::size_t>(c.dim));
-                               for (int a = 0; a < c.dim; ++a) t[static_cast<std::size_t>(a)] = c.image_reach[static_cast<std::size_t>(a)];
-                               return t;
-                             })
+      .def_property_readonly("image_reach", [](const Cells& c) { return per_axis(c.image_reach, c.dim); })
       // per generator
       .def_property_readonly("cell_of", [](py::object s) { return view_flat(s.cast<const Cells&>().cell_of, s); })
       // merged mesh

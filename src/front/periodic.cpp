@@ -81,9 +81,11 @@ PeriodicInput periodic_input(std::span<const double> points, int dim, std::span<
     in.reach_cap[au] = std::min(cap, k * in.length[au]);
     in.reach_clamped[au] = in.reach_cap[au] < cap;
     // The grid: multiples of g below 2^(e+1) are doubles, and every image
-    // x + k L (|k| <= max_shift) stays below that.
+    // x + k L (|k| <= max_shift, x in the box) stays below that; the margin
+    // covers the box's own rounding to the grid (g / 2 of m's 2^-52). Also
+    // the wrap's steps by a period (x within a period of the box).
     const double lo = in.box.lo[au], hi = in.box.hi[au];
-    const double m = (std::max(std::fabs(lo), std::fabs(hi)) + (k + 1) * in.length[au]) * (1 + 0x1p-40);
+    const double m = (std::max(std::fabs(lo), std::fabs(hi)) + k * in.length[au]) * (1 + 0x1p-40);
     if (!std::isfinite(m)) throw InputError("the periodic box's images overflow double; scale the input down");
     const double g = std::ldexp(1.0, std::max(std::ilogb(m) - 52, -1074));
     in.box.lo[au] = snap(lo, g);
