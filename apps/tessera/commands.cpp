@@ -206,6 +206,13 @@ VoronoiOptions make_options(const ComputeArgs& a, int dim) {
   }
   if (!a.periodic.empty() && a.bounds.empty())
     throw InputError("--periodic needs --bounds: the box that repeats");
+  if (!a.tilt.empty()) {
+    if (a.periodic.empty()) throw InputError("--tilt needs --periodic (a triclinic box repeats along its tilted axes)");
+    if (a.tilt.size() != (dim == 3 ? 3u : 1u))
+      throw InputError(dim == 3 ? "--tilt: expected three values, XY XZ YZ, for 3D points"
+                                : "--tilt: expected one value, XY, for 2D points");
+    for (std::size_t t = 0; t < a.tilt.size(); ++t) o.tilt[t] = a.tilt[t];
+  }
   return o;
 }
 
@@ -299,6 +306,12 @@ void print_summary(const VoronoiArgs& a, const io::PointCloud& pc, const Cells& 
       }
     std::printf("  %-18s %s (%zu images of points, within %s beyond the box)\n", "periodic", axes.c_str(),
                 c.periodic_images, reach.c_str());
+    if (c.tilt[0] != 0 || c.tilt[1] != 0 || c.tilt[2] != 0) {
+      if (c.dim == 2)
+        std::printf("  %-18s xy %.17g\n", "tilt (triclinic)", c.tilt[0]);
+      else
+        std::printf("  %-18s xy %.17g, xz %.17g, yz %.17g\n", "tilt (triclinic)", c.tilt[0], c.tilt[1], c.tilt[2]);
+    }
   }
   if (c.far_points != 0)
     std::printf("  %-18s %zu (beyond the bulk of the points; they stretch the default domain: outliers?)\n",

@@ -39,6 +39,7 @@ struct ComputeArgs {
   double bin_points = 0;        ///< 0: automatic
   std::string cell_method = "auto";  ///< auto | search | insertion (voronoi only; add_cell_method_option)
   std::string periodic;         ///< "" or periodic axes, e.g. "xyz" (voronoi only; add_periodic_option)
+  std::vector<double> tilt;     ///< triclinic tilts: xy (2D), or xy xz yz (3D); empty: orthogonal
 };
 
 struct VoronoiArgs {

@@ -128,6 +128,13 @@ void add_periodic_option(CLI::App* app, ComputeArgs& c) {
                   "lengths (2^-51 for a unit box) so that every image is exact. Cells keep their shape across the "
                   "box's faces; neighbours may be images (--neighbor-shifts)")
       ->type_name("AXES");
+  app->add_option("--tilt", c.tilt,
+                  "With --periodic: a triclinic (sheared) box's tilt factors as lengths, as LAMMPS and Voro++ give "
+                  "them: XY in 2D, XY XZ YZ in 3D. The box is the parallelepiped spanned from --bounds' lower "
+                  "corner by a = (Lx,0,0), b = (XY,Ly,0), c = (XZ,YZ,Lz), L the extents of --bounds; a tilt needs "
+                  "both its axes periodic. Points are wrapped into it, and --neighbor-shifts count a, b, c")
+      ->type_name("XY [XZ YZ]")
+      ->expected(1, 3);
 }
 
 /// Converts the --bounds words to numbers. A fifth word that is not a number

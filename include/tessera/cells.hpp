@@ -78,6 +78,20 @@ struct VoronoiOptions {
   /// Cells::neighbor_shifts says which image each neighbour is. Delaunay,
   /// graphs, face sets, flowers and surface nets refuse periodic input.
   std::array<bool, 3> periodic{false, false, false};
+  /// Tilt factors of a triclinic (sheared) periodic box, as lengths in
+  /// LAMMPS's and Voro++'s convention: {xy, xz, yz}. The box repeats by the
+  /// lattice vectors a = (Lx, 0, 0), b = (xy, Ly, 0), c = (xz, yz, Lz), with
+  /// L the extents of `bounds`; it is the parallelepiped spanned by them
+  /// from bounds' lower corner (2D: a = (Lx, 0), b = (xy, Ly); xz and yz
+  /// must be 0). A tilt needs both of its axes periodic (xy: x and y).
+  /// Points are wrapped into the parallelepiped, and the tilts are rounded
+  /// to the same grid as the coordinates. Cells::neighbor_shifts then count
+  /// lattice vectors. All zero: an orthogonal box.
+  std::array<double, 3> tilt{0, 0, 0};
+  /// Some axis periodic, or a tilt given (which needs periodic axes).
+  bool periodic_box() const {
+    return periodic[0] || periodic[1] || periodic[2] || tilt[0] != 0 || tilt[1] != 0 || tilt[2] != 0;
+  }
   /// Called from the calling thread with the fraction done, in [0,1]; may throw
   /// Cancelled to stop the run (the engine stops between batches).
   std::function<void(double)> progress;
@@ -115,7 +129,8 @@ struct Cells {
   /// Periodic boxes only (VoronoiOptions::periodic), else empty: for each
   /// entry of `neighbors`, dim shifts: the face is shared with the image of
   /// that point moved by shift[a] box lengths along axis a (0 on axes that
-  /// are not periodic). A point may be listed more than once (several of
+  /// are not periodic); in a triclinic box by shift[0] a + shift[1] b +
+  /// shift[2] c (VoronoiOptions::tilt's lattice vectors). A point may be listed more than once (several of
   /// its images, in a box only a few cells wide), even as its own
   /// neighbour; entries are ascending by id, then by shift.
   Buffer<std::int8_t> neighbor_shifts;
@@ -171,6 +186,8 @@ struct Cells {
   /// is then the box as rounded), the images of points that took part, and
   /// how far beyond the box they reached along each periodic axis.
   std::array<bool, 3> periodic{false, false, false};
+  /// A triclinic box's tilts {xy, xz, yz} as rounded (VoronoiOptions::tilt).
+  std::array<double, 3> tilt{0, 0, 0};
   std::size_t periodic_images = 0;
   std::array<double, 3> image_reach{0, 0, 0};
 

@@ -252,9 +252,12 @@ Cells run_periodic(std::span<const double> input, int dim, std::span<const std::
 
 Cells voronoi(std::span<const double> input, int dim, std::span<const std::int32_t> labels,
               const VoronoiOptions& options) {
-  if (options.periodic[0] || options.periodic[1] || options.periodic[2])
+  if (options.periodic_box()) {
+    if (!options.periodic[0] && !options.periodic[1] && !options.periodic[2])
+      throw InputError("a tilt (triclinic box) needs periodic axes");
     return dim == 3 ? run_periodic<kernels::Hull>(input, dim, labels, options)
                     : run_periodic<kernels::Tile>(input, dim, labels, options);
+  }
   const front::CheckedInput<VoronoiOptions> in(input, dim, labels, options);
   return dim == 3 ? run<kernels::Hull>(in.points, labels, in.options)
                   : run<kernels::Tile>(in.points, labels, in.options);

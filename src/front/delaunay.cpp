@@ -612,7 +612,7 @@ bool inside_reaches_out(std::span<const double> points, int dim, std::span<const
 
 Delaunay delaunay(std::span<const double> input, int dim, std::span<const std::int32_t> labels,
                   const DelaunayOptions& given) {
-  if (given.periodic[0] || given.periodic[1] || given.periodic[2])
+  if (given.periodic_box())
     throw InputError("periodic boxes: only the cells (tessera::voronoi), not the Delaunay triangulation");
   const front::CheckedInput<DelaunayOptions> in(input, dim, labels, given);
   const std::span<const double> points = in.points;

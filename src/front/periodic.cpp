@@ -59,41 +59,127 @@ PeriodicInput periodic_input(std::span<const double> points, int dim, std::span<
     in.length[au] = in.box.hi[au] - in.box.lo[au];
     if (!std::isfinite(in.length[au])) throw InputError("the periodic box's extent overflows double");
   }
-  // A cell lies within its point's images one box length away along each
-  // periodic axis (the box about the point) and within the walls along the
-  // others: its security sphere (twice its farthest vertex) reaches at most
-  // `cap` from the point.
-  double r2 = 0;
-  for (int a = 0; a < dim; ++a) {
-    const auto au = static_cast<std::size_t>(a);
-    const double half = in.periodic[au] ? 0.5 * in.length[au] : in.length[au];
-    r2 += half * half;
+  // Tilts: tilt t (xy, xz, yz) is lattice[hi][lo], a shear of axis lo by axis hi.
+  static constexpr int tilt_lo[3] = {0, 0, 1}, tilt_hi[3] = {1, 2, 2};
+  static constexpr const char* tilt_name[3] = {"xy", "xz", "yz"};
+  for (std::size_t t = 0; t < 3; ++t) {
+    const double v = options.tilt[t];
+    if (v == 0) continue;
+    const auto lo = static_cast<std::size_t>(tilt_lo[t]), hi = static_cast<std::size_t>(tilt_hi[t]);
+    if (!std::isfinite(v)) throw InputError(std::string("tilt ") + tilt_name[t] + " must be finite, not " + num(v));
+    if (static_cast<int>(hi) >= dim) throw InputError(std::string("tilt ") + tilt_name[t] + " of 2D points (only xy)");
+    if (!in.periodic[lo] || !in.periodic[hi])
+      throw InputError(std::string("tilt ") + tilt_name[t] + " needs " + axis_name(tilt_lo[t]) + " and " +
+                       axis_name(tilt_hi[t]) + " periodic (a tilted wall is not supported)");
+    // The fractional coordinates' rounding stays far below fraction_slack.
+    if (!(std::fabs(v) <= 0x1p10 * in.length[lo]))
+      throw InputError(std::string("tilt ") + tilt_name[t] + " " + num(v) + " is over 1024 box lengths along " +
+                       axis_name(tilt_lo[t]) + "; reduce it by whole box lengths (the same lattice)");
   }
-  const double cap = 2 * std::sqrt(r2) * (1 + 0x1p-20);
-  for (int a = 0; a < dim; ++a) {
-    const auto au = static_cast<std::size_t>(a);
-    if (!in.periodic[au]) continue;
-    // Shifts are int8 (Cells::neighbor_shifts). A box whose walls are more
-    // than ~60 periods long may ask for more than 127 only where its cells
-    // are that long (a few points): the driver then reports it.
-    const double k = std::min(std::ceil(cap / in.length[au]), double{max_periodic_shift});
-    in.max_shift[au] = static_cast<int>(k);
-    in.reach_cap[au] = std::min(cap, k * in.length[au]);
-    in.reach_clamped[au] = in.reach_cap[au] < cap;
-    // The grid: multiples of g below 2^(e+1) are doubles, and every image
-    // x + k L (|k| <= max_shift, x in the box) stays below that; the margin
-    // covers the box's own rounding to the grid (g / 2 of m's 2^-52). Also
-    // the wrap's steps by a period (x within a period of the box).
-    const double lo = in.box.lo[au], hi = in.box.hi[au];
-    const double m = (std::max(std::fabs(lo), std::fabs(hi)) + k * in.length[au]) * (1 + 0x1p-40);
-    if (!std::isfinite(m)) throw InputError("the periodic box's images overflow double; scale the input down");
-    const double g = std::ldexp(1.0, std::max(std::ilogb(m) - 52, -1074));
-    in.box.lo[au] = snap(lo, g);
-    in.box.hi[au] = snap(hi, g);
-    if (!(in.box.lo[au] < in.box.hi[au])) throw InputError("the periodic box is too thin for its coordinates");
-    in.length[au] = in.box.hi[au] - in.box.lo[au];  // exact: both on the grid
-    in.grid[au] = g;
+  in.sheared = options.tilt[0] != 0 || options.tilt[1] != 0 || options.tilt[2] != 0;
+
+  // The grid along each periodic axis, with the box and tilts rounded to it.
+  // Multiples of g below 2^(e+1) are doubles; every image's coordinate
+  // (a point of the box plus at most max_shift lattice vectors, each term a
+  // multiple of g) and every step of the wrap stay below that, so all are
+  // exact. max_shift follows the cap, which follows the rounded box: rounded
+  // again on a coarser grid until the grid suffices (twice at most, but for
+  // boxes of a few grid steps).
+  std::array<double, 3> grid{0, 0, 0};
+  const Bounds given = in.box;
+  for (int attempt = 0;; ++attempt) {
+    in.box = given;
+    in.tilt = options.tilt;
+    for (std::size_t a = 0; a < du; ++a) {
+      if (grid[a] == 0) continue;
+      in.box.lo[a] = snap(given.lo[a], grid[a]);
+      in.box.hi[a] = snap(given.hi[a], grid[a]);
+      if (!(in.box.lo[a] < in.box.hi[a])) throw InputError("the periodic box is too thin for its coordinates");
+    }
+    for (std::size_t t = 0; t < 3; ++t)
+      if (grid[static_cast<std::size_t>(tilt_lo[t])] != 0)
+        in.tilt[t] = snap(in.tilt[t], grid[static_cast<std::size_t>(tilt_lo[t])]);
+    for (std::size_t a = 0; a < du; ++a) in.length[a] = in.box.hi[a] - in.box.lo[a];  // exact on the grid
+    for (std::size_t a = 0; a < 3; ++a) {
+      in.lattice[a] = {0, 0, 0};
+      in.lattice[a][a] = a < du ? in.length[a] : 1.0;
+    }
+    for (std::size_t t = 0; t < 3; ++t)
+      in.lattice[static_cast<std::size_t>(tilt_hi[t])][static_cast<std::size_t>(tilt_lo[t])] = in.tilt[t];
+    if (in.sheared) {
+      const auto& v = in.lattice;
+      const double volume = in.length[0] * in.length[1] * v[2][2];
+      for (std::size_t i = 0; i < 3; ++i) {
+        const auto& p = v[(i + 1) % 3];
+        const auto& q = v[(i + 2) % 3];
+        const double area = std::hypot(p[1] * q[2] - p[2] * q[1], p[2] * q[0] - p[0] * q[2], p[0] * q[1] - p[1] * q[0]);
+        in.height[i] = volume / area;
+      }
+    } else {
+      in.height = in.length;
+    }
+    // A cell lies within the half-spaces |y.v| <= |v|^2 / 2 of its point's
+    // images one lattice vector v away (y relative to the point) and within
+    // the walls along the others. Along periodic axes, lower triangular
+    // lattice vectors bound |y_a| by forward substitution (the box about the
+    // point, L_a / 2, when orthogonal); along walls by the box's extent. The
+    // security sphere (twice the farthest vertex) reaches at most `cap`.
+    std::array<double, 3> bound{0, 0, 0};
+    double r2 = 0;
+    for (std::size_t a = 0; a < du; ++a) {
+      if (!in.periodic[a]) {
+        bound[a] = in.length[a];
+      } else if (!in.sheared) {
+        bound[a] = 0.5 * in.length[a];
+      } else {
+        const auto& v = in.lattice[a];
+        double s = 0.5 * (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+        for (std::size_t b = 0; b < a; ++b) s += std::fabs(v[b]) * bound[b];
+        bound[a] = s / in.length[a] * (1 + 0x1p-40);
+      }
+      r2 += bound[a] * bound[a];
+    }
+    const double cap = 2 * std::sqrt(r2) * (1 + 0x1p-20);
+    // An image within the cap of a point of the box lies within cap / h
+    // lattice vectors along each (one more for a triclinic box's rounded
+    // fractional coordinates).
+    const int extra = in.sheared ? 1 : 0;
+    for (std::size_t a = 0; a < du; ++a) {
+      if (!in.periodic[a]) continue;
+      // Shifts are int8 (Cells::neighbor_shifts). A box whose walls are more
+      // than ~60 periods long may ask for more than 127 only where its cells
+      // are that long (a few points): the driver then reports it.
+      const double k = std::min(std::ceil(cap / in.height[a]) + extra, double{max_periodic_shift});
+      in.max_shift[a] = static_cast<int>(k);
+      in.reach_cap[a] = std::min(cap, (k - extra) * in.height[a]);
+      in.reach_clamped[a] = in.reach_cap[a] < cap;
+    }
+    // The grid each periodic axis needs: the box's range along it (the
+    // parallelepiped's, triclinic) plus max_shift of each lattice vector's
+    // component there; the margin covers the box's own rounding (g / 2 of
+    // m's 2^-52) and the wrap's steps (within one lattice vector of the box).
+    bool enough = true;
+    for (std::size_t a = 0; a < du; ++a) {
+      if (!in.periodic[a]) continue;
+      double lo = in.box.lo[a], hi = in.box.hi[a], shifts = 0;
+      for (std::size_t i = a + 1; i < du; ++i) {
+        lo += std::min(0.0, in.lattice[i][a]);
+        hi += std::max(0.0, in.lattice[i][a]);
+      }
+      for (std::size_t i = 0; i < du; ++i)
+        if (in.periodic[i]) shifts += in.max_shift[i] * std::fabs(in.lattice[i][a]);
+      const double m = (std::max(std::fabs(lo), std::fabs(hi)) + shifts) * (1 + 0x1p-40);
+      if (!std::isfinite(m)) throw InputError("the periodic box's images overflow double; scale the input down");
+      const double g = std::ldexp(1.0, std::max(std::ilogb(m) - 52, -1074));
+      if (g > grid[a]) {
+        grid[a] = g;
+        enough = false;
+      }
+    }
+    if (enough) break;
+    if (attempt == 8) throw InputError("the periodic box is too thin for its coordinates");
   }
+  in.grid = grid;
 
   in.points.assign(points.begin(), points.end());
   in.takes_part.assign(in.n, 1);
@@ -108,42 +194,70 @@ PeriodicInput periodic_input(std::span<const double> points, int dim, std::span<
       continue;
     }
     for (std::size_t a = 0; a < du && in.takes_part[i]; ++a) {
-      const double lo = in.box.lo[a], hi = in.box.hi[a], len = in.length[a];
-      if (!in.periodic[a]) {
-        if (p[a] < lo || p[a] > hi) {
-          if (!options.ignore_outside_points)
-            throw InputError("point " + std::to_string(i) + " lies outside the bounds along " +
-                             axis_name(static_cast<int>(a)) +
-                             ", which is not periodic (use --ignore-outside to drop such points)");
-          in.takes_part[i] = 0;
-          in.ignored.push_back(static_cast<std::int32_t>(i));
-        }
-        continue;
+      if (!in.periodic[a] && (p[a] < in.box.lo[a] || p[a] > in.box.hi[a])) {
+        if (!options.ignore_outside_points)
+          throw InputError("point " + std::to_string(i) + " lies outside the bounds along " +
+                           axis_name(static_cast<int>(a)) +
+                           ", which is not periodic (use --ignore-outside to drop such points)");
+        in.takes_part[i] = 0;
+        in.ignored.push_back(static_cast<std::int32_t>(i));
       }
-      // Wrapped into [lo, hi): nearly, in floating point, where it lies a
-      // period or more out; then rounded to the grid, where the last steps
-      // of a box length are exact.
-      double x = p[a];
-      if (x < lo - len || x >= hi + len) {
-        // fmod is exact: the error is only that of x - lo, the point's own
-        // imprecision at that distance.
-        const double off = x - lo;
+    }
+    if (!in.takes_part[i]) continue;
+    // Wrapped into the box, last axis first: the lattice vector along axis a
+    // moves the axes below it too (by the tilts), which are wrapped after.
+    // Along an axis the box starts at lo + sum of f_b times the tilts of the
+    // axes b above (their fractional coordinates, now final): exactly lo
+    // when orthogonal, else up to rounding (the layer's slack covers it).
+    for (std::size_t a = du; a-- > 0;) {
+      if (!in.periodic[a]) continue;
+      const double len = in.length[a];
+      double start = in.box.lo[a];
+      if (in.sheared) {
+        double f[3];
+        fractional(in, p, f);
+        for (std::size_t b = a + 1; b < du; ++b) start += f[b] * in.lattice[b][a];
+      }
+      auto step = [&](double k) {  // p -= k lattice[a] (exact on axis a once on the grid)
+        p[a] -= k * len;
+        for (std::size_t b = 0; b < a; ++b) p[b] -= k * in.lattice[a][b];
+      };
+      // Nearly, in floating point, where it lies a period or more out; then
+      // rounded to the grid, where the last steps of a period are exact.
+      double off = p[a] - start;
+      if (off < -len || off >= 2 * len) {
+        // fmod is exact: the error is only that of the offset, the point's
+        // own imprecision at that distance.
         if (!std::isfinite(off))
           throw InputError("point " + std::to_string(i) + " lies too far from the periodic box to be wrapped into it");
         double r = std::fmod(off, len);
         if (r < 0) r += len;
-        x = lo + r;
+        const double k = std::nearbyint((off - r) / len);
+        for (std::size_t b = 0; b < a; ++b) p[b] -= k * in.lattice[a][b];
+        p[a] = start + r;
       }
-      x = snap(x, in.grid[a]);
-      while (x >= hi) x -= len;
-      while (x < lo) x += len;
-      p[a] = x;
+      p[a] = snap(p[a], in.grid[a]);
+      while (p[a] - start >= len) step(1);
+      while (p[a] - start < 0) step(-1);
+      for (std::size_t b = 0; b < a; ++b)
+        if (!std::isfinite(p[b]))
+          throw InputError("point " + std::to_string(i) + " lies too far from the periodic box to be wrapped into it");
     }
   }
   if (in.ignored.size() == in.n) throw InputError("all points lie outside the bounds");
   std::sort(in.ignored.begin(), in.ignored.end());
   in.ignored.erase(std::unique(in.ignored.begin(), in.ignored.end()), in.ignored.end());
   return in;
+}
+
+void fractional(const PeriodicInput& in, const double* p, double f[3]) {
+  const auto du = static_cast<std::size_t>(in.dim);
+  f[0] = f[1] = f[2] = 0;
+  for (std::size_t a = du; a-- > 0;) {
+    double x = p[a] - in.box.lo[a];
+    for (std::size_t b = a + 1; b < du; ++b) x -= f[b] * in.lattice[b][a];
+    f[a] = x / in.length[a];
+  }
 }
 
 PeriodicImages periodic_images(const PeriodicInput& in, std::span<const std::int32_t> labels,
@@ -153,12 +267,34 @@ PeriodicImages periodic_images(const PeriodicInput& in, std::span<const std::int
   PeriodicImages im;
   im.domain = in.box;
   std::array<int, 3> k{0, 0, 0};  // the largest shift per axis
+  std::array<double, 3> lo_f{0, 0, 0}, hi_f{1, 1, 1};  // triclinic: the layer in fractional coordinates
+  const int extra = in.sheared ? 1 : 0;                // (PeriodicInput::max_shift)
   for (std::size_t a = 0; a < du; ++a) {
     if (!in.periodic[a]) continue;
     const double w = std::min(width[a], in.reach_cap[a]);
+    im.width[a] = w;
     im.domain.lo[a] = in.box.lo[a] - w;
     im.domain.hi[a] = in.box.hi[a] + w;
-    k[a] = std::min(in.max_shift[a], static_cast<int>(std::ceil(w / in.length[a])));
+    k[a] = std::min(in.max_shift[a], static_cast<int>(std::ceil(w / in.height[a])) + extra);
+    lo_f[a] = -w / in.height[a] - fraction_slack;
+    hi_f[a] = 1 + w / in.height[a] + fraction_slack;
+  }
+  if (in.sheared) {
+    // The bounding box of the parallelepiped's layer (with the slack twice
+    // and a margin for the rounding of this sum): every image lies in it.
+    for (std::size_t a = 0; a < du; ++a) {
+      if (!in.periodic[a]) continue;
+      double lo = in.box.lo[a], hi = in.box.lo[a], size = 0;
+      for (std::size_t i = 0; i < du; ++i) {
+        const double v = in.lattice[i][a];
+        const double f0 = lo_f[i] - fraction_slack, f1 = hi_f[i] + fraction_slack;
+        lo += std::min(f0 * v, f1 * v);
+        hi += std::max(f0 * v, f1 * v);
+        size += (f1 - f0) * std::fabs(v);
+      }
+      im.domain.lo[a] = lo - 0x1p-30 * size;
+      im.domain.hi[a] = hi + 0x1p-30 * size;
+    }
   }
   // Shifts in lexicographic order (x, then y, then z), shift 0 among them
   // (periodic.hpp: the perturbation's order).
@@ -170,14 +306,33 @@ PeriodicImages periodic_images(const PeriodicInput& in, std::span<const std::int
   auto for_each_image = [&](std::size_t i, auto&& f) {
     if (!in.takes_part[i]) return;
     const double* p = in.points.data() + i * du;
+    if (!in.sheared) {
+      for (const auto& s : shifts) {
+        double y[3] = {0, 0, 0};
+        bool inside = true;
+        for (std::size_t a = 0; a < du && inside; ++a) {
+          y[a] = p[a] + s[a] * in.length[a];  // exact (PeriodicInput's grid)
+          inside = y[a] >= im.domain.lo[a] && y[a] <= im.domain.hi[a];
+        }
+        if (inside) f(s, y);
+      }
+      return;
+    }
+    double fp[3];
+    fractional(in, p, fp);
     for (const auto& s : shifts) {
-      double y[3] = {0, 0, 0};
       bool inside = true;
       for (std::size_t a = 0; a < du && inside; ++a) {
-        y[a] = p[a] + s[a] * in.length[a];  // exact (PeriodicInput's grid)
-        inside = y[a] >= im.domain.lo[a] && y[a] <= im.domain.hi[a];
+        const double fa = fp[a] + s[a];
+        inside = !in.periodic[a] || (fa >= lo_f[a] && fa <= hi_f[a]);
       }
-      if (inside) f(s, y);
+      if (!inside) continue;
+      double y[3] = {0, 0, 0};
+      for (std::size_t a = 0; a < du; ++a) {
+        y[a] = p[a];  // each term a multiple of the grid within its range: exact
+        for (std::size_t b = a; b < du; ++b) y[a] += s[b] * in.lattice[b][a];
+      }
+      f(s, y);
     }
   };
   // Counted, then written at their offsets, one block of points per task:
@@ -243,9 +398,16 @@ std::array<double, 3> needed_image_reach(const PeriodicInput& in, const Periodic
     const auto g = static_cast<std::size_t>(cells.generator[c]);
     const double r = reach[g];
     const double* p = im.points.data() + g * du;
+    double f[3] = {0, 0, 0};
+    if (in.sheared) fractional(in, p, f);
     for (std::size_t a = 0; a < du; ++a) {
       if (!in.periodic[a]) continue;
-      const double beyond = std::max(in.box.lo[a] - (p[a] - r), (p[a] + r) - in.box.hi[a]);
+      // How far the security sphere reaches past the box's faces along a:
+      // across the parallelepiped's, triclinic, plus the layer's slack
+      // (which its test took on the other side: periodic.hpp).
+      const double beyond =
+          in.sheared ? std::max(-f[a], f[a] - 1) * in.height[a] + r + 2 * fraction_slack * in.height[a]
+                     : std::max(in.box.lo[a] - (p[a] - r), (p[a] + r) - in.box.hi[a]);
       need[a] = beyond <= need[a] ? need[a] : beyond;  // NaN too: unbounded, below
     }
   }
@@ -262,9 +424,9 @@ Cells periodic_cells(Cells&& aug, const PeriodicInput& in, const PeriodicImages&
   out.n_points = in.n;
   out.bounds = in.box;
   out.periodic = in.periodic;
+  out.tilt = in.tilt;
   out.periodic_images = im.images;
-  for (std::size_t a = 0; a < du; ++a)
-    if (in.periodic[a]) out.image_reach[a] = std::min(in.box.lo[a] - im.domain.lo[a], im.domain.hi[a] - in.box.hi[a]);
+  out.image_reach = im.width;
   auto base = [&](std::int32_t id) { return id < 0 ? id : im.base[static_cast<std::size_t>(id)]; };
   const std::size_t nc = aug.n_cells();
   // Element-wise maps over the outputs, in blocks on the caller's threads.

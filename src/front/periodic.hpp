@@ -10,6 +10,16 @@
 // clip it) lies within that layer; the driver (cells.cpp) checks it and
 // widens the layer once where it does not.
 //
+// Triclinic boxes (VoronoiOptions::tilt) repeat by the lattice vectors
+// a = (Lx, 0, 0), b = (xy, Ly, 0), c = (xz, yz, Lz). The same holds with
+// "box length" read as "lattice vector" and the layer measured across the
+// parallelepiped's faces: an image is in the layer when its fractional
+// coordinate along each periodic lattice vector lies within w / h of
+// [0, 1] (h: the parallelepiped's height across that vector's faces). The
+// fractional coordinates are computed in floating point, so the layer takes
+// a slack of `fraction_slack` either side and the check of the spheres adds
+// it: an image the layer needs is never left out by a rounding.
+//
 // Exactness. Two things make the cells agree across the box's faces, ties
 // included, as they agree inside it:
 // * every image is exact: the box and the points' coordinates along a
@@ -44,7 +54,17 @@ struct PeriodicInput {
   std::array<bool, 3> periodic{};
   Bounds box;                          ///< the user's box, rounded to the grid along periodic axes
   std::array<double, 3> length{};      ///< box length along each axis (exact on periodic ones)
-  /// The most box lengths an image may lie from its point along each
+  /// Triclinic: VoronoiOptions::tilt rounded to the grid (xy and xz to x's,
+  /// yz to y's); all zero for an orthogonal box.
+  std::array<double, 3> tilt{};
+  bool sheared = false;                ///< some tilt is not zero
+  /// lattice[i]: the box's edge vector along axis i (b = (xy, Ly, 0), ...;
+  /// length[i] e_i along a wall, and (0, 0, 1) for 2D's z).
+  std::array<std::array<double, 3>, 3> lattice{};
+  /// The parallelepiped's height across the faces that lattice[i] leaves
+  /// (its volume over the area of the other two): length[i] when orthogonal.
+  std::array<double, 3> height{};
+  /// The most box lengths (lattice vectors) an image may lie from its point along each
   /// periodic axis: enough for any cell (a priori_reach), and the grid is
   /// chosen so that all those images are exact.
   std::array<int, 3> max_shift{};
@@ -67,14 +87,23 @@ struct PeriodicInput {
 PeriodicInput periodic_input(std::span<const double> points, int dim, std::span<const std::int32_t> labels,
                              const VoronoiOptions& options);
 
-/// The augmented input for a layer of widths `width` (per periodic axis).
+/// Slack of a triclinic layer's test, in fractional coordinates (periodic.hpp).
+inline constexpr double fraction_slack = 0x1p-24;
+
+/// p's fractional coordinates along the lattice vectors (PeriodicInput::lattice),
+/// from the box's lower corner: in [0, 1) inside the box, up to rounding.
+void fractional(const PeriodicInput& in, const double* p, double f[3]);
+
+/// The augmented input for a layer of widths `width` (per periodic axis;
+/// across the faces of a triclinic box).
 struct PeriodicImages {
   std::vector<double> points;          ///< augmented, m * dim
   std::vector<std::int32_t> labels;    ///< the point's label (0 without labels) at shift 0; -1 for images
   std::vector<std::int32_t> base;      ///< per augmented point: the input point it is an image of
   std::vector<std::int8_t> shift;      ///< per augmented point: dim shifts, in box lengths
   std::vector<std::int32_t> original;  ///< per input point: its augmented id at shift 0 (-1: takes no part)
-  Bounds domain;                       ///< the box widened by the layer along periodic axes
+  Bounds domain;                       ///< the box widened by the layer along periodic axes (its bounding box, triclinic)
+  std::array<double, 3> width{};       ///< the layer's widths (what Cells::image_reach reports)
   std::size_t images = 0;              ///< augmented points that are images
 };
 

@@ -9,10 +9,14 @@
 //   lattices every neighbour entry (i, j, s) has its twin (j, i, -s), the
 //   volumes tile the box, and 1 and 2 threads give identical bytes;
 // * points outside the box along a periodic axis are wrapped in;
-// * what is refused: no bounds, a z axis in 2D, products other than cells.
+// * what is refused: no bounds, a z axis in 2D, products other than cells;
+// * the same for triclinic boxes (tilts), against the oracle among images
+//   by the sheared lattice vectors, and two bases of one lattice agree.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <tuple>
 #include <vector>
@@ -36,17 +40,42 @@ std::vector<double> grid_aligned(std::size_t n, int dim, std::uint64_t seed, con
   return p;
 }
 
+using Tilt = std::array<double, 3>;  // xy, xz, yz
+
 tessera::VoronoiOptions periodic_options(int dim, const tessera::Bounds& box, std::array<bool, 3> periodic,
-                                         int threads = 1) {
+                                         int threads = 1, const Tilt& tilt = {0, 0, 0}) {
   auto o = options(dim, box, threads);
   o.periodic = periodic;
+  o.tilt = tilt;
   return o;
 }
 
 tessera::Cells run_periodic(const std::vector<double>& pts, int dim, const tessera::Bounds& box,
                             std::array<bool, 3> periodic, int threads = 1,
-                            const std::vector<std::int32_t>& labels = {}) {
-  return tessera::voronoi(pts, dim, labels, periodic_options(dim, box, periodic, threads));
+                            const std::vector<std::int32_t>& labels = {}, const Tilt& tilt = {0, 0, 0}) {
+  return tessera::voronoi(pts, dim, labels, periodic_options(dim, box, periodic, threads, tilt));
+}
+
+/// The box's lattice vectors (VoronoiOptions::tilt): v[i] along axis i.
+std::array<std::array<double, 3>, 3> lattice(const tessera::Bounds& box, const Tilt& t) {
+  return {{{box.hi[0] - box.lo[0], 0, 0}, {t[0], box.hi[1] - box.lo[1], 0}, {t[1], t[2], box.hi[2] - box.lo[2]}}};
+}
+
+/// Points inside a triclinic box (fractional coordinates in [2^-20, 1 -
+/// 2^-20), so that rounding to 2^-30 leaves them inside and wrapping as they are).
+std::vector<double> in_parallelepiped(std::size_t n, int dim, std::uint64_t seed, const tessera::Bounds& box,
+                                      const Tilt& tilt) {
+  const auto du = static_cast<std::size_t>(dim);
+  const auto f = random_points(n, dim, seed, make_bounds({0x1p-20, 0x1p-20, 0x1p-20}, {1 - 0x1p-20, 1 - 0x1p-20, 1 - 0x1p-20}));
+  const auto v = lattice(box, tilt);
+  std::vector<double> p(n * du);
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t a = 0; a < du; ++a) {
+      double x = box.lo[a];
+      for (std::size_t b = a; b < du; ++b) x += f[i * du + b] * v[b][a];
+      p[i * du + a] = std::ldexp(std::floor(std::ldexp(x, 30)), -30);
+    }
+  return p;
 }
 
 /// Each cell's (neighbour, shift) entries.
@@ -87,11 +116,13 @@ std::size_t asymmetric_entries(const tessera::Cells& c) {
 /// plain doubles settle otherwise (with faces of rounding-noise area, or
 /// none). Then the oracle's faces of some area must be among the cell's.
 void compare_with_oracle(const std::vector<double>& pts, int dim, const tessera::Bounds& box,
-                         std::array<bool, 3> periodic, int reach, const std::string& what, bool ties = false) {
+                         std::array<bool, 3> periodic, int reach, const std::string& what, bool ties = false,
+                         const Tilt& tilt = {0, 0, 0}) {
   SCOPED_TRACE(what);
   const auto du = static_cast<std::size_t>(dim);
   const std::size_t n = pts.size() / du;
-  const tessera::Cells c = run_periodic(pts, dim, box, periodic);
+  const tessera::Cells c = run_periodic(pts, dim, box, periodic, 1, {}, tilt);
+  const auto v = lattice(box, tilt);
   ASSERT_EQ(c.n_cells(), n);
   std::vector<double> all;
   std::vector<Entry> label;
@@ -104,14 +135,20 @@ void compare_with_oracle(const std::vector<double>& pts, int dim, const tessera:
         for (int s2 = -k[2]; s2 <= k[2]; ++s2) {
           const Shift s{s0, s1, s2};
           if (s == Shift{0, 0, 0}) original[i] = label.size();
-          for (std::size_t a = 0; a < du; ++a) all.push_back(pts[i * du + a] + s[a] * (box.hi[a] - box.lo[a]));
+          for (std::size_t a = 0; a < du; ++a) {
+            double x = pts[i * du + a];
+            for (std::size_t b = a; b < du; ++b) x += s[b] * v[b][a];
+            all.push_back(x);
+          }
           label.push_back({static_cast<std::int32_t>(i), s});
         }
   std::array<double, 3> lo = box.lo, hi = box.hi;
   for (std::size_t a = 0; a < du; ++a)
     if (periodic[a]) {
-      lo[a] -= (reach + 1) * (box.hi[a] - box.lo[a]);
-      hi[a] += (reach + 1) * (box.hi[a] - box.lo[a]);
+      double span = 0;
+      for (std::size_t b = a; b < du; ++b) span += std::fabs(v[b][a]);
+      lo[a] -= (reach + 1) * span;
+      hi[a] += (reach + 1) * span;
     }
   const auto got = entries(c);
   double total = 0;
@@ -338,6 +375,157 @@ TEST(Periodic, Refused) {
   EXPECT_THROW(tessera::delaunay(pts, 3, {}, dopt), tessera::InputError);
   const tessera::Cells c = run_periodic(pts, 3, box, {true, true, true});
   EXPECT_THROW(tessera::adjacency_graph(c), tessera::InputError);
+}
+
+// ---- triclinic boxes (VoronoiOptions::tilt) ----
+
+TEST(Triclinic, EqualsTheOracleAmongExplicitImages) {
+  const auto box3 = make_bounds({-1, 0, 2}, {1, 1.5, 3});
+  const Tilt t3{0.375, -0.5, 0.25};
+  compare_with_oracle(in_parallelepiped(150, 3, 1, box3, t3), 3, box3, {true, true, true}, 1, "3D xyz", false, t3);
+  const Tilt xy{0.75, 0, 0}, xz{0, -0.625, 0};
+  compare_with_oracle(in_parallelepiped(150, 3, 2, box3, xy), 3, box3, {true, true, false}, 1, "3D xy, z walls",
+                      false, xy);
+  compare_with_oracle(in_parallelepiped(150, 3, 3, box3, xz), 3, box3, {true, false, true}, 1, "3D xz, y walls",
+                      false, xz);
+  // Sheared past half a period (LAMMPS would flip it; the lattice is the same).
+  const Tilt far{1.625, 1.25, -0.875};
+  compare_with_oracle(in_parallelepiped(150, 3, 4, box3, far), 3, box3, {true, true, true}, 2, "3D far sheared",
+                      false, far);
+  const auto box2 = make_bounds({0.5, -2, 0}, {1.5, 0, 0});
+  const Tilt t2{-0.3125, 0, 0};
+  compare_with_oracle(in_parallelepiped(300, 2, 5, box2, t2), 2, box2, {true, true, false}, 1, "2D xy", false, t2);
+}
+
+TEST(Triclinic, BoxesOfAFewPointsReachSeveralPeriods) {
+  const auto box3 = make_bounds({0, 0, 0}, {1, 2, 1});
+  const auto box2 = make_bounds({0, 0, 0}, {3, 1, 0});
+  const Tilt t3{0.5, 0.25, -0.75}, t2{2.25, 0, 0};
+  for (std::size_t n : {1, 2, 3, 5}) {
+    compare_with_oracle(in_parallelepiped(n, 3, 60 + n, box3, t3), 3, box3, {true, true, true}, 3,
+                        "3D, " + std::to_string(n) + " points", true, t3);
+    compare_with_oracle(in_parallelepiped(n, 2, 70 + n, box2, t2), 2, box2, {true, true, false}, 4,
+                        "2D, " + std::to_string(n) + " points", true, t2);
+  }
+}
+
+TEST(Triclinic, ShearedLatticeTiesAgreeAcrossTheBox) {
+  // A lattice sheared with its box: every vertex is a tie, settled alike
+  // from either side of the slanted faces; the cells tile the box.
+  for (int dim : {2, 3}) {
+    SCOPED_TRACE(dim);
+    const int k = dim == 3 ? 5 : 10;
+    const auto box = make_bounds({0, 0, 0}, {k * 0.25, k * 0.25, dim == 3 ? k * 0.25 : 0});
+    const Tilt tilt = dim == 3 ? Tilt{0.5, 0.25, -0.75} : Tilt{0.75, 0, 0};
+    const auto v = lattice(box, tilt);
+    const auto du = static_cast<std::size_t>(dim);
+    std::vector<double> pts;
+    const int kz = dim == 3 ? k : 1;
+    for (int i = 0; i < k; ++i)
+      for (int j = 0; j < k; ++j)
+        for (int l = 0; l < kz; ++l) {
+          const double f[3] = {(i + 0.5) / k, (j + 0.5) / k, dim == 3 ? (l + 0.5) / k : 0};
+          for (std::size_t a = 0; a < du; ++a) {
+            double x = 0;
+            for (std::size_t b = a; b < du; ++b) x += f[b] * v[b][a];
+            pts.push_back(x);
+          }
+        }
+    const std::array<bool, 3> all{true, true, dim == 3};
+    const tessera::Cells c = run_periodic(pts, dim, box, all, 1, {}, tilt);
+    const tessera::Cells c2 = run_periodic(pts, dim, box, all, 2, {}, tilt);
+    expect_same_cells(c, c2, "1 vs 2 threads");
+    EXPECT_EQ(c.neighbor_shifts, c2.neighbor_shifts);
+    ASSERT_EQ(c.n_cells(), pts.size() / du);
+    EXPECT_EQ(asymmetric_entries(c), 0u);
+    const double cell_volume = box_volume(box, dim) / static_cast<double>(c.n_cells());
+    for (double vol : c.volume) EXPECT_NEAR(vol, cell_volume, 1e-12 * cell_volume);
+    const tessera::ValidationReport r = tessera::validate(c, {}, pts);
+    EXPECT_TRUE(r.ok) << (r.messages.empty() ? "" : r.messages[0]);
+  }
+}
+
+TEST(Triclinic, RandomPointsThreadsAndValidation) {
+  // Full mantissas (rounded to the box's grid), some outside the
+  // parallelepiped (wrapped in), 1 and 2 threads.
+  const auto box = make_bounds({0, 0, 0}, {1, 1, 1});
+  const Tilt tilt{0.3, -0.2, 0.45};
+  const auto pts = random_points(20000, 3, 8, box);
+  const tessera::Cells a = run_periodic(pts, 3, box, {true, true, true}, 1, {}, tilt);
+  const tessera::Cells b = run_periodic(pts, 3, box, {true, true, true}, 2, {}, tilt);
+  expect_same_cells(a, b, "1 vs 2 threads");
+  EXPECT_EQ(a.neighbor_shifts, b.neighbor_shifts);
+  EXPECT_EQ(asymmetric_entries(a), 0u);
+  const tessera::ValidationReport r = tessera::validate(a, {}, pts);
+  EXPECT_TRUE(r.ok) << (r.messages.empty() ? "" : r.messages[0]);
+  EXPECT_LT(r.volume_rel_error, 1e-12);
+  // The tilts as rounded to x's and y's grids (a few 2^-52 at a few box lengths).
+  EXPECT_NEAR(a.tilt[0], 0.3, 0x1p-46);
+  EXPECT_NEAR(a.tilt[1], -0.2, 0x1p-46);
+  EXPECT_NEAR(a.tilt[2], 0.45, 0x1p-46);
+  EXPECT_NE(a.tilt[0], 0.3);  // not a multiple of the grid: rounded
+}
+
+TEST(Triclinic, PointsMovedByLatticeVectorsAreWrappedBack) {
+  const auto box = make_bounds({-1, 0, 2}, {1, 1.5, 3});
+  const Tilt tilt{0.375, -0.5, 0.25};
+  const auto v = lattice(box, tilt);
+  const auto pts = in_parallelepiped(200, 3, 31, box, tilt);
+  auto moved = pts;
+  for (std::size_t i = 0; i < 200; ++i) {
+    const int m[3] = {static_cast<int>(i % 5) - 2, static_cast<int>(i % 3) - 1, i % 7 == 0 ? 3 : 0};
+    for (std::size_t a = 0; a < 3; ++a)
+      for (std::size_t b = a; b < 3; ++b) moved[3 * i + a] += m[b] * v[b][a];  // exact: dyadic
+  }
+  const tessera::Cells a = run_periodic(moved, 3, box, {true, true, true}, 1, {}, tilt);
+  const tessera::Cells b = run_periodic(pts, 3, box, {true, true, true}, 1, {}, tilt);
+  expect_same_cells(a, b, "wrapped");
+  EXPECT_EQ(a.neighbor_shifts, b.neighbor_shifts);
+}
+
+TEST(Triclinic, AnotherBasisOfTheSameLatticeGivesTheSameCells) {
+  // b + a = (xy + Lx, Ly, 0) and c + a - b = (xz + Lx - xy, yz - Ly, Lz)
+  // span the same lattice with a: the same cells (volumes, neighbour ids);
+  // only the shifts count other vectors.
+  const auto box = make_bounds({0, 0, 0}, {1, 1.25, 0.75});
+  const Tilt t{0.25, 0.125, -0.375};
+  const Tilt u{t[0] + 1, t[1] + 1 - t[0], t[2] - 1.25};
+  const auto pts = in_parallelepiped(500, 3, 32, box, t);
+  const tessera::Cells a = run_periodic(pts, 3, box, {true, true, true}, 1, {}, t);
+  const tessera::Cells b = run_periodic(pts, 3, box, {true, true, true}, 1, {}, u);
+  ASSERT_EQ(a.n_cells(), b.n_cells());
+  for (std::size_t i = 0; i < 500; ++i) {
+    const auto ca = static_cast<std::size_t>(a.cell_of[i]), cb = static_cast<std::size_t>(b.cell_of[i]);
+    EXPECT_NEAR(a.volume[ca], b.volume[cb], 1e-12 * a.volume[ca]) << "point " << i;
+    const std::vector<std::int32_t> na(a.neighbors.begin() + a.neighbor_offsets[ca],
+                                       a.neighbors.begin() + a.neighbor_offsets[ca + 1]);
+    const std::vector<std::int32_t> nb(b.neighbors.begin() + b.neighbor_offsets[cb],
+                                       b.neighbors.begin() + b.neighbor_offsets[cb + 1]);
+    EXPECT_EQ(na, nb) << "point " << i;
+  }
+}
+
+TEST(Triclinic, Refused) {
+  const auto box = make_bounds({0, 0, 0}, {1, 1, 1});
+  const auto pts = random_points(50, 3, 40, box);
+  const std::array<bool, 3> all{true, true, true};
+  auto refused = [&](std::array<bool, 3> per, Tilt t, int dim = 3) {
+    const auto p = dim == 3 ? pts : random_points(50, 2, 41, box);
+    EXPECT_THROW(tessera::voronoi(p, dim, {}, periodic_options(dim, box, per, 1, t)), tessera::InputError)
+        << t[0] << " " << t[1] << " " << t[2];
+  };
+  refused({false, false, false}, {0.5, 0, 0});               // no periodic axis
+  refused({true, false, true}, {0.5, 0, 0});                 // xy with y a wall
+  refused({false, true, true}, {0, 0.5, 0});                 // xz with x a wall
+  refused(all, {std::nan(""), 0, 0});
+  refused(all, {0, std::numeric_limits<double>::infinity(), 0});
+  refused(all, {2000.0, 0, 0});                              // over 1024 box lengths
+  refused({true, true, false}, {0.25, 0.5, 0}, 2);           // xz in 2D
+  tessera::DelaunayOptions dopt;
+  dopt.dim = 3;
+  dopt.bounds = box;
+  dopt.tilt = {0.5, 0, 0};
+  EXPECT_THROW(tessera::delaunay(pts, 3, {}, dopt), tessera::InputError);
 }
 
 }  // namespace

@@ -148,6 +148,51 @@ TEST(VoroPlusPlus, PeriodicBox) {
   }
 }
 
+TEST(VoroPlusPlus, TriclinicBox) {
+  // Voro++'s periodic container is triclinic with the same convention:
+  // lattice vectors (bx, 0, 0), (bxy, by, 0), (bxz, byz, bz) from the origin.
+  const double bx = 2, by = 1.5, bz = 1, bxy = 0.375, bxz = -0.5, byz = 0.25;
+  const std::size_t n = 3000;
+  const auto f = random_points(n, 3, 605, make_bounds({0, 0, 0}, {1, 1, 1}));
+  std::vector<double> pts(3 * n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const double* t = f.data() + 3 * i;
+    pts[3 * i] = std::ldexp(std::floor(std::ldexp(t[0] * bx + t[1] * bxy + t[2] * bxz, 30)), -30);
+    pts[3 * i + 1] = std::ldexp(std::floor(std::ldexp(t[1] * by + t[2] * byz, 30)), -30);
+    pts[3 * i + 2] = std::ldexp(std::floor(std::ldexp(t[2] * bz, 30)), -30);
+  }
+  voro::container_periodic con(bx, bxy, by, bxz, byz, bz, 8, 8, 8, 8);
+  for (std::size_t i = 0; i < n; ++i) con.put(int(i), pts[3 * i], pts[3 * i + 1], pts[3 * i + 2]);
+  auto o = tessera::VoronoiOptions{};
+  o.dim = 3;
+  o.bounds = make_bounds({0, 0, 0}, {bx, by, bz});
+  o.threads = 2;
+  o.periodic = {true, true, true};
+  o.tilt = {bxy, bxz, byz};
+  const tessera::Cells c = tessera::voronoi(pts, 3, {}, o);
+  ASSERT_EQ(c.n_cells(), n);
+  voro::c_loop_all_periodic loop(con);
+  voro::voronoicell_neighbor cell;
+  std::vector<int> nb;
+  std::size_t computed = 0, bad_volume = 0, bad_neighbours = 0;
+  if (loop.start()) do {
+      ASSERT_TRUE(con.compute_cell(cell, loop));
+      ++computed;
+      const int i = loop.pid();
+      const auto k = static_cast<std::size_t>(c.cell_of[static_cast<std::size_t>(i)]);
+      if (!(std::abs(c.volume[k] - cell.volume()) <= 1e-9 * cell.volume()) && ++bad_volume <= 5)
+        ADD_FAILURE() << "point " << i << " volume " << c.volume[k] << " Voro++ " << cell.volume();
+      cell.neighbors(nb);
+      const std::set<int> vn(nb.begin(), nb.end());
+      const auto t = neighbours_of(c, k);
+      const std::set<int> tn(t.begin(), t.end());
+      if (tn != vn && ++bad_neighbours <= 5) ADD_FAILURE() << "point " << i << ": neighbour ids differ";
+    } while (loop.inc());
+  EXPECT_EQ(computed, n);
+  EXPECT_EQ(bad_volume, 0u);
+  EXPECT_EQ(bad_neighbours, 0u);
+}
+
 }  // namespace
 
 #endif  // TESSERA_HAVE_VORO
