@@ -23,11 +23,12 @@ using Points = py::array_t<double, py::array::c_style>;
 
 Cells run_voronoi(const Points& points, const py::object& labels, const std::optional<std::vector<double>>& bounds,
                   double padding, bool ignore_outside, int threads, bool merge, const std::string& method,
-                  const std::array<bool, 3>& periodic) {
+                  const std::array<bool, 3>& periodic, const std::array<double, 3>& tilt) {
   const int dim = checked_dim(points);
   VoronoiOptions opt;
   fill_common(opt, dim, bounds, padding, ignore_outside, threads);
   opt.periodic = periodic;
+  opt.tilt = tilt;
   opt.build_mesh = merge;
   if (method == "auto") opt.cell_method = CellMethod::automatic;
   else if (method == "search") opt.cell_method = CellMethod::search;
@@ -123,6 +124,7 @@ void bind_voronoi(py::module_& m) {
                              })
       .def_property_readonly("periodic", [](const Cells& c) { return per_axis(c.periodic, c.dim); })
       .def_readonly("periodic_images", &Cells::periodic_images)
+      .def_property_readonly("tilt", [](const Cells& c) { return c.tilt; })
       .def_property_readonly("image_reach", [](const Cells& c) { return per_axis(c.image_reach, c.dim); })
       // per generator
       .def_property_readonly("cell_of", [](py::object s) { return view_flat(s.cast<const Cells&>().cell_of, s); })
@@ -163,7 +165,7 @@ void bind_voronoi(py::module_& m) {
 
   m.def("voronoi", &run_voronoi, py::arg("points").noconvert(), py::arg("labels").none(true), py::arg("bounds"),
         py::arg("padding"), py::arg("ignore_outside"), py::arg("threads"), py::arg("merge"),
-        py::arg("method"), py::arg("periodic"), "Cells of float64 C-ordered (N, D) points; labels None or int32 (N,). Runs without the GIL.");
+        py::arg("method"), py::arg("periodic"), py::arg("tilt"), "Cells of float64 C-ordered (N, D) points; labels None or int32 (N,). Runs without the GIL.");
 
   m.def(
       "validate_cells",

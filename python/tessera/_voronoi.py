@@ -142,6 +142,13 @@ class Voronoi:
         return self._cells.periodic
 
     @property
+    def tilt(self) -> Tuple[float, ...]:
+        """A triclinic box's tilts as rounded: ``(xy,)`` in 2D, ``(xy, xz, yz)``
+        in 3D; all zero for an orthogonal box (see :func:`voronoi`'s ``tilt``)."""
+        t = self._cells.tilt
+        return (t[0],) if self._cells.dim == 2 else (t[0], t[1], t[2])
+
+    @property
     def periodic_images(self) -> int:
         """Images of points that took part in a periodic box's cells."""
         return self._cells.periodic_images
@@ -305,6 +312,7 @@ def voronoi(
     ignore_outside: bool = False,
     method: str = "auto",
     periodic: Any = False,
+    tilt: Optional[Sequence[float]] = None,
 ) -> Voronoi:
     """Voronoi cells of 2D or 3D points, clipped to a box, with exact topology.
 
@@ -351,6 +359,14 @@ def voronoi(
         doubles at a few box lengths (2^-51 for a unit box), so that every
         image is exact; cells keep their shape across the box's faces, and
         :attr:`Voronoi.neighbor_shifts` says which image each neighbour is.
+    tilt : sequence of float, optional
+        A triclinic (sheared) periodic box: its tilt factors as lengths, as
+        LAMMPS and Voro++ give them, ``(xy,)`` in 2D and ``(xy, xz, yz)`` in
+        3D. The box is the parallelepiped spanned from ``bounds``' lower
+        corner by a = (Lx, 0, 0), b = (xy, Ly, 0), c = (xz, yz, Lz), L the
+        extents of ``bounds``; a tilt needs both of its axes periodic. Points
+        are wrapped into it, the tilts are rounded like the coordinates, and
+        :attr:`Voronoi.neighbor_shifts` count a, b and c.
 
     Returns
     -------
@@ -373,6 +389,9 @@ def voronoi(
     per = _periodic_axes(periodic, dim)
     if any(per) and bounds is None:
         raise ValueError("periodic: give bounds, the box that repeats")
+    tilts = _tilts(tilt, dim)
+    if any(tilts) and not any(per):
+        raise ValueError("tilt: give periodic axes (a triclinic box repeats along its tilted axes)")
     cells = _inputs.call(
         _core.voronoi,
         pts,
@@ -384,8 +403,20 @@ def voronoi(
         bool(merge),
         str(method),
         per,
+        tilts,
     )
     return Voronoi(cells, pts, lab)
+
+
+def _tilts(tilt: Any, dim: int) -> Tuple[float, float, float]:
+    """``voronoi``'s ``tilt`` as (xy, xz, yz)."""
+    if tilt is None:
+        return (0.0, 0.0, 0.0)
+    values = [float(t) for t in tilt]
+    if len(values) != (3 if dim == 3 else 1):
+        raise ValueError(f"tilt: expected {'(xy, xz, yz)' if dim == 3 else '(xy,)'} for {dim}D points, got {len(values)} values")
+    values += [0.0] * (3 - len(values))
+    return (values[0], values[1], values[2])
 
 
 def _periodic_axes(periodic: Any, dim: int) -> Tuple[bool, bool, bool]:

@@ -278,3 +278,49 @@ def test_periodic_box():
         tessera.voronoi(pts, periodic=True)
     with pytest.raises(ValueError, match="periodic"):
         tessera.voronoi(pts[:, :2].copy(), bounds=[0, 1, 0, 1], periodic="xz")
+
+
+def test_triclinic_box_against_scipy():
+    # A sheared 2D box: each cell's area equals that of its point's region
+    # in scipy's (Qhull's) diagram of the points with their images by the
+    # lattice vectors a = (Lx, 0) and b = (xy, Ly), and the neighbour
+    # entries (j, s) are the ridges of that diagram.
+    from scipy.spatial import Voronoi as ScipyVoronoi
+
+    rng = np.random.default_rng(33)
+    lx, ly, xy = 2.0, 1.0, 0.625
+    f = rng.random((300, 2)) * (1 - 2e-6) + 1e-6
+    pts = np.stack([f[:, 0] * lx + f[:, 1] * xy, f[:, 1] * ly], axis=1)
+    pts = np.ldexp(np.floor(np.ldexp(pts, 30)), -30)  # on the box's grid: the library keeps them
+    v = tessera.voronoi(pts, bounds=[0, lx, 0, ly], periodic=True, tilt=[xy])
+    assert v.tilt == (xy,) and v.periodic == (True, True)
+    shifts = [(i, j) for i in (-1, 0, 1) for j in (-1, 0, 1)]
+    images = np.concatenate([pts + i * np.array([lx, 0]) + j * np.array([xy, ly]) for i, j in shifts])
+    sv = ScipyVoronoi(images)
+    zero = shifts.index((0, 0))
+    n = len(pts)
+    ridges = {}
+    for (p, q) in sv.ridge_points:
+        for u, w in ((p, q), (q, p)):
+            if u // n == zero:
+                ridges.setdefault(u % n, set()).add((int(w % n), shifts[w // n]))
+    for k in range(n):
+        region = sv.regions[sv.point_region[zero * n + k]]
+        assert -1 not in region
+        poly = sv.vertices[region]
+        hull = poly[np.argsort(np.arctan2(*(poly - poly.mean(axis=0)).T[::-1]))]
+        x, y = hull[:, 0], hull[:, 1]
+        area = 0.5 * abs(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1)))
+        c = v.cell_of[k]
+        assert abs(v.volumes[c] - area) < 1e-9 * area
+        off = v.neighbor_offsets
+        got = {(int(v.neighbors[e]), tuple(int(s) for s in v.neighbor_shifts[e])) for e in range(off[c], off[c + 1])}
+        assert got == ridges[k]
+    assert abs(v.volumes.sum() - lx * ly) < 1e-12
+    assert v.validate()
+    with pytest.raises(ValueError, match="tilt"):
+        tessera.voronoi(pts, bounds=[0, lx, 0, ly], tilt=[xy])
+    with pytest.raises(ValueError, match="tilt"):
+        tessera.voronoi(pts, bounds=[0, lx, 0, ly], periodic=True, tilt=[xy, 0, 0])
+    with pytest.raises(ValueError, match="tilt"):
+        tessera.voronoi(pts, bounds=[0, lx, 0, ly], periodic="x", tilt=[xy])
