@@ -984,6 +984,36 @@ class Periodic(TempDirCase):
             tables.append(read_bytes(t))
         self.assertEqual(tables[0], tables[1])
 
+    def test_triclinic_box(self):
+        # --tilt: the sheared box tiles with paired shifts; a point moved by a
+        # lattice vector is wrapped back (the same table); 2D takes one tilt.
+        for dim, box, tilt in ((3, ["0", "2", "0", "1.5", "0", "1"], ["0.375", "-0.5", "0.25"]),
+                               (2, ["0", "2", "0", "1"], ["-0.625"])):
+            lo = np.array([float(x) for x in box[0::2]])
+            hi = np.array([float(x) for x in box[1::2]])
+            vec = np.diag(hi - lo)
+            for k, (a, b) in enumerate([(0, 1), (0, 2), (1, 2)][:len(tilt)]):
+                vec[b, a] = float(tilt[k])
+            f = np.random.default_rng(dim + 10).random((2000, dim)) * (1 - 2e-6) + 1e-6
+            pts = np.ldexp(np.floor(np.ldexp(lo + f @ vec, 30)), -30)
+            moved = pts.copy()
+            moved[::3] += vec[dim - 1]  # the last lattice vector: every axis moves
+            tables = []
+            for name, p in (("t.npy", pts), ("m.npy", moved)):
+                nb, sh, tab = self.p("n" + name), self.p("s" + name), self.p(name + ".csv")
+                r = self.ok(["voronoi", self.save(name, p), "--bounds"] + box + ["--periodic", "xyz"[:dim],
+                             "--tilt"] + tilt + ["--neighbors", nb, "--neighbor-shifts", sh, "--cell-table", tab,
+                                                 "--validate"])
+                self.assertIn("tilt (triclinic)", r.stdout)
+                self.assertIn("validation: OK", r.stdout)
+                e = self.entries(nb, sh)
+                for (i, j, s), m in e.items():
+                    self.assertEqual(e.get((j, i, tuple(-x for x in s))), m, "entry %d %d %s has no twin" % (i, j, s))
+                tables.append(read_bytes(tab))
+            self.assertEqual(tables[0], tables[1])
+            vol = np.loadtxt(self.p("t.npy.csv"), delimiter=",", skiprows=1)[:, 2]
+            self.assertAlmostEqual(vol.sum(), float(np.prod(hi - lo)), delta=1e-12 * float(np.prod(hi - lo)))
+
     def test_bench(self):
         inp = self.save("b.npy", np.random.default_rng(6).random((2000, 3)))
         r = self.ok(["bench", "voronoi", inp, "--bounds"] + BOX3 + ["--periodic", "xyz"])
@@ -1120,6 +1150,15 @@ class BadInput(TempDirCase):
         self.fails(["voronoi", self.good3, "--neighbor-shifts", self.p("s.npy"), "--bounds"] + BOX3, "--periodic")
         self.fails(["voronoi", self.good3, "--neighbor-shifts", self.p("s.csv"), "--bounds"] + BOX3 +
                    ["--periodic", "x"], ".npy")
+        # --tilt: only with --periodic, as many values as the dimension asks,
+        # both of a tilt's axes periodic, finite.
+        tilted = ["voronoi", self.good3, "-o", out, "--bounds"] + BOX3
+        self.fails(tilted + ["--tilt", "0.1", "0", "0"], "--periodic")
+        self.fails(tilted + ["--periodic", "xyz", "--tilt", "0.1"], "three values")
+        self.fails(["voronoi", self.good2, "-o", self.out("c.vtp"), "--bounds"] + BOX2 +
+                   ["--periodic", "xy", "--tilt", "0.1", "0", "0"], "one value")
+        self.fails(tilted + ["--periodic", "xz", "--tilt", "0.1", "0", "0"], "tilt xy needs x and y periodic")
+        self.fails(tilted + ["--periodic", "xyz", "--tilt", "nan", "0", "0"], "tilt")
         # Outside a wall (y is not periodic) stays an error.
         pts = np.random.default_rng(2).random((50, 3))
         pts[3, 1] = 1.5
