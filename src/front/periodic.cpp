@@ -318,22 +318,29 @@ PeriodicImages periodic_images(const PeriodicInput& in, std::span<const std::int
       }
       return;
     }
+    // The test is one per axis in fractional coordinates: the shifts in
+    // the layer are a box, walked in the same lexicographic order.
     double fp[3];
     fractional(in, p, fp);
-    for (const auto& s : shifts) {
-      bool inside = true;
-      for (std::size_t a = 0; a < du && inside; ++a) {
-        const double fa = fp[a] + s[a];
-        inside = !in.periodic[a] || (fa >= lo_f[a] && fa <= hi_f[a]);
-      }
-      if (!inside) continue;
-      double y[3] = {0, 0, 0};
-      for (std::size_t a = 0; a < du; ++a) {
-        y[a] = p[a];  // each term a multiple of the grid within its range: exact
-        for (std::size_t b = a; b < du; ++b) y[a] += s[b] * in.lattice[b][a];
-      }
-      f(s, y);
+    std::array<int, 3> first{0, 0, 0}, last{0, 0, 0};
+    for (std::size_t a = 0; a < du; ++a) {
+      if (!in.periodic[a]) continue;
+      first[a] = -k[a];
+      last[a] = k[a];
+      while (first[a] <= last[a] && !(fp[a] + first[a] >= lo_f[a])) ++first[a];
+      while (last[a] >= first[a] && !(fp[a] + last[a] <= hi_f[a])) --last[a];
     }
+    std::array<int, 3> s{};
+    for (s[0] = first[0]; s[0] <= last[0]; ++s[0])
+      for (s[1] = first[1]; s[1] <= last[1]; ++s[1])
+        for (s[2] = first[2]; s[2] <= last[2]; ++s[2]) {
+          double y[3] = {0, 0, 0};
+          for (std::size_t a = 0; a < du; ++a) {
+            y[a] = p[a];  // each term a multiple of the grid within its range: exact
+            for (std::size_t b = a; b < du; ++b) y[a] += s[b] * in.lattice[b][a];
+          }
+          f(s, y);
+        }
   };
   // Counted, then written at their offsets, one block of points per task:
   // the same array for any thread count.
