@@ -50,6 +50,14 @@ void print_header(const char* command, const ComputeArgs& a, const Computed& r) 
   std::printf("  %-18s %zu\n", "cells", r.cells.n_cells());
   std::printf("  %-18s %.3f s on %d thread%s\n", "compute", r.seconds, r.cells.threads_used,
               r.cells.threads_used == 1 ? "" : "s");
+  if (r.cells.is_periodic()) {
+    std::string axes;
+    for (int k = 0; k < r.cells.dim; ++k)
+      if (r.cells.periodic[static_cast<std::size_t>(k)]) axes += "xyz"[k];
+    const bool tilted = r.cells.tilt[0] != 0 || r.cells.tilt[1] != 0 || r.cells.tilt[2] != 0;
+    std::printf("  %-18s %s%s (%zu images of points)\n", "periodic", axes.c_str(), tilted ? ", triclinic" : "",
+                r.cells.periodic_images);
+  }
 }
 
 void print_written(const std::vector<std::string>& written) {
@@ -64,9 +72,16 @@ void print_written(const std::vector<std::string>& written) {
 // ------------------------------------------------------------------ graph
 
 int run_graph(const GraphArgs& a) {
-  if (a.output.empty() && a.csr.empty() && a.spoke_classes.empty() && a.spoke_measures.empty())
+  if (a.output.empty() && a.csr.empty() && a.spoke_classes.empty() && a.spoke_measures.empty() &&
+      a.spoke_shifts.empty())
     throw InputError(
-        "nothing to do: give -o GRAPH.vtp, --csr FILE.npy, --spoke-classes FILE.npy or --spoke-measures FILE.npy");
+        "nothing to do: give -o GRAPH.vtp, --csr FILE.npy, --spoke-classes FILE.npy, --spoke-measures FILE.npy "
+        "or --spoke-shifts FILE.npy");
+  if (!a.spoke_shifts.empty()) {
+    require_extension(a.spoke_shifts, ".npy", "--spoke-shifts", "the spoke shifts");
+    if (a.compute.periodic.empty())
+      throw InputError("--spoke-shifts: only with --periodic (without it every spoke leads to the point itself)");
+  }
   if (!a.output.empty()) require_extension(a.output, ".vtp", "output", "the graph (lines)");
   if (!a.csr.empty()) require_extension(a.csr, ".npy", "--csr", "the wheels");
   if (!a.spoke_classes.empty()) require_extension(a.spoke_classes, ".npy", "--spoke-classes", "the spoke classes");
@@ -75,14 +90,16 @@ int run_graph(const GraphArgs& a) {
   if (!(a.prune_tolerance >= 0) || !std::isfinite(a.prune_tolerance))
     throw InputError("--prune-tolerance must be a finite number >= 0");
   check_bounds_arg(a.compute.bounds);
-  for (const std::string* p : {&a.output, &a.csr, &a.spoke_classes, &a.spoke_measures})
+  for (const std::string* p : {&a.output, &a.csr, &a.spoke_classes, &a.spoke_measures, &a.spoke_shifts})
     if (!p->empty()) io::check_writable(*p);
 
   const Computed r = read_and_compute(a.compute, a.quiet);
   const AdjacencyGraph g = adjacency_graph(r.cells, {a.prune_tolerance});
   std::vector<std::string> written;
   if (!a.output.empty()) {
-    io::write_graph_vtp(a.output, g, r.pc.coords, r.pc.labels);
+    io::write_graph_vtp(a.output, g, r.cells.is_periodic() ? std::span<const double>(r.cells.periodic_points)
+                                                           : std::span<const double>(r.pc.coords),
+                        r.pc.labels);
     written.push_back(a.output);
   }
   if (!a.csr.empty()) {
@@ -96,6 +113,11 @@ int run_graph(const GraphArgs& a) {
   if (!a.spoke_measures.empty()) {
     io::write_spoke_measures_npy(a.spoke_measures, g);
     written.push_back(a.spoke_measures);
+  }
+
+  if (!a.spoke_shifts.empty()) {
+    io::write_spoke_shifts_npy(a.spoke_shifts, g);
+    written.push_back(a.spoke_shifts);
   }
 
   if (!a.quiet) {

@@ -75,6 +75,7 @@ struct GraphArgs {
   std::string csr;             ///< .npy wheels (layout of --neighbors), or empty
   std::string spoke_classes;   ///< .npy uint8 class per spoke, or empty
   std::string spoke_measures;  ///< .npy float64 face area (2D: length) per spoke, or empty
+  std::string spoke_shifts;    ///< .npy int8 (spokes, D) image shifts (periodic boxes), or empty
   double prune_tolerance = 0;
   bool quiet = false;
 };

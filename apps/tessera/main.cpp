@@ -258,7 +258,9 @@ int main(int argc, char** argv) {
   add_compute_options(graph, ga.compute, graph_bounds);
   graph->add_option("-o,--output", ga.output,
                     "Graph as VTK PolyData lines (.vtp): points = input points, one line per undirected edge, "
-                    "cell data SpokeClass (0 same region, 1 region boundary, 3 outside) and FaceArea/FaceLength");
+                    "cell data SpokeClass (0 same region, 1 region boundary, 3 outside) and FaceArea/FaceLength. "
+                    "With --periodic the points are wrapped into the box, and an edge to an image ends at an extra "
+                    "point there (point data PointId: whose image)");
   graph->add_option("--csr", ga.csr,
                     "Wheels as one int64 .npy array: [n_points, offsets (n_points+1), spokes...]; spokes of point "
                     "p are ids[offsets[p]:offsets[p+1]], ascending, box planes negative (x0=-1 .. z1=-6)");
@@ -268,6 +270,10 @@ int main(int argc, char** argv) {
   graph->add_option("--spoke-measures", ga.spoke_measures,
                     "Area (3D) or length (2D) of the face behind every spoke of --csr, as a float64 .npy array: "
                     "face-area weights for neighbour statistics; both directions of a face get the same value");
+  add_periodic_option(graph, ga.compute);
+  graph->add_option("--spoke-shifts", ga.spoke_shifts,
+                    "With --periodic: which image every spoke of --csr leads to, as an int8 .npy array of shape "
+                    "(spokes, D) in box lengths (lattice vectors with --tilt); the twin of i -> (j, s) is j -> (i, -s)");
   graph->add_option("--prune-tolerance", ga.prune_tolerance,
                     "Drop spokes whose face area (length in 2D) is below F * (mean cell volume)^((D-1)/D), both "
                     "directions together (VTK parity; default 0: keep all)")

@@ -158,6 +158,9 @@ struct Cells {
   Buffer<std::int32_t> face_vertices;
   Buffer<std::int32_t> face_neighbor;
   Buffer<SpokeClass> face_class;
+  /// Periodic boxes only, else empty: per face, dim shifts of its neighbour's
+  /// image (as neighbor_shifts; 0 for a wall).
+  Buffer<std::int8_t> face_shift;
 
   // ---- diagnostics ----
   /// Pairs (duplicate id, owner id): exactly coincident inputs; the lowest id owns the cell.
@@ -188,10 +191,21 @@ struct Cells {
   std::array<bool, 3> periodic{false, false, false};
   /// A triclinic box's tilts {xy, xz, yz} as rounded (VoronoiOptions::tilt).
   std::array<double, 3> tilt{0, 0, 0};
+  /// Periodic boxes only, else empty: the points as the cells took them,
+  /// n_points * dim, wrapped into the box and rounded to its grid (rows of
+  /// points set aside as given). Neighbour shifts are relative to these.
+  std::vector<double> periodic_points;
   std::size_t periodic_images = 0;
   std::array<double, 3> image_reach{0, 0, 0};
 
   bool is_periodic() const { return periodic[0] || periodic[1] || periodic[2]; }
+  /// A periodic box's lattice vectors: row a is the shift by one along axis
+  /// a, (Lx, 0, 0), (xy, Ly, 0), (xz, yz, Lz) (the first dim entries count).
+  std::array<std::array<double, 3>, 3> lattice() const {
+    return {{{bounds.hi[0] - bounds.lo[0], 0, 0},
+             {tilt[0], bounds.hi[1] - bounds.lo[1], 0},
+             {tilt[1], tilt[2], bounds.hi[2] - bounds.lo[2]}}};
+  }
   std::size_t n_cells() const { return generator.size(); }
   std::size_t n_vertices() const { return vertex_keys.size() / (dim + 1); }
 };

@@ -7,6 +7,7 @@
 // (every spoke i -> j between two cells has its twin j -> i).
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -41,6 +42,14 @@ struct AdjacencyGraph {
   /// Area (3D) or length (2D) of the face behind each spoke; equal for both
   /// directions of a face.
   std::vector<double> spoke_measure;
+  /// Periodic boxes only, else empty: per spoke, dim shifts of the
+  /// neighbour's image (Cells::neighbor_shifts). Within a wheel spokes are
+  /// then ascending by neighbour, then shift, and the twin of spoke
+  /// i -> (j, s) is j -> (i, -s).
+  std::vector<std::int8_t> spoke_shift;
+  std::array<bool, 3> periodic{false, false, false};
+  /// Periodic boxes: Cells::lattice(), what a shift of one moves by.
+  std::array<std::array<double, 3>, 3> lattice{};
   double prune_threshold = 0;               ///< absolute measure threshold used (0: no pruning)
   std::size_t pruned_spokes = 0;            ///< spokes dropped by pruning (each direction counted)
 
@@ -48,17 +57,21 @@ struct AdjacencyGraph {
 };
 
 /// The graph of a tessellation computed with VoronoiOptions::build_mesh
-/// (std::invalid_argument otherwise). Throws InputError for a negative or
+/// (std::invalid_argument otherwise), periodic boxes included. Throws InputError for a negative or
 /// non-finite prune tolerance.
 AdjacencyGraph adjacency_graph(const Cells& cells, const GraphOptions& options = {});
 
 /// The undirected edges between generators: one per face between two cells
-/// (from the lower id to the higher) and one per face between a cell and an
-/// outside point (from the cell's generator); box spokes are not edges.
-/// Edges are listed in the order of their spokes in the graph.
+/// (from the lower id to the higher; in a periodic box from the lower of
+/// (i, j, s) and (j, i, -s), so an edge between a point and its own image is
+/// listed once) and one per face between a cell and an outside point (from
+/// the cell's generator); box spokes are not edges. Edges are listed in the
+/// order of their spokes in the graph.
 struct GraphEdges {
   std::vector<std::int32_t> ends;     ///< 2 point ids per edge
   std::vector<std::int64_t> spoke;    ///< index of the representing spoke in AdjacencyGraph::spokes
+  /// Periodic boxes only: dim shifts per edge, of its second end's image.
+  std::vector<std::int8_t> shift;
   std::size_t size() const { return spoke.size(); }
 };
 GraphEdges graph_edges(const AdjacencyGraph& graph);

@@ -2,6 +2,7 @@
 #include "tessera/graph.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numeric>
 #include <stdexcept>
@@ -10,9 +11,33 @@
 #include "mesh_faces.hpp"
 
 namespace tessera {
+namespace {
+
+/// A spoke's shift (periodic boxes; zeros otherwise), and the order of
+/// spokes within a wheel: by neighbour, then shift.
+struct SpokeShifts {
+  const std::int8_t* shift = nullptr;  // dim per spoke, or null
+  std::size_t dim = 3;
+  std::array<int, 3> of(std::size_t f) const {
+    std::array<int, 3> s{0, 0, 0};
+    if (shift != nullptr)
+      for (std::size_t a = 0; a < dim; ++a) s[a] = shift[f * dim + a];
+    return s;
+  }
+};
+
+std::array<int, 3> negated(const std::array<int, 3>& s) { return {-s[0], -s[1], -s[2]}; }
+
+/// Of the two directions (i, j, s) and (j, i, -s) of a face, the one that
+/// speaks for it (its measure, its edge): the lower triple.
+bool speaks(std::int32_t i, std::int32_t j, const std::array<int, 3>& s) {
+  return i < j || (i == j && !(negated(s) < s));
+}
+
+}  // namespace
 
 AdjacencyGraph adjacency_graph(const Cells& c, const GraphOptions& options) {
-  front::require_mesh(c, "adjacency_graph");
+  front::require_mesh(c, "adjacency_graph", true);
   if (!(options.prune_tolerance >= 0) || !std::isfinite(options.prune_tolerance))
     throw InputError("prune tolerance must be a finite number >= 0, got " + std::to_string(options.prune_tolerance));
   const std::size_t nc = c.n_cells();
@@ -22,17 +47,25 @@ AdjacencyGraph adjacency_graph(const Cells& c, const GraphOptions& options) {
   AdjacencyGraph g;
   g.dim = c.dim;
   g.n_points = c.n_points;
+  g.periodic = c.periodic;
+  if (c.is_periodic()) g.lattice = c.lattice();
+  const auto du = static_cast<std::size_t>(c.dim);
+  const SpokeShifts shifts{c.is_periodic() ? c.face_shift.data() : nullptr, du};
+  auto before = [&](std::int64_t x, std::int64_t y) {
+    const auto xu = static_cast<std::size_t>(x), yu = static_cast<std::size_t>(y);
+    if (c.face_neighbor[xu] != c.face_neighbor[yu]) return c.face_neighbor[xu] < c.face_neighbor[yu];
+    return shifts.of(xu) < shifts.of(yu);
+  };
 
   // Pass 1, per face: its measure; per cell: its faces in wheel order
-  // (ascending neighbour id; a convex cell has one face per neighbour).
+  // (ascending neighbour id, then shift; a convex cell has one face per
+  // neighbour and image).
   std::vector<double> measure(nf);
   std::vector<std::int64_t> wheel_order(nf);
   front::for_each_cell(c, [&](std::size_t k) {
     const auto b = wheel_order.begin() + cfo[k], e = wheel_order.begin() + cfo[k + 1];
     std::iota(b, e, cfo[k]);
-    std::sort(b, e, [&](std::int64_t x, std::int64_t y) {
-      return c.face_neighbor[static_cast<std::size_t>(x)] < c.face_neighbor[static_cast<std::size_t>(y)];
-    });
+    std::sort(b, e, before);
     for (auto f = cfo[k]; f < cfo[k + 1]; ++f) measure[static_cast<std::size_t>(f)] = front::face_measure(c, f);
   });
 
@@ -56,13 +89,17 @@ AdjacencyGraph adjacency_graph(const Cells& c, const GraphOptions& options) {
       const std::int32_t j = c.face_neighbor[fu];
       double m = measure[fu];
       const std::int32_t cj = j >= 0 ? c.cell_of[static_cast<std::size_t>(j)] : -1;
-      if (cj >= 0 && j < gen) {
+      const std::array<int, 3> s = shifts.of(fu);
+      if (cj >= 0 && !speaks(gen, j, s)) {
         const auto b = wheel_order.begin() + cfo[static_cast<std::size_t>(cj)];
         const auto e = wheel_order.begin() + cfo[static_cast<std::size_t>(cj) + 1];
+        const std::array<int, 3> back = negated(s);
         const auto twin = std::lower_bound(b, e, gen, [&](std::int64_t x, std::int32_t id) {
-          return c.face_neighbor[static_cast<std::size_t>(x)] < id;
+          const auto xu = static_cast<std::size_t>(x);
+          return c.face_neighbor[xu] != id ? c.face_neighbor[xu] < id : shifts.of(xu) < back;
         });
-        if (twin == e || c.face_neighbor[static_cast<std::size_t>(*twin)] != gen)
+        if (twin == e || c.face_neighbor[static_cast<std::size_t>(*twin)] != gen ||
+            shifts.of(static_cast<std::size_t>(*twin)) != back)
           throw std::logic_error("adjacency_graph: one-sided spoke " + std::to_string(gen) + " -> " +
                                  std::to_string(j) + " (inconsistent cells)");
         m = measure[static_cast<std::size_t>(*twin)];
@@ -79,6 +116,7 @@ AdjacencyGraph adjacency_graph(const Cells& c, const GraphOptions& options) {
   g.spokes.resize(ns);
   g.spoke_class.resize(ns);
   g.spoke_measure.resize(ns);
+  if (shifts.shift != nullptr) g.spoke_shift.resize(ns * du);
 
   // Pass 3: fill the wheels in wheel order.
   front::for_each_cell(c, [&](std::size_t k) {
@@ -89,6 +127,8 @@ AdjacencyGraph adjacency_graph(const Cells& c, const GraphOptions& options) {
       g.spokes[s] = c.face_neighbor[f];
       g.spoke_class[s] = c.face_class[f];
       g.spoke_measure[s] = shared[f];
+      if (shifts.shift != nullptr)
+        for (std::size_t a = 0; a < du; ++a) g.spoke_shift[s * du + a] = c.face_shift[f * du + a];
       ++s;
     }
   });
@@ -97,17 +137,20 @@ AdjacencyGraph adjacency_graph(const Cells& c, const GraphOptions& options) {
 
 GraphEdges graph_edges(const AdjacencyGraph& g) {
   GraphEdges edges;
+  const auto du = static_cast<std::size_t>(g.dim);
+  const SpokeShifts shifts{g.spoke_shift.empty() ? nullptr : g.spoke_shift.data(), du};
   for (std::size_t p = 0; p < g.n_points; ++p) {
     const auto i = static_cast<std::int32_t>(p);
     for (auto s = g.wheel_offsets[p]; s < g.wheel_offsets[p + 1]; ++s) {
       const auto su = static_cast<std::size_t>(s);
       const std::int32_t j = g.spokes[su];
       // An outside point has no wheel, so its spoke is listed once; between
-      // two cells the lower id speaks for the pair.
-      if (j < 0 || (j < i && g.spoke_class[su] != SpokeClass::outside)) continue;
+      // two cells the lower direction speaks for the pair.
+      if (j < 0 || (!speaks(i, j, shifts.of(su)) && g.spoke_class[su] != SpokeClass::outside)) continue;
       edges.ends.push_back(i);
       edges.ends.push_back(j);
       edges.spoke.push_back(s);
+      if (shifts.shift != nullptr) edges.shift.insert(edges.shift.end(), &g.spoke_shift[su * du], &g.spoke_shift[su * du] + du);
     }
   }
   return edges;

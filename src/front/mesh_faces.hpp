@@ -19,13 +19,14 @@ namespace tessera::front {
 
 /// The mesh arrays exist and have consistent sizes. A Cells without a mesh is
 /// a programming error of the caller (std::invalid_argument), not bad input.
-inline void require_mesh(const Cells& c, const char* who) {
+/// Periodic cells only where `periodic_too` (their faces meet images: the
+/// product must carry Cells::face_shift).
+inline void require_mesh(const Cells& c, const char* who, bool periodic_too = false) {
   const std::size_t nc = c.n_cells();
   auto fail = [who](const char* what) { throw std::invalid_argument(std::string(who) + ": " + what); };
   if (c.dim != 2 && c.dim != 3) fail("dim must be 2 or 3");
-  // Their faces pair cells across the box's faces with images, whose
-  // shifts the mesh does not carry.
-  if (c.is_periodic()) throw InputError(std::string(who) + ": not available for cells in a periodic box");
+  if (c.is_periodic() && !periodic_too)
+    throw InputError(std::string(who) + ": not available for cells in a periodic box");
   if (c.cell_face_offsets.size() != nc + 1)
     fail("cells have no mesh (compute them with VoronoiOptions::build_mesh = true)");
   const std::size_t nf = static_cast<std::size_t>(c.cell_face_offsets.back());
@@ -36,6 +37,7 @@ inline void require_mesh(const Cells& c, const char* who) {
       c.cell_of.size() != c.n_points)
     fail("per-cell arrays have inconsistent sizes");
   if (c.vertices.size() != c.n_vertices() * static_cast<std::size_t>(c.dim)) fail("bad vertex array");
+  if (c.is_periodic() && c.face_shift.size() != nf * static_cast<std::size_t>(c.dim)) fail("periodic cells without face shifts");
 }
 
 /// Area of a 3D face (a planar convex polygon, via the fan from its first

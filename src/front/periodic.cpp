@@ -432,6 +432,7 @@ Cells periodic_cells(Cells&& aug, const PeriodicInput& in, const PeriodicImages&
   out.bounds = in.box;
   out.periodic = in.periodic;
   out.tilt = in.tilt;
+  out.periodic_points = in.points;
   out.periodic_images = im.images;
   out.image_reach = im.width;
   auto base = [&](std::int32_t id) { return id < 0 ? id : im.base[static_cast<std::size_t>(id)]; };
@@ -483,11 +484,15 @@ Cells periodic_cells(Cells&& aug, const PeriodicInput& in, const PeriodicImages&
     out.face_vertices = std::move(aug.face_vertices);
     out.face_neighbor = std::move(aug.face_neighbor);
     out.face_class = std::move(aug.face_class);
+    out.face_shift.resize(out.face_neighbor.size() * du);
     const engine::RegionClassifier classify(labels);
     each(nc, [&](std::size_t c) {
       for (auto f = out.cell_face_offsets[c]; f < out.cell_face_offsets[c + 1]; ++f) {
         const auto fu = static_cast<std::size_t>(f);
-        out.face_neighbor[fu] = base(out.face_neighbor[fu]);
+        const std::int32_t j = out.face_neighbor[fu];
+        for (std::size_t a = 0; a < du; ++a)
+          out.face_shift[fu * du + a] = j < 0 ? std::int8_t{0} : im.shift[static_cast<std::size_t>(j) * du + a];
+        out.face_neighbor[fu] = base(j);
         out.face_class[fu] = classify(out.generator[c], out.face_neighbor[fu]);
       }
     });

@@ -1,8 +1,10 @@
 // Writers for the adjacency graph, face sets and flowers (include/tessera/io/dual.hpp).
 #include "tessera/io/dual.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <numeric>
 #include <stdexcept>
 #include <vector>
 
@@ -44,13 +46,40 @@ void write_graph_vtp(const std::string& path, const AdjacencyGraph& g, std::span
     cls[e] = static_cast<std::uint8_t>(g.spoke_class[s]);
     measure[e] = g.spoke_measure[s];
   }
-  const std::vector<std::int32_t> region = labels.empty() ? std::vector<std::int32_t>(g.n_points, 0)
-                                                          : std::vector<std::int32_t>(labels.begin(), labels.end());
+  std::vector<std::int32_t> region = labels.empty() ? std::vector<std::int32_t>(g.n_points, 0)
+                                                    : std::vector<std::int32_t>(labels.begin(), labels.end());
 
   PolyData pd;
   pd.dim = g.dim;
   pd.points = points;
   pd.lines = {offsets, edges.ends};
+  // A periodic graph: edges to images end at extra points, one per edge
+  // with a shift, placed at the image (the point moved by its lattice vectors).
+  std::vector<double> all_points;
+  std::vector<std::int32_t> ends, point_id;
+  if (!edges.shift.empty()) {
+    const auto du = static_cast<std::size_t>(g.dim);
+    all_points.assign(points.begin(), points.end());
+    ends = edges.ends;
+    point_id.resize(g.n_points);
+    std::iota(point_id.begin(), point_id.end(), 0);
+    for (std::size_t e = 0; e < ne; ++e) {
+      const std::int8_t* s = &edges.shift[e * du];
+      if (std::all_of(s, s + du, [](std::int8_t x) { return x == 0; })) continue;
+      const auto j = static_cast<std::size_t>(ends[2 * e + 1]);
+      for (std::size_t a = 0; a < du; ++a) {
+        double x = points[j * du + a];
+        for (std::size_t b = a; b < du; ++b) x += s[b] * g.lattice[b][a];
+        all_points.push_back(x);
+      }
+      ends[2 * e + 1] = static_cast<std::int32_t>(point_id.size());
+      point_id.push_back(static_cast<std::int32_t>(j));
+      region.push_back(region[j]);
+    }
+    pd.points = all_points;
+    pd.lines = {offsets, ends};
+    pd.point_data.push_back({"PointId", std::span<const std::int32_t>(point_id)});
+  }
   pd.point_data.push_back({"Region", std::span<const std::int32_t>(region)});
   pd.cell_data.push_back({"SpokeClass", std::span<const std::uint8_t>(cls)});
   pd.cell_data.push_back({g.dim == 3 ? "FaceArea" : "FaceLength", std::span<const double>(measure)});
@@ -64,6 +93,12 @@ void write_graph_csr_npy(const std::string& path, const AdjacencyGraph& g) {
   a.insert(a.end(), g.wheel_offsets.begin(), g.wheel_offsets.end());
   a.insert(a.end(), g.spokes.begin(), g.spokes.end());
   write_file_atomic(path, npy_bytes(a.data(), {a.size()}));
+}
+
+void write_spoke_shifts_npy(const std::string& path, const AdjacencyGraph& g) {
+  if (g.spoke_shift.empty()) throw std::invalid_argument("write_spoke_shifts_npy: the graph is not periodic");
+  const auto du = static_cast<std::size_t>(g.dim);
+  write_file_atomic(path, npy_bytes(g.spoke_shift.data(), {g.spoke_shift.size() / du, du}));
 }
 
 void write_spoke_classes_npy(const std::string& path, const AdjacencyGraph& g) {

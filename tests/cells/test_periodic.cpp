@@ -24,6 +24,7 @@
 #include "helpers.hpp"
 #include "oracle.hpp"
 #include "tessera/delaunay.hpp"
+#include "tessera/faces.hpp"
 #include "tessera/graph.hpp"
 
 namespace {
@@ -374,7 +375,62 @@ TEST(Periodic, Refused) {
   dopt.periodic = {true, true, true};
   EXPECT_THROW(tessera::delaunay(pts, 3, {}, dopt), tessera::InputError);
   const tessera::Cells c = run_periodic(pts, 3, box, {true, true, true});
-  EXPECT_THROW(tessera::adjacency_graph(c), tessera::InputError);
+  EXPECT_THROW(tessera::extract_faces(c, {}, {}), tessera::InputError);
+}
+
+TEST(Periodic, AdjacencyGraphHasShiftedSpokes) {
+  // The graph of periodic cells (orthogonal and triclinic): spokes are the
+  // cells' neighbour entries with their shifts, each with its twin
+  // j -> (i, -s) of the same measure; every cell's pyramids over its faces
+  // (height: half the distance to the neighbour's image) fill it; edges
+  // list each face once; 1 and 2 threads give the same graph.
+  for (const Tilt& tilt : {Tilt{0, 0, 0}, Tilt{0.25, -0.125, 0.375}}) {
+    SCOPED_TRACE(tilt[0]);
+    const auto box = make_bounds({0, 0, 0}, {1, 1, 1});
+    const auto pts = in_parallelepiped(400, 3, 45, box, tilt);
+    const auto v = lattice(box, tilt);
+    const tessera::Cells c = run_periodic(pts, 3, box, {true, true, true}, 1, {}, tilt);
+    const tessera::Cells c2 = run_periodic(pts, 3, box, {true, true, true}, 2, {}, tilt);
+    const tessera::AdjacencyGraph g = tessera::adjacency_graph(c);
+    const tessera::AdjacencyGraph g2 = tessera::adjacency_graph(c2);
+    EXPECT_EQ(g.spokes, g2.spokes);
+    EXPECT_EQ(g.spoke_shift, g2.spoke_shift);
+    EXPECT_EQ(g.spoke_measure, g2.spoke_measure);
+    ASSERT_EQ(g.spoke_shift.size(), 3 * g.n_spokes());
+    // The spokes are the neighbour entries (no walls here).
+    EXPECT_EQ(std::vector<std::int32_t>(g.spokes.begin(), g.spokes.end()),
+              std::vector<std::int32_t>(c.neighbors.begin(), c.neighbors.end()));
+    EXPECT_EQ(std::vector<std::int8_t>(g.spoke_shift.begin(), g.spoke_shift.end()),
+              std::vector<std::int8_t>(c.neighbor_shifts.begin(), c.neighbor_shifts.end()));
+    std::map<std::tuple<std::int32_t, std::int32_t, Shift>, double> measure;
+    for (std::size_t i = 0; i < 400; ++i) {
+      double total = 0;
+      for (auto s = g.wheel_offsets[i]; s < g.wheel_offsets[i + 1]; ++s) {
+        const auto su = static_cast<std::size_t>(s);
+        const auto j = static_cast<std::size_t>(g.spokes[su]);
+        const Shift sh{g.spoke_shift[3 * su], g.spoke_shift[3 * su + 1], g.spoke_shift[3 * su + 2]};
+        double d2 = 0;
+        for (std::size_t a = 0; a < 3; ++a) {
+          double x = pts[3 * j + a] - pts[3 * i + a];
+          for (std::size_t b = a; b < 3; ++b) x += sh[b] * v[b][a];
+          d2 += x * x;
+        }
+        total += g.spoke_measure[su] * 0.5 * std::sqrt(d2) / 3;
+        measure[{static_cast<std::int32_t>(i), g.spokes[su], sh}] = g.spoke_measure[su];
+      }
+      const double vol = c.volume[static_cast<std::size_t>(c.cell_of[i])];
+      EXPECT_NEAR(total, vol, 1e-12 * vol) << "point " << i;
+    }
+    for (const auto& [key, m] : measure) {
+      const auto& [i, j, s] = key;
+      const auto twin = measure.find({j, i, Shift{-s[0], -s[1], -s[2]}});
+      ASSERT_NE(twin, measure.end());
+      EXPECT_EQ(twin->second, m);
+    }
+    const tessera::GraphEdges edges = tessera::graph_edges(g);
+    EXPECT_EQ(2 * edges.size(), g.n_spokes());
+    EXPECT_EQ(edges.shift.size(), 3 * edges.size());
+  }
 }
 
 // ---- triclinic boxes (VoronoiOptions::tilt) ----

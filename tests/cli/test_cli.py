@@ -1164,9 +1164,10 @@ class BadInput(TempDirCase):
         pts[3, 1] = 1.5
         self.fails(["voronoi", self.save("wall.npy", pts), "-o", out, "--bounds"] + BOX3 + ["--periodic", "xz"],
                    "not periodic")
-        for cmd in (["graph", "-o", self.p("g.vtp")], ["delaunay", "-o", self.p("d.vtu")]):
+        for cmd in (["faces", "-o", self.p("f.vtp")], ["delaunay", "-o", self.p("d.vtu")]):
             r = run([cmd[0], self.good3] + cmd[1:] + ["--bounds"] + BOX3 + ["--periodic", "xyz"])
             self.assertEqual(r.returncode, 2)  # no such option there
+        self.fails(["graph", self.good3, "--spoke-shifts", self.p("s.npy"), "--bounds"] + BOX3, "--periodic")
 
     def test_coplanar_3d_suggests_dim2(self):
         pts = np.random.default_rng(1).random((50, 3))

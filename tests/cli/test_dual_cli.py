@@ -193,6 +193,56 @@ class Graph(base.TempDirCase):
             for (i, j), a in at.items():
                 self.assertEqual(a, at[(j, i)])
 
+    def test_periodic_graph(self):
+        # A triclinic periodic box: spokes lead to images (--spoke-shifts);
+        # every spoke i -> (j, s) has its twin j -> (i, -s) with the same
+        # class and measure; each cell's pyramids over its faces, apex at its
+        # point, fill it (height: half the distance to the image); the VTK
+        # lines to images end at extra points there, tagged with PointId.
+        for dim, box, tilt in ((3, ["0", "1", "0", "1", "0", "1"], ["0.25", "0", "-0.125"]),
+                               (2, ["0", "1", "0", "1"], ["0.375"])):
+            vec = np.eye(dim)
+            for k, (a, b) in enumerate([(0, 1), (0, 2), (1, 2)][:len(tilt)]):
+                vec[b, a] = float(tilt[k])
+            f = np.random.default_rng(40 + dim).random((800, dim)) * (1 - 2e-6) + 1e-6
+            pts = np.ldexp(np.floor(np.ldexp(f @ vec, 30)), -30)
+            inp = self.save("p%d.npy" % dim, pts)
+            files = [self.p(x) for x in ("pc.npy", "ps.npy", "pm.npy", "pk.npy", "pg.vtp", "pt.csv")]
+            per = ["--bounds"] + box + ["--periodic", "xyz"[:dim], "--tilt"] + tilt
+            r = self.ok(["graph", inp, "--csr", files[0], "--spoke-shifts", files[1], "--spoke-measures", files[2],
+                         "--spoke-classes", files[3], "-o", files[4]] + per)
+            self.assertIn("triclinic", r.stdout)
+            self.ok(["voronoi", inp, "--cell-table", files[5], "-q"] + per)
+            n, off, ids = load_csr(files[0])
+            sh, m, cls = np.load(files[1]), np.load(files[2]), np.load(files[3])
+            self.assertEqual((sh.dtype, sh.shape), (np.int8, (len(ids), dim)))
+            self.assertTrue(np.all(ids >= 0) and np.all(cls == SAME), "no walls, one region")
+            vol = np.loadtxt(files[5], delimiter=",", skiprows=1)[:, 2]
+            spoke = {}
+            for i in range(n):
+                total = 0.0
+                for e in range(off[i], off[i + 1]):
+                    j, s = int(ids[e]), tuple(int(x) for x in sh[e])
+                    self.assertNotIn((i, j, s), spoke)
+                    spoke[(i, j, s)] = (m[e], cls[e])
+                    total += m[e] * 0.5 * np.linalg.norm(pts[j] + np.array(s) @ vec - pts[i]) / dim
+                self.assertAlmostEqual(total, vol[i], delta=1e-12 * vol[i], msg="%dD cell %d" % (dim, i))
+            for (i, j, s), v in spoke.items():
+                self.assertEqual(spoke[(j, i, tuple(-x for x in s))], v)
+            pd = read_vtp(files[4])
+            xyz = vtk_to_numpy(pd.GetPoints().GetData())[:, :dim]
+            pid = vtk_to_numpy(pd.GetPointData().GetArray("PointId"))
+            np.testing.assert_array_equal(pid[:n], np.arange(n))
+            np.testing.assert_array_equal(xyz[:n], pts)
+            lines = cells_of(pd.GetLines())
+            self.assertEqual(len(lines), len(spoke) // 2)
+            for a, b in lines:
+                self.assertTrue(a < n)
+                # the line's length is the distance to the neighbour's image
+                d = np.linalg.norm(xyz[b] - xyz[a])
+                self.assertTrue(any(abs(d - np.linalg.norm(pts[pid[b]] + np.array(s) @ vec - pts[a])) < 1e-12
+                                    for (i, j, s) in spoke if i == a and j == pid[b]))
+
     def test_threads_byte_identical(self):
         inp = self.save("big.npy", np.random.default_rng(25).random((5000, 3)))
         outs = []
@@ -333,7 +383,8 @@ class HelpAndSummary(base.TempDirCase):
         top = run(["--help"]).stdout
         for sub in ("graph", "faces", "flower"):
             self.assertIn(sub, top)
-        options = {"graph": ("--csr", "--spoke-classes", "--spoke-measures", "--prune-tolerance"),
+        options = {"graph": ("--csr", "--spoke-classes", "--spoke-measures", "--spoke-shifts", "--periodic",
+                             "--tilt", "--prune-tolerance"),
                    "faces": ("--kind", "--capping"),
                    "flower": ("--point", "--glyphs")}
         for sub, own in options.items():

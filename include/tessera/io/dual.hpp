@@ -19,6 +19,10 @@ namespace tessera::io {
 /// line per undirected edge (graph_edges). Point data: Region (Int32, the
 /// label, 0 without labels). Cell data: SpokeClass (UInt8, tessera::SpokeClass)
 /// and FaceArea (3D) / FaceLength (2D) (Float64, the face behind the edge).
+/// A periodic box's graph (AdjacencyGraph::periodic): `points` are the
+/// points as the cells took them (Cells::periodic_points), and an edge to an
+/// image ends at an extra point there, after the n (point data PointId: the
+/// point it is an image of; the n points' own ids for them).
 void write_graph_vtp(const std::string& path, const AdjacencyGraph& graph, std::span<const double> points,
                      std::span<const std::int32_t> labels);
 
@@ -26,6 +30,10 @@ void write_graph_vtp(const std::string& path, const AdjacencyGraph& graph, std::
 /// points: a = [n_points, offsets (n_points+1), spokes...]; the spokes of point
 /// p are a[n+2:][off[p]:off[p+1]], ascending, negative ids for box planes.
 void write_graph_csr_npy(const std::string& path, const AdjacencyGraph& graph);
+
+/// A periodic graph's spoke shifts (AdjacencyGraph::spoke_shift), int8 .npy
+/// of shape (spokes, dim) aligned with the spokes of the CSR file.
+void write_spoke_shifts_npy(const std::string& path, const AdjacencyGraph& graph);
 
 /// The class of every spoke, uint8 .npy aligned with the spokes of the CSR file.
 void write_spoke_classes_npy(const std::string& path, const AdjacencyGraph& graph);
