@@ -63,11 +63,20 @@ void bind_dual(py::module_& m) {
                              [](py::object s) { return byte_view(s.cast<const GraphResult&>().graph.spoke_class, s); })
       .def_property_readonly(
           "spoke_measure", [](py::object s) { return view_flat(s.cast<const GraphResult&>().graph.spoke_measure, s); })
+      .def_property_readonly("spoke_shifts",
+                             [](py::object s) {
+                               const AdjacencyGraph& g = s.cast<const GraphResult&>().graph;
+                               return view_rows(g.spoke_shift, static_cast<std::size_t>(g.dim), s);
+                             })
       // Edges: computed on first use, then shared by every view.
       .def_property_readonly("edge_ends",
                              [](py::object s) { return view_rows(edges_of(s.cast<GraphResult&>()).ends, 2, s); })
       .def_property_readonly("edge_spokes",
-                             [](py::object s) { return view_flat(edges_of(s.cast<GraphResult&>()).spoke, s); });
+                             [](py::object s) { return view_flat(edges_of(s.cast<GraphResult&>()).spoke, s); })
+      .def_property_readonly("edge_shifts", [](py::object s) {
+        GraphResult& r = s.cast<GraphResult&>();
+        return view_rows(edges_of(r).shift, static_cast<std::size_t>(r.graph.dim), s);
+      });
 
   m.def(
       "adjacency_graph",

@@ -125,6 +125,11 @@ void bind_voronoi(py::module_& m) {
       .def_property_readonly("periodic", [](const Cells& c) { return per_axis(c.periodic, c.dim); })
       .def_readonly("periodic_images", &Cells::periodic_images)
       .def_property_readonly("tilt", [](const Cells& c) { return c.tilt; })
+      .def_property_readonly("periodic_points",
+                             [](py::object s) {
+                               const Cells& c = s.cast<const Cells&>();
+                               return view_rows(c.periodic_points, static_cast<std::size_t>(c.dim), s);
+                             })
       .def_property_readonly("image_reach", [](const Cells& c) { return per_axis(c.image_reach, c.dim); })
       // per generator
       .def_property_readonly("cell_of", [](py::object s) { return view_flat(s.cast<const Cells&>().cell_of, s); })

@@ -72,6 +72,10 @@ class AdjacencyGraph:
     bounds) have empty wheels. The graph is exactly symmetric: every spoke
     ``i -> j`` between two cells has its twin ``j -> i``.
 
+    Of periodic cells (``voronoi(..., periodic=..., merge=True)``), spokes lead
+    to images: :attr:`spoke_shifts` says which, wheels are ascending by
+    neighbour then shift, and the twin of ``i -> (j, s)`` is ``j -> (i, -s)``.
+
     Arrays are read-only views of buffers the compiled result owns.
     """
 
@@ -130,6 +134,19 @@ class AdjacencyGraph:
         return self._g.spoke_measure
 
     @property
+    def spoke_shifts(self) -> np.ndarray:
+        """int8 (n_spokes, D), periodic cells only (empty otherwise): the image
+        of the neighbour across each spoke, in box lengths (lattice vectors
+        of a triclinic box), as :attr:`Voronoi.neighbor_shifts`."""
+        return self._g.spoke_shifts
+
+    @property
+    def edge_shifts(self) -> np.ndarray:
+        """int8 (E, D), periodic cells only (empty otherwise): the image of
+        each edge's second end."""
+        return self._g.edge_shifts
+
+    @property
     def prune_tolerance(self) -> float:
         return self._prune_tolerance
 
@@ -150,7 +167,9 @@ class AdjacencyGraph:
 
     def edges(self) -> np.ndarray:
         """int32 (E, 2): the undirected edges, one per face between two cells
-        (lower id first) and one per face between a cell and an outside point
+        (lower id first; periodic: the lower of (i, j, s) and (j, i, -s), so
+        a point meeting its own image is listed once, see :attr:`edge_shifts`)
+        and one per face between a cell and an outside point
         (the cell's generator first); box faces are not edges. In the order of
         their spokes; :attr:`edge_spokes` gives each edge's spoke. Computed on
         first use, then kept."""
@@ -164,9 +183,12 @@ class AdjacencyGraph:
     def save(self, path: PathLike) -> None:
         """Write the graph for ParaView as ``.vtp``: the input points, one line
         per edge. Point data Region (the label, 0 without labels); cell data
-        SpokeClass and FaceArea (3D) / FaceLength (2D). ValueError for another
-        extension, OSError when the file cannot be written."""
-        _core.write_graph_vtp(_check_vtp(path, "a graph"), self._g, self.points, self.labels)
+        SpokeClass and FaceArea (3D) / FaceLength (2D). Periodic cells: the
+        points as wrapped (:attr:`Voronoi.periodic_points`), and an edge to an
+        image ends at an extra point there (point data PointId: whose image).
+        ValueError for another extension, OSError when the file cannot be written."""
+        pts = self._vor.periodic_points if any(self._vor.periodic) else self.points
+        _core.write_graph_vtp(_check_vtp(path, "a graph"), self._g, pts, self.labels)
 
     def to_vtk(self) -> Any:
         """The graph as a ``vtkPolyData`` of lines with the data of :meth:`save` (needs ``vtk``)."""

@@ -149,6 +149,13 @@ class Voronoi:
         return (t[0],) if self._cells.dim == 2 else (t[0], t[1], t[2])
 
     @property
+    def periodic_points(self) -> np.ndarray:
+        """float64 (N, D), periodic boxes only (empty otherwise): the points as
+        the cells took them, wrapped into the box and rounded to its grid; the
+        neighbour shifts are relative to these."""
+        return self._cells.periodic_points
+
+    @property
     def periodic_images(self) -> int:
         """Images of points that took part in a periodic box's cells."""
         return self._cells.periodic_images

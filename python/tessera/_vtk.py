@@ -149,7 +149,15 @@ def faces_to_vtk(fs: Any) -> Any:
 
 def graph_to_vtk(g: Any) -> Any:
     """vtkPolyData of the graph: the input points, a line per edge; point data
-    Region, cell data SpokeClass and FaceArea / FaceLength."""
+    Region, cell data SpokeClass and FaceArea / FaceLength. A periodic graph's
+    is the file its save() writes, read back (images as extra points)."""
+    if any(g.voronoi.periodic):
+        import tempfile
+
+        with tempfile.TemporaryDirectory(prefix="tessera-") as tmp:
+            path = os.path.join(tmp, "graph.vtp")
+            g.save(path)
+            return read_vtp(path)
     out = vtkPolyData()
     out.SetPoints(_points(g.points))
     ends = g.edges()

@@ -147,6 +147,33 @@ def test_graph_vtp_read_by_vtk(tmp_path):
         assert np.array_equal(cell_data(mem, name), cell_data(data, name))
 
 
+def test_graph_of_periodic_cells(tmp_path):
+    # Spokes lead to images: the wheels are the cells' neighbour entries with
+    # their shifts; edges list each face once; the .vtp (and to_vtk) end
+    # lines to images at extra points placed there.
+    pts = random_points(500, 3, seed=12)
+    tilt = (0.25, 0.0, -0.125)
+    v = tessera.voronoi(pts, bounds=UNIT_BOX[3], periodic=True, tilt=tilt)
+    g = tessera.adjacency(v)
+    assert np.array_equal(g.spokes, v.neighbors) and np.array_equal(g.spoke_shifts, v.neighbor_shifts)
+    assert 2 * len(g.edges()) == g.n_spokes and g.edge_shifts.shape == (len(g.edges()), 3)
+    lattice = np.array([[1.0, 0, 0], [v.tilt[0], 1, 0], [v.tilt[1], v.tilt[2], 1]])
+    g.save(tmp_path / "graph.vtp")
+    data = read_vtp(tmp_path / "graph.vtp")
+    xyz = vtk_to_numpy(data.GetPoints().GetData())
+    pid = vtk_to_numpy(data.GetPointData().GetArray("PointId"))
+    conn = vtk_to_numpy(data.GetLines().GetConnectivityArray()).reshape(-1, 2)
+    wrapped = v.periodic_points
+    assert np.array_equal(xyz[:500], wrapped)
+    ends = g.edges()
+    assert np.array_equal(conn[:, 0], ends[:, 0]) and np.array_equal(pid[conn[:, 1]], ends[:, 1])
+    np.testing.assert_allclose(xyz[conn[:, 1]], wrapped[ends[:, 1]] + g.edge_shifts @ lattice, rtol=0, atol=1e-15)
+    mem = g.to_vtk()
+    assert np.array_equal(vtk_to_numpy(mem.GetLines().GetConnectivityArray()).reshape(-1, 2), conn)
+    plain = tessera.adjacency(tessera.voronoi(pts, bounds=UNIT_BOX[3]))
+    assert plain.spoke_shifts.size == 0 and plain.edge_shifts.size == 0
+
+
 # ----------------------------------------------------------------- face sets
 
 @pytest.mark.parametrize("dim", [2, 3])
