@@ -76,7 +76,8 @@ struct VoronoiOptions {
   /// image is exact (for a unit box 2^-51: each moves by at most 2^-52).
   /// Cells straddle the box's faces where their points lie near them.
   /// Cells::neighbor_shifts says which image each neighbour is. Delaunay,
-  /// graphs, face sets, flowers and surface nets refuse periodic input.
+  /// face sets, flowers and surface nets refuse periodic input (the
+  /// adjacency graph takes it).
   std::array<bool, 3> periodic{false, false, false};
   /// Tilt factors of a triclinic (sheared) periodic box, as lengths in
   /// LAMMPS's and Voro++'s convention: {xy, xz, yz}. The box repeats by the
