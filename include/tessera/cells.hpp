@@ -38,6 +38,13 @@ struct Cancelled : std::runtime_error {
   Cancelled() : std::runtime_error("cancelled") {}
 };
 
+/// A periodic box's lattice vectors: row a is the shift by one along axis a,
+/// (Lx, 0, 0), (xy, Ly, 0), (xz, yz, Lz) for tilts {xy, xz, yz} (the first
+/// dim entries count).
+inline std::array<std::array<double, 3>, 3> periodic_lattice(const Bounds& box, const std::array<double, 3>& tilt) {
+  return {{{box.hi[0] - box.lo[0], 0, 0}, {tilt[0], box.hi[1] - box.lo[1], 0}, {tilt[1], tilt[2], box.hi[2] - box.lo[2]}}};
+}
+
 /// How a cell finds the points that clip it (tessera::voronoi).
 enum class CellMethod {
   /// The search, unless a pilot of a few hundred cells finds them far
@@ -148,6 +155,11 @@ struct Cells {
   /// there, without the shifts: a vertex shared by cells on opposite sides
   /// of the box is listed once beside each, and keys need not be unique.
   Buffer<std::int32_t> vertex_keys; ///< n_vertices * (dim+1)
+  /// Periodic boxes only, else empty: per key entry, dim shifts of that
+  /// point's image (n_vertices * (dim+1) * dim); a key is then ascending by
+  /// (id, shift), and two keys that differ by a common shift are the same
+  /// Delaunay simplex seen from different cells.
+  Buffer<std::int8_t> vertex_key_shifts;
   /// 3D: faces of each cell: cell_face_offsets (n_cells+1) into faces; each face
   /// has face_vertex_offsets (n_faces_total+1) into face_vertices (global vertex
   /// ids, counter-clockwise seen from outside the cell) and face_neighbor (the
@@ -200,13 +212,8 @@ struct Cells {
   std::array<double, 3> image_reach{0, 0, 0};
 
   bool is_periodic() const { return periodic[0] || periodic[1] || periodic[2]; }
-  /// A periodic box's lattice vectors: row a is the shift by one along axis
-  /// a, (Lx, 0, 0), (xy, Ly, 0), (xz, yz, Lz) (the first dim entries count).
-  std::array<std::array<double, 3>, 3> lattice() const {
-    return {{{bounds.hi[0] - bounds.lo[0], 0, 0},
-             {tilt[0], bounds.hi[1] - bounds.lo[1], 0},
-             {tilt[1], tilt[2], bounds.hi[2] - bounds.lo[2]}}};
-  }
+  /// A periodic box's lattice vectors (periodic_lattice).
+  std::array<std::array<double, 3>, 3> lattice() const { return periodic_lattice(bounds, tilt); }
   std::size_t n_cells() const { return generator.size(); }
   std::size_t n_vertices() const { return vertex_keys.size() / (dim + 1); }
 };

@@ -9,6 +9,10 @@
 // surfaces), points go to incremental insertion instead, which builds the same
 // simplices. With labels, the result is the simplices of that whole
 // triangulation whose vertices are all inside points (label >= 0).
+//
+// In a periodic box (every axis periodic, VoronoiOptions::periodic and
+// tilt) the triangulation is that of the points among all their images,
+// each simplex once, with the shifts of its vertices (Delaunay::simplex_shifts).
 #pragma once
 
 #include <cstddef>
@@ -92,7 +96,20 @@ struct Delaunay {
   std::vector<std::int32_t> ignored_outside_bounds;
   std::uint64_t exact_predicate_calls = 0;
   int threads_used = 1;
+  /// Periodic boxes (DelaunayOptions::periodic, every axis periodic), else
+  /// empty: per row entry, dim shifts of that point's image (n_simplices *
+  /// (dim+1) * dim, in box lengths; lattice vectors with tilts). Each
+  /// simplex of the periodic triangulation is listed once, translated so
+  /// that its first entry is its lowest id at shift 0 (of those, the
+  /// translation whose (id, shift) row is least); rows ascend by (id,
+  /// shift), but for the orientation's swap, and are positively oriented
+  /// with the shifts applied (Cells::periodic_points + shift . lattice).
+  Buffer<std::int8_t> simplex_shifts;
+  std::array<bool, 3> periodic{false, false, false};
+  std::array<double, 3> tilt{0, 0, 0};     ///< as rounded (Cells::tilt)
+  std::vector<double> periodic_points;     ///< the points as wrapped and rounded (Cells::periodic_points)
 
+  bool is_periodic() const { return periodic[0] || periodic[1] || periodic[2]; }
   std::size_t n_simplices() const { return simplices.size() / static_cast<std::size_t>(dim + 1); }
 };
 

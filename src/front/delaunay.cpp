@@ -23,6 +23,7 @@
 #include "id_hash.hpp"
 #include "insertion.hpp"
 #include "pass.hpp"
+#include "periodic.hpp"
 #include "pilot.hpp"
 #include "point_buckets.hpp"
 #include "simplex_facets.hpp"
@@ -612,8 +613,11 @@ bool inside_reaches_out(std::span<const double> points, int dim, std::span<const
 
 Delaunay delaunay(std::span<const double> input, int dim, std::span<const std::int32_t> labels,
                   const DelaunayOptions& given) {
-  if (given.periodic_box())
-    throw InputError("periodic boxes: only the cells (tessera::voronoi), not the Delaunay triangulation");
+  if (given.periodic_box()) {
+    if (!given.periodic[0] && !given.periodic[1] && !given.periodic[2])
+      throw InputError("a tilt (triclinic box) needs periodic axes");
+    return front::periodic_delaunay(input, dim, labels, given);
+  }
   const front::CheckedInput<DelaunayOptions> in(input, dim, labels, given);
   const std::span<const double> points = in.points;
   const DelaunayOptions& options = in.options;
@@ -651,6 +655,7 @@ Delaunay delaunay(std::span<const double> input, int dim, std::span<const std::i
 }
 
 std::vector<std::int32_t> simplex_neighbors(const Delaunay& dt) {
+  front::refuse_periodic(dt, "simplex_neighbors");
   const std::size_t w = static_cast<std::size_t>(dt.dim + 1);
   std::vector<std::int32_t> nb(dt.n_simplices() * w, -1);
   // Each point pairs the facets it is lowest in (simplex_facets.hpp): every
@@ -685,6 +690,7 @@ std::vector<std::int32_t> vertex_to_simplex(const Delaunay& dt) {
 }
 
 VertexNeighbors vertex_neighbors(const Delaunay& dt) {
+  front::refuse_periodic(dt, "vertex_neighbors");
   front::check_simplex_ids(dt);
   const std::size_t n = dt.n_points, w = static_cast<std::size_t>(dt.dim + 1);
   // A simplex's edges as slot pairs (i < j): 3 in 2D, 6 in 3D.

@@ -12,6 +12,7 @@
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 
+#include "point_buckets.hpp"
 #include "tessera/engine/thread_arena.hpp"
 #include "tessera/kernels/delaunay_predicates.hpp"
 
@@ -48,6 +49,7 @@ std::int64_t SimplexLocator::bin_of(int d, double x) const {
 SimplexLocator::SimplexLocator(const Delaunay& dt, std::span<const double> points, int threads, LocateMethod method,
                                Adjacency neighbors)
     : dim_(dt.dim), n_simplices_(dt.n_simplices()), n_points_(dt.n_points), neighbors_(std::move(neighbors)) {
+  front::refuse_periodic(dt, "locate");
   check_points(dt, points, "locate");
   if (method == LocateMethod::walk && !dt.hull_completed)
     throw InputError("locate: a walk needs a triangulation of the whole convex hull (no labels, hull completion on)");

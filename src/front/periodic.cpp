@@ -474,10 +474,22 @@ Cells periodic_cells(Cells&& aug, const PeriodicInput& in, const PeriodicImages&
   if (!aug.vertex_keys.empty() || !aug.cell_face_offsets.empty()) {
     out.vertices = std::move(aug.vertices);
     out.vertex_keys = std::move(aug.vertex_keys);
+    out.vertex_key_shifts.resize(out.vertex_keys.size() * du);
     each(out.vertex_keys.size() / (du + 1), [&](std::size_t v) {
+      // (id, shift) per entry, ascending; a box plane (a wall) has shift 0.
       std::int32_t* key = out.vertex_keys.data() + v * (du + 1);
-      for (std::size_t d = 0; d <= du; ++d) key[d] = base(key[d]);
-      std::sort(key, key + du + 1);
+      std::int8_t* key_shift = out.vertex_key_shifts.data() + v * (du + 1) * du;
+      std::array<std::pair<std::int32_t, std::array<std::int8_t, 3>>, 4> e{};
+      for (std::size_t d = 0; d <= du; ++d) {
+        e[d].first = base(key[d]);
+        if (key[d] >= 0)
+          for (std::size_t a = 0; a < du; ++a) e[d].second[a] = im.shift[static_cast<std::size_t>(key[d]) * du + a];
+      }
+      std::sort(e.begin(), e.begin() + static_cast<std::ptrdiff_t>(du) + 1);
+      for (std::size_t d = 0; d <= du; ++d) {
+        key[d] = e[d].first;
+        for (std::size_t a = 0; a < du; ++a) key_shift[d * du + a] = e[d].second[a];
+      }
     });
     out.cell_face_offsets = std::move(aug.cell_face_offsets);
     out.face_vertex_offsets = std::move(aug.face_vertex_offsets);

@@ -42,6 +42,7 @@
 #include <vector>
 
 #include "tessera/cells.hpp"
+#include "tessera/delaunay.hpp"
 
 namespace tessera::front {
 
@@ -128,5 +129,17 @@ std::array<double, 3> needed_image_reach(const PeriodicInput& in, const Periodic
 /// and keys mapped back, neighbour shifts, face classes by the user's labels.
 Cells periodic_cells(Cells&& augmented, const PeriodicInput& in, const PeriodicImages& im,
                      std::span<const std::int32_t> labels, int threads);
+
+/// The Delaunay triangulation of a periodic box (every axis periodic):
+/// read off the periodic cells (periodic_delaunay.cpp). Throws InputError for
+/// walls and outside points.
+Delaunay periodic_delaunay(std::span<const double> points, int dim, std::span<const std::int32_t> labels,
+                           const DelaunayOptions& options);
+
+/// validate() of a periodic triangulation: orientation with the shifts
+/// applied, every facet (up to translation) in exactly two simplices with
+/// apexes on opposite sides and locally Delaunay, every point a vertex,
+/// volumes summing to the box's.
+DelaunayReport validate_periodic(const Delaunay& dt);
 
 }  // namespace tessera::front

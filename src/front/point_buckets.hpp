@@ -19,6 +19,13 @@
 
 namespace tessera::front {
 
+/// A periodic triangulation's rows name images (Delaunay::simplex_shifts):
+/// what matches facets or edges by ids alone refuses it.
+inline void refuse_periodic(const Delaunay& dt, const char* who) {
+  if (dt.is_periodic())
+    throw InputError(std::string(who) + ": not available for a periodic triangulation (its simplices meet images)");
+}
+
 /// Throws InputError unless every id in dt's rows names one of its points
 /// (a Delaunay put together by hand may not), and when the simplices
 /// outnumber 32-bit indices. Whatever indexes points by a row's ids checks first.

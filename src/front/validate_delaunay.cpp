@@ -18,6 +18,7 @@
 
 #include "tessera/delaunay.hpp"
 #include "simplex_facets.hpp"
+#include "periodic.hpp"
 #include "point_buckets.hpp"
 #include "tessera/kernels/delaunay_predicates.hpp"
 
@@ -88,6 +89,7 @@ bool is_flat(const kernels::ExactContext& ctx, const Delaunay& dt) {
 
 DelaunayReport validate(const Delaunay& dt, std::span<const double> points, std::span<const std::int32_t> labels) {
   front::check_simplex_ids(dt);
+  if (dt.is_periodic()) return front::validate_periodic(dt);  // its own points (wrapped)
   if (points.size() != dt.n_points * static_cast<std::size_t>(dt.dim))
     throw InputError("validate: " + std::to_string(points.size()) + " coordinates for a triangulation of " +
                      std::to_string(dt.n_points) + " points in " + std::to_string(dt.dim) + "D");

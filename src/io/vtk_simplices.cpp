@@ -6,7 +6,9 @@
 // Simplices are all of one type, so offsets and types are generated on the fly.
 #include "tessera/io/vtk_simplices.hpp"
 
+#include <array>
 #include <cstdint>
+#include <map>
 #include <numeric>
 #include <ostream>
 #include <vector>
@@ -25,7 +27,9 @@ void put(std::ostream& os, const T& v) {
   os.write(reinterpret_cast<const char*>(&v), sizeof(T));
 }
 
-void write_vtu(const std::string& path, const Delaunay& dt, std::span<const double> points) {
+/// point_id: per point of `points`, the point it is (an image's), or empty: its own index.
+void write_vtu(const std::string& path, const Delaunay& dt, std::span<const double> points,
+               std::span<const std::int32_t> point_id) {
   const int D = dt.dim;
   const std::size_t n = dt.n_points, m = dt.n_simplices(), w = static_cast<std::size_t>(D + 1);
   struct Array { const char* type; const char* name; int comps; std::uint64_t bytes; };
@@ -67,7 +71,7 @@ void write_vtu(const std::string& path, const Delaunay& dt, std::span<const doub
       if (buf.size() > (1u << 20)) flush();
     };
     emit(arrays[0].bytes);
-    for (std::size_t i = 0; i < n; ++i) emit(static_cast<std::int32_t>(i));
+    for (std::size_t i = 0; i < n; ++i) emit(point_id.empty() ? static_cast<std::int32_t>(i) : point_id[i]);
     emit(arrays[1].bytes);
     for (std::size_t s = 0; s < m; ++s) emit(static_cast<std::int64_t>(s));
     emit(arrays[2].bytes);
@@ -85,14 +89,18 @@ void write_vtu(const std::string& path, const Delaunay& dt, std::span<const doub
   });
 }
 
-void write_vtp(const std::string& path, const Delaunay& dt, std::span<const double> points) {
+void write_vtp(const std::string& path, const Delaunay& dt, std::span<const double> points,
+               std::span<const std::int32_t> point_id) {
   const std::size_t m = dt.n_simplices();
   std::vector<std::int64_t> offsets(m + 1);
   for (std::size_t s = 0; s <= m; ++s) offsets[s] = static_cast<std::int64_t>(3 * s);
   std::vector<std::int64_t> ids(m);
   std::iota(ids.begin(), ids.end(), 0);
-  std::vector<std::int32_t> pids(dt.n_points);
-  std::iota(pids.begin(), pids.end(), 0);
+  std::vector<std::int32_t> pids(point_id.begin(), point_id.end());
+  if (pids.empty()) {
+    pids.resize(dt.n_points);
+    std::iota(pids.begin(), pids.end(), 0);
+  }
   PolyData pd;
   pd.dim = 2;
   pd.points = points;
@@ -104,10 +112,55 @@ void write_vtp(const std::string& path, const Delaunay& dt, std::span<const doub
 
 }  // namespace
 
+/// A periodic triangulation as a plain one: the points as wrapped, then one
+/// point per image a simplex uses (in order of first use), the rows over them.
+struct Unrolled {
+  Delaunay dt;
+  std::vector<double> points;
+  std::vector<std::int32_t> point_id;
+};
+
+Unrolled unroll(const Delaunay& dt) {
+  const auto du = static_cast<std::size_t>(dt.dim);
+  const auto lattice = periodic_lattice(dt.bounds, dt.tilt);
+  Unrolled u;
+  u.dt.dim = dt.dim;
+  u.points = dt.periodic_points;
+  u.point_id.resize(dt.n_points);
+  std::iota(u.point_id.begin(), u.point_id.end(), 0);
+  u.dt.simplices.resize(dt.simplices.size());
+  std::map<std::pair<std::int32_t, std::array<std::int8_t, 3>>, std::int32_t> images;
+  for (std::size_t e = 0; e < dt.simplices.size(); ++e) {
+    const std::int32_t id = dt.simplices[e];
+    std::array<std::int8_t, 3> s{0, 0, 0};
+    for (std::size_t a = 0; a < du; ++a) s[a] = dt.simplex_shifts[e * du + a];
+    if (s == std::array<std::int8_t, 3>{0, 0, 0}) {
+      u.dt.simplices[e] = id;
+      continue;
+    }
+    const auto [it, fresh] = images.try_emplace({id, s}, static_cast<std::int32_t>(u.point_id.size()));
+    if (fresh) {
+      for (std::size_t a = 0; a < du; ++a) {
+        double x = dt.periodic_points[static_cast<std::size_t>(id) * du + a];
+        for (std::size_t b = a; b < du; ++b) x += s[b] * lattice[b][a];
+        u.points.push_back(x);
+      }
+      u.point_id.push_back(id);
+    }
+    u.dt.simplices[e] = it->second;
+  }
+  u.dt.n_points = u.point_id.size();
+  return u;
+}
+
 void write_simplices_vtk(const std::string& path, const Delaunay& dt, std::span<const double> points) {
   const std::string ext = detail::lower_extension(path);
-  if (ext == ".vtu") return write_vtu(path, dt, points);
-  if (ext == ".vtp" && dt.dim == 2) return write_vtp(path, dt, points);
+  if (dt.is_periodic() && (ext == ".vtu" || (ext == ".vtp" && dt.dim == 2))) {
+    const Unrolled u = unroll(dt);
+    return ext == ".vtu" ? write_vtu(path, u.dt, u.points, u.point_id) : write_vtp(path, u.dt, u.points, u.point_id);
+  }
+  if (ext == ".vtu") return write_vtu(path, dt, points, {});
+  if (ext == ".vtp" && dt.dim == 2) return write_vtp(path, dt, points, {});
   if (ext == ".vtp")
     throw InputError("cannot write " + path + ": 3D Delaunay output is an unstructured grid (.vtu)");
   throw InputError("cannot write " + path + ": unknown extension '" + ext + "' (use .vtu, or .vtp in 2D)");

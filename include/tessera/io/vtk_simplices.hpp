@@ -12,6 +12,9 @@ namespace tessera::io {
 /// written with z = 0); .vtp (2D only): triangles as polygons. Cell data:
 /// SimplexId (Int64). Point data: PointId (Int32). Written atomically. Throws
 /// InputError on another extension, .vtp in 3D, or an unwritable path.
+/// A periodic triangulation (Delaunay::is_periodic) is written over its own
+/// points as wrapped (`points` is not read), followed by one point at each
+/// image a simplex uses; PointId names the point an image is of.
 void write_simplices_vtk(const std::string& path, const Delaunay& dt, std::span<const double> points);
 
 }  // namespace tessera::io

@@ -1,0 +1,335 @@
+// The Delaunay triangulation of a periodic box (delaunay() with every axis
+// periodic): read off the periodic cells' merged vertices.
+//
+// Every vertex of a point's periodic cell is a simplex of the periodic
+// triangulation, with its vertices' images (Cells::vertex_key_shifts), and
+// every simplex is one: translated so that one of its vertices is a point
+// at shift 0, it is a vertex of that point's cell. The same simplex seen
+// from its other vertices' cells differs by a common shift; a canonical
+// translation (below) makes the copies equal, and sorting drops them.
+//
+// Orientation: in the frame of the cell it came from, the simplex's
+// vertices are the augmented input's exact images, so the exact orientation
+// of those coordinates is its orientation (translation keeps it). It is
+// never zero: three bisectors of a flat simplex would not meet in a vertex.
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <stdexcept>
+#include <numeric>
+#include <string>
+#include <vector>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_sort.h>
+
+#include "periodic.hpp"
+#include "tessera/delaunay.hpp"
+#include "tessera/engine/thread_arena.hpp"
+#include "tessera/kernels/delaunay_predicates.hpp"
+
+namespace tessera::front {
+namespace {
+
+/// One vertex of a simplex: a point and its image's shift.
+struct Entry {
+  std::int32_t id;
+  std::array<int, 3> shift;
+  auto operator<=>(const Entry&) const = default;
+};
+
+/// A simplex as its canonical entries (ascending) and, for the
+/// orientation, the entries as its cell saw them in the same order.
+struct Row {
+  std::array<Entry, 4> canonical;
+  std::array<Entry, 4> seen;
+};
+
+}  // namespace
+
+Delaunay periodic_delaunay(std::span<const double> input, int dim, std::span<const std::int32_t> labels,
+                           const DelaunayOptions& options) {
+  for (int a = 0; a < dim && a < 3; ++a)
+    if (!options.periodic[static_cast<std::size_t>(a)])
+      throw InputError(std::string("a periodic Delaunay triangulation needs every axis periodic (") + "xyz"[a] +
+                       " is a wall: the triangulation would need its hull there)");
+  for (const std::int32_t l : labels)
+    if (l < 0) throw InputError("a periodic Delaunay triangulation takes no outside points (labels < 0)");
+  VoronoiOptions vo = options;
+  vo.build_mesh = true;
+  const Cells c = voronoi(input, dim, labels, vo);
+
+  const auto du = static_cast<std::size_t>(dim);
+  const std::size_t w = du + 1;
+  const std::size_t nv = c.n_vertices();
+  const auto lattice = c.lattice();
+  // The exact image of entry e (the coordinates the augmented pass used).
+  auto place = [&](const Entry& e, double* out) {
+    for (std::size_t a = 0; a < du; ++a) {
+      double x = c.periodic_points[static_cast<std::size_t>(e.id) * du + a];
+      for (std::size_t b = a; b < du; ++b) x += e.shift[b] * lattice[b][a];
+      out[a] = x;
+    }
+  };
+
+  std::vector<Row> rows(nv);
+  engine::ThreadArena arena(c.threads_used);
+  arena.execute([&] {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nv, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
+      for (std::size_t v = r.begin(); v != r.end(); ++v) {
+        std::array<Entry, 4> seen{};
+        for (std::size_t k = 0; k < w; ++k) {
+          seen[k].id = c.vertex_keys[v * w + k];
+          seen[k].shift = {0, 0, 0};
+          for (std::size_t a = 0; a < du; ++a) seen[k].shift[a] = c.vertex_key_shifts[(v * w + k) * du + a];
+        }
+        // Canonical translation: one of the lowest id's entries moved to
+        // shift 0, the one that makes the ascending row least (several only
+        // where a box a few cells wide has a point meet its own image).
+        Row best{};
+        bool have = false;
+        for (std::size_t p = 0; p < w && seen[p].id == seen[0].id; ++p) {
+          std::array<std::pair<Entry, std::size_t>, 4> moved{};
+          for (std::size_t k = 0; k < w; ++k) {
+            moved[k].first.id = seen[k].id;
+            for (std::size_t a = 0; a < 3; ++a) moved[k].first.shift[a] = seen[k].shift[a] - seen[p].shift[a];
+            moved[k].second = k;
+          }
+          std::sort(moved.begin(), moved.begin() + static_cast<std::ptrdiff_t>(w));
+          Row row{};
+          for (std::size_t k = 0; k < w; ++k) {
+            row.canonical[k] = moved[k].first;
+            row.seen[k] = seen[moved[k].second];
+          }
+          if (!have || row.canonical < best.canonical) best = row;
+          have = true;
+        }
+        rows[v] = best;
+      }
+    });
+    tbb::parallel_sort(rows.begin(), rows.end(),
+                       [](const Row& x, const Row& y) { return x.canonical < y.canonical; });
+  });
+  rows.erase(std::unique(rows.begin(), rows.end(),
+                         [](const Row& x, const Row& y) { return x.canonical == y.canonical; }),
+             rows.end());
+
+  Delaunay dt;
+  dt.dim = dim;
+  dt.n_points = c.n_points;
+  dt.bounds = c.bounds;
+  dt.periodic = c.periodic;
+  dt.tilt = c.tilt;
+  dt.periodic_points = c.periodic_points;
+  dt.duplicates = c.duplicates;
+  dt.ignored_outside_bounds = c.ignored_outside_bounds;
+  dt.exact_predicate_calls = c.exact_predicate_calls;
+  dt.threads_used = c.threads_used;
+  const std::size_t ns = rows.size();
+  dt.simplices.resize(ns * w);
+  dt.simplex_shifts.resize(ns * w * du);
+  dt.from_cells = ns;
+  arena.execute([&] {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, ns, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
+      for (std::size_t s = r.begin(); s != r.end(); ++s) {
+        Row& row = rows[s];
+        double xyz[4][3];
+        const double* pts[4];
+        for (std::size_t k = 0; k < w; ++k) {
+          place(row.seen[k], xyz[k]);
+          pts[k] = xyz[k];
+        }
+        if (kernels::orientation(dim, pts) < 0) std::swap(row.canonical[w - 2], row.canonical[w - 1]);
+        for (std::size_t k = 0; k < w; ++k) {
+          dt.simplices[s * w + k] = row.canonical[k].id;
+          for (std::size_t a = 0; a < du; ++a) {
+            const int x = row.canonical[k].shift[a];
+            // Shifts within a simplex differ by a few at most; int8 holds
+            // them unless a cell reached past ~60 periods (then refused).
+            if (x < -127 || x > 127)
+              throw InputError("periodic Delaunay: a simplex spans more than 127 box lengths");
+            dt.simplex_shifts[(s * w + k) * du + a] = static_cast<std::int8_t>(x);
+          }
+        }
+      }
+    });
+  });
+  return dt;
+}
+
+DelaunayReport validate_periodic(const Delaunay& dt) {
+  const int D = dt.dim;
+  const auto du = static_cast<std::size_t>(D);
+  const std::size_t w = du + 1, m = dt.n_simplices();
+  if (dt.simplex_shifts.size() != m * w * du || dt.periodic_points.size() != dt.n_points * du)
+    throw std::invalid_argument("validate: a periodic triangulation without its shifts or points");
+  DelaunayReport rep;
+  rep.simplices = m;
+  const auto lattice = periodic_lattice(dt.bounds, dt.tilt);
+  auto entry = [&](std::size_t s, std::size_t k) {
+    Entry e{dt.simplices[s * w + k], {0, 0, 0}};
+    for (std::size_t a = 0; a < du; ++a) e.shift[a] = dt.simplex_shifts[(s * w + k) * du + a];
+    return e;
+  };
+  auto place = [&](const Entry& e, double* out) {
+    for (std::size_t a = 0; a < du; ++a) {
+      double x = dt.periodic_points[static_cast<std::size_t>(e.id) * du + a];
+      for (std::size_t b = a; b < du; ++b) x += e.shift[b] * lattice[b][a];
+      out[a] = x;
+    }
+  };
+  // Exact orientation of D+1 entries (images placed exactly: the grid).
+  auto orient = [&](const std::array<Entry, 4>& e) {
+    double xyz[4][3];
+    const double* pts[4];
+    for (std::size_t k = 0; k < w; ++k) {
+      place(e[k], xyz[k]);
+      pts[k] = xyz[k];
+    }
+    return kernels::orientation(D, pts);
+  };
+
+  // Orientation and volume (the volumes of a periodic triangulation tile
+  // the box: Lx Ly Lz, the lattice's determinant).
+  const double fact = D == 2 ? 2.0 : 6.0;
+  double volume = 0, perm_sum = 0;
+  std::vector<Entry> used;
+  for (std::size_t s = 0; s < m; ++s) {
+    std::array<Entry, 4> e{};
+    for (std::size_t k = 0; k < w; ++k) e[k] = entry(s, k);
+    rep.flat_or_inverted += orient(e) != 1;
+    double xyz[4][3];
+    for (std::size_t k = 0; k < w; ++k) place(e[k], xyz[k]);
+    double r[3][3] = {};
+    for (std::size_t k = 1; k < w; ++k)
+      for (std::size_t a = 0; a < du; ++a) r[k - 1][a] = xyz[k][a] - xyz[0][a];
+    const double det = D == 2 ? r[0][0] * r[1][1] - r[0][1] * r[1][0]
+                              : r[0][0] * (r[1][1] * r[2][2] - r[1][2] * r[2][1]) -
+                                    r[0][1] * (r[1][0] * r[2][2] - r[1][2] * r[2][0]) +
+                                    r[0][2] * (r[1][0] * r[2][1] - r[1][1] * r[2][0]);
+    volume += det / fact;
+    perm_sum += std::fabs(det) / fact;
+  }
+
+  // Facets: each, translated canonically (its lowest entry at shift 0, the
+  // least such row), in exactly two simplices, whose apexes lie on opposite
+  // sides and neither in the other's circumsphere (perturbed as the cells
+  // were: by (id, shift) order).
+  struct Facet {
+    std::array<Entry, 3> key;       // canonical, ascending
+    std::array<int, 3> translation;  // subtracted from the simplex's shifts
+    std::size_t simplex, k;          // the simplex and the slot of its apex
+    bool operator<(const Facet& o) const {
+      return key != o.key ? key < o.key : (simplex != o.simplex ? simplex < o.simplex : k < o.k);
+    }
+  };
+  std::vector<Facet> facets;
+  facets.reserve(m * w);
+  for (std::size_t s = 0; s < m; ++s)
+    for (std::size_t k = 0; k < w; ++k) {
+      std::array<Entry, 3> f{};
+      for (std::size_t j = 0, c = 0; j < w; ++j)
+        if (j != k) f[c++] = entry(s, j);
+      std::sort(f.begin(), f.begin() + static_cast<std::ptrdiff_t>(du));
+      Facet best{};
+      bool have = false;
+      for (std::size_t p = 0; p < du && f[p].id == f[0].id; ++p) {
+        Facet g{f, f[p].shift, s, k};
+        for (std::size_t c = 0; c < du; ++c)
+          for (std::size_t a = 0; a < 3; ++a) g.key[c].shift[a] = f[c].shift[a] - f[p].shift[a];
+        std::sort(g.key.begin(), g.key.begin() + static_cast<std::ptrdiff_t>(du));
+        if (!have || g.key < best.key) best = g;
+        have = true;
+      }
+      facets.push_back(best);
+    }
+  std::sort(facets.begin(), facets.end());
+  for (std::size_t i = 0; i < facets.size();) {
+    std::size_t j = i + 1;
+    while (j < facets.size() && facets[j].key == facets[i].key) ++j;
+    if (j - i == 1) {
+      ++rep.boundary_facets;
+    } else if (j - i > 2) {
+      rep.nonmanifold_facets += j - i - 2;
+    } else {
+      const Facet& a = facets[i];
+      const Facet& b = facets[i + 1];
+      // b's apex in a's frame.
+      Entry apex = entry(b.simplex, b.k);
+      for (std::size_t t = 0; t < 3; ++t) apex.shift[t] += a.translation[t] - b.translation[t];
+      std::array<Entry, 4> row{};
+      for (std::size_t k = 0; k < w; ++k) row[k] = entry(a.simplex, k);
+      std::array<Entry, 4> swapped = row;
+      swapped[a.k] = apex;
+      if (orient(swapped) != -1) {
+        ++rep.nonmanifold_facets;
+      } else {
+        // The five points in (id, shift) order as local ids: the
+        // perturbation's order, as in the augmented input.
+        std::array<Entry, 5> all{};
+        for (std::size_t k = 0; k < w; ++k) all[k] = row[k];
+        all[w] = apex;
+        std::array<std::size_t, 5> order{0, 1, 2, 3, 4};
+        std::sort(order.begin(), order.begin() + static_cast<std::ptrdiff_t>(w) + 1,
+                  [&](std::size_t x, std::size_t y) { return all[x] < all[y]; });
+        std::array<std::int32_t, 5> local{};
+        double xyz[5][3] = {};
+        for (std::size_t r = 0; r <= w; ++r) {
+          local[order[r]] = static_cast<std::int32_t>(r);
+          place(all[order[r]], xyz[r]);
+        }
+        kernels::ExactContext ctx;
+        ctx.points = &xyz[0][0];
+        ctx.dim = D;
+        if (D == 2) {  // in_sphere reads dim doubles per point
+          double packed[10];
+          for (std::size_t r = 0; r <= w; ++r) {
+            packed[2 * r] = xyz[r][0];
+            packed[2 * r + 1] = xyz[r][1];
+          }
+          ctx.points = packed;
+          const std::array<std::int32_t, 2> planes{local[1], local[2]};
+          rep.local_delaunay_violations += kernels::in_sphere(ctx, local[0], planes.data(), local[w]);
+        } else {
+          const std::array<std::int32_t, 3> planes{local[1], local[2], local[3]};
+          rep.local_delaunay_violations += kernels::in_sphere(ctx, local[0], planes.data(), local[w]);
+        }
+      }
+    }
+    i = j;
+  }
+
+  // Every point that takes part is a vertex.
+  std::vector<std::uint8_t> seen(dt.n_points, 0);
+  for (std::int32_t id : dt.simplices) seen[static_cast<std::size_t>(id)] = 1;
+  for (auto [dup, owner] : dt.duplicates) seen[static_cast<std::size_t>(dup)] = 1;
+  for (std::int32_t id : dt.ignored_outside_bounds) seen[static_cast<std::size_t>(id)] = 1;
+  rep.missing_points = static_cast<std::size_t>(std::count(seen.begin(), seen.end(), 0));
+
+  auto fail = [&](std::size_t count, const std::string& what) {
+    if (count == 0) return;
+    rep.ok = false;
+    rep.messages.push_back(std::to_string(count) + " " + what);
+  };
+  fail(rep.flat_or_inverted, "simplices are flat or inverted");
+  fail(rep.nonmanifold_facets, "facets are shared by more than two simplices or overlap");
+  fail(rep.boundary_facets, "facets are in one simplex only (a periodic triangulation has no boundary)");
+  fail(rep.missing_points, "points are in no simplex");
+  fail(rep.local_delaunay_violations, "facets are not locally Delaunay");
+  rep.volume_sum = volume;
+  rep.enclosed_volume = dt.bounds.volume(D);
+  rep.volume_tolerance = 1e-9 * rep.enclosed_volume + 32 * std::numeric_limits<double>::epsilon() * perm_sum;
+  if (!(std::fabs(rep.volume_sum - rep.enclosed_volume) <= rep.volume_tolerance)) {
+    rep.ok = false;
+    char buf[160];
+    std::snprintf(buf, sizeof buf, "simplex volumes sum to %.17g but the periodic box holds %.17g", rep.volume_sum,
+                  rep.enclosed_volume);
+    rep.messages.push_back(buf);
+  }
+  return rep;
+}
+
+}  // namespace tessera::front

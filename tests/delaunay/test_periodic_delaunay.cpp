@@ -1,0 +1,212 @@
+// The Delaunay triangulation of a periodic box (every axis periodic).
+//
+// What this proves:
+// * the simplices, as (point, image) tuples up to a common translation,
+//   equal CGAL's Periodic_3_Delaunay_triangulation_3 on random points in a
+//   cube (general position);
+// * triclinic and 2D boxes give valid periodic triangulations (validate():
+//   orientation with the shifts, every facet in two simplices and locally
+//   Delaunay, volumes tiling the box), with the counts a torus has (2D:
+//   2n triangles; 3D: V - E + T = 0);
+// * a lattice (all ties) too, and 1 and 2 threads give identical rows;
+// * what is refused: walls, outside points, the helpers that match facets
+//   or edges by ids alone.
+#include <gtest/gtest.h>
+
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Periodic_3_Delaunay_triangulation_3.h>
+#include <CGAL/Periodic_3_Delaunay_triangulation_traits_3.h>
+#include <CGAL/Triangulation_vertex_base_with_info_3.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <set>
+#include <vector>
+
+#include "random_points.hpp"
+#include "tessera/delaunay.hpp"
+#include "tessera/locate.hpp"
+
+namespace {
+
+using K = CGAL::Exact_predicates_inexact_constructions_kernel;
+using Gt = CGAL::Periodic_3_Delaunay_triangulation_traits_3<K>;
+using VbDs = CGAL::Triangulation_vertex_base_3<Gt, CGAL::Periodic_3_triangulation_ds_vertex_base_3<>>;
+using Vb = CGAL::Triangulation_vertex_base_with_info_3<std::int32_t, Gt, VbDs>;
+using Cb = CGAL::Triangulation_cell_base_3<Gt, CGAL::Periodic_3_triangulation_ds_cell_base_3<>>;
+using Tds = CGAL::Triangulation_data_structure_3<Vb, Cb>;
+using P3DT = CGAL::Periodic_3_Delaunay_triangulation_3<Gt, Tds>;
+
+using Entry = std::pair<std::int32_t, std::array<int, 3>>;
+using Simplex = std::vector<Entry>;
+
+/// A simplex up to translation: of the translations that put its lowest id
+/// at shift 0, the one whose ascending entries are least.
+Simplex canonical(Simplex s) {
+  std::sort(s.begin(), s.end());
+  Simplex best;
+  for (std::size_t p = 0; p < s.size() && s[p].first == s[0].first; ++p) {
+    Simplex t = s;
+    for (auto& [id, sh] : t)
+      for (int a = 0; a < 3; ++a) sh[static_cast<std::size_t>(a)] -= s[p].second[static_cast<std::size_t>(a)];
+    std::sort(t.begin(), t.end());
+    if (best.empty() || t < best) best = t;
+  }
+  return best;
+}
+
+std::set<Simplex> ours(const tessera::Delaunay& dt) {
+  const auto du = static_cast<std::size_t>(dt.dim), w = du + 1;
+  std::set<Simplex> out;
+  for (std::size_t s = 0; s < dt.n_simplices(); ++s) {
+    Simplex x;
+    for (std::size_t k = 0; k < w; ++k) {
+      std::array<int, 3> sh{0, 0, 0};
+      for (std::size_t a = 0; a < du; ++a) sh[a] = dt.simplex_shifts[(s * w + k) * du + a];
+      x.push_back({dt.simplices[s * w + k], sh});
+    }
+    const Simplex c = canonical(x);
+    Simplex sorted = x;
+    std::sort(sorted.begin(), sorted.end());
+    EXPECT_EQ(sorted, c) << "row " << s << " is not in canonical form";
+    out.insert(c);
+  }
+  EXPECT_EQ(out.size(), dt.n_simplices()) << "a simplex listed twice";
+  return out;
+}
+
+tessera::DelaunayOptions periodic_options(int dim, const std::array<double, 3>& hi, const std::array<double, 3>& tilt,
+                                          int threads = 1) {
+  tessera::DelaunayOptions o;
+  o.dim = dim;
+  o.bounds = tessera::Bounds{{0, 0, 0}, hi};
+  o.periodic = {true, true, dim == 3};
+  o.tilt = tilt;
+  o.threads = threads;
+  return o;
+}
+
+void expect_valid(const tessera::Delaunay& dt) {
+  const tessera::DelaunayReport r = tessera::validate(dt, {}, {});
+  EXPECT_TRUE(r.ok) << (r.messages.empty() ? "" : r.messages[0]);
+  EXPECT_EQ(r.boundary_facets, 0u);
+  EXPECT_EQ(r.local_delaunay_violations, 0u);
+  EXPECT_NEAR(r.volume_sum, r.enclosed_volume, 1e-12 * r.enclosed_volume);
+}
+
+/// Distinct edges up to translation.
+std::size_t edges(const tessera::Delaunay& dt) {
+  const auto du = static_cast<std::size_t>(dt.dim), w = du + 1;
+  std::set<Simplex> out;
+  for (std::size_t s = 0; s < dt.n_simplices(); ++s)
+    for (std::size_t i = 0; i < w; ++i)
+      for (std::size_t j = i + 1; j < w; ++j) {
+        Simplex e;
+        for (std::size_t k : {i, j}) {
+          std::array<int, 3> sh{0, 0, 0};
+          for (std::size_t a = 0; a < du; ++a) sh[a] = dt.simplex_shifts[(s * w + k) * du + a];
+          e.push_back({dt.simplices[s * w + k], sh});
+        }
+        out.insert(canonical(e));
+      }
+  return out.size();
+}
+
+TEST(PeriodicDelaunay, EqualsCgalsPeriodicTriangulation) {
+  const std::size_t n = 2000;
+  const auto pts = uniform_points(n, 3, 71);
+  P3DT cgal(P3DT::Iso_cuboid(0, 0, 0, 1, 1, 1));
+  for (std::size_t i = 0; i < n; ++i)
+    cgal.insert(K::Point_3(pts[3 * i], pts[3 * i + 1], pts[3 * i + 2]))->info() = static_cast<std::int32_t>(i);
+  ASSERT_TRUE(cgal.is_1_cover());
+  std::set<Simplex> want;
+  for (auto c = cgal.cells_begin(); c != cgal.cells_end(); ++c) {
+    Simplex s;
+    for (int k = 0; k < 4; ++k) {
+      const auto off = cgal.get_offset(c, k);
+      s.push_back({c->vertex(k)->info(), {off.x(), off.y(), off.z()}});
+    }
+    want.insert(canonical(s));
+  }
+  // The points lie on a grid finer than the box's (2^-51): as given.
+  const tessera::Delaunay dt = tessera::delaunay(pts, 3, {}, periodic_options(3, {1, 1, 1}, {0, 0, 0}));
+  EXPECT_EQ(ours(dt), want);
+  EXPECT_EQ(dt.n_simplices(), cgal.number_of_cells());
+  expect_valid(dt);
+}
+
+TEST(PeriodicDelaunay, TriclinicAnd2DBoxesAreValidTori) {
+  {
+    const auto pts = uniform_points(3000, 3, 72);
+    const auto o = periodic_options(3, {1, 1.5, 0.75}, {0.3, -0.2, 0.45});
+    const tessera::Delaunay a = tessera::delaunay(pts, 3, {}, o);
+    auto o2 = o;
+    o2.threads = 2;
+    const tessera::Delaunay b = tessera::delaunay(pts, 3, {}, o2);
+    EXPECT_EQ(a.simplices, b.simplices);
+    EXPECT_EQ(a.simplex_shifts, b.simplex_shifts);
+    ours(a);
+    expect_valid(a);
+    // Euler characteristic of the 3-torus: V - E + F - T = 0 with F = 2T.
+    EXPECT_EQ(static_cast<long>(3000) - static_cast<long>(edges(a)) + static_cast<long>(a.n_simplices()), 0);
+    // validate() sees a vertex moved to another image, and a dropped simplex.
+    tessera::Delaunay moved = a;
+    moved.simplex_shifts[3 * 100 + 1] = static_cast<std::int8_t>(moved.simplex_shifts[3 * 100 + 1] + 1);
+    EXPECT_FALSE(tessera::validate(moved, {}, {}).ok);
+    tessera::Delaunay dropped = a;
+    dropped.simplices.resize(dropped.simplices.size() - 4);
+    dropped.simplex_shifts.resize(dropped.simplex_shifts.size() - 12);
+    const tessera::DelaunayReport r = tessera::validate(dropped, {}, {});
+    EXPECT_FALSE(r.ok);
+    EXPECT_EQ(r.boundary_facets, 4u);
+  }
+  {
+    const auto pts = uniform_points(3000, 2, 73);
+    const tessera::Delaunay dt = tessera::delaunay(pts, 2, {}, periodic_options(2, {2, 1, 0}, {-0.625, 0, 0}));
+    ours(dt);
+    expect_valid(dt);
+    EXPECT_EQ(dt.n_simplices(), 2u * 3000u);  // a triangulated torus: F = 2V
+  }
+}
+
+TEST(PeriodicDelaunay, LatticeTiesAndFewPoints) {
+  // A cubic lattice: every Delaunay ball holds 8 points, split alike from
+  // every cell by the perturbation. Boxes of 1-3 points: simplices meet
+  // several images of one point.
+  std::vector<double> lattice;
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < 4; ++j)
+      for (int k = 0; k < 4; ++k) lattice.insert(lattice.end(), {(i + 0.5) / 4, (j + 0.5) / 4, (k + 0.5) / 4});
+  const tessera::Delaunay dt = tessera::delaunay(lattice, 3, {}, periodic_options(3, {1, 1, 1}, {0, 0, 0}));
+  ours(dt);
+  expect_valid(dt);
+  for (std::size_t n : {1, 2, 3}) {
+    const auto pts = uniform_points(n, 3, 80 + n);
+    const tessera::Delaunay few = tessera::delaunay(pts, 3, {}, periodic_options(3, {1, 1, 1}, {0.25, 0, 0.5}));
+    ours(few);
+    expect_valid(few);
+    const auto pts2 = uniform_points(n, 2, 90 + n);
+    const tessera::Delaunay few2 = tessera::delaunay(pts2, 2, {}, periodic_options(2, {1, 1, 0}, {0.375, 0, 0}));
+    ours(few2);
+    expect_valid(few2);
+    EXPECT_EQ(few2.n_simplices(), 2 * n);
+  }
+}
+
+TEST(PeriodicDelaunay, Refused) {
+  const auto pts = uniform_points(200, 3, 74);
+  auto walls = periodic_options(3, {1, 1, 1}, {0, 0, 0});
+  walls.periodic = {true, true, false};
+  EXPECT_THROW(tessera::delaunay(pts, 3, {}, walls), tessera::InputError);
+  std::vector<std::int32_t> labels(200, 0);
+  labels[5] = -1;
+  EXPECT_THROW(tessera::delaunay(pts, 3, labels, periodic_options(3, {1, 1, 1}, {0, 0, 0})), tessera::InputError);
+  const tessera::Delaunay dt = tessera::delaunay(pts, 3, {}, periodic_options(3, {1, 1, 1}, {0, 0, 0}));
+  EXPECT_THROW(tessera::simplex_neighbors(dt), tessera::InputError);
+  EXPECT_THROW(tessera::vertex_neighbors(dt), tessera::InputError);
+  EXPECT_THROW(tessera::SimplexLocator(dt, pts), tessera::InputError);
+  EXPECT_EQ(tessera::vertex_to_simplex(dt).size(), 200u);  // ids alone: served
+}
+
+}  // namespace
