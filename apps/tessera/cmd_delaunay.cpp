@@ -55,11 +55,20 @@ void check_delaunay_outputs(const DelaunayArgs& a) {
   }
   if (!a.simplices.empty() && a.simplices != "-" && extension(a.simplices) != ".npy")
     throw InputError("--simplices " + a.simplices + ": must be a .npy file");
-  if (a.output.empty() && a.simplices.empty() && !a.validate)
+  if (!a.simplex_shifts.empty()) {
+    if (a.simplex_shifts != "-" && extension(a.simplex_shifts) != ".npy")
+      throw InputError("--simplex-shifts " + a.simplex_shifts + ": must be a .npy file");
+    if (a.compute.periodic.empty())
+      throw InputError("--simplex-shifts: only with --periodic (without it every vertex is the point itself)");
+  }
+  if (!a.compute.periodic.empty() && (a.no_hull_completion || a.skip_cells >= 0 || a.method != "auto"))
+    throw InputError("--periodic: a periodic triangulation has no hull (--no-hull-completion, --skip-cells and "
+                     "--method do not apply)");
+  if (a.output.empty() && a.simplices.empty() && a.simplex_shifts.empty() && !a.validate)
     throw InputError("nothing to do: give -o OUTPUT.vtu|.vtp, --simplices FILE.npy or --validate");
-  for (const std::string* p : {&a.output, &a.simplices})
+  for (const std::string* p : {&a.output, &a.simplices, &a.simplex_shifts})
     if (!p->empty()) io::check_writable(*p);
-  route_standard_output({&a.simplices});
+  route_standard_output({&a.simplices, &a.simplex_shifts});
 }
 
 }  // namespace
@@ -92,6 +101,11 @@ int run_delaunay(const DelaunayArgs& a) {
     io::write_file_atomic(a.simplices, io::npy_bytes(s.data(), {dt.n_simplices(), std::size_t(pc.dim + 1)}));
     written.push_back(shown_output(a.simplices));
   }
+  if (!a.simplex_shifts.empty()) {
+    const auto d = static_cast<std::size_t>(pc.dim);
+    io::write_file_atomic(a.simplex_shifts, io::npy_bytes(dt.simplex_shifts.data(), {dt.n_simplices(), d + 1, d}));
+    written.push_back(shown_output(a.simplex_shifts));
+  }
   const double write_s = seconds_since(t0);
 
   if (!a.quiet) {
@@ -100,7 +114,11 @@ int run_delaunay(const DelaunayArgs& a) {
     const std::string outside =
         dt.outside_simplices == 0 ? std::string()
                                   : "; " + std::to_string(dt.outside_simplices) + " with an outside vertex left out";
-    if (dt.from_insertion > 0)
+    if (dt.is_periodic())
+      std::fprintf(stderr, "tessera: %zu points (%dD) -> %zu %s of the periodic box%s (each once, with its images)\n",
+                   pc.n, pc.dim, dt.n_simplices(), pc.dim == 3 ? "tetrahedra" : "triangles",
+                   dt.tilt[0] != 0 || dt.tilt[1] != 0 || dt.tilt[2] != 0 ? " (triclinic)" : "");
+    else if (dt.from_insertion > 0)
       std::fprintf(stderr, "tessera: %zu points (%dD) -> %zu %s (by incremental insertion%s)\n", pc.n, pc.dim,
                    dt.n_simplices(), pc.dim == 3 ? "tetrahedra" : "triangles", outside.c_str());
     else
@@ -142,10 +160,12 @@ int run_delaunay(const DelaunayArgs& a) {
       std::fprintf(stderr,
                    "tessera: validation %s: %zu simplices, %zu flat/inverted, %zu non-manifold facets, %zu boundary "
                    "facets, %zu open ridges, %zu non-convex ridges, %zu missing points, %zu non-Delaunay facets, "
-                   "volume %.17g (boundary encloses %.17g; they agree within %.3g)\n",
+                   "volume %.17g (%s %.17g; they agree within %.3g)\n",
                    r.ok ? "passed" : "FAILED", r.simplices, r.flat_or_inverted, r.nonmanifold_facets,
                    r.boundary_facets, r.open_boundary_ridges, r.nonconvex_boundary, r.missing_points,
-                   r.local_delaunay_violations, r.volume_sum, r.enclosed_volume, r.volume_tolerance);
+                   r.local_delaunay_violations, r.volume_sum,
+                   dt.is_periodic() ? "the periodic box holds" : "boundary encloses", r.enclosed_volume,
+                   r.volume_tolerance);
       for (const auto& m : r.messages) std::fprintf(stderr, "tessera: validation: %s\n", m.c_str());
     }
     if (!r.ok) {

@@ -101,6 +101,7 @@ struct DelaunayArgs {
   ComputeArgs compute;
   std::string output;          ///< .vtu (VTK_TETRA / VTK_TRIANGLE) or .vtp (2D), or empty
   std::string simplices;       ///< .npy int64 (M, D+1), or empty
+  std::string simplex_shifts;  ///< .npy int8 (M, D+1, D) image shifts (periodic boxes), or empty
   bool no_hull_completion = false;
   double skip_cells = -1;      ///< DelaunayOptions::skip_cells (negative: automatic)
   std::string method = "auto"; ///< DelaunayOptions::method: auto|cells|insertion

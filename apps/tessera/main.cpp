@@ -219,6 +219,11 @@ int main(int argc, char** argv) {
   del->add_option("--simplices", dla.simplices,
                   "Simplices as an int64 .npy array of shape (M, D+1), point ids; tetrahedra positively oriented, "
                   "triangles counter-clockwise; - writes it to standard output");
+  add_periodic_option(del, dla.compute);
+  del->add_option("--simplex-shifts", dla.simplex_shifts,
+                  "With --periodic (every axis): which image each vertex of --simplices is, as an int8 .npy array "
+                  "of shape (M, D+1, D) in box lengths (lattice vectors with --tilt). Each simplex of the periodic "
+                  "triangulation is listed once, translated so that its lowest id is at shift 0");
   del->add_flag("--no-hull-completion", dla.no_hull_completion,
                 "Keep only the simplices whose circumcentre lies in the domain box (skip closing the triangulation "
                 "up to the convex hull)");
@@ -245,7 +250,10 @@ int main(int argc, char** argv) {
       "Without labels the triangulation covers the convex hull (CGAL's on points in general position; a valid\n"
       "one chosen by symbolic perturbation on degenerate input). With --labels: that triangulation's simplices\n"
       "whose vertices all have labels >= 0 (concave results allowed; with --no-hull-completion, only those\n"
-      "whose circumcentre lies in the domain box).\n"
+      "whose circumcentre lies in the domain box). With --periodic (every axis periodic, --bounds the box,\n"
+      "--tilt for a triclinic one) the triangulation of the points among all their images: each simplex once,\n"
+      "with its vertices' images in --simplex-shifts; -o writes the points as wrapped into the box and one more\n"
+      "point at each image a simplex uses (point data PointId: whose image).\n"
       "Examples:\n"
       "  tessera delaunay points.npy -o tets.vtu --simplices tets.npy\n"
       "  tessera delaunay points.csv --dim 2 -o triangles.vtp --validate");

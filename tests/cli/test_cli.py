@@ -1014,6 +1014,38 @@ class Periodic(TempDirCase):
             vol = np.loadtxt(self.p("t.npy.csv"), delimiter=",", skiprows=1)[:, 2]
             self.assertAlmostEqual(vol.sum(), float(np.prod(hi - lo)), delta=1e-12 * float(np.prod(hi - lo)))
 
+    def test_periodic_delaunay(self):
+        # delaunay --periodic: every simplex once with its vertices' images,
+        # validated; the .vtu holds the wrapped points and one point per
+        # image used (PointId), and each tetrahedron's corners there are the
+        # images the shifts name. 2D: a torus has twice as many triangles as
+        # points.
+        for dim, box, tilt in ((3, ["0", "1", "0", "1.5", "0", "1"], ["0.25", "0", "-0.125"]), (2, BOX2, ["0.375"])):
+            lo = np.array([float(x) for x in box[0::2]])
+            hi = np.array([float(x) for x in box[1::2]])
+            vec = np.diag(hi - lo)
+            for k, (a, b) in enumerate([(0, 1), (0, 2), (1, 2)][:len(tilt)]):
+                vec[b, a] = float(tilt[k])
+            f = np.random.default_rng(20 + dim).random((1500, dim)) * (1 - 2e-6) + 1e-6
+            pts = np.ldexp(np.floor(np.ldexp(lo + f @ vec, 30)), -30)
+            inp = self.save("d%d.npy" % dim, pts)
+            out, simp, shifts = self.p("d.vtu"), self.p("s.npy"), self.p("sh.npy")
+            r = self.ok(["delaunay", inp, "--bounds"] + box + ["--periodic", "xyz"[:dim], "--tilt"] + tilt +
+                        ["-o", out, "--simplices", simp, "--simplex-shifts", shifts, "--validate"])
+            self.assertIn("validation passed", r.stderr)
+            s, sh = np.load(simp), np.load(shifts)
+            self.assertEqual((sh.dtype, sh.shape), (np.int8, (len(s), dim + 1, dim)))
+            if dim == 2:
+                self.assertEqual(len(s), 2 * len(pts))
+            g = read_vtu(out)
+            self.assertEqual(g.GetNumberOfCells(), len(s))
+            xyz = vtk_to_numpy(g.GetPoints().GetData())[:, :dim]
+            pid = vtk_to_numpy(g.GetPointData().GetArray("PointId"))
+            np.testing.assert_array_equal(xyz[:len(pts)], pts)
+            conn = vtk_to_numpy(g.GetCells().GetConnectivityArray()).reshape(len(s), dim + 1)
+            np.testing.assert_array_equal(pid[conn], s)
+            np.testing.assert_allclose(xyz[conn], pts[s] + sh @ vec, rtol=0, atol=1e-14)
+
     def test_bench(self):
         inp = self.save("b.npy", np.random.default_rng(6).random((2000, 3)))
         r = self.ok(["bench", "voronoi", inp, "--bounds"] + BOX3 + ["--periodic", "xyz"])
@@ -1164,10 +1196,15 @@ class BadInput(TempDirCase):
         pts[3, 1] = 1.5
         self.fails(["voronoi", self.save("wall.npy", pts), "-o", out, "--bounds"] + BOX3 + ["--periodic", "xz"],
                    "not periodic")
-        for cmd in (["faces", "-o", self.p("f.vtp")], ["delaunay", "-o", self.p("d.vtu")]):
+        for cmd in (["faces", "-o", self.p("f.vtp")], ["flower", "--point", "0", "-o", self.p("f.vtp")]):
             r = run([cmd[0], self.good3] + cmd[1:] + ["--bounds"] + BOX3 + ["--periodic", "xyz"])
             self.assertEqual(r.returncode, 2)  # no such option there
         self.fails(["graph", self.good3, "--spoke-shifts", self.p("s.npy"), "--bounds"] + BOX3, "--periodic")
+        dl = ["delaunay", self.good3, "-o", self.p("d.vtu"), "--bounds"] + BOX3
+        self.fails(dl + ["--simplex-shifts", self.p("s.npy")], "--periodic")
+        self.fails(dl + ["--periodic", "xy"], "every axis periodic")
+        self.fails(dl + ["--periodic", "xyz", "--no-hull-completion"], "no hull")
+        self.fails(dl + ["--periodic", "xyz", "--simplex-shifts", self.p("s.csv")], ".npy")
 
     def test_coplanar_3d_suggests_dim2(self):
         pts = np.random.default_rng(1).random((50, 3))
