@@ -24,10 +24,13 @@ using Points = py::array_t<double, py::array::c_style>;
 
 DelaunayResult run_delaunay(const Points& points, const py::object& labels,
                             const std::optional<std::vector<double>>& bounds, double padding, bool ignore_outside,
-                            int threads, bool complete_hull, const std::string& method) {
+                            int threads, bool complete_hull, const std::string& method,
+                            const std::array<bool, 3>& periodic, const std::array<double, 3>& tilt) {
   const int dim = checked_dim(points);
   DelaunayOptions opt;
   fill_common(opt, dim, bounds, padding, ignore_outside, threads);
+  opt.periodic = periodic;
+  opt.tilt = tilt;
   opt.complete_hull = complete_hull;
   if (method == "auto") opt.method = DelaunayMethod::automatic;
   else if (method == "cells") opt.method = DelaunayMethod::cells;
@@ -129,11 +132,25 @@ void bind_delaunay(py::module_& m) {
                              })
       .def_property_readonly("exact_predicate_calls",
                              [](const DelaunayResult& r) { return r.dt.exact_predicate_calls; })
-      .def_property_readonly("threads_used", [](const DelaunayResult& r) { return r.dt.threads_used; });
+      .def_property_readonly("threads_used", [](const DelaunayResult& r) { return r.dt.threads_used; })
+      .def_property_readonly("periodic", [](const DelaunayResult& r) { return r.dt.periodic; })
+      .def_property_readonly("tilt", [](const DelaunayResult& r) { return r.dt.tilt; })
+      .def_property_readonly("simplex_shifts",
+                             [](py::object s) {
+                               const Delaunay& dt = s.cast<const DelaunayResult&>().dt;
+                               const auto d = static_cast<py::ssize_t>(dt.dim);
+                               return view(std::span<const std::int8_t>(dt.simplex_shifts.data(), dt.simplex_shifts.size()),
+                                           {dt.is_periodic() ? static_cast<py::ssize_t>(dt.n_simplices()) : 0, d + 1, d},
+                                           s);
+                             })
+      .def_property_readonly("periodic_points", [](py::object s) {
+        const Delaunay& dt = s.cast<const DelaunayResult&>().dt;
+        return view_rows(dt.periodic_points, static_cast<std::size_t>(dt.dim), s);
+      });
 
   m.def("delaunay", &run_delaunay, py::arg("points").noconvert(), py::arg("labels").none(true), py::arg("bounds"),
         py::arg("padding"), py::arg("ignore_outside"), py::arg("threads"), py::arg("complete_hull"),
-        py::arg("method"), "Delaunay simplices of float64 C-ordered (N, D) points; labels None or int32 (N,). Runs without the GIL.");
+        py::arg("method"), py::arg("periodic"), py::arg("tilt"), "Delaunay simplices of float64 C-ordered (N, D) points; labels None or int32 (N,). Runs without the GIL.");
 
   m.def("locate", &locate_points, py::arg("delaunay"), py::arg("points").noconvert(), py::arg("queries").noconvert(),
         py::arg("threads"),

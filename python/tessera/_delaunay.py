@@ -8,6 +8,7 @@ from typing import Any, Optional, Sequence, Tuple, Union
 import numpy as np
 
 from . import _core, _inputs
+from ._voronoi import _periodic_axes, _tilts
 
 PathLike = Union[str, "os.PathLike[str]"]
 
@@ -141,6 +142,8 @@ class Delaunay:
         as scipy's: for a point ``x`` in simplex ``s``,
         ``c = transform[s, :D] @ (x - transform[s, D])`` gives the first D
         coordinates and ``1 - c.sum()`` the last. Computed on first use."""
+        if self.is_periodic:
+            raise ValueError("transform: not available for a periodic triangulation (its simplices meet images)")
         if self._transform is None:
             d = self.ndim
             v = self.points[self.simplices]  # (m, D+1, D)
@@ -214,6 +217,31 @@ class Delaunay:
     def threads_used(self) -> int:
         return self._dt.threads_used
 
+    @property
+    def is_periodic(self) -> bool:
+        """A periodic box's triangulation (``delaunay(..., periodic=...)``)."""
+        return any(self._dt.periodic)
+
+    @property
+    def simplex_shifts(self) -> np.ndarray:
+        """int8 (nsimplex, D+1, D), periodic boxes only (empty otherwise): the
+        image of each vertex of :attr:`simplices`, in box lengths (lattice
+        vectors of a triclinic box): vertex ``k`` of simplex ``s`` sits at
+        ``periodic_points[simplices[s, k]] + simplex_shifts[s, k] @ lattice``."""
+        return self._dt.simplex_shifts
+
+    @property
+    def periodic_points(self) -> np.ndarray:
+        """float64 (N, D), periodic boxes only: the points as wrapped into the
+        box and rounded to its grid (the shifts are relative to these)."""
+        return self._dt.periodic_points
+
+    @property
+    def tilt(self) -> Tuple[float, ...]:
+        """A triclinic box's tilts as rounded (``(xy,)`` in 2D)."""
+        t = self._dt.tilt
+        return (t[0],) if self.ndim == 2 else (t[0], t[1], t[2])
+
     def validate(self) -> "_core.DelaunayReport":
         """Checks: orientation, manifold facets, closed and (without labels)
         convex boundary, every point used, empty circumspheres (local Delaunay).
@@ -252,6 +280,8 @@ def delaunay(
     complete_hull: bool = True,
     ignore_outside: bool = False,
     method: str = "auto",
+    periodic: Any = False,
+    tilt: Optional[Sequence[float]] = None,
 ) -> Delaunay:
     """Delaunay triangulation of 2D or 3D points, the dual of the Voronoi cells.
 
@@ -273,6 +303,14 @@ def delaunay(
         (surface samples, 2D curves and circles) or meets no ties on one or
         two threads (uniform points), or where 3D hull
         completion stalls (rotated lattices); else the cells (lattices).
+    periodic, tilt : as in :func:`tessera.voronoi`, every axis periodic
+        The triangulation of the points among all their images (``bounds``
+        the box that repeats): each simplex once, translated so that its
+        lowest id is at shift 0, and :attr:`Delaunay.simplex_shifts` the
+        image of each of its vertices. No hull, so ``complete_hull`` and
+        ``method`` do not apply; what matches facets by ids alone
+        (``neighbors``, ``vertex_neighbor_vertices``, ``find_simplex``,
+        ``convex_hull``, ``transform``) raises ValueError.
 
     Exact predicates and a symbolic perturbation decide every simplex, so
     degenerate input (lattices, cospherical points) gets a valid triangulation
@@ -281,6 +319,12 @@ def delaunay(
     pts = _inputs.as_points(points)
     dim = pts.shape[1]
     lab = _inputs.as_labels(labels, pts.shape[0])
+    per = _periodic_axes(periodic, dim)
+    tilts = _tilts(tilt, dim)
+    if any(per) and bounds is None:
+        raise ValueError("periodic: give bounds, the box that repeats")
+    if any(tilts) and not any(per):
+        raise ValueError("tilt: give periodic axes (a triclinic box repeats along its tilted axes)")
     dt = _inputs.call(
         _core.delaunay,
         pts,
@@ -291,5 +335,7 @@ def delaunay(
         _inputs.as_threads(threads),
         bool(complete_hull),
         str(method),
+        per,
+        tilts,
     )
     return Delaunay(dt, pts, lab)

@@ -110,7 +110,21 @@ def cells_to_vtk(vor: "Voronoi") -> Any:
 
 
 def simplices_to_vtk(dt: "Delaunay") -> Any:
-    """vtkUnstructuredGrid of VTK_TETRA (3D) / VTK_TRIANGLE (2D) over all input points."""
+    """vtkUnstructuredGrid of VTK_TETRA (3D) / VTK_TRIANGLE (2D) over all input
+    points. A periodic triangulation's is the file its save() writes, read back
+    (the wrapped points, then one point per image a simplex uses)."""
+    if dt.is_periodic:
+        import tempfile
+
+        from vtkmodules.vtkIOXML import vtkXMLUnstructuredGridReader
+
+        with tempfile.TemporaryDirectory(prefix="tessera-") as tmp:
+            path = os.path.join(tmp, "simplices.vtu")
+            dt.save(path)
+            reader = vtkXMLUnstructuredGridReader()
+            reader.SetFileName(path)
+            reader.Update()
+            return reader.GetOutput()
     out = vtkUnstructuredGrid()
     out.SetPoints(_points(dt.points))
     k = dt.ndim + 1

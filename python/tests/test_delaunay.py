@@ -128,3 +128,55 @@ def test_insertion_method_gives_the_same_simplices():
         assert by_insertion.from_insertion == by_insertion.nsimplex and by_cells.from_insertion == 0
     with pytest.raises(ValueError, match="whole convex hull"):
         tessera.delaunay(random_points(100, 2, seed=1), method="insertion", complete_hull=False)
+
+
+def test_periodic_triangulation_against_scipy():
+    # A sheared 2D box: the simplices, up to a common translation of their
+    # vertices' images, are scipy's (Qhull's) triangles of the points with
+    # their images by a = (Lx, 0), b = (xy, Ly) that have a vertex at shift 0;
+    # each once, counter-clockwise with the shifts applied; a torus has 2N.
+    from scipy.spatial import Delaunay as ScipyDelaunay
+
+    rng = np.random.default_rng(44)
+    lx, ly, xy = 2.0, 1.0, 0.625
+    f = rng.random((400, 2)) * (1 - 2e-6) + 1e-6
+    pts = np.ldexp(np.floor(np.ldexp(np.stack([f[:, 0] * lx + f[:, 1] * xy, f[:, 1] * ly], 1), 30)), -30)
+    dt = tessera.delaunay(pts, bounds=[0, lx, 0, ly], periodic=True, tilt=[xy])
+    assert dt.is_periodic and dt.tilt == (xy,) and dt.nsimplex == 2 * len(pts)
+    lattice = np.array([[lx, 0.0], [xy, ly]])
+    sh = dt.simplex_shifts
+    assert sh.dtype == np.int8 and sh.shape == (dt.nsimplex, 3, 2)
+    corners = dt.periodic_points[dt.simplices] + sh @ lattice
+    e1, e2 = corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]
+    assert np.all(e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0] > 0)
+
+    def canonical(entries):
+        entries = sorted(entries)
+        best = None
+        for p in [e for e in entries if e[0] == entries[0][0]]:
+            t = sorted((i, (s[0] - p[1][0], s[1] - p[1][1])) for i, s in entries)
+            best = t if best is None or t < best else best
+        return tuple(best)
+
+    ours = {canonical([(int(i), tuple(int(x) for x in s)) for i, s in zip(row, shifts)])
+            for row, shifts in zip(dt.simplices, sh)}
+    assert len(ours) == dt.nsimplex
+    shifts = [(i, j) for i in (-2, -1, 0, 1, 2) for j in (-2, -1, 0, 1, 2)]
+    images = np.concatenate([pts + np.array(s) @ lattice for s in shifts])
+    n = len(pts)
+    theirs = set()
+    for row in ScipyDelaunay(images).simplices:
+        if any(shifts[v // n] == (0, 0) for v in row):
+            c = canonical([(int(v % n), shifts[v // n]) for v in row])
+            # Triangles far out in the images are clipped by the hull of the
+            # 5 x 5 copies; those meeting shift 0 are whole.
+            theirs.add(c)
+    assert ours == theirs
+    assert dt.validate()
+    grid = dt.to_vtk()
+    assert grid.GetNumberOfCells() == dt.nsimplex and grid.GetNumberOfPoints() > len(pts)
+    with pytest.raises(ValueError, match="periodic"):
+        dt.neighbors
+    with pytest.raises(ValueError, match="periodic"):
+        dt.transform
+    assert tessera.delaunay(pts).simplex_shifts.shape == (0, 3, 2)
