@@ -82,9 +82,9 @@ struct VoronoiOptions {
   /// spacing of doubles at a few box lengths from the origin, so that every
   /// image is exact (for a unit box 2^-51: each moves by at most 2^-52).
   /// Cells straddle the box's faces where their points lie near them.
-  /// Cells::neighbor_shifts says which image each neighbour is. Delaunay,
-  /// face sets, flowers and surface nets refuse periodic input (the
-  /// adjacency graph takes it).
+  /// Cells::neighbor_shifts says which image each neighbour is. Face sets,
+  /// flowers and surface nets refuse periodic input; the adjacency graph
+  /// takes it, and delaunay() where every axis is periodic.
   std::array<bool, 3> periodic{false, false, false};
   /// Tilt factors of a triclinic (sheared) periodic box, as lengths in
   /// LAMMPS's and Voro++'s convention: {xy, xz, yz}. The box repeats by the
