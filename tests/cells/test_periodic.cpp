@@ -368,12 +368,8 @@ TEST(Periodic, Refused) {
   const auto strip = make_bounds({0, 0, 0}, {1, 300, 0});
   compare_with_oracle(grid_aligned(1000, 2, 42, strip), 2, strip, {true, false, false}, 1, "a short period");
   EXPECT_THROW(run_periodic({0.5, 150}, 2, strip, {true, false, false}), tessera::InputError);
-  // Products other than the cells.
-  tessera::DelaunayOptions dopt;
-  dopt.dim = 3;
-  dopt.bounds = box;
-  dopt.periodic = {true, true, true};
-  EXPECT_THROW(tessera::delaunay(pts, 3, {}, dopt), tessera::InputError);
+  // Face sets (and the Delaunay triangulation of a box with walls:
+  // test_periodic_delaunay.cpp).
   const tessera::Cells c = run_periodic(pts, 3, box, {true, true, true});
   EXPECT_THROW(tessera::extract_faces(c, {}, {}), tessera::InputError);
 }
