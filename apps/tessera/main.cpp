@@ -223,7 +223,7 @@ int main(int argc, char** argv) {
   del->add_option("--simplex-shifts", dla.simplex_shifts,
                   "With --periodic (every axis): which image each vertex of --simplices is, as an int8 .npy array "
                   "of shape (M, D+1, D) in box lengths (lattice vectors with --tilt). Each simplex of the periodic "
-                  "triangulation is listed once, translated so that its lowest id is at shift 0");
+                  "triangulation is listed once, translated so that its least (id, shift) vertex is at shift 0");
   del->add_flag("--no-hull-completion", dla.no_hull_completion,
                 "Keep only the simplices whose circumcentre lies in the domain box (skip closing the triangulation "
                 "up to the convex hull)");

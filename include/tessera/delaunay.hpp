@@ -100,10 +100,10 @@ struct Delaunay {
   /// empty: per row entry, dim shifts of that point's image (n_simplices *
   /// (dim+1) * dim, in box lengths; lattice vectors with tilts). Each
   /// simplex of the periodic triangulation is listed once, translated so
-  /// that its first entry is its lowest id at shift 0 (of those, the
-  /// translation whose (id, shift) row is least); rows ascend by (id,
-  /// shift), but for the orientation's swap, and are positively oriented
-  /// with the shifts applied (Cells::periodic_points + shift . lattice).
+  /// that its least (id, shift) entry, its first, is at shift 0; rows
+  /// ascend by (id, shift) entries, but for the orientation's swap, and are
+  /// positively oriented with the shifts applied (Cells::periodic_points +
+  /// shift . lattice).
   Buffer<std::int8_t> simplex_shifts;
   std::array<bool, 3> periodic{false, false, false};
   std::array<double, 3> tilt{0, 0, 0};     ///< as rounded (Cells::tilt)

@@ -306,7 +306,7 @@ def delaunay(
     periodic, tilt : as in :func:`tessera.voronoi`, every axis periodic
         The triangulation of the points among all their images (``bounds``
         the box that repeats): each simplex once, translated so that its
-        lowest id is at shift 0, and :attr:`Delaunay.simplex_shifts` the
+        least (id, shift) vertex is at shift 0, and :attr:`Delaunay.simplex_shifts` the
         image of each of its vertices. No hull, so ``complete_hull`` and
         ``method`` do not apply; what matches facets by ids alone
         (``neighbors``, ``vertex_neighbor_vertices``, ``find_simplex``,

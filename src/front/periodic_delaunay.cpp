@@ -5,8 +5,10 @@
 // triangulation, with its vertices' images (Cells::vertex_key_shifts), and
 // every simplex is one: translated so that one of its vertices is a point
 // at shift 0, it is a vertex of that point's cell. The same simplex seen
-// from its other vertices' cells differs by a common shift; a canonical
-// translation (below) makes the copies equal, and sorting drops them.
+// from its other vertices' cells differs by a common shift. Its canonical
+// translate puts its least (id, shift) entry at shift 0 (lexicographic
+// order of shifts is kept by translation, so this is well defined): that
+// merged vertex stands for it.
 //
 // Orientation: in the frame of the cell it came from, the simplex's
 // vertices are the augmented input's exact images, so the exact orientation
@@ -41,13 +43,6 @@ struct Entry {
   auto operator<=>(const Entry&) const = default;
 };
 
-/// A simplex as its canonical entries (ascending) and, for the
-/// orientation, the entries as its cell saw them in the same order.
-struct Row {
-  std::array<Entry, 4> canonical;
-  std::array<Entry, 4> seen;
-};
-
 }  // namespace
 
 Delaunay periodic_delaunay(std::span<const double> input, int dim, std::span<const std::int32_t> labels,
@@ -75,47 +70,40 @@ Delaunay periodic_delaunay(std::span<const double> input, int dim, std::span<con
     }
   };
 
-  std::vector<Row> rows(nv);
+  // Entry k of merged vertex v.
+  auto entry = [&](std::size_t v, std::size_t k) {
+    Entry e{c.vertex_keys[v * w + k], {0, 0, 0}};
+    for (std::size_t a = 0; a < du; ++a) e.shift[a] = c.vertex_key_shifts[(v * w + k) * du + a];
+    return e;
+  };
+  // A key ascends by (id, shift), so the canonical translate is the one
+  // whose first entry has shift 0: that merged vertex, of that point's own
+  // cell, stands for the simplex (every translate is a distinct augmented
+  // key, merged once), and the others are dropped without a sort.
+  std::vector<std::uint8_t> canonical(nv);
   engine::ThreadArena arena(c.threads_used);
   arena.execute([&] {
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nv, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nv, 16384), [&](const tbb::blocked_range<std::size_t>& r) {
       for (std::size_t v = r.begin(); v != r.end(); ++v) {
-        std::array<Entry, 4> seen{};
-        for (std::size_t k = 0; k < w; ++k) {
-          seen[k].id = c.vertex_keys[v * w + k];
-          seen[k].shift = {0, 0, 0};
-          for (std::size_t a = 0; a < du; ++a) seen[k].shift[a] = c.vertex_key_shifts[(v * w + k) * du + a];
-        }
-        // Canonical translation: one of the lowest id's entries moved to
-        // shift 0, the one that makes the ascending row least (several only
-        // where a box a few cells wide has a point meet its own image).
-        Row best{};
-        bool have = false;
-        for (std::size_t p = 0; p < w && seen[p].id == seen[0].id; ++p) {
-          std::array<std::pair<Entry, std::size_t>, 4> moved{};
-          for (std::size_t k = 0; k < w; ++k) {
-            moved[k].first.id = seen[k].id;
-            for (std::size_t a = 0; a < 3; ++a) moved[k].first.shift[a] = seen[k].shift[a] - seen[p].shift[a];
-            moved[k].second = k;
-          }
-          std::sort(moved.begin(), moved.begin() + static_cast<std::ptrdiff_t>(w));
-          Row row{};
-          for (std::size_t k = 0; k < w; ++k) {
-            row.canonical[k] = moved[k].first;
-            row.seen[k] = seen[moved[k].second];
-          }
-          if (!have || row.canonical < best.canonical) best = row;
-          have = true;
-        }
-        rows[v] = best;
+        bool zero = true;
+        for (std::size_t a = 0; a < du; ++a) zero &= c.vertex_key_shifts[v * w * du + a] == 0;
+        canonical[v] = zero;
       }
     });
-    tbb::parallel_sort(rows.begin(), rows.end(),
-                       [](const Row& x, const Row& y) { return x.canonical < y.canonical; });
   });
-  rows.erase(std::unique(rows.begin(), rows.end(),
-                         [](const Row& x, const Row& y) { return x.canonical == y.canonical; }),
-             rows.end());
+  std::vector<std::uint32_t> rows;
+  rows.reserve(nv / 4 + 16);
+  for (std::size_t v = 0; v < nv; ++v)
+    if (canonical[v]) rows.push_back(static_cast<std::uint32_t>(v));
+  // In ascending order of their (id, shift) entries.
+  auto key_less = [&](std::uint32_t x, std::uint32_t y) {
+    for (std::size_t k = 0; k < w; ++k) {
+      const Entry ex = entry(x, k), ey = entry(y, k);
+      if (ex != ey) return ex < ey;
+    }
+    return false;
+  };
+  arena.execute([&] { tbb::parallel_sort(rows.begin(), rows.end(), key_less); });
 
   Delaunay dt;
   dt.dim = dim;
@@ -135,24 +123,18 @@ Delaunay periodic_delaunay(std::span<const double> input, int dim, std::span<con
   arena.execute([&] {
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, ns, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
       for (std::size_t s = r.begin(); s != r.end(); ++s) {
-        Row& row = rows[s];
+        std::array<Entry, 4> row{};
         double xyz[4][3];
         const double* pts[4];
         for (std::size_t k = 0; k < w; ++k) {
-          place(row.seen[k], xyz[k]);
+          row[k] = entry(rows[s], k);
+          place(row[k], xyz[k]);
           pts[k] = xyz[k];
         }
-        if (kernels::orientation(dim, pts) < 0) std::swap(row.canonical[w - 2], row.canonical[w - 1]);
+        if (kernels::orientation(dim, pts) < 0) std::swap(row[w - 2], row[w - 1]);
         for (std::size_t k = 0; k < w; ++k) {
-          dt.simplices[s * w + k] = row.canonical[k].id;
-          for (std::size_t a = 0; a < du; ++a) {
-            const int x = row.canonical[k].shift[a];
-            // Shifts within a simplex differ by a few at most; int8 holds
-            // them unless a cell reached past ~60 periods (then refused).
-            if (x < -127 || x > 127)
-              throw InputError("periodic Delaunay: a simplex spans more than 127 box lengths");
-            dt.simplex_shifts[(s * w + k) * du + a] = static_cast<std::int8_t>(x);
-          }
+          dt.simplices[s * w + k] = row[k].id;
+          for (std::size_t a = 0; a < du; ++a) dt.simplex_shifts[(s * w + k) * du + a] = static_cast<std::int8_t>(row[k].shift[a]);
         }
       }
     });
@@ -214,8 +196,8 @@ DelaunayReport validate_periodic(const Delaunay& dt) {
     perm_sum += std::fabs(det) / fact;
   }
 
-  // Facets: each, translated canonically (its lowest entry at shift 0, the
-  // least such row), in exactly two simplices, whose apexes lie on opposite
+  // Facets: each, translated canonically (its least (id, shift) entry at
+  // shift 0), in exactly two simplices, whose apexes lie on opposite
   // sides and neither in the other's circumsphere (perturbed as the cells
   // were: by (id, shift) order).
   struct Facet {
@@ -234,17 +216,10 @@ DelaunayReport validate_periodic(const Delaunay& dt) {
       for (std::size_t j = 0, c = 0; j < w; ++j)
         if (j != k) f[c++] = entry(s, j);
       std::sort(f.begin(), f.begin() + static_cast<std::ptrdiff_t>(du));
-      Facet best{};
-      bool have = false;
-      for (std::size_t p = 0; p < du && f[p].id == f[0].id; ++p) {
-        Facet g{f, f[p].shift, s, k};
-        for (std::size_t c = 0; c < du; ++c)
-          for (std::size_t a = 0; a < 3; ++a) g.key[c].shift[a] = f[c].shift[a] - f[p].shift[a];
-        std::sort(g.key.begin(), g.key.begin() + static_cast<std::ptrdiff_t>(du));
-        if (!have || g.key < best.key) best = g;
-        have = true;
-      }
-      facets.push_back(best);
+      Facet g{f, f[0].shift, s, k};
+      for (std::size_t c = 0; c < du; ++c)
+        for (std::size_t a = 0; a < 3; ++a) g.key[c].shift[a] = f[c].shift[a] - f[0].shift[a];
+      facets.push_back(g);
     }
   std::sort(facets.begin(), facets.end());
   for (std::size_t i = 0; i < facets.size();) {

@@ -41,19 +41,13 @@ using P3DT = CGAL::Periodic_3_Delaunay_triangulation_3<Gt, Tds>;
 using Entry = std::pair<std::int32_t, std::array<int, 3>>;
 using Simplex = std::vector<Entry>;
 
-/// A simplex up to translation: of the translations that put its lowest id
-/// at shift 0, the one whose ascending entries are least.
+/// A simplex up to translation: its least (id, shift) entry moved to shift 0.
 Simplex canonical(Simplex s) {
   std::sort(s.begin(), s.end());
-  Simplex best;
-  for (std::size_t p = 0; p < s.size() && s[p].first == s[0].first; ++p) {
-    Simplex t = s;
-    for (auto& [id, sh] : t)
-      for (int a = 0; a < 3; ++a) sh[static_cast<std::size_t>(a)] -= s[p].second[static_cast<std::size_t>(a)];
-    std::sort(t.begin(), t.end());
-    if (best.empty() || t < best) best = t;
-  }
-  return best;
+  const std::array<int, 3> first = s[0].second;
+  for (auto& [id, sh] : s)
+    for (std::size_t a = 0; a < 3; ++a) sh[a] -= first[a];
+  return s;
 }
 
 std::set<Simplex> ours(const tessera::Delaunay& dt) {
