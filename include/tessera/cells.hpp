@@ -45,6 +45,19 @@ inline std::array<std::array<double, 3>, 3> periodic_lattice(const Bounds& box, 
   return {{{box.hi[0] - box.lo[0], 0, 0}, {tilt[0], box.hi[1] - box.lo[1], 0}, {tilt[1], tilt[2], box.hi[2] - box.lo[2]}}};
 }
 
+/// out = p + sum_b shift[b] lattice[b] (dim coordinates): p's image moved by
+/// `shift` lattice vectors. Exact for a periodic computation's points and
+/// shifts (its grid makes every term and partial sum a double).
+template <class Shift>
+inline void periodic_image(const std::array<std::array<double, 3>, 3>& lattice, int dim, const double* p,
+                           const Shift& shift, double* out) {
+  for (int a = 0; a < dim; ++a) {
+    double x = p[a];
+    for (int b = a; b < dim; ++b) x += shift[b] * lattice[static_cast<std::size_t>(b)][static_cast<std::size_t>(a)];
+    out[a] = x;
+  }
+}
+
 /// How a cell finds the points that clip it (tessera::voronoi).
 enum class CellMethod {
   /// The search, unless a pilot of a few hundred cells finds them far

@@ -335,10 +335,7 @@ PeriodicImages periodic_images(const PeriodicInput& in, std::span<const std::int
       for (s[1] = first[1]; s[1] <= last[1]; ++s[1])
         for (s[2] = first[2]; s[2] <= last[2]; ++s[2]) {
           double y[3] = {0, 0, 0};
-          for (std::size_t a = 0; a < du; ++a) {
-            y[a] = p[a];  // each term a multiple of the grid within its range: exact
-            for (std::size_t b = a; b < du; ++b) y[a] += s[b] * in.lattice[b][a];
-          }
+          periodic_image(in.lattice, dim, p, s, y);  // exact: every term on the grid, within its range
           f(s, y);
         }
   };

@@ -63,11 +63,7 @@ Delaunay periodic_delaunay(std::span<const double> input, int dim, std::span<con
   const auto lattice = c.lattice();
   // The exact image of entry e (the coordinates the augmented pass used).
   auto place = [&](const Entry& e, double* out) {
-    for (std::size_t a = 0; a < du; ++a) {
-      double x = c.periodic_points[static_cast<std::size_t>(e.id) * du + a];
-      for (std::size_t b = a; b < du; ++b) x += e.shift[b] * lattice[b][a];
-      out[a] = x;
-    }
+    periodic_image(lattice, dim, &c.periodic_points[static_cast<std::size_t>(e.id) * du], e.shift, out);
   };
 
   // Entry k of merged vertex v.
@@ -157,11 +153,7 @@ DelaunayReport validate_periodic(const Delaunay& dt) {
     return e;
   };
   auto place = [&](const Entry& e, double* out) {
-    for (std::size_t a = 0; a < du; ++a) {
-      double x = dt.periodic_points[static_cast<std::size_t>(e.id) * du + a];
-      for (std::size_t b = a; b < du; ++b) x += e.shift[b] * lattice[b][a];
-      out[a] = x;
-    }
+    periodic_image(lattice, D, &dt.periodic_points[static_cast<std::size_t>(e.id) * du], e.shift, out);
   };
   // Exact orientation of D+1 entries (images placed exactly: the grid).
   auto orient = [&](const std::array<Entry, 4>& e) {
@@ -215,7 +207,8 @@ DelaunayReport validate_periodic(const Delaunay& dt) {
       std::array<Entry, 3> f{};
       for (std::size_t j = 0, c = 0; j < w; ++j)
         if (j != k) f[c++] = entry(s, j);
-      std::sort(f.begin(), f.begin() + static_cast<std::ptrdiff_t>(du));
+      for (std::size_t x = 1; x < du; ++x)  // ascending (insertion: at most 3)
+        for (std::size_t y = x; y > 0 && f[y] < f[y - 1]; --y) std::swap(f[y], f[y - 1]);
       Facet g{f, f[0].shift, s, k};
       for (std::size_t c = 0; c < du; ++c)
         for (std::size_t a = 0; a < 3; ++a) g.key[c].shift[a] = f[c].shift[a] - f[0].shift[a];

@@ -67,11 +67,9 @@ void write_graph_vtp(const std::string& path, const AdjacencyGraph& g, std::span
       const std::int8_t* s = &edges.shift[e * du];
       if (std::all_of(s, s + du, [](std::int8_t x) { return x == 0; })) continue;
       const auto j = static_cast<std::size_t>(ends[2 * e + 1]);
-      for (std::size_t a = 0; a < du; ++a) {
-        double x = points[j * du + a];
-        for (std::size_t b = a; b < du; ++b) x += s[b] * g.lattice[b][a];
-        all_points.push_back(x);
-      }
+      double x[3];
+      periodic_image(g.lattice, g.dim, &points[j * du], s, x);
+      all_points.insert(all_points.end(), x, x + du);
       ends[2 * e + 1] = static_cast<std::int32_t>(point_id.size());
       point_id.push_back(static_cast<std::int32_t>(j));
       region.push_back(region[j]);

@@ -140,11 +140,9 @@ Unrolled unroll(const Delaunay& dt) {
     }
     const auto [it, fresh] = images.try_emplace({id, s}, static_cast<std::int32_t>(u.point_id.size()));
     if (fresh) {
-      for (std::size_t a = 0; a < du; ++a) {
-        double x = dt.periodic_points[static_cast<std::size_t>(id) * du + a];
-        for (std::size_t b = a; b < du; ++b) x += s[b] * lattice[b][a];
-        u.points.push_back(x);
-      }
+      double x[3];
+      periodic_image(lattice, dt.dim, &dt.periodic_points[static_cast<std::size_t>(id) * du], s, x);
+      u.points.insert(u.points.end(), x, x + du);
       u.point_id.push_back(id);
     }
     u.dt.simplices[e] = it->second;
