@@ -179,6 +179,8 @@ int run_delaunay(const DelaunayArgs& a) {
 int run_bench_delaunay(const BenchArgs& a) {
   check_bounds_arg(a.compute.bounds);
   if (a.repeat < 1) throw InputError("--repeat must be at least 1");
+  if (!a.compute.periodic.empty() && (a.skip_cells >= 0 || a.method != "auto"))
+    throw InputError("--periodic: a periodic triangulation has no hull (--skip-cells and --method do not apply)");
   const io::PointCloud pc = read_input(a.compute);
   DelaunayOptions opt = delaunay_options(a.compute, pc.dim, true);
   opt.skip_cells = a.skip_cells;

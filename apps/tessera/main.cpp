@@ -349,6 +349,7 @@ int main(int argc, char** argv) {
       "{\"tool\":\"tessera\",\"op\":\"delaunay3\"|\"delaunay2\",\"n\",\"threads\",\"seconds\",\"simplices\","
       "\"extra\":{cpu_user_s,cpu_sys_s,minflt,peak_rss_bytes,from_cells,from_hull_completion,from_insertion,skipped_cells,exact_calls,repeat}}");
   add_compute_options(bench_del, bda.compute, bench_del_bounds);
+  add_periodic_option(bench_del, bda.compute);
   bench_del->add_option("--repeat", bda.repeat, "Number of timed runs")
       ->check(Positive)
       ->capture_default_str();

@@ -1052,6 +1052,12 @@ class Periodic(TempDirCase):
         j = json.loads(r.stdout.splitlines()[0])
         self.assertEqual(j["simplices"], 2000)
         self.assertAlmostEqual(j["extra"]["volume_sum"], 1.0, delta=1e-12)
+        # The periodic triangulation: as many simplices as delaunay writes.
+        r = self.ok(["bench", "delaunay", inp, "--bounds"] + BOX3 + ["--periodic", "xyz", "--tilt", "0.25", "0", "0"])
+        simp = self.p("s.npy")
+        self.ok(["delaunay", inp, "--bounds"] + BOX3 + ["--periodic", "xyz", "--tilt", "0.25", "0", "0",
+                                                       "--simplices", simp, "-q"])
+        self.assertEqual(json.loads(r.stdout.splitlines()[0])["simplices"], len(np.load(simp)))
 
 
 class Help(unittest.TestCase):
