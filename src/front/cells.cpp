@@ -216,36 +216,17 @@ template <class CellT>
 Cells run_periodic(std::span<const double> input, int dim, std::span<const std::int32_t> labels,
                    const VoronoiOptions& opt) {
   const front::PeriodicInput in = front::periodic_input(input, dim, labels, opt);
-  std::array<double, 3> width = front::initial_image_reach(in);
   const int threads = resolve_threads(opt.threads);
   VoronoiOptions o = opt;
   o.periodic = {false, false, false};
+  o.tilt = {0, 0, 0};
   o.ignore_outside_points = false;  // set aside already; every image lies in the layer
-  for (int round = 0;; ++round) {
-    const front::PeriodicImages im = front::periodic_images(in, labels, width, threads);
-    o.bounds = im.domain;
-    std::vector<double> reach(im.base.size(), 0.0);
-    Cells aug = run<CellT>(im.points, im.labels, o, &reach);
-    const std::array<double, 3> need = front::needed_image_reach(in, im, aug, reach);
-    bool enough = true;
-    for (std::size_t a = 0; a < 3; ++a) {
-      if (!in.periodic[a] || need[a] <= width[a]) continue;
-      if (width[a] >= in.reach_cap[a]) {
-        // At the a-priori bound every cell is final; held below it, some
-        // cell reaches farther than the images go.
-        if (in.reach_clamped[a])
-          throw InputError(std::string("periodic along ") + "xyz"[a] + ": some cell reaches past " +
-                           std::to_string(front::max_periodic_shift) +
-                           " box lengths (a few points in a box far longer along its walls than its period)");
-        continue;
-      }
-      enough = false;
-      width[a] = std::min(need[a] * 1.0625, in.reach_cap[a]);
-    }
-    if (enough) return front::periodic_cells(std::move(aug), in, im, labels, threads);
-    if (round == 2)  // the second layer covers what the first one's cells asked for
-      throw std::logic_error("tessera: periodic cells still reach past their images' layer after widening it");
-  }
+  auto [aug, im] = front::run_in_final_layer(in, labels, threads, [&](const front::PeriodicImages& images,
+                                                                      std::vector<double>& reach) {
+    o.bounds = images.domain;
+    return run<CellT>(images.points, images.labels, o, &reach);
+  });
+  return front::periodic_cells(std::move(aug), in, im, labels, threads);
 }
 
 }  // namespace

@@ -609,6 +609,34 @@ bool inside_reaches_out(std::span<const double> points, int dim, std::span<const
   return false;
 }
 
+/// delaunay_of_images (front/periodic.hpp): the cells pass alone, its
+/// compositor given no labels so that images (label < 0, no cell of their
+/// own) may be vertices; no hull, no skipped cells.
+template <class CellT>
+Delaunay images_pass(std::span<const double> points, std::span<const std::int32_t> labels,
+                     const VoronoiOptions& opt, std::vector<double>& reach) {
+  constexpr int D = CellT::dim;
+  const std::size_t n = points.size() / D;
+  front::Pass<D> pass(points, labels, opt);
+  Delaunay out;
+  out.dim = D;
+  out.n_points = n;
+  out.bounds = pass.user_bounds;
+  out.threads_used = pass.engine_options.threads;
+  front::DelaunayPassResult<D> found;
+  front::DelaunayCompositor<CellT> comp(found, n, {}, false);
+  comp.record_reach(&reach);
+  out.exact_predicate_calls = engine::tessellate<CellT>(pass.gens, comp, pass.engine_options);
+  out.from_cells = found.found;
+  out.duplicates = std::move(found.duplicates);
+  front::report_duplicates(pass, labels, out.duplicates);
+  std::sort(out.duplicates.begin(), out.duplicates.end());
+  const std::vector<std::array<std::int32_t, D + 1>> none;
+  engine::ThreadArena(pass.engine_options.threads).execute([&] { comp.write(none, out.simplices); });
+  for (double& r : reach) r = pass.unscale(std::sqrt(r));
+  return out;
+}
+
 }  // namespace
 
 Delaunay delaunay(std::span<const double> input, int dim, std::span<const std::int32_t> labels,
@@ -653,6 +681,16 @@ Delaunay delaunay(std::span<const double> input, int dim, std::span<const std::i
   }
   return dim == 3 ? run<kernels::Hull>(points, labels, options) : run<kernels::Tile>(points, labels, options);
 }
+
+namespace front {
+
+Delaunay delaunay_of_images(std::span<const double> points, int dim, std::span<const std::int32_t> labels,
+                            const VoronoiOptions& options, std::vector<double>& reach) {
+  return dim == 3 ? images_pass<kernels::Hull>(points, labels, options, reach)
+                  : images_pass<kernels::Tile>(points, labels, options, reach);
+}
+
+}  // namespace front
 
 std::vector<std::int32_t> simplex_neighbors(const Delaunay& dt) {
   front::refuse_periodic(dt, "simplex_neighbors");

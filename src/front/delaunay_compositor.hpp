@@ -113,9 +113,16 @@ class DelaunayCompositor {
     }
   }
 
+  /// Record each built cell's squared security radius at its generator's
+  /// index (sized for every point), as CellsCompositor::record_reach: the
+  /// periodic triangulation checks its images' layer by it.
+  void record_reach(std::vector<double>* reach) { reach_ = reach; }
+
   void add(Batch& b, std::int32_t gen, const kernels::BuildStatus& st, CellT& cell) {
     b.gen.push_back(gen);
     b.dup_of.push_back(st.has_cell ? -1 : st.duplicate_of);
+    if (st.has_cell && reach_ != nullptr) [[unlikely]]
+      (*reach_)[static_cast<std::size_t>(gen)] = cell.security_radius2();
     if (st.has_cell) {
       const auto& verts = cell.vertices();
       const auto& planes = cell.planes();
@@ -434,6 +441,7 @@ class DelaunayCompositor {
   std::vector<Kept> kept_;
   std::size_t n_;
   std::span<const std::int32_t> labels_;
+  std::vector<double>* reach_ = nullptr;  // record_reach
   bool hull_info_;
   std::span<const std::uint8_t> skipped_;
   std::vector<std::uint64_t> skipped_bits_;  // skipped_ as bits

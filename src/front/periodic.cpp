@@ -394,13 +394,13 @@ std::array<double, 3> initial_image_reach(const PeriodicInput& in) {
   return width;
 }
 
-std::array<double, 3> needed_image_reach(const PeriodicInput& in, const PeriodicImages& im, const Cells& cells,
+std::array<double, 3> needed_image_reach(const PeriodicInput& in, const PeriodicImages& im,
                                          std::span<const double> reach) {
   const auto du = static_cast<std::size_t>(in.dim);
   std::array<double, 3> need{0, 0, 0};
-  for (std::size_t c = 0; c < cells.n_cells(); ++c) {
-    const auto g = static_cast<std::size_t>(cells.generator[c]);
+  for (std::size_t g = 0; g < reach.size(); ++g) {
     const double r = reach[g];
+    if (r == 0) continue;  // no cell (an image, a duplicate); NaN (unbounded) goes on
     const double* p = im.points.data() + g * du;
     double f[3] = {0, 0, 0};
     if (in.sheared) fractional(in, p, f);

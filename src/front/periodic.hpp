@@ -39,6 +39,9 @@
 #include <array>
 #include <cstdint>
 #include <span>
+#include <stdexcept>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include "tessera/cells.hpp"
@@ -122,17 +125,59 @@ std::array<double, 3> initial_image_reach(const PeriodicInput& in);
 /// from `reach` (per augmented point: the cell's security radius, 0 without
 /// a cell). A computation whose widths are at least these, or at an
 /// unclamped reach_cap, is final.
-std::array<double, 3> needed_image_reach(const PeriodicInput& in, const PeriodicImages& im, const Cells& cells,
+std::array<double, 3> needed_image_reach(const PeriodicInput& in, const PeriodicImages& im,
                                          std::span<const double> reach);
+
+/// Runs `run(images, reach)`, a pass over the augmented input that records
+/// each built cell's security radius (input units) in `reach` (sized for the
+/// augmented points, zeros), on a layer of images that starts at
+/// initial_image_reach and is widened once to what the cells asked for
+/// (which suffices: more images never grow a cell). Returns {its result,
+/// the images}. InputError where a cell reaches past 127 periods.
+template <class Run>
+auto run_in_final_layer(const PeriodicInput& in, std::span<const std::int32_t> labels, int threads, Run&& run) {
+  std::array<double, 3> width = initial_image_reach(in);
+  for (int round = 0;; ++round) {
+    PeriodicImages im = periodic_images(in, labels, width, threads);
+    std::vector<double> reach(im.base.size(), 0.0);
+    auto result = run(im, reach);
+    const std::array<double, 3> need = needed_image_reach(in, im, reach);
+    bool enough = true;
+    for (std::size_t a = 0; a < 3; ++a) {
+      if (!in.periodic[a] || need[a] <= width[a]) continue;
+      if (width[a] >= in.reach_cap[a]) {
+        // At the a-priori bound every cell is final; held below it, some
+        // cell reaches farther than the images go.
+        if (in.reach_clamped[a])
+          throw InputError(std::string("periodic along ") + "xyz"[a] + ": some cell reaches past " +
+                           std::to_string(max_periodic_shift) +
+                           " box lengths (a few points in a box far longer along its walls than its period)");
+        continue;
+      }
+      enough = false;
+      width[a] = std::min(need[a] * 1.0625, in.reach_cap[a]);
+    }
+    if (enough) return std::pair{std::move(result), std::move(im)};
+    if (round == 2)  // the second layer covers what the first one's cells asked for
+      throw std::logic_error("tessera: periodic cells still reach past their images' layer after widening it");
+  }
+}
 
 /// The cells of the augmented input, as the cells of the input points: ids
 /// and keys mapped back, neighbour shifts, face classes by the user's labels.
 Cells periodic_cells(Cells&& augmented, const PeriodicInput& in, const PeriodicImages& im,
                      std::span<const std::int32_t> labels, int threads);
 
-/// The Delaunay triangulation of a periodic box (every axis periodic):
-/// read off the periodic cells (periodic_delaunay.cpp). Throws InputError for
-/// walls and outside points.
+/// The simplices the cells of an augmented input's points (label >= 0)
+/// find, images (label < 0) among their vertices: each from its lowest id's
+/// cell, oriented, rows ascending (delaunay.cpp). `reach` as for
+/// run_in_final_layer.
+Delaunay delaunay_of_images(std::span<const double> points, int dim, std::span<const std::int32_t> labels,
+                            const VoronoiOptions& options, std::vector<double>& reach);
+
+/// The Delaunay triangulation of a periodic box (every axis periodic), from
+/// the points' cells among their images (periodic_delaunay.cpp). Throws
+/// InputError for walls and outside points.
 Delaunay periodic_delaunay(std::span<const double> points, int dim, std::span<const std::int32_t> labels,
                            const DelaunayOptions& options);
 

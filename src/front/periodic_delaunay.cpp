@@ -1,19 +1,15 @@
 // The Delaunay triangulation of a periodic box (delaunay() with every axis
-// periodic): read off the periodic cells' merged vertices.
+// periodic), and its validation.
 //
-// Every vertex of a point's periodic cell is a simplex of the periodic
-// triangulation, with its vertices' images (Cells::vertex_key_shifts), and
-// every simplex is one: translated so that one of its vertices is a point
-// at shift 0, it is a vertex of that point's cell. The same simplex seen
-// from its other vertices' cells differs by a common shift. Its canonical
-// translate puts its least (id, shift) entry at shift 0 (lexicographic
-// order of shifts is kept by translation, so this is well defined): that
-// merged vertex stands for it.
-//
-// Orientation: in the frame of the cell it came from, the simplex's
-// vertices are the augmented input's exact images, so the exact orientation
-// of those coordinates is its orientation (translation keeps it). It is
-// never zero: three bisectors of a flat simplex would not meet in a vertex.
+// The points' cells among their images (front/periodic.hpp, the same layer
+// of images as the periodic cells) find the simplices: the cells pass's
+// Delaunay compositor emits each vertex of a cell from its lowest id's cell
+// (delaunay_of_images). Every simplex of the periodic triangulation,
+// translated so that its least (id, shift) entry is at shift 0, is such a
+// vertex of that point's cell, and it is its lowest augmented id (the
+// augmented input lists each point's images by shift): each simplex comes
+// exactly once, in that canonical translate, oriented by the cell's exact
+// topology (a flat simplex cannot arise: its bisectors would not meet).
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -53,87 +49,47 @@ Delaunay periodic_delaunay(std::span<const double> input, int dim, std::span<con
                        " is a wall: the triangulation would need its hull there)");
   for (const std::int32_t l : labels)
     if (l < 0) throw InputError("a periodic Delaunay triangulation takes no outside points (labels < 0)");
-  VoronoiOptions vo = options;
-  vo.build_mesh = true;
-  const Cells c = voronoi(input, dim, labels, vo);
-
-  const auto du = static_cast<std::size_t>(dim);
-  const std::size_t w = du + 1;
-  const std::size_t nv = c.n_vertices();
-  const auto lattice = c.lattice();
-  // The exact image of entry e (the coordinates the augmented pass used).
-  auto place = [&](const Entry& e, double* out) {
-    periodic_image(lattice, dim, &c.periodic_points[static_cast<std::size_t>(e.id) * du], e.shift, out);
-  };
-
-  // Entry k of merged vertex v.
-  auto entry = [&](std::size_t v, std::size_t k) {
-    Entry e{c.vertex_keys[v * w + k], {0, 0, 0}};
-    for (std::size_t a = 0; a < du; ++a) e.shift[a] = c.vertex_key_shifts[(v * w + k) * du + a];
-    return e;
-  };
-  // A key ascends by (id, shift), so the canonical translate is the one
-  // whose first entry has shift 0: that merged vertex, of that point's own
-  // cell, stands for the simplex (every translate is a distinct augmented
-  // key, merged once), and the others are dropped without a sort.
-  std::vector<std::uint8_t> canonical(nv);
-  engine::ThreadArena arena(c.threads_used);
-  arena.execute([&] {
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nv, 16384), [&](const tbb::blocked_range<std::size_t>& r) {
-      for (std::size_t v = r.begin(); v != r.end(); ++v) {
-        bool zero = true;
-        for (std::size_t a = 0; a < du; ++a) zero &= c.vertex_key_shifts[v * w * du + a] == 0;
-        canonical[v] = zero;
-      }
-    });
+  const PeriodicInput in = periodic_input(input, dim, labels, options);
+  const int threads = resolve_threads(options.threads);
+  VoronoiOptions o = options;
+  o.periodic = {false, false, false};
+  o.tilt = {0, 0, 0};
+  o.ignore_outside_points = false;  // set aside already; every image lies in the layer
+  auto [aug, im] = run_in_final_layer(in, labels, threads, [&](const PeriodicImages& images, std::vector<double>& reach) {
+    o.bounds = images.domain;
+    return delaunay_of_images(images.points, dim, images.labels, o, reach);
   });
-  std::vector<std::uint32_t> rows;
-  rows.reserve(nv / 4 + 16);
-  for (std::size_t v = 0; v < nv; ++v)
-    if (canonical[v]) rows.push_back(static_cast<std::uint32_t>(v));
-  // In ascending order of their (id, shift) entries.
-  auto key_less = [&](std::uint32_t x, std::uint32_t y) {
-    for (std::size_t k = 0; k < w; ++k) {
-      const Entry ex = entry(x, k), ey = entry(y, k);
-      if (ex != ey) return ex < ey;
-    }
-    return false;
-  };
-  arena.execute([&] { tbb::parallel_sort(rows.begin(), rows.end(), key_less); });
 
+  // Rows in augmented ids, each from its lowest id's cell: a point at shift
+  // 0, the least (id, shift) entry (augmented ids ascend by (point, shift)),
+  // so each simplex comes once, as its canonical translate, ascending but
+  // for the orientation's swap. Mapped to (point, shift) in place.
+  const auto du = static_cast<std::size_t>(dim);
   Delaunay dt;
   dt.dim = dim;
-  dt.n_points = c.n_points;
-  dt.bounds = c.bounds;
-  dt.periodic = c.periodic;
-  dt.tilt = c.tilt;
-  dt.periodic_points = c.periodic_points;
-  dt.duplicates = c.duplicates;
-  dt.ignored_outside_bounds = c.ignored_outside_bounds;
-  dt.exact_predicate_calls = c.exact_predicate_calls;
-  dt.threads_used = c.threads_used;
-  const std::size_t ns = rows.size();
-  dt.simplices.resize(ns * w);
-  dt.simplex_shifts.resize(ns * w * du);
-  dt.from_cells = ns;
-  arena.execute([&] {
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, ns, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
-      for (std::size_t s = r.begin(); s != r.end(); ++s) {
-        std::array<Entry, 4> row{};
-        double xyz[4][3];
-        const double* pts[4];
-        for (std::size_t k = 0; k < w; ++k) {
-          row[k] = entry(rows[s], k);
-          place(row[k], xyz[k]);
-          pts[k] = xyz[k];
-        }
-        if (kernels::orientation(dim, pts) < 0) std::swap(row[w - 2], row[w - 1]);
-        for (std::size_t k = 0; k < w; ++k) {
-          dt.simplices[s * w + k] = row[k].id;
-          for (std::size_t a = 0; a < du; ++a) dt.simplex_shifts[(s * w + k) * du + a] = static_cast<std::int8_t>(row[k].shift[a]);
-        }
-      }
-    });
+  dt.n_points = in.n;
+  dt.bounds = in.box;
+  dt.periodic = in.periodic;
+  dt.tilt = in.tilt;
+  dt.periodic_points = in.points;
+  dt.from_cells = aug.n_simplices();
+  dt.exact_predicate_calls = aug.exact_predicate_calls;
+  dt.threads_used = aug.threads_used;
+  dt.ignored_outside_bounds = in.ignored;
+  for (const auto& [d, owner] : aug.duplicates) dt.duplicates.emplace_back(im.base[static_cast<std::size_t>(d)],
+                                                                            im.base[static_cast<std::size_t>(owner)]);
+  std::sort(dt.duplicates.begin(), dt.duplicates.end());
+  dt.simplices = std::move(aug.simplices);
+  dt.simplex_shifts.resize(dt.simplices.size() * du);
+  engine::ThreadArena(threads).execute([&] {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, dt.simplices.size(), 16384),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+                        for (std::size_t e = r.begin(); e != r.end(); ++e) {
+                          const auto j = static_cast<std::size_t>(dt.simplices[e]);
+                          dt.simplices[e] = im.base[j];
+                          for (std::size_t a = 0; a < du; ++a) dt.simplex_shifts[e * du + a] = im.shift[j * du + a];
+                        }
+                      });
   });
   return dt;
 }
