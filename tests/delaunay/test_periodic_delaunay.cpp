@@ -130,6 +130,36 @@ TEST(PeriodicDelaunay, EqualsCgalsPeriodicTriangulation) {
   expect_valid(dt);
 }
 
+TEST(PeriodicDelaunay, EqualsThePeriodicCellsMergedVertices) {
+  // The cells' merged vertices with their keys' shifts (Cells::
+  // vertex_key_shifts), each simplex taken where its key starts at shift 0:
+  // the same simplices as the triangulation's, which comes from the cells
+  // pass instead (triclinic 3D and 2D).
+  for (int dim : {2, 3}) {
+    SCOPED_TRACE(dim);
+    const auto pts = uniform_points(1500, dim, 75);
+    const auto o = periodic_options(dim, {1, 1.25, dim == 3 ? 0.75 : 0}, {0.25, dim == 3 ? -0.375 : 0, 0});
+    const tessera::Delaunay dt = tessera::delaunay(pts, dim, {}, o);
+    tessera::VoronoiOptions vo = o;
+    vo.build_mesh = true;
+    const tessera::Cells c = tessera::voronoi(pts, dim, {}, vo);
+    const auto du = static_cast<std::size_t>(dim), w = du + 1;
+    ASSERT_EQ(c.vertex_key_shifts.size(), c.vertex_keys.size() * du);
+    std::set<Simplex> from_keys;
+    for (std::size_t v = 0; v < c.n_vertices(); ++v) {
+      Simplex s;
+      for (std::size_t k = 0; k < w; ++k) {
+        std::array<int, 3> sh{0, 0, 0};
+        for (std::size_t a = 0; a < du; ++a) sh[a] = c.vertex_key_shifts[(v * w + k) * du + a];
+        s.push_back({c.vertex_keys[v * w + k], sh});
+      }
+      EXPECT_TRUE(std::is_sorted(s.begin(), s.end())) << "key " << v << " not ascending by (id, shift)";
+      from_keys.insert(canonical(s));
+    }
+    EXPECT_EQ(ours(dt), from_keys);
+  }
+}
+
 TEST(PeriodicDelaunay, TriclinicAnd2DBoxesAreValidTori) {
   {
     const auto pts = uniform_points(3000, 3, 72);
