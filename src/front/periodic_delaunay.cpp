@@ -16,13 +16,11 @@
 #include <cstdio>
 #include <limits>
 #include <stdexcept>
-#include <numeric>
 #include <string>
 #include <vector>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
-#include <tbb/parallel_sort.h>
 
 #include "periodic.hpp"
 #include "tessera/delaunay.hpp"
