@@ -353,11 +353,13 @@ bool report_validation(const Cells& c, const io::PointCloud& pc, bool quiet) {
       std::printf("  %-18s not checked: the domain volume %.17g is outside double's range for %s at this scale\n",
                   "volume sum", r.domain_volume, c.dim == 3 ? "cell volumes" : "cell areas");
     std::printf("  %-18s %zu\n", "asymmetric spokes", r.asymmetric_spokes);
-    if (c.is_periodic())
-      std::printf("  %-18s not checked in a periodic box (keys name points without their images' shifts; "
-                  "nor are the exact measures)\n", "bad vertex degree");
+    if (c.is_periodic() && c.vertex_key_shifts.empty())
+      std::printf("  %-18s not checked without the mesh's key shifts\n", "bad vertex degree");
     else
-      std::printf("  %-18s %zu\n", "bad vertex degree", r.bad_vertex_degree);
+      std::printf("  %-18s %zu%s\n", "bad vertex degree", r.bad_vertex_degree,
+                  c.is_periodic() ? " (by the cells of each key's points at shift 0; exact measures not checked in a "
+                                    "periodic box)"
+                                  : "");
     if (c.dim == 3) std::printf("  %-18s %zu\n", "bad Euler", r.bad_euler);
     if (r.underflowed_volumes)
       std::printf("  %-18s %zu (below the smallest double, reported as 0)\n", "tiny cells", r.underflowed_volumes);

@@ -277,9 +277,9 @@ inline constexpr double measure_tolerance = 0x1p-28;
 /// `points` (n_points x dim, the coordinates the cells were computed from)
 /// enables the exact check of sampled cells' measures; an empty span skips
 /// it. std::invalid_argument where its size is not n_points x dim. Cells of
-/// a periodic box: neighbour entries must pair up with opposite shifts, and
-/// the vertex-degree and exact-measure checks are left out (their keys name
-/// points without the shifts of their images).
+/// a periodic box: neighbour entries must pair up with opposite shifts, a
+/// merged vertex is used by the cells of its key's points at shift 0
+/// (Cells::vertex_key_shifts), and the exact-measure check is left out.
 ValidationReport validate(const Cells& cells, std::span<const std::int32_t> labels,
                           std::span<const double> points = {});
 

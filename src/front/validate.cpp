@@ -238,18 +238,24 @@ ValidationReport validate_in_arena(const Cells& c, std::span<const std::int32_t>
         a.unresolved += b.unresolved;
         return a;
       });
-  // In a periodic box a merged vertex's key names points without the
-  // shifts of their images (Cells::vertex_keys), so neither the users of a
-  // vertex nor its exact position follow from the key: those two checks
-  // are left out there.
-  if (!c.is_periodic()) r.bad_vertex_degree = tbb::parallel_reduce(
+  // In a periodic box a merged vertex is used by the cells of its key's
+  // points at shift 0 (Cells::vertex_key_shifts; the entries at other shifts
+  // are images, whose copies of the vertex are other merged vertices). The
+  // exact measure is left out there: it would place the key's images.
+  const bool shifted = c.is_periodic();
+  const bool degrees = !shifted || c.vertex_key_shifts.size() == c.vertex_keys.size() * Du;
+  if (degrees) r.bad_vertex_degree = tbb::parallel_reduce(
       tbb::blocked_range<std::size_t>(0, nv), std::size_t{0},
       [&](const tbb::blocked_range<std::size_t>& range, std::size_t n) {
         for (std::size_t v = range.begin(); v != range.end(); ++v) {
           std::int32_t expect = 0;
           for (std::size_t d = 0; d <= Du; ++d) {
-            const std::int32_t id = c.vertex_keys[v * (Du + 1) + d];
-            if (id >= 0 && c.cell_of[static_cast<std::size_t>(id)] >= 0) ++expect;
+            const std::size_t e = v * (Du + 1) + d;
+            const std::int32_t id = c.vertex_keys[e];
+            bool here = id >= 0 && c.cell_of[static_cast<std::size_t>(id)] >= 0;
+            if (shifted)
+              for (std::size_t a = 0; a < Du; ++a) here &= c.vertex_key_shifts[e * Du + a] == 0;
+            expect += here;
           }
           n += users[v] != expect;
         }

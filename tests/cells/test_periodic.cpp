@@ -511,6 +511,14 @@ TEST(Triclinic, RandomPointsThreadsAndValidation) {
   const tessera::ValidationReport r = tessera::validate(a, {}, pts);
   EXPECT_TRUE(r.ok) << (r.messages.empty() ? "" : r.messages[0]);
   EXPECT_LT(r.volume_rel_error, 1e-12);
+  // Each merged vertex is used by the cells of its key's points at shift 0
+  // (Cells::vertex_key_shifts): validate counts it, and sees one entry
+  // moved to another image.
+  EXPECT_EQ(r.bad_vertex_degree, 0u);
+  ASSERT_EQ(a.vertex_key_shifts.size(), a.vertex_keys.size() * 3);
+  tessera::Cells moved = a;
+  moved.vertex_key_shifts[0] = static_cast<std::int8_t>(moved.vertex_key_shifts[0] + 1);
+  EXPECT_EQ(tessera::validate(moved, {}, pts).bad_vertex_degree, 1u);
   // The tilts as rounded to x's and y's grids (a few 2^-52 at a few box lengths).
   EXPECT_NEAR(a.tilt[0], 0.3, 0x1p-46);
   EXPECT_NEAR(a.tilt[1], -0.2, 0x1p-46);
