@@ -50,16 +50,22 @@ Simplex canonical(Simplex s) {
   return s;
 }
 
+/// Row r of D+1 (id, shift) entries from parallel arrays of ids and shifts.
+Simplex row_of(const std::int32_t* ids, const std::int8_t* shifts, std::size_t r, std::size_t du) {
+  Simplex x;
+  for (std::size_t k = 0; k <= du; ++k) {
+    std::array<int, 3> sh{0, 0, 0};
+    for (std::size_t a = 0; a < du; ++a) sh[a] = shifts[(r * (du + 1) + k) * du + a];
+    x.push_back({ids[r * (du + 1) + k], sh});
+  }
+  return x;
+}
+
 std::set<Simplex> ours(const tessera::Delaunay& dt) {
-  const auto du = static_cast<std::size_t>(dt.dim), w = du + 1;
+  const auto du = static_cast<std::size_t>(dt.dim);
   std::set<Simplex> out;
   for (std::size_t s = 0; s < dt.n_simplices(); ++s) {
-    Simplex x;
-    for (std::size_t k = 0; k < w; ++k) {
-      std::array<int, 3> sh{0, 0, 0};
-      for (std::size_t a = 0; a < du; ++a) sh[a] = dt.simplex_shifts[(s * w + k) * du + a];
-      x.push_back({dt.simplices[s * w + k], sh});
-    }
+    const Simplex x = row_of(dt.simplices.data(), dt.simplex_shifts.data(), s, du);
     const Simplex c = canonical(x);
     Simplex sorted = x;
     std::sort(sorted.begin(), sorted.end());
@@ -93,17 +99,11 @@ void expect_valid(const tessera::Delaunay& dt) {
 std::size_t edges(const tessera::Delaunay& dt) {
   const auto du = static_cast<std::size_t>(dt.dim), w = du + 1;
   std::set<Simplex> out;
-  for (std::size_t s = 0; s < dt.n_simplices(); ++s)
+  for (std::size_t s = 0; s < dt.n_simplices(); ++s) {
+    const Simplex x = row_of(dt.simplices.data(), dt.simplex_shifts.data(), s, du);
     for (std::size_t i = 0; i < w; ++i)
-      for (std::size_t j = i + 1; j < w; ++j) {
-        Simplex e;
-        for (std::size_t k : {i, j}) {
-          std::array<int, 3> sh{0, 0, 0};
-          for (std::size_t a = 0; a < du; ++a) sh[a] = dt.simplex_shifts[(s * w + k) * du + a];
-          e.push_back({dt.simplices[s * w + k], sh});
-        }
-        out.insert(canonical(e));
-      }
+      for (std::size_t j = i + 1; j < w; ++j) out.insert(canonical({x[i], x[j]}));
+  }
   return out.size();
 }
 
@@ -143,16 +143,11 @@ TEST(PeriodicDelaunay, EqualsThePeriodicCellsMergedVertices) {
     tessera::VoronoiOptions vo = o;
     vo.build_mesh = true;
     const tessera::Cells c = tessera::voronoi(pts, dim, {}, vo);
-    const auto du = static_cast<std::size_t>(dim), w = du + 1;
+    const auto du = static_cast<std::size_t>(dim);
     ASSERT_EQ(c.vertex_key_shifts.size(), c.vertex_keys.size() * du);
     std::set<Simplex> from_keys;
     for (std::size_t v = 0; v < c.n_vertices(); ++v) {
-      Simplex s;
-      for (std::size_t k = 0; k < w; ++k) {
-        std::array<int, 3> sh{0, 0, 0};
-        for (std::size_t a = 0; a < du; ++a) sh[a] = c.vertex_key_shifts[(v * w + k) * du + a];
-        s.push_back({c.vertex_keys[v * w + k], sh});
-      }
+      const Simplex s = row_of(c.vertex_keys.data(), c.vertex_key_shifts.data(), v, du);
       EXPECT_TRUE(std::is_sorted(s.begin(), s.end())) << "key " << v << " not ascending by (id, shift)";
       from_keys.insert(canonical(s));
     }
