@@ -419,17 +419,36 @@ std::array<double, 3> needed_image_reach(const PeriodicInput& in, const Periodic
   return need;
 }
 
+void to_points(const PeriodicImages& im, int dim, std::span<std::int32_t> ids, std::span<std::int8_t> shifts,
+               int threads) {
+  const auto du = static_cast<std::size_t>(dim);
+  engine::ThreadArena(threads).execute([&] {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, ids.size(), 16384), [&](const tbb::blocked_range<std::size_t>& r) {
+      for (std::size_t e = r.begin(); e != r.end(); ++e) {
+        const auto j = static_cast<std::size_t>(ids[e]);
+        ids[e] = im.base[j];
+        for (std::size_t a = 0; a < du; ++a) shifts[e * du + a] = im.shift[j * du + a];
+      }
+    });
+  });
+}
+
+std::vector<std::pair<std::int32_t, std::int32_t>> duplicates_as_points(
+    const PeriodicImages& im, std::span<const std::pair<std::int32_t, std::int32_t>> duplicates) {
+  std::vector<std::pair<std::int32_t, std::int32_t>> out;
+  out.reserve(duplicates.size());
+  for (const auto& [d, owner] : duplicates)
+    out.emplace_back(im.base[static_cast<std::size_t>(d)], im.base[static_cast<std::size_t>(owner)]);
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
 Cells periodic_cells(Cells&& aug, const PeriodicInput& in, const PeriodicImages& im,
                      std::span<const std::int32_t> labels, int threads) {
   const int dim = in.dim;
   const auto du = static_cast<std::size_t>(dim);
   Cells out;
-  out.dim = dim;
-  out.n_points = in.n;
-  out.bounds = in.box;
-  out.periodic = in.periodic;
-  out.tilt = in.tilt;
-  out.periodic_points = in.points;
+  describe_box(in, out);
   out.periodic_images = im.images;
   out.image_reach = im.width;
   auto base = [&](std::int32_t id) { return id < 0 ? id : im.base[static_cast<std::size_t>(id)]; };
@@ -459,13 +478,7 @@ Cells periodic_cells(Cells&& aug, const PeriodicInput& in, const PeriodicImages&
   out.neighbor_offsets = std::move(aug.neighbor_offsets);
   out.neighbors = std::move(aug.neighbors);
   out.neighbor_shifts.resize(out.neighbors.size() * du);
-  // Augmented ids list each point's images together, by shift, so their
-  // ascending order is (point, shift): the order the entries keep.
-  each(out.neighbors.size(), [&](std::size_t e) {
-    const auto j = static_cast<std::size_t>(out.neighbors[e]);
-    out.neighbors[e] = im.base[j];
-    for (std::size_t a = 0; a < du; ++a) out.neighbor_shifts[e * du + a] = im.shift[j * du + a];
-  });
+  to_points(im, dim, out.neighbors, out.neighbor_shifts, threads);  // ascending by (point, shift)
 
   // The mesh: keys and faces by the points' ids; classes by their labels.
   if (!aug.vertex_keys.empty() || !aug.cell_face_offsets.empty()) {
@@ -507,11 +520,7 @@ Cells periodic_cells(Cells&& aug, const PeriodicInput& in, const PeriodicImages&
     });
   }
 
-  // Duplicates among the points (the pass reports generators only, so not
-  // their images' copies; an owner is the lowest id of its group, at shift 0).
-  for (const auto& [d, o] : aug.duplicates) out.duplicates.emplace_back(base(d), base(o));
-  std::sort(out.duplicates.begin(), out.duplicates.end());
-  out.ignored_outside_bounds = in.ignored;
+  out.duplicates = duplicates_as_points(im, aug.duplicates);
   out.exact_predicate_calls = aug.exact_predicate_calls;
   out.far_points = aug.far_points;
   out.threads_used = aug.threads_used;

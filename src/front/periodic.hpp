@@ -36,6 +36,7 @@
 //   an image of i) is the same perturbed configuration.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <span>
@@ -162,6 +163,33 @@ auto run_in_final_layer(const PeriodicInput& in, std::span<const std::int32_t> l
       throw std::logic_error("tessera: periodic cells still reach past their images' layer after widening it");
   }
 }
+
+/// Augmented ids (>= 0) mapped in place to the points they are images of,
+/// each one's dim shifts written to `shifts` (sized ids.size() * dim), on
+/// `threads`. Augmented ids ascend by (point, shift), so ascending ids stay
+/// ascending by (point, shift).
+void to_points(const PeriodicImages& im, int dim, std::span<std::int32_t> ids, std::span<std::int8_t> shifts,
+               int threads);
+
+/// What a periodic result (Cells, Delaunay) says of its box and points: the
+/// dimension, point count, box as rounded, periodic axes, tilts, the points
+/// as wrapped, and those set aside.
+template <class Result>
+void describe_box(const PeriodicInput& in, Result& out) {
+  out.dim = in.dim;
+  out.n_points = in.n;
+  out.bounds = in.box;
+  out.periodic = in.periodic;
+  out.tilt = in.tilt;
+  out.periodic_points = in.points;
+  out.ignored_outside_bounds = in.ignored;
+}
+
+/// A pass's (duplicate, owner) pairs as point ids, sorted. The pass reports
+/// generators only, so not their images' copies; an owner is the lowest id
+/// of its group, at shift 0.
+std::vector<std::pair<std::int32_t, std::int32_t>> duplicates_as_points(
+    const PeriodicImages& im, std::span<const std::pair<std::int32_t, std::int32_t>> duplicates);
 
 /// The cells of the augmented input, as the cells of the input points: ids
 /// and keys mapped back, neighbour shifts, face classes by the user's labels.

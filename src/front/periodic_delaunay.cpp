@@ -19,12 +19,8 @@
 #include <string>
 #include <vector>
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-
 #include "periodic.hpp"
 #include "tessera/delaunay.hpp"
-#include "tessera/engine/thread_arena.hpp"
 #include "tessera/kernels/delaunay_predicates.hpp"
 
 namespace tessera::front {
@@ -64,31 +60,14 @@ Delaunay periodic_delaunay(std::span<const double> input, int dim, std::span<con
   // for the orientation's swap. Mapped to (point, shift) in place.
   const auto du = static_cast<std::size_t>(dim);
   Delaunay dt;
-  dt.dim = dim;
-  dt.n_points = in.n;
-  dt.bounds = in.box;
-  dt.periodic = in.periodic;
-  dt.tilt = in.tilt;
-  dt.periodic_points = in.points;
+  describe_box(in, dt);
   dt.from_cells = aug.n_simplices();
   dt.exact_predicate_calls = aug.exact_predicate_calls;
   dt.threads_used = aug.threads_used;
-  dt.ignored_outside_bounds = in.ignored;
-  for (const auto& [d, owner] : aug.duplicates) dt.duplicates.emplace_back(im.base[static_cast<std::size_t>(d)],
-                                                                            im.base[static_cast<std::size_t>(owner)]);
-  std::sort(dt.duplicates.begin(), dt.duplicates.end());
+  dt.duplicates = duplicates_as_points(im, aug.duplicates);
   dt.simplices = std::move(aug.simplices);
   dt.simplex_shifts.resize(dt.simplices.size() * du);
-  engine::ThreadArena(threads).execute([&] {
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, dt.simplices.size(), 16384),
-                      [&](const tbb::blocked_range<std::size_t>& r) {
-                        for (std::size_t e = r.begin(); e != r.end(); ++e) {
-                          const auto j = static_cast<std::size_t>(dt.simplices[e]);
-                          dt.simplices[e] = im.base[j];
-                          for (std::size_t a = 0; a < du; ++a) dt.simplex_shifts[e * du + a] = im.shift[j * du + a];
-                        }
-                      });
-  });
+  to_points(im, dim, dt.simplices, dt.simplex_shifts, threads);
   return dt;
 }
 
