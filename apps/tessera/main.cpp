@@ -292,13 +292,16 @@ int main(int argc, char** argv) {
   CLI::App* faces = app.add_subcommand(
       "faces", "Voronoi faces (3D polygons, 2D segments), each once, oriented, with BoundaryLabels per face");
   add_compute_options(faces, fa.compute, faces_bounds);
-  faces->add_option("-o,--output", fa.output, "Faces as VTK PolyData (.vtp), cell data BoundaryLabels, Sides, "
-                                              "SpokeClass");
+  faces->add_option("-o,--output", fa.output,
+                    "Faces as VTK PolyData (.vtp), cell data BoundaryLabels, Sides, SpokeClass; with --periodic "
+                    "also SideShift (which image of side 1 the face meets; each face lies where side 0's cell "
+                    "is, so faces fit together across the box's faces by lattice translations)");
   faces->add_option("--kind", fa.kind,
                     "boundary: faces on the box or against outside points; complex: every face once; "
                     "surface-net: faces between different regions")
       ->required();
   faces->add_flag("--capping", fa.capping, "surface-net: also the boundary faces, closing every region");
+  add_periodic_option(faces, fa.compute);
   faces->add_flag("-q,--quiet", fa.quiet, "No summary and no progress bar");
 
   FlowerArgs wa;

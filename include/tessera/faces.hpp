@@ -16,6 +16,15 @@
 // its left (counter-clockwise around side 0's tile), so its right-hand normal
 // (dy, -dx) points into side 1.
 //
+// Periodic boxes (cells computed with VoronoiOptions::periodic). Side 1 of a
+// face between cells is an image of its point (FaceSet::side_shifts), and
+// side 0's cell sits at shift 0: a face's vertices are those of side 0's cell
+// as computed (Cells: one copy of a vertex per frame it is seen from), so a
+// face set is a set of pieces that fit together across the box's faces by
+// lattice translations. Side 0 is chosen by (region label, generator id) as
+// above; a face between a cell and an image of itself is taken from the side
+// whose shift towards the other is lexicographically positive.
+//
 // BoundaryLabels (two per face) are the labels of side 0 and side 1. Side 0
 // always holds a cell's label (>= 0). Side 1 holds the neighbour's label: a
 // cell's region, an outside point's own (negative) label, or
@@ -23,6 +32,7 @@
 // every cell's label is 0.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <optional>
@@ -71,9 +81,21 @@ struct FaceSet {
   std::vector<std::int32_t> sides;            ///< n_faces * 2
   std::vector<std::int32_t> boundary_labels;  ///< n_faces * 2, see the header comment
   std::vector<SpokeClass> face_class;         ///< the spoke from side 0 to side 1
+  /// Periodic cells only, else empty: per face, dim shifts of side 1's image
+  /// (Cells::face_shift of side 0's face: box lengths along each axis, or
+  /// lattice vectors in a triclinic box; zeros for a box plane).
+  std::vector<std::int8_t> side_shifts;       ///< n_faces * dim
+  /// Periodic cells only, else empty: per key entry, dim shifts of that
+  /// point's image (Cells::vertex_key_shifts). Two vertices whose keys agree
+  /// up to a common shift t are copies of one vertex, t lattice vectors apart.
+  std::vector<std::int8_t> vertex_key_shifts;  ///< n_vertices * (dim + 1) * dim
+  /// The periodic axes and the lattice vectors (Cells::periodic, lattice()).
+  std::array<bool, 3> periodic{false, false, false};
+  std::array<std::array<double, 3>, 3> lattice{};
 
   std::size_t n_faces() const { return face_offsets.empty() ? 0 : face_offsets.size() - 1; }
   std::size_t n_vertices() const { return vertex_keys.size() / static_cast<std::size_t>(dim + 1); }
+  bool is_periodic() const { return periodic[0] || periodic[1] || periodic[2]; }
 };
 
 /// Extract a face set from cells computed with VoronoiOptions::build_mesh

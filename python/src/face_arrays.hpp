@@ -47,7 +47,27 @@ void def_face_arrays(py::class_<Class>& cls, Mesh mesh) {
       .def_property_readonly("face_vertices", [of](py::object s) { return view_flat(of(s).face_vertices, s); })
       .def_property_readonly("sides", [of](py::object s) { return view_rows(of(s).sides, 2, s); })
       .def_property_readonly("boundary_labels", [of](py::object s) { return view_rows(of(s).boundary_labels, 2, s); })
-      .def_property_readonly("face_class", [of](py::object s) { return byte_view(of(s).face_class, s); });
+      .def_property_readonly("face_class", [of](py::object s) { return byte_view(of(s).face_class, s); })
+      // Periodic cells only (empty otherwise): int8 (n_faces, D) and (n_vertices, D + 1, D).
+      .def_property_readonly("side_shifts",
+                             [of](py::object s) {
+                               const FaceSet& f = of(s);
+                               return view_rows(f.side_shifts, static_cast<std::size_t>(f.dim), s);
+                             })
+      .def_property_readonly("vertex_key_shifts",
+                             [of](py::object s) {
+                               const FaceSet& f = of(s);
+                               const auto du = static_cast<std::size_t>(f.dim);
+                               const auto nv = static_cast<py::ssize_t>(f.vertex_key_shifts.size() / (du * (du + 1)));
+                               return view(std::span<const std::int8_t>(f.vertex_key_shifts),
+                                           {nv, static_cast<py::ssize_t>(du + 1), static_cast<py::ssize_t>(du)}, s);
+                             })
+      .def_property_readonly("periodic", [mesh](const Class& c) {
+        const FaceSet& f = mesh(c);
+        py::tuple t(static_cast<std::size_t>(f.dim));
+        for (int a = 0; a < f.dim; ++a) t[static_cast<std::size_t>(a)] = f.periodic[static_cast<std::size_t>(a)];
+        return t;
+      });
 }
 
 }  // namespace tessera::python

@@ -8,7 +8,7 @@ first, with the keyword arguments of :func:`tessera.voronoi`).
 from __future__ import annotations
 
 import os
-from typing import Any, Iterator, List, Optional, Sequence, Union
+from typing import Any, Iterator, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
@@ -261,6 +261,15 @@ class FaceSet:
     ``face_vertices[face_offsets[f]:face_offsets[f+1]]`` (ids into
     :attr:`vertices`, the used merged vertices of the cells in ascending order
     of their id there). Arrays are read-only views of the compiled result.
+
+    Of periodic cells (``voronoi(..., periodic=..., merge=True)``), side 1 of
+    a face between cells is an image of its point (:attr:`side_shifts`), and
+    each face lies where side 0's cell is: the faces are pieces that fit
+    together across the box's faces by lattice translations. A vertex is
+    listed once per frame it is seen from; :attr:`vertex_key_shifts` tells
+    which copies are one vertex (keys equal up to a common shift). A face
+    between a cell and an image of itself is taken from the side whose shift
+    is lexicographically positive.
     """
 
     def __init__(self, fs: Any, vor: Optional[Voronoi], capping: bool, background_label: int):
@@ -336,6 +345,24 @@ class FaceSet:
         """uint8 (n_faces,): the class of the spoke from side 0 to side 1
         (SAME_REGION, REGION_BOUNDARY, DOMAIN_BOUNDARY or OUTSIDE)."""
         return self._fs.face_class
+
+    @property
+    def periodic(self) -> Tuple[bool, ...]:
+        """The periodic axes of the cells (all False for an ordinary box)."""
+        return self._fs.periodic
+
+    @property
+    def side_shifts(self) -> np.ndarray:
+        """int8 (n_faces, D), periodic cells only (empty otherwise): which
+        image of side 1 each face meets, in box lengths (lattice vectors in a
+        triclinic box); zeros for a box plane."""
+        return self._fs.side_shifts
+
+    @property
+    def vertex_key_shifts(self) -> np.ndarray:
+        """int8 (n_vertices, D+1, D), periodic cells only (empty otherwise):
+        per entry of :attr:`vertex_keys`, the shift of that point's image."""
+        return self._fs.vertex_key_shifts
 
     def face(self, f: int) -> np.ndarray:
         """Vertex ids of face ``f`` (a view)."""

@@ -146,7 +146,8 @@ def _line_offsets(n: int, k: int = 2) -> np.ndarray:
 
 def faces_to_vtk(fs: Any) -> Any:
     """vtkPolyData of a face set (polygons in 3D, lines in 2D) or surface net,
-    with the cell data of the C++ writer (BoundaryLabels, Sides, SpokeClass)."""
+    with the cell data of the C++ writer (BoundaryLabels, Sides, SpokeClass,
+    and SideShift for periodic cells)."""
     out = vtkPolyData()
     out.SetPoints(_points(fs.vertices))
     cells = _cell_array(fs.face_offsets, fs.face_vertices)
@@ -158,6 +159,8 @@ def faces_to_vtk(fs: Any) -> Any:
     _add_data(cd, "BoundaryLabels", fs.boundary_labels)
     _add_data(cd, "Sides", fs.sides)
     _add_data(cd, "SpokeClass", fs.face_class)
+    if fs.side_shifts.size:  # periodic cells: which image of side 1 (int32, as the C++ writer)
+        _add_data(cd, "SideShift", fs.side_shifts.astype(np.int32))
     return out
 
 

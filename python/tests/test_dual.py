@@ -278,6 +278,44 @@ def test_faces_vtp_read_by_vtk(tmp_path):
         assert np.array_equal(cell_data(mem, name), cell_data(data, name))
 
 
+@pytest.mark.parametrize("dim", [2, 3])
+def test_faces_of_periodic_cells(tmp_path, dim):
+    # A periodic box (triclinic in 3D): the complex lists each face once,
+    # and with its twin each neighbour entry (j, s) of the cells; every
+    # corner lies on the bisector of side 0's point and side 1's image;
+    # the .vtp and to_vtk carry SideShift.
+    pts = random_points(300, dim, seed=14)
+    tilt = (0.25, 0.0, -0.125) if dim == 3 else (0.375,)
+    v = tessera.voronoi(pts, bounds=UNIT_BOX[dim], periodic=True, tilt=tilt, merge=True)
+    fs = tessera.faces(v, kind="complex")
+    assert fs.periodic == (True,) * dim and fs.side_shifts.shape == (fs.n_faces, dim)
+    assert fs.vertex_key_shifts.shape == (fs.n_vertices, dim + 1, dim)
+    faces = set()
+    for (i, j), s in zip(fs.sides.tolist(), fs.side_shifts.tolist()):
+        faces |= {(i, j, tuple(s)), (j, i, tuple(-x for x in s))}
+    entries = set()
+    for c in range(v.n_cells):
+        for e in range(v.neighbor_offsets[c], v.neighbor_offsets[c + 1]):
+            entries.add((int(v.generators[c]), int(v.neighbors[e]), tuple(v.neighbor_shifts[e].tolist())))
+    assert faces == entries and 2 * fs.n_faces == len(v.neighbors)
+    lattice = np.eye(dim)
+    lattice[1, 0] = v.tilt[0]
+    if dim == 3:
+        lattice[2, :2] = v.tilt[1:]
+    p = v.periodic_points
+    for f in range(fs.n_faces):
+        i, j = fs.sides[f]
+        image = p[j] + fs.side_shifts[f] @ lattice
+        x = fs.vertices[fs.face(f)]
+        np.testing.assert_allclose(np.linalg.norm(x - p[i], axis=1), np.linalg.norm(x - image, axis=1), atol=1e-12)
+    fs.save(str(tmp_path / "faces.vtp"))
+    data = read_vtp(tmp_path / "faces.vtp")
+    assert np.array_equal(cell_data(data, "SideShift"), fs.side_shifts)
+    assert np.array_equal(cell_data(fs.to_vtk(), "SideShift"), fs.side_shifts)
+    plain = tessera.faces(tessera.voronoi(pts, bounds=UNIT_BOX[dim], merge=True), kind="complex")
+    assert plain.side_shifts.size == 0 and plain.vertex_key_shifts.size == 0
+
+
 def test_2d_faces_vtp_are_lines(tmp_path):
     pts, lab = labelled(500, 2, seed=11)
     fs = tessera.faces(pts, labels=lab, kind="complex")

@@ -43,19 +43,27 @@ class FaceSelector {
     const bool bounding = cls == SpokeClass::domain_boundary || cls == SpokeClass::outside;
     switch (o_.kind) {
       case FaceSetKind::boundary: return bounding;
-      case FaceSetKind::complex: return bounding || is_side0(cell, c_.face_neighbor[face]);
+      case FaceSetKind::complex: return bounding || is_side0(cell, face);
       case FaceSetKind::surface_net:
-        return (cls == SpokeClass::region_boundary && is_side0(cell, c_.face_neighbor[face])) ||
-               (o_.capping && bounding);
+        return (cls == SpokeClass::region_boundary && is_side0(cell, face)) || (o_.capping && bounding);
     }
     return false;
   }
 
  private:
   /// Between two cells: does `cell` have the smaller (region, generator)?
-  bool is_side0(std::size_t cell, std::int32_t neighbor) const {
+  /// In a periodic box its twin is the face of the neighbour's cell towards
+  /// the opposite shift, so a face with an image of the cell itself is taken
+  /// where its shift is lexicographically positive (faces.hpp).
+  bool is_side0(std::size_t cell, std::size_t face) const {
+    const std::int32_t neighbor = c_.face_neighbor[face];
     const auto other = static_cast<std::size_t>(c_.cell_of[static_cast<std::size_t>(neighbor)]);
-    return std::pair(c_.region[cell], c_.generator[cell]) < std::pair(c_.region[other], neighbor);
+    const auto mine = std::pair(c_.region[cell], c_.generator[cell]), theirs = std::pair(c_.region[other], neighbor);
+    if (mine != theirs || c_.face_shift.empty()) return mine < theirs;
+    const std::int8_t* s = &c_.face_shift[face * static_cast<std::size_t>(c_.dim)];
+    for (int a = 0; a < c_.dim; ++a)
+      if (s[a] != 0) return s[a] > 0;
+    return false;  // a face with itself at shift 0 does not exist
   }
 
   const Cells& c_;
@@ -65,7 +73,7 @@ class FaceSelector {
 }  // namespace
 
 FaceSet extract_faces(const Cells& c, std::span<const std::int32_t> labels, const FaceSetOptions& options) {
-  front::require_mesh(c, "extract_faces");
+  front::require_mesh(c, "extract_faces", true);
   if (!labels.empty() && labels.size() != c.n_points)
     throw InputError("labels: " + std::to_string(labels.size()) + " values for " + std::to_string(c.n_points) +
                      " points");
@@ -83,6 +91,11 @@ FaceSet extract_faces(const Cells& c, std::span<const std::int32_t> labels, cons
   FaceSet out;
   out.dim = D;
   out.kind = options.kind;
+  const bool periodic = c.is_periodic();
+  if (periodic) {
+    out.periodic = c.periodic;
+    out.lattice = c.lattice();
+  }
 
   // Pass 1: per cell, the faces and corners it contributes; mark used vertices.
   std::vector<std::int64_t> face_start(nc + 1, 0), corner_start(nc + 1, 0);
@@ -112,11 +125,13 @@ FaceSet extract_faces(const Cells& c, std::span<const std::int32_t> labels, cons
   const std::size_t dn = static_cast<std::size_t>(D), kn = dn + 1;
   out.vertices.resize(static_cast<std::size_t>(nu) * dn);
   out.vertex_keys.resize(static_cast<std::size_t>(nu) * kn);
+  if (periodic) out.vertex_key_shifts.resize(static_cast<std::size_t>(nu) * kn * dn);
   for (std::size_t v = 0; v < nv; ++v) {
     if (new_id[v] < 0) continue;
     const auto w = static_cast<std::size_t>(new_id[v]);
     std::copy_n(&c.vertices[v * dn], dn, &out.vertices[w * dn]);
     std::copy_n(&c.vertex_keys[v * kn], kn, &out.vertex_keys[w * kn]);
+    if (periodic) std::copy_n(&c.vertex_key_shifts[v * kn * dn], kn * dn, &out.vertex_key_shifts[w * kn * dn]);
   }
 
   // Pass 2: fill.
@@ -127,6 +142,7 @@ FaceSet extract_faces(const Cells& c, std::span<const std::int32_t> labels, cons
   out.sides.resize(2 * nf);
   out.boundary_labels.resize(2 * nf);
   out.face_class.resize(nf);
+  if (periodic) out.side_shifts.resize(nf * dn);
   front::for_each_cell(c, [&](std::size_t k) {
     auto o = static_cast<std::size_t>(face_start[k]);
     auto q = static_cast<std::size_t>(corner_start[k]);
@@ -148,6 +164,7 @@ FaceSet extract_faces(const Cells& c, std::span<const std::int32_t> labels, cons
       out.boundary_labels[2 * o] = c.region[k];
       out.boundary_labels[2 * o + 1] = other_label;
       out.face_class[o] = cls;
+      if (periodic) std::copy_n(&c.face_shift[fu * dn], dn, &out.side_shifts[o * dn]);
       ++o;
     }
   });

@@ -109,6 +109,16 @@ void write_spoke_measures_npy(const std::string& path, const AdjacencyGraph& g) 
 
 // ------------------------------------------------------------------ faces
 
+namespace {
+/// A periodic face set's side shifts as VTK cell data (int32: the writer has
+/// no int8 arrays), one D-component tuple per face; empty otherwise.
+std::vector<std::int32_t> side_shift_data(const FaceSet& fs, PolyData& pd) {
+  std::vector<std::int32_t> wide(fs.side_shifts.begin(), fs.side_shifts.end());
+  if (!wide.empty()) pd.cell_data.push_back({"SideShift", std::span<const std::int32_t>(wide), fs.dim});
+  return wide;
+}
+}  // namespace
+
 void write_faces_vtp(const std::string& path, const FaceSet& fs) {
   PolyData pd;
   pd.dim = fs.dim;
@@ -117,6 +127,7 @@ void write_faces_vtp(const std::string& path, const FaceSet& fs) {
   pd.cell_data.push_back({"BoundaryLabels", std::span<const std::int32_t>(fs.boundary_labels), 2});
   pd.cell_data.push_back({"Sides", std::span<const std::int32_t>(fs.sides), 2});
   pd.cell_data.push_back({"SpokeClass", class_bytes(fs.face_class)});
+  const std::vector<std::int32_t> shifts = side_shift_data(fs, pd);
   write_polydata(path, pd);
 }
 
@@ -134,6 +145,7 @@ void write_surface_net_vtp(const std::string& path, const SurfaceNet& net) {
   pd.cell_data.push_back({"Sides", std::span<const std::int32_t>(fs.sides), 2});
   pd.cell_data.push_back({"SpokeClass", class_bytes(fs.face_class)});
   pd.cell_data.push_back({"PolygonId", std::span<const std::int64_t>(net.polygon_of_face)});
+  const std::vector<std::int32_t> shifts = side_shift_data(fs, pd);
   write_polydata(path, pd);
 }
 

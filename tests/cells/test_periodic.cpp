@@ -9,7 +9,9 @@
 //   lattices every neighbour entry (i, j, s) has its twin (j, i, -s), the
 //   volumes tile the box, and 1 and 2 threads give identical bytes;
 // * points outside the box along a periodic axis are wrapped in;
-// * what is refused: no bounds, a z axis in 2D, products other than cells;
+// * what is refused: no bounds, a z axis in 2D;
+// * face sets list each face once with the image it meets, on its bisector,
+//   and each region's faces close up modulo the lattice;
 // * the same for triclinic boxes (tilts), against the oracle among images
 //   by the sheared lattice vectors, and two bases of one lattice agree.
 #include <gtest/gtest.h>
@@ -368,10 +370,237 @@ TEST(Periodic, Refused) {
   const auto strip = make_bounds({0, 0, 0}, {1, 300, 0});
   compare_with_oracle(grid_aligned(1000, 2, 42, strip), 2, strip, {true, false, false}, 1, "a short period");
   EXPECT_THROW(run_periodic({0.5, 150}, 2, strip, {true, false, false}), tessera::InputError);
-  // Face sets (and the Delaunay triangulation of a box with walls:
-  // test_periodic_delaunay.cpp).
-  const tessera::Cells c = run_periodic(pts, 3, box, {true, true, true});
-  EXPECT_THROW(tessera::extract_faces(c, {}, {}), tessera::InputError);
+  // (The Delaunay triangulation of a box with walls: test_periodic_delaunay.cpp.)
+}
+
+/// A face set's faces as (side 0, side 1, shift), with their twins (side 1,
+/// side 0, -shift) for faces between cells: each neighbour entry once.
+std::vector<std::tuple<std::int32_t, std::int32_t, Shift>> face_entries(const tessera::FaceSet& fs) {
+  std::vector<std::tuple<std::int32_t, std::int32_t, Shift>> out;
+  const auto du = static_cast<std::size_t>(fs.dim);
+  for (std::size_t f = 0; f < fs.n_faces(); ++f) {
+    if (fs.sides[2 * f + 1] < 0) continue;  // a wall
+    Shift s{0, 0, 0};
+    for (std::size_t a = 0; a < du; ++a) s[a] = fs.side_shifts[f * du + a];
+    out.emplace_back(fs.sides[2 * f], fs.sides[2 * f + 1], s);
+    out.emplace_back(fs.sides[2 * f + 1], fs.sides[2 * f], Shift{-s[0], -s[1], -s[2]});
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+/// Copies of one periodic vertex (FaceSet::vertex_key_shifts): per vertex,
+/// its key with the shifts taken relative to the first point's, numbered by
+/// first appearance, and that point's shift (the copy's translation).
+struct Copies {
+  std::vector<int> group;
+  std::vector<Shift> at;
+};
+Copies vertex_copies_of(const tessera::FaceSet& fs) {
+  const auto du = static_cast<std::size_t>(fs.dim), kn = du + 1;
+  std::map<std::vector<int>, int> index;
+  Copies out;
+  for (std::size_t v = 0; v < fs.n_vertices(); ++v) {
+    std::size_t first = 0;
+    while (fs.vertex_keys[v * kn + first] < 0) ++first;
+    Shift t{0, 0, 0};
+    for (std::size_t a = 0; a < du; ++a) t[a] = fs.vertex_key_shifts[(v * kn + first) * du + a];
+    std::vector<int> key;
+    for (std::size_t e = 0; e < kn; ++e) {
+      key.push_back(fs.vertex_keys[v * kn + e]);
+      for (std::size_t a = 0; a < du; ++a)
+        key.push_back(fs.vertex_key_shifts[(v * kn + e) * du + a] - (fs.vertex_keys[v * kn + e] < 0 ? 0 : t[a]));
+    }
+    out.group.push_back(index.emplace(key, static_cast<int>(index.size())).first->second);
+    out.at.push_back(t);
+  }
+  return out;
+}
+
+/// Directed edges (3D) or segment ends (2D) of a region's faces, its faces
+/// on side 1 reversed, over copies of vertices: a surface closed in the
+/// periodic box has each directed edge matched by its reverse (the same two
+/// vertices, the same relative translation). Returns the unmatched.
+std::size_t open_edges_modulo_lattice(const tessera::FaceSet& fs, std::int32_t region) {
+  const Copies cp = vertex_copies_of(fs);
+  std::map<std::tuple<int, int, Shift>, int> balance;  // (from, to, to's translation - from's)
+  auto rel = [&](std::int32_t u, std::int32_t w) {
+    const Shift& a = cp.at[static_cast<std::size_t>(u)];
+    const Shift& b = cp.at[static_cast<std::size_t>(w)];
+    return Shift{b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+  };
+  for (std::size_t f = 0; f < fs.n_faces(); ++f) {
+    const bool side0 = fs.boundary_labels[2 * f] == region, side1 = fs.boundary_labels[2 * f + 1] == region;
+    if (side0 == side1) continue;
+    std::vector<std::int32_t> loop(fs.face_vertices.begin() + fs.face_offsets[f],
+                                   fs.face_vertices.begin() + fs.face_offsets[f + 1]);
+    if (side1) std::reverse(loop.begin(), loop.end());
+    const std::size_t n = loop.size(), edges = fs.dim == 2 ? 1 : n;
+    for (std::size_t k = 0; k < edges; ++k) {
+      const std::int32_t u = loop[k], w = loop[(k + 1) % n];
+      const int gu = cp.group[static_cast<std::size_t>(u)], gw = cp.group[static_cast<std::size_t>(w)];
+      const Shift d = rel(u, w);
+      if (fs.dim == 2) {  // a segment's ends: it leaves gu and arrives at gw
+        ++balance[{gu, -1, Shift{0, 0, 0}}];
+        --balance[{gw, -1, Shift{0, 0, 0}}];
+        continue;
+      }
+      ++balance[{gu, gw, d}];
+      --balance[{gw, gu, Shift{-d[0], -d[1], -d[2]}}];
+    }
+  }
+  std::size_t open = 0;
+  for (const auto& [edge, m] : balance) open += m != 0;
+  return open;
+}
+
+TEST(Periodic, FaceSetsListEachFaceOnceWithItsImage) {
+  // Face sets of periodic cells (orthogonal, triclinic, 2D, and x-z
+  // periodic with y walls): the complex lists every face once, and with its
+  // twin each neighbour entry; each face lies on the bisector of side 0's
+  // point and side 1's image, its normal towards the image; each region's
+  // surface-net faces close up modulo the lattice; 1 and 2 threads agree.
+  struct Case {
+    int dim;
+    std::array<bool, 3> periodic;
+    Tilt tilt;
+  };
+  for (const Case& k : {Case{3, {true, true, true}, {0, 0, 0}}, Case{3, {true, true, true}, {0.25, -0.125, 0.375}},
+                        Case{3, {true, false, true}, {0, 0, 0}}, Case{2, {true, true, false}, {0.375, 0, 0}}}) {
+    SCOPED_TRACE(k.dim * 100 + k.periodic[1] * 10 + (k.tilt[0] != 0));
+    const auto box = make_bounds({0, 0, 0}, {1, 1, 1});
+    const auto du = static_cast<std::size_t>(k.dim);
+    const auto pts = in_parallelepiped(300, k.dim, 46, box, k.tilt);
+    std::vector<std::int32_t> labels(300);
+    for (std::size_t i = 0; i < 300; ++i) labels[i] = pts[i * du] + pts[i * du + 1] < 1.0 ? 3 : 7;
+    auto o = periodic_options(k.dim, box, k.periodic, 1, k.tilt);
+    o.build_mesh = true;
+    const tessera::Cells c = tessera::voronoi(pts, k.dim, labels, o);
+    o.threads = 2;
+    const tessera::Cells c2 = tessera::voronoi(pts, k.dim, labels, o);
+    const auto v = lattice(box, k.tilt);
+
+    tessera::FaceSetOptions fo;
+    fo.kind = tessera::FaceSetKind::complex;
+    const tessera::FaceSet fs = tessera::extract_faces(c, labels, fo);
+    const tessera::FaceSet fs2 = tessera::extract_faces(c2, labels, fo);
+    EXPECT_EQ(fs.face_vertices, fs2.face_vertices);
+    EXPECT_EQ(fs.side_shifts, fs2.side_shifts);
+    EXPECT_EQ(fs.vertices, fs2.vertices);
+    ASSERT_TRUE(fs.is_periodic());
+    ASSERT_EQ(fs.side_shifts.size(), fs.n_faces() * du);
+    ASSERT_EQ(fs.vertex_key_shifts.size(), fs.vertex_keys.size() * du);
+    std::vector<std::tuple<std::int32_t, std::int32_t, Shift>> want;
+    const auto cell_entries = entries(c);
+    for (std::size_t cell = 0; cell < c.n_cells(); ++cell)
+      for (const auto& [j, s] : cell_entries[cell]) want.emplace_back(c.generator[cell], j, s);
+    std::sort(want.begin(), want.end());
+    EXPECT_EQ(face_entries(fs), want);
+
+    // Geometry: on the bisector with the image, facing it.
+    const std::vector<double>& p = c.periodic_points;
+    std::size_t off_bisector = 0, facing_back = 0;
+    for (std::size_t f = 0; f < fs.n_faces(); ++f) {
+      const std::int32_t j = fs.sides[2 * f + 1];
+      if (j < 0) continue;
+      const auto i = static_cast<std::size_t>(fs.sides[2 * f]);
+      double img[3] = {0, 0, 0};
+      tessera::periodic_image(fs.lattice, k.dim, &p[static_cast<std::size_t>(j) * du], &fs.side_shifts[f * du], img);
+      V3 pi{0, 0, 0}, pj{0, 0, 0};
+      for (std::size_t a = 0; a < du; ++a) pi[a] = p[i * du + a], pj[a] = img[a];
+      const double h = norm(sub(pj, pi));
+      std::vector<V3> corner;
+      for (auto q = fs.face_offsets[f]; q < fs.face_offsets[f + 1]; ++q) {
+        V3 x{0, 0, 0};
+        for (std::size_t a = 0; a < du; ++a) x[a] = fs.vertices[static_cast<std::size_t>(fs.face_vertices[q]) * du + a];
+        off_bisector += std::fabs(norm(sub(x, pi)) - norm(sub(x, pj))) > 1e-9 * h;
+        corner.push_back(x);
+      }
+      V3 normal{0, 0, 0};
+      if (k.dim == 2) {
+        normal = {corner[1][1] - corner[0][1], corner[0][0] - corner[1][0], 0};  // (dy, -dx)
+      } else {
+        for (std::size_t t = 1; t + 1 < corner.size(); ++t) {
+          const V3 n = cross(sub(corner[t], corner[0]), sub(corner[t + 1], corner[0]));
+          for (int a = 0; a < 3; ++a) normal[a] += n[a];
+        }
+      }
+      if (norm(normal) > 1e-9) facing_back += dot(normal, sub(pj, pi)) <= 0;
+    }
+    EXPECT_EQ(off_bisector, 0u);
+    EXPECT_EQ(facing_back, 0u);
+
+    // Each region's surface-net faces close up across the box's faces.
+    fo.kind = tessera::FaceSetKind::surface_net;
+    fo.capping = true;
+    const tessera::FaceSet net = tessera::extract_faces(c, labels, fo);
+    EXPECT_GT(net.n_faces(), 0u);
+    EXPECT_EQ(open_edges_modulo_lattice(net, 3), 0u);
+    EXPECT_EQ(open_edges_modulo_lattice(net, 7), 0u);
+    (void)v;
+  }
+}
+
+TEST(Periodic, FaceSetsOfAFewPointsTakeFacesWithTheirOwnImagesOnce) {
+  // Boxes of 1-3 points: faces between a cell and its own images, each
+  // taken from the side whose shift is positive, so once.
+  const auto box = make_bounds({0, 0, 0}, {1, 1, 1});
+  for (int dim : {2, 3})
+    for (std::size_t n : {1u, 2u, 3u}) {
+      SCOPED_TRACE(dim * 10 + static_cast<int>(n));
+      const auto pts = grid_aligned(n, dim, 47 + n, box);
+      auto o = periodic_options(dim, box, {true, true, dim == 3});
+      o.build_mesh = true;
+      const tessera::Cells c = tessera::voronoi(pts, dim, {}, o);
+      tessera::FaceSetOptions fo;
+      fo.kind = tessera::FaceSetKind::complex;
+      const tessera::FaceSet fs = tessera::extract_faces(c, {}, fo);
+      std::vector<std::tuple<std::int32_t, std::int32_t, Shift>> want;
+      const auto cell_entries = entries(c);
+      for (std::size_t cell = 0; cell < c.n_cells(); ++cell)
+        for (const auto& [j, s] : cell_entries[cell]) want.emplace_back(c.generator[cell], j, s);
+      std::sort(want.begin(), want.end());
+      EXPECT_EQ(face_entries(fs), want);
+      EXPECT_EQ(2 * fs.n_faces(), want.size());
+    }
+}
+
+TEST(Periodic, SurfaceNetFacesOfSlabsInALatticeAreTwoPlanes) {
+  // Voxel centres of a periodic 6^3 lattice, labelled by slabs along x:
+  // the interfaces are the planes x = 1/2 and x = 0 (= 1), area 1 each.
+  const auto box = make_bounds({0, 0, 0}, {1, 1, 1});
+  std::vector<double> pts;
+  std::vector<std::int32_t> labels;
+  for (int i = 0; i < 6; ++i)
+    for (int j = 0; j < 6; ++j)
+      for (int l = 0; l < 6; ++l) {
+        pts.insert(pts.end(), {(l + 0.5) / 6, (j + 0.5) / 6, (i + 0.5) / 6});
+        labels.push_back(l < 3 ? 0 : 1);
+      }
+  auto o = periodic_options(3, box, {true, true, true});
+  o.build_mesh = true;
+  const tessera::Cells c = tessera::voronoi(pts, 3, labels, o);
+  tessera::FaceSetOptions fo;
+  fo.kind = tessera::FaceSetKind::surface_net;
+  const tessera::FaceSet net = tessera::extract_faces(c, labels, fo);
+  double area = 0, at_half = 0;
+  for (std::size_t f = 0; f < net.n_faces(); ++f) {
+    double s[3] = {0, 0, 0};
+    auto at = [&](std::int64_t q) { return &net.vertices[static_cast<std::size_t>(net.face_vertices[static_cast<std::size_t>(q)]) * 3]; };
+    const double* o0 = at(net.face_offsets[f]);
+    for (auto q = net.face_offsets[f] + 1; q + 1 < net.face_offsets[f + 1]; ++q) {
+      const V3 n = cross(sub({at(q)[0], at(q)[1], at(q)[2]}, {o0[0], o0[1], o0[2]}),
+                         sub({at(q + 1)[0], at(q + 1)[1], at(q + 1)[2]}, {o0[0], o0[1], o0[2]}));
+      for (int a = 0; a < 3; ++a) s[a] += n[a];
+    }
+    const double a = 0.5 * std::sqrt(s[0] * s[0] + s[1] * s[1] + s[2] * s[2]);
+    area += a;
+    if (std::fabs(o0[0] - 0.5) < 1e-12) at_half += a;
+  }
+  EXPECT_NEAR(area, 2.0, 1e-12);
+  EXPECT_NEAR(at_half, 1.0, 1e-12);
+  EXPECT_EQ(open_edges_modulo_lattice(net, 0), 0u);
+  EXPECT_EQ(open_edges_modulo_lattice(net, 1), 0u);
 }
 
 TEST(Periodic, AdjacencyGraphHasShiftedSpokes) {

@@ -243,6 +243,52 @@ class Graph(base.TempDirCase):
                 self.assertTrue(any(abs(d - np.linalg.norm(pts[pid[b]] + np.array(s) @ vec - pts[a])) < 1e-12
                                     for (i, j, s) in spoke if i == a and j == pid[b]))
 
+    def test_periodic_faces(self):
+        # Faces of periodic cells (x-z periodic, y walls, so both kinds of
+        # side): SideShift names side 1's image; every corner of a face lies
+        # on the bisector of side 0's point and that image (a wall's face on
+        # its plane); the capped surface net of each region closes up when
+        # copies of a vertex (the same cell corner seen from several frames)
+        # are identified: each polygon edge, as a pair of corners a lattice
+        # translation apart, has its reverse.
+        pts = np.ldexp(np.floor(np.ldexp(np.random.default_rng(44).random((600, 3)) * (1 - 2e-6) + 1e-6, 30)), -30)
+        lab = (pts[:, 0] + pts[:, 2] > 1).astype(np.int32)
+        inp, labf, out = self.save("pf.npy", pts), self.save("pfl.npy", lab), self.p("pf.vtp")
+        per = ["--bounds", "0", "1", "0", "1", "0", "1", "--periodic", "xz", "--labels", labf]
+        for kind in ("complex", "surface-net"):
+            self.ok(["faces", inp, "--kind", kind, "-o", out, "-q"] + per + (["--capping"] if kind != "complex" else []))
+            pd = read_vtp(out)
+            xyz = vtk_to_numpy(pd.GetPoints().GetData())
+            sides = vtk_to_numpy(pd.GetCellData().GetArray("Sides")).reshape(-1, 2)
+            shift = vtk_to_numpy(pd.GetCellData().GetArray("SideShift")).reshape(-1, 3)
+            self.assertTrue(np.all(shift[:, 1] == 0) and np.any(shift != 0))
+            polys = cells_of(pd.GetPolys())
+            for f, loop in enumerate(polys):
+                i, j = sides[f]
+                x = xyz[loop]
+                if j < 0:  # a wall: y = 0 (-3) or y = 1 (-4)
+                    self.assertIn(j, (-3, -4))
+                    np.testing.assert_allclose(x[:, 1], 0.0 if j == -3 else 1.0, atol=1e-15)
+                    continue
+                image = pts[j] + shift[f]
+                np.testing.assert_allclose(np.linalg.norm(x - pts[i], axis=1), np.linalg.norm(x - image, axis=1),
+                                           atol=1e-12)
+            if kind == "surface-net":
+                labels = vtk_to_numpy(pd.GetCellData().GetArray("BoundaryLabels")).reshape(-1, 2)
+                # A corner is identified across frames by rounding it back into the box.
+                key = [tuple(np.round(np.mod(p, 1.0) * 1e9).astype(np.int64) % 10**9) for p in xyz]
+                for region in (0, 1):
+                    edges = {}
+                    for f, loop in enumerate(polys):
+                        if region not in labels[f]:
+                            continue
+                        loop = list(loop) if labels[f][0] == region else list(reversed(loop))
+                        for a, b in zip(loop, loop[1:] + loop[:1]):
+                            d = tuple(np.round(xyz[b] - xyz[a], 6))
+                            edges[(key[a], key[b], d)] = edges.get((key[a], key[b], d), 0) + 1
+                    for (a, b, d), m in edges.items():
+                        self.assertEqual(edges.get((b, a, tuple(-x + 0.0 for x in d))), m, "region %d" % region)
+
     def test_threads_byte_identical(self):
         inp = self.save("big.npy", np.random.default_rng(25).random((5000, 3)))
         outs = []
