@@ -6,6 +6,7 @@
 #include <tbb/parallel_sort.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -162,7 +163,9 @@ SurfaceNetsOptions net_options(const SurfaceNetsArgs& a, const NetInput& in) {
 /// Watertightness of every selected label's surface (its faces, reversed
 /// where the label is on side 1). 3D: an edge used once is a boundary edge;
 /// used twice in the same direction, or more than twice, non-manifold. 2D:
-/// a vertex without exactly one arriving and one leaving segment.
+/// a vertex without exactly one arriving and one leaving segment. In a
+/// periodic box an edge's ends are copies of vertices (vertex_copies): the
+/// edge is the pair of copies' groups and the translation between them.
 struct Watertight {
   std::size_t boundary_edges = 0, nonmanifold_edges = 0;
   std::vector<std::int32_t> open_labels;  ///< ascending
@@ -173,33 +176,53 @@ Watertight check_watertight(const SurfaceNet& net) {
   const FaceSet& m = net.mesh;
   const auto& sel = net.selected;
   auto selected = [&](std::int32_t l) { return std::binary_search(sel.begin(), sel.end(), l); };
-  // (label, a, b, direction) with a < b; 2D: (label, vertex, 0, +1 leaving / -1 arriving).
-  std::vector<std::tuple<std::int32_t, std::int32_t, std::int32_t, std::int8_t>> e;
+  const VertexCopies copies = vertex_copies(m);
+  const auto du = static_cast<std::size_t>(m.dim);
+  // (label, a, b, translation from a to b, direction), a <= b (by group, then
+  // translation); 2D: (label, vertex, 0, 0, +1 leaving / -1 arriving).
+  using Shift = std::array<std::int32_t, 3>;
+  std::vector<std::tuple<std::int32_t, std::int32_t, std::int32_t, Shift, std::int8_t>> e;
+  auto shift_of = [&](std::int32_t v) {
+    Shift s{0, 0, 0};
+    if (copies.periodic())
+      for (std::size_t a = 0; a < du; ++a) s[a] = copies.shift[static_cast<std::size_t>(v) * du + a];
+    return s;
+  };
   for (std::size_t f = 0; f < m.n_faces(); ++f) {
     const auto b = static_cast<std::size_t>(m.face_offsets[f]), n = static_cast<std::size_t>(m.face_offsets[f + 1]) - b;
     for (int side = 0; side < 2; ++side) {
       const std::int32_t l = m.boundary_labels[2 * f + side];
       if (side == 1 && !selected(l)) continue;
       const std::int8_t dir = side == 0 ? 1 : -1;
+      auto group = [&](std::int32_t v) { return copies.group[static_cast<std::size_t>(v)]; };
       if (m.dim == 2) {
-        e.emplace_back(l, m.face_vertices[b], 0, dir);
-        e.emplace_back(l, m.face_vertices[b + 1], 0, static_cast<std::int8_t>(-dir));
+        e.emplace_back(l, group(m.face_vertices[b]), 0, Shift{}, dir);
+        e.emplace_back(l, group(m.face_vertices[b + 1]), 0, Shift{}, static_cast<std::int8_t>(-dir));
         continue;
       }
       for (std::size_t q = 0; q < n; ++q) {
         const std::int32_t u = m.face_vertices[b + q], w = m.face_vertices[b + (q + 1) % n];
-        e.emplace_back(l, std::min(u, w), std::max(u, w), static_cast<std::int8_t>(u < w ? dir : -dir));
+        const Shift su = shift_of(u), sw = shift_of(w);
+        Shift d{sw[0] - su[0], sw[1] - su[1], sw[2] - su[2]};
+        const std::int32_t gu = group(u), gw = group(w);
+        const Shift minus{-d[0], -d[1], -d[2]};
+        if (std::tie(gu, d) <= std::tie(gw, minus))
+          e.emplace_back(l, gu, gw, d, dir);
+        else
+          e.emplace_back(l, gw, gu, minus, static_cast<std::int8_t>(-dir));
       }
     }
   }
   tbb::parallel_sort(e.begin(), e.end());
   Watertight w;
+  auto same_edge = [](const auto& x, const auto& y) {
+    return std::get<0>(x) == std::get<0>(y) && std::get<1>(x) == std::get<1>(y) && std::get<2>(x) == std::get<2>(y) &&
+           std::get<3>(x) == std::get<3>(y);
+  };
   for (std::size_t i = 0; i < e.size();) {
     std::size_t j = i;
     int sum = 0;
-    while (j < e.size() && std::get<0>(e[j]) == std::get<0>(e[i]) && std::get<1>(e[j]) == std::get<1>(e[i]) &&
-           std::get<2>(e[j]) == std::get<2>(e[i]))
-      sum += std::get<3>(e[j++]);
+    while (j < e.size() && same_edge(e[j], e[i])) sum += std::get<4>(e[j++]);
     const std::size_t count = j - i;
     if (count != 2 || sum != 0) {
       ++(count == 1 ? w.boundary_edges : w.nonmanifold_edges);

@@ -326,6 +326,7 @@ int main(int argc, char** argv) {
       "label image");
   add_compute_options(snets, sna.compute, sn_bounds);
   add_surface_nets_options(snets, sna, false);
+  add_periodic_option(snets, sna.compute);
 
   BenchArgs ba;
   CLI::App* bench = app.add_subcommand("bench", "Benchmarks printing one JSON line per run on stdout");

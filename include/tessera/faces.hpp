@@ -98,6 +98,31 @@ struct FaceSet {
   bool is_periodic() const { return periodic[0] || periodic[1] || periodic[2]; }
 };
 
+/// Copies of one vertex in a periodic face set. Periodic cells keep their
+/// vertices in their own frames (a vertex shared by cells on opposite sides
+/// of the box is listed once beside each), so a face set of them holds
+/// several copies of one Voronoi vertex, lattice translations apart; their
+/// keys agree up to a common shift (FaceSet::vertex_key_shifts). Whatever
+/// moves one copy (the surface nets' smoothing) moves all of them alike, and
+/// a surface is closed in the box when its edges pair up between copies.
+struct VertexCopies {
+  /// Per vertex: its group (the copies of one vertex), numbered by first vertex.
+  std::vector<std::int32_t> group;
+  /// Per group: its first vertex (the lowest id).
+  std::vector<std::int32_t> first;
+  /// Per vertex, dim integers (periodic face sets only, else empty): the
+  /// lattice translation from its group's first vertex to it, in lattice
+  /// vectors (FaceSet::lattice).
+  std::vector<std::int32_t> shift;
+
+  std::size_t n_groups() const { return first.size(); }
+  bool periodic() const { return !shift.empty(); }
+};
+
+/// The copies of each vertex of `faces` (every vertex alone, with no
+/// shifts, when it is not periodic).
+VertexCopies vertex_copies(const FaceSet& faces);
+
 /// Extract a face set from cells computed with VoronoiOptions::build_mesh
 /// (std::invalid_argument otherwise). `labels` are the labels the cells were
 /// computed with (empty or one per point); they give outside points' labels.

@@ -20,6 +20,7 @@
 #include "net_smoothing.hpp"
 #include "pass.hpp"
 #include "tessera/surface_nets.hpp"
+#include "vertex_copies.hpp"
 
 namespace tessera {
 namespace front {
@@ -109,15 +110,25 @@ bool is_junction_edge(const FaceSet& mesh, std::span<const std::int32_t> labels,
   return n >= 3 && distinct(r, n) >= 3;
 }
 
-std::vector<double> petal_radii(const FaceSet& mesh, std::span<const double> positions, std::span<const double> points) {
+std::vector<double> petal_radii(const FaceSet& mesh, std::span<const double> positions, std::span<const double> points,
+                                int k) {
   const std::size_t dn = static_cast<std::size_t>(mesh.dim), kn = dn + 1;
+  const bool periodic = mesh.is_periodic();
   std::vector<double> petal(mesh.n_vertices(), 0.0);
   parallel_range(petal.size(), 4096, [&](std::size_t v) {
     const std::int32_t* key = &mesh.vertex_keys[v * kn];
     std::size_t a = 0;
     while (a < kn && key[a] < 0) ++a;  // box planes come first; a vertex has a generator
     if (a == kn) return;
-    const double* g = &points[static_cast<std::size_t>(key[a]) * dn];
+    double g[3] = {0, 0, 0};
+    std::copy_n(&points[static_cast<std::size_t>(key[a]) * dn], dn, g);
+    if (periodic) {  // the image the key names
+      std::int32_t s[3] = {0, 0, 0};
+      for (std::size_t c = 0; c < dn; ++c) s[c] = mesh.vertex_key_shifts[(v * kn + a) * dn + c];
+      double t[3];
+      lattice_translation(mesh.lattice, mesh.dim, s, k, t);
+      for (std::size_t c = 0; c < dn; ++c) g[c] += t[c];
+    }
     double d[3] = {0, 0, 0}, d2 = 0;
     for (std::size_t c = 0; c < dn; ++c) {
       d[c] = positions[v * dn + c] - g[c];
@@ -263,7 +274,7 @@ std::vector<NetVertexKind> smooth_surface_net(FaceSet& mesh, std::span<const dou
 
   // Per vertex: the constraint radius and the axes pinned to a box plane.
   const std::vector<double> x0 = mesh.vertices;
-  const std::vector<double> petal = front::petal_radii(mesh, x0, points);
+  const std::vector<double> petal = front::petal_radii(mesh, x0, points, k);
   std::vector<double> radius(nv);
   std::vector<std::uint8_t> pinned(nv, 0);
   front::parallel_range(nv, 4096, [&](std::size_t v) {
@@ -275,13 +286,77 @@ std::vector<NetVertexKind> smooth_surface_net(FaceSet& mesh, std::span<const dou
     radius[v] = options.constraint_is_absolute ? options.constraint : options.constraint * petal[v];
   });
 
+  // The Jacobi step moves groups of copies of one vertex (a periodic face
+  // set's; every vertex alone otherwise: front/vertex_copies.hpp), each by
+  // its first copy's constraint, over the union of its copies' stencils
+  // brought into its frame; its copies then follow by their translations,
+  // so the surface stays closed across the box's faces.
+  const VertexCopies copies = vertex_copies(mesh);
+  const bool periodic = copies.periodic();
+  const std::size_t ng = copies.n_groups();
+  auto translation = [&](const std::int32_t* shift, double* out) {
+    front::lattice_translation(mesh.lattice, D, shift, k, out);
+  };
+  // Group stencils: (group, translation from this group's first copy to the
+  // neighbour copy's group's first copy's frame), unique.
+  std::vector<std::int64_t> g_off(ng + 1, 0);
+  std::vector<std::int32_t> g_nbr;
+  std::vector<double> g_rel;  // periodic only: dn per entry, added to the neighbour group's position
+  if (!periodic) {
+    g_off = st.offsets;
+    g_nbr = st.neighbors;
+  } else {
+    std::vector<std::vector<std::int32_t>> members(ng);
+    for (std::size_t v = 0; v < nv; ++v) members[static_cast<std::size_t>(copies.group[v])].push_back(static_cast<std::int32_t>(v));
+    std::vector<std::vector<std::array<std::int32_t, 4>>> entries(ng);  // (group, shift)
+    front::parallel_range(ng, 1024, [&](std::size_t g) {
+      auto& e = entries[g];
+      for (const std::int32_t v : members[g]) {
+        const auto vu = static_cast<std::size_t>(v);
+        for (auto t = st.offsets[vu]; t < st.offsets[vu + 1]; ++t) {
+          const auto w = static_cast<std::size_t>(st.neighbors[static_cast<std::size_t>(t)]);
+          // w's position = its group's + shift_w; seen from v's frame, moved
+          // back by shift_v: relative shift shift_w - shift_v.
+          std::array<std::int32_t, 4> x{copies.group[w], 0, 0, 0};
+          for (std::size_t a = 0; a < dn; ++a) x[a + 1] = copies.shift[w * dn + a] - copies.shift[vu * dn + a];
+          e.push_back(x);
+        }
+      }
+      std::sort(e.begin(), e.end());
+      e.erase(std::unique(e.begin(), e.end()), e.end());
+    });
+    for (std::size_t g = 0; g < ng; ++g) g_off[g + 1] = g_off[g] + static_cast<std::int64_t>(entries[g].size());
+    g_nbr.resize(static_cast<std::size_t>(g_off[ng]));
+    g_rel.resize(g_nbr.size() * dn);
+    front::parallel_range(ng, 1024, [&](std::size_t g) {
+      auto o = static_cast<std::size_t>(g_off[g]);
+      for (const auto& x : entries[g]) {
+        g_nbr[o] = x[0];
+        translation(&x[1], &g_rel[o * dn]);
+        ++o;
+      }
+    });
+  }
+  // A copy's position from its group's: the group's plus its translation.
+  std::vector<double> offset;  // periodic only: dn per vertex
+  if (periodic) {
+    offset.resize(nv * dn);
+    front::parallel_range(nv, 4096, [&](std::size_t v) { translation(&copies.shift[v * dn], &offset[v * dn]); });
+  }
+  auto place = [&](const std::vector<double>& group_pos, std::vector<double>& out) {
+    front::parallel_range(nv, 4096, [&](std::size_t v) {
+      const double* x = &group_pos[static_cast<std::size_t>(copies.group[v]) * dn];
+      for (std::size_t a = 0; a < dn; ++a) out[v * dn + a] = x[a] + offset[v * dn + a];
+    });
+  };
+
   // The guard: after each Jacobi step every polygon must still have a ladder
   // triangulation whose triangles all face the polygon's original normal (2D:
   // every segment keeps its direction). Where a polygon has none, its
   // vertices keep their current positions for this step; this is decided in
   // rounds that each read the previous round's frozen set, so the outcome
   // does not depend on the schedule, and freezing everything is the
-  // current, valid state, so the rounds end.
+  // current, valid state, so the rounds end. A frozen copy freezes its group.
   const std::size_t nf = mesh.n_faces();
   std::vector<double> ref(nf * dn);
   std::vector<std::uint32_t> rotation(nf, 0);  // last valid ladder rotation
@@ -290,22 +365,37 @@ std::vector<NetVertexKind> smooth_surface_net(FaceSet& mesh, std::span<const dou
     front::reference_orientation(D, x0.data(), petal.data(), &mesh.face_vertices[b], e - b, &ref[dn * f]);
   });
 
-  std::vector<double> cur = x0, nxt(x0.size());
-  std::vector<std::uint8_t> frozen(nv), freeze(nv);
+  // Group positions (gcur, gnxt) and, for periodic sets, every copy's (cur, nxt).
+  std::vector<double> gcur(ng * dn), gnxt(ng * dn);
+  front::parallel_range(ng, 4096, [&](std::size_t g) {
+    std::copy_n(&x0[static_cast<std::size_t>(copies.first[g]) * dn], dn, &gcur[g * dn]);
+  });
+  std::vector<double> cur_copies, nxt_copies;
+  if (periodic) {
+    cur_copies.resize(nv * dn);
+    nxt_copies.resize(nv * dn);
+    place(gcur, cur_copies);
+  }
+  std::vector<std::uint8_t> frozen(nv), freeze(nv), group_frozen(periodic ? ng : 0);
   const double lambda = options.relaxation;
   for (int it = 0; it < options.iterations; ++it) {
-    front::parallel_range(nv, 2048, [&](std::size_t v) {
-      double* out = &nxt[v * dn];
-      const double* x = &cur[v * dn];
-      const auto b = st.offsets[v], e = st.offsets[v + 1];
+    front::parallel_range(ng, 2048, [&](std::size_t g) {
+      const auto v = static_cast<std::size_t>(copies.first[g]);
+      double* out = &gnxt[g * dn];
+      const double* x = &gcur[g * dn];
+      const auto b = g_off[g], e = g_off[g + 1];
       if (b == e) {
         std::copy_n(x, dn, out);
         return;
       }
       double mean[3] = {0, 0, 0};
       for (auto t = b; t < e; ++t) {
-        const double* y = &cur[static_cast<std::size_t>(st.neighbors[static_cast<std::size_t>(t)]) * dn];
-        for (std::size_t a = 0; a < dn; ++a) mean[a] += y[a];
+        const auto tu = static_cast<std::size_t>(t);
+        const double* y = &gcur[static_cast<std::size_t>(g_nbr[tu]) * dn];
+        if (periodic)
+          for (std::size_t a = 0; a < dn; ++a) mean[a] += y[a] + g_rel[tu * dn + a];
+        else
+          for (std::size_t a = 0; a < dn; ++a) mean[a] += y[a];
       }
       const double inv = 1.0 / static_cast<double>(e - b);
       double d[3] = {0, 0, 0}, d2 = 0;
@@ -324,6 +414,9 @@ std::vector<NetVertexKind> smooth_surface_net(FaceSet& mesh, std::span<const dou
       for (std::size_t a = 0; a < dn; ++a)
         out[a] = (pinned[v] >> a) & 1u ? x0[v * dn + a] : x0[v * dn + a] + scale * d[a];
     });
+    if (periodic) place(gnxt, nxt_copies);
+    const std::vector<double>& cur = periodic ? cur_copies : gcur;
+    const std::vector<double>& nxt = periodic ? nxt_copies : gnxt;
 
     std::fill(frozen.begin(), frozen.end(), 0);
     for (bool grew = true; grew;) {
@@ -353,14 +446,22 @@ std::vector<NetVertexKind> smooth_surface_net(FaceSet& mesh, std::span<const dou
         for (std::size_t q = 0; q < n; ++q)
           std::atomic_ref<std::uint8_t>(freeze[static_cast<std::size_t>(loop[q])]).store(1, std::memory_order_relaxed);
       });
+      if (periodic) {  // a frozen copy freezes every copy of its vertex
+        std::fill(group_frozen.begin(), group_frozen.end(), 0);
+        for (std::size_t v = 0; v < nv; ++v) group_frozen[static_cast<std::size_t>(copies.group[v])] |= freeze[v];
+        for (std::size_t v = 0; v < nv; ++v) freeze[v] = group_frozen[static_cast<std::size_t>(copies.group[v])];
+      }
       grew = freeze != frozen;
       frozen.swap(freeze);
     }
-    front::parallel_range(nv, 4096, [&](std::size_t v) {
-      if (frozen[v]) std::copy_n(&cur[v * dn], dn, &nxt[v * dn]);
+    // Frozen groups keep their positions (a group is frozen iff its first copy is).
+    front::parallel_range(ng, 4096, [&](std::size_t g) {
+      if (frozen[static_cast<std::size_t>(copies.first[g])]) std::copy_n(&gcur[g * dn], dn, &gnxt[g * dn]);
     });
-    cur.swap(nxt);
+    gcur.swap(gnxt);
+    if (periodic) place(gcur, cur_copies);
   }
+  std::vector<double> cur = periodic ? std::move(cur_copies) : std::move(gcur);
 
   moved = 0;
   for (std::size_t v = 0; v < nv; ++v) {

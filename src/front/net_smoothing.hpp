@@ -54,9 +54,13 @@ inline void newell(const double* xyz, const std::int32_t* loop, std::size_t n, d
 /// Per mesh vertex at `positions` (mesh.vertices' layout: the vertices
 /// where the cells left them), its distance to its generators (a Voronoi
 /// vertex is equidistant from all of them; box planes in its key are
-/// skipped): the radius of its petal, the local spacing there. Runs in the
-/// caller's task arena.
-std::vector<double> petal_radii(const FaceSet& mesh, std::span<const double> positions, std::span<const double> points);
+/// skipped): the radius of its petal, the local spacing there. In a periodic
+/// face set `points` are the points as the cells took them (wrapped into the
+/// box, Cells::periodic_points) and the generator is the image the key names,
+/// the lattice vectors scaled by 2^k as the points are. Runs in the caller's
+/// task arena.
+std::vector<double> petal_radii(const FaceSet& mesh, std::span<const double> positions, std::span<const double> points,
+                                int k = 0);
 
 /// The net's computation frame: smoothing and triangulation square lengths
 /// and multiply them (constraints, normals, areas), which overflowed for

@@ -75,13 +75,15 @@ void triangulate_ladder(FaceSet& m, std::vector<double> before, std::span<const 
     xyz = scaled_vertices.data();
     front::scale_pow2(before, k);
   }
-  const std::vector<double> petal = front::petal_radii(m, before, points);
+  const std::vector<double> petal = front::petal_radii(m, before, points, k);
   const std::size_t np = m.n_faces();
+  const std::size_t dn = 3, shifted = m.side_shifts.empty() ? 0 : dn;  // periodic: side shifts per triangle
   // Polygon p starts at triangle offset[p] - 2p: n - 2 triangles per n corners.
   const std::size_t nt = np == 0 ? 0 : static_cast<std::size_t>(m.face_offsets[np]) - 2 * np;
   std::vector<std::int64_t> offsets(nt + 1);
   std::vector<std::int32_t> corners(3 * nt), sides(2 * nt), labels(2 * nt);
   std::vector<SpokeClass> cls(nt);
+  std::vector<std::int8_t> side_shifts(shifted * nt);
   polygon_of_face.resize(nt);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, np, 1024), [&](const tbb::blocked_range<std::size_t>& r) {
     for (std::size_t p = r.begin(); p != r.end(); ++p) {
@@ -117,6 +119,7 @@ void triangulate_ladder(FaceSet& m, std::vector<double> before, std::span<const 
         sides[2 * t] = m.sides[2 * p], sides[2 * t + 1] = m.sides[2 * p + 1];
         labels[2 * t] = m.boundary_labels[2 * p], labels[2 * t + 1] = m.boundary_labels[2 * p + 1];
         cls[t] = m.face_class[p];
+        std::copy_n(m.side_shifts.data() + shifted * p, shifted, side_shifts.data() + shifted * t);
         polygon_of_face[t] = static_cast<std::int64_t>(p);
         ++t;
       });
@@ -128,6 +131,7 @@ void triangulate_ladder(FaceSet& m, std::vector<double> before, std::span<const 
   m.sides = std::move(sides);
   m.boundary_labels = std::move(labels);
   m.face_class = std::move(cls);
+  m.side_shifts = std::move(side_shifts);
 }
 
 }  // namespace
@@ -136,8 +140,6 @@ SurfaceNet surface_nets(std::span<const double> points, std::span<const std::int
                         const SurfaceNetsOptions& options) {
   const int D = options.voronoi.dim;
   if (D != 2 && D != 3) throw InputError("dim must be 2 or 3, got " + std::to_string(D));
-  if (options.voronoi.periodic_box())
-    throw InputError("periodic boxes: only the cells (tessera::voronoi), not surface nets");
   if (points.size() % static_cast<std::size_t>(D) != 0)
     throw InputError("points: " + std::to_string(points.size()) + " coordinates is not a multiple of dim " +
                      std::to_string(D));
@@ -172,8 +174,15 @@ SurfaceNet surface_nets(std::span<const double> points, std::span<const std::int
   auto t0 = Clock::now();
   VoronoiOptions vo = options.voronoi;
   vo.build_mesh = true;
+  // In a periodic box the faces lie where the cells took the points (wrapped
+  // into the box): smoothing and triangulation measure against those.
+  std::vector<double> wrapped;
   {
     const Cells cells = voronoi(points, D, cell_labels, vo);
+    if (cells.is_periodic()) {
+      wrapped.assign(cells.periodic_points.begin(), cells.periodic_points.end());
+      points = wrapped;
+    }
     out.n_cells = cells.n_cells();
     out.seconds.cells = since(t0);
     std::vector<std::int32_t>().swap(cell_labels);

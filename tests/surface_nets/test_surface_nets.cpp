@@ -13,6 +13,7 @@
 #include <numbers>
 #include <set>
 #include <string>
+#include <tuple>
 
 #include "net_test_util.hpp"
 #include "tessera/cells.hpp"
@@ -613,3 +614,162 @@ TEST(SurfaceNets, BadInputGivesOneLineErrors) {
 }
 
 }  // namespace
+
+// ------------------------------------------------------------ periodic boxes
+
+namespace {
+
+/// n random points in the unit box, on a grid of 2^-30 (the periodic box's
+/// rounding leaves them as they are), labelled in three bands across x + y
+/// (junction curves in 3D), so every region wraps around the box.
+Labelled periodic_bands(std::size_t n, int dim, std::uint64_t seed) {
+  Labelled in;
+  in.dim = dim;
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(0x1p-20, 1 - 0x1p-20);
+  for (std::size_t i = 0; i < n; ++i) {
+    double s = 0;
+    for (int a = 0; a < dim; ++a) {
+      const double x = std::ldexp(std::floor(std::ldexp(u(rng), 30)), -30);
+      in.points.push_back(x);
+      if (a < 2) s += x;
+    }
+    in.labels.push_back(static_cast<std::int32_t>(std::floor(3 * s)) % 3);
+  }
+  return in;
+}
+
+SurfaceNetsOptions periodic_opts(int dim, int iterations, bool triangles = false, int threads = 1,
+                                 std::array<double, 3> tilt = {0, 0, 0}) {
+  SurfaceNetsOptions o = net_options(dim, iterations, triangles, threads);
+  o.voronoi.periodic = {true, true, dim == 3};
+  o.voronoi.tilt = tilt;
+  return o;
+}
+
+/// Directed edges (3D; 2D: segment ends) of every region's faces over copies
+/// of vertices (tessera::vertex_copies) that have no reverse: 0 when each
+/// region's surface closes up in the periodic box.
+std::size_t open_edges(const tessera::FaceSet& m, const std::vector<std::int32_t>& regions) {
+  const tessera::VertexCopies cp = tessera::vertex_copies(m);
+  const auto du = static_cast<std::size_t>(m.dim);
+  using Key = std::tuple<std::int32_t, std::int32_t, std::int32_t, std::array<std::int32_t, 3>>;
+  std::map<Key, int> balance;
+  auto shift = [&](std::int32_t v) {
+    std::array<std::int32_t, 3> s{0, 0, 0};
+    for (std::size_t a = 0; a < du; ++a) s[a] = cp.shift[static_cast<std::size_t>(v) * du + a];
+    return s;
+  };
+  for (std::int32_t r : regions)
+    for (std::size_t f = 0; f < m.n_faces(); ++f) {
+      const bool s0 = m.boundary_labels[2 * f] == r, s1 = m.boundary_labels[2 * f + 1] == r;
+      if (s0 == s1) continue;
+      std::vector<std::int32_t> loop(m.face_vertices.begin() + m.face_offsets[f],
+                                     m.face_vertices.begin() + m.face_offsets[f + 1]);
+      if (s1) std::reverse(loop.begin(), loop.end());
+      const std::size_t n = loop.size();
+      for (std::size_t k = 0; k < (m.dim == 2 ? 1 : n); ++k) {
+        const std::int32_t u = loop[k], w = loop[(k + 1) % n];
+        const auto gu = cp.group[static_cast<std::size_t>(u)], gw = cp.group[static_cast<std::size_t>(w)];
+        if (m.dim == 2) {
+          ++balance[{r, gu, -1, {}}];
+          --balance[{r, gw, -1, {}}];
+          continue;
+        }
+        const auto a = shift(u), b = shift(w);
+        ++balance[{r, gu, gw, {b[0] - a[0], b[1] - a[1], b[2] - a[2]}}];
+        --balance[{r, gw, gu, {a[0] - b[0], a[1] - b[1], a[2] - b[2]}}];
+      }
+    }
+  std::size_t open = 0;
+  for (const auto& [key, m2] : balance) open += m2 != 0;
+  return open;
+}
+
+}  // namespace
+
+TEST(SurfaceNets, PeriodicNetsCloseUpAndCopiesMoveTogether) {
+  // Surface nets in periodic boxes (orthogonal and triclinic 3D, 2D): every
+  // region's surface closes up across the box's faces, before and after
+  // smoothing and triangulation; the copies of a vertex (one per frame its
+  // cells see it from) stay exact lattice translations of each other and
+  // have one kind; 1 and 2 threads agree.
+  struct Case {
+    int dim;
+    std::array<double, 3> tilt;
+  };
+  for (const Case& k : {Case{3, {0, 0, 0}}, Case{3, {0.25, -0.125, 0.375}}, Case{2, {0.375, 0, 0}}}) {
+    SCOPED_TRACE(k.dim * 10 + (k.tilt[0] != 0));
+    const Labelled in = periodic_bands(600, k.dim, 50);
+    for (bool triangles : {false, true}) {
+      if (triangles && k.dim == 2) continue;
+      const SurfaceNet net = run(in, periodic_opts(k.dim, 20, triangles, 1, k.tilt));
+      const SurfaceNet two = run(in, periodic_opts(k.dim, 20, triangles, 2, k.tilt));
+      EXPECT_EQ(net.mesh.vertices, two.mesh.vertices);
+      EXPECT_EQ(net.mesh.face_vertices, two.mesh.face_vertices);
+      const tessera::FaceSet& m = net.mesh;
+      ASSERT_TRUE(m.is_periodic());
+      ASSERT_EQ(m.side_shifts.size(), m.n_faces() * static_cast<std::size_t>(k.dim));
+      EXPECT_GT(m.n_faces(), 0u);
+      EXPECT_GT(net.max_displacement, 0.0);
+      EXPECT_EQ(open_edges(m, {0, 1, 2}), 0u);
+      const tessera::VertexCopies cp = tessera::vertex_copies(m);
+      EXPECT_LT(cp.n_groups(), m.n_vertices());  // some vertices are seen from several frames
+      const auto du = static_cast<std::size_t>(k.dim);
+      double worst = 0;
+      for (std::size_t v = 0; v < m.n_vertices(); ++v) {
+        const auto f = static_cast<std::size_t>(cp.first[static_cast<std::size_t>(cp.group[v])]);
+        EXPECT_EQ(net.vertex_kind[v], net.vertex_kind[f]);
+        for (std::size_t a = 0; a < du; ++a) {
+          double t = 0;
+          for (std::size_t b = 0; b < du; ++b) t += cp.shift[v * du + b] * m.lattice[b][a];
+          worst = std::max(worst, std::fabs(m.vertices[v * du + a] - (m.vertices[f * du + a] + t)));
+        }
+      }
+      EXPECT_LE(worst, 1e-15);
+    }
+  }
+}
+
+TEST(SurfaceNets, PeriodicSmoothingEqualsTheNetOfTiledImages) {
+  // The periodic net against an oracle: the ordinary net of the points'
+  // 3 x 3 x 3 images (walls far away) smooths each vertex of the middle
+  // region as the periodic net smooths it, as long as the smoothing's reach
+  // (two iterations: two polygon edges) stays inside the tiling.
+  const Labelled in = periodic_bands(150, 3, 51);
+  const SurfaceNet before = run(in, periodic_opts(3, 0));
+  const SurfaceNet after = run(in, periodic_opts(3, 2));
+  Labelled tiled;
+  for (int sx = -1; sx <= 1; ++sx)
+    for (int sy = -1; sy <= 1; ++sy)
+      for (int sz = -1; sz <= 1; ++sz)
+        for (std::size_t i = 0; i < 150; ++i) {
+          tiled.points.insert(tiled.points.end(),
+                              {in.points[3 * i] + sx, in.points[3 * i + 1] + sy, in.points[3 * i + 2] + sz});
+          tiled.labels.push_back(in.labels[i]);
+        }
+  SurfaceNetsOptions o = net_options(3, 0);
+  o.voronoi.bounds->lo = {-1, -1, -1};
+  o.voronoi.bounds->hi = {2, 2, 2};
+  const SurfaceNet tiled_before = run(tiled, o);
+  o.smoothing.iterations = 2;
+  const SurfaceNet tiled_after = run(tiled, o);
+  ASSERT_EQ(before.mesh.n_vertices(), after.mesh.n_vertices());
+  ASSERT_EQ(tiled_before.mesh.n_vertices(), tiled_after.mesh.n_vertices());
+  std::size_t matched = 0;
+  double worst = 0;
+  for (std::size_t v = 0; v < before.mesh.n_vertices(); ++v) {
+    const double* x = &before.mesh.vertices[3 * v];
+    for (std::size_t w = 0; w < tiled_before.mesh.n_vertices(); ++w) {
+      const double* y = &tiled_before.mesh.vertices[3 * w];
+      if (std::fabs(x[0] - y[0]) + std::fabs(x[1] - y[1]) + std::fabs(x[2] - y[2]) > 1e-12) continue;
+      ++matched;
+      EXPECT_EQ(after.vertex_kind[v], tiled_after.vertex_kind[w]);
+      for (int a = 0; a < 3; ++a) worst = std::max(worst, std::fabs(after.mesh.vertices[3 * v + a] - tiled_after.mesh.vertices[3 * w + a]));
+      break;
+    }
+  }
+  EXPECT_EQ(matched, before.mesh.n_vertices());
+  EXPECT_LE(worst, 1e-12);
+  EXPECT_GT(after.max_displacement, 1e-3);
+}
