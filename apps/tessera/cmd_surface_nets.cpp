@@ -135,18 +135,18 @@ NetInput read_net_input(const SurfaceNetsArgs& a) {
 
 SurfaceNetsOptions net_options(const SurfaceNetsArgs& a, const NetInput& in) {
   SurfaceNetsOptions o;
-  o.voronoi = make_options(a.compute, in.dim);
+  ComputeArgs compute = a.compute;
   if (in.from_image && a.compute.bounds.empty()) {
     // The domain is the image's voxels: half a spacing beyond the outer
-    // voxel centres, so surfaces reaching the image border lie on the box.
-    Bounds b;
+    // voxel centres, so surfaces reaching the image border lie on the box,
+    // and with --periodic the image tiles space (a periodic microstructure).
     for (int d = 0; d < in.dim; ++d) {
       const double h = in.geometry.spacing[d], o0 = in.geometry.origin[d];
-      b.lo[d] = o0 - 0.5 * h;
-      b.hi[d] = o0 + (static_cast<double>(in.geometry.size[d]) - 0.5) * h;
+      compute.bounds.push_back(o0 - 0.5 * h);
+      compute.bounds.push_back(o0 + (static_cast<double>(in.geometry.size[d]) - 0.5) * h);
     }
-    o.voronoi.bounds = b;
   }
+  o.voronoi = make_options(compute, in.dim);
   o.select = a.select;
   o.background_label = a.background_label;
   o.capping = a.capping;
@@ -348,6 +348,14 @@ int run_surface_nets(const SurfaceNetsArgs& a) {
                 in.dim == 3 ? ("x" + std::to_string(in.geometry.size[2])).c_str() : "");
   std::printf("  %-18s %s\n", "selected labels", label_list(net.selected).c_str());
   std::printf("  %-18s %zu\n", "cells", net.n_cells);
+  if (m.is_periodic()) {
+    std::string axes;
+    for (int k = 0; k < m.dim; ++k)
+      if (m.periodic[static_cast<std::size_t>(k)]) axes += "xyz"[k];
+    std::printf("  %-18s %s%s; %zu of the %zu vertices repeat others across the box's faces\n",
+                "periodic", axes.c_str(), a.compute.tilt.empty() ? "" : ", triclinic",
+                m.n_vertices() - vertex_copies(m).n_groups(), m.n_vertices());
+  }
   if (m.dim == 3 && a.triangles)
     std::printf("  %-18s %zu triangles from %zu polygons\n", "faces", m.n_faces(), polygon_count(net));
   else

@@ -313,8 +313,11 @@ int main(int argc, char** argv) {
       ->allow_extra_args(false)
       ->delimiter(',');
   flower->add_option("-o,--output", wa.output,
-                     "Flower as VTK PolyData (.vtp): point data Radius, Role, GeneratorId, PointId");
+                     "Flower as VTK PolyData (.vtp): point data Radius, Role, GeneratorId, PointId; with --periodic "
+                     "the cell lies where its point is wrapped to, and each neighbour is drawn at the image across "
+                     "its face");
   flower->add_flag("--glyphs", wa.glyphs, "Also draw each petal and the circumflower as a circle (2D) / sphere (3D)");
+  add_periodic_option(flower, wa.compute);
   flower->add_flag("-q,--quiet", wa.quiet, "No summary and no progress bar");
 
   // Generalized surface nets (cmd_surface_nets.cpp).

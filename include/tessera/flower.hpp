@@ -21,7 +21,7 @@ namespace tessera {
 struct Flower {
   int dim = 3;
   std::int32_t generator = -1;
-  std::array<double, 3> site{0, 0, 0};      ///< the generator's position (z = 0 in 2D)
+  std::array<double, 3> site{0, 0, 0};      ///< the generator's position (z = 0 in 2D; in a periodic box as wrapped)
   /// Petals: one per cell vertex. The centres are the cell's merged vertices
   /// (their ids in Cells in `vertex_ids`), in ascending vertex id.
   std::vector<std::int32_t> vertex_ids;
@@ -36,6 +36,14 @@ struct Flower {
   std::vector<std::int32_t> face_neighbor;
   /// The neighbours that clipped the cell (generators across its faces), ascending.
   std::vector<std::int32_t> neighbors;
+  /// Where each neighbour is (n_neighbors * dim): its point, or in a periodic
+  /// box the image across the face (its point as wrapped, moved by its shift).
+  std::vector<double> neighbor_positions;
+  /// Periodic boxes only, else empty: the shift of each neighbour's image
+  /// (n_neighbors * dim, Cells::neighbor_shifts) and of each face's
+  /// (n_faces * dim, Cells::face_shift; 0 for a wall).
+  std::vector<std::int8_t> neighbor_shifts;
+  std::vector<std::int8_t> face_shifts;
 
   std::size_t n_petals() const { return petal_radii.size(); }
 };

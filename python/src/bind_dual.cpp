@@ -138,7 +138,21 @@ void bind_dual(py::module_& m) {
                              [](py::object s) { return view_flat(s.cast<const Flower&>().face_vertices, s); })
       .def_property_readonly("face_neighbor",
                              [](py::object s) { return view_flat(s.cast<const Flower&>().face_neighbor, s); })
-      .def_property_readonly("neighbors", [](py::object s) { return view_flat(s.cast<const Flower&>().neighbors, s); });
+      .def_property_readonly("neighbors", [](py::object s) { return view_flat(s.cast<const Flower&>().neighbors, s); })
+      .def_property_readonly("neighbor_positions",
+                             [](py::object s) {
+                               const Flower& f = s.cast<const Flower&>();
+                               return view_rows(f.neighbor_positions, static_cast<std::size_t>(f.dim), s);
+                             })
+      .def_property_readonly("neighbor_shifts",
+                             [](py::object s) {
+                               const Flower& f = s.cast<const Flower&>();
+                               return view_rows(f.neighbor_shifts, static_cast<std::size_t>(f.dim), s);
+                             })
+      .def_property_readonly("face_shifts", [](py::object s) {
+        const Flower& f = s.cast<const Flower&>();
+        return view_rows(f.face_shifts, static_cast<std::size_t>(f.dim), s);
+      });
 
   py::class_<FlowerSet>(m, "Flowers", "Result of flowers(): one Flower per requested point.")
       .def("__len__", [](const FlowerSet& s) { return s.flowers.size(); })

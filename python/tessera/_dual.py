@@ -512,6 +512,24 @@ class Flower:
         """int32: the points that clipped the cell (across its faces), ascending."""
         return self._fl.neighbors
 
+    @property
+    def neighbor_positions(self) -> np.ndarray:
+        """float64 (len(neighbors), D): where each neighbour is; in a periodic
+        box the image across the face."""
+        return self._fl.neighbor_positions
+
+    @property
+    def neighbor_shifts(self) -> np.ndarray:
+        """int8 (len(neighbors), D), periodic boxes only (empty otherwise):
+        each neighbour's image, as :attr:`Voronoi.neighbor_shifts`."""
+        return self._fl.neighbor_shifts
+
+    @property
+    def face_shifts(self) -> np.ndarray:
+        """int8 (n_faces, D), periodic boxes only (empty otherwise): the image
+        across each face (0 for a wall)."""
+        return self._fl.face_shifts
+
     def __repr__(self) -> str:
         return (f"<tessera.Flower of point {self.generator}: {self.n_petals} petals, "
                 f"circumflower radius {self.circumflower_radius:.6g}, {len(self.neighbors)} neighbours>")

@@ -9,6 +9,7 @@ import numpy as np
 
 from . import _core, _inputs
 from ._dual import FaceSet
+from ._voronoi import _periodic_axes, _tilts
 
 PathLike = Union[str, "os.PathLike[str]"]
 
@@ -37,6 +38,12 @@ class SurfaceNet(FaceSet):
     as regions. With ``triangles=True`` (3D) each polygon is split into
     triangles that copy its sides and labels; :attr:`polygon_of_face` maps them
     back. Arrays are read-only views of the compiled result.
+
+    In a periodic box (``surface_nets(..., periodic=...)``) each face lies
+    where its side-0 cell is, and a vertex seen from several frames is listed
+    once per frame, the copies lattice translations apart (they move as one);
+    every region's surface is closed once copies are identified
+    (:attr:`vertex_key_shifts`, :attr:`side_shifts`).
     """
 
     def __init__(self, net: Any, points: np.ndarray, labels: np.ndarray, options: Dict[str, Any]):
@@ -140,6 +147,8 @@ def surface_nets(
     threads: Optional[int] = None,
     *,
     ignore_outside: bool = False,
+    periodic: Any = False,
+    tilt: Optional[Sequence[float]] = None,
 ) -> SurfaceNet:
     """Generalized surface nets: the surfaces between the regions of labelled points.
 
@@ -174,6 +183,12 @@ def surface_nets(
         3D: split each polygon into triangles (labels and sides copied).
     bounds, padding, threads, ignore_outside
         As in :func:`tessera.voronoi`.
+    periodic, tilt
+        A periodic box, as in :func:`tessera.voronoi` (``bounds`` is the box):
+        the regions wrap around it, each face lies where its side-0 cell is
+        (:attr:`side_shifts` names side 1's image), and the copies of a vertex
+        seen from several frames are smoothed as one, so every region's
+        surface closes up across the box's faces.
 
     Returns
     -------
@@ -192,6 +207,12 @@ def surface_nets(
     dim = pts.shape[1]
     if labels is None:
         raise ValueError("labels: surface nets need one region label per point")
+    per = _periodic_axes(periodic, dim)
+    if any(per) and bounds is None:
+        raise ValueError("periodic: give bounds, the box that repeats")
+    tilts = _tilts(tilt, dim)
+    if any(tilts) and not any(per):
+        raise ValueError("tilt: give periodic axes (a triclinic box repeats along its tilted axes)")
     lab = _inputs.as_labels(labels, pts.shape[0])
     sel = [] if select is None else _inputs.as_label_list(select, "select")
     if select is not None and not sel:
@@ -210,5 +231,5 @@ def surface_nets(
     net = _inputs.call(
         _core.surface_nets, pts, lab, sel, bg, bool(capping), iterations, relaxation, limit,
         bool(constraint_is_absolute), bool(triangles), _inputs.as_bounds(bounds, dim), _inputs.as_padding(padding),
-        bool(ignore_outside), _inputs.as_threads(threads))
+        bool(ignore_outside), _inputs.as_threads(threads), per, tilts)
     return SurfaceNet(net, pts, lab, options)

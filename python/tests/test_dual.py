@@ -316,6 +316,31 @@ def test_faces_of_periodic_cells(tmp_path, dim):
     assert plain.side_shifts.size == 0 and plain.vertex_key_shifts.size == 0
 
 
+def test_flowers_of_periodic_cells(tmp_path):
+    # The flower of a periodic cell: its site is the point as wrapped, its
+    # neighbours sit at the images across its faces (shifts as the cells'),
+    # and the saved flower draws them there.
+    pts = random_points(300, 3, seed=15)
+    v = tessera.voronoi(pts, bounds=UNIT_BOX[3], periodic=True, merge=True)
+    fl = tessera.flower(v, [0, 7])
+    for f in fl:
+        g = f.generator
+        np.testing.assert_array_equal(f.site, v.periodic_points[g])
+        off = v.neighbor_offsets
+        assert np.array_equal(f.neighbor_shifts, v.neighbor_shifts[off[v.cell_of[g]]:off[v.cell_of[g] + 1]])
+        np.testing.assert_allclose(f.neighbor_positions, v.periodic_points[f.neighbors] + f.neighbor_shifts,
+                                   rtol=0, atol=1e-15)
+        assert f.face_shifts.shape == (len(f.face_neighbor), 3)
+        assert np.all(np.linalg.norm(f.neighbor_positions - f.site, axis=1) <= f.circumflower_radius)
+    fl.save(str(tmp_path / "fl.vtp"))
+    data = read_vtp(tmp_path / "fl.vtp")
+    xyz = vtk_to_numpy(data.GetPoints().GetData())
+    role = vtk_to_numpy(data.GetPointData().GetArray("Role"))
+    np.testing.assert_array_equal(xyz[role == 2], np.concatenate([f.neighbor_positions for f in fl]))
+    plain = tessera.flower(tessera.voronoi(pts, bounds=UNIT_BOX[3], merge=True), [0])[0]
+    assert plain.neighbor_shifts.size == 0 and np.array_equal(plain.neighbor_positions, pts[plain.neighbors])
+
+
 def test_2d_faces_vtp_are_lines(tmp_path):
     pts, lab = labelled(500, 2, seed=11)
     fs = tessera.faces(pts, labels=lab, kind="complex")

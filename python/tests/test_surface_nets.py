@@ -201,6 +201,51 @@ def test_2d_net_saves_lines(tmp_path):
     assert reader.GetOutput().GetNumberOfLines() == net.n_faces == net.to_vtk().GetNumberOfLines()
 
 
+@pytest.mark.parametrize("dim", [2, 3])
+def test_periodic_nets_close_up_across_the_box(dim, tmp_path):
+    # Three bands across x + y that wrap around a periodic (triclinic in 3D)
+    # box: with copies of a vertex identified by their keys up to a common
+    # shift, every region's surface is closed, oriented, and the copies stay
+    # lattice translations apart after smoothing; the .vtp has SideShift.
+    rng = np.random.default_rng(21)
+    pts = np.ldexp(np.floor(np.ldexp(rng.random((800, dim)) * (1 - 2e-6) + 1e-6, 30)), -30)
+    lab = (np.floor(3 * (pts[:, 0] + pts[:, 1])) % 3).astype(np.int32)
+    tilt = (0.25, 0.0, -0.125) if dim == 3 else None
+    net = tessera.surface_nets(pts, lab, bounds=UNIT_BOX[dim], periodic=True, tilt=tilt)
+    assert net.periodic == (True,) * dim and net.side_shifts.shape == (net.n_faces, dim)
+    keys, shifts = net.vertex_keys, net.vertex_key_shifts.astype(int)
+    lead = shifts[:, 0, :]  # no walls: every entry is a point
+    canon = {}
+    group = np.array([canon.setdefault((tuple(k), tuple((s - t).ravel())), len(canon))
+                      for k, s, t in zip(keys.tolist(), shifts, lead)])
+    lattice = np.eye(dim)
+    if dim == 3:
+        lattice[1, 0], lattice[2, 0], lattice[2, 1] = 0.25, 0.0, -0.125
+    first = {}
+    for v, g in enumerate(group):
+        first.setdefault(g, v)
+    for v, g in enumerate(group):
+        f = first[g]
+        np.testing.assert_allclose(net.vertices[v], net.vertices[f] + (lead[v] - lead[f]) @ lattice, rtol=0, atol=1e-15)
+    for label in (0, 1, 2):
+        edges = Counter()
+        for loop in oriented_faces(net, label):
+            pairs = zip(loop, loop[1:]) if dim == 2 else zip(loop, np.roll(loop, -1))
+            for a, b in pairs:
+                edges[(group[a], group[b], tuple(lead[b] - lead[a]))] += 1
+        assert edges and max(edges.values()) == 1, label
+        if dim == 3:
+            assert all(edges[(b, a, tuple(-x for x in d))] == 1 for a, b, d in edges), label
+        else:
+            assert Counter(a for a, _, _ in edges) == Counter(b for _, b, _ in edges), label
+    net.save(str(tmp_path / "net.vtp"))
+    reader = vtkXMLPolyDataReader()
+    reader.SetFileName(str(tmp_path / "net.vtp"))
+    reader.Update()
+    side = vtk_to_numpy(reader.GetOutput().GetCellData().GetArray("SideShift"))
+    assert np.array_equal(side.reshape(net.side_shifts.shape), net.side_shifts)
+
+
 def test_net_arrays_are_read_only_views():
     pts, lab = spheres(4000, 3, seed=9)
     net = tessera.surface_nets(pts, lab, capping=True)
@@ -291,6 +336,8 @@ BAD = {
     "points NaN": (dict(points=np.where(np.arange(3000)[:, None] == 9, np.nan, PTS)), r"point 9 has a NaN"),
     "bounds": (dict(bounds=(0, 1, 0, 1)), r"bounds: expected 6 numbers"),
     "threads": (dict(threads=0), r"threads: expected a positive integer"),
+    "periodic without bounds": (dict(periodic=True), r"periodic: give bounds"),
+    "tilt without periodic": (dict(bounds=(0, 1, 0, 1, 0, 1), tilt=(0.1, 0, 0)), r"tilt: give periodic axes"),
 }
 
 

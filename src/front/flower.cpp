@@ -26,7 +26,10 @@ Flower flower_of(const Cells& c, std::span<const double> points, std::int32_t id
   Flower fl;
   fl.dim = c.dim;
   fl.generator = id;
-  for (std::size_t a = 0; a < D; ++a) fl.site[a] = points[static_cast<std::size_t>(id) * D + a];
+  // A periodic box's cells lie where they took their points: wrapped into it.
+  const bool periodic = c.is_periodic();
+  const std::span<const double> at = periodic ? std::span<const double>(c.periodic_points) : points;
+  for (std::size_t a = 0; a < D; ++a) fl.site[a] = at[static_cast<std::size_t>(id) * D + a];
 
   const auto f0 = static_cast<std::size_t>(c.cell_face_offsets[k]);
   const auto f1 = static_cast<std::size_t>(c.cell_face_offsets[k + 1]);
@@ -61,13 +64,28 @@ Flower flower_of(const Cells& c, std::span<const double> points, std::int32_t id
     fl.face_neighbor.push_back(c.face_neighbor[f]);
   }
   fl.neighbors.assign(c.neighbors.begin() + c.neighbor_offsets[k], c.neighbors.begin() + c.neighbor_offsets[k + 1]);
+  if (periodic) {
+    fl.neighbor_shifts.assign(c.neighbor_shifts.begin() + c.neighbor_offsets[k] * c.dim,
+                              c.neighbor_shifts.begin() + c.neighbor_offsets[k + 1] * c.dim);
+    fl.face_shifts.assign(c.face_shift.begin() + static_cast<std::ptrdiff_t>(f0 * D),
+                          c.face_shift.begin() + static_cast<std::ptrdiff_t>(f1 * D));
+  }
+  const auto lattice = periodic ? c.lattice() : std::array<std::array<double, 3>, 3>{};
+  fl.neighbor_positions.resize(fl.neighbors.size() * D);
+  for (std::size_t e = 0; e < fl.neighbors.size(); ++e) {
+    const double* p = &at[static_cast<std::size_t>(fl.neighbors[e]) * D];
+    if (periodic)
+      periodic_image(lattice, c.dim, p, &fl.neighbor_shifts[e * D], &fl.neighbor_positions[e * D]);
+    else
+      std::copy_n(p, D, &fl.neighbor_positions[e * D]);
+  }
   return fl;
 }
 
 }  // namespace
 
 std::vector<Flower> flowers(const Cells& c, std::span<const double> points, std::span<const std::int32_t> ids) {
-  front::require_mesh(c, "flowers");
+  front::require_mesh(c, "flowers", true);
   if (points.size() != c.n_points * static_cast<std::size_t>(c.dim))
     throw std::invalid_argument("flowers: points are not the array the cells were computed from");
   std::vector<Flower> out;

@@ -276,10 +276,14 @@ void write_flowers_vtp(const std::string& path, std::span<const Flower> flowers,
       const std::int32_t v = m.point(&fl.petal_centres[p * D], fl.petal_radii[p], FlowerRole::petal_centre, gen, -1);
       m.cell(m.verts, {&v, 1}, FlowerRole::petal_centre, gen, kNoSpoke);
     }
-    for (std::int32_t j : fl.neighbors) {
+    if (fl.neighbor_positions.size() != fl.neighbors.size() * D)
+      throw std::invalid_argument("write_flowers_vtp: a flower without its neighbours' positions");
+    for (std::size_t e = 0; e < fl.neighbors.size(); ++e) {
+      const std::int32_t j = fl.neighbors[e];
       if (j < 0 || static_cast<std::size_t>(j) * D >= points.size())
         throw std::invalid_argument("write_flowers_vtp: neighbour id out of range of the points");
-      const std::int32_t v = m.point(&points[static_cast<std::size_t>(j) * D], 0, FlowerRole::neighbor, gen, j);
+      // Where the neighbour is: its point, or the image across the face.
+      const std::int32_t v = m.point(&fl.neighbor_positions[e * D], 0, FlowerRole::neighbor, gen, j);
       m.cell(m.verts, {&v, 1}, FlowerRole::neighbor, gen, kNoSpoke);
       const std::int32_t line[2] = {site, v};
       m.cell(m.lines, line, FlowerRole::spoke, gen, j);

@@ -27,6 +27,7 @@
 #include "oracle.hpp"
 #include "tessera/delaunay.hpp"
 #include "tessera/faces.hpp"
+#include "tessera/flower.hpp"
 #include "tessera/graph.hpp"
 
 namespace {
@@ -563,6 +564,58 @@ TEST(Periodic, FaceSetsOfAFewPointsTakeFacesWithTheirOwnImagesOnce) {
       EXPECT_EQ(face_entries(fs), want);
       EXPECT_EQ(2 * fs.n_faces(), want.size());
     }
+}
+
+TEST(Periodic, FlowersLieWhereTheirCellsAre) {
+  // Flowers of periodic cells (triclinic 3D, 2D): the site is the point as
+  // wrapped; each face's corners are equidistant from the site and the
+  // neighbour's image across it, which is where the flower puts that
+  // neighbour; petals reach the site; the circumflower holds every neighbour.
+  for (int dim : {2, 3}) {
+    SCOPED_TRACE(dim);
+    const auto box = make_bounds({0, 0, 0}, {1, 1, 1});
+    const Tilt tilt = dim == 3 ? Tilt{0.25, -0.125, 0.375} : Tilt{0.375, 0, 0};
+    const auto du = static_cast<std::size_t>(dim);
+    auto pts = in_parallelepiped(200, dim, 48, box, tilt);
+    for (std::size_t a = 0; a < du; ++a) pts[a] += 1.0 * (a == 0);  // point 0 given a period out: wrapped back
+    auto o = periodic_options(dim, box, {true, true, dim == 3}, 1, tilt);
+    o.build_mesh = true;
+    const tessera::Cells c = tessera::voronoi(pts, dim, {}, o);
+    std::vector<std::int32_t> ids(200);
+    for (std::int32_t i = 0; i < 200; ++i) ids[static_cast<std::size_t>(i)] = i;
+    const auto fl = tessera::flowers(c, pts, ids);
+    for (const tessera::Flower& f : fl) {
+      const auto i = static_cast<std::size_t>(f.generator);
+      for (std::size_t a = 0; a < du; ++a) ASSERT_EQ(f.site[a], c.periodic_points[i * du + a]);
+      ASSERT_EQ(f.neighbor_shifts.size(), f.neighbors.size() * du);
+      ASSERT_EQ(f.face_shifts.size(), f.face_neighbor.size() * du);
+      auto dist = [&](const double* x, const double* y) {
+        double d2 = 0;
+        for (std::size_t a = 0; a < du; ++a) d2 += (x[a] - y[a]) * (x[a] - y[a]);
+        return std::sqrt(d2);
+      };
+      for (std::size_t p = 0; p < f.n_petals(); ++p)
+        EXPECT_NEAR(dist(&f.petal_centres[p * du], f.site.data()), f.petal_radii[p], 1e-15);
+      for (std::size_t e = 0; e < f.neighbors.size(); ++e)
+        EXPECT_LE(dist(&f.neighbor_positions[e * du], f.site.data()), f.circumflower_radius);
+      for (std::size_t face = 0; face + 1 < f.face_offsets.size(); ++face) {
+        const std::int32_t j = f.face_neighbor[face];
+        ASSERT_GE(j, 0);
+        // The neighbour entry of this face: same id and shift.
+        std::size_t e = 0;
+        while (e < f.neighbors.size() &&
+               !(f.neighbors[e] == j && std::equal(&f.neighbor_shifts[e * du], &f.neighbor_shifts[e * du] + du,
+                                                   &f.face_shifts[face * du])))
+          ++e;
+        ASSERT_LT(e, f.neighbors.size());
+        const double* q = &f.neighbor_positions[e * du];
+        for (auto t = f.face_offsets[face]; t < f.face_offsets[face + 1]; ++t) {
+          const double* x = &f.petal_centres[static_cast<std::size_t>(f.face_vertices[static_cast<std::size_t>(t)]) * du];
+          EXPECT_NEAR(dist(x, f.site.data()), dist(x, q), 1e-12);
+        }
+      }
+    }
+  }
 }
 
 TEST(Periodic, SurfaceNetFacesOfSlabsInALatticeAreTwoPlanes) {

@@ -423,6 +423,33 @@ class Flower(base.TempDirCase):
                 self.assertEqual(set(cell_role) >= {5, 6}, glyphs)
                 self.assertEqual(int(np.sum(cell_role == 3)), int(np.sum(role == 2)), "one spoke line per neighbour")
 
+    def test_periodic_flower(self):
+        # A periodic box: the cell of a point near a corner reaches across the
+        # box's faces; its site is the point as wrapped, its neighbours are
+        # drawn at the images across its faces (each at the petal-empty
+        # distance: within the circumflower, none strictly inside a petal).
+        pts = np.ldexp(np.floor(np.ldexp(np.random.default_rng(45).random((300, 3)) * (1 - 2e-6) + 1e-6, 30)), -30)
+        pts[0] = [1 / 128, 1 / 64, 1 - 1 / 128]  # on the box's grid: kept as is
+        out = self.p("pfl.vtp")
+        self.ok(["flower", self.save("pfl.npy", pts), "--point", "0", "--bounds", *base.BOX3, "--periodic", "xyz",
+                 "-o", out, "-q"])
+        pd = read_vtp(out)
+        P = vtk_to_numpy(pd.GetPoints().GetData())
+        radius = vtk_to_numpy(pd.GetPointData().GetArray("Radius"))
+        role = vtk_to_numpy(pd.GetPointData().GetArray("Role"))
+        pid = vtk_to_numpy(pd.GetPointData().GetArray("PointId"))
+        np.testing.assert_array_equal(P[role == 0][0], pts[0])
+        petals = role == 1
+        self.assertTrue(np.any(P[petals] < 0) and np.any(P[petals] > 1), "the cell crosses the box's faces")
+        neigh = np.flatnonzero(role == 2)
+        self.assertTrue(np.any((P[neigh] < 0) | (P[neigh] > 1)), "some neighbours are images")
+        d = np.linalg.norm(P[neigh] - pts[0], axis=1)
+        self.assertTrue(np.all(d <= radius[role == 0][0]))
+        for k in neigh:  # an image of its point: the point moved by whole periods
+            np.testing.assert_allclose(np.mod(P[k] - pts[pid[k]] + 0.5, 1.0), 0.5, atol=1e-12)
+        for c, r in zip(P[petals], radius[petals]):
+            self.assertGreaterEqual(np.linalg.norm(P[neigh] - c, axis=1).min(), r * (1 - 1e-9))
+
 
 class HelpAndSummary(base.TempDirCase):
     def test_help(self):
@@ -431,8 +458,8 @@ class HelpAndSummary(base.TempDirCase):
             self.assertIn(sub, top)
         options = {"graph": ("--csr", "--spoke-classes", "--spoke-measures", "--spoke-shifts", "--periodic",
                              "--tilt", "--prune-tolerance"),
-                   "faces": ("--kind", "--capping"),
-                   "flower": ("--point", "--glyphs")}
+                   "faces": ("--kind", "--capping", "--periodic", "--tilt"),
+                   "flower": ("--point", "--glyphs", "--periodic", "--tilt")}
         for sub, own in options.items():
             r = run([sub, "--help"])
             self.assertEqual(r.returncode, 0)
