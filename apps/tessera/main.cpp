@@ -377,6 +377,7 @@ int main(int argc, char** argv) {
       "triangulation_s,repeat}}");
   add_compute_options(bench_sn, bsna.compute, bench_sn_bounds);
   add_surface_nets_options(bench_sn, bsna, true);
+  add_periodic_option(bench_sn, bsna.compute);
 
   DemoArgs da;
   CLI::App* demo = app.add_subcommand(

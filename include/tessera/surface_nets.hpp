@@ -18,6 +18,14 @@
 // with the region on side 0, plus the reversed faces with it on side 1) is
 // closed and outward-facing.
 //
+// Periodic boxes (voronoi.periodic, voronoi.tilt): regions wrap around the box.
+// Faces lie where their side-0 cell is (FaceSet::side_shifts names side 1's
+// image), a vertex is listed once per frame its cells see it from, and its
+// copies (vertex_copies, faces.hpp) are smoothed as one: the stencil is the
+// union of the copies' stencils, each brought into one frame, and the copies
+// stay lattice translations of each other, so every region's surface closes
+// up across the box's faces.
+//
 // Smoothing. Each merged vertex is classified from its topological
 // coordinate by the number of distinct regions among its D+1 generators —
 // counting the domain box planes each as its own region and every unselected
@@ -129,7 +137,9 @@ SurfaceNet surface_nets(std::span<const double> points, std::span<const std::int
 /// intact (exposed for tests): classifies the vertices as above (`labels` =
 /// the labels of the points the face set was computed from; box planes are
 /// their own regions), smooths `mesh.vertices` in place and returns the kinds.
-/// `points` gives the local spacing. Returns max displacement via `moved`.
+/// `points` gives the local spacing (for a periodic face set, the points as
+/// the cells took them: Cells::periodic_points). Returns max displacement
+/// via `moved`.
 std::vector<NetVertexKind> smooth_surface_net(FaceSet& mesh, std::span<const double> points,
                                               std::span<const std::int32_t> labels,
                                               const SmoothingOptions& options, double& moved);

@@ -698,10 +698,12 @@ TEST(SurfaceNets, PeriodicNetsCloseUpAndCopiesMoveTogether) {
     int dim;
     std::array<double, 3> tilt;
     bool voxels;  // exact voxel centres: several vertices share each corner
+    bool walls;   // y not periodic: walls there, capped
   };
-  for (const Case& k : {Case{3, {0, 0, 0}, false}, Case{3, {0.25, -0.125, 0.375}, false}, Case{2, {0.375, 0, 0}, false},
-                        Case{3, {0, 0, 0}, true}, Case{2, {0, 0, 0}, true}}) {
-    SCOPED_TRACE(k.dim * 100 + (k.tilt[0] != 0) * 10 + k.voxels);
+  for (const Case& k : {Case{3, {0, 0, 0}, false, false}, Case{3, {0.25, -0.125, 0.375}, false, false},
+                        Case{2, {0.375, 0, 0}, false, false}, Case{3, {0, 0, 0}, true, false},
+                        Case{2, {0, 0, 0}, true, false}, Case{3, {0, 0, 0}, false, true}, Case{3, {0, 0, 0}, true, true}}) {
+    SCOPED_TRACE(k.dim * 1000 + (k.tilt[0] != 0) * 100 + k.voxels * 10 + k.walls);
     Labelled in = periodic_bands(600, k.dim, 50);
     if (k.voxels) {
       in = grid_points(8, k.dim, 0.0, 1, [](const V3& x) { return static_cast<int>(std::floor(3 * (x[0] + x[1]))) % 3; });
@@ -709,8 +711,16 @@ TEST(SurfaceNets, PeriodicNetsCloseUpAndCopiesMoveTogether) {
     }
     for (bool triangles : {false, true}) {
       if (triangles && k.dim == 2) continue;
-      const SurfaceNet net = run(in, periodic_opts(k.dim, 20, triangles, 1, k.tilt));
-      const SurfaceNet two = run(in, periodic_opts(k.dim, 20, triangles, 2, k.tilt));
+      SurfaceNetsOptions o1 = periodic_opts(k.dim, 20, triangles, 1, k.tilt), o2 = o1;
+      o2.voronoi.threads = 2;
+      if (k.walls) {
+        for (SurfaceNetsOptions* o : {&o1, &o2}) {
+          o->voronoi.periodic[1] = false;
+          o->capping = true;
+        }
+      }
+      const SurfaceNet net = run(in, o1);
+      const SurfaceNet two = run(in, o2);
       EXPECT_EQ(net.mesh.vertices, two.mesh.vertices);
       EXPECT_EQ(net.mesh.face_vertices, two.mesh.face_vertices);
       const tessera::FaceSet& m = net.mesh;
