@@ -357,9 +357,7 @@ bool report_validation(const Cells& c, const io::PointCloud& pc, bool quiet) {
       std::printf("  %-18s not checked without the mesh's key shifts\n", "bad vertex degree");
     else
       std::printf("  %-18s %zu%s\n", "bad vertex degree", r.bad_vertex_degree,
-                  c.is_periodic() ? " (by the cells of each key's points at shift 0; exact measures not checked in a "
-                                    "periodic box)"
-                                  : "");
+                  c.is_periodic() ? " (by the cells of each key's points at shift 0)" : "");
     if (c.dim == 3) std::printf("  %-18s %zu\n", "bad Euler", r.bad_euler);
     if (r.underflowed_volumes)
       std::printf("  %-18s %zu (below the smallest double, reported as 0)\n", "tiny cells", r.underflowed_volumes);

@@ -182,6 +182,10 @@ ValidationReport validate_in_arena(const Cells& c, std::span<const std::int32_t>
   // measured once, from the first generator in its key.
   const std::size_t nv = c.n_vertices();
   const bool measuring = !points.empty() && r.volumes_checked;
+  // A periodic box's cells lie where they took their points: wrapped into it.
+  const bool periodic = c.is_periodic();
+  if (periodic && measuring) points = c.periodic_points;
+  const auto lattice = periodic ? c.lattice() : std::array<std::array<double, 3>, 3>{};
   std::vector<std::int32_t> users(nv, 0);
   std::vector<double> dist2(measuring ? nv : 0, 0.0), radius2(measuring ? nc : 0, 0.0);
   if (measuring)
@@ -191,6 +195,13 @@ ValidationReport validate_in_arena(const Cells& c, std::span<const std::int32_t>
         const std::int32_t* g = std::find_if(key, key + Du + 1, [](std::int32_t id) { return id >= 0; });
         if (g == key + Du + 1) continue;  // no generator: the degree check below fails it
         const double* p = points.data() + static_cast<std::size_t>(*g) * Du;
+        double image[3];
+        if (periodic && c.vertex_key_shifts.size() == c.vertex_keys.size() * Du) {  // the entry's image
+          const auto e = v * (Du + 1) + static_cast<std::size_t>(g - key);
+          periodic_image(lattice, c.dim, &c.periodic_points[static_cast<std::size_t>(*g) * Du],
+                         &c.vertex_key_shifts[e * Du], image);
+          p = image;
+        }
         double s = 0;
         for (std::size_t d = 0; d < Du; ++d) {
           const double x = c.vertices[v * Du + d] - p[d];
@@ -240,8 +251,7 @@ ValidationReport validate_in_arena(const Cells& c, std::span<const std::int32_t>
       });
   // In a periodic box a merged vertex is used by the cells of its key's
   // points at shift 0 (Cells::vertex_key_shifts; the entries at other shifts
-  // are images, whose copies of the vertex are other merged vertices). The
-  // exact measure is left out there: it would place the key's images.
+  // are images, whose copies of the vertex are other merged vertices).
   const bool shifted = c.is_periodic();
   const bool degrees = !shifted || c.vertex_key_shifts.size() == c.vertex_keys.size() * Du;
   if (degrees) r.bad_vertex_degree = tbb::parallel_reduce(
@@ -279,7 +289,10 @@ ValidationReport validate_in_arena(const Cells& c, std::span<const std::int32_t>
   // Every vertex used by exactly the cells of its key (so the distance
   // measured from its key's first generator is each of its cells' own) and
   // every corner resolved: the mesh can be measured exactly.
-  if (measuring && !c.is_periodic() && r.bad_vertex_degree == 0 && counts.unresolved == 0)
+  // (A periodic box's cells are measured among their keys' images, which
+  // needs every key's shifts.)
+  if (measuring && r.bad_vertex_degree == 0 && counts.unresolved == 0 &&
+      (!periodic || c.vertex_key_shifts.size() == c.vertex_keys.size() * Du))
     front::check_measures(c, points, radius2, r);
   return r;
 }

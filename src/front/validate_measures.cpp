@@ -15,9 +15,12 @@
 #include "validate_measures.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <map>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 #include <unordered_map>
@@ -61,11 +64,52 @@ struct Outcome {
   std::int32_t vertex_worst = -1;
 };
 
+/// The points a periodic cell's planes name: its generator and the images in
+/// its keys and faces, numbered locally (the generator 0, each (point,
+/// shift) from 1 in order of appearance) and placed at their images. Those
+/// sums are exact (the periodic box's grid, periodic_image), so the exact
+/// measure reads them as any input points; it decides no ties, so the local
+/// numbering does not matter.
+class LocalImages {
+ public:
+  LocalImages(const Cells& c, std::int32_t g) : c_(c), du_(static_cast<std::size_t>(c.dim)), lattice_(c.lattice()) {
+    const std::int8_t zero[3] = {0, 0, 0};
+    (void)id_of(g, zero);
+  }
+  /// The local id of point `id` moved by `shift` (dim int8); box planes
+  /// (negative ids) stay as they are.
+  std::int32_t id_of(std::int32_t id, const std::int8_t* shift) {
+    if (id < 0) return id;
+    std::array<std::int32_t, 4> key{id, 0, 0, 0};
+    for (std::size_t a = 0; a < du_; ++a) key[a + 1] = shift[a];
+    const auto [it, fresh] = ids_.try_emplace(key, static_cast<std::int32_t>(ids_.size()));
+    if (fresh) {
+      double x[3];
+      periodic_image(lattice_, c_.dim, &c_.periodic_points[static_cast<std::size_t>(id) * du_], shift, x);
+      points_.insert(points_.end(), x, x + du_);
+    }
+    return it->second;
+  }
+  const std::vector<double>& points() const { return points_; }
+
+ private:
+  const Cells& c_;
+  std::size_t du_;
+  std::array<std::array<double, 3>, 3> lattice_;
+  std::map<std::array<std::int32_t, 4>, std::int32_t> ids_;
+  std::vector<double> points_;
+};
+
 Outcome measure_cell(const Cells& c, const kernels::ExactContext& ctx, std::span<const double> points,
                      const std::vector<double>& radius2, std::size_t k) {
   const auto Du = static_cast<std::size_t>(c.dim);
   const std::size_t nv = c.n_vertices();
-  const std::int32_t g = c.generator[k];
+  // In a periodic box the cell's planes are named by (point, shift), and its
+  // generator is local point 0 (LocalImages).
+  const bool periodic = c.is_periodic();
+  std::optional<LocalImages> images;
+  if (periodic) images.emplace(c, c.generator[k]);
+  const std::int32_t g = periodic ? 0 : c.generator[k];
   std::unordered_map<std::int32_t, std::uint32_t> local;  // merged vertex -> its index in the cell
   std::vector<std::int32_t> merged;                        // the inverse
   std::vector<std::int32_t> vertex_planes;
@@ -78,11 +122,13 @@ Outcome measure_cell(const Cells& c, const kernels::ExactContext& ctx, std::span
       merged.push_back(v);
       // The vertex's planes: its key without the generator (ascending,
       // box planes negative, as exact_cell_measure takes them).
-      const std::int32_t* key = c.vertex_keys.data() + static_cast<std::size_t>(v) * (Du + 1);
+      const std::size_t e0 = static_cast<std::size_t>(v) * (Du + 1);
+      const std::int32_t* key = c.vertex_keys.data() + e0;
       std::size_t own = 0;
       for (std::size_t d = 0; d <= Du; ++d) {
-        if (key[d] == g) ++own;
-        else vertex_planes.push_back(key[d]);
+        const std::int32_t id = periodic ? images->id_of(key[d], &c.vertex_key_shifts[(e0 + d) * Du]) : key[d];
+        if (id == g) ++own;
+        else vertex_planes.push_back(id);
       }
       o.keyed &= own == 1;
     }
@@ -98,7 +144,10 @@ Outcome measure_cell(const Cells& c, const kernels::ExactContext& ctx, std::span
     // 3D: the cone over each edge a -> b of the face's loop
     // (counter-clockwise from outside) from the foot of its plane. 2D: a
     // face is an edge, its two vertices counter-clockwise (the shoelace term).
-    const std::int32_t plane = c.dim == 3 ? c.face_neighbor[static_cast<std::size_t>(f)] : 0;
+    const auto fu = static_cast<std::size_t>(f);
+    const std::int32_t plane = c.dim != 3 ? 0
+                               : periodic ? images->id_of(c.face_neighbor[fu], &c.face_shift[fu * Du])
+                                          : c.face_neighbor[fu];
     const std::size_t m = q1 - q0;
     for (std::size_t t = 0; t < (c.dim == 3 ? m : 1); ++t) {
       const std::uint32_t a = index_of(c.face_vertices[q0 + t]);
@@ -107,9 +156,14 @@ Outcome measure_cell(const Cells& c, const kernels::ExactContext& ctx, std::span
     }
   }
   if (!o.keyed) return o;
+  kernels::ExactContext local_ctx = ctx;
+  if (periodic) {
+    local_ctx.points = images->points().data();
+    points = images->points();
+  }
   double centroid[3] = {0, 0, 0};
   try {
-    o.exact = kernels::exact_cell_measure(ctx, g, vertex_planes, terms, centroid);
+    o.exact = kernels::exact_cell_measure(local_ctx, g, vertex_planes, terms, centroid);
   } catch (const std::logic_error&) {  // exact_vertex: the key's planes meet in no point
     o.solvable = false;
     return o;
@@ -133,7 +187,7 @@ Outcome measure_cell(const Cells& c, const kernels::ExactContext& ctx, std::span
   // the last bits for exact ones; the tolerance allows 2^-28.
   for (std::size_t l = 0; l < merged.size(); ++l) {
     double y[3] = {0, 0, 0};
-    kernels::exact_vertex(ctx, g, vertex_planes.data() + l * Du, y);  // solvable: the measure solved it
+    kernels::exact_vertex(local_ctx, g, vertex_planes.data() + l * Du, y);  // solvable: the measure solved it
     const double* v = c.vertices.data() + static_cast<std::size_t>(merged[l]) * Du;
     double off = 0;
     for (std::size_t d = 0; d < Du; ++d) off = std::max(off, std::fabs(v[d] - (p[d] + y[d])));

@@ -801,6 +801,17 @@ TEST(Triclinic, RandomPointsThreadsAndValidation) {
   tessera::Cells moved = a;
   moved.vertex_key_shifts[0] = static_cast<std::int8_t>(moved.vertex_key_shifts[0] + 1);
   EXPECT_EQ(tessera::validate(moved, {}, pts).bad_vertex_degree, 1u);
+  // Sampled cells are measured exactly among their keys' images (since stop
+  // 76), and a volume off by 1e-6 relative is seen: the smallest cell's, one
+  // the sample always takes.
+  EXPECT_GT(r.measures_checked, 100u);
+  EXPECT_LT(r.measure_rel_error, 1e-9);
+  tessera::Cells off = a;
+  const auto smallest = static_cast<std::size_t>(std::min_element(off.volume.begin(), off.volume.end()) - off.volume.begin());
+  off.volume[smallest] *= 1 + 1e-6;
+  const tessera::ValidationReport ro = tessera::validate(off, {}, pts);
+  EXPECT_FALSE(ro.ok);
+  EXPECT_EQ(ro.measure_worst, off.generator[smallest]);
   // The tilts as rounded to x's and y's grids (a few 2^-52 at a few box lengths).
   EXPECT_NEAR(a.tilt[0], 0.3, 0x1p-46);
   EXPECT_NEAR(a.tilt[1], -0.2, 0x1p-46);
