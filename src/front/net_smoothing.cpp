@@ -287,7 +287,7 @@ std::vector<NetVertexKind> smooth_surface_net(FaceSet& mesh, std::span<const dou
   });
 
   // The Jacobi step moves groups of copies of one vertex (a periodic face
-  // set's; every vertex alone otherwise: front/vertex_copies.hpp), each by
+  // set's; every vertex alone otherwise: vertex_copies, faces.hpp), each by
   // its first copy's constraint, over the union of its copies' stencils
   // brought into its frame; its copies then follow by their translations,
   // so the surface stays closed across the box's faces.
@@ -299,13 +299,11 @@ std::vector<NetVertexKind> smooth_surface_net(FaceSet& mesh, std::span<const dou
   };
   // Group stencils: (group, translation from this group's first copy to the
   // neighbour copy's group's first copy's frame), unique.
-  std::vector<std::int64_t> g_off(ng + 1, 0);
+  std::vector<std::int64_t> g_off;
   std::vector<std::int32_t> g_nbr;
   std::vector<double> g_rel;  // periodic only: dn per entry, added to the neighbour group's position
-  if (!periodic) {
-    g_off = st.offsets;
-    g_nbr = st.neighbors;
-  } else {
+  if (periodic) {
+    g_off.assign(ng + 1, 0);
     std::vector<std::vector<std::int32_t>> members(ng);
     for (std::size_t v = 0; v < nv; ++v) members[static_cast<std::size_t>(copies.group[v])].push_back(static_cast<std::int32_t>(v));
     std::vector<std::vector<std::array<std::int32_t, 4>>> entries(ng);  // (group, shift)
@@ -337,6 +335,9 @@ std::vector<NetVertexKind> smooth_surface_net(FaceSet& mesh, std::span<const dou
       }
     });
   }
+  // Without a box the groups' stencils are the vertices' own.
+  const std::span<const std::int64_t> stencil_off = periodic ? std::span<const std::int64_t>(g_off) : st.offsets;
+  const std::span<const std::int32_t> stencil = periodic ? std::span<const std::int32_t>(g_nbr) : st.neighbors;
   // A copy's position from its group's: the group's plus its translation.
   std::vector<double> offset;  // periodic only: dn per vertex
   if (periodic) {
@@ -383,7 +384,7 @@ std::vector<NetVertexKind> smooth_surface_net(FaceSet& mesh, std::span<const dou
       const auto v = static_cast<std::size_t>(copies.first[g]);
       double* out = &gnxt[g * dn];
       const double* x = &gcur[g * dn];
-      const auto b = g_off[g], e = g_off[g + 1];
+      const auto b = stencil_off[g], e = stencil_off[g + 1];
       if (b == e) {
         std::copy_n(x, dn, out);
         return;
@@ -391,7 +392,7 @@ std::vector<NetVertexKind> smooth_surface_net(FaceSet& mesh, std::span<const dou
       double mean[3] = {0, 0, 0};
       for (auto t = b; t < e; ++t) {
         const auto tu = static_cast<std::size_t>(t);
-        const double* y = &gcur[static_cast<std::size_t>(g_nbr[tu]) * dn];
+        const double* y = &gcur[static_cast<std::size_t>(stencil[tu]) * dn];
         if (periodic)
           for (std::size_t a = 0; a < dn; ++a) mean[a] += y[a] + g_rel[tu * dn + a];
         else
