@@ -8,7 +8,7 @@ from typing import Any, Optional, Sequence, Tuple, Union
 import numpy as np
 
 from . import _core, _inputs
-from ._voronoi import _periodic_axes, _tilts
+from ._voronoi import periodic_box
 
 PathLike = Union[str, "os.PathLike[str]"]
 
@@ -319,12 +319,7 @@ def delaunay(
     pts = _inputs.as_points(points)
     dim = pts.shape[1]
     lab = _inputs.as_labels(labels, pts.shape[0])
-    per = _periodic_axes(periodic, dim)
-    tilts = _tilts(tilt, dim)
-    if any(per) and bounds is None:
-        raise ValueError("periodic: give bounds, the box that repeats")
-    if any(tilts) and not any(per):
-        raise ValueError("tilt: give periodic axes (a triclinic box repeats along its tilted axes)")
+    per, tilts = periodic_box(periodic, tilt, bounds, dim)
     dt = _inputs.call(
         _core.delaunay,
         pts,

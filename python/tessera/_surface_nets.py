@@ -9,7 +9,7 @@ import numpy as np
 
 from . import _core, _inputs
 from ._dual import FaceSet
-from ._voronoi import _periodic_axes, _tilts
+from ._voronoi import periodic_box
 
 PathLike = Union[str, "os.PathLike[str]"]
 
@@ -207,12 +207,7 @@ def surface_nets(
     dim = pts.shape[1]
     if labels is None:
         raise ValueError("labels: surface nets need one region label per point")
-    per = _periodic_axes(periodic, dim)
-    if any(per) and bounds is None:
-        raise ValueError("periodic: give bounds, the box that repeats")
-    tilts = _tilts(tilt, dim)
-    if any(tilts) and not any(per):
-        raise ValueError("tilt: give periodic axes (a triclinic box repeats along its tilted axes)")
+    per, tilts = periodic_box(periodic, tilt, bounds, dim)
     lab = _inputs.as_labels(labels, pts.shape[0])
     sel = [] if select is None else _inputs.as_label_list(select, "select")
     if select is not None and not sel:

@@ -393,12 +393,7 @@ def voronoi(
     pts = _inputs.as_points(points)
     dim = pts.shape[1]
     lab = _inputs.as_labels(labels, pts.shape[0])
-    per = _periodic_axes(periodic, dim)
-    if any(per) and bounds is None:
-        raise ValueError("periodic: give bounds, the box that repeats")
-    tilts = _tilts(tilt, dim)
-    if any(tilts) and not any(per):
-        raise ValueError("tilt: give periodic axes (a triclinic box repeats along its tilted axes)")
+    per, tilts = periodic_box(periodic, tilt, bounds, dim)
     cells = _inputs.call(
         _core.voronoi,
         pts,
@@ -413,6 +408,19 @@ def voronoi(
         tilts,
     )
     return Voronoi(cells, pts, lab)
+
+
+def periodic_box(periodic: Any, tilt: Any, bounds: Any, dim: int) -> Tuple[Tuple[bool, bool, bool],
+                                                                           Tuple[float, float, float]]:
+    """``periodic`` and ``tilt`` (of voronoi, delaunay, surface_nets) as three
+    flags and (xy, xz, yz); a periodic box needs ``bounds``, a tilt periodic axes."""
+    per = _periodic_axes(periodic, dim)
+    if any(per) and bounds is None:
+        raise ValueError("periodic: give bounds, the box that repeats")
+    tilts = _tilts(tilt, dim)
+    if any(tilts) and not any(per):
+        raise ValueError("tilt: give periodic axes (a triclinic box repeats along its tilted axes)")
+    return per, tilts
 
 
 def _tilts(tilt: Any, dim: int) -> Tuple[float, float, float]:

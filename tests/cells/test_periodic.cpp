@@ -374,6 +374,16 @@ TEST(Periodic, Refused) {
   // (The Delaunay triangulation of a box with walls: test_periodic_delaunay.cpp.)
 }
 
+/// Every cell's neighbour entries as (point, neighbour, shift), sorted.
+std::vector<std::tuple<std::int32_t, std::int32_t, Shift>> all_entries(const tessera::Cells& c) {
+  std::vector<std::tuple<std::int32_t, std::int32_t, Shift>> out;
+  const auto per_cell = entries(c);
+  for (std::size_t cell = 0; cell < c.n_cells(); ++cell)
+    for (const auto& [j, s] : per_cell[cell]) out.emplace_back(c.generator[cell], j, s);
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
 /// A face set's faces as (side 0, side 1, shift), with their twins (side 1,
 /// side 0, -shift) for faces between cells: each neighbour entry once.
 std::vector<std::tuple<std::int32_t, std::int32_t, Shift>> face_entries(const tessera::FaceSet& fs) {
@@ -479,7 +489,6 @@ TEST(Periodic, FaceSetsListEachFaceOnceWithItsImage) {
     const tessera::Cells c = tessera::voronoi(pts, k.dim, labels, o);
     o.threads = 2;
     const tessera::Cells c2 = tessera::voronoi(pts, k.dim, labels, o);
-    const auto v = lattice(box, k.tilt);
 
     tessera::FaceSetOptions fo;
     fo.kind = tessera::FaceSetKind::complex;
@@ -491,11 +500,7 @@ TEST(Periodic, FaceSetsListEachFaceOnceWithItsImage) {
     ASSERT_TRUE(fs.is_periodic());
     ASSERT_EQ(fs.side_shifts.size(), fs.n_faces() * du);
     ASSERT_EQ(fs.vertex_key_shifts.size(), fs.vertex_keys.size() * du);
-    std::vector<std::tuple<std::int32_t, std::int32_t, Shift>> want;
-    const auto cell_entries = entries(c);
-    for (std::size_t cell = 0; cell < c.n_cells(); ++cell)
-      for (const auto& [j, s] : cell_entries[cell]) want.emplace_back(c.generator[cell], j, s);
-    std::sort(want.begin(), want.end());
+    const auto want = all_entries(c);
     EXPECT_EQ(face_entries(fs), want);
 
     // Geometry: on the bisector with the image, facing it.
@@ -538,7 +543,6 @@ TEST(Periodic, FaceSetsListEachFaceOnceWithItsImage) {
     EXPECT_GT(net.n_faces(), 0u);
     EXPECT_EQ(open_edges_modulo_lattice(net, 3), 0u);
     EXPECT_EQ(open_edges_modulo_lattice(net, 7), 0u);
-    (void)v;
   }
 }
 
@@ -556,11 +560,7 @@ TEST(Periodic, FaceSetsOfAFewPointsTakeFacesWithTheirOwnImagesOnce) {
       tessera::FaceSetOptions fo;
       fo.kind = tessera::FaceSetKind::complex;
       const tessera::FaceSet fs = tessera::extract_faces(c, {}, fo);
-      std::vector<std::tuple<std::int32_t, std::int32_t, Shift>> want;
-      const auto cell_entries = entries(c);
-      for (std::size_t cell = 0; cell < c.n_cells(); ++cell)
-        for (const auto& [j, s] : cell_entries[cell]) want.emplace_back(c.generator[cell], j, s);
-      std::sort(want.begin(), want.end());
+      const auto want = all_entries(c);
       EXPECT_EQ(face_entries(fs), want);
       EXPECT_EQ(2 * fs.n_faces(), want.size());
     }
