@@ -302,36 +302,60 @@ std::vector<NetVertexKind> smooth_surface_net(FaceSet& mesh, std::span<const dou
   std::vector<std::int64_t> g_off;
   std::vector<std::int32_t> g_nbr;
   std::vector<double> g_rel;  // periodic only: dn per entry, added to the neighbour group's position
+  // Periodic only: the copies of each group as CSR (a counting sort by
+  // group: ascending vertex ids within a group).
+  std::vector<std::int64_t> member_off;
+  std::vector<std::int32_t> members;
   if (periodic) {
-    g_off.assign(ng + 1, 0);
-    std::vector<std::vector<std::int32_t>> members(ng);
-    for (std::size_t v = 0; v < nv; ++v) members[static_cast<std::size_t>(copies.group[v])].push_back(static_cast<std::int32_t>(v));
-    std::vector<std::vector<std::array<std::int32_t, 4>>> entries(ng);  // (group, shift)
-    front::parallel_range(ng, 1024, [&](std::size_t g) {
-      auto& e = entries[g];
-      for (const std::int32_t v : members[g]) {
-        const auto vu = static_cast<std::size_t>(v);
+    member_off.assign(ng + 1, 0);
+    for (std::size_t v = 0; v < nv; ++v) ++member_off[static_cast<std::size_t>(copies.group[v]) + 1];
+    std::partial_sum(member_off.begin(), member_off.end(), member_off.begin());
+    members.resize(nv);
+    {
+      std::vector<std::int64_t> fill(member_off.begin(), member_off.end() - 1);
+      for (std::size_t v = 0; v < nv; ++v)
+        members[static_cast<std::size_t>(fill[static_cast<std::size_t>(copies.group[v])]++)] = static_cast<std::int32_t>(v);
+    }
+    // A group's entries (neighbour group, relative shift), sorted and unique:
+    // w's position is its group's plus shift_w; seen from v's frame, moved
+    // back by shift_v, the relative shift is shift_w - shift_v.
+    using Entry = std::array<std::int32_t, 4>;
+    auto gather = [&](std::size_t g, std::vector<Entry>& e) {
+      e.clear();
+      for (auto m = member_off[g]; m < member_off[g + 1]; ++m) {
+        const auto vu = static_cast<std::size_t>(members[static_cast<std::size_t>(m)]);
         for (auto t = st.offsets[vu]; t < st.offsets[vu + 1]; ++t) {
           const auto w = static_cast<std::size_t>(st.neighbors[static_cast<std::size_t>(t)]);
-          // w's position = its group's + shift_w; seen from v's frame, moved
-          // back by shift_v: relative shift shift_w - shift_v.
-          std::array<std::int32_t, 4> x{copies.group[w], 0, 0, 0};
+          Entry x{copies.group[w], 0, 0, 0};
           for (std::size_t a = 0; a < dn; ++a) x[a + 1] = copies.shift[w * dn + a] - copies.shift[vu * dn + a];
           e.push_back(x);
         }
       }
       std::sort(e.begin(), e.end());
       e.erase(std::unique(e.begin(), e.end()), e.end());
+    };
+    // Two passes, as build_stencils: counts, then the entries in place.
+    g_off.assign(ng + 1, 0);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, ng, 2048), [&](const tbb::blocked_range<std::size_t>& r) {
+      std::vector<Entry> e;
+      for (std::size_t g = r.begin(); g != r.end(); ++g) {
+        gather(g, e);
+        g_off[g + 1] = static_cast<std::int64_t>(e.size());
+      }
     });
-    for (std::size_t g = 0; g < ng; ++g) g_off[g + 1] = g_off[g] + static_cast<std::int64_t>(entries[g].size());
+    std::partial_sum(g_off.begin(), g_off.end(), g_off.begin());
     g_nbr.resize(static_cast<std::size_t>(g_off[ng]));
     g_rel.resize(g_nbr.size() * dn);
-    front::parallel_range(ng, 1024, [&](std::size_t g) {
-      auto o = static_cast<std::size_t>(g_off[g]);
-      for (const auto& x : entries[g]) {
-        g_nbr[o] = x[0];
-        translation(&x[1], &g_rel[o * dn]);
-        ++o;
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, ng, 2048), [&](const tbb::blocked_range<std::size_t>& r) {
+      std::vector<Entry> e;
+      for (std::size_t g = r.begin(); g != r.end(); ++g) {
+        gather(g, e);
+        auto o = static_cast<std::size_t>(g_off[g]);
+        for (const Entry& x : e) {
+          g_nbr[o] = x[0];
+          translation(&x[1], &g_rel[o * dn]);
+          ++o;
+        }
       }
     });
   }
@@ -448,9 +472,12 @@ std::vector<NetVertexKind> smooth_surface_net(FaceSet& mesh, std::span<const dou
           std::atomic_ref<std::uint8_t>(freeze[static_cast<std::size_t>(loop[q])]).store(1, std::memory_order_relaxed);
       });
       if (periodic) {  // a frozen copy freezes every copy of its vertex
-        std::fill(group_frozen.begin(), group_frozen.end(), 0);
-        for (std::size_t v = 0; v < nv; ++v) group_frozen[static_cast<std::size_t>(copies.group[v])] |= freeze[v];
-        for (std::size_t v = 0; v < nv; ++v) freeze[v] = group_frozen[static_cast<std::size_t>(copies.group[v])];
+        front::parallel_range(ng, 4096, [&](std::size_t g) {
+          std::uint8_t any = 0;
+          for (auto m = member_off[g]; m < member_off[g + 1]; ++m) any |= freeze[static_cast<std::size_t>(members[static_cast<std::size_t>(m)])];
+          group_frozen[g] = any;
+        });
+        front::parallel_range(nv, 4096, [&](std::size_t v) { freeze[v] = group_frozen[static_cast<std::size_t>(copies.group[v])]; });
       }
       grew = freeze != frozen;
       frozen.swap(freeze);
