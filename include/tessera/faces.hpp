@@ -120,7 +120,8 @@ struct VertexCopies {
 };
 
 /// The copies of each vertex of `faces` (every vertex alone, with no
-/// shifts, when it is not periodic).
+/// shifts, when it is not periodic). std::invalid_argument for a periodic
+/// face set without a shift per key entry.
 VertexCopies vertex_copies(const FaceSet& faces);
 
 /// Extract a face set from cells computed with VoronoiOptions::build_mesh

@@ -5,6 +5,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <numeric>
+#include <stdexcept>
 #include <tuple>
 #include <vector>
 
@@ -26,6 +27,8 @@ VertexCopies vertex_copies(const FaceSet& fs) {
     return out;
   }
   const auto du = static_cast<std::size_t>(fs.dim), kn = du + 1;
+  if ((du != 2 && du != 3) || fs.vertex_keys.size() != nv * kn || fs.vertex_key_shifts.size() != nv * kn * du)
+    throw std::invalid_argument("vertex_copies: a periodic face set needs dim 2 or 3 and a shift per key entry");
   // Per vertex: its key, relative shifts, and the first point's shift t.
   struct Row {
     std::array<std::int32_t, 4> id{};

@@ -20,6 +20,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <set>
 #include <tuple>
 #include <vector>
 
@@ -543,6 +544,25 @@ TEST(Periodic, FaceSetsListEachFaceOnceWithItsImage) {
     EXPECT_GT(net.n_faces(), 0u);
     EXPECT_EQ(open_edges_modulo_lattice(net, 3), 0u);
     EXPECT_EQ(open_edges_modulo_lattice(net, 7), 0u);
+
+    // The library's copies (tessera::vertex_copies) are this test's: the same
+    // groups, each copy the same translation from its group's first.
+    const Copies mine = vertex_copies_of(net);
+    const tessera::VertexCopies lib = tessera::vertex_copies(net);
+    ASSERT_EQ(lib.group.size(), net.n_vertices());
+    ASSERT_EQ(lib.shift.size(), net.n_vertices() * du);
+    EXPECT_LT(lib.n_groups(), net.n_vertices());
+    for (std::size_t v = 0; v < net.n_vertices(); ++v) {
+      const auto f = static_cast<std::size_t>(lib.first[static_cast<std::size_t>(lib.group[v])]);
+      EXPECT_EQ(mine.group[v], mine.group[f]);
+      EXPECT_LE(f, v);
+      for (std::size_t a = 0; a < du; ++a) EXPECT_EQ(lib.shift[v * du + a], mine.at[v][a] - mine.at[f][a]);
+    }
+    std::set<int> groups(mine.group.begin(), mine.group.end());
+    EXPECT_EQ(groups.size(), lib.n_groups());
+    tessera::FaceSet bad = net;
+    bad.vertex_key_shifts.pop_back();
+    EXPECT_THROW(tessera::vertex_copies(bad), std::invalid_argument);
   }
 }
 
