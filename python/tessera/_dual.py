@@ -29,15 +29,19 @@ def cells_for(
     padding: Optional[float],
     threads: Optional[int],
     ignore_outside: bool,
+    periodic: Any = False,
+    tilt: Optional[Sequence[float]] = None,
 ) -> Voronoi:
     """The Voronoi result a product is read from: `source` itself when it is
     one (the cell options must then be left out: they were fixed when it was
     computed), else the cells of the points `source`, with the mesh."""
     if isinstance(source, Voronoi):
-        given = [n for n, v in (("labels", labels), ("bounds", bounds), ("padding", padding), ("threads", threads))
-                 if v is not None]
+        given = [n for n, v in (("labels", labels), ("bounds", bounds), ("padding", padding), ("threads", threads),
+                                ("tilt", tilt)) if v is not None]
         if ignore_outside:
             given.append("ignore_outside")
+        if periodic is not None and periodic is not False:
+            given.append("periodic")
         if given:
             raise ValueError(
                 f"{what}: {', '.join(given)} {'is' if len(given) == 1 else 'are'} for computing cells from points; "
@@ -47,7 +51,7 @@ def cells_for(
                              "compute it with merge=True")
         return source
     return voronoi(source, labels=labels, bounds=bounds, padding=0.01 if padding is None else padding,
-                   threads=threads, merge=True, ignore_outside=ignore_outside)
+                   threads=threads, merge=True, ignore_outside=ignore_outside, periodic=periodic, tilt=tilt)
 
 
 def _check_vtp(path: PathLike, what: str) -> str:
@@ -209,6 +213,8 @@ def adjacency(
     *,
     prune_tolerance: float = 0.0,
     ignore_outside: bool = False,
+    periodic: Any = False,
+    tilt: Optional[Sequence[float]] = None,
 ) -> AdjacencyGraph:
     """The adjacency graph (wheels and spokes) of a tessellation.
 
@@ -217,7 +223,7 @@ def adjacency(
     source : Voronoi or array_like, shape (N, 2) or (N, 3)
         A :class:`Voronoi` computed with ``merge=True`` (reused as is), or
         points whose cells are computed first.
-    labels, bounds, padding, threads, ignore_outside
+    labels, bounds, padding, threads, ignore_outside, periodic, tilt
         As in :func:`tessera.voronoi`, for points only (ValueError with a
         Voronoi: its cells are already computed). The graph is read off in
         parallel on the thread count the cells were computed with.
@@ -235,7 +241,7 @@ def adjacency(
     tol = _inputs.as_float(prune_tolerance, "prune_tolerance", "a finite number >= 0")
     if not (np.isfinite(tol) and tol >= 0):
         raise ValueError(f"prune_tolerance: expected a finite number >= 0, got {prune_tolerance!r}")
-    vor = cells_for("adjacency", source, labels, bounds, padding, threads, ignore_outside)
+    vor = cells_for("adjacency", source, labels, bounds, padding, threads, ignore_outside, periodic, tilt)
     return AdjacencyGraph(_inputs.call(_core.adjacency_graph, vor._cells, tol), vor, tol)
 
 
@@ -404,6 +410,8 @@ def faces(
     threads: Optional[int] = None,
     *,
     ignore_outside: bool = False,
+    periodic: Any = False,
+    tilt: Optional[Sequence[float]] = None,
 ) -> FaceSet:
     """A face set of a tessellation: its boundary, the whole polygonal complex,
     or the surface net between regions.
@@ -422,7 +430,7 @@ def faces(
         surface-net only: add the boundary faces, so every region is enclosed.
     background_label : int
         The side-1 label of faces on the domain box; must be < 0.
-    labels, bounds, padding, threads, ignore_outside
+    labels, bounds, padding, threads, ignore_outside, periodic, tilt
         As in :func:`tessera.voronoi`, for points only (ValueError with a Voronoi).
 
     Returns
@@ -434,7 +442,7 @@ def faces(
     if capping and kind != "surface-net":
         raise ValueError(f"capping: applies to kind='surface-net' only, got kind={kind!r}")
     bg = _inputs.as_label_value(background_label, "background_label", negative=True)
-    vor = cells_for("faces", source, labels, bounds, padding, threads, ignore_outside)
+    vor = cells_for("faces", source, labels, bounds, padding, threads, ignore_outside, periodic, tilt)
     fs = _inputs.call(_core.extract_faces, vor._cells, vor.labels, kind, capping, bg)
     return FaceSet(fs, vor, capping, bg)
 
@@ -615,6 +623,8 @@ def flower(
     threads: Optional[int] = None,
     *,
     ignore_outside: bool = False,
+    periodic: Any = False,
+    tilt: Optional[Sequence[float]] = None,
 ) -> Flowers:
     """The flowers of the cells of points ``ids``, for debugging and teaching.
 
@@ -628,7 +638,7 @@ def flower(
     glyphs : bool
         Default for :meth:`Flowers.save`: add a circle (2D) / sphere (3D) per
         petal and for the circumflower.
-    labels, bounds, padding, threads, ignore_outside
+    labels, bounds, padding, threads, ignore_outside, periodic, tilt
         As in :func:`tessera.voronoi`, for points only (ValueError with a Voronoi).
 
     Returns
@@ -636,7 +646,7 @@ def flower(
     Flowers
         ``flowers[k]`` is the :class:`Flower` of ``ids[k]``.
     """
-    vor = cells_for("flower", source, labels, bounds, padding, threads, ignore_outside)
+    vor = cells_for("flower", source, labels, bounds, padding, threads, ignore_outside, periodic, tilt)
     idx = as_ids(ids, vor.points.shape[0])
     fs = _inputs.call(_core.flowers, vor._cells, vor.points, idx)
     return Flowers(fs, vor, bool(glyphs))

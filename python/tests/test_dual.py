@@ -314,6 +314,17 @@ def test_faces_of_periodic_cells(tmp_path, dim):
     assert np.array_equal(cell_data(fs.to_vtk(), "SideShift"), fs.side_shifts)
     plain = tessera.faces(tessera.voronoi(pts, bounds=UNIT_BOX[dim], merge=True), kind="complex")
     assert plain.side_shifts.size == 0 and plain.vertex_key_shifts.size == 0
+    # From points, with the box's options: the same faces.
+    direct = tessera.faces(pts, kind="complex", bounds=UNIT_BOX[dim], periodic=True, tilt=tilt)
+    assert np.array_equal(direct.face_vertices, fs.face_vertices) and np.array_equal(direct.side_shifts, fs.side_shifts)
+    assert np.array_equal(tessera.adjacency(pts, bounds=UNIT_BOX[dim], periodic=True, tilt=tilt).spoke_shifts,
+                          tessera.adjacency(v).spoke_shifts)
+    assert np.array_equal(tessera.flower(pts, [3], bounds=UNIT_BOX[dim], periodic=True, tilt=tilt)[0].face_shifts,
+                          tessera.flower(v, [3])[0].face_shifts)
+    with pytest.raises(ValueError, match="periodic"):
+        tessera.faces(v, kind="complex", periodic=True)
+    with pytest.raises(ValueError, match="periodic: give bounds"):
+        tessera.faces(pts, kind="complex", periodic=True)
 
 
 def test_flowers_of_periodic_cells(tmp_path):
