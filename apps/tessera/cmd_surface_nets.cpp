@@ -172,16 +172,16 @@ struct Watertight {
   bool closed() const { return boundary_edges == 0 && nonmanifold_edges == 0; }
 };
 
-Watertight check_watertight(const SurfaceNet& net) {
+Watertight check_watertight(const SurfaceNet& net, const VertexCopies& copies) {
   const FaceSet& m = net.mesh;
   const auto& sel = net.selected;
   auto selected = [&](std::int32_t l) { return std::binary_search(sel.begin(), sel.end(), l); };
-  const VertexCopies copies = vertex_copies(m);
   const auto du = static_cast<std::size_t>(m.dim);
   // (label, a, b, translation from a to b, direction), a <= b (by group, then
   // translation); 2D: (label, vertex, 0, 0, +1 leaving / -1 arriving).
   using Shift = std::array<std::int32_t, 3>;
   std::vector<std::tuple<std::int32_t, std::int32_t, std::int32_t, Shift, std::int8_t>> e;
+  auto group = [&](std::int32_t v) { return copies.group[static_cast<std::size_t>(v)]; };
   auto shift_of = [&](std::int32_t v) {
     Shift s{0, 0, 0};
     if (copies.periodic())
@@ -194,7 +194,6 @@ Watertight check_watertight(const SurfaceNet& net) {
       const std::int32_t l = m.boundary_labels[2 * f + side];
       if (side == 1 && !selected(l)) continue;
       const std::int8_t dir = side == 0 ? 1 : -1;
-      auto group = [&](std::int32_t v) { return copies.group[static_cast<std::size_t>(v)]; };
       if (m.dim == 2) {
         e.emplace_back(l, group(m.face_vertices[b]), 0, Shift{}, dir);
         e.emplace_back(l, group(m.face_vertices[b + 1]), 0, Shift{}, static_cast<std::int8_t>(-dir));
@@ -338,7 +337,8 @@ int run_surface_nets(const SurfaceNetsArgs& a) {
   for (std::size_t f = 0; f < m.n_faces(); ++f) pairs.emplace_back(m.boundary_labels[2 * f], m.boundary_labels[2 * f + 1]);
   std::sort(pairs.begin(), pairs.end());
   pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
-  const Watertight w = check_watertight(net);
+  const VertexCopies copies = vertex_copies(m);
+  const Watertight w = check_watertight(net, copies);
 
   std::printf("tessera surface-nets: %zu points (%dD) from %s%s\n", in.size(), in.dim, shown_path(a.compute.input).c_str(),
               in.from_image ? " (sampled image)" : "");
@@ -354,7 +354,7 @@ int run_surface_nets(const SurfaceNetsArgs& a) {
       if (m.periodic[static_cast<std::size_t>(k)]) axes += "xyz"[k];
     std::printf("  %-18s %s%s; %zu of the %zu vertices repeat others across the box's faces\n",
                 "periodic", axes.c_str(), a.compute.tilt.empty() ? "" : ", triclinic",
-                m.n_vertices() - vertex_copies(m).n_groups(), m.n_vertices());
+                m.n_vertices() - copies.n_groups(), m.n_vertices());
   }
   if (m.dim == 3 && a.triangles)
     std::printf("  %-18s %zu triangles from %zu polygons\n", "faces", m.n_faces(), polygon_count(net));
@@ -406,7 +406,7 @@ int run_bench_surface_nets(const SurfaceNetsArgs& a) {
     const SurfaceNet net = surface_nets(in.coords, in.labels, net_options(a, in));
     const double secs = seconds_since(t0);
     const Usage u1 = usage_now();
-    const Watertight w = check_watertight(net);
+    const Watertight w = check_watertight(net, vertex_copies(net.mesh));
     const std::size_t tris = net.mesh.dim == 3 && a.triangles ? net.mesh.n_faces() : triangle_count(net);
     std::printf(
         "{\"tool\":\"tessera\",\"op\":\"surface-nets\",\"n\":%zu,\"threads\":%d,\"seconds\":%.6f,\"simplices\":%zu,"

@@ -20,7 +20,6 @@
 #include "net_smoothing.hpp"
 #include "pass.hpp"
 #include "tessera/surface_nets.hpp"
-#include "vertex_copies.hpp"
 
 namespace tessera {
 namespace front {
@@ -114,21 +113,19 @@ std::vector<double> petal_radii(const FaceSet& mesh, std::span<const double> pos
                                 int k) {
   const std::size_t dn = static_cast<std::size_t>(mesh.dim), kn = dn + 1;
   const bool periodic = mesh.is_periodic();
+  const auto lattice = net_lattice(mesh, k);
   std::vector<double> petal(mesh.n_vertices(), 0.0);
   parallel_range(petal.size(), 4096, [&](std::size_t v) {
     const std::int32_t* key = &mesh.vertex_keys[v * kn];
     std::size_t a = 0;
     while (a < kn && key[a] < 0) ++a;  // box planes come first; a vertex has a generator
     if (a == kn) return;
+    const double* p = &points[static_cast<std::size_t>(key[a]) * dn];
     double g[3] = {0, 0, 0};
-    std::copy_n(&points[static_cast<std::size_t>(key[a]) * dn], dn, g);
-    if (periodic) {  // the image the key names
-      std::int32_t s[3] = {0, 0, 0};
-      for (std::size_t c = 0; c < dn; ++c) s[c] = mesh.vertex_key_shifts[(v * kn + a) * dn + c];
-      double t[3];
-      lattice_translation(mesh.lattice, mesh.dim, s, k, t);
-      for (std::size_t c = 0; c < dn; ++c) g[c] += t[c];
-    }
+    if (periodic)  // the image the key names
+      periodic_image(lattice, mesh.dim, p, &mesh.vertex_key_shifts[(v * kn + a) * dn], g);
+    else
+      std::copy_n(p, dn, g);
     double d[3] = {0, 0, 0}, d2 = 0;
     for (std::size_t c = 0; c < dn; ++c) {
       d[c] = positions[v * dn + c] - g[c];
@@ -137,6 +134,13 @@ std::vector<double> petal_radii(const FaceSet& mesh, std::span<const double> pos
     petal[v] = length(d, dn, d2);
   });
   return petal;
+}
+
+std::array<std::array<double, 3>, 3> net_lattice(const FaceSet& mesh, int k) {
+  auto lattice = mesh.lattice;
+  for (auto& row : lattice)
+    for (double& x : row) x = std::ldexp(x, k);
+  return lattice;
 }
 
 int net_frame_shift(std::span<const double> vertices, std::span<const double> points, int dim) {
@@ -294,9 +298,9 @@ std::vector<NetVertexKind> smooth_surface_net(FaceSet& mesh, std::span<const dou
   const VertexCopies copies = vertex_copies(mesh);
   const bool periodic = copies.periodic();
   const std::size_t ng = copies.n_groups();
-  auto translation = [&](const std::int32_t* shift, double* out) {
-    front::lattice_translation(mesh.lattice, D, shift, k, out);
-  };
+  const auto lattice = front::net_lattice(mesh, k);
+  const double origin[3] = {0, 0, 0};
+  auto translation = [&](const std::int32_t* shift, double* out) { periodic_image(lattice, D, origin, shift, out); };
   // Group stencils: (group, translation from this group's first copy to the
   // neighbour copy's group's first copy's frame), unique.
   std::vector<std::int64_t> g_off;

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -70,6 +71,9 @@ std::vector<double> petal_radii(const FaceSet& mesh, std::span<const double> pos
 /// (choose_scaling over the points and the vertices' extent): exact, and
 /// k = 0 for input of ordinary range.
 int net_frame_shift(std::span<const double> vertices, std::span<const double> points, int dim);
+/// A periodic face set's lattice vectors in the net's frame (scaled by 2^k,
+/// exactly), for periodic_image.
+std::array<std::array<double, 3>, 3> net_lattice(const FaceSet& mesh, int k);
 /// x scaled by 2^k, in place (exact while nothing becomes subnormal).
 inline void scale_pow2(std::vector<double>& x, int k) {
   for (double& v : x) v = std::ldexp(v, k);
