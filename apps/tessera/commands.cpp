@@ -174,6 +174,12 @@ io::PointCloud read_input(const ComputeArgs& a) {
   ro.keep_non_finite = a.ignore_outside;  // set aside by the computation, as points outside --bounds
   ro.non_finite_hint = "--ignore-outside sets such points aside";
   io::PointCloud pc = io::read_points(a.input, ro);
+  if (!a.radii.empty()) {
+    pc.radii = io::read_point_scalars(a.input, a.radii);
+    if (pc.radii.size() != pc.n)
+      throw InputError("--radii " + a.radii + ": " + std::to_string(pc.radii.size()) + " values for " +
+                       std::to_string(pc.n) + " points");
+  }
   check_against_input(a, pc);
   return pc;
 }
@@ -226,6 +232,7 @@ Cells compute(const io::PointCloud& pc, VoronoiOptions opt, bool show_progress, 
     if (InterruptGuard::interrupted()) throw Cancelled();
     bar.update(f);
   };
+  opt.radii = pc.radii;
   const auto t0 = Clock::now();
   Cells cells = voronoi(pc.coords, pc.dim, pc.labels, opt);
   seconds = seconds_since(t0);
@@ -275,6 +282,16 @@ void print_volume_line(const Cells& c, const char* name) {
 
 // ------------------------------------------------------------------ summary
 
+/// Power cells: the radii's range and the points whose cells are empty.
+void print_power_line(const io::PointCloud& pc, const Cells& c) {
+  const auto [lo, hi] = std::minmax_element(pc.radii.begin(), pc.radii.end());
+  std::string empty = std::to_string(c.empty_cells.size());
+  for (std::size_t i = 0; i < std::min<std::size_t>(c.empty_cells.size(), 5); ++i)
+    empty += strf("%s%d", i ? ", " : " (points ", c.empty_cells[i]);
+  if (!c.empty_cells.empty()) empty += c.empty_cells.size() > 5 ? ", ...)" : ")";
+  std::printf("  %-18s radii %.10g to %.10g; empty cells %s\n", "power cells", *lo, *hi, empty.c_str());
+}
+
 void print_summary(const VoronoiArgs& a, const io::PointCloud& pc, const Cells& c, double read_s,
                    double compute_s, double write_s, const std::vector<std::string>& written) {
   const bool d3 = c.dim == 3;
@@ -289,6 +306,7 @@ void print_summary(const VoronoiArgs& a, const io::PointCloud& pc, const Cells& 
     dup += strf("%s point %d duplicates point %d", i ? ";" : ":", c.duplicates[i].first, c.duplicates[i].second);
   if (c.duplicates.size() > 5) dup += "; ...";
   std::printf("  %-18s %s\n", "duplicates", dup.c_str());
+  if (c.power) print_power_line(pc, c);
   if (a.compute.ignore_outside || !c.ignored_outside_bounds.empty()) {
     std::string ign = std::to_string(c.ignored_outside_bounds.size());
     for (std::size_t i = 0; i < std::min<std::size_t>(c.ignored_outside_bounds.size(), 5); ++i)
@@ -343,7 +361,7 @@ void print_summary(const VoronoiArgs& a, const io::PointCloud& pc, const Cells& 
 }
 
 bool report_validation(const Cells& c, const io::PointCloud& pc, bool quiet) {
-  const ValidationReport r = validate(c, pc.labels, pc.coords);
+  const ValidationReport r = validate(c, pc.labels, pc.coords, pc.radii);
   if (!quiet) {
     std::printf("validation: %s\n", r.ok ? "OK" : "FAILED");
     if (r.volumes_checked)
@@ -455,6 +473,7 @@ int run_bench_voronoi(const BenchArgs& a) {
   const io::PointCloud pc = read_input(a.compute);
   VoronoiOptions opt = make_options(a.compute, pc.dim);
   opt.build_mesh = a.mesh;
+  opt.radii = pc.radii;
   const char* op = pc.dim == 3 ? (a.mesh ? "voronoi3_mesh" : "voronoi3") : (a.mesh ? "voronoi2_mesh" : "voronoi2");
 
   for (int rep = 0; rep < a.repeat; ++rep) {

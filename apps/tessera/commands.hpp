@@ -32,6 +32,7 @@ struct ComputeArgs {
   std::string input;
   int dim = 0;                  ///< 0: from the file
   std::string labels;           ///< "" | NAME | FILE.npy
+  std::string radii;            ///< "" | NAME | FILE.npy: power cells (add_radii_option)
   std::vector<double> bounds;   ///< empty, 4 (2D) or 6 (3D) numbers: lo/hi per axis
   double padding = VoronoiOptions{}.padding;
   bool ignore_outside = false;

@@ -119,6 +119,18 @@ void add_cell_method_option(CLI::App* app, ComputeArgs& c) {
       ->capture_default_str();
 }
 
+/// --radii of the commands that take power cells.
+void add_radii_option(CLI::App* app, ComputeArgs& c) {
+  app->add_option("--radii", c.radii,
+                  "Sphere radii for power cells (the radical tessellation of polydisperse spheres, as Voro++'s "
+                  "container_poly): FILE.npy (float array, length N) or the name of a numeric .ply vertex property / "
+                  ".csv column / .vtp or .vtu point data array / .pcd or structured .npy field. Each cell is where "
+                  "its point's power |x-p|^2 - r^2 is the least; a point may own no cell (listed as empty), and of "
+                  "coincident points the largest radius owns it. Radii must be finite and >= 0; computed by the "
+                  "search; not with --periodic")
+      ->type_name("FILE|NAME");
+}
+
 /// --periodic of the commands whose product is the cells themselves.
 void add_periodic_option(CLI::App* app, ComputeArgs& c) {
   app->add_option("--periodic", c.periodic,
@@ -177,6 +189,7 @@ int main(int argc, char** argv) {
   std::vector<std::string> vor_bounds, bench_bounds;
   add_compute_options(vor, va.compute, vor_bounds);
   add_cell_method_option(vor, va.compute);
+  add_radii_option(vor, va.compute);
   add_periodic_option(vor, va.compute);
   vor->add_option("-o,--output", va.output,
                   "Cells as VTK XML: .vtu (3D, one polyhedron per cell) or .vtp (2D, one polygon per cell), "
@@ -264,6 +277,7 @@ int main(int argc, char** argv) {
   CLI::App* graph = app.add_subcommand(
       "graph", "The adjacency graph: each generator's face neighbours (wheels and spokes) with spoke classes");
   add_compute_options(graph, ga.compute, graph_bounds);
+  add_radii_option(graph, ga.compute);
   graph->add_option("-o,--output", ga.output,
                     "Graph as VTK PolyData lines (.vtp): points = input points, one line per undirected edge, "
                     "cell data SpokeClass (0 same region, 1 region boundary, 3 outside) and FaceArea/FaceLength. "
@@ -292,6 +306,7 @@ int main(int argc, char** argv) {
   CLI::App* faces = app.add_subcommand(
       "faces", "Voronoi faces (3D polygons, 2D segments), each once, oriented, with BoundaryLabels per face");
   add_compute_options(faces, fa.compute, faces_bounds);
+  add_radii_option(faces, fa.compute);
   faces->add_option("-o,--output", fa.output,
                     "Faces as VTK PolyData (.vtp), cell data BoundaryLabels, Sides, SpokeClass; with --periodic "
                     "also SideShift (which image of side 1 the face meets; each face lies where side 0's cell "
@@ -342,6 +357,7 @@ int main(int argc, char** argv) {
       "volume_sum,repeat}}; seconds is wall time of the computation only");
   add_compute_options(bench_vor, ba.compute, bench_bounds);
   add_cell_method_option(bench_vor, ba.compute);
+  add_radii_option(bench_vor, ba.compute);
   add_periodic_option(bench_vor, ba.compute);
   bench_vor->add_option("--repeat", ba.repeat, "Number of timed runs")
       ->check(Positive)

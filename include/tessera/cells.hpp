@@ -109,6 +109,18 @@ struct VoronoiOptions {
   /// to the same grid as the coordinates. Cells::neighbor_shifts then count
   /// lattice vectors. All zero: an orthogonal box.
   std::array<double, 3> tilt{0, 0, 0};
+  /// Radii of spheres at the points (one per point, finite, >= 0; viewed,
+  /// not copied: it must outlive the call), or empty. With them each cell is
+  /// its point's power cell (radical or Laguerre cell: where the point's
+  /// power |x - p|^2 - r^2 is the least; Voro++'s container_poly): the
+  /// face with a neighbour lies on their spheres' radical plane. A point
+  /// may then own no cell (Cells::empty_cells), or lie outside its own;
+  /// of exactly coincident points the largest radius owns the cell (ties:
+  /// the lowest id). All radii equal give the ordinary cells. Not with a
+  /// periodic box, nor CellMethod::insertion (the automatic method takes the
+  /// search), nor input that no power-of-two frame fits (coordinates
+  /// spanning more than ~1e-150..1e150 of each other); delaunay() takes none.
+  std::span<const double> radii;
   /// Some axis periodic, or a tilt given (which needs periodic axes).
   bool periodic_box() const {
     return periodic[0] || periodic[1] || periodic[2] || tilt[0] != 0 || tilt[1] != 0 || tilt[2] != 0;
@@ -189,9 +201,16 @@ struct Cells {
   Buffer<std::int8_t> face_shift;
 
   // ---- diagnostics ----
-  /// Pairs (duplicate id, owner id): exactly coincident inputs; the lowest id owns the cell.
+  /// Pairs (duplicate id, owner id): exactly coincident inputs; the lowest id owns the cell
+  /// (with VoronoiOptions::radii the largest radius, then the lowest id).
   std::vector<std::pair<std::int32_t, std::int32_t>> duplicates;
   std::vector<std::int32_t> ignored_outside_bounds;  ///< with ignore_outside_points
+  /// Power cells only (VoronoiOptions::radii): generators whose cell is
+  /// empty (their sphere's power is nowhere the least), ascending; they have
+  /// no cell (cell_of -1) and nobody lists them as a neighbour.
+  std::vector<std::int32_t> empty_cells;
+  /// Whether the cells are power cells (VoronoiOptions::radii, not all equal).
+  bool power = false;
   std::uint64_t exact_predicate_calls = 0;          ///< filter failures resolved exactly
   /// Points far beyond the bulk of the input along some axis (a few points
   /// that stretch the default domain to over four times the bulk's extent:
@@ -280,8 +299,10 @@ inline constexpr double measure_tolerance = 0x1p-28;
 /// a periodic box: neighbour entries must pair up with opposite shifts, a
 /// merged vertex is used by the cells of its key's points at shift 0
 /// (Cells::vertex_key_shifts), and the exact-measure check is left out.
+/// Power cells (Cells::power) measure exactly with their `radii`, which
+/// must then come with the points (std::invalid_argument otherwise).
 ValidationReport validate(const Cells& cells, std::span<const std::int32_t> labels,
-                          std::span<const double> points = {});
+                          std::span<const double> points = {}, std::span<const double> radii = {});
 
 /// Whether the cell volumes of a domain of volume `domain_volume` cut into
 /// `cells` cells are normal doubles (the rule behind volumes_checked): the

@@ -108,8 +108,10 @@ inline void unit_normal(const double* n, double* out) {
 // The 3D measure's sums (below), of the vertices and feet scaled by `sc`
 // (a power of two; Scaled false: 1, without the multiplications), and
 // emax, the largest Vertex::e (unscaled), for sums_uncertain.
-// ScaledPlanes: some bisector is stored scaled (Hull::has_scaled_planes);
-// otherwise every bisector's foot is n / 2 without reading Plane::scale.
+// ScaledPlanes: some bisector's foot is not n / 2: it is stored scaled
+// (Hull::has_scaled_planes), or the cell is a power cell (Hull::weighted),
+// whose bisectors' feet are n d / |n|^2 (power.hpp); otherwise every
+// bisector's foot is n / 2 without reading Plane::scale.
 //
 // Fan false: each term is det(c_f, a, b), the cone over the triangle
 // (c_f, a, b), c_f the foot of f's plane. Its rounding error is up to
@@ -158,6 +160,7 @@ void hull_sums(const kernels::Hull& hull, double sc, double& vol, double& mag, d
   }
   vol = 0, mag = 0, c[0] = c[1] = c[2] = 0, emax = 0;
   if constexpr (Fan) blur = 0;
+  const bool weighted = ScaledPlanes && hull.weighted();
   for (std::size_t t = 0; t < verts.size(); ++t) {
     const auto& v = verts[t];
     emax = std::max(emax, v.e);
@@ -172,7 +175,9 @@ void hull_sums(const kernels::Hull& hull, double sc, double& vol, double& mag, d
       // that on a scaled one), |n| = 1 on a box plane.
       double w = pl.id < 0 ? pl.d : 0.5;
       if constexpr (ScaledPlanes)
-        if (pl.id >= 0 && pl.scale != 0) w = std::ldexp(0.5, pl.scale);
+        if (pl.id >= 0 && (weighted || pl.scale != 0))
+          w = weighted ? pl.d / (pl.n[0] * pl.n[0] + pl.n[1] * pl.n[1] + pl.n[2] * pl.n[2])  // scale-free
+                       : std::ldexp(0.5, pl.scale);
       if constexpr (Scaled) w *= sc;
       const double f[3] = {pl.n[0] * w, pl.n[1] * w, pl.n[2] * w};
       double bs[3];
@@ -341,7 +346,7 @@ inline std::int32_t measure(const kernels::Hull& hull, double& volume, std::arra
   const auto& verts = hull.vertices();
   const auto& planes = hull.planes();
   double vol, mag, c[3], blur = 0, emax = 0;
-  const bool scaled_planes = hull.has_scaled_planes();
+  const bool scaled_planes = hull.has_scaled_planes() || hull.weighted();
   if (scaled_planes) [[unlikely]]
     detail::hull_sums<false, true, false>(hull, 1.0, vol, mag, c, blur, emax);
   else

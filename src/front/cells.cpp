@@ -123,6 +123,7 @@ Cells run(std::span<const double> input, std::span<const std::int32_t> labels, c
   out.ignored_outside_bounds = pass.ignored_outside;
   out.threads_used = pass.engine_options.threads;
   out.far_points = pass.locator->outside_core();
+  out.power = !pass.radii.empty();
 
   front::report_duplicates(pass, labels, out.duplicates);
   // Cells whose search would cost far more than on uniform points (points
@@ -147,7 +148,8 @@ Cells run(std::span<const double> input, std::span<const std::int32_t> labels, c
     // (docs/design.md, "Delaunay beyond the frame"), where its own sample of
     // searched cells cost up to 0.4 s (2,003 log-uniform points: 0.6 s, 0.17 s
     // without it).
-    if (opt.cell_method == CellMethod::automatic) {
+    if (opt.cell_method == CellMethod::automatic && !out.power) {  // power cells: the search (a regular
+                                                                   // triangulation's insertion is not built)
       if (pass.exact.may_underflow) {
         insert = true;
       } else {
@@ -233,6 +235,11 @@ Cells run_periodic(std::span<const double> input, int dim, std::span<const std::
 
 Cells voronoi(std::span<const double> input, int dim, std::span<const std::int32_t> labels,
               const VoronoiOptions& options) {
+  if (!options.radii.empty()) {
+    if (options.periodic_box()) throw InputError("radii (power cells) are not supported in a periodic box");
+    if (options.cell_method == CellMethod::insertion)
+      throw InputError("radii (power cells) are computed by the search; --method insertion does not take them");
+  }
   if (options.periodic_box()) {
     if (!options.periodic[0] && !options.periodic[1] && !options.periodic[2])
       throw InputError("a tilt (triclinic box) needs periodic axes");

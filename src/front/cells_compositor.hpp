@@ -32,6 +32,8 @@ template <class CellT>
 class CellsCompositor {
  public:
   static constexpr int D = CellT::dim;
+  /// Batch::dup_of of a generator whose power cell came out empty (Cells::empty_cells).
+  static constexpr std::int32_t empty_cell = -2;
 
   /// A cell's measures. add() appends them to its thread's store, in batch
   /// order, and finish() places them by cell: written by generator id from
@@ -60,7 +62,8 @@ class CellsCompositor {
 
   struct Batch {
     std::vector<std::int32_t> gen;          // every generator of the batch, in order
-    std::vector<std::int32_t> dup_of;       // -1, or the owner it duplicates (no cell)
+    std::vector<std::int32_t> dup_of;       // -1; the owner it duplicates (no cell); empty_cell
+
     // Per generator, running ends into the batch's runs in its thread's
     // store, which start at the bases. (One thread builds a whole batch, and
     // no other batch in between: the engine's workspaces rely on the same.)
@@ -119,7 +122,8 @@ class CellsCompositor {
     Buffer<std::int32_t>& nbrs = s.nbrs;
     b.assembled += st.assembled;
     b.gen.push_back(gen);
-    b.dup_of.push_back(st.has_cell ? -1 : st.duplicate_of);
+    // No cell and no duplicate: a power cell that others' spheres emptied.
+    b.dup_of.push_back(st.has_cell ? -1 : st.duplicate_of >= 0 ? st.duplicate_of : empty_cell);
     if (!st.has_cell) {
       s.measures.push_back(Measures{});
       close_cell(b, s);
@@ -164,7 +168,9 @@ class CellsCompositor {
     for (const Batch& b : batches)
       for (std::size_t t = 0; t < b.gen.size(); ++t)
         if (b.dup_of[t] >= 0) o.duplicates.emplace_back(b.gen[t], b.dup_of[t]);
+        else if (b.dup_of[t] == empty_cell) o.empty_cells.push_back(b.gen[t]);
     std::sort(o.duplicates.begin(), o.duplicates.end());
+    std::sort(o.empty_cells.begin(), o.empty_cells.end());
     // Cells in generator-id order: when every point is a generator (no
     // outside labels, none ignored) and none is a duplicate, cell g is
     // generator g.
@@ -173,7 +179,7 @@ class CellsCompositor {
       generators += b.gen.size();
       o.assembled_from_stars += b.assembled;
     }
-    dense_ = o.duplicates.empty() && generators == n;
+    dense_ = o.duplicates.empty() && o.empty_cells.empty() && generators == n;
     const bool dense = dense_;
     o.cell_of.assign(n, dense ? 1 : 0);
     // cell_of first holds 1 for a generator with a cell. Every generator
@@ -181,7 +187,7 @@ class CellsCompositor {
     if (!dense)
       tbb::parallel_for(std::size_t(0), batches.size(), [&](std::size_t k) {
         const Batch& b = batches[k];
-        for (std::size_t t = 0; t < b.gen.size(); ++t) o.cell_of[static_cast<std::size_t>(b.gen[t])] = b.dup_of[t] < 0;
+        for (std::size_t t = 0; t < b.gen.size(); ++t) o.cell_of[static_cast<std::size_t>(b.gen[t])] = b.dup_of[t] == -1;
       });
     std::int32_t nc = 0;
     for (std::size_t g = 0; g < n; ++g) o.cell_of[g] = o.cell_of[g] ? nc++ : -1;

@@ -7,6 +7,7 @@
 #include <limits>
 #include <sstream>
 #include <string>
+#include <unordered_map>
 
 #include "tessera/engine/thread_arena.hpp"
 #include "tessera/finite_points.hpp"
@@ -230,6 +231,7 @@ Pass<D>::Pass(std::span<const double> input, std::span<const std::int32_t> label
     }
     points = scaled;
   }
+  set_radii(opt.radii, n, scaling);
 
   // Which points take part (inside the box) and which get cells (also label >= 0).
   in_box.assign(n, 1);
@@ -272,11 +274,34 @@ Pass<D>::Pass(std::span<const double> input, std::span<const std::int32_t> label
     if (!locator->has_coincident()) return;
     const std::vector<std::int32_t> lowest = locator->lowest_coincident();
     std::vector<std::uint8_t> use = in_box;
-    for (std::size_t s = 0; s < lowest.size(); ++s)
-      if (lowest[s] >= 0) {
-        duplicates.emplace_back(locator->id(s), lowest[s]);
-        use[static_cast<std::size_t>(locator->id(s))] = 0;
+    if (radii.empty()) {
+      for (std::size_t s = 0; s < lowest.size(); ++s)
+        if (lowest[s] >= 0) {
+          duplicates.emplace_back(locator->id(s), lowest[s]);
+          use[static_cast<std::size_t>(locator->id(s))] = 0;
+        }
+    } else {
+      // Power cells: the largest radius of each group owns it (its power
+      // is the least everywhere), ties to the lowest id.
+      std::unordered_map<std::int32_t, std::int32_t> owner;  // group (its lowest id) -> owner
+      auto better = [&](std::int32_t a, std::int32_t b) {
+        const double ra = radii[static_cast<std::size_t>(a)], rb = radii[static_cast<std::size_t>(b)];
+        return ra > rb || (ra == rb && a < b);
+      };
+      for (std::size_t s = 0; s < lowest.size(); ++s)
+        if (lowest[s] >= 0) {
+          auto [it, fresh] = owner.try_emplace(lowest[s], lowest[s]);
+          if (better(locator->id(s), it->second)) it->second = locator->id(s);
+        }
+      for (std::size_t s = 0; s < lowest.size(); ++s) {
+        const std::int32_t id = locator->id(s);
+        const auto it = owner.find(lowest[s] >= 0 ? lowest[s] : id);
+        if (it != owner.end() && it->second != id) {
+          duplicates.emplace_back(id, it->second);
+          use[static_cast<std::size_t>(id)] = 0;
+        }
       }
+    }
     std::sort(duplicates.begin(), duplicates.end());
     locator.emplace(points, use, lo, hi, ppb);
   });
@@ -326,6 +351,10 @@ Pass<D>::Pass(std::span<const double> input, std::span<const std::int32_t> label
   exact.points = points.data();
   exact.dim = D;
   exact.may_underflow = scaling.may_underflow;
+  if (!radii.empty()) {
+    exact.radii = radii.data();
+    exact.max_radius = *std::max_element(radii.begin(), radii.end());
+  }
   for (int d = 0; d < 3; ++d) {
     exact.lo[static_cast<std::size_t>(d)] = bounds.lo[static_cast<std::size_t>(d)];
     exact.hi[static_cast<std::size_t>(d)] = bounds.hi[static_cast<std::size_t>(d)];
@@ -341,6 +370,30 @@ Pass<D>::Pass(std::span<const double> input, std::span<const std::int32_t> label
   gens.tree = &*tree;
 
   engine_options.progress = opt.progress;
+}
+
+template <int D>
+void Pass<D>::set_radii(std::span<const double> given, std::size_t n, const Scaling& scaling) {
+  if (given.empty()) return;
+  if (given.size() != n)
+    throw InputError("radii: " + std::to_string(given.size()) + " values for " + std::to_string(n) + " points");
+  for (std::size_t i = 0; i < n; ++i)
+    if (!(given[i] >= 0 && given[i] <= std::numeric_limits<double>::max()))
+      throw InputError("radius of point " + std::to_string(i) + " is " +
+                       (std::isnan(given[i]) ? std::string("NaN") : std::to_string(given[i])) +
+                       ": radii must be finite and non-negative");
+  // Equal radii add one constant to every power: the ordinary cells, by
+  // the ordinary (faster, prepared) predicates.
+  if (std::all_of(given.begin(), given.end(), [&](double r) { return r == given[0]; })) return;
+  if (scaling.may_underflow)
+    throw InputError("radii (power cells) need coordinates within ~1e-150..1e150 of each other; this input spans more");
+  if (k == 0) {
+    radii = given;
+    return;
+  }
+  scaled_radii.resize(n);  // in the computation's frame, exactly (as the coordinates)
+  for (std::size_t i = 0; i < n; ++i) scaled_radii[i] = std::ldexp(given[i], k);
+  radii = scaled_radii;
 }
 
 template struct Pass<2>;

@@ -89,6 +89,10 @@ struct Pass {
   std::span<const double> points;            ///< the computation's coordinates
   std::vector<std::uint8_t> in_box;          ///< per point: inside the domain
   std::vector<std::int32_t> ignored_outside; ///< points dropped (ignore_outside_points)
+  /// VoronoiOptions::radii in the computation's frame (scaled by 2^k), or
+  /// empty: none given, or all equal (the ordinary cells). exact.radii views it.
+  std::span<const double> radii;
+  std::vector<double> scaled_radii;          ///< radii's storage when k != 0
   /// Located points at exactly the coordinates of a lower id: (id, the
   /// group's lowest id), ascending. They are left out of the locator, so
   /// no cell meets them and none is built for them: a copy's bisectors are
@@ -103,6 +107,10 @@ struct Pass {
   std::vector<std::int32_t> grid;            ///< exact.grid's storage, when the input has one
   engine::Generators<D> gens;
   engine::EngineOptions engine_options;
+
+ private:
+  // Checks the given radii (InputError) and sets `radii`.
+  void set_radii(std::span<const double> given, std::size_t n, const Scaling& scaling);
 };
 
 /// Appends the pass's duplicates that a result reports: those that would

@@ -11,6 +11,7 @@
 #include <atomic>
 #include <bit>
 #include <cmath>
+#include <limits>
 #include <cstdint>
 #include <sstream>
 #include <stdexcept>
@@ -111,7 +112,7 @@ std::size_t asymmetric_periodic_spokes(const Cells& c) {
 }
 
 ValidationReport validate_in_arena(const Cells& c, std::span<const std::int32_t> labels,
-                                   std::span<const double> points) {
+                                   std::span<const double> points, std::span<const double> radii) {
   ValidationReport r;
   const std::size_t nc = c.n_cells();
   const int D = c.dim;
@@ -187,6 +188,11 @@ ValidationReport validate_in_arena(const Cells& c, std::span<const std::int32_t>
   if (periodic && measuring) points = c.periodic_points;
   const auto lattice = periodic ? c.lattice() : std::array<std::array<double, 3>, 3>{};
   std::vector<std::int32_t> users(nv, 0);
+  // Power cells: a vertex has equal powers, not distances, to its key's
+  // points; dist2 holds that power (|v - p_g|^2 - r_g^2), and a cell's
+  // radius adds its own r^2 back.
+  const bool power = !radii.empty();
+  auto r_squared = [&](std::int32_t g) { return power ? radii[static_cast<std::size_t>(g)] * radii[static_cast<std::size_t>(g)] : 0.0; };
   std::vector<double> dist2(measuring ? nv : 0, 0.0), radius2(measuring ? nc : 0, 0.0);
   if (measuring)
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nv), [&](const tbb::blocked_range<std::size_t>& range) {
@@ -207,7 +213,7 @@ ValidationReport validate_in_arena(const Cells& c, std::span<const std::int32_t>
           const double x = c.vertices[v * Du + d] - p[d];
           s += x * x;
         }
-        dist2[v] = s;
+        dist2[v] = s - r_squared(*g);
       }
     });
   tbb::enumerable_thread_specific<CornerSet> sets;
@@ -221,7 +227,7 @@ ValidationReport validate_in_arena(const Cells& c, std::span<const std::int32_t>
           const auto q_end = c.face_vertex_offsets[static_cast<std::size_t>(f1)];
           seen.start(static_cast<std::size_t>(q_end - q_begin));
           std::int64_t corners = 0, distinct = 0;
-          double r2 = 0;
+          double r2 = power ? -std::numeric_limits<double>::infinity() : 0.0;
           for (auto q = q_begin; q < q_end; ++q) {
             const std::int32_t v = c.face_vertices[static_cast<std::size_t>(q)];
             if (v < 0 || static_cast<std::size_t>(v) >= nv) {
@@ -234,7 +240,7 @@ ValidationReport validate_in_arena(const Cells& c, std::span<const std::int32_t>
             std::atomic_ref<std::int32_t>(users[static_cast<std::size_t>(v)]).fetch_add(1, std::memory_order_relaxed);
             if (measuring) r2 = std::max(r2, dist2[static_cast<std::size_t>(v)]);
           }
-          if (measuring) radius2[k] = r2;
+          if (measuring) radius2[k] = power ? std::max(0.0, r2 + r_squared(c.generator[k])) : r2;
           if (D == 3) {
             // Every corner starts an edge of its face's loop, and every edge
             // is in two faces.
@@ -293,18 +299,23 @@ ValidationReport validate_in_arena(const Cells& c, std::span<const std::int32_t>
   // needs every key's shifts.)
   if (measuring && r.bad_vertex_degree == 0 && counts.unresolved == 0 &&
       (!periodic || c.vertex_key_shifts.size() == c.vertex_keys.size() * Du))
-    front::check_measures(c, points, radius2, r);
+    front::check_measures(c, points, radii, radius2, r);
   return r;
 }
 
 }  // namespace
 
-ValidationReport validate(const Cells& c, std::span<const std::int32_t> labels, std::span<const double> points) {
+ValidationReport validate(const Cells& c, std::span<const std::int32_t> labels, std::span<const double> points,
+                          std::span<const double> radii) {
   if (!points.empty() && points.size() != c.n_points * static_cast<std::size_t>(c.dim))
     throw std::invalid_argument("validate: " + std::to_string(points.size()) + " coordinates given for " +
                                 std::to_string(c.n_points) + " points in " + std::to_string(c.dim) + "D");
+  if (!points.empty() && c.power && radii.size() != c.n_points)
+    throw std::invalid_argument("validate: power cells need their radii with the points (" +
+                                std::to_string(radii.size()) + " given for " + std::to_string(c.n_points) + ")");
+  if (!c.power) radii = {};  // equal radii gave the ordinary cells
   engine::ThreadArena arena(c.threads_used);
-  return arena.execute([&] { return validate_in_arena(c, labels, points); });
+  return arena.execute([&] { return validate_in_arena(c, labels, points, radii); });
 }
 
 }  // namespace tessera

@@ -201,8 +201,8 @@ Outcome measure_cell(const Cells& c, const kernels::ExactContext& ctx, std::span
 
 }  // namespace
 
-void check_measures(const Cells& c, std::span<const double> points, const std::vector<double>& radius2,
-                    ValidationReport& r) {
+void check_measures(const Cells& c, std::span<const double> points, std::span<const double> radii,
+                    const std::vector<double>& radius2, ValidationReport& r) {
   const int D = c.dim;
   const std::size_t nc = c.n_cells();
   if (nc == 0 || c.vertex_keys.empty()) return;
@@ -260,6 +260,7 @@ void check_measures(const Cells& c, std::span<const double> points, const std::v
   ctx.dim = D;
   ctx.lo = c.bounds.lo;
   ctx.hi = c.bounds.hi;
+  if (!radii.empty()) ctx.radii = radii.data();
   std::vector<Outcome> outcomes(measured.size());
   tbb::parallel_for(std::size_t{0}, measured.size(),
                     [&](std::size_t s) { outcomes[s] = measure_cell(c, ctx, points, radius2, measured[s]); });

@@ -24,7 +24,8 @@ namespace tessera::front {
 /// larger than the cells it would show in (one point far off a row of
 /// points: stop 64's strips were off by up to 14%, their sum still within
 /// 1e-9 of the domain's), nor errors that cancel between neighbours.
-void check_measures(const Cells& c, std::span<const double> points, const std::vector<double>& radius2,
-                    ValidationReport& r);
+/// `radii`: power cells' radii (Cells::power), else empty.
+void check_measures(const Cells& c, std::span<const double> points, std::span<const double> radii,
+                    const std::vector<double>& radius2, ValidationReport& r);
 
 }  // namespace tessera::front

@@ -65,6 +65,12 @@ int build_rows(const ExactContext& ctx, std::int32_t i, const std::int32_t* gen,
       grid.see(box_plane_upper(gen[r]) ? ctx.hi[axis] : ctx.lo[axis]);
     }
   }
+  // The radii join the grid: their squares enter b with the coordinates'.
+  if (ctx.radii != nullptr) {
+    grid.see(ctx.radii[i]);
+    for (int r = 0; r < rows; ++r)
+      if (gen[r] >= 0) grid.see(ctx.radii[gen[r]]);
+  }
   const int shift = grid.scale();
 
   // Scaled p_i and |p_i|^2.
@@ -72,6 +78,10 @@ int build_rows(const ExactContext& ctx, std::int32_t i, const std::int32_t* gen,
   for (int d = 0; d < dim; ++d) set_scaled(ci[d], pi[d], shift);
   mpz_set_ui(s.t1, 0);
   for (int d = 0; d < dim; ++d) mpz_addmul(s.t1, ci[d], ci[d]);  // t1 = |p_i|^2
+  if (ctx.radii != nullptr) {  // t1 = |p_i|^2 - r_i^2: the row's constant is p_k's power less p_i's
+    set_scaled(s.t2, ctx.radii[i], shift);
+    mpz_submul(s.t1, s.t2, s.t2);
+  }
 
   // Build M = [a | b] row by row.
   for (int r = 0; r < rows; ++r) {
@@ -84,7 +94,11 @@ int build_rows(const ExactContext& ctx, std::int32_t i, const std::int32_t* gen,
         mpz_mul_2exp(s.a[r][d], s.a[r][d], 1);          // 2 (p_k - p_i)
         mpz_addmul(s.b[r], s.coord[r][d], s.coord[r][d]);
       }
-      mpz_sub(s.b[r], s.b[r], s.t1);                      // |p_k|^2 - |p_i|^2
+      if (ctx.radii != nullptr) {
+        set_scaled(s.t2, ctx.radii[gen[r]], shift);
+        mpz_submul(s.b[r], s.t2, s.t2);                   // - r_k^2
+      }
+      mpz_sub(s.b[r], s.b[r], s.t1);                      // |p_k|^2 - |p_i|^2 (- r_k^2 + r_i^2)
     } else {
       int axis = box_plane_axis(gen[r]);
       for (int d = 0; d < dim; ++d) mpz_set_ui(s.a[r][d], d == axis ? 1 : 0);
@@ -319,6 +333,7 @@ int sign_of(T x) { return (x > 0) - (x < 0); }
 }  // namespace
 
 int exact_clip_sign(const ExactContext& ctx, std::int32_t i, const std::int32_t* planes, std::int32_t j) {
+  if (ctx.radii != nullptr) return exact_clip_sign_by_arithmetic(ctx, i, planes, j);  // no box-tie pattern with radii
   // A tie at the corners of an axis-aligned box (lattices, voxel centres of
   // any spacing) is decided by the coordinates' pattern; anything else fails
   // that test within a few comparisons.
@@ -333,6 +348,10 @@ int exact_clip_sign_by_arithmetic(const ExactContext& ctx, std::int32_t i, const
   for (int r = 0; r < dim; ++r) gen[r] = planes[r];
   gen[dim] = j;
   ClipSigns sg;
+  if (ctx.radii != nullptr) {  // the integer stages know no radii
+    signs_gmp(ctx, i, gen, sg);
+    return decide(sg, i, gen, dim);
+  }
   if (ctx.grid != nullptr) {
     if (dim == 3) signs_on_grid<3>(ctx, i, gen, sg);
     else signs_on_grid<2>(ctx, i, gen, sg);
@@ -344,6 +363,42 @@ int exact_clip_sign_by_arithmetic(const ExactContext& ctx, std::int32_t i, const
   if (wide.prepare(ctx, i, planes, j) && wide.sign_on_grid(ctx, j, s)) return s;
   signs_gmp(ctx, i, gen, sg);
   return decide(sg, i, gen, dim);
+}
+
+double exact_power_offset(const ExactContext& ctx, std::int32_t i, std::int32_t j) {
+  thread_local Scratch s;
+  const int dim = ctx.dim;
+  const double* pi = ctx.points + static_cast<std::size_t>(i) * dim;
+  const double* pj = ctx.points + static_cast<std::size_t>(j) * dim;
+  const double ri = ctx.radii != nullptr ? ctx.radii[i] : 0.0, rj = ctx.radii != nullptr ? ctx.radii[j] : 0.0;
+  GridScale grid;
+  for (int d = 0; d < dim; ++d) {
+    grid.see(pi[d]);
+    grid.see(pj[d]);
+  }
+  grid.see(ri);
+  grid.see(rj);
+  const int shift = grid.scale();
+  // 2d / 2^(2 shift) = sum_d (P_j - P_i)^2 + R_i^2 - R_j^2, in integers.
+  mpz_set_ui(s.acc, 0);
+  for (int d = 0; d < dim; ++d) {
+    set_scaled(s.t0, pj[d], shift);
+    set_scaled(s.t1, pi[d], shift);
+    mpz_sub(s.t0, s.t0, s.t1);
+    mpz_addmul(s.acc, s.t0, s.t0);
+  }
+  set_scaled(s.t0, ri, shift);
+  mpz_addmul(s.acc, s.t0, s.t0);
+  set_scaled(s.t0, rj, shift);
+  mpz_submul(s.acc, s.t0, s.t0);
+  if (mpz_sgn(s.acc) == 0) return 0.0;
+  // mpz_get_d_2exp truncates to 53 bits (toward zero); ldexp then scales.
+  long e = 0;
+  const double m = mpz_get_d_2exp(&e, s.acc);
+  const long total = e + 2L * shift - 1;
+  if (total > 2000) return std::copysign(std::numeric_limits<double>::infinity(), m);
+  if (total < -2000) return std::copysign(0.0, m);
+  return std::ldexp(m, static_cast<int>(total));
 }
 
 int exact_ray_side(const ExactContext& ctx, std::int32_t i, std::int32_t a, std::int32_t b, const double* n) {

@@ -212,7 +212,7 @@ void vertex_numerators_wide(const DoubleParts (*pv)[Scratch::kMaxDim], const std
 // (GMP's turn).
 bool grid_numerators(const ExactContext& ctx, std::int32_t i, const std::int32_t* planes, GridNumerators& g) {
   const int dim = ctx.dim;
-  if (dim != 2 && dim != 3) return false;
+  if ((dim != 2 && dim != 3) || ctx.radii != nullptr) return false;  // the integer rows know no radii
   DoubleParts pv[Scratch::kRows][Scratch::kMaxDim];
   GridScale span;
   exact_rows::row_parts(ctx, i, planes, dim, pv, span);
@@ -403,6 +403,16 @@ void exact_vertex_on_plane(const ExactContext& ctx, std::int32_t i, const std::i
 
 // ---- The cell measure ----
 
+namespace {
+// The first of the vertices (dim planes each) that lies on `plane`.
+std::size_t vertex_on_plane(std::span<const std::int32_t> vertex_planes, int dim, std::int32_t plane) {
+  const auto du = static_cast<std::size_t>(dim);
+  for (std::size_t k = 0; k < vertex_planes.size(); ++k)
+    if (vertex_planes[k] == plane) return k / du;
+  throw std::logic_error("exact cell measure: a face's plane has no vertex (corrupt cell)");
+}
+}  // namespace
+
 // In canonical rationals (GMP's mpq): every vertex, term and sum exact, then
 // truncated to double. Slow: each operation takes gcds, and the sum's
 // denominator grows towards the product of the vertices' determinants (a
@@ -450,7 +460,13 @@ double rational_cell_measure(const ExactContext& ctx, std::int32_t i, std::span<
     } else {
       // The foot of the plane from p_i: (p_j - p_i) / 2 on a bisector,
       // (bound - p_i) along the axis on a box plane.
-      if (term.plane >= 0) {
+      if (term.plane >= 0 && ctx.radii != nullptr) {
+        // A power bisector's foot is no simple point; any point of the
+        // plane serves (a face's terms sum to its cone whatever point of its
+        // plane they share): one of the cell's vertices on it.
+        const std::size_t v = vertex_on_plane(vertex_planes, dim, term.plane);
+        for (int d = 0; d < 3; ++d) mpq_set(foot[d], y(v, d));
+      } else if (term.plane >= 0) {
         const double* pj = ctx.points + static_cast<std::size_t>(term.plane) * 3;
         for (int d = 0; d < 3; ++d) {
           mpq_set_d(foot[d], pj[d]);
@@ -706,7 +722,14 @@ bool fixed_point_cell_measure(const ExactContext& ctx, std::int32_t i, std::span
     mpz_ptr f[3] = {z[feet + 3 * k], z[feet + 3 * k + 1], z[feet + 3 * k + 2]};
     if (k == foot_plane.size()) {
       foot_plane.push_back(plane);
-      if (plane >= 0) {
+      if (plane >= 0 && ctx.radii != nullptr) {
+        // A power bisector's: one of the cell's vertices on the plane
+        // (rational_cell_measure). Truncated as every vertex is, it lies
+        // within one unit of a point of the plane, as a truncated foot does,
+        // and below 2^(bits + 1): the bounds below hold.
+        const std::size_t v = vertex_on_plane(vertex_planes, dim, plane);
+        for (std::size_t d = 0; d < 3; ++d) mpz_set(f[d], fixed(v, d));
+      } else if (plane >= 0) {
         const double* pj = ctx.points + static_cast<std::size_t>(plane) * 3;
         for (int d = 0; d < 3; ++d) difference_truncated(f[d], pj[d], pi[d], -1, g, s, exact);
       } else {

@@ -8,6 +8,9 @@
 // points on the plane. Plain doubles: meant only for random inputs in general
 // position, where it is accurate to ~1e-14 relative.
 //
+// With radii (power cells) each bisector is the radical plane: |y - d|^2 - r_j^2
+// <= |y|^2 - r_i^2, i.e. y.d <= (|d|^2 + r_i^2 - r_j^2) / 2.
+//
 // Labels follow tessera's spoke convention: generator id >= 0, or a box plane
 // -1-2*axis (lo) / -2-2*axis (hi).
 #pragma once
@@ -67,7 +70,7 @@ inline std::vector<std::size_t> by_distance(const std::vector<double>& pts, int 
 
 /// The 2D cell of point i in the box [lo, hi].
 inline Cell cell2d(const std::vector<double>& pts, std::size_t i, const std::array<double, 3>& lo,
-                   const std::array<double, 3>& hi) {
+                   const std::array<double, 3>& hi, const std::vector<double>& radii = {}) {
   using detail::cut;
   const double px = pts[2 * i], py = pts[2 * i + 1];
   // Vertices relative to the generator; lab[k] labels the edge v[k] -> v[k+1]. CCW.
@@ -78,7 +81,8 @@ inline Cell cell2d(const std::vector<double>& pts, std::size_t i, const std::arr
   std::vector<int> lab = {-3, -2, -4, -1};
   for (std::size_t j : detail::by_distance(pts, 2, i)) {
     const double dx = pts[2 * j] - px, dy = pts[2 * j + 1] - py;
-    const double h = 0.5 * (dx * dx + dy * dy);  // keep y with y.d <= |d|^2/2
+    double h = 0.5 * (dx * dx + dy * dy);  // keep y with y.d <= |d|^2/2
+    if (!radii.empty()) h += 0.5 * (radii[i] * radii[i] - radii[j] * radii[j]);
     std::vector<double> s(v.size());
     bool any_out = false;
     for (std::size_t k = 0; k < v.size(); ++k) {
@@ -119,13 +123,13 @@ inline Cell cell2d(const std::vector<double>& pts, std::size_t i, const std::arr
     if (len > 0) c.face[lab[k]] += len;
   }
   c.volume = 0.5 * a2;
-  c.centroid = {px + cx / (3 * a2), py + cy / (3 * a2), 0};
+  c.centroid = a2 > 0 ? P3{px + cx / (3 * a2), py + cy / (3 * a2), 0} : P3{px, py, 0};
   return c;
 }
 
 /// The 3D cell of point i in the box [lo, hi].
 inline Cell cell3d(const std::vector<double>& pts, std::size_t i, const std::array<double, 3>& lo,
-                   const std::array<double, 3>& hi) {
+                   const std::array<double, 3>& hi, const std::vector<double>& radii = {}) {
   using namespace detail;
   const P3 p{pts[3 * i], pts[3 * i + 1], pts[3 * i + 2]};
   const P3 a = sub(lo, p), b = sub(hi, p);  // box relative to the generator
@@ -144,7 +148,8 @@ inline Cell cell3d(const std::vector<double>& pts, std::size_t i, const std::arr
   };
   for (std::size_t j : by_distance(pts, 3, i)) {
     const P3 d = sub({pts[3 * j], pts[3 * j + 1], pts[3 * j + 2]}, p);
-    const double h = 0.5 * dot(d, d);
+    double h = 0.5 * dot(d, d);
+    if (!radii.empty()) h += 0.5 * (radii[i] * radii[i] - radii[j] * radii[j]);
     bool any_out = false;
     for (auto& f : faces)
       for (auto& x : f.v) any_out |= dot(x, d) - h > 0;
@@ -194,9 +199,19 @@ inline Cell cell3d(const std::vector<double>& pts, std::size_t i, const std::arr
     }
     faces.swap(kept);
   }
-  // Volume and centroid: fan of tetrahedra from the generator (strictly inside
-  // the convex cell, so every face's fan has one sign: take it per face).
+  // Volume and centroid: fan of tetrahedra from the mean o of the vertices
+  // (inside the convex cell; a power cell need not hold its generator), so
+  // every face's fan has one sign: take it per face.
   Cell c;
+  P3 o{0, 0, 0};
+  std::size_t corners = 0;
+  for (auto& f : faces)
+    for (auto& x : f.v) {
+      for (int q = 0; q < 3; ++q) o[q] += x[q];
+      ++corners;
+    }
+  if (corners != 0)
+    for (int q = 0; q < 3; ++q) o[q] /= double(corners);
   double vol = 0;
   P3 mom{0, 0, 0};
   for (auto& f : faces) {
@@ -204,10 +219,10 @@ inline Cell cell3d(const std::vector<double>& pts, std::size_t i, const std::arr
     P3 fm{0, 0, 0};
     P3 area{0, 0, 0};
     for (std::size_t k = 1; k + 1 < f.v.size(); ++k) {
-      const P3 cr = cross(f.v[k], f.v[k + 1]);
-      const double t = dot(f.v[0], cr) / 6.0;
+      const P3 cr = cross(sub(f.v[k], o), sub(f.v[k + 1], o));
+      const double t = dot(sub(f.v[0], o), cr) / 6.0;
       fv += t;
-      for (int q = 0; q < 3; ++q) fm[q] += t * (f.v[0][q] + f.v[k][q] + f.v[k + 1][q]) / 4.0;
+      for (int q = 0; q < 3; ++q) fm[q] += t * (o[q] + f.v[0][q] + f.v[k][q] + f.v[k + 1][q]) / 4.0;
       const P3 tri = cross(sub(f.v[k], f.v[0]), sub(f.v[k + 1], f.v[0]));
       for (int q = 0; q < 3; ++q) area[q] += tri[q];
     }
@@ -218,13 +233,13 @@ inline Cell cell3d(const std::vector<double>& pts, std::size_t i, const std::arr
     if (ar > 0) c.face[f.label] += ar;
   }
   c.volume = vol;
-  for (int q = 0; q < 3; ++q) c.centroid[q] = p[q] + mom[q] / vol;
+  for (int q = 0; q < 3; ++q) c.centroid[q] = vol > 0 ? p[q] + mom[q] / vol : p[q];
   return c;
 }
 
 inline Cell cell(const std::vector<double>& pts, int dim, std::size_t i, const std::array<double, 3>& lo,
-                 const std::array<double, 3>& hi) {
-  return dim == 2 ? cell2d(pts, i, lo, hi) : cell3d(pts, i, lo, hi);
+                 const std::array<double, 3>& hi, const std::vector<double>& radii = {}) {
+  return dim == 2 ? cell2d(pts, i, lo, hi, radii) : cell3d(pts, i, lo, hi, radii);
 }
 
 }  // namespace oracle

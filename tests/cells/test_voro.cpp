@@ -4,12 +4,14 @@
 // volume agrees with Voro++'s to 1e-9 relative and its face-neighbour set is
 // the same, except for faces so small (< 1e-12 of the cell's scale squared)
 // that Voro++'s 1e-11 vertex tolerance may have merged or created them; those
-// are counted and printed (expected 0 on random input).
+// are counted and printed (expected 0 on random input). Power cells against
+// Voro++'s container_poly likewise, their empty cells included.
 #ifdef TESSERA_HAVE_VORO
 
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <random>
 #include <voro++.hh>
 
 #include "helpers.hpp"
@@ -24,13 +26,9 @@ struct VoroCell {
   bool computed = false;
 };
 
-std::vector<VoroCell> voro_cells(const std::vector<double>& pts, const tessera::Bounds& b) {
-  const std::size_t n = pts.size() / 3;
-  // About 5 particles per block, non-periodic: cells are cut by the box walls.
-  const int blocks = std::max(1, int(std::cbrt(double(n) / 5.0)));
-  voro::container con(b.lo[0], b.hi[0], b.lo[1], b.hi[1], b.lo[2], b.hi[2], blocks, blocks, blocks, false,
-                      false, false, 8);
-  for (std::size_t i = 0; i < n; ++i) con.put(int(i), pts[3 * i], pts[3 * i + 1], pts[3 * i + 2]);
+/// Every cell of the n particles in `con` (an empty power cell is not computed).
+template <class Container>
+std::vector<VoroCell> voro_loop(Container& con, std::size_t n) {
   std::vector<VoroCell> out(n);
   voro::c_loop_all loop(con);
   voro::voronoicell_neighbor cell;
@@ -50,20 +48,50 @@ std::vector<VoroCell> voro_cells(const std::vector<double>& pts, const tessera::
   return out;
 }
 
-void compare_with_voro(std::size_t n, std::uint64_t seed) {
-  SCOPED_TRACE(::testing::Message() << "n " << n << " seed " << seed);
+/// Voro++'s cells of `pts` in the box b: container, or container_poly with `radii`.
+std::vector<VoroCell> voro_cells(const std::vector<double>& pts, const tessera::Bounds& b,
+                                 const std::vector<double>& radii = {}) {
+  const std::size_t n = pts.size() / 3;
+  // About 5 particles per block, non-periodic: cells are cut by the box walls.
+  const int blocks = std::max(1, int(std::cbrt(double(n) / 5.0)));
+  if (radii.empty()) {
+    voro::container con(b.lo[0], b.hi[0], b.lo[1], b.hi[1], b.lo[2], b.hi[2], blocks, blocks, blocks, false,
+                        false, false, 8);
+    for (std::size_t i = 0; i < n; ++i) con.put(int(i), pts[3 * i], pts[3 * i + 1], pts[3 * i + 2]);
+    return voro_loop(con, n);
+  }
+  voro::container_poly con(b.lo[0], b.hi[0], b.lo[1], b.hi[1], b.lo[2], b.hi[2], blocks, blocks, blocks, false,
+                           false, false, 8);
+  for (std::size_t i = 0; i < n; ++i) con.put(int(i), pts[3 * i], pts[3 * i + 1], pts[3 * i + 2], radii[i]);
+  return voro_loop(con, n);
+}
+
+/// rmax > 0: power cells, radii uniform in [0, rmax).
+void compare_with_voro(std::size_t n, std::uint64_t seed, double rmax = 0) {
+  SCOPED_TRACE(::testing::Message() << "n " << n << " seed " << seed << " rmax " << rmax);
   const auto box = make_bounds({-1, 0, 2}, {1, 1.5, 3});
   const auto pts = random_points(n, 3, seed, box);
-  const auto c = run(pts, 3, box);
-  const auto v = voro_cells(pts, box);
-  ASSERT_EQ(c.n_cells(), n);
+  std::vector<double> radii;
+  std::mt19937_64 rng(seed + 1000);
+  std::uniform_real_distribution<double> u(0.0, rmax);
+  for (std::size_t i = 0; rmax > 0 && i < n; ++i) radii.push_back(u(rng));
+  auto o = options(3, box);
+  o.radii = radii;
+  const auto c = tessera::voronoi(pts, 3, {}, o);
+  const auto v = voro_cells(pts, box, radii);
+  if (rmax == 0) ASSERT_EQ(c.n_cells(), n);
 
-  std::size_t tolerated = 0, bad_volume = 0, bad_neighbours = 0;
+  std::size_t tolerated = 0, bad_volume = 0, bad_neighbours = 0, empty = 0;
   double vsum = 0;
   for (std::size_t i = 0; i < n; ++i) {
+    const auto k = c.cell_of[i];
+    if (rmax > 0 && (!v[i].computed || k < 0)) {  // a power cell may be empty, then for both
+      EXPECT_EQ(v[i].computed, k >= 0) << "point " << i << ": empty for one of the two";
+      empty += k < 0;
+      continue;
+    }
     ASSERT_TRUE(v[i].computed) << "Voro++ did not compute cell " << i;
     vsum += v[i].volume;
-    const auto k = c.cell_of[i];
     ASSERT_GE(k, 0);
     if (!(std::abs(c.volume[k] - v[i].volume) <= 1e-9 * v[i].volume) && ++bad_volume <= 5)
       ADD_FAILURE() << "point " << i << " volume " << c.volume[k] << " Voro++ " << v[i].volume;
@@ -87,8 +115,8 @@ void compare_with_voro(std::size_t n, std::uint64_t seed) {
       }
     }
   }
-  std::printf("[ voro++ ] n %zu seed %llu: tiny-face neighbour mismatches tolerated: %zu\n", n,
-              (unsigned long long)seed, tolerated);
+  std::printf("[ voro++ ] n %zu seed %llu rmax %g: tiny-face neighbour mismatches tolerated: %zu; empty cells %zu\n",
+              n, (unsigned long long)seed, rmax, tolerated, empty);
   EXPECT_NEAR(vsum, box_volume(box, 3), 1e-9 * box_volume(box, 3)) << "Voro++ itself should tile the box";
   EXPECT_EQ(bad_volume, 0u);
   EXPECT_EQ(bad_neighbours, 0u);
@@ -101,6 +129,14 @@ TEST(VoroPlusPlus, Random1000) {
 }
 
 TEST(VoroPlusPlus, Random20000) { compare_with_voro(20000, 603); }
+
+// Power cells (VoronoiOptions::radii) against container_poly: radii up to
+// half the mean spacing (overlapping spheres, a few cells empty), and up to
+// twice it (over half of them empty).
+TEST(VoroPlusPlus, PowerCells) {
+  compare_with_voro(3000, 611, 0.05);
+  compare_with_voro(3000, 612, 0.2);
+}
 
 /// Every cell of Voro++'s periodic container `con` (looped by Loop) against
 /// Tessera's cells `c` of the same n points: the same volume (1e-9) and the

@@ -67,7 +67,7 @@ Tally check_cell(const Scene<dim_of<CellT>>& s, std::int32_t i, std::size_t head
   s.reset(cell, i);
   for (std::size_t k = 0; k < std::min(head, order.size()); ++k) s.clip(cell, order[k]);
   SupportBound<D> bound;
-  bound.measure(cell.vertices());
+  bound.measure(cell.vertices(), cell.power_slack());
   CellT later = cell;
   for (std::size_t k = head; k < std::min(head + more, order.size()); ++k) s.clip(later, order[k]);
   Tally t;
@@ -122,7 +122,7 @@ void lattice_scene() {
   for (std::int32_t j = 0; j < s.size(); ++j)
     if (j != centre) s.clip(cell, j);
   SupportBound<D> bound;
-  bound.measure(cell.vertices());
+  bound.measure(cell.vertices(), cell.power_slack());
   for (std::int32_t j = 0; j < s.size(); ++j) {
     if (j == centre) continue;
     double q[D];

@@ -18,6 +18,9 @@ struct PointCloud {
   std::size_t n = 0;
   std::vector<double> coords;         ///< n * dim
   std::vector<std::int32_t> labels;   ///< empty, or n labels
+  /// Empty, or n sphere radii for power cells (VoronoiOptions::radii): not
+  /// read by read_points; the CLI's --radii fills it (read_point_scalars).
+  std::vector<double> radii;
 };
 
 struct ReadOptions {

@@ -496,13 +496,13 @@ class CellBuilder {
       sort_keys(keys, head_end);
       for (std::uint64_t* it = keys; next == Next::go && it != head_end; ++it) next = visit(*it);
       if (next == Next::go && head_end != end) {
-        support_.measure(cell.vertices());
+        support_.measure(cell.vertices(), cell.power_slack());
         for (std::uint64_t* it = head_end; next != Next::no_cell && next != Next::capped && it != end; ++it) {
           const Candidate& cd = cand_[static_cast<std::uint32_t>(*it)];
           if (cd.r2 > sec2 || support_.excludes(cd.q)) continue;
           const double before = sec2;
           next = visit(*it);
-          if (sec2 != before) support_.measure(cell.vertices());  // it clipped
+          if (sec2 != before) support_.measure(cell.vertices(), cell.power_slack());  // it clipped
         }
       }
       if (next == Next::no_cell) return status;
@@ -787,7 +787,7 @@ class CellBuilder {
   /// of many vertices. The clips that follow are exactly those without the
   /// screen, in the same order: a dropped candidate could not have clipped.
   std::size_t screen(const CellT& cell, std::size_t nc, double sec2) {
-    support_.measure(cell.vertices());
+    support_.measure(cell.vertices(), cell.power_slack());
     std::uint64_t* const keys = keys_.data();
     std::size_t kept = 0;
     for (std::size_t k = 0; k < nc; ++k) {

@@ -133,7 +133,24 @@ struct ExactContext {
   /// kernels may round into the subnormal range (front/pass.cpp,
   /// choose_scaling): their vertex bounds then add filter::underflow_slack.
   bool may_underflow = false;
+  /// A power (radical) diagram: the radius of each point's sphere (n
+  /// entries, >= 0, in the computation's frame), or null for the ordinary
+  /// diagram. Point k's power at x is |x - p_k|^2 - radii[k]^2, so every
+  /// bisector row's right-hand side gains r_i^2 - r_k^2 (exact: the radii
+  /// join the coordinates' grid, and their squares are the coordinates'
+  /// degree). With radii every exact question goes to the GMP rows
+  /// (build_rows): the prepared integer stages, the box-tie stage and the
+  /// integer vertex solves assume |q|^2 alone. `max_radius` is the largest.
+  const double* radii = nullptr;
+  double max_radius = 0;
 };
+
+/// The offset d of the power bisector of points i and j relative to p_i:
+/// the plane q.y = d, q = p_j - p_i, d = (|q|^2 + r_i^2 - r_j^2) / 2 with
+/// the exact q and radii (ctx.radii), rounded toward zero (within one ulp)
+/// and then to the double range. For the clips whose float d cancels
+/// (the plane passes near p_i: kernels/power.hpp).
+double exact_power_offset(const ExactContext& ctx, std::int32_t i, std::int32_t j);
 
 /// Put n points (n * dim doubles) and the box [lo, hi] on their common grid
 /// when it has at most 22 bits (lattices, voxel centres, integer and dyadic

@@ -31,6 +31,7 @@
 #include "tessera/kernels/dual_faces.hpp"
 #include "tessera/kernels/exact_predicates.hpp"
 #include "tessera/kernels/filter.hpp"
+#include "tessera/kernels/power.hpp"
 #include "tessera/kernels/prepared_signs.hpp"
 
 namespace tessera::kernels {
@@ -107,7 +108,8 @@ class Hull {
       deferred_asks_ = 0;
       solve_deferred();
     }
-    const filter::Bisector<3> b(q);
+    filter::Bisector<3> b(q);
+    if (weighted_) [[unlikely]] weigh(b, *exact_, gen_, j);  // a power diagram's plane (power.hpp)
     const std::size_t nv = verts_.size();
     auto exact = [&](std::size_t t) { return exact_sign(t, j); };
     // Where no frame fits, n.y may overflow (filter::classify).
@@ -285,11 +287,15 @@ class Hull {
   /// Upper bound on (2R)^2, R = the largest distance from the generator to a
   /// vertex: a neighbour farther than 2R cannot clip (security radius).
   double security_radius2() const { return security2_; }
+  /// power_slack (power.hpp) of a power cell, in every vertex's r2; 0 without radii.
+  double power_slack() const { return slack_; }
 
   std::int32_t generator() const { return gen_; }
   /// Whether some plane is a scaled bisector (Plane::scale != 0): only in
   /// input no frame fits; the measure reads every plane's scale only then.
   bool has_scaled_planes() const { return scaled_planes_; }
+  /// Whether this is a power cell (ExactContext::radii; power.hpp).
+  bool weighted() const { return weighted_; }
   /// The generator's coordinates: vertices are relative to them.
   const double* site() const { return site_; }
   std::size_t num_vertices() const { return verts_.size(); }
@@ -522,6 +528,8 @@ class Hull {
     for (int a = 0; a < 3; ++a) site_[a] = p[a];
     exact_ = exact;
     may_underflow_ = exact != nullptr && exact->may_underflow;
+    weighted_ = exact != nullptr && exact->radii != nullptr;
+    slack_ = weighted_ ? kernels::power_slack(exact->max_radius, exact->radii[gen]) : 0.0;
     scaled_planes_ = false;
     if (hashed_) [[unlikely]] leave_hash();
     signs_.start_cell();
@@ -790,10 +798,11 @@ class Hull {
 
   // |y_exact| <= |y| + sqrt(3) err, so |y_exact|^2 <= |y|^2 + 4 err |y|_1 + 4 err^2
   // (|y| <= |y|_1), with a relative margin for the rounding of this sum.
-  static void set_radius(Vertex& v, double err) {
+  // With radii it bounds |y|^2 + slack_ (power.hpp); slack_ 0 adds nothing.
+  void set_radius(Vertex& v, double err) const {
     double a = v.y[0] * v.y[0] + v.y[1] * v.y[1] + v.y[2] * v.y[2];
     double l1 = std::fabs(v.y[0]) + std::fabs(v.y[1]) + std::fabs(v.y[2]);
-    v.r2 = (a + 4.0 * err * (l1 + err)) * (1.0 + 1e-12) + filter::radius_abs_eps;
+    v.r2 = (a + 4.0 * err * (l1 + err) + slack_) * (1.0 + 1e-12) + filter::radius_abs_eps;
     if (!(v.r2 < std::numeric_limits<double>::infinity())) v.r2 = std::numeric_limits<double>::infinity();  // NaN too
   }
 
@@ -811,6 +820,8 @@ class Hull {
   double site_[3] = {};  // the generator's coordinates
   const ExactContext* exact_ = nullptr;
   bool may_underflow_ = false;  // exact_->may_underflow: solve() adds filter::underflow_slack
+  bool weighted_ = false;       // exact_->radii: a power cell (power.hpp)
+  double slack_ = 0;            // power_slack of this cell (0 without radii), in every r2
   bool scaled_planes_ = false;  // has_scaled_planes()
   mutable std::uint64_t exact_solves_ = 0;  // exact_solves(); counted by the const solve
   mutable std::size_t deferred_ = 0;  // vertices deferred (Vertex::deferred) since the cell started

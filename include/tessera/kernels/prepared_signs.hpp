@@ -66,6 +66,10 @@ class PreparedSigns {
   int sign(const ExactContext& ctx, std::int32_t gen, std::size_t t, const Index* p, const std::int32_t* ids,
            std::int32_t j) {
     ++calls_;
+    if (ctx.radii != nullptr) [[unlikely]] {  // the prepared stages know no radii (ExactContext::radii)
+      ++off_grid_;
+      return exact_clip_sign_by_arithmetic(ctx, gen, ids, j);
+    }
     if (slots_.size() <= t) slots_.resize(t + 1);
     Slot& s = slots_[t];
     bool same = s.cell == cell_;

@@ -47,8 +47,11 @@ class SupportBound {
  public:
   /// Measure the extents of `vertices` (each with y[D], the position relative
   /// to the generator, and e >= its error bound in the infinity norm).
+  /// `slack`: a power cell's power_slack (power.hpp), 0 for an ordinary one:
+  /// its bisector with q lies at d >= (|q|^2 - slack) / 2.
   template <class Vertices>
-  void measure(const Vertices& vertices) {
+  void measure(const Vertices& vertices, double slack) {
+    slack_ = slack;
     for (int f = 0; f < forms; ++f) {
       hi_[f] = -std::numeric_limits<double>::infinity();
       lo_[f] = std::numeric_limits<double>::infinity();
@@ -123,13 +126,13 @@ class SupportBound {
     // sum to |q|_1), and 1e-12 rinf per unit for the rounding of q against
     // the exact difference, of the forms and of this sum; |q|^2 likewise.
     const double slack = n1 * (emax_ + 1e-12 * rinf_);
-    const double q2lo = q2 * (1.0 - 1e-12) - filter::abs_eps;
+    const double q2lo = q2 * (1.0 - 1e-12) - filter::abs_eps - slack_;
     return 2.0 * (bound + slack) < q2lo;  // false on NaN (an unbounded measure)
   }
 
  private:
   double hi_[forms], lo_[forms];
-  double emax_ = 0, rinf_ = 0;
+  double emax_ = 0, rinf_ = 0, slack_ = 0;
 };
 
 /// A cheap test that no point of a box can clip a cell: the box meets none

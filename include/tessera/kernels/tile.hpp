@@ -23,6 +23,7 @@
 #include "tessera/kernels/exact_predicates.hpp"
 #include "tessera/kernels/filter.hpp"
 #include "tessera/kernels/hull.hpp"  // ClipResult
+#include "tessera/kernels/power.hpp"
 #include "tessera/kernels/prepared_signs.hpp"
 
 namespace tessera::kernels {
@@ -85,7 +86,8 @@ class Tile {
       deferred_asks_ = 0;
       solve_deferred();
     }
-    const filter::Bisector<2> b(q);
+    filter::Bisector<2> b(q);
+    if (weighted_) [[unlikely]] weigh(b, *exact_, gen_, j);  // a power diagram's plane (power.hpp)
     const std::size_t nv = verts_.size();
     auto exact = [&](std::size_t t) { return exact_sign(t, j); };
     // Where no frame fits, n.y may overflow (filter::classify).
@@ -227,6 +229,8 @@ class Tile {
   }
 
   double security_radius2() const { return security2_; }
+  /// power_slack (power.hpp) of a power cell, in every vertex's r2; 0 without radii.
+  double power_slack() const { return slack_; }
   std::int32_t generator() const { return gen_; }
   /// The generator's coordinates: vertices are relative to them.
   const double* site() const { return site_; }
@@ -295,6 +299,8 @@ class Tile {
     for (int a = 0; a < 2; ++a) site_[a] = p[a];
     exact_ = exact;
     may_underflow_ = exact != nullptr && exact->may_underflow;
+    weighted_ = exact != nullptr && exact->radii != nullptr;
+    slack_ = weighted_ ? kernels::power_slack(exact->max_radius, exact->radii[gen]) : 0.0;
     signs_.start_cell();
     exact_solves_ = 0;
     deferred_.clear();
@@ -361,11 +367,12 @@ class Tile {
     T err() const { return filter::vertex_eps * inv_norm * (amax * ymax + bmax); }
   };
   // The bound on |y|^2 before set_radius's clamp to infinity.
+  // With radii it bounds |y|^2 + slack_ (power.hpp); slack_ 0 adds nothing.
   template <class T>
-  static T radius2(T y0, T y1, T err) {
+  T radius2(T y0, T y1, T err) const {
     const T a = y0 * y0 + y1 * y1;
     const T l1 = magnitude(y0) + magnitude(y1);
-    return (a + 4.0 * err * (l1 + err)) * (1.0 + 1e-12) + filter::radius_abs_eps;
+    return (a + 4.0 * err * (l1 + err) + slack_) * (1.0 + 1e-12) + filter::radius_abs_eps;
   }
 
   // solve() for the two new vertices of a clip at once, one division for
@@ -451,7 +458,7 @@ class Tile {
   static double clamp_radius(double r2) {
     return r2 < std::numeric_limits<double>::infinity() ? r2 : std::numeric_limits<double>::infinity();  // NaN too
   }
-  static void set_radius(Vertex& v, double err) { v.r2 = clamp_radius(radius2(v.y[0], v.y[1], err)); }
+  void set_radius(Vertex& v, double err) const { v.r2 = clamp_radius(radius2(v.y[0], v.y[1], err)); }
 
   void update_radius() {
     security2_ = 4.0 * lanes_.max_r2() * (1 + 1e-12);
@@ -461,6 +468,8 @@ class Tile {
   double site_[2] = {};  // the generator's coordinates
   const ExactContext* exact_ = nullptr;
   bool may_underflow_ = false;  // exact_->may_underflow: solve() adds filter::underflow_slack
+  bool weighted_ = false;       // exact_->radii: a power cell (power.hpp)
+  double slack_ = 0;            // power_slack of this cell (0 without radii), in every r2
   mutable std::uint64_t exact_solves_ = 0;  // exact_solves(); counted by the const solve
   mutable DeferredSolves deferred_;  // pair_keys of vertices whose exact solve waits (solve_deferred)
   // Exact evaluations asked while some vertex is deferred (a tile cannot
