@@ -118,4 +118,16 @@ inline std::span<const std::int32_t> as_labels(const py::object& labels) {
   return {a.data(), static_cast<std::size_t>(a.size())};
 }
 
+/// Radii of power cells: None (ordinary cells) or a float64 C-contiguous
+/// 1-D array. The span views the caller's array, which must stay alive (and
+/// unchanged) for as long as the span is used.
+inline std::span<const double> as_radii(const py::object& radii) {
+  if (radii.is_none()) return {};
+  if (!py::isinstance<py::array_t<double, py::array::c_style>>(radii))
+    throw py::type_error("radii must be None or a C-contiguous float64 array");
+  auto a = radii.cast<py::array_t<double, py::array::c_style>>();
+  if (a.ndim() != 1) throw py::value_error("radii must be one-dimensional");
+  return {a.data(), static_cast<std::size_t>(a.size())};
+}
+
 }  // namespace tessera::python

@@ -23,12 +23,14 @@ using Points = py::array_t<double, py::array::c_style>;
 
 Cells run_voronoi(const Points& points, const py::object& labels, const std::optional<std::vector<double>>& bounds,
                   double padding, bool ignore_outside, int threads, bool merge, const std::string& method,
-                  const std::array<bool, 3>& periodic, const std::array<double, 3>& tilt) {
+                  const std::array<bool, 3>& periodic, const std::array<double, 3>& tilt,
+                  const py::object& radii) {
   const int dim = checked_dim(points);
   VoronoiOptions opt;
   fill_common(opt, dim, bounds, padding, ignore_outside, threads);
   opt.periodic = periodic;
   opt.tilt = tilt;
+  opt.radii = as_radii(radii);  // views the caller's array, alive through the call
   opt.build_mesh = merge;
   if (method == "auto") opt.cell_method = CellMethod::automatic;
   else if (method == "search") opt.cell_method = CellMethod::search;
@@ -160,6 +162,9 @@ void bind_voronoi(py::module_& m) {
                              })
       // diagnostics
       .def_property_readonly("duplicates", [](const Cells& c) { return pairs_copy(c.duplicates); })
+      .def_readonly("power", &Cells::power)
+      .def_property_readonly("empty_cells",
+                             [](py::object s) { return view_flat(s.cast<const Cells&>().empty_cells, s); })
       .def_property_readonly("ignored_outside_bounds",
                              [](py::object s) { return view_flat(s.cast<const Cells&>().ignored_outside_bounds, s); });
 
@@ -170,12 +175,15 @@ void bind_voronoi(py::module_& m) {
 
   m.def("voronoi", &run_voronoi, py::arg("points").noconvert(), py::arg("labels").none(true), py::arg("bounds"),
         py::arg("padding"), py::arg("ignore_outside"), py::arg("threads"), py::arg("merge"),
-        py::arg("method"), py::arg("periodic"), py::arg("tilt"), "Cells of float64 C-ordered (N, D) points; labels None or int32 (N,). Runs without the GIL.");
+        py::arg("method"), py::arg("periodic"), py::arg("tilt"), py::arg("radii").none(true) = py::none(),
+        "Cells of float64 C-ordered (N, D) points; labels None or int32 (N,); radii None or float64 (N,) "
+        "(power cells). Runs without the GIL.");
 
   m.def(
       "validate_cells",
-      [](const Cells& c, const py::object& labels, const py::object& points) {
+      [](const Cells& c, const py::object& labels, const py::object& points, const py::object& radii) {
         const auto lab = as_labels(labels);
+        const auto rad = as_radii(radii);  // the caller's array: alive through the call
         std::span<const double> pts;
         std::optional<Points> held;  // keeps the array alive while the GIL is released
         if (!points.is_none()) {
@@ -184,11 +192,16 @@ void bind_voronoi(py::module_& m) {
             throw py::value_error("validate_cells: points are not the ones the cells were computed from");
           pts = as_span(*held);
         }
-        return without_gil([&] { return validate(c, lab, pts); });
+        if (!rad.empty() && rad.size() != c.n_points)
+          throw py::value_error("validate_cells: radii are not the ones the cells were computed with");
+        if (!pts.empty() && c.power && rad.empty())
+          throw py::value_error("validate_cells: power cells need their radii with the points");
+        return without_gil([&] { return validate(c, lab, pts, rad); });
       },
       py::arg("cells"), py::arg("labels").none(true), py::arg("points").none(true) = py::none(),
-      "Invariant checks (the CLI's --validate); with the points, also a sample of cells' measures "
-      "against exact arithmetic.");
+      py::arg("radii").none(true) = py::none(),
+      "Invariant checks (the CLI's --validate); with the points (and a power diagram's radii), also a "
+      "sample of cells' measures against exact arithmetic.");
 }
 
 }  // namespace tessera::python

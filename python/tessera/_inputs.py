@@ -73,6 +73,23 @@ def as_labels(labels: Any, n: int) -> Optional[np.ndarray]:
     return np.ascontiguousarray(a, dtype=np.int32)
 
 
+def as_radii(radii: Any, n: int) -> Optional[np.ndarray]:
+    """Radii of power cells as ``None`` or a float64 C-contiguous (n,) array.
+
+    No copy when ``radii`` already is one: the result is the caller's array,
+    which the compiled cells view during the call and ``Voronoi.radii`` keeps.
+    Finite and >= 0 is checked by the front end (InputError naming the point).
+    """
+    if radii is None:
+        return None
+    a = read_array(radii, "radii", "an array of numbers")
+    if a.dtype.kind not in _POINT_KINDS:
+        raise ValueError(f"radii: expected real numbers (one radius >= 0 per point), got dtype {a.dtype}")
+    if a.ndim != 1 or a.shape[0] != n:
+        raise ValueError(f"radii: expected one radius per point, shape ({n},), got {a.shape}")
+    return np.ascontiguousarray(a, dtype=np.float64)
+
+
 def as_bounds(bounds: Optional[Sequence[float]], dim: int) -> Optional[list]:
     """Bounds in the CLI's order (x0, x1, y0, y1[, z0, z1]) as 2*dim floats."""
     if bounds is None:
@@ -116,6 +133,7 @@ _CLI_WORDING = (
     ("--bounds", "bounds="),
     ("--dim 2", "(N, 2) points"),
     ("--ignore-outside", "ignore_outside=True"),
+    ("--method insertion", "method='insertion'"),
     ("--padding", "padding="),
 )
 

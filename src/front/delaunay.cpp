@@ -641,6 +641,8 @@ Delaunay images_pass(std::span<const double> points, std::span<const std::int32_
 
 Delaunay delaunay(std::span<const double> input, int dim, std::span<const std::int32_t> labels,
                   const DelaunayOptions& given) {
+  if (!given.radii.empty())
+    throw InputError("delaunay: radii (a regular triangulation, the dual of power cells) are not supported");
   if (given.periodic_box()) {
     if (!given.periodic[0] && !given.periodic[1] && !given.periodic[2])
       throw InputError("a tilt (triclinic box) needs periodic axes");

@@ -17,6 +17,8 @@ std::string no_cell_reason(const Cells& c, std::int32_t id) {
   if (std::find(c.ignored_outside_bounds.begin(), c.ignored_outside_bounds.end(), id) !=
       c.ignored_outside_bounds.end())
     return "it lies outside the bounds (or has a NaN or infinite coordinate)";
+  if (std::binary_search(c.empty_cells.begin(), c.empty_cells.end(), id))
+    return "its power cell is empty (other spheres' powers are less everywhere)";
   return "it is an outside point (label < 0)";
 }
 
@@ -86,6 +88,9 @@ Flower flower_of(const Cells& c, std::span<const double> points, std::int32_t id
 
 std::vector<Flower> flowers(const Cells& c, std::span<const double> points, std::span<const std::int32_t> ids) {
   front::require_mesh(c, "flowers", true);
+  // A flower's petals are the balls through the generator: an ordinary
+  // cell's. A power cell's would be wider by its weights (kernels/power.hpp).
+  if (c.power) throw InputError("flowers of power cells (radii) are not supported");
   if (points.size() != c.n_points * static_cast<std::size_t>(c.dim))
     throw std::invalid_argument("flowers: points are not the array the cells were computed from");
   std::vector<Flower> out;

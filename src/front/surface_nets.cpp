@@ -140,6 +140,7 @@ SurfaceNet surface_nets(std::span<const double> points, std::span<const std::int
                         const SurfaceNetsOptions& options) {
   const int D = options.voronoi.dim;
   if (D != 2 && D != 3) throw InputError("dim must be 2 or 3, got " + std::to_string(D));
+  if (!options.voronoi.radii.empty()) throw InputError("surface nets of power cells (radii) are not supported");
   if (points.size() % static_cast<std::size_t>(D) != 0)
     throw InputError("points: " + std::to_string(points.size()) + " coordinates is not a multiple of dim " +
                      std::to_string(D));
