@@ -31,13 +31,14 @@ def cells_for(
     ignore_outside: bool,
     periodic: Any = False,
     tilt: Optional[Sequence[float]] = None,
+    radii: Any = None,
 ) -> Voronoi:
     """The Voronoi result a product is read from: `source` itself when it is
     one (the cell options must then be left out: they were fixed when it was
     computed), else the cells of the points `source`, with the mesh."""
     if isinstance(source, Voronoi):
         given = [n for n, v in (("labels", labels), ("bounds", bounds), ("padding", padding), ("threads", threads),
-                                ("tilt", tilt)) if v is not None]
+                                ("tilt", tilt), ("radii", radii)) if v is not None]
         if ignore_outside:
             given.append("ignore_outside")
         if periodic is not None and periodic is not False:
@@ -51,7 +52,8 @@ def cells_for(
                              "compute it with merge=True")
         return source
     return voronoi(source, labels=labels, bounds=bounds, padding=0.01 if padding is None else padding,
-                   threads=threads, merge=True, ignore_outside=ignore_outside, periodic=periodic, tilt=tilt)
+                   threads=threads, merge=True, ignore_outside=ignore_outside, periodic=periodic, tilt=tilt,
+                   radii=radii)
 
 
 def _check_vtp(path: PathLike, what: str) -> str:
@@ -73,8 +75,8 @@ class AdjacencyGraph:
     ``spokes[wheel_offsets[i]:wheel_offsets[i+1]]``, ascending, the box planes
     first as negative ids (x0=-1, x1=-2, y0=-3, y1=-4, z0=-5, z1=-6); points
     without a cell (outside points, duplicates, points dropped outside the
-    bounds) have empty wheels. The graph is exactly symmetric: every spoke
-    ``i -> j`` between two cells has its twin ``j -> i``.
+    bounds, empty power cells) have empty wheels. The graph is exactly
+    symmetric: every spoke ``i -> j`` between two cells has its twin ``j -> i``.
 
     Of periodic cells (``voronoi(..., periodic=..., merge=True)``), spokes lead
     to images: :attr:`spoke_shifts` says which, wheels are ascending by
@@ -215,6 +217,7 @@ def adjacency(
     ignore_outside: bool = False,
     periodic: Any = False,
     tilt: Optional[Sequence[float]] = None,
+    radii: Any = None,
 ) -> AdjacencyGraph:
     """The adjacency graph (wheels and spokes) of a tessellation.
 
@@ -223,10 +226,12 @@ def adjacency(
     source : Voronoi or array_like, shape (N, 2) or (N, 3)
         A :class:`Voronoi` computed with ``merge=True`` (reused as is), or
         points whose cells are computed first.
-    labels, bounds, padding, threads, ignore_outside, periodic, tilt
+    labels, bounds, padding, threads, ignore_outside, periodic, tilt, radii
         As in :func:`tessera.voronoi`, for points only (ValueError with a
         Voronoi: its cells are already computed). The graph is read off in
-        parallel on the thread count the cells were computed with.
+        parallel on the thread count the cells were computed with. With
+        ``radii`` (power cells) the points whose cell is empty have empty
+        wheels.
     prune_tolerance : float
         Drop spokes whose face is tiny, for parity with VTK's PruneTolerance
         (0, the default, keeps every face: with exact topology none needs
@@ -241,7 +246,7 @@ def adjacency(
     tol = _inputs.as_float(prune_tolerance, "prune_tolerance", "a finite number >= 0")
     if not (np.isfinite(tol) and tol >= 0):
         raise ValueError(f"prune_tolerance: expected a finite number >= 0, got {prune_tolerance!r}")
-    vor = cells_for("adjacency", source, labels, bounds, padding, threads, ignore_outside, periodic, tilt)
+    vor = cells_for("adjacency", source, labels, bounds, padding, threads, ignore_outside, periodic, tilt, radii)
     return AdjacencyGraph(_inputs.call(_core.adjacency_graph, vor._cells, tol), vor, tol)
 
 
@@ -412,6 +417,7 @@ def faces(
     ignore_outside: bool = False,
     periodic: Any = False,
     tilt: Optional[Sequence[float]] = None,
+    radii: Any = None,
 ) -> FaceSet:
     """A face set of a tessellation: its boundary, the whole polygonal complex,
     or the surface net between regions.
@@ -430,8 +436,9 @@ def faces(
         surface-net only: add the boundary faces, so every region is enclosed.
     background_label : int
         The side-1 label of faces on the domain box; must be < 0.
-    labels, bounds, padding, threads, ignore_outside, periodic, tilt
-        As in :func:`tessera.voronoi`, for points only (ValueError with a Voronoi).
+    labels, bounds, padding, threads, ignore_outside, periodic, tilt, radii
+        As in :func:`tessera.voronoi`, for points only (ValueError with a
+        Voronoi). With ``radii`` the faces are those of the power cells.
 
     Returns
     -------
@@ -442,7 +449,7 @@ def faces(
     if capping and kind != "surface-net":
         raise ValueError(f"capping: applies to kind='surface-net' only, got kind={kind!r}")
     bg = _inputs.as_label_value(background_label, "background_label", negative=True)
-    vor = cells_for("faces", source, labels, bounds, padding, threads, ignore_outside, periodic, tilt)
+    vor = cells_for("faces", source, labels, bounds, padding, threads, ignore_outside, periodic, tilt, radii)
     fs = _inputs.call(_core.extract_faces, vor._cells, vor.labels, kind, capping, bg)
     return FaceSet(fs, vor, capping, bg)
 
@@ -632,6 +639,9 @@ def flower(
     ----------
     source : Voronoi or array_like, shape (N, 2) or (N, 3)
         A :class:`Voronoi` computed with ``merge=True`` (reused), or points.
+        Not power cells (``voronoi(..., radii=...)``: ``tessera.InputError``):
+        a petal is a ball through the generator, which holds for ordinary
+        cells only.
     ids : int or sequence of int
         The points whose cells to show; each must own a cell (not an outside
         point, a duplicate or a point dropped outside the bounds).
@@ -647,6 +657,11 @@ def flower(
         ``flowers[k]`` is the :class:`Flower` of ``ids[k]``.
     """
     vor = cells_for("flower", source, labels, bounds, padding, threads, ignore_outside, periodic, tilt)
+    if vor.power:
+        # Petals are the balls through the generator centred at its cell's
+        # vertices: an ordinary cell's, not a power cell's.
+        raise _core.InputError("flower: flowers of power cells are not supported (the petals assume ordinary "
+                               "Voronoi cells)")
     idx = as_ids(ids, vor.points.shape[0])
     fs = _inputs.call(_core.flowers, vor._cells, vor.points, idx)
     return Flowers(fs, vor, bool(glyphs))

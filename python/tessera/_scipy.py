@@ -114,7 +114,8 @@ class ScipyVoronoi:
     @property
     def point_region(self) -> np.ndarray:
         """int32 (N,): the region (cell) of each point, -1 for a point without one
-        (outside label, dropped outside the bounds, or a duplicate)."""
+        (outside label, dropped outside the bounds, a duplicate, or an empty
+        power cell)."""
         return self._vor.cell_of
 
     @cached_property

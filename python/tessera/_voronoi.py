@@ -24,8 +24,9 @@ class Voronoi:
     it alive); copy what you want to change. Cells are listed in generator-id
     order: cell ``c`` belongs to point ``generators[c]`` and point ``i`` owns cell
     ``cell_of[i]`` (-1 when it owns none: an outside point (label < 0), a point
-    dropped outside the bounds, or an exact duplicate of a lower id, see
-    :attr:`duplicates`).
+    dropped outside the bounds, an exact duplicate of a lower id, see
+    :attr:`duplicates`, or, of power cells, a point whose cell is empty, see
+    :attr:`empty_cells`).
 
     Per cell (``n_cells`` rows): :attr:`generators`, :attr:`regions`,
     :attr:`volumes`, :attr:`centroids`, :attr:`num_faces`, and the face
@@ -45,10 +46,12 @@ class Voronoi:
     :attr:`scipy` is a view with the attributes of ``scipy.spatial.Voronoi``.
     """
 
-    def __init__(self, cells: _core.Cells, points: np.ndarray, labels: Optional[np.ndarray]):
+    def __init__(self, cells: _core.Cells, points: np.ndarray, labels: Optional[np.ndarray],
+                 radii: Optional[np.ndarray] = None):
         self._cells = cells
         self._points = points
         self._labels = labels
+        self._radii = radii  # kept: validate() measures power cells with them
 
     # ---- input and domain -------------------------------------------------
     @property
@@ -60,6 +63,12 @@ class Voronoi:
     def labels(self) -> Optional[np.ndarray]:
         """The region labels given (int32 (N,)), or None."""
         return self._labels
+
+    @property
+    def radii(self) -> Optional[np.ndarray]:
+        """The radii given (float64 (N,), the caller's array itself when it was
+        one), or None."""
+        return self._radii
 
     @property
     def ndim(self) -> int:
@@ -220,6 +229,19 @@ class Voronoi:
         return self._cells.duplicates
 
     @property
+    def power(self) -> bool:
+        """Whether these are power cells (``radii`` given, not all equal: equal
+        radii give the ordinary cells, and ``power`` is then False)."""
+        return self._cells.power
+
+    @property
+    def empty_cells(self) -> np.ndarray:
+        """int32, ascending: of power cells, the points whose cell is empty (their
+        sphere's power is nowhere the least); they own no cell (``cell_of`` -1)
+        and are nobody's neighbour. Empty for ordinary cells."""
+        return self._cells.empty_cells
+
+    @property
     def ignored_outside_bounds(self) -> np.ndarray:
         """int32: points dropped outside the bounds or not finite (ignore_outside=True)."""
         return self._cells.ignored_outside_bounds
@@ -269,8 +291,10 @@ class Voronoi:
         The report is truthy when all pass; ``report.messages`` says what
         failed. In a periodic box neighbours must pair up with opposite
         shifts, and the vertex and exact-measure checks are left out (the
-        keys name points without their images' shifts)."""
-        return _core.validate_cells(self._cells, self._labels, self._points)
+        keys name points without their images' shifts). Power cells are
+        checked with their radii (a vertex has equal powers, not distances,
+        to its key's points)."""
+        return _core.validate_cells(self._cells, self._labels, self._points, self._radii)
 
     @cached_property
     def scipy(self) -> "ScipyVoronoi":
@@ -305,7 +329,8 @@ class Voronoi:
 
     def __repr__(self) -> str:
         mesh = f", {self.n_vertices} vertices" if self.has_mesh else ", no mesh"
-        return f"<tessera.Voronoi {self.ndim}D: {self._cells.n_points} points, {self.n_cells} cells{mesh}>"
+        kind = "power cells" if self.power else "cells"
+        return f"<tessera.Voronoi {self.ndim}D: {self._cells.n_points} points, {self.n_cells} {kind}{mesh}>"
 
 
 def voronoi(
@@ -320,6 +345,7 @@ def voronoi(
     method: str = "auto",
     periodic: Any = False,
     tilt: Optional[Sequence[float]] = None,
+    radii: Any = None,
 ) -> Voronoi:
     """Voronoi cells of 2D or 3D points, clipped to a box, with exact topology.
 
@@ -374,6 +400,18 @@ def voronoi(
         extents of ``bounds``; a tilt needs both of its axes periodic. Points
         are wrapped into it, the tilts are rounded like the coordinates, and
         :attr:`Voronoi.neighbor_shifts` count a, b and c.
+    radii : array_like of float, shape (N,), optional
+        Radii of spheres at the points (finite, >= 0): power cells (the
+        radical or Laguerre tessellation of polydisperse spheres, as Voro++'s
+        ``container_poly``). Each cell is where its point's power
+        ``|x - p|^2 - r^2`` is the least, so the face between two cells lies
+        on their spheres' radical plane. A point may own no cell
+        (:attr:`Voronoi.empty_cells`) or lie outside its own; of exactly
+        coincident points the largest radius owns the cell (ties: the lowest
+        id). All radii equal give exactly the ordinary cells. Computed by the
+        search: not with ``method="insertion"``, nor with ``periodic`` or
+        ``tilt``. The array is kept (:attr:`Voronoi.radii`, no copy when
+        it is float64 and contiguous) for :meth:`Voronoi.validate`.
 
     Returns
     -------
@@ -384,7 +422,9 @@ def voronoi(
     ValueError
         Bad input (``tessera.InputError`` for the library's own checks): wrong
         shape or dtype, NaN or infinite coordinates, label count mismatch,
-        empty bounds, points outside the bounds, no extent to build a box from.
+        empty bounds, points outside the bounds, no extent to build a box from,
+        radius count mismatch, a negative, NaN or infinite radius, radii with
+        a periodic box or ``method="insertion"``.
     KeyboardInterrupt
         Ctrl-C during the run (it stops between batches of cells).
 
@@ -394,6 +434,7 @@ def voronoi(
     dim = pts.shape[1]
     lab = _inputs.as_labels(labels, pts.shape[0])
     per, tilts = periodic_box(periodic, tilt, bounds, dim)
+    rad = _inputs.as_radii(radii, pts.shape[0])
     cells = _inputs.call(
         _core.voronoi,
         pts,
@@ -406,8 +447,9 @@ def voronoi(
         str(method),
         per,
         tilts,
+        rad,
     )
-    return Voronoi(cells, pts, lab)
+    return Voronoi(cells, pts, lab, rad)
 
 
 def periodic_box(periodic: Any, tilt: Any, bounds: Any, dim: int) -> Tuple[Tuple[bool, bool, bool],

@@ -1060,14 +1060,172 @@ class Periodic(TempDirCase):
         self.assertEqual(json.loads(r.stdout.splitlines()[0])["simplices"], len(np.load(simp)))
 
 
+class Power(TempDirCase):
+    """--radii: power (radical) cells, some empty; the summary's power line."""
+
+    N = 500
+
+    def setUp(self):
+        super().setUp()
+        rng = np.random.default_rng(11)
+        self.pts3 = rng.random((self.N, 3))
+        self.r3 = rng.random(self.N) * 0.12
+        self.pts2 = rng.random((self.N, 2))
+        self.r2 = rng.random(self.N) * 0.045
+        self.inp3, self.rad3 = self.save("p3.npy", self.pts3), self.save("r3.npy", self.r3)
+        self.inp2, self.rad2 = self.save("p2.npy", self.pts2), self.save("r2.npy", self.r2)
+
+    def power_line(self, out, n_empty):
+        m = re.search(r"^  power cells +radii (\S+) to (\S+); empty cells (\d+)(?: \(points ([\d, .]+)\))?$",
+                      out, re.M)
+        self.assertIsNotNone(m, out)
+        self.assertEqual(int(m.group(3)), n_empty, out)
+        return float(m.group(1)), float(m.group(2)), m.group(4)
+
+    def owning_their_position(self, pts, r):
+        """Points whose power is strictly the least at their own position: their
+        cells hold them, so they cannot be empty."""
+        pw = ((pts[:, None, :] - pts[None, :, :]) ** 2).sum(axis=2) - r[None, :] ** 2
+        own = np.diag(pw).copy()
+        np.fill_diagonal(pw, np.inf)
+        return np.flatnonzero(own < pw.min(axis=1))
+
+    def test_vtu_read_back_and_validate(self):
+        out, tab = self.p("power.vtu"), self.p("t.csv")
+        r = self.ok(["voronoi", self.inp3, "--radii", self.rad3, "--bounds"] + BOX3 +
+                    ["--validate", "-o", out, "--cell-table", tab])
+        self.assertIn("validation: OK", r.stdout)
+        g = read_vtu(out)
+        n = g.GetNumberOfCells()
+        self.assertLess(n, self.N, "radii this large leave some cells empty")
+        lo, hi, listed = self.power_line(r.stdout, self.N - n)
+        self.assertAlmostEqual(lo, self.r3.min(), delta=1e-9 * self.r3.max())
+        self.assertAlmostEqual(hi, self.r3.max(), delta=1e-9 * self.r3.max())
+        self.assertRegex(r.stdout, r"cells +%d\n" % n)
+        gid = vtk_to_numpy(cell_array(g, "GeneratorId"))
+        empty = np.setdiff1d(np.arange(self.N), gid)
+        self.assertEqual(listed, ", ".join(str(i) for i in empty[:5]) + (", ..." if len(empty) > 5 else ""))
+        self.assertFalse(np.isin(self.owning_their_position(self.pts3, self.r3), empty).any())
+        vol = vtk_to_numpy(cell_array(g, "Volume"))
+        self.assertTrue(np.all(vol > 0))
+        self.assertAlmostEqual(vol.sum(), 1.0, delta=1e-12)
+        geo_vol, nfaces = polyhedron_volumes(g)
+        np.testing.assert_allclose(geo_vol, vol, rtol=1e-9, atol=1e-15)
+        np.testing.assert_array_equal(nfaces, vtk_to_numpy(cell_array(g, "NumberOfFaces")))
+        t = np.loadtxt(tab, delimiter=",", skiprows=1)
+        np.testing.assert_array_equal(t[:, 0], gid)
+
+    def test_2d_vtp_read_back_and_validate(self):
+        out = self.p("power.vtp")
+        r = self.ok(["voronoi", self.inp2, "--radii", self.rad2, "--bounds"] + BOX2 + ["--validate", "-o", out])
+        self.assertIn("validation: OK", r.stdout)
+        poly = read_vtp(out)
+        n = poly.GetNumberOfCells()
+        self.assertLess(n, self.N)
+        self.power_line(r.stdout, self.N - n)
+        area = vtk_to_numpy(cell_array(poly, "Area"))
+        geo, _ = polygon_areas(poly)
+        np.testing.assert_allclose(geo, area, rtol=1e-9, atol=1e-15)
+        self.assertAlmostEqual(area.sum(), 1.0, delta=1e-12)
+        empty = np.setdiff1d(np.arange(self.N), vtk_to_numpy(cell_array(poly, "GeneratorId")))
+        self.assertFalse(np.isin(self.owning_their_position(self.pts2, self.r2), empty).any())
+
+    def test_ply_property_and_csv_column(self):
+        # The radii as a float32 .ply vertex property and as a .csv column: the
+        # same cells as from an .npy of those values.
+        header = ("ply\nformat binary_little_endian 1.0\nelement vertex %d\nproperty double x\nproperty double y\n"
+                  "property double z\nproperty float radius\nend_header\n" % self.N).encode()
+        rec = np.zeros(self.N, dtype=[("x", "<f8"), ("y", "<f8"), ("z", "<f8"), ("radius", "<f4")])
+        rec["x"], rec["y"], rec["z"] = self.pts3.T
+        rec["radius"] = self.r3
+        ply = self.p("s.ply")
+        with open(ply, "wb") as f:
+            f.write(header + rec.tobytes())
+        csv_in = self.p("s.csv")
+        with open(csv_in, "w") as f:
+            f.write("x,y,z,r\n")
+            for (x, y, z), ri in zip(self.pts3, self.r3):
+                f.write("%.17g,%.17g,%.17g,%.17g\n" % (x, y, z, ri))
+        r32 = self.save("r32.npy", rec["radius"].astype(np.float64))
+        tables = {}
+        for name, args in (("ply", [ply, "--radii", "radius"]), ("ply_ref", [self.inp3, "--radii", r32]),
+                           ("csv", [csv_in, "--radii", "r"]), ("csv_ref", [self.inp3, "--radii", self.rad3])):
+            t = self.p(name + ".csv")
+            r = self.ok(["voronoi"] + args + ["--bounds"] + BOX3 + ["--cell-table", t, "--validate"])
+            self.assertIn("power cells", r.stdout)
+            self.assertIn("validation: OK", r.stdout)
+            tables[name] = read_bytes(t)
+        self.assertEqual(tables["ply"], tables["ply_ref"])
+        self.assertEqual(tables["csv"], tables["csv_ref"])
+
+    def test_equal_radii_are_the_ordinary_cells(self):
+        plain, same = self.p("plain.vtu"), self.p("same.vtu")
+        self.ok(["voronoi", self.inp3, "--bounds"] + BOX3 + ["-o", plain, "-q"])
+        r = self.ok(["voronoi", self.inp3, "--radii", self.save("eq.npy", np.full(self.N, 0.25)), "--bounds"] +
+                    BOX3 + ["-o", same])
+        self.assertNotIn("power cells", r.stdout)
+        self.assertEqual(read_bytes(plain), read_bytes(same))
+
+    def test_threads_byte_identical(self):
+        outs = []
+        for th in ("1", "2"):
+            out = self.p("t%s.vtu" % th)
+            self.ok(["voronoi", self.inp3, "--radii", self.rad3, "-o", out, "--threads", th, "-q"])
+            outs.append(read_bytes(out))
+        self.assertEqual(outs[0], outs[1])
+
+    def test_graph_and_faces(self):
+        cells = self.p("c.vtu")
+        self.ok(["voronoi", self.inp3, "--radii", self.rad3, "--bounds"] + BOX3 + ["-o", cells, "-q"])
+        gid = vtk_to_numpy(cell_array(read_vtu(cells), "GeneratorId"))
+        empty = np.setdiff1d(np.arange(self.N), gid)
+        self.assertGreater(len(empty), 0)
+        gv, csr = self.p("g.vtp"), self.p("w.npy")
+        self.ok(["graph", self.inp3, "--radii", self.rad3, "--bounds"] + BOX3 + ["-o", gv, "--csr", csr, "-q"])
+        g = read_vtp(gv)
+        edges = np.concatenate(cells_of(g.GetLines())).reshape(-1, 2)
+        self.assertFalse(np.isin(edges, empty).any(), "no edge to a point whose cell is empty")
+        self.assertEqual(len(np.unique(edges)), len(gid))
+        fv = self.p("f.vtp")
+        r = self.ok(["faces", self.inp3, "--radii", self.rad3, "--bounds"] + BOX3 + ["--kind", "complex", "-o", fv])
+        f = read_vtp(fv)
+        sides = vtk_to_numpy(cell_array(f, "Sides")).reshape(-1, 2)
+        self.assertFalse(np.isin(sides, empty).any())
+        np.testing.assert_array_equal(np.unique(sides[sides >= 0]), gid)
+        self.assertEqual(f.GetNumberOfCells(), len(edges) + int((sides[:, 1] < 0).sum()))
+        # 2D too.
+        self.ok(["faces", self.inp2, "--radii", self.rad2, "--bounds"] + BOX2 + ["--kind", "boundary", "-o",
+                                                                                 self.p("f2.vtp"), "-q"])
+        self.ok(["graph", self.inp2, "--radii", self.rad2, "--bounds"] + BOX2 + ["-o", self.p("g2.vtp"), "-q"])
+
+    def test_bench(self):
+        tab = self.p("t.csv")
+        self.ok(["voronoi", self.inp3, "--radii", self.rad3, "--bounds"] + BOX3 + ["--cell-table", tab, "-q"])
+        n_cells = len(np.loadtxt(tab, delimiter=",", skiprows=1))
+        for extra in ([], ["--mesh", "--repeat", "2"]):
+            r = self.ok(["bench", "voronoi", self.inp3, "--radii", self.rad3, "--bounds"] + BOX3 + extra)
+            lines = r.stdout.splitlines()
+            self.assertEqual(len(lines), 2 if extra else 1, r.stdout)
+            for line in lines:
+                j = json.loads(line)
+                self.assertEqual(j["op"], "voronoi3_mesh" if extra else "voronoi3")
+                self.assertEqual(j["n"], self.N)
+                self.assertEqual(j["simplices"], n_cells)
+                self.assertAlmostEqual(j["extra"]["volume_sum"], 1.0, delta=1e-12)
+        r = self.ok(["bench", "voronoi", self.inp2, "--radii", self.rad2, "--bounds"] + BOX2)
+        self.assertEqual(json.loads(r.stdout.splitlines()[0])["op"], "voronoi2")
+
+
 class Help(unittest.TestCase):
     def test_help_lists_everything(self):
         r = run(["voronoi", "--help"])
         self.assertEqual(r.returncode, 0)
         for opt in ("INPUT", "--output", "--dim", "--labels", "--bounds", "--padding", "--ignore-outside",
                     "--threads", "--bin-points", "--cell-table", "--neighbors", "--validate", "--quiet",
-                    "--periodic", "--neighbor-shifts"):
+                    "--periodic", "--neighbor-shifts", "--radii"):
             self.assertIn(opt, r.stdout)
+        for cmd in (["bench", "voronoi"], ["graph"], ["faces"]):
+            self.assertIn("--radii", run(cmd + ["--help"]).stdout, cmd)
         r = run(["--help"])
         self.assertEqual(r.returncode, 0)
         for sub in ("voronoi", "bench", "run-default"):
@@ -1212,6 +1370,42 @@ class BadInput(TempDirCase):
         self.fails(dl + ["--periodic", "xy"], "every axis periodic")
         self.fails(dl + ["--periodic", "xyz", "--no-hull-completion"], "no hull")
         self.fails(dl + ["--periodic", "xyz", "--simplex-shifts", self.p("s.csv")], ".npy")
+
+    def test_bad_radii(self):
+        out = self.out()
+        vor = ["voronoi", self.good3, "-o", out, "--bounds"] + BOX3
+        r = np.random.default_rng(2).random(50) * 0.1
+        msg = self.fails(vor + ["--radii", self.save("short.npy", r[:-1])], "--radii", outputs=[out])
+        self.assertIn("49 values for 50 points", msg)
+        for value, shown in ((-0.5, "radius of point 7 is -0.5"), (np.nan, "radius of point 7 is NaN"),
+                             (np.inf, "radius of point 7 is inf")):
+            bad = r.copy()
+            bad[7] = value
+            self.fails(vor + ["--radii", self.save("bad.npy", bad)], shown, outputs=[out])
+        rad = self.save("r.npy", r)
+        self.fails(vor + ["--radii", rad, "--periodic", "xyz"], "periodic", outputs=[out])
+        self.fails(vor + ["--radii", rad, "--method", "insertion"], "--method insertion", outputs=[out])
+        self.fails(vor + ["--radii", self.p("missing.npy")], "missing.npy", outputs=[out])
+        self.fails(vor + ["--radii", self.save("r2d.npy", np.stack([r, r], 1))], "1-D", outputs=[out])
+        self.fails(vor + ["--radii", self.save("rs.npy", np.array(["a"] * 50))], outputs=[out])
+        # A name that the input has no column / property / field of.
+        csv_in = self.p("s.csv")
+        with open(csv_in, "w") as f:
+            f.write("x,y,z,r\n")
+            for p, ri in zip(np.load(self.good3), r):
+                f.write("%.17g,%.17g,%.17g,%.17g\n" % (p[0], p[1], p[2], ri))
+        self.fails(["voronoi", csv_in, "-o", out, "--bounds"] + BOX3 + ["--radii", "radius"], "'radius'",
+                   outputs=[out])
+        self.fails(vor + ["--radii", "radius"], "'radius'", outputs=[out])  # a plain .npy has no names
+        # The other commands that take --radii check them alike; flower takes none.
+        for args in (["graph", self.good3, "-o", self.p("g.vtp")],
+                     ["faces", self.good3, "--kind", "complex", "-o", self.p("f.vtp")],
+                     ["bench", "voronoi", self.good3]):
+            args = args + ["--bounds"] + BOX3
+            self.fails(args + ["--radii", self.p("short.npy")], "49 values for 50 points")
+            self.fails(args + ["--radii", self.p("bad.npy")], "radius of point 7")
+            self.fails(args + ["--radii", rad, "--periodic", "xyz"], "periodic")
+        self.fails(["flower", self.good3, "--point", "0", "-o", self.p("fl.vtp"), "--radii", rad], "--radii")
 
     def test_coplanar_3d_suggests_dim2(self):
         pts = np.random.default_rng(1).random((50, 3))
