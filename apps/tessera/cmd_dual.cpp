@@ -50,6 +50,7 @@ void print_header(const char* command, const ComputeArgs& a, const Computed& r) 
   std::printf("  %-18s %zu\n", "cells", r.cells.n_cells());
   std::printf("  %-18s %.3f s on %d thread%s\n", "compute", r.seconds, r.cells.threads_used,
               r.cells.threads_used == 1 ? "" : "s");
+  if (r.cells.power) print_power_line(r.pc, r.cells);
   if (r.cells.is_periodic()) {
     std::string axes;
     for (int k = 0; k < r.cells.dim; ++k)

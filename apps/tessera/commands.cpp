@@ -175,7 +175,11 @@ io::PointCloud read_input(const ComputeArgs& a) {
   ro.non_finite_hint = "--ignore-outside sets such points aside";
   io::PointCloud pc = io::read_points(a.input, ro);
   if (!a.radii.empty()) {
-    pc.radii = io::read_point_scalars(a.input, a.radii);
+    try {
+      pc.radii = io::read_point_scalars(a.input, a.radii);
+    } catch (const InputError& e) {  // its words are for any scalars: name the option
+      throw InputError(std::string("--radii: ") + e.what());
+    }
     if (pc.radii.size() != pc.n)
       throw InputError("--radii " + a.radii + ": " + std::to_string(pc.radii.size()) + " values for " +
                        std::to_string(pc.n) + " points");
@@ -220,6 +224,16 @@ VoronoiOptions make_options(const ComputeArgs& a, int dim) {
     for (std::size_t t = 0; t < a.tilt.size(); ++t) o.tilt[t] = a.tilt[t];
   }
   return o;
+}
+
+/// Power cells: the radii's range and the points whose cells are empty.
+void print_power_line(const io::PointCloud& pc, const Cells& c) {
+  const auto [lo, hi] = std::minmax_element(pc.radii.begin(), pc.radii.end());
+  std::string empty = std::to_string(c.empty_cells.size());
+  for (std::size_t i = 0; i < std::min<std::size_t>(c.empty_cells.size(), 5); ++i)
+    empty += strf("%s%d", i ? ", " : " (points ", c.empty_cells[i]);
+  if (!c.empty_cells.empty()) empty += c.empty_cells.size() > 5 ? ", ...)" : ")";
+  std::printf("  %-18s radii %.10g to %.10g; empty cells %s\n", "power cells", *lo, *hi, empty.c_str());
 }
 
 /// Runs the engine with a progress bar (when wanted) and Ctrl-C cancellation.
@@ -282,15 +296,6 @@ void print_volume_line(const Cells& c, const char* name) {
 
 // ------------------------------------------------------------------ summary
 
-/// Power cells: the radii's range and the points whose cells are empty.
-void print_power_line(const io::PointCloud& pc, const Cells& c) {
-  const auto [lo, hi] = std::minmax_element(pc.radii.begin(), pc.radii.end());
-  std::string empty = std::to_string(c.empty_cells.size());
-  for (std::size_t i = 0; i < std::min<std::size_t>(c.empty_cells.size(), 5); ++i)
-    empty += strf("%s%d", i ? ", " : " (points ", c.empty_cells[i]);
-  if (!c.empty_cells.empty()) empty += c.empty_cells.size() > 5 ? ", ...)" : ")";
-  std::printf("  %-18s radii %.10g to %.10g; empty cells %s\n", "power cells", *lo, *hi, empty.c_str());
-}
 
 void print_summary(const VoronoiArgs& a, const io::PointCloud& pc, const Cells& c, double read_s,
                    double compute_s, double write_s, const std::vector<std::string>& written) {
@@ -486,9 +491,9 @@ int run_bench_voronoi(const BenchArgs& a) {
     std::printf(
         "{\"tool\":\"tessera\",\"op\":\"%s\",\"n\":%zu,\"threads\":%d,\"seconds\":%.6f,\"simplices\":%zu,"
         "\"extra\":{\"cpu_user_s\":%.6f,\"cpu_sys_s\":%.6f,\"minflt\":%lld,\"peak_rss_bytes\":%lld,"
-        "\"neighbors\":%zu,\"from_insertion\":%s,\"assembled\":%zu,\"from_pilot\":%zu,\"exact_calls\":%llu,\"volume_sum\":%.17g,\"repeat\":%d}}\n",
+        "\"neighbors\":%zu,\"empty_cells\":%zu,\"from_insertion\":%s,\"assembled\":%zu,\"from_pilot\":%zu,\"exact_calls\":%llu,\"volume_sum\":%.17g,\"repeat\":%d}}\n",
         op, pc.n, cells.threads_used, secs, cells.n_cells(), u1.user_s - u0.user_s, u1.sys_s - u0.sys_s,
-        u1.minflt - u0.minflt, u1.maxrss_bytes, cells.neighbors.size(), cells.from_insertion ? "true" : "false",
+        u1.minflt - u0.minflt, u1.maxrss_bytes, cells.neighbors.size(), cells.empty_cells.size(), cells.from_insertion ? "true" : "false",
         cells.assembled_from_stars, cells.cells_from_pilot, static_cast<unsigned long long>(cells.exact_predicate_calls),
         accurate_sum(cells.volume), rep);
     std::fflush(stdout);

@@ -302,5 +302,7 @@ io::PointCloud read_input(const ComputeArgs& args);        ///< read and check I
 VoronoiOptions make_options(const ComputeArgs& args, int dim);
 /// tessera::voronoi with a progress bar (when `show_progress`) and Ctrl-C cancellation.
 Cells compute(const io::PointCloud& pc, VoronoiOptions options, bool show_progress, double& seconds);
+/// The summary's line on power cells (Cells::power): the radii's range and the empty cells.
+void print_power_line(const io::PointCloud& pc, const Cells& c);
 
 }  // namespace tessera::cli

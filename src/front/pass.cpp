@@ -378,10 +378,12 @@ void Pass<D>::set_radii(std::span<const double> given, std::size_t n, const Scal
   if (given.size() != n)
     throw InputError("radii: " + std::to_string(given.size()) + " values for " + std::to_string(n) + " points");
   for (std::size_t i = 0; i < n; ++i)
-    if (!(given[i] >= 0 && given[i] <= std::numeric_limits<double>::max()))
-      throw InputError("radius of point " + std::to_string(i) + " is " +
-                       (std::isnan(given[i]) ? std::string("NaN") : std::to_string(given[i])) +
-                       ": radii must be finite and non-negative");
+    if (!(given[i] >= 0 && given[i] <= std::numeric_limits<double>::max())) {
+      std::ostringstream m;
+      m.precision(17);
+      m << "radius of point " << i << " is " << given[i] << ": radii must be finite and non-negative";
+      throw InputError(m.str());
+    }
   // Equal radii add one constant to every power: the ordinary cells, by
   // the ordinary (faster, prepared) predicates.
   if (std::all_of(given.begin(), given.end(), [&](double r) { return r == given[0]; })) return;
