@@ -381,7 +381,10 @@ void Pass<D>::set_radii(std::span<const double> given, std::size_t n, const Scal
     if (!(given[i] >= 0 && given[i] <= std::numeric_limits<double>::max())) {
       std::ostringstream m;
       m.precision(17);
-      m << "radius of point " << i << " is " << given[i] << ": radii must be finite and non-negative";
+      m << "radius of point " << i << " is ";
+      if (std::isnan(given[i])) m << "NaN";
+      else m << given[i];
+      m << ": radii must be finite and non-negative";
       throw InputError(m.str());
     }
   // Equal radii add one constant to every power: the ordinary cells, by
