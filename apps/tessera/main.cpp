@@ -127,7 +127,7 @@ void add_radii_option(CLI::App* app, ComputeArgs& c) {
                   ".csv column / .vtp or .vtu point data array / .pcd or structured .npy field. Each cell is where "
                   "its point's power |x-p|^2 - r^2 is the least; a point may own no cell (listed as empty), and of "
                   "coincident points the largest radius owns it. Radii must be finite and >= 0; computed by the "
-                  "search; not with --periodic")
+                  "search; with --periodic every image has its point's radius")
       ->type_name("FILE|NAME");
 }
 

@@ -116,10 +116,11 @@ struct VoronoiOptions {
   /// face with a neighbour lies on their spheres' radical plane. A point
   /// may then own no cell (Cells::empty_cells), or lie outside its own;
   /// of exactly coincident points the largest radius owns the cell (ties:
-  /// the lowest id). All radii equal give the ordinary cells. Not with a
-  /// periodic box, nor CellMethod::insertion (the automatic method takes the
-  /// search), nor input that no power-of-two frame fits (coordinates
-  /// spanning more than ~1e-150..1e150 of each other); delaunay() takes none.
+  /// the lowest id). All radii equal give the ordinary cells. In a periodic
+  /// box every image has its point's radius. Not with CellMethod::insertion
+  /// (the automatic method takes the search), nor input that no power-of-two
+  /// frame fits (coordinates spanning more than ~1e-150..1e150 of each
+  /// other); delaunay() takes none.
   std::span<const double> radii;
   /// Some axis periodic, or a tilt given (which needs periodic axes).
   bool periodic_box() const {

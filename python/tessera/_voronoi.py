@@ -408,9 +408,9 @@ def voronoi(
         on their spheres' radical plane. A point may own no cell
         (:attr:`Voronoi.empty_cells`) or lie outside its own; of exactly
         coincident points the largest radius owns the cell (ties: the lowest
-        id). All radii equal give exactly the ordinary cells. Computed by the
-        search: not with ``method="insertion"``, nor with ``periodic`` or
-        ``tilt``. The array is kept (:attr:`Voronoi.radii`, no copy when
+        id). All radii equal give exactly the ordinary cells. In a periodic
+        box every image has its point's radius. Computed by the search: not
+        with ``method="insertion"``. The array is kept (:attr:`Voronoi.radii`, no copy when
         it is float64 and contiguous) for :meth:`Voronoi.validate`.
 
     Returns
@@ -424,7 +424,7 @@ def voronoi(
         shape or dtype, NaN or infinite coordinates, label count mismatch,
         empty bounds, points outside the bounds, no extent to build a box from,
         radius count mismatch, a negative, NaN or infinite radius, radii with
-        a periodic box or ``method="insertion"``.
+        ``method="insertion"``.
     KeyboardInterrupt
         Ctrl-C during the run (it stops between batches of cells).
 

@@ -223,9 +223,15 @@ Cells run_periodic(std::span<const double> input, int dim, std::span<const std::
   o.periodic = {false, false, false};
   o.tilt = {0, 0, 0};
   o.ignore_outside_points = false;  // set aside already; every image lies in the layer
+  std::vector<double> radii;  // power cells: each image has its point's radius
   auto [aug, im] = front::run_in_final_layer(in, labels, threads, [&](const front::PeriodicImages& images,
                                                                       std::vector<double>& reach) {
     o.bounds = images.domain;
+    if (!opt.radii.empty()) {
+      radii.resize(images.base.size());
+      for (std::size_t k = 0; k < radii.size(); ++k) radii[k] = opt.radii[static_cast<std::size_t>(images.base[k])];
+      o.radii = radii;
+    }
     return run<CellT>(images.points, images.labels, o, &reach);
   });
   return front::periodic_cells(std::move(aug), in, im, labels, threads);
@@ -236,7 +242,7 @@ Cells run_periodic(std::span<const double> input, int dim, std::span<const std::
 Cells voronoi(std::span<const double> input, int dim, std::span<const std::int32_t> labels,
               const VoronoiOptions& options) {
   if (!options.radii.empty()) {
-    if (options.periodic_box()) throw InputError("radii (power cells) are not supported in a periodic box");
+    if (dim == 2 || dim == 3) front::check_radii(options.radii, input.size() / static_cast<std::size_t>(dim));
     if (options.cell_method == CellMethod::insertion)
       throw InputError("radii (power cells) are computed by the search; --method insertion does not take them");
   }

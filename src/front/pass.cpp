@@ -372,21 +372,26 @@ Pass<D>::Pass(std::span<const double> input, std::span<const std::int32_t> label
   engine_options.progress = opt.progress;
 }
 
-template <int D>
-void Pass<D>::set_radii(std::span<const double> given, std::size_t n, const Scaling& scaling) {
-  if (given.empty()) return;
-  if (given.size() != n)
-    throw InputError("radii: " + std::to_string(given.size()) + " values for " + std::to_string(n) + " points");
+void check_radii(std::span<const double> radii, std::size_t n) {
+  if (radii.empty()) return;
+  if (radii.size() != n)
+    throw InputError("radii: " + std::to_string(radii.size()) + " values for " + std::to_string(n) + " points");
   for (std::size_t i = 0; i < n; ++i)
-    if (!(given[i] >= 0 && given[i] <= std::numeric_limits<double>::max())) {
+    if (!(radii[i] >= 0 && radii[i] <= std::numeric_limits<double>::max())) {
       std::ostringstream m;
       m.precision(17);
       m << "radius of point " << i << " is ";
-      if (std::isnan(given[i])) m << "NaN";
-      else m << given[i];
+      if (std::isnan(radii[i])) m << "NaN";
+      else m << radii[i];
       m << ": radii must be finite and non-negative";
       throw InputError(m.str());
     }
+}
+
+template <int D>
+void Pass<D>::set_radii(std::span<const double> given, std::size_t n, const Scaling& scaling) {
+  if (given.empty()) return;
+  check_radii(given, n);
   // Equal radii add one constant to every power: the ordinary cells, by
   // the ordinary (faster, prepared) predicates.
   if (std::all_of(given.begin(), given.end(), [&](double r) { return r == given[0]; })) return;

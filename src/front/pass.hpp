@@ -51,6 +51,10 @@ struct CheckedInput {
   CheckedInput& operator=(const CheckedInput&) = delete;
 };
 
+/// Throws InputError unless `radii` (VoronoiOptions::radii) is empty, or n
+/// finite radii >= 0.
+void check_radii(std::span<const double> radii, std::size_t n);
+
 /// The bounding box of the points, or of the inside ones (label >= 0) when
 /// labels are given; +inf..-inf on an axis with none.
 Bounds bounding_box(std::span<const double> points, int dim, std::span<const std::int32_t> labels = {});

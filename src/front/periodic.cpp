@@ -14,6 +14,7 @@
 #include "tessera/engine/classifier.hpp"
 #include "tessera/engine/thread_arena.hpp"
 #include "tessera/finite_points.hpp"
+#include "tessera/kernels/power.hpp"
 
 namespace tessera::front {
 namespace {
@@ -77,6 +78,12 @@ PeriodicInput periodic_input(std::span<const double> points, int dim, std::span<
                        axis_name(tilt_lo[t]) + "; reduce it by whole box lengths (the same lattice)");
   }
   in.sheared = options.tilt[0] != 0 || options.tilt[1] != 0 || options.tilt[2] != 0;
+  // r_max^2 - r_min^2 of power cells (an upper bound), 0 without radii.
+  double radii_spread = 0;
+  if (!options.radii.empty() && options.radii.size() == in.n) {
+    const auto [rmin, rmax] = std::minmax_element(options.radii.begin(), options.radii.end());
+    radii_spread = kernels::power_slack(*rmax, *rmin);
+  }
 
   // The grid along each periodic axis, with the box and tilts rounded to it.
   // Multiples of g below 2^(e+1) are doubles; every image's coordinate
@@ -139,7 +146,11 @@ PeriodicInput periodic_input(std::span<const double> points, int dim, std::span<
       }
       r2 += bound[a] * bound[a];
     }
-    const double cap = 2 * std::sqrt(r2) * (1 + 0x1p-20);
+    // Power cells (radii): a vertex's petal reaches sqrt(|y|^2 + slack)
+    // beyond it (kernels/power.hpp), slack at most r_max^2 - r_min^2; the
+    // bound on |y| holds as it is (a point's own images have its radius, so
+    // their planes are the bisectors). Without radii, twice sqrt(r2) exactly.
+    const double cap = (std::sqrt(r2) + std::sqrt(r2 + radii_spread)) * (1 + 0x1p-20);
     // An image within the cap of a point of the box lies within cap / h
     // lattice vectors along each (one more for a triclinic box's rounded
     // fractional coordinates).
@@ -521,6 +532,9 @@ Cells periodic_cells(Cells&& aug, const PeriodicInput& in, const PeriodicImages&
   }
 
   out.duplicates = duplicates_as_points(im, aug.duplicates);
+  out.power = aug.power;
+  for (const std::int32_t e : aug.empty_cells) out.empty_cells.push_back(base(e));
+  std::sort(out.empty_cells.begin(), out.empty_cells.end());
   out.exact_predicate_calls = aug.exact_predicate_calls;
   out.far_points = aug.far_points;
   out.threads_used = aug.threads_used;

@@ -72,7 +72,9 @@ struct Outcome {
 /// numbering does not matter.
 class LocalImages {
  public:
-  LocalImages(const Cells& c, std::int32_t g) : c_(c), du_(static_cast<std::size_t>(c.dim)), lattice_(c.lattice()) {
+  /// `radii`: power cells' (input ids), else null; each image has its point's.
+  LocalImages(const Cells& c, std::int32_t g, const double* radii)
+      : c_(c), du_(static_cast<std::size_t>(c.dim)), lattice_(c.lattice()), given_radii_(radii) {
     const std::int8_t zero[3] = {0, 0, 0};
     (void)id_of(g, zero);
   }
@@ -87,10 +89,12 @@ class LocalImages {
       double x[3];
       periodic_image(lattice_, c_.dim, &c_.periodic_points[static_cast<std::size_t>(id) * du_], shift, x);
       points_.insert(points_.end(), x, x + du_);
+      if (given_radii_ != nullptr) radii_.push_back(given_radii_[id]);
     }
     return it->second;
   }
   const std::vector<double>& points() const { return points_; }
+  const std::vector<double>& radii() const { return radii_; }  ///< per local id (power cells)
 
  private:
   const Cells& c_;
@@ -98,6 +102,8 @@ class LocalImages {
   std::array<std::array<double, 3>, 3> lattice_;
   std::map<std::array<std::int32_t, 4>, std::int32_t> ids_;
   std::vector<double> points_;
+  const double* given_radii_;
+  std::vector<double> radii_;
 };
 
 Outcome measure_cell(const Cells& c, const kernels::ExactContext& ctx, std::span<const double> points,
@@ -108,7 +114,7 @@ Outcome measure_cell(const Cells& c, const kernels::ExactContext& ctx, std::span
   // generator is local point 0 (LocalImages).
   const bool periodic = c.is_periodic();
   std::optional<LocalImages> images;
-  if (periodic) images.emplace(c, c.generator[k]);
+  if (periodic) images.emplace(c, c.generator[k], ctx.radii);
   const std::int32_t g = periodic ? 0 : c.generator[k];
   std::unordered_map<std::int32_t, std::uint32_t> local;  // merged vertex -> its index in the cell
   std::vector<std::int32_t> merged;                        // the inverse
@@ -159,6 +165,7 @@ Outcome measure_cell(const Cells& c, const kernels::ExactContext& ctx, std::span
   kernels::ExactContext local_ctx = ctx;
   if (periodic) {
     local_ctx.points = images->points().data();
+    if (ctx.radii != nullptr) local_ctx.radii = images->radii().data();
     points = images->points();
   }
   double centroid[3] = {0, 0, 0};

@@ -233,7 +233,6 @@ TEST(PowerCells, BadRadiiRefused) {
   r[7] = INFINITY;
   bad(r, none);
   r = random_radii(50, 0.1, 52);
-  bad(r, [](tessera::VoronoiOptions& o) { o.periodic = {true, true, true}; });
   bad(r, [](tessera::VoronoiOptions& o) { o.cell_method = tessera::CellMethod::insertion; });
   // Power cells measured without their radii cannot be checked exactly.
   auto o = options(3, unit_box());

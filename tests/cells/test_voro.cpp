@@ -140,18 +140,22 @@ TEST(VoroPlusPlus, PowerCells) {
 
 /// Every cell of Voro++'s periodic container `con` (looped by Loop) against
 /// Tessera's cells `c` of the same n points: the same volume (1e-9) and the
-/// same set of neighbour ids (Voro++'s walls, negative, left out).
+/// same set of neighbour ids (Voro++'s walls, negative, left out). Power
+/// cells (a _poly container): an empty cell is empty for both.
 template <class Loop, class Container>
 void expect_same_periodic_cells(Container& con, const tessera::Cells& c, std::size_t n) {
-  ASSERT_EQ(c.n_cells(), n);
+  ASSERT_EQ(c.n_cells() + c.empty_cells.size(), n);
   Loop loop(con);
   voro::voronoicell_neighbor cell;
   std::vector<int> nb;
   std::size_t computed = 0, bad_volume = 0, bad_neighbours = 0;
   if (loop.start()) do {
-      ASSERT_TRUE(con.compute_cell(cell, loop));
-      ++computed;
       const int i = loop.pid();
+      if (!con.compute_cell(cell, loop)) {
+        EXPECT_EQ(c.cell_of[static_cast<std::size_t>(i)], -1) << "point " << i << " empty for Voro++ alone";
+        continue;
+      }
+      ++computed;
       const auto k = static_cast<std::size_t>(c.cell_of[static_cast<std::size_t>(i)]);
       if (!(std::abs(c.volume[k] - cell.volume()) <= 1e-9 * cell.volume()) && ++bad_volume <= 5)
         ADD_FAILURE() << "point " << i << " volume " << c.volume[k] << " Voro++ " << cell.volume();
@@ -163,7 +167,7 @@ void expect_same_periodic_cells(Container& con, const tessera::Cells& c, std::si
       const std::set<int> tn(t.begin(), t.end());
       if (tn != vn && ++bad_neighbours <= 5) ADD_FAILURE() << "point " << i << ": neighbour ids differ";
     } while (loop.inc());
-  EXPECT_EQ(computed, n);
+  EXPECT_EQ(computed, c.n_cells());
   EXPECT_EQ(bad_volume, 0u);
   EXPECT_EQ(bad_neighbours, 0u);
 }
@@ -189,6 +193,61 @@ TEST(VoroPlusPlus, PeriodicBox) {
     o.periodic = per;
     expect_same_periodic_cells<voro::c_loop_all>(con, tessera::voronoi(pts, 3, {}, o), n);
   }
+}
+
+// Power cells in periodic boxes: container_poly with periodic flags (fully,
+// and along x and z only), and container_periodic_poly (triclinic), against
+// VoronoiOptions::radii with periodic axes. Radii on a dyadic grid (exact
+// squares), up to half the mean spacing and up to 1.5 times it (a third of
+// the cells empty).
+TEST(VoroPlusPlus, PeriodicPowerCells) {
+  const auto box = make_bounds({-1, 0, 2}, {1, 1.5, 3});
+  const std::size_t n = 3000;
+  auto pts = random_points(n, 3, 606, box);
+  for (double& x : pts) x = std::ldexp(std::floor(std::ldexp(x, 30)), -30);
+  std::mt19937_64 rng(607);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (const double rmax : {0.05, 0.15}) {
+    std::vector<double> radii(n);
+    for (double& r : radii) r = std::ldexp(std::floor(std::ldexp(u(rng) * rmax, 20)), -20);
+    for (const std::array<bool, 3> per : {std::array<bool, 3>{true, true, true}, std::array<bool, 3>{true, false, true}}) {
+      SCOPED_TRACE(::testing::Message() << "rmax " << rmax << " periodic " << per[0] << per[1] << per[2]);
+      voro::container_poly con(box.lo[0], box.hi[0], box.lo[1], box.hi[1], box.lo[2], box.hi[2], 8, 8, 8, per[0],
+                               per[1], per[2], 8);
+      for (std::size_t i = 0; i < n; ++i) con.put(int(i), pts[3 * i], pts[3 * i + 1], pts[3 * i + 2], radii[i]);
+      auto o = options(3, box, 2);
+      o.periodic = per;
+      o.radii = radii;
+      const auto c = tessera::voronoi(pts, 3, {}, o);
+      EXPECT_TRUE(c.power);
+      if (rmax > 0.1) EXPECT_GT(c.empty_cells.size(), 100u);
+      expect_same_periodic_cells<voro::c_loop_all>(con, c, n);
+      const auto r = tessera::validate(c, {}, pts, radii);
+      EXPECT_TRUE(r.ok) << (r.messages.empty() ? "" : r.messages[0]);
+      EXPECT_GT(r.measures_checked, 0u);
+    }
+  }
+  // Triclinic (container_periodic_poly), as TriclinicBox below.
+  const double bx = 2, by = 1.5, bz = 1, bxy = 0.375, bxz = -0.5, byz = 0.25;
+  const auto f = random_points(n, 3, 608, make_bounds({0, 0, 0}, {1, 1, 1}));
+  std::vector<double> tp(3 * n), radii(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const double* t = f.data() + 3 * i;
+    tp[3 * i] = std::ldexp(std::floor(std::ldexp(t[0] * bx + t[1] * bxy + t[2] * bxz, 30)), -30);
+    tp[3 * i + 1] = std::ldexp(std::floor(std::ldexp(t[1] * by + t[2] * byz, 30)), -30);
+    tp[3 * i + 2] = std::ldexp(std::floor(std::ldexp(t[2] * bz, 30)), -30);
+    radii[i] = std::ldexp(std::floor(std::ldexp(u(rng) * 0.06, 20)), -20);
+  }
+  voro::container_periodic_poly con(bx, bxy, by, bxz, byz, bz, 8, 8, 8, 8);
+  for (std::size_t i = 0; i < n; ++i) con.put(int(i), tp[3 * i], tp[3 * i + 1], tp[3 * i + 2], radii[i]);
+  auto o = options(3, make_bounds({0, 0, 0}, {bx, by, bz}), 2);
+  o.periodic = {true, true, true};
+  o.tilt = {bxy, bxz, byz};
+  o.radii = radii;
+  const auto c = tessera::voronoi(tp, 3, {}, o);
+  expect_same_periodic_cells<voro::c_loop_all_periodic>(con, c, n);
+  const auto r = tessera::validate(c, {}, tp, radii);
+  EXPECT_TRUE(r.ok) << (r.messages.empty() ? "" : r.messages[0]);
 }
 
 TEST(VoroPlusPlus, TriclinicBox) {

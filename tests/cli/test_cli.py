@@ -1090,6 +1090,15 @@ class Power(TempDirCase):
         np.fill_diagonal(pw, np.inf)
         return np.flatnonzero(own < pw.min(axis=1))
 
+    def test_periodic_box(self):
+        # Every image has its point's radius; validate measures cells among the images.
+        for extra in (["--periodic", "xyz"], ["--periodic", "xz"], ["--periodic", "xyz", "--tilt", "0.25", "0", "0.125"]):
+            nb, sh = self.p("nb.npy"), self.p("sh.npy")
+            r = self.ok(["voronoi", self.inp3, "--radii", self.rad3, "--bounds"] + BOX3 + extra +
+                        ["--validate", "--neighbors", nb, "--neighbor-shifts", sh])
+            self.assertIn("validation: OK", r.stdout)
+            self.power_line(r.stdout, self.N - int(re.search(r"cells +(\d+)", r.stdout).group(1)))
+
     def test_vtu_read_back_and_validate(self):
         out, tab = self.p("power.vtu"), self.p("t.csv")
         r = self.ok(["voronoi", self.inp3, "--radii", self.rad3, "--bounds"] + BOX3 +
@@ -1383,7 +1392,6 @@ class BadInput(TempDirCase):
             bad[7] = value
             self.fails(vor + ["--radii", self.save("bad.npy", bad)], shown, outputs=[out])
         rad = self.save("r.npy", r)
-        self.fails(vor + ["--radii", rad, "--periodic", "xyz"], "periodic", outputs=[out])
         self.fails(vor + ["--radii", rad, "--method", "insertion"], "--method insertion", outputs=[out])
         self.fails(vor + ["--radii", self.p("missing.npy")], "missing.npy", outputs=[out])
         self.fails(vor + ["--radii", self.save("r2d.npy", np.stack([r, r], 1))], "1-D", outputs=[out])
@@ -1404,7 +1412,6 @@ class BadInput(TempDirCase):
             args = args + ["--bounds"] + BOX3
             self.fails(args + ["--radii", self.p("short.npy")], "49 values for 50 points")
             self.fails(args + ["--radii", self.p("bad.npy")], "radius of point 7")
-            self.fails(args + ["--radii", rad, "--periodic", "xyz"], "periodic")
         self.fails(["flower", self.good3, "--point", "0", "-o", self.p("fl.vtp"), "--radii", rad], "--radii")
 
     def test_coplanar_3d_suggests_dim2(self):
