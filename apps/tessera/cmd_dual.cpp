@@ -39,9 +39,7 @@ Computed read_and_compute(const ComputeArgs& a, bool quiet) {
   VoronoiOptions opt = make_options(a, r.pc.dim);
   opt.build_mesh = true;
   r.cells = compute(r.pc, opt, !quiet && stderr_is_terminal(), r.seconds);
-  if (r.cells.n_cells() == 0)
-    throw InputError("no cells: none of the " + std::to_string(r.pc.n) + " points is inside the domain" +
-                     (r.pc.labels.empty() ? "" : " with a label >= 0"));
+  if (r.cells.n_cells() == 0) throw InputError(no_cells_reason(r.pc, r.cells));
   return r;
 }
 

@@ -236,6 +236,15 @@ void print_power_line(const io::PointCloud& pc, const Cells& c) {
   std::printf("  %-18s radii %.10g to %.10g; empty cells %s\n", "power cells", *lo, *hi, empty.c_str());
 }
 
+std::string no_cells_reason(const io::PointCloud& pc, const Cells& c) {
+  if (!c.empty_cells.empty())
+    return strf("no cells: every point that could own one (%zu%s) has an empty power cell: other spheres' powers "
+                "are less everywhere",
+                c.empty_cells.size(), pc.labels.empty() ? "" : ", label >= 0");
+  return strf("no cells: none of the %zu points is inside the domain%s", pc.n,
+              pc.labels.empty() ? "" : " with a label >= 0");
+}
+
 /// Runs the engine with a progress bar (when wanted) and Ctrl-C cancellation.
 /// A Ctrl-C that arrives after the engine's last progress call still cancels,
 /// so an interrupted run never writes output.
@@ -439,9 +448,7 @@ int run_voronoi(const VoronoiArgs& a) {
   opt.build_mesh = !a.output.empty() || a.validate;
   double compute_s = 0;
   const Cells cells = compute(pc, opt, !a.quiet && stderr_is_terminal(), compute_s);
-  if (cells.n_cells() == 0)
-    throw InputError(strf("no cells: none of the %zu points is inside the domain%s", pc.n,
-                          pc.labels.empty() ? "" : " with a label >= 0"));
+  if (cells.n_cells() == 0) throw InputError(no_cells_reason(pc, cells));
 
   t0 = Clock::now();
   std::vector<std::string> written;

@@ -302,6 +302,8 @@ io::PointCloud read_input(const ComputeArgs& args);        ///< read and check I
 VoronoiOptions make_options(const ComputeArgs& args, int dim);
 /// tessera::voronoi with a progress bar (when `show_progress`) and Ctrl-C cancellation.
 Cells compute(const io::PointCloud& pc, VoronoiOptions options, bool show_progress, double& seconds);
+/// Why a computation gave no cells, as an error line (points outside, or every power cell empty).
+std::string no_cells_reason(const io::PointCloud& pc, const Cells& c);
 /// The summary's line on power cells (Cells::power): the radii's range and the empty cells.
 void print_power_line(const io::PointCloud& pc, const Cells& c);
 

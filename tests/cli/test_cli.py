@@ -1413,6 +1413,12 @@ class BadInput(TempDirCase):
             self.fails(args + ["--radii", self.p("short.npy")], "49 values for 50 points")
             self.fails(args + ["--radii", self.p("bad.npy")], "radius of point 7")
         self.fails(["flower", self.good3, "--point", "0", "-o", self.p("fl.vtp"), "--radii", rad], "--radii")
+        # Every point that could own a cell has an empty power cell: said so, not "outside".
+        few = self.save("few.npy", np.array([[0.5, 0.5, 0.5], [0.51, 0.5, 0.5], [0.2, 0.2, 0.2]]))
+        few_r = self.save("few_r.npy", np.array([0.0, 0.5, 0.5]))
+        few_l = self.save("few_l.npy", np.array([0, -1, -1], dtype=np.int32))
+        self.fails(["voronoi", few, "--radii", few_r, "--labels", few_l, "--bounds"] + BOX3 + ["-o", out],
+                   "has an empty power cell", outputs=[out])
 
     def test_coplanar_3d_suggests_dim2(self):
         pts = np.random.default_rng(1).random((50, 3))
