@@ -657,11 +657,6 @@ def flower(
         ``flowers[k]`` is the :class:`Flower` of ``ids[k]``.
     """
     vor = cells_for("flower", source, labels, bounds, padding, threads, ignore_outside, periodic, tilt)
-    if vor.power:
-        # Petals are the balls through the generator centred at its cell's
-        # vertices: an ordinary cell's, not a power cell's.
-        raise _core.InputError("flower: flowers of power cells are not supported (the petals assume ordinary "
-                               "Voronoi cells)")
     idx = as_ids(ids, vor.points.shape[0])
     fs = _inputs.call(_core.flowers, vor._cells, vor.points, idx)
     return Flowers(fs, vor, bool(glyphs))

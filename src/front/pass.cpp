@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <unordered_map>
 
@@ -391,7 +392,9 @@ void check_radii(std::span<const double> radii, std::size_t n) {
 template <int D>
 void Pass<D>::set_radii(std::span<const double> given, std::size_t n, const Scaling& scaling) {
   if (given.empty()) return;
-  check_radii(given, n);
+  // voronoi() checked them (check_radii, by the input's ids); a periodic
+  // pass's are its points' radii, copied to their images.
+  if (given.size() != n) throw std::logic_error("tessera: radii do not match the pass's points");
   // Equal radii add one constant to every power: the ordinary cells, by
   // the ordinary (faster, prepared) predicates.
   if (std::all_of(given.begin(), given.end(), [&](double r) { return r == given[0]; })) return;

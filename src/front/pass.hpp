@@ -113,7 +113,7 @@ struct Pass {
   engine::EngineOptions engine_options;
 
  private:
-  // Checks the given radii (InputError) and sets `radii`.
+  // Sets `radii` from VoronoiOptions::radii, which voronoi() checked (check_radii).
   void set_radii(std::span<const double> given, std::size_t n, const Scaling& scaling);
 };
 
