@@ -192,7 +192,10 @@ ValidationReport validate_in_arena(const Cells& c, std::span<const std::int32_t>
   // points; dist2 holds that power (|v - p_g|^2 - r_g^2), and a cell's
   // radius adds its own r^2 back.
   const bool power = !radii.empty();
-  auto r_squared = [&](std::int32_t g) { return power ? radii[static_cast<std::size_t>(g)] * radii[static_cast<std::size_t>(g)] : 0.0; };
+  auto r_squared = [&](std::int32_t g) {
+    const double r = power ? radii[static_cast<std::size_t>(g)] : 0.0;
+    return r * r;
+  };
   std::vector<double> dist2(measuring ? nv : 0, 0.0), radius2(measuring ? nc : 0, 0.0);
   if (measuring)
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nv), [&](const tbb::blocked_range<std::size_t>& range) {
