@@ -92,7 +92,17 @@ struct Delaunay {
   /// simplex, building the inside cells only.
   std::size_t outside_simplices = 0;
   /// (duplicate, owner): not vertices. With labels, only inside duplicates.
+  /// With radii, coincident points leave the largest radius (ties: the
+  /// lowest id) as the owner.
   std::vector<std::pair<std::int32_t, std::int32_t>> duplicates;
+  /// A regular triangulation (VoronoiOptions::radii, not all equal): the
+  /// dual of the power cells.
+  bool power = false;
+  /// With radii and hull completion: the points in no simplex, neither
+  /// duplicates nor set aside (ascending). Their power cells are empty:
+  /// every point of the hull has a lower power to some other point. With
+  /// labels, only inside points.
+  std::vector<std::int32_t> hidden;
   std::vector<std::int32_t> ignored_outside_bounds;
   std::uint64_t exact_predicate_calls = 0;
   int threads_used = 1;
@@ -115,6 +125,11 @@ struct Delaunay {
 
 /// Compute the Delaunay triangulation. Same input rules as voronoi() (points
 /// n*dim row-major; labels empty or n ints, < 0 = outside). Throws InputError.
+/// With options.radii (n finite radii >= 0, not all equal) it is the regular
+/// (weighted Delaunay) triangulation, the dual of the power cells: a simplex
+/// is regular when no point's power to its orthocentre is below the
+/// vertices' (symbolically perturbed as the cells are). Built by the cells
+/// pass and hull completion (not insertion); not for periodic boxes.
 Delaunay delaunay(std::span<const double> points, int dim, std::span<const std::int32_t> labels,
                   const DelaunayOptions& options);
 
@@ -145,7 +160,9 @@ struct DelaunayReport {
   std::size_t open_boundary_ridges = 0;    ///< (no labels) boundary ridges not shared by exactly two boundary facets
   std::size_t nonconvex_boundary = 0;      ///< (no labels) boundary ridges where the hull is not convex
   std::size_t missing_points = 0;          ///< (no labels) non-duplicate points in no simplex
-  std::size_t local_delaunay_violations = 0;  ///< interior facets whose opposite vertex is in the circumsphere
+  std::size_t local_delaunay_violations = 0;  ///< interior facets whose opposite vertex is in the circumsphere (radii: power sphere)
+  std::size_t hidden_not_hidden = 0;       ///< (radii) points in Delaunay::hidden that are vertices, duplicates or set aside
+  std::size_t hidden_in_conflict = 0;      ///< (radii, no labels) hidden points in conflict with the simplex holding them
   double volume_sum = 0;                   ///< sum of simplex volumes (areas in 2D)
   double enclosed_volume = 0;              ///< volume enclosed by the boundary facets
   /// How far the two volumes may differ and still agree: their float
@@ -154,6 +171,10 @@ struct DelaunayReport {
   double volume_tolerance = 0;
   std::vector<std::string> messages;       ///< one line each
 };
-DelaunayReport validate(const Delaunay& dt, std::span<const double> points, std::span<const std::int32_t> labels);
+/// A regular triangulation (dt.power) needs the radii it was computed with;
+/// local Delaunay is then local regularity, and each hidden point must lie in
+/// a simplex whose orthosphere it is not in conflict with.
+DelaunayReport validate(const Delaunay& dt, std::span<const double> points, std::span<const std::int32_t> labels,
+                        std::span<const double> radii = {});
 
 }  // namespace tessera

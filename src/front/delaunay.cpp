@@ -8,6 +8,7 @@
 #include <atomic>
 #include <cmath>
 #include <cstring>
+#include <functional>
 #include <limits>
 #include <numbers>
 #include <numeric>
@@ -320,6 +321,7 @@ Delaunay run(std::span<const double> input, std::span<const std::int32_t> labels
   out.bounds = pass.user_bounds;
   out.ignored_outside_bounds = pass.ignored_outside;
   out.threads_used = pass.engine_options.threads;
+  out.power = !pass.radii.empty();
 
   // The labelled cells pass of delaunay()'s first way, with the automatic
   // method: where a sample of its cells finds them costly, and costlier in
@@ -534,6 +536,14 @@ Delaunay run(std::span<const double> input, std::span<const std::int32_t> labels
   std::vector<std::array<std::int32_t, D + 1>>().swap(found.foreign);
   engine::ThreadArena(pass.engine_options.threads).execute([&] { comp.write(added, out.simplices); });
   std::sort(out.duplicates.begin(), out.duplicates.end());
+  if (out.power && complete) {
+    // Hidden points: only those whose cell is empty within the box can be
+    // (a point with a cell there is a vertex of the simplices it reads off).
+    std::vector<std::uint8_t> used(n, 0);
+    for (std::int32_t id : out.simplices) used[static_cast<std::size_t>(id)] = 1;
+    for (std::int32_t e : found.empty_cells)
+      if (!used[static_cast<std::size_t>(e)]) out.hidden.push_back(e);
+  }
   return out;
 }
 
@@ -596,6 +606,7 @@ void keep_inside(Delaunay& dt, std::span<const std::int32_t> labels) {
   dt.outside_simplices = n - kept;
   dt.hull_completed = false;  // a region, not the convex hull: locate() must not walk
   std::erase_if(dt.duplicates, [&](const auto& d) { return labels[static_cast<std::size_t>(d.first)] < 0; });
+  std::erase_if(dt.hidden, [&](std::int32_t id) { return labels[static_cast<std::size_t>(id)] < 0; });
 }
 
 // Whether the inside points come within 5% of the points' extent of the
@@ -641,8 +652,22 @@ Delaunay images_pass(std::span<const double> points, std::span<const std::int32_
 
 Delaunay delaunay(std::span<const double> input, int dim, std::span<const std::int32_t> labels,
                   const DelaunayOptions& given) {
-  if (!given.radii.empty())
-    throw InputError("delaunay: radii (a regular triangulation, the dual of power cells) are not supported");
+  if (!given.radii.empty()) {
+    // The regular (weighted Delaunay) triangulation, the dual of the power
+    // cells (docs/design.md, "Regular triangulations"): the cells pass and
+    // hull completion with the power test. Equal radii are the ordinary
+    // triangulation, by any method.
+    if (dim == 2 || dim == 3) front::check_radii(given.radii, input.size() / static_cast<std::size_t>(dim));
+    if (std::adjacent_find(given.radii.begin(), given.radii.end(), std::not_equal_to<>()) == given.radii.end()) {
+      DelaunayOptions plain = given;
+      plain.radii = {};
+      return delaunay(input, dim, labels, plain);
+    }
+    if (given.periodic_box())
+      throw InputError("radii: periodic regular triangulations are not supported (periodic power cells are: voronoi)");
+    if (given.method == DelaunayMethod::insertion)
+      throw InputError("radii (a regular triangulation) are triangulated from the power cells; --method insertion does not take them");
+  }
   if (given.periodic_box()) {
     if (!given.periodic[0] && !given.periodic[1] && !given.periodic[2])
       throw InputError("a tilt (triclinic box) needs periodic axes");
@@ -656,6 +681,21 @@ Delaunay delaunay(std::span<const double> input, int dim, std::span<const std::i
   if (!(options.skip_cells < 1))
     throw InputError("skip_cells must be below 1 (a fraction of the points; negative: automatic), got " +
                      std::to_string(options.skip_cells));
+  if (!options.radii.empty()) {
+    // From the power cells and hull completion only: no insertion (it knows
+    // no weights), no skipped cells (their cavities' wraps would do), and
+    // with labels the whole triangulation filtered (the labelled pass's
+    // shortcut rests on each point lying in its own cell, which a power
+    // cell need not hold).
+    DelaunayOptions weighted = options;
+    weighted.method = DelaunayMethod::cells;
+    weighted.skip_cells = 0;
+    if (labels.empty() || !options.complete_hull)
+      return dim == 3 ? run<kernels::Hull>(points, labels, weighted) : run<kernels::Tile>(points, labels, weighted);
+    Delaunay dt = dim == 3 ? run<kernels::Hull>(points, {}, weighted) : run<kernels::Tile>(points, {}, weighted);
+    keep_inside(dt, labels);
+    return dt;
+  }
   if (!labels.empty() && options.complete_hull) {
     // The whole triangulation's inside simplices. An inside simplex whose
     // circumcentre v lies beyond the box has each vertex's cell holding v

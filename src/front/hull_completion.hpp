@@ -460,12 +460,23 @@ class HullCompletion {
   // made hull completion quadratic (100k points: 752 such searches, each
   // over ~50k candidates, more work than all the other 760k searches
   // together). Slow (GMP), but rare: ~0.5% of the balls there.
+  //
+  // Power cells (ExactContext::radii): the ball is the orthoball's reach. A
+  // point q of weight w_q = r_q^2 is in conflict with the orthosphere (centre
+  // c, power R^2 = |c - a|^2 - w_a) when |q - c|^2 < R^2 + w_q, so every
+  // better point lies within sqrt(R^2 + w_max) of c. The centre solves
+  // 2 r_k . y = s_k - (w_k - w_a); the error analysis above holds with
+  // max |r_k| read as max (s_k + w_k + w_a) / |r_k| (a numerator's term
+  // s_k c_k / det is at most that times cond / 2).
   void circumball(const Facet& f, std::int32_t best, typename CandidateTree<D>::Query& q) const {
     const double* a = pt(f[0]);
+    const double* radii = ctx_.radii;
+    const double wa = radii != nullptr ? radii[f[0]] * radii[f[0]] : 0.0;
     double r[D][D], s[D];
     double lengths = 1, longest = 0;
     for (int k = 0; k < D; ++k) {
-      const double* p = pt(k + 1 < D ? f[static_cast<std::size_t>(k + 1)] : best);
+      const std::int32_t id = k + 1 < D ? f[static_cast<std::size_t>(k + 1)] : best;
+      const double* p = pt(id);
       s[k] = 0;
       for (int d = 0; d < D; ++d) {
         r[k][d] = p[d] - a[d];
@@ -482,6 +493,11 @@ class HullCompletion {
       if (!(s[k] >= 0x1p-600)) {
         q.ball_r2 = std::numeric_limits<double>::infinity();
         return;
+      }
+      if (radii != nullptr) {
+        const double wk = radii[id] * radii[id];
+        longest = std::max(longest, (s[k] + wk + wa) / std::sqrt(s[k]));
+        s[k] -= wk - wa;
       }
     }
     // Centre y relative to a: 2 r_k . y = s_k (Cramer).
@@ -550,7 +566,15 @@ class HullCompletion {
       q.ball_centre[d] = a[d] + y[d];
       big = std::max({big, std::fabs(a[d]), std::fabs(q.ball_centre[d])});
     }
-    const double reach = rad + slack + 64 * kernels::filter::u * big;
+    double reach = rad + slack + 64 * kernels::filter::u * big;
+    if (radii != nullptr) {
+      // A conflicting point lies within E + sqrt((|y| + E)^2 + w_max - w_a)
+      // of the computed centre (E: its error, within slack); the weights'
+      // rounding is covered by 1e-12 of the magnitudes under the root.
+      const double wmax = ctx_.max_radius * ctx_.max_radius;
+      const double extra = wmax - wa + 1e-12 * (rad2 + wa + wmax);
+      reach = std::sqrt(reach * reach + std::max(extra, 0.0)) + slack;
+    }
     q.ball_r2 = reach * reach;
   }
 

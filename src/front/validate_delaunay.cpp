@@ -17,6 +17,8 @@
 #include <tbb/parallel_for.h>
 
 #include "tessera/delaunay.hpp"
+#include "tessera/locate.hpp"
+#include "pass.hpp"
 #include "simplex_facets.hpp"
 #include "periodic.hpp"
 #include "point_buckets.hpp"
@@ -87,8 +89,15 @@ bool is_flat(const kernels::ExactContext& ctx, const Delaunay& dt) {
 
 }  // namespace
 
-DelaunayReport validate(const Delaunay& dt, std::span<const double> points, std::span<const std::int32_t> labels) {
+DelaunayReport validate(const Delaunay& dt, std::span<const double> points, std::span<const std::int32_t> labels,
+                        std::span<const double> radii) {
   front::check_simplex_ids(dt);
+  if (dt.power && radii.size() != dt.n_points)
+    throw InputError("validate: a regular triangulation of " + std::to_string(dt.n_points) + " points needs their " +
+                     std::to_string(dt.n_points) + " radii, got " + std::to_string(radii.size()));
+  if (!dt.power && !radii.empty())
+    throw InputError("validate: radii given for a triangulation computed without them");
+  if (!radii.empty()) front::check_radii(radii, dt.n_points);
   if (dt.is_periodic()) return front::validate_periodic(dt);  // its own points (wrapped)
   if (points.size() != dt.n_points * static_cast<std::size_t>(dt.dim))
     throw InputError("validate: " + std::to_string(points.size()) + " coordinates for a triangulation of " +
@@ -103,6 +112,10 @@ DelaunayReport validate(const Delaunay& dt, std::span<const double> points, std:
   kernels::ExactContext ctx;
   ctx.points = points.data();
   ctx.dim = D;
+  if (dt.power) {  // the power test: in_sphere and the regular triangulation's perturbation
+    ctx.radii = radii.data();
+    ctx.max_radius = *std::max_element(radii.begin(), radii.end());
+  }
   auto pt = [&](std::int32_t id) { return points.data() + static_cast<std::size_t>(id) * static_cast<std::size_t>(D); };
   const double fact = D == 2 ? 2.0 : 6.0;
   // Volumes are computed in units of a power of two per axis, near the
@@ -257,15 +270,46 @@ DelaunayReport validate(const Delaunay& dt, std::span<const double> points, std:
     i = j;
   }
 
-  // Every point that takes part is a vertex.
+  // Every point that takes part is a vertex, or (radii) hidden: it lies in
+  // a simplex whose orthosphere it is not in conflict with. With local
+  // regularity everywhere, that makes the simplices the lower hull of the
+  // lifted points, every one of them on or above it.
   if (labels.empty()) {
     std::vector<std::uint8_t> used(dt.n_points, 0);
     for (std::int32_t id : dt.simplices) used[static_cast<std::size_t>(id)] = 1;
     for (auto [dup, owner] : dt.duplicates) used[static_cast<std::size_t>(dup)] = 1;
     for (std::int32_t id : dt.ignored_outside_bounds) used[static_cast<std::size_t>(id)] = 1;
+    std::vector<std::int32_t> hidden;
+    for (std::int32_t id : dt.hidden) {
+      if (used[static_cast<std::size_t>(id)]) ++rep.hidden_not_hidden;  // a vertex, duplicate or set aside
+      else hidden.push_back(id);
+      used[static_cast<std::size_t>(id)] = 1;
+    }
     rep.missing_points = static_cast<std::size_t>(std::count(used.begin(), used.end(), 0));
-    // Exactly flat (coplanar / collinear) input has no simplex: nothing is missing.
-    if (m == 0 && is_flat(ctx, dt)) rep.missing_points = 0;
+    if (m == 0) {
+      // Exactly flat (coplanar / collinear) input has no simplex: nothing
+      // is missing; with radii, neither where the points not hidden are.
+      Delaunay live;
+      live.dim = dt.dim;
+      live.n_points = dt.n_points;
+      live.duplicates = dt.duplicates;
+      live.ignored_outside_bounds = dt.ignored_outside_bounds;
+      for (std::int32_t id : dt.hidden) live.ignored_outside_bounds.push_back(id);
+      if (is_flat(ctx, live)) rep.missing_points = 0;
+    } else if (!hidden.empty()) {
+      const std::vector<double> at = [&] {
+        std::vector<double> q(hidden.size() * static_cast<std::size_t>(D));
+        for (std::size_t i = 0; i < hidden.size(); ++i)
+          std::copy_n(pt(hidden[i]), D, q.begin() + static_cast<std::ptrdiff_t>(i * static_cast<std::size_t>(D)));
+        return q;
+      }();
+      const SimplexLocator loc(dt, points, 0, LocateMethod::grid);
+      const std::vector<std::int32_t> in = loc.locate(dt, points, at);
+      for (std::size_t i = 0; i < hidden.size(); ++i) {
+        const std::int32_t* row = in[i] < 0 ? nullptr : dt.simplices.data() + static_cast<std::size_t>(in[i]) * w;
+        if (row == nullptr || kernels::in_sphere(ctx, row[0], row + 1, hidden[i])) ++rep.hidden_in_conflict;
+      }
+    }
   }
 
   auto fail = [&](std::size_t count, const char* what) {
@@ -279,7 +323,9 @@ DelaunayReport validate(const Delaunay& dt, std::span<const double> points, std:
   fail(rep.nonmanifold_facets, "facets are shared by more than two simplices or overlap");
   fail(rep.open_boundary_ridges, "boundary ridges are not shared by exactly two boundary facets");
   fail(rep.nonconvex_boundary, "boundary ridges are not convex (the hull is incomplete)");
-  fail(rep.missing_points, "points are in no simplex");
+  fail(rep.missing_points, dt.power ? "points are in no simplex and not hidden" : "points are in no simplex");
+  fail(rep.hidden_not_hidden, "points listed as hidden are vertices, duplicates or set aside");
+  fail(rep.hidden_in_conflict, "hidden points are in conflict with the simplex that holds them (they should be vertices)");
   fail(rep.local_delaunay_violations, "interior facets are not locally Delaunay");
   // Float volumes: the comparison allows their rounding (a bound from each
   // determinant's permanent, which matters for nearly flat input) plus 1e-9.

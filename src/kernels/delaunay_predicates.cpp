@@ -226,8 +226,17 @@ int orientation_exact(int D, const double* const* pts) {
 // separate evaluation per minor.
 constexpr int permanents_out_of_range = 2;  // in_sphere_filter: undecided, sum them in T
 
+//
+// Power test (ExactContext::radii; `rho` non-null: the radii of p[0..D] and,
+// last, of a): the lifted column becomes s_k = |p_k - a|^2 - (rho_k^2 -
+// rho_a^2), the regular triangulation's lifting translated to a, and q is
+// inside when its power distance to the orthocentre is below the orthoradius's
+// square (Edelsbrunner and Shah, "Incremental topological flipping works for
+// regular triangulations", 1996). sd_k, the entry's magnitude for the
+// permanent, gains rho_k^2 + rho_a^2: the weighted entry then errs by at most
+// ~9 units of sd_k (5 without weights), and the bound takes 128 units.
 template <int D, class T, class P = double>
-int in_sphere_filter(const double* pa, const double* const* p, T unit, P eps) {
+int in_sphere_filter(const double* pa, const double* const* p, T unit, P eps, const double* rho = nullptr) {
   using std::fabs;
   T r[D + 1][D], s[D + 1];
   P rd[D + 1][D], sd[D + 1];
@@ -239,6 +248,11 @@ int in_sphere_filter(const double* pa, const double* const* p, T unit, P eps) {
       rd[k][d] = static_cast<P>(p[k][d]) - static_cast<P>(pa[d]);  // r itself when P is T
       s[k] += r[k][d] * r[k][d];
       sd[k] += rd[k][d] * rd[k][d];
+    }
+    if (rho != nullptr) {
+      const T rk = static_cast<T>(rho[k]), ra = static_cast<T>(rho[D + 1]);
+      s[k] -= rk * rk - ra * ra;
+      sd[k] += static_cast<P>(rho[k]) * static_cast<P>(rho[k]) + static_cast<P>(rho[D + 1]) * static_cast<P>(rho[D + 1]);
     }
   }
   // xy(i, j) = the 2x2 minor of rows i < j in the first two columns.
@@ -304,7 +318,7 @@ int in_sphere_filter(const double* pa, const double* const* p, T unit, P eps) {
     double z = 0, s_sum = 0, m_sum = 0;
     for (int k = 0; k <= D; ++k) {
       if constexpr (D == 3) z += fabs(r[k][2]);
-      s_sum += s[k];
+      s_sum += sd[k];  // s[k] itself without radii (P is T here)
       m_sum += fabs(m[k]);
     }
     abs_r = filter::underflow_bound(2 * z + 3);
@@ -313,7 +327,7 @@ int in_sphere_filter(const double* pa, const double* const* p, T unit, P eps) {
   const T bound_r = 16 * unit * static_cast<T>(perm_r) + abs_r;
   // The lifted column is itself rounded (relative 3 units per entry): 64
   // units cover the classic 11 of Shewchuk's insphere bound with a wide margin.
-  const T bound_m = 64 * unit * static_cast<T>(perm_m) + abs_m;
+  const T bound_m = (rho != nullptr ? 128 : 64) * unit * static_cast<T>(perm_m) + abs_m;
   if (fabs(det_r) > bound_r && fabs(det_m) > bound_m)
     return (det_m > 0) != (det_r > 0) ? 1 : -1;  // P = det M / det R; inside iff P < 0
   return 0;
@@ -322,11 +336,12 @@ int in_sphere_filter(const double* pa, const double* const* p, T unit, P eps) {
 // in_sphere past its double filter: the long double filter, then the exact sign.
 template <int D>
 bool in_sphere_extended(const ExactContext& ctx, const double* pa, const double* const* p, std::int32_t a,
-                        const std::int32_t* planes, std::int32_t q) {
+                        const std::int32_t* planes, std::int32_t q, const double* rho) {
   // Ties at the corners of an axis-aligned box (the in-sphere ties of
   // lattices and voxel centres, whatever the spacing) first: decided from the
-  // coordinates' pattern, where the long double stage can only fail.
-  if (int s; box_tie_sign<D>(ctx, a, planes, q, s)) return s < 0;
+  // coordinates' pattern, where the long double stage can only fail. The
+  // pattern knows no radii.
+  if (int s; rho == nullptr && box_tie_sign<D>(ctx, a, planes, q, s)) return s < 0;
   // Near-degenerate input (a rotated lattice, points nearly on one sphere)
   // leaves a tenth of the tests or more to this stage, where the 64-bit
   // mantissa settles most of what double rounding could not. Exact ties (a
@@ -336,8 +351,8 @@ bool in_sphere_extended(const ExactContext& ctx, const double* pa, const double*
   if constexpr (std::numeric_limits<long double>::digits >= 64) {
     thread_local StageGate gate;
     if (gate.open()) {
-      int s = in_sphere_filter<D, long double>(pa, p, 0x1p-64L, 0.0);
-      if (s == permanents_out_of_range) s = in_sphere_filter<D, long double, long double>(pa, p, 0x1p-64L, 0.0L);
+      int s = in_sphere_filter<D, long double>(pa, p, 0x1p-64L, 0.0, rho);
+      if (s == permanents_out_of_range) s = in_sphere_filter<D, long double, long double>(pa, p, 0x1p-64L, 0.0L, rho);
       gate.record(s == 1 || s == -1);
       if (s == 1 || s == -1) return s > 0;
     }
@@ -353,9 +368,16 @@ bool in_sphere_staged(const ExactContext& ctx, std::int32_t a, const std::int32_
   const double* p[D + 1];
   for (int k = 0; k <= D; ++k) p[k] = pt(ctx, k < D ? planes[k] : q);
   const double* pa = pt(ctx, a);
+  double radii[D + 2];
+  const double* rho = nullptr;
+  if (ctx.radii != nullptr) {
+    for (int k = 0; k <= D; ++k) radii[k] = ctx.radii[k < D ? planes[k] : q];
+    radii[D + 1] = ctx.radii[a];
+    rho = radii;
+  }
   if (double_filter)
-    if (const int s = in_sphere_filter<D, double>(pa, p, filter::u, filter::abs_eps); s == 1 || s == -1) return s > 0;
-  return in_sphere_extended<D>(ctx, pa, p, a, planes, q);
+    if (const int s = in_sphere_filter<D, double>(pa, p, filter::u, filter::abs_eps, rho); s == 1 || s == -1) return s > 0;
+  return in_sphere_extended<D>(ctx, pa, p, a, planes, q, rho);
 }
 
 }  // namespace
