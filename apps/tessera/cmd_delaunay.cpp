@@ -1,5 +1,6 @@
 // `tessera delaunay` and `tessera bench delaunay` (see commands.hpp).
 #include <chrono>
+#include <span>
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -38,6 +39,7 @@ Delaunay triangulate(const io::PointCloud& pc, DelaunayOptions opt, bool show_pr
     if (InterruptGuard::interrupted()) throw Cancelled();
     bar.update(f);
   };
+  opt.radii = pc.radii;
   const auto t0 = Clock::now();
   Delaunay dt = delaunay(pc.coords, pc.dim, pc.labels, opt);
   seconds = seconds_since(t0);
@@ -138,6 +140,9 @@ int run_delaunay(const DelaunayArgs& a) {
       else if (dt.outside_simplices > 0)
         std::fprintf(stderr, "tessera: no simplices: each of the triangulation's %zu has an outside vertex (label < 0)\n",
                      dt.outside_simplices);
+      else if (dt.power && !dt.hidden.empty())
+        std::fprintf(stderr, "tessera: no simplices: %zu points are hidden, and the rest are %s\n", dt.hidden.size(),
+                     pc.dim == 3 ? "at most three or coplanar" : "at most two or collinear");
       else if (!pc.labels.empty())
         std::fprintf(stderr, "tessera: no simplices: none has all its vertices inside (label >= 0), or the points are %s\n",
                      flat);
@@ -147,6 +152,7 @@ int run_delaunay(const DelaunayArgs& a) {
     if (!dt.duplicates.empty())
       std::fprintf(stderr, "tessera: %zu duplicate points are not vertices (first: %d = %d)\n", dt.duplicates.size(),
                    dt.duplicates.front().first, dt.duplicates.front().second);
+    if (dt.power) print_regular_line(pc, dt);
     if (!dt.ignored_outside_bounds.empty())
       std::fprintf(stderr, "tessera: %zu points outside --bounds (or not finite) ignored\n",
                    dt.ignored_outside_bounds.size());
@@ -155,15 +161,19 @@ int run_delaunay(const DelaunayArgs& a) {
     for (const auto& w : written) std::fprintf(stderr, "tessera: wrote %s\n", w.c_str());
   }
   if (a.validate) {
-    const DelaunayReport r = validate(dt, pc.coords, pc.labels);
+    const DelaunayReport r = validate(dt, pc.coords, pc.labels, dt.power ? std::span<const double>(pc.radii) : std::span<const double>());
     if (!a.quiet || !r.ok) {
+      const std::string hidden =
+          dt.power ? ", " + std::to_string(dt.hidden.size()) + " hidden points (" + std::to_string(r.hidden_in_conflict) +
+                         " in conflict)"
+                   : std::string();
       std::fprintf(stderr,
                    "tessera: validation %s: %zu simplices, %zu flat/inverted, %zu non-manifold facets, %zu boundary "
-                   "facets, %zu open ridges, %zu non-convex ridges, %zu missing points, %zu non-Delaunay facets, "
+                   "facets, %zu open ridges, %zu non-convex ridges, %zu missing points%s, %zu non-%s facets, "
                    "volume %.17g (%s %.17g; they agree within %.3g)\n",
                    r.ok ? "passed" : "FAILED", r.simplices, r.flat_or_inverted, r.nonmanifold_facets,
-                   r.boundary_facets, r.open_boundary_ridges, r.nonconvex_boundary, r.missing_points,
-                   r.local_delaunay_violations, r.volume_sum,
+                   r.boundary_facets, r.open_boundary_ridges, r.nonconvex_boundary, r.missing_points, hidden.c_str(),
+                   r.local_delaunay_violations, dt.power ? "regular" : "Delaunay", r.volume_sum,
                    dt.is_periodic() ? "the periodic box holds" : "boundary encloses", r.enclosed_volume,
                    r.volume_tolerance);
       for (const auto& m : r.messages) std::fprintf(stderr, "tessera: validation: %s\n", m.c_str());
@@ -185,6 +195,7 @@ int run_bench_delaunay(const BenchArgs& a) {
   DelaunayOptions opt = delaunay_options(a.compute, pc.dim, true);
   opt.skip_cells = a.skip_cells;
   opt.method = delaunay_method(a.method);
+  opt.radii = pc.radii;
   for (int rep = 0; rep < a.repeat; ++rep) {
     // Timed region: the library call only (no I/O), as the peers do.
     const Usage u0 = usage_now();
@@ -195,9 +206,9 @@ int run_bench_delaunay(const BenchArgs& a) {
     std::printf(
         "{\"tool\":\"tessera\",\"op\":\"delaunay%d\",\"n\":%zu,\"threads\":%d,\"seconds\":%.6f,\"simplices\":%zu,"
         "\"extra\":{\"cpu_user_s\":%.6f,\"cpu_sys_s\":%.6f,\"minflt\":%lld,\"peak_rss_bytes\":%lld,"
-        "\"from_cells\":%zu,\"from_hull_completion\":%zu,\"from_insertion\":%zu,\"skipped_cells\":%zu,\"exact_calls\":%llu,\"repeat\":%d}}\n",
+        "\"from_cells\":%zu,\"from_hull_completion\":%zu,\"from_insertion\":%zu,\"skipped_cells\":%zu,\"hidden\":%zu,\"exact_calls\":%llu,\"repeat\":%d}}\n",
         pc.dim, pc.n, dt.threads_used, secs, dt.n_simplices(), u1.user_s - u0.user_s, u1.sys_s - u0.sys_s,
-        u1.minflt - u0.minflt, u1.maxrss_bytes, dt.from_cells, dt.from_hull_completion, dt.from_insertion, dt.skipped_cells,
+        u1.minflt - u0.minflt, u1.maxrss_bytes, dt.from_cells, dt.from_hull_completion, dt.from_insertion, dt.skipped_cells, dt.hidden.size(),
         static_cast<unsigned long long>(dt.exact_predicate_calls), rep);
     std::fflush(stdout);
   }

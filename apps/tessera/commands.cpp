@@ -236,6 +236,17 @@ void print_power_line(const io::PointCloud& pc, const Cells& c) {
   std::printf("  %-18s radii %.10g to %.10g; empty cells %s\n", "power cells", *lo, *hi, empty.c_str());
 }
 
+/// A regular triangulation: the radii's range and its hidden points.
+void print_regular_line(const io::PointCloud& pc, const Delaunay& dt) {
+  const auto [lo, hi] = std::minmax_element(pc.radii.begin(), pc.radii.end());
+  std::string hidden = std::to_string(dt.hidden.size());
+  for (std::size_t i = 0; i < std::min<std::size_t>(dt.hidden.size(), 5); ++i)
+    hidden += strf("%s%d", i ? ", " : " (points ", dt.hidden[i]);
+  if (!dt.hidden.empty()) hidden += dt.hidden.size() > 5 ? ", ...)" : ")";
+  std::fprintf(stderr, "tessera: regular triangulation: radii %.10g to %.10g; hidden points %s\n", *lo, *hi,
+               hidden.c_str());
+}
+
 std::string no_cells_reason(const io::PointCloud& pc, const Cells& c) {
   if (!c.empty_cells.empty())
     return strf("no cells: every point that could own one (%zu%s) has an empty power cell: other spheres' powers "

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "tessera/cells.hpp"
+#include "tessera/delaunay.hpp"
 #include "tessera/image.hpp"
 #include "tessera/surface_nets.hpp"
 #include "tessera/io/points.hpp"
@@ -306,5 +307,7 @@ Cells compute(const io::PointCloud& pc, VoronoiOptions options, bool show_progre
 std::string no_cells_reason(const io::PointCloud& pc, const Cells& c);
 /// The summary's line on power cells (Cells::power): the radii's range and the empty cells.
 void print_power_line(const io::PointCloud& pc, const Cells& c);
+/// The delaunay summary's line (stderr) on a regular triangulation (Delaunay::power): radii and hidden points.
+void print_regular_line(const io::PointCloud& pc, const Delaunay& dt);
 
 }  // namespace tessera::cli

@@ -131,6 +131,19 @@ void add_radii_option(CLI::App* app, ComputeArgs& c) {
       ->type_name("FILE|NAME");
 }
 
+/// --radii of `delaunay` and `bench delaunay`: the regular triangulation.
+void add_regular_radii_option(CLI::App* app, ComputeArgs& c) {
+  app->add_option("--radii", c.radii,
+                  "Sphere radii for the regular (weighted Delaunay) triangulation, the dual of the power cells "
+                  "(weights r^2, as CGAL's Regular_triangulation): FILE.npy (float array, length N) or the name of "
+                  "a numeric .ply vertex property / .csv column / .vtp or .vtu point data array / .pcd or "
+                  "structured .npy field. A simplex is regular when no point's power |x-p|^2 - r^2 at its "
+                  "orthocentre is below its vertices'; a point whose power cell is empty is hidden (in no "
+                  "simplex), and of coincident points the largest radius is the vertex. Radii must be finite and "
+                  ">= 0; built from the cells (not with --method insertion or --periodic)")
+      ->type_name("FILE|NAME");
+}
+
 /// --periodic of the commands whose product is the cells themselves.
 void add_periodic_option(CLI::App* app, ComputeArgs& c) {
   app->add_option("--periodic", c.periodic,
@@ -233,6 +246,7 @@ int main(int argc, char** argv) {
                   "Simplices as an int64 .npy array of shape (M, D+1), point ids; tetrahedra positively oriented, "
                   "triangles counter-clockwise; - writes it to standard output");
   add_periodic_option(del, dla.compute);
+  add_regular_radii_option(del, dla.compute);
   del->add_option("--simplex-shifts", dla.simplex_shifts,
                   "With --periodic (every axis): which image each vertex of --simplices is, as an int8 .npy array "
                   "of shape (M, D+1, D) in box lengths (lattice vectors with --tilt). Each simplex of the periodic "
@@ -266,10 +280,12 @@ int main(int argc, char** argv) {
       "whose circumcentre lies in the domain box). With --periodic (every axis periodic, --bounds the box,\n"
       "--tilt for a triclinic one) the triangulation of the points among all their images: each simplex once,\n"
       "with its vertices' images in --simplex-shifts; -o writes the points as wrapped into the box and one more\n"
-      "point at each image a simplex uses (point data PointId: whose image).\n"
+      "point at each image a simplex uses (point data PointId: whose image). With --radii the regular\n"
+      "triangulation (CGAL's Regular_triangulation on points in general position), its hidden points listed.\n"
       "Examples:\n"
       "  tessera delaunay points.npy -o tets.vtu --simplices tets.npy\n"
-      "  tessera delaunay points.csv --dim 2 -o triangles.vtp --validate");
+      "  tessera delaunay points.csv --dim 2 -o triangles.vtp --validate\n"
+      "  tessera delaunay spheres.ply --radii radius --simplices tets.npy --validate");
 
   // Products read off the merged cells (cmd_dual.cpp).
   GraphArgs ga;
@@ -370,9 +386,10 @@ int main(int argc, char** argv) {
       "delaunay",
       "Time tessera::delaunay (hull completion included; no output files) K times. Each run prints "
       "{\"tool\":\"tessera\",\"op\":\"delaunay3\"|\"delaunay2\",\"n\",\"threads\",\"seconds\",\"simplices\","
-      "\"extra\":{cpu_user_s,cpu_sys_s,minflt,peak_rss_bytes,from_cells,from_hull_completion,from_insertion,skipped_cells,exact_calls,repeat}}");
+      "\"extra\":{cpu_user_s,cpu_sys_s,minflt,peak_rss_bytes,from_cells,from_hull_completion,from_insertion,skipped_cells,hidden,exact_calls,repeat}}");
   add_compute_options(bench_del, bda.compute, bench_del_bounds);
   add_periodic_option(bench_del, bda.compute);
+  add_regular_radii_option(bench_del, bda.compute);
   bench_del->add_option("--repeat", bda.repeat, "Number of timed runs")
       ->check(Positive)
       ->capture_default_str();

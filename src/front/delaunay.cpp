@@ -537,12 +537,12 @@ Delaunay run(std::span<const double> input, std::span<const std::int32_t> labels
   engine::ThreadArena(pass.engine_options.threads).execute([&] { comp.write(added, out.simplices); });
   std::sort(out.duplicates.begin(), out.duplicates.end());
   if (out.power && complete) {
-    // Hidden points: only those whose cell is empty within the box can be
-    // (a point with a cell there is a vertex of the simplices it reads off).
+    // Hidden points: in the domain, in no simplex, and no duplicate.
     std::vector<std::uint8_t> used(n, 0);
     for (std::int32_t id : out.simplices) used[static_cast<std::size_t>(id)] = 1;
-    for (std::int32_t e : found.empty_cells)
-      if (!used[static_cast<std::size_t>(e)]) out.hidden.push_back(e);
+    for (const auto& [dup, owner] : out.duplicates) used[static_cast<std::size_t>(dup)] = 1;
+    for (std::size_t i = 0; i < n; ++i)
+      if (!used[i] && pass.in_box[i]) out.hidden.push_back(static_cast<std::int32_t>(i));
   }
   return out;
 }
@@ -683,13 +683,13 @@ Delaunay delaunay(std::span<const double> input, int dim, std::span<const std::i
                      std::to_string(options.skip_cells));
   if (!options.radii.empty()) {
     // From the power cells and hull completion only: no insertion (it knows
-    // no weights), no skipped cells (their cavities' wraps would do), and
-    // with labels the whole triangulation filtered (the labelled pass's
-    // shortcut rests on each point lying in its own cell, which a power
-    // cell need not hold).
+    // no weights), and with labels the whole triangulation filtered (the
+    // labelled pass's shortcut rests on each point lying in its own cell,
+    // which a power cell need not hold). Skipped cells work as without
+    // radii: their simplices are read off their neighbours' cells, and the
+    // wraps that close their cavities use the power test.
     DelaunayOptions weighted = options;
     weighted.method = DelaunayMethod::cells;
-    weighted.skip_cells = 0;
     if (labels.empty() || !options.complete_hull)
       return dim == 3 ? run<kernels::Hull>(points, labels, weighted) : run<kernels::Tile>(points, labels, weighted);
     Delaunay dt = dim == 3 ? run<kernels::Hull>(points, {}, weighted) : run<kernels::Tile>(points, {}, weighted);

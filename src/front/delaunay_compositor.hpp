@@ -67,9 +67,6 @@ struct DelaunayPassResult {
   /// beyond the box: hull simplices may have circumcentres there).
   bool labelled_cell_touches_box = false;
   std::vector<std::pair<std::int32_t, std::int32_t>> duplicates;
-  /// Power cells: the generators whose cells came out empty within the box
-  /// (ascending). Each may still be a vertex of simplices beyond the box.
-  std::vector<std::int32_t> empty_cells;
   /// Simplices whose lowest id is a skipped point (oriented rows, their
   /// lowest id first: that point has no cell to lay them out under).
   std::vector<std::array<std::int32_t, D + 1>> foreign;
@@ -91,7 +88,6 @@ class DelaunayCompositor {
     std::vector<Simplex> simplices;
     std::vector<OpenFacet<D>> open;
     std::vector<std::int32_t> touches_box;
-    std::vector<std::int32_t> empty_cells;   // power cells empty within the box
     bool labelled_touch = false;             // labels: a cell of this batch has a box face
     std::vector<Simplex> foreign;            // rows whose lowest id is skipped
     std::vector<OpenFacet<D>> skipped_facets;  // facets of skipped points only, apex the generator
@@ -172,11 +168,10 @@ class DelaunayCompositor {
       }
       place_in_order(b);
       if (hull_info_ && touches) b.touches_box.push_back(gen);
-    } else if (st.duplicate_of < 0) {
+    } else if (st.duplicate_of < 0) {  // (no cell and no duplicate)
       // An empty power cell (within the box): the point may still be a
       // vertex of simplices whose orthocentres lie beyond the box, so it is
       // a candidate of completion like the cells that reach the box.
-      b.empty_cells.push_back(gen);
       if (hull_info_) b.touches_box.push_back(gen);
     }
     b.simplex_end.push_back(static_cast<std::uint32_t>(b.simplices.size()));
@@ -199,12 +194,10 @@ class DelaunayCompositor {
       out_.labelled_cell_touches_box |= b.labelled_touch;
       for (std::size_t t = 0; t < b.gen.size(); ++t)
         if (b.dup_of[t] >= 0) out_.duplicates.emplace_back(b.gen[t], b.dup_of[t]);
-      out_.empty_cells.insert(out_.empty_cells.end(), b.empty_cells.begin(), b.empty_cells.end());
       kept_[k].gen = std::move(b.gen);
       kept_[k].simplex_end = std::move(b.simplex_end);
       kept_[k].simplices = std::move(b.simplices);
     }
-    std::sort(out_.empty_cells.begin(), out_.empty_cells.end());
     if (hull_info_) {
       out_.touches_box.assign(n_, 0);
       std::vector<OpenFacet<D>> skipped_facets;

@@ -182,6 +182,31 @@ TEST(Regular, TwoSizesEqualCgalAndDualToThePowerCells) {
   }
 }
 
+// Skipped cells: their simplices come from their neighbours' cells, and the
+// cavities of skipped points only are wrapped with the power test. Skipped
+// points that are hidden are found hidden all the same.
+TEST(Regular, SkippedCellsGiveTheSameRows) {
+  for (int dim : {2, 3}) {
+    const std::size_t n = 4000;
+    const auto p = uniform_points(n, dim, 81);
+    const auto radii = random_radii(n, dim, 1.5, 82);
+    tessera::DelaunayOptions o;
+    o.dim = dim;
+    o.radii = radii;
+    o.skip_cells = 0;
+    const tessera::Delaunay all = tessera::delaunay(p, dim, {}, o);
+    ASSERT_FALSE(all.hidden.empty());
+    for (double skip : {0.4, 0.9}) {
+      o.skip_cells = skip;
+      const tessera::Delaunay skipped = tessera::delaunay(p, dim, {}, o);
+      EXPECT_GT(skipped.skipped_cells, 0u);
+      EXPECT_EQ(skipped.simplices, all.simplices) << dim << "D, skip " << skip;
+      EXPECT_EQ(skipped.hidden, all.hidden);
+    }
+    expect_equal_to_cgal(all, cgal_regular(p, radii, dim));
+  }
+}
+
 TEST(Regular, EqualRadiiGiveTheOrdinaryTriangulation) {
   for (int dim : {2, 3}) {
     const auto p = uniform_points(1500, dim, 21);
