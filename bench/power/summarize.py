@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
-"""Markdown table of bench/power/run.sh's JSON lines: the fastest of each
-tool's repeats per input, size and thread count, with Voro++'s container_poly
-(one thread) as the reference."""
+"""Markdown tables of bench/power/run.sh's JSON lines: the fastest of each
+tool's repeats per input, size and thread count. Power cells against Voro++'s
+container_poly (one thread); regular triangulations against CGAL's
+Regular_triangulation_3."""
 import json
 import sys
 from collections import defaultdict
@@ -15,6 +16,14 @@ def main():
         key = (j["input"], j["n"], j["tool"], j["threads"])
         best[key] = min(best[key], j["seconds"])
         cells[key] = j["simplices"]
+    if any(k[2] == "voro++-poly" for k in best):
+        print_cells(best, cells)
+    if any(k[2] == "cgal-regular" for k in best):
+        print()
+        print_regular(best, cells)
+
+
+def print_cells(best, cells):
     print("| input | n | Voro++ poly (1 thread) | Tessera power, 1 thread | 2 threads | vs Voro++ (2 threads) "
           "| Tessera ordinary cells, 2 threads | cells (Tessera / Voro++) |")
     print("|---|---:|---:|---:|---:|---:|---:|---|")
@@ -25,6 +34,20 @@ def main():
         o2 = best.get((inp, n, "tessera", 2), float("nan"))
         c = f"{cells.get((inp, n, 'tessera-power', 2), '?')} / {cells[(inp, n, tool, t)]}"
         print(f"| {inp} | {n:,} | {v:.2f} s | {p1:.2f} s | {p2:.2f} s | {v / p2:.1f}x | {o2:.2f} s | {c} |")
+
+
+def print_regular(best, simplices):
+    """The regular triangulations: CGAL's Regular_triangulation_3 (sequential
+    and Parallel_tag) against Tessera's, simplices compared."""
+    print("| input | n | CGAL regular, 1 thread | 2 threads | Tessera regular, 1 thread | 2 threads "
+          "| vs CGAL (2 threads) | Tessera Delaunay, 2 threads | simplices (Tessera / CGAL) |")
+    print("|---|---:|---:|---:|---:|---:|---:|---:|---|")
+    for (inp, n) in sorted({(k[0], k[1]) for k in best if k[2] == "cgal-regular"}):
+        g = lambda tool, t: best.get((inp, n, tool, t), float("nan"))
+        c1, c2, t1, t2, d2 = (g("cgal-regular", 1), g("cgal-regular", 2), g("tessera-regular", 1),
+                              g("tessera-regular", 2), g("tessera-delaunay", 2))
+        s = f"{simplices.get((inp, n, 'tessera-regular', 2), '?')} / {simplices.get((inp, n, 'cgal-regular', 2), '?')}"
+        print(f"| {inp} | {n:,} | {c1:.2f} s | {c2:.2f} s | {t1:.2f} s | {t2:.2f} s | {c2 / t2:.2f}x | {d2:.2f} s | {s} |")
 
 
 if __name__ == "__main__":

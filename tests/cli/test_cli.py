@@ -1225,6 +1225,81 @@ class Power(TempDirCase):
         self.assertEqual(json.loads(r.stdout.splitlines()[0])["op"], "voronoi2")
 
 
+class Regular(TempDirCase):
+    """delaunay --radii: the regular triangulation, dual of the power cells."""
+
+    N = 400
+
+    def setUp(self):
+        super().setUp()
+        rng = np.random.default_rng(21)
+        self.pts3, self.r3 = rng.random((self.N, 3)), rng.random(self.N) * 0.15
+        self.pts2, self.r2 = rng.random((self.N, 2)), rng.random(self.N) * 0.06
+        self.inp3, self.rad3 = self.save("p3.npy", self.pts3), self.save("r3.npy", self.r3)
+        self.inp2, self.rad2 = self.save("p2.npy", self.pts2), self.save("r2.npy", self.r2)
+
+    def hidden_line(self, err):
+        m = re.search(r"^tessera: regular triangulation: radii \S+ to \S+; hidden points (\d+)", err, re.M)
+        self.assertIsNotNone(m, err)
+        return int(m.group(1))
+
+    def check_regular(self, pts, r, simplices):
+        """Brute force: no point's power at a simplex's orthocentre is below its vertices'."""
+        d = pts.shape[1]
+        p0 = pts[simplices[:, 0]]
+        rows = pts[simplices[:, 1:]] - p0[:, None, :]
+        w = r ** 2
+        rhs = (rows ** 2).sum(axis=2) - (w[simplices[:, 1:]] - w[simplices[:, :1]])
+        c = np.linalg.solve(2 * rows, rhs[..., None])[..., 0] + p0  # orthocentres
+        own = ((p0 - c) ** 2).sum(axis=1) - w[simplices[:, 0]]
+        power = ((pts[None, :, :] - c[:, None, :]) ** 2).sum(axis=2) - w[None, :]
+        scale = 1e-9 * (1 + np.abs(own))
+        self.assertTrue(np.all(power >= own[:, None] - scale[:, None]), "a point in conflict with a simplex")
+        self.assertEqual(d + 1, simplices.shape[1])
+
+    def test_3d_and_2d_with_validate(self):
+        for pts, inp, rad, r, out in ((self.pts3, self.inp3, self.rad3, self.r3, "t.vtu"),
+                                      (self.pts2, self.inp2, self.rad2, self.r2, "t.vtp")):
+            sim, vtk = self.p("s.npy"), self.p(out)
+            res = self.ok(["delaunay", inp, "--radii", rad, "--simplices", sim, "-o", vtk, "--validate"])
+            self.assertIn("validation passed", res.stderr)
+            self.assertIn("non-regular facets", res.stderr)
+            s = np.load(sim)
+            hidden = np.setdiff1d(np.arange(self.N), s)
+            self.assertEqual(self.hidden_line(res.stderr), len(hidden))
+            self.assertGreater(len(hidden), 0, "radii this large hide some points")
+            self.check_regular(pts, r, s)
+            g = read_vtu(vtk) if out.endswith(".vtu") else read_vtp(vtk)
+            self.assertEqual(g.GetNumberOfCells(), len(s))
+            # Hidden points own no power cell.
+            tab = self.p("c.csv")
+            self.ok(["voronoi", inp, "--radii", rad, "--cell-table", tab, "-q"])
+            owners = np.loadtxt(tab, delimiter=",", skiprows=1)[:, 0].astype(int)
+            self.assertFalse(np.isin(hidden, owners).any())
+
+    def test_threads_and_bench(self):
+        outs = []
+        for th in ("1", "2"):
+            sim = self.p("s%s.npy" % th)
+            self.ok(["delaunay", self.inp3, "--radii", self.rad3, "--simplices", sim, "--threads", th, "-q"])
+            outs.append(read_bytes(sim))
+        self.assertEqual(outs[0], outs[1])
+        r = self.ok(["bench", "delaunay", self.inp3, "--radii", self.rad3, "--repeat", "2"])
+        lines = [json.loads(x) for x in r.stdout.splitlines()]
+        self.assertEqual(len(lines), 2)
+        s = np.load(self.p("s1.npy"))
+        for j in lines:
+            self.assertEqual(j["op"], "delaunay3")
+            self.assertEqual(j["simplices"], len(s))
+            self.assertEqual(j["extra"]["hidden"], self.N - len(np.unique(s)))
+        # Equal radii: the ordinary triangulation, and no regular line.
+        eq, plain = self.p("eq.npy"), self.p("plain.npy")
+        r = self.ok(["delaunay", self.inp3, "--radii", self.save("er.npy", np.full(self.N, 0.1)), "--simplices", eq])
+        self.assertNotIn("regular triangulation", r.stderr)
+        self.ok(["delaunay", self.inp3, "--simplices", plain, "-q"])
+        self.assertEqual(read_bytes(eq), read_bytes(plain))
+
+
 class Help(unittest.TestCase):
     def test_help_lists_everything(self):
         r = run(["voronoi", "--help"])
@@ -1233,7 +1308,7 @@ class Help(unittest.TestCase):
                     "--threads", "--bin-points", "--cell-table", "--neighbors", "--validate", "--quiet",
                     "--periodic", "--neighbor-shifts", "--radii"):
             self.assertIn(opt, r.stdout)
-        for cmd in (["bench", "voronoi"], ["graph"], ["faces"]):
+        for cmd in (["bench", "voronoi"], ["graph"], ["faces"], ["delaunay"], ["bench", "delaunay"]):
             self.assertIn("--radii", run(cmd + ["--help"]).stdout, cmd)
         r = run(["--help"])
         self.assertEqual(r.returncode, 0)
@@ -1419,6 +1494,20 @@ class BadInput(TempDirCase):
         few_l = self.save("few_l.npy", np.array([0, -1, -1], dtype=np.int32))
         self.fails(["voronoi", few, "--radii", few_r, "--labels", few_l, "--bounds"] + BOX3 + ["-o", out],
                    "has an empty power cell", outputs=[out])
+
+    def test_bad_regular_radii(self):
+        # delaunay --radii (the regular triangulation) checks them as voronoi does.
+        out = self.p("t.vtu")
+        r = np.random.default_rng(3).random(50) * 0.1
+        base = ["delaunay", self.good3, "-o", out, "--radii"]
+        rad = self.save("r.npy", r)
+        self.fails(base + [rad, "--method", "insertion"], "--method insertion", outputs=[out])
+        self.fails(base + [rad, "--periodic", "xyz", "--bounds"] + BOX3, "periodic regular", outputs=[out])
+        bad = r.copy()
+        bad[3] = -1
+        self.fails(base + [self.save("bad.npy", bad)], "radius of point 3", outputs=[out])
+        self.fails(base + [self.save("short.npy", r[:-1])], "49 values for 50 points", outputs=[out])
+        self.fails(["bench", "delaunay", self.good3, "--radii", self.p("short.npy")], "49 values for 50 points")
 
     def test_coplanar_3d_suggests_dim2(self):
         pts = np.random.default_rng(1).random((50, 3))
