@@ -25,12 +25,14 @@ using Points = py::array_t<double, py::array::c_style>;
 DelaunayResult run_delaunay(const Points& points, const py::object& labels,
                             const std::optional<std::vector<double>>& bounds, double padding, bool ignore_outside,
                             int threads, bool complete_hull, const std::string& method,
-                            const std::array<bool, 3>& periodic, const std::array<double, 3>& tilt) {
+                            const std::array<bool, 3>& periodic, const std::array<double, 3>& tilt,
+                            const py::object& radii) {
   const int dim = checked_dim(points);
   DelaunayOptions opt;
   fill_common(opt, dim, bounds, padding, ignore_outside, threads);
   opt.periodic = periodic;
   opt.tilt = tilt;
+  opt.radii = as_radii(radii);  // views the caller's array, alive through the call
   opt.complete_hull = complete_hull;
   if (method == "auto") opt.method = DelaunayMethod::automatic;
   else if (method == "cells") opt.method = DelaunayMethod::cells;
@@ -95,6 +97,10 @@ void bind_delaunay(py::module_& m) {
       .def_readonly("nonconvex_boundary", &DelaunayReport::nonconvex_boundary)
       .def_readonly("missing_points", &DelaunayReport::missing_points)
       .def_readonly("local_delaunay_violations", &DelaunayReport::local_delaunay_violations)
+      .def_readonly("hidden_not_hidden", &DelaunayReport::hidden_not_hidden,
+                    "(radii) points listed as hidden that are vertices, duplicates or set aside")
+      .def_readonly("hidden_in_conflict", &DelaunayReport::hidden_in_conflict,
+                    "(radii, no labels) hidden points in conflict with the simplex holding them")
       .def_readonly("volume_sum", &DelaunayReport::volume_sum)
       .def_readonly("enclosed_volume", &DelaunayReport::enclosed_volume)
       .def_readonly("volume_tolerance", &DelaunayReport::volume_tolerance)
@@ -102,9 +108,10 @@ void bind_delaunay(py::module_& m) {
       .def("__bool__", [](const DelaunayReport& r) { return r.ok; })
       .def("__repr__", [](const DelaunayReport& r) {
         return py::str("DelaunayReport(ok={}, simplices={}, flat_or_inverted={}, nonmanifold_facets={}, "
-                       "local_delaunay_violations={}, missing_points={})")
+                       "local_delaunay_violations={}, missing_points={}, hidden_not_hidden={}, "
+                       "hidden_in_conflict={})")
             .format(r.ok, r.simplices, r.flat_or_inverted, r.nonmanifold_facets, r.local_delaunay_violations,
-                    r.missing_points);
+                    r.missing_points, r.hidden_not_hidden, r.hidden_in_conflict);
       });
 
   py::class_<DelaunayResult>(m, "Delaunay", "Result of delaunay(): owns the buffers its array properties view.")
@@ -126,6 +133,9 @@ void bind_delaunay(py::module_& m) {
       .def_property_readonly("hull_completed", [](const DelaunayResult& r) { return r.dt.hull_completed; })
       .def_property_readonly("outside_simplices", [](const DelaunayResult& r) { return r.dt.outside_simplices; })
       .def_property_readonly("duplicates", [](const DelaunayResult& r) { return pairs_copy(r.dt.duplicates); })
+      .def_property_readonly("power", [](const DelaunayResult& r) { return r.dt.power; })
+      .def_property_readonly("hidden",
+                             [](py::object s) { return view_flat(s.cast<const DelaunayResult&>().dt.hidden, s); })
       .def_property_readonly("ignored_outside_bounds",
                              [](py::object s) {
                                return view_flat(s.cast<const DelaunayResult&>().dt.ignored_outside_bounds, s);
@@ -150,7 +160,9 @@ void bind_delaunay(py::module_& m) {
 
   m.def("delaunay", &run_delaunay, py::arg("points").noconvert(), py::arg("labels").none(true), py::arg("bounds"),
         py::arg("padding"), py::arg("ignore_outside"), py::arg("threads"), py::arg("complete_hull"),
-        py::arg("method"), py::arg("periodic"), py::arg("tilt"), "Delaunay simplices of float64 C-ordered (N, D) points; labels None or int32 (N,). Runs without the GIL.");
+        py::arg("method"), py::arg("periodic"), py::arg("tilt"), py::arg("radii").none(true) = py::none(),
+        "Delaunay simplices of float64 C-ordered (N, D) points; labels None or int32 (N,); radii None or float64 "
+        "(N,) (the regular triangulation, dual of the power cells). Runs without the GIL.");
 
   m.def("locate", &locate_points, py::arg("delaunay"), py::arg("points").noconvert(), py::arg("queries").noconvert(),
         py::arg("threads"),
@@ -158,15 +170,20 @@ void bind_delaunay(py::module_& m) {
 
   m.def(
       "validate_delaunay",
-      [](const DelaunayResult& r, const Points& points, const py::object& labels) {
+      [](const DelaunayResult& r, const Points& points, const py::object& labels, const py::object& radii) {
         if (checked_dim(points) != r.dt.dim || static_cast<std::size_t>(points.shape(0)) != r.dt.n_points)
           throw py::value_error("validate_delaunay: points are not the ones triangulated");
         const auto pts = as_span(points);
         const auto lab = as_labels(labels);
-        return without_gil([&] { return validate(r.dt, pts, lab); });
+        const auto rad = as_radii(radii);  // the caller's array: alive through the call
+        // Radii missing (or too few) for a regular triangulation, or given for
+        // an ordinary one: the library's InputError.
+        return without_gil([&] { return validate(r.dt, pts, lab, rad); });
       },
       py::arg("delaunay"), py::arg("points").noconvert(), py::arg("labels").none(true),
-      "Checks of a triangulation (the CLI's `delaunay --validate`).");
+      py::arg("radii").none(true) = py::none(),
+      "Checks of a triangulation (the CLI's `delaunay --validate`); a regular triangulation (power) needs "
+      "the radii it was computed with.");
 }
 
 }  // namespace tessera::python

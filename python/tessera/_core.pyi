@@ -162,6 +162,10 @@ class DelaunayReport:
     @property
     def local_delaunay_violations(self) -> int: ...
     @property
+    def hidden_not_hidden(self) -> int: ...
+    @property
+    def hidden_in_conflict(self) -> int: ...
+    @property
     def volume_sum(self) -> float: ...
     @property
     def enclosed_volume(self) -> float: ...
@@ -197,6 +201,12 @@ class Delaunay:
     def outside_simplices(self) -> int: ...
     @property
     def duplicates(self) -> npt.NDArray[np.int32]: ...
+    # A regular triangulation (radii, not all equal) and its points in no
+    # simplex (empty power cells; ascending).
+    @property
+    def power(self) -> bool: ...
+    @property
+    def hidden(self) -> npt.NDArray[np.int32]: ...
     @property
     def ignored_outside_bounds(self) -> npt.NDArray[np.int32]: ...
     @property
@@ -212,10 +222,19 @@ def delaunay(
     ignore_outside: bool,
     threads: int,
     complete_hull: bool,
+    method: str,
+    periodic: Tuple[bool, bool, bool],
+    tilt: Tuple[float, float, float],
+    radii: Optional[npt.NDArray[np.float64]] = ...,
 ) -> Delaunay: ...
 def write_simplices_vtk(path: str, delaunay: Delaunay, points: npt.NDArray[np.float64]) -> None: ...
+# A regular triangulation (power) needs the radii it was computed with; radii
+# for an ordinary one are an InputError.
 def validate_delaunay(
-    delaunay: Delaunay, points: npt.NDArray[np.float64], labels: Optional[npt.NDArray[np.int32]]
+    delaunay: Delaunay,
+    points: npt.NDArray[np.float64],
+    labels: Optional[npt.NDArray[np.int32]],
+    radii: Optional[npt.NDArray[np.float64]] = ...,
 ) -> DelaunayReport: ...
 def locate(
     delaunay: Delaunay, points: npt.NDArray[np.float64], queries: npt.NDArray[np.float64], threads: int

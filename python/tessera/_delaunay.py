@@ -28,12 +28,18 @@ class Delaunay:
     Without labels the simplices cover the convex hull of the points exactly
     (hull completion); with labels they are those of that whole triangulation
     whose points are all inside points (label >= 0).
+
+    With ``radii`` (not all equal) it is the regular (weighted Delaunay)
+    triangulation, the dual of the power cells (:attr:`power`); points whose
+    power cell is empty are in no simplex (:attr:`hidden`).
     """
 
-    def __init__(self, dt: Any, points: np.ndarray, labels: Optional[np.ndarray]):
+    def __init__(self, dt: Any, points: np.ndarray, labels: Optional[np.ndarray],
+                 radii: Optional[np.ndarray] = None):
         self._dt = dt
         self._points = points
         self._labels = labels
+        self._radii = radii  # kept: validate() checks a regular triangulation with them
         self._hull: Optional[np.ndarray] = None
         self._vertex_to_simplex: Optional[np.ndarray] = None
         self._transform: Optional[np.ndarray] = None
@@ -47,6 +53,28 @@ class Delaunay:
     def labels(self) -> Optional[np.ndarray]:
         """The region labels given (int32 (N,)), or None."""
         return self._labels
+
+    @property
+    def radii(self) -> Optional[np.ndarray]:
+        """The radii given (float64 (N,), the caller's array itself when it was
+        one), or None."""
+        return self._radii
+
+    @property
+    def power(self) -> bool:
+        """Whether this is a regular (weighted Delaunay) triangulation, the dual
+        of the power cells (``radii`` given, not all equal: equal radii give the
+        ordinary triangulation, and ``power`` is then False)."""
+        return self._dt.power
+
+    @property
+    def hidden(self) -> np.ndarray:
+        """int32, ascending: of a regular triangulation with hull completion,
+        the points in no simplex because their power cell is empty (neither
+        duplicates nor ignored outside the bounds); with labels, only inside
+        points. Empty for an ordinary triangulation. :attr:`vertex_to_simplex`
+        is -1 for them."""
+        return self._dt.hidden
 
     @property
     def ndim(self) -> int:
@@ -122,7 +150,7 @@ class Delaunay:
     def vertex_to_simplex(self) -> np.ndarray:
         """int32 (npoints,): a simplex holding each point as a vertex (the
         lowest-indexed one), -1 for a point in none (a duplicate, an outside
-        point). Computed on first use."""
+        point, a :attr:`hidden` point). Computed on first use."""
         if self._vertex_to_simplex is None:
             v2s = self._dt.vertex_to_simplex()
             v2s.setflags(write=False)
@@ -245,8 +273,14 @@ class Delaunay:
     def validate(self) -> "_core.DelaunayReport":
         """Checks: orientation, manifold facets, closed and (without labels)
         convex boundary, every point used, empty circumspheres (local Delaunay).
+        A regular triangulation (:attr:`power`) is checked with its radii:
+        local regularity (power spheres), and every :attr:`hidden` point is
+        in no simplex (``hidden_not_hidden``) and, without labels, not in
+        conflict with the simplex holding it (``hidden_in_conflict``).
         The report is truthy when all pass; ``report.messages`` says what failed."""
-        return _core.validate_delaunay(self._dt, self._points, self._labels)
+        # Equal radii gave the ordinary triangulation: it is checked without them.
+        radii = self._radii if self.power else None
+        return _core.validate_delaunay(self._dt, self._points, self._labels, radii)
 
     def save(self, path: PathLike) -> None:
         """Write the simplices for ParaView: ``.vtu`` (VTK_TETRA / VTK_TRIANGLE
@@ -267,6 +301,9 @@ class Delaunay:
         return simplices_to_vtk(self)
 
     def __repr__(self) -> str:
+        if self.power:
+            return (f"<tessera.Delaunay {self.ndim}D: {self.npoints} points, {self.nsimplex} simplices, "
+                    f"regular, {len(self.hidden)} hidden>")
         return f"<tessera.Delaunay {self.ndim}D: {self.npoints} points, {self.nsimplex} simplices>"
 
 
@@ -282,6 +319,7 @@ def delaunay(
     method: str = "auto",
     periodic: Any = False,
     tilt: Optional[Sequence[float]] = None,
+    radii: Any = None,
 ) -> Delaunay:
     """Delaunay triangulation of 2D or 3D points, the dual of the Voronoi cells.
 
@@ -311,6 +349,20 @@ def delaunay(
         ``method`` do not apply; what matches facets by ids alone
         (``neighbors``, ``vertex_neighbor_vertices``, ``find_simplex``,
         ``convex_hull``, ``transform``) raises ValueError.
+    radii : array_like of float, shape (N,), optional
+        Radii of spheres at the points (finite, >= 0), as for the power cells
+        of :func:`tessera.voronoi`: the regular (weighted Delaunay)
+        triangulation, weights ``r**2`` (as CGAL's ``Regular_triangulation``),
+        the dual of the power cells. A simplex is regular when no point's
+        power ``|x - p|^2 - r^2`` to its orthocentre is below its vertices'.
+        A point whose power cell is empty is in no simplex
+        (:attr:`Delaunay.hidden`, with hull completion); of exactly
+        coincident points the largest radius is the vertex (ties: the lowest
+        id). All radii equal give exactly the ordinary triangulation
+        (:attr:`Delaunay.power` False). Built by the cells pass and hull
+        completion: not with ``method="insertion"`` nor in a periodic box
+        (``tessera.InputError``). The array is kept (:attr:`Delaunay.radii`,
+        no copy when it is float64 and contiguous) for :meth:`Delaunay.validate`.
 
     Exact predicates and a symbolic perturbation decide every simplex, so
     degenerate input (lattices, cospherical points) gets a valid triangulation
@@ -320,6 +372,7 @@ def delaunay(
     dim = pts.shape[1]
     lab = _inputs.as_labels(labels, pts.shape[0])
     per, tilts = periodic_box(periodic, tilt, bounds, dim)
+    rad = _inputs.as_radii(radii, pts.shape[0])
     dt = _inputs.call(
         _core.delaunay,
         pts,
@@ -332,5 +385,6 @@ def delaunay(
         str(method),
         per,
         tilts,
+        rad,
     )
-    return Delaunay(dt, pts, lab)
+    return Delaunay(dt, pts, lab, rad)
