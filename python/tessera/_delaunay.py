@@ -360,8 +360,9 @@ def delaunay(
         coincident points the largest radius is the vertex (ties: the lowest
         id). All radii equal give exactly the ordinary triangulation
         (:attr:`Delaunay.power` False). Built by the cells pass and hull
-        completion: not with ``method="insertion"`` nor in a periodic box
-        (``tessera.InputError``). The array is kept (:attr:`Delaunay.radii`,
+        completion: not with ``method="insertion"`` (``tessera.InputError``).
+        In a periodic box every image has its point's radius, and
+        :attr:`Delaunay.hidden` lists the points in no simplex. The array is kept (:attr:`Delaunay.radii`,
         no copy when it is float64 and contiguous) for :meth:`Delaunay.validate`.
 
     Exact predicates and a symbolic perturbation decide every simplex, so

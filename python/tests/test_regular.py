@@ -248,8 +248,11 @@ def test_bad_radii_raise(dim):
     with pytest.raises(tessera.InputError, match="method='insertion' does not take them") as e:
         tessera.delaunay(pts, radii=r, method="insertion")
     assert "--" not in str(e.value)
-    with pytest.raises(tessera.InputError, match="periodic regular triangulations are not supported"):
-        tessera.delaunay(pts, bounds=box, radii=r, periodic=True)
+    # Periodic boxes take radii (every image has its point's radius).
+    per = tessera.delaunay(pts, bounds=box, radii=r, periodic=True)
+    assert per.power and per.validate().ok
+    hidden = np.setdiff1d(np.arange(100), per.simplices)
+    np.testing.assert_array_equal(per.hidden, hidden)
     # Equal radii are the ordinary triangulation: periodic too.
     per = tessera.delaunay(pts, bounds=box, radii=np.full(100, 0.1), periodic=True)
     assert not per.power and per.nsimplex == tessera.delaunay(pts, bounds=box, periodic=True).nsimplex

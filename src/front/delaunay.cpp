@@ -634,6 +634,7 @@ Delaunay images_pass(std::span<const double> points, std::span<const std::int32_
   out.n_points = n;
   out.bounds = pass.user_bounds;
   out.threads_used = pass.engine_options.threads;
+  out.power = !pass.radii.empty();
   front::DelaunayPassResult<D> found;
   front::DelaunayCompositor<CellT> comp(found, n, {}, false);
   comp.record_reach(&reach);
@@ -663,8 +664,6 @@ Delaunay delaunay(std::span<const double> input, int dim, std::span<const std::i
       plain.radii = {};
       return delaunay(input, dim, labels, plain);
     }
-    if (given.periodic_box())
-      throw InputError("radii: periodic regular triangulations are not supported (periodic power cells are: voronoi)");
     if (given.method == DelaunayMethod::insertion)
       throw InputError("radii (a regular triangulation) are triangulated from the power cells; --method insertion does not take them");
   }

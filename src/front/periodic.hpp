@@ -213,6 +213,6 @@ Delaunay periodic_delaunay(std::span<const double> points, int dim, std::span<co
 /// applied, every facet (up to translation) in exactly two simplices with
 /// apexes on opposite sides and locally Delaunay, every point a vertex,
 /// volumes summing to the box's.
-DelaunayReport validate_periodic(const Delaunay& dt);
+DelaunayReport validate_periodic(const Delaunay& dt, std::span<const double> radii);
 
 }  // namespace tessera::front

@@ -15,6 +15,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <span>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -33,6 +34,103 @@ struct Entry {
   auto operator<=>(const Entry&) const = default;
 };
 
+// The hidden points (wrapped into the box) that no translate of a simplex
+// holds, or that one holding them is in conflict with (`conflicts`, as the
+// facets' test). The translates by -1..1 lattice vectors per axis cover the
+// box (a canonical translate has its least entry at shift 0 and the others
+// within a box length); those whose bounding box meets the hidden points'
+// are tested, through a grid of the hidden points. Containment is exact
+// (`orient` of the simplex with one vertex replaced by the point).
+template <class Conflicts, class Orient>
+std::size_t hidden_in_conflict(const Delaunay& dt, std::span<const std::int32_t> hidden, const Conflicts& conflicts,
+                               const Orient& orient) {
+  const int D = dt.dim;
+  const auto du = static_cast<std::size_t>(D);
+  const std::size_t w = du + 1;
+  const auto lattice = periodic_lattice(dt.bounds, dt.tilt);
+  auto at = [&](std::int32_t id) { return &dt.periodic_points[static_cast<std::size_t>(id) * du]; };
+  // The grid: about one hidden point per bin.
+  double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0}, size[3] = {1, 1, 1};
+  std::int64_t bins[3] = {1, 1, 1};
+  for (std::size_t a = 0; a < du; ++a) {
+    lo[a] = INFINITY, hi[a] = -INFINITY;
+    for (const std::int32_t h : hidden) lo[a] = std::min(lo[a], at(h)[a]), hi[a] = std::max(hi[a], at(h)[a]);
+    bins[a] = std::max<std::int64_t>(1, static_cast<std::int64_t>(std::pow(static_cast<double>(hidden.size()), 1.0 / D)));
+    size[a] = std::max(hi[a] - lo[a], 1e-300) / static_cast<double>(bins[a]);
+  }
+  auto bin_of = [&](std::size_t a, double x) {
+    return std::clamp(static_cast<std::int64_t>(std::floor((x - lo[a]) / size[a])), std::int64_t{0}, bins[a] - 1);
+  };
+  const auto n_bins = static_cast<std::size_t>(bins[0] * bins[1] * bins[2]);
+  std::vector<std::size_t> start(n_bins + 1, 0);
+  std::vector<std::size_t> key(hidden.size());
+  for (std::size_t i = 0; i < hidden.size(); ++i) {
+    std::size_t k = 0;
+    for (std::size_t a = du; a-- > 0;) k = k * static_cast<std::size_t>(bins[a]) + static_cast<std::size_t>(bin_of(a, at(hidden[i])[a]));
+    ++start[(key[i] = k) + 1];
+  }
+  for (std::size_t k = 0; k < n_bins; ++k) start[k + 1] += start[k];
+  std::vector<std::size_t> slot(hidden.size()), fill(start.begin(), start.end() - 1);
+  for (std::size_t i = 0; i < hidden.size(); ++i) slot[fill[key[i]]++] = i;
+
+  std::vector<std::uint8_t> held(hidden.size(), 0), bad(hidden.size(), 0);
+  const std::size_t m = dt.n_simplices();
+  const int translates = D == 3 ? 27 : 9;
+  for (std::size_t s = 0; s < m; ++s) {
+    std::array<Entry, 4> row{};
+    double blo[3] = {INFINITY, INFINITY, INFINITY}, bhi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (std::size_t k = 0; k < w; ++k) {
+      row[k].id = dt.simplices[s * w + k];
+      for (std::size_t a = 0; a < du; ++a) row[k].shift[a] = dt.simplex_shifts[(s * w + k) * du + a];
+      double x[3];
+      periodic_image(lattice, D, at(row[k].id), row[k].shift, x);
+      for (std::size_t a = 0; a < du; ++a) blo[a] = std::min(blo[a], x[a]), bhi[a] = std::max(bhi[a], x[a]);
+    }
+    for (int t = 0; t < translates; ++t) {
+      std::array<int, 3> by{0, 0, 0};
+      for (std::size_t a = 0, r = static_cast<std::size_t>(t); a < du; ++a, r /= 3) by[a] = static_cast<int>(r % 3) - 1;
+      // The translate's box, widened by a relative 1e-9 for the rounding of the float move.
+      double tlo[3], thi[3];
+      bool meets = true;
+      for (std::size_t a = 0; a < du; ++a) {
+        double move = 0;
+        for (std::size_t b = a; b < du; ++b) move += by[b] * lattice[b][a];
+        const double slack = 1e-9 * (std::fabs(bhi[a]) + std::fabs(blo[a]) + std::fabs(move) + (hi[a] - lo[a]));
+        tlo[a] = blo[a] + move - slack;
+        thi[a] = bhi[a] + move + slack;
+        meets &= tlo[a] <= hi[a] && thi[a] >= lo[a];
+      }
+      if (!meets) continue;
+      std::array<Entry, 4> moved = row;
+      for (std::size_t k = 0; k < w; ++k)
+        for (std::size_t a = 0; a < du; ++a) moved[k].shift[a] += by[a];
+      std::int64_t b0[3] = {0, 0, 0}, b1[3] = {0, 0, 0};
+      for (std::size_t a = 0; a < du; ++a) b0[a] = bin_of(a, tlo[a]), b1[a] = bin_of(a, thi[a]);
+      for (std::int64_t z = b0[2]; z <= b1[2]; ++z)
+        for (std::int64_t y = b0[1]; y <= b1[1]; ++y)
+          for (std::int64_t x = b0[0]; x <= b1[0]; ++x) {
+            const auto k = static_cast<std::size_t>((z * bins[1] + y) * bins[0] + x);
+            for (std::size_t e = start[k]; e < start[k + 1]; ++e) {
+              const std::size_t i = slot[e];
+              const Entry q{hidden[i], {0, 0, 0}};
+              bool inside = true;
+              for (std::size_t k2 = 0; k2 < w && inside; ++k2) {
+                std::array<Entry, 4> swapped = moved;
+                swapped[k2] = q;
+                inside = orient(swapped) >= 0;
+              }
+              if (!inside) continue;
+              held[i] = 1;
+              bad[i] |= static_cast<std::uint8_t>(conflicts(moved, q));
+            }
+          }
+    }
+  }
+  std::size_t count = 0;
+  for (std::size_t i = 0; i < hidden.size(); ++i) count += !held[i] || bad[i];
+  return count;
+}
+
 }  // namespace
 
 Delaunay periodic_delaunay(std::span<const double> input, int dim, std::span<const std::int32_t> labels,
@@ -49,8 +147,14 @@ Delaunay periodic_delaunay(std::span<const double> input, int dim, std::span<con
   o.periodic = {false, false, false};
   o.tilt = {0, 0, 0};
   o.ignore_outside_points = false;  // set aside already; every image lies in the layer
+  std::vector<double> radii;  // regular triangulations: each image has its point's radius
   auto [aug, im] = run_in_final_layer(in, labels, threads, [&](const PeriodicImages& images, std::vector<double>& reach) {
     o.bounds = images.domain;
+    if (!options.radii.empty()) {
+      radii.resize(images.base.size());
+      for (std::size_t k = 0; k < radii.size(); ++k) radii[k] = options.radii[static_cast<std::size_t>(images.base[k])];
+      o.radii = radii;
+    }
     return delaunay_of_images(images.points, dim, images.labels, o, reach);
   });
 
@@ -68,10 +172,19 @@ Delaunay periodic_delaunay(std::span<const double> input, int dim, std::span<con
   dt.simplices = std::move(aug.simplices);
   dt.simplex_shifts.resize(dt.simplices.size() * du);
   to_points(im, dim, dt.simplices, dt.simplex_shifts, threads);
+  dt.power = aug.power;
+  if (dt.power) {  // hidden: taking part, in no simplex, and no duplicate
+    std::vector<std::uint8_t> used(dt.n_points, 0);
+    for (const std::int32_t id : dt.simplices) used[static_cast<std::size_t>(id)] = 1;
+    for (const auto& [dup, owner] : dt.duplicates) used[static_cast<std::size_t>(dup)] = 1;
+    for (const std::int32_t id : dt.ignored_outside_bounds) used[static_cast<std::size_t>(id)] = 1;
+    for (std::size_t i = 0; i < dt.n_points; ++i)
+      if (!used[i]) dt.hidden.push_back(static_cast<std::int32_t>(i));
+  }
   return dt;
 }
 
-DelaunayReport validate_periodic(const Delaunay& dt) {
+DelaunayReport validate_periodic(const Delaunay& dt, std::span<const double> radii) {
   const int D = dt.dim;
   const auto du = static_cast<std::size_t>(D);
   const std::size_t w = du + 1, m = dt.n_simplices();
@@ -121,6 +234,36 @@ DelaunayReport validate_periodic(const Delaunay& dt) {
     perm_sum += std::fabs(det) / fact;
   }
 
+  // Is `q` in conflict with the (power) sphere of `row` (D+1 entries), in
+  // the perturbation of the cells: the D+2 points in (id, shift) order as
+  // local ids, the order of the augmented input.
+  auto conflicts = [&](const std::array<Entry, 4>& row, const Entry& q) {
+    std::array<Entry, 5> all{};
+    for (std::size_t k = 0; k < w; ++k) all[k] = row[k];
+    all[w] = q;
+    std::array<std::size_t, 5> order{0, 1, 2, 3, 4};
+    std::sort(order.begin(), order.begin() + static_cast<std::ptrdiff_t>(w) + 1,
+              [&](std::size_t x, std::size_t y) { return all[x] < all[y]; });
+    std::array<std::int32_t, 5> local{};
+    double xyz[5][3] = {}, packed[15] = {}, rho[5] = {};
+    for (std::size_t r = 0; r <= w; ++r) {
+      local[order[r]] = static_cast<std::int32_t>(r);
+      place(all[order[r]], xyz[r]);
+      for (std::size_t a = 0; a < du; ++a) packed[r * du + a] = xyz[r][a];  // in_sphere reads dim doubles per point
+      if (dt.power) rho[r] = radii[static_cast<std::size_t>(all[order[r]].id)];
+    }
+    kernels::ExactContext ctx;
+    ctx.points = packed;
+    ctx.dim = D;
+    if (dt.power) {
+      ctx.radii = rho;
+      ctx.max_radius = *std::max_element(rho, rho + w + 1);
+    }
+    std::array<std::int32_t, 3> planes{};
+    for (std::size_t k = 0; k < du; ++k) planes[k] = local[k + 1];
+    return kernels::in_sphere(ctx, local[0], planes.data(), local[w]) ? 1 : 0;
+  };
+
   // Facets: each, translated canonically (its least (id, shift) entry at
   // shift 0), in exactly two simplices, whose apexes lie on opposite
   // sides and neither in the other's circumsphere (perturbed as the cells
@@ -168,47 +311,26 @@ DelaunayReport validate_periodic(const Delaunay& dt) {
       if (orient(swapped) != -1) {
         ++rep.nonmanifold_facets;
       } else {
-        // The five points in (id, shift) order as local ids: the
-        // perturbation's order, as in the augmented input.
-        std::array<Entry, 5> all{};
-        for (std::size_t k = 0; k < w; ++k) all[k] = row[k];
-        all[w] = apex;
-        std::array<std::size_t, 5> order{0, 1, 2, 3, 4};
-        std::sort(order.begin(), order.begin() + static_cast<std::ptrdiff_t>(w) + 1,
-                  [&](std::size_t x, std::size_t y) { return all[x] < all[y]; });
-        std::array<std::int32_t, 5> local{};
-        double xyz[5][3] = {};
-        for (std::size_t r = 0; r <= w; ++r) {
-          local[order[r]] = static_cast<std::int32_t>(r);
-          place(all[order[r]], xyz[r]);
-        }
-        kernels::ExactContext ctx;
-        ctx.points = &xyz[0][0];
-        ctx.dim = D;
-        if (D == 2) {  // in_sphere reads dim doubles per point
-          double packed[10];
-          for (std::size_t r = 0; r <= w; ++r) {
-            packed[2 * r] = xyz[r][0];
-            packed[2 * r + 1] = xyz[r][1];
-          }
-          ctx.points = packed;
-          const std::array<std::int32_t, 2> planes{local[1], local[2]};
-          rep.local_delaunay_violations += kernels::in_sphere(ctx, local[0], planes.data(), local[w]);
-        } else {
-          const std::array<std::int32_t, 3> planes{local[1], local[2], local[3]};
-          rep.local_delaunay_violations += kernels::in_sphere(ctx, local[0], planes.data(), local[w]);
-        }
+        rep.local_delaunay_violations += conflicts(row, apex);
       }
     }
     i = j;
   }
 
-  // Every point that takes part is a vertex.
+  // Every point that takes part is a vertex, or (radii) hidden: in some
+  // translate of a simplex, not in conflict with it.
   std::vector<std::uint8_t> seen(dt.n_points, 0);
   for (std::int32_t id : dt.simplices) seen[static_cast<std::size_t>(id)] = 1;
   for (auto [dup, owner] : dt.duplicates) seen[static_cast<std::size_t>(dup)] = 1;
   for (std::int32_t id : dt.ignored_outside_bounds) seen[static_cast<std::size_t>(id)] = 1;
+  std::vector<std::int32_t> hidden;
+  for (std::int32_t id : dt.hidden) {
+    if (seen[static_cast<std::size_t>(id)]) ++rep.hidden_not_hidden;
+    else hidden.push_back(id);
+    seen[static_cast<std::size_t>(id)] = 1;
+  }
   rep.missing_points = static_cast<std::size_t>(std::count(seen.begin(), seen.end(), 0));
+  if (!hidden.empty()) rep.hidden_in_conflict = hidden_in_conflict(dt, hidden, conflicts, orient);
 
   auto fail = [&](std::size_t count, const std::string& what) {
     if (count == 0) return;
@@ -218,8 +340,10 @@ DelaunayReport validate_periodic(const Delaunay& dt) {
   fail(rep.flat_or_inverted, "simplices are flat or inverted");
   fail(rep.nonmanifold_facets, "facets are shared by more than two simplices or overlap");
   fail(rep.boundary_facets, "facets are in one simplex only (a periodic triangulation has no boundary)");
-  fail(rep.missing_points, "points are in no simplex");
-  fail(rep.local_delaunay_violations, "facets are not locally Delaunay");
+  fail(rep.missing_points, dt.power ? "points are in no simplex and not hidden" : "points are in no simplex");
+  fail(rep.hidden_not_hidden, "points listed as hidden are vertices, duplicates or set aside");
+  fail(rep.hidden_in_conflict, "hidden points are in conflict with the simplex that holds them (they should be vertices)");
+  fail(rep.local_delaunay_violations, dt.power ? "facets are not locally regular" : "facets are not locally Delaunay");
   rep.volume_sum = volume;
   rep.enclosed_volume = dt.bounds.volume(D);
   rep.volume_tolerance = 1e-9 * rep.enclosed_volume + 32 * std::numeric_limits<double>::epsilon() * perm_sum;

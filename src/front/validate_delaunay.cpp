@@ -98,7 +98,7 @@ DelaunayReport validate(const Delaunay& dt, std::span<const double> points, std:
   if (!dt.power && !radii.empty())
     throw InputError("validate: radii given for a triangulation computed without them");
   if (!radii.empty()) front::check_radii(radii, dt.n_points);
-  if (dt.is_periodic()) return front::validate_periodic(dt);  // its own points (wrapped)
+  if (dt.is_periodic()) return front::validate_periodic(dt, radii);  // its own points (wrapped)
   if (points.size() != dt.n_points * static_cast<std::size_t>(dt.dim))
     throw InputError("validate: " + std::to_string(points.size()) + " coordinates for a triangulation of " +
                      std::to_string(dt.n_points) + " points in " + std::to_string(dt.dim) + "D");

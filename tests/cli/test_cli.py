@@ -1277,6 +1277,22 @@ class Regular(TempDirCase):
             owners = np.loadtxt(tab, delimiter=",", skiprows=1)[:, 0].astype(int)
             self.assertFalse(np.isin(hidden, owners).any())
 
+    def test_periodic_boxes(self):
+        # Every image has its point's radius; --validate checks local regularity
+        # among the images and each hidden point under a translate of a simplex.
+        for inp, extra in ((self.inp3, ["--periodic", "xyz", "--bounds"] + BOX3),
+                           (self.inp3, ["--periodic", "xyz", "--bounds"] + BOX3 + ["--tilt", "0.25", "0", "-0.125"]),
+                           (self.inp2, ["--periodic", "xy", "--bounds"] + BOX2 + ["--tilt", "0.5"])):
+            rad = self.rad3 if inp == self.inp3 else self.rad2
+            sim, sh = self.p("s.npy"), self.p("sh.npy")
+            res = self.ok(["delaunay", inp, "--radii", rad, "--simplices", sim, "--simplex-shifts", sh, "--validate"] +
+                          extra)
+            self.assertIn("validation passed", res.stderr)
+            self.assertIn("of the periodic box", res.stderr)
+            hidden = np.setdiff1d(np.arange(self.N), np.load(sim))
+            self.assertEqual(self.hidden_line(res.stderr), len(hidden))
+            self.assertGreater(len(hidden), 0)
+
     def test_threads_and_bench(self):
         outs = []
         for th in ("1", "2"):
@@ -1502,7 +1518,6 @@ class BadInput(TempDirCase):
         base = ["delaunay", self.good3, "-o", out, "--radii"]
         rad = self.save("r.npy", r)
         self.fails(base + [rad, "--method", "insertion"], "--method insertion", outputs=[out])
-        self.fails(base + [rad, "--periodic", "xyz", "--bounds"] + BOX3, "periodic regular", outputs=[out])
         bad = r.copy()
         bad[3] = -1
         self.fails(base + [self.save("bad.npy", bad)], "radius of point 3", outputs=[out])

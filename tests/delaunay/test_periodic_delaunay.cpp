@@ -21,6 +21,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <random>
 #include <set>
 #include <vector>
 
@@ -210,6 +211,74 @@ TEST(PeriodicDelaunay, LatticeTiesAndFewPoints) {
     ours(few2);
     expect_valid(few2);
     EXPECT_EQ(few2.n_simplices(), 2 * n);
+  }
+}
+
+// Regular triangulations of a periodic box (radii): the same simplices as
+// the non-periodic regular triangulation of the points' 3^D tiled copies
+// (each copy with its point's radius), taken where they touch the central
+// copy; the same hidden points as the central copy's. Points on a 2^-40
+// grid, so the copies are exact; an orthogonal 3D box, a triclinic one, and
+// a triclinic 2D one.
+TEST(PeriodicDelaunay, RegularEqualsTheTiledRegularTriangulation) {
+  for (int dim : {3, 2}) {
+    for (const std::array<double, 3> tilt : {std::array<double, 3>{0, 0, 0}, std::array<double, 3>{0.25, -0.125, 0.375}}) {
+      const std::size_t n = dim == 3 ? 400 : 600;
+      auto pts = uniform_points(n, dim, 75);
+      for (double& x : pts) x = std::ldexp(std::floor(std::ldexp(x, 40)), -40);
+      std::mt19937_64 rng(76);
+      std::uniform_real_distribution<double> u(0, (dim == 3 ? 1.2 : 1.5) * std::pow(double(n), -1.0 / dim));
+      std::vector<double> radii(n);
+      for (double& r : radii) r = u(rng);
+      auto o = periodic_options(dim, {1, 1, 1}, dim == 3 ? tilt : std::array<double, 3>{tilt[0], 0, 0}, 2);
+      o.radii = radii;
+      const tessera::Delaunay dt = tessera::delaunay(pts, dim, {}, o);
+      EXPECT_TRUE(dt.power);
+      ASSERT_FALSE(dt.hidden.empty());
+      const tessera::DelaunayReport rep = tessera::validate(dt, {}, {}, radii);
+      EXPECT_TRUE(rep.ok) << (rep.messages.empty() ? "" : rep.messages[0]);
+
+      // The tiled copies: copy c has shift (c % 3 - 1, c / 3 % 3 - 1, c / 9 - 1).
+      const auto lattice = tessera::periodic_lattice(dt.bounds, dt.tilt);
+      const int copies = dim == 3 ? 27 : 9;
+      std::vector<double> tiled, tiled_radii;
+      std::vector<std::array<int, 3>> shift_of;
+      for (int c = 0; c < copies; ++c) {
+        const std::array<int, 3> sh{c % 3 - 1, c / 3 % 3 - 1, dim == 3 ? c / 9 - 1 : 0};
+        shift_of.push_back(sh);
+        for (std::size_t i = 0; i < n; ++i) {
+          double x[3];
+          tessera::periodic_image(lattice, dim, &dt.periodic_points[i * static_cast<std::size_t>(dim)], sh, x);
+          tiled.insert(tiled.end(), x, x + dim);
+          tiled_radii.push_back(radii[i]);
+        }
+      }
+      tessera::DelaunayOptions plain;
+      plain.dim = dim;
+      plain.radii = tiled_radii;
+      const tessera::Delaunay big = tessera::delaunay(tiled, dim, {}, plain);
+      std::set<Simplex> want;
+      const std::size_t w = static_cast<std::size_t>(dim + 1);
+      for (std::size_t s = 0; s < big.n_simplices(); ++s) {
+        Simplex x;
+        bool central = false;
+        for (std::size_t k = 0; k < w; ++k) {
+          const auto id = static_cast<std::size_t>(big.simplices[s * w + k]);
+          x.push_back({static_cast<std::int32_t>(id % n), shift_of[id / n]});
+          central |= shift_of[id / n] == std::array<int, 3>{0, 0, 0};
+        }
+        if (central) want.insert(canonical(x));
+      }
+      EXPECT_EQ(ours(dt), want) << dim << "D, tilt " << tilt[0];
+      const std::size_t centre = static_cast<std::size_t>(copies / 2) * n;
+      std::vector<std::int32_t> hidden;
+      for (const std::int32_t h : big.hidden)
+        if (static_cast<std::size_t>(h) >= centre && static_cast<std::size_t>(h) < centre + n)
+          hidden.push_back(static_cast<std::int32_t>(static_cast<std::size_t>(h) - centre));
+      EXPECT_EQ(dt.hidden, hidden);
+      o.threads = 1;
+      EXPECT_EQ(tessera::delaunay(pts, dim, {}, o).simplices, dt.simplices);
+    }
   }
 }
 

@@ -315,10 +315,6 @@ TEST(Regular, RefusedWhereUnsupported) {
   o.method = tessera::DelaunayMethod::insertion;
   EXPECT_THROW(tessera::delaunay(p, 3, {}, o), tessera::InputError);
   o.method = tessera::DelaunayMethod::automatic;
-  o.periodic = {true, true, true};
-  o.bounds = tessera::Bounds{{0, 0, 0}, {1, 1, 1}};
-  EXPECT_THROW(tessera::delaunay(p, 3, {}, o), tessera::InputError);
-  o.periodic = {false, false, false};
   radii[7] = -1;
   o.radii = radii;
   EXPECT_THROW(tessera::delaunay(p, 3, {}, o), tessera::InputError);
