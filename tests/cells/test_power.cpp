@@ -21,7 +21,6 @@
 
 #include "helpers.hpp"
 #include "oracle.hpp"
-#include "tessera/delaunay.hpp"
 #include "tessera/flower.hpp"
 #include "tessera/surface_nets.hpp"
 
@@ -240,14 +239,10 @@ TEST(PowerCells, BadRadiiRefused) {
   const auto c = tessera::voronoi(pts, 3, {}, o);
   EXPECT_THROW(tessera::validate(c, {}, pts), std::invalid_argument);
   // What assumes ordinary cells refuses power cells: flowers (petals through
-  // the generator), the Delaunay triangulation (its dual would be a regular
-  // triangulation) and surface nets.
+  // the generator) and surface nets. (The Delaunay triangulation takes radii:
+  // the regular triangulation, tests/delaunay/test_regular.cpp.)
   const std::int32_t id = c.generator[0];
   EXPECT_THROW(tessera::flowers(c, pts, std::span<const std::int32_t>(&id, 1)), tessera::InputError);
-  tessera::DelaunayOptions d;
-  d.dim = 3;
-  d.radii = r;
-  EXPECT_THROW(tessera::delaunay(pts, 3, {}, d), tessera::InputError);
   tessera::SurfaceNetsOptions s;
   s.voronoi = o;
   const std::vector<std::int32_t> labels(50, 1);
