@@ -2,7 +2,8 @@
 """Markdown tables of bench/power/run.sh's JSON lines: the fastest of each
 tool's repeats per input, size and thread count. Power cells against Voro++'s
 container_poly (one thread); regular triangulations against CGAL's
-Regular_triangulation_3."""
+Regular_triangulation_3, and periodic ones against its
+Periodic_3_regular_triangulation_3."""
 import json
 import sys
 from collections import defaultdict
@@ -21,6 +22,9 @@ def main():
     if any(k[2] == "cgal-regular" for k in best):
         print()
         print_regular(best, cells)
+    if any(k[2] == "cgal-periodic-regular" for k in best):
+        print()
+        print_periodic_regular(best, cells)
 
 
 def print_cells(best, cells):
@@ -48,6 +52,20 @@ def print_regular(best, simplices):
                               g("tessera-regular", 2), g("tessera-delaunay", 2))
         s = f"{simplices.get((inp, n, 'tessera-regular', 2), '?')} / {simplices.get((inp, n, 'cgal-regular', 2), '?')}"
         print(f"| {inp} | {n:,} | {c1:.2f} s | {c2:.2f} s | {t1:.2f} s | {t2:.2f} s | {c2 / t2:.2f}x | {d2:.2f} s | {s} |")
+
+
+def print_periodic_regular(best, simplices):
+    """Periodic regular triangulations of the unit cube: CGAL's
+    Periodic_3_regular_triangulation_3 (sequential) against Tessera's."""
+    print("| input | n | CGAL periodic regular (1 thread) | Tessera, 1 thread | 2 threads | vs CGAL (1 thread) "
+          "| vs CGAL (2 threads) | simplices (Tessera / CGAL) |")
+    print("|---|---:|---:|---:|---:|---:|---:|---|")
+    for (inp, n) in sorted({(k[0], k[1]) for k in best if k[2] == "cgal-periodic-regular"}):
+        g = lambda tool, t: best.get((inp, n, tool, t), float("nan"))
+        c, t1, t2 = g("cgal-periodic-regular", 1), g("tessera-periodic-regular", 1), g("tessera-periodic-regular", 2)
+        s = (f"{simplices.get((inp, n, 'tessera-periodic-regular', 2), '?')} / "
+             f"{simplices.get((inp, n, 'cgal-periodic-regular', 1), '?')}")
+        print(f"| {inp} | {n:,} | {c:.2f} s | {t1:.2f} s | {t2:.2f} s | {c / t1:.1f}x | {c / t2:.1f}x | {s} |")
 
 
 if __name__ == "__main__":
