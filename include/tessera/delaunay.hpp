@@ -129,7 +129,8 @@ struct Delaunay {
 /// (weighted Delaunay) triangulation, the dual of the power cells: a simplex
 /// is regular when no point's power to its orthocentre is below the
 /// vertices' (symbolically perturbed as the cells are). Built by the cells
-/// pass and hull completion (not insertion); not for periodic boxes.
+/// pass and hull completion (not insertion); in a periodic box every image
+/// has its point's radius.
 Delaunay delaunay(std::span<const double> points, int dim, std::span<const std::int32_t> labels,
                   const DelaunayOptions& options);
 

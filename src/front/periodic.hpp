@@ -212,7 +212,9 @@ Delaunay periodic_delaunay(std::span<const double> points, int dim, std::span<co
 /// validate() of a periodic triangulation: orientation with the shifts
 /// applied, every facet (up to translation) in exactly two simplices with
 /// apexes on opposite sides and locally Delaunay, every point a vertex,
-/// volumes summing to the box's.
+/// volumes summing to the box's. A regular triangulation (dt.power) is
+/// checked with `radii` (validate() checked them): power spheres, and each
+/// hidden point under a translate of a simplex it is not in conflict with.
 DelaunayReport validate_periodic(const Delaunay& dt, std::span<const double> radii);
 
 }  // namespace tessera::front
