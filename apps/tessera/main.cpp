@@ -140,8 +140,8 @@ void add_regular_radii_option(CLI::App* app, ComputeArgs& c) {
                   "structured .npy field. A simplex is regular when no point's power |x-p|^2 - r^2 at its "
                   "orthocentre is below its vertices'; a point whose power cell is empty is hidden (in no "
                   "simplex), and of coincident points the largest radius is the vertex. Radii must be finite and "
-                  ">= 0; built from the cells (not with --method insertion); with --periodic every image has its "
-                  "point's radius")
+                  ">= 0; either --method gives the same simplices; with --periodic every image has its point's "
+                  "radius")
       ->type_name("FILE|NAME");
 }
 

@@ -359,9 +359,8 @@ def delaunay(
         (:attr:`Delaunay.hidden`, with hull completion); of exactly
         coincident points the largest radius is the vertex (ties: the lowest
         id). All radii equal give exactly the ordinary triangulation
-        (:attr:`Delaunay.power` False). Built by the cells pass and hull
-        completion: not with ``method="insertion"`` (``tessera.InputError``).
-        In a periodic box every image has its point's radius, and
+        (:attr:`Delaunay.power` False). Either ``method`` builds it, with
+        the same rows. In a periodic box every image has its point's radius, and
         :attr:`Delaunay.hidden` lists the points in no simplex. The array is kept (:attr:`Delaunay.radii`,
         no copy when it is float64 and contiguous) for :meth:`Delaunay.validate`.
 

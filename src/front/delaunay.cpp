@@ -294,6 +294,19 @@ inline constexpr double clean_exact_per_cell = 1.0;
 /// (as the cells' pilot: few inside points are measured too).
 inline constexpr double labelled_pilot_share = 0.5;
 
+// Regular triangulations (hull completed): the hidden points, those in the
+// domain in no simplex and no duplicate (Delaunay::hidden). Call with the
+// duplicates sorted.
+template <int D>
+void list_hidden(const front::Pass<D>& pass, Delaunay& out) {
+  if (!out.power) return;
+  std::vector<std::uint8_t> used(out.n_points, 0);
+  for (std::int32_t id : out.simplices) used[static_cast<std::size_t>(id)] = 1;
+  for (const auto& [dup, owner] : out.duplicates) used[static_cast<std::size_t>(dup)] = 1;
+  for (std::size_t i = 0; i < out.n_points; ++i)
+    if (!used[i] && pass.in_box[i]) out.hidden.push_back(static_cast<std::int32_t>(i));
+}
+
 // The triangulation by insertion of the located points (front::insert_located).
 template <int D>
 Delaunay by_insertion(const front::Pass<D>& pass, Delaunay out) {
@@ -305,6 +318,8 @@ Delaunay by_insertion(const front::Pass<D>& pass, Delaunay out) {
     out.from_insertion = ins.rows->size() / (D + 1);
     out.simplices = std::move(*ins.rows);
   });
+  std::sort(out.duplicates.begin(), out.duplicates.end());
+  if (out.n_simplices() > 0) list_hidden(pass, out);  // (flat input: no simplex, nobody hidden)
   return out;
 }
 
@@ -536,14 +551,7 @@ Delaunay run(std::span<const double> input, std::span<const std::int32_t> labels
   std::vector<std::array<std::int32_t, D + 1>>().swap(found.foreign);
   engine::ThreadArena(pass.engine_options.threads).execute([&] { comp.write(added, out.simplices); });
   std::sort(out.duplicates.begin(), out.duplicates.end());
-  if (out.power && complete) {
-    // Hidden points: in the domain, in no simplex, and no duplicate.
-    std::vector<std::uint8_t> used(n, 0);
-    for (std::int32_t id : out.simplices) used[static_cast<std::size_t>(id)] = 1;
-    for (const auto& [dup, owner] : out.duplicates) used[static_cast<std::size_t>(dup)] = 1;
-    for (std::size_t i = 0; i < n; ++i)
-      if (!used[i] && pass.in_box[i]) out.hidden.push_back(static_cast<std::int32_t>(i));
-  }
+  if (complete) list_hidden(pass, out);
   return out;
 }
 
@@ -664,8 +672,6 @@ Delaunay delaunay(std::span<const double> input, int dim, std::span<const std::i
       plain.radii = {};
       return delaunay(input, dim, labels, plain);
     }
-    if (given.method == DelaunayMethod::insertion)
-      throw InputError("radii (a regular triangulation) are triangulated from the power cells; --method insertion does not take them");
   }
   if (given.periodic_box()) {
     if (!given.periodic[0] && !given.periodic[1] && !given.periodic[2])
@@ -680,18 +686,14 @@ Delaunay delaunay(std::span<const double> input, int dim, std::span<const std::i
   if (!(options.skip_cells < 1))
     throw InputError("skip_cells must be below 1 (a fraction of the points; negative: automatic), got " +
                      std::to_string(options.skip_cells));
-  if (!options.radii.empty()) {
-    // From the power cells and hull completion only: no insertion (it knows
-    // no weights), and with labels the whole triangulation filtered (the
-    // labelled pass's shortcut rests on each point lying in its own cell,
-    // which a power cell need not hold). Skipped cells work as without
-    // radii: their simplices are read off their neighbours' cells, and the
-    // wraps that close their cavities use the power test.
-    DelaunayOptions weighted = options;
-    weighted.method = DelaunayMethod::cells;
-    if (labels.empty() || !options.complete_hull)
-      return dim == 3 ? run<kernels::Hull>(points, labels, weighted) : run<kernels::Tile>(points, labels, weighted);
-    Delaunay dt = dim == 3 ? run<kernels::Hull>(points, {}, weighted) : run<kernels::Tile>(points, {}, weighted);
+  if (!options.radii.empty() && !labels.empty() && options.complete_hull) {
+    // With labels the whole regular triangulation, filtered: the labelled
+    // pass's shortcut (below) rests on each point lying in its own cell,
+    // which a power cell need not hold. Otherwise radii take every path as
+    // the ordinary triangulation does: the cells pass with hull completion
+    // and skipped cells (their cavities' wraps use the power test), or the
+    // insertion (with the power test, hidden points left out).
+    Delaunay dt = dim == 3 ? run<kernels::Hull>(points, {}, options) : run<kernels::Tile>(points, {}, options);
     keep_inside(dt, labels);
     return dt;
   }

@@ -74,12 +74,16 @@ struct Worker : insertion::Worker {
     int slot = 0;
   };
   std::vector<Facet> boundary;
+  std::vector<std::int32_t> removed;  // weighted: the cavity's vertices (those it may hide)
   std::vector<Edge> edges;          // 3D: new tetrahedra by the edge they share
   std::vector<std::uint64_t> used;  // 3D: the entries of edges in use
   std::int32_t pending_infinite = -1;  // 2D: pending_'s entry for the infinite vertex
 };
 
-template <int D>
+// Weighted: a regular triangulation (ExactContext::radii): power tests,
+// hidden points. A template parameter, so the ordinary insertion's hot loop
+// carries none of it.
+template <int D, bool Weighted>
 class Triangulation {
  public:
   static constexpr int K = D + 1;
@@ -91,10 +95,19 @@ class Triangulation {
   /// points a walk and a cavity meet lie close in memory too.
   Triangulation(const ExactContext& ctx, std::vector<std::int32_t> global, Buffer<double> coords,
                 std::vector<std::int32_t> guide, int threads)
-      : ctx_(ctx), underflow_(ctx.may_underflow), global_(std::move(global)), guide_(std::move(guide)), coords_(std::move(coords)),
-        workers_(insertion::make_workers<W>(threads)) {
+      : ctx_(ctx), underflow_(ctx.may_underflow), global_(std::move(global)),
+        guide_(std::move(guide)), coords_(std::move(coords)), workers_(insertion::make_workers<W>(threads)) {
     const std::size_t n = global_.size();
     vsimplex_.resize(n);  // written for each vertex as it is inserted
+    if constexpr (Weighted) {
+      hidden_.assign(n, 0);
+      stamp_.assign(n, 0);
+      weight_.resize(n);
+      for (std::size_t k = 0; k < n; ++k) {
+        const double r = ctx.radii[global_[k]];
+        weight_[k] = r * r;
+      }
+    }
     if constexpr (D == 2) pending_.assign(n, -1);
     // A Delaunay tetrahedralisation of uniform points has about 6.8
     // tetrahedra per point, a triangulation 2 triangles. The capacity is
@@ -315,7 +328,15 @@ class Triangulation {
     const std::uint32_t mark_out = w.epoch << 1, mark_in = mark_out | 1;
     S* ss = store_.simplices();
     std::uint32_t* state = store_.state();
-    if (!conflicts(t0, q)) throw std::logic_error("tessera: insertion: the located simplex is not in conflict");
+    if (!conflicts(t0, q)) {
+      // Regular triangulations: a point in conflict with no simplex (its
+      // lift lies above the lower hull) is hidden, for good (later points
+      // only lower the hull). Without weights the simplex holding q is
+      // always in conflict.
+      if constexpr (!Weighted) throw std::logic_error("tessera: insertion: the located simplex is not in conflict");
+      hidden_[static_cast<std::size_t>(q)] = 1;
+      return true;
+    }
     state[t0] = mark_in;
     // The cavity grows breadth first: w.cavity is both the simplices found
     // in conflict and the queue of those whose neighbours are still to be
@@ -363,6 +384,18 @@ class Triangulation {
         w.boundary.push_back(f);
       }
     }
+    // Regular triangulations: a cavity may swallow a vertex's whole star
+    // (its lift now lies above the lower hull). The cavity's vertices that
+    // no boundary facet keeps (stamp_, below) become hidden, and their
+    // vsimplex_ entries stale (walk_start skips them). Read before the
+    // cavity's slots are reused below. In a phase every vertex here is the
+    // worker's own (owned), so the stamps do not race.
+    if constexpr (Weighted) {
+      w.removed.clear();
+      for (const std::int32_t t : w.cavity)
+        for (int m = 0; m < K; ++m)
+          if (ss[t].v[m] != infinite) w.removed.push_back(ss[t].v[m]);
+    }
     // Slots for the new simplices: the cavity's, the worker's free ones,
     // then fresh ones.
     const std::size_t have = w.cavity.size() + w.slots_at_hand();
@@ -393,10 +426,14 @@ class Triangulation {
       S& t = ss[nt];
       for (int m = 0; m < K; ++m) {
         t.v[m] = f.v[m];
-        // Every vertex of a removed simplex lies on the cavity's boundary,
-        // so each keeps a live one.
-        if (f.v[m] != infinite) vsimplex_[static_cast<std::size_t>(f.v[m])] = nt;
-        else ghost = nt;
+        // Every vertex of a removed simplex that stays (without weights:
+        // all of them) lies on the cavity's boundary, so each keeps a live one.
+        if (f.v[m] != infinite) {
+          vsimplex_[static_cast<std::size_t>(f.v[m])] = nt;
+          if constexpr (Weighted) stamp_[static_cast<std::size_t>(f.v[m])] = w.epoch;
+        } else {
+          ghost = nt;
+        }
       }
       t.n[f.k] = across(f.outside, f.back);
       ss[f.outside].n[f.back] = across(nt, f.k);
@@ -444,6 +481,9 @@ class Triangulation {
     }
     if constexpr (D == 3)
       for (const std::uint64_t h : w.used) w.edges[h] = Edge{};
+    if constexpr (Weighted)
+      for (const std::int32_t v : w.removed)
+        if (stamp_[static_cast<std::size_t>(v)] != w.epoch) hidden_[static_cast<std::size_t>(v)] = 1;
     w.prev = q;
     w.hull_ghost = ghost;
     return true;
@@ -460,6 +500,7 @@ class Triangulation {
   std::int32_t walk_start(W& w, std::int32_t q) const {
     const std::int32_t g = guide_[static_cast<std::size_t>(q)];
     if (g < 0 || w.prev < 0 || (Check && part_[static_cast<std::size_t>(g)] != w.part)) return w.last;
+    if (Weighted && hidden_[static_cast<std::size_t>(g)]) return w.last;  // no live simplex of its own
     auto dist2 = [&](std::int32_t v) {
       double r2 = 0;
       for (int e = 0; e < D; ++e) r2 += (at(v)[e] - at(q)[e]) * (at(v)[e] - at(q)[e]);
@@ -520,11 +561,21 @@ class Triangulation {
     return kernels::orientation(ctx_, ids);
   }
 
-  // kernels::in_sphere for a finite simplex, its filter inline.
+  // kernels::in_sphere for a finite simplex, its filter inline (with
+  // weights the power test's, from the vertices' squared radii in insertion
+  // order, read beside their coordinates).
   bool in_sphere(const S& t, std::int32_t q) const {
     int s;
-    if constexpr (D == 3) s = insertion::in_sphere_filter(at(t.v[0]), at(t.v[1]), at(t.v[2]), at(t.v[3]), at(q), underflow_);
-    else s = insertion::in_circle_filter(at(t.v[0]), at(t.v[1]), at(t.v[2]), at(q), underflow_);
+    if constexpr (Weighted) {
+      double w[K + 1];
+      for (int k = 0; k < K; ++k) w[k] = weight_[static_cast<std::size_t>(t.v[k])];
+      w[K] = weight_[static_cast<std::size_t>(q)];
+      if constexpr (D == 3) s = insertion::in_sphere_filter(at(t.v[0]), at(t.v[1]), at(t.v[2]), at(t.v[3]), at(q), underflow_, w);
+      else s = insertion::in_circle_filter(at(t.v[0]), at(t.v[1]), at(t.v[2]), at(q), underflow_, w);
+    } else {
+      if constexpr (D == 3) s = insertion::in_sphere_filter(at(t.v[0]), at(t.v[1]), at(t.v[2]), at(t.v[3]), at(q), underflow_);
+      else s = insertion::in_circle_filter(at(t.v[0]), at(t.v[1]), at(t.v[2]), at(q), underflow_);
+    }
     if (s != 0) return s > 0;
     std::int32_t planes[D];
     for (int k = 0; k < D; ++k) planes[k] = global(t.v[k + 1]);
@@ -681,6 +732,9 @@ class Triangulation {
 
   const ExactContext& ctx_;
   const bool underflow_;                // ctx_.may_underflow, for the filters (insertion_filters.hpp)
+  std::vector<std::uint8_t> hidden_;    // weighted: vertex -> hidden (never a vertex, or removed)
+  std::vector<double> weight_;          // weighted: vertex -> its squared radius (the power test's weight)
+  std::vector<std::uint32_t> stamp_;    // weighted: vertex -> the last insertion (epoch) whose new simplices hold it
   std::vector<std::int32_t> global_;    // vertex -> input id
   std::vector<std::int32_t> guide_;     // vertex -> an earlier round's vertex near it, or -1 (walk_start)
   Buffer<std::int32_t> vsimplex_;       // inserted vertex -> a live simplex of it
@@ -731,7 +785,7 @@ std::optional<std::array<std::int32_t, D + 1>> first_simplex(const ExactContext&
   return local;
 }
 
-template <int D>
+template <int D, bool Weighted>
 std::optional<Buffer<std::int32_t>> insert_all(const ExactContext& ctx, std::span<const std::int32_t> ids,
                                                const double* coords, const double* lo, const double* hi,
                                                const InsertionOptions& options) {
@@ -750,7 +804,7 @@ std::optional<Buffer<std::int32_t>> insert_all(const ExactContext& ctx, std::spa
   const std::size_t m = order.ids.size();
   std::vector<std::int32_t> guide = brio_guides(D, order);
   order.codes = {};
-  Triangulation<D> tri(ctx, std::move(order.ids), std::move(order.coords), std::move(guide), options.threads);
+  Triangulation<D, Weighted> tri(ctx, std::move(order.ids), std::move(order.coords), std::move(guide), options.threads);
   tri.start(*first);
   for (std::size_t r = 0; r + 1 < order.rounds.size(); ++r) {
     const std::size_t a = order.rounds[r], b = order.rounds[r + 1];
@@ -774,8 +828,11 @@ std::optional<Buffer<std::int32_t>> insert_all(const ExactContext& ctx, std::spa
 std::optional<Buffer<std::int32_t>> insertion_delaunay(const ExactContext& ctx, std::span<const std::int32_t> ids,
                                                        const double* coords, const double* lo, const double* hi,
                                                        const InsertionOptions& options) {
-  if (ctx.dim == 2) return insert_all<2>(ctx, ids, coords, lo, hi, options);
-  if (ctx.dim == 3) return insert_all<3>(ctx, ids, coords, lo, hi, options);
+  const bool weighted = ctx.radii != nullptr;
+  if (ctx.dim == 2)
+    return weighted ? insert_all<2, true>(ctx, ids, coords, lo, hi, options) : insert_all<2, false>(ctx, ids, coords, lo, hi, options);
+  if (ctx.dim == 3)
+    return weighted ? insert_all<3, true>(ctx, ids, coords, lo, hi, options) : insert_all<3, false>(ctx, ids, coords, lo, hi, options);
   throw std::logic_error("tessera: insertion_delaunay: dimension must be 2 or 3");
 }
 

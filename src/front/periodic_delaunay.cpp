@@ -36,11 +36,14 @@ struct Entry {
 
 // The hidden points (wrapped into the box) that no translate of a simplex
 // holds, or that one holding them is in conflict with (`conflicts`, as the
-// facets' test). The translates by -1..1 lattice vectors per axis cover the
-// box (a canonical translate has its least entry at shift 0 and the others
-// within a box length); those whose bounding box meets the hidden points'
-// are tested, through a grid of the hidden points. Containment is exact
-// (`orient` of the simplex with one vertex replaced by the point).
+// facets' test). In the lattice's fractional coordinates an entry with
+// shift s lies in [s, s + 1) along each axis, so a translate by t meets the
+// box [0, 1) only for -max s <= t <= -min s over the simplex's entries
+// (-1..1 as a rule; weights far above the box's size give simplices that
+// span several box lengths). Those translates whose bounding box meets the
+// hidden points' are tested, through a grid of the hidden points.
+// Containment is exact (`orient` of the simplex with one vertex replaced by
+// the point).
 template <class Conflicts, class Orient>
 std::size_t hidden_in_conflict(const Delaunay& dt, std::span<const std::int32_t> hidden, const Conflicts& conflicts,
                                const Orient& orient) {
@@ -75,20 +78,30 @@ std::size_t hidden_in_conflict(const Delaunay& dt, std::span<const std::int32_t>
 
   std::vector<std::uint8_t> held(hidden.size(), 0), bad(hidden.size(), 0);
   const std::size_t m = dt.n_simplices();
-  const int translates = D == 3 ? 27 : 9;
   for (std::size_t s = 0; s < m; ++s) {
     std::array<Entry, 4> row{};
     double blo[3] = {INFINITY, INFINITY, INFINITY}, bhi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    std::array<int, 3> smin{0, 0, 0}, smax{0, 0, 0};
     for (std::size_t k = 0; k < w; ++k) {
       row[k].id = dt.simplices[s * w + k];
-      for (std::size_t a = 0; a < du; ++a) row[k].shift[a] = dt.simplex_shifts[(s * w + k) * du + a];
+      for (std::size_t a = 0; a < du; ++a) {
+        row[k].shift[a] = dt.simplex_shifts[(s * w + k) * du + a];
+        smin[a] = k == 0 ? row[k].shift[a] : std::min(smin[a], row[k].shift[a]);
+        smax[a] = k == 0 ? row[k].shift[a] : std::max(smax[a], row[k].shift[a]);
+      }
       double x[3];
       periodic_image(lattice, D, at(row[k].id), row[k].shift, x);
       for (std::size_t a = 0; a < du; ++a) blo[a] = std::min(blo[a], x[a]), bhi[a] = std::max(bhi[a], x[a]);
     }
+    // The translates -smax..-smin per axis, x fastest.
+    int span[3] = {1, 1, 1}, translates = 1;
+    for (std::size_t a = 0; a < du; ++a) translates *= span[a] = smax[a] - smin[a] + 1;
     for (int t = 0; t < translates; ++t) {
       std::array<int, 3> by{0, 0, 0};
-      for (std::size_t a = 0, r = static_cast<std::size_t>(t); a < du; ++a, r /= 3) by[a] = static_cast<int>(r % 3) - 1;
+      for (std::size_t a = 0, r = static_cast<std::size_t>(t); a < du; ++a) {
+        by[a] = -smax[a] + static_cast<int>(r % static_cast<std::size_t>(span[a]));
+        r /= static_cast<std::size_t>(span[a]);
+      }
       // The translate's box, widened by a relative 1e-9 for the rounding of the float move.
       double tlo[3], thi[3];
       bool meets = true;

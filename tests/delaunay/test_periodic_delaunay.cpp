@@ -282,6 +282,61 @@ TEST(PeriodicDelaunay, RegularEqualsTheTiledRegularTriangulation) {
   }
 }
 
+// Weights far above the box's size (fuzz, stop 78): two spheres of radius
+// 2 in a unit box hide the 60 small ones, and the triangles join one of
+// them to images of the other up to two box lengths away. validate() used
+// to look for the hidden points' triangles only among translates by -1..1
+// and reported them in conflict. The triangles equal those of the 7x7 tiled
+// copies' regular triangulation that touch the central copy.
+TEST(PeriodicDelaunay, RegularWithWeightsBeyondTheBox) {
+  const std::size_t n = 62;
+  auto pts = uniform_points(n, 2, 77);
+  for (double& x : pts) x = std::ldexp(std::floor(std::ldexp(x, 40)), -40);
+  // The two large ones where their triangles' canonical translates reach
+  // the second image up (found by a search over positions).
+  pts[0] = 0.125, pts[1] = 0.796875, pts[2] = 0.078125, pts[3] = 0.078125;
+  std::vector<double> radii(n, 0.02);
+  radii[0] = radii[1] = 2.0;
+  auto o = periodic_options(2, {1, 1, 1}, {0.25, 0, 0}, 2);
+  o.radii = radii;
+  const tessera::Delaunay dt = tessera::delaunay(pts, 2, {}, o);
+  const tessera::DelaunayReport rep = tessera::validate(dt, {}, {}, radii);
+  EXPECT_TRUE(rep.ok) << (rep.messages.empty() ? "" : rep.messages[0]);
+  EXPECT_EQ(dt.hidden.size(), n - 2);
+  int far = 0;
+  for (const std::int8_t s : dt.simplex_shifts) far = std::max(far, std::abs(int{s}));
+  EXPECT_GE(far, 2) << "the triangles should span two box lengths";
+  const auto lattice = tessera::periodic_lattice(dt.bounds, dt.tilt);
+  std::vector<double> tiled, tiled_radii;
+  std::vector<std::array<int, 3>> shift_of;
+  for (int i = -3; i <= 3; ++i)
+    for (int j = -3; j <= 3; ++j)
+      for (std::size_t k = 0; k < n; ++k) {
+        const std::array<int, 3> sh{i, j, 0};
+        double x[3];
+        tessera::periodic_image(lattice, 2, &dt.periodic_points[2 * k], sh, x);
+        tiled.insert(tiled.end(), x, x + 2);
+        tiled_radii.push_back(radii[k]);
+        shift_of.push_back(sh);
+      }
+  tessera::DelaunayOptions plain;
+  plain.dim = 2;
+  plain.radii = tiled_radii;
+  const tessera::Delaunay big = tessera::delaunay(tiled, 2, {}, plain);
+  std::set<Simplex> want;
+  for (std::size_t s = 0; s < big.n_simplices(); ++s) {
+    Simplex x;
+    bool central = false;
+    for (std::size_t k = 0; k < 3; ++k) {
+      const auto id = static_cast<std::size_t>(big.simplices[s * 3 + k]);
+      x.push_back({static_cast<std::int32_t>(id % n), shift_of[id]});
+      central |= shift_of[id] == std::array<int, 3>{0, 0, 0};
+    }
+    if (central) want.insert(canonical(x));
+  }
+  EXPECT_EQ(ours(dt), want);
+}
+
 TEST(PeriodicDelaunay, Refused) {
   const auto pts = uniform_points(200, 3, 74);
   auto walls = periodic_options(3, {1, 1, 1}, {0, 0, 0});
