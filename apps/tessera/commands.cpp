@@ -226,25 +226,29 @@ VoronoiOptions make_options(const ComputeArgs& a, int dim) {
   return o;
 }
 
+namespace {
+
+/// "radii LO to HI; WHAT N (points a, b, ...)": the radii's range and the
+/// count of `ids` with the first five (the power cells' and regular
+/// triangulations' summary lines).
+std::string radii_and_points(const io::PointCloud& pc, const char* what, const std::vector<std::int32_t>& ids) {
+  const auto [lo, hi] = std::minmax_element(pc.radii.begin(), pc.radii.end());
+  std::string line = strf("radii %.10g to %.10g; %s %zu", *lo, *hi, what, ids.size());
+  for (std::size_t i = 0; i < std::min<std::size_t>(ids.size(), 5); ++i) line += strf("%s%d", i ? ", " : " (points ", ids[i]);
+  if (!ids.empty()) line += ids.size() > 5 ? ", ...)" : ")";
+  return line;
+}
+
+}  // namespace
+
 /// Power cells: the radii's range and the points whose cells are empty.
 void print_power_line(const io::PointCloud& pc, const Cells& c) {
-  const auto [lo, hi] = std::minmax_element(pc.radii.begin(), pc.radii.end());
-  std::string empty = std::to_string(c.empty_cells.size());
-  for (std::size_t i = 0; i < std::min<std::size_t>(c.empty_cells.size(), 5); ++i)
-    empty += strf("%s%d", i ? ", " : " (points ", c.empty_cells[i]);
-  if (!c.empty_cells.empty()) empty += c.empty_cells.size() > 5 ? ", ...)" : ")";
-  std::printf("  %-18s radii %.10g to %.10g; empty cells %s\n", "power cells", *lo, *hi, empty.c_str());
+  std::printf("  %-18s %s\n", "power cells", radii_and_points(pc, "empty cells", c.empty_cells).c_str());
 }
 
 /// A regular triangulation: the radii's range and its hidden points.
 void print_regular_line(const io::PointCloud& pc, const Delaunay& dt) {
-  const auto [lo, hi] = std::minmax_element(pc.radii.begin(), pc.radii.end());
-  std::string hidden = std::to_string(dt.hidden.size());
-  for (std::size_t i = 0; i < std::min<std::size_t>(dt.hidden.size(), 5); ++i)
-    hidden += strf("%s%d", i ? ", " : " (points ", dt.hidden[i]);
-  if (!dt.hidden.empty()) hidden += dt.hidden.size() > 5 ? ", ...)" : ")";
-  std::fprintf(stderr, "tessera: regular triangulation: radii %.10g to %.10g; hidden points %s\n", *lo, *hi,
-               hidden.c_str());
+  std::fprintf(stderr, "tessera: regular triangulation: %s\n", radii_and_points(pc, "hidden points", dt.hidden).c_str());
 }
 
 std::string no_cells_reason(const io::PointCloud& pc, const Cells& c) {

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "random_points.hpp"
+#include "simplex_set.hpp"
 #include "tessera/delaunay.hpp"
 #include "common/hostile_points.hpp"
 #include "tessera/io/points.hpp"
@@ -33,7 +34,6 @@ using Vb2 = CGAL::Triangulation_vertex_base_with_info_2<std::int32_t, K>;
 using Tds2 = CGAL::Triangulation_data_structure_2<Vb2>;
 using DT2 = CGAL::Delaunay_triangulation_2<K, Tds2>;
 
-using SimplexSet = std::set<std::vector<std::int32_t>>;
 
 std::vector<double> random_points(std::size_t n, int dim, std::uint64_t seed) { return uniform_points(n, dim, seed); }
 
@@ -61,18 +61,6 @@ SimplexSet cgal_simplices(const std::vector<double>& p, int dim) {
       std::sort(s.begin(), s.end());
       out.insert(s);
     }
-  }
-  return out;
-}
-
-SimplexSet as_set(const tessera::Delaunay& dt) {
-  SimplexSet out;
-  const std::size_t w = static_cast<std::size_t>(dt.dim + 1);
-  for (std::size_t s = 0; s < dt.n_simplices(); ++s) {
-    std::vector<std::int32_t> v(dt.simplices.begin() + static_cast<std::ptrdiff_t>(s * w),
-                                dt.simplices.begin() + static_cast<std::ptrdiff_t>((s + 1) * w));
-    std::sort(v.begin(), v.end());
-    out.insert(v);
   }
   return out;
 }

@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "random_points.hpp"
+#include "simplex_set.hpp"
 #include "tessera/cells.hpp"
 #include "tessera/delaunay.hpp"
 
@@ -35,7 +36,6 @@ using Vb2 = CGAL::Triangulation_vertex_base_with_info_2<std::int32_t, K, CGAL::R
 using Tds2 = CGAL::Triangulation_data_structure_2<Vb2, CGAL::Regular_triangulation_face_base_2<K>>;
 using RT2 = CGAL::Regular_triangulation_2<K, Tds2>;
 
-using SimplexSet = std::set<std::vector<std::int32_t>>;
 
 struct Oracle {
   SimplexSet simplices;
@@ -72,18 +72,6 @@ Oracle cgal_regular(const std::vector<double>& p, const std::vector<double>& rad
   }
   for (std::size_t i = 0; i < n; ++i)
     if (!vertex[i]) out.hidden.push_back(static_cast<std::int32_t>(i));
-  return out;
-}
-
-SimplexSet as_set(const tessera::Delaunay& dt) {
-  SimplexSet out;
-  const std::size_t w = static_cast<std::size_t>(dt.dim + 1);
-  for (std::size_t s = 0; s < dt.n_simplices(); ++s) {
-    std::vector<std::int32_t> v(dt.simplices.begin() + static_cast<std::ptrdiff_t>(s * w),
-                                dt.simplices.begin() + static_cast<std::ptrdiff_t>((s + 1) * w));
-    std::sort(v.begin(), v.end());
-    out.insert(v);
-  }
   return out;
 }
 
