@@ -126,8 +126,9 @@ void add_radii_option(CLI::App* app, ComputeArgs& c) {
                   "container_poly): FILE.npy (float array, length N) or the name of a numeric .ply vertex property / "
                   ".csv column / .vtp or .vtu point data array / .pcd or structured .npy field. Each cell is where "
                   "its point's power |x-p|^2 - r^2 is the least; a point may own no cell (listed as empty), and of "
-                  "coincident points the largest radius owns it. Radii must be finite and >= 0; computed by the "
-                  "search; with --periodic every image has its point's radius")
+                  "coincident points the largest radius owns it. Radii must be finite and >= 0; either --method "
+                  "(the search, or the regular triangulation's stars); with --periodic every image has its point's "
+                  "radius")
       ->type_name("FILE|NAME");
 }
 

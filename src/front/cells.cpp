@@ -148,8 +148,7 @@ Cells run(std::span<const double> input, std::span<const std::int32_t> labels, c
     // (docs/design.md, "Delaunay beyond the frame"), where its own sample of
     // searched cells cost up to 0.4 s (2,003 log-uniform points: 0.6 s, 0.17 s
     // without it).
-    if (opt.cell_method == CellMethod::automatic && !out.power) {  // power cells: the search (a regular
-                                                                   // triangulation's insertion is not built)
+    if (opt.cell_method == CellMethod::automatic) {
       if (pass.exact.may_underflow) {
         insert = true;
       } else {
@@ -241,11 +240,8 @@ Cells run_periodic(std::span<const double> input, int dim, std::span<const std::
 
 Cells voronoi(std::span<const double> input, int dim, std::span<const std::int32_t> labels,
               const VoronoiOptions& options) {
-  if (!options.radii.empty()) {
-    if (dim == 2 || dim == 3) front::check_radii(options.radii, input.size() / static_cast<std::size_t>(dim));
-    if (options.cell_method == CellMethod::insertion)
-      throw InputError("radii (power cells) are computed by the search; --method insertion does not take them");
-  }
+  if (!options.radii.empty() && (dim == 2 || dim == 3))
+    front::check_radii(options.radii, input.size() / static_cast<std::size_t>(dim));
   if (options.periodic_box()) {
     if (!options.periodic[0] && !options.periodic[1] && !options.periodic[2])
       throw InputError("a tilt (triclinic box) needs periodic axes");

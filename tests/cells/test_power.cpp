@@ -37,10 +37,12 @@ std::vector<double> random_radii(std::size_t n, double rmax, std::uint64_t seed)
 }
 
 tessera::Cells run_power(const std::vector<double>& pts, int dim, const tessera::Bounds& box,
-                         const std::vector<double>& radii, int threads = 1, bool mesh = true) {
+                         const std::vector<double>& radii, int threads = 1, bool mesh = true,
+                         tessera::CellMethod method = tessera::CellMethod::search) {
   auto o = options(dim, box, threads);
   o.radii = radii;
   o.build_mesh = mesh;
+  o.cell_method = method;
   return tessera::voronoi(pts, dim, {}, o);
 }
 
@@ -54,13 +56,15 @@ void expect_valid(const tessera::Cells& c, const std::vector<double>& pts, const
   EXPECT_NEAR(r.volume_sum, r.domain_volume, 1e-12 * r.domain_volume) << what;
 }
 
-void compare_with_oracle(int dim, std::size_t n, double rmax, std::uint64_t seed) {
+void compare_with_oracle(int dim, std::size_t n, double rmax, std::uint64_t seed,
+                         tessera::CellMethod method = tessera::CellMethod::search) {
   SCOPED_TRACE(::testing::Message() << "dim " << dim << " n " << n << " rmax " << rmax << " seed " << seed);
   const auto box = make_bounds({-1, 0, 2}, {1, 1.5, 3});
   const auto pts = random_points(n, dim, seed, box);
   const auto radii = random_radii(n, rmax, seed + 1);
-  const auto c = run_power(pts, dim, box, radii);
+  const auto c = run_power(pts, dim, box, radii, 1, true, method);
   EXPECT_TRUE(c.power);
+  EXPECT_EQ(c.from_insertion, method == tessera::CellMethod::insertion);
   const double L = box_size(box, dim), V = box_volume(box, dim);
   std::size_t empty = 0, bad = 0;
   for (std::size_t i = 0; i < n; ++i) {
@@ -99,6 +103,37 @@ TEST(PowerCells, OracleSmallRadii2D) { compare_with_oracle(2, 400, 0.02, 11); }
 TEST(PowerCells, OracleLargeRadii2D) { compare_with_oracle(2, 400, 0.3, 12); }  // many empty cells
 TEST(PowerCells, OracleSmallRadii3D) { compare_with_oracle(3, 250, 0.05, 13); }
 TEST(PowerCells, OracleLargeRadii3D) { compare_with_oracle(3, 250, 0.4, 14); }
+// From the regular triangulation's stars (the insertion with the power test):
+// each cell clipped by its star's points, hidden points' cells empty.
+TEST(PowerCells, OracleByInsertion) {
+  compare_with_oracle(2, 400, 0.3, 15, tessera::CellMethod::insertion);
+  compare_with_oracle(3, 250, 0.4, 16, tessera::CellMethod::insertion);
+  compare_with_oracle(3, 250, 0.05, 17, tessera::CellMethod::insertion);
+}
+
+// The search and the stars give the same cells: the same owners, empty
+// cells and neighbours, and volumes up to the clip order's last bits; on a
+// tied checkerboard lattice too.
+TEST(PowerCells, InsertionGivesTheSearchsCells) {
+  for (int dim : {2, 3}) {
+    const std::size_t n = dim == 2 ? 3000 : 2000;
+    const auto box = unit_box();
+    const auto pts = random_points(n, dim, 18, box);
+    const auto radii = random_radii(n, dim == 2 ? 0.03 : 0.1, 19);
+    const auto s = run_power(pts, dim, box, radii, 2, true, tessera::CellMethod::search);
+    const auto i = run_power(pts, dim, box, radii, 2, true, tessera::CellMethod::insertion);
+    EXPECT_TRUE(i.from_insertion);
+    EXPECT_FALSE(s.empty_cells.empty());
+    EXPECT_EQ(i.cell_of, s.cell_of);
+    EXPECT_EQ(i.empty_cells, s.empty_cells);
+    ASSERT_EQ(i.n_cells(), s.n_cells());
+    for (std::size_t k = 0; k < s.n_cells(); ++k) {
+      EXPECT_NEAR(i.volume[k], s.volume[k], 1e-12) << k;
+      EXPECT_EQ(neighbours_of(i, k), neighbours_of(s, k)) << k;
+    }
+    expect_valid(i, pts, radii, "by insertion");
+  }
+}
 
 TEST(PowerCells, ThreadsIdentical) {
   for (int dim : {2, 3}) {
@@ -145,6 +180,10 @@ TEST(PowerCells, CheckerboardLatticeTies) {
     EXPECT_TRUE(c.power);
     EXPECT_EQ(c.n_cells(), n);
     expect_valid(c, pts, radii, "checkerboard");
+    // By the regular triangulation's stars: the same perturbed ties.
+    const auto by_stars = run_power(pts, dim, box, radii, 2, true, tessera::CellMethod::insertion);
+    expect_valid(by_stars, pts, radii, "checkerboard by insertion");
+    for (std::size_t k = 0; k < n; ++k) EXPECT_EQ(neighbours_of(by_stars, k), neighbours_of(c, k)) << k;
     // Each colour's interior cells are alike, and the oracle's (in plain
     // doubles: right on volumes at ties, whatever it makes of the topology).
     for (std::size_t i = 0; i < n; ++i) {
@@ -232,7 +271,6 @@ TEST(PowerCells, BadRadiiRefused) {
   r[7] = INFINITY;
   bad(r, none);
   r = random_radii(50, 0.1, 52);
-  bad(r, [](tessera::VoronoiOptions& o) { o.cell_method = tessera::CellMethod::insertion; });
   // Power cells measured without their radii cannot be checked exactly.
   auto o = options(3, unit_box());
   o.radii = r;

@@ -1483,7 +1483,6 @@ class BadInput(TempDirCase):
             bad[7] = value
             self.fails(vor + ["--radii", self.save("bad.npy", bad)], shown, outputs=[out])
         rad = self.save("r.npy", r)
-        self.fails(vor + ["--radii", rad, "--method", "insertion"], "--method insertion", outputs=[out])
         self.fails(vor + ["--radii", self.p("missing.npy")], "missing.npy", outputs=[out])
         self.fails(vor + ["--radii", self.save("r2d.npy", np.stack([r, r], 1))], "1-D", outputs=[out])
         self.fails(vor + ["--radii", self.save("rs.npy", np.array(["a"] * 50))], outputs=[out])

@@ -200,10 +200,20 @@ class CellBuilder {
   /// The cell is the one build_from gives either way (the same exact
   /// predicate decided the triangulation), up to the last bits of its
   /// geometry.
+  ///
+  /// Power cells (ExactContext::radii) come from the regular triangulation's
+  /// stars, clipped by their points (assembly knows no weights); a point in
+  /// no simplex is hidden, and its power cell is empty.
   BuildStatus build_from_star(std::int32_t i, const double* p, std::uint32_t s, const std::uint32_t* rows,
                               std::span<const std::uint32_t> star, CellT& cell) {
     constexpr int W = D + 1;
     const std::size_t nt = star.size();
+    if (nt == 0 && exact_ != nullptr && exact_->radii != nullptr) {
+      cell.reset(i, p, lo_, hi_, exact_);
+      BuildStatus hidden;
+      hidden.has_cell = false;  // (duplicate_of -1: empty)
+      return hidden;
+    }
     nn_ = 0;
     if (slot_mark_.size() < loc_.size()) slot_mark_.assign(loc_.size(), 0);
     if (++mark_epoch_ == std::uint64_t{1} << 32) {  // wrapped: stale marks could read as this cell's

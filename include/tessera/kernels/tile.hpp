@@ -179,7 +179,9 @@ class Tile {
                 const std::int32_t* ids, const double* q, std::size_t m, const Index* corners,
                 std::size_t nt, bool open = false) {
     start(gen, p, lo, hi, exact);
-    if (may_underflow_ || m > max_assembled_planes) return false;
+    // Power cells: assembly's planes are plain bisectors, so their cells are
+    // clipped by the star's points instead (CellBuilder::build_from_star).
+    if (may_underflow_ || weighted_ || m > max_assembled_planes) return false;
     assembly::bisector_planes<2>(planes_, box_planes, ids, q, m);
     verts_.resize(open ? nt + 2 : nt);
     for (std::size_t t = 0; t < nt; ++t) {
