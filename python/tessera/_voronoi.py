@@ -409,9 +409,11 @@ def voronoi(
         (:attr:`Voronoi.empty_cells`) or lie outside its own; of exactly
         coincident points the largest radius owns the cell (ties: the lowest
         id). All radii equal give exactly the ordinary cells. In a periodic
-        box every image has its point's radius. Computed by the search: not
-        with ``method="insertion"``. The array is kept (:attr:`Voronoi.radii`, no copy when
-        it is float64 and contiguous) for :meth:`Voronoi.validate`.
+        box every image has its point's radius. Either ``method`` computes
+        them: the search, or the regular triangulation's stars
+        (``method="insertion"``; automatically where the search is costly).
+        The array is kept (:attr:`Voronoi.radii`, no copy when it is float64
+        and contiguous) for :meth:`Voronoi.validate`.
 
     Returns
     -------
@@ -423,8 +425,7 @@ def voronoi(
         Bad input (``tessera.InputError`` for the library's own checks): wrong
         shape or dtype, NaN or infinite coordinates, label count mismatch,
         empty bounds, points outside the bounds, no extent to build a box from,
-        radius count mismatch, a negative, NaN or infinite radius, radii with
-        ``method="insertion"``.
+        radius count mismatch, a negative, NaN or infinite radius.
     KeyboardInterrupt
         Ctrl-C during the run (it stops between batches of cells).
 
