@@ -17,9 +17,14 @@ The example checks the following, then draws the picture:
   radical planes is at least its radius;
 * with ordinary cells some large spheres cross their cells' faces;
 * both tessellations tile the box;
-* validate() passes (exact measures of sampled cells, with the radii).
+* validate() passes (exact measures of sampled cells, with the radii);
+* the regular triangulation, tessera.delaunay(points, radii=...), is the
+  power cells' dual: every pair of face neighbours among the cells is one of
+  its edges, no sphere is hidden (none overlaps another, so each holds its
+  own centre's cell), and its validate() passes (local regularity).
 
 OUT/packing_cells.vtu: the power cells (open in ParaView beside the spheres).
+OUT/packing_regular.vtu: the regular triangulation's tetrahedra.
 
 OUT/polydisperse_packing.png: left, a 2D packing of discs with its power
 cells (solid) and ordinary cells (dotted); right, the 3D local packing
@@ -131,6 +136,23 @@ def main():
               f"{fraction_ordinary[big].mean():.3f} (ordinary), max {fraction_power[big].max():.3f} / "
               f"{fraction_ordinary[big].max():.3f}")
     assert fraction_power.max() <= 1
+
+    # ---- The dual: the regular triangulation ------------------------------
+    regular = tessera.delaunay(points, radii=radii)
+    assert regular.power and len(regular.hidden) == 0
+    assert regular.validate().ok
+    indptr, indices = regular.vertex_neighbor_vertices
+    counts = np.diff(power.neighbor_offsets)
+    owner = np.repeat(power.generators, counts)
+    inside = power.neighbors >= 0  # (box faces have negative ids)
+    edges = set(zip(np.repeat(np.arange(len(points)), np.diff(indptr)).tolist(), indices.tolist()))
+    missing = sum((a, b) not in edges for a, b in zip(owner[inside].tolist(), power.neighbors[inside].tolist()))
+    assert missing == 0, f"{missing} face neighbours are not regular edges"
+    regular.save(os.path.join(args.out, "packing_regular.vtu"))
+    shared = int(inside.sum()) // 2
+    print(f"regular triangulation: {regular.nsimplex:,} tetrahedra; every face between two power cells is one "
+          f"of its {len(indices) // 2:,} edges ({shared:,}; the other {len(indices) // 2 - shared:,} are dual "
+          f"to faces beyond the box)")
 
     # ---- 2D: the picture ---------------------------------------------------
     sizes2 = (0.012, 0.03)
