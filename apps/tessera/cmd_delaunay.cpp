@@ -94,7 +94,7 @@ int run_delaunay(const DelaunayArgs& a) {
   t0 = Clock::now();
   std::vector<std::string> written;
   if (!a.output.empty()) {
-    io::write_simplices_vtk(a.output, dt, pc.coords);
+    io::write_simplices_vtk(a.output, dt, pc.coords, dt.power ? std::span<const double>(pc.radii) : std::span<const double>());
     written.push_back(a.output);
   }
   if (!a.simplices.empty()) {

@@ -243,7 +243,8 @@ int main(int argc, char** argv) {
       "delaunay", "The Delaunay triangulation (tetrahedra in 3D, triangles in 2D), dual of the cells");
   add_compute_options(del, dla.compute, del_bounds);
   del->add_option("-o,--output", dla.output,
-                  "Triangulation as VTK: .vtu (VTK_TETRA / VTK_TRIANGLE over the input points) or, in 2D, .vtp");
+                  "Triangulation as VTK: .vtu (VTK_TETRA / VTK_TRIANGLE over the input points) or, in 2D, .vtp; "
+                  "with --radii point data Radius (for sphere glyphs in ParaView)");
   del->add_option("--simplices", dla.simplices,
                   "Simplices as an int64 .npy array of shape (M, D+1), point ids; tetrahedra positively oriented, "
                   "triangles counter-clockwise; - writes it to standard output");

@@ -53,15 +53,17 @@ void bind_io(py::module_& m) {
 
   m.def(
       "write_simplices_vtk",
-      [](const std::string& path, const DelaunayResult& r, const py::array_t<double, py::array::c_style>& points) {
+      [](const std::string& path, const DelaunayResult& r, const py::array_t<double, py::array::c_style>& points,
+         const py::object& radii) {
         if (checked_dim(points) != r.dt.dim || static_cast<std::size_t>(points.shape(0)) != r.dt.n_points)
           throw py::value_error("write_simplices_vtk: points are not the ones triangulated");
         const auto pts = as_span(points);
-        write_or_oserror([&] { io::write_simplices_vtk(path, r.dt, pts); });
+        const auto rad = as_radii(radii);  // the caller's array: alive through the call
+        write_or_oserror([&] { io::write_simplices_vtk(path, r.dt, pts, rad); });
       },
-      py::arg("path"), py::arg("delaunay"), py::arg("points").noconvert(),
-      "Write simplices as .vtu (VTK_TETRA / VTK_TRIANGLE over all points; 2D also .vtp polygons). "
-      "OSError if the file cannot be written.");
+      py::arg("path"), py::arg("delaunay"), py::arg("points").noconvert(), py::arg("radii").none(true) = py::none(),
+      "Write simplices as .vtu (VTK_TETRA / VTK_TRIANGLE over all points; 2D also .vtp polygons); radii "
+      "(a regular triangulation's) add point data Radius. OSError if the file cannot be written.");
 
   m.def(
       "write_graph_vtp",

@@ -286,13 +286,14 @@ class Delaunay:
         """Write the simplices for ParaView: ``.vtu`` (VTK_TETRA / VTK_TRIANGLE
         cells over all input points, 2D points with z = 0) or, in 2D, ``.vtp``
         (triangles as polygons); binary, written atomically. Cell data
-        SimplexId, point data PointId. ValueError for a wrong extension,
-        OSError when the file cannot be written."""
+        SimplexId, point data PointId, and for a regular triangulation
+        (:attr:`power`) Radius. ValueError for a wrong extension, OSError when
+        the file cannot be written."""
         path = os.fspath(path)
         allowed = (".vtu",) if self.ndim == 3 else (".vtu", ".vtp")
         if not path.lower().endswith(allowed):
             raise ValueError(f"save: a {self.ndim}D triangulation is written as {' or '.join(allowed)}, got {path!r}")
-        _core.write_simplices_vtk(path, self._dt, self._points)
+        _core.write_simplices_vtk(path, self._dt, self._points, self._radii if self.power else None)
 
     def to_vtk(self) -> Any:
         """The triangulation as a ``vtkUnstructuredGrid`` (needs ``vtk``)."""

@@ -298,3 +298,26 @@ def test_regular_triangulation_views_and_files(tmp_path, dim):
     path = tmp_path / "regular.vtu"
     dt.save(path)
     assert path.stat().st_size > 0
+
+
+@pytest.mark.parametrize("dim,ext", [(2, ".vtp"), (2, ".vtu"), (3, ".vtu")])
+def test_regular_triangulation_saves_its_radii(tmp_path, dim, ext):
+    from vtkmodules.util.numpy_support import vtk_to_numpy
+    from vtkmodules.vtkIOXML import vtkXMLPolyDataReader, vtkXMLUnstructuredGridReader
+
+    pts, r = spheres(500, dim, seed=40 + dim)
+    dt = tessera.delaunay(pts, radii=r)
+    path = tmp_path / ("regular" + ext)
+    dt.save(path)
+    reader = vtkXMLPolyDataReader() if ext == ".vtp" else vtkXMLUnstructuredGridReader()
+    reader.SetFileName(str(path))
+    reader.Update()
+    data = reader.GetOutput()
+    assert data.GetNumberOfCells() == dt.nsimplex
+    np.testing.assert_array_equal(vtk_to_numpy(data.GetPointData().GetArray("Radius")), r)
+    # An ordinary triangulation has no Radius array.
+    plain = tessera.delaunay(pts)
+    plain.save(path)
+    reader.Modified()
+    reader.Update()
+    assert reader.GetOutput().GetPointData().GetArray("Radius") is None

@@ -27,9 +27,10 @@ void put(std::ostream& os, const T& v) {
   os.write(reinterpret_cast<const char*>(&v), sizeof(T));
 }
 
-/// point_id: per point of `points`, the point it is (an image's), or empty: its own index.
+/// point_id: per point of `points`, the point it is (an image's), or empty:
+/// its own index. radii: per point id, or empty (no Radius array).
 void write_vtu(const std::string& path, const Delaunay& dt, std::span<const double> points,
-               std::span<const std::int32_t> point_id) {
+               std::span<const std::int32_t> point_id, std::span<const double> radii) {
   const int D = dt.dim;
   const std::size_t n = dt.n_points, m = dt.n_simplices(), w = static_cast<std::size_t>(D + 1);
   struct Array { const char* type; const char* name; int comps; std::uint64_t bytes; };
@@ -40,12 +41,15 @@ void write_vtu(const std::string& path, const Delaunay& dt, std::span<const doub
       {"Int32", "connectivity", 1, m * w * 4},
       {"Int64", "offsets", 1, m * 8},
       {"UInt8", "types", 1, m},
+      {"Float64", "Radius", 1, n * 8},  // written only with radii, last in the appended block
   };
-  std::uint64_t offsets[6], at = 0;
-  for (int k = 0; k < 6; ++k) {
+  const int n_arrays = radii.empty() ? 6 : 7;
+  std::uint64_t offsets[7], at = 0;
+  for (int k = 0; k < n_arrays; ++k) {
     offsets[k] = at;
     at += 8 + arrays[k].bytes;
   }
+  auto id_of = [&](std::size_t i) { return point_id.empty() ? static_cast<std::int32_t>(i) : point_id[i]; };
   auto tag = [&](int k, const char* indent) {
     std::string s = std::string(indent) + "<DataArray type=\"" + arrays[k].type + "\" Name=\"" + arrays[k].name + "\"";
     if (arrays[k].comps != 1) s += " NumberOfComponents=\"" + std::to_string(arrays[k].comps) + "\"";
@@ -55,7 +59,7 @@ void write_vtu(const std::string& path, const Delaunay& dt, std::span<const doub
       "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" "
       "header_type=\"UInt64\">\n  <UnstructuredGrid>\n    <Piece NumberOfPoints=\"" +
       std::to_string(n) + "\" NumberOfCells=\"" + std::to_string(m) + "\">\n";
-  xml += "      <PointData>\n" + tag(0, "        ") + "      </PointData>\n";
+  xml += "      <PointData>\n" + tag(0, "        ") + (radii.empty() ? "" : tag(6, "        ")) + "      </PointData>\n";
   xml += "      <CellData>\n" + tag(1, "        ") + "      </CellData>\n";
   xml += "      <Points>\n" + tag(2, "        ") + "      </Points>\n";
   xml += "      <Cells>\n" + tag(3, "        ") + tag(4, "        ") + tag(5, "        ") + "      </Cells>\n";
@@ -71,7 +75,7 @@ void write_vtu(const std::string& path, const Delaunay& dt, std::span<const doub
       if (buf.size() > (1u << 20)) flush();
     };
     emit(arrays[0].bytes);
-    for (std::size_t i = 0; i < n; ++i) emit(point_id.empty() ? static_cast<std::int32_t>(i) : point_id[i]);
+    for (std::size_t i = 0; i < n; ++i) emit(id_of(i));
     emit(arrays[1].bytes);
     for (std::size_t s = 0; s < m; ++s) emit(static_cast<std::int64_t>(s));
     emit(arrays[2].bytes);
@@ -84,13 +88,17 @@ void write_vtu(const std::string& path, const Delaunay& dt, std::span<const doub
     for (std::size_t s = 1; s <= m; ++s) emit(static_cast<std::int64_t>(s * w));
     emit(arrays[5].bytes);
     for (std::size_t s = 0; s < m; ++s) emit(D == 3 ? kVtkTetra : kVtkTriangle);
+    if (!radii.empty()) {
+      emit(arrays[6].bytes);
+      for (std::size_t i = 0; i < n; ++i) emit(radii[static_cast<std::size_t>(id_of(i))]);
+    }
     flush();
     os << "\n  </AppendedData>\n</VTKFile>\n";
   });
 }
 
 void write_vtp(const std::string& path, const Delaunay& dt, std::span<const double> points,
-               std::span<const std::int32_t> point_id) {
+               std::span<const std::int32_t> point_id, std::span<const double> radii) {
   const std::size_t m = dt.n_simplices();
   std::vector<std::int64_t> offsets(m + 1);
   for (std::size_t s = 0; s <= m; ++s) offsets[s] = static_cast<std::int64_t>(3 * s);
@@ -106,6 +114,11 @@ void write_vtp(const std::string& path, const Delaunay& dt, std::span<const doub
   pd.points = points;
   pd.polys = {offsets, dt.simplices};
   pd.point_data.push_back({"PointId", std::span<const std::int32_t>(pids), 1});
+  std::vector<double> radius;
+  if (!radii.empty()) {
+    for (const std::int32_t id : pids) radius.push_back(radii[static_cast<std::size_t>(id)]);
+    pd.point_data.push_back({"Radius", std::span<const double>(radius), 1});
+  }
   pd.cell_data.push_back({"SimplexId", std::span<const std::int64_t>(ids), 1});
   write_polydata(path, pd);
 }
@@ -151,14 +164,19 @@ Unrolled unroll(const Delaunay& dt) {
   return u;
 }
 
-void write_simplices_vtk(const std::string& path, const Delaunay& dt, std::span<const double> points) {
+void write_simplices_vtk(const std::string& path, const Delaunay& dt, std::span<const double> points,
+                         std::span<const double> radii) {
   const std::string ext = detail::lower_extension(path);
+  if (!radii.empty() && radii.size() != dt.n_points)
+    throw InputError("cannot write " + path + ": " + std::to_string(radii.size()) + " radii for " +
+                     std::to_string(dt.n_points) + " points");
   if (dt.is_periodic() && (ext == ".vtu" || (ext == ".vtp" && dt.dim == 2))) {
     const Unrolled u = unroll(dt);
-    return ext == ".vtu" ? write_vtu(path, u.dt, u.points, u.point_id) : write_vtp(path, u.dt, u.points, u.point_id);
+    return ext == ".vtu" ? write_vtu(path, u.dt, u.points, u.point_id, radii)
+                         : write_vtp(path, u.dt, u.points, u.point_id, radii);
   }
-  if (ext == ".vtu") return write_vtu(path, dt, points, {});
-  if (ext == ".vtp" && dt.dim == 2) return write_vtp(path, dt, points, {});
+  if (ext == ".vtu") return write_vtu(path, dt, points, {}, radii);
+  if (ext == ".vtp" && dt.dim == 2) return write_vtp(path, dt, points, {}, radii);
   if (ext == ".vtp")
     throw InputError("cannot write " + path + ": 3D Delaunay output is an unstructured grid (.vtu)");
   throw InputError("cannot write " + path + ": unknown extension '" + ext + "' (use .vtu, or .vtp in 2D)");

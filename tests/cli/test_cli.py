@@ -1271,6 +1271,7 @@ class Regular(TempDirCase):
             self.check_regular(pts, r, s)
             g = read_vtu(vtk) if out.endswith(".vtu") else read_vtp(vtk)
             self.assertEqual(g.GetNumberOfCells(), len(s))
+            np.testing.assert_array_equal(vtk_to_numpy(g.GetPointData().GetArray("Radius")), r)
             # Hidden points own no power cell.
             tab = self.p("c.csv")
             self.ok(["voronoi", inp, "--radii", rad, "--cell-table", tab, "-q"])
@@ -1284,9 +1285,14 @@ class Regular(TempDirCase):
                            (self.inp3, ["--periodic", "xyz", "--bounds"] + BOX3 + ["--tilt", "0.25", "0", "-0.125"]),
                            (self.inp2, ["--periodic", "xy", "--bounds"] + BOX2 + ["--tilt", "0.5"])):
             rad = self.rad3 if inp == self.inp3 else self.rad2
-            sim, sh = self.p("s.npy"), self.p("sh.npy")
-            res = self.ok(["delaunay", inp, "--radii", rad, "--simplices", sim, "--simplex-shifts", sh, "--validate"] +
-                          extra)
+            sim, sh, vtk = self.p("s.npy"), self.p("sh.npy"), self.p("t.vtu")
+            res = self.ok(["delaunay", inp, "--radii", rad, "--simplices", sim, "--simplex-shifts", sh, "--validate",
+                           "-o", vtk] + extra)
+            # Every point, and every image a simplex uses, has its point's radius.
+            g = read_vtu(vtk)
+            pid = vtk_to_numpy(g.GetPointData().GetArray("PointId"))
+            r = self.r3 if inp == self.inp3 else self.r2
+            np.testing.assert_array_equal(vtk_to_numpy(g.GetPointData().GetArray("Radius")), r[pid])
             self.assertIn("validation passed", res.stderr)
             self.assertIn("of the periodic box", res.stderr)
             hidden = np.setdiff1d(np.arange(self.N), np.load(sim))

@@ -14,7 +14,10 @@ namespace tessera::io {
 /// InputError on another extension, .vtp in 3D, or an unwritable path.
 /// A periodic triangulation (Delaunay::is_periodic) is written over its own
 /// points as wrapped (`points` is not read), followed by one point at each
-/// image a simplex uses; PointId names the point an image is of.
-void write_simplices_vtk(const std::string& path, const Delaunay& dt, std::span<const double> points);
+/// image a simplex uses; PointId names the point an image is of. `radii`
+/// (a regular triangulation's, one per point, or empty) add point data Radius
+/// (Float64; an image has its point's), for glyphs in ParaView.
+void write_simplices_vtk(const std::string& path, const Delaunay& dt, std::span<const double> points,
+                         std::span<const double> radii = {});
 
 }  // namespace tessera::io
