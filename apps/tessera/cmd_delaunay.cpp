@@ -93,8 +93,10 @@ int run_delaunay(const DelaunayArgs& a) {
 
   t0 = Clock::now();
   std::vector<std::string> written;
+  // A regular triangulation's radii (equal radii gave an ordinary one).
+  const std::span<const double> radii = dt.power ? std::span<const double>(pc.radii) : std::span<const double>();
   if (!a.output.empty()) {
-    io::write_simplices_vtk(a.output, dt, pc.coords, dt.power ? std::span<const double>(pc.radii) : std::span<const double>());
+    io::write_simplices_vtk(a.output, dt, pc.coords, radii);
     written.push_back(a.output);
   }
   if (!a.simplices.empty()) {
@@ -161,7 +163,7 @@ int run_delaunay(const DelaunayArgs& a) {
     for (const auto& w : written) std::fprintf(stderr, "tessera: wrote %s\n", w.c_str());
   }
   if (a.validate) {
-    const DelaunayReport r = validate(dt, pc.coords, pc.labels, dt.power ? std::span<const double>(pc.radii) : std::span<const double>());
+    const DelaunayReport r = validate(dt, pc.coords, pc.labels, radii);
     if (!a.quiet || !r.ok) {
       const std::string hidden =
           dt.power ? ", " + std::to_string(dt.hidden.size()) + " hidden points (" + std::to_string(r.hidden_in_conflict) +

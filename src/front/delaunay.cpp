@@ -294,19 +294,6 @@ inline constexpr double clean_exact_per_cell = 1.0;
 /// (as the cells' pilot: few inside points are measured too).
 inline constexpr double labelled_pilot_share = 0.5;
 
-// Regular triangulations (hull completed): the hidden points, those in the
-// domain in no simplex and no duplicate (Delaunay::hidden). Call with the
-// duplicates sorted.
-template <int D>
-void list_hidden(const front::Pass<D>& pass, Delaunay& out) {
-  if (!out.power) return;
-  std::vector<std::uint8_t> used(out.n_points, 0);
-  for (std::int32_t id : out.simplices) used[static_cast<std::size_t>(id)] = 1;
-  for (const auto& [dup, owner] : out.duplicates) used[static_cast<std::size_t>(dup)] = 1;
-  for (std::size_t i = 0; i < out.n_points; ++i)
-    if (!used[i] && pass.in_box[i]) out.hidden.push_back(static_cast<std::int32_t>(i));
-}
-
 // The triangulation by insertion of the located points (front::insert_located).
 template <int D>
 Delaunay by_insertion(const front::Pass<D>& pass, Delaunay out) {
@@ -318,8 +305,7 @@ Delaunay by_insertion(const front::Pass<D>& pass, Delaunay out) {
     out.from_insertion = ins.rows->size() / (D + 1);
     out.simplices = std::move(*ins.rows);
   });
-  std::sort(out.duplicates.begin(), out.duplicates.end());
-  if (out.n_simplices() > 0) list_hidden(pass, out);  // (flat input: no simplex, nobody hidden)
+  if (out.n_simplices() > 0) front::list_hidden(out);  // (flat input: no simplex, nobody hidden)
   return out;
 }
 
@@ -551,7 +537,7 @@ Delaunay run(std::span<const double> input, std::span<const std::int32_t> labels
   std::vector<std::array<std::int32_t, D + 1>>().swap(found.foreign);
   engine::ThreadArena(pass.engine_options.threads).execute([&] { comp.write(added, out.simplices); });
   std::sort(out.duplicates.begin(), out.duplicates.end());
-  if (complete) list_hidden(pass, out);
+  if (complete) front::list_hidden(out);
   return out;
 }
 
@@ -726,6 +712,16 @@ Delaunay delaunay(std::span<const double> input, int dim, std::span<const std::i
 }
 
 namespace front {
+
+void list_hidden(Delaunay& dt) {
+  if (!dt.power) return;
+  std::vector<std::uint8_t> used(dt.n_points, 0);
+  for (const std::int32_t id : dt.simplices) used[static_cast<std::size_t>(id)] = 1;
+  for (const auto& [dup, owner] : dt.duplicates) used[static_cast<std::size_t>(dup)] = 1;
+  for (const std::int32_t id : dt.ignored_outside_bounds) used[static_cast<std::size_t>(id)] = 1;
+  for (std::size_t i = 0; i < dt.n_points; ++i)
+    if (!used[i]) dt.hidden.push_back(static_cast<std::int32_t>(i));
+}
 
 Delaunay delaunay_of_images(std::span<const double> points, int dim, std::span<const std::int32_t> labels,
                             const VoronoiOptions& options, std::vector<double>& reach) {

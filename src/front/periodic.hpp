@@ -196,6 +196,11 @@ std::vector<std::pair<std::int32_t, std::int32_t>> duplicates_as_points(
 Cells periodic_cells(Cells&& augmented, const PeriodicInput& in, const PeriodicImages& im,
                      std::span<const std::int32_t> labels, int threads);
 
+/// A regular triangulation's (Delaunay::power) hidden points: those in no
+/// simplex, neither duplicates nor set aside (Delaunay::hidden, ascending);
+/// nothing without radii (delaunay.cpp). Call once the simplices are final.
+void list_hidden(Delaunay& dt);
+
 /// The simplices the cells of an augmented input's points (label >= 0)
 /// find, images (label < 0) among their vertices: each from its lowest id's
 /// cell, oriented, rows ascending (delaunay.cpp). `reach` as for

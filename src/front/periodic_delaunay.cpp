@@ -186,14 +186,7 @@ Delaunay periodic_delaunay(std::span<const double> input, int dim, std::span<con
   dt.simplex_shifts.resize(dt.simplices.size() * du);
   to_points(im, dim, dt.simplices, dt.simplex_shifts, threads);
   dt.power = aug.power;
-  if (dt.power) {  // hidden: taking part, in no simplex, and no duplicate
-    std::vector<std::uint8_t> used(dt.n_points, 0);
-    for (const std::int32_t id : dt.simplices) used[static_cast<std::size_t>(id)] = 1;
-    for (const auto& [dup, owner] : dt.duplicates) used[static_cast<std::size_t>(dup)] = 1;
-    for (const std::int32_t id : dt.ignored_outside_bounds) used[static_cast<std::size_t>(id)] = 1;
-    for (std::size_t i = 0; i < dt.n_points; ++i)
-      if (!used[i]) dt.hidden.push_back(static_cast<std::int32_t>(i));
-  }
+  list_hidden(dt);
   return dt;
 }
 

@@ -44,11 +44,13 @@ double det_rows(const double (*r)[3], int D, double& perm) {
   return r[0][0] * m0 - r[0][1] * m1 + r[0][2] * m2;
 }
 
-/// True when the points that take part span less than D dimensions (exactly).
+/// True when the points that take part (not hidden ones either) span less
+/// than D dimensions (exactly).
 bool is_flat(const kernels::ExactContext& ctx, const Delaunay& dt) {
   std::vector<std::uint8_t> skip(dt.n_points, 0);
   for (auto [dup, owner] : dt.duplicates) skip[static_cast<std::size_t>(dup)] = 1;
   for (std::int32_t id : dt.ignored_outside_bounds) skip[static_cast<std::size_t>(id)] = 1;
+  for (std::int32_t id : dt.hidden) skip[static_cast<std::size_t>(id)] = 1;
   // Grow an affinely independent set greedily; the input is flat iff it stops short of D+1.
   std::array<std::int32_t, 4> basis{};
   int size = 0;
@@ -289,13 +291,7 @@ DelaunayReport validate(const Delaunay& dt, std::span<const double> points, std:
     if (m == 0) {
       // Exactly flat (coplanar / collinear) input has no simplex: nothing
       // is missing; with radii, neither where the points not hidden are.
-      Delaunay live;
-      live.dim = dt.dim;
-      live.n_points = dt.n_points;
-      live.duplicates = dt.duplicates;
-      live.ignored_outside_bounds = dt.ignored_outside_bounds;
-      for (std::int32_t id : dt.hidden) live.ignored_outside_bounds.push_back(id);
-      if (is_flat(ctx, live)) rep.missing_points = 0;
+      if (is_flat(ctx, dt)) rep.missing_points = 0;
     } else if (!hidden.empty()) {
       const std::vector<double> at = [&] {
         std::vector<double> q(hidden.size() * static_cast<std::size_t>(D));
@@ -326,7 +322,8 @@ DelaunayReport validate(const Delaunay& dt, std::span<const double> points, std:
   fail(rep.missing_points, dt.power ? "points are in no simplex and not hidden" : "points are in no simplex");
   fail(rep.hidden_not_hidden, "points listed as hidden are vertices, duplicates or set aside");
   fail(rep.hidden_in_conflict, "hidden points are in conflict with the simplex that holds them (they should be vertices)");
-  fail(rep.local_delaunay_violations, "interior facets are not locally Delaunay");
+  fail(rep.local_delaunay_violations,
+       dt.power ? "interior facets are not locally regular" : "interior facets are not locally Delaunay");
   // Float volumes: the comparison allows their rounding (a bound from each
   // determinant's permanent, which matters for nearly flat input) plus 1e-9.
   rep.volume_sum = std::ldexp(volume_sum, unit_exp_sum);
