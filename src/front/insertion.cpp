@@ -74,10 +74,10 @@ struct Worker : insertion::Worker {
     int slot = 0;
   };
   std::vector<Facet> boundary;
-  std::vector<std::int32_t> removed;  // weighted: the cavity's vertices (those it may hide)
   std::vector<Edge> edges;          // 3D: new tetrahedra by the edge they share
   std::vector<std::uint64_t> used;  // 3D: the entries of edges in use
   std::int32_t pending_infinite = -1;  // 2D: pending_'s entry for the infinite vertex
+  std::vector<std::int32_t> removed;  // weighted: the cavity's vertices (those it may hide)
 };
 
 // Weighted: a regular triangulation (ExactContext::radii): power tests,
@@ -570,8 +570,8 @@ class Triangulation {
       double w[K + 1];
       for (int k = 0; k < K; ++k) w[k] = weight_[static_cast<std::size_t>(t.v[k])];
       w[K] = weight_[static_cast<std::size_t>(q)];
-      if constexpr (D == 3) s = insertion::in_sphere_filter(at(t.v[0]), at(t.v[1]), at(t.v[2]), at(t.v[3]), at(q), underflow_, w);
-      else s = insertion::in_circle_filter(at(t.v[0]), at(t.v[1]), at(t.v[2]), at(q), underflow_, w);
+      if constexpr (D == 3) s = insertion::in_sphere_filter<true>(at(t.v[0]), at(t.v[1]), at(t.v[2]), at(t.v[3]), at(q), underflow_, w);
+      else s = insertion::in_circle_filter<true>(at(t.v[0]), at(t.v[1]), at(t.v[2]), at(q), underflow_, w);
     } else {
       if constexpr (D == 3) s = insertion::in_sphere_filter(at(t.v[0]), at(t.v[1]), at(t.v[2]), at(t.v[3]), at(q), underflow_);
       else s = insertion::in_circle_filter(at(t.v[0]), at(t.v[1]), at(t.v[2]), at(q), underflow_);
@@ -732,9 +732,6 @@ class Triangulation {
 
   const ExactContext& ctx_;
   const bool underflow_;                // ctx_.may_underflow, for the filters (insertion_filters.hpp)
-  std::vector<std::uint8_t> hidden_;    // weighted: vertex -> hidden (never a vertex, or removed)
-  std::vector<double> weight_;          // weighted: vertex -> its squared radius (the power test's weight)
-  std::vector<std::uint32_t> stamp_;    // weighted: vertex -> the last insertion (epoch) whose new simplices hold it
   std::vector<std::int32_t> global_;    // vertex -> input id
   std::vector<std::int32_t> guide_;     // vertex -> an earlier round's vertex near it, or -1 (walk_start)
   Buffer<std::int32_t> vsimplex_;       // inserted vertex -> a live simplex of it
@@ -752,6 +749,10 @@ class Triangulation {
   bool retry_left_ = true;          // whether the phases may still try again once they stopped
   std::size_t retry_from_ = 0;      // the round size that tries again, once they stopped
   std::size_t inserted_before_round_ = 0;  // vertices in before the current round (reserve_round)
+  // Weighted only (empty otherwise), after the hot members.
+  std::vector<std::uint8_t> hidden_;    // weighted: vertex -> hidden (never a vertex, or removed)
+  std::vector<double> weight_;          // weighted: vertex -> its squared radius (the power test's weight)
+  std::vector<std::uint32_t> stamp_;    // weighted: vertex -> the last insertion (epoch) whose new simplices hold it
   InsertionStats stats_;
 };
 
