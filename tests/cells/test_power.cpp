@@ -95,6 +95,9 @@ void compare_with_oracle(int dim, std::size_t n, double rmax, std::uint64_t seed
   }
   EXPECT_EQ(bad, 0u);
   EXPECT_EQ(empty, c.empty_cells.size());
+  // The stars' cells are assembled (their planes weighed), not clipped:
+  // all but those with a vertex within rounding of the box.
+  if (method == tessera::CellMethod::insertion) EXPECT_GE(c.assembled_from_stars, (n - empty) * 9 / 10);
   std::printf("[ power ] dim %d n %zu: %zu empty cells\n", dim, n, empty);
   expect_valid(c, pts, radii, "random");
 }
@@ -123,6 +126,7 @@ TEST(PowerCells, InsertionGivesTheSearchsCells) {
     const auto s = run_power(pts, dim, box, radii, 2, true, tessera::CellMethod::search);
     const auto i = run_power(pts, dim, box, radii, 2, true, tessera::CellMethod::insertion);
     EXPECT_TRUE(i.from_insertion);
+    EXPECT_GE(i.assembled_from_stars, i.n_cells() * 9 / 10);
     EXPECT_FALSE(s.empty_cells.empty());
     EXPECT_EQ(i.cell_of, s.cell_of);
     EXPECT_EQ(i.empty_cells, s.empty_cells);
@@ -223,34 +227,43 @@ TEST(PowerCells, CoincidentPointsLargestRadiusOwns) {
 
 // Planes through p_i and beyond it: d exactly 0 (r_j^2 - r_i^2 = |q|^2), and
 // negative, where p_i lies outside its own cell; a cell emptied by a sphere
-// that contains another's whole reach.
+// that contains another's whole reach. By the search, and assembled from
+// the regular triangulation's stars (every point here is on the hull: open
+// stars, closed by the far plane).
 TEST(PowerCells, PlanesThroughAndBeyondTheGenerator) {
   const auto box = make_bounds({-2, -2, -2}, {2, 2, 2});
-  // 2D: p0 = 0 (r 0), p1 = (1, 0) with r1 = 1: their plane is x = 0, through p0.
-  // p2 = (-1, 0.5) with r2 = 1.5: plane with p0 at d = (1.25 - 2.25) / 2 < 0.
-  const std::vector<double> pts2 = {0, 0, 1, 0, -1, 0.5, 0, -1.5, 1.5, 1.5};
-  const std::vector<double> r2 = {0, 1, 1.5, 0.25, 0.5};
-  const auto c2 = run_power(pts2, 2, box, r2);
-  for (std::size_t i = 0; i < 5; ++i) {
-    const oracle::Cell o = oracle::cell(pts2, 2, i, box.lo, box.hi, r2);
-    const auto k = c2.cell_of[i];
-    if (k < 0) {
-      EXPECT_LE(o.volume, 1e-15) << i;
-    } else {
-      EXPECT_NEAR(c2.volume[static_cast<std::size_t>(k)], o.volume, 1e-13) << i;
+  for (const auto method : {tessera::CellMethod::search, tessera::CellMethod::insertion}) {
+    SCOPED_TRACE(method == tessera::CellMethod::search ? "search" : "insertion");
+    // 2D: p0 = 0 (r 0), p1 = (1, 0) with r1 = 1: their plane is x = 0, through p0.
+    // p2 = (-1, 0.5) with r2 = 1.5: plane with p0 at d = (1.25 - 2.25) / 2 < 0.
+    const std::vector<double> pts2 = {0, 0, 1, 0, -1, 0.5, 0, -1.5, 1.5, 1.5};
+    const std::vector<double> r2 = {0, 1, 1.5, 0.25, 0.5};
+    const auto c2 = run_power(pts2, 2, box, r2, 1, true, method);
+    for (std::size_t i = 0; i < 5; ++i) {
+      const oracle::Cell o = oracle::cell(pts2, 2, i, box.lo, box.hi, r2);
+      const auto k = c2.cell_of[i];
+      if (k < 0) {
+        EXPECT_LE(o.volume, 1e-15) << i;
+      } else {
+        EXPECT_NEAR(c2.volume[static_cast<std::size_t>(k)], o.volume, 1e-13) << i;
+      }
+    }
+    expect_valid(c2, pts2, r2, "through p_i (2D)");
+    // 3D: a small sphere deep inside a large one's reach owns no cell.
+    const std::vector<double> pts3 = {0, 0, 0, 0.1, 0, 0, 1, 1, 1, -1, 1, -1};
+    const std::vector<double> r3 = {1, 0.05, 0.5, 0.5};
+    const auto c3 = run_power(pts3, 3, box, r3, 1, true, method);
+    EXPECT_EQ(c3.empty_cells, std::vector<std::int32_t>{1});
+    for (std::size_t i : {0u, 2u, 3u}) {
+      const oracle::Cell o = oracle::cell(pts3, 3, i, box.lo, box.hi, r3);
+      EXPECT_NEAR(c3.volume[static_cast<std::size_t>(c3.cell_of[i])], o.volume, 1e-12) << i;
+    }
+    expect_valid(c3, pts3, r3, "emptied (3D)");
+    if (method == tessera::CellMethod::insertion) {
+      EXPECT_EQ(c2.assembled_from_stars, c2.n_cells());
+      EXPECT_EQ(c3.assembled_from_stars, c3.n_cells());
     }
   }
-  expect_valid(c2, pts2, r2, "through p_i (2D)");
-  // 3D: a small sphere deep inside a large one's reach owns no cell.
-  const std::vector<double> pts3 = {0, 0, 0, 0.1, 0, 0, 1, 1, 1, -1, 1, -1};
-  const std::vector<double> r3 = {1, 0.05, 0.5, 0.5};
-  const auto c3 = run_power(pts3, 3, box, r3);
-  EXPECT_EQ(c3.empty_cells, std::vector<std::int32_t>{1});
-  for (std::size_t i : {0u, 2u, 3u}) {
-    const oracle::Cell o = oracle::cell(pts3, 3, i, box.lo, box.hi, r3);
-    EXPECT_NEAR(c3.volume[static_cast<std::size_t>(c3.cell_of[i])], o.volume, 1e-12) << i;
-  }
-  expect_valid(c3, pts3, r3, "emptied (3D)");
 }
 
 TEST(PowerCells, BadRadiiRefused) {

@@ -16,6 +16,7 @@
 
 #include "tessera/kernels/exact_predicates.hpp"
 #include "tessera/kernels/filter.hpp"
+#include "tessera/kernels/power.hpp"
 
 namespace tessera::kernels::assembly {
 
@@ -41,6 +42,32 @@ void bisector_planes(std::vector<Plane>& planes, std::size_t first, const std::i
     pl.id = ids[k];
     pl.scale = 0;  // assemble() refuses extreme input (may_underflow), the only kind with huge bisectors
   }
+}
+
+/// bisector_planes for a power cell of generator `gen` (power.hpp): each
+/// plane written as a power cell's clip writes it (filter::Bisector, then
+/// weigh: d moved by (r_gen^2 - r_j^2) / 2), so an assembled power cell has
+/// the vertices its clips would give. The star comes from the regular
+/// triangulation, whose simplices are the power cells' vertices as the
+/// Delaunay triangulation's are the Voronoi cells'. False where a plane
+/// needed scaling (filter::Bisector::rescale: never outside the extreme
+/// input assemble() refuses), leaving the cell to the clips.
+template <int D, class Plane>
+bool power_planes(std::vector<Plane>& planes, std::size_t first, const std::int32_t* ids, const double* q,
+                  std::size_t m, const ExactContext& ctx, std::int32_t gen) {
+  planes.resize(first + m);
+  for (std::size_t k = 0; k < m; ++k) {
+    filter::Bisector<D> b(q + D * k);
+    weigh(b, ctx, gen, ids[k]);
+    if (b.scale != 0) return false;
+    Plane& pl = planes[first + k];
+    for (int a = 0; a < D; ++a) pl.n[a] = b.n[a];
+    pl.d = b.d;
+    pl.n1 = b.n1;
+    pl.id = ids[k];
+    pl.scale = 0;
+  }
+  return true;
 }
 
 /// The id of the far plane that closes a hull point's cell (far_plane): no

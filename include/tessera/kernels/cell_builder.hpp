@@ -202,8 +202,9 @@ class CellBuilder {
   /// geometry.
   ///
   /// Power cells (ExactContext::radii) come from the regular triangulation's
-  /// stars, clipped by their points (assembly knows no weights); a point in
-  /// no simplex is hidden, and its power cell is empty.
+  /// stars, assembled the same way from their weighed planes
+  /// (assembly::power_planes); a point in no simplex is hidden, and its
+  /// power cell is empty.
   BuildStatus build_from_star(std::int32_t i, const double* p, std::uint32_t s, const std::uint32_t* rows,
                               std::span<const std::uint32_t> star, CellT& cell) {
     constexpr int W = D + 1;
