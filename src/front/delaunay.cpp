@@ -404,7 +404,8 @@ Delaunay run(std::span<const double> input, std::span<const std::int32_t> labels
   // over (HullCompletion::set_budget). It builds the same rows, so only
   // the automatic method may switch.
   const bool fall_back = D == 3 && complete && opt.method == DelaunayMethod::automatic && attempt == 0;
-  const Delaunay before_cells = fall_back ? out : Delaunay{};
+  const bool power = complete && !pass.radii.empty() && attempt == 0;
+  const Delaunay before_cells = fall_back || power ? out : Delaunay{};
   // Progress never restarts: where an insertion may take over, the cells
   // report the bar's first 80% and the insertion the rest (it restarted the
   // bar at 0 after the cells had filled it).
@@ -437,6 +438,16 @@ Delaunay run(std::span<const double> input, std::span<const std::int32_t> labels
     return out;
   }
   const bool none_found = complete && out.from_cells == 0 && pass.locator->size() - found_duplicates > D;
+  if (none_found && power) {
+    // A regular triangulation whose power cells have no vertex in the box
+    // is not flat input: one sphere's power is the least all over the box
+    // (its weight beyond the others' by far more than the box's extent
+    // squared), and every orthocentre lies beyond it, 1e24 box lengths out
+    // for a radius of 1e12 beside unit ones; larger boxes would not reach
+    // them, and the seeded wrap below reported the points flat. Insertion
+    // builds the same rows from no box at all.
+    return by_insertion(pass, before_cells);
+  }
   if (none_found && attempt < 2) {
     // Every circumcentre lies outside the box (a handful of points, or nearly
     // flat input), so completion has no found simplex to start from. The

@@ -192,11 +192,15 @@ ValidationReport validate_in_arena(const Cells& c, std::span<const std::int32_t>
   // points; dist2 holds that power (|v - p_g|^2 - r_g^2), and a cell's
   // radius adds its own r^2 back.
   const bool power = !radii.empty();
-  auto r_squared = [&](std::int32_t g) {
-    const double r = power ? radii[static_cast<std::size_t>(g)] : 0.0;
-    return r * r;
-  };
+  // A power cell's vertex v lies as far in power from every generator of
+  // its key, so its squared distance from the cell's generator k is its
+  // squared distance s from the key's first generator g plus r_k^2 - r_g^2,
+  // taken as (r_k - r_g)(r_k + r_g): a radius past ~1e154 has no finite
+  // square, and s - r_g^2 + r_k^2 gave NaN there (the cell's radius then
+  // read 0, and its corners' offsets infinite relative to it).
+  auto radius_of = [&](std::int32_t g) { return power ? radii[static_cast<std::size_t>(g)] : 0.0; };
   std::vector<double> dist2(measuring ? nv : 0, 0.0), radius2(measuring ? nc : 0, 0.0);
+  std::vector<double> key_radius(measuring && power ? nv : 0, 0.0);  // r_g of each vertex's g
   if (measuring)
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nv), [&](const tbb::blocked_range<std::size_t>& range) {
       for (std::size_t v = range.begin(); v != range.end(); ++v) {
@@ -216,7 +220,8 @@ ValidationReport validate_in_arena(const Cells& c, std::span<const std::int32_t>
           const double x = c.vertices[v * Du + d] - p[d];
           s += x * x;
         }
-        dist2[v] = s - r_squared(*g);
+        dist2[v] = s;
+        if (power) key_radius[v] = radius_of(*g);
       }
     });
   tbb::enumerable_thread_specific<CornerSet> sets;
@@ -230,7 +235,8 @@ ValidationReport validate_in_arena(const Cells& c, std::span<const std::int32_t>
           const auto q_end = c.face_vertex_offsets[static_cast<std::size_t>(f1)];
           seen.start(static_cast<std::size_t>(q_end - q_begin));
           std::int64_t corners = 0, distinct = 0;
-          double r2 = power ? -std::numeric_limits<double>::infinity() : 0.0;
+          double r2 = 0.0;
+          const double rk = radius_of(c.generator[k]);
           for (auto q = q_begin; q < q_end; ++q) {
             const std::int32_t v = c.face_vertices[static_cast<std::size_t>(q)];
             if (v < 0 || static_cast<std::size_t>(v) >= nv) {
@@ -241,9 +247,13 @@ ValidationReport validate_in_arena(const Cells& c, std::span<const std::int32_t>
             if (!seen.insert(v)) continue;
             ++distinct;
             std::atomic_ref<std::int32_t>(users[static_cast<std::size_t>(v)]).fetch_add(1, std::memory_order_relaxed);
-            if (measuring) r2 = std::max(r2, dist2[static_cast<std::size_t>(v)]);
+            if (measuring) {
+              const auto vu = static_cast<std::size_t>(v);
+              const double rg = power ? key_radius[vu] : 0.0;
+              r2 = std::max(r2, dist2[vu] + (rk - rg) * (rk + rg));
+            }
           }
-          if (measuring) radius2[k] = power ? std::max(0.0, r2 + r_squared(c.generator[k])) : r2;
+          if (measuring) radius2[k] = r2;
           if (D == 3) {
             // Every corner starts an edge of its face's loop, and every edge
             // is in two faces.

@@ -301,3 +301,34 @@ TEST(PowerCells, BadRadiiRefused) {
 }
 
 }  // namespace
+
+// Radii whose squares overflow double (up to 1e300: finite, so accepted).
+// One such sphere owns the whole box; random ones of that size leave a few
+// cells. Both methods give the same cells, and `validate` measures their
+// corners against the cell radius: it summed s - r_g^2 + r_k^2 for it,
+// which is NaN there, and read the radius as 0.
+TEST(PowerCells, RadiiBeyondTheSquaresRange) {
+  const auto pts = random_points(50, 3, 61);
+  for (const double big : {1e160, 1e200, 1e300}) {
+    SCOPED_TRACE(big);
+    auto one = random_radii(50, 0.1, 62);
+    one[3] = big;
+    auto all = random_radii(50, big, 63);
+    for (const auto& radii : {one, all}) {
+      const auto s = run_power(pts, 3, unit_box(), radii, 2, true, tessera::CellMethod::search);
+      const auto i = run_power(pts, 3, unit_box(), radii, 2, true, tessera::CellMethod::insertion);
+      EXPECT_EQ(i.cell_of, s.cell_of);
+      ASSERT_EQ(i.n_cells(), s.n_cells());
+      for (std::size_t k = 0; k < s.n_cells(); ++k) EXPECT_EQ(neighbours_of(i, k), neighbours_of(s, k)) << k;
+      for (const auto* c : {&s, &i}) {
+        expect_valid(*c, pts, radii, "huge radii");
+        const auto r = tessera::validate(*c, {}, pts, radii);
+        EXPECT_LE(r.vertex_rel_error, 1e-12);
+      }
+    }
+    const auto c = run_power(pts, 3, unit_box(), one, 1);
+    ASSERT_EQ(c.n_cells(), 1u);
+    EXPECT_EQ(c.cell_of[3], 0);
+    EXPECT_NEAR(c.volume[0], 1.0, 1e-15);
+  }
+}

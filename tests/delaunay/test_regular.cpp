@@ -276,6 +276,32 @@ TEST(Regular, FewLargeSpheresHideTheRest) {
   expect_equal_to_cgal(dt2, cgal_regular(q, rq, 2));
 }
 
+// One sphere far larger than the box: its power is the least all over the
+// box, so no power vertex lies in it (nor in one 2^50 times larger: a radius
+// of 1e12 beside unit points puts the orthocentres ~1e24 out). The cells
+// pass found no simplex and reported the points flat; the triangulation is
+// the cone from that sphere's centre over the hull, every inner point
+// hidden. Radii whose squares overflow double (1e200) too, with CGAL as the
+// oracle where the weights are finite.
+TEST(Regular, OneSphereBeyondTheBox) {
+  for (int dim : {2, 3}) {
+    const auto p = uniform_points(300, dim, 35, 0, 1);
+    for (const double big : {1e12, 1e200}) {
+      SCOPED_TRACE(::testing::Message() << dim << "D, radius " << big);
+      auto radii = random_radii(300, dim, 0.5, 36);
+      radii[7] = big;
+      const tessera::Delaunay dt = regular(p, radii, dim, 2, {}, tessera::DelaunayMethod::cells);
+      expect_valid(dt, p, radii);
+      expect_methods_agree(dt, p, radii, dim);
+      for (std::size_t k = 0; k < dt.n_simplices(); ++k) {  // every simplex has the big sphere's centre
+        const auto* row = dt.simplices.data() + k * static_cast<std::size_t>(dim + 1);
+        EXPECT_NE(std::find(row, row + dim + 1, 7), row + dim + 1) << k;
+      }
+      if (big < 1e150) expect_equal_to_cgal(dt, cgal_regular(p, radii, dim));
+    }
+  }
+}
+
 // Coincident points: the largest radius is the vertex, the others duplicates.
 TEST(Regular, CoincidentPointsKeepTheLargestRadius) {
   auto p = uniform_points(300, 3, 41);
