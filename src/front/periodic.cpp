@@ -307,6 +307,25 @@ PeriodicImages periodic_images(const PeriodicInput& in, std::span<const std::int
       im.domain.hi[a] = hi + 0x1p-30 * size;
     }
   }
+  // The images a layer may hold: 64 per point, and 2^24 more for boxes of
+  // a few points (ten points in a cube hold ~100 each; 1M uniform points
+  // ~1.1). A box whose heights are tiny next to its cells takes up to 127
+  // lattice vectors along each axis: a slab a millionth as thick as wide,
+  // sheared so that its third vector lies nearly in the slab's plane, has
+  // every height tiny, and its 300 points asked for ~5e9 images (51 GB)
+  // before the allocation failed. Refused before the shifts are walked, by
+  // the count the walk would reach, and after it, by the count itself.
+  const std::size_t taking = in.n - in.ignored.size();
+  const double image_budget = 64.0 * static_cast<double>(taking) + 0x1p24;
+  auto refuse_images = [&](double count) {
+    throw InputError("the periodic box would need ~" + num(count) + " images of its " + std::to_string(taking) +
+                     " points: its heights (distances between opposite faces) are tiny next to its cells' reach "
+                     "(a box far thinner than wide, or sheared nearly flat); give a thicker box, or a less sheared "
+                     "box of the same lattice");
+  };
+  double walked = static_cast<double>(taking);
+  for (std::size_t a = 0; a < du; ++a) walked *= 2.0 * k[a] + 1;
+  if (walked > 8 * image_budget) refuse_images(walked);
   // Shifts in lexicographic order (x, then y, then z), shift 0 among them
   // (periodic.hpp: the perturbation's order).
   std::vector<std::array<int, 3>> shifts;
@@ -362,6 +381,7 @@ PeriodicImages periodic_images(const PeriodicInput& in, std::span<const std::int
   });
   std::partial_sum(first.begin(), first.end(), first.begin());
   const std::size_t m = first.back();
+  if (static_cast<double>(m) > image_budget) refuse_images(static_cast<double>(m));
   if (m > static_cast<std::size_t>(INT32_MAX - 1))
     throw InputError("too many points with their periodic images (ids are 32-bit)");
   im.original.assign(in.n, -1);

@@ -902,4 +902,23 @@ TEST(Triclinic, Refused) {
   EXPECT_THROW(tessera::delaunay(pts, 3, {}, dopt), tessera::InputError);
 }
 
+// A slab a millionth as thick as wide, sheared so that its third vector
+// lies nearly in its plane: every height of the box is tiny, and its layer
+// of images would hold billions (a hostile fuzz case ran out of memory at
+// 51 GB). Refused at once, naming the box; the same slab unsheared keeps
+// its own refusal (cells reaching past 127 box lengths).
+TEST(Triclinic, NearlyFlatShearRefused) {
+  const auto box = make_bounds({0, 0, 0}, {2, 2, 2e-9});
+  auto pts = random_points(120, 3, 42, make_bounds({0, 0, 0}, {2, 2, 1}));
+  for (std::size_t i = 0; i < 120; ++i) pts[3 * i + 2] *= 2e-9;
+  const std::array<bool, 3> all{true, true, true};
+  try {
+    tessera::voronoi(pts, 3, {}, periodic_options(3, box, all, 1, {0.6, 0.4, -0.5}));
+    ADD_FAILURE() << "not refused";
+  } catch (const tessera::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("images"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(tessera::voronoi(pts, 3, {}, periodic_options(3, box, all, 1)), tessera::InputError);
+}
+
 }  // namespace

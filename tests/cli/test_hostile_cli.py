@@ -21,9 +21,19 @@ cluster in a huge cloud, nearly collinear and nearly coplanar points, points
 on a sphere with its centre, small integer grids, a bulk with a few far
 outliers (up to 1e30 away, and 1e160 to 1e300), magnitudes spread
 log-uniformly over 1e-300..1e300, fcc, bcc and hexagonal packings, every point
-with a near twin, with random labels on a third of the cases. The only accepted
-failure is the input error for a zero extent (all points on an axis plane,
-or one point).
+with a near twin, with random labels on a third of the cases. A quarter of
+the cases run again as spheres (power cells and the regular triangulation,
+each by both methods): radii at the points' spacing, half zero, two tied
+sizes, one sphere far beyond the box (radii up to 1e200 box lengths, whose
+squares overflow), all beyond it, and radii near 1e-300. Another quarter
+run in a periodic box a little larger than the points (some axes or all,
+sheared a third of the time where x and y are periodic): the cells by both
+methods, the periodic triangulation, graph and faces. The only accepted
+failures are the input error for a zero extent (all points on an axis plane,
+or one point), and with radii the one for input no frame fits and the one
+for labelled input whose inside points all have empty power cells, and a
+periodic box's own (coordinates too coarse for the box, images past
+double's range or too many, cells longer than 127 periods).
 
 Prints "N passed, M failed" last; exits 1 if anything failed.
 """
@@ -176,19 +186,65 @@ def generate(kind, rng, n, d):
     raise ValueError(kind)
 
 
+# A periodic box's own input errors: coordinates too coarse for the box's
+# doubles (a box 1e-9 wide at 1e6), images past double's range, more images
+# than 32-bit ids or memory allow (heights tiny next to the cells), and
+# cells reaching past the 127 box lengths an int8 shift can name.
+PERIODIC_REFUSALS = ("too thin for its coordinates", "images overflow double", "with their periodic images",
+                     "images of its", "reaches past 127 box lengths")
+
+RADII_KINDS = ["spacing", "zeros", "tied", "one_huge", "all_huge", "tiny"]
+
+
+def hostile_radii(kind, rng, pts):
+    """Radii for power cells and regular triangulations, relative to the
+    points' extent and spacing (the point kinds span 1e-200..1e200)."""
+    n, d = pts.shape
+    extent = float(np.max(np.ptp(pts, axis=0))) if n > 1 else 1.0
+    extent = extent if np.isfinite(extent) and extent > 0 else 1.0
+    s = extent * n ** (-1.0 / d)
+    if kind == "spacing":  # polydisperse spheres, up to overlapping ones
+        return rng.random(n) * s * float(rng.choice([0.1, 0.5, 2.0]))
+    if kind == "zeros":  # ordinary points among spheres: ties between zero radii
+        r = rng.random(n) * s
+        r[rng.random(n) < 0.6] = 0.0
+        return r
+    if kind == "tied":  # two sizes (a binary packing): power ties on lattices
+        return rng.choice([0.2, 0.35], n) * s
+    if kind == "one_huge":  # one sphere owns the box (or everything): up to radii whose squares overflow
+        r = rng.random(n) * s * 0.3
+        r[int(rng.integers(0, n))] = extent * 10.0 ** int(rng.integers(0, 200))
+        return r
+    if kind == "all_huge":  # weights far beyond the box, differing in their last bits relative to it
+        return extent * 10.0 ** int(rng.integers(1, 100)) * (1 + rng.random(n) * 1e-9)
+    if kind == "tiny":  # radii at the bottom of double's range
+        return rng.random(n) * 1e-300
+    raise ValueError(kind)
+
+
+# Power cells need a power-of-two frame for their exact weights: inputs that
+# span more than ~1e-150..1e150 are refused for radii (an input error); and
+# where one outside point's sphere takes the whole box, no inside point has
+# a cell (an input error too).
+RADII_REFUSALS = ("need coordinates within", "has an empty power cell")
 ZERO_EXTENT = ("zero extent", "coplanar", "collinear", "--dim 2", "single point", "one point")
 
 
 class Hostile(base.TempDirCase):
-    def check(self, args, inp, labels, kind, d, case):
+    def check(self, args, inp, labels, kind, d, case, radii=None, periodic=False):
         r = run(args)
         if r.returncode == 2 and any(w in r.stderr for w in ZERO_EXTENT):
+            return False
+        if periodic and r.returncode == 2 and any(w in r.stderr for w in PERIODIC_REFUSALS):
+            return False
+        if radii is not None and r.returncode == 2 and any(w in r.stderr for w in RADII_REFUSALS):
             return False
         if r.returncode != 0:
             keep = tempfile.mkdtemp(prefix="tessera-hostile-")
             shutil.copy(inp, keep)
-            if labels:
-                shutil.copy(labels, keep)
+            for extra in (labels, radii):
+                if extra:
+                    shutil.copy(extra, keep)
             self.fail("case %d (%s, %dD): tessera %s -> exit %d\n%s%s\ninput kept in %s" % (
                 case, kind, d, " ".join(map(str, args)), r.returncode, r.stdout[-2000:], r.stderr[-2000:], keep))
         return True
@@ -243,6 +299,78 @@ class Hostile(base.TempDirCase):
                 for k in ("complex", "boundary", "surface-net"):
                     self.check(["faces"] + common + ["-o", self.p("f.vtp"), "--kind", k], inp, labels, kind, d, case)
                 self.check(["flower"] + common + ["--point", "0", "-o", self.p("fl.vtp")], inp, labels, kind, d, case)
+            # A quarter of the cases, rotating through the kinds: the same
+            # points as spheres (power cells, the regular triangulation).
+            if (case + case // len(names)) % 4 == 1:
+                self.check_power(case, kind, d, pts, inp, labels, common, rng)
+            # Another quarter: the points in a periodic box around them.
+            if (case + case // len(names)) % 4 == 3:
+                self.check_periodic(case, kind, d, pts, inp, labels, threads, rng)
+
+    def check_periodic(self, case, kind, d, pts, inp, labels, threads, rng):
+        """The cells in a periodic box a little larger than the points'
+        (some axes, or all; sheared where x and y are periodic): by both
+        methods (validated, the same neighbours and shifts), the periodic
+        triangulation where every axis is periodic, and the graph."""
+        lo, hi = pts.min(axis=0), pts.max(axis=0)
+        ext = hi - lo
+        if not (np.all(np.isfinite(ext)) and np.all(ext > 0)):
+            return  # a zero extent along some axis: the plain runs refused it
+        pad = ext * float(rng.choice([0.01, 0.1, 0.5]))
+        bounds = [str(float(x)) for a in range(d) for x in (lo[a] - pad[a], hi[a] + pad[a])]
+        axes = "xyz"[:d] if rng.random() < 0.5 else "".join(a for a in "xyz"[:d] if rng.random() < 0.6) or "x"
+        pc = [inp, "--threads", threads, "--quiet", "--bounds"] + bounds + ["--periodic", axes]
+        if "x" in axes and "y" in axes and rng.random() < 0.3:
+            lx, ly = ext[0] + 2 * pad[0], ext[1] + 2 * pad[1]
+            pc += ["--tilt", str(0.3 * lx)] + ([] if d == 2 else
+                                                [str(0.2 * lx) if "z" in axes else "0", str(-0.25 * ly) if "z" in axes else "0"])
+        lab = list(labels and ["--labels", labels] or [])
+        what = "%s, periodic %s" % (kind, " ".join(pc[pc.index("--periodic") + 1:]))
+        nb, sh = {}, {}
+        for method in ("search", "insertion"):
+            nb[method], sh[method] = self.p("qnb_%s.npy" % method), self.p("qsh_%s.npy" % method)
+            if not self.check(["voronoi"] + pc + lab + ["--method", method, "--neighbors", nb[method],
+                                                        "--neighbor-shifts", sh[method], "--validate"],
+                              inp, labels, what, d, case, periodic=True):
+                return
+        for out in (nb, sh):
+            self.assertTrue(np.array_equal(np.load(out["search"]), np.load(out["insertion"])),
+                            "case %d (%s): periodic cells by search and by insertion differ" % (case, what))
+        if len(axes) == d and (labels is None or (np.load(labels) >= 0).all()):
+            self.check(["delaunay"] + pc + ["--simplices", self.p("qt.npy"), "--validate"],
+                       inp, labels, what, d, case, periodic=True)
+        if case % 2 == 1:
+            self.check(["graph"] + pc + lab + ["-o", self.p("qg.vtp")], inp, labels, what, d, case, periodic=True)
+            self.check(["faces"] + pc + lab + ["-o", self.p("qf.vtp"), "--kind", "complex"],
+                       inp, labels, what, d, case, periodic=True)
+
+    def check_power(self, case, kind, d, pts, inp, labels, common, rng):
+        """Power cells by both methods (validated, the same neighbours), the
+        regular triangulation by both methods (validated, the same rows), and
+        the graph and faces of the power cells."""
+        rkind = RADII_KINDS[(case // 4) % len(RADII_KINDS)]
+        radii = self.save("case%d_radii.npy" % case, np.ascontiguousarray(hostile_radii(rkind, rng, pts), dtype="<f8"))
+        what = "%s, radii %s" % (kind, rkind)
+        pc = common + ["--radii", radii]
+        nb = {}
+        for method in ("search", "insertion"):
+            nb[method] = self.p("pnb_%s.npy" % method)
+            if not self.check(["voronoi"] + pc + ["--method", method, "--neighbors", nb[method], "--validate"],
+                              inp, labels, what, d, case, radii):
+                return  # refused (no frame, or a zero extent): every product refuses it alike
+        self.assertTrue(np.array_equal(np.load(nb["search"]), np.load(nb["insertion"])),
+                        "case %d (%s): power cells' neighbours by search and by insertion differ" % (case, what))
+        rows = {}
+        for method in ("cells", "insertion"):
+            rows[method] = self.p("prt_%s.npy" % method)
+            self.check(["delaunay"] + pc + ["--method", method, "--simplices", rows[method], "--validate"],
+                       inp, labels, what, d, case, radii)
+        self.assertTrue(np.array_equal(np.load(rows["cells"]), np.load(rows["insertion"])),
+                        "case %d (%s): regular triangulations by the cells and by insertion differ" % (case, what))
+        if case % 2 == 0:
+            self.check(["graph"] + pc + ["-o", self.p("pg.vtp")], inp, labels, what, d, case, radii)
+            for k in ("complex", "boundary"):
+                self.check(["faces"] + pc + ["-o", self.p("pf.vtp"), "--kind", k], inp, labels, what, d, case, radii)
 
 
 def main():
