@@ -189,15 +189,13 @@ ValidationReport validate_in_arena(const Cells& c, std::span<const std::int32_t>
   const auto lattice = periodic ? c.lattice() : std::array<std::array<double, 3>, 3>{};
   std::vector<std::int32_t> users(nv, 0);
   // Power cells: a vertex has equal powers, not distances, to its key's
-  // points; dist2 holds that power (|v - p_g|^2 - r_g^2), and a cell's
-  // radius adds its own r^2 back.
+  // points. dist2 holds its squared distance s from the key's first point
+  // g, so its squared distance from the cell's generator k is s + r_k^2 -
+  // r_g^2, taken as (r_k - r_g)(r_k + r_g): a radius past ~1e154 has no
+  // finite square, and s - r_g^2 + r_k^2 gave NaN there (until stop 79 the
+  // cell's radius then read 0, and its corners' offsets infinite relative
+  // to it).
   const bool power = !radii.empty();
-  // A power cell's vertex v lies as far in power from every generator of
-  // its key, so its squared distance from the cell's generator k is its
-  // squared distance s from the key's first generator g plus r_k^2 - r_g^2,
-  // taken as (r_k - r_g)(r_k + r_g): a radius past ~1e154 has no finite
-  // square, and s - r_g^2 + r_k^2 gave NaN there (the cell's radius then
-  // read 0, and its corners' offsets infinite relative to it).
   auto radius_of = [&](std::int32_t g) { return power ? radii[static_cast<std::size_t>(g)] : 0.0; };
   std::vector<double> dist2(measuring ? nv : 0, 0.0), radius2(measuring ? nc : 0, 0.0);
   std::vector<double> key_radius(measuring && power ? nv : 0, 0.0);  // r_g of each vertex's g
