@@ -77,7 +77,6 @@ struct Worker : insertion::Worker {
   std::vector<Edge> edges;          // 3D: new tetrahedra by the edge they share
   std::vector<std::uint64_t> used;  // 3D: the entries of edges in use
   std::int32_t pending_infinite = -1;  // 2D: pending_'s entry for the infinite vertex
-  std::vector<std::int32_t> removed;  // weighted: the cavity's vertices (those it may hide)
 };
 
 // Weighted: a regular triangulation (ExactContext::radii): power tests,
@@ -384,18 +383,6 @@ class Triangulation {
         w.boundary.push_back(f);
       }
     }
-    // Regular triangulations: a cavity may swallow a vertex's whole star
-    // (its lift now lies above the lower hull). The cavity's vertices that
-    // no boundary facet keeps (stamp_, below) become hidden, and their
-    // vsimplex_ entries stale (walk_start skips them). Read before the
-    // cavity's slots are reused below. In a phase every vertex here is the
-    // worker's own (owned), so the stamps do not race.
-    if constexpr (Weighted) {
-      w.removed.clear();
-      for (const std::int32_t t : w.cavity)
-        for (int m = 0; m < K; ++m)
-          if (ss[t].v[m] != infinite) w.removed.push_back(ss[t].v[m]);
-    }
     // Slots for the new simplices: the cavity's, the worker's free ones,
     // then fresh ones.
     const std::size_t have = w.cavity.size() + w.slots_at_hand();
@@ -403,6 +390,24 @@ class Triangulation {
       if (!w.claim(store_, w.boundary.size() - have, Check)) return false;
       ss = store_.simplices();  // a serial claim may have moved the arrays
       state = store_.state();
+    }
+    // Regular triangulations: a cavity may swallow a vertex's whole star
+    // (its lift now lies above the lower hull). The cavity's vertices that
+    // no boundary facet keeps (stamped here) become hidden, and their
+    // vsimplex_ entries stale (walk_start skips them). Read once the
+    // insertion can no longer give way (a phase's claim, above: a point
+    // deferred to a later phase must hide nothing) and before the cavity's
+    // slots are reused below. In a phase every vertex here is the
+    // worker's own (owned), so the stamps do not race.
+    if constexpr (Weighted) {
+      for (const Facet& f : w.boundary)
+        for (int m = 0; m < K; ++m)
+          if (f.v[m] != infinite) stamp_[static_cast<std::size_t>(f.v[m])] = w.epoch;
+      for (const std::int32_t t : w.cavity)
+        for (int m = 0; m < K; ++m) {
+          const std::int32_t v = ss[t].v[m];
+          if (v != infinite && stamp_[static_cast<std::size_t>(v)] != w.epoch) hidden_[static_cast<std::size_t>(v)] = 1;
+        }
     }
     w.free.insert(w.free.end(), w.cavity.begin(), w.cavity.end());
     // The new simplices fan around q; two of them meet across each facet
@@ -430,7 +435,6 @@ class Triangulation {
         // all of them) lies on the cavity's boundary, so each keeps a live one.
         if (f.v[m] != infinite) {
           vsimplex_[static_cast<std::size_t>(f.v[m])] = nt;
-          if constexpr (Weighted) stamp_[static_cast<std::size_t>(f.v[m])] = w.epoch;
         } else {
           ghost = nt;
         }
@@ -481,9 +485,6 @@ class Triangulation {
     }
     if constexpr (D == 3)
       for (const std::uint64_t h : w.used) w.edges[h] = Edge{};
-    if constexpr (Weighted)
-      for (const std::int32_t v : w.removed)
-        if (stamp_[static_cast<std::size_t>(v)] != w.epoch) hidden_[static_cast<std::size_t>(v)] = 1;
     w.prev = q;
     w.hull_ghost = ghost;
     return true;
