@@ -30,6 +30,19 @@ std::string num(double v) {
 /// x rounded to the nearest multiple of g (a power of two), ties to even.
 double snap(double x, double g) { return std::nearbyint(x / g) * g; }
 
+/// The power of two that brings the box's largest length or tilt near 1.
+/// Its volumes, areas and squared lengths are taken in that frame: in
+/// doubles they underflow or overflow far before the lengths do (a box
+/// 1e-191 wide has a volume of 1e-573, which is 0, and a squared length of
+/// 0; one 1e120 wide a volume of infinity). Scaling by a power of two is
+/// exact, so the results are the same doubles wherever nothing overflowed.
+int geometry_exponent(const PeriodicInput& in) {
+  double m = 0;
+  for (int a = 0; a < in.dim; ++a) m = std::max(m, in.length[static_cast<std::size_t>(a)]);
+  for (double t : in.tilt) m = std::max(m, std::fabs(t));
+  return m > 0 && std::isfinite(m) ? std::ilogb(m) : 0;
+}
+
 }  // namespace
 
 PeriodicInput periodic_input(std::span<const double> points, int dim, std::span<const std::int32_t> labels,
@@ -78,11 +91,13 @@ PeriodicInput periodic_input(std::span<const double> points, int dim, std::span<
                        axis_name(tilt_lo[t]) + "; reduce it by whole box lengths (the same lattice)");
   }
   in.sheared = options.tilt[0] != 0 || options.tilt[1] != 0 || options.tilt[2] != 0;
-  // r_max^2 - r_min^2 of power cells (an upper bound), 0 without radii.
-  double radii_spread = 0;
+  // The extreme radii of power cells (0 without radii): r_max^2 - r_min^2
+  // bounds their slack (below, in the geometry's frame).
+  double rmin = 0, rmax = 0;
   if (!options.radii.empty() && options.radii.size() == in.n) {
-    const auto [rmin, rmax] = std::minmax_element(options.radii.begin(), options.radii.end());
-    radii_spread = kernels::power_slack(*rmax, *rmin);
+    const auto [lo_r, hi_r] = std::minmax_element(options.radii.begin(), options.radii.end());
+    rmin = *lo_r;
+    rmax = *hi_r;
   }
 
   // The grid along each periodic axis, with the box and tilts rounded to it.
@@ -113,14 +128,23 @@ PeriodicInput periodic_input(std::span<const double> points, int dim, std::span<
     }
     for (std::size_t t = 0; t < 3; ++t)
       in.lattice[static_cast<std::size_t>(tilt_hi[t])][static_cast<std::size_t>(tilt_lo[t])] = in.tilt[t];
+    // The box's geometry in the frame scaled by `to` (geometry_exponent):
+    // lattice vectors v and lengths l there, results scaled back by `back`.
+    const int e = geometry_exponent(in);
+    const double to = std::ldexp(1.0, -e), back = std::ldexp(1.0, e);
+    std::array<std::array<double, 3>, 3> v{};
+    std::array<double, 3> l{};
+    for (std::size_t i = 0; i < 3; ++i) {
+      for (std::size_t a = 0; a < 3; ++a) v[i][a] = i < du ? in.lattice[i][a] * to : in.lattice[i][a];
+      l[i] = i < du ? in.length[i] * to : 1.0;
+    }
     if (in.sheared) {
-      const auto& v = in.lattice;
-      const double volume = in.length[0] * in.length[1] * v[2][2];
+      const double volume = l[0] * l[1] * v[2][2];
       for (std::size_t i = 0; i < 3; ++i) {
         const auto& p = v[(i + 1) % 3];
         const auto& q = v[(i + 2) % 3];
         const double area = std::hypot(p[1] * q[2] - p[2] * q[1], p[2] * q[0] - p[0] * q[2], p[0] * q[1] - p[1] * q[0]);
-        in.height[i] = volume / area;
+        in.height[i] = volume / area * back;
       }
     } else {
       in.height = in.length;
@@ -131,18 +155,19 @@ PeriodicInput periodic_input(std::span<const double> points, int dim, std::span<
     // lattice vectors bound |y_a| by forward substitution (the box about the
     // point, L_a / 2, when orthogonal); along walls by the box's extent. The
     // security sphere (twice the farthest vertex) reaches at most `cap`.
+    // (In the scaled frame: bound and r2 as the text says, times `to`.)
     std::array<double, 3> bound{0, 0, 0};
     double r2 = 0;
     for (std::size_t a = 0; a < du; ++a) {
       if (!in.periodic[a]) {
-        bound[a] = in.length[a];
+        bound[a] = l[a];
       } else if (!in.sheared) {
-        bound[a] = 0.5 * in.length[a];
+        bound[a] = 0.5 * l[a];
       } else {
-        const auto& v = in.lattice[a];
-        double s = 0.5 * (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
-        for (std::size_t b = 0; b < a; ++b) s += std::fabs(v[b]) * bound[b];
-        bound[a] = s / in.length[a] * (1 + 0x1p-40);
+        const auto& va = v[a];
+        double s = 0.5 * (va[0] * va[0] + va[1] * va[1] + va[2] * va[2]);
+        for (std::size_t b = 0; b < a; ++b) s += std::fabs(va[b]) * bound[b];
+        bound[a] = s / l[a] * (1 + 0x1p-40);
       }
       r2 += bound[a] * bound[a];
     }
@@ -150,7 +175,8 @@ PeriodicInput periodic_input(std::span<const double> points, int dim, std::span<
     // beyond it (kernels/power.hpp), slack at most r_max^2 - r_min^2; the
     // bound on |y| holds as it is (a point's own images have its radius, so
     // their planes are the bisectors). Without radii, twice sqrt(r2) exactly.
-    const double cap = (std::sqrt(r2) + std::sqrt(r2 + radii_spread)) * (1 + 0x1p-20);
+    const double radii_spread = kernels::power_slack(rmax * to, rmin * to);
+    const double cap = (std::sqrt(r2) + std::sqrt(r2 + radii_spread)) * (1 + 0x1p-20) * back;
     // An image within the cap of a point of the box lies within cap / h
     // lattice vectors along each (one more for a triclinic box's rounded
     // fractional coordinates).
@@ -412,10 +438,13 @@ PeriodicImages periodic_images(const PeriodicInput& in, std::span<const std::int
 }
 
 std::array<double, 3> initial_image_reach(const PeriodicInput& in) {
+  // The volume in the frame of geometry_exponent (a box 1e-191 wide has
+  // none in doubles, one 1e120 wide an infinite one).
+  const int e = geometry_exponent(in);
   double volume = 1;
-  for (int a = 0; a < in.dim; ++a) volume *= in.length[static_cast<std::size_t>(a)];
+  for (int a = 0; a < in.dim; ++a) volume *= std::ldexp(in.length[static_cast<std::size_t>(a)], -e);
   const double taking = static_cast<double>(in.n - in.ignored.size());
-  const double spacing = std::pow(volume / taking, 1.0 / in.dim);
+  const double spacing = std::ldexp(std::pow(volume / taking, 1.0 / in.dim), e);
   // Four spacings: uniform points (20k, 200k and 1M, 2D and 3D) needed no
   // wider layer; at 3.5 one 2D cell of 20k asked for 4.0.
   const double w = 4.0 * spacing;

@@ -219,7 +219,15 @@ DelaunayReport validate_periodic(const Delaunay& dt, std::span<const double> rad
   };
 
   // Orientation and volume (the volumes of a periodic triangulation tile
-  // the box: Lx Ly Lz, the lattice's determinant).
+  // the box: Lx Ly Lz, the lattice's determinant). The volumes are summed
+  // in units of 2^ve per length, ve the exponent of the box's largest
+  // length: a box 2^665 wide holds 2^1995 (infinite in doubles) and one
+  // 2^-615 wide 2^-1845 (zero), where its triangulation is the unit box's.
+  double largest = 0;
+  for (int a = 0; a < D; ++a)
+    largest = std::max(largest, dt.bounds.hi[static_cast<std::size_t>(a)] - dt.bounds.lo[static_cast<std::size_t>(a)]);
+  const int ve = largest > 0 && std::isfinite(largest) ? std::ilogb(largest) : 0;
+  const double unit = std::ldexp(1.0, -ve);
   const double fact = D == 2 ? 2.0 : 6.0;
   double volume = 0, perm_sum = 0;
   std::vector<Entry> used;
@@ -231,7 +239,7 @@ DelaunayReport validate_periodic(const Delaunay& dt, std::span<const double> rad
     for (std::size_t k = 0; k < w; ++k) place(e[k], xyz[k]);
     double r[3][3] = {};
     for (std::size_t k = 1; k < w; ++k)
-      for (std::size_t a = 0; a < du; ++a) r[k - 1][a] = xyz[k][a] - xyz[0][a];
+      for (std::size_t a = 0; a < du; ++a) r[k - 1][a] = (xyz[k][a] - xyz[0][a]) * unit;
     const double det = D == 2 ? r[0][0] * r[1][1] - r[0][1] * r[1][0]
                               : r[0][0] * (r[1][1] * r[2][2] - r[1][2] * r[2][1]) -
                                     r[0][1] * (r[1][0] * r[2][2] - r[1][2] * r[2][0]) +
@@ -248,8 +256,10 @@ DelaunayReport validate_periodic(const Delaunay& dt, std::span<const double> rad
     for (std::size_t k = 0; k < w; ++k) all[k] = row[k];
     all[w] = q;
     std::array<std::size_t, 5> order{0, 1, 2, 3, 4};
-    std::sort(order.begin(), order.begin() + static_cast<std::ptrdiff_t>(w) + 1,
-              [&](std::size_t x, std::size_t y) { return all[x] < all[y]; });
+    // Insertion sort of the w + 1 <= 5 entries (std::sort's introsort here
+    // drew GCC 12's -Warray-bounds, a false positive of its inlining).
+    for (std::size_t r = 1; r <= w; ++r)
+      for (std::size_t t = r; t > 0 && all[order[t]] < all[order[t - 1]]; --t) std::swap(order[t], order[t - 1]);
     std::array<std::int32_t, 5> local{};
     double xyz[5][3] = {}, packed[15] = {}, rho[5] = {};
     for (std::size_t r = 0; r <= w; ++r) {
@@ -350,10 +360,14 @@ DelaunayReport validate_periodic(const Delaunay& dt, std::span<const double> rad
   fail(rep.hidden_not_hidden, "points listed as hidden are vertices, duplicates or set aside");
   fail(rep.hidden_in_conflict, "hidden points are in conflict with the simplex that holds them (they should be vertices)");
   fail(rep.local_delaunay_violations, dt.power ? "facets are not locally regular" : "facets are not locally Delaunay");
-  rep.volume_sum = volume;
-  rep.enclosed_volume = dt.bounds.volume(D);
-  rep.volume_tolerance = 1e-9 * rep.enclosed_volume + 32 * std::numeric_limits<double>::epsilon() * perm_sum;
-  if (!(std::fabs(rep.volume_sum - rep.enclosed_volume) <= rep.volume_tolerance)) {
+  double enclosed = 1;  // in the units above
+  for (int a = 0; a < D; ++a)
+    enclosed *= (dt.bounds.hi[static_cast<std::size_t>(a)] - dt.bounds.lo[static_cast<std::size_t>(a)]) * unit;
+  const double tolerance = 1e-9 * enclosed + 32 * std::numeric_limits<double>::epsilon() * perm_sum;
+  rep.volume_sum = std::ldexp(volume, D * ve);
+  rep.enclosed_volume = std::ldexp(enclosed, D * ve);
+  rep.volume_tolerance = std::ldexp(tolerance, D * ve);
+  if (!(std::fabs(volume - enclosed) <= tolerance)) {
     rep.ok = false;
     char buf[160];
     std::snprintf(buf, sizeof buf, "simplex volumes sum to %.17g but the periodic box holds %.17g", rep.volume_sum,

@@ -354,10 +354,14 @@ TEST(Periodic, Refused) {
   EXPECT_THROW(tessera::voronoi(pts, 3, {}, o), tessera::InputError);  // no box
   const auto pts2 = random_points(50, 2, 41, box);
   EXPECT_THROW(tessera::voronoi(pts2, 2, {}, periodic_options(2, box, {false, false, true})), tessera::InputError);
-  // A box whose images leave double's range is refused.
-  const auto huge = make_bounds({-1e308, 0, 0}, {-0.9e308, 1, 1});
-  EXPECT_THROW(run_periodic({-0.95e308, 0.5, 0.5, -0.92e308, 0.5, 0.5}, 3, huge, {true, false, false}),
+  // A box whose images leave double's range is refused. (Until stop 79 a
+  // box 1e307 long at -1e308 was too: its squared length overflowed, so the
+  // layer took 127 lengths; its images within two lengths are computed now.)
+  const auto huge = make_bounds({-1.7e308, 0, 0}, {-0.2e308, 1, 1});
+  EXPECT_THROW(run_periodic({-1e308, 0.5, 0.5, -0.5e308, 0.5, 0.5}, 3, huge, {true, false, false}),
                tessera::InputError);
+  const auto long_box = make_bounds({-1e308, 0, 0}, {-0.9e308, 1, 1});
+  EXPECT_EQ(run_periodic({-0.95e308, 0.5, 0.5, -0.92e308, 0.5, 0.5}, 3, long_box, {true, false, false}).n_cells(), 2u);
   // Outside a wall (a non-periodic axis): refused, or dropped where asked.
   auto out = pts;
   out[1] = 1.5;
@@ -919,6 +923,64 @@ TEST(Triclinic, NearlyFlatShearRefused) {
     EXPECT_NE(std::string(e.what()).find("images"), std::string::npos) << e.what();
   }
   EXPECT_THROW(tessera::voronoi(pts, 3, {}, periodic_options(3, box, all, 1)), tessera::InputError);
+}
+
+}  // namespace
+
+namespace {
+
+// Periodic boxes at the ends of double's range: the points and the box
+// scaled by 2^k give the unit box's cells, neighbours and shifts exactly
+// (scaling by a power of two is exact). The box's volume, squared lengths
+// and areas under- and overflowed from ~1e-100 and ~1e100 on: a box 2^-615
+// (1e-185) wide lost its images' reach (wrong neighbours, validated), a
+// sheared one got NaN heights, and one 2^665 (1e200) wide an infinite first
+// layer, refused. They are now taken in a frame scaled near 1.
+TEST(Periodic, BoxesAtTheEndsOfTheRange) {
+  struct Case {
+    int dim;
+    std::array<bool, 3> per;
+    Tilt tilt;
+  };
+  const Case cases[] = {{3, {true, true, true}, {0, 0, 0}},
+                        {3, {true, true, true}, {0.25, 0.125, -0.375}},
+                        {3, {true, false, true}, {0, 0, 0}},
+                        {2, {true, true, false}, {0.375, 0, 0}},
+                        {2, {false, true, false}, {0, 0, 0}}};
+  for (const Case& cs : cases) {
+    const auto unit = make_bounds({0, 0, 0}, {1, 1, 1});
+    const auto pts = in_parallelepiped(300, cs.dim, 77, unit, cs.tilt);
+    std::vector<double> radii(300);
+    for (std::size_t i = 0; i < 300; ++i) radii[i] = std::ldexp(static_cast<double>((i * 37) % 11), -6);
+    for (const bool power : {false, true}) {
+      auto o = periodic_options(cs.dim, unit, cs.per, 2, cs.tilt);
+      if (power) o.radii = radii;
+      const tessera::Cells ref = tessera::voronoi(pts, cs.dim, {}, o);
+      for (const int k : {-1000, -615, -330, 330, 665, 1000}) {
+        SCOPED_TRACE(::testing::Message() << cs.dim << "D, tilt " << cs.tilt[0] << ", power " << power << ", 2^" << k);
+        auto scaled = pts;
+        for (double& x : scaled) x = std::ldexp(x, k);
+        auto so = o;
+        so.bounds = make_bounds({0, 0, 0}, {std::ldexp(1.0, k), std::ldexp(1.0, k), std::ldexp(1.0, k)});
+        for (double& t : so.tilt) t = std::ldexp(t, k);
+        std::vector<double> scaled_radii = radii;
+        for (double& r : scaled_radii) r = std::ldexp(r, k);
+        if (power) so.radii = scaled_radii;
+        tessera::Cells c;
+        try {
+          c = tessera::voronoi(scaled, cs.dim, {}, so);
+        } catch (const tessera::InputError& e) {
+          // Past ~2^1020 the images themselves overflow; radii need a frame.
+          ADD_FAILURE() << e.what();
+          continue;
+        }
+        EXPECT_EQ(c.cell_of, ref.cell_of);
+        EXPECT_EQ(c.neighbor_offsets, ref.neighbor_offsets);
+        EXPECT_EQ(c.neighbors, ref.neighbors);
+        EXPECT_EQ(c.neighbor_shifts, ref.neighbor_shifts);
+      }
+    }
+  }
 }
 
 }  // namespace

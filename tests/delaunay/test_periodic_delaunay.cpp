@@ -190,6 +190,33 @@ TEST(PeriodicDelaunay, TriclinicAnd2DBoxesAreValidTori) {
   }
 }
 
+// Boxes at the ends of double's range (the points, box and tilts scaled by
+// 2^k, exactly): the unit box's rows and shifts, validated. The periodic
+// setup's heights and first layer under- and overflowed there (wrong or
+// refused, as for the cells: Periodic.BoxesAtTheEndsOfTheRange), and
+// validate's volume sum read 2^1995 as infinity and failed.
+TEST(PeriodicDelaunay, BoxesAtTheEndsOfTheRange) {
+  for (int dim : {2, 3}) {
+    const auto pts = uniform_points(400, dim, 74);
+    const std::array<double, 3> tilt = dim == 3 ? std::array<double, 3>{0.25, 0.125, -0.375}
+                                                : std::array<double, 3>{0.375, 0, 0};
+    const tessera::Delaunay ref = tessera::delaunay(pts, dim, {}, periodic_options(dim, {1, 1, 1}, tilt));
+    for (const int k : {-1000, -615, 665, 1000}) {
+      SCOPED_TRACE(::testing::Message() << dim << "D, 2^" << k);
+      auto scaled = pts;
+      for (double& x : scaled) x = std::ldexp(x, k);
+      std::array<double, 3> t = tilt;
+      for (double& x : t) x = std::ldexp(x, k);
+      const double l = std::ldexp(1.0, k);
+      const tessera::Delaunay dt = tessera::delaunay(scaled, dim, {}, periodic_options(dim, {l, l, l}, t, 2));
+      EXPECT_EQ(dt.simplices, ref.simplices);
+      EXPECT_EQ(dt.simplex_shifts, ref.simplex_shifts);
+      const tessera::DelaunayReport r = tessera::validate(dt, {}, {});
+      EXPECT_TRUE(r.ok) << (r.messages.empty() ? "" : r.messages[0]);
+    }
+  }
+}
+
 TEST(PeriodicDelaunay, LatticeTiesAndFewPoints) {
   // A cubic lattice: every Delaunay ball holds 8 points, split alike from
   // every cell by the perturbation. Boxes of 1-3 points: simplices meet
