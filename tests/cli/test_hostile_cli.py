@@ -30,12 +30,12 @@ run in a periodic box a little larger than the points (some axes or all,
 sheared a third of the time where x and y are periodic): the cells by both
 methods, the periodic triangulation, graph and faces. Labelled cases also
 build their surface net, and one in eight runs fill -> joggle -> voronoi.
-The only accepted
-failures are the input error for a zero extent (all points on an axis plane,
-or one point), and with radii the one for input no frame fits and the one
-for labelled input whose inside points all have empty power cells, and a
-periodic box's own (coordinates too coarse for the box, images past
-double's range or too many, cells longer than 127 periods).
+The only accepted failures are input errors: a zero extent (all points on
+an axis plane, or one point); with radii, input no frame fits and labelled
+input whose inside points all have empty power cells; a periodic box's own
+(coordinates too coarse for the box, images past double's range or too
+many, cells longer than 127 periods); and fill's bins too narrow for the
+coordinates' doubles.
 
 Prints "N passed, M failed" last; exits 1 if anything failed.
 """
@@ -339,7 +339,7 @@ class Hostile(base.TempDirCase):
         """The cells in a periodic box a little larger than the points'
         (some axes, or all; sheared where x and y are periodic): by both
         methods (validated, the same neighbours and shifts), the periodic
-        triangulation where every axis is periodic, and the graph."""
+        triangulation where every axis is periodic, graph and faces."""
         lo, hi = pts.min(axis=0), pts.max(axis=0)
         ext = hi - lo
         if not (np.all(np.isfinite(ext)) and np.all(ext > 0)):
@@ -352,7 +352,7 @@ class Hostile(base.TempDirCase):
             lx, ly = ext[0] + 2 * pad[0], ext[1] + 2 * pad[1]
             pc += ["--tilt", str(0.3 * lx)] + ([] if d == 2 else
                                                 [str(0.2 * lx) if "z" in axes else "0", str(-0.25 * ly) if "z" in axes else "0"])
-        lab = list(labels and ["--labels", labels] or [])
+        lab = ["--labels", labels] if labels else []
         what = "%s, periodic %s" % (kind, " ".join(pc[pc.index("--periodic") + 1:]))
         nb, sh = {}, {}
         for method in ("search", "insertion"):
@@ -391,8 +391,9 @@ class Hostile(base.TempDirCase):
         rows = {}
         for method in ("cells", "insertion"):
             rows[method] = self.p("prt_%s.npy" % method)
-            self.check(["delaunay"] + pc + ["--method", method, "--simplices", rows[method], "--validate"],
-                       inp, labels, what, d, case, radii)
+            if not self.check(["delaunay"] + pc + ["--method", method, "--simplices", rows[method], "--validate"],
+                              inp, labels, what, d, case, radii):
+                return
         self.assertTrue(np.array_equal(np.load(rows["cells"]), np.load(rows["insertion"])),
                         "case %d (%s): regular triangulations by the cells and by insertion differ" % (case, what))
         if case % 2 == 0:
