@@ -29,7 +29,8 @@ squares overflow), all beyond it, and radii near 1e-300. Another quarter
 run in a periodic box a little larger than the points (some axes or all,
 sheared a third of the time where x and y are periodic): the cells by both
 methods, the periodic triangulation, graph and faces. Labelled cases also
-build their surface net, and one in eight runs fill -> joggle -> voronoi.
+build their surface net; one in eight runs fill -> joggle -> voronoi, and
+one in eight cuts --bounds through the points (--ignore-outside).
 The only accepted failures are input errors: a zero extent (all points on
 an axis plane, or one point); with radii, input no frame fits and labelled
 input whose inside points all have empty power cells; a periodic box's own
@@ -317,6 +318,31 @@ class Hostile(base.TempDirCase):
                 self.check(net, inp, labels, kind, d, case)
             if case % 8 == 6:
                 self.check_pipeline(case, kind, d, inp, labels, threads)
+            if case % 8 == 2:
+                self.check_cut_bounds(case, kind, d, pts, inp, labels, common, rng)
+
+    def check_cut_bounds(self, case, kind, d, pts, inp, labels, common, rng):
+        """--bounds through the point cloud with --ignore-outside: the
+        points outside are dropped and listed, the rest give cells by both
+        methods (validated, the same neighbours) and a triangulation."""
+        lo, hi = pts.min(axis=0), pts.max(axis=0)
+        ext = hi - lo
+        if not (np.all(np.isfinite(ext)) and np.all(ext > 0)):
+            return
+        cut = rng.uniform(0.05, 0.4, size=(2, d)) * ext
+        bounds = [str(float(x)) for a in range(d) for x in (lo[a] + cut[0][a], hi[a] - cut[1][a])]
+        bc = common + ["--bounds"] + bounds + ["--ignore-outside"]
+        nb = {}
+        for method in ("search", "insertion"):
+            nb[method] = self.p("bnb_%s.npy" % method)
+            # All points outside the cut box (a cluster at one end) is an input error.
+            if not self.check(["voronoi"] + bc + ["--method", method, "--neighbors", nb[method], "--validate"],
+                              inp, labels, kind, d, case, accept=("all points lie outside", "none inside")):
+                return
+        self.assertTrue(np.array_equal(np.load(nb["search"]), np.load(nb["insertion"])),
+                        "case %d (%s, cut bounds): neighbours by search and by insertion differ" % (case, kind))
+        self.check(["delaunay"] + bc + ["--simplices", self.p("bt.npy"), "--validate"], inp, labels, kind, d, case,
+                   accept=("all points lie outside", "none inside"))
 
     def check_pipeline(self, case, kind, d, inp, labels, threads):
         """fill (background points in the empty bins) -> joggle -> voronoi
