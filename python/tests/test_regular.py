@@ -124,6 +124,31 @@ def test_regular_triangulation_against_brute_force(dim, seed):
     assert total == pytest.approx(ConvexHull(pts).volume, rel=1e-12)  # hull vertices are never hidden
 
 
+@pytest.mark.parametrize("dim", [2, 3])
+def test_one_sphere_far_larger_than_the_box(dim):
+    """One sphere 1e12 (or 1e200) times the others: its power is the least all
+    over the box, so no orthocentre lies in it, nor in any box a cells pass
+    could grow to. Every method gives the cone from its centre over the hull,
+    every inner point hidden (until stop 79 method="cells" called the points
+    flat)."""
+    pts, r = spheres(200, dim, seed=40 + dim, rmax=0.05)
+    try:
+        from scipy.spatial import ConvexHull
+    except ImportError:
+        ConvexHull = None
+    for big in (1e12, 1e200):
+        r[7] = big
+        rows = {m: tessera.delaunay(pts, radii=r, method=m) for m in ("cells", "insertion", "auto")}
+        for m, dt in rows.items():
+            assert dt.validate().ok, m
+            assert np.array_equal(dt.simplices, rows["insertion"].simplices), m
+            assert (dt.simplices == 7).any(axis=1).all(), m  # every simplex has the big sphere's centre
+            if ConvexHull is not None:
+                hull = ConvexHull(pts)
+                inner = np.setdiff1d(np.arange(200), np.append(hull.vertices, 7))
+                assert np.array_equal(dt.hidden, inner), m
+
+
 def test_brute_force_sees_hidden_points():
     """The brute-force seeds above do hide points (else they test little)."""
     hidden = {2: 0, 3: 0}
