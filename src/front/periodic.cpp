@@ -14,6 +14,7 @@
 #include "tessera/engine/classifier.hpp"
 #include "tessera/engine/thread_arena.hpp"
 #include "tessera/finite_points.hpp"
+#include "tessera/kernels/filter.hpp"
 #include "tessera/kernels/power.hpp"
 
 namespace tessera::front {
@@ -40,7 +41,7 @@ int geometry_exponent(const PeriodicInput& in) {
   double m = 0;
   for (int a = 0; a < in.dim; ++a) m = std::max(m, in.length[static_cast<std::size_t>(a)]);
   for (double t : in.tilt) m = std::max(m, std::fabs(t));
-  return m > 0 && std::isfinite(m) ? std::ilogb(m) : 0;
+  return kernels::filter::binary_exponent(m);  // the lengths are finite and positive (checked)
 }
 
 }  // namespace

@@ -23,6 +23,7 @@
 #include "periodic.hpp"
 #include "tessera/delaunay.hpp"
 #include "tessera/kernels/delaunay_predicates.hpp"
+#include "tessera/kernels/filter.hpp"
 
 namespace tessera::front {
 namespace {
@@ -226,7 +227,7 @@ DelaunayReport validate_periodic(const Delaunay& dt, std::span<const double> rad
   double largest = 0;
   for (int a = 0; a < D; ++a)
     largest = std::max(largest, dt.bounds.hi[static_cast<std::size_t>(a)] - dt.bounds.lo[static_cast<std::size_t>(a)]);
-  const int ve = largest > 0 && std::isfinite(largest) ? std::ilogb(largest) : 0;
+  const int ve = kernels::filter::binary_exponent(largest);
   const double unit = std::ldexp(1.0, -ve);
   const double fact = D == 2 ? 2.0 : 6.0;
   double volume = 0, perm_sum = 0;

@@ -70,6 +70,17 @@ bool power_planes(std::vector<Plane>& planes, std::size_t first, const std::int3
   return true;
 }
 
+/// The planes of a star for Hull/Tile::assemble: bisector_planes, or with
+/// `weights` (the ExactContext of a power cell's radii) power_planes. False
+/// where power_planes declines.
+template <int D, class Plane>
+bool star_planes(std::vector<Plane>& planes, std::size_t first, const std::int32_t* ids, const double* q,
+                 std::size_t m, const ExactContext* weights, std::int32_t gen) {
+  if (weights != nullptr) return power_planes<D>(planes, first, ids, q, m, *weights, gen);
+  bisector_planes<D>(planes, first, ids, q, m);
+  return true;
+}
+
 /// The id of the far plane that closes a hull point's cell (far_plane): no
 /// generator's and no box plane's. It never reaches a finished cell: the box
 /// cuts away every vertex on it, and the kernels then drop it.

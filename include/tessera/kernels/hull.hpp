@@ -231,13 +231,10 @@ class Hull {
                 const std::int32_t* ids, const double* q, std::size_t m, const Index* corners,
                 std::size_t nt, bool open = false) {
     start(gen, p, lo, hi, exact);
-    if (may_underflow_ || m > max_assembled_planes) return false;
     // A power cell's star comes from the regular triangulation, its planes weighed.
-    if (weighted_) {
-      if (!assembly::power_planes<3>(planes_, box_planes, ids, q, m, *exact_, gen)) return false;
-    } else {
-      assembly::bisector_planes<3>(planes_, box_planes, ids, q, m);
-    }
+    if (may_underflow_ || m > max_assembled_planes ||
+        !assembly::star_planes<3>(planes_, box_planes, ids, q, m, weighted_ ? exact_ : nullptr, gen))
+      return false;
     // Room for the far plane too: dense up to dense_planes, else the hash.
     const std::size_t need = planes_.size() + 1;
     if (need <= dense_planes) {

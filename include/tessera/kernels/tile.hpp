@@ -179,13 +179,10 @@ class Tile {
                 const std::int32_t* ids, const double* q, std::size_t m, const Index* corners,
                 std::size_t nt, bool open = false) {
     start(gen, p, lo, hi, exact);
-    if (may_underflow_ || m > max_assembled_planes) return false;
     // A power cell's star comes from the regular triangulation, its planes weighed.
-    if (weighted_) {
-      if (!assembly::power_planes<2>(planes_, box_planes, ids, q, m, *exact_, gen)) return false;
-    } else {
-      assembly::bisector_planes<2>(planes_, box_planes, ids, q, m);
-    }
+    if (may_underflow_ || m > max_assembled_planes ||
+        !assembly::star_planes<2>(planes_, box_planes, ids, q, m, weighted_ ? exact_ : nullptr, gen))
+      return false;
     verts_.resize(open ? nt + 2 : nt);
     for (std::size_t t = 0; t < nt; ++t) {
       verts_[t].p[0] = box_planes + corners[2 * t];
