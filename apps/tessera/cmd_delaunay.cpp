@@ -19,6 +19,11 @@ using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
 DelaunayOptions delaunay_options(const ComputeArgs& c, int dim, bool complete_hull) {
+  // A dump's box with walls: say where the periodic axes came from.
+  if (!c.box_source.empty() && !c.periodic.empty() && c.periodic.size() != static_cast<std::size_t>(dim))
+    throw InputError(c.box_source + " is periodic along " + c.periodic +
+                     " only, and a periodic triangulation needs every axis periodic: give --bounds (walls "
+                     "everywhere) for the triangulation of the points as they lie");
   DelaunayOptions o;
   static_cast<VoronoiOptions&>(o) = make_options(c, dim);
   o.complete_hull = complete_hull;
@@ -118,6 +123,7 @@ int run_delaunay(const DelaunayArgs& a) {
     const std::string outside =
         dt.outside_simplices == 0 ? std::string()
                                   : "; " + std::to_string(dt.outside_simplices) + " with an outside vertex left out";
+    if (!a.compute.box_source.empty()) std::fprintf(stderr, "tessera: domain from %s\n", a.compute.box_source.c_str());
     if (dt.is_periodic())
       std::fprintf(stderr, "tessera: %zu points (%dD) -> %zu %s of the periodic box%s (each once, with its images)\n",
                    pc.n, pc.dim, dt.n_simplices(), pc.dim == 3 ? "tetrahedra" : "triangles",

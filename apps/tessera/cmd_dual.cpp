@@ -49,6 +49,7 @@ void print_header(const char* command, const ComputeArgs& a, const Computed& r) 
   std::printf("  %-18s %.3f s on %d thread%s\n", "compute", r.seconds, r.cells.threads_used,
               r.cells.threads_used == 1 ? "" : "s");
   if (r.cells.power) print_power_line(r.pc, r.cells);
+  if (!a.box_source.empty()) std::printf("  %-18s %s\n", "domain from", a.box_source.c_str());
   if (r.cells.is_periodic()) {
     std::string axes;
     for (int k = 0; k < r.cells.dim; ++k)

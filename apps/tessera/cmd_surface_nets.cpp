@@ -348,6 +348,7 @@ int run_surface_nets(const SurfaceNetsArgs& a) {
                 in.dim == 3 ? ("x" + std::to_string(in.geometry.size[2])).c_str() : "");
   std::printf("  %-18s %s\n", "selected labels", label_list(net.selected).c_str());
   std::printf("  %-18s %zu\n", "cells", net.n_cells);
+  if (!a.compute.box_source.empty()) std::printf("  %-18s %s\n", "domain from", a.compute.box_source.c_str());
   if (m.is_periodic()) {
     std::string axes;
     for (int k = 0; k < m.dim; ++k)

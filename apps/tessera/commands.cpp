@@ -167,6 +167,37 @@ void check_against_input(const ComputeArgs& a, const io::PointCloud& pc) {
 
 }  // namespace
 
+void apply_file_box(ComputeArgs& a) {
+  if (!a.bounds.empty() || !a.periodic.empty() || !a.tilt.empty()) return;
+  const std::optional<io::FileBox> box = io::read_file_box(a.input);
+  if (!box) return;
+  const int dim = a.dim == 0 ? 3 : a.dim;
+  for (int d = 0; d < dim; ++d) {
+    const auto k = static_cast<std::size_t>(d);
+    a.bounds.push_back(box->lo[k]);
+    a.bounds.push_back(box->hi[k]);
+    if (box->periodic[k]) a.periodic += "xyz"[d];
+  }
+  static const char* const tilt_name[3] = {"xy", "xz", "yz"};
+  static const int tilt_axes[3][2] = {{0, 1}, {0, 2}, {1, 2}};
+  const int tilts = dim == 3 ? 3 : 1;
+  bool tilted = false;
+  for (int t = 0; t < tilts; ++t) {
+    const auto k = static_cast<std::size_t>(t);
+    if (box->tilt[k] == 0) continue;
+    tilted = true;
+    for (const int axis : tilt_axes[t])
+      if (!box->periodic[static_cast<std::size_t>(axis)])
+        throw InputError(strf("%s: the box tilts by %s = %.17g, but %s is a wall there; give the domain yourself "
+                              "(--bounds, with --periodic and --tilt)",
+                              shown_path(a.input).c_str(), tilt_name[t], box->tilt[k], axis_name(axis)));
+  }
+  if (tilted)
+    for (int t = 0; t < tilts; ++t) a.tilt.push_back(box->tilt[static_cast<std::size_t>(t)]);
+  a.box_source = strf("the box of %s (LAMMPS dump, timestep %lld)", shown_path(a.input).c_str(),
+                      static_cast<long long>(box->timestep));
+}
+
 io::PointCloud read_input(const ComputeArgs& a) {
   io::ReadOptions ro;
   ro.dim = a.dim;
@@ -344,6 +375,7 @@ void print_summary(const VoronoiArgs& a, const io::PointCloud& pc, const Cells& 
     std::printf("  %-18s %s\n", "ignored (outside)", ign.c_str());  // (or not finite)
   }
   std::printf("  %-18s %s\n", "domain", domain_string(c).c_str());
+  if (!a.compute.box_source.empty()) std::printf("  %-18s %s\n", "domain from", a.compute.box_source.c_str());
   if (c.is_periodic()) {
     std::string axes, reach;
     for (int a = 0; a < c.dim; ++a)

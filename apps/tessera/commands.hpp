@@ -42,6 +42,10 @@ struct ComputeArgs {
   std::string cell_method = "auto";  ///< auto | search | insertion (voronoi only; add_cell_method_option)
   std::string periodic;         ///< "" or periodic axes, e.g. "xyz" (voronoi only; add_periodic_option)
   std::vector<double> tilt;     ///< triclinic tilts: xy (2D), or xy xz yz (3D); empty: orthogonal
+  /// Set where INPUT's own box (a LAMMPS dump's) gave bounds, periodic and
+  /// tilt (apply_file_box): what the summary says of it, e.g. "the box of
+  /// run.dump (timestep 100)".
+  std::string box_source;
 };
 
 struct VoronoiArgs {
@@ -299,6 +303,9 @@ double parse_number(const std::string& word, const std::string& what, bool allow
 /// The comma-separated words of `s`, spaces dropped ("" gives one empty word).
 std::vector<std::string> split_commas(const std::string& s);
 void check_bounds_arg(const std::vector<double>& bounds);  ///< InputError unless 4 or 6 valid numbers
+/// Where INPUT declares its box (a LAMMPS dump) and the command line gives
+/// none of --bounds, --periodic and --tilt: those from the file's box.
+void apply_file_box(ComputeArgs& args);
 io::PointCloud read_input(const ComputeArgs& args);        ///< read and check INPUT (InputError)
 VoronoiOptions make_options(const ComputeArgs& args, int dim);
 /// tessera::voronoi with a progress bar (when `show_progress`) and Ctrl-C cancellation.

@@ -68,8 +68,10 @@ void add_compute_options(CLI::App* app, ComputeArgs& c, std::vector<std::string>
                   "Point file (required): .npy (float array, shape (N,2) or (N,3), or records with fields "
                   "x,y[,z]), .csv/.xyz/.txt (the columns a header names x,y[,z], else the first 2 or 3 "
                   "numeric columns; also Qhull's format, as rbox writes it), .ply (vertex x,y,z), .vtp/.vtu (VTK XML "
-                  "points, as ParaView saves them) or .pcd (PCL's point clouds); - reads standard input, in any of "
-                  "these formats (rbox 1000 D3 | tessera voronoi - ...)");
+                  "points, as ParaView saves them), .pcd (PCL's point clouds) or .dump/.lammpstrj (a LAMMPS dump's first "
+                  "frame: x y z, xu yu zu or scaled xs ys zs, atoms in file order; its box and periodic axes are the "
+                  "domain unless --bounds, --periodic or --tilt is given); - reads standard input, in any of these "
+                  "formats (rbox 1000 D3 | tessera voronoi - ...)");
   app->add_option("--dim", c.dim,
                   "Dimension: 2 or 3 (default: the number of columns or fields; .ply, .vtp and .vtu are 3D). --dim 2 "
                   "on 3-column input keeps x,y")
@@ -188,6 +190,7 @@ void finish_compute_args(ComputeArgs& c, const std::vector<std::string>& raw_bou
   }
   if (c.input.empty()) throw tessera::InputError("INPUT is required (run with --help for usage)");
   c.input = input_path(c.input);
+  apply_file_box(c);
 }
 
 }  // namespace

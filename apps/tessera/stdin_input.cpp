@@ -42,6 +42,7 @@ std::string sniff(std::string_view head) {
     throw InputError("stdin: XML, but not a VTK PolyData, UnstructuredGrid or ImageData file");
   }
   if (body.substr(0, 10) == "ObjectType" || body.substr(0, 5) == "NDims") return ".mha";
+  if (body.substr(0, 14) == "ITEM: TIMESTEP") return ".dump";  // LAMMPS
   // PCD: comment lines, then VERSION (or FIELDS) opens the header.
   std::size_t at = k;
   while (at < head.size() && head[at] == '#') {

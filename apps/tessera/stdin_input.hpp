@@ -8,7 +8,7 @@ namespace tessera::cli {
 
 /// `arg` itself, or for "-" standard input spooled into a temporary file
 /// (io::TemporaryFile, removed at exit or on a fatal signal) whose extension
-/// is the format its first bytes show: .npy, .ply, .pcd, .vtp/.vtu/.vti,
+/// is the format its first bytes show: .npy, .ply, .pcd, .vtp/.vtu/.vti, .dump,
 /// .nrrd, .mha, else .txt (csv, xyz, Qhull's format). Standard input is read
 /// once; a second "-" (threshold's scalars read the points' file again) is
 /// the same file. Throws InputError where standard input is a terminal.

@@ -319,6 +319,16 @@ void bind_prep(py::module_& m) {
       py::arg("path"), py::arg("dim"), py::arg("labels"), py::arg("keep_non_finite"),
       "A point file as the command line reads it: (points (n, dim), labels (n,) or None).");
 
+  // ---- read_box ---------------------------------------------------------------
+  m.def(
+      "read_box",
+      [](const std::string& path) -> py::object {
+        const std::optional<io::FileBox> b = without_gil([&] { return io::read_file_box(path); });
+        if (!b) return py::none();
+        return py::make_tuple(b->lo, b->hi, b->tilt, b->periodic, b->timestep);
+      },
+      py::arg("path"), "The box a point file declares: (lo, hi, tilt, periodic, timestep), or None.");
+
   // ---- threshold --------------------------------------------------------------
   m.def(
       "threshold",

@@ -456,6 +456,10 @@ def read_label_image(path: str, spacing: Optional[Sequence[float]], origin: Opti
 def read_points(
     path: str, dim: int, labels: str, keep_non_finite: bool
 ) -> Tuple[np.ndarray, Optional[np.ndarray]]: ...
+def read_box(
+    path: str,
+) -> Optional[Tuple[Tuple[float, float, float], Tuple[float, float, float], Tuple[float, float, float],
+                    Tuple[bool, bool, bool], int]]: ...
 def read_scalar_image(
     path: str, spacing: Optional[Sequence[float]], origin: Optional[Sequence[float]]
 ) -> ScalarImage: ...

@@ -122,7 +122,9 @@ def read_points(
     (N, 2) or (N, 3) array in C or Fortran order, or a structured array with
     fields x, y[, z]), ``.csv`` / ``.xyz`` / ``.txt`` (the columns a header
     names x, y[, z], else the first ones), ``.ply``, ``.vtp`` / ``.vtu``
-    (VTK XML points) or ``.pcd`` (PCL's point clouds).
+    (VTK XML points), ``.pcd`` (PCL's point clouds) or ``.dump`` /
+    ``.lammpstrj`` (a LAMMPS dump's first frame: columns x y z, xu yu zu or
+    scaled xs ys zs; atoms in file order; its box: :func:`read_box`).
 
     ``dim`` forces 2 or 3 (2 keeps x, y). ``labels``: a ``.npy`` file of N
     integers, or the name of an integer column, property, point data array
@@ -144,6 +146,40 @@ def read_points(
         raise ValueError(f"labels: expected a file or field name, got {type(labels).__name__}")
     lab = "" if labels is None else os.fsdecode(labels)
     return _inputs.call(_core.read_points, os.fsdecode(path), dim or 0, lab, bool(keep_non_finite))
+
+
+def read_box(path: PathLike, dim: Optional[int] = None) -> Optional[dict]:
+    """The simulation box a point file declares (a LAMMPS dump's ``BOX
+    BOUNDS``; other formats declare none: None), as the keyword arguments
+    ``bounds``, ``periodic`` and ``tilt`` of :func:`voronoi` and the others::
+
+        points, types = tessera.read_points("run.lammpstrj", labels="type")
+        vor = tessera.voronoi(points, labels=types, **tessera.read_box("run.lammpstrj"))
+
+    ``bounds`` is the box's lower corner and its edge lengths along the axes
+    (x0, x1, y0, y1[, z0, z1]); ``periodic`` one bool per axis (LAMMPS's
+    ``pp`` flags; f, s and m are walls); ``tilt`` the triclinic tilts xy, xz,
+    yz as lengths, or None for an orthogonal box. Only the header is read.
+    ``dim=2`` gives the x, y part (ValueError where the box tilts along z).
+    ValueError (:class:`tessera.InputError`) for a malformed header.
+    """
+    if not _is_path(path):
+        raise ValueError(f"path: expected a file name, got {type(path).__name__}")
+    if dim not in (None, 2, 3):
+        raise ValueError(f"dim: expected 2, 3 or None, got {dim!r}")
+    box = _inputs.call(_core.read_box, os.fsdecode(path))
+    if box is None:
+        return None
+    lo, hi, tilt, periodic, _timestep = box
+    d = dim or 3
+    if d == 2 and (tilt[1] != 0 or tilt[2] != 0):
+        raise ValueError(f"{os.fsdecode(path)}: dim=2, but the box tilts along z (xz, yz not 0)")
+    tilts = tuple(float(t) for t in tilt[: 3 if d == 3 else 1])
+    return {
+        "bounds": tuple(float(v) for a in range(d) for v in (lo[a], hi[a])),
+        "periodic": tuple(bool(p) for p in periodic[:d]),
+        "tilt": tilts if any(t != 0 for t in tilts) else None,
+    }
 
 
 # -------------------------------------------------------------- sample_image

@@ -89,6 +89,16 @@ std::vector<double> read_ply_property(const std::string& path, const std::string
 /// line (NaN and Inf allowed; the caller decides).
 std::vector<double> read_text_column(const std::string& path, const std::string& name);
 
+/// LAMMPS dumps (.dump, .lammpstrj; lammps_dump.cpp): the first frame's
+/// atoms (`label_column`: empty, or the integer column holding labels), one
+/// numeric column of it, and its box (the header alone is read).
+PointCloud read_dump_points(const std::string& path, const ReadOptions& options, const std::string& label_column);
+std::vector<double> read_dump_column(const std::string& path, const std::string& name);
+FileBox read_dump_box(const std::string& path);
+
+/// Whether `ext` (lowercased, with its dot) is a LAMMPS dump's.
+inline bool is_dump_extension(const std::string& ext) { return ext == ".dump" || ext == ".lammpstrj"; }
+
 /// VTK XML point sets: .vtp (PolyData) and .vtu (UnstructuredGrid), the
 /// points of every piece (vtk_points.cpp). `label_array` is empty, or the
 /// name of an integer point data array holding labels.

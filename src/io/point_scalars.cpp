@@ -25,6 +25,7 @@ std::vector<double> read_point_scalars(const std::string& points_path, const std
   if (ext == ".ply") return detail::read_ply_property(points_path, source);
   if (ext == ".vtp" || ext == ".vtu") return detail::read_vtk_point_array(points_path, source);
   if (ext == ".pcd") return detail::read_pcd_field(points_path, source);
+  if (detail::is_dump_extension(ext)) return detail::read_dump_column(points_path, source);
   if (ext == ".csv" || ext == ".xyz" || ext == ".txt") return detail::read_text_column(points_path, source);
   if (ext == ".npy") {  // a field of a structured array
     NpyRecords r = read_npy_records(points_path, [&](const std::string& name) { return name == source; });
@@ -33,7 +34,7 @@ std::vector<double> read_point_scalars(const std::string& points_path, const std
     if (r.structured) detail::fail(points_path, "no field '" + source + "' for scalars");
   }
   detail::fail(points_path, "scalars '" + source + "': name a .ply property, a .csv column, a .vtp/.vtu point data "
-                            "array or a field of a .pcd or a structured .npy, or give a .npy file");
+                            "array, a LAMMPS dump's column or a field of a .pcd or a structured .npy, or give a .npy file");
 }
 
 }  // namespace tessera::io

@@ -172,6 +172,11 @@ std::string non_finite_hint(const ReadOptions& options) {
   return options.non_finite_hint.empty() ? "keep_non_finite keeps such points" : options.non_finite_hint;
 }
 
+std::optional<FileBox> read_file_box(const std::string& path) {
+  if (detail::is_dump_extension(detail::lower_extension(path))) return detail::read_dump_box(path);
+  return std::nullopt;
+}
+
 PointCloud read_points(const std::string& path, const ReadOptions& options) {
   if (options.dim != 0 && options.dim != 2 && options.dim != 3)
     detail::fail(path, "dimension must be 2 or 3, not " + std::to_string(options.dim));
@@ -192,8 +197,11 @@ PointCloud read_points(const std::string& path, const ReadOptions& options) {
     pc = detail::read_vtk_points(path, options, label_name);
   } else if (ext == ".pcd") {
     pc = detail::read_pcd_points(path, options, label_name);
+  } else if (detail::is_dump_extension(ext)) {
+    pc = detail::read_dump_points(path, options, label_name);
   } else {
-    detail::fail(path, "unknown input extension '" + ext + "' (expected .npy, .csv, .xyz, .txt, .ply, .vtp, .vtu, .pcd)");
+    detail::fail(path, "unknown input extension '" + ext +
+                           "' (expected .npy, .csv, .xyz, .txt, .ply, .vtp, .vtu, .pcd, .dump, .lammpstrj)");
   }
 
   if (pc.n == 0) detail::fail(path, "no points");

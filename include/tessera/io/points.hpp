@@ -1,8 +1,10 @@
 // Reading point clouds (and their labels) from files, by extension.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <string>
 #include <utility>
@@ -45,8 +47,28 @@ struct ReadOptions {
 /// ReadOptions::non_finite_hint, or its default when empty.
 std::string non_finite_hint(const ReadOptions& options);
 
+/// The simulation box a point file declares (a LAMMPS dump's BOX BOUNDS), in
+/// the terms of --bounds, --periodic and --tilt (VoronoiOptions): the box is
+/// the parallelepiped spanned from `lo` by a = (Lx, 0, 0), b = (xy, Ly, 0),
+/// c = (xz, yz, Lz), L = hi - lo.
+struct FileBox {
+  std::array<double, 3> lo{0, 0, 0};
+  std::array<double, 3> hi{0, 0, 0};
+  std::array<double, 3> tilt{0, 0, 0};       ///< xy, xz, yz as lengths (0 unless triclinic)
+  std::array<bool, 3> periodic{false, false, false};
+  bool triclinic = false;                    ///< the file declared tilts (possibly all 0)
+  std::int64_t timestep = 0;                 ///< of the frame read (the first)
+};
+
+/// The box `path` declares, read from its header alone: LAMMPS dumps
+/// (.dump, .lammpstrj) have one, other formats none (nullopt). Throws
+/// InputError on a malformed header.
+std::optional<FileBox> read_file_box(const std::string& path);
+
 /// Read .npy (C or Fortran order), .csv/.xyz/.txt (the columns a header names
-/// x, y and z in any case, else the first ones) or .ply. Throws tessera::InputError (one line naming the
+/// x, y and z in any case, else the first ones), .ply, .vtp/.vtu, .pcd, or a
+/// LAMMPS dump's first frame (.dump, .lammpstrj: its x y z, xu yu zu, or
+/// scaled xs ys zs columns, atoms in file order). Throws tessera::InputError (one line naming the
 /// file and the problem) on a missing/unreadable file, unknown extension, wrong
 /// dtype/shape, empty input, NaN/Inf, or labels of the wrong length.
 PointCloud read_points(const std::string& path, const ReadOptions& options = {});

@@ -1,0 +1,314 @@
+// LAMMPS dump files (`dump atom` and `dump custom`, text; .dump, .lammpstrj):
+// the first frame's atoms, one of their columns (labels, radii), and the
+// simulation box with its periodic axes. LIGGGHTS writes the same format.
+//
+// A frame, as LAMMPS writes it:
+//   ITEM: TIMESTEP            then the step
+//   ITEM: NUMBER OF ATOMS     then n
+//   ITEM: BOX BOUNDS [xy xz yz] XX YY ZZ
+//                             then one line per axis, "lo hi [tilt]"; XX..ZZ
+//                             are the boundary flags, "pp" periodic, f/s/m
+//                             walls (fixed, shrink-wrapped, with a minimum)
+//   ITEM: ATOMS name name ... then n lines of values
+// Other items (UNITS, TIME) may stand before ATOMS; they are skipped. Only the
+// first frame is read: a trajectory's later frames are left alone.
+//
+// A triclinic box's BOX BOUNDS are the bounding box of the tilted box; the
+// box itself (LAMMPS's "Howto triclinic") has
+//   xlo = xlo_bound - min(0, xy, xz, xy + xz), xhi = xhi_bound - max(0, xy, xz, xy + xz),
+//   ylo = ylo_bound - min(0, yz),              yhi = yhi_bound - max(0, yz),
+// and lattice vectors a = (xhi - xlo, 0, 0), b = (xy, yhi - ylo, 0),
+// c = (xz, yz, zhi - zlo): tessera's --bounds and --tilt exactly.
+//
+// Coordinates: columns x y z (as written, wrapped or not), else xu yu zu
+// (unwrapped), else xs ys zs or xsu ysu zsu (fractions of the box:
+// x = xlo + xs Lx + ys xy + zs xz, y = ylo + ys Ly + zs yz, z = zlo + zs Lz).
+// Atoms keep the file's order (LAMMPS writes them in processor order unless
+// `dump_modify sort id`): point k is the k-th atom line, whatever its id.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <memory>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "io_detail.hpp"
+#include "tessera/cells.hpp"
+#include "tessera/io/points.hpp"
+#include "text_fields.hpp"
+
+namespace tessera::io::detail {
+namespace {
+
+constexpr std::string_view item = "ITEM:";
+
+/// What a frame's header says, and where its atom lines start.
+struct DumpHeader {
+  std::int64_t timestep = 0;
+  std::size_t atoms = 0;
+  FileBox box;
+  std::vector<std::string> columns;
+};
+
+bool starts_with(std::string_view s, std::string_view p) { return s.substr(0, p.size()) == p; }
+
+std::string_view after_item(std::string_view line) {
+  return trim(line.substr(item.size()));
+}
+
+std::vector<std::string_view> words(std::string_view line) {
+  std::vector<std::string_view> w;
+  Fields fs(line, ' ');
+  std::string_view f;
+  while (fs.next(f)) w.push_back(f);
+  return w;
+}
+
+/// The box from BOX BOUNDS' words (after "BOX BOUNDS") and its three lines.
+FileBox parse_box(const std::string& path, const std::vector<std::string_view>& flags_words,
+                  const std::string_view lines[3], const std::size_t numbers[3]) {
+  FileBox b;
+  std::size_t w = 0;
+  b.triclinic = flags_words.size() >= 3 && flags_words[0] == "xy" && flags_words[1] == "xz" && flags_words[2] == "yz";
+  if (b.triclinic) w = 3;
+  const std::size_t flags = flags_words.size() - w;
+  if (flags != 0 && flags != 3)
+    fail(path, "ITEM: BOX BOUNDS: expected three boundary flags (such as pp pp pp), got " + std::to_string(flags));
+  double lo[3], hi[3], tilt[3] = {0, 0, 0};
+  for (int a = 0; a < 3; ++a) {
+    const std::vector<std::string_view> v = words(lines[a]);
+    const std::size_t want = b.triclinic ? 3 : 2;
+    double x[3] = {0, 0, 0};
+    bool ok = v.size() == want;
+    for (std::size_t k = 0; ok && k < want; ++k) ok = parse_double(v[k], x[k]) && std::isfinite(x[k]);
+    if (!ok)
+      fail(path, "line " + std::to_string(numbers[a]) + ": the box's " + "xyz"[a] + " bounds: expected " +
+                     std::to_string(want) + " finite numbers (lo hi" + (b.triclinic ? " tilt)" : ")"));
+    lo[a] = x[0];
+    hi[a] = x[1];
+    tilt[a] = x[2];  // xy, xz, yz in that order of lines
+    // A flag is two letters, lower and upper side; p on either means periodic
+    // (LAMMPS writes pp); without flags (old dumps) every axis is a wall.
+    if (flags == 3) b.periodic[a] = flags_words[w + static_cast<std::size_t>(a)].find('p') != std::string_view::npos;
+  }
+  if (b.triclinic) {
+    const double xy = tilt[0], xz = tilt[1], yz = tilt[2];
+    lo[0] -= std::min({0.0, xy, xz, xy + xz});
+    hi[0] -= std::max({0.0, xy, xz, xy + xz});
+    lo[1] -= std::min(0.0, yz);
+    hi[1] -= std::max(0.0, yz);
+    b.tilt = {xy, xz, yz};
+  }
+  for (int a = 0; a < 3; ++a) {
+    if (!(hi[a] > lo[a]))
+      fail(path, std::string("ITEM: BOX BOUNDS: empty ") + "xyz"[a] + " range of the box [" + std::to_string(lo[a]) +
+                     ", " + std::to_string(hi[a]) + "]");
+    b.lo[static_cast<std::size_t>(a)] = lo[a];
+    b.hi[static_cast<std::size_t>(a)] = hi[a];
+  }
+  return b;
+}
+
+/// Reads the first frame's header; `lines` then stands at its first atom line.
+DumpHeader read_header(const std::string& path, Lines& lines) {
+  DumpHeader h;
+  std::string_view line;
+  std::size_t number = 0;
+  bool have_step = false, have_atoms = false, have_box = false;
+  auto next = [&](const char* what) {
+    if (!lines.next(line, number)) fail(path, std::string("the file ends before ") + what);
+    return trim(line);
+  };
+  if (!lines.next(line, number) || trim(line) != "ITEM: TIMESTEP")
+    fail(path, "not a LAMMPS dump: its first line is not 'ITEM: TIMESTEP'");
+  for (;;) {
+    const std::string_view l = trim(line);
+    if (!starts_with(l, item)) fail(path, "line " + std::to_string(number) + ": expected an 'ITEM:' line");
+    const std::string_view what = after_item(l);
+    if (what == "TIMESTEP") {
+      const std::string_view v = next("the timestep");
+      double t = 0;
+      if (!parse_double(v, t) || !(t >= -9e18 && t <= 9e18) || t != std::floor(t))
+        fail(path, "line " + std::to_string(number) + ": the timestep is not an integer");
+      h.timestep = static_cast<std::int64_t>(t);
+      have_step = true;
+    } else if (what == "NUMBER OF ATOMS") {
+      const std::string_view v = next("the number of atoms");
+      std::uint64_t n = 0;
+      auto [p, ec] = std::from_chars(v.data(), v.data() + v.size(), n);
+      if (ec != std::errc() || p != v.data() + v.size())
+        fail(path, "line " + std::to_string(number) + ": the number of atoms is not a count");
+      if (n > (std::uint64_t{1} << 31) - 1) fail(path, "more than 2^31 - 1 atoms (point ids are int32)");
+      h.atoms = static_cast<std::size_t>(n);
+      have_atoms = true;
+    } else if (starts_with(what, "BOX BOUNDS")) {
+      const std::vector<std::string_view> flags = words(what.substr(std::string_view("BOX BOUNDS").size()));
+      std::string_view box_lines[3];
+      std::size_t numbers[3];
+      for (int a = 0; a < 3; ++a) {
+        box_lines[a] = next("the box's three lines");
+        numbers[a] = number;
+      }
+      h.box = parse_box(path, flags, box_lines, numbers);
+      have_box = true;
+    } else if (starts_with(what, "ATOMS")) {
+      if (!have_step || !have_atoms || !have_box)
+        fail(path, std::string("ITEM: ATOMS before the frame's ") +
+                       (!have_atoms ? "NUMBER OF ATOMS" : !have_box ? "BOX BOUNDS" : "TIMESTEP"));
+      for (std::string_view w : words(what.substr(5))) h.columns.emplace_back(w);
+      if (h.columns.empty()) fail(path, "ITEM: ATOMS names no columns");
+      h.box.timestep = h.timestep;
+      return h;
+    } else {
+      // Another item (UNITS, TIME, ...): its lines up to the next item.
+      for (;;) {
+        if (!lines.next(line, number)) fail(path, "the file ends before ITEM: ATOMS");
+        if (starts_with(trim(line), item)) break;
+      }
+      continue;
+    }
+    if (!lines.next(line, number)) fail(path, "the file ends before ITEM: ATOMS");
+  }
+}
+
+std::size_t column_index(const std::string& path, const DumpHeader& h, const std::string& name, const char* what) {
+  const auto it = std::find(h.columns.begin(), h.columns.end(), name);
+  if (it == h.columns.end()) fail(path, "no column '" + name + "' for " + what + " (columns: " + quoted_list(h.columns) + ")");
+  return static_cast<std::size_t>(it - h.columns.begin());
+}
+
+/// The atom lines' values of `cols` (columns of the header), atoms × cols,
+/// row-major. Every line must have one field per column; the wanted ones
+/// must be numbers (others, such as an element name, are not read).
+std::vector<double> atom_values(const std::string& path, Lines& lines, const DumpHeader& h,
+                                const std::vector<std::size_t>& cols) {
+  std::vector<double> out(h.atoms * cols.size());
+  std::vector<std::string_view> f(h.columns.size());
+  std::string_view line;
+  std::size_t number = 0;
+  for (std::size_t k = 0; k < h.atoms; ++k) {
+    if (!lines.next(line, number))
+      fail(path, "the frame ends after " + std::to_string(k) + " of its " + std::to_string(h.atoms) + " atoms");
+    Fields fs(line, ' ');
+    std::size_t got = 0;
+    std::string_view field;
+    while (fs.next(field)) {
+      if (got == f.size()) break;
+      f[got++] = field;
+    }
+    if (got != f.size() || fs.next(field))
+      fail(path, "line " + std::to_string(number) + ": expected " + std::to_string(f.size()) +
+                     " values (the columns of ITEM: ATOMS)" +
+                     (starts_with(trim(line), item) ? ", found the next item: fewer atoms than NUMBER OF ATOMS" : ""));
+    for (std::size_t c = 0; c < cols.size(); ++c)
+      if (!parse_double(f[cols[c]], out[k * cols.size() + c]))
+        fail(path, "line " + std::to_string(number) + ": column '" + h.columns[cols[c]] + "' is not a number: '" +
+                       std::string(f[cols[c]]) + "'");
+  }
+  return out;
+}
+
+/// Which columns hold the coordinates, and whether they are box fractions.
+struct CoordinateColumns {
+  std::size_t col[3] = {0, 0, 0};
+  bool scaled = false;
+};
+
+CoordinateColumns coordinate_columns(const std::string& path, const DumpHeader& h, int dim) {
+  static const char* const sets[4][3] = {{"x", "y", "z"}, {"xu", "yu", "zu"}, {"xs", "ys", "zs"}, {"xsu", "ysu", "zsu"}};
+  for (int s = 0; s < 4; ++s) {
+    CoordinateColumns c;
+    c.scaled = s >= 2;
+    bool all = true;
+    // A scaled x needs every fraction: y and z move it in a triclinic box.
+    const int needed = c.scaled ? 3 : dim;
+    for (int a = 0; a < needed && all; ++a) {
+      const auto it = std::find(h.columns.begin(), h.columns.end(), sets[s][a]);
+      all = it != h.columns.end();
+      if (all) c.col[a] = static_cast<std::size_t>(it - h.columns.begin());
+    }
+    if (all) return c;
+  }
+  fail(path, "no coordinate columns: expected x y z, xu yu zu, xs ys zs or xsu ysu zsu among " + quoted_list(h.columns));
+}
+
+}  // namespace
+
+PointCloud read_dump_points(const std::string& path, const ReadOptions& options, const std::string& label_column) {
+  const std::string text = read_file_bytes(path);
+  Lines lines(text);
+  const DumpHeader h = read_header(path, lines);
+  const int dim = options.dim == 0 ? 3 : options.dim;
+  if (dim == 2 && (h.box.tilt[1] != 0 || h.box.tilt[2] != 0))
+    fail(path, "--dim 2: the box tilts along z (xz, yz not 0); a 2D box has the xy tilt only");
+  const CoordinateColumns cc = coordinate_columns(path, h, dim);
+  std::vector<std::size_t> cols(cc.col, cc.col + (cc.scaled ? 3 : dim));
+  const std::size_t coords = cols.size();
+  if (!label_column.empty()) cols.push_back(column_index(path, h, label_column, "labels"));
+  const std::vector<double> v = atom_values(path, lines, h, cols);
+
+  PointCloud pc;
+  pc.dim = dim;
+  pc.n = h.atoms;
+  pc.coords.resize(pc.n * static_cast<std::size_t>(dim));
+  const FileBox& b = h.box;
+  for (std::size_t k = 0; k < pc.n; ++k) {
+    const double* r = &v[k * cols.size()];
+    double* x = &pc.coords[k * static_cast<std::size_t>(dim)];
+    if (cc.scaled) {
+      const double L[3] = {b.hi[0] - b.lo[0], b.hi[1] - b.lo[1], b.hi[2] - b.lo[2]};
+      const double full[3] = {b.lo[0] + r[0] * L[0] + r[1] * b.tilt[0] + r[2] * b.tilt[1],
+                              b.lo[1] + r[1] * L[1] + r[2] * b.tilt[2], b.lo[2] + r[2] * L[2]};
+      for (int a = 0; a < dim; ++a) x[a] = full[a];
+    } else {
+      for (int a = 0; a < dim; ++a) x[a] = r[a];
+    }
+  }
+  if (!label_column.empty()) {
+    pc.labels.resize(pc.n);
+    for (std::size_t k = 0; k < pc.n; ++k) {
+      const double l = v[k * cols.size() + coords];
+      if (!(l == std::floor(l) && l >= std::numeric_limits<std::int32_t>::min() &&
+            l <= std::numeric_limits<std::int32_t>::max()))
+        fail(path, "labels '" + label_column + "' of atom " + std::to_string(k) + " (0-based, in file order): " +
+                       std::to_string(l) + " is not an int32");
+      pc.labels[k] = static_cast<std::int32_t>(l);
+    }
+  }
+  return pc;
+}
+
+std::vector<double> read_dump_column(const std::string& path, const std::string& name) {
+  const std::string text = read_file_bytes(path);
+  Lines lines(text);
+  const DumpHeader h = read_header(path, lines);
+  return atom_values(path, lines, h, {column_index(path, h, name, "scalars")});
+}
+
+FileBox read_dump_box(const std::string& path) {
+  // The header only: a trajectory may be gigabytes. Its items come first,
+  // so a prefix holds them (a longer one where another item is long).
+  check_readable(path);
+  struct Closer {
+    void operator()(std::FILE* f) const { std::fclose(f); }
+  };
+  std::unique_ptr<std::FILE, Closer> f(std::fopen(path.c_str(), "rb"));
+  if (!f) fail(path, "cannot open");
+  std::string head;
+  for (std::size_t want = 1 << 16;; want *= 4) {
+    const std::size_t had = head.size();
+    head.resize(want);
+    head.resize(had + std::fread(head.data() + had, 1, want - had, f.get()));
+    const std::size_t atoms = head.find("ITEM: ATOMS");
+    const bool whole = head.size() < want;
+    if ((atoms != std::string::npos && head.find('\n', atoms) != std::string::npos) || whole) {
+      Lines lines(head);
+      return read_header(path, lines).box;
+    }
+  }
+}
+
+}  // namespace tessera::io::detail
