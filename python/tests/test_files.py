@@ -268,6 +268,41 @@ def test_read_points_reads_what_the_command_reads(tmp_path):
         tessera.read_points(tmp_path / "r.npy", dim=4)
 
 
+def test_lammps_dump_points_and_box(tmp_path):
+    # A triclinic periodic dump in scaled coordinates: read_points places the
+    # atoms in the box, read_box gives voronoi() the box, and the cells equal
+    # those of the box given by hand; the volumes tile it.
+    lo = np.array([0.0, -1.0, 2.0])
+    vec = np.array([[3.0, 0, 0], [0.5, 2.5, 0], [0.25, -0.75, 2.0]])
+    frac = np.random.default_rng(12).random((300, 3))
+    xy, xz, yz = vec[1, 0], vec[2, 0], vec[2, 1]
+    with open(tmp_path / "run.lammpstrj", "w") as f:
+        f.write("ITEM: TIMESTEP\n5\nITEM: NUMBER OF ATOMS\n300\nITEM: BOX BOUNDS xy xz yz pp pp pp\n")
+        f.write("%r %r %r\n" % (lo[0] + min(0, xy, xz, xy + xz), lo[0] + 3 + max(0, xy, xz, xy + xz), xy))
+        f.write("%r %r %r\n" % (lo[1] + min(0, yz), lo[1] + 2.5 + max(0, yz), xz))
+        f.write("%r %r %r\nITEM: ATOMS id type xs ys zs\n" % (lo[2], lo[2] + 2, yz))
+        for k, r in enumerate(frac):
+            f.write("%d %d %r %r %r\n" % (k + 1, 1 + k % 2, r[0], r[1], r[2]))
+    path = tmp_path / "run.lammpstrj"
+    p, types = tessera.read_points(path, labels="type")
+    np.testing.assert_allclose(p, lo + frac @ vec, rtol=0, atol=1e-14)
+    np.testing.assert_array_equal(types, 1 + np.arange(300) % 2)
+    box = tessera.read_box(path)
+    assert box == {"bounds": (0.0, 3.0, -1.0, 1.5, 2.0, 4.0), "periodic": (True, True, True), "tilt": (0.5, 0.25, -0.75)}
+    vor = tessera.voronoi(p, labels=types, **box)
+    by_hand = tessera.voronoi(p, labels=types, bounds=(0, 3, -1, 1.5, 2, 4), periodic=True, tilt=(0.5, 0.25, -0.75))
+    np.testing.assert_array_equal(vor.volumes, by_hand.volumes)
+    assert abs(vor.volumes.sum() - 15.0) < 1e-12
+    with pytest.raises(ValueError, match="tilts along z"):
+        tessera.read_box(path, dim=2)
+    np.save(tmp_path / "p.npy", p)
+    assert tessera.read_box(tmp_path / "p.npy") is None
+    with open(tmp_path / "bad.dump", "w") as f:
+        f.write("ITEM: TIMESTEP\n5\nITEM: NUMBER OF ATOMS\n1\nITEM: BOX BOUNDS pp pp\n0 1\n0 1\n0 1\n")
+    with pytest.raises(ValueError, match="three boundary flags"):
+        tessera.read_box(tmp_path / "bad.dump")
+
+
 def test_non_finite_points_kept_and_set_aside(tmp_path):
     # An organized cloud's missing returns: an error, or kept and then set
     # aside by ignore_outside, ids unchanged.

@@ -195,11 +195,9 @@ std::vector<double> atom_values(const std::string& path, Lines& lines, const Dum
     Fields fs(line, ' ');
     std::size_t got = 0;
     std::string_view field;
-    while (fs.next(field)) {
-      if (got == f.size()) break;
-      f[got++] = field;
-    }
-    if (got != f.size() || fs.next(field))
+    while (fs.next(field) && got <= f.size())
+      if (got++ < f.size()) f[got - 1] = field;
+    if (got != f.size())
       fail(path, "line " + std::to_string(number) + ": expected " + std::to_string(f.size()) +
                      " values (the columns of ITEM: ATOMS)" +
                      (starts_with(trim(line), item) ? ", found the next item: fewer atoms than NUMBER OF ATOMS" : ""));
@@ -273,8 +271,12 @@ PointCloud read_dump_points(const std::string& path, const ReadOptions& options,
       const double l = v[k * cols.size() + coords];
       if (!(l == std::floor(l) && l >= std::numeric_limits<std::int32_t>::min() &&
             l <= std::numeric_limits<std::int32_t>::max()))
+      {
+        char buf[40];
+        std::snprintf(buf, sizeof buf, "%.17g", l);
         fail(path, "labels '" + label_column + "' of atom " + std::to_string(k) + " (0-based, in file order): " +
-                       std::to_string(l) + " is not an int32");
+                       buf + " is not an int32");
+      }
       pc.labels[k] = static_cast<std::int32_t>(l);
     }
   }

@@ -11,6 +11,7 @@ output file (not even a temporary) left behind.
 
 Prints "N passed, M failed" last; exits 1 if anything failed.
 """
+import io
 import json
 import os
 import re
@@ -1058,6 +1059,116 @@ class Periodic(TempDirCase):
         self.ok(["delaunay", inp, "--bounds"] + BOX3 + ["--periodic", "xyz", "--tilt", "0.25", "0", "0",
                                                        "--simplices", simp, "-q"])
         self.assertEqual(json.loads(r.stdout.splitlines()[0])["simplices"], len(np.load(simp)))
+
+
+class LammpsDump(TempDirCase):
+    """A LAMMPS dump as INPUT: its box and periodic axes are the domain
+    unless the command line gives one; columns as labels and radii."""
+
+    LO = np.array([-1.0, 0.5, 2.0])
+    VEC = np.array([[4.0, 0, 0], [1.5, 5.0, 0], [-0.5, 0.75, 6.0]])  # a, b, c as rows
+
+    def dump(self, name, frac, flags="pp pp pp", tilted=True, scaled=False, extra=""):
+        vec = self.VEC if tilted else np.diag(np.diag(self.VEC))
+        xy, xz, yz = vec[1, 0], vec[2, 0], vec[2, 1]
+        lo, hi = self.LO, self.LO + np.diag(vec)
+        pts = self.LO + frac @ vec
+        with open(self.p(name), "w") as f:
+            f.write("ITEM: TIMESTEP\n42\nITEM: NUMBER OF ATOMS\n%d\n" % len(frac))
+            if tilted:
+                f.write("ITEM: BOX BOUNDS xy xz yz %s\n" % flags)
+                f.write("%r %r %r\n" % (lo[0] + min(0, xy, xz, xy + xz), hi[0] + max(0, xy, xz, xy + xz), xy))
+                f.write("%r %r %r\n" % (lo[1] + min(0, yz), hi[1] + max(0, yz), xz))
+                f.write("%r %r %r\n" % (lo[2], hi[2], yz))
+            else:
+                f.write("ITEM: BOX BOUNDS %s\n" % flags)
+                for a in range(3):
+                    f.write("%r %r\n" % (lo[a], hi[a]))
+            cols = "xs ys zs" if scaled else "x y z"
+            f.write("ITEM: ATOMS id type %s radius%s\n" % (cols, extra))
+            for k in range(len(frac)):
+                c = frac[k] if scaled else pts[k]
+                f.write("%d %d %r %r %r %r\n" % (k + 1, 1 + k % 3, c[0], c[1], c[2], 0.1 + 0.05 * (k % 2)))
+        return self.p(name), pts
+
+    def test_box_from_the_header(self):
+        # The triclinic periodic box of the header gives the same cells as
+        # --bounds/--periodic/--tilt on the same points; scaled columns too.
+        frac = np.random.default_rng(30).random((800, 3))
+        for scaled in (False, True):
+            inp, pts = self.dump("t.lammpstrj", frac, scaled=scaled)
+            t1, nb1, sh1 = self.p("t1.csv"), self.p("n1.npy"), self.p("s1.npy")
+            r = self.ok(["voronoi", inp, "--cell-table", t1, "--neighbors", nb1, "--neighbor-shifts", sh1,
+                         "--labels", "type", "--validate"])
+            self.assertIn("domain from        the box of %s (LAMMPS dump, timestep 42)" % inp, r.stdout)
+            self.assertIn("periodic           xyz (", r.stdout)
+            self.assertIn("tilt (triclinic)", r.stdout)
+            self.assertIn("validation: OK", r.stdout)
+            box = [repr(v) for a in range(3) for v in (self.LO[a], self.LO[a] + self.VEC[a, a])]
+            tilt = [repr(self.VEC[1, 0]), repr(self.VEC[2, 0]), repr(self.VEC[2, 1])]
+            t2, nb2, sh2 = self.p("t2.csv"), self.p("n2.npy"), self.p("s2.npy")
+            self.ok(["voronoi", self.save("p.npy", pts), "--bounds"] + box + ["--periodic", "xyz", "--tilt"] + tilt +
+                    ["--cell-table", t2, "--neighbors", nb2, "--neighbor-shifts", sh2, "--labels",
+                     self.save("l.npy", (1 + np.arange(800) % 3).astype(np.int32)), "-q"])
+            a, b = np.loadtxt(t1, delimiter=",", skiprows=1), np.loadtxt(t2, delimiter=",", skiprows=1)
+            np.testing.assert_allclose(a, b, rtol=1e-12, atol=1e-12)
+            self.assertEqual(load_neighbors(nb1)[2].tolist(), load_neighbors(nb2)[2].tolist())
+            np.testing.assert_array_equal(np.load(sh1), np.load(sh2))
+            self.assertAlmostEqual(a[:, 2].sum(), abs(np.linalg.det(self.VEC)), delta=1e-9)
+
+    def test_walls_radii_and_overrides(self):
+        frac = np.random.default_rng(31).random((600, 3))
+        inp, pts = self.dump("w.dump", frac, flags="pp ff pp", tilted=False)
+        t = self.p("t.csv")
+        r = self.ok(["voronoi", inp, "--radii", "radius", "--cell-table", t, "--validate"])
+        self.assertIn("periodic           xz (", r.stdout)
+        self.assertIn("power cells", r.stdout)
+        self.assertIn("domain             [-1, 3] x [0.5, 5.5] x [2, 8]", r.stdout)
+        # Any of --bounds, --periodic, --tilt: the command line's domain alone.
+        r = self.ok(["voronoi", inp, "--bounds", "-2", "4", "0", "6", "1", "9", "--cell-table", t])
+        self.assertNotIn("domain from", r.stdout)
+        self.assertNotIn("periodic", r.stdout)
+        self.assertAlmostEqual(np.loadtxt(t, delimiter=",", skiprows=1)[:, 2].sum(), 6 * 6 * 8, delta=1e-9)
+        # A triangulation needs every axis periodic: the dump's walls are named.
+        r = run(["delaunay", inp, "--validate"])
+        self.assertEqual(r.returncode, 2)
+        self.assertIn("is periodic along xz only", r.stderr)
+        self.assertEqual(len(r.stderr.strip().splitlines()), 1)
+        r = self.ok(["delaunay", inp, "--bounds", "-1", "3", "0.5", "5.5", "2", "8", "--validate"])
+        self.assertIn("validation passed", r.stderr)
+        # Fully periodic: the periodic triangulation; standard input too.
+        inp2, _ = self.dump("p.dump", frac)
+        r = self.ok(["delaunay", inp2, "--validate"])
+        self.assertIn("of the periodic box (triclinic)", r.stderr)
+        with open(inp2, "rb") as f:
+            r = run_bytes(["voronoi", "-", "--cell-table", "-", "-q"], f.read())
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertAlmostEqual(np.loadtxt(io.StringIO(r.stdout.decode()), delimiter=",", skiprows=1)[:, 2].sum(),
+                               abs(np.linalg.det(self.VEC)), delta=1e-9)
+        # --dim 2 takes x, y of an orthogonal box.
+        inp3, _ = self.dump("o.dump", frac, tilted=False)
+        r = self.ok(["voronoi", inp3, "--dim", "2", "--cell-table", t])
+        self.assertIn("periodic           xy (", r.stdout)
+        self.assertAlmostEqual(np.loadtxt(t, delimiter=",", skiprows=1)[:, 2].sum(), 20.0, delta=1e-9)
+
+    def test_bad_dumps(self):
+        frac = np.random.default_rng(32).random((50, 3))
+        inp, _ = self.dump("x.dump", frac, flags="ff pp pp")  # xy tilt, x a wall
+        for cmd in (["voronoi", inp, "--validate"], ["graph", inp, "--csr", self.p("g.npy")]):
+            r = run(cmd)
+            self.assertEqual(r.returncode, 2)
+            self.assertIn("the box tilts by xy = 1.5, but x is a wall there", r.stderr)
+        inp, _ = self.dump("t.dump", frac)
+        r = run(["voronoi", inp, "--dim", "2", "--validate"])
+        self.assertEqual(r.returncode, 2)
+        self.assertIn("tilts along z", r.stderr)
+        with open(inp) as g, open(self.p("cut.dump"), "w") as f:
+            f.write(g.read()[:-40])
+        out = self.p("c.vtu")
+        r = run(["voronoi", self.p("cut.dump"), "-o", out])
+        self.assertEqual(r.returncode, 2)
+        self.assertIn("cut.dump: line", r.stderr)
+        self.assertFalse(os.path.exists(out))
 
 
 class Power(TempDirCase):

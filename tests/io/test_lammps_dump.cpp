@@ -1,0 +1,157 @@
+// LAMMPS dump files: the first frame's atoms in every coordinate style, the
+// box (orthogonal and triclinic, periodic flags), columns as labels and
+// scalars, and the errors.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "io/io_test_util.hpp"
+#include "tessera/io/points.hpp"
+
+using namespace tessera_test;
+using tessera::io::FileBox;
+using tessera::io::read_file_box;
+using tessera::io::read_point_scalars;
+using tessera::io::read_points;
+using tessera::io::ReadOptions;
+
+namespace {
+
+// Three atoms of a box [-1, 3] x [0.5, 5.5] x [2, 8], periodic in x and y.
+const double kX[3][3] = {{0.5, 1.0, 2.5}, {-0.75, 4.0, 7.5}, {2.25, 0.5, 3.0}};
+
+std::string ortho(const std::string& columns, const std::string& rows, const char* flags = " pp pp fm") {
+  return std::string("ITEM: TIMESTEP\n1500\nITEM: NUMBER OF ATOMS\n3\nITEM: BOX BOUNDS") + flags +
+         "\n-1 3\n0.5 5.5\n2 8\nITEM: ATOMS " + columns + "\n" + rows;
+}
+
+const char* kRows =
+    "7 2 0.5 1 2.5 0.25\n"
+    "3 1 -0.75 4 7.5 0.5\n"
+    "5 2 2.25 0.5 3 0.125\n";
+
+}  // namespace
+
+TEST(LammpsDump, OrthogonalBoxAndAtomsInFileOrder) {
+  TempDir dir;
+  // Another frame after the first, and an item LAMMPS may add (UNITS).
+  const std::string text = "ITEM: UNITS\nlj\n" + ortho("id type x y z radius", kRows) +
+                           "ITEM: TIMESTEP\n1600\nITEM: NUMBER OF ATOMS\n1\n";
+  const std::string with_units = "ITEM: TIMESTEP\n1500\nITEM: UNITS\nlj\n" + text.substr(text.find("ITEM: NUMBER"));
+  for (const std::string& name : {"a.dump", "a.lammpstrj"}) {
+    const std::string p = dir.write(name, with_units);
+    const auto pc = read_points(p, labels("type"));
+    ASSERT_EQ(pc.n, 3u);
+    EXPECT_EQ(pc.dim, 3);
+    for (int k = 0; k < 3; ++k)
+      for (int a = 0; a < 3; ++a) EXPECT_EQ(pc.coords[static_cast<std::size_t>(3 * k + a)], kX[k][a]);
+    EXPECT_EQ(pc.labels, (std::vector<std::int32_t>{2, 1, 2}));
+    EXPECT_EQ(read_point_scalars(p, "radius"), (std::vector<double>{0.25, 0.5, 0.125}));
+    const auto box = read_file_box(p);
+    ASSERT_TRUE(box.has_value());
+    EXPECT_EQ(box->lo, (std::array<double, 3>{-1, 0.5, 2}));
+    EXPECT_EQ(box->hi, (std::array<double, 3>{3, 5.5, 8}));
+    EXPECT_EQ(box->periodic, (std::array<bool, 3>{true, true, false}));
+    EXPECT_FALSE(box->triclinic);
+    EXPECT_EQ(box->tilt, (std::array<double, 3>{0, 0, 0}));
+    EXPECT_EQ(box->timestep, 1500);
+  }
+  // --dim 2 keeps x and y.
+  ReadOptions two;
+  two.dim = 2;
+  const auto pc2 = read_points(dir.write("b.dump", ortho("id type x y z", "1 1 0.5 1 2.5\n2 1 -0.75 4 7.5\n3 1 2.25 0.5 3\n")), two);
+  EXPECT_EQ(pc2.coords, (std::vector<double>{0.5, 1, -0.75, 4, 2.25, 0.5}));
+  // Other formats declare no box.
+  EXPECT_FALSE(read_file_box(dir.write("c.csv", "x,y,z\n0,0,0\n1,1,1\n")).has_value());
+}
+
+TEST(LammpsDump, CoordinateStyles) {
+  TempDir dir;
+  // Unwrapped coordinates are taken as they are (the periodic box wraps them).
+  auto pc = read_points(dir.write("u.dump", ortho("id xu yu zu", "1 0.5 1 2.5\n2 -4.75 4 7.5\n3 2.25 10.5 3\n")));
+  EXPECT_EQ(pc.coords[3], -4.75);
+  EXPECT_EQ(pc.coords[7], 10.5);
+  // Plain x y z are preferred to the others when several are written.
+  pc = read_points(dir.write("both.dump", ortho("xs ys zs x y z", "0 0 0 0.5 1 2.5\n0 0 0 -0.75 4 7.5\n0 0 0 2.25 0.5 3\n")));
+  EXPECT_EQ(pc.coords[0], 0.5);
+  // Scaled: fractions of the box (dyadic here, so exact).
+  pc = read_points(dir.write("s.dump", ortho("id type xs ys zs", "1 1 0.375 0.1 0.25\n2 1 0 0.7 0.9375\n3 1 0.8125 0 0.125\n")));
+  EXPECT_EQ(pc.coords[0], 0.5);   // -1 + 0.375 * 4
+  EXPECT_EQ(pc.coords[2], 3.5);   // 2 + 0.25 * 6
+  EXPECT_EQ(pc.coords[5], 7.625);  // 2 + 0.9375 * 6
+  EXPECT_EQ(pc.coords[6], 2.25);  // -1 + 0.8125 * 4
+}
+
+TEST(LammpsDump, TriclinicBoxFromItsBoundingBox) {
+  TempDir dir;
+  // Lattice vectors a = (4, 0, 0), b = (1.5, 5, 0), c = (-0.5, 0.75, 6) from
+  // (-1, 0.5, 2): LAMMPS writes the bounding box, xlo_bound = -1 + min(0,
+  // 1.5, -0.5, 1) = -1.5, xhi_bound = 3 + max(0, 1.5, -0.5, 1) = 4.5,
+  // ylo_bound = 0.5, yhi_bound = 5.5 + 0.75 = 6.25.
+  const std::string text =
+      "ITEM: TIMESTEP\n0\nITEM: NUMBER OF ATOMS\n2\nITEM: BOX BOUNDS xy xz yz pp pp pp\n"
+      "-1.5 4.5 1.5\n0.5 6.25 -0.5\n2 8 0.75\nITEM: ATOMS id type xs ys zs\n"
+      "1 1 0.5 0.5 0.5\n2 1 0 0 1\n";
+  const std::string p = dir.write("t.lammpstrj", text);
+  const auto box = read_file_box(p);
+  ASSERT_TRUE(box.has_value());
+  EXPECT_TRUE(box->triclinic);
+  EXPECT_EQ(box->lo, (std::array<double, 3>{-1, 0.5, 2}));
+  EXPECT_EQ(box->hi, (std::array<double, 3>{3, 5.5, 8}));
+  EXPECT_EQ(box->tilt, (std::array<double, 3>{1.5, -0.5, 0.75}));
+  EXPECT_EQ(box->periodic, (std::array<bool, 3>{true, true, true}));
+  const auto pc = read_points(p);
+  // The centre: lo + (a + b + c) / 2; the second atom: lo + c.
+  EXPECT_EQ(pc.coords, (std::vector<double>{-1 + 2.5, 0.5 + 2.875, 5, -1.5, 1.25, 8}));
+  // In 2D only the xy tilt exists.
+  ReadOptions two;
+  two.dim = 2;
+  EXPECT_NE(input_error([&] { read_points(p, two); }).find("tilts along z"), std::string::npos);
+}
+
+TEST(LammpsDump, Errors) {
+  TempDir dir;
+  struct Case {
+    std::string text, expect;
+  };
+  const std::string head = "ITEM: TIMESTEP\n1\nITEM: NUMBER OF ATOMS\n2\nITEM: BOX BOUNDS pp pp pp\n0 1\n0 1\n0 1\n";
+  const std::vector<Case> cases = {
+      {"", "not a LAMMPS dump"},
+      {"x y z\n0 0 0\n", "not a LAMMPS dump"},
+      {"ITEM: TIMESTEP\n1\n", "ends before"},
+      {"ITEM: TIMESTEP\nnoon\n", "timestep is not an integer"},
+      {"ITEM: TIMESTEP\n1\nITEM: NUMBER OF ATOMS\n-2\n", "not a count"},
+      {"ITEM: TIMESTEP\n1\nITEM: NUMBER OF ATOMS\n2\nITEM: ATOMS x y z\n", "before the frame's BOX BOUNDS"},
+      {"ITEM: TIMESTEP\n1\nITEM: NUMBER OF ATOMS\n2\nITEM: BOX BOUNDS pp pp\n0 1\n0 1\n0 1\n", "three boundary flags"},
+      {"ITEM: TIMESTEP\n1\nITEM: NUMBER OF ATOMS\n2\nITEM: BOX BOUNDS pp pp pp\n0 1\n0 nan\n0 1\n", "y bounds"},
+      {"ITEM: TIMESTEP\n1\nITEM: NUMBER OF ATOMS\n2\nITEM: BOX BOUNDS pp pp pp\n0 1\n0 1\n1 1\n", "empty z range"},
+      {"ITEM: TIMESTEP\n1\nITEM: NUMBER OF ATOMS\n2\nITEM: BOX BOUNDS xy xz yz pp pp pp\n0 1\n0 1\n0 1\n", "3 finite numbers"},
+      {head + "ITEM: ATOMS\n", "names no columns"},
+      {head + "ITEM: ATOMS id type\n1 1\n2 1\n", "no coordinate columns"},
+      {head + "ITEM: ATOMS id xs ys\n1 0 0\n2 0 0\n", "no coordinate columns"},  // scaled needs all three
+      {head + "ITEM: ATOMS id x y z\n1 0 0 0\n", "ends after 1 of its 2 atoms"},
+      {head + "ITEM: ATOMS id x y z\n1 0 0 0\nITEM: TIMESTEP\n", "fewer atoms than NUMBER OF ATOMS"},
+      {head + "ITEM: ATOMS id x y z\n1 0 0 0\n2 0 0\n", "line 11: expected 4 values"},
+      {head + "ITEM: ATOMS id x y z\n1 0 0 0\n2 0 0 0 9\n", "expected 4 values"},
+      {head + "ITEM: ATOMS id x y z\n1 0 0 0\n2 0 zero 0\n", "column 'y' is not a number: 'zero'"},
+      {head + "ITEM: ATOMS id x y z\n1 0 0 0\n2 0 inf 0\n", "non-finite coordinate"},
+  };
+  for (const Case& c : cases) {
+    const std::string p = dir.write("e.dump", c.text);
+    const std::string msg = input_error([&] { read_points(p); });
+    EXPECT_NE(msg.find(c.expect), std::string::npos) << c.text << "\n-> " << msg;
+    EXPECT_EQ(msg.rfind(p, 0), 0u) << msg;  // names the file
+  }
+  // Labels must be integers in a column that exists; scalars likewise named.
+  const std::string p = dir.write("l.dump", head + "ITEM: ATOMS id type q x y z\n1 1 0.5 0 0 0\n2 1.5 -1 1 1 1\n");
+  EXPECT_NE(input_error([&] { read_points(p, labels("type")); }).find("1.5 is not an int32"), std::string::npos);
+  EXPECT_NE(input_error([&] { read_points(p, labels("mol")); }).find("no column 'mol'"), std::string::npos);
+  EXPECT_EQ(read_point_scalars(p, "q"), (std::vector<double>{0.5, -1}));
+  EXPECT_NE(input_error([&] { read_point_scalars(p, "radius"); }).find("no column 'radius'"), std::string::npos);
+  // A non-numeric column that is not asked for is fine (an element name).
+  const auto pc = read_points(dir.write("el.dump", head + "ITEM: ATOMS id element x y z\n1 Cu 0 0 0\n2 Ni 1 1 1\n"));
+  EXPECT_EQ(pc.n, 2u);
+}
