@@ -33,14 +33,14 @@ constexpr const char* kOutputHelp =
 
 /// The flag's help, per command: what it does to those points there.
 void add_input_options(CLI::App* app, PrepInput& p, bool labels, const char* keep_help) {
-  app->add_option("INPUT", p.input, "Point file: .npy, .csv/.xyz/.txt (or Qhull's format), .ply, .vtp/.vtu or .pcd (as for `voronoi`); - reads standard input")->required();
+  app->add_option("INPUT", p.input, "Point file: .npy, .csv/.xyz/.txt (or Qhull's format), .ply, .vtp/.vtu, .pcd or .dump/.lammpstrj (as for `voronoi`); - reads standard input")->required();
   app->add_option("-o,--output", p.output, kOutputHelp)->required();
   app->add_option("--dim", p.dim, "Dimension: 2 or 3 (default: the number of columns or fields; .ply, .vtp and .vtu are 3D)")
       ->check(CLI::IsMember({2, 3}));
   if (labels)
     app->add_option("--labels", p.labels,
                     "Per-point integer labels, carried to the output: FILE.npy, or the name of an integer .ply "
-                    "vertex property / .csv column / .vtp or .vtu point data array / .pcd or structured .npy field");
+                    "vertex property / .csv column / .vtp or .vtu point data array / LAMMPS dump column / .pcd or structured .npy field");
   app->add_flag("--keep-non-finite", p.keep_non_finite, keep_help);
   app->add_flag("-q,--quiet", p.quiet, "No summary line");
 }
@@ -163,7 +163,7 @@ void add_prep_commands(CLI::App& app, PrepCommands& c) {
                     "them aside");
   t->add_option("--scalars", c.threshold.scalars,
                 "S.npy (one number per point), or the name of a .ply vertex property / .csv column / .vtp or .vtu "
-                "point data array / .pcd or structured .npy field of INPUT "
+                "point data array / LAMMPS dump column / .pcd or structured .npy field of INPUT "
                 "(with a .csv whose header does not name x,y[,z], use --dim so that the column is not taken "
                 "as a coordinate)")
       ->required();
