@@ -230,6 +230,8 @@ def hostile_radii(kind, rng, pts):
 # where one outside point's sphere takes the whole box, no inside point has
 # a cell (an input error too).
 RADII_REFUSALS = ("need coordinates within", "has an empty power cell")
+# --bounds cut through the points: none left inside, or none with a label >= 0.
+CUT_REFUSALS = ("all points lie outside", "none inside", "none of the")
 ZERO_EXTENT = ("zero extent", "coplanar", "collinear", "--dim 2", "single point", "one point")
 
 
@@ -338,12 +340,12 @@ class Hostile(base.TempDirCase):
             # All points outside the cut box (a cluster at one end), or all that
             # the cut keeps labelled outside, is an input error.
             if not self.check(["voronoi"] + bc + ["--method", method, "--neighbors", nb[method], "--validate"],
-                              inp, labels, kind, d, case, accept=("all points lie outside", "none inside", "none of the")):
+                              inp, labels, kind, d, case, accept=CUT_REFUSALS):
                 return
         self.assertTrue(np.array_equal(np.load(nb["search"]), np.load(nb["insertion"])),
                         "case %d (%s, cut bounds): neighbours by search and by insertion differ" % (case, kind))
         self.check(["delaunay"] + bc + ["--simplices", self.p("bt.npy"), "--validate"], inp, labels, kind, d, case,
-                   accept=("all points lie outside", "none inside", "none of the"))
+                   accept=CUT_REFUSALS)
 
     def check_pipeline(self, case, kind, d, inp, labels, threads):
         """fill (background points in the empty bins) -> joggle -> voronoi
