@@ -194,8 +194,7 @@ void apply_file_box(ComputeArgs& a) {
   }
   if (tilted)
     for (int t = 0; t < tilts; ++t) a.tilt.push_back(box->tilt[static_cast<std::size_t>(t)]);
-  a.box_source = strf("the box of %s (LAMMPS dump, timestep %lld)", shown_path(a.input).c_str(),
-                      static_cast<long long>(box->timestep));
+  a.box_source = "the box of " + shown_path(a.input) + " (" + box->declared_by + ")";
 }
 
 io::PointCloud read_input(const ComputeArgs& a) {

@@ -67,7 +67,8 @@ void add_compute_options(CLI::App* app, ComputeArgs& c, std::vector<std::string>
   app->add_option("INPUT", c.input,
                   "Point file (required): .npy (float array, shape (N,2) or (N,3), or records with fields "
                   "x,y[,z]), .csv/.xyz/.txt (the columns a header names x,y[,z], else the first 2 or 3 "
-                  "numeric columns; also Qhull's format, as rbox writes it), .ply (vertex x,y,z), .vtp/.vtu (VTK XML "
+                  "numeric columns; also Qhull's format, as rbox writes it, and XYZ: a count, a comment, then species x y z; "
+                  "extended XYZ's Lattice and pbc are the domain as a dump's box), .ply (vertex x,y,z), .vtp/.vtu (VTK XML "
                   "points, as ParaView saves them), .pcd (PCL's point clouds) or .dump/.lammpstrj (a LAMMPS dump's first "
                   "frame: x y z, xu yu zu or scaled xs ys zs, atoms in file order; its box and periodic axes are the "
                   "domain unless --bounds, --periodic or --tilt is given); - reads standard input, in any of these "

@@ -124,7 +124,10 @@ def read_points(
     names x, y[, z], else the first ones), ``.ply``, ``.vtp`` / ``.vtu``
     (VTK XML points), ``.pcd`` (PCL's point clouds) or ``.dump`` /
     ``.lammpstrj`` (a LAMMPS dump's first frame: columns x y z, xu yu zu or
-    scaled xs ys zs; atoms in file order; its box: :func:`read_box`).
+    scaled xs ys zs; atoms in file order; its box: :func:`read_box`). An
+    ``.xyz`` / ``.txt`` that starts with a lone count is XYZ (count,
+    comment, ``species x y z`` per atom; extended XYZ's ``Properties`` name
+    its columns, an integer one can be the labels).
 
     ``dim`` forces 2 or 3 (2 keeps x, y). ``labels``: a ``.npy`` file of N
     integers, or the name of an integer column, property, point data array
@@ -150,7 +153,8 @@ def read_points(
 
 def read_box(path: PathLike, dim: Optional[int] = None) -> Optional[dict]:
     """The simulation box a point file declares (a LAMMPS dump's ``BOX
-    BOUNDS``; other formats declare none: None), as the keyword arguments
+    BOUNDS``, an extended XYZ's ``Lattice``, ``Origin`` and ``pbc``; other
+    formats declare none: None), as the keyword arguments
     ``bounds``, ``periodic`` and ``tilt`` of :func:`voronoi` and the others::
 
         points, types = tessera.read_points("run.lammpstrj", labels="type")
@@ -158,7 +162,8 @@ def read_box(path: PathLike, dim: Optional[int] = None) -> Optional[dict]:
 
     ``bounds`` is the box's lower corner and its edge lengths along the axes
     (x0, x1, y0, y1[, z0, z1]); ``periodic`` one bool per axis (LAMMPS's
-    ``pp`` flags; f, s and m are walls); ``tilt`` the triclinic tilts xy, xz,
+    ``pp`` flags, f, s and m being walls; extended XYZ's pbc, T T T where it
+    is absent); ``tilt`` the triclinic tilts xy, xz,
     yz as lengths, or None for an orthogonal box. Only the header is read.
     ``dim=2`` gives the x, y part (ValueError where the box tilts along z).
     ValueError (:class:`tessera.InputError`) for a malformed header.

@@ -96,6 +96,20 @@ PointCloud read_dump_points(const std::string& path, const ReadOptions& options,
 std::vector<double> read_dump_column(const std::string& path, const std::string& name);
 FileBox read_dump_box(const std::string& path);
 
+/// XYZ and extended XYZ files (xyz_points.cpp), read by the text reader
+/// where the first line is a lone count: the first frame's atoms, one
+/// property's values, and the Lattice's box (from `head`, the file's first
+/// bytes; none without a Lattice).
+bool looks_like_xyz(std::string_view text);
+PointCloud read_xyz_points(const std::string& path, std::string_view text, const ReadOptions& options,
+                           const std::string& label_column);
+std::vector<double> read_xyz_column(const std::string& path, std::string_view text, const std::string& name);
+std::optional<FileBox> read_xyz_box(const std::string& path, std::string_view head);
+
+/// The first `bytes` bytes of a file (all of a shorter one), for the
+/// readers of a header alone.
+std::string read_file_head(const std::string& path, std::size_t bytes);
+
 /// Whether `ext` (lowercased, with its dot) is a LAMMPS dump's.
 inline bool is_dump_extension(const std::string& ext) { return ext == ".dump" || ext == ".lammpstrj"; }
 

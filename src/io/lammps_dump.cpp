@@ -29,7 +29,6 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
-#include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -161,6 +160,7 @@ DumpHeader read_header(const std::string& path, Lines& lines) {
       for (std::string_view w : words(what.substr(5))) h.columns.emplace_back(w);
       if (h.columns.empty()) fail(path, "ITEM: ATOMS names no columns");
       h.box.timestep = h.timestep;
+      h.box.declared_by = "LAMMPS dump, timestep " + std::to_string(h.timestep);
       return h;
     } else {
       // Another item (UNITS, TIME, ...): its lines up to the next item.
@@ -293,20 +293,10 @@ std::vector<double> read_dump_column(const std::string& path, const std::string&
 FileBox read_dump_box(const std::string& path) {
   // The header only: a trajectory may be gigabytes. Its items come first,
   // so a prefix holds them (a longer one where another item is long).
-  check_readable(path);
-  struct Closer {
-    void operator()(std::FILE* f) const { std::fclose(f); }
-  };
-  std::unique_ptr<std::FILE, Closer> f(std::fopen(path.c_str(), "rb"));
-  if (!f) fail(path, "cannot open");
-  std::string head;
   for (std::size_t want = 1 << 16;; want *= 4) {
-    const std::size_t had = head.size();
-    head.resize(want);
-    head.resize(had + std::fread(head.data() + had, 1, want - had, f.get()));
+    const std::string head = read_file_head(path, want);
     const std::size_t atoms = head.find("ITEM: ATOMS");
-    const bool whole = head.size() < want;
-    if ((atoms != std::string::npos && head.find('\n', atoms) != std::string::npos) || whole) {
+    if ((atoms != std::string::npos && head.find('\n', atoms) != std::string::npos) || head.size() < want) {
       Lines lines(head);
       return read_header(path, lines).box;
     }

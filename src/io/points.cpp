@@ -69,6 +69,19 @@ std::string read_file_bytes(const std::string& path) {
   return bytes;
 }
 
+std::string read_file_head(const std::string& path, std::size_t bytes) {
+  check_readable(path);
+  struct Closer {
+    void operator()(std::FILE* f) const { std::fclose(f); }
+  };
+  std::unique_ptr<std::FILE, Closer> f(std::fopen(path.c_str(), "rb"));
+  if (!f) throw InputError("cannot open " + path + ": " + std::strerror(errno));
+  std::string head(bytes, '\0');
+  head.resize(std::fread(head.data(), 1, bytes, f.get()));
+  if (std::ferror(f.get())) throw InputError("cannot read " + path + ": " + std::strerror(errno));
+  return head;
+}
+
 std::string lower_extension(const std::string& path) {
   return lower(std::filesystem::path(path).extension().string());
 }
@@ -173,7 +186,12 @@ std::string non_finite_hint(const ReadOptions& options) {
 }
 
 std::optional<FileBox> read_file_box(const std::string& path) {
-  if (detail::is_dump_extension(detail::lower_extension(path))) return detail::read_dump_box(path);
+  const std::string ext = detail::lower_extension(path);
+  if (detail::is_dump_extension(ext)) return detail::read_dump_box(path);
+  if (ext == ".xyz" || ext == ".txt") {  // an extended XYZ's Lattice (its first two lines)
+    const std::string head = detail::read_file_head(path, 1 << 16);
+    if (detail::looks_like_xyz(head)) return detail::read_xyz_box(path, head);
+  }
   return std::nullopt;
 }
 

@@ -172,6 +172,9 @@ PointCloud read_text_points(const std::string& path, const ReadOptions& options,
     }
   }
 
+  // XYZ (chemistry's, and extended XYZ): a lone count, a comment, the atoms.
+  if (looks_like_xyz(text)) return read_xyz_points(path, text, options, label_column);
+
   // Layout from the first content line: delimiter, header, column count.
   const TextLayout layout = text_layout(line);
   const char delim = layout.delim;
@@ -265,6 +268,7 @@ std::vector<double> read_text_column(const std::string& path, const std::string&
   std::string_view line;
   std::size_t line_no = 0;
   if (!lines.next(line, line_no)) fail(path, "no points");
+  if (looks_like_xyz(text)) return read_xyz_column(path, text, name);
   // The first content line must be a header naming the column.
   const TextLayout layout = text_layout(line);
   const char delim = layout.delim;

@@ -1061,9 +1061,10 @@ class Periodic(TempDirCase):
         self.assertEqual(json.loads(r.stdout.splitlines()[0])["simplices"], len(np.load(simp)))
 
 
-class LammpsDump(TempDirCase):
-    """A LAMMPS dump as INPUT: its box and periodic axes are the domain
-    unless the command line gives one; columns as labels and radii."""
+class FileBoxes(TempDirCase):
+    """A LAMMPS dump or an extended XYZ as INPUT: its box and periodic axes
+    are the domain unless the command line gives one; columns as labels and
+    radii."""
 
     LO = np.array([-1.0, 0.5, 2.0])
     VEC = np.array([[4.0, 0, 0], [1.5, 5.0, 0], [-0.5, 0.75, 6.0]])  # a, b, c as rows
@@ -1150,6 +1151,42 @@ class LammpsDump(TempDirCase):
         r = self.ok(["voronoi", inp3, "--dim", "2", "--cell-table", t])
         self.assertIn("periodic           xy (", r.stdout)
         self.assertAlmostEqual(np.loadtxt(t, delimiter=",", skiprows=1)[:, 2].sum(), 20.0, delta=1e-9)
+
+    def test_extended_xyz(self):
+        # An extended XYZ's Lattice, Origin and pbc are the domain as a
+        # dump's box is (also from standard input); a plain XYZ has none.
+        frac = np.random.default_rng(33).random((500, 3))
+        vec = self.VEC.copy()
+        vec[2, :2] = 0  # z is a wall: c may not tilt
+        pts = self.LO + frac @ vec
+        with open(self.p("e.xyz"), "w") as f:
+            f.write("%d\nLattice=\"%s\" Origin=\"%s\" Properties=species:S:1:pos:R:3:tag:I:1 pbc=\"T T F\"\n" % (
+                len(pts), " ".join(repr(v) for v in vec.ravel()), " ".join(repr(v) for v in self.LO)))
+            for k, q in enumerate(pts):
+                f.write("%s %r %r %r %d\n" % ("Cu" if k % 2 else "Ni", q[0], q[1], q[2], k % 2))
+        t1, t2 = self.p("t1.csv"), self.p("t2.csv")
+        r = self.ok(["voronoi", self.p("e.xyz"), "--labels", "tag", "--cell-table", t1, "--validate"])
+        self.assertIn("(extended XYZ Lattice)", r.stdout)
+        self.assertIn("periodic           xy (", r.stdout)
+        self.assertIn("validation: OK", r.stdout)
+        box = [repr(v) for a in range(3) for v in (self.LO[a], self.LO[a] + vec[a, a])]
+        self.ok(["voronoi", self.save("p.npy", pts), "--bounds"] + box + ["--periodic", "xy", "--tilt",
+                repr(vec[1, 0]), "0", "0", "--labels", self.save("l.npy", (np.arange(500) % 2).astype(np.int32)),
+                "--cell-table", t2, "-q"])
+        self.assertEqual(read_bytes(t1), read_bytes(t2))
+        vol = np.loadtxt(t1, delimiter=",", skiprows=1)[:, 2]
+        self.assertAlmostEqual(vol.sum(), abs(np.linalg.det(vec)), delta=1e-9)
+        with open(self.p("e.xyz"), "rb") as f:
+            r = run_bytes(["voronoi", "-", "--labels", "tag", "--cell-table", "-", "-q"], f.read())
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertEqual(r.stdout, read_bytes(t1))
+        with open(self.p("plain.xyz"), "w") as f:
+            f.write("%d\nplain\n" % len(pts))
+            for q in pts:
+                f.write("C %r %r %r\n" % tuple(q))
+        r = self.ok(["voronoi", self.p("plain.xyz"), "--cell-table", t1])
+        self.assertNotIn("domain from", r.stdout)
+        self.assertNotIn("periodic", r.stdout)
 
     def test_bad_dumps(self):
         frac = np.random.default_rng(32).random((50, 3))

@@ -57,11 +57,13 @@ struct FileBox {
   std::array<double, 3> tilt{0, 0, 0};       ///< xy, xz, yz as lengths (0 unless triclinic)
   std::array<bool, 3> periodic{false, false, false};
   bool triclinic = false;                    ///< the file declared tilts (possibly all 0)
-  std::int64_t timestep = 0;                 ///< of the frame read (the first)
+  std::int64_t timestep = 0;                 ///< of the frame read (the first); 0 where none
+  std::string declared_by;                   ///< "LAMMPS dump, timestep 100", "extended XYZ Lattice"
 };
 
 /// The box `path` declares, read from its header alone: LAMMPS dumps
-/// (.dump, .lammpstrj) have one, other formats none (nullopt). Throws
+/// (.dump, .lammpstrj) and extended XYZ files with a Lattice have one,
+/// other formats none (nullopt). Throws
 /// InputError on a malformed header.
 std::optional<FileBox> read_file_box(const std::string& path);
 

@@ -1,0 +1,321 @@
+// XYZ files as chemistry and materials codes write them (ASE, OVITO, VMD,
+// LAMMPS's `dump xyz`), and extended XYZ (ASE's and libAtoms' extxyz):
+//
+//   N                                   the number of atoms
+//   comment                             free text, possibly empty; in
+//                                       extended XYZ key=value pairs:
+//                                       Lattice="ax ay az bx by bz cx cy cz"
+//                                       Properties=species:S:1:pos:R:3:...
+//                                       pbc="T T F", Origin="x y z"
+//   N lines: species x y z [more]       (extended: the Properties' columns)
+//
+// A trajectory repeats the block; the first frame is read. Without
+// Properties the columns are a species name and the position. Properties
+// name each column group as name:type:count, type S (text), R (real),
+// I (integer) or L (logical); pos (R:3) gives the position, an I:1 property
+// can be labels and an R:1 or I:1 one scalars (radii).
+//
+// The box: Lattice's rows are the cell vectors a, b, c from Origin (0 when
+// absent); pbc defaults to T T T where a Lattice is given (the extxyz
+// convention). tessera's boxes are a = (Lx, 0, 0), b = (xy, Ly, 0),
+// c = (xz, yz, Lz): a cell in another orientation would have to be rotated,
+// points and all, and is refused with that said.
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <limits>
+#include <memory>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "io_detail.hpp"
+#include "tessera/cells.hpp"
+#include "tessera/io/points.hpp"
+#include "text_fields.hpp"
+
+namespace tessera::io::detail {
+namespace {
+
+/// Raw lines, empty ones included (an XYZ comment may be empty); '\r' and a
+/// UTF-8 BOM stripped.
+class RawLines {
+ public:
+  explicit RawLines(std::string_view text) : p_(text.data()), end_(text.data() + text.size()) {
+    if (text.substr(0, 3) == "\xEF\xBB\xBF") p_ += 3;
+  }
+  bool next(std::string_view& line) {
+    if (p_ >= end_) return false;
+    const char* nl = static_cast<const char*>(std::memchr(p_, '\n', static_cast<std::size_t>(end_ - p_)));
+    const char* e = nl ? nl : end_;
+    line = std::string_view(p_, static_cast<std::size_t>(e - p_));
+    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+    p_ = nl ? nl + 1 : end_;
+    ++number_;
+    return true;
+  }
+  std::size_t number() const { return number_; }
+
+ private:
+  const char* p_;
+  const char* end_;
+  std::size_t number_ = 0;
+};
+
+/// `line` as a lone count (an XYZ file's first line), if it is one.
+std::optional<std::size_t> lone_count(std::string_view line) {
+  const std::string_view t = trim(line);
+  std::size_t n = 0;
+  auto [p, ec] = std::from_chars(t.data(), t.data() + t.size(), n);
+  if (t.empty() || ec != std::errc() || p != t.data() + t.size()) return std::nullopt;
+  return n;
+}
+
+/// One column group of Properties: name, type letter, first column, count.
+struct Property {
+  std::string name;
+  char type = 'R';
+  std::size_t column = 0, count = 1;
+};
+
+struct XyzHeader {
+  std::size_t atoms = 0;
+  std::vector<Property> properties;
+  std::size_t columns = 0;                 // fields per atom line
+  std::optional<FileBox> box;
+};
+
+/// The comment line's key=value pairs (values bare or in double quotes);
+/// keys lowercased. A comment that is plain text gives pairs of nothing.
+std::vector<std::pair<std::string, std::string>> key_values(std::string_view s) {
+  std::vector<std::pair<std::string, std::string>> kv;
+  std::size_t i = 0;
+  while (i < s.size()) {
+    while (i < s.size() && is_blank(s[i])) ++i;
+    const std::size_t k0 = i;
+    while (i < s.size() && s[i] != '=' && !is_blank(s[i])) ++i;
+    if (i >= s.size() || s[i] != '=') continue;  // a word with no value
+    std::string key = lower(s.substr(k0, i - k0));
+    ++i;
+    std::string value;
+    if (i < s.size() && s[i] == '"') {
+      const std::size_t close = s.find('"', i + 1);
+      const std::size_t e = close == std::string_view::npos ? s.size() : close;
+      value = std::string(s.substr(i + 1, e - i - 1));
+      i = e + 1;
+    } else {
+      const std::size_t v0 = i;
+      while (i < s.size() && !is_blank(s[i])) ++i;
+      value = std::string(s.substr(v0, i - v0));
+    }
+    kv.emplace_back(std::move(key), std::move(value));
+  }
+  return kv;
+}
+
+std::vector<double> numbers(const std::string& path, const std::string& what, const std::string& value,
+                            std::size_t want) {
+  std::vector<double> v;
+  Fields fs(value, ' ');
+  std::string_view f;
+  double x = 0;
+  while (fs.next(f)) {
+    if (!parse_double(f, x) || !std::isfinite(x)) fail(path, "line 2: " + what + " holds '" + std::string(f) + "', not a finite number");
+    v.push_back(x);
+  }
+  if (v.size() != want)
+    fail(path, "line 2: " + what + " needs " + std::to_string(want) + " numbers, got " + std::to_string(v.size()));
+  return v;
+}
+
+XyzHeader read_header(const std::string& path, RawLines& lines) {
+  XyzHeader h;
+  std::string_view line;
+  if (!lines.next(line)) fail(path, "no points");
+  const std::optional<std::size_t> n = lone_count(line);
+  if (!n) fail(path, "not an XYZ file: its first line is not the number of atoms");
+  if (*n == 0) fail(path, "no points (the XYZ frame has 0 atoms)");
+  if (*n > (std::size_t{1} << 31) - 1) fail(path, "more than 2^31 - 1 atoms (point ids are int32)");
+  h.atoms = *n;
+  if (!lines.next(line)) fail(path, "the file ends before the comment line");
+  const auto kv = key_values(line);
+  auto find = [&](const char* key) -> const std::string* {
+    for (const auto& [k, v] : kv)
+      if (k == key) return &v;
+    return nullptr;
+  };
+  // Columns: Properties, or a species name and the position.
+  if (const std::string* props = find("properties")) {
+    std::vector<std::string> parts;
+    std::size_t from = 0;
+    for (std::size_t c = 0; c <= props->size(); ++c)
+      if (c == props->size() || (*props)[c] == ':') {
+        parts.push_back(props->substr(from, c - from));
+        from = c + 1;
+      }
+    if (parts.size() % 3 != 0) fail(path, "line 2: Properties must be name:type:count triples, got '" + *props + "'");
+    for (std::size_t k = 0; k < parts.size(); k += 3) {
+      Property p;
+      p.name = parts[k];
+      const std::string type = parts[k + 1];
+      std::size_t count = 0;
+      const std::string& cs = parts[k + 2];
+      auto [q, ec] = std::from_chars(cs.data(), cs.data() + cs.size(), count);
+      if (type.size() != 1 || std::string("SRIL").find(type[0]) == std::string::npos || ec != std::errc() ||
+          q != cs.data() + cs.size() || count == 0 || count > 1000)
+        fail(path, "line 2: Properties entry '" + p.name + ":" + type + ":" + cs + "' is not name:S|R|I|L:count");
+      p.type = type[0];
+      p.count = count;
+      p.column = h.columns;
+      h.columns += count;
+      h.properties.push_back(p);
+    }
+  } else {
+    h.properties = {{"species", 'S', 0, 1}, {"pos", 'R', 1, 3}};
+    h.columns = 4;
+  }
+  if (const std::string* lattice = find("lattice")) {
+    const std::vector<double> v = numbers(path, "Lattice", *lattice, 9);
+    FileBox b;
+    if (v[1] != 0 || v[2] != 0 || v[5] != 0 || !(v[0] > 0 && v[4] > 0 && v[8] > 0))
+      fail(path, "line 2: the Lattice's cell must have a along +x and b in the xy plane (ay = az = bz = 0, and "
+                 "ax, by, cz > 0), as LAMMPS's and tessera's boxes; rotate the cell and the atoms to that "
+                 "orientation, or give --bounds");
+    std::vector<double> origin = {0, 0, 0};
+    if (const std::string* o = find("origin")) origin = numbers(path, "Origin", *o, 3);
+    b.periodic = {true, true, true};
+    if (const std::string* pbc = find("pbc")) {
+      Fields fs(*pbc, ' ');
+      std::string_view f;
+      std::size_t a = 0;
+      for (; fs.next(f); ++a) {
+        const std::string w = lower(f);
+        const bool t = w == "t" || w == "true" || w == "1", no = w == "f" || w == "false" || w == "0";
+        if (a >= 3 || (!t && !no)) fail(path, "line 2: pbc must be three of T and F, got '" + *pbc + "'");
+        b.periodic[a] = t;
+      }
+      if (a != 3) fail(path, "line 2: pbc must be three of T and F, got '" + *pbc + "'");
+    }
+    for (std::size_t a = 0; a < 3; ++a) {
+      b.lo[a] = origin[a];
+      b.hi[a] = origin[a] + v[a * 4];  // the diagonal: ax, by, cz
+    }
+    b.tilt = {v[3], v[6], v[7]};     // bx, cx, cy
+    b.triclinic = v[3] != 0 || v[6] != 0 || v[7] != 0;
+    b.declared_by = "extended XYZ Lattice";
+    h.box = b;
+  }
+  return h;
+}
+
+const Property* find_property(const XyzHeader& h, const std::string& name) {
+  for (const Property& p : h.properties)
+    if (p.name == name) return &p;
+  return nullptr;
+}
+
+/// The column of the one-value property `name` of a type in `types`.
+std::size_t property_column(const std::string& path, const XyzHeader& h, const std::string& name, const char* types,
+                            const char* what) {
+  const Property* p = find_property(h, name);
+  if (p == nullptr) {
+    std::vector<std::string> names;
+    for (const Property& q : h.properties) names.push_back(q.name);
+    fail(path, "no property '" + name + "' for " + what + " (properties: " + quoted_list(names) + ")");
+  }
+  if (p->count != 1 || std::string(types).find(p->type) == std::string::npos)
+    fail(path, "property '" + name + "' for " + what + " is " + std::string(1, p->type) + ":" +
+                   std::to_string(p->count) + "; need " + (std::string(types) == "I" ? "I:1 (integers)" : "R:1 or I:1"));
+  return p->column;
+}
+
+/// The atom lines' values of `cols`, atoms × cols.
+std::vector<double> atom_values(const std::string& path, RawLines& lines, const XyzHeader& h,
+                                const std::vector<std::size_t>& cols) {
+  std::vector<double> out(h.atoms * cols.size());
+  std::vector<std::string_view> f(h.columns);
+  std::string_view line;
+  // Plain XYZ lines may carry more columns (velocities) than the four read.
+  const bool plain = h.properties.size() == 2 && h.properties[0].name == "species" && h.columns == 4;
+  for (std::size_t k = 0; k < h.atoms; ++k) {
+    if (!lines.next(line))
+      fail(path, "the frame ends after " + std::to_string(k) + " of its " + std::to_string(h.atoms) + " atoms");
+    Fields fs(line, ' ');
+    std::size_t got = 0;
+    std::string_view field;
+    while (fs.next(field) && got <= f.size())
+      if (got++ < f.size()) f[got - 1] = field;
+    if (got < f.size() || (got > f.size() && !plain))
+      fail(path, "line " + std::to_string(lines.number()) + ": expected " + std::to_string(f.size()) +
+                     " values per atom, got " + std::to_string(got));
+    for (std::size_t c = 0; c < cols.size(); ++c)
+      if (!parse_double(f[cols[c]], out[k * cols.size() + c]))
+        fail(path, "line " + std::to_string(lines.number()) + ": '" + std::string(f[cols[c]]) + "' is not a number");
+  }
+  return out;
+}
+
+}  // namespace
+
+bool looks_like_xyz(std::string_view text) {
+  // A lone count, any comment, then an atom line of a position at least (a
+  // column of single numbers is a one-column point file, refused as such).
+  RawLines lines(text);
+  std::string_view first, comment, atom;
+  if (!lines.next(first) || !lone_count(first) || !lines.next(comment) || !lines.next(atom)) return false;
+  Fields fs(atom, ' ');
+  std::string_view f;
+  int fields = 0;
+  while (fields < 3 && fs.next(f)) ++fields;
+  return fields >= 3;
+}
+
+PointCloud read_xyz_points(const std::string& path, std::string_view text, const ReadOptions& options,
+                           const std::string& label_column) {
+  RawLines lines(text);
+  const XyzHeader h = read_header(path, lines);
+  const int dim = options.dim == 0 ? 3 : options.dim;
+  const Property* pos = find_property(h, "pos");
+  if (pos == nullptr || pos->type != 'R' || pos->count != 3)
+    fail(path, "line 2: Properties has no pos:R:3 (the positions)");
+  std::vector<std::size_t> cols;
+  for (int a = 0; a < dim; ++a) cols.push_back(pos->column + static_cast<std::size_t>(a));
+  if (!label_column.empty()) cols.push_back(property_column(path, h, label_column, "I", "labels"));
+  if (dim == 2 && h.box && (h.box->tilt[1] != 0 || h.box->tilt[2] != 0))
+    fail(path, "--dim 2: the Lattice tilts along z (cx, cy not 0); a 2D box has the xy tilt only");
+  const std::vector<double> v = atom_values(path, lines, h, cols);
+  PointCloud pc;
+  pc.dim = dim;
+  pc.n = h.atoms;
+  pc.coords.resize(pc.n * static_cast<std::size_t>(dim));
+  for (std::size_t k = 0; k < pc.n; ++k)
+    for (int a = 0; a < dim; ++a)
+      pc.coords[k * static_cast<std::size_t>(dim) + static_cast<std::size_t>(a)] = v[k * cols.size() + static_cast<std::size_t>(a)];
+  if (!label_column.empty()) {
+    pc.labels.resize(pc.n);
+    for (std::size_t k = 0; k < pc.n; ++k) {
+      const double l = v[k * cols.size() + static_cast<std::size_t>(dim)];
+      if (!(l == std::floor(l) && l >= std::numeric_limits<std::int32_t>::min() &&
+            l <= std::numeric_limits<std::int32_t>::max()))
+        fail(path, "labels '" + label_column + "' of atom " + std::to_string(k) + " are not an int32");
+      pc.labels[k] = static_cast<std::int32_t>(l);
+    }
+  }
+  return pc;
+}
+
+std::vector<double> read_xyz_column(const std::string& path, std::string_view text, const std::string& name) {
+  RawLines lines(text);
+  const XyzHeader h = read_header(path, lines);
+  return atom_values(path, lines, h, {property_column(path, h, name, "RI", "scalars")});
+}
+
+std::optional<FileBox> read_xyz_box(const std::string& path, std::string_view head) {
+  RawLines lines(head);
+  return read_header(path, lines).box;
+}
+
+}  // namespace tessera::io::detail

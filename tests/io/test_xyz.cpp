@@ -1,0 +1,109 @@
+// XYZ files (chemistry's: count, comment, species and positions) and
+// extended XYZ (Properties, Lattice, pbc, Origin): points, labels and
+// scalars from properties, the box, and the errors.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <string>
+#include <vector>
+
+#include "io/io_test_util.hpp"
+#include "tessera/io/points.hpp"
+
+using namespace tessera_test;
+using tessera::io::read_file_box;
+using tessera::io::read_point_scalars;
+using tessera::io::read_points;
+using tessera::io::ReadOptions;
+
+TEST(Xyz, PlainFramesAndEmptyComment) {
+  TempDir dir;
+  // An empty comment line, CRLF endings, velocities after the positions,
+  // and a second frame (a trajectory: the first is read).
+  const std::string text =
+      "3\r\n\r\nO 0.0 0.0 0.125 1 2 3\r\nH 0.757 0.586 0.0\r\nH -0.757 0.586 0.5\r\n"
+      "1\r\nnext frame\r\nO 9 9 9\r\n";
+  for (const char* name : {"w.xyz", "w.txt"}) {
+    const std::string p = dir.write(name, text);
+    const auto pc = read_points(p);
+    ASSERT_EQ(pc.n, 3u);
+    EXPECT_EQ(pc.coords, (std::vector<double>{0, 0, 0.125, 0.757, 0.586, 0, -0.757, 0.586, 0.5}));
+    EXPECT_FALSE(read_file_box(p).has_value());  // no Lattice: the default domain
+  }
+  ReadOptions two;
+  two.dim = 2;
+  EXPECT_EQ(read_points(dir.write("w2.xyz", text), two).coords, (std::vector<double>{0, 0, 0.757, 0.586, -0.757, 0.586}));
+  // A comment that is free text with an '=' in it is still a comment.
+  EXPECT_EQ(read_points(dir.write("c.xyz", "1\nE = -76.4 eV, a=b\nO 1 2 3\n")).n, 1u);
+}
+
+TEST(Xyz, ExtendedLatticePropertiesAndPbc) {
+  TempDir dir;
+  const std::string text =
+      "3\n"
+      "Lattice=\"4.0 0.0 0.0 1.5 5.0 0.0 -0.5 0.75 6.0\" Origin=\"-1 0.5 2\" "
+      "Properties=species:S:1:tag:I:1:pos:R:3:radius:R:1 pbc=\"T F T\" energy=-3.5\n"
+      "Cu 7 0.5 1 2.5 0.25\n"
+      "Ni 3 -0.75 4 7.5 0.5\n"
+      "Cu 7 2.25 0.5 3 0.125\n";
+  const std::string p = dir.write("e.xyz", text);
+  const auto pc = read_points(p, labels("tag"));
+  EXPECT_EQ(pc.coords, (std::vector<double>{0.5, 1, 2.5, -0.75, 4, 7.5, 2.25, 0.5, 3}));
+  EXPECT_EQ(pc.labels, (std::vector<std::int32_t>{7, 3, 7}));
+  EXPECT_EQ(read_point_scalars(p, "radius"), (std::vector<double>{0.25, 0.5, 0.125}));
+  EXPECT_EQ(read_point_scalars(p, "tag"), (std::vector<double>{7, 3, 7}));
+  const auto box = read_file_box(p);
+  ASSERT_TRUE(box.has_value());
+  EXPECT_EQ(box->lo, (std::array<double, 3>{-1, 0.5, 2}));
+  EXPECT_EQ(box->hi, (std::array<double, 3>{3, 5.5, 8}));
+  EXPECT_EQ(box->tilt, (std::array<double, 3>{1.5, -0.5, 0.75}));
+  EXPECT_EQ(box->periodic, (std::array<bool, 3>{true, false, true}));
+  EXPECT_TRUE(box->triclinic);
+  EXPECT_EQ(box->declared_by, "extended XYZ Lattice");
+  // Without pbc a Lattice is periodic on every axis; without Origin it starts at 0.
+  const auto b2 = read_file_box(dir.write("o.xyz", "1\nLattice=\"2 0 0 0 3 0 0 0 4\"\nAr 1 1 1\n"));
+  ASSERT_TRUE(b2.has_value());
+  EXPECT_EQ(b2->lo, (std::array<double, 3>{0, 0, 0}));
+  EXPECT_EQ(b2->hi, (std::array<double, 3>{2, 3, 4}));
+  EXPECT_EQ(b2->periodic, (std::array<bool, 3>{true, true, true}));
+  EXPECT_FALSE(b2->triclinic);
+}
+
+TEST(Xyz, Errors) {
+  TempDir dir;
+  struct Case {
+    std::string text, expect;
+  };
+  const std::vector<Case> cases = {
+      {"2\n\nC 0 0 0\n", "ends after 1 of its 2 atoms"},
+      {"2\n\nC 0 0 0\nC 0 0\n", "line 4: expected 4 values per atom, got 3"},
+      {"1\n\nC 0 zero 0\n", "'zero' is not a number"},
+      {"1\nProperties=species:S:1:pos:R\nC 0 0 0\n", "name:type:count triples"},
+      {"1\nProperties=species:S:1:pos:X:3\nC 0 0 0\n", "is not name:S|R|I|L:count"},
+      {"1\nProperties=species:S:1:position:R:3\nC 0 0 0\n", "no pos:R:3"},
+      {"1\nProperties=species:S:1:pos:R:3:q:R:1\nC 0 0 0\n", "expected 5 values per atom, got 4"},
+      {"1\nLattice=\"1 0 0 0 1\"\nC 0 0 0\n", "Lattice needs 9 numbers, got 5"},
+      {"1\nLattice=\"1 0 0 0 1 0 0 0 inf\"\nC 0 0 0\n", "not a finite number"},
+      {"1\nLattice=\"0.7 0.7 0 -0.7 0.7 0 0 0 1\"\nC 0 0 0\n", "rotate the cell"},
+      {"1\nLattice=\"1 0 0 0 1 0 0 0 1\" pbc=\"T T\"\nC 0 0 0\n", "pbc must be three of T and F"},
+      {"1\nLattice=\"1 0 0 0 1 0 0 0 1\" pbc=\"T T yes\"\nC 0 0 0\n", "pbc must be three of T and F"},
+      {"1\n\nC 0 0 nan\n", "non-finite coordinate"},
+  };
+  for (const Case& c : cases) {
+    const std::string p = dir.write("e.xyz", c.text);
+    const std::string msg = input_error([&] {
+      read_file_box(p);
+      read_points(p);
+    });
+    EXPECT_NE(msg.find(c.expect), std::string::npos) << c.text << "\n-> " << msg;
+    EXPECT_EQ(msg.rfind(p, 0), 0u) << msg;
+  }
+  const std::string p = dir.write("l.xyz", "2\nProperties=species:S:1:pos:R:3:q:R:1\nC 0 0 0 0.5\nO 1 1 1 1\n");
+  EXPECT_NE(input_error([&] { read_points(p, labels("q")); }).find("is R:1; need I:1"), std::string::npos);
+  EXPECT_NE(input_error([&] { read_points(p, labels("species")); }).find("is S:1; need I:1"), std::string::npos);
+  EXPECT_NE(input_error([&] { read_points(p, labels("tag")); }).find("no property 'tag'"), std::string::npos);
+  EXPECT_NE(input_error([&] { read_point_scalars(p, "species"); }).find("need R:1 or I:1"), std::string::npos);
+  // A column of single numbers is a one-column point file, not XYZ.
+  EXPECT_NE(input_error([&] { read_points(dir.write("one.xyz", "1\n2\n3\n4\n")); }).find("1 coordinate column"),
+            std::string::npos);
+}
