@@ -297,6 +297,16 @@ def test_lammps_dump_points_and_box(tmp_path):
         tessera.read_box(path, dim=2)
     np.save(tmp_path / "p.npy", p)
     assert tessera.read_box(tmp_path / "p.npy") is None
+    # The same cell as an extended XYZ's Lattice (rows a, b, c) and Origin.
+    with open(tmp_path / "run.xyz", "w") as f:
+        f.write("300\nLattice=\"%s\" Origin=\"%s\" Properties=species:S:1:pos:R:3:type:I:1\n" % (
+            " ".join(repr(v) for v in vec.ravel()), " ".join(repr(v) for v in lo)))
+        for k, q in enumerate(p):
+            f.write("Ar %r %r %r %d\n" % (q[0], q[1], q[2], types[k]))
+    q, t = tessera.read_points(tmp_path / "run.xyz", labels="type")
+    np.testing.assert_array_equal(q, p)
+    np.testing.assert_array_equal(t, types)
+    assert tessera.read_box(tmp_path / "run.xyz") == box
     with open(tmp_path / "bad.dump", "w") as f:
         f.write("ITEM: TIMESTEP\n5\nITEM: NUMBER OF ATOMS\n1\nITEM: BOX BOUNDS pp pp\n0 1\n0 1\n0 1\n")
     with pytest.raises(ValueError, match="three boundary flags"):
