@@ -169,7 +169,10 @@ class Delaunay:
         """float64 (nsimplex, D+1, D): affine maps to barycentric coordinates,
         as scipy's: for a point ``x`` in simplex ``s``,
         ``c = transform[s, :D] @ (x - transform[s, D])`` gives the first D
-        coordinates and ``1 - c.sum()`` the last. Computed on first use."""
+        coordinates and ``1 - c.sum()`` the last. Computed on first use.
+        A simplex too thin for its matrix to be inverted in doubles (points
+        an ulp apart: exactly non-flat, singular once rounded) gets NaN rows,
+        as scipy gives its degenerate simplices."""
         if self.is_periodic:
             raise ValueError("transform: not available for a periodic triangulation (its simplices meet images)")
         if self._transform is None:
@@ -177,8 +180,17 @@ class Delaunay:
             v = self.points[self.simplices]  # (m, D+1, D)
             t = np.empty((len(v), d + 1, d))
             t[:, d, :] = v[:, d, :]
-            # Columns v_k - v_D; a positively oriented simplex is never flat.
-            t[:, :d, :] = np.linalg.inv(np.transpose(v[:, :d, :] - v[:, d:, :], (0, 2, 1)))
+            # Columns v_k - v_D. A positively oriented simplex is never flat,
+            # but its LU factors may round to a zero pivot, where inv would
+            # raise: slogdet (the same factorisation, and no underflow at
+            # tiny scales) has sign 0 exactly there.
+            m = np.transpose(v[:, :d, :] - v[:, d:, :], (0, 2, 1))
+            ok = np.linalg.slogdet(m)[0] != 0 if len(m) else np.zeros(0, dtype=bool)
+            t[:, :d, :] = np.nan
+            if ok.all():
+                t[:, :d, :] = np.linalg.inv(m)
+            elif ok.any():
+                t[ok, :d, :] = np.linalg.inv(m[ok])
             t.setflags(write=False)
             self._transform = t
         return self._transform

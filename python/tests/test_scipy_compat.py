@@ -171,6 +171,26 @@ def test_find_simplex_and_transform_match_scipy(dim):
     assert (dt.find_simplex(pts) == dt.vertex_to_simplex).all()
 
 
+def test_transform_of_simplices_too_thin_for_doubles():
+    # Exactly non-flat, but the rounded LU of v_k - v_D has a zero pivot
+    # (points an ulp apart): NaN rows there, as scipy's degenerate
+    # simplices, and the others finite (numpy's inv raised for all).
+    h = ["0x1.d1a94e3d7d0d3p-1", "0x1.3cf7a4fa23980p-6", "0x1.d1a94e3d7d0d2p-1", "0x1.3cf7a4fa23981p-6",
+         "0x1.7fa9ec5aac111p-5", "0x1.34a72e6f75a1fp-5"]
+    thin = np.array([float.fromhex(x) for x in h]).reshape(3, 2)
+    dt = tessera.delaunay(thin)
+    assert dt.validate() and dt.nsimplex == 1
+    t = dt.transform
+    assert np.isnan(t[0, :2]).all() and (t[0, 2] == thin[dt.simplices[0, 2]]).all()
+    pts = np.r_[thin, random_points(40, 2, seed=4) * 0.01 + 0.5]
+    dt = tessera.delaunay(pts)
+    t = dt.transform
+    bad = np.isnan(t[:, :2]).any(axis=(1, 2))
+    assert bad.sum() >= 1 and np.isfinite(t[~bad]).all()
+    # Tiny scales: no underflow of the test (det ~1e-480), every row finite.
+    assert np.isfinite(tessera.delaunay(random_points(50, 3, seed=5) * 1e-160).transform).all()
+
+
 def test_find_simplex_with_labels_holes_and_bad_queries():
     pts = random_points(3000, 3, seed=90)
     r2 = ((pts - 0.5) ** 2).sum(axis=1)
