@@ -448,25 +448,29 @@ Delaunay run(std::span<const double> input, std::span<const std::int32_t> labels
     // builds the same rows from no box at all.
     return by_insertion(pass, before_cells);
   }
-  if (none_found && attempt < 2) {
-    // Every circumcentre lies outside the box (a handful of points, or nearly
-    // flat input), so completion has no found simplex to start from. The
-    // triangulation does not depend on the box: run again in a box 2^20, then
-    // 2^50 times larger, and complete the rest from there. Costly (every cell
-    // then reaches across the set: 2,000 points flat to an ulp take ~6 s)
-    // but reached only on such inputs, and cheaper there than wrapping the
-    // whole triangulation from one seed (below: ~36 s on those points,
-    // whose slivers' balls are too ill-conditioned to prune the search).
+  // Every circumcentre lies outside the box (a handful of points, or nearly
+  // flat input), so completion has no found simplex to start from. The
+  // triangulation does not depend on the box: run again in a box 2^20, then
+  // 2^50 times larger, and complete the rest from there. Costly (every cell
+  // then reaches across the set: 2,000 points flat to an ulp take ~6 s)
+  // but reached only on such inputs, and cheaper there than wrapping the
+  // whole triangulation from one seed (below: ~36 s on those points,
+  // whose slivers' balls are too ill-conditioned to prune the search).
+  // Near the end of double's range (points at 1e300) the larger box would
+  // not be finite: the seeded wrap below takes it from this one.
+  Bounds b = pass.user_bounds;
+  bool finite = true;
+  for (int d = 0; d < D; ++d) {
+    auto du = static_cast<std::size_t>(d);
+    double mid = 0.5 * (b.lo[du] + b.hi[du]), half = 0.5 * (b.hi[du] - b.lo[du]);
+    const double grow = attempt == 0 ? 0x1p20 : 0x1p50;
+    b.lo[du] = mid - grow * half;
+    b.hi[du] = mid + grow * half;
+    finite &= std::isfinite(b.lo[du]) && std::isfinite(b.hi[du]) && std::isfinite(b.hi[du] - b.lo[du]);
+  }
+  if (none_found && attempt < 2 && finite) {
     DelaunayOptions big = opt;
     big.progress = nullptr;
-    Bounds b = pass.user_bounds;
-    for (int d = 0; d < D; ++d) {
-      auto du = static_cast<std::size_t>(d);
-      double mid = 0.5 * (b.lo[du] + b.hi[du]), half = 0.5 * (b.hi[du] - b.lo[du]);
-      const double grow = attempt == 0 ? 0x1p20 : 0x1p50;
-      b.lo[du] = mid - grow * half;
-      b.hi[du] = mid + grow * half;
-    }
     big.bounds = b;
     big.ignore_outside_points = true;
     std::vector<double> kept;

@@ -696,6 +696,33 @@ TEST(Delaunay, NearlyFlatInput) {
   expect_valid(none, flat);
 }
 
+// Nearly flat input near the end of double's range: the cells pass finds no
+// circumcentre in the box, and its retry in a box 2^20 times larger would
+// overflow (it reported "bounds: x range [-inf, inf]"; a fuzz of the Python
+// module found it). The seeded wrap takes it from the box itself: the
+// insertion's rows, and CGAL's (scale-free, so on the unscaled points).
+TEST(Delaunay, NearlyFlatInputNearTheEndOfTheRange) {
+  for (const double scale : {1e300, 0x1p1020}) {
+    const std::vector<std::vector<double>> inputs = {
+        {0, 0, 1, 0, 0.5, 1e-12, 0.3, -1e-12},
+        {0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 1e-9, 0.5, 0.5, 0.3e-9, 0.25, 0.75, -0.2e-9}};
+    for (const auto& unit : inputs) {
+      const int dim = unit.size() == 8 ? 2 : 3;
+      std::vector<double> p(unit);
+      for (double& x : p) x *= scale;
+      tessera::DelaunayOptions o;
+      o.method = tessera::DelaunayMethod::cells;
+      const tessera::Delaunay cells = tessera::delaunay(p, dim, {}, o);
+      o.method = tessera::DelaunayMethod::insertion;
+      const tessera::Delaunay ins = tessera::delaunay(p, dim, {}, o);
+      ASSERT_GT(cells.n_simplices(), 0u) << scale;
+      EXPECT_EQ(as_set(cells), as_set(ins)) << scale;
+      EXPECT_EQ(as_set(cells), cgal_simplices(unit, dim)) << scale;
+      expect_valid(cells, p);
+    }
+  }
+}
+
 // Exactly flat input, tilted so the domain box has depth: no simplex. The
 // cells pass finds none, and the retry in boxes 2^20 and 2^50 larger made
 // every cell reach across the whole set (2,170 points took 61 s; the fuzz
