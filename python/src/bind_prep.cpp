@@ -39,8 +39,10 @@ using Geometry = std::optional<std::vector<double>>;
 // ---- images ---------------------------------------------------------------
 
 /// Spacing / origin overrides (x, y[, z] order, one value per axis, or one
-/// value for every axis).
-void apply_geometry(ImageGeometry& g, const Geometry& spacing, const Geometry& origin) {
+/// value for every axis), then the readers' check of the whole geometry
+/// (`what` names the image in its errors): voxel centres past double's
+/// range were returned as infinite points.
+void apply_geometry(ImageGeometry& g, const Geometry& spacing, const Geometry& origin, const std::string& what) {
   auto set = [&](const Geometry& v, std::array<double, 3>& out, const char* name) {
     if (!v) return;
     if (v->size() == 1) {
@@ -58,6 +60,7 @@ void apply_geometry(ImageGeometry& g, const Geometry& spacing, const Geometry& o
   for (int a = 0; a < g.dim; ++a)
     if (!(g.spacing[static_cast<std::size_t>(a)] > 0))
       throw py::value_error("spacing: must be positive, got " + std::to_string(g.spacing[static_cast<std::size_t>(a)]));
+  io::check_image_geometry(what, g);
 }
 
 /// Geometry of a C-ordered array of shape (ny, nx) or (nz, ny, nx): x fastest.
@@ -141,11 +144,12 @@ void check_threads(int threads) {
 }
 
 /// (points (n, dim), labels (n,) or None), both taking over the library's vectors.
+/// (points, labels) of sample_image and fill, whose points always carry
+/// labels: none at all is an int32 array of length 0, not None.
 py::tuple labelled_points(LabelledPoints&& lp) {
   const auto n = static_cast<py::ssize_t>(lp.size());
-  py::object labels = py::none();
-  if (!lp.labels.empty()) labels = adopt_flat(std::move(lp.labels));
-  return py::make_tuple(adopt(std::move(lp.coords), {n, static_cast<py::ssize_t>(lp.dim)}), labels);
+  return py::make_tuple(adopt(std::move(lp.coords), {n, static_cast<py::ssize_t>(lp.dim)}),
+                        adopt_flat(std::move(lp.labels)));
 }
 
 }  // namespace
@@ -174,7 +178,7 @@ void bind_prep(py::module_& m) {
       [](const py::array_t<std::int32_t, py::array::c_style>& a, const Geometry& spacing, const Geometry& origin) {
         LabelImage im;
         im.geometry = geometry_of(a);
-        apply_geometry(im.geometry, spacing, origin);
+        apply_geometry(im.geometry, spacing, origin, "image");
         im.labels.assign(a.data(), a.data() + a.size());
         return im;
       },
@@ -185,7 +189,7 @@ void bind_prep(py::module_& m) {
       [](const py::array_t<double, py::array::c_style>& a, const Geometry& spacing, const Geometry& origin) {
         ScalarImage im;
         im.geometry = geometry_of(a);
-        apply_geometry(im.geometry, spacing, origin);
+        apply_geometry(im.geometry, spacing, origin, "image");
         im.values.assign(a.data(), a.data() + a.size());
         return im;
       },
@@ -195,7 +199,7 @@ void bind_prep(py::module_& m) {
       "read_label_image",
       [](const std::string& path, const Geometry& spacing, const Geometry& origin) {
         LabelImage im = without_gil([&] { return io::read_label_image(path); });
-        apply_geometry(im.geometry, spacing, origin);
+        apply_geometry(im.geometry, spacing, origin, path);
         return im;
       },
       py::arg("path"), py::arg("spacing").none(true), py::arg("origin").none(true),
@@ -204,7 +208,7 @@ void bind_prep(py::module_& m) {
       "read_scalar_image",
       [](const std::string& path, const Geometry& spacing, const Geometry& origin) {
         ScalarImage im = without_gil([&] { return io::read_scalar_image(path); });
-        apply_geometry(im.geometry, spacing, origin);
+        apply_geometry(im.geometry, spacing, origin, path);
         return im;
       },
       py::arg("path"), py::arg("spacing").none(true), py::arg("origin").none(true),

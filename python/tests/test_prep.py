@@ -198,6 +198,26 @@ def test_sample_image_outputs_selection_and_background_label():
     assert len(a[0]) < len(full)
 
 
+def test_sample_image_edge_cases_from_the_fuzz(tmp_path):
+    # No points: labels are still an int32 array (were None).
+    p, l = tessera.sample_image(np.zeros((4, 4), np.int32))
+    assert p.shape == (0, 2) and l.dtype == np.int32 and l.shape == (0,)
+    a = np.zeros((3, 3, 3), np.int32)
+    a[1, 1, 1] = 1
+    p, l = tessera.sample_image(a, probability_range=(0, 0))
+    assert p.shape == (0, 3) and l.dtype == np.int32 and l.shape == (0,)
+    # Overridden geometry past double's range is refused as the command
+    # refuses it (voxel centres came back infinite).
+    np.save(tmp_path / "a.npy", a)
+    for source in (a, tmp_path / "a.npy"):
+        with pytest.raises(ValueError, match="pass double's range"):
+            tessera.sample_image(source, spacing=1e308, randomize=False)
+    with pytest.raises(ValueError, match="pass double's range"):
+        tessera.probe(a.astype(float), [[1.5e308, 0, 0]], spacing=1e308)
+    with pytest.raises(ValueError, match="pass double's range"):
+        tessera.read_image(tmp_path / "a.npy", spacing=(1, 1e308, 1))
+
+
 def test_sample_image_2d_from_a_file_and_joggle(tmp_path):
     im = np.zeros((30, 40), dtype=np.uint8)
     im[10:20, 5:35] = 3

@@ -322,6 +322,8 @@ RawImage read_raw(const std::string& path, const ImageReadOptions& options, bool
 
 }  // namespace
 
+void check_image_geometry(const std::string& what, const ImageGeometry& g) { detail::check_geometry(what, g); }
+
 LabelImage read_label_image(const std::string& path, const ImageReadOptions& options) {
   RawImage raw = read_raw(path, options, true);
   if (detail::is_float(raw.type))

@@ -41,6 +41,13 @@ struct ImageReadOptions {
 /// header says, non-integer data, or values out of int32 range.
 LabelImage read_label_image(const std::string& path, const ImageReadOptions& options = {});
 
+/// Throws tessera::InputError ("WHAT: ...", one line) unless `g` is a
+/// geometry the image tools can use: 2D or 3D, 1 to 2^40 voxels, finite
+/// spacing > 0, finite origin, and every voxel centre (with the half voxel
+/// around it) within double's range. The readers check what they read;
+/// callers that build a geometry or override one check it here.
+void check_image_geometry(const std::string& what, const ImageGeometry& g);
+
 /// Any numeric image, converted to double. Same errors as read_label_image
 /// (float data is accepted; NaN is kept and probes as NaN).
 ScalarImage read_scalar_image(const std::string& path, const ImageReadOptions& options = {});
