@@ -14,6 +14,7 @@
 #include <span>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "tessera/buffer.hpp"
@@ -27,10 +28,20 @@ struct Bounds {
   double volume(int dim) const;  ///< area in 2D
 };
 
+/// `message` as one printable line of valid UTF-8: line breaks and tabs
+/// become spaces, other control bytes (NUL included) and bytes that are not
+/// UTF-8 become '?'. Error messages quote file contents (a header's keys,
+/// a field's text), which may be any bytes: raw, they reached the terminal
+/// as such, and Python could not decode them (an empty message).
+std::string one_printable_line(std::string_view message);
+
 /// Invalid input (shape, NaN, bounds, labels...). The message is one line
-/// naming the problem; the CLI prints it and exits non-zero.
+/// naming the problem (one_printable_line); the CLI prints it and exits
+/// non-zero.
 struct InputError : std::runtime_error {
-  using std::runtime_error::runtime_error;
+  explicit InputError(std::string_view message) : std::runtime_error(one_printable_line(message)) {}
+  explicit InputError(const std::string& message) : InputError(std::string_view(message)) {}
+  explicit InputError(const char* message) : InputError(std::string_view(message)) {}
 };
 
 /// Raised from a progress callback to cancel a run (e.g. Ctrl-C in Python).

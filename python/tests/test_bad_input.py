@@ -66,3 +66,15 @@ def test_library_checks_raise_input_error_a_value_error():
     assert issubclass(tessera.InputError, ValueError)
     with pytest.raises(tessera.InputError, match="NaN"):
         tessera.voronoi(with_nan(P3))
+
+
+def test_errors_quoting_bad_bytes_keep_their_message(tmp_path):
+    # A header with a byte that is not UTF-8: the message (which quotes it)
+    # was empty in Python; now the byte shows as '?'.
+    np.save(tmp_path / "a.npy", np.zeros((2, 3)))
+    raw = bytearray((tmp_path / "a.npy").read_bytes())
+    raw[raw.index(b"fortran_order") + 2] = 0xFF
+    (tmp_path / "b.npy").write_bytes(bytes(raw))
+    for call in (tessera.read_image, tessera.read_points):
+        with pytest.raises(tessera.InputError, match=r"unexpected key 'fo\?tran_order'"):
+            call(tmp_path / "b.npy")

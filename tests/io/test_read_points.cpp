@@ -84,3 +84,24 @@ TEST(ReadPoints, NonFiniteInNpyNamesRow) {
   auto msg = input_error([&] { read_points(dir.write("p.npy", make_npy("<f8", "(2, 3)", raw_bytes(d)))); });
   EXPECT_NE(msg.find("row 1"), std::string::npos) << msg;
 }
+
+// Error messages quote file contents, which may be any bytes: one printable
+// line of valid UTF-8 (Python could not decode raw bytes and showed an
+// empty message; the terminal got them raw).
+TEST(ReadPoints, ErrorMessagesArePrintableUtf8) {
+  using tessera::one_printable_line;
+  EXPECT_EQ(one_printable_line("plain"), "plain");
+  EXPECT_EQ(one_printable_line("two\nlines\r\tand tab"), "two lines  and tab");
+  EXPECT_EQ(one_printable_line(std::string_view("nul\0here\x7f", 9)), "nul?here?");
+  EXPECT_EQ(one_printable_line("donn\xc3\xa9" "es \xe2\x82\xac \xf0\x9f\x98\x80"), "donn\xc3\xa9" "es \xe2\x82\xac \xf0\x9f\x98\x80");
+  EXPECT_EQ(one_printable_line("fo\xffr \xc3 \xe0\x80\x80 \xed\xa0\x80 \xf5\x80\x80\x80 \x80"), "fo?r ? ??? ??? ???? ?");
+  TempDir dir;
+  std::string header = make_npy("<f8", "(1, 3)", std::string(24, '\0'));
+  const std::size_t at = header.find("fortran_order");
+  ASSERT_NE(at, std::string::npos);
+  header[at + 2] = '\xff';
+  header[at + 3] = '\0';
+  const std::string msg = input_error([&] { read_points(dir.write("bad.npy", header)); });
+  EXPECT_NE(msg.find("unexpected key 'fo??ran_order'"), std::string::npos) << msg;
+  EXPECT_EQ(one_printable_line(msg), msg);
+}
