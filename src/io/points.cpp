@@ -40,6 +40,11 @@ void check_readable(const std::string& path) {
   }
   if (std::filesystem::is_directory(st))
     throw InputError("cannot open " + path + ": " + std::strerror(EISDIR));
+  // A device never ends (/dev/zero, /dev/urandom) or is a disk: read whole,
+  // it took all memory. Pipes and FIFOs end, and are read (<(command)).
+  if (std::filesystem::is_character_file(st) || std::filesystem::is_block_file(st) ||
+      std::filesystem::is_socket(st))
+    throw InputError("cannot read " + path + ": a device or socket, not a file");
 }
 
 std::string read_file_bytes(const std::string& path) {

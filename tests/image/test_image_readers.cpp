@@ -286,6 +286,14 @@ TEST_F(image_readers, NrrdMalformed) {
   const std::string nhdr = slurp(f("nhdr_gzip.nhdr"));
   d.write("gone.nhdr", replace(nhdr, "nhdr_gzip.raw.gz", "nothere.raw.gz"));
   expect_error(input_error([&] { read_label_image(d.file("gone.nhdr")); }), {"gone.nhdr", "cannot open data file", "nothere.raw.gz"});
+  // A data file, or the image itself, that never ends (a device): refused at
+  // once, where it was read until memory ran out.
+  d.write("zero.nhdr", replace(nhdr, "nhdr_gzip.raw.gz", "/dev/zero"));
+  expect_error(input_error([&] { read_label_image(d.file("zero.nhdr")); }), {"zero.nhdr", "/dev/zero", "a device"});
+  std::filesystem::create_symlink("/dev/zero", d.path() / "endless.nrrd");
+  expect_error(input_error([&] { read_label_image(d.file("endless.nrrd")); }), {"endless.nrrd", "a device"});
+  std::filesystem::create_symlink("/dev/zero", d.path() / "endless.npy");
+  expect_error(input_error([&] { tessera::io::read_points(d.file("endless.npy")); }), {"endless.npy", "a device"});
   // Options that only .vti understands.
   ImageReadOptions o;
   o.array = "x";
