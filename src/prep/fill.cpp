@@ -90,6 +90,11 @@ Grid make_grid(int dim, const double* lo, const double* hi, std::size_t n, doubl
   for (int d = 0; d < dim; ++d) {
     g.lo[d] = lo[d];
     extent[d] = hi[d] - lo[d];
+    // Points spanning more than double's range: one infinite bin added
+    // nothing (uniform), or the adaptive grid's image refused its spacing.
+    if (!std::isfinite(extent[d]))
+      throw InputError(std::string("fill: the region's ") + axis_name(d) + " extent [" + num(lo[d]) + ", " +
+                       num(hi[d]) + "] overflows double: scale the points down");
   }
   const double target = std::max(1.0, static_cast<double>(n) / points_per_bin);
   if (target > kMaxBins) {

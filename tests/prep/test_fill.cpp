@@ -238,6 +238,25 @@ TEST(PrepFill, BinsAtDoubleResolutionAreAnError) {
       EXPECT_FALSE(out.coords[a] == wide[b] && out.coords[a + 1] == wide[b + 1]) << "added point " << a / 2;
 }
 
+TEST(PrepFill, RegionPastDoublesRangeIsAnError) {
+  // x from -1e308 to 1e308: the extent overflows. The uniform grid made one
+  // infinite bin and added nothing; the adaptive one refused its own image's
+  // spacing (a fuzz of the Python module found both).
+  const std::vector<double> p = {-1e308, 0, 1e308, 1, 0.5, 0.5};
+  for (const auto strategy : {tessera::FillStrategy::uniform, tessera::FillStrategy::adaptive}) {
+    FillOptions o;
+    o.strategy = strategy;
+    o.points_per_bin = 0.5;
+    try {
+      tessera::fill(p, 2, {}, o);
+      FAIL() << "a region past double's range was filled";
+    } catch (const tessera::InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("x extent [-1e+308, 1e+308] overflows double"), std::string::npos)
+          << e.what();
+    }
+  }
+}
+
 TEST(PrepFill, NonFinitePointsKeptUnbinnedWhenKept) {
   // Missing returns between the points: kept in place with their labels,
   // and the added points are those of the finite points alone (the same
