@@ -28,7 +28,9 @@ sizes, one sphere far beyond the box (radii up to 1e200 box lengths, whose
 squares overflow), all beyond it, and radii near 1e-300. Another quarter
 run in a periodic box a little larger than the points (some axes or all,
 sheared a third of the time where x and y are periodic): the cells by both
-methods, the periodic triangulation, graph and faces. Labelled cases also
+methods, the periodic triangulation, graph and faces; a third of the
+orthogonal ones again with the box declared by the file itself (a LAMMPS
+dump or an extended XYZ), which must give the same cells. Labelled cases also
 build their surface net; one in eight runs fill -> joggle -> voronoi, and
 one in eight cuts --bounds through the points (--ignore-outside).
 The only accepted failures are input errors: a zero extent (all points on
@@ -393,6 +395,8 @@ class Hostile(base.TempDirCase):
         for out in (nb, sh):
             self.assertTrue(np.array_equal(np.load(out["search"]), np.load(out["insertion"])),
                             "case %d (%s): periodic cells by search and by insertion differ" % (case, what))
+        if "--tilt" not in pc and case % 3 == 0 and np.all(np.isfinite(pts)):
+            self.check_file_box(case, d, pts, labels, bounds, axes, threads, nb["search"], sh["search"], what)
         if len(axes) == d and (labels is None or (np.load(labels) >= 0).all()):
             self.check(["delaunay"] + pc + ["--simplices", self.p("qt.npy"), "--validate"],
                        inp, labels, what, d, case, periodic=True)
@@ -400,6 +404,47 @@ class Hostile(base.TempDirCase):
             self.check(["graph"] + pc + lab + ["-o", self.p("qg.vtp")], inp, labels, what, d, case, periodic=True)
             self.check(["faces"] + pc + lab + ["-o", self.p("qf.vtp"), "--kind", "complex"],
                        inp, labels, what, d, case, periodic=True)
+
+    def check_file_box(self, case, d, pts, labels, bounds, axes, threads, nb, sh, what):
+        """The same periodic box declared by the input file itself, a LAMMPS
+        dump (even cases) or an extended XYZ (odd), its coordinates written
+        to round-trip: the cells' neighbours and shifts are the explicit
+        run's, with no --bounds/--periodic given."""
+        lo = [float(bounds[2 * a]) for a in range(d)] + ([] if d == 3 else [-0.5])
+        hi = [float(bounds[2 * a + 1]) for a in range(d)] + ([] if d == 3 else [0.5])
+        per = [("xyz"[a] in axes) for a in range(3)]
+        xyz = np.c_[pts, np.zeros(len(pts))] if d == 2 else pts
+        lab = np.load(labels) if labels else np.zeros(len(pts), dtype=np.int64)
+        if case % 2 == 0:
+            path = self.p("box%d.dump" % case)
+            with open(path, "w") as f:
+                f.write("ITEM: TIMESTEP\n%d\nITEM: NUMBER OF ATOMS\n%d\nITEM: BOX BOUNDS %s\n" % (
+                    case, len(pts), " ".join("pp" if q else "ff" for q in per)))
+                for a in range(3):
+                    f.write("%r %r\n" % (lo[a], hi[a]))
+                f.write("ITEM: ATOMS id type x y z\n")
+                for k in range(len(pts)):
+                    f.write("%d %d %r %r %r\n" % (k + 1, lab[k], xyz[k, 0], xyz[k, 1], xyz[k, 2]))
+        else:
+            path = self.p("box%d.xyz" % case)
+            with open(path, "w") as f:
+                f.write("%d\nLattice=\"%r 0 0 0 %r 0 0 0 %r\" Origin=\"%r %r %r\" pbc=\"%s\" "
+                        "Properties=species:S:1:pos:R:3:type:I:1\n" % (
+                            len(pts), hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2], lo[0], lo[1], lo[2],
+                            " ".join("T" if q else "F" for q in per)))
+                for k in range(len(pts)):
+                    f.write("Ar %r %r %r %d\n" % (xyz[k, 0], xyz[k, 1], xyz[k, 2], lab[k]))
+        # The lengths hi - lo are what the file can say: where they round,
+        # the box is another one (an input this check cannot compare).
+        if any(lo[a] + (hi[a] - lo[a]) != hi[a] for a in range(3)):
+            return
+        fnb, fsh = self.p("fnb.npy"), self.p("fsh.npy")
+        args = ["voronoi", path, "--threads", threads, "--quiet", "--neighbors", fnb, "--neighbor-shifts", fsh,
+                "--validate"] + (["--dim", "2"] if d == 2 else []) + (["--labels", "type"] if labels else [])
+        if not self.check(args, path, None, what + ", box from the file", d, case, periodic=True):
+            return
+        self.assertTrue(np.array_equal(np.load(fnb), np.load(nb)) and np.array_equal(np.load(fsh), np.load(sh)),
+                        "case %d (%s): the file's own box gave other cells than the options" % (case, what))
 
     def check_power(self, case, kind, d, pts, inp, labels, common, rng):
         """Power cells by both methods (validated, the same neighbours), the
