@@ -44,7 +44,7 @@ namespace {
 
 constexpr std::string_view item = "ITEM:";
 
-/// What a frame's header says, and where its atom lines start.
+/// What a frame's header says.
 struct DumpHeader {
   std::int64_t timestep = 0;
   std::size_t atoms = 0;
@@ -54,9 +54,7 @@ struct DumpHeader {
 
 bool starts_with(std::string_view s, std::string_view p) { return s.substr(0, p.size()) == p; }
 
-std::string_view after_item(std::string_view line) {
-  return trim(line.substr(item.size()));
-}
+std::string_view after_item(std::string_view line) { return trim(line.substr(item.size())); }
 
 std::vector<std::string_view> words(std::string_view line) {
   std::vector<std::string_view> w;
@@ -102,9 +100,11 @@ FileBox parse_box(const std::string& path, const std::vector<std::string_view>& 
     b.tilt = {xy, xz, yz};
   }
   for (int a = 0; a < 3; ++a) {
-    if (!(hi[a] > lo[a]))
-      fail(path, std::string("ITEM: BOX BOUNDS: empty ") + "xyz"[a] + " range of the box [" + std::to_string(lo[a]) +
-                     ", " + std::to_string(hi[a]) + "]");
+    if (!(hi[a] > lo[a])) {
+      char buf[96];
+      std::snprintf(buf, sizeof buf, "[%.17g, %.17g]", lo[a], hi[a]);
+      fail(path, std::string("ITEM: BOX BOUNDS: empty ") + "xyz"[a] + " range of the box " + buf);
+    }
     b.lo[static_cast<std::size_t>(a)] = lo[a];
     b.hi[static_cast<std::size_t>(a)] = hi[a];
   }
@@ -129,10 +129,9 @@ DumpHeader read_header(const std::string& path, Lines& lines) {
     const std::string_view what = after_item(l);
     if (what == "TIMESTEP") {
       const std::string_view v = next("the timestep");
-      double t = 0;
-      if (!parse_double(v, t) || !(t >= -9e18 && t <= 9e18) || t != std::floor(t))
+      auto [p, ec] = std::from_chars(v.data(), v.data() + v.size(), h.timestep);
+      if (ec != std::errc() || p != v.data() + v.size())
         fail(path, "line " + std::to_string(number) + ": the timestep is not an integer");
-      h.timestep = static_cast<std::int64_t>(t);
       have_step = true;
     } else if (what == "NUMBER OF ATOMS") {
       const std::string_view v = next("the number of atoms");
@@ -155,8 +154,9 @@ DumpHeader read_header(const std::string& path, Lines& lines) {
       have_box = true;
     } else if (starts_with(what, "ATOMS")) {
       if (!have_step || !have_atoms || !have_box)
-        fail(path, std::string("ITEM: ATOMS before the frame's ") +
-                       (!have_atoms ? "NUMBER OF ATOMS" : !have_box ? "BOX BOUNDS" : "TIMESTEP"));
+        fail(path, std::string("ITEM: ATOMS before the frame's ") + (!have_atoms ? "NUMBER OF ATOMS"
+                                                                     : !have_box ? "BOX BOUNDS"
+                                                                                 : "TIMESTEP"));
       for (std::string_view w : words(what.substr(5))) h.columns.emplace_back(w);
       if (h.columns.empty()) fail(path, "ITEM: ATOMS names no columns");
       h.box.timestep = h.timestep;
@@ -176,7 +176,8 @@ DumpHeader read_header(const std::string& path, Lines& lines) {
 
 std::size_t column_index(const std::string& path, const DumpHeader& h, const std::string& name, const char* what) {
   const auto it = std::find(h.columns.begin(), h.columns.end(), name);
-  if (it == h.columns.end()) fail(path, "no column '" + name + "' for " + what + " (columns: " + quoted_list(h.columns) + ")");
+  if (it == h.columns.end())
+    fail(path, "no column '" + name + "' for " + what + " (columns: " + quoted_list(h.columns) + ")");
   return static_cast<std::size_t>(it - h.columns.begin());
 }
 
@@ -216,7 +217,8 @@ struct CoordinateColumns {
 };
 
 CoordinateColumns coordinate_columns(const std::string& path, const DumpHeader& h, int dim) {
-  static const char* const sets[4][3] = {{"x", "y", "z"}, {"xu", "yu", "zu"}, {"xs", "ys", "zs"}, {"xsu", "ysu", "zsu"}};
+  static const char* const sets[4][3] = {
+      {"x", "y", "z"}, {"xu", "yu", "zu"}, {"xs", "ys", "zs"}, {"xsu", "ysu", "zsu"}};
   for (int s = 0; s < 4; ++s) {
     CoordinateColumns c;
     c.scaled = s >= 2;
@@ -230,7 +232,8 @@ CoordinateColumns coordinate_columns(const std::string& path, const DumpHeader& 
     }
     if (all) return c;
   }
-  fail(path, "no coordinate columns: expected x y z, xu yu zu, xs ys zs or xsu ysu zsu among " + quoted_list(h.columns));
+  fail(path,
+       "no coordinate columns: expected x y z, xu yu zu, xs ys zs or xsu ysu zsu among " + quoted_list(h.columns));
 }
 
 }  // namespace
@@ -270,12 +273,11 @@ PointCloud read_dump_points(const std::string& path, const ReadOptions& options,
     for (std::size_t k = 0; k < pc.n; ++k) {
       const double l = v[k * cols.size() + coords];
       if (!(l == std::floor(l) && l >= std::numeric_limits<std::int32_t>::min() &&
-            l <= std::numeric_limits<std::int32_t>::max()))
-      {
+            l <= std::numeric_limits<std::int32_t>::max())) {
         char buf[40];
         std::snprintf(buf, sizeof buf, "%.17g", l);
-        fail(path, "labels '" + label_column + "' of atom " + std::to_string(k) + " (0-based, in file order): " +
-                       buf + " is not an int32");
+        fail(path, "labels '" + label_column + "' of atom " + std::to_string(k) + " (0-based, in file order): " + buf +
+                       " is not an int32");
       }
       pc.labels[k] = static_cast<std::int32_t>(l);
     }

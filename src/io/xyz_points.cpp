@@ -84,7 +84,7 @@ struct Property {
 struct XyzHeader {
   std::size_t atoms = 0;
   std::vector<Property> properties;
-  std::size_t columns = 0;                 // fields per atom line
+  std::size_t columns = 0;  // fields per atom line
   std::optional<FileBox> box;
 };
 
@@ -123,7 +123,8 @@ std::vector<double> numbers(const std::string& path, const std::string& what, co
   std::string_view f;
   double x = 0;
   while (fs.next(f)) {
-    if (!parse_double(f, x) || !std::isfinite(x)) fail(path, "line 2: " + what + " holds '" + std::string(f) + "', not a finite number");
+    if (!parse_double(f, x) || !std::isfinite(x))
+      fail(path, "line 2: " + what + " holds '" + std::string(f) + "', not a finite number");
     v.push_back(x);
   }
   if (v.size() != want)
@@ -181,9 +182,10 @@ XyzHeader read_header(const std::string& path, RawLines& lines) {
     const std::vector<double> v = numbers(path, "Lattice", *lattice, 9);
     FileBox b;
     if (v[1] != 0 || v[2] != 0 || v[5] != 0 || !(v[0] > 0 && v[4] > 0 && v[8] > 0))
-      fail(path, "line 2: the Lattice's cell must have a along +x and b in the xy plane (ay = az = bz = 0, and "
-                 "ax, by, cz > 0), as LAMMPS's and tessera's boxes; rotate the cell and the atoms to that "
-                 "orientation, or give --bounds");
+      fail(path,
+           "line 2: the Lattice's cell must have a along +x and b in the xy plane (ay = az = bz = 0, and "
+           "ax, by, cz > 0), as LAMMPS's and tessera's boxes; rotate the cell and the atoms to that "
+           "orientation, or give --bounds");
     std::vector<double> origin = {0, 0, 0};
     if (const std::string* o = find("origin")) origin = numbers(path, "Origin", *o, 3);
     b.periodic = {true, true, true};
@@ -203,7 +205,7 @@ XyzHeader read_header(const std::string& path, RawLines& lines) {
       b.lo[a] = origin[a];
       b.hi[a] = origin[a] + v[a * 4];  // the diagonal: ax, by, cz
     }
-    b.tilt = {v[3], v[6], v[7]};     // bx, cx, cy
+    b.tilt = {v[3], v[6], v[7]};  // bx, cx, cy
     b.triclinic = v[3] != 0 || v[6] != 0 || v[7] != 0;
     b.declared_by = "extended XYZ Lattice";
     h.box = b;
@@ -228,7 +230,8 @@ std::size_t property_column(const std::string& path, const XyzHeader& h, const s
   }
   if (p->count != 1 || std::string(types).find(p->type) == std::string::npos)
     fail(path, "property '" + name + "' for " + what + " is " + std::string(1, p->type) + ":" +
-                   std::to_string(p->count) + "; need " + (std::string(types) == "I" ? "I:1 (integers)" : "R:1 or I:1"));
+                   std::to_string(p->count) + "; need " +
+                   (std::string(types) == "I" ? "I:1 (integers)" : "R:1 or I:1"));
   return p->column;
 }
 
@@ -293,7 +296,8 @@ PointCloud read_xyz_points(const std::string& path, std::string_view text, const
   pc.coords.resize(pc.n * static_cast<std::size_t>(dim));
   for (std::size_t k = 0; k < pc.n; ++k)
     for (int a = 0; a < dim; ++a)
-      pc.coords[k * static_cast<std::size_t>(dim) + static_cast<std::size_t>(a)] = v[k * cols.size() + static_cast<std::size_t>(a)];
+      pc.coords[k * static_cast<std::size_t>(dim) + static_cast<std::size_t>(a)] =
+          v[k * cols.size() + static_cast<std::size_t>(a)];
   if (!label_column.empty()) {
     pc.labels.resize(pc.n);
     for (std::size_t k = 0; k < pc.n; ++k) {

@@ -38,8 +38,8 @@ const char* kRows =
 TEST(LammpsDump, OrthogonalBoxAndAtomsInFileOrder) {
   TempDir dir;
   // Another frame after the first, and an item LAMMPS may add (UNITS).
-  const std::string text = "ITEM: UNITS\nlj\n" + ortho("id type x y z radius", kRows) +
-                           "ITEM: TIMESTEP\n1600\nITEM: NUMBER OF ATOMS\n1\n";
+  const std::string text =
+      "ITEM: UNITS\nlj\n" + ortho("id type x y z radius", kRows) + "ITEM: TIMESTEP\n1600\nITEM: NUMBER OF ATOMS\n1\n";
   const std::string with_units = "ITEM: TIMESTEP\n1500\nITEM: UNITS\nlj\n" + text.substr(text.find("ITEM: NUMBER"));
   for (const std::string& name : {"a.dump", "a.lammpstrj"}) {
     const std::string p = dir.write(name, with_units);
@@ -62,7 +62,8 @@ TEST(LammpsDump, OrthogonalBoxAndAtomsInFileOrder) {
   // --dim 2 keeps x and y.
   ReadOptions two;
   two.dim = 2;
-  const auto pc2 = read_points(dir.write("b.dump", ortho("id type x y z", "1 1 0.5 1 2.5\n2 1 -0.75 4 7.5\n3 1 2.25 0.5 3\n")), two);
+  const auto pc2 =
+      read_points(dir.write("b.dump", ortho("id type x y z", "1 1 0.5 1 2.5\n2 1 -0.75 4 7.5\n3 1 2.25 0.5 3\n")), two);
   EXPECT_EQ(pc2.coords, (std::vector<double>{0.5, 1, -0.75, 4, 2.25, 0.5}));
   // Other formats declare no box.
   EXPECT_FALSE(read_file_box(dir.write("c.csv", "x,y,z\n0,0,0\n1,1,1\n")).has_value());
@@ -75,14 +76,16 @@ TEST(LammpsDump, CoordinateStyles) {
   EXPECT_EQ(pc.coords[3], -4.75);
   EXPECT_EQ(pc.coords[7], 10.5);
   // Plain x y z are preferred to the others when several are written.
-  pc = read_points(dir.write("both.dump", ortho("xs ys zs x y z", "0 0 0 0.5 1 2.5\n0 0 0 -0.75 4 7.5\n0 0 0 2.25 0.5 3\n")));
+  pc = read_points(
+      dir.write("both.dump", ortho("xs ys zs x y z", "0 0 0 0.5 1 2.5\n0 0 0 -0.75 4 7.5\n0 0 0 2.25 0.5 3\n")));
   EXPECT_EQ(pc.coords[0], 0.5);
   // Scaled: fractions of the box (dyadic here, so exact).
-  pc = read_points(dir.write("s.dump", ortho("id type xs ys zs", "1 1 0.375 0.1 0.25\n2 1 0 0.7 0.9375\n3 1 0.8125 0 0.125\n")));
-  EXPECT_EQ(pc.coords[0], 0.5);   // -1 + 0.375 * 4
-  EXPECT_EQ(pc.coords[2], 3.5);   // 2 + 0.25 * 6
+  pc = read_points(
+      dir.write("s.dump", ortho("id type xs ys zs", "1 1 0.375 0.1 0.25\n2 1 0 0.7 0.9375\n3 1 0.8125 0 0.125\n")));
+  EXPECT_EQ(pc.coords[0], 0.5);    // -1 + 0.375 * 4
+  EXPECT_EQ(pc.coords[2], 3.5);    // 2 + 0.25 * 6
   EXPECT_EQ(pc.coords[5], 7.625);  // 2 + 0.9375 * 6
-  EXPECT_EQ(pc.coords[6], 2.25);  // -1 + 0.8125 * 4
+  EXPECT_EQ(pc.coords[6], 2.25);   // -1 + 0.8125 * 4
 }
 
 TEST(LammpsDump, TriclinicBoxFromItsBoundingBox) {
@@ -128,7 +131,8 @@ TEST(LammpsDump, Errors) {
       {"ITEM: TIMESTEP\n1\nITEM: NUMBER OF ATOMS\n2\nITEM: BOX BOUNDS pp pp\n0 1\n0 1\n0 1\n", "three boundary flags"},
       {"ITEM: TIMESTEP\n1\nITEM: NUMBER OF ATOMS\n2\nITEM: BOX BOUNDS pp pp pp\n0 1\n0 nan\n0 1\n", "y bounds"},
       {"ITEM: TIMESTEP\n1\nITEM: NUMBER OF ATOMS\n2\nITEM: BOX BOUNDS pp pp pp\n0 1\n0 1\n1 1\n", "empty z range"},
-      {"ITEM: TIMESTEP\n1\nITEM: NUMBER OF ATOMS\n2\nITEM: BOX BOUNDS xy xz yz pp pp pp\n0 1\n0 1\n0 1\n", "3 finite numbers"},
+      {"ITEM: TIMESTEP\n1\nITEM: NUMBER OF ATOMS\n2\nITEM: BOX BOUNDS xy xz yz pp pp pp\n0 1\n0 1\n0 1\n",
+       "3 finite numbers"},
       {head + "ITEM: ATOMS\n", "names no columns"},
       {head + "ITEM: ATOMS id type\n1 1\n2 1\n", "no coordinate columns"},
       {head + "ITEM: ATOMS id xs ys\n1 0 0\n2 0 0\n", "no coordinate columns"},  // scaled needs all three

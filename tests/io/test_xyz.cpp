@@ -32,7 +32,8 @@ TEST(Xyz, PlainFramesAndEmptyComment) {
   }
   ReadOptions two;
   two.dim = 2;
-  EXPECT_EQ(read_points(dir.write("w2.xyz", text), two).coords, (std::vector<double>{0, 0, 0.757, 0.586, -0.757, 0.586}));
+  EXPECT_EQ(read_points(dir.write("w2.xyz", text), two).coords,
+            (std::vector<double>{0, 0, 0.757, 0.586, -0.757, 0.586}));
   // A comment that is free text with an '=' in it is still a comment.
   EXPECT_EQ(read_points(dir.write("c.xyz", "1\nE = -76.4 eV, a=b\nO 1 2 3\n")).n, 1u);
 }
