@@ -97,18 +97,45 @@ std::vector<double> read_dump_column(const std::string& path, const std::string&
 FileBox read_dump_box(const std::string& path);
 
 /// XYZ and extended XYZ files (xyz_points.cpp), read by the text reader
-/// where the first line is a lone count: the first frame's atoms, one
-/// property's values, and the Lattice's box (from `head`, the file's first
-/// bytes; none without a Lattice).
+/// where `text` (the file's first bytes) starts as XYZ does: the first
+/// frame's atoms, one property's values, and the Lattice's box (none
+/// without a Lattice); the frames after the first are not read.
 bool looks_like_xyz(std::string_view text);
-PointCloud read_xyz_points(const std::string& path, std::string_view text, const ReadOptions& options,
-                           const std::string& label_column);
-std::vector<double> read_xyz_column(const std::string& path, std::string_view text, const std::string& name);
-std::optional<FileBox> read_xyz_box(const std::string& path, std::string_view head);
+PointCloud read_xyz_points(const std::string& path, const ReadOptions& options, const std::string& label_column);
+std::vector<double> read_xyz_column(const std::string& path, const std::string& name);
+std::optional<FileBox> read_xyz_box(const std::string& path);
+
+/// Atom k's label read from `column` of a trajectory file (LAMMPS dump,
+/// XYZ) as a number: an integer in int32's range, else InputError naming
+/// the atom in file order.
+std::int32_t atom_label(const std::string& path, const std::string& column, std::size_t k, double value);
 
 /// The first `bytes` bytes of a file (all of a shorter one), for the
 /// readers of a header alone.
 std::string read_file_head(const std::string& path, std::size_t bytes);
+
+/// Thrown by a frame parser whose frame runs past the end of a prefix of the
+/// file that is not the whole file: first_frame reads more.
+struct FrameCut {};
+
+/// `parse(text, whole)` on the first bytes of `path`, cut after their last
+/// line break, on more of them each time it throws FrameCut: the first frame
+/// of a trajectory without reading the frames after it (a trajectory may be
+/// gigabytes). `whole`: the text is the whole file, so running out of lines
+/// is the file's error, not the prefix's.
+template <class Parse>
+auto first_frame(const std::string& path, Parse&& parse) {
+  for (std::size_t want = std::size_t{1} << 20;; want *= 4) {
+    std::string head = read_file_head(path, want);
+    const bool whole = head.size() < want;
+    if (!whole) head.resize(head.rfind('\n') + 1);  // (npos + 1 == 0: no line yet)
+    try {
+      return parse(std::string_view(head), whole);
+    } catch (const FrameCut&) {
+      if (whole) throw;  // a parser's bug: it may only ask for more of a prefix
+    }
+  }
+}
 
 /// Whether `ext` (lowercased, with its dot) is a LAMMPS dump's.
 inline bool is_dump_extension(const std::string& ext) { return ext == ".dump" || ext == ".lammpstrj"; }

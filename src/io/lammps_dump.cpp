@@ -111,18 +111,25 @@ FileBox parse_box(const std::string& path, const std::vector<std::string_view>& 
   return b;
 }
 
+/// The frame's text ran out: the file's error where `whole`, else more of
+/// the file is needed (first_frame).
+[[noreturn]] void ended(const std::string& path, const std::string& what, bool whole) {
+  if (!whole) throw FrameCut{};
+  fail(path, what);
+}
+
 /// Reads the first frame's header; `lines` then stands at its first atom line.
-DumpHeader read_header(const std::string& path, Lines& lines) {
+DumpHeader read_header(const std::string& path, Lines& lines, bool whole) {
   DumpHeader h;
   std::string_view line;
   std::size_t number = 0;
   bool have_step = false, have_atoms = false, have_box = false;
   auto next = [&](const char* what) {
-    if (!lines.next(line, number)) fail(path, std::string("the file ends before ") + what);
+    if (!lines.next(line, number)) ended(path, std::string("the file ends before ") + what, whole);
     return trim(line);
   };
-  if (!lines.next(line, number) || trim(line) != "ITEM: TIMESTEP")
-    fail(path, "not a LAMMPS dump: its first line is not 'ITEM: TIMESTEP'");
+  if (!lines.next(line, number)) ended(path, "not a LAMMPS dump: it is empty", whole);
+  if (trim(line) != "ITEM: TIMESTEP") fail(path, "not a LAMMPS dump: its first line is not 'ITEM: TIMESTEP'");
   for (;;) {
     const std::string_view l = trim(line);
     if (!starts_with(l, item)) fail(path, "line " + std::to_string(number) + ": expected an 'ITEM:' line");
@@ -165,12 +172,12 @@ DumpHeader read_header(const std::string& path, Lines& lines) {
     } else {
       // Another item (UNITS, TIME, ...): its lines up to the next item.
       for (;;) {
-        if (!lines.next(line, number)) fail(path, "the file ends before ITEM: ATOMS");
+        if (!lines.next(line, number)) ended(path, "the file ends before ITEM: ATOMS", whole);
         if (starts_with(trim(line), item)) break;
       }
       continue;
     }
-    if (!lines.next(line, number)) fail(path, "the file ends before ITEM: ATOMS");
+    if (!lines.next(line, number)) ended(path, "the file ends before ITEM: ATOMS", whole);
   }
 }
 
@@ -185,14 +192,14 @@ std::size_t column_index(const std::string& path, const DumpHeader& h, const std
 /// row-major. Every line must have one field per column; the wanted ones
 /// must be numbers (others, such as an element name, are not read).
 std::vector<double> atom_values(const std::string& path, Lines& lines, const DumpHeader& h,
-                                const std::vector<std::size_t>& cols) {
+                                const std::vector<std::size_t>& cols, bool whole) {
   std::vector<double> out(h.atoms * cols.size());
   std::vector<std::string_view> f(h.columns.size());
   std::string_view line;
   std::size_t number = 0;
   for (std::size_t k = 0; k < h.atoms; ++k) {
     if (!lines.next(line, number))
-      fail(path, "the frame ends after " + std::to_string(k) + " of its " + std::to_string(h.atoms) + " atoms");
+      ended(path, "the frame ends after " + std::to_string(k) + " of its " + std::to_string(h.atoms) + " atoms", whole);
     Fields fs(line, ' ');
     std::size_t got = 0;
     std::string_view field;
@@ -239,17 +246,21 @@ CoordinateColumns coordinate_columns(const std::string& path, const DumpHeader& 
 }  // namespace
 
 PointCloud read_dump_points(const std::string& path, const ReadOptions& options, const std::string& label_column) {
-  const std::string text = read_file_bytes(path);
-  Lines lines(text);
-  const DumpHeader h = read_header(path, lines);
   const int dim = options.dim == 0 ? 3 : options.dim;
-  if (dim == 2 && (h.box.tilt[1] != 0 || h.box.tilt[2] != 0))
-    fail(path, "--dim 2: the box tilts along z (xz, yz not 0); a 2D box has the xy tilt only");
-  const CoordinateColumns cc = coordinate_columns(path, h, dim);
-  std::vector<std::size_t> cols(cc.col, cc.col + (cc.scaled ? 3 : dim));
-  const std::size_t coords = cols.size();
-  if (!label_column.empty()) cols.push_back(column_index(path, h, label_column, "labels"));
-  const std::vector<double> v = atom_values(path, lines, h, cols);
+  DumpHeader h;
+  CoordinateColumns cc;
+  std::vector<std::size_t> cols;
+  const std::vector<double> v = first_frame(path, [&](std::string_view text, bool whole) {
+    Lines lines(text);
+    h = read_header(path, lines, whole);
+    if (dim == 2 && (h.box.tilt[1] != 0 || h.box.tilt[2] != 0))
+      fail(path, "--dim 2: the box tilts along z (xz, yz not 0); a 2D box has the xy tilt only");
+    cc = coordinate_columns(path, h, dim);
+    cols.assign(cc.col, cc.col + (cc.scaled ? 3 : dim));
+    if (!label_column.empty()) cols.push_back(column_index(path, h, label_column, "labels"));
+    return atom_values(path, lines, h, cols, whole);
+  });
+  const std::size_t coords = cc.scaled ? 3 : static_cast<std::size_t>(dim);
 
   PointCloud pc;
   pc.dim = dim;
@@ -270,39 +281,24 @@ PointCloud read_dump_points(const std::string& path, const ReadOptions& options,
   }
   if (!label_column.empty()) {
     pc.labels.resize(pc.n);
-    for (std::size_t k = 0; k < pc.n; ++k) {
-      const double l = v[k * cols.size() + coords];
-      if (!(l == std::floor(l) && l >= std::numeric_limits<std::int32_t>::min() &&
-            l <= std::numeric_limits<std::int32_t>::max())) {
-        char buf[40];
-        std::snprintf(buf, sizeof buf, "%.17g", l);
-        fail(path, "labels '" + label_column + "' of atom " + std::to_string(k) + " (0-based, in file order): " + buf +
-                       " is not an int32");
-      }
-      pc.labels[k] = static_cast<std::int32_t>(l);
-    }
+    for (std::size_t k = 0; k < pc.n; ++k) pc.labels[k] = atom_label(path, label_column, k, v[k * cols.size() + coords]);
   }
   return pc;
 }
 
 std::vector<double> read_dump_column(const std::string& path, const std::string& name) {
-  const std::string text = read_file_bytes(path);
-  Lines lines(text);
-  const DumpHeader h = read_header(path, lines);
-  return atom_values(path, lines, h, {column_index(path, h, name, "scalars")});
+  return first_frame(path, [&](std::string_view text, bool whole) {
+    Lines lines(text);
+    const DumpHeader h = read_header(path, lines, whole);
+    return atom_values(path, lines, h, {column_index(path, h, name, "scalars")}, whole);
+  });
 }
 
 FileBox read_dump_box(const std::string& path) {
-  // The header only: a trajectory may be gigabytes. Its items come first,
-  // so a prefix holds them (a longer one where another item is long).
-  for (std::size_t want = 1 << 16;; want *= 4) {
-    const std::string head = read_file_head(path, want);
-    const std::size_t atoms = head.find("ITEM: ATOMS");
-    if ((atoms != std::string::npos && head.find('\n', atoms) != std::string::npos) || head.size() < want) {
-      Lines lines(head);
-      return read_header(path, lines).box;
-    }
-  }
+  return first_frame(path, [&](std::string_view text, bool whole) {
+    Lines lines(text);
+    return read_header(path, lines, whole).box;
+  });
 }
 
 }  // namespace tessera::io::detail

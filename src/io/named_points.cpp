@@ -1,6 +1,8 @@
 // Helpers shared by the readers whose points come from named columns or
 // fields (text headers, structured .npy records, PCD fields; .vtp/.vtu and
 // .ply labels): the coordinates by name and labels from numeric values.
+#include <cmath>
+#include <cstdio>
 #include <limits>
 #include <string>
 #include <vector>
@@ -53,6 +55,17 @@ std::vector<std::int32_t> labels_from_values(const std::string& path, const std:
     labels[i] = static_cast<std::int32_t>(v[i]);
   }
   return labels;
+}
+
+std::int32_t atom_label(const std::string& path, const std::string& column, std::size_t k, double value) {
+  if (!(value == std::floor(value) && value >= std::numeric_limits<std::int32_t>::min() &&
+        value <= std::numeric_limits<std::int32_t>::max())) {
+    char buf[40];
+    std::snprintf(buf, sizeof buf, "%.17g", value);
+    fail(path, "labels '" + column + "' of atom " + std::to_string(k) + " (0-based, in file order): " + buf +
+                   " is not an int32");
+  }
+  return static_cast<std::int32_t>(value);
 }
 
 }  // namespace tessera::io::detail

@@ -193,10 +193,9 @@ std::string non_finite_hint(const ReadOptions& options) {
 std::optional<FileBox> read_file_box(const std::string& path) {
   const std::string ext = detail::lower_extension(path);
   if (detail::is_dump_extension(ext)) return detail::read_dump_box(path);
-  if (ext == ".xyz" || ext == ".txt") {  // an extended XYZ's Lattice (its first two lines)
-    const std::string head = detail::read_file_head(path, 1 << 16);
-    if (detail::looks_like_xyz(head)) return detail::read_xyz_box(path, head);
-  }
+  // An extended XYZ's Lattice.
+  if ((ext == ".xyz" || ext == ".txt") && detail::looks_like_xyz(detail::read_file_head(path, 1 << 16)))
+    return detail::read_xyz_box(path);
   return std::nullopt;
 }
 

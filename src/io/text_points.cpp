@@ -149,6 +149,9 @@ PointCloud qhull_points(const std::string& path, Lines& lines, std::size_t ndim,
 
 PointCloud read_text_points(const std::string& path, const ReadOptions& options,
                             const std::string& label_column) {
+  // XYZ (chemistry's, and extended XYZ): a lone count, a comment, the atoms;
+  // a trajectory's frames after the first are not read.
+  if (looks_like_xyz(read_file_head(path, 1 << 16))) return read_xyz_points(path, options, label_column);
   const std::string text = read_file_bytes(path);
   Lines lines(text);
   std::string_view line;
@@ -171,9 +174,6 @@ PointCloud read_text_points(const std::string& path, const ReadOptions& options,
       if (fields >= 2) return qhull_points(path, after, std::min(a, b), std::max(a, b), options, label_column);
     }
   }
-
-  // XYZ (chemistry's, and extended XYZ): a lone count, a comment, the atoms.
-  if (looks_like_xyz(text)) return read_xyz_points(path, text, options, label_column);
 
   // Layout from the first content line: delimiter, header, column count.
   const TextLayout layout = text_layout(line);
@@ -263,12 +263,12 @@ PointCloud read_text_points(const std::string& path, const ReadOptions& options,
 }
 
 std::vector<double> read_text_column(const std::string& path, const std::string& name) {
+  if (looks_like_xyz(read_file_head(path, 1 << 16))) return read_xyz_column(path, name);
   const std::string text = read_file_bytes(path);
   Lines lines(text);
   std::string_view line;
   std::size_t line_no = 0;
   if (!lines.next(line, line_no)) fail(path, "no points");
-  if (looks_like_xyz(text)) return read_xyz_column(path, text, name);
   // The first content line must be a header naming the column.
   const TextLayout layout = text_layout(line);
   const char delim = layout.delim;

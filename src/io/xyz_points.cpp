@@ -132,16 +132,23 @@ std::vector<double> numbers(const std::string& path, const std::string& what, co
   return v;
 }
 
-XyzHeader read_header(const std::string& path, RawLines& lines) {
+/// The frame's text ran out: the file's error where `whole`, else more of
+/// the file is needed (first_frame).
+[[noreturn]] void ended(const std::string& path, const std::string& what, bool whole) {
+  if (!whole) throw FrameCut{};
+  fail(path, what);
+}
+
+XyzHeader read_header(const std::string& path, RawLines& lines, bool whole) {
   XyzHeader h;
   std::string_view line;
-  if (!lines.next(line)) fail(path, "no points");
+  if (!lines.next(line)) ended(path, "no points", whole);
   const std::optional<std::size_t> n = lone_count(line);
   if (!n) fail(path, "not an XYZ file: its first line is not the number of atoms");
   if (*n == 0) fail(path, "no points (the XYZ frame has 0 atoms)");
   if (*n > (std::size_t{1} << 31) - 1) fail(path, "more than 2^31 - 1 atoms (point ids are int32)");
   h.atoms = *n;
-  if (!lines.next(line)) fail(path, "the file ends before the comment line");
+  if (!lines.next(line)) ended(path, "the file ends before the comment line", whole);
   const auto kv = key_values(line);
   auto find = [&](const char* key) -> const std::string* {
     for (const auto& [k, v] : kv)
@@ -237,7 +244,7 @@ std::size_t property_column(const std::string& path, const XyzHeader& h, const s
 
 /// The atom lines' values of `cols`, atoms × cols.
 std::vector<double> atom_values(const std::string& path, RawLines& lines, const XyzHeader& h,
-                                const std::vector<std::size_t>& cols) {
+                                const std::vector<std::size_t>& cols, bool whole) {
   std::vector<double> out(h.atoms * cols.size());
   std::vector<std::string_view> f(h.columns);
   std::string_view line;
@@ -245,7 +252,7 @@ std::vector<double> atom_values(const std::string& path, RawLines& lines, const 
   const bool plain = h.properties.size() == 2 && h.properties[0].name == "species" && h.columns == 4;
   for (std::size_t k = 0; k < h.atoms; ++k) {
     if (!lines.next(line))
-      fail(path, "the frame ends after " + std::to_string(k) + " of its " + std::to_string(h.atoms) + " atoms");
+      ended(path, "the frame ends after " + std::to_string(k) + " of its " + std::to_string(h.atoms) + " atoms", whole);
     Fields fs(line, ' ');
     std::size_t got = 0;
     std::string_view field;
@@ -266,9 +273,11 @@ std::vector<double> atom_values(const std::string& path, RawLines& lines, const 
 bool looks_like_xyz(std::string_view text) {
   // A lone count, any comment, then an atom line of a position at least (a
   // column of single numbers is a one-column point file, refused as such).
+  // A second count is Qhull's header (dimension, then count: rbox's output).
   RawLines lines(text);
   std::string_view first, comment, atom;
-  if (!lines.next(first) || !lone_count(first) || !lines.next(comment) || !lines.next(atom)) return false;
+  if (!lines.next(first) || !lone_count(first) || !lines.next(comment) || lone_count(comment) || !lines.next(atom))
+    return false;
   Fields fs(atom, ' ');
   std::string_view f;
   int fields = 0;
@@ -276,20 +285,23 @@ bool looks_like_xyz(std::string_view text) {
   return fields >= 3;
 }
 
-PointCloud read_xyz_points(const std::string& path, std::string_view text, const ReadOptions& options,
-                           const std::string& label_column) {
-  RawLines lines(text);
-  const XyzHeader h = read_header(path, lines);
+PointCloud read_xyz_points(const std::string& path, const ReadOptions& options, const std::string& label_column) {
   const int dim = options.dim == 0 ? 3 : options.dim;
-  const Property* pos = find_property(h, "pos");
-  if (pos == nullptr || pos->type != 'R' || pos->count != 3)
-    fail(path, "line 2: Properties has no pos:R:3 (the positions)");
+  XyzHeader h;
   std::vector<std::size_t> cols;
-  for (int a = 0; a < dim; ++a) cols.push_back(pos->column + static_cast<std::size_t>(a));
-  if (!label_column.empty()) cols.push_back(property_column(path, h, label_column, "I", "labels"));
-  if (dim == 2 && h.box && (h.box->tilt[1] != 0 || h.box->tilt[2] != 0))
-    fail(path, "--dim 2: the Lattice tilts along z (cx, cy not 0); a 2D box has the xy tilt only");
-  const std::vector<double> v = atom_values(path, lines, h, cols);
+  const std::vector<double> v = first_frame(path, [&](std::string_view text, bool whole) {
+    RawLines lines(text);
+    h = read_header(path, lines, whole);
+    const Property* pos = find_property(h, "pos");
+    if (pos == nullptr || pos->type != 'R' || pos->count != 3)
+      fail(path, "line 2: Properties has no pos:R:3 (the positions)");
+    cols.clear();
+    for (int a = 0; a < dim; ++a) cols.push_back(pos->column + static_cast<std::size_t>(a));
+    if (!label_column.empty()) cols.push_back(property_column(path, h, label_column, "I", "labels"));
+    if (dim == 2 && h.box && (h.box->tilt[1] != 0 || h.box->tilt[2] != 0))
+      fail(path, "--dim 2: the Lattice tilts along z (cx, cy not 0); a 2D box has the xy tilt only");
+    return atom_values(path, lines, h, cols, whole);
+  });
   PointCloud pc;
   pc.dim = dim;
   pc.n = h.atoms;
@@ -300,26 +312,25 @@ PointCloud read_xyz_points(const std::string& path, std::string_view text, const
           v[k * cols.size() + static_cast<std::size_t>(a)];
   if (!label_column.empty()) {
     pc.labels.resize(pc.n);
-    for (std::size_t k = 0; k < pc.n; ++k) {
-      const double l = v[k * cols.size() + static_cast<std::size_t>(dim)];
-      if (!(l == std::floor(l) && l >= std::numeric_limits<std::int32_t>::min() &&
-            l <= std::numeric_limits<std::int32_t>::max()))
-        fail(path, "labels '" + label_column + "' of atom " + std::to_string(k) + " are not an int32");
-      pc.labels[k] = static_cast<std::int32_t>(l);
-    }
+    for (std::size_t k = 0; k < pc.n; ++k)
+      pc.labels[k] = atom_label(path, label_column, k, v[k * cols.size() + static_cast<std::size_t>(dim)]);
   }
   return pc;
 }
 
-std::vector<double> read_xyz_column(const std::string& path, std::string_view text, const std::string& name) {
-  RawLines lines(text);
-  const XyzHeader h = read_header(path, lines);
-  return atom_values(path, lines, h, {property_column(path, h, name, "RI", "scalars")});
+std::vector<double> read_xyz_column(const std::string& path, const std::string& name) {
+  return first_frame(path, [&](std::string_view text, bool whole) {
+    RawLines lines(text);
+    const XyzHeader h = read_header(path, lines, whole);
+    return atom_values(path, lines, h, {property_column(path, h, name, "RI", "scalars")}, whole);
+  });
 }
 
-std::optional<FileBox> read_xyz_box(const std::string& path, std::string_view head) {
-  RawLines lines(head);
-  return read_header(path, lines).box;
+std::optional<FileBox> read_xyz_box(const std::string& path) {
+  return first_frame(path, [&](std::string_view text, bool whole) {
+    RawLines lines(text);
+    return read_header(path, lines, whole).box;
+  });
 }
 
 }  // namespace tessera::io::detail

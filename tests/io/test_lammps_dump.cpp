@@ -159,3 +159,21 @@ TEST(LammpsDump, Errors) {
   const auto pc = read_points(dir.write("el.dump", head + "ITEM: ATOMS id element x y z\n1 Cu 0 0 0\n2 Ni 1 1 1\n"));
   EXPECT_EQ(pc.n, 2u);
 }
+
+// A trajectory's first frame is read without the frames after it: here the
+// file goes on to 64 GiB (sparse: NUL bytes), which reading whole would
+// never do.
+TEST(LammpsDump, FirstFrameOfAHugeTrajectory) {
+  TempDir dir;
+  const std::string p = dir.write("huge.lammpstrj", ortho("id type x y z radius", kRows));
+  try {
+    std::filesystem::resize_file(p, std::uintmax_t{1} << 36);
+  } catch (const std::filesystem::filesystem_error& e) {
+    GTEST_SKIP() << "no sparse 64 GiB file here: " << e.what();
+  }
+  const auto pc = read_points(p, labels("type"));
+  EXPECT_EQ(pc.n, 3u);
+  EXPECT_EQ(pc.labels, (std::vector<std::int32_t>{2, 1, 2}));
+  EXPECT_EQ(read_point_scalars(p, "radius"), (std::vector<double>{0.25, 0.5, 0.125}));
+  EXPECT_TRUE(read_file_box(p).has_value());
+}

@@ -108,3 +108,19 @@ TEST(Xyz, Errors) {
   EXPECT_NE(input_error([&] { read_points(dir.write("one.xyz", "1\n2\n3\n4\n")); }).find("1 coordinate column"),
             std::string::npos);
 }
+
+// The first frame of a trajectory that goes on to 64 GiB (sparse).
+TEST(Xyz, FirstFrameOfAHugeTrajectory) {
+  TempDir dir;
+  const std::string p =
+      dir.write("huge.xyz", "2\nLattice=\"2 0 0 0 3 0 0 0 4\" Properties=species:S:1:pos:R:3:q:R:1\nAr 1 1 1 0.5\nAr 0.5 2 3 1\n");
+  try {
+    std::filesystem::resize_file(p, std::uintmax_t{1} << 36);
+  } catch (const std::filesystem::filesystem_error& e) {
+    GTEST_SKIP() << "no sparse 64 GiB file here: " << e.what();
+  }
+  EXPECT_EQ(read_points(p).coords, (std::vector<double>{1, 1, 1, 0.5, 2, 3}));
+  EXPECT_EQ(read_point_scalars(p, "q"), (std::vector<double>{0.5, 1}));
+  ASSERT_TRUE(read_file_box(p).has_value());
+  EXPECT_EQ(read_file_box(p)->hi, (std::array<double, 3>{2, 3, 4}));
+}
