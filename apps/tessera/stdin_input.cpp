@@ -42,7 +42,9 @@ std::string sniff(std::string_view head) {
     throw InputError("stdin: XML, but not a VTK PolyData, UnstructuredGrid or ImageData file");
   }
   if (body.substr(0, 10) == "ObjectType" || body.substr(0, 5) == "NDims") return ".mha";
-  if (body.substr(0, 14) == "ITEM: TIMESTEP") return ".dump";  // LAMMPS
+  // LAMMPS: TIMESTEP first, or UNITS and TIME before it (dump_modify units, time).
+  for (const std::string_view first : {"ITEM: TIMESTEP", "ITEM: UNITS", "ITEM: TIME"})
+    if (body.substr(0, first.size()) == first) return ".dump";
   // PCD: comment lines, then VERSION (or FIELDS) opens the header.
   std::size_t at = k;
   while (at < head.size() && head[at] == '#') {

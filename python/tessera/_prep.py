@@ -178,7 +178,7 @@ def read_box(path: PathLike, dim: Optional[int] = None) -> Optional[dict]:
     lo, hi, tilt, periodic, _timestep = box
     d = dim or 3
     if d == 2 and (tilt[1] != 0 or tilt[2] != 0):
-        raise ValueError(f"{os.fsdecode(path)}: dim=2, but the box tilts along z (xz, yz not 0)")
+        raise _core.InputError(f"{os.fsdecode(path)}: dim=2, but the box tilts along z (xz, yz not 0)")
     tilts = tuple(float(t) for t in tilt[: 3 if d == 3 else 1])
     return {
         "bounds": tuple(float(v) for a in range(d) for v in (lo[a], hi[a])),

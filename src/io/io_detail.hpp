@@ -101,6 +101,7 @@ FileBox read_dump_box(const std::string& path);
 /// frame's atoms, one property's values, and the Lattice's box (none
 /// without a Lattice); the frames after the first are not read.
 bool looks_like_xyz(std::string_view text);
+bool is_xyz_file(const std::string& path);  ///< looks_like_xyz on as much of the file as its first lines take
 PointCloud read_xyz_points(const std::string& path, const ReadOptions& options, const std::string& label_column);
 std::vector<double> read_xyz_column(const std::string& path, const std::string& name);
 std::optional<FileBox> read_xyz_box(const std::string& path);
@@ -118,23 +119,35 @@ std::string read_file_head(const std::string& path, std::size_t bytes);
 /// file that is not the whole file: first_frame reads more.
 struct FrameCut {};
 
-/// `parse(text, whole)` on the first bytes of `path`, cut after their last
+/// `parse(text, tail)` on the first bytes of `path`, cut after their last
 /// line break, on more of them each time it throws FrameCut: the first frame
 /// of a trajectory without reading the frames after it (a trajectory may be
-/// gigabytes). `whole`: the text is the whole file, so running out of lines
-/// is the file's error, not the prefix's.
+/// gigabytes). `tail`: the bytes after the cut, the start of a line not yet
+/// whole; nullopt where `text` is the whole file, so that running out of
+/// lines is the file's error, not the prefix's.
 template <class Parse>
 auto first_frame(const std::string& path, Parse&& parse) {
   for (std::size_t want = std::size_t{1} << 20;; want *= 4) {
-    std::string head = read_file_head(path, want);
+    const std::string head = read_file_head(path, want);
     const bool whole = head.size() < want;
-    if (!whole) head.resize(head.rfind('\n') + 1);  // (npos + 1 == 0: no line yet)
+    const std::size_t cut = whole ? head.size() : head.rfind('\n') + 1;  // (npos + 1 == 0: no line yet)
+    const std::string_view text(head.data(), cut);
     try {
-      return parse(std::string_view(head), whole);
+      return parse(text, whole ? std::nullopt : std::optional<std::string_view>(std::string_view(head).substr(cut)));
     } catch (const FrameCut&) {
       if (whole) throw;  // a parser's bug: it may only ask for more of a prefix
     }
   }
+}
+
+/// After a frame's last atom line, where `lines` ran out of a prefix: what
+/// follows is a next frame's first line if `tail` starts with `start` (the
+/// check asks for more of the file while `tail` is shorter than `start`).
+/// True: a next frame (or the end of the file); false: something else.
+inline bool frame_follows(std::optional<std::string_view> tail, std::string_view start) {
+  if (!tail) return true;  // the end of the file
+  if (tail->size() < start.size()) throw FrameCut{};
+  return tail->substr(0, start.size()) == start;
 }
 
 /// Whether `ext` (lowercased, with its dot) is a LAMMPS dump's.

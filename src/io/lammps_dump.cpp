@@ -87,9 +87,17 @@ FileBox parse_box(const std::string& path, const std::vector<std::string_view>& 
     lo[a] = x[0];
     hi[a] = x[1];
     tilt[a] = x[2];  // xy, xz, yz in that order of lines
-    // A flag is two letters, lower and upper side; p on either means periodic
-    // (LAMMPS writes pp); without flags (old dumps) every axis is a wall.
-    if (flags == 3) b.periodic[a] = flags_words[w + static_cast<std::size_t>(a)].find('p') != std::string_view::npos;
+    // A flag is two letters, the lower and the upper side: pp periodic, or
+    // f, s, m walls (fixed, shrink-wrapped, with a minimum); without flags
+    // (old dumps) every axis is a wall.
+    if (flags == 3) {
+      const std::string_view f = flags_words[w + static_cast<std::size_t>(a)];
+      const auto side = [](char c) { return c == 'f' || c == 's' || c == 'm'; };
+      b.periodic[a] = f == "pp";
+      if (!b.periodic[a] && !(f.size() == 2 && side(f[0]) && side(f[1])))
+        fail(path, "ITEM: BOX BOUNDS: boundary flag '" + std::string(f) + "' along " + "xyz"[a] +
+                       " is not pp, or two of f, s, m");
+    }
   }
   if (b.triclinic) {
     const double xy = tilt[0], xz = tilt[1], yz = tilt[2];
@@ -123,24 +131,36 @@ DumpHeader read_header(const std::string& path, Lines& lines, bool whole) {
   DumpHeader h;
   std::string_view line;
   std::size_t number = 0;
-  bool have_step = false, have_atoms = false, have_box = false;
+  bool have_step = false, have_atoms = false, have_box = false, have_units = false, have_time = false;
   auto next = [&](const char* what) {
     if (!lines.next(line, number)) ended(path, std::string("the file ends before ") + what, whole);
     return trim(line);
   };
+  // Each item once before ATOMS: a second one means this frame's ATOMS line
+  // is missing or corrupted, and reading on would take a later frame's
+  // atoms for the first's.
+  auto once = [&](bool& seen, const char* name) {
+    if (seen) fail(path, "line " + std::to_string(number) + ": ITEM: " + name + " again before ITEM: ATOMS");
+    seen = true;
+  };
   if (!lines.next(line, number)) ended(path, "not a LAMMPS dump: it is empty", whole);
-  if (trim(line) != "ITEM: TIMESTEP") fail(path, "not a LAMMPS dump: its first line is not 'ITEM: TIMESTEP'");
+  // LAMMPS writes UNITS and TIME (dump_modify units, time) before TIMESTEP.
+  for (const char* first : {"ITEM: TIMESTEP", "ITEM: UNITS", "ITEM: TIME"})
+    if (trim(line) == first) goto header;
+  fail(path, "not a LAMMPS dump: its first line is not 'ITEM: TIMESTEP' (or UNITS, TIME)");
+header:
   for (;;) {
     const std::string_view l = trim(line);
     if (!starts_with(l, item)) fail(path, "line " + std::to_string(number) + ": expected an 'ITEM:' line");
     const std::string_view what = after_item(l);
     if (what == "TIMESTEP") {
+      once(have_step, "TIMESTEP");
       const std::string_view v = next("the timestep");
       auto [p, ec] = std::from_chars(v.data(), v.data() + v.size(), h.timestep);
       if (ec != std::errc() || p != v.data() + v.size())
         fail(path, "line " + std::to_string(number) + ": the timestep is not an integer");
-      have_step = true;
     } else if (what == "NUMBER OF ATOMS") {
+      once(have_atoms, "NUMBER OF ATOMS");
       const std::string_view v = next("the number of atoms");
       std::uint64_t n = 0;
       auto [p, ec] = std::from_chars(v.data(), v.data() + v.size(), n);
@@ -148,8 +168,8 @@ DumpHeader read_header(const std::string& path, Lines& lines, bool whole) {
         fail(path, "line " + std::to_string(number) + ": the number of atoms is not a count");
       if (n > (std::uint64_t{1} << 31) - 1) fail(path, "more than 2^31 - 1 atoms (point ids are int32)");
       h.atoms = static_cast<std::size_t>(n);
-      have_atoms = true;
-    } else if (starts_with(what, "BOX BOUNDS")) {
+    } else if (what == "BOX BOUNDS" || starts_with(what, "BOX BOUNDS ")) {
+      once(have_box, "BOX BOUNDS");
       const std::vector<std::string_view> flags = words(what.substr(std::string_view("BOX BOUNDS").size()));
       std::string_view box_lines[3];
       std::size_t numbers[3];
@@ -158,8 +178,7 @@ DumpHeader read_header(const std::string& path, Lines& lines, bool whole) {
         numbers[a] = number;
       }
       h.box = parse_box(path, flags, box_lines, numbers);
-      have_box = true;
-    } else if (starts_with(what, "ATOMS")) {
+    } else if (what == "ATOMS" || starts_with(what, "ATOMS ")) {
       if (!have_step || !have_atoms || !have_box)
         fail(path, std::string("ITEM: ATOMS before the frame's ") + (!have_atoms ? "NUMBER OF ATOMS"
                                                                      : !have_box ? "BOX BOUNDS"
@@ -169,13 +188,15 @@ DumpHeader read_header(const std::string& path, Lines& lines, bool whole) {
       h.box.timestep = h.timestep;
       h.box.declared_by = "LAMMPS dump, timestep " + std::to_string(h.timestep);
       return h;
+    } else if (what == "UNITS" || what == "TIME") {
+      // LAMMPS's optional items: one line (the unit style, the time).
+      once(what == "UNITS" ? have_units : have_time, what == "UNITS" ? "UNITS" : "TIME");
+      next(what == "UNITS" ? "the unit style" : "the time");
     } else {
-      // Another item (UNITS, TIME, ...): its lines up to the next item.
-      for (;;) {
-        if (!lines.next(line, number)) ended(path, "the file ends before ITEM: ATOMS", whole);
-        if (starts_with(trim(line), item)) break;
-      }
-      continue;
+      // Any other name is a corrupted one, ATOMS perhaps, whose atoms would
+      // be skipped as its lines.
+      fail(path, "line " + std::to_string(number) + ": unknown item '" + std::string(what) +
+                     "' (a dump frame has UNITS, TIME, TIMESTEP, NUMBER OF ATOMS, BOX BOUNDS and ATOMS)");
     }
     if (!lines.next(line, number)) ended(path, "the file ends before ITEM: ATOMS", whole);
   }
@@ -191,15 +212,20 @@ std::size_t column_index(const std::string& path, const DumpHeader& h, const std
 /// The atom lines' values of `cols` (columns of the header), atoms × cols,
 /// row-major. Every line must have one field per column; the wanted ones
 /// must be numbers (others, such as an element name, are not read).
-std::vector<double> atom_values(const std::string& path, Lines& lines, const DumpHeader& h,
-                                const std::vector<std::size_t>& cols, bool whole) {
-  std::vector<double> out(h.atoms * cols.size());
+std::vector<double> atom_values(const std::string& path, Lines& lines, std::size_t text_size, const DumpHeader& h,
+                                const std::vector<std::size_t>& cols, std::optional<std::string_view> tail) {
+  const bool whole = !tail;
+  // Sized by the lines the text can hold, not by the count the header
+  // claims (2^31 - 1 atoms in a 150-byte file asked for 48 GB).
+  std::vector<double> out;
+  out.reserve(std::min(h.atoms, text_size / 2) * cols.size());
   std::vector<std::string_view> f(h.columns.size());
   std::string_view line;
   std::size_t number = 0;
   for (std::size_t k = 0; k < h.atoms; ++k) {
     if (!lines.next(line, number))
       ended(path, "the frame ends after " + std::to_string(k) + " of its " + std::to_string(h.atoms) + " atoms", whole);
+    out.resize(out.size() + cols.size());
     Fields fs(line, ' ');
     std::size_t got = 0;
     std::string_view field;
@@ -214,6 +240,13 @@ std::vector<double> atom_values(const std::string& path, Lines& lines, const Dum
         fail(path, "line " + std::to_string(number) + ": column '" + h.columns[cols[c]] + "' is not a number: '" +
                        std::string(f[cols[c]]) + "'");
   }
+  // The frame ends at the next frame's first item or at the end of the
+  // file: another line is an atom NUMBER OF ATOMS did not count.
+  const std::size_t last = number;
+  const bool more = lines.next(line, number);
+  if (more ? !starts_with(trim(line), item) : !frame_follows(tail, item))
+    fail(path, (more ? "line " + std::to_string(number) : "after line " + std::to_string(last)) +
+                   ": more atom lines than NUMBER OF ATOMS (" + std::to_string(h.atoms) + ")");
   return out;
 }
 
@@ -250,15 +283,15 @@ PointCloud read_dump_points(const std::string& path, const ReadOptions& options,
   DumpHeader h;
   CoordinateColumns cc;
   std::vector<std::size_t> cols;
-  const std::vector<double> v = first_frame(path, [&](std::string_view text, bool whole) {
+  const std::vector<double> v = first_frame(path, [&](std::string_view text, std::optional<std::string_view> tail) {
     Lines lines(text);
-    h = read_header(path, lines, whole);
+    h = read_header(path, lines, !tail);
     if (dim == 2 && (h.box.tilt[1] != 0 || h.box.tilt[2] != 0))
       fail(path, "--dim 2: the box tilts along z (xz, yz not 0); a 2D box has the xy tilt only");
     cc = coordinate_columns(path, h, dim);
     cols.assign(cc.col, cc.col + (cc.scaled ? 3 : dim));
     if (!label_column.empty()) cols.push_back(column_index(path, h, label_column, "labels"));
-    return atom_values(path, lines, h, cols, whole);
+    return atom_values(path, lines, text.size(), h, cols, tail);
   });
   const std::size_t coords = cc.scaled ? 3 : static_cast<std::size_t>(dim);
 
@@ -287,17 +320,17 @@ PointCloud read_dump_points(const std::string& path, const ReadOptions& options,
 }
 
 std::vector<double> read_dump_column(const std::string& path, const std::string& name) {
-  return first_frame(path, [&](std::string_view text, bool whole) {
+  return first_frame(path, [&](std::string_view text, std::optional<std::string_view> tail) {
     Lines lines(text);
-    const DumpHeader h = read_header(path, lines, whole);
-    return atom_values(path, lines, h, {column_index(path, h, name, "scalars")}, whole);
+    const DumpHeader h = read_header(path, lines, !tail);
+    return atom_values(path, lines, text.size(), h, {column_index(path, h, name, "scalars")}, tail);
   });
 }
 
 FileBox read_dump_box(const std::string& path) {
-  return first_frame(path, [&](std::string_view text, bool whole) {
+  return first_frame(path, [&](std::string_view text, std::optional<std::string_view> tail) {
     Lines lines(text);
-    return read_header(path, lines, whole).box;
+    return read_header(path, lines, !tail).box;
   });
 }
 

@@ -194,8 +194,7 @@ std::optional<FileBox> read_file_box(const std::string& path) {
   const std::string ext = detail::lower_extension(path);
   if (detail::is_dump_extension(ext)) return detail::read_dump_box(path);
   // An extended XYZ's Lattice.
-  if ((ext == ".xyz" || ext == ".txt") && detail::looks_like_xyz(detail::read_file_head(path, 1 << 16)))
-    return detail::read_xyz_box(path);
+  if ((ext == ".xyz" || ext == ".txt") && detail::is_xyz_file(path)) return detail::read_xyz_box(path);
   return std::nullopt;
 }
 

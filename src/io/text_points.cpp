@@ -151,7 +151,7 @@ PointCloud read_text_points(const std::string& path, const ReadOptions& options,
                             const std::string& label_column) {
   // XYZ (chemistry's, and extended XYZ): a lone count, a comment, the atoms;
   // a trajectory's frames after the first are not read.
-  if (looks_like_xyz(read_file_head(path, 1 << 16))) return read_xyz_points(path, options, label_column);
+  if (is_xyz_file(path)) return read_xyz_points(path, options, label_column);
   const std::string text = read_file_bytes(path);
   Lines lines(text);
   std::string_view line;
@@ -263,7 +263,7 @@ PointCloud read_text_points(const std::string& path, const ReadOptions& options,
 }
 
 std::vector<double> read_text_column(const std::string& path, const std::string& name) {
-  if (looks_like_xyz(read_file_head(path, 1 << 16))) return read_xyz_column(path, name);
+  if (is_xyz_file(path)) return read_xyz_column(path, name);
   const std::string text = read_file_bytes(path);
   Lines lines(text);
   std::string_view line;

@@ -243,9 +243,12 @@ std::size_t property_column(const std::string& path, const XyzHeader& h, const s
 }
 
 /// The atom lines' values of `cols`, atoms × cols.
-std::vector<double> atom_values(const std::string& path, RawLines& lines, const XyzHeader& h,
-                                const std::vector<std::size_t>& cols, bool whole) {
-  std::vector<double> out(h.atoms * cols.size());
+std::vector<double> atom_values(const std::string& path, RawLines& lines, std::size_t text_size, const XyzHeader& h,
+                                const std::vector<std::size_t>& cols, std::optional<std::string_view> tail) {
+  const bool whole = !tail;
+  // Sized by the lines the text can hold, not by the count the file claims.
+  std::vector<double> out;
+  out.reserve(std::min(h.atoms, text_size / 2) * cols.size());
   std::vector<std::string_view> f(h.columns);
   std::string_view line;
   // Plain XYZ lines may carry more columns (velocities) than the four read.
@@ -253,6 +256,7 @@ std::vector<double> atom_values(const std::string& path, RawLines& lines, const 
   for (std::size_t k = 0; k < h.atoms; ++k) {
     if (!lines.next(line))
       ended(path, "the frame ends after " + std::to_string(k) + " of its " + std::to_string(h.atoms) + " atoms", whole);
+    out.resize(out.size() + cols.size());
     Fields fs(line, ' ');
     std::size_t got = 0;
     std::string_view field;
@@ -265,6 +269,23 @@ std::vector<double> atom_values(const std::string& path, RawLines& lines, const 
       if (!parse_double(f[cols[c]], out[k * cols.size() + c]))
         fail(path, "line " + std::to_string(lines.number()) + ": '" + std::string(f[cols[c]]) + "' is not a number");
   }
+  // The frame ends at the next frame's count line or at the end of the file
+  // (blank lines aside): another line is an atom the count did not count.
+  const std::size_t last = lines.number();
+  while (lines.next(line))
+    if (!trim(line).empty()) {
+      if (!lone_count(line))
+        fail(path, "line " + std::to_string(lines.number()) + ": more atom lines than the frame's count (" +
+                       std::to_string(h.atoms) + ")");
+      return out;
+    }
+  if (tail) {  // the next line starts in the bytes past the prefix
+    const std::string_view t = trim(*tail);
+    if (t.empty()) throw FrameCut{};
+    if (t[0] < '0' || t[0] > '9')
+      fail(path, "after line " + std::to_string(last) + ": more atom lines than the frame's count (" +
+                     std::to_string(h.atoms) + ")");
+  }
   return out;
 }
 
@@ -276,22 +297,25 @@ bool looks_like_xyz(std::string_view text) {
   // A second count is Qhull's header (dimension, then count: rbox's output).
   RawLines lines(text);
   std::string_view first, comment, atom;
-  if (!lines.next(first) || !lone_count(first) || !lines.next(comment) || lone_count(comment) || !lines.next(atom))
-    return false;
+  if (!lines.next(first) || !lone_count(first) || !lines.next(comment) || !lines.next(atom)) return false;
   Fields fs(atom, ' ');
   std::string_view f;
-  int fields = 0;
-  while (fields < 3 && fs.next(f)) ++fields;
-  return fields >= 3;
+  std::size_t fields = 0;
+  while (fields < 5 && fs.next(f)) ++fields;
+  // Two counts are also Qhull's header (dimension and count, either first:
+  // rbox's output), whose points have as many coordinates as the smaller.
+  if (fields < 3) return false;
+  if (const auto second = lone_count(comment)) return fields != std::min(*lone_count(first), *second);
+  return true;
 }
 
 PointCloud read_xyz_points(const std::string& path, const ReadOptions& options, const std::string& label_column) {
   const int dim = options.dim == 0 ? 3 : options.dim;
   XyzHeader h;
   std::vector<std::size_t> cols;
-  const std::vector<double> v = first_frame(path, [&](std::string_view text, bool whole) {
+  const std::vector<double> v = first_frame(path, [&](std::string_view text, std::optional<std::string_view> tail) {
     RawLines lines(text);
-    h = read_header(path, lines, whole);
+    h = read_header(path, lines, !tail);
     const Property* pos = find_property(h, "pos");
     if (pos == nullptr || pos->type != 'R' || pos->count != 3)
       fail(path, "line 2: Properties has no pos:R:3 (the positions)");
@@ -300,7 +324,7 @@ PointCloud read_xyz_points(const std::string& path, const ReadOptions& options, 
     if (!label_column.empty()) cols.push_back(property_column(path, h, label_column, "I", "labels"));
     if (dim == 2 && h.box && (h.box->tilt[1] != 0 || h.box->tilt[2] != 0))
       fail(path, "--dim 2: the Lattice tilts along z (cx, cy not 0); a 2D box has the xy tilt only");
-    return atom_values(path, lines, h, cols, whole);
+    return atom_values(path, lines, text.size(), h, cols, tail);
   });
   PointCloud pc;
   pc.dim = dim;
@@ -319,17 +343,25 @@ PointCloud read_xyz_points(const std::string& path, const ReadOptions& options, 
 }
 
 std::vector<double> read_xyz_column(const std::string& path, const std::string& name) {
-  return first_frame(path, [&](std::string_view text, bool whole) {
+  return first_frame(path, [&](std::string_view text, std::optional<std::string_view> tail) {
     RawLines lines(text);
-    const XyzHeader h = read_header(path, lines, whole);
-    return atom_values(path, lines, h, {property_column(path, h, name, "RI", "scalars")}, whole);
+    const XyzHeader h = read_header(path, lines, !tail);
+    return atom_values(path, lines, text.size(), h, {property_column(path, h, name, "RI", "scalars")}, tail);
   });
 }
 
 std::optional<FileBox> read_xyz_box(const std::string& path) {
-  return first_frame(path, [&](std::string_view text, bool whole) {
+  return first_frame(path, [&](std::string_view text, std::optional<std::string_view> tail) {
     RawLines lines(text);
-    return read_header(path, lines, whole).box;
+    return read_header(path, lines, !tail).box;
+  });
+}
+
+bool is_xyz_file(const std::string& path) {
+  // Its first three lines, however long the comment (extended XYZ's can be).
+  return first_frame(path, [&](std::string_view text, std::optional<std::string_view> tail) {
+    if (tail && std::count(text.begin(), text.end(), '\n') < 3) throw FrameCut{};
+    return looks_like_xyz(text);
   });
 }
 

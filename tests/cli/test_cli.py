@@ -1142,7 +1142,8 @@ class FileBoxes(TempDirCase):
         r = self.ok(["delaunay", inp2, "--validate"])
         self.assertIn("of the periodic box (triclinic)", r.stderr)
         with open(inp2, "rb") as f:
-            r = run_bytes(["voronoi", "-", "--cell-table", "-", "-q"], f.read())
+            # LAMMPS writes UNITS and TIME first with dump_modify units/time yes.
+            r = run_bytes(["voronoi", "-", "--cell-table", "-", "-q"], b"ITEM: UNITS\nlj\nITEM: TIME\n0.5\n" + f.read())
         self.assertEqual(r.returncode, 0, r.stderr)
         self.assertAlmostEqual(np.loadtxt(io.StringIO(r.stdout.decode()), delimiter=",", skiprows=1)[:, 2].sum(),
                                abs(np.linalg.det(self.VEC)), delta=1e-9)

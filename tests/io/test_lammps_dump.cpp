@@ -35,6 +35,16 @@ const char* kRows =
 
 }  // namespace
 
+TEST(LammpsDump, UnitsAndTimeBeforeTheTimestep) {
+  // What LAMMPS writes with dump_modify units yes, time yes.
+  TempDir dir;
+  const std::string text = "ITEM: UNITS\nlj\nITEM: TIME\n0.5\n" +
+                           ortho("id type x y z", "1 1 0.5 1 2.5\n2 1 -0.75 4 7.5\n3 1 2.25 0.5 3\n");
+  const auto pc = read_points(dir.write("units.dump", text));
+  EXPECT_EQ(pc.n, 3u);
+  EXPECT_EQ(read_file_box(dir.file("units.dump"))->timestep, 1500);
+}
+
 TEST(LammpsDump, OrthogonalBoxAndAtomsInFileOrder) {
   TempDir dir;
   // Another frame after the first, and an item LAMMPS may add (UNITS).
@@ -142,6 +152,21 @@ TEST(LammpsDump, Errors) {
       {head + "ITEM: ATOMS id x y z\n1 0 0 0\n2 0 0 0 9\n", "expected 4 values"},
       {head + "ITEM: ATOMS id x y z\n1 0 0 0\n2 0 zero 0\n", "column 'y' is not a number: 'zero'"},
       {head + "ITEM: ATOMS id x y z\n1 0 0 0\n2 0 inf 0\n", "non-finite coordinate"},
+      // Found by a fuzz of the readers: more atom lines than the count (an
+      // atom was dropped silently), a corrupted ATOMS item (a later frame
+      // was read silently), items twice, boundary flags that are none.
+      {head + "ITEM: ATOMS id x y z\n1 0 0 0\n2 0 0 0\n3 1 1 1\n", "line 12: more atom lines than NUMBER OF ATOMS (2)"},
+      {head + "ITEM: ATOM id x y z\n1 0 0 0\n2 0 0 0\n" + head + "ITEM: ATOMS id x y z\n1 0 0 0\n2 1 1 1\n",
+       "line 9: unknown item 'ATOM id x y z'"},
+      {head + "ITEM: ATOMSX id x y z\n1 0 0 0\n2 0 0 0\n", "unknown item 'ATOMSX id x y z'"},
+      {head + "ITEM: NOTES\nhello\nITEM: ATOMS id x y z\n1 0 0 0\n2 1 1 1\n", "unknown item 'NOTES'"},
+      {"ITEM: TIMESTEP\n1\nITEM: TIMESTEP\n2\n", "line 3: ITEM: TIMESTEP again before ITEM: ATOMS"},
+      {"ITEM: TIMESTEP\n1\nITEM: NUMBER OF ATOMS\n2\nITEM: BOX BOUNDS PP pp pp\n0 1\n0 1\n0 1\n", "flag 'PP' along x"},
+      {"ITEM: TIMESTEP\n1\nITEM: NUMBER OF ATOMS\n2\nITEM: BOX BOUNDS pp fp pp\n0 1\n0 1\n0 1\n", "flag 'fp' along y"},
+      // A count far beyond the file: an error, not its memory (48 GB asked).
+      {"ITEM: TIMESTEP\n1\nITEM: NUMBER OF ATOMS\n2147483647\nITEM: BOX BOUNDS pp pp pp\n0 1\n0 1\n0 1\n"
+       "ITEM: ATOMS x y z\n0 0 0\n",
+       "ends after 1 of its 2147483647 atoms"},
   };
   for (const Case& c : cases) {
     const std::string p = dir.write("e.dump", c.text);
@@ -165,7 +190,7 @@ TEST(LammpsDump, Errors) {
 // never do.
 TEST(LammpsDump, FirstFrameOfAHugeTrajectory) {
   TempDir dir;
-  const std::string p = dir.write("huge.lammpstrj", ortho("id type x y z radius", kRows));
+  const std::string p = dir.write("huge.lammpstrj", ortho("id type x y z radius", kRows) + "ITEM: TIMESTEP\n");
   try {
     std::filesystem::resize_file(p, std::uintmax_t{1} << 36);
   } catch (const std::filesystem::filesystem_error& e) {

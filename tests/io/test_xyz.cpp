@@ -38,6 +38,22 @@ TEST(Xyz, PlainFramesAndEmptyComment) {
   EXPECT_EQ(read_points(dir.write("c.xyz", "1\nE = -76.4 eV, a=b\nO 1 2 3\n")).n, 1u);
 }
 
+TEST(Xyz, CommentsThatLookLikeOtherThings) {
+  TempDir dir;
+  // A comment that is a number, atoms of numeric species: XYZ, not Qhull's
+  // header (whose points have as many numbers as the smaller count).
+  auto pc = read_points(dir.write("n.xyz", "3\n4\n1 0.1 0.2 0.3\n1 0.4 0.5 0.6\n2 0.7 0.8 0.9\n"));
+  EXPECT_EQ(pc.coords, (std::vector<double>{0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9}));
+  pc = read_points(dir.write("q.txt", "3\n4\n0.1 0.2 0.3\n0.4 0.5 0.6\n0.7 0.8 0.9\n1 1 1\n"));  // Qhull's
+  EXPECT_EQ(pc.n, 4u);
+  // An extended XYZ comment past 64 KiB keeps its box.
+  const std::string comment = "Lattice=\"2 0 0 0 3 0 0 0 4\" pbc=\"T T T\" note=\"" + std::string(70000, 'x') + "\"";
+  const std::string p = dir.write("long.xyz", "1\n" + comment + "\nAr 1 1 1\n");
+  ASSERT_TRUE(read_file_box(p).has_value());
+  EXPECT_EQ(read_file_box(p)->hi, (std::array<double, 3>{2, 3, 4}));
+  EXPECT_EQ(read_points(p).n, 1u);
+}
+
 TEST(Xyz, ExtendedLatticePropertiesAndPbc) {
   TempDir dir;
   const std::string text =
@@ -89,6 +105,10 @@ TEST(Xyz, Errors) {
       {"1\nLattice=\"1 0 0 0 1 0 0 0 1\" pbc=\"T T\"\nC 0 0 0\n", "pbc must be three of T and F"},
       {"1\nLattice=\"1 0 0 0 1 0 0 0 1\" pbc=\"T T yes\"\nC 0 0 0\n", "pbc must be three of T and F"},
       {"1\n\nC 0 0 nan\n", "non-finite coordinate"},
+      // More atom lines than the count (an atom was dropped silently), and
+      // a count far beyond the file (its memory was asked for).
+      {"2\n\nH 0 0 0\nH 1 1 1\nH 2 2 2\n", "line 5: more atom lines than the frame's count (2)"},
+      {"2147483647\n\nH 0 0 0\n", "ends after 1 of its 2147483647 atoms"},
   };
   for (const Case& c : cases) {
     const std::string p = dir.write("e.xyz", c.text);
@@ -113,7 +133,7 @@ TEST(Xyz, Errors) {
 TEST(Xyz, FirstFrameOfAHugeTrajectory) {
   TempDir dir;
   const std::string p =
-      dir.write("huge.xyz", "2\nLattice=\"2 0 0 0 3 0 0 0 4\" Properties=species:S:1:pos:R:3:q:R:1\nAr 1 1 1 0.5\nAr 0.5 2 3 1\n");
+      dir.write("huge.xyz", "2\nLattice=\"2 0 0 0 3 0 0 0 4\" Properties=species:S:1:pos:R:3:q:R:1\nAr 1 1 1 0.5\nAr 0.5 2 3 1\n2\n");
   try {
     std::filesystem::resize_file(p, std::uintmax_t{1} << 36);
   } catch (const std::filesystem::filesystem_error& e) {
