@@ -319,10 +319,15 @@ PeriodicImages periodic_images(const PeriodicInput& in, std::span<const std::int
   }
   if (in.sheared) {
     // The bounding box of the parallelepiped's layer (with the slack twice
-    // and a margin for the rounding of this sum): every image lies in it.
+    // and a margin for the rounding): every image lies in it. The offsets
+    // from the corner are summed apart from it, and the margin counts the
+    // corner's own rounding too: far from the origin (a box 0.2 wide at
+    // 1e14, where an ulp is 0.016) the sum with the corner rounded by more
+    // than the offsets' margin, an image fell outside, and the pass
+    // reported "point 24890 lies outside the bounds" (a hostile-input fuzz).
     for (std::size_t a = 0; a < du; ++a) {
       if (!in.periodic[a]) continue;
-      double lo = in.box.lo[a], hi = in.box.lo[a], size = 0;
+      double lo = 0, hi = 0, size = 0;
       for (std::size_t i = 0; i < du; ++i) {
         const double v = in.lattice[i][a];
         const double f0 = lo_f[i] - fraction_slack, f1 = hi_f[i] + fraction_slack;
@@ -330,8 +335,11 @@ PeriodicImages periodic_images(const PeriodicInput& in, std::span<const std::int
         hi += std::max(f0 * v, f1 * v);
         size += (f1 - f0) * std::fabs(v);
       }
-      im.domain.lo[a] = lo - 0x1p-30 * size;
-      im.domain.hi[a] = hi + 0x1p-30 * size;
+      const double corner = in.box.lo[a];
+      const double margin = 0x1p-30 * size + 4 * std::numeric_limits<double>::epsilon() *
+                                                 (std::fabs(corner) + std::fabs(lo) + std::fabs(hi));
+      im.domain.lo[a] = corner + lo - margin;
+      im.domain.hi[a] = corner + hi + margin;
     }
   }
   // The images a layer may hold: 64 per point, and 2^24 more for boxes of

@@ -30,6 +30,7 @@
 #include "tessera/faces.hpp"
 #include "tessera/flower.hpp"
 #include "tessera/graph.hpp"
+#include "tessera/io/points.hpp"
 
 namespace {
 
@@ -911,6 +912,33 @@ TEST(Triclinic, Refused) {
 // of images would hold billions (a hostile fuzz case ran out of memory at
 // 51 GB). Refused at once, naming the box; the same slab unsheared keeps
 // its own refusal (cells reaching past 127 box lengths).
+TEST(Triclinic, FarFromTheOrigin) {
+  // A sheared box 0.19 wide at 1e14, where an ulp is 2^-6: the pass's
+  // domain, the layer's bounding box, was summed with the corner and rounded
+  // inward past its margin, an image fell outside, and the cells were
+  // refused with "point 24890 lies outside the bounds". The input is the
+  // hostile-input fuzz's (seed 9506, case 130): 1,665 points on a 7^3 grid
+  // of step 2^-6, with duplicates.
+  const std::vector<double> pts =
+      tessera::io::read_points(std::string(TESSERA_TEST_DATA_DIR) + "/periodic_sheared_far_from_origin_3d.npy").coords;
+  const auto box = make_bounds({99999999999999.95, 99999999999999.95, 99999999999999.95},
+                               {100000000000000.14, 100000000000000.14, 100000000000000.14});
+  const Tilt tilt{0.056249999999999994, 0.037500000000000006, -0.046875};
+  std::vector<std::int32_t> neighbors[2];
+  int m = 0;
+  for (const auto method : {tessera::CellMethod::search, tessera::CellMethod::insertion}) {
+    tessera::VoronoiOptions opt = periodic_options(3, box, {true, true, true}, 1, tilt);
+    opt.cell_method = method;
+    opt.build_mesh = true;
+    const tessera::Cells c = tessera::voronoi(pts, 3, {}, opt);
+    EXPECT_EQ(asymmetric_entries(c), 0u);
+    const tessera::ValidationReport r = tessera::validate(c, {}, pts);
+    EXPECT_TRUE(r.ok) << (r.messages.empty() ? "" : r.messages[0]);
+    neighbors[m++].assign(c.neighbors.begin(), c.neighbors.end());
+  }
+  EXPECT_EQ(neighbors[0], neighbors[1]);
+}
+
 TEST(Triclinic, NearlyFlatShearRefused) {
   const auto box = make_bounds({0, 0, 0}, {2, 2, 2e-9});
   auto pts = random_points(120, 3, 42, make_bounds({0, 0, 0}, {2, 2, 1}));
