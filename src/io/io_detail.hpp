@@ -140,6 +140,13 @@ auto first_frame(const std::string& path, Parse&& parse) {
   }
 }
 
+/// A frame parser's text ran out: the file's error where `whole`, else
+/// more of the file is needed (first_frame).
+[[noreturn]] inline void frame_ended(const std::string& path, const std::string& what, bool whole) {
+  if (!whole) throw FrameCut{};
+  fail(path, what);
+}
+
 /// After a frame's last atom line, where `lines` ran out of a prefix: what
 /// follows is a next frame's first line if `tail` starts with `start` (the
 /// check asks for more of the file while `tail` is shorter than `start`).

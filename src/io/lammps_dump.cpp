@@ -119,13 +119,6 @@ FileBox parse_box(const std::string& path, const std::vector<std::string_view>& 
   return b;
 }
 
-/// The frame's text ran out: the file's error where `whole`, else more of
-/// the file is needed (first_frame).
-[[noreturn]] void ended(const std::string& path, const std::string& what, bool whole) {
-  if (!whole) throw FrameCut{};
-  fail(path, what);
-}
-
 /// Reads the first frame's header; `lines` then stands at its first atom line.
 DumpHeader read_header(const std::string& path, Lines& lines, bool whole) {
   DumpHeader h;
@@ -133,7 +126,7 @@ DumpHeader read_header(const std::string& path, Lines& lines, bool whole) {
   std::size_t number = 0;
   bool have_step = false, have_atoms = false, have_box = false, have_units = false, have_time = false;
   auto next = [&](const char* what) {
-    if (!lines.next(line, number)) ended(path, std::string("the file ends before ") + what, whole);
+    if (!lines.next(line, number)) frame_ended(path, std::string("the file ends before ") + what, whole);
     return trim(line);
   };
   // Each item once before ATOMS: a second one means this frame's ATOMS line
@@ -143,7 +136,7 @@ DumpHeader read_header(const std::string& path, Lines& lines, bool whole) {
     if (seen) fail(path, "line " + std::to_string(number) + ": ITEM: " + name + " again before ITEM: ATOMS");
     seen = true;
   };
-  if (!lines.next(line, number)) ended(path, "not a LAMMPS dump: it is empty", whole);
+  if (!lines.next(line, number)) frame_ended(path, "not a LAMMPS dump: it is empty", whole);
   // LAMMPS writes UNITS and TIME (dump_modify units, time) before TIMESTEP.
   for (const char* first : {"ITEM: TIMESTEP", "ITEM: UNITS", "ITEM: TIME"})
     if (trim(line) == first) goto header;
@@ -198,7 +191,7 @@ header:
       fail(path, "line " + std::to_string(number) + ": unknown item '" + std::string(what) +
                      "' (a dump frame has UNITS, TIME, TIMESTEP, NUMBER OF ATOMS, BOX BOUNDS and ATOMS)");
     }
-    if (!lines.next(line, number)) ended(path, "the file ends before ITEM: ATOMS", whole);
+    if (!lines.next(line, number)) frame_ended(path, "the file ends before ITEM: ATOMS", whole);
   }
 }
 
@@ -224,7 +217,7 @@ std::vector<double> atom_values(const std::string& path, Lines& lines, std::size
   std::size_t number = 0;
   for (std::size_t k = 0; k < h.atoms; ++k) {
     if (!lines.next(line, number))
-      ended(path, "the frame ends after " + std::to_string(k) + " of its " + std::to_string(h.atoms) + " atoms", whole);
+      frame_ended(path, "the frame ends after " + std::to_string(k) + " of its " + std::to_string(h.atoms) + " atoms", whole);
     out.resize(out.size() + cols.size());
     Fields fs(line, ' ');
     std::size_t got = 0;

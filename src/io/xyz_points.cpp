@@ -132,23 +132,16 @@ std::vector<double> numbers(const std::string& path, const std::string& what, co
   return v;
 }
 
-/// The frame's text ran out: the file's error where `whole`, else more of
-/// the file is needed (first_frame).
-[[noreturn]] void ended(const std::string& path, const std::string& what, bool whole) {
-  if (!whole) throw FrameCut{};
-  fail(path, what);
-}
-
 XyzHeader read_header(const std::string& path, RawLines& lines, bool whole) {
   XyzHeader h;
   std::string_view line;
-  if (!lines.next(line)) ended(path, "no points", whole);
+  if (!lines.next(line)) frame_ended(path, "no points", whole);
   const std::optional<std::size_t> n = lone_count(line);
   if (!n) fail(path, "not an XYZ file: its first line is not the number of atoms");
   if (*n == 0) fail(path, "no points (the XYZ frame has 0 atoms)");
   if (*n > (std::size_t{1} << 31) - 1) fail(path, "more than 2^31 - 1 atoms (point ids are int32)");
   h.atoms = *n;
-  if (!lines.next(line)) ended(path, "the file ends before the comment line", whole);
+  if (!lines.next(line)) frame_ended(path, "the file ends before the comment line", whole);
   const auto kv = key_values(line);
   auto find = [&](const char* key) -> const std::string* {
     for (const auto& [k, v] : kv)
@@ -255,7 +248,7 @@ std::vector<double> atom_values(const std::string& path, RawLines& lines, std::s
   const bool plain = h.properties.size() == 2 && h.properties[0].name == "species" && h.columns == 4;
   for (std::size_t k = 0; k < h.atoms; ++k) {
     if (!lines.next(line))
-      ended(path, "the frame ends after " + std::to_string(k) + " of its " + std::to_string(h.atoms) + " atoms", whole);
+      frame_ended(path, "the frame ends after " + std::to_string(k) + " of its " + std::to_string(h.atoms) + " atoms", whole);
     out.resize(out.size() + cols.size());
     Fields fs(line, ' ');
     std::size_t got = 0;
