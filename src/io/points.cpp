@@ -25,10 +25,7 @@ void fail(const std::string& path, std::string_view what) {
   std::string msg = path;
   msg += ": ";
   msg += what;
-  // Keep messages on one line whatever got spliced into them.
-  std::replace(msg.begin(), msg.end(), '\n', ' ');
-  std::replace(msg.begin(), msg.end(), '\r', ' ');
-  throw InputError(msg);
+  throw InputError(msg);  // one printable line, whatever got spliced in (one_printable_line)
 }
 
 void check_readable(const std::string& path) {
