@@ -323,6 +323,28 @@ void bind_prep(py::module_& m) {
       py::arg("path"), py::arg("dim"), py::arg("labels"), py::arg("keep_non_finite"),
       "A point file as the command line reads it: (points (n, dim), labels (n,) or None).");
 
+  // ---- read_frame -------------------------------------------------------------
+  m.def(
+      "read_frame",
+      [](const std::string& path, std::uint64_t offset, std::size_t line, int dim, const std::string& labels) {
+        io::ReadOptions opt;
+        opt.dim = dim;
+        opt.labels = labels;
+        io::TrajectoryFrame f = without_gil([&] { return io::read_frame(path, offset, line, opt); });
+        const auto n = static_cast<py::ssize_t>(f.points.n);
+        py::object lab = py::none(), box = py::none(), step = py::none();
+        if (!labels.empty()) lab = adopt_flat(std::move(f.points.labels));
+        if (f.box) {
+          box = py::make_tuple(f.box->lo, f.box->hi, f.box->tilt, f.box->periodic, f.box->timestep);
+          if (f.box->declared_by.rfind("LAMMPS", 0) == 0) step = py::int_(f.box->timestep);
+        }
+        return py::make_tuple(adopt(std::move(f.points.coords), {n, static_cast<py::ssize_t>(f.points.dim)}), lab, box,
+                              step, f.next_offset, f.next_line, f.last);
+      },
+      py::arg("path"), py::arg("offset"), py::arg("line"), py::arg("dim"), py::arg("labels"),
+      "The trajectory frame at a byte offset: (points, labels or None, box or None, timestep or None, next_offset, "
+      "next_line, last).");
+
   // ---- read_box ---------------------------------------------------------------
   m.def(
       "read_box",

@@ -23,7 +23,7 @@ numpy in, numpy out::
 * :func:`surface_nets` -> :class:`SurfaceNet`: smooth, watertight region
   surfaces of labelled points, with ``vertex_kind``.
 * Point preparation: :func:`sample_image` (label image -> labelled points),
-  :func:`read_image`, :func:`read_points`, :func:`read_box`, :func:`fill`, :func:`joggle`, :func:`threshold`,
+  :func:`read_image`, :func:`read_points`, :func:`read_box`, :func:`read_frames`, :func:`fill`, :func:`joggle`, :func:`threshold`,
   :func:`probe`.
 
 :func:`adjacency`, :func:`faces` and :func:`flower` take points or a
@@ -54,7 +54,7 @@ from ._core import (
 )
 from ._delaunay import Delaunay, delaunay
 from ._dual import AdjacencyGraph, FaceSet, Flower, Flowers, adjacency, faces, flower
-from ._prep import fill, joggle, probe, read_box, read_image, read_points, sample_image, threshold
+from ._prep import Frame, fill, joggle, probe, read_box, read_frames, read_image, read_points, sample_image, threshold
 from ._scipy import ScipyVoronoi
 from ._surface_nets import NET_CORNER, NET_JUNCTION, NET_SURFACE, SurfaceNet, surface_nets
 from ._voronoi import Voronoi, voronoi
@@ -82,6 +82,8 @@ __all__ = [
     "read_image",
     "read_points",
     "read_box",
+    "read_frames",
+    "Frame",
     "joggle",
     "fill",
     "threshold",

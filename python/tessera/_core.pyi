@@ -2,7 +2,7 @@
 # functions of the `tessera` package, which check input and document the
 # meanings; these are the raw bindings. Every ndarray property is a read-only
 # view whose base is the object it belongs to.
-from typing import Dict, List, Optional, Sequence, Tuple
+from typing import Any, Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
 import numpy.typing as npt
@@ -456,6 +456,9 @@ def read_label_image(path: str, spacing: Optional[Sequence[float]], origin: Opti
 def read_points(
     path: str, dim: int, labels: str, keep_non_finite: bool
 ) -> Tuple[np.ndarray, Optional[np.ndarray]]: ...
+def read_frame(
+    path: str, offset: int, line: int, dim: int, labels: str
+) -> Tuple[np.ndarray, Optional[np.ndarray], Optional[Tuple[Any, ...]], Optional[int], int, int, bool]: ...
 def read_box(
     path: str,
 ) -> Optional[Tuple[Tuple[float, float, float], Tuple[float, float, float], Tuple[float, float, float],

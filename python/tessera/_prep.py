@@ -19,7 +19,7 @@ may be written.
 from __future__ import annotations
 
 import os
-from typing import Any, Optional, Sequence, Tuple, Union
+from typing import Any, Iterator, NamedTuple, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
@@ -151,6 +151,74 @@ def read_points(
     return _inputs.call(_core.read_points, os.fsdecode(path), dim or 0, lab, bool(keep_non_finite))
 
 
+class Frame(NamedTuple):
+    """One frame of a trajectory (:func:`read_frames`)."""
+
+    points: np.ndarray
+    """float64 (N, D): the atoms, in file order."""
+    labels: Optional[np.ndarray]
+    """int32 (N,) from the ``labels`` column, or None."""
+    box: Optional[dict]
+    """The frame's box as :func:`read_box` gives it (``voronoi(points, **box)``), or None."""
+    timestep: Optional[int]
+    """A LAMMPS dump's TIMESTEP; None for XYZ."""
+
+
+def read_frames(path: PathLike, labels: Optional[str] = None, dim: Optional[int] = None) -> Iterator[Frame]:
+    """The frames of a trajectory, one after another: a LAMMPS dump
+    (``.dump`` / ``.lammpstrj``) or an XYZ file (frames back to back). Each
+    frame is read when the loop asks for it (a trajectory may be far larger
+    than memory)::
+
+        for f in tessera.read_frames("run.lammpstrj", labels="type"):
+            vor = tessera.voronoi(f.points, labels=f.labels, **f.box, merge=False)
+
+    ``labels`` names an integer column (dump) or ``I:1`` property (extended
+    XYZ); ``dim=2`` keeps x, y. Each frame is checked as :func:`read_points`
+    checks the first (ValueError, :class:`tessera.InputError`, naming the
+    line), when the loop reaches it.
+    """
+    if not _is_path(path):
+        raise ValueError(f"path: expected a file name, got {type(path).__name__}")
+    if dim not in (None, 2, 3):
+        raise ValueError(f"dim: expected 2, 3 or None, got {dim!r}")
+    if labels is not None and not isinstance(labels, str):
+        raise ValueError(f"labels: expected a column name, got {type(labels).__name__}")
+    name = os.fsdecode(path)
+
+    def read(offset: int, line: int) -> Tuple[Frame, int, int, bool]:
+        pts, lab, box, step, offset, line, last = _inputs.call(_core.read_frame, name, offset, line, dim or 0,
+                                                               labels or "")
+        return Frame(pts, lab, None if box is None else _box_arguments(name, box, dim), step), offset, line, last
+
+    # The first frame now: a missing file or another format is said here,
+    # not at the loop's first step.
+    first = read(0, 1)
+
+    def frames() -> Iterator[Frame]:
+        frame, offset, line, last = first
+        yield frame
+        while not last:
+            frame, offset, line, last = read(offset, line)
+            yield frame
+
+    return frames()
+
+
+def _box_arguments(name: str, box: tuple, dim: Optional[int]) -> dict:
+    """A file's box (lo, hi, tilt, periodic, timestep) as voronoi()'s keyword arguments."""
+    lo, hi, tilt, periodic, _timestep = box
+    d = dim or 3
+    if d == 2 and (tilt[1] != 0 or tilt[2] != 0):
+        raise _core.InputError(f"{name}: dim=2, but the box tilts along z (xz, yz not 0)")
+    tilts = tuple(float(t) for t in tilt[: 3 if d == 3 else 1])
+    return {
+        "bounds": tuple(float(v) for a in range(d) for v in (lo[a], hi[a])),
+        "periodic": tuple(bool(p) for p in periodic[:d]),
+        "tilt": tilts if any(t != 0 for t in tilts) else None,
+    }
+
+
 def read_box(path: PathLike, dim: Optional[int] = None) -> Optional[dict]:
     """The simulation box a point file declares (a LAMMPS dump's ``BOX
     BOUNDS``, an extended XYZ's ``Lattice``, ``Origin`` and ``pbc``; other
@@ -173,18 +241,7 @@ def read_box(path: PathLike, dim: Optional[int] = None) -> Optional[dict]:
     if dim not in (None, 2, 3):
         raise ValueError(f"dim: expected 2, 3 or None, got {dim!r}")
     box = _inputs.call(_core.read_box, os.fsdecode(path))
-    if box is None:
-        return None
-    lo, hi, tilt, periodic, _timestep = box
-    d = dim or 3
-    if d == 2 and (tilt[1] != 0 or tilt[2] != 0):
-        raise _core.InputError(f"{os.fsdecode(path)}: dim=2, but the box tilts along z (xz, yz not 0)")
-    tilts = tuple(float(t) for t in tilt[: 3 if d == 3 else 1])
-    return {
-        "bounds": tuple(float(v) for a in range(d) for v in (lo[a], hi[a])),
-        "periodic": tuple(bool(p) for p in periodic[:d]),
-        "tilt": tilts if any(t != 0 for t in tilts) else None,
-    }
+    return None if box is None else _box_arguments(os.fsdecode(path), box, dim)
 
 
 # -------------------------------------------------------------- sample_image

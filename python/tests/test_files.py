@@ -313,6 +313,43 @@ def test_lammps_dump_points_and_box(tmp_path):
         tessera.read_box(tmp_path / "bad.dump")
 
 
+def test_read_frames_of_a_trajectory(tmp_path):
+    # A dump of three frames, each with its box and atom count: frames one
+    # after another, usable as voronoi's arguments; errors at the first call
+    # for the file, at its frame for a broken later frame.
+    rng = np.random.default_rng(13)
+    frames = []
+    with open(tmp_path / "t.lammpstrj", "w") as f:
+        for s, n in enumerate((40, 55, 30)):
+            box = 1.0 + s
+            pts = rng.random((n, 3)) * box
+            frames.append((pts, box))
+            f.write("ITEM: TIMESTEP\n%d\nITEM: NUMBER OF ATOMS\n%d\nITEM: BOX BOUNDS pp pp pp\n" % (10 * s, n))
+            f.write("0 %r\n0 %r\n0 %r\nITEM: ATOMS id type x y z\n" % (box, box, box))
+            for k, q in enumerate(pts):
+                f.write("%d %d %r %r %r\n" % (k + 1, 1 + k % 3, q[0], q[1], q[2]))
+    got = list(tessera.read_frames(tmp_path / "t.lammpstrj", labels="type"))
+    assert [f.timestep for f in got] == [0, 10, 20]
+    for f, (pts, box) in zip(got, frames):
+        np.testing.assert_array_equal(f.points, pts)
+        np.testing.assert_array_equal(f.labels, 1 + np.arange(len(pts)) % 3)
+        assert f.box == {"bounds": (0.0, box, 0.0, box, 0.0, box), "periodic": (True, True, True), "tilt": None}
+        vor = tessera.voronoi(f.points, labels=f.labels, **f.box, merge=False)
+        assert abs(vor.volumes.sum() - box**3) < 1e-9 * box**3
+    with pytest.raises(ValueError, match="cannot open"):
+        tessera.read_frames(tmp_path / "missing.dump")
+    np.save(tmp_path / "p.npy", frames[0][0])
+    with pytest.raises(ValueError, match="not a trajectory"):
+        tessera.read_frames(tmp_path / "p.npy")
+    text = (tmp_path / "t.lammpstrj").read_text()
+    broken = text[: text.index("ITEM: TIMESTEP\n20")] + "ITEM: TIMESTEP\n20\nITEM: NUMBER OF ATOMS\nmany\n"
+    (tmp_path / "b.lammpstrj").write_text(broken)
+    it = tessera.read_frames(tmp_path / "b.lammpstrj")
+    assert next(it).points.shape == (40, 3) and next(it).points.shape == (55, 3)
+    with pytest.raises(ValueError, match="number of atoms is not a count"):
+        next(it)
+
+
 def test_non_finite_points_kept_and_set_aside(tmp_path):
     # An organized cloud's missing returns: an error, or kept and then set
     # aside by ignore_outside, ids unchanged.

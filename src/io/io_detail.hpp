@@ -3,9 +3,12 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cstdint>
 #include <cstring>
+#include <optional>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "tessera/cells.hpp"
@@ -89,9 +92,11 @@ std::vector<double> read_ply_property(const std::string& path, const std::string
 /// line (NaN and Inf allowed; the caller decides).
 std::vector<double> read_text_column(const std::string& path, const std::string& name);
 
-/// LAMMPS dumps (.dump, .lammpstrj; lammps_dump.cpp): the first frame's
-/// atoms (`label_column`: empty, or the integer column holding labels), one
-/// numeric column of it, and its box (the header alone is read).
+/// LAMMPS dumps (.dump, .lammpstrj; lammps_dump.cpp): a frame's atoms
+/// (`label_column`: empty, or the integer column holding labels), the first
+/// frame's atoms, one numeric column of it, and its box (the header alone).
+TrajectoryFrame read_dump_frame(const std::string& path, std::uint64_t offset, std::size_t line,
+                                const ReadOptions& options, const std::string& label_column);
 PointCloud read_dump_points(const std::string& path, const ReadOptions& options, const std::string& label_column);
 std::vector<double> read_dump_column(const std::string& path, const std::string& name);
 FileBox read_dump_box(const std::string& path);
@@ -102,6 +107,8 @@ FileBox read_dump_box(const std::string& path);
 /// without a Lattice); the frames after the first are not read.
 bool looks_like_xyz(std::string_view text);
 bool is_xyz_file(const std::string& path);  ///< looks_like_xyz on as much of the file as its first lines take
+TrajectoryFrame read_xyz_frame(const std::string& path, std::uint64_t offset, std::size_t line,
+                               const ReadOptions& options, const std::string& label_column);
 PointCloud read_xyz_points(const std::string& path, const ReadOptions& options, const std::string& label_column);
 std::vector<double> read_xyz_column(const std::string& path, const std::string& name);
 std::optional<FileBox> read_xyz_box(const std::string& path);
@@ -111,24 +118,24 @@ std::optional<FileBox> read_xyz_box(const std::string& path);
 /// the atom in file order.
 std::int32_t atom_label(const std::string& path, const std::string& column, std::size_t k, double value);
 
-/// The first `bytes` bytes of a file (all of a shorter one), for the
-/// readers of a header alone.
-std::string read_file_head(const std::string& path, std::size_t bytes);
+/// `bytes` bytes of a file from byte `offset` (to its end where it is
+/// shorter), for the readers of a header alone and of a trajectory's frames.
+std::string read_file_head(const std::string& path, std::size_t bytes, std::uint64_t offset = 0);
 
 /// Thrown by a frame parser whose frame runs past the end of a prefix of the
 /// file that is not the whole file: first_frame reads more.
 struct FrameCut {};
 
-/// `parse(text, tail)` on the first bytes of `path`, cut after their last
+/// `parse(text, tail)` on the bytes of `path` from `offset`, cut after their last
 /// line break, on more of them each time it throws FrameCut: the first frame
 /// of a trajectory without reading the frames after it (a trajectory may be
 /// gigabytes). `tail`: the bytes after the cut, the start of a line not yet
 /// whole; nullopt where `text` is the whole file, so that running out of
 /// lines is the file's error, not the prefix's.
 template <class Parse>
-auto first_frame(const std::string& path, Parse&& parse) {
+auto frame_at(const std::string& path, std::uint64_t offset, Parse&& parse) {
   for (std::size_t want = std::size_t{1} << 20;; want *= 4) {
-    const std::string head = read_file_head(path, want);
+    const std::string head = read_file_head(path, want, offset);
     const bool whole = head.size() < want;
     const std::size_t cut = whole ? head.size() : head.rfind('\n') + 1;  // (npos + 1 == 0: no line yet)
     const std::string_view text(head.data(), cut);
@@ -145,6 +152,12 @@ auto first_frame(const std::string& path, Parse&& parse) {
 [[noreturn]] inline void frame_ended(const std::string& path, const std::string& what, bool whole) {
   if (!whole) throw FrameCut{};
   fail(path, what);
+}
+
+/// frame_at the file's start.
+template <class Parse>
+auto first_frame(const std::string& path, Parse&& parse) {
+  return frame_at(path, 0, std::forward<Parse>(parse));
 }
 
 /// After a frame's last atom line, where `lines` ran out of a prefix: what

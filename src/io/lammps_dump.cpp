@@ -205,8 +205,16 @@ std::size_t column_index(const std::string& path, const DumpHeader& h, const std
 /// The atom lines' values of `cols` (columns of the header), atoms × cols,
 /// row-major. Every line must have one field per column; the wanted ones
 /// must be numbers (others, such as an element name, are not read).
+/// Where the frame ended: the bytes of the text it took, the next line's
+/// number, and whether another frame follows.
+struct FrameEnd {
+  std::size_t bytes = 0, next_line = 1;
+  bool last = true;
+};
+
 std::vector<double> atom_values(const std::string& path, Lines& lines, std::size_t text_size, const DumpHeader& h,
-                                const std::vector<std::size_t>& cols, std::optional<std::string_view> tail) {
+                                const std::vector<std::size_t>& cols, std::optional<std::string_view> tail,
+                                FrameEnd* end = nullptr) {
   const bool whole = !tail;
   // Sized by the lines the text can hold, not by the count the header
   // claims (2^31 - 1 atoms in a 150-byte file asked for 48 GB).
@@ -235,11 +243,13 @@ std::vector<double> atom_values(const std::string& path, Lines& lines, std::size
   }
   // The frame ends at the next frame's first item or at the end of the
   // file: another line is an atom NUMBER OF ATOMS did not count.
-  const std::size_t last = number;
+  if (end != nullptr) *end = FrameEnd{lines.position(), lines.line_number() + 1, true};
+  const std::size_t last = lines.line_number();
   const bool more = lines.next(line, number);
   if (more ? !starts_with(trim(line), item) : !frame_follows(tail, item))
     fail(path, (more ? "line " + std::to_string(number) : "after line " + std::to_string(last)) +
                    ": more atom lines than NUMBER OF ATOMS (" + std::to_string(h.atoms) + ")");
+  if (end != nullptr) end->last = !more && !tail;
   return out;
 }
 
@@ -271,24 +281,31 @@ CoordinateColumns coordinate_columns(const std::string& path, const DumpHeader& 
 
 }  // namespace
 
-PointCloud read_dump_points(const std::string& path, const ReadOptions& options, const std::string& label_column) {
+TrajectoryFrame read_dump_frame(const std::string& path, std::uint64_t offset, std::size_t line,
+                                const ReadOptions& options, const std::string& label_column) {
   const int dim = options.dim == 0 ? 3 : options.dim;
   DumpHeader h;
   CoordinateColumns cc;
   std::vector<std::size_t> cols;
-  const std::vector<double> v = first_frame(path, [&](std::string_view text, std::optional<std::string_view> tail) {
-    Lines lines(text);
+  FrameEnd end;
+  const std::vector<double> v = frame_at(path, offset, [&](std::string_view text, std::optional<std::string_view> tail) {
+    Lines lines(text, line);
     h = read_header(path, lines, !tail);
     if (dim == 2 && (h.box.tilt[1] != 0 || h.box.tilt[2] != 0))
       fail(path, "--dim 2: the box tilts along z (xz, yz not 0); a 2D box has the xy tilt only");
     cc = coordinate_columns(path, h, dim);
     cols.assign(cc.col, cc.col + (cc.scaled ? 3 : dim));
     if (!label_column.empty()) cols.push_back(column_index(path, h, label_column, "labels"));
-    return atom_values(path, lines, text.size(), h, cols, tail);
+    return atom_values(path, lines, text.size(), h, cols, tail, &end);
   });
   const std::size_t coords = cc.scaled ? 3 : static_cast<std::size_t>(dim);
 
-  PointCloud pc;
+  TrajectoryFrame frame;
+  frame.box = h.box;
+  frame.next_offset = offset + end.bytes;
+  frame.next_line = end.next_line;
+  frame.last = end.last;
+  PointCloud& pc = frame.points;
   pc.dim = dim;
   pc.n = h.atoms;
   pc.coords.resize(pc.n * static_cast<std::size_t>(dim));
@@ -309,7 +326,11 @@ PointCloud read_dump_points(const std::string& path, const ReadOptions& options,
     pc.labels.resize(pc.n);
     for (std::size_t k = 0; k < pc.n; ++k) pc.labels[k] = atom_label(path, label_column, k, v[k * cols.size() + coords]);
   }
-  return pc;
+  return frame;
+}
+
+PointCloud read_dump_points(const std::string& path, const ReadOptions& options, const std::string& label_column) {
+  return read_dump_frame(path, 0, 1, options, label_column).points;
 }
 
 std::vector<double> read_dump_column(const std::string& path, const std::string& name) {

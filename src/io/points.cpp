@@ -71,13 +71,15 @@ std::string read_file_bytes(const std::string& path) {
   return bytes;
 }
 
-std::string read_file_head(const std::string& path, std::size_t bytes) {
+std::string read_file_head(const std::string& path, std::size_t bytes, std::uint64_t offset) {
   check_readable(path);
   struct Closer {
     void operator()(std::FILE* f) const { std::fclose(f); }
   };
   std::unique_ptr<std::FILE, Closer> f(std::fopen(path.c_str(), "rb"));
   if (!f) throw InputError("cannot open " + path + ": " + std::strerror(errno));
+  if (offset != 0 && fseeko(f.get(), static_cast<off_t>(offset), SEEK_SET) != 0)
+    throw InputError("cannot read " + path + " from byte " + std::to_string(offset) + ": " + std::strerror(errno));
   std::string head(bytes, '\0');
   head.resize(std::fread(head.data(), 1, bytes, f.get()));
   if (std::ferror(f.get())) throw InputError("cannot read " + path + ": " + std::strerror(errno));
@@ -193,6 +195,28 @@ std::optional<FileBox> read_file_box(const std::string& path) {
   // An extended XYZ's Lattice.
   if ((ext == ".xyz" || ext == ".txt") && detail::is_xyz_file(path)) return detail::read_xyz_box(path);
   return std::nullopt;
+}
+
+TrajectoryFrame read_frame(const std::string& path, std::uint64_t offset, std::size_t line,
+                           const ReadOptions& options) {
+  if (options.dim != 0 && options.dim != 2 && options.dim != 3)
+    detail::fail(path, "dimension must be 2 or 3, not " + std::to_string(options.dim));
+  if (!options.labels.empty() && detail::lower_extension(options.labels) == ".npy")
+    detail::fail(path, "labels of a trajectory's frames: name a column of the file, not a .npy file");
+  const std::string ext = detail::lower_extension(path);
+  TrajectoryFrame f;
+  if (detail::is_dump_extension(ext))
+    f = detail::read_dump_frame(path, offset, line, options, options.labels);
+  else if ((ext == ".xyz" || ext == ".txt") && detail::is_xyz_file(path))
+    f = detail::read_xyz_frame(path, offset, line, options, options.labels);
+  else
+    detail::fail(path, "not a trajectory: frames are read from LAMMPS dumps (.dump, .lammpstrj) and XYZ files");
+  for (std::size_t k = 0; k < f.points.coords.size() && !options.keep_non_finite; ++k)
+    if (!std::isfinite(f.points.coords[k]))
+      detail::fail(path, "non-finite coordinate in the frame from line " + std::to_string(line) + ", atom " +
+                             std::to_string(k / static_cast<std::size_t>(f.points.dim)) + " (0-based; " +
+                             non_finite_hint(options) + ")");
+  return f;
 }
 
 PointCloud read_points(const std::string& path, const ReadOptions& options) {

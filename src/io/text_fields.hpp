@@ -87,9 +87,15 @@ inline bool parse_label(std::string_view f, std::int32_t& out) {
 /// Cursor over the content lines (skips blank and '#' lines, strips '\r').
 class Lines {
  public:
-  explicit Lines(std::string_view text) : p_(text.data()), end_(text.data() + text.size()) {
+  /// `first_line`: the number of the text's first line (a frame of a
+  /// trajectory read from its offset).
+  explicit Lines(std::string_view text, std::size_t first_line = 1)
+      : begin_(text.data()), p_(text.data()), end_(text.data() + text.size()), line_no_(first_line - 1) {
     if (text.substr(0, 3) == "\xEF\xBB\xBF") p_ += 3;
   }
+  /// Bytes of the text consumed so far, and the number of the last line read.
+  std::size_t position() const { return static_cast<std::size_t>(p_ - begin_); }
+  std::size_t line_number() const { return line_no_; }
   /// Next content line and its 1-based number; false at end of file.
   bool next(std::string_view& line, std::size_t& number) {
     while (p_ < end_) {
@@ -110,9 +116,10 @@ class Lines {
   }
 
  private:
+  const char* begin_;
   const char* p_;
   const char* end_;
-  std::size_t line_no_ = 0;
+  std::size_t line_no_;
 };
 
 }  // namespace tessera::io::detail

@@ -44,9 +44,11 @@ namespace {
 /// UTF-8 BOM stripped.
 class RawLines {
  public:
-  explicit RawLines(std::string_view text) : p_(text.data()), end_(text.data() + text.size()) {
+  explicit RawLines(std::string_view text, std::size_t first_line = 1)
+      : begin_(text.data()), p_(text.data()), end_(text.data() + text.size()), number_(first_line - 1) {
     if (text.substr(0, 3) == "\xEF\xBB\xBF") p_ += 3;
   }
+  std::size_t position() const { return static_cast<std::size_t>(p_ - begin_); }
   bool next(std::string_view& line) {
     if (p_ >= end_) return false;
     const char* nl = static_cast<const char*>(std::memchr(p_, '\n', static_cast<std::size_t>(end_ - p_)));
@@ -60,9 +62,10 @@ class RawLines {
   std::size_t number() const { return number_; }
 
  private:
+  const char* begin_;
   const char* p_;
   const char* end_;
-  std::size_t number_ = 0;
+  std::size_t number_;
 };
 
 /// `line` as a lone count (an XYZ file's first line), if it is one.
@@ -83,6 +86,7 @@ struct Property {
 
 struct XyzHeader {
   std::size_t atoms = 0;
+  std::size_t comment_line = 2;             // its number in the file
   std::vector<Property> properties;
   std::size_t columns = 0;  // fields per atom line
   std::optional<FileBox> box;
@@ -116,19 +120,19 @@ std::vector<std::pair<std::string, std::string>> key_values(std::string_view s) 
   return kv;
 }
 
-std::vector<double> numbers(const std::string& path, const std::string& what, const std::string& value,
-                            std::size_t want) {
+std::vector<double> numbers(const std::string& path, const std::string& where, const std::string& what,
+                            const std::string& value, std::size_t want) {
   std::vector<double> v;
   Fields fs(value, ' ');
   std::string_view f;
   double x = 0;
   while (fs.next(f)) {
     if (!parse_double(f, x) || !std::isfinite(x))
-      fail(path, "line 2: " + what + " holds '" + std::string(f) + "', not a finite number");
+      fail(path, where + what + " holds '" + std::string(f) + "', not a finite number");
     v.push_back(x);
   }
   if (v.size() != want)
-    fail(path, "line 2: " + what + " needs " + std::to_string(want) + " numbers, got " + std::to_string(v.size()));
+    fail(path, where + what + " needs " + std::to_string(want) + " numbers, got " + std::to_string(v.size()));
   return v;
 }
 
@@ -142,6 +146,8 @@ XyzHeader read_header(const std::string& path, RawLines& lines, bool whole) {
   if (*n > (std::size_t{1} << 31) - 1) fail(path, "more than 2^31 - 1 atoms (point ids are int32)");
   h.atoms = *n;
   if (!lines.next(line)) frame_ended(path, "the file ends before the comment line", whole);
+  h.comment_line = lines.number();
+  const std::string where = "line " + std::to_string(h.comment_line) + ": ";
   const auto kv = key_values(line);
   auto find = [&](const char* key) -> const std::string* {
     for (const auto& [k, v] : kv)
@@ -157,7 +163,7 @@ XyzHeader read_header(const std::string& path, RawLines& lines, bool whole) {
         parts.push_back(props->substr(from, c - from));
         from = c + 1;
       }
-    if (parts.size() % 3 != 0) fail(path, "line 2: Properties must be name:type:count triples, got '" + *props + "'");
+    if (parts.size() % 3 != 0) fail(path, where + "Properties must be name:type:count triples, got '" + *props + "'");
     for (std::size_t k = 0; k < parts.size(); k += 3) {
       Property p;
       p.name = parts[k];
@@ -167,7 +173,7 @@ XyzHeader read_header(const std::string& path, RawLines& lines, bool whole) {
       auto [q, ec] = std::from_chars(cs.data(), cs.data() + cs.size(), count);
       if (type.size() != 1 || std::string("SRIL").find(type[0]) == std::string::npos || ec != std::errc() ||
           q != cs.data() + cs.size() || count == 0 || count > 1000)
-        fail(path, "line 2: Properties entry '" + p.name + ":" + type + ":" + cs + "' is not name:S|R|I|L:count");
+        fail(path, where + "Properties entry '" + p.name + ":" + type + ":" + cs + "' is not name:S|R|I|L:count");
       p.type = type[0];
       p.count = count;
       p.column = h.columns;
@@ -179,15 +185,15 @@ XyzHeader read_header(const std::string& path, RawLines& lines, bool whole) {
     h.columns = 4;
   }
   if (const std::string* lattice = find("lattice")) {
-    const std::vector<double> v = numbers(path, "Lattice", *lattice, 9);
+    const std::vector<double> v = numbers(path, where, "Lattice", *lattice, 9);
     FileBox b;
     if (v[1] != 0 || v[2] != 0 || v[5] != 0 || !(v[0] > 0 && v[4] > 0 && v[8] > 0))
       fail(path,
-           "line 2: the Lattice's cell must have a along +x and b in the xy plane (ay = az = bz = 0, and "
+           where + "the Lattice's cell must have a along +x and b in the xy plane (ay = az = bz = 0, and "
            "ax, by, cz > 0), as LAMMPS's and tessera's boxes; rotate the cell and the atoms to that "
            "orientation, or give --bounds");
     std::vector<double> origin = {0, 0, 0};
-    if (const std::string* o = find("origin")) origin = numbers(path, "Origin", *o, 3);
+    if (const std::string* o = find("origin")) origin = numbers(path, where, "Origin", *o, 3);
     b.periodic = {true, true, true};
     if (const std::string* pbc = find("pbc")) {
       Fields fs(*pbc, ' ');
@@ -196,10 +202,10 @@ XyzHeader read_header(const std::string& path, RawLines& lines, bool whole) {
       for (; fs.next(f); ++a) {
         const std::string w = lower(f);
         const bool t = w == "t" || w == "true" || w == "1", no = w == "f" || w == "false" || w == "0";
-        if (a >= 3 || (!t && !no)) fail(path, "line 2: pbc must be three of T and F, got '" + *pbc + "'");
+        if (a >= 3 || (!t && !no)) fail(path, where + "pbc must be three of T and F, got '" + *pbc + "'");
         b.periodic[a] = t;
       }
-      if (a != 3) fail(path, "line 2: pbc must be three of T and F, got '" + *pbc + "'");
+      if (a != 3) fail(path, where + "pbc must be three of T and F, got '" + *pbc + "'");
     }
     for (std::size_t a = 0; a < 3; ++a) {
       b.lo[a] = origin[a];
@@ -236,8 +242,17 @@ std::size_t property_column(const std::string& path, const XyzHeader& h, const s
 }
 
 /// The atom lines' values of `cols`, atoms × cols.
+/// Where the frame ended: the bytes of the text up to the next frame's
+/// count line (blank lines skipped), that line's number, and whether a
+/// frame follows.
+struct FrameEnd {
+  std::size_t bytes = 0, next_line = 1;
+  bool last = true;
+};
+
 std::vector<double> atom_values(const std::string& path, RawLines& lines, std::size_t text_size, const XyzHeader& h,
-                                const std::vector<std::size_t>& cols, std::optional<std::string_view> tail) {
+                                const std::vector<std::size_t>& cols, std::optional<std::string_view> tail,
+                                FrameEnd* end = nullptr) {
   const bool whole = !tail;
   // Sized by the lines the text can hold, not by the count the file claims.
   std::vector<double> out;
@@ -265,11 +280,12 @@ std::vector<double> atom_values(const std::string& path, RawLines& lines, std::s
   // The frame ends at the next frame's count line or at the end of the file
   // (blank lines aside): another line is an atom the count did not count.
   const std::size_t last = lines.number();
-  while (lines.next(line))
+  for (std::size_t at = lines.position(); lines.next(line); at = lines.position())
     if (!trim(line).empty()) {
       if (!lone_count(line))
         fail(path, "line " + std::to_string(lines.number()) + ": more atom lines than the frame's count (" +
                        std::to_string(h.atoms) + ")");
+      if (end != nullptr) *end = FrameEnd{at, lines.number(), false};
       return out;
     }
   if (tail) {  // the next line starts in the bytes past the prefix
@@ -278,7 +294,10 @@ std::vector<double> atom_values(const std::string& path, RawLines& lines, std::s
     if (t[0] < '0' || t[0] > '9')
       fail(path, "after line " + std::to_string(last) + ": more atom lines than the frame's count (" +
                      std::to_string(h.atoms) + ")");
+    if (end != nullptr) *end = FrameEnd{lines.position(), lines.number() + 1, false};
+    return out;
   }
+  if (end != nullptr) *end = FrameEnd{lines.position(), lines.number() + 1, true};
   return out;
 }
 
@@ -302,24 +321,31 @@ bool looks_like_xyz(std::string_view text) {
   return true;
 }
 
-PointCloud read_xyz_points(const std::string& path, const ReadOptions& options, const std::string& label_column) {
+TrajectoryFrame read_xyz_frame(const std::string& path, std::uint64_t offset, std::size_t line,
+                               const ReadOptions& options, const std::string& label_column) {
   const int dim = options.dim == 0 ? 3 : options.dim;
   XyzHeader h;
   std::vector<std::size_t> cols;
-  const std::vector<double> v = first_frame(path, [&](std::string_view text, std::optional<std::string_view> tail) {
-    RawLines lines(text);
+  FrameEnd end;
+  const std::vector<double> v = frame_at(path, offset, [&](std::string_view text, std::optional<std::string_view> tail) {
+    RawLines lines(text, line);
     h = read_header(path, lines, !tail);
     const Property* pos = find_property(h, "pos");
     if (pos == nullptr || pos->type != 'R' || pos->count != 3)
-      fail(path, "line 2: Properties has no pos:R:3 (the positions)");
+      fail(path, "line " + std::to_string(h.comment_line) + ": Properties has no pos:R:3 (the positions)");
     cols.clear();
     for (int a = 0; a < dim; ++a) cols.push_back(pos->column + static_cast<std::size_t>(a));
     if (!label_column.empty()) cols.push_back(property_column(path, h, label_column, "I", "labels"));
     if (dim == 2 && h.box && (h.box->tilt[1] != 0 || h.box->tilt[2] != 0))
       fail(path, "--dim 2: the Lattice tilts along z (cx, cy not 0); a 2D box has the xy tilt only");
-    return atom_values(path, lines, text.size(), h, cols, tail);
+    return atom_values(path, lines, text.size(), h, cols, tail, &end);
   });
-  PointCloud pc;
+  TrajectoryFrame frame;
+  frame.box = h.box;
+  frame.next_offset = offset + end.bytes;
+  frame.next_line = end.next_line;
+  frame.last = end.last;
+  PointCloud& pc = frame.points;
   pc.dim = dim;
   pc.n = h.atoms;
   pc.coords.resize(pc.n * static_cast<std::size_t>(dim));
@@ -332,7 +358,11 @@ PointCloud read_xyz_points(const std::string& path, const ReadOptions& options, 
     for (std::size_t k = 0; k < pc.n; ++k)
       pc.labels[k] = atom_label(path, label_column, k, v[k * cols.size() + static_cast<std::size_t>(dim)]);
   }
-  return pc;
+  return frame;
+}
+
+PointCloud read_xyz_points(const std::string& path, const ReadOptions& options, const std::string& label_column) {
+  return read_xyz_frame(path, 0, 1, options, label_column).points;
 }
 
 std::vector<double> read_xyz_column(const std::string& path, const std::string& name) {

@@ -202,3 +202,49 @@ TEST(LammpsDump, FirstFrameOfAHugeTrajectory) {
   EXPECT_EQ(read_point_scalars(p, "radius"), (std::vector<double>{0.25, 0.5, 0.125}));
   EXPECT_TRUE(read_file_box(p).has_value());
 }
+
+// A trajectory's frames one after another (read_frame from each one's
+// offset): atoms, boxes and timesteps per frame, the last one said, and a
+// later frame's error naming its line in the whole file.
+TEST(LammpsDump, FramesOneAfterAnother) {
+  TempDir dir;
+  std::string text;
+  const int counts[3] = {3, 5, 2};
+  for (int s = 0; s < 3; ++s) {
+    text += "ITEM: TIMESTEP\n" + std::to_string(100 * s) + "\nITEM: NUMBER OF ATOMS\n" + std::to_string(counts[s]) +
+            "\nITEM: BOX BOUNDS pp pp " + (s == 1 ? "ff" : "pp") + "\n0 " + std::to_string(s + 1) + "\n0 1\n0 1\n" +
+            "ITEM: ATOMS id type x y z\n";
+    for (int k = 0; k < counts[s]; ++k)
+      text += std::to_string(k + 1) + " " + std::to_string(s + 1) + " " + std::to_string(0.125 * k) + " 0.5 0.25\n";
+    if (s == 0) text += "\n";  // a blank line between frames
+  }
+  const std::string p = dir.write("t.lammpstrj", text);
+  std::uint64_t offset = 0;
+  std::size_t line = 1;
+  for (int s = 0; s < 3; ++s) {
+    const auto f = tessera::io::read_frame(p, offset, line, labels("type"));
+    ASSERT_EQ(f.points.n, static_cast<std::size_t>(counts[s])) << s;
+    EXPECT_EQ(f.points.coords[3], 0.125);
+    EXPECT_EQ(f.points.labels, std::vector<std::int32_t>(static_cast<std::size_t>(counts[s]), s + 1));
+    ASSERT_TRUE(f.box.has_value());
+    EXPECT_EQ(f.box->timestep, 100 * s);
+    EXPECT_EQ(f.box->hi[0], s + 1);
+    EXPECT_EQ(f.box->periodic[2], s != 1);
+    EXPECT_EQ(f.last, s == 2) << s;
+    offset = f.next_offset;
+    line = f.next_line;
+  }
+  EXPECT_EQ(offset, text.size());
+  // The second frame's 4th atom broken: its line in the file is named.
+  std::string bad = text;
+  const std::size_t at = bad.find("4 2 0.375");
+  bad.replace(at, 9, "4 2 zero!");
+  const std::string q = dir.write("bad.lammpstrj", bad);
+  const auto f0 = tessera::io::read_frame(q);
+  const std::size_t expected_line = static_cast<std::size_t>(std::count(bad.begin(), bad.begin() + static_cast<std::ptrdiff_t>(at), '\n')) + 1;
+  const std::string msg = input_error([&] { tessera::io::read_frame(q, f0.next_offset, f0.next_line); });
+  EXPECT_NE(msg.find("line " + std::to_string(expected_line) + ": column 'x' is not a number"), std::string::npos) << msg;
+  // A file of another format has no frames.
+  EXPECT_NE(input_error([&] { tessera::io::read_frame(dir.write("p.csv", "x,y\n0,0\n1,1\n")); }).find("not a trajectory"),
+            std::string::npos);
+}

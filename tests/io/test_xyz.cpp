@@ -144,3 +144,31 @@ TEST(Xyz, FirstFrameOfAHugeTrajectory) {
   ASSERT_TRUE(read_file_box(p).has_value());
   EXPECT_EQ(read_file_box(p)->hi, (std::array<double, 3>{2, 3, 4}));
 }
+
+// XYZ frames one after another (blank lines between them), each with its
+// own Lattice; a later frame's error names its line in the whole file.
+TEST(Xyz, FramesOneAfterAnother) {
+  TempDir dir;
+  const std::string text =
+      "2\nLattice=\"2 0 0 0 2 0 0 0 2\"\nAr 0 0 0\nAr 1 1 1\n\n"
+      "3\nLattice=\"3 0 0 0 3 0 0 0 3\" pbc=\"T T F\"\nAr 0 0 0\nAr 1 1 1\nAr 2 2 2\n"
+      "1\nplain comment\nAr 0.5 0.5 0.5\n";
+  const std::string p = dir.write("t.xyz", text);
+  std::uint64_t offset = 0;
+  std::size_t line = 1;
+  const std::size_t counts[3] = {2, 3, 1};
+  for (int s = 0; s < 3; ++s) {
+    const auto f = tessera::io::read_frame(p, offset, line);
+    ASSERT_EQ(f.points.n, counts[s]) << s;
+    EXPECT_EQ(f.box.has_value(), s < 2);
+    if (s == 1) EXPECT_EQ(f.box->periodic, (std::array<bool, 3>{true, true, false}));
+    EXPECT_EQ(f.last, s == 2);
+    offset = f.next_offset;
+    line = f.next_line;
+  }
+  EXPECT_EQ(line, 14u);
+  const std::string q = dir.write("bad.xyz", text.substr(0, text.find("Ar 2 2 2")) + "Ar 2 two 2\n1\n\nAr 0 0 0\n");
+  const auto f0 = tessera::io::read_frame(q);
+  EXPECT_NE(input_error([&] { tessera::io::read_frame(q, f0.next_offset, f0.next_line); }).find("line 10: 'two' is not a number"),
+            std::string::npos);
+}

@@ -67,6 +67,25 @@ struct FileBox {
 /// InputError on a malformed header.
 std::optional<FileBox> read_file_box(const std::string& path);
 
+/// One frame of a trajectory file (a LAMMPS dump, an XYZ file).
+struct TrajectoryFrame {
+  PointCloud points;              ///< its atoms, in file order (labels where asked)
+  std::optional<FileBox> box;     ///< its box: every dump frame's, an extended XYZ's Lattice
+  std::uint64_t next_offset = 0;  ///< the byte where the next frame starts
+  std::size_t next_line = 1;      ///< the number of its first line (for error messages)
+  bool last = true;               ///< no frame follows (only blank lines, or nothing)
+};
+
+/// The frame of a LAMMPS dump (.dump, .lammpstrj) or an XYZ file that starts
+/// at byte `offset`, line `line`: 0 and 1 for the first, then the previous
+/// frame's next_offset and next_line. Only that frame's bytes are read.
+/// `options.labels` names an integer column (a .npy file of labels is one
+/// array for every frame: the caller's). Throws InputError on a malformed
+/// frame (its line numbers count from the file's start) and on a file with
+/// no frames (other formats).
+TrajectoryFrame read_frame(const std::string& path, std::uint64_t offset = 0, std::size_t line = 1,
+                           const ReadOptions& options = {});
+
 /// Read .npy (C or Fortran order), .csv/.xyz/.txt (the columns a header names
 /// x, y and z in any case, else the first ones), .ply, .vtp/.vtu, .pcd, or a
 /// LAMMPS dump's first frame (.dump, .lammpstrj: its x y z, xu yu zu, or
