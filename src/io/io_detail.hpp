@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <cstring>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -123,12 +124,15 @@ std::int32_t atom_label(const std::string& path, const std::string& column, std:
 std::string read_file_head(const std::string& path, std::size_t bytes, std::uint64_t offset = 0);
 
 /// Thrown by a frame parser whose frame runs past the end of a prefix of the
-/// file that is not the whole file: first_frame reads more.
-struct FrameCut {};
+/// file that is not the whole file: frame_at reads more. (A logic_error:
+/// should one escape frame_at, a bug, it is an internal error, not input's.)
+struct FrameCut : std::logic_error {
+  FrameCut() : std::logic_error("a frame parser asked for more of a whole file") {}
+};
 
-/// `parse(text, tail)` on the bytes of `path` from `offset`, cut after their last
-/// line break, on more of them each time it throws FrameCut: the first frame
-/// of a trajectory without reading the frames after it (a trajectory may be
+/// `parse(text, tail)` on the bytes of `path` from `offset`, cut after their
+/// last line break, on more of them each time it throws FrameCut: a frame of
+/// a trajectory without reading the frames after it (a trajectory may be
 /// gigabytes). `tail`: the bytes after the cut, the start of a line not yet
 /// whole; nullopt where `text` is the whole file, so that running out of
 /// lines is the file's error, not the prefix's.
@@ -148,7 +152,7 @@ auto frame_at(const std::string& path, std::uint64_t offset, Parse&& parse) {
 }
 
 /// A frame parser's text ran out: the file's error where `whole`, else
-/// more of the file is needed (first_frame).
+/// more of the file is needed (frame_at).
 [[noreturn]] inline void frame_ended(const std::string& path, const std::string& what, bool whole) {
   if (!whole) throw FrameCut{};
   fail(path, what);

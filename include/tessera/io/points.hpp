@@ -47,7 +47,8 @@ struct ReadOptions {
 /// ReadOptions::non_finite_hint, or its default when empty.
 std::string non_finite_hint(const ReadOptions& options);
 
-/// The simulation box a point file declares (a LAMMPS dump's BOX BOUNDS), in
+/// The simulation box a point file declares (a LAMMPS dump's BOX BOUNDS, an
+/// extended XYZ's Lattice, Origin and pbc), in
 /// the terms of --bounds, --periodic and --tilt (VoronoiOptions): the box is
 /// the parallelepiped spanned from `lo` by a = (Lx, 0, 0), b = (xy, Ly, 0),
 /// c = (xz, yz, Lz), L = hi - lo.
@@ -57,14 +58,14 @@ struct FileBox {
   std::array<double, 3> tilt{0, 0, 0};       ///< xy, xz, yz as lengths (0 unless triclinic)
   std::array<bool, 3> periodic{false, false, false};
   bool triclinic = false;                    ///< the file declared tilts (possibly all 0)
-  std::int64_t timestep = 0;                 ///< of the frame read (the first); 0 where none
+  std::int64_t timestep = 0;                 ///< a dump frame's TIMESTEP; 0 for XYZ
   std::string declared_by;                   ///< "LAMMPS dump, timestep 100", "extended XYZ Lattice"
 };
 
-/// The box `path` declares, read from its header alone: LAMMPS dumps
-/// (.dump, .lammpstrj) and extended XYZ files with a Lattice have one,
-/// other formats none (nullopt). Throws
-/// InputError on a malformed header.
+/// The box `path` declares in its first frame, read from its header alone:
+/// LAMMPS dumps (.dump, .lammpstrj) and extended XYZ files with a Lattice
+/// have one, other formats none (nullopt). Throws InputError on a malformed
+/// header.
 std::optional<FileBox> read_file_box(const std::string& path);
 
 /// One frame of a trajectory file (a LAMMPS dump, an XYZ file).
@@ -87,9 +88,10 @@ TrajectoryFrame read_frame(const std::string& path, std::uint64_t offset = 0, st
                            const ReadOptions& options = {});
 
 /// Read .npy (C or Fortran order), .csv/.xyz/.txt (the columns a header names
-/// x, y and z in any case, else the first ones), .ply, .vtp/.vtu, .pcd, or a
-/// LAMMPS dump's first frame (.dump, .lammpstrj: its x y z, xu yu zu, or
-/// scaled xs ys zs columns, atoms in file order). Throws tessera::InputError (one line naming the
+/// x, y and z in any case, else the first ones; Qhull's format; XYZ's first
+/// frame), .ply, .vtp/.vtu, .pcd, or a LAMMPS dump's first frame (.dump,
+/// .lammpstrj: its x y z, xu yu zu, or scaled xs ys zs columns, atoms in
+/// file order). Throws tessera::InputError (one line naming the
 /// file and the problem) on a missing/unreadable file, unknown extension, wrong
 /// dtype/shape, empty input, NaN/Inf, or labels of the wrong length.
 PointCloud read_points(const std::string& path, const ReadOptions& options = {});
