@@ -61,4 +61,8 @@ std::string one_printable_line(std::string_view message) {
   return out;
 }
 
+InputError::InputError(std::string_view message) : std::runtime_error(one_printable_line(message)) {}
+InputError::InputError(const std::string& message) : InputError(std::string_view(message)) {}
+InputError::InputError(const char* message) : InputError(std::string_view(message)) {}
+
 }  // namespace tessera

@@ -39,9 +39,12 @@ std::string one_printable_line(std::string_view message);
 /// naming the problem (one_printable_line); the CLI prints it and exits
 /// non-zero.
 struct InputError : std::runtime_error {
-  explicit InputError(std::string_view message) : std::runtime_error(one_printable_line(message)) {}
-  explicit InputError(const std::string& message) : InputError(std::string_view(message)) {}
-  explicit InputError(const char* message) : InputError(std::string_view(message)) {}
+  // Out of line (input_error.cpp): a throw site stays one call, as
+  // runtime_error's own constructors are, and the hot code around the
+  // library's checks is compiled as before.
+  explicit InputError(std::string_view message);
+  explicit InputError(const std::string& message);
+  explicit InputError(const char* message);
 };
 
 /// Raised from a progress callback to cancel a run (e.g. Ctrl-C in Python).
