@@ -158,9 +158,10 @@ struct DelaunayReport {
   std::size_t flat_or_inverted = 0;        ///< simplices not strictly positively oriented
   std::size_t nonmanifold_facets = 0;      ///< facets in more than two simplices, or twice with one orientation
   std::size_t boundary_facets = 0;         ///< facets in exactly one simplex
-  std::size_t open_boundary_ridges = 0;    ///< (no labels) boundary ridges not shared by exactly two boundary facets
-  std::size_t nonconvex_boundary = 0;      ///< (no labels) boundary ridges where the hull is not convex
-  std::size_t missing_points = 0;          ///< (no labels) non-duplicate points in no simplex
+  // The three below need a hull-complete result without labels (hull_completed).
+  std::size_t open_boundary_ridges = 0;    ///< boundary ridges not shared by exactly two boundary facets
+  std::size_t nonconvex_boundary = 0;      ///< boundary ridges where the hull is not convex
+  std::size_t missing_points = 0;          ///< non-duplicate points in no simplex
   std::size_t local_delaunay_violations = 0;  ///< interior facets whose opposite vertex is in the circumsphere (radii: power sphere)
   std::size_t hidden_not_hidden = 0;       ///< (radii) points in Delaunay::hidden that are vertices, duplicates or set aside
   std::size_t hidden_in_conflict = 0;      ///< (radii, no labels) hidden points in conflict with the simplex holding them

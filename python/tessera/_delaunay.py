@@ -283,8 +283,9 @@ class Delaunay:
         return (t[0],) if self.ndim == 2 else (t[0], t[1], t[2])
 
     def validate(self) -> "_core.DelaunayReport":
-        """Checks: orientation, manifold facets, closed and (without labels)
-        convex boundary, every point used, empty circumspheres (local Delaunay).
+        """Checks: orientation, manifold facets, closed and (without labels, and
+        with hull completion) convex boundary and every point used, empty
+        circumspheres (local Delaunay).
         A regular triangulation (:attr:`power`) is checked with its radii:
         local regularity (power spheres), and every :attr:`hidden` point is
         in no simplex (``hidden_not_hidden``) and, without labels, not in
@@ -301,7 +302,7 @@ class Delaunay:
         SimplexId, point data PointId, and for a regular triangulation
         (:attr:`power`) Radius. ValueError for a wrong extension, OSError when
         the file cannot be written."""
-        path = os.fspath(path)
+        path = _inputs.as_path(path)
         allowed = (".vtu",) if self.ndim == 3 else (".vtu", ".vtp")
         if not path.lower().endswith(allowed):
             raise ValueError(f"save: a {self.ndim}D triangulation is written as {' or '.join(allowed)}, got {path!r}")

@@ -57,7 +57,7 @@ def cells_for(
 
 
 def _check_vtp(path: PathLike, what: str) -> str:
-    path = os.fspath(path)
+    path = _inputs.as_path(path)
     if not path.lower().endswith(".vtp"):
         raise ValueError(f"save: {what} is written as VTK PolyData (.vtp), got {path!r}")
     return path
@@ -169,6 +169,7 @@ class AdjacencyGraph:
     def wheel(self, i: int) -> np.ndarray:
         """The spokes of point ``i`` (a view)."""
         off = self.wheel_offsets
+        i = _inputs.as_index(i, len(off) - 1, "i", "points")
         return self.spokes[off[i]:off[i + 1]]
 
     def edges(self) -> np.ndarray:
@@ -378,6 +379,7 @@ class FaceSet:
     def face(self, f: int) -> np.ndarray:
         """Vertex ids of face ``f`` (a view)."""
         off = self.face_offsets
+        f = _inputs.as_index(f, len(off) - 1, "f", "faces")
         return self.face_vertices[off[f]:off[f + 1]]
 
     def save(self, path: PathLike) -> None:

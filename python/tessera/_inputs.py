@@ -11,6 +11,7 @@ end (NaN, bounds ranges, points outside the bounds, padding), and raised as
 from __future__ import annotations
 
 import operator
+import os
 from typing import Any, Optional, Sequence, Tuple
 
 import numpy as np
@@ -96,13 +97,34 @@ def as_bounds(bounds: Optional[Sequence[float]], dim: int) -> Optional[list]:
         return None
     try:
         b = np.asarray(bounds, dtype=np.float64)
-    except (ValueError, TypeError):
+    except (ValueError, TypeError, OverflowError):
         raise ValueError(f"bounds: expected {2 * dim} numbers (x0, x1, y0, y1{', z0, z1' if dim == 3 else ''}), "
                          f"got {bounds!r}") from None
     if b.shape != (2 * dim,):
         raise ValueError(f"bounds: expected {2 * dim} numbers (x0, x1, y0, y1{', z0, z1' if dim == 3 else ''}) "
                          f"for {dim}D points, got shape {b.shape}")
     return b.tolist()
+
+
+def as_path(path: Any) -> str:
+    """A file name as str; ValueError for an embedded NUL, which the C++
+    side would cut the name at (writing or reading another file)."""
+    name = os.fsdecode(path)
+    if "\0" in name:
+        raise ValueError(f"path: embedded null byte in {name!r}")
+    return name
+
+
+def as_index(i: Any, n: int, name: str, what: str) -> int:
+    """An index into n items, negative ones counting from the end (as
+    Python's sequences); IndexError naming the argument past either end
+    (slices of the CSR offsets gave [] or another item's entries)."""
+    if isinstance(i, (bool, np.bool_)) or not isinstance(i, (int, np.integer)):
+        raise TypeError(f"{name}: expected an integer index, got {type(i).__name__}")
+    k = int(i)
+    if not -n <= k < n:
+        raise IndexError(f"{name}: index {k} is out of range for {n} {what}")
+    return k + n if k < 0 else k
 
 
 def as_threads(threads: Optional[int]) -> int:

@@ -64,7 +64,7 @@ def _geometry(spacing: Any, origin: Any, dim: Optional[int]) -> Tuple[Optional[l
 def _label_image(image: Any, spacing: Any, origin: Any) -> Any:
     if _is_path(image):
         sp, org = _geometry(spacing, origin, None)
-        return _inputs.call(_core.read_label_image, os.fsdecode(image), sp, org)
+        return _inputs.call(_core.read_label_image, _inputs.as_path(image), sp, org)
     a = _image_array(image, "iu", "integer labels (a label image); threshold a scalar image first")
     info = np.iinfo(np.int32)
     if a.min() < info.min or a.max() > info.max:
@@ -76,7 +76,7 @@ def _label_image(image: Any, spacing: Any, origin: Any) -> Any:
 def _scalar_image(image: Any, spacing: Any, origin: Any) -> Any:
     if _is_path(image):
         sp, org = _geometry(spacing, origin, None)
-        return _inputs.call(_core.read_scalar_image, os.fsdecode(image), sp, org)
+        return _inputs.call(_core.read_scalar_image, _inputs.as_path(image), sp, org)
     a = _image_array(image, "fiu", "real numbers")
     sp, org = _geometry(spacing, origin, a.ndim)
     return _core.scalar_image(np.ascontiguousarray(a, dtype=np.float64), sp, org)
@@ -98,7 +98,7 @@ def read_image(
     """
     if not _is_path(path):
         raise ValueError(f"path: expected a file name, got {type(path).__name__}")
-    name = os.fsdecode(path)
+    name = _inputs.as_path(path)
     sp, org = _geometry(spacing, origin, None)
     try:
         im = _inputs.call(_core.read_label_image, name, sp, org)
@@ -147,8 +147,8 @@ def read_points(
         raise ValueError(f"dim: expected 2, 3 or None, got {dim!r}")
     if labels is not None and not _is_path(labels):
         raise ValueError(f"labels: expected a file or field name, got {type(labels).__name__}")
-    lab = "" if labels is None else os.fsdecode(labels)
-    return _inputs.call(_core.read_points, os.fsdecode(path), dim or 0, lab, bool(keep_non_finite))
+    lab = "" if labels is None else _inputs.as_path(labels)
+    return _inputs.call(_core.read_points, _inputs.as_path(path), dim or 0, lab, bool(keep_non_finite))
 
 
 class Frame(NamedTuple):
@@ -184,7 +184,7 @@ def read_frames(path: PathLike, labels: Optional[str] = None, dim: Optional[int]
         raise ValueError(f"dim: expected 2, 3 or None, got {dim!r}")
     if labels is not None and not isinstance(labels, str):
         raise ValueError(f"labels: expected a column name, got {type(labels).__name__}")
-    name = os.fsdecode(path)
+    name = _inputs.as_path(path)
 
     def read(offset: int, line: int) -> Tuple[Frame, int, int, bool]:
         pts, lab, box, step, offset, line, last = _inputs.call(_core.read_frame, name, offset, line, dim or 0,
@@ -240,8 +240,8 @@ def read_box(path: PathLike, dim: Optional[int] = None) -> Optional[dict]:
         raise ValueError(f"path: expected a file name, got {type(path).__name__}")
     if dim not in (None, 2, 3):
         raise ValueError(f"dim: expected 2, 3 or None, got {dim!r}")
-    box = _inputs.call(_core.read_box, os.fsdecode(path))
-    return None if box is None else _box_arguments(os.fsdecode(path), box, dim)
+    box = _inputs.call(_core.read_box, _inputs.as_path(path))
+    return None if box is None else _box_arguments(_inputs.as_path(path), box, dim)
 
 
 # -------------------------------------------------------------- sample_image

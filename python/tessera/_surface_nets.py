@@ -114,7 +114,7 @@ class SurfaceNet(FaceSet):
         lines with z = 0). Cell data BoundaryLabels, Sides, SpokeClass (as
         :meth:`FaceSet.save`) and PolygonId; point data VertexKind.
         ValueError for another extension, OSError when the file cannot be written."""
-        path = os.fspath(path)
+        path = _inputs.as_path(path)
         if not path.lower().endswith(".vtp"):
             raise ValueError(f"save: a surface net is written as VTK PolyData (.vtp), got {path!r}")
         _core.write_surface_net_vtp(path, self._fs)

@@ -170,8 +170,10 @@ class Voronoi:
         return self._cells.periodic_images
 
     def cell_neighbors(self, c: int) -> np.ndarray:
-        """The point ids across the faces of cell ``c`` (a view)."""
+        """The point ids across the faces of cell ``c`` (a view; negative ``c``
+        counts from the end, as Python's sequences)."""
         off = self.neighbor_offsets
+        c = _inputs.as_index(c, len(off) - 1, "c", "cells")
         return self.neighbors[off[c]:off[c + 1]]
 
     # ---- merged mesh ------------------------------------------------------
@@ -220,6 +222,7 @@ class Voronoi:
     def cell_faces(self, c: int) -> list:
         """The faces of cell ``c``, each an int32 array of vertex ids (views)."""
         cfo, fvo, fv = self.cell_face_offsets, self.face_vertex_offsets, self.face_vertices
+        c = _inputs.as_index(c, len(cfo) - 1, "c", "cells")
         return [fv[fvo[f]:fvo[f + 1]] for f in range(cfo[c], cfo[c + 1])]
 
     # ---- diagnostics ------------------------------------------------------
@@ -311,7 +314,7 @@ class Voronoi:
         (NumberOfEdges), NumberOfNeighbors. Needs merge=True. ValueError for a
         wrong extension, OSError when the file cannot be written.
         """
-        path = os.fspath(path)
+        path = _inputs.as_path(path)
         want = ".vtu" if self.ndim == 3 else ".vtp"
         if not path.lower().endswith(want):
             kind = "UnstructuredGrid" if self.ndim == 3 else "PolyData"
@@ -470,9 +473,13 @@ def _tilts(tilt: Any, dim: int) -> Tuple[float, float, float]:
     """``voronoi``'s ``tilt`` as (xy, xz, yz)."""
     if tilt is None:
         return (0.0, 0.0, 0.0)
-    values = [float(t) for t in tilt]
+    want = "(xy, xz, yz)" if dim == 3 else "(xy,)"
+    try:
+        values = [float(t) for t in tilt]
+    except (TypeError, ValueError, OverflowError):
+        raise ValueError(f"tilt: expected {want}, numbers, got {tilt!r}") from None
     if len(values) != (3 if dim == 3 else 1):
-        raise ValueError(f"tilt: expected {'(xy, xz, yz)' if dim == 3 else '(xy,)'} for {dim}D points, got {len(values)} values")
+        raise ValueError(f"tilt: expected {want} for {dim}D points, got {len(values)} values")
     values += [0.0] * (3 - len(values))
     return (values[0], values[1], values[2])
 
@@ -491,7 +498,15 @@ def _periodic_axes(periodic: Any, dim: int) -> Tuple[bool, bool, bool]:
                 raise ValueError(f"periodic: expected axes among {'xyz'[:dim]!r}, each at most once, got {periodic!r}")
             axes[k] = True
         return (axes[0], axes[1], axes[2])
-    flags = [bool(f) for f in periodic]
+    # One flag per axis, booleans (numpy's too): a bare number, or strings
+    # such as "False" (true by truthiness), are not flags.
+    try:
+        items = list(periodic)
+    except TypeError:
+        raise ValueError(f"periodic: expected True, False, axes such as 'xyz', or one bool per axis, got {periodic!r}") from None
+    if not all(isinstance(f, (bool, np.bool_)) for f in items):
+        raise ValueError(f"periodic: expected one bool per axis, got {periodic!r}")
+    flags = [bool(f) for f in items]
     if len(flags) != dim:
         raise ValueError(f"periodic: expected {dim} flags (one per axis), got {len(flags)}")
     return (flags[0], flags[1], flags[2] if dim == 3 else False)

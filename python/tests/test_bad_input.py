@@ -1,5 +1,7 @@
 """Every kind of bad input raises ValueError with a message that names the problem."""
 
+import os
+
 import numpy as np
 import pytest
 
@@ -78,3 +80,74 @@ def test_errors_quoting_bad_bytes_keep_their_message(tmp_path):
     for call in (tessera.read_image, tessera.read_points):
         with pytest.raises(tessera.InputError, match=r"unexpected key 'fo\?tran_order'"):
             call(tmp_path / "b.npy")
+
+
+def test_arguments_found_by_a_fuzz_of_the_module(tmp_path):
+    p = np.random.default_rng(1).random((30, 3))
+    # periodic: strings are not flags (["False"] * 3 made every axis
+    # periodic), a bare number is neither; tilt and bounds name themselves.
+    box = (0, 1, 0, 1, 0, 1)
+    for bad in (["False"] * 3, [1, 0, 1], 0, 1.0, [None, True, True]):
+        with pytest.raises(ValueError, match="periodic: expected"):
+            tessera.voronoi(p, bounds=box, periodic=bad)
+    for bad in (0.3, "abc", (None, 0, 0), (1j, 0, 0)):
+        with pytest.raises(ValueError, match="tilt: expected"):
+            tessera.voronoi(p, bounds=box, periodic=True, tilt=bad)
+    with pytest.raises(ValueError, match="bounds: expected"):
+        tessera.voronoi(p, bounds=(0, 10**400, 0, 1, 0, 1))
+    assert tessera.voronoi(p, bounds=box, periodic=[True, np.True_, False]).periodic == (True, True, False)
+    # Indices: negative ones count from the end, past either end an
+    # IndexError naming the argument (slices gave [] or another cell's).
+    vor = tessera.voronoi(p)
+    n = vor.n_cells
+    assert np.array_equal(vor.cell_neighbors(-1), vor.cell_neighbors(n - 1))
+    assert len(vor.cell_faces(-n)) == len(vor.cell_faces(0))
+    for bad in (n, -n - 1):
+        with pytest.raises(IndexError, match="c: index"):
+            vor.cell_neighbors(bad)
+    with pytest.raises(TypeError, match="c: expected an integer"):
+        vor.cell_faces(1.0)
+    g = tessera.adjacency(vor)
+    assert np.array_equal(g.wheel(-1), g.wheel(len(p) - 1))
+    with pytest.raises(IndexError, match="i: index 30"):
+        g.wheel(30)
+    # A path with a NUL byte: refused, not cut at the NUL (the cells were
+    # written to another file); a bytes path is a path.
+    with pytest.raises(ValueError, match="embedded null byte"):
+        vor.save(str(tmp_path / "a\0.vtu"))
+    assert not (tmp_path / "a").exists()
+    vor.save(os.fsencode(tmp_path / "b.vtu"))
+    assert (tmp_path / "b.vtu").exists()
+    with pytest.raises(ValueError, match="embedded null byte"):
+        tessera.read_points(str(tmp_path / "b.vtu") + "\0.npy")
+
+
+def test_validate_after_the_arrays_changed():
+    # The points and radii are kept without a copy: changed to NaN or inf
+    # after the cells, validate raised SIGFPE in GMP (the process died).
+    p = np.random.default_rng(1).random((30, 3))
+    r = np.linspace(0, 0.1, 30)
+    vor = tessera.voronoi(p, radii=r)
+    assert vor.validate()
+    r[5] = np.nan
+    with pytest.raises(tessera.InputError, match="radius of point 5"):
+        vor.validate()
+    q = p.copy()
+    vor = tessera.voronoi(q)
+    q[3] = np.inf
+    with pytest.raises(tessera.InputError, match="point 3 has a non-finite coordinate"):
+        vor.validate()
+
+
+def test_radii_with_points_set_aside():
+    # A point set aside (NaN, or far outside the bounds) made radii refuse
+    # the input for its magnitude ("need coordinates within ~1e-150..1e150").
+    p = np.random.default_rng(1).random((30, 3))
+    r = np.linspace(0, 0.1, 30)
+    for bad in (np.nan, 1e200):
+        q = p.copy()
+        q[1] = bad
+        vor = tessera.voronoi(q, radii=r, bounds=(0, 1, 0, 1, 0, 1), ignore_outside=True)
+        assert vor.n_cells == 29 and list(vor.ignored_outside_bounds) == [1] and vor.validate()
+        dt = tessera.delaunay(q, radii=r, bounds=(0, 1, 0, 1, 0, 1), ignore_outside=True)
+        assert dt.validate()

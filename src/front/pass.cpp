@@ -191,7 +191,18 @@ Scaling choose_scaling(std::span<const double> points, const Bounds& b, int dim)
     m = std::max(m, x);
     if (x != 0) m_min = std::min(m_min, x);
   };
-  for (double x : points) see(x);
+  // The points that take part only: those outside the box (or not finite)
+  // are set aside (--ignore-outside) or refused, and one at 1e200 beside
+  // the box's points made radii refuse the whole input ("need coordinates
+  // within ~1e-150..1e150"; a fuzz of the Python module).
+  const auto du = static_cast<std::size_t>(dim);
+  for (std::size_t i = 0; i + du <= points.size(); i += du) {
+    bool inside = true;
+    for (std::size_t a = 0; a < du && inside; ++a)
+      inside = points[i + a] >= b.lo[a] && points[i + a] <= b.hi[a];  // false on NaN
+    if (inside)
+      for (std::size_t a = 0; a < du; ++a) see(points[i + a]);
+  }
   for (int d = 0; d < dim; ++d) {
     see(b.lo[static_cast<std::size_t>(d)]);
     see(b.hi[static_cast<std::size_t>(d)]);

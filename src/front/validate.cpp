@@ -325,6 +325,27 @@ ValidationReport validate(const Cells& c, std::span<const std::int32_t> labels, 
     throw std::invalid_argument("validate: power cells need their radii with the points (" +
                                 std::to_string(radii.size()) + " given for " + std::to_string(c.n_points) + ")");
   if (!c.power) radii = {};  // equal radii gave the ordinary cells
+  // The points and radii are the caller's (Python keeps them without a
+  // copy): changed since the cells to NaN or inf, the exact measures got
+  // them, and GMP's conversion of a non-finite double aborted the process.
+  // Points set aside as outside or not finite are not read.
+  if (!points.empty()) {
+    std::vector<std::uint8_t> aside(c.n_points, 0);
+    for (const std::int32_t i : c.ignored_outside_bounds) aside[static_cast<std::size_t>(i)] = 1;
+    const auto du = static_cast<std::size_t>(c.dim);
+    for (std::size_t i = 0; i < c.n_points; ++i) {
+      if (aside[i]) continue;
+      for (std::size_t a = 0; a < du; ++a)
+        if (!std::isfinite(points[i * du + a]))
+          throw InputError("validate: point " + std::to_string(i) +
+                           " has a non-finite coordinate, which its cells were not computed from (were the points "
+                           "changed since?)");
+      if (!radii.empty() && !(std::isfinite(radii[i]) && radii[i] >= 0))
+        throw InputError("validate: the radius of point " + std::to_string(i) +
+                         " is not finite and >= 0, which its cells were not computed from (were the radii changed "
+                         "since?)");
+    }
+  }
   engine::ThreadArena arena(c.threads_used);
   return arena.execute([&] { return validate_in_arena(c, labels, points, radii); });
 }

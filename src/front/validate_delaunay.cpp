@@ -254,8 +254,10 @@ DelaunayReport validate(const Delaunay& dt, std::span<const double> points, std:
   for (std::size_t i = 0; i < ridges.size();) {
     std::size_t j = i + 1;
     while (j < ridges.size() && ridges[j].ridge == ridges[i].ridge) ++j;
-    if (!labels.empty()) {
-      // Labelled results may be concave and pinched: nothing to check here.
+    if (!labels.empty() || !dt.hull_completed) {
+      // Labelled results, and those without hull completion (the simplices
+      // whose circumcentre lies in the box), may be concave and pinched:
+      // nothing to check here.
     } else if (j - i != 2) {
       ++rep.open_boundary_ridges;
     } else {
@@ -276,7 +278,7 @@ DelaunayReport validate(const Delaunay& dt, std::span<const double> points, std:
   // a simplex whose orthosphere it is not in conflict with. With local
   // regularity everywhere, that makes the simplices the lower hull of the
   // lifted points, every one of them on or above it.
-  if (labels.empty()) {
+  if (labels.empty() && dt.hull_completed) {
     std::vector<std::uint8_t> used(dt.n_points, 0);
     for (std::int32_t id : dt.simplices) used[static_cast<std::size_t>(id)] = 1;
     for (auto [dup, owner] : dt.duplicates) used[static_cast<std::size_t>(dup)] = 1;

@@ -58,6 +58,7 @@ tessera::Delaunay with_rows(const tessera::Delaunay& dt, const std::vector<std::
   out.n_points = dt.n_points;
   out.bounds = dt.bounds;
   out.threads_used = dt.threads_used;
+  out.hull_completed = dt.hull_completed;  // validate checks the hull of hull-complete results only
   const std::size_t w = static_cast<std::size_t>(dt.dim + 1);
   std::vector<std::int32_t> all;
   for (std::size_t s = 0; s < dt.n_simplices(); ++s)
