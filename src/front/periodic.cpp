@@ -342,7 +342,7 @@ PeriodicImages periodic_images(const PeriodicInput& in, std::span<const std::int
       im.domain.hi[a] = corner + hi + margin;
     }
   }
-  // The images a layer may hold: 64 per point, and 2^24 more for boxes of
+  // The images a layer may hold: 64 per point, and 2^20 more for boxes of
   // a few points (ten points in a cube hold ~100 each; 1M uniform points
   // ~1.1). A box whose heights are tiny next to its cells takes up to 127
   // lattice vectors along each axis: a slab a millionth as thick as wide,
@@ -350,8 +350,12 @@ PeriodicImages periodic_images(const PeriodicInput& in, std::span<const std::int
   // every height tiny, and its 300 points asked for ~5e9 images (51 GB)
   // before the allocation failed. Refused before the shifts are walked, by
   // the count the walk would reach, and after it, by the count itself.
+  // (2^24 let 30 points in a box 2e16 long and 3 wide take ~6e6 images,
+  // whose cells, each reaching across them all, ran for minutes; and tilts
+  // of 1000 box lengths took 3 GB before the reach was refused: a fuzz of
+  // the Python module.)
   const std::size_t taking = in.n - in.ignored.size();
-  const double image_budget = 64.0 * static_cast<double>(taking) + 0x1p24;
+  const double image_budget = 64.0 * static_cast<double>(taking) + 0x1p20;
   auto refuse_images = [&](double count) {
     throw InputError("the periodic box would need ~" + num(count) + " images of its " + std::to_string(taking) +
                      " points: its heights (distances between opposite faces) are tiny next to its cells' reach "

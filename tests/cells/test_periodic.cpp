@@ -912,6 +912,25 @@ TEST(Triclinic, Refused) {
 // of images would hold billions (a hostile fuzz case ran out of memory at
 // 51 GB). Refused at once, naming the box; the same slab unsheared keeps
 // its own refusal (cells reaching past 127 box lengths).
+TEST(Periodic, BoxesNeedingMillionsOfImagesRefusedAtOnce) {
+  // A fuzz of the Python module: 30 points in a box 2e16 long and 3 wide
+  // took ~6e6 images, whose cells each reach across them all (it ran for
+  // minutes), and tilts of 1000 box lengths took 3 GB before the reach was
+  // refused. Refused now by the images they would need.
+  const auto pts = random_points(30, 3, 1, make_bounds({0, 0, 0}, {1, 1, 1}));
+  const std::array<bool, 3> all{true, true, true};
+  for (int c = 0; c < 2; ++c) {
+    const auto box = c == 0 ? make_bounds({-1e16, -1, -1}, {1e16, 2, 2}) : make_bounds({0, 0, 0}, {1, 1, 1});
+    const Tilt tilt = c == 0 ? Tilt{0, 0, 0} : Tilt{1e3, 1e3, 1e3};
+    try {
+      tessera::voronoi(pts, 3, {}, periodic_options(3, box, all, 1, tilt));
+      ADD_FAILURE() << "case " << c << " not refused";
+    } catch (const tessera::InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("images of its 30 points"), std::string::npos) << e.what();
+    }
+  }
+}
+
 TEST(Triclinic, FarFromTheOrigin) {
   // A sheared box 0.19 wide at 1e14, where an ulp is 2^-6: the pass's
   // domain, the layer's bounding box, was summed with the corner and rounded
