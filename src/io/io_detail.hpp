@@ -114,14 +114,23 @@ PointCloud read_xyz_points(const std::string& path, const ReadOptions& options, 
 std::vector<double> read_xyz_column(const std::string& path, const std::string& name);
 std::optional<FileBox> read_xyz_box(const std::string& path);
 
-/// Atom k's label read from `column` of a trajectory file (LAMMPS dump,
-/// XYZ) as a number: an integer in int32's range, else InputError naming
-/// the atom in file order.
-std::int32_t atom_label(const std::string& path, const std::string& column, std::size_t k, double value);
+/// The labels read from `column` of a trajectory file (LAMMPS dump, XYZ)
+/// as numbers, values[k * stride + at] for atom k: integers in int32's
+/// range, else InputError naming the atom in file order.
+std::vector<std::int32_t> atom_labels(const std::string& path, const std::string& column,
+                                      const std::vector<double>& values, std::size_t stride, std::size_t at);
 
 /// `bytes` bytes of a file from byte `offset` (to its end where it is
 /// shorter), for the readers of a header alone and of a trajectory's frames.
 std::string read_file_head(const std::string& path, std::size_t bytes, std::uint64_t offset = 0);
+
+/// Where a trajectory's frame ended: the bytes of the parsed text it took
+/// (up to the next frame's first line), that line's number, and whether no
+/// frame follows.
+struct FrameEnd {
+  std::size_t bytes = 0, next_line = 1;
+  bool last = true;
+};
 
 /// Thrown by a frame parser whose frame runs past the end of a prefix of the
 /// file that is not the whole file: frame_at reads more. (A logic_error:

@@ -205,13 +205,6 @@ std::size_t column_index(const std::string& path, const DumpHeader& h, const std
 /// The atom lines' values of `cols` (columns of the header), atoms × cols,
 /// row-major. Every line must have one field per column; the wanted ones
 /// must be numbers (others, such as an element name, are not read).
-/// Where the frame ended: the bytes of the text it took, the next line's
-/// number, and whether another frame follows.
-struct FrameEnd {
-  std::size_t bytes = 0, next_line = 1;
-  bool last = true;
-};
-
 std::vector<double> atom_values(const std::string& path, Lines& lines, std::size_t text_size, const DumpHeader& h,
                                 const std::vector<std::size_t>& cols, std::optional<std::string_view> tail,
                                 FrameEnd* end = nullptr) {
@@ -225,13 +218,10 @@ std::vector<double> atom_values(const std::string& path, Lines& lines, std::size
   std::size_t number = 0;
   for (std::size_t k = 0; k < h.atoms; ++k) {
     if (!lines.next(line, number))
-      frame_ended(path, "the frame ends after " + std::to_string(k) + " of its " + std::to_string(h.atoms) + " atoms", whole);
+      frame_ended(path, "the frame ends after " + std::to_string(k) + " of its " + std::to_string(h.atoms) + " atoms",
+                  whole);
     out.resize(out.size() + cols.size());
-    Fields fs(line, ' ');
-    std::size_t got = 0;
-    std::string_view field;
-    while (fs.next(field) && got <= f.size())
-      if (got++ < f.size()) f[got - 1] = field;
+    const std::size_t got = split_fields(line, f);
     if (got != f.size())
       fail(path, "line " + std::to_string(number) + ": expected " + std::to_string(f.size()) +
                      " values (the columns of ITEM: ATOMS)" +
@@ -288,16 +278,17 @@ TrajectoryFrame read_dump_frame(const std::string& path, std::uint64_t offset, s
   CoordinateColumns cc;
   std::vector<std::size_t> cols;
   FrameEnd end;
-  const std::vector<double> v = frame_at(path, offset, [&](std::string_view text, std::optional<std::string_view> tail) {
-    Lines lines(text, line);
-    h = read_header(path, lines, !tail);
-    if (dim == 2 && (h.box.tilt[1] != 0 || h.box.tilt[2] != 0))
-      fail(path, "--dim 2: the box tilts along z (xz, yz not 0); a 2D box has the xy tilt only");
-    cc = coordinate_columns(path, h, dim);
-    cols.assign(cc.col, cc.col + (cc.scaled ? 3 : dim));
-    if (!label_column.empty()) cols.push_back(column_index(path, h, label_column, "labels"));
-    return atom_values(path, lines, text.size(), h, cols, tail, &end);
-  });
+  const std::vector<double> v =
+      frame_at(path, offset, [&](std::string_view text, std::optional<std::string_view> tail) {
+        Lines lines(text, line);
+        h = read_header(path, lines, !tail);
+        if (dim == 2 && (h.box.tilt[1] != 0 || h.box.tilt[2] != 0))
+          fail(path, "--dim 2: the box tilts along z (xz, yz not 0); a 2D box has the xy tilt only");
+        cc = coordinate_columns(path, h, dim);
+        cols.assign(cc.col, cc.col + (cc.scaled ? 3 : dim));
+        if (!label_column.empty()) cols.push_back(column_index(path, h, label_column, "labels"));
+        return atom_values(path, lines, text.size(), h, cols, tail, &end);
+      });
   const std::size_t coords = cc.scaled ? 3 : static_cast<std::size_t>(dim);
 
   TrajectoryFrame frame;
@@ -322,10 +313,7 @@ TrajectoryFrame read_dump_frame(const std::string& path, std::uint64_t offset, s
       for (int a = 0; a < dim; ++a) x[a] = r[a];
     }
   }
-  if (!label_column.empty()) {
-    pc.labels.resize(pc.n);
-    for (std::size_t k = 0; k < pc.n; ++k) pc.labels[k] = atom_label(path, label_column, k, v[k * cols.size() + coords]);
-  }
+  if (!label_column.empty()) pc.labels = atom_labels(path, label_column, v, cols.size(), coords);
   return frame;
 }
 

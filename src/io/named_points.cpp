@@ -57,15 +57,21 @@ std::vector<std::int32_t> labels_from_values(const std::string& path, const std:
   return labels;
 }
 
-std::int32_t atom_label(const std::string& path, const std::string& column, std::size_t k, double value) {
-  if (!(value == std::floor(value) && value >= std::numeric_limits<std::int32_t>::min() &&
-        value <= std::numeric_limits<std::int32_t>::max())) {
-    char buf[40];
-    std::snprintf(buf, sizeof buf, "%.17g", value);
-    fail(path, "labels '" + column + "' of atom " + std::to_string(k) + " (0-based, in file order): " + buf +
-                   " is not an int32");
+std::vector<std::int32_t> atom_labels(const std::string& path, const std::string& column,
+                                      const std::vector<double>& values, std::size_t stride, std::size_t at) {
+  std::vector<std::int32_t> labels(stride == 0 ? 0 : values.size() / stride);
+  for (std::size_t k = 0; k < labels.size(); ++k) {
+    const double value = values[k * stride + at];
+    if (!(value == std::floor(value) && value >= std::numeric_limits<std::int32_t>::min() &&
+          value <= std::numeric_limits<std::int32_t>::max())) {
+      char buf[40];
+      std::snprintf(buf, sizeof buf, "%.17g", value);
+      fail(path, "labels '" + column + "' of atom " + std::to_string(k) + " (0-based, in file order): " + buf +
+                     " is not an int32");
+    }
+    labels[k] = static_cast<std::int32_t>(value);
   }
-  return static_cast<std::int32_t>(value);
+  return labels;
 }
 
 }  // namespace tessera::io::detail

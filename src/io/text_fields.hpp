@@ -10,6 +10,7 @@
 #include <cstring>
 #include <limits>
 #include <string_view>
+#include <vector>
 
 namespace tessera::io::detail {
 
@@ -54,6 +55,18 @@ class Fields {
   char delim_;
   bool done_ = false;
 };
+
+/// The whitespace-separated fields of `line` into f[0..f.size()); returns
+/// how many it has, counting to f.size() + 1 at most (one more says "too
+/// many" without reading the rest).
+inline std::size_t split_fields(std::string_view line, std::vector<std::string_view>& f) {
+  Fields fs(line, ' ');
+  std::size_t got = 0;
+  std::string_view field;
+  while (got <= f.size() && fs.next(field))
+    if (got++ < f.size()) f[got - 1] = field;
+  return got;
+}
 
 /// Parse a whole field as a double (a leading '+' is allowed). "nan"/"inf"
 /// parse; the caller rejects them with the line number.

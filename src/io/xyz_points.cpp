@@ -86,7 +86,7 @@ struct Property {
 
 struct XyzHeader {
   std::size_t atoms = 0;
-  std::size_t comment_line = 2;             // its number in the file
+  std::size_t comment_line = 2;  // its number in the file
   std::vector<Property> properties;
   std::size_t columns = 0;  // fields per atom line
   std::optional<FileBox> box;
@@ -188,10 +188,10 @@ XyzHeader read_header(const std::string& path, RawLines& lines, bool whole) {
     const std::vector<double> v = numbers(path, where, "Lattice", *lattice, 9);
     FileBox b;
     if (v[1] != 0 || v[2] != 0 || v[5] != 0 || !(v[0] > 0 && v[4] > 0 && v[8] > 0))
-      fail(path,
-           where + "the Lattice's cell must have a along +x and b in the xy plane (ay = az = bz = 0, and "
-           "ax, by, cz > 0), as LAMMPS's and tessera's boxes; rotate the cell and the atoms to that "
-           "orientation, or give --bounds");
+      fail(path, where +
+                     "the Lattice's cell must have a along +x and b in the xy plane (ay = az = bz = 0, and "
+                     "ax, by, cz > 0), as LAMMPS's and tessera's boxes; rotate the cell and the atoms to that "
+                     "orientation, or give --bounds");
     std::vector<double> origin = {0, 0, 0};
     if (const std::string* o = find("origin")) origin = numbers(path, where, "Origin", *o, 3);
     b.periodic = {true, true, true};
@@ -242,14 +242,6 @@ std::size_t property_column(const std::string& path, const XyzHeader& h, const s
 }
 
 /// The atom lines' values of `cols`, atoms × cols.
-/// Where the frame ended: the bytes of the text up to the next frame's
-/// count line (blank lines skipped), that line's number, and whether a
-/// frame follows.
-struct FrameEnd {
-  std::size_t bytes = 0, next_line = 1;
-  bool last = true;
-};
-
 std::vector<double> atom_values(const std::string& path, RawLines& lines, std::size_t text_size, const XyzHeader& h,
                                 const std::vector<std::size_t>& cols, std::optional<std::string_view> tail,
                                 FrameEnd* end = nullptr) {
@@ -263,13 +255,10 @@ std::vector<double> atom_values(const std::string& path, RawLines& lines, std::s
   const bool plain = h.properties.size() == 2 && h.properties[0].name == "species" && h.columns == 4;
   for (std::size_t k = 0; k < h.atoms; ++k) {
     if (!lines.next(line))
-      frame_ended(path, "the frame ends after " + std::to_string(k) + " of its " + std::to_string(h.atoms) + " atoms", whole);
+      frame_ended(path, "the frame ends after " + std::to_string(k) + " of its " + std::to_string(h.atoms) + " atoms",
+                  whole);
     out.resize(out.size() + cols.size());
-    Fields fs(line, ' ');
-    std::size_t got = 0;
-    std::string_view field;
-    while (fs.next(field) && got <= f.size())
-      if (got++ < f.size()) f[got - 1] = field;
+    const std::size_t got = split_fields(line, f);
     if (got < f.size() || (got > f.size() && !plain))
       fail(path, "line " + std::to_string(lines.number()) + ": expected " + std::to_string(f.size()) +
                      " values per atom, got " + std::to_string(got));
@@ -327,19 +316,20 @@ TrajectoryFrame read_xyz_frame(const std::string& path, std::uint64_t offset, st
   XyzHeader h;
   std::vector<std::size_t> cols;
   FrameEnd end;
-  const std::vector<double> v = frame_at(path, offset, [&](std::string_view text, std::optional<std::string_view> tail) {
-    RawLines lines(text, line);
-    h = read_header(path, lines, !tail);
-    const Property* pos = find_property(h, "pos");
-    if (pos == nullptr || pos->type != 'R' || pos->count != 3)
-      fail(path, "line " + std::to_string(h.comment_line) + ": Properties has no pos:R:3 (the positions)");
-    cols.clear();
-    for (int a = 0; a < dim; ++a) cols.push_back(pos->column + static_cast<std::size_t>(a));
-    if (!label_column.empty()) cols.push_back(property_column(path, h, label_column, "I", "labels"));
-    if (dim == 2 && h.box && (h.box->tilt[1] != 0 || h.box->tilt[2] != 0))
-      fail(path, "--dim 2: the Lattice tilts along z (cx, cy not 0); a 2D box has the xy tilt only");
-    return atom_values(path, lines, text.size(), h, cols, tail, &end);
-  });
+  const std::vector<double> v =
+      frame_at(path, offset, [&](std::string_view text, std::optional<std::string_view> tail) {
+        RawLines lines(text, line);
+        h = read_header(path, lines, !tail);
+        const Property* pos = find_property(h, "pos");
+        if (pos == nullptr || pos->type != 'R' || pos->count != 3)
+          fail(path, "line " + std::to_string(h.comment_line) + ": Properties has no pos:R:3 (the positions)");
+        cols.clear();
+        for (int a = 0; a < dim; ++a) cols.push_back(pos->column + static_cast<std::size_t>(a));
+        if (!label_column.empty()) cols.push_back(property_column(path, h, label_column, "I", "labels"));
+        if (dim == 2 && h.box && (h.box->tilt[1] != 0 || h.box->tilt[2] != 0))
+          fail(path, "--dim 2: the Lattice tilts along z (cx, cy not 0); a 2D box has the xy tilt only");
+        return atom_values(path, lines, text.size(), h, cols, tail, &end);
+      });
   TrajectoryFrame frame;
   frame.box = h.box;
   frame.next_offset = offset + end.bytes;
@@ -353,11 +343,7 @@ TrajectoryFrame read_xyz_frame(const std::string& path, std::uint64_t offset, st
     for (int a = 0; a < dim; ++a)
       pc.coords[k * static_cast<std::size_t>(dim) + static_cast<std::size_t>(a)] =
           v[k * cols.size() + static_cast<std::size_t>(a)];
-  if (!label_column.empty()) {
-    pc.labels.resize(pc.n);
-    for (std::size_t k = 0; k < pc.n; ++k)
-      pc.labels[k] = atom_label(path, label_column, k, v[k * cols.size() + static_cast<std::size_t>(dim)]);
-  }
+  if (!label_column.empty()) pc.labels = atom_labels(path, label_column, v, cols.size(), static_cast<std::size_t>(dim));
   return frame;
 }
 
