@@ -61,13 +61,14 @@ def freud_box_to_tessera(Lx, Ly, Lz, xy, xz, yz):
 def polygon_area(corners):
     """Area of a planar convex polygon given by its corners in any order."""
     c = corners.mean(axis=0)
-    normal = np.zeros(3)
-    for k in range(len(corners)):  # Newell's normal needs an order: take one
-        normal += np.cross(corners[k] - c, corners[(k + 1) % len(corners)] - c)
-    if np.linalg.norm(normal) == 0:
+    # The plane's normal from the widest pair of spokes (the corners' order
+    # is not known, so a ring sum could cancel).
+    spokes = corners - c
+    normals = np.cross(spokes[0], spokes)
+    normal = normals[np.argmax(np.linalg.norm(normals, axis=1))]
+    if len(corners) < 3 or np.linalg.norm(normal) == 0:
         return 0.0
-    u = corners[0] - c
-    u /= np.linalg.norm(u)
+    u = spokes[0] / np.linalg.norm(spokes[0])
     n = normal / np.linalg.norm(normal)
     v = np.cross(n, u)
     angle = np.arctan2((corners - c) @ v, (corners - c) @ u)

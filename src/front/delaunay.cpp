@@ -294,6 +294,18 @@ inline constexpr double clean_exact_per_cell = 1.0;
 /// (as the cells' pilot: few inside points are measured too).
 inline constexpr double labelled_pilot_share = 0.5;
 
+// `b` grown about its centre by `grow` on every axis, or nullopt where that
+// box, or its extent, would not be finite.
+std::optional<Bounds> grown_box(Bounds b, int dim, double grow) {
+  for (std::size_t a = 0; a < static_cast<std::size_t>(dim); ++a) {
+    const double mid = 0.5 * (b.lo[a] + b.hi[a]), half = 0.5 * (b.hi[a] - b.lo[a]);
+    b.lo[a] = mid - grow * half;
+    b.hi[a] = mid + grow * half;
+    if (!(std::isfinite(b.lo[a]) && std::isfinite(b.hi[a]) && std::isfinite(b.hi[a] - b.lo[a]))) return std::nullopt;
+  }
+  return b;
+}
+
 // The triangulation by insertion of the located points (front::insert_located).
 template <int D>
 Delaunay by_insertion(const front::Pass<D>& pass, Delaunay out) {
@@ -458,17 +470,10 @@ Delaunay run(std::span<const double> input, std::span<const std::int32_t> labels
   // whose slivers' balls are too ill-conditioned to prune the search).
   // Near the end of double's range (points at 1e300) the larger box would
   // not be finite: the seeded wrap below takes it from this one.
-  Bounds b = pass.user_bounds;
-  bool finite = true;
-  for (int d = 0; d < D; ++d) {
-    auto du = static_cast<std::size_t>(d);
-    double mid = 0.5 * (b.lo[du] + b.hi[du]), half = 0.5 * (b.hi[du] - b.lo[du]);
-    const double grow = attempt == 0 ? 0x1p20 : 0x1p50;
-    b.lo[du] = mid - grow * half;
-    b.hi[du] = mid + grow * half;
-    finite &= std::isfinite(b.lo[du]) && std::isfinite(b.hi[du]) && std::isfinite(b.hi[du] - b.lo[du]);
-  }
-  if (none_found && attempt < 2 && finite) {
+  const std::optional<Bounds> grown =
+      none_found && attempt < 2 ? grown_box(pass.user_bounds, D, attempt == 0 ? 0x1p20 : 0x1p50) : std::nullopt;
+  if (grown) {
+    const Bounds& b = *grown;
     DelaunayOptions big = opt;
     big.progress = nullptr;
     big.bounds = b;

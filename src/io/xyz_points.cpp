@@ -367,8 +367,12 @@ std::optional<FileBox> read_xyz_box(const std::string& path) {
 }
 
 bool is_xyz_file(const std::string& path) {
-  // Its first three lines, however long the comment (extended XYZ's can be).
+  // Its first three lines, however long the comment (extended XYZ's can be);
+  // a first line that is no lone count settles it without more.
   return first_frame(path, [&](std::string_view text, std::optional<std::string_view> tail) {
+    RawLines lines(text);
+    std::string_view first;
+    if (lines.next(first) && !lone_count(first)) return false;
     if (tail && std::count(text.begin(), text.end(), '\n') < 3) throw FrameCut{};
     return looks_like_xyz(text);
   });

@@ -412,6 +412,10 @@ class Hostile(base.TempDirCase):
         run's, with no --bounds/--periodic given."""
         lo = [float(bounds[2 * a]) for a in range(d)] + ([] if d == 3 else [-0.5])
         hi = [float(bounds[2 * a + 1]) for a in range(d)] + ([] if d == 3 else [0.5])
+        # The lengths hi - lo are what the file can say: where they round,
+        # the box is another one (an input this check cannot compare).
+        if any(lo[a] + (hi[a] - lo[a]) != hi[a] for a in range(3)):
+            return
         per = [("xyz"[a] in axes) for a in range(3)]
         xyz = np.c_[pts, np.zeros(len(pts))] if d == 2 else pts
         lab = np.load(labels) if labels else np.zeros(len(pts), dtype=np.int64)
@@ -434,10 +438,6 @@ class Hostile(base.TempDirCase):
                             " ".join("T" if q else "F" for q in per)))
                 for k in range(len(pts)):
                     f.write("Ar %r %r %r %d\n" % (xyz[k, 0], xyz[k, 1], xyz[k, 2], lab[k]))
-        # The lengths hi - lo are what the file can say: where they round,
-        # the box is another one (an input this check cannot compare).
-        if any(lo[a] + (hi[a] - lo[a]) != hi[a] for a in range(3)):
-            return
         fnb, fsh = self.p("fnb.npy"), self.p("fsh.npy")
         args = ["voronoi", path, "--threads", threads, "--quiet", "--neighbors", fnb, "--neighbor-shifts", fsh,
                 "--validate"] + (["--dim", "2"] if d == 2 else []) + (["--labels", "type"] if labels else [])
