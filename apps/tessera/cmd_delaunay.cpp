@@ -123,6 +123,7 @@ int run_delaunay(const DelaunayArgs& a) {
     const std::string outside =
         dt.outside_simplices == 0 ? std::string()
                                   : "; " + std::to_string(dt.outside_simplices) + " with an outside vertex left out";
+    if (!a.compute.frame.empty()) std::fprintf(stderr, "tessera: points from %s\n", shown_input(a.compute).c_str());
     if (!a.compute.box_source.empty()) std::fprintf(stderr, "tessera: domain from %s\n", a.compute.box_source.c_str());
     if (dt.is_periodic())
       std::fprintf(stderr, "tessera: %zu points (%dD) -> %zu %s of the periodic box%s (each once, with its images)\n",

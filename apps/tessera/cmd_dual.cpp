@@ -44,7 +44,7 @@ Computed read_and_compute(const ComputeArgs& a, bool quiet) {
 }
 
 void print_header(const char* command, const ComputeArgs& a, const Computed& r) {
-  std::printf("tessera %s: %zu points (%dD) from %s\n", command, r.pc.n, r.cells.dim, shown_path(a.input).c_str());
+  std::printf("tessera %s: %zu points (%dD) from %s\n", command, r.pc.n, r.cells.dim, shown_input(a).c_str());
   std::printf("  %-18s %zu\n", "cells", r.cells.n_cells());
   std::printf("  %-18s %.3f s on %d thread%s\n", "compute", r.seconds, r.cells.threads_used,
               r.cells.threads_used == 1 ? "" : "s");

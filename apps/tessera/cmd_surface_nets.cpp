@@ -340,7 +340,7 @@ int run_surface_nets(const SurfaceNetsArgs& a) {
   const VertexCopies copies = vertex_copies(m);
   const Watertight w = check_watertight(net, copies);
 
-  std::printf("tessera surface-nets: %zu points (%dD) from %s%s\n", in.size(), in.dim, shown_path(a.compute.input).c_str(),
+  std::printf("tessera surface-nets: %zu points (%dD) from %s%s\n", in.size(), in.dim, shown_input(a.compute).c_str(),
               in.from_image ? " (sampled image)" : "");
   if (in.from_image)
     std::printf("  %-18s %lldx%lld%s voxels\n", "image", static_cast<long long>(in.geometry.size[0]),

@@ -2,6 +2,7 @@
 #include "commands.hpp"
 #include "stdin_input.hpp"
 
+#include <charconv>
 #include <sys/resource.h>
 
 #include <algorithm>
@@ -167,9 +168,29 @@ void check_against_input(const ComputeArgs& a, const io::PointCloud& pc) {
 
 }  // namespace
 
+void find_input_frame(ComputeArgs& a) {
+  if (a.frame.empty()) return;  // (CLI11 refuses an empty --frame)
+  std::int64_t index = 0;
+  const char* end = a.frame.data() + a.frame.size();
+  const auto [p, ec] = std::from_chars(a.frame.data(), end, index);
+  if (ec != std::errc() || p != end)
+    throw InputError("--frame: '" + a.frame + "' is not a whole number (0 the first frame, -1 the last)");
+  try {
+    a.frame_place = io::find_frame(a.input, index);
+  } catch (const InputError& e) {
+    throw InputError(std::string("--frame: ") + e.what());
+  }
+}
+
+std::string shown_input(const ComputeArgs& a) {
+  const std::string path = shown_path(a.input);
+  if (a.frame.empty()) return path;
+  return strf("%s, frame %zu (from line %zu)", path.c_str(), a.frame_place.index, a.frame_place.line);
+}
+
 void apply_file_box(ComputeArgs& a) {
   if (!a.bounds.empty() || !a.periodic.empty() || !a.tilt.empty()) return;
-  const std::optional<io::FileBox> box = io::read_file_box(a.input);
+  const std::optional<io::FileBox> box = io::read_file_box(a.input, a.frame_place);
   if (!box) return;
   const int dim = a.dim == 0 ? 3 : a.dim;
   for (int d = 0; d < dim; ++d) {
@@ -194,7 +215,8 @@ void apply_file_box(ComputeArgs& a) {
   }
   if (tilted)
     for (int t = 0; t < tilts; ++t) a.tilt.push_back(box->tilt[static_cast<std::size_t>(t)]);
-  a.box_source = "the box of " + shown_path(a.input) + " (" + box->declared_by + ")";
+  a.box_source = "the box of " + (a.frame.empty() ? "" : strf("frame %zu of ", a.frame_place.index)) +
+                 shown_path(a.input) + " (" + box->declared_by + ")";
 }
 
 io::PointCloud read_input(const ComputeArgs& a) {
@@ -203,10 +225,11 @@ io::PointCloud read_input(const ComputeArgs& a) {
   ro.labels = a.labels;
   ro.keep_non_finite = a.ignore_outside;  // set aside by the computation, as points outside --bounds
   ro.non_finite_hint = "--ignore-outside sets such points aside";
+  ro.frame = a.frame_place;
   io::PointCloud pc = io::read_points(a.input, ro);
   if (!a.radii.empty()) {
     try {
-      pc.radii = io::read_point_scalars(a.input, a.radii);
+      pc.radii = io::read_point_scalars(a.input, a.radii, a.frame_place);
     } catch (const InputError& e) {  // its words are for any scalars: name the option
       throw InputError(std::string("--radii: ") + e.what());
     }
@@ -354,7 +377,7 @@ void print_volume_line(const Cells& c, const char* name) {
 void print_summary(const VoronoiArgs& a, const io::PointCloud& pc, const Cells& c, double read_s,
                    double compute_s, double write_s, const std::vector<std::string>& written) {
   const bool d3 = c.dim == 3;
-  std::printf("tessera voronoi: %zu points (%dD) from %s\n", pc.n, c.dim, shown_path(a.compute.input).c_str());
+  std::printf("tessera voronoi: %zu points (%dD) from %s\n", pc.n, c.dim, shown_input(a.compute).c_str());
   std::printf("  %-18s %zu\n", "cells", c.n_cells());
   if (!pc.labels.empty()) {
     const auto outside = std::count_if(pc.labels.begin(), pc.labels.end(), [](std::int32_t l) { return l < 0; });

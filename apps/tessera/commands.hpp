@@ -46,6 +46,10 @@ struct ComputeArgs {
   /// tilt (apply_file_box): what the summary says of it, e.g. "the box of
   /// run.dump (timestep 100)".
   std::string box_source;
+  /// --frame as given ("" when not): a trajectory's frame, 0 the first,
+  /// negative from the end; finish_compute_args finds where it starts.
+  std::string frame;
+  io::FramePlace frame_place;  ///< where the frame read starts (the first by default)
 };
 
 struct VoronoiArgs {
@@ -306,6 +310,15 @@ void check_bounds_arg(const std::vector<double>& bounds);  ///< InputError unles
 /// Where INPUT declares its box (a LAMMPS dump) and the command line gives
 /// none of --bounds, --periodic and --tilt: those from the file's box.
 void apply_file_box(ComputeArgs& args);
+
+/// --frame: where the frame asked for starts (args.frame_place), or nothing
+/// where --frame was not given. InputError for a file that is no trajectory
+/// or has no such frame.
+void find_input_frame(ComputeArgs& args);
+
+/// INPUT as the summaries name it: "stdin" for standard input, and the frame
+/// read where --frame was given ("run.dump, frame 3 (from line 4017)").
+std::string shown_input(const ComputeArgs& args);
 io::PointCloud read_input(const ComputeArgs& args);        ///< read and check INPUT (InputError)
 VoronoiOptions make_options(const ComputeArgs& args, int dim);
 /// tessera::voronoi with a progress bar (when `show_progress`) and Ctrl-C cancellation.

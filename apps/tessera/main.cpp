@@ -70,9 +70,17 @@ void add_compute_options(CLI::App* app, ComputeArgs& c, std::vector<std::string>
                   "numeric columns; also Qhull's format, as rbox writes it, and XYZ: a count, a comment, then species x y z; "
                   "extended XYZ's Lattice and pbc are the domain as a dump's box), .ply (vertex x,y,z), .vtp/.vtu (VTK XML "
                   "points, as ParaView saves them), .pcd (PCL's point clouds) or .dump/.lammpstrj (a LAMMPS dump's first "
-                  "frame: x y z, xu yu zu or scaled xs ys zs, atoms in file order; its box and periodic axes are the "
+                  "frame, or --frame's: x y z, xu yu zu or scaled xs ys zs, atoms in file order; its box and periodic axes are the "
                   "domain unless --bounds, --periodic or --tilt is given); - reads standard input, in any of these "
                   "formats (rbox 1000 D3 | tessera voronoi - ...)");
+  app->add_option("--frame", c.frame,
+                  "Of a trajectory (a LAMMPS dump, an XYZ file): the frame to read, 0 the first (default), 1 the "
+                  "next; negative counts from the end, -1 the last. Its box is the domain, as the first frame's "
+                  "would be; --labels and --radii columns are read from it (a .npy file serves every frame)")
+      ->type_name("INDEX")
+      ->check(CLI::Validator(
+          [](std::string& v) { return v.empty() ? std::string("expected a frame's index (0 the first, -1 the last), got ''") : ""; },
+          "", "frame"));
   app->add_option("--dim", c.dim,
                   "Dimension: 2 or 3 (default: the number of columns or fields; .ply, .vtp and .vtu are 3D). --dim 2 "
                   "on 3-column input keeps x,y")
@@ -191,6 +199,7 @@ void finish_compute_args(ComputeArgs& c, const std::vector<std::string>& raw_bou
   }
   if (c.input.empty()) throw tessera::InputError("INPUT is required (run with --help for usage)");
   c.input = input_path(c.input);
+  find_input_frame(c);
   apply_file_box(c);
 }
 

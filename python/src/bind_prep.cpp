@@ -308,20 +308,24 @@ void bind_prep(py::module_& m) {
   // ---- read_points -----------------------------------------------------------
   m.def(
       "read_points",
-      [](const std::string& path, int dim, const std::string& labels, bool keep_non_finite) {
+      [](const std::string& path, int dim, const std::string& labels, bool keep_non_finite, std::int64_t frame) {
         io::ReadOptions opt;
         opt.dim = dim;
         opt.labels = labels;
         opt.keep_non_finite = keep_non_finite;
         opt.non_finite_hint = "keep_non_finite=True keeps such points";
-        io::PointCloud pc = without_gil([&] { return io::read_points(path, opt); });
+        io::PointCloud pc = without_gil([&] {
+          if (frame != 0) opt.frame = io::find_frame(path, frame);
+          return io::read_points(path, opt);
+        });
         const auto n = static_cast<py::ssize_t>(pc.n);
         py::object lab = py::none();
         if (!labels.empty()) lab = adopt_flat(std::move(pc.labels));
         return py::make_tuple(adopt(std::move(pc.coords), {n, static_cast<py::ssize_t>(pc.dim)}), lab);
       },
-      py::arg("path"), py::arg("dim"), py::arg("labels"), py::arg("keep_non_finite"),
-      "A point file as the command line reads it: (points (n, dim), labels (n,) or None).");
+      py::arg("path"), py::arg("dim"), py::arg("labels"), py::arg("keep_non_finite"), py::arg("frame"),
+      "A point file as the command line reads it: (points (n, dim), labels (n,) or None); a trajectory's frame "
+      "(0 the first, negative from the end).");
 
   // ---- read_frame -------------------------------------------------------------
   m.def(
@@ -348,12 +352,15 @@ void bind_prep(py::module_& m) {
   // ---- read_box ---------------------------------------------------------------
   m.def(
       "read_box",
-      [](const std::string& path) -> py::object {
-        const std::optional<io::FileBox> b = without_gil([&] { return io::read_file_box(path); });
+      [](const std::string& path, std::int64_t frame) -> py::object {
+        const std::optional<io::FileBox> b = without_gil(
+            [&] { return io::read_file_box(path, frame == 0 ? io::FramePlace{} : io::find_frame(path, frame)); });
         if (!b) return py::none();
         return py::make_tuple(b->lo, b->hi, b->tilt, b->periodic, b->timestep);
       },
-      py::arg("path"), "The box a point file declares: (lo, hi, tilt, periodic, timestep), or None.");
+      py::arg("path"), py::arg("frame"),
+      "The box a point file declares in a frame (0 the first, negative from the end): (lo, hi, tilt, periodic, "
+      "timestep), or None.");
 
   // ---- threshold --------------------------------------------------------------
   m.def(

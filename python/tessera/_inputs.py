@@ -127,6 +127,17 @@ def as_index(i: Any, n: int, name: str, what: str) -> int:
     return k + n if k < 0 else k
 
 
+def as_frame(frame: Any) -> int:
+    """A trajectory's frame index (0 the first, negative from the end), in
+    int64's range; ValueError naming ``frame`` otherwise."""
+    if isinstance(frame, (bool, np.bool_)) or not isinstance(frame, (int, np.integer)):
+        raise ValueError(f"frame: expected an integer (0 the first frame, -1 the last), got {type(frame).__name__}")
+    k = int(frame)
+    if not -(2**63) <= k < 2**63:
+        raise ValueError(f"frame: {k} is out of range")
+    return k
+
+
 def as_threads(threads: Optional[int]) -> int:
     """threads=None -> 0 (TESSERA_NUM_THREADS if set, else every core)."""
     if threads is None:

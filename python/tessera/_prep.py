@@ -117,17 +117,23 @@ def read_points(
     dim: Optional[int] = None,
     labels: Optional[PathLike] = None,
     keep_non_finite: bool = False,
+    frame: int = 0,
 ) -> Tuple[np.ndarray, Optional[np.ndarray]]:
     """Read a point file as the ``tessera`` command reads it: ``.npy`` (an
     (N, 2) or (N, 3) array in C or Fortran order, or a structured array with
     fields x, y[, z]), ``.csv`` / ``.xyz`` / ``.txt`` (the columns a header
     names x, y[, z], else the first ones), ``.ply``, ``.vtp`` / ``.vtu``
     (VTK XML points), ``.pcd`` (PCL's point clouds) or ``.dump`` /
-    ``.lammpstrj`` (a LAMMPS dump's first frame: columns x y z, xu yu zu or
+    ``.lammpstrj`` (a LAMMPS dump's frame: columns x y z, xu yu zu or
     scaled xs ys zs; atoms in file order; its box: :func:`read_box`). An
     ``.xyz`` / ``.txt`` that starts with a lone count is XYZ (count,
     comment, ``species x y z`` per atom; extended XYZ's ``Properties`` name
     its columns, an integer one can be the labels).
+
+    ``frame``: of a trajectory (a dump, an XYZ file), the frame to read: 0
+    the first, 1 the next, negative from the end (-1 the last); the frames
+    before it are skipped by their line counts. :func:`read_frames` walks
+    them all.
 
     ``dim`` forces 2 or 3 (2 keeps x, y). ``labels``: a ``.npy`` file of N
     integers, or the name of an integer column, property, point data array
@@ -148,7 +154,8 @@ def read_points(
     if labels is not None and not _is_path(labels):
         raise ValueError(f"labels: expected a file or field name, got {type(labels).__name__}")
     lab = "" if labels is None else _inputs.as_path(labels)
-    return _inputs.call(_core.read_points, _inputs.as_path(path), dim or 0, lab, bool(keep_non_finite))
+    return _inputs.call(_core.read_points, _inputs.as_path(path), dim or 0, lab, bool(keep_non_finite),
+                        _inputs.as_frame(frame))
 
 
 class Frame(NamedTuple):
@@ -219,7 +226,7 @@ def _box_arguments(name: str, box: tuple, dim: Optional[int]) -> dict:
     }
 
 
-def read_box(path: PathLike, dim: Optional[int] = None) -> Optional[dict]:
+def read_box(path: PathLike, dim: Optional[int] = None, frame: int = 0) -> Optional[dict]:
     """The simulation box a point file declares (a LAMMPS dump's ``BOX
     BOUNDS``, an extended XYZ's ``Lattice``, ``Origin`` and ``pbc``; other
     formats declare none: None), as the keyword arguments
@@ -232,7 +239,8 @@ def read_box(path: PathLike, dim: Optional[int] = None) -> Optional[dict]:
     (x0, x1, y0, y1[, z0, z1]); ``periodic`` one bool per axis (LAMMPS's
     ``pp`` flags, f, s and m being walls; extended XYZ's pbc, T T T where it
     is absent); ``tilt`` the triclinic tilts xy, xz,
-    yz as lengths, or None for an orthogonal box. Only the header is read.
+    yz as lengths, or None for an orthogonal box. Only the header is read,
+    of ``frame`` (as :func:`read_points`' ``frame``; the first by default).
     ``dim=2`` gives the x, y part (ValueError where the box tilts along z).
     ValueError (:class:`tessera.InputError`) for a malformed header.
     """
@@ -240,7 +248,7 @@ def read_box(path: PathLike, dim: Optional[int] = None) -> Optional[dict]:
         raise ValueError(f"path: expected a file name, got {type(path).__name__}")
     if dim not in (None, 2, 3):
         raise ValueError(f"dim: expected 2, 3 or None, got {dim!r}")
-    box = _inputs.call(_core.read_box, _inputs.as_path(path))
+    box = _inputs.call(_core.read_box, _inputs.as_path(path), _inputs.as_frame(frame))
     return None if box is None else _box_arguments(_inputs.as_path(path), box, dim)
 
 

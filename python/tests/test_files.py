@@ -341,6 +341,23 @@ def test_read_frames_of_a_trajectory(tmp_path):
     np.save(tmp_path / "p.npy", frames[0][0])
     with pytest.raises(ValueError, match="not a trajectory"):
         tessera.read_frames(tmp_path / "p.npy")
+    with pytest.raises(ValueError, match="not a trajectory"):
+        tessera.read_points(tmp_path / "p.npy", frame=-1)
+    assert tessera.read_points(tmp_path / "p.npy", frame=0)[0].shape == (40, 3)
+    # One frame by its index, from either end: read_points and read_box.
+    for index in range(-3, 3):
+        pts, lab = tessera.read_points(tmp_path / "t.lammpstrj", labels="type", frame=index)
+        np.testing.assert_array_equal(pts, got[index].points)
+        np.testing.assert_array_equal(lab, got[index].labels)
+        assert tessera.read_box(tmp_path / "t.lammpstrj", frame=index) == got[index].box
+    with pytest.raises(ValueError, match=r"no frame 3: it has 3 frames \(0 to 2, or -3 to -1 from the end\)"):
+        tessera.read_points(tmp_path / "t.lammpstrj", frame=3)
+    with pytest.raises(ValueError, match="no frame -4"):
+        tessera.read_box(tmp_path / "t.lammpstrj", frame=-4)
+    for bad in (1.5, True, "1", None):
+        with pytest.raises(ValueError, match="frame: expected an integer"):
+            tessera.read_points(tmp_path / "t.lammpstrj", frame=bad)
+    assert tessera.read_points(tmp_path / "t.lammpstrj", frame=np.int64(-1))[0].shape == (30, 3)
     text = (tmp_path / "t.lammpstrj").read_text()
     broken = text[: text.index("ITEM: TIMESTEP\n20")] + "ITEM: TIMESTEP\n20\nITEM: NUMBER OF ATOMS\nmany\n"
     (tmp_path / "b.lammpstrj").write_text(broken)

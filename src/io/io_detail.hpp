@@ -91,28 +91,40 @@ std::vector<double> read_ply_property(const std::string& path, const std::string
 
 /// The values of the header column `name` of a text point file, one per data
 /// line (NaN and Inf allowed; the caller decides).
-std::vector<double> read_text_column(const std::string& path, const std::string& name);
+/// An XYZ file's property is read from `frame`.
+std::vector<double> read_text_column(const std::string& path, const std::string& name, const FramePlace& frame);
+
+/// Where a trajectory's frame ended: the bytes of the parsed text it took
+/// (up to the next frame's first line), that line's number, and whether no
+/// frame follows.
+struct FrameEnd {
+  std::size_t bytes = 0, next_line = 1;
+  bool last = true;
+};
 
 /// LAMMPS dumps (.dump, .lammpstrj; lammps_dump.cpp): a frame's atoms
-/// (`label_column`: empty, or the integer column holding labels), the first
-/// frame's atoms, one numeric column of it, and its box (the header alone).
+/// (`label_column`: empty, or the integer column holding labels), the atoms
+/// of options.frame, one numeric column of a frame, its box (the header
+/// alone), and a frame skipped (its lines split, not parsed: find_frame).
 TrajectoryFrame read_dump_frame(const std::string& path, std::uint64_t offset, std::size_t line,
                                 const ReadOptions& options, const std::string& label_column);
 PointCloud read_dump_points(const std::string& path, const ReadOptions& options, const std::string& label_column);
-std::vector<double> read_dump_column(const std::string& path, const std::string& name);
-FileBox read_dump_box(const std::string& path);
+std::vector<double> read_dump_column(const std::string& path, const std::string& name, const FramePlace& frame);
+FileBox read_dump_box(const std::string& path, const FramePlace& frame);
+FrameEnd skip_dump_frame(const std::string& path, std::uint64_t offset, std::size_t line);
 
 /// XYZ and extended XYZ files (xyz_points.cpp), read by the text reader
-/// where `text` (the file's first bytes) starts as XYZ does: the first
-/// frame's atoms, one property's values, and the Lattice's box (none
-/// without a Lattice); the frames after the first are not read.
+/// where `text` (the file's first bytes) starts as XYZ does: the atoms of
+/// options.frame, one property's values, the Lattice's box (none without a
+/// Lattice) and a frame skipped, as the dump's.
 bool looks_like_xyz(std::string_view text);
 bool is_xyz_file(const std::string& path);  ///< looks_like_xyz on as much of the file as its first lines take
 TrajectoryFrame read_xyz_frame(const std::string& path, std::uint64_t offset, std::size_t line,
                                const ReadOptions& options, const std::string& label_column);
 PointCloud read_xyz_points(const std::string& path, const ReadOptions& options, const std::string& label_column);
-std::vector<double> read_xyz_column(const std::string& path, const std::string& name);
-std::optional<FileBox> read_xyz_box(const std::string& path);
+std::vector<double> read_xyz_column(const std::string& path, const std::string& name, const FramePlace& frame);
+std::optional<FileBox> read_xyz_box(const std::string& path, const FramePlace& frame);
+FrameEnd skip_xyz_frame(const std::string& path, std::uint64_t offset, std::size_t line);
 
 /// The labels read from `column` of a trajectory file (LAMMPS dump, XYZ)
 /// as numbers, values[k * stride + at] for atom k: integers in int32's
@@ -123,14 +135,6 @@ std::vector<std::int32_t> atom_labels(const std::string& path, const std::string
 /// `bytes` bytes of a file from byte `offset` (to its end where it is
 /// shorter), for the readers of a header alone and of a trajectory's frames.
 std::string read_file_head(const std::string& path, std::size_t bytes, std::uint64_t offset = 0);
-
-/// Where a trajectory's frame ended: the bytes of the parsed text it took
-/// (up to the next frame's first line), that line's number, and whether no
-/// frame follows.
-struct FrameEnd {
-  std::size_t bytes = 0, next_line = 1;
-  bool last = true;
-};
 
 /// Thrown by a frame parser whose frame runs past the end of a prefix of the
 /// file that is not the whole file: frame_at reads more. (A logic_error:

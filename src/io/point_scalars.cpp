@@ -10,7 +10,8 @@
 
 namespace tessera::io {
 
-std::vector<double> read_point_scalars(const std::string& points_path, const std::string& source) {
+std::vector<double> read_point_scalars(const std::string& points_path, const std::string& source,
+                                       const FramePlace& frame) {
   if (source.empty()) throw InputError("no scalars given (a .npy file or a property/column name)");
   if (detail::lower_extension(source) == ".npy") {
     NpyArray a = read_npy_double(source);
@@ -25,8 +26,8 @@ std::vector<double> read_point_scalars(const std::string& points_path, const std
   if (ext == ".ply") return detail::read_ply_property(points_path, source);
   if (ext == ".vtp" || ext == ".vtu") return detail::read_vtk_point_array(points_path, source);
   if (ext == ".pcd") return detail::read_pcd_field(points_path, source);
-  if (detail::is_dump_extension(ext)) return detail::read_dump_column(points_path, source);
-  if (ext == ".csv" || ext == ".xyz" || ext == ".txt") return detail::read_text_column(points_path, source);
+  if (detail::is_dump_extension(ext)) return detail::read_dump_column(points_path, source, frame);
+  if (ext == ".csv" || ext == ".xyz" || ext == ".txt") return detail::read_text_column(points_path, source, frame);
   if (ext == ".npy") {  // a field of a structured array
     NpyRecords r = read_npy_records(points_path, [&](const std::string& name) { return name == source; });
     for (auto& f : r.fields)

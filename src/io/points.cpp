@@ -189,12 +189,44 @@ std::string non_finite_hint(const ReadOptions& options) {
   return options.non_finite_hint.empty() ? "keep_non_finite keeps such points" : options.non_finite_hint;
 }
 
-std::optional<FileBox> read_file_box(const std::string& path) {
+bool is_trajectory(const std::string& path) {
   const std::string ext = detail::lower_extension(path);
-  if (detail::is_dump_extension(ext)) return detail::read_dump_box(path);
+  return detail::is_dump_extension(ext) || ((ext == ".xyz" || ext == ".txt") && detail::is_xyz_file(path));
+}
+
+std::optional<FileBox> read_file_box(const std::string& path, const FramePlace& frame) {
+  const std::string ext = detail::lower_extension(path);
+  if (detail::is_dump_extension(ext)) return detail::read_dump_box(path, frame);
   // An extended XYZ's Lattice.
-  if ((ext == ".xyz" || ext == ".txt") && detail::is_xyz_file(path)) return detail::read_xyz_box(path);
+  if ((ext == ".xyz" || ext == ".txt") && detail::is_xyz_file(path)) return detail::read_xyz_box(path, frame);
   return std::nullopt;
+}
+
+FramePlace find_frame(const std::string& path, std::int64_t index) {
+  if (!is_trajectory(path))
+    detail::fail(path, "not a trajectory: frames are read from LAMMPS dumps (.dump, .lammpstrj) and XYZ files");
+  const bool dump = detail::is_dump_extension(detail::lower_extension(path));
+  // The frames' starts, walked until `index` is reached or, for an index
+  // from the end, to the last (24 bytes a frame).
+  std::vector<FramePlace> starts;
+  FramePlace at;
+  for (;;) {
+    if (index >= 0 && at.index == static_cast<std::uint64_t>(index)) return at;
+    starts.push_back(at);
+    const detail::FrameEnd end =
+        dump ? detail::skip_dump_frame(path, at.offset, at.line) : detail::skip_xyz_frame(path, at.offset, at.line);
+    if (end.last) break;
+    at.offset += end.bytes;
+    at.line = end.next_line;
+    ++at.index;
+  }
+  const std::size_t frames = starts.size();
+  if (index < 0 && static_cast<std::uint64_t>(-(index + 1)) < frames)
+    return starts[frames - 1 - static_cast<std::size_t>(-(index + 1))];
+  detail::fail(path, "no frame " + std::to_string(index) + ": it has " + std::to_string(frames) +
+                         (frames == 1 ? " frame (0, or -1 from the end)"
+                                      : " frames (0 to " + std::to_string(frames - 1) + ", or -" +
+                                            std::to_string(frames) + " to -1 from the end)"));
 }
 
 TrajectoryFrame read_frame(const std::string& path, std::uint64_t offset, std::size_t line,
@@ -222,6 +254,10 @@ TrajectoryFrame read_frame(const std::string& path, std::uint64_t offset, std::s
 PointCloud read_points(const std::string& path, const ReadOptions& options) {
   if (options.dim != 0 && options.dim != 2 && options.dim != 3)
     detail::fail(path, "dimension must be 2 or 3, not " + std::to_string(options.dim));
+
+  if ((options.frame.offset != 0 || options.frame.index != 0) && !is_trajectory(path))
+    detail::fail(path, "frame " + std::to_string(options.frame.index) +
+                           ": not a trajectory (frames are read from LAMMPS dumps and XYZ files)");
 
   // A labels option ending in .npy is a file; anything else names a column/property.
   const bool labels_file = !options.labels.empty() && detail::lower_extension(options.labels) == ".npy";

@@ -150,7 +150,7 @@ PointCloud qhull_points(const std::string& path, Lines& lines, std::size_t ndim,
 PointCloud read_text_points(const std::string& path, const ReadOptions& options,
                             const std::string& label_column) {
   // XYZ (chemistry's, and extended XYZ): a lone count, a comment, the atoms;
-  // a trajectory's frames after the first are not read.
+  // of a trajectory, options.frame alone is read.
   if (is_xyz_file(path)) return read_xyz_points(path, options, label_column);
   const std::string text = read_file_bytes(path);
   Lines lines(text);
@@ -262,8 +262,8 @@ PointCloud read_text_points(const std::string& path, const ReadOptions& options,
   return pc;
 }
 
-std::vector<double> read_text_column(const std::string& path, const std::string& name) {
-  if (is_xyz_file(path)) return read_xyz_column(path, name);
+std::vector<double> read_text_column(const std::string& path, const std::string& name, const FramePlace& frame) {
+  if (is_xyz_file(path)) return read_xyz_column(path, name, frame);
   const std::string text = read_file_bytes(path);
   Lines lines(text);
   std::string_view line;

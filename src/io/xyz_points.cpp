@@ -9,7 +9,7 @@
 //                                       pbc="T T F", Origin="x y z"
 //   N lines: species x y z [more]       (extended: the Properties' columns)
 //
-// A trajectory repeats the block; the first frame is read. Without
+// A trajectory repeats the block; one frame is read (the first by default). Without
 // Properties the columns are a species name and the position. Properties
 // name each column group as name:type:count, type S (text), R (real),
 // I (integer) or L (logical); pos (R:3) gives the position, an I:1 property
@@ -241,7 +241,8 @@ std::size_t property_column(const std::string& path, const XyzHeader& h, const s
   return p->column;
 }
 
-/// The atom lines' values of `cols`, atoms × cols.
+/// The atom lines' values of `cols`, atoms × cols; no columns: the lines
+/// are only counted (a frame skipped).
 std::vector<double> atom_values(const std::string& path, RawLines& lines, std::size_t text_size, const XyzHeader& h,
                                 const std::vector<std::size_t>& cols, std::optional<std::string_view> tail,
                                 FrameEnd* end = nullptr) {
@@ -257,6 +258,7 @@ std::vector<double> atom_values(const std::string& path, RawLines& lines, std::s
     if (!lines.next(line))
       frame_ended(path, "the frame ends after " + std::to_string(k) + " of its " + std::to_string(h.atoms) + " atoms",
                   whole);
+    if (cols.empty()) continue;  // a frame skipped (find_frame): its lines counted, not split
     out.resize(out.size() + cols.size());
     const std::size_t got = split_fields(line, f);
     if (got < f.size() || (got > f.size() && !plain))
@@ -348,21 +350,30 @@ TrajectoryFrame read_xyz_frame(const std::string& path, std::uint64_t offset, st
 }
 
 PointCloud read_xyz_points(const std::string& path, const ReadOptions& options, const std::string& label_column) {
-  return read_xyz_frame(path, 0, 1, options, label_column).points;
+  return read_xyz_frame(path, options.frame.offset, options.frame.line, options, label_column).points;
 }
 
-std::vector<double> read_xyz_column(const std::string& path, const std::string& name) {
-  return first_frame(path, [&](std::string_view text, std::optional<std::string_view> tail) {
-    RawLines lines(text);
+std::vector<double> read_xyz_column(const std::string& path, const std::string& name, const FramePlace& frame) {
+  return frame_at(path, frame.offset, [&](std::string_view text, std::optional<std::string_view> tail) {
+    RawLines lines(text, frame.line);
     const XyzHeader h = read_header(path, lines, !tail);
     return atom_values(path, lines, text.size(), h, {property_column(path, h, name, "RI", "scalars")}, tail);
   });
 }
 
-std::optional<FileBox> read_xyz_box(const std::string& path) {
-  return first_frame(path, [&](std::string_view text, std::optional<std::string_view> tail) {
-    RawLines lines(text);
+std::optional<FileBox> read_xyz_box(const std::string& path, const FramePlace& frame) {
+  return frame_at(path, frame.offset, [&](std::string_view text, std::optional<std::string_view> tail) {
+    RawLines lines(text, frame.line);
     return read_header(path, lines, !tail).box;
+  });
+}
+
+FrameEnd skip_xyz_frame(const std::string& path, std::uint64_t offset, std::size_t line) {
+  return frame_at(path, offset, [&](std::string_view text, std::optional<std::string_view> tail) {
+    RawLines lines(text, line);
+    FrameEnd end;
+    atom_values(path, lines, text.size(), read_header(path, lines, !tail), {}, tail, &end);
+    return end;
   });
 }
 

@@ -1189,6 +1189,71 @@ class FileBoxes(TempDirCase):
         self.assertNotIn("domain from", r.stdout)
         self.assertNotIn("periodic", r.stdout)
 
+    def test_frames(self):
+        # --frame reads any frame of a trajectory, by its index from either
+        # end, with its own box, labels and radii: the same cells as that
+        # frame alone in a file. Standard input too; every command.
+        rng = np.random.default_rng(34)
+        frames, texts = [], []
+        for k in range(3):
+            frac = rng.random((200 + 50 * k, 3))
+            name = "f%d.dump" % k
+            inp, _ = self.dump(name, frac, tilted=(k != 1))
+            frames.append(inp)
+            with open(inp) as f:
+                texts.append(f.read().replace("TIMESTEP\n42\n", "TIMESTEP\n%d\n" % (1000 * k)))
+        traj = self.p("run.lammpstrj")
+        with open(traj, "w") as f:
+            f.write("\n".join(texts))  # a blank line between frames
+        common = ["--labels", "type", "--radii", "radius", "-q"]
+        for k, index in ((0, "0"), (1, "1"), (2, "2"), (2, "-1"), (0, "-3")):
+            t1, t2 = self.p("t1.csv"), self.p("t2.csv")
+            r = self.ok(["voronoi", traj, "--frame", index, "--cell-table", t1, "--labels", "type", "--radii",
+                         "radius"])
+            self.assertIn("from %s, frame %d (from line " % (traj, k), r.stdout)
+            self.assertIn("the box of frame %d of %s (LAMMPS dump, timestep %d)" % (k, traj, 1000 * k), r.stdout)
+            self.ok(["voronoi", frames[k], "--cell-table", t2] + common)
+            self.assertEqual(read_bytes(t1), read_bytes(t2), index)
+        with open(traj, "rb") as f:
+            r = run_bytes(["voronoi", "-", "--frame", "-2", "--cell-table", "-"] + common, f.read())
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.ok(["voronoi", frames[1], "--cell-table", self.p("t2.csv")] + common)
+        self.assertEqual(r.stdout, read_bytes(self.p("t2.csv")))
+        r = self.ok(["delaunay", traj, "--frame", "-1", "--validate"])
+        self.assertIn("tessera: points from %s, frame 2 (from line " % traj, r.stderr)
+        self.assertIn("validation passed", r.stderr)
+        self.ok(["graph", traj, "--frame", "1", "--csr", self.p("g.npy"), "-q"])
+        self.ok(["bench", "voronoi", traj, "--frame", "2"])
+        # A .npy of labels serves every frame: its length is the frame's.
+        self.ok(["voronoi", traj, "--frame", "1", "--labels", self.save("l.npy", np.ones(250, np.int32)),
+                 "--cell-table", self.p("t1.csv"), "-q"])
+        # Bad frames: one line, exit 2, nothing written.
+        out = self.p("bad.csv")
+        for args, fragment in (
+                (["--frame", "3"], "--frame: %s: no frame 3: it has 3 frames (0 to 2, or -3 to -1 from the end)" % traj),
+                (["--frame", "-4"], "no frame -4: it has 3 frames"),
+                (["--frame", "1.5"], "--frame: '1.5' is not a whole number"),
+                (["--frame", "99999999999999999999"], "is not a whole number"),
+                (["--frame", ""], "expected a frame's index"),
+                (["--frame", "0", "--labels", self.p("l.npy")], "labels: 250 values for 200 points")):
+            r = run(["voronoi", traj, "--cell-table", out] + args)
+            self.assertEqual(r.returncode, 2, args)
+            self.assertEqual(len(r.stderr.strip().splitlines()), 1, r.stderr)
+            self.assertIn(fragment, r.stderr, args)
+            self.assertFalse(os.path.exists(out))
+        npy = self.save("p.npy", rng.random((20, 3)))
+        r = run(["voronoi", npy, "--frame", "0", "--cell-table", out])
+        self.assertEqual(r.returncode, 2)
+        self.assertIn("not a trajectory", r.stderr)
+        # A frame on the way one atom line short is named by its line.
+        broken = texts[0].replace("\n2 2 ", "\nX", 1)
+        broken = "\n".join(l for l in broken.split("\n") if not l.startswith("X"))
+        with open(self.p("broken.dump"), "w") as f:
+            f.write("\n".join([broken] + texts[1:]))
+        r = run(["voronoi", self.p("broken.dump"), "--frame", "-1", "--cell-table", out])
+        self.assertEqual(r.returncode, 2)
+        self.assertIn("fewer atoms than NUMBER OF ATOMS", r.stderr)
+
     def test_bad_dumps(self):
         frac = np.random.default_rng(32).random((50, 3))
         inp, _ = self.dump("x.dump", frac, flags="ff pp pp")  # xy tilt, x a wall

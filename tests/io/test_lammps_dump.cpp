@@ -248,3 +248,71 @@ TEST(LammpsDump, FramesOneAfterAnother) {
   EXPECT_NE(input_error([&] { tessera::io::read_frame(dir.write("p.csv", "x,y\n0,0\n1,1\n")); }).find("not a trajectory"),
             std::string::npos);
 }
+
+// find_frame: any frame by its index from either end, read with its own box,
+// labels and scalars; frames on the way are walked by their line counts, and
+// a frame whose lines do not match its count is named by its line.
+TEST(LammpsDump, FramesByIndex) {
+  TempDir dir;
+  std::string text;
+  const int counts[4] = {3, 5, 2, 4};
+  for (int s = 0; s < 4; ++s) {
+    if (s == 2) text += "ITEM: UNITS\nlj\n";  // items before TIMESTEP
+    text += "ITEM: TIMESTEP\n" + std::to_string(100 * s) + "\nITEM: NUMBER OF ATOMS\n" + std::to_string(counts[s]) +
+            "\nITEM: BOX BOUNDS pp pp pp\n0 " + std::to_string(s + 1) + "\n0 1\n0 1\nITEM: ATOMS id type x y z r\n";
+    for (int k = 0; k < counts[s]; ++k)
+      text += std::to_string(k + 1) + " " + std::to_string(s + 1) + " " + std::to_string(0.125 * k) + " 0.5 0.25 " +
+              std::to_string(s) + ".5\n";
+    if (s == 0) text += "\n\n";  // blank lines between frames
+  }
+  const std::string p = dir.write("t.lammpstrj", text);
+  // The frames' own starts, as read_frame walks them.
+  std::vector<tessera::io::TrajectoryFrame> walked;
+  for (std::uint64_t offset = 0, line = 1;;) {
+    walked.push_back(tessera::io::read_frame(p, offset, line, labels("type")));
+    offset = walked.back().next_offset;
+    line = walked.back().next_line;
+    if (walked.back().last) break;
+  }
+  ASSERT_EQ(walked.size(), 4u);
+  for (int index = -4; index < 4; ++index) {
+    const std::size_t s = static_cast<std::size_t>(index < 0 ? index + 4 : index);
+    const tessera::io::FramePlace at = tessera::io::find_frame(p, index);
+    EXPECT_EQ(at.index, s) << index;
+    EXPECT_EQ(at.offset, s == 0 ? 0 : walked[s - 1].next_offset) << index;
+    EXPECT_EQ(at.line, s == 0 ? 1 : walked[s - 1].next_line) << index;
+    ReadOptions o = labels("type");
+    o.frame = at;
+    const auto pc = read_points(p, o);
+    EXPECT_EQ(pc.coords, walked[s].points.coords) << index;
+    EXPECT_EQ(pc.labels, std::vector<std::int32_t>(static_cast<std::size_t>(counts[s]), static_cast<int>(s) + 1));
+    EXPECT_EQ(read_point_scalars(p, "r", at), std::vector<double>(static_cast<std::size_t>(counts[s]), s + 0.5));
+    EXPECT_EQ(read_file_box(p, at)->hi[0], static_cast<double>(s + 1));
+    EXPECT_EQ(read_file_box(p, at)->timestep, static_cast<std::int64_t>(100 * s));
+  }
+  for (const std::int64_t index : {std::int64_t{4}, std::int64_t{-5}, std::numeric_limits<std::int64_t>::min()})
+    EXPECT_NE(input_error([&] { tessera::io::find_frame(p, index); })
+                  .find("no frame " + std::to_string(index) + ": it has 4 frames (0 to 3, or -4 to -1 from the end)"),
+              std::string::npos);
+  // A frame with an atom line too few or too many, on the way to another.
+  for (const char* edit : {"drop", "add"}) {
+    std::string bad = text;
+    const std::size_t at = bad.find("2 2 0.125000");
+    if (std::string(edit) == "drop")
+      bad.erase(at, bad.find('\n', at) + 1 - at);
+    else
+      bad.insert(at, "9 2 0.5 0.5 0.5 1.5\n");
+    const std::string q = dir.write(std::string(edit) + ".dump", bad);
+    const std::string msg = input_error([&] { tessera::io::find_frame(q, -1); });
+    EXPECT_NE(msg.find(std::string(edit) == "drop" ? "fewer atoms than NUMBER OF ATOMS" : "more atom lines than"),
+              std::string::npos)
+        << msg;
+    EXPECT_EQ(tessera::io::find_frame(q, 1).index, 1u);  // the broken frame is found; reading it fails
+  }
+  // Another format: only its one frame.
+  const std::string csv = dir.write("p.csv", "x,y\n0,0\n1,1\n");
+  EXPECT_NE(input_error([&] { tessera::io::find_frame(csv, 0); }).find("not a trajectory"), std::string::npos);
+  ReadOptions second;
+  second.frame.index = 1;
+  EXPECT_NE(input_error([&] { read_points(csv, second); }).find("not a trajectory"), std::string::npos);
+}

@@ -172,3 +172,36 @@ TEST(Xyz, FramesOneAfterAnother) {
   EXPECT_NE(input_error([&] { tessera::io::read_frame(q, f0.next_offset, f0.next_line); }).find("line 10: 'two' is not a number"),
             std::string::npos);
 }
+
+TEST(Xyz, FramesByIndex) {
+  TempDir dir;
+  const std::string text =
+      "2\nLattice=\"2 0 0 0 2 0 0 0 2\" Properties=species:S:1:pos:R:3:r:R:1\nAr 0 0 0 0.5\nAr 1 1 1 0.5\n\n"
+      "3\nLattice=\"3 0 0 0 3 0 0 0 3\" Properties=species:S:1:pos:R:3:r:R:1\nAr 0 0 0 1\nAr 1 1 1 1\nAr 2 2 2 1\n"
+      "1\nplain comment\nAr 0.5 0.5 0.5\n";
+  const std::string p = dir.write("t.xyz", text);
+  const std::size_t lines[3] = {1, 6, 11};
+  for (int index = -3; index < 3; ++index) {
+    const std::size_t s = static_cast<std::size_t>(index < 0 ? index + 3 : index);
+    const tessera::io::FramePlace at = tessera::io::find_frame(p, index);
+    EXPECT_EQ(at.index, s);
+    EXPECT_EQ(at.line, lines[s]);
+    EXPECT_EQ(at.offset, s == 0 ? 0 : text.find(s == 1 ? "3\n" : "1\nplain"));
+    tessera::io::ReadOptions o;
+    o.frame = at;
+    EXPECT_EQ(tessera::io::read_points(p, o).n, s == 0 ? 2u : s == 1 ? 3u : 1u);
+    const auto box = tessera::io::read_file_box(p, at);
+    EXPECT_EQ(box.has_value(), s < 2);
+    if (s < 2) {
+      EXPECT_EQ(box->hi[0], s == 0 ? 2.0 : 3.0);
+      EXPECT_EQ(tessera::io::read_point_scalars(p, "r", at), std::vector<double>(s == 0 ? 2 : 3, s == 0 ? 0.5 : 1.0));
+    }
+  }
+  EXPECT_NE(input_error([&] { tessera::io::find_frame(p, 3); }).find("no frame 3: it has 3 frames"), std::string::npos);
+  // A count one short: its frame's next line is no count.
+  std::string bad = text;
+  bad.replace(bad.find("3\nLattice=\"3"), 1, "2");
+  const std::string q = dir.write("bad.xyz", bad);
+  const std::string msg = input_error([&] { tessera::io::find_frame(q, -1); });
+  EXPECT_NE(msg.find("more atom lines than the frame's count (2)"), std::string::npos) << msg;
+}

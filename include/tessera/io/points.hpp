@@ -25,6 +25,15 @@ struct PointCloud {
   std::vector<double> radii;
 };
 
+/// Where a frame of a trajectory (a LAMMPS dump, an XYZ file) starts: its
+/// byte and its line in the file, and its place among the frames (0 the
+/// first). The default is the first frame (find_frame gives the others).
+struct FramePlace {
+  std::uint64_t offset = 0;
+  std::size_t line = 1;
+  std::size_t index = 0;
+};
+
 struct ReadOptions {
   /// 2 or 3 to force the dimension (3-column input with dim 2 keeps x,y);
   /// 0: take it from the file (2 or 3 columns, or a text header's named x, y
@@ -42,6 +51,9 @@ struct ReadOptions {
   /// option ("--ignore-outside sets such points aside"); empty: this
   /// struct's keep_non_finite.
   std::string non_finite_hint;
+  /// The frame of a trajectory to read (find_frame); the first by default.
+  /// A file of another format has only the first.
+  FramePlace frame;
 };
 
 /// ReadOptions::non_finite_hint, or its default when empty.
@@ -62,11 +74,24 @@ struct FileBox {
   std::string declared_by;                   ///< "LAMMPS dump, timestep 100", "extended XYZ Lattice"
 };
 
-/// The box `path` declares in its first frame, read from its header alone:
-/// LAMMPS dumps (.dump, .lammpstrj) and extended XYZ files with a Lattice
-/// have one, other formats none (nullopt). Throws InputError on a malformed
-/// header.
-std::optional<FileBox> read_file_box(const std::string& path);
+/// The box `path` declares in a frame (the first by default), read from its
+/// header alone: LAMMPS dumps (.dump, .lammpstrj) and extended XYZ files
+/// with a Lattice have one, other formats none (nullopt). Throws InputError
+/// on a malformed header.
+std::optional<FileBox> read_file_box(const std::string& path, const FramePlace& frame = {});
+
+/// Whether `path` is a trajectory whose frames read_frame and find_frame
+/// read: a LAMMPS dump (.dump, .lammpstrj), or an .xyz/.txt file in XYZ's
+/// format.
+bool is_trajectory(const std::string& path);
+
+/// Where frame `index` of a trajectory starts: 0 the first, 1 the next, and
+/// negative indices count from the end (-1 the last). The frames before it
+/// (all of them for a negative index) are walked by their headers and line
+/// counts, their numbers not parsed. Throws InputError where the file has no
+/// such frame (saying how many it has), is no trajectory, or a frame on the
+/// way is malformed (naming its line).
+FramePlace find_frame(const std::string& path, std::int64_t index);
 
 /// One frame of a trajectory file (a LAMMPS dump, an XYZ file).
 struct TrajectoryFrame {
@@ -104,7 +129,9 @@ std::vector<std::int32_t> read_labels_npy(const std::string& path);
 /// property or a header column of a .csv/.xyz/.txt file (the points' own
 /// file). NaN values are allowed. The length is the caller's to check.
 /// Throws InputError (one line naming the file) on a missing array/column.
-std::vector<double> read_point_scalars(const std::string& points_path, const std::string& source);
+/// A trajectory's column is read from `frame`.
+std::vector<double> read_point_scalars(const std::string& points_path, const std::string& source,
+                                       const FramePlace& frame = {});
 
 struct WritePointsOptions {
   /// .npy output only: where the labels go ("" = OUT with "_labels.npy" in
