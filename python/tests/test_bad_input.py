@@ -43,7 +43,7 @@ CASES = {
     "bounds text": (dict(points=P2, bounds="0 1 0 1"), r"bounds: expected 4 numbers"),
     "bounds empty": (dict(points=P2, bounds=(1, 0, 0, 1)), r"bounds: x range \[1, 0\] is empty"),
     "bounds NaN": (dict(points=P2, bounds=(0, 1, 0, np.nan)), r"bounds: y range .* not finite"),
-    "outside bounds": (dict(points=P2 + 2, bounds=(0, 1, 0, 1)), r"lies outside the bounds \(use ignore_outside=True"),
+    "outside bounds": (dict(points=P2 + 2, bounds=(0, 1, 0, 1)), r"lies outside the bounds: x = 2\.\d+ is not in \[0, 1\] \(use ignore_outside=True"),
     "threads 0": (dict(points=P2, threads=0), r"threads: expected a positive integer or None, got 0"),
     "threads float": (dict(points=P2, threads=1.5), r"threads: expected a positive integer or None, got 1\.5"),
     "threads text": (dict(points=P2, threads="2"), r"threads: expected a positive integer"),

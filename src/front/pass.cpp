@@ -12,10 +12,10 @@
 
 #include "tessera/engine/thread_arena.hpp"
 #include "tessera/finite_points.hpp"
+#include "../message_text.hpp"
 
 namespace tessera::front {
 namespace {
-const char* axis_name(int d) { return d == 0 ? "x" : (d == 1 ? "y" : "z"); }
 }  // namespace
 
 void check_input(std::span<const double> points, int dim, std::span<const std::int32_t> labels) {
@@ -104,7 +104,7 @@ Bounds make_domain(std::span<const double> pts, int dim, const VoronoiOptions& o
       auto du = static_cast<std::size_t>(d);
       if (!std::isfinite(b.lo[du]) || !std::isfinite(b.hi[du]) || !(b.lo[du] < b.hi[du])) {
         std::ostringstream m;
-        m << "bounds: " << axis_name(d) << " range [" << b.lo[du] << ", " << b.hi[du] << "] is empty or not finite";
+        m << "bounds: " << detail::axis_name(d) << " range [" << b.lo[du] << ", " << b.hi[du] << "] is empty or not finite";
         throw InputError(m.str());
       }
     }
@@ -124,7 +124,7 @@ Bounds make_domain(std::span<const double> pts, int dim, const VoronoiOptions& o
     double e = 0.5 * b.hi[du] - 0.5 * b.lo[du];
     if (!(b.hi[du] > b.lo[du])) {
       std::ostringstream m;
-      m << "all points have the same " << axis_name(d) << " coordinate (" << b.lo[du]
+      m << "all points have the same " << detail::axis_name(d) << " coordinate (" << b.lo[du]
         << "): the bounding box has zero extent";
       if (dim == 3) m << "; for planar input use --dim 2, or give --bounds";
       else m << "; give --bounds";
@@ -147,7 +147,7 @@ Bounds make_domain(std::span<const double> pts, int dim, const VoronoiOptions& o
     b.hi[du] = std::ceil((b.hi[du] + pad) / step) * step;
     if (!std::isfinite(b.lo[du]) || !std::isfinite(b.hi[du])) {
       std::ostringstream m;
-      m << "the padded domain's " << axis_name(d) << " range overflows double (padding " << opt.padding
+      m << "the padded domain's " << detail::axis_name(d) << " range overflows double (padding " << opt.padding
         << " of the points' extent); give a smaller --padding, or --bounds";
       throw InputError(m.str());
     }
@@ -249,18 +249,24 @@ Pass<D>::Pass(std::span<const double> input, std::span<const std::int32_t> label
   in_box.assign(n, 1);
   std::size_t n_in = n;
   for (std::size_t i = 0; i < n; ++i) {
+    int out_along = -1;
     for (int d = 0; d < D; ++d) {
       double x = points[i * D + static_cast<std::size_t>(d)];
       if (x < bounds.lo[static_cast<std::size_t>(d)] || x > bounds.hi[static_cast<std::size_t>(d)]) {
         in_box[i] = 0;
+        out_along = d;
         break;
       }
     }
     if (!in_box[i]) {
       if (!opt.ignore_outside_points) {
-        std::ostringstream m;
-        m << "point " << i << " lies outside the bounds (use --ignore-outside to drop such points)";
-        throw InputError(m.str());
+        // The user's numbers (not the rescaled copy's), each in its shortest
+        // exact text: a point an ulp outside a box read from a file shows it.
+        const auto du = static_cast<std::size_t>(out_along);
+        throw InputError("point " + std::to_string(i) + " lies outside the bounds: " + detail::axis_name(out_along) +
+                         " = " + detail::number_text(input[i * D + du]) + " is not in [" +
+                         detail::number_text(user_bounds.lo[du]) + ", " + detail::number_text(user_bounds.hi[du]) +
+                         "] (use --ignore-outside to drop such points)");
       }
       ignored_outside.push_back(static_cast<std::int32_t>(i));
       --n_in;

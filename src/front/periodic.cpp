@@ -16,11 +16,11 @@
 #include "tessera/finite_points.hpp"
 #include "tessera/kernels/filter.hpp"
 #include "tessera/kernels/power.hpp"
+#include "../message_text.hpp"
 
 namespace tessera::front {
 namespace {
 
-const char* axis_name(int a) { return a == 0 ? "x" : (a == 1 ? "y" : "z"); }
 
 std::string num(double v) {
   char buf[32];
@@ -62,14 +62,14 @@ PeriodicInput periodic_input(std::span<const double> points, int dim, std::span<
     throw InputError("labels: " + std::to_string(labels.size()) + " values for " + std::to_string(in.n) + " points");
   for (int a = dim; a < 3; ++a)
     if (options.periodic[static_cast<std::size_t>(a)])
-      throw InputError(std::string("periodic axis ") + axis_name(a) + " of " + std::to_string(dim) + "D points");
+      throw InputError(std::string("periodic axis ") + detail::axis_name(a) + " of " + std::to_string(dim) + "D points");
   if (!options.bounds) throw InputError("a periodic box needs its bounds (the box that repeats)");
   in.periodic = options.periodic;
   in.box = *options.bounds;
   for (int a = 0; a < dim; ++a) {
     const auto au = static_cast<std::size_t>(a);
     if (!std::isfinite(in.box.lo[au]) || !std::isfinite(in.box.hi[au]) || !(in.box.lo[au] < in.box.hi[au]))
-      throw InputError(std::string("bounds along ") + axis_name(a) + " must be finite with lo < hi, not [" +
+      throw InputError(std::string("bounds along ") + detail::axis_name(a) + " must be finite with lo < hi, not [" +
                        num(in.box.lo[au]) + ", " + num(in.box.hi[au]) + "]");
     in.length[au] = in.box.hi[au] - in.box.lo[au];
     if (!std::isfinite(in.length[au])) throw InputError("the periodic box's extent overflows double");
@@ -84,12 +84,12 @@ PeriodicInput periodic_input(std::span<const double> points, int dim, std::span<
     if (!std::isfinite(v)) throw InputError(std::string("tilt ") + tilt_name[t] + " must be finite, not " + num(v));
     if (static_cast<int>(hi) >= dim) throw InputError(std::string("tilt ") + tilt_name[t] + " of 2D points (only xy)");
     if (!in.periodic[lo] || !in.periodic[hi])
-      throw InputError(std::string("tilt ") + tilt_name[t] + " needs " + axis_name(tilt_lo[t]) + " and " +
-                       axis_name(tilt_hi[t]) + " periodic (a tilted wall is not supported)");
+      throw InputError(std::string("tilt ") + tilt_name[t] + " needs " + detail::axis_name(tilt_lo[t]) + " and " +
+                       detail::axis_name(tilt_hi[t]) + " periodic (a tilted wall is not supported)");
     // The fractional coordinates' rounding stays far below fraction_slack.
     if (!(std::fabs(v) <= 0x1p10 * in.length[lo]))
       throw InputError(std::string("tilt ") + tilt_name[t] + " " + num(v) + " is over 1024 box lengths along " +
-                       axis_name(tilt_lo[t]) + "; reduce it by whole box lengths (the same lattice)");
+                       detail::axis_name(tilt_lo[t]) + "; reduce it by whole box lengths (the same lattice)");
   }
   in.sheared = options.tilt[0] != 0 || options.tilt[1] != 0 || options.tilt[2] != 0;
   // The extreme radii of power cells (0 without radii): r_max^2 - r_min^2
@@ -233,10 +233,13 @@ PeriodicInput periodic_input(std::span<const double> points, int dim, std::span<
     }
     for (std::size_t a = 0; a < du && in.takes_part[i]; ++a) {
       if (!in.periodic[a] && (p[a] < in.box.lo[a] || p[a] > in.box.hi[a])) {
-        if (!options.ignore_outside_points)
-          throw InputError("point " + std::to_string(i) + " lies outside the bounds along " +
-                           axis_name(static_cast<int>(a)) +
-                           ", which is not periodic (use --ignore-outside to drop such points)");
+        if (!options.ignore_outside_points) {
+          const std::string axis = detail::axis_name(static_cast<int>(a));
+          throw InputError("point " + std::to_string(i) + " lies outside the bounds: " + axis + " = " +
+                           detail::number_text(p[a]) + " is not in [" + detail::number_text(in.box.lo[a]) + ", " +
+                           detail::number_text(in.box.hi[a]) + "], and " + axis +
+                           " is not periodic (use --ignore-outside to drop such points)");
+        }
         in.takes_part[i] = 0;
         in.ignored.push_back(static_cast<std::int32_t>(i));
       }

@@ -31,6 +31,7 @@
 #include "tessera/finite_points.hpp"
 #include "tessera/image.hpp"
 #include "tessera/prep/sample_image.hpp"
+#include "../message_text.hpp"
 
 namespace tessera {
 namespace {
@@ -40,14 +41,7 @@ constexpr std::size_t kGrain = 4096;
 /// it the bins are far smaller than any sensible use of fill.
 constexpr double kMaxBins = 268435456.0;  // 2^28
 
-const char* axis_name(int d) { return d == 0 ? "x" : d == 1 ? "y" : "z"; }
 
-/// Shortest text that reads back as `v`.
-std::string num(double v) {
-  char buf[32];
-  const auto r = std::to_chars(buf, buf + sizeof buf, v);
-  return std::string(buf, r.ptr);
-}
 
 struct Grid {
   int dim = 3;
@@ -93,14 +87,14 @@ Grid make_grid(int dim, const double* lo, const double* hi, std::size_t n, doubl
     // Points spanning more than double's range: one infinite bin added
     // nothing (uniform), or the adaptive grid's image refused its spacing.
     if (!std::isfinite(extent[d]))
-      throw InputError(std::string("fill: the region's ") + axis_name(d) + " extent [" + num(lo[d]) + ", " +
-                       num(hi[d]) + "] overflows double: scale the points down");
+      throw InputError(std::string("fill: the region's ") + detail::axis_name(d) + " extent [" + detail::number_text(lo[d]) + ", " +
+                       detail::number_text(hi[d]) + "] overflows double: scale the points down");
   }
   const double target = std::max(1.0, static_cast<double>(n) / points_per_bin);
   if (target > kMaxBins) {
     char buf[32];
     std::snprintf(buf, sizeof buf, "%.3g", target);
-    throw InputError(std::string("fill: ") + buf + " bins asked (points per bin " + num(points_per_bin) +
+    throw InputError(std::string("fill: ") + buf + " bins asked (points per bin " + detail::number_text(points_per_bin) +
                      "); at most 2^28: raise the points per bin");
   }
   bool active[3] = {dim > 0, dim > 1, dim > 2};
@@ -130,7 +124,7 @@ Grid make_grid(int dim, const double* lo, const double* hi, std::size_t n, doubl
     double c = active[d] ? std::max(1.0, std::round(extent[d] / h)) : 1.0;
     total *= c;
     if (total > 2 * kMaxBins)
-      throw InputError("fill: too many bins (points per bin " + num(points_per_bin) + "): raise the points per bin");
+      throw InputError("fill: too many bins (points per bin " + detail::number_text(points_per_bin) + "): raise the points per bin");
     g.count[d] = static_cast<std::int64_t>(c);
     g.edge[d] = extent[d] / c;
     g.inv_edge[d] = c / extent[d];
@@ -141,8 +135,8 @@ Grid make_grid(int dim, const double* lo, const double* hi, std::size_t n, doubl
     const double magnitude = std::max(std::fabs(lo[d]), std::fabs(hi[d]));
     const double ulp = std::nextafter(magnitude, INFINITY) - magnitude;
     if (c > 1 && g.edge[d] < 1024 * ulp)
-      throw InputError(std::string("fill: bins along ") + axis_name(d) + " would be " + num(g.edge[d]) +
-                       " wide, within 1024 steps of double's resolution at " + num(magnitude) +
+      throw InputError(std::string("fill: bins along ") + detail::axis_name(d) + " would be " + detail::number_text(g.edge[d]) +
+                       " wide, within 1024 steps of double's resolution at " + detail::number_text(magnitude) +
                        ": raise the points per bin, or give larger bounds");
   }
   return g;
@@ -175,10 +169,10 @@ LabelledPoints fill(std::span<const double> coords, int dim, std::span<const std
     throw InputError("fill: the background label must be < 0 (outside points), not " +
                      std::to_string(options.background_label));
   if (!(options.points_per_bin > 0) || !std::isfinite(options.points_per_bin))
-    throw InputError("fill: points per bin must be a finite number > 0, not " + num(options.points_per_bin));
+    throw InputError("fill: points per bin must be a finite number > 0, not " + detail::number_text(options.points_per_bin));
   if (!(options.joggle >= 0 && options.joggle <= 0.5))
     throw InputError("fill: joggle must be between 0 and 0.5 (a fraction of the bin edge), not " +
-                     num(options.joggle));
+                     detail::number_text(options.joggle));
   if (options.strategy != FillStrategy::uniform && options.strategy != FillStrategy::adaptive)
     throw InputError("fill: unknown strategy");
   // Points that take part: all, or with keep_non_finite the finite ones.
@@ -189,7 +183,7 @@ LabelledPoints fill(std::span<const double> coords, int dim, std::span<const std
   } else {
     for (std::size_t k = 0; k < coords.size(); ++k)
       if (!std::isfinite(coords[k]))
-        throw InputError("fill: non-finite coordinate " + num(coords[k]) + " in point " + std::to_string(k / sdim) +
+        throw InputError("fill: non-finite coordinate " + detail::number_text(coords[k]) + " in point " + std::to_string(k / sdim) +
                          " (keep_non_finite keeps such points, unbinned)");
   }
   auto takes_part = [&](std::size_t i) { return finite.empty() || finite[i] != 0; };
@@ -204,15 +198,15 @@ LabelledPoints fill(std::span<const double> coords, int dim, std::span<const std
       lo[d] = options.bounds->lo[static_cast<std::size_t>(d)];
       hi[d] = options.bounds->hi[static_cast<std::size_t>(d)];
       if (!std::isfinite(lo[d]) || !std::isfinite(hi[d]) || !(lo[d] < hi[d]))
-        throw InputError(std::string("fill: bounds along ") + axis_name(d) + " must be finite with lo < hi, not [" +
-                         num(lo[d]) + ", " + num(hi[d]) + "]");
+        throw InputError(std::string("fill: bounds along ") + detail::axis_name(d) + " must be finite with lo < hi, not [" +
+                         detail::number_text(lo[d]) + ", " + detail::number_text(hi[d]) + "]");
     }
     for (std::size_t i = 0; i < n; ++i)
       for (int d = 0; d < dim && takes_part(i); ++d) {
         const double v = coords[i * sdim + static_cast<std::size_t>(d)];
         if (v < lo[d] || v > hi[d])
-          throw InputError("fill: point " + std::to_string(i) + " lies outside the bounds (" + axis_name(d) + " = " +
-                           num(v) + " not in [" + num(lo[d]) + ", " + num(hi[d]) + "])");
+          throw InputError("fill: point " + std::to_string(i) + " lies outside the bounds (" + detail::axis_name(d) + " = " +
+                           detail::number_text(v) + " not in [" + detail::number_text(lo[d]) + ", " + detail::number_text(hi[d]) + "])");
       }
   } else {
     bool first = true;
@@ -228,7 +222,7 @@ LabelledPoints fill(std::span<const double> coords, int dim, std::span<const std
     for (int d = 0; d < dim; ++d)
       if (!(lo[d] < hi[d]))
         throw InputError(std::string("fill: all ") + std::to_string(taking) + (taking < n ? " finite" : "") +
-                         " points have " + axis_name(d) + " = " + num(lo[d]) + ": give bounds for the region to fill" +
+                         " points have " + detail::axis_name(d) + " = " + detail::number_text(lo[d]) + ": give bounds for the region to fill" +
                          (dim == 3 && d == 2 ? " (or use 2D points)" : ""));
   }
 

@@ -17,18 +17,13 @@
 #include "tessera/cells.hpp"
 #include "tessera/engine/thread_arena.hpp"
 #include "tessera/finite_points.hpp"
+#include "../message_text.hpp"
 
 namespace tessera {
 namespace {
 
 constexpr std::size_t kGrain = 4096;
 
-/// Shortest text that reads back as `v`.
-std::string num(double v) {
-  char buf[32];
-  const auto r = std::to_chars(buf, buf + sizeof buf, v);
-  return std::string(buf, r.ptr);
-}
 
 /// `r` times the length of the diagonal of the bounding box of the finite
 /// points (every point, unless keep_non_finite let others in); 0 when none is.
@@ -67,7 +62,7 @@ std::vector<double> joggle(std::span<const double> coords, int dim, const Joggle
                      std::to_string(dim) + "D points");
   const std::size_t n = coords.size() / static_cast<std::size_t>(dim);
   if (!(options.radius >= 0) || !std::isfinite(options.radius))
-    throw InputError("joggle: radius must be a finite number >= 0, not " + num(options.radius));
+    throw InputError("joggle: radius must be a finite number >= 0, not " + detail::number_text(options.radius));
   if (options.mode != JoggleMode::ball && dim != 3)
     throw InputError("joggle: plane modes (xy, xz, yz) need 3D points; 2D points joggle in their plane (ball)");
   if (static_cast<unsigned>(options.mode) > static_cast<unsigned>(JoggleMode::yz))
@@ -77,7 +72,7 @@ std::vector<double> joggle(std::span<const double> coords, int dim, const Joggle
                      " points");
   for (std::size_t k = 0; k < coords.size() && !options.keep_non_finite; ++k)
     if (!std::isfinite(coords[k]))
-      throw InputError("joggle: non-finite coordinate " + num(coords[k]) + " in point " +
+      throw InputError("joggle: non-finite coordinate " + detail::number_text(coords[k]) + " in point " +
                        std::to_string(k / static_cast<std::size_t>(dim)) +
                        " (keep_non_finite copies such points through unmoved)");
 
@@ -86,7 +81,7 @@ std::vector<double> joggle(std::span<const double> coords, int dim, const Joggle
   const double radius = options.absolute ? options.radius : times_diagonal(options.radius, coords, dim);
   if (radius == 0) return out;
   if (!std::isfinite(radius))
-    throw InputError("joggle: the displacement radius (" + num(options.radius) +
+    throw InputError("joggle: the displacement radius (" + detail::number_text(options.radius) +
                      " of the bounding box's diagonal) overflows double; give a smaller radius");
 
   // The axes that move: all of them (ball), or the two of the plane.
@@ -118,7 +113,7 @@ std::vector<double> joggle(std::span<const double> coords, int dim, const Joggle
   for (std::size_t k = 0; k < out.size(); ++k)
     if (!std::isfinite(out[k]) && std::isfinite(coords[k]))
       throw InputError("joggle: point " + std::to_string(k / stride) + " moved past double's range (radius " +
-                       num(radius) + "); give a smaller radius");
+                       detail::number_text(radius) + "); give a smaller radius");
   return out;
 }
 

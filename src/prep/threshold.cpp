@@ -12,19 +12,14 @@
 #include <string>
 
 #include "tessera/cells.hpp"
+#include "../message_text.hpp"
 
 namespace tessera {
 namespace {
 
-/// Shortest text that reads back as `v`.
-std::string num(double v) {
-  char buf[32];
-  const auto r = std::to_chars(buf, buf + sizeof buf, v);
-  return std::string(buf, r.ptr);
-}
 
 std::string interval_text(const ThresholdInterval& iv) {
-  return "[" + num(iv.lo) + ", " + num(iv.hi) + ") -> " + std::to_string(iv.label);
+  return "[" + detail::number_text(iv.lo) + ", " + detail::number_text(iv.hi) + ") -> " + std::to_string(iv.label);
 }
 
 }  // namespace

@@ -1272,6 +1272,15 @@ class FileBoxes(TempDirCase):
         self.assertEqual(r.returncode, 2)
         self.assertIn("cut.dump: line", r.stderr)
         self.assertFalse(os.path.exists(out))
+        # An atom outside a wall of the dump's box: the error shows the
+        # coordinate and the box's range along that axis, in full.
+        frac2 = frac.copy()
+        frac2[7, 1] = 1.25
+        for flags, tail in (("ff ff ff", " (use --ignore-outside"), ("pp ff pp", ", and y is not periodic")):
+            inp, pts = self.dump("o.dump", frac2, flags=flags, tilted=False)
+            r = run(["voronoi", inp, "-o", out])
+            self.assertEqual(r.returncode, 2)
+            self.assertIn("point 7 lies outside the bounds: y = %r is not in [0.5, 5.5]%s" % (pts[7, 1], tail), r.stderr)
 
 
 class Power(TempDirCase):
