@@ -447,7 +447,7 @@ def faces(
     FaceSet
     """
     kind = as_face_kind(kind)
-    capping = bool(capping)
+    capping = _inputs.as_flag(capping, "capping")
     if capping and kind != "surface-net":
         raise ValueError(f"capping: applies to kind='surface-net' only, got kind={kind!r}")
     bg = _inputs.as_label_value(background_label, "background_label", negative=True)
@@ -592,7 +592,7 @@ class Flowers:
         0 generator, 1 petal centre, 2 neighbour, 3 spoke, 4 cell face,
         5 petal glyph, 6 circumflower glyph.
         """
-        g = self.glyphs if glyphs is None else bool(glyphs)
+        g = self.glyphs if glyphs is None else _inputs.as_flag(glyphs, "glyphs")
         _core.write_flowers_vtp(_check_vtp(path, "a flower"), self._fs, self._vor.points, g)
 
     def to_vtk(self, glyphs: Optional[bool] = None) -> Any:
@@ -600,7 +600,7 @@ class Flowers:
         written to a temporary file and read back: needs ``vtk``)."""
         from ._vtk import flowers_to_vtk
 
-        return flowers_to_vtk(self, self.glyphs if glyphs is None else bool(glyphs))
+        return flowers_to_vtk(self, self.glyphs if glyphs is None else _inputs.as_flag(glyphs, "glyphs"))
 
     def __repr__(self) -> str:
         return f"<tessera.Flowers of points {self.ids}>"
@@ -661,4 +661,4 @@ def flower(
     vor = cells_for("flower", source, labels, bounds, padding, threads, ignore_outside, periodic, tilt)
     idx = as_ids(ids, vor.points.shape[0])
     fs = _inputs.call(_core.flowers, vor._cells, vor.points, idx)
-    return Flowers(fs, vor, bool(glyphs))
+    return Flowers(fs, vor, _inputs.as_flag(glyphs, "glyphs"))

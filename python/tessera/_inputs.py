@@ -154,10 +154,19 @@ def as_threads(threads: Optional[int]) -> int:
 
 
 def as_padding(padding: float) -> float:
-    try:
-        return float(padding)
-    except (ValueError, TypeError):
-        raise ValueError(f"padding: expected a number >= 0, got {padding!r}") from None
+    # (Its sign and size are the library's to check, which names --padding.)
+    return as_float(padding, "padding", "a number >= 0")
+
+
+def as_flag(value: Any, name: str) -> bool:
+    """A yes/no argument: a bool (numpy's too) or the integers 0 and 1. Not
+    truthiness: an array raised numpy's "truth value ... is ambiguous",
+    which names no argument, and a string such as "False" is true."""
+    if isinstance(value, (bool, np.bool_)):
+        return bool(value)
+    if isinstance(value, (int, np.integer)) and value in (0, 1):
+        return bool(value)
+    raise ValueError(f"{name}: expected True or False, got {value!r}")
 
 
 # The front end's messages are written for the command line and may name its
@@ -213,8 +222,10 @@ def as_seed(seed: Any) -> int:
 
 
 def as_float(value: Any, name: str, what: str = "a number") -> float:
+    """A number as a float: not a bool, and not a string (float("0.1") would
+    take one that a caller meant to be something else)."""
     try:
-        if isinstance(value, (bool, np.bool_)):
+        if isinstance(value, (bool, np.bool_, str, bytes)):
             raise TypeError
         return float(value)
     except (ValueError, TypeError):

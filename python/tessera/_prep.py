@@ -154,8 +154,8 @@ def read_points(
     if labels is not None and not _is_path(labels):
         raise ValueError(f"labels: expected a file or field name, got {type(labels).__name__}")
     lab = "" if labels is None else _inputs.as_path(labels)
-    return _inputs.call(_core.read_points, _inputs.as_path(path), dim or 0, lab, bool(keep_non_finite),
-                        _inputs.as_frame(frame))
+    return _inputs.call(_core.read_points, _inputs.as_path(path), dim or 0, lab,
+                        _inputs.as_flag(keep_non_finite, "keep_non_finite"), _inputs.as_frame(frame))
 
 
 class Frame(NamedTuple):
@@ -327,7 +327,8 @@ def sample_image(
     jog = _inputs.as_float(joggle, "joggle", "a number in [0, 0.5]")
     if not (np.isfinite(jog) and jog >= 0):
         raise ValueError(f"joggle: expected a number in [0, 0.5], got {joggle!r}")
-    pts, lab = _inputs.call(_core.sample_image, im, sel, sched, st, bool(randomize), pr, _inputs.as_seed(seed), out,
+    pts, lab = _inputs.call(_core.sample_image, im, sel, sched, st, _inputs.as_flag(randomize, "randomize"), pr,
+                            _inputs.as_seed(seed), out,
                             bg, jog, _inputs.as_threads(threads))
     return pts, lab
 
@@ -382,8 +383,8 @@ def joggle(
     if m != "ball" and pts.shape[1] == 2:
         raise ValueError(f"mode: {m!r} needs 3D points; 2D points joggle in their plane (mode='ball')")
     mk = _inputs.as_mask(mask, pts.shape[0])
-    return _inputs.call(_core.joggle, pts, r, bool(absolute), m, mk, _inputs.as_seed(seed),
-                        _inputs.as_threads(threads), bool(keep_non_finite))
+    return _inputs.call(_core.joggle, pts, r, _inputs.as_flag(absolute, "absolute"), m, mk, _inputs.as_seed(seed),
+                        _inputs.as_threads(threads), _inputs.as_flag(keep_non_finite, "keep_non_finite"))
 
 
 # ---------------------------------------------------------------------- fill
@@ -447,7 +448,8 @@ def fill(
     if not 0 <= jog <= 0.5:
         raise ValueError(f"joggle: expected a number in [0, 0.5] (a fraction of the bin edge), got {joggle!r}")
     return _inputs.call(_core.fill, pts, lab, strat, bg, inl, ppb, _inputs.as_bounds(bounds, dim), jog,
-                        _inputs.as_seed(seed), _inputs.as_threads(threads), bool(keep_non_finite))
+                        _inputs.as_seed(seed), _inputs.as_threads(threads),
+                        _inputs.as_flag(keep_non_finite, "keep_non_finite"))
 
 
 # ----------------------------------------------------------------- threshold
@@ -520,5 +522,6 @@ def probe(
     if pts.shape[1] != im.dim:
         raise ValueError(f"points: {pts.shape[1]}D points for a {im.dim}D image (shape {im.shape})")
     ov = _inputs.as_float(outside_value, "outside_value")
-    values, valid = _inputs.call(_core.probe, im, pts, ov, _inputs.as_threads(threads), bool(keep_non_finite))
+    values, valid = _inputs.call(_core.probe, im, pts, ov, _inputs.as_threads(threads),
+                                 _inputs.as_flag(keep_non_finite, "keep_non_finite"))
     return values, valid.view(np.bool_)

@@ -220,11 +220,13 @@ def surface_nets(
     limit = _inputs.as_float(constraint, "constraint", "a finite number >= 0")
     if not (np.isfinite(limit) and limit >= 0):
         raise ValueError(f"constraint: expected a finite number >= 0, got {constraint!r}")
-    options = dict(select=sel or None, background_label=bg, capping=bool(capping), smooth=iterations,
-                   relax=relaxation, constraint=limit, constraint_is_absolute=bool(constraint_is_absolute),
-                   triangles=bool(triangles))
+    cap = _inputs.as_flag(capping, "capping")
+    absolute = _inputs.as_flag(constraint_is_absolute, "constraint_is_absolute")
+    tri = _inputs.as_flag(triangles, "triangles")
+    options = dict(select=sel or None, background_label=bg, capping=cap, smooth=iterations, relax=relaxation,
+                   constraint=limit, constraint_is_absolute=absolute, triangles=tri)
     net = _inputs.call(
-        _core.surface_nets, pts, lab, sel, bg, bool(capping), iterations, relaxation, limit,
-        bool(constraint_is_absolute), bool(triangles), _inputs.as_bounds(bounds, dim), _inputs.as_padding(padding),
-        bool(ignore_outside), _inputs.as_threads(threads), per, tilts)
+        _core.surface_nets, pts, lab, sel, bg, cap, iterations, relaxation, limit, absolute, tri,
+        _inputs.as_bounds(bounds, dim), _inputs.as_padding(padding), _inputs.as_flag(ignore_outside, "ignore_outside"),
+        _inputs.as_threads(threads), per, tilts)
     return SurfaceNet(net, pts, lab, options)

@@ -122,6 +122,33 @@ def test_arguments_found_by_a_fuzz_of_the_module(tmp_path):
         tessera.read_points(str(tmp_path / "b.vtu") + "\0.npy")
 
 
+def test_flags_and_numbers_are_not_taken_by_truthiness():
+    # Yes/no arguments take bools (numpy's too) and 0/1; an array raised
+    # numpy's "truth value ... is ambiguous", naming no argument, and a
+    # string such as "False" was true. Numbers are not strings or bools.
+    p = np.random.default_rng(2).random((40, 3))
+    lab = np.arange(40) % 2
+    for call, name in ((lambda v: tessera.voronoi(p, merge=v), "merge"),
+                       (lambda v: tessera.voronoi(p, ignore_outside=v), "ignore_outside"),
+                       (lambda v: tessera.delaunay(p, complete_hull=v), "complete_hull"),
+                       (lambda v: tessera.faces(p, labels=lab, kind="surface-net", capping=v), "capping"),
+                       (lambda v: tessera.surface_nets(p, lab, constraint_is_absolute=v), "constraint_is_absolute"),
+                       (lambda v: tessera.surface_nets(p, lab, triangles=v), "triangles"),
+                       (lambda v: tessera.joggle(p, keep_non_finite=v), "keep_non_finite")):
+        for bad in (np.array([True, False]), "False", 2, None, 0.0):
+            with pytest.raises(ValueError, match=name + ": expected True or False"):
+                call(bad)
+        for good in (True, np.False_, 1, np.int64(0)):
+            call(good)
+    with pytest.raises(ValueError, match="padding: expected a number >= 0, got True"):
+        tessera.voronoi(p, padding=True)
+    with pytest.raises(ValueError, match="padding: expected a number >= 0, got '0.1'"):
+        tessera.voronoi(p, padding="0.1")
+    with pytest.raises(ValueError, match="prune_tolerance: expected a finite number >= 0, got '0.1'"):
+        tessera.adjacency(p, prune_tolerance="0.1")
+    assert tessera.voronoi(p, padding=np.float32(0.5)).n_cells == 40
+
+
 def test_validate_after_the_arrays_changed():
     # The points and radii are kept without a copy: changed to NaN or inf
     # after the cells, validate raised SIGFPE in GMP (the process died).
