@@ -15,6 +15,7 @@ std::vector<double> read_point_scalars(const std::string& points_path, const std
   if (source.empty()) throw InputError("no scalars given (a .npy file or a property/column name)");
   if (detail::lower_extension(source) == ".npy") {
     NpyArray a = read_npy_double(source);
+    if (a.kind == 'b') detail::fail(source, "scalars must be floats or integers, found dtype bool");
     if (!(a.shape.size() == 1 || (a.shape.size() == 2 && a.shape[1] == 1))) {
       std::string shape = "(";
       for (std::size_t k = 0; k < a.shape.size(); ++k) shape += (k ? ", " : "") + std::to_string(a.shape[k]);

@@ -136,6 +136,8 @@ PointCloud read_npy_points(const std::string& path, const ReadOptions& options, 
   if (!label_name.empty())
     detail::fail(path, "labels '" + label_name + "': with .npy points, labels must be a .npy file (or a field of a structured array)");
   NpyArray a = read_npy_double(path);
+  // (As Python's points=: a bool array is a mask, not coordinates.)
+  if (a.kind == 'b') detail::fail(path, "expected a float or integer point array, found dtype bool");
   const auto& s = a.shape;
   if (s.size() != 2 || s[1] < 2 || s[1] > 3) {
     std::ostringstream shape;

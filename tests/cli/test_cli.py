@@ -1614,7 +1614,7 @@ class BadInput(TempDirCase):
 
     def test_wrong_dtypes(self):
         for name, arr in [("complex.npy", np.zeros((10, 3), complex)), ("str.npy", np.array([["a", "b", "c"]] * 10)),
-                          ("obj.npy", None)]:
+                          ("obj.npy", None), ("bool.npy", np.eye(10, 3, dtype=bool))]:
             path = self.p(name)
             if arr is None:
                 np.save(path, np.array([{"a": 1}] * 4, dtype=object), allow_pickle=True)
@@ -1715,6 +1715,10 @@ class BadInput(TempDirCase):
         self.fails(vor + ["--radii", self.p("missing.npy")], "missing.npy", outputs=[out])
         self.fails(vor + ["--radii", self.save("r2d.npy", np.stack([r, r], 1))], "1-D", outputs=[out])
         self.fails(vor + ["--radii", self.save("rs.npy", np.array(["a"] * 50))], outputs=[out])
+        # Bools are a mask, not radii (as in Python); an (N, 1) column is N radii.
+        self.fails(vor + ["--radii", self.save("rb.npy", np.ones(50, bool))], "found dtype bool", outputs=[out])
+        self.assertEqual(run(vor + ["--radii", self.save("rc.npy", r[:, None]), "-q"]).returncode, 0)
+        os.remove(out)
         # A name that the input has no column / property / field of.
         csv_in = self.p("s.csv")
         with open(csv_in, "w") as f:
