@@ -13,6 +13,7 @@
 #include <cstdarg>
 #include <cstdio>
 #include <filesystem>
+#include <optional>
 #include <random>
 #include <string>
 #include <system_error>
@@ -168,17 +169,73 @@ void check_against_input(const ComputeArgs& a, const io::PointCloud& pc) {
 
 }  // namespace
 
+namespace {
+
+/// One part of a --frame slice: empty (the default), else a whole number.
+std::optional<std::int64_t> slice_part(const std::string& frame, const std::string& part) {
+  if (part.empty()) return std::nullopt;
+  std::int64_t v = 0;
+  const char* end = part.data() + part.size();
+  const auto [p, ec] = std::from_chars(part.data(), end, v);
+  if (ec != std::errc() || p != end)
+    throw InputError("--frame: '" + frame +
+                     "' is not a frame's index or a series (all, or START:STOP[:STEP] as Python's slices)");
+  return v;
+}
+
+/// The frame indices of the slice A:B[:S] over n frames, as Python's
+/// range(*slice(A, B, S).indices(n)): B excluded, negatives from the end.
+std::vector<std::size_t> slice_indices(const std::string& frame, std::int64_t n) {
+  if (frame == "all") return slice_indices(":", n);
+  std::vector<std::string> parts(1);
+  for (const char c : frame) {
+    if (c == ':')
+      parts.emplace_back();
+    else
+      parts.back() += c;
+  }
+  if (parts.size() < 2 || parts.size() > 3)
+    throw InputError("--frame: '" + frame + "' is not START:STOP or START:STOP:STEP");
+  const std::optional<std::int64_t> a = slice_part(frame, parts[0]), b = slice_part(frame, parts[1]);
+  const std::int64_t step = parts.size() == 3 ? slice_part(frame, parts[2]).value_or(1) : 1;
+  if (step == 0) throw InputError("--frame: '" + frame + "': the step is 0");
+  // Out-of-range ends are clamped to the frames there are, as Python does.
+  auto clamp_end = [&](std::optional<std::int64_t> v, std::int64_t absent) {
+    if (!v) return absent;
+    const std::int64_t lo = step > 0 ? 0 : -1, hi = step > 0 ? n : n - 1;
+    return std::clamp(*v < 0 ? (*v < -n ? (step > 0 ? 0 : -1) : *v + n) : *v, lo, hi);
+  };
+  const std::int64_t start = clamp_end(a, step > 0 ? 0 : n - 1), stop = clamp_end(b, step > 0 ? n : -1);
+  std::vector<std::size_t> out;
+  // (step's magnitude may be near INT64_MAX: no overflow past stop)
+  for (std::int64_t k = start; step > 0 ? k < stop : k > stop;) {
+    out.push_back(static_cast<std::size_t>(k));
+    if (step > 0 ? stop - k <= step : k - stop <= -step) break;
+    k += step;
+  }
+  return out;
+}
+
+}  // namespace
+
 void find_input_frame(ComputeArgs& a) {
   if (a.frame.empty()) return;  // (CLI11 refuses an empty --frame)
-  std::int64_t index = 0;
-  const char* end = a.frame.data() + a.frame.size();
-  const auto [p, ec] = std::from_chars(a.frame.data(), end, index);
-  if (ec != std::errc() || p != end)
-    throw InputError("--frame: '" + a.frame + "' is not a whole number (0 the first frame, -1 the last)");
   try {
-    a.frame_place = io::find_frame(a.input, index);
+    if (a.frame == "all" || a.frame.find(':') != std::string::npos) {
+      const std::vector<io::FramePlace> all = io::find_frames(a.input);
+      for (const std::size_t k : slice_indices(a.frame, static_cast<std::int64_t>(all.size())))
+        a.frames.push_back(all[k]);
+      if (a.frames.empty())
+        throw InputError(strf("'%s' selects none of the %zu frames of %s", a.frame.c_str(), all.size(),
+                              shown_path(a.input).c_str()));
+      a.frame_place = a.frames.front();
+      return;
+    }
+    const std::optional<std::int64_t> index = slice_part(a.frame, a.frame);
+    a.frame_place = io::find_frame(a.input, *index);
   } catch (const InputError& e) {
-    throw InputError(std::string("--frame: ") + e.what());
+    const std::string m = e.what();
+    throw InputError(m.rfind("--frame", 0) == 0 ? m : "--frame: " + m);
   }
 }
 
@@ -491,7 +548,10 @@ Usage usage_now() {
 
 // ---------------------------------------------------------------- voronoi
 
-int run_voronoi(const VoronoiArgs& a) {
+namespace {
+
+/// `voronoi` on one frame (or a file that has one).
+int run_voronoi_frame(const VoronoiArgs& a) {
   check_output_names(a);
   check_bounds_arg(a.compute.bounds);
   if (a.compute.dim != 0 && !a.compute.bounds.empty() && int(a.compute.bounds.size()) != 2 * a.compute.dim)
@@ -544,6 +604,47 @@ int run_voronoi(const VoronoiArgs& a) {
   if (!a.quiet) print_summary(a, pc, cells, read_s, compute_s, write_s, written);
   if (a.validate && !report_validation(cells, pc, a.quiet)) return kExitFailure;
   return kExitOk;
+}
+
+}  // namespace
+
+int run_voronoi(const VoronoiArgs& a) {
+  if (a.compute.frames.empty()) return run_voronoi_frame(a);
+  // A series of frames (--frame all, A:B[:S]): each in turn, with its own
+  // box where the file's box is the domain, into outputs named by its index.
+  // Each frame's files are whole when written; an error in a later frame
+  // leaves those of the frames before it (said in the message).
+  for (const auto& [name, path] : {std::pair<const char*, const std::string*>{"-o", &a.output},
+                                   {"--cell-table", &a.cell_table},
+                                   {"--neighbors", &a.neighbors},
+                                   {"--neighbor-shifts", &a.neighbor_shifts}})
+    if (!path->empty() && (*path == "-" || path->find("{frame}") == std::string::npos))
+      throw InputError(strf("--frame %s writes one file per frame: %s's name must hold {frame} (e.g. cells_{frame}%s)",
+                            a.compute.frame.c_str(), name, *path == "-" ? ".csv" : extension(*path).c_str()));
+  int rc = kExitOk;
+  for (std::size_t k = 0; k < a.compute.frames.size(); ++k) {
+    const io::FramePlace& place = a.compute.frames[k];
+    VoronoiArgs f = a;
+    f.compute.frames.clear();
+    f.compute.frame_place = place;
+    if (!a.compute.box_source.empty()) {
+      f.compute.bounds.clear();
+      f.compute.periodic.clear();
+      f.compute.tilt.clear();
+      f.compute.box_source.clear();
+      apply_file_box(f.compute);
+    }
+    for (std::string* path : {&f.output, &f.cell_table, &f.neighbors, &f.neighbor_shifts})
+      for (std::size_t at; (at = path->find("{frame}")) != std::string::npos;)
+        path->replace(at, 7, std::to_string(place.index));
+    try {
+      if (run_voronoi_frame(f) != kExitOk) rc = kExitFailure;
+    } catch (const InputError& e) {
+      throw InputError(strf("frame %zu: %s%s", place.index, e.what(),
+                            k == 0 ? "" : "; the frames before it were written"));
+    }
+  }
+  return rc;
 }
 
 // ------------------------------------------------------------------ bench

@@ -50,6 +50,10 @@ struct ComputeArgs {
   /// negative from the end; finish_compute_args finds where it starts.
   std::string frame;
   io::FramePlace frame_place;  ///< where the frame read starts (the first by default)
+  /// --frame all or A:B[:S] (a series: `voronoi` computes each, its output
+  /// names carrying {frame}): the frames selected, in their order; empty
+  /// for one INDEX.
+  std::vector<io::FramePlace> frames;
 };
 
 struct VoronoiArgs {
@@ -312,8 +316,10 @@ void check_bounds_arg(const std::vector<double>& bounds);  ///< InputError unles
 void apply_file_box(ComputeArgs& args);
 
 /// --frame: where the frame asked for starts (args.frame_place), or nothing
-/// where --frame was not given. InputError for a file that is no trajectory
-/// or has no such frame.
+/// where --frame was not given; for a series (all, A:B[:S]) every frame
+/// selected (args.frames; frame_place is the first). InputError for a file
+/// that is no trajectory, a frame it does not have, or a series that
+/// selects none.
 void find_input_frame(ComputeArgs& args);
 
 /// INPUT as the summaries name it: "stdin" for standard input, and the frame

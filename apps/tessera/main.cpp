@@ -76,7 +76,10 @@ void add_compute_options(CLI::App* app, ComputeArgs& c, std::vector<std::string>
   app->add_option("--frame", c.frame,
                   "Of a trajectory (a LAMMPS dump, an XYZ file): the frame to read, 0 the first (default), 1 the "
                   "next; negative counts from the end, -1 the last. Its box is the domain, as the first frame's "
-                  "would be; --labels and --radii columns are read from it (a .npy file serves every frame)")
+                  "would be; --labels and --radii columns are read from it (a .npy file serves every frame). voronoi also takes a series, "
+                  "all or START:STOP[:STEP] as Python's slices (-10: the last ten, ::5 every fifth): each frame is "
+                  "computed in turn, and every output's name must hold {frame}, replaced by the frame's index "
+                  "(-o cells_{frame}.vtu, a series ParaView opens as one)")
       ->type_name("INDEX")
       ->check(CLI::Validator(
           [](std::string& v) { return v.empty() ? std::string("expected a frame's index (0 the first, -1 the last), got ''") : ""; },
@@ -177,8 +180,9 @@ void add_periodic_option(CLI::App* app, ComputeArgs& c) {
 
 /// Converts the --bounds words to numbers. A fifth word that is not a number
 /// is the INPUT that CLI11 attached to a 2D --bounds (when INPUT is otherwise
-/// missing). Throws InputError for anything else that is not a number.
-void finish_compute_args(ComputeArgs& c, const std::vector<std::string>& raw_bounds) {
+/// missing). Throws InputError for anything else that is not a number, and
+/// for a series of frames (--frame all, A:B) where `series` is false.
+void finish_compute_args(ComputeArgs& c, const std::vector<std::string>& raw_bounds, bool series = false) {
   auto parse = [](const std::string& w, double& v) {
     errno = 0;
     return whole_number(w, v) && errno != ERANGE;
@@ -199,6 +203,10 @@ void finish_compute_args(ComputeArgs& c, const std::vector<std::string>& raw_bou
   }
   if (c.input.empty()) throw tessera::InputError("INPUT is required (run with --help for usage)");
   c.input = input_path(c.input);
+  if (!series && (c.frame == "all" || c.frame.find(':') != std::string::npos))
+    throw tessera::InputError("--frame " + c.frame +
+                              ": a series of frames is for `tessera voronoi` (outputs named with {frame}); give "
+                              "one frame's INDEX here");
   find_input_frame(c);
   apply_file_box(c);
 }
@@ -456,7 +464,7 @@ int main(int argc, char** argv) {
 
   try {
     if (vor->parsed()) {
-      finish_compute_args(va.compute, vor_bounds);
+      finish_compute_args(va.compute, vor_bounds, true);
       return run_voronoi(va);
     }
     if (bench_vor->parsed()) {

@@ -204,17 +204,21 @@ std::optional<FileBox> read_file_box(const std::string& path, const FramePlace& 
   return std::nullopt;
 }
 
-FramePlace find_frame(const std::string& path, std::int64_t index) {
+namespace {
+
+/// The starts of a trajectory's frames, walked from the first until
+/// `stop(place)` is true (that frame's start is the last listed) or the
+/// frames end.
+template <class Stop>
+std::vector<FramePlace> walk_frames(const std::string& path, Stop&& stop) {
   if (!is_trajectory(path))
     detail::fail(path, "not a trajectory: frames are read from LAMMPS dumps (.dump, .lammpstrj) and XYZ files");
   const bool dump = detail::is_dump_extension(detail::lower_extension(path));
-  // The frames' starts, walked until `index` is reached or, for an index
-  // from the end, to the last (24 bytes a frame).
-  std::vector<FramePlace> starts;
+  std::vector<FramePlace> starts;  // 24 bytes a frame
   FramePlace at;
   for (;;) {
-    if (index >= 0 && at.index == static_cast<std::uint64_t>(index)) return at;
     starts.push_back(at);
+    if (stop(at)) break;
     const detail::FrameEnd end =
         dump ? detail::skip_dump_frame(path, at.offset, at.line) : detail::skip_xyz_frame(path, at.offset, at.line);
     if (end.last) break;
@@ -222,13 +226,26 @@ FramePlace find_frame(const std::string& path, std::int64_t index) {
     at.line = end.next_line;
     ++at.index;
   }
+  return starts;
+}
+
+}  // namespace
+
+FramePlace find_frame(const std::string& path, std::int64_t index) {
+  const std::vector<FramePlace> starts = walk_frames(
+      path, [&](const FramePlace& at) { return index >= 0 && at.index == static_cast<std::uint64_t>(index); });
   const std::size_t frames = starts.size();
+  if (index >= 0 && starts.back().index == static_cast<std::uint64_t>(index)) return starts.back();
   if (index < 0 && static_cast<std::uint64_t>(-(index + 1)) < frames)
     return starts[frames - 1 - static_cast<std::size_t>(-(index + 1))];
   detail::fail(path, "no frame " + std::to_string(index) + ": it has " + std::to_string(frames) +
                          (frames == 1 ? " frame (0, or -1 from the end)"
                                       : " frames (0 to " + std::to_string(frames - 1) + ", or -" +
                                             std::to_string(frames) + " to -1 from the end)"));
+}
+
+std::vector<FramePlace> find_frames(const std::string& path) {
+  return walk_frames(path, [](const FramePlace&) { return false; });
 }
 
 TrajectoryFrame read_frame(const std::string& path, std::uint64_t offset, std::size_t line,

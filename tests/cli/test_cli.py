@@ -1232,8 +1232,12 @@ class FileBoxes(TempDirCase):
         for args, fragment in (
                 (["--frame", "3"], "--frame: %s: no frame 3: it has 3 frames (0 to 2, or -3 to -1 from the end)" % traj),
                 (["--frame", "-4"], "no frame -4: it has 3 frames"),
-                (["--frame", "1.5"], "--frame: '1.5' is not a whole number"),
-                (["--frame", "99999999999999999999"], "is not a whole number"),
+                (["--frame", "1.5"], "--frame: '1.5' is not a frame's index or a series"),
+                (["--frame", "99999999999999999999"], "is not a frame's index"),
+                (["--frame", "5:"], "--frame: '5:' selects none of the 3 frames of %s" % traj),
+                (["--frame", "::0"], "the step is 0"),
+                (["--frame", "1:2:3:4"], "is not START:STOP or START:STOP:STEP"),
+                (["--frame", "all"], "--frame all writes one file per frame: --cell-table's name must hold {frame}"),
                 (["--frame", ""], "expected a frame's index"),
                 (["--frame", "0", "--labels", self.p("l.npy")], "labels: 250 values for 200 points")):
             r = run(["voronoi", traj, "--cell-table", out] + args)
@@ -1241,6 +1245,37 @@ class FileBoxes(TempDirCase):
             self.assertEqual(len(r.stderr.strip().splitlines()), 1, r.stderr)
             self.assertIn(fragment, r.stderr, args)
             self.assertFalse(os.path.exists(out))
+        # A series: every frame selected, in its order, each with its own
+        # box, into outputs named by its index; the same files as one by one.
+        for sel, ks in (("all", [0, 1, 2]), ("-2:", [1, 2]), ("::-2", [2, 0]), ("1:2", [1])):
+            for f in os.listdir(self.dir):
+                if f.startswith("s_"):
+                    os.remove(self.p(f))
+            r = self.ok(["voronoi", traj, "--frame=" + sel, "--cell-table", self.p("s_{frame}.csv"), "--neighbors",
+                         self.p("s_{frame}.npy"), "--validate", "--labels", "type", "--radii", "radius"])
+            self.assertEqual([int(l.split("frame ")[1].split(" ")[0]) for l in r.stdout.splitlines()
+                              if l.startswith("tessera voronoi:")], ks)
+            self.assertEqual(r.stdout.count("validation: OK"), len(ks))
+            self.assertEqual(sorted(f for f in os.listdir(self.dir) if f.startswith("s_")),
+                             sorted("s_%d.%s" % (k, e) for k in ks for e in ("csv", "npy")))
+            for k in ks:
+                self.ok(["voronoi", traj, "--frame", str(k), "--cell-table", self.p("one.csv")] + common)
+                self.assertEqual(read_bytes(self.p("s_%d.csv" % k)), read_bytes(self.p("one.csv")), (sel, k))
+        # Other commands take one frame; a series' error names its frame and
+        # keeps the frames before it (each whole).
+        r = run(["delaunay", traj, "--frame", "all", "-o", self.p("d_{frame}.vtu")])
+        self.assertEqual(r.returncode, 2)
+        self.assertIn("a series of frames is for `tessera voronoi`", r.stderr)
+        bad = texts[:2] + [texts[2].replace("\n1 1 ", "\n1 1 nan ", 1)]
+        with open(self.p("nan.dump"), "w") as f:
+            f.write("\n".join(bad))
+        r = run(["voronoi", self.p("nan.dump"), "--frame", "all", "--cell-table", self.p("n_{frame}.csv"), "-q"])
+        self.assertEqual(r.returncode, 2)
+        self.assertIn("frame 2: ", r.stderr)
+        self.assertIn("; the frames before it were written", r.stderr)
+        self.assertEqual(len(r.stderr.strip().splitlines()), 1, r.stderr)
+        self.assertTrue(os.path.exists(self.p("n_1.csv")))
+        self.assertFalse(os.path.exists(self.p("n_2.csv")))
         npy = self.save("p.npy", rng.random((20, 3)))
         r = run(["voronoi", npy, "--frame", "0", "--cell-table", out])
         self.assertEqual(r.returncode, 2)

@@ -93,6 +93,10 @@ bool is_trajectory(const std::string& path);
 /// way is malformed (naming its line).
 FramePlace find_frame(const std::string& path, std::int64_t index);
 
+/// Where every frame of a trajectory starts, in file order (find_frame's
+/// walk to the end).
+std::vector<FramePlace> find_frames(const std::string& path);
+
 /// One frame of a trajectory file (a LAMMPS dump, an XYZ file).
 struct TrajectoryFrame {
   PointCloud points;              ///< its atoms, in file order (labels where asked)
