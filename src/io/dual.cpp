@@ -111,10 +111,12 @@ void write_spoke_measures_npy(const std::string& path, const AdjacencyGraph& g) 
 
 namespace {
 /// A periodic face set's side shifts as VTK cell data (int32: the writer has
-/// no int8 arrays), one D-component tuple per face; empty otherwise.
+/// no int8 arrays), one D-component tuple per face; none for a set that is
+/// not periodic. An empty periodic set has the array too, with no tuples:
+/// a reader of a series of frames finds the same arrays in every file.
 std::vector<std::int32_t> side_shift_data(const FaceSet& fs, PolyData& pd) {
   std::vector<std::int32_t> wide(fs.side_shifts.begin(), fs.side_shifts.end());
-  if (!wide.empty()) pd.cell_data.push_back({"SideShift", std::span<const std::int32_t>(wide), fs.dim});
+  if (fs.is_periodic()) pd.cell_data.push_back({"SideShift", std::span<const std::int32_t>(wide), fs.dim});
   return wide;
 }
 }  // namespace

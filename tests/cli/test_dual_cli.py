@@ -289,6 +289,15 @@ class Graph(base.TempDirCase):
                     for (a, b, d), m in edges.items():
                         self.assertEqual(edges.get((b, a, tuple(-x + 0.0 for x in d))), m, "region %d" % region)
 
+        # An empty periodic face set (no labels: no boundary) has the
+        # SideShift array too, with no tuples (a fuzz found it missing).
+        self.ok(["faces", inp, "--kind", "boundary", "-o", out, "-q", "--bounds", "0", "1", "0", "1", "0", "1",
+                 "--periodic", "xyz"])
+        pd = read_vtp(out)
+        self.assertEqual(pd.GetNumberOfCells(), 0)
+        self.assertIsNotNone(pd.GetCellData().GetArray("SideShift"))
+        self.assertEqual(pd.GetCellData().GetArray("SideShift").GetNumberOfComponents(), 3)
+
     def test_threads_byte_identical(self):
         inp = self.save("big.npy", np.random.default_rng(25).random((5000, 3)))
         outs = []
