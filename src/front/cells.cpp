@@ -133,7 +133,7 @@ Cells run(std::span<const double> input, std::span<const std::int32_t> labels, c
   // neighbours: the same cells (docs/design.md, "Cells from Delaunay
   // neighbours", "Cells assembled from their stars").
   std::optional<engine::DelaunayStars> stars;
-  front::CellsCompositor<CellT> comp(out, labels, opt.build_mesh, pass.k);
+  front::CellsCompositor<CellT> comp(out, labels, opt.build_mesh, pass.k, pass.bounds);
   comp.record_reach(reach);
   front::PilotKeep<front::CellsCompositor<CellT>> kept{comp, {}, 0};  // the pilot's whole cells
   {

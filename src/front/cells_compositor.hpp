@@ -106,9 +106,10 @@ class CellsCompositor {
   /// owners again.
   /// `frame_k`: the cells are computed on the input scaled by 2^frame_k
   /// (front/pass.cpp); volumes are stored in the input's units, the rest in
-  /// the scaled frame.
-  CellsCompositor(Cells& out, std::span<const std::int32_t> labels, bool mesh, int frame_k = 0)
-      : out_(out), labels_(labels), classify_(labels), mesh_(mesh), frame_k_(frame_k) {}
+  /// the scaled frame. `box`: the domain in that frame, whose planes the
+  /// mesh's vertices on them are set on.
+  CellsCompositor(Cells& out, std::span<const std::int32_t> labels, bool mesh, int frame_k, const Bounds& box)
+      : out_(out), labels_(labels), classify_(labels), mesh_(mesh), frame_k_(frame_k), box_(box) {}
 
   /// Record each built cell's security radius, squared (in the pass's
   /// frame), at its generator's index of `reach` (sized for every point):
@@ -539,6 +540,17 @@ class CellsCompositor {
           }
           const std::size_t from = src++;
           for (int d = 0; d < D; ++d) o.vertices[gid * D + d] = b.pos()[from * D + d];
+          // A vertex on a box plane (its key names it; ascending, so box
+          // planes first) lies on it exactly: the solve left its coordinate
+          // within an ulp or so, outside the box as often as not (a fuzz of
+          // the surface nets: 5.6e-17 outside a unit box). The measures are
+          // the kernel's, computed before.
+          for (int e = 0; e <= D && key[static_cast<std::size_t>(e)] < 0; ++e) {
+            const std::int64_t plane = -1 - std::int64_t{key[static_cast<std::size_t>(e)]};  // 2 axis (+1: upper)
+            if (plane >= 2 * D) continue;  // (the far plane's id: the box cuts it away, never in a mesh)
+            const auto axis = static_cast<std::size_t>(plane / 2);
+            o.vertices[gid * D + axis] = plane % 2 ? box_.hi[axis] : box_.lo[axis];
+          }
           // Id by id: the sorted key leaves its registers as 4-byte stores,
           // which a wider copy would have to wait for.
           for (int d = 0; d <= D; ++d) o.vertex_keys[gid * (D + 1) + d] = key[static_cast<std::size_t>(d)];
@@ -679,6 +691,7 @@ class CellsCompositor {
   bool mesh_;
   std::vector<double>* reach_ = nullptr;  // record_reach
   int frame_k_;  // the scaled frame's 2^k (front/pass.cpp)
+  Bounds box_;    // the domain in that frame
   bool dense_ = false;  // set by finish: every generator owns a cell, cell g = generator g
   // Per thread (element references stay valid until the compositor dies).
   tbb::enumerable_thread_specific<Store> stores_;

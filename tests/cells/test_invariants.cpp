@@ -1024,3 +1024,56 @@ TEST(Invariants, SliverCellsGetExactPositiveVolumes) {
 }
 
 }  // namespace
+
+// Merged vertices on a box plane (their key names it) lie on it exactly and
+// inside the box: the float solve had left such coordinates an ulp or so off,
+// outside the box as often as not (a fuzz of the surface nets: 5.6e-17
+// outside a unit box). Also at scales the pass rescales, in a box away from
+// the origin, with labels, by either method, and with walls beside periodic
+// axes.
+TEST(Invariants, VerticesOnBoxPlanesLieOnThem) {
+  for (const int dim : {2, 3}) {
+    const auto far = make_bounds({100.1, -0.3, 5}, {103.7, -0.01, 5.9});
+    for (const double scale : {1.0, std::ldexp(1.0, -170), std::ldexp(1.0, 170)}) {
+      for (const bool insertion : {false, true}) {
+        for (const bool periodic : {false, true}) {
+          tessera::Bounds box = far;
+          for (int a = 0; a < 3; ++a) {
+            box.lo[a] *= scale;
+            box.hi[a] *= scale;
+          }
+          auto pts = random_points(2000, dim, 881, far);
+          for (double& x : pts) x *= scale;
+          tessera::VoronoiOptions o;
+          o.dim = dim;
+          o.bounds = box;
+          o.build_mesh = true;
+          o.cell_method = insertion ? tessera::CellMethod::insertion : tessera::CellMethod::search;
+          if (periodic) o.periodic = {true, false, false};  // walls along y (and z)
+          std::vector<std::int32_t> labels(pts.size() / static_cast<std::size_t>(dim));
+          for (std::size_t i = 0; i < labels.size(); ++i) labels[i] = i % 7 == 0 ? -1 : static_cast<int>(i % 3);
+          const tessera::Cells c = tessera::voronoi(pts, dim, labels, o);
+          const auto w = static_cast<std::size_t>(dim + 1);
+          const std::size_t nv = c.vertex_keys.size() / w;
+          ASSERT_GT(nv, 0u);
+          std::size_t on_planes = 0;
+          for (std::size_t v = 0; v < nv; ++v) {
+            const double* x = &c.vertices[v * static_cast<std::size_t>(dim)];
+            for (int a = 0; a < dim; ++a)
+              if (!(periodic && a == 0)) {
+                ASSERT_GE(x[a], c.bounds.lo[a]) << "dim " << dim << " scale " << scale << " vertex " << v;
+                ASSERT_LE(x[a], c.bounds.hi[a]) << "dim " << dim << " scale " << scale << " vertex " << v;
+              }
+            for (std::size_t k = 0; k < w && c.vertex_keys[v * w + k] < 0; ++k) {
+              const int plane = -1 - c.vertex_keys[v * w + k];
+              ASSERT_EQ(x[plane / 2], plane % 2 ? c.bounds.hi[plane / 2] : c.bounds.lo[plane / 2])
+                  << "dim " << dim << " scale " << scale << " vertex " << v << " plane " << -1 - plane;
+              ++on_planes;
+            }
+          }
+          EXPECT_GT(on_planes, 100u);
+        }
+      }
+    }
+  }
+}
