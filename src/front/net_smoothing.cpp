@@ -405,7 +405,7 @@ std::vector<NetVertexKind> smooth_surface_net(FaceSet& mesh, std::span<const dou
     nxt_copies.resize(nv * dn);
     place(gcur, cur_copies);
   }
-  std::vector<std::uint8_t> frozen(nv), freeze(nv), group_frozen(periodic ? ng : 0);
+  std::vector<std::uint8_t> frozen(nv), freeze(nv), newly(nv), group_frozen(periodic ? ng : 0);
   const double lambda = options.relaxation;
   for (int it = 0; it < options.iterations; ++it) {
     front::parallel_range(ng, 2048, [&](std::size_t g) {
@@ -448,12 +448,19 @@ std::vector<NetVertexKind> smooth_surface_net(FaceSet& mesh, std::span<const dou
     const std::vector<double>& nxt = periodic ? nxt_copies : gnxt;
 
     std::fill(frozen.begin(), frozen.end(), 0);
-    for (bool grew = true; grew;) {
+    for (bool grew = true, first = true; grew; first = false) {
+      // After the first round a polygon none of whose corners froze in the
+      // last round sees the positions it passed with then: only those with
+      // a newly frozen corner are evaluated again (same outcome, same
+      // rotations; `freeze` holds the round before's set here).
+      if (!first) front::parallel_range(nv, 4096, [&](std::size_t v) { newly[v] = frozen[v] & ~freeze[v]; });
       std::copy(frozen.begin(), frozen.end(), freeze.begin());
       front::parallel_range(nf, 1024, [&](std::size_t f) {
         const auto b = static_cast<std::size_t>(mesh.face_offsets[f]);
         const auto n = static_cast<std::size_t>(mesh.face_offsets[f + 1]) - b;
         const std::int32_t* loop = &mesh.face_vertices[b];
+        if (!first && std::none_of(loop, loop + n, [&](std::int32_t v) { return newly[static_cast<std::size_t>(v)]; }))
+          return;
         auto at = [&](std::int32_t v) {
           const auto u = static_cast<std::size_t>(v);
           return frozen[u] ? &cur[u * dn] : &nxt[u * dn];
