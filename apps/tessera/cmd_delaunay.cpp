@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "frame_series.hpp"
 #include "progress.hpp"
 #include "tessera/delaunay.hpp"
 #include "tessera/io/atomic_file.hpp"
@@ -80,7 +81,10 @@ void check_delaunay_outputs(const DelaunayArgs& a) {
 
 }  // namespace
 
-int run_delaunay(const DelaunayArgs& a) {
+namespace {
+
+/// `delaunay` on one frame (a series: run_frame_series).
+int run_delaunay_frame(const DelaunayArgs& a) {
   check_delaunay_outputs(a);
   check_bounds_arg(a.compute.bounds);
   auto t0 = Clock::now();
@@ -193,6 +197,17 @@ int run_delaunay(const DelaunayArgs& a) {
     }
   }
   return kExitOk;
+}
+
+}  // namespace
+
+int run_delaunay(const DelaunayArgs& a) {
+  if (a.compute.frames.empty()) return run_delaunay_frame(a);
+  return run_frame_series(a,
+                          {{"-o", &DelaunayArgs::output},
+                           {"--simplices", &DelaunayArgs::simplices},
+                           {"--simplex-shifts", &DelaunayArgs::simplex_shifts}},
+                          run_delaunay_frame);
 }
 
 int run_bench_delaunay(const BenchArgs& a) {

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "frame_series.hpp"
 #include "stdin_input.hpp"
 #include "progress.hpp"
 #include "tessera/faces.hpp"
@@ -71,7 +72,10 @@ void print_written(const std::vector<std::string>& written) {
 
 // ------------------------------------------------------------------ graph
 
-int run_graph(const GraphArgs& a) {
+namespace {
+
+/// `graph` on one frame (a series: run_frame_series).
+int run_graph_frame(const GraphArgs& a) {
   if (a.output.empty() && a.csr.empty() && a.spoke_classes.empty() && a.spoke_measures.empty() &&
       a.spoke_shifts.empty())
     throw InputError(
@@ -135,9 +139,25 @@ int run_graph(const GraphArgs& a) {
   return kExitOk;
 }
 
+}  // namespace
+
+int run_graph(const GraphArgs& a) {
+  if (a.compute.frames.empty()) return run_graph_frame(a);
+  return run_frame_series(a,
+                          {{"-o", &GraphArgs::output},
+                           {"--csr", &GraphArgs::csr},
+                           {"--spoke-classes", &GraphArgs::spoke_classes},
+                           {"--spoke-measures", &GraphArgs::spoke_measures},
+                           {"--spoke-shifts", &GraphArgs::spoke_shifts}},
+                          run_graph_frame);
+}
+
 // ------------------------------------------------------------------ faces
 
-int run_faces(const FacesArgs& a) {
+namespace {
+
+/// `faces` on one frame (a series: run_frame_series).
+int run_faces_frame(const FacesArgs& a) {
   const auto kind = parse_face_set_kind(a.kind);
   if (!kind) throw InputError("--kind must be boundary, complex or surface-net, got '" + a.kind + "'");
   if (a.capping && *kind != FaceSetKind::surface_net)
@@ -166,9 +186,19 @@ int run_faces(const FacesArgs& a) {
   return kExitOk;
 }
 
+}  // namespace
+
+int run_faces(const FacesArgs& a) {
+  if (a.compute.frames.empty()) return run_faces_frame(a);
+  return run_frame_series(a, {{"-o", &FacesArgs::output}}, run_faces_frame);
+}
+
 // ------------------------------------------------------------------ flower
 
-int run_flower(const FlowerArgs& a) {
+namespace {
+
+/// `flower` on one frame (a series: run_frame_series).
+int run_flower_frame(const FlowerArgs& a) {
   if (a.points.empty()) throw InputError("give at least one --point ID");
   if (a.output.empty()) throw InputError("nothing to do: give -o FLOWER.vtp");
   require_extension(a.output, ".vtp", "output", "a flower");
@@ -196,6 +226,13 @@ int run_flower(const FlowerArgs& a) {
     print_written({a.output});
   }
   return kExitOk;
+}
+
+}  // namespace
+
+int run_flower(const FlowerArgs& a) {
+  if (a.compute.frames.empty()) return run_flower_frame(a);
+  return run_frame_series(a, {{"-o", &FlowerArgs::output}}, run_flower_frame);
 }
 
 }  // namespace tessera::cli

@@ -17,6 +17,7 @@
 #include <CLI/CLI.hpp>
 
 #include "commands.hpp"
+#include "frame_series.hpp"
 #include "stdin_input.hpp"
 #include "option_checks.hpp"
 #include "progress.hpp"
@@ -320,7 +321,10 @@ void add_surface_nets_options(CLI::App* app, SurfaceNetsArgs& a, bool bench) {
 
 // ------------------------------------------------------------------ run
 
-int run_surface_nets(const SurfaceNetsArgs& a) {
+namespace {
+
+/// `surface-nets` on one frame (a series: run_frame_series).
+int run_surface_nets_frame(const SurfaceNetsArgs& a) {
   check_args(a, true);
   io::check_writable(a.output);
   const NetInput in = read_net_input(a);
@@ -384,6 +388,13 @@ int run_surface_nets(const SurfaceNetsArgs& a) {
   std::printf("  %-18s %s\n", "wrote", a.output.c_str());
   std::fflush(stdout);
   return kExitOk;
+}
+
+}  // namespace
+
+int run_surface_nets(const SurfaceNetsArgs& a) {
+  if (a.compute.frames.empty()) return run_surface_nets_frame(a);
+  return run_frame_series(a, {{"-o", &SurfaceNetsArgs::output}}, run_surface_nets_frame);
 }
 
 int run_bench_surface_nets(const SurfaceNetsArgs& a) {

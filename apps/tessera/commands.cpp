@@ -1,5 +1,6 @@
 // Implementation of the tessera subcommands (see commands.hpp).
 #include "commands.hpp"
+#include "frame_series.hpp"
 #include "stdin_input.hpp"
 
 #include <charconv>
@@ -550,7 +551,7 @@ Usage usage_now() {
 
 namespace {
 
-/// `voronoi` on one frame (or a file that has one).
+/// `voronoi` on one frame (a series: run_frame_series).
 int run_voronoi_frame(const VoronoiArgs& a) {
   check_output_names(a);
   check_bounds_arg(a.compute.bounds);
@@ -610,41 +611,12 @@ int run_voronoi_frame(const VoronoiArgs& a) {
 
 int run_voronoi(const VoronoiArgs& a) {
   if (a.compute.frames.empty()) return run_voronoi_frame(a);
-  // A series of frames (--frame all, A:B[:S]): each in turn, with its own
-  // box where the file's box is the domain, into outputs named by its index.
-  // Each frame's files are whole when written; an error in a later frame
-  // leaves those of the frames before it (said in the message).
-  for (const auto& [name, path] : {std::pair<const char*, const std::string*>{"-o", &a.output},
-                                   {"--cell-table", &a.cell_table},
-                                   {"--neighbors", &a.neighbors},
-                                   {"--neighbor-shifts", &a.neighbor_shifts}})
-    if (!path->empty() && (*path == "-" || path->find("{frame}") == std::string::npos))
-      throw InputError(strf("--frame %s writes one file per frame: %s's name must hold {frame} (e.g. cells_{frame}%s)",
-                            a.compute.frame.c_str(), name, *path == "-" ? ".csv" : extension(*path).c_str()));
-  int rc = kExitOk;
-  for (std::size_t k = 0; k < a.compute.frames.size(); ++k) {
-    const io::FramePlace& place = a.compute.frames[k];
-    VoronoiArgs f = a;
-    f.compute.frames.clear();
-    f.compute.frame_place = place;
-    if (!a.compute.box_source.empty()) {
-      f.compute.bounds.clear();
-      f.compute.periodic.clear();
-      f.compute.tilt.clear();
-      f.compute.box_source.clear();
-      apply_file_box(f.compute);
-    }
-    for (std::string* path : {&f.output, &f.cell_table, &f.neighbors, &f.neighbor_shifts})
-      for (std::size_t at; (at = path->find("{frame}")) != std::string::npos;)
-        path->replace(at, 7, std::to_string(place.index));
-    try {
-      if (run_voronoi_frame(f) != kExitOk) rc = kExitFailure;
-    } catch (const InputError& e) {
-      throw InputError(strf("frame %zu: %s%s", place.index, e.what(),
-                            k == 0 ? "" : "; the frames before it were written"));
-    }
-  }
-  return rc;
+  return run_frame_series(a,
+                          {{"-o", &VoronoiArgs::output},
+                           {"--cell-table", &VoronoiArgs::cell_table},
+                           {"--neighbors", &VoronoiArgs::neighbors},
+                           {"--neighbor-shifts", &VoronoiArgs::neighbor_shifts}},
+                          run_voronoi_frame);
 }
 
 // ------------------------------------------------------------------ bench

@@ -76,7 +76,7 @@ void add_compute_options(CLI::App* app, ComputeArgs& c, std::vector<std::string>
   app->add_option("--frame", c.frame,
                   "Of a trajectory (a LAMMPS dump, an XYZ file): the frame to read, 0 the first (default), 1 the "
                   "next; negative counts from the end, -1 the last. Its box is the domain, as the first frame's "
-                  "would be; --labels and --radii columns are read from it (a .npy file serves every frame). voronoi also takes a series, "
+                  "would be; --labels and --radii columns are read from it (a .npy file serves every frame). Also a series (not in bench), "
                   "all or START:STOP[:STEP] as Python's slices (-10: the last ten, ::5 every fifth): each frame is "
                   "computed in turn, and every output's name must hold {frame}, replaced by the frame's index "
                   "(-o cells_{frame}.vtu, a series ParaView opens as one)")
@@ -204,9 +204,7 @@ void finish_compute_args(ComputeArgs& c, const std::vector<std::string>& raw_bou
   if (c.input.empty()) throw tessera::InputError("INPUT is required (run with --help for usage)");
   c.input = input_path(c.input);
   if (!series && (c.frame == "all" || c.frame.find(':') != std::string::npos))
-    throw tessera::InputError("--frame " + c.frame +
-                              ": a series of frames is for `tessera voronoi` (outputs named with {frame}); give "
-                              "one frame's INDEX here");
+    throw tessera::InputError("--frame " + c.frame + ": a bench runs on one frame; give its INDEX");
   find_input_frame(c);
   apply_file_box(c);
 }
@@ -472,23 +470,23 @@ int main(int argc, char** argv) {
       return run_bench_voronoi(ba);
     }
     if (graph->parsed()) {
-      finish_compute_args(ga.compute, graph_bounds);
+      finish_compute_args(ga.compute, graph_bounds, true);
       return run_graph(ga);
     }
     if (faces->parsed()) {
-      finish_compute_args(fa.compute, faces_bounds);
+      finish_compute_args(fa.compute, faces_bounds, true);
       return run_faces(fa);
     }
     if (flower->parsed()) {
-      finish_compute_args(wa.compute, flower_bounds);
+      finish_compute_args(wa.compute, flower_bounds, true);
       return run_flower(wa);
     }
     if (del->parsed()) {
-      finish_compute_args(dla.compute, del_bounds);
+      finish_compute_args(dla.compute, del_bounds, true);
       return run_delaunay(dla);
     }
     if (snets->parsed()) {
-      finish_compute_args(sna.compute, sn_bounds);
+      finish_compute_args(sna.compute, sn_bounds, true);
       return run_surface_nets(sna);
     }
     if (bench_sn->parsed()) {

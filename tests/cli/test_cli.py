@@ -1261,11 +1261,34 @@ class FileBoxes(TempDirCase):
             for k in ks:
                 self.ok(["voronoi", traj, "--frame", str(k), "--cell-table", self.p("one.csv")] + common)
                 self.assertEqual(read_bytes(self.p("s_%d.csv" % k)), read_bytes(self.p("one.csv")), (sel, k))
-        # Other commands take one frame; a series' error names its frame and
-        # keeps the frames before it (each whole).
-        r = run(["delaunay", traj, "--frame", "all", "-o", self.p("d_{frame}.vtu")])
-        self.assertEqual(r.returncode, 2)
-        self.assertIn("a series of frames is for `tessera voronoi`", r.stderr)
+        # The other commands take series too, the benches one frame; standard
+        # output takes no series. A series' error names its frame and keeps
+        # the frames before it (each whole).
+        r = self.ok(["delaunay", traj, "--frame", "1:", "--simplices", self.p("d_{frame}.npy"), "--validate"])
+        self.assertEqual(r.stderr.count("validation passed"), 2)
+        for k in (1, 2):
+            self.ok(["delaunay", traj, "--frame", str(k), "--simplices", self.p("one.npy"), "-q"])
+            self.assertEqual(read_bytes(self.p("d_%d.npy" % k)), read_bytes(self.p("one.npy")))
+        self.ok(["graph", traj, "--frame", "::2", "--csr", self.p("g_{frame}.npy"), "--spoke-measures",
+                 self.p("m_{frame}.npy"), "-q"])
+        self.ok(["faces", traj, "--frame", "all", "--kind", "boundary", "--labels", "type", "-o",
+                 self.p("f_{frame}.vtp"), "-q"])
+        self.ok(["surface-nets", traj, "--frame", "-1:", "--labels", "type", "-o", self.p("n_{frame}.vtp"), "-q"])
+        self.ok(["flower", traj, "--frame", "0:2", "--point", "3", "-o", self.p("w_{frame}.vtp"), "-q"])
+        made = sorted(f for f in os.listdir(self.dir) if f[:2] in ("g_", "m_", "f_", "n_", "w_"))
+        self.assertEqual(made, ["f_0.vtp", "f_1.vtp", "f_2.vtp", "g_0.npy", "g_2.npy", "m_0.npy", "m_2.npy",
+                                "n_2.vtp", "w_0.vtp", "w_1.vtp"])
+        for f in made:
+            os.remove(self.p(f))
+        for cmd, fragment in ((["bench", "voronoi", traj, "--frame", "all"], "a bench runs on one frame"),
+                              (["delaunay", traj, "--frame", "all", "--simplices", "-"],
+                               "--simplices cannot go to standard output"),
+                              (["graph", traj, "--frame", "all", "--csr", self.p("g.npy")],
+                               "--csr's name must hold {frame}")):
+            r = run(cmd)
+            self.assertEqual(r.returncode, 2, cmd)
+            self.assertIn(fragment, r.stderr)
+            self.assertEqual(len(r.stderr.strip().splitlines()), 1, r.stderr)
         bad = texts[:2] + [texts[2].replace("\n1 1 ", "\n1 1 nan ", 1)]
         with open(self.p("nan.dump"), "w") as f:
             f.write("\n".join(bad))

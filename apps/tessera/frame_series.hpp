@@ -1,0 +1,69 @@
+// A command on a series of a trajectory's frames (--frame all, or a slice
+// START:STOP[:STEP]): the command once per frame selected, each with its own
+// box where the file's box is the domain, into outputs whose names hold
+// {frame}, replaced by the frame's index (cells_{frame}.vtu: cells_0.vtu,
+// cells_1.vtu, ..., a series ParaView opens as one).
+#pragma once
+
+#include <initializer_list>
+#include <string>
+
+#include "commands.hpp"
+
+namespace tessera::cli {
+
+/// One output of a command: its option, as the messages name it, and where
+/// its Args keep the path.
+template <class Args>
+struct SeriesOutput {
+  const char* option;
+  std::string Args::*path;
+};
+
+/// `run_one(args)` for each frame of args.compute.frames, with the frame's
+/// place, its box (where the domain is the file's: apply_file_box) and its
+/// output names. Every output given must hold {frame} (standard output is
+/// refused: several tables in one stream). Each frame's files are whole when
+/// written; an error in a frame names it, and the files of the frames before
+/// it stay. The exit code is the worst of the frames' (a failed --validate
+/// goes on to the next frame).
+template <class Args, class Run>
+int run_frame_series(const Args& a, std::initializer_list<SeriesOutput<Args>> outputs, Run&& run_one) {
+  for (const SeriesOutput<Args>& o : outputs) {
+    const std::string& path = a.*(o.path);
+    if (path == "-")
+      throw InputError("--frame " + a.compute.frame + " writes one file per frame: " + o.option +
+                       " cannot go to standard output; give a file name holding {frame}");
+    if (!path.empty() && path.find("{frame}") == std::string::npos)
+      throw InputError("--frame " + a.compute.frame + " writes one file per frame: " + o.option +
+                       "'s name must hold {frame} (e.g. out_{frame}" + extension(path) + ")");
+  }
+  int rc = kExitOk;
+  for (std::size_t k = 0; k < a.compute.frames.size(); ++k) {
+    const io::FramePlace& place = a.compute.frames[k];
+    Args f = a;
+    f.compute.frames.clear();
+    f.compute.frame_place = place;
+    if (!a.compute.box_source.empty()) {  // the file's box: this frame's own
+      f.compute.bounds.clear();
+      f.compute.periodic.clear();
+      f.compute.tilt.clear();
+      f.compute.box_source.clear();
+      apply_file_box(f.compute);
+    }
+    const std::string index = std::to_string(place.index);
+    for (const SeriesOutput<Args>& o : outputs) {
+      std::string& path = f.*(o.path);
+      for (std::size_t at; (at = path.find("{frame}")) != std::string::npos;) path.replace(at, 7, index);
+    }
+    try {
+      const int r = run_one(f);
+      if (r != kExitOk) rc = r;
+    } catch (const InputError& e) {
+      throw InputError("frame " + index + ": " + e.what() + (k == 0 ? "" : "; the frames before it were written"));
+    }
+  }
+  return rc;
+}
+
+}  // namespace tessera::cli
