@@ -247,7 +247,8 @@ std::string shown_input(const ComputeArgs& a) {
 }
 
 void apply_file_box(ComputeArgs& a) {
-  if (!a.bounds.empty() || !a.periodic.empty() || !a.tilt.empty()) return;
+  a.domain_given = !a.bounds.empty() || !a.periodic.empty() || !a.tilt.empty();
+  if (a.domain_given) return;
   const std::optional<io::FileBox> box = io::read_file_box(a.input, a.frame_place);
   if (!box) return;
   const int dim = a.dim == 0 ? 3 : a.dim;

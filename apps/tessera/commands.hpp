@@ -46,6 +46,9 @@ struct ComputeArgs {
   /// tilt (apply_file_box): what the summary says of it, e.g. "the box of
   /// run.dump (timestep 100)".
   std::string box_source;
+  /// Whether the command line gave the domain (--bounds, --periodic or
+  /// --tilt): otherwise each frame of a series takes its own file's box.
+  bool domain_given = false;
   /// --frame as given ("" when not): a trajectory's frame, 0 the first,
   /// negative from the end; finish_compute_args finds where it starts.
   std::string frame;

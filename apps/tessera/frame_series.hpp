@@ -44,7 +44,7 @@ int run_frame_series(const Args& a, std::initializer_list<SeriesOutput<Args>> ou
     Args f = a;
     f.compute.frames.clear();
     f.compute.frame_place = place;
-    if (!a.compute.box_source.empty()) {  // the file's box: this frame's own
+    if (!a.compute.domain_given) {  // the file's box, where it has one: this frame's own
       f.compute.bounds.clear();
       f.compute.periodic.clear();
       f.compute.tilt.clear();

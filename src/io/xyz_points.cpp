@@ -142,7 +142,8 @@ XyzHeader read_header(const std::string& path, RawLines& lines, bool whole) {
   if (!lines.next(line)) frame_ended(path, "no points", whole);
   const std::optional<std::size_t> n = lone_count(line);
   if (!n) fail(path, "not an XYZ file: its first line is not the number of atoms");
-  if (*n == 0) fail(path, "no points (the XYZ frame has 0 atoms)");
+  // (A frame of 0 atoms is a frame, as a dump's: read_points refuses it as
+  // "no points", a trajectory's walk goes past it.)
   if (*n > (std::size_t{1} << 31) - 1) fail(path, "more than 2^31 - 1 atoms (point ids are int32)");
   h.atoms = *n;
   if (!lines.next(line)) frame_ended(path, "the file ends before the comment line", whole);

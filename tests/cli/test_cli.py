@@ -1299,6 +1299,17 @@ class FileBoxes(TempDirCase):
         self.assertEqual(len(r.stderr.strip().splitlines()), 1, r.stderr)
         self.assertTrue(os.path.exists(self.p("n_1.csv")))
         self.assertFalse(os.path.exists(self.p("n_2.csv")))
+        # Each frame of a series takes its own box, whichever frames have one
+        # (an XYZ whose first frame is plain, its second with a Lattice).
+        with open(self.p("mixed.xyz"), "w") as f:
+            for comment in ("plain", 'Lattice="2 0 0 0 2 0 0 0 2" pbc="T T T"', "plain again"):
+                f.write("3\n%s\nC 0.1 0.2 0.3\nC 0.5 0.6 0.7\nC 0.9 0.1 0.5\n" % comment)
+        for sel in ("all", "::-1"):
+            self.ok(["voronoi", self.p("mixed.xyz"), "--frame", sel, "--cell-table", self.p("x_{frame}.csv"), "-q"])
+            for k in range(3):
+                self.ok(["voronoi", self.p("mixed.xyz"), "--frame", str(k), "--cell-table", self.p("one.csv"), "-q"])
+                self.assertEqual(read_bytes(self.p("x_%d.csv" % k)), read_bytes(self.p("one.csv")), (sel, k))
+        self.assertAlmostEqual(np.loadtxt(self.p("x_1.csv"), delimiter=",", skiprows=1)[:, 2].sum(), 8.0, delta=1e-12)
         npy = self.save("p.npy", rng.random((20, 3)))
         r = run(["voronoi", npy, "--frame", "0", "--cell-table", out])
         self.assertEqual(r.returncode, 2)

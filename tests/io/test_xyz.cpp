@@ -205,3 +205,21 @@ TEST(Xyz, FramesByIndex) {
   const std::string msg = input_error([&] { tessera::io::find_frame(q, -1); });
   EXPECT_NE(msg.find("more atom lines than the frame's count (2)"), std::string::npos) << msg;
 }
+
+// A frame of 0 atoms is a frame (as a dump's): walked past, read as empty by
+// read_frame, refused as "no points" by read_points.
+TEST(Xyz, FrameOfNoAtoms) {
+  TempDir dir;
+  const std::string p = dir.write("z.xyz", "2\n\nC 0 0 0\nC 1 1 1\n0\nempty frame\n3\n\nC 0 0 0\nC 1 1 1\nC 2 0 1\n");
+  EXPECT_EQ(tessera::io::find_frames(p).size(), 3u);
+  const auto at = tessera::io::find_frame(p, -1);
+  EXPECT_EQ(at.index, 2u);
+  EXPECT_EQ(at.line, 7u);
+  tessera::io::ReadOptions o;
+  o.frame = at;
+  EXPECT_EQ(tessera::io::read_points(p, o).n, 3u);
+  const auto mid = tessera::io::find_frame(p, 1);
+  EXPECT_EQ(tessera::io::read_frame(p, mid.offset, mid.line).points.n, 0u);
+  o.frame = mid;
+  EXPECT_NE(input_error([&] { tessera::io::read_points(p, o); }).find("no points"), std::string::npos);
+}
