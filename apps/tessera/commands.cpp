@@ -219,10 +219,12 @@ std::vector<std::size_t> slice_indices(const std::string& frame, std::int64_t n)
 
 }  // namespace
 
+bool is_frame_series(const std::string& frame) { return frame == "all" || frame.find(':') != std::string::npos; }
+
 void find_input_frame(ComputeArgs& a) {
   if (a.frame.empty()) return;  // (CLI11 refuses an empty --frame)
   try {
-    if (a.frame == "all" || a.frame.find(':') != std::string::npos) {
+    if (is_frame_series(a.frame)) {
       const std::vector<io::FramePlace> all = io::find_frames(a.input);
       for (const std::size_t k : slice_indices(a.frame, static_cast<std::int64_t>(all.size())))
         a.frames.push_back(all[k]);
@@ -285,12 +287,22 @@ io::PointCloud read_input(const ComputeArgs& a) {
   ro.keep_non_finite = a.ignore_outside;  // set aside by the computation, as points outside --bounds
   ro.non_finite_hint = "--ignore-outside sets such points aside";
   ro.frame = a.frame_place;
-  io::PointCloud pc = io::read_points(a.input, ro);
+  // One frame asked for by --frame: its errors say which (a series' wrapper,
+  // run_frame_series, says it for all of a frame's errors).
+  const std::string which =
+      a.frame.empty() || is_frame_series(a.frame) ? "" : strf("frame %zu: ", a.frame_place.index);
+  io::PointCloud pc;
+  try {
+    pc = io::read_points(a.input, ro);
+  } catch (const InputError& e) {
+    if (which.empty()) throw;
+    throw InputError(which + e.what());
+  }
   if (!a.radii.empty()) {
     try {
       pc.radii = io::read_point_scalars(a.input, a.radii, a.frame_place);
     } catch (const InputError& e) {  // its words are for any scalars: name the option
-      throw InputError(std::string("--radii: ") + e.what());
+      throw InputError(which + "--radii: " + e.what());
     }
     if (pc.radii.size() != pc.n)
       throw InputError("--radii " + a.radii + ": " + std::to_string(pc.radii.size()) + " values for " +

@@ -318,6 +318,10 @@ void check_bounds_arg(const std::vector<double>& bounds);  ///< InputError unles
 /// none of --bounds, --periodic and --tilt: those from the file's box.
 void apply_file_box(ComputeArgs& args);
 
+/// Whether --frame's text asks for a series (all, START:STOP[:STEP]), not
+/// one frame's index.
+bool is_frame_series(const std::string& frame);
+
 /// --frame: where the frame asked for starts (args.frame_place), or nothing
 /// where --frame was not given; for a series (all, A:B[:S]) every frame
 /// selected (args.frames; frame_place is the first). InputError for a file

@@ -203,7 +203,7 @@ void finish_compute_args(ComputeArgs& c, const std::vector<std::string>& raw_bou
   }
   if (c.input.empty()) throw tessera::InputError("INPUT is required (run with --help for usage)");
   c.input = input_path(c.input);
-  if (!series && (c.frame == "all" || c.frame.find(':') != std::string::npos))
+  if (!series && is_frame_series(c.frame))
     throw tessera::InputError("--frame " + c.frame + ": a bench runs on one frame; give its INDEX");
   find_input_frame(c);
   apply_file_box(c);

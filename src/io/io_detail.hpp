@@ -119,8 +119,10 @@ FrameEnd skip_dump_frame(const std::string& path, std::uint64_t offset, std::siz
 /// Lattice) and a frame skipped, as the dump's.
 bool looks_like_xyz(std::string_view text);
 bool is_xyz_file(const std::string& path);  ///< looks_like_xyz on as much of the file as its first lines take
+/// (`with_box`: a Lattice that is no box of ours is an error, as the
+/// frame's box; read_xyz_points reads the atoms alone.)
 TrajectoryFrame read_xyz_frame(const std::string& path, std::uint64_t offset, std::size_t line,
-                               const ReadOptions& options, const std::string& label_column);
+                               const ReadOptions& options, const std::string& label_column, bool with_box);
 PointCloud read_xyz_points(const std::string& path, const ReadOptions& options, const std::string& label_column);
 std::vector<double> read_xyz_column(const std::string& path, const std::string& name, const FramePlace& frame);
 std::optional<FileBox> read_xyz_box(const std::string& path, const FramePlace& frame);
@@ -164,11 +166,20 @@ auto frame_at(const std::string& path, std::uint64_t offset, Parse&& parse) {
   }
 }
 
-/// A frame parser's text ran out: the file's error where `whole`, else
-/// more of the file is needed (frame_at).
+/// A frame that the end of the file cuts short (the last of a trajectory
+/// still being written): an input error, which a walk over the frames
+/// (find_frames) takes as the end of the frames, listing the cut frame so
+/// that the frames before it stay readable and reading it names the problem.
+struct FrameTruncated : InputError {
+  using InputError::InputError;
+};
+
+/// A frame parser's text ran out: the file's error where `whole`
+/// (FrameTruncated, naming the file), else more of the file is needed
+/// (frame_at).
 [[noreturn]] inline void frame_ended(const std::string& path, const std::string& what, bool whole) {
   if (!whole) throw FrameCut{};
-  fail(path, what);
+  throw FrameTruncated(path + ": " + what);
 }
 
 /// frame_at the file's start.
@@ -183,8 +194,12 @@ auto first_frame(const std::string& path, Parse&& parse) {
 /// True: a next frame (or the end of the file); false: something else.
 inline bool frame_follows(std::optional<std::string_view> tail, std::string_view start) {
   if (!tail) return true;  // the end of the file
-  if (tail->size() < start.size()) throw FrameCut{};
-  return tail->substr(0, start.size()) == start;
+  // (Blanks first: a blank line cut by the prefix, which the frame's reader
+  // skips as it skips whole ones.)
+  std::string_view t = *tail;
+  while (!t.empty() && (t.front() == ' ' || t.front() == '\t' || t.front() == '\r')) t.remove_prefix(1);
+  if (t.size() < start.size()) throw FrameCut{};
+  return t.substr(0, start.size()) == start;
 }
 
 /// Whether `ext` (lowercased, with its dot) is a LAMMPS dump's.

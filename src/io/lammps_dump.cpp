@@ -221,7 +221,9 @@ std::vector<double> atom_values(const std::string& path, Lines& lines, std::size
   std::size_t number = 0;
   for (std::size_t k = 0; k < h.atoms; ++k) {
     if (!lines.next(line, number))
-      frame_ended(path, "the frame ends after " + std::to_string(k) + " of its " + std::to_string(h.atoms) + " atoms",
+      frame_ended(path,
+                  "the file ends at line " + std::to_string(lines.line_number()) + ", after " + std::to_string(k) +
+                      " of the frame's " + std::to_string(h.atoms) + " atoms",
                   whole);
     if (cols.empty()) {  // a frame skipped (find_frame): its lines counted, not split
       if (starts_with(trim(line), item))
@@ -247,7 +249,10 @@ std::vector<double> atom_values(const std::string& path, Lines& lines, std::size
   if (more ? !starts_with(trim(line), item) : !frame_follows(tail, item))
     fail(path, (more ? "line " + std::to_string(number) : "after line " + std::to_string(last)) +
                    ": more atom lines than NUMBER OF ATOMS (" + std::to_string(h.atoms) + ")");
-  if (end != nullptr) end->last = !more && !tail;
+  if (end != nullptr) {
+    end->last = !more && !tail;
+    if (more) *end = FrameEnd{lines.offset_of(line), number, false};  // the next frame's first item, past blank lines
+  }
   return out;
 }
 

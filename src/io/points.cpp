@@ -219,8 +219,12 @@ std::vector<FramePlace> walk_frames(const std::string& path, Stop&& stop) {
   for (;;) {
     starts.push_back(at);
     if (stop(at)) break;
-    const detail::FrameEnd end =
-        dump ? detail::skip_dump_frame(path, at.offset, at.line) : detail::skip_xyz_frame(path, at.offset, at.line);
+    detail::FrameEnd end;
+    try {
+      end = dump ? detail::skip_dump_frame(path, at.offset, at.line) : detail::skip_xyz_frame(path, at.offset, at.line);
+    } catch (const detail::FrameTruncated&) {
+      break;  // the last frame, cut short (still being written): listed, and reading it says so
+    }
     if (end.last) break;
     at.offset += end.bytes;
     at.line = end.next_line;
@@ -259,7 +263,7 @@ TrajectoryFrame read_frame(const std::string& path, std::uint64_t offset, std::s
   if (detail::is_dump_extension(ext))
     f = detail::read_dump_frame(path, offset, line, options, options.labels);
   else if ((ext == ".xyz" || ext == ".txt") && detail::is_xyz_file(path))
-    f = detail::read_xyz_frame(path, offset, line, options, options.labels);
+    f = detail::read_xyz_frame(path, offset, line, options, options.labels, true);
   else
     detail::fail(path, "not a trajectory: frames are read from LAMMPS dumps (.dump, .lammpstrj) and XYZ files");
   for (std::size_t k = 0; k < f.points.coords.size() && !options.keep_non_finite; ++k)

@@ -109,6 +109,8 @@ class Lines {
   /// Bytes of the text consumed so far, and the number of the last line read.
   std::size_t position() const { return static_cast<std::size_t>(p_ - begin_); }
   std::size_t line_number() const { return line_no_; }
+  /// Where a line that next() returned starts in the text.
+  std::size_t offset_of(std::string_view line) const { return static_cast<std::size_t>(line.data() - begin_); }
   /// Next content line and its 1-based number; false at end of file.
   bool next(std::string_view& line, std::size_t& number) {
     while (p_ < end_) {

@@ -90,6 +90,10 @@ struct XyzHeader {
   std::vector<Property> properties;
   std::size_t columns = 0;  // fields per atom line
   std::optional<FileBox> box;
+  /// Why the Lattice is no box of ours (a cell in another orientation), or
+  /// empty: said where the box is asked for (read_xyz_box, read_xyz_frame),
+  /// not where only the atoms are, so that --bounds can stand in for it.
+  std::string box_error;
 };
 
 /// The comment line's key=value pairs (values bare or in double quotes);
@@ -188,11 +192,13 @@ XyzHeader read_header(const std::string& path, RawLines& lines, bool whole) {
   if (const std::string* lattice = find("lattice")) {
     const std::vector<double> v = numbers(path, where, "Lattice", *lattice, 9);
     FileBox b;
-    if (v[1] != 0 || v[2] != 0 || v[5] != 0 || !(v[0] > 0 && v[4] > 0 && v[8] > 0))
-      fail(path, where +
-                     "the Lattice's cell must have a along +x and b in the xy plane (ay = az = bz = 0, and "
-                     "ax, by, cz > 0), as LAMMPS's and tessera's boxes; rotate the cell and the atoms to that "
-                     "orientation, or give --bounds");
+    if (v[1] != 0 || v[2] != 0 || v[5] != 0 || !(v[0] > 0 && v[4] > 0 && v[8] > 0)) {
+      h.box_error = where +
+                    "the Lattice's cell must have a along +x and b in the xy plane (ay = az = bz = 0, and "
+                    "ax, by, cz > 0), as LAMMPS's and tessera's boxes; rotate the cell and the atoms to that "
+                    "orientation, or give --bounds";
+      return h;
+    }
     std::vector<double> origin = {0, 0, 0};
     if (const std::string* o = find("origin")) origin = numbers(path, where, "Origin", *o, 3);
     b.periodic = {true, true, true};
@@ -257,7 +263,9 @@ std::vector<double> atom_values(const std::string& path, RawLines& lines, std::s
   const bool plain = h.properties.size() == 2 && h.properties[0].name == "species" && h.columns == 4;
   for (std::size_t k = 0; k < h.atoms; ++k) {
     if (!lines.next(line))
-      frame_ended(path, "the frame ends after " + std::to_string(k) + " of its " + std::to_string(h.atoms) + " atoms",
+      frame_ended(path,
+                  "the file ends at line " + std::to_string(lines.number()) + ", after " + std::to_string(k) +
+                      " of the frame's " + std::to_string(h.atoms) + " atoms",
                   whole);
     if (cols.empty()) continue;  // a frame skipped (find_frame): its lines counted, not split
     out.resize(out.size() + cols.size());
@@ -314,7 +322,7 @@ bool looks_like_xyz(std::string_view text) {
 }
 
 TrajectoryFrame read_xyz_frame(const std::string& path, std::uint64_t offset, std::size_t line,
-                               const ReadOptions& options, const std::string& label_column) {
+                               const ReadOptions& options, const std::string& label_column, bool with_box) {
   const int dim = options.dim == 0 ? 3 : options.dim;
   XyzHeader h;
   std::vector<std::size_t> cols;
@@ -333,6 +341,7 @@ TrajectoryFrame read_xyz_frame(const std::string& path, std::uint64_t offset, st
           fail(path, "--dim 2: the Lattice tilts along z (cx, cy not 0); a 2D box has the xy tilt only");
         return atom_values(path, lines, text.size(), h, cols, tail, &end);
       });
+  if (with_box && !h.box_error.empty()) fail(path, h.box_error);  // no box would be a wrong one
   TrajectoryFrame frame;
   frame.box = h.box;
   frame.next_offset = offset + end.bytes;
@@ -351,7 +360,7 @@ TrajectoryFrame read_xyz_frame(const std::string& path, std::uint64_t offset, st
 }
 
 PointCloud read_xyz_points(const std::string& path, const ReadOptions& options, const std::string& label_column) {
-  return read_xyz_frame(path, options.frame.offset, options.frame.line, options, label_column).points;
+  return read_xyz_frame(path, options.frame.offset, options.frame.line, options, label_column, false).points;
 }
 
 std::vector<double> read_xyz_column(const std::string& path, const std::string& name, const FramePlace& frame) {
@@ -365,7 +374,9 @@ std::vector<double> read_xyz_column(const std::string& path, const std::string& 
 std::optional<FileBox> read_xyz_box(const std::string& path, const FramePlace& frame) {
   return frame_at(path, frame.offset, [&](std::string_view text, std::optional<std::string_view> tail) {
     RawLines lines(text, frame.line);
-    return read_header(path, lines, !tail).box;
+    const XyzHeader h = read_header(path, lines, !tail);
+    if (!h.box_error.empty()) fail(path, h.box_error);
+    return h.box;
   });
 }
 

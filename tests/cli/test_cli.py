@@ -1310,6 +1310,20 @@ class FileBoxes(TempDirCase):
                 self.ok(["voronoi", self.p("mixed.xyz"), "--frame", str(k), "--cell-table", self.p("one.csv"), "-q"])
                 self.assertEqual(read_bytes(self.p("x_%d.csv" % k)), read_bytes(self.p("one.csv")), (sel, k))
         self.assertAlmostEqual(np.loadtxt(self.p("x_1.csv"), delimiter=",", skiprows=1)[:, 2].sum(), 8.0, delta=1e-12)
+        # A trajectory still being written: its last frame cut short. The
+        # frames before it are read; the cut one is named, with its line.
+        with open(traj) as f:
+            whole = f.read()
+        with open(self.p("cut.lammpstrj"), "w") as f:
+            f.write(whole[: whole.rfind("\n5 ")])
+        self.ok(["voronoi", self.p("cut.lammpstrj"), "--frame", "-2", "--cell-table", self.p("c1.csv"), "-q"])
+        self.ok(["voronoi", traj, "--frame", "1", "--cell-table", self.p("one.csv"), "-q"])
+        self.assertEqual(read_bytes(self.p("c1.csv")), read_bytes(self.p("one.csv")))
+        r = run(["voronoi", self.p("cut.lammpstrj"), "--frame", "-1", "--cell-table", out])
+        self.assertEqual(r.returncode, 2)
+        self.assertIn("error: frame 2: %s: the file ends at line " % self.p("cut.lammpstrj"), r.stderr)
+        self.assertIn(", after 4 of the frame's 300 atoms", r.stderr)
+        self.assertFalse(os.path.exists(out))
         npy = self.save("p.npy", rng.random((20, 3)))
         r = run(["voronoi", npy, "--frame", "0", "--cell-table", out])
         self.assertEqual(r.returncode, 2)

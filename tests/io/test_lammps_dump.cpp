@@ -146,7 +146,7 @@ TEST(LammpsDump, Errors) {
       {head + "ITEM: ATOMS\n", "names no columns"},
       {head + "ITEM: ATOMS id type\n1 1\n2 1\n", "no coordinate columns"},
       {head + "ITEM: ATOMS id xs ys\n1 0 0\n2 0 0\n", "no coordinate columns"},  // scaled needs all three
-      {head + "ITEM: ATOMS id x y z\n1 0 0 0\n", "ends after 1 of its 2 atoms"},
+      {head + "ITEM: ATOMS id x y z\n1 0 0 0\n", "the file ends at line 10, after 1 of the frame's 2 atoms"},
       {head + "ITEM: ATOMS id x y z\n1 0 0 0\nITEM: TIMESTEP\n", "fewer atoms than NUMBER OF ATOMS"},
       {head + "ITEM: ATOMS id x y z\n1 0 0 0\n2 0 0\n", "line 11: expected 4 values"},
       {head + "ITEM: ATOMS id x y z\n1 0 0 0\n2 0 0 0 9\n", "expected 4 values"},
@@ -166,7 +166,7 @@ TEST(LammpsDump, Errors) {
       // A count far beyond the file: an error, not its memory (48 GB asked).
       {"ITEM: TIMESTEP\n1\nITEM: NUMBER OF ATOMS\n2147483647\nITEM: BOX BOUNDS pp pp pp\n0 1\n0 1\n0 1\n"
        "ITEM: ATOMS x y z\n0 0 0\n",
-       "ends after 1 of its 2147483647 atoms"},
+       "after 1 of the frame's 2147483647 atoms"},
   };
   for (const Case& c : cases) {
     const std::string p = dir.write("e.dump", c.text);
@@ -315,4 +315,36 @@ TEST(LammpsDump, FramesByIndex) {
   ReadOptions second;
   second.frame.index = 1;
   EXPECT_NE(input_error([&] { read_points(csv, second); }).find("not a trajectory"), std::string::npos);
+}
+
+// A trajectory still being written: its last frame cut short, at a line
+// break or within a line. The frames before it stay reachable from either
+// end, and reading the cut frame names where the file ends. A frame after
+// blank lines starts at its first item (the summary's "from line").
+TEST(LammpsDump, LastFrameCutShort) {
+  TempDir dir;
+  std::string text;
+  for (int s = 0; s < 4; ++s) {
+    text += "ITEM: TIMESTEP\n" + std::to_string(s) +
+            "\nITEM: NUMBER OF ATOMS\n4\nITEM: BOX BOUNDS pp pp pp\n0 1\n0 1\n0 1\nITEM: ATOMS id x y z\n"
+            "1 0.1 0.2 0.3\n2 0.6 0.5 0.4\n3 0.3 0.8 0.2\n4 0.9 0.1 0.7\n";
+    if (s == 0) text += "\n\n";
+  }
+  EXPECT_EQ(tessera::io::find_frame(dir.write("full.dump", text), 1).line, 16u);  // after two blank lines
+  const std::size_t cut_at_line = text.rfind("3 0.3"), cut_in_line = text.size() - 5;
+  for (const std::size_t cut : {cut_at_line, cut_in_line}) {
+    const std::string p = dir.write("cut.dump", text.substr(0, cut));
+    EXPECT_EQ(tessera::io::find_frames(p).size(), 4u);
+    const tessera::io::FramePlace before = tessera::io::find_frame(p, -2);
+    EXPECT_EQ(before.index, 2u);
+    ReadOptions o;
+    o.frame = before;
+    EXPECT_EQ(read_points(p, o).n, 4u);
+    o.frame = tessera::io::find_frame(p, -1);
+    const std::string msg = input_error([&] { read_points(p, o); });
+    EXPECT_NE(msg.find(cut == cut_at_line ? "the file ends at line 52, after 2 of the frame's 4 atoms"
+                                          : "line 54: expected 4 values"),
+              std::string::npos)
+        << msg;
+  }
 }

@@ -92,7 +92,7 @@ TEST(Xyz, Errors) {
     std::string text, expect;
   };
   const std::vector<Case> cases = {
-      {"2\n\nC 0 0 0\n", "ends after 1 of its 2 atoms"},
+      {"2\n\nC 0 0 0\n", "the file ends at line 3, after 1 of the frame's 2 atoms"},
       {"2\n\nC 0 0 0\nC 0 0\n", "line 4: expected 4 values per atom, got 3"},
       {"1\n\nC 0 zero 0\n", "'zero' is not a number"},
       {"1\nProperties=species:S:1:pos:R\nC 0 0 0\n", "name:type:count triples"},
@@ -108,7 +108,7 @@ TEST(Xyz, Errors) {
       // More atom lines than the count (an atom was dropped silently), and
       // a count far beyond the file (its memory was asked for).
       {"2\n\nH 0 0 0\nH 1 1 1\nH 2 2 2\n", "line 5: more atom lines than the frame's count (2)"},
-      {"2147483647\n\nH 0 0 0\n", "ends after 1 of its 2147483647 atoms"},
+      {"2147483647\n\nH 0 0 0\n", "after 1 of the frame's 2147483647 atoms"},
   };
   for (const Case& c : cases) {
     const std::string p = dir.write("e.xyz", c.text);
@@ -124,6 +124,12 @@ TEST(Xyz, Errors) {
   EXPECT_NE(input_error([&] { read_points(p, labels("species")); }).find("is S:1; need I:1"), std::string::npos);
   EXPECT_NE(input_error([&] { read_points(p, labels("tag")); }).find("no property 'tag'"), std::string::npos);
   EXPECT_NE(input_error([&] { read_point_scalars(p, "species"); }).find("need R:1 or I:1"), std::string::npos);
+  // A Lattice that is no box of ours fails where the box is asked for, not
+  // where only the atoms are: --bounds (bounds= in Python) can stand in.
+  const std::string rot = dir.write("rot.xyz", "2\nLattice=\"0.7 0.7 0 -0.7 0.7 0 0 0 1\"\nC 0 0 0\nC 1 1 1\n");
+  EXPECT_EQ(read_points(rot).n, 2u);
+  EXPECT_NE(input_error([&] { tessera::io::read_frame(rot); }).find("rotate the cell"), std::string::npos);
+  EXPECT_EQ(tessera::io::find_frame(rot, -1).index, 0u);
   // A column of single numbers is a one-column point file, not XYZ.
   EXPECT_NE(input_error([&] { read_points(dir.write("one.xyz", "1\n2\n3\n4\n")); }).find("1 coordinate column"),
             std::string::npos);
