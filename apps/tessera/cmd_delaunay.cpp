@@ -83,7 +83,7 @@ void check_delaunay_outputs(const DelaunayArgs& a) {
 
 namespace {
 
-/// `delaunay` on one frame (a series: run_frame_series).
+/// `delaunay` on one frame (any --frame: run_frames).
 int run_delaunay_frame(const DelaunayArgs& a) {
   check_delaunay_outputs(a);
   check_bounds_arg(a.compute.bounds);
@@ -202,12 +202,11 @@ int run_delaunay_frame(const DelaunayArgs& a) {
 }  // namespace
 
 int run_delaunay(const DelaunayArgs& a) {
-  if (a.compute.frames.empty()) return run_delaunay_frame(a);
-  return run_frame_series(a,
-                          {{"-o", &DelaunayArgs::output},
-                           {"--simplices", &DelaunayArgs::simplices},
-                           {"--simplex-shifts", &DelaunayArgs::simplex_shifts}},
-                          run_delaunay_frame);
+  return run_frames(a,
+                    {{"-o", &DelaunayArgs::output},
+                     {"--simplices", &DelaunayArgs::simplices},
+                     {"--simplex-shifts", &DelaunayArgs::simplex_shifts}},
+                    run_delaunay_frame);
 }
 
 int run_bench_delaunay(const BenchArgs& a) {

@@ -74,7 +74,7 @@ void print_written(const std::vector<std::string>& written) {
 
 namespace {
 
-/// `graph` on one frame (a series: run_frame_series).
+/// `graph` on one frame (any --frame: run_frames).
 int run_graph_frame(const GraphArgs& a) {
   if (a.output.empty() && a.csr.empty() && a.spoke_classes.empty() && a.spoke_measures.empty() &&
       a.spoke_shifts.empty())
@@ -142,21 +142,20 @@ int run_graph_frame(const GraphArgs& a) {
 }  // namespace
 
 int run_graph(const GraphArgs& a) {
-  if (a.compute.frames.empty()) return run_graph_frame(a);
-  return run_frame_series(a,
-                          {{"-o", &GraphArgs::output},
-                           {"--csr", &GraphArgs::csr},
-                           {"--spoke-classes", &GraphArgs::spoke_classes},
-                           {"--spoke-measures", &GraphArgs::spoke_measures},
-                           {"--spoke-shifts", &GraphArgs::spoke_shifts}},
-                          run_graph_frame);
+  return run_frames(a,
+                    {{"-o", &GraphArgs::output},
+                     {"--csr", &GraphArgs::csr},
+                     {"--spoke-classes", &GraphArgs::spoke_classes},
+                     {"--spoke-measures", &GraphArgs::spoke_measures},
+                     {"--spoke-shifts", &GraphArgs::spoke_shifts}},
+                    run_graph_frame);
 }
 
 // ------------------------------------------------------------------ faces
 
 namespace {
 
-/// `faces` on one frame (a series: run_frame_series).
+/// `faces` on one frame (any --frame: run_frames).
 int run_faces_frame(const FacesArgs& a) {
   const auto kind = parse_face_set_kind(a.kind);
   if (!kind) throw InputError("--kind must be boundary, complex or surface-net, got '" + a.kind + "'");
@@ -189,15 +188,14 @@ int run_faces_frame(const FacesArgs& a) {
 }  // namespace
 
 int run_faces(const FacesArgs& a) {
-  if (a.compute.frames.empty()) return run_faces_frame(a);
-  return run_frame_series(a, {{"-o", &FacesArgs::output}}, run_faces_frame);
+  return run_frames(a, {{"-o", &FacesArgs::output}}, run_faces_frame);
 }
 
 // ------------------------------------------------------------------ flower
 
 namespace {
 
-/// `flower` on one frame (a series: run_frame_series).
+/// `flower` on one frame (any --frame: run_frames).
 int run_flower_frame(const FlowerArgs& a) {
   if (a.points.empty()) throw InputError("give at least one --point ID");
   if (a.output.empty()) throw InputError("nothing to do: give -o FLOWER.vtp");
@@ -231,8 +229,7 @@ int run_flower_frame(const FlowerArgs& a) {
 }  // namespace
 
 int run_flower(const FlowerArgs& a) {
-  if (a.compute.frames.empty()) return run_flower_frame(a);
-  return run_frame_series(a, {{"-o", &FlowerArgs::output}}, run_flower_frame);
+  return run_frames(a, {{"-o", &FlowerArgs::output}}, run_flower_frame);
 }
 
 }  // namespace tessera::cli

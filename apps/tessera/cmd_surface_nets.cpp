@@ -323,7 +323,7 @@ void add_surface_nets_options(CLI::App* app, SurfaceNetsArgs& a, bool bench) {
 
 namespace {
 
-/// `surface-nets` on one frame (a series: run_frame_series).
+/// `surface-nets` on one frame (any --frame: run_frames).
 int run_surface_nets_frame(const SurfaceNetsArgs& a) {
   check_args(a, true);
   io::check_writable(a.output);
@@ -393,8 +393,7 @@ int run_surface_nets_frame(const SurfaceNetsArgs& a) {
 }  // namespace
 
 int run_surface_nets(const SurfaceNetsArgs& a) {
-  if (a.compute.frames.empty()) return run_surface_nets_frame(a);
-  return run_frame_series(a, {{"-o", &SurfaceNetsArgs::output}}, run_surface_nets_frame);
+  return run_frames(a, {{"-o", &SurfaceNetsArgs::output}}, run_surface_nets_frame);
 }
 
 int run_bench_surface_nets(const SurfaceNetsArgs& a) {

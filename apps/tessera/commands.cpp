@@ -288,7 +288,7 @@ io::PointCloud read_input(const ComputeArgs& a) {
   ro.non_finite_hint = "--ignore-outside sets such points aside";
   ro.frame = a.frame_place;
   // One frame asked for by --frame: its errors say which (a series' wrapper,
-  // run_frame_series, says it for all of a frame's errors).
+  // run_frames, says it for all of a frame's errors).
   const std::string which =
       a.frame.empty() || is_frame_series(a.frame) ? "" : strf("frame %zu: ", a.frame_place.index);
   io::PointCloud pc;
@@ -564,7 +564,7 @@ Usage usage_now() {
 
 namespace {
 
-/// `voronoi` on one frame (a series: run_frame_series).
+/// `voronoi` on one frame (any --frame: run_frames).
 int run_voronoi_frame(const VoronoiArgs& a) {
   check_output_names(a);
   check_bounds_arg(a.compute.bounds);
@@ -623,13 +623,12 @@ int run_voronoi_frame(const VoronoiArgs& a) {
 }  // namespace
 
 int run_voronoi(const VoronoiArgs& a) {
-  if (a.compute.frames.empty()) return run_voronoi_frame(a);
-  return run_frame_series(a,
-                          {{"-o", &VoronoiArgs::output},
-                           {"--cell-table", &VoronoiArgs::cell_table},
-                           {"--neighbors", &VoronoiArgs::neighbors},
-                           {"--neighbor-shifts", &VoronoiArgs::neighbor_shifts}},
-                          run_voronoi_frame);
+  return run_frames(a,
+                    {{"-o", &VoronoiArgs::output},
+                     {"--cell-table", &VoronoiArgs::cell_table},
+                     {"--neighbors", &VoronoiArgs::neighbors},
+                     {"--neighbor-shifts", &VoronoiArgs::neighbor_shifts}},
+                    run_voronoi_frame);
 }
 
 // ------------------------------------------------------------------ bench

@@ -1,8 +1,9 @@
-// A command on a series of a trajectory's frames (--frame all, or a slice
-// START:STOP[:STEP]): the command once per frame selected, each with its own
-// box where the file's box is the domain, into outputs whose names hold
-// {frame}, replaced by the frame's index (cells_{frame}.vtu: cells_0.vtu,
-// cells_1.vtu, ..., a series ParaView opens as one).
+// A command on a trajectory's frames: one (--frame INDEX) or a series
+// (--frame all, or a slice START:STOP[:STEP]), the command once per frame
+// selected, each with its own box where the file's box is the domain, into
+// outputs whose names hold {frame}, replaced by the frame's index
+// (cells_{frame}.vtu: cells_0.vtu, cells_1.vtu, ..., a series ParaView opens
+// as one).
 #pragma once
 
 #include <initializer_list>
@@ -20,15 +21,32 @@ struct SeriesOutput {
   std::string Args::*path;
 };
 
-/// `run_one(args)` for each frame of args.compute.frames, with the frame's
-/// place, its box (where the domain is the file's: apply_file_box) and its
-/// output names. Every output given must hold {frame} (standard output is
-/// refused: several tables in one stream). Each frame's files are whole when
-/// written; an error in a frame names it, and the files of the frames before
-/// it stay. The exit code is the worst of the frames' (a failed --validate
-/// goes on to the next frame).
+/// `args` with {frame} in its outputs' names replaced by `index`.
+template <class Args>
+Args with_frame_names(Args a, std::initializer_list<SeriesOutput<Args>> outputs, std::size_t index) {
+  const std::string text = std::to_string(index);
+  for (const SeriesOutput<Args>& o : outputs) {
+    std::string& path = a.*(o.path);
+    for (std::size_t at; (at = path.find("{frame}")) != std::string::npos;) path.replace(at, 7, text);
+  }
+  return a;
+}
+
+/// A command's run: `run_one(args)` once, or for each frame of a series.
+/// One frame asked for by its INDEX: {frame} in an output's name is its
+/// index (from the start, also for -1), as in a series, so that a loop
+/// over indices names its files alike; no --frame: the names as given.
+/// A series (args.compute.frames): each frame with its place, its box
+/// (where the domain is the file's: apply_file_box) and its output names.
+/// Every output given must hold {frame} (standard output is refused:
+/// several tables in one stream). Each frame's files are whole when
+/// written; an error in a frame names it, and the files of the frames
+/// before it stay. The exit code is the worst of the frames' (a failed
+/// --validate goes on to the next frame).
 template <class Args, class Run>
-int run_frame_series(const Args& a, std::initializer_list<SeriesOutput<Args>> outputs, Run&& run_one) {
+int run_frames(const Args& a, std::initializer_list<SeriesOutput<Args>> outputs, Run&& run_one) {
+  if (a.compute.frames.empty())
+    return run_one(a.compute.frame.empty() ? a : with_frame_names(a, outputs, a.compute.frame_place.index));
   for (const SeriesOutput<Args>& o : outputs) {
     const std::string& path = a.*(o.path);
     if (path == "-")
@@ -51,16 +69,12 @@ int run_frame_series(const Args& a, std::initializer_list<SeriesOutput<Args>> ou
       f.compute.box_source.clear();
       apply_file_box(f.compute);
     }
-    const std::string index = std::to_string(place.index);
-    for (const SeriesOutput<Args>& o : outputs) {
-      std::string& path = f.*(o.path);
-      for (std::size_t at; (at = path.find("{frame}")) != std::string::npos;) path.replace(at, 7, index);
-    }
     try {
-      const int r = run_one(f);
+      const int r = run_one(with_frame_names(f, outputs, place.index));
       if (r != kExitOk) rc = r;
     } catch (const InputError& e) {
-      throw InputError("frame " + index + ": " + e.what() + (k == 0 ? "" : "; the frames before it were written"));
+      throw InputError("frame " + std::to_string(place.index) + ": " + e.what() +
+                       (k == 0 ? "" : "; the frames before it were written"));
     }
   }
   return rc;

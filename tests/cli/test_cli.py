@@ -1224,6 +1224,11 @@ class FileBoxes(TempDirCase):
         self.assertIn("validation passed", r.stderr)
         self.ok(["graph", traj, "--frame", "1", "--csr", self.p("g.npy"), "-q"])
         self.ok(["bench", "voronoi", traj, "--frame", "2"])
+        # One frame by its index names its outputs as a series would: {frame}
+        # is the index from the start (a loop over indices, or -1).
+        self.ok(["voronoi", traj, "--frame", "-1", "--cell-table", self.p("k_{frame}.csv"), "-q"])
+        self.ok(["voronoi", traj, "--frame", "2", "--cell-table", self.p("one.csv"), "-q"])
+        self.assertEqual(read_bytes(self.p("k_2.csv")), read_bytes(self.p("one.csv")))
         # A .npy of labels serves every frame: its length is the frame's.
         self.ok(["voronoi", traj, "--frame", "1", "--labels", self.save("l.npy", np.ones(250, np.int32)),
                  "--cell-table", self.p("t1.csv"), "-q"])
