@@ -3,11 +3,11 @@
 #include "frame_series.hpp"
 #include "stdin_input.hpp"
 
-#include <charconv>
 #include <sys/resource.h>
 
 #include <algorithm>
 #include <cctype>
+#include <charconv>
 #include <chrono>
 #include <cerrno>
 #include <cmath>
@@ -167,10 +167,6 @@ void check_against_input(const ComputeArgs& a, const io::PointCloud& pc) {
   throw InputError(where + " (planar input): for a 2D tessellation drop that column and use --dim 2, or give " +
                    box_hint + " for a 3D domain");
 }
-
-}  // namespace
-
-namespace {
 
 /// One part of a --frame slice: empty (the default), else a whole number.
 std::optional<std::int64_t> slice_part(const std::string& frame, const std::string& part) {

@@ -76,14 +76,16 @@ void add_compute_options(CLI::App* app, ComputeArgs& c, std::vector<std::string>
   app->add_option("--frame", c.frame,
                   "Of a trajectory (a LAMMPS dump, an XYZ file): the frame to read, 0 the first (default), 1 the "
                   "next; negative counts from the end, -1 the last. Its box is the domain, as the first frame's "
-                  "would be; --labels and --radii columns are read from it (a .npy file serves every frame). Also a series (not in bench), "
-                  "all or START:STOP[:STEP] as Python's slices (-10: the last ten, ::5 every fifth): each frame is "
-                  "computed in turn, and every output's name must hold {frame}, replaced by the frame's index "
-                  "(-o cells_{frame}.vtu, a series ParaView opens as one); with one INDEX, {frame} in a name is "
-                  "replaced alike")
+                  "would be; --labels and --radii columns are read from it (a .npy file serves every frame). Also "
+                  "a series (not in bench), all or START:STOP[:STEP] as Python's slices (-10: the last ten, ::5 "
+                  "every fifth): each frame is computed in turn, and every output's name must hold {frame}, "
+                  "replaced by the frame's index (-o cells_{frame}.vtu, a series ParaView opens as one); with one "
+                  "INDEX, {frame} in a name is replaced alike")
       ->type_name("INDEX")
       ->check(CLI::Validator(
-          [](std::string& v) { return v.empty() ? std::string("expected a frame's index (0 the first, -1 the last), got ''") : ""; },
+          [](std::string& v) {
+            return v.empty() ? std::string("expected a frame's index (0 the first, -1 the last), got ''") : "";
+          },
           "", "frame"));
   app->add_option("--dim", c.dim,
                   "Dimension: 2 or 3 (default: the number of columns or fields; .ply, .vtp and .vtu are 3D). --dim 2 "
