@@ -349,6 +349,17 @@ void bind_prep(py::module_& m) {
       "The trajectory frame at a byte offset: (points, labels or None, box or None, timestep or None, next_offset, "
       "next_line, last).");
 
+  // ---- find_frames ------------------------------------------------------------
+  m.def(
+      "find_frames",
+      [](const std::string& path) {
+        const std::vector<io::FramePlace> places = without_gil([&] { return io::find_frames(path); });
+        py::list out;
+        for (const io::FramePlace& p : places) out.append(py::make_tuple(p.offset, p.line));
+        return out;
+      },
+      py::arg("path"), "Where each frame of a trajectory starts: [(offset, line), ...], in file order.");
+
   // ---- read_box ---------------------------------------------------------------
   m.def(
       "read_box",

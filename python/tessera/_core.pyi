@@ -459,6 +459,7 @@ def read_points(
 def read_frame(
     path: str, offset: int, line: int, dim: int, labels: str
 ) -> Tuple[np.ndarray, Optional[np.ndarray], Optional[Tuple[Any, ...]], Optional[int], int, int, bool]: ...
+def find_frames(path: str) -> List[Tuple[int, int]]: ...
 def read_box(
     path: str, frame: int
 ) -> Optional[Tuple[Tuple[float, float, float], Tuple[float, float, float], Tuple[float, float, float],

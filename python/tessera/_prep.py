@@ -171,7 +171,8 @@ class Frame(NamedTuple):
     """A LAMMPS dump's TIMESTEP; None for XYZ."""
 
 
-def read_frames(path: PathLike, labels: Optional[str] = None, dim: Optional[int] = None) -> Iterator[Frame]:
+def read_frames(path: PathLike, labels: Optional[str] = None, dim: Optional[int] = None,
+                frames: Optional[Union[slice, Sequence[int]]] = None) -> Iterator[Frame]:
     """The frames of a trajectory, one after another: a LAMMPS dump
     (``.dump`` / ``.lammpstrj``) or an XYZ file (frames back to back). Each
     frame is read when the loop asks for it (a trajectory may be far larger
@@ -184,6 +185,13 @@ def read_frames(path: PathLike, labels: Optional[str] = None, dim: Optional[int]
     XYZ); ``dim=2`` keeps x, y. Each frame is checked as :func:`read_points`
     checks the first (ValueError, :class:`tessera.InputError`, naming the
     line), when the loop reaches it.
+
+    ``frames``: some of the frames, by a slice (``slice(-10, None)`` the last
+    ten, ``slice(None, None, 5)`` every fifth) or a sequence of indices
+    (negative from the end), in that order. The file is first walked once
+    for where its frames start (their lines counted, not parsed); the frames
+    not asked for are not read. ``--frame`` takes the same selections on the
+    command line.
     """
     if not _is_path(path):
         raise ValueError(f"path: expected a file name, got {type(path).__name__}")
@@ -192,11 +200,28 @@ def read_frames(path: PathLike, labels: Optional[str] = None, dim: Optional[int]
     if labels is not None and not isinstance(labels, str):
         raise ValueError(f"labels: expected a column name, got {type(labels).__name__}")
     name = _inputs.as_path(path)
+    places = None
+    if frames is not None:
+        if not isinstance(frames, slice) and (isinstance(frames, (str, bytes)) or
+                                              not isinstance(frames, (Sequence, np.ndarray))):
+            raise ValueError(f"frames: expected a slice or a sequence of frame indices, got {type(frames).__name__}")
+        every = _inputs.call(_core.find_frames, name)
+        if isinstance(frames, slice):
+            places = every[frames]
+        else:
+            places = [every[_inputs.as_index(k, len(every), "frames", "frames")] for k in frames]
 
     def read(offset: int, line: int) -> Tuple[Frame, int, int, bool]:
         pts, lab, box, step, offset, line, last = _inputs.call(_core.read_frame, name, offset, line, dim or 0,
                                                                labels or "")
         return Frame(pts, lab, None if box is None else _box_arguments(name, box, dim), step), offset, line, last
+
+    if places is not None:
+        def chosen() -> Iterator[Frame]:
+            for offset, line in places:
+                yield read(offset, line)[0]
+
+        return chosen()
 
     # The first frame now: a missing file or another format is said here,
     # not at the loop's first step.

@@ -358,6 +358,18 @@ def test_read_frames_of_a_trajectory(tmp_path):
         with pytest.raises(ValueError, match="frame: expected an integer"):
             tessera.read_points(tmp_path / "t.lammpstrj", frame=bad)
     assert tessera.read_points(tmp_path / "t.lammpstrj", frame=np.int64(-1))[0].shape == (30, 3)
+    # Some of the frames, by a slice or indices, in that order.
+    for sel in (slice(None, None, 2), slice(-2, None), slice(None, None, -1), [2, 0, -1], np.array([1]), range(1, 3)):
+        want = list(range(3))[sel] if isinstance(sel, slice) else [int(k) % 3 for k in sel]
+        some = list(tessera.read_frames(tmp_path / "t.lammpstrj", labels="type", frames=sel))
+        assert [f.timestep for f in some] == [10 * k for k in want]
+        for f, k in zip(some, want):
+            np.testing.assert_array_equal(f.points, got[k].points)
+            np.testing.assert_array_equal(f.labels, got[k].labels)
+    with pytest.raises(IndexError, match="frames: index 3 is out of range for 3 frames"):
+        tessera.read_frames(tmp_path / "t.lammpstrj", frames=[0, 3])
+    with pytest.raises(ValueError, match="frames: expected a slice or a sequence"):
+        tessera.read_frames(tmp_path / "t.lammpstrj", frames="::2")
     text = (tmp_path / "t.lammpstrj").read_text()
     broken = text[: text.index("ITEM: TIMESTEP\n20")] + "ITEM: TIMESTEP\n20\nITEM: NUMBER OF ATOMS\nmany\n"
     (tmp_path / "b.lammpstrj").write_text(broken)
