@@ -62,14 +62,14 @@ int run_frames(const Args& a, std::initializer_list<SeriesOutput<Args>> outputs,
     Args f = a;
     f.compute.frames.clear();
     f.compute.frame_place = place;
-    if (!a.compute.domain_given) {  // the file's box, where it has one: this frame's own
-      f.compute.bounds.clear();
-      f.compute.periodic.clear();
-      f.compute.tilt.clear();
-      f.compute.box_source.clear();
-      apply_file_box(f.compute);
-    }
     try {
+      if (!a.compute.domain_given) {  // the file's box, where it has one: this frame's own
+        f.compute.bounds.clear();
+        f.compute.periodic.clear();
+        f.compute.tilt.clear();
+        f.compute.box_source.clear();
+        apply_file_box(f.compute);
+      }
       const int r = run_one(with_frame_names(f, outputs, place.index));
       if (r != kExitOk) rc = r;
     } catch (const InputError& e) {

@@ -209,7 +209,12 @@ void finish_compute_args(ComputeArgs& c, const std::vector<std::string>& raw_bou
   if (!series && is_frame_series(c.frame))
     throw tessera::InputError("--frame " + c.frame + ": a bench runs on one frame; give its INDEX");
   find_input_frame(c);
-  apply_file_box(c);
+  try {
+    apply_file_box(c);
+  } catch (const tessera::InputError& e) {  // a frame's box: say which frame, as its other errors do
+    if (c.frame.empty()) throw;
+    throw tessera::InputError("frame " + std::to_string(c.frame_place.index) + ": " + e.what());
+  }
 }
 
 }  // namespace
