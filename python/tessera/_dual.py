@@ -39,9 +39,9 @@ def cells_for(
     if isinstance(source, Voronoi):
         given = [n for n, v in (("labels", labels), ("bounds", bounds), ("padding", padding), ("threads", threads),
                                 ("tilt", tilt), ("radii", radii)) if v is not None]
-        if ignore_outside:
+        if _inputs.as_flag(ignore_outside, "ignore_outside"):
             given.append("ignore_outside")
-        if periodic is not None and periodic is not False:
+        if periodic is not None and periodic is not False and not (isinstance(periodic, np.bool_) and not periodic):
             given.append("periodic")
         if given:
             raise ValueError(
@@ -592,7 +592,7 @@ class Flowers:
         0 generator, 1 petal centre, 2 neighbour, 3 spoke, 4 cell face,
         5 petal glyph, 6 circumflower glyph.
         """
-        g = self.glyphs if glyphs is None else _inputs.as_flag(glyphs, "glyphs")
+        g = _inputs.as_flag(self.glyphs if glyphs is None else glyphs, "glyphs")
         _core.write_flowers_vtp(_check_vtp(path, "a flower"), self._fs, self._vor.points, g)
 
     def to_vtk(self, glyphs: Optional[bool] = None) -> Any:
@@ -600,7 +600,7 @@ class Flowers:
         written to a temporary file and read back: needs ``vtk``)."""
         from ._vtk import flowers_to_vtk
 
-        return flowers_to_vtk(self, self.glyphs if glyphs is None else _inputs.as_flag(glyphs, "glyphs"))
+        return flowers_to_vtk(self, _inputs.as_flag(self.glyphs if glyphs is None else glyphs, "glyphs"))
 
     def __repr__(self) -> str:
         return f"<tessera.Flowers of points {self.ids}>"

@@ -91,12 +91,33 @@ def as_radii(radii: Any, n: int) -> Optional[np.ndarray]:
     return np.ascontiguousarray(a, dtype=np.float64)
 
 
+def numbers_array(values: Any) -> np.ndarray:
+    """`values` as a float64 array, refusing strings, bools, None and
+    complex numbers among them as the scalar arguments do (np.asarray(
+    ["0.1"], float) would parse text, None become NaN, a complex number
+    lose its imaginary part); TypeError or ValueError otherwise."""
+    a = np.asarray(values)
+    if a.dtype.kind in "USbcMm" or (a.dtype.kind == "O" and any(
+            v is None or isinstance(v, (str, bytes, bool, np.bool_)) for v in a.ravel())):
+        raise TypeError("not numbers")
+    return np.asarray(a, dtype=np.float64)
+
+
+def as_dim(dim: Any) -> int:
+    """A read function's ``dim``: None, 2 or 3 (ints, numpy's too) -> 0, 2, 3."""
+    if dim is None:
+        return 0
+    if isinstance(dim, (bool, np.bool_)) or not isinstance(dim, (int, np.integer)) or dim not in (2, 3):
+        raise ValueError(f"dim: expected 2, 3 or None, got {dim!r}")
+    return int(dim)
+
+
 def as_bounds(bounds: Optional[Sequence[float]], dim: int) -> Optional[list]:
     """Bounds in the CLI's order (x0, x1, y0, y1[, z0, z1]) as 2*dim floats."""
     if bounds is None:
         return None
     try:
-        b = np.asarray(bounds, dtype=np.float64)
+        b = numbers_array(bounds)
     except (ValueError, TypeError, OverflowError):
         raise ValueError(f"bounds: expected {2 * dim} numbers (x0, x1, y0, y1{', z0, z1' if dim == 3 else ''}), "
                          f"got {bounds!r}") from None
@@ -142,11 +163,13 @@ def as_threads(threads: Optional[int]) -> int:
     """threads=None -> 0 (TESSERA_NUM_THREADS if set, else every core)."""
     if threads is None:
         return 0
+    if isinstance(threads, (bool, np.bool_)):
+        raise ValueError(f"threads: expected a positive integer or None, got {threads!r}")
     try:
         t = operator.index(threads)
     except TypeError:
         raise ValueError(f"threads: expected a positive integer or None, got {threads!r}") from None
-    if isinstance(threads, bool) or t < 1:
+    if t < 1:
         raise ValueError(f"threads: expected a positive integer or None, got {threads!r}")
     if t > _INT32.max:
         raise ValueError(f"threads: at most {_INT32.max}, got {threads!r}")
@@ -159,9 +182,12 @@ def as_padding(padding: float) -> float:
 
 
 def as_flag(value: Any, name: str) -> bool:
-    """A yes/no argument: a bool (numpy's too) or the integers 0 and 1. Not
-    truthiness: an array raised numpy's "truth value ... is ambiguous",
-    which names no argument, and a string such as "False" is true."""
+    """A yes/no argument: a bool (numpy's too, or a 0-d array of one, as an
+    .npz gives it back) or the integers 0 and 1. Not truthiness: an array
+    raised numpy's "truth value ... is ambiguous", which names no argument,
+    and a string such as "False" is true."""
+    if isinstance(value, np.ndarray) and value.ndim == 0 and value.dtype.kind in "biu":
+        value = value[()]
     if isinstance(value, (bool, np.bool_)):
         return bool(value)
     if isinstance(value, (int, np.integer)) and value in (0, 1):
@@ -201,11 +227,13 @@ _INT32 = np.iinfo(np.int32)
 
 def as_int(value: Any, name: str, lo: Optional[int] = None, hi: Optional[int] = None, what: str = "an integer") -> int:
     """A Python int in [lo, hi] (bools rejected: they are almost always a mistake)."""
-    try:
-        v = operator.index(value)
-    except TypeError:
-        v = None
-    if v is None or isinstance(value, (bool, np.bool_)) or (lo is not None and v < lo) or (hi is not None and v > hi):
+    v = None
+    if not isinstance(value, (bool, np.bool_)):  # (numpy warns on a bool as an index)
+        try:
+            v = operator.index(value)
+        except TypeError:
+            pass
+    if v is None or (lo is not None and v < lo) or (hi is not None and v > hi):
         raise ValueError(f"{name}: expected {what}, got {value!r}")
     return v
 
@@ -291,8 +319,8 @@ def as_geometry(values: Any, name: str, dim: Optional[int], positive: bool = Fal
     if values is None:
         return None
     try:
-        a = np.asarray(values, dtype=np.float64)
-    except (ValueError, TypeError):
+        a = numbers_array(values)
+    except (ValueError, TypeError, OverflowError):
         a = None
     want = f"{dim}" if dim else "2 or 3"
     if a is None or a.ndim != 1 or (a.shape[0] != dim if dim else a.shape[0] not in (2, 3)):

@@ -149,8 +149,7 @@ def read_points(
     """
     if not _is_path(path):
         raise ValueError(f"path: expected a file name, got {type(path).__name__}")
-    if dim not in (None, 2, 3):
-        raise ValueError(f"dim: expected 2, 3 or None, got {dim!r}")
+    dim = _inputs.as_dim(dim) or None
     if labels is not None and not _is_path(labels):
         raise ValueError(f"labels: expected a file or field name, got {type(labels).__name__}")
     lab = "" if labels is None else _inputs.as_path(labels)
@@ -195,8 +194,7 @@ def read_frames(path: PathLike, labels: Optional[str] = None, dim: Optional[int]
     """
     if not _is_path(path):
         raise ValueError(f"path: expected a file name, got {type(path).__name__}")
-    if dim not in (None, 2, 3):
-        raise ValueError(f"dim: expected 2, 3 or None, got {dim!r}")
+    dim = _inputs.as_dim(dim) or None
     if labels is not None and not isinstance(labels, str):
         raise ValueError(f"labels: expected a column name, got {type(labels).__name__}")
     name = _inputs.as_path(path)
@@ -271,8 +269,7 @@ def read_box(path: PathLike, dim: Optional[int] = None, frame: int = 0) -> Optio
     """
     if not _is_path(path):
         raise ValueError(f"path: expected a file name, got {type(path).__name__}")
-    if dim not in (None, 2, 3):
-        raise ValueError(f"dim: expected 2, 3 or None, got {dim!r}")
+    dim = _inputs.as_dim(dim) or None
     box = _inputs.call(_core.read_box, _inputs.as_path(path), _inputs.as_frame(frame))
     return None if box is None else _box_arguments(_inputs.as_path(path), box, dim)
 
@@ -342,7 +339,7 @@ def sample_image(
     out = _inputs.as_choice(output, "output", _OUTPUTS)
     st = _inputs.as_int(step, "step", 1, 2**31 - 1, "an integer >= 2 (exponential) or >= 1 (linear)")
     try:
-        pr = [float(x) for x in probability_range]
+        pr = [float(x) for x in _inputs.numbers_array(probability_range).ravel()]
     except (TypeError, ValueError):
         pr = []
     if len(pr) != 2 or not (0 <= pr[0] <= pr[1] <= 1):

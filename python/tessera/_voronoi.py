@@ -475,9 +475,12 @@ def _tilts(tilt: Any, dim: int) -> Tuple[float, float, float]:
         return (0.0, 0.0, 0.0)
     want = "(xy, xz, yz)" if dim == 3 else "(xy,)"
     try:
-        values = [float(t) for t in tilt]
+        a = _inputs.numbers_array(tilt)
     except (TypeError, ValueError, OverflowError):
-        raise ValueError(f"tilt: expected {want}, numbers, got {tilt!r}") from None
+        a = None
+    if a is None or a.ndim != 1:
+        raise ValueError(f"tilt: expected {want}, numbers, got {tilt!r}")
+    values = [float(t) for t in a]
     if len(values) != (3 if dim == 3 else 1):
         raise ValueError(f"tilt: expected {want} for {dim}D points, got {len(values)} values")
     values += [0.0] * (3 - len(values))
@@ -486,6 +489,8 @@ def _tilts(tilt: Any, dim: int) -> Tuple[float, float, float]:
 
 def _periodic_axes(periodic: Any, dim: int) -> Tuple[bool, bool, bool]:
     """``voronoi``'s ``periodic`` as three flags."""
+    if isinstance(periodic, np.bool_):
+        periodic = bool(periodic)
     if periodic is None or periodic is False:
         return (False, False, False)
     if periodic is True:

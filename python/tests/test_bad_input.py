@@ -122,7 +122,7 @@ def test_arguments_found_by_a_fuzz_of_the_module(tmp_path):
         tessera.read_points(str(tmp_path / "b.vtu") + "\0.npy")
 
 
-def test_flags_and_numbers_are_not_taken_by_truthiness():
+def test_flags_and_numbers_are_not_taken_by_truthiness(tmp_path):
     # Yes/no arguments take bools (numpy's too) and 0/1; an array raised
     # numpy's "truth value ... is ambiguous", naming no argument, and a
     # string such as "False" was true. Numbers are not strings or bools.
@@ -147,6 +147,27 @@ def test_flags_and_numbers_are_not_taken_by_truthiness():
     with pytest.raises(ValueError, match="prune_tolerance: expected a finite number >= 0, got '0.1'"):
         tessera.adjacency(p, prune_tolerance="0.1")
     assert tessera.voronoi(p, padding=np.float32(0.5)).n_cells == 40
+    # The same for numbers in sequences, numpy's bools in periodic and
+    # threads, 0-d arrays as flags (as an .npz gives them), and dim.
+    for bad, name in (({"bounds": ("0", "1") * 3}, "bounds"), ({"bounds": (False, True) * 3}, "bounds"),
+                      ({"bounds": (0, 1, 0, 1, 0, 1), "periodic": True, "tilt": ("0.1", "0", "0")}, "tilt"),
+                      ({"bounds": (0, 1, 0, 1, 0, 1), "periodic": True, "tilt": (1j, 0, 0)}, "tilt"),
+                      ({"threads": np.True_}, "threads")):
+        with pytest.raises(ValueError, match=name + ": expected"):
+            tessera.voronoi(p, **bad)
+    box = (0, 1, 0, 1, 0, 1)
+    assert tessera.voronoi(p, bounds=box, periodic=np.True_).periodic == (True, True, True)
+    assert tessera.voronoi(p, bounds=box, periodic=np.False_).periodic == (False, False, False)
+    assert tessera.voronoi(p, merge=np.array(False)).has_mesh is False
+    vor = tessera.voronoi(p)
+    with pytest.raises(ValueError, match="ignore_outside: expected True or False"):
+        tessera.adjacency(vor, ignore_outside=np.array([True, False]))
+    tessera.adjacency(vor, periodic=np.False_)
+    np.save(tmp_path / "p.npy", p)
+    for bad in (2.0, True, "2"):
+        with pytest.raises(ValueError, match="dim: expected 2, 3 or None"):
+            tessera.read_points(tmp_path / "p.npy", dim=bad)
+    assert tessera.read_points(tmp_path / "p.npy", dim=np.int64(2))[0].shape == (40, 2)
 
 
 def test_validate_after_the_arrays_changed():
