@@ -318,6 +318,18 @@ def sample_image(
         1 and 0; for a file they override its own).
     select : int or sequence of int, optional
         The labels to sample around (each must occur); default every label >= 0.
+    schedule : {'exponential', 'linear'}
+        Which distances are candidates (step 2 above).
+    step : int
+        The schedule's base N: at least 2 for ``exponential``, 1 for
+        ``linear`` (every voxel).
+    randomize : bool
+        Keep each candidate with probability ``clip(1/d, *probability_range)``
+        (step 3); False keeps every candidate.
+    probability_range : (lo, hi)
+        Bounds of that probability, 0 <= lo <= hi <= 1.
+    seed : int
+        Seeds the random choice, per voxel.
     output : {'all', 'labelled', 'background'}
         Points of selected voxels, of the others, or both.
     background_label : int, optional
@@ -326,6 +338,7 @@ def sample_image(
         Random offset radius as a fraction of the smallest spacing (at most
         0.5: points stay in their voxel); 0 = exact voxel centres.
     threads : int, optional
+        Worker threads (None: all cores); the output is the same for any.
 
     Returns
     -------
@@ -380,6 +393,8 @@ def joggle(
     radius : float
         Largest displacement, as a fraction of the bounding-box diagonal, or a
         distance with ``absolute=True``.
+    absolute : bool
+        ``radius`` is a distance, not a fraction of the diagonal.
     mode : {'ball', 'xy', 'xz', 'yz'}
         Uniform in the ball (disk in 2D), or in a disk in a coordinate plane (3D only).
     mask : array_like of bool, shape (N,), optional
@@ -387,6 +402,8 @@ def joggle(
     seed : int
         Each point's displacement depends only on (seed, point id): the same
         for any thread count and any mask.
+    threads : int, optional
+        Worker threads (None: all cores).
     keep_non_finite : bool
         Points with a NaN or infinite coordinate (an organized cloud's missing
         returns) are copied through unmoved instead of refused, so ids stay;
@@ -440,13 +457,22 @@ def fill(
     points : array_like, shape (N, 2) or (N, 3)
     labels : array_like of int, shape (N,), optional
         Kept for the input points; without them they get ``in_label``.
+    strategy : {'uniform', 'adaptive'}
+        One point per empty bin, or dense next to the data and sparse far
+        from it.
     background_label : int
         Label of the added points (< 0).
+    in_label : int
+        Label of the input points when ``labels`` is None.
+    points_per_bin : float
+        Mean input points per bin: the bins' size.
     bounds : sequence of float, optional
         (x0, x1, y0, y1[, z0, z1]); must contain every point.
     joggle : float
         Offset of the added points as a fraction of the bin edge (at most 0.5).
     seed : int
+    threads : int, optional
+        Worker threads (None: all cores); the output is the same for any.
     keep_non_finite : bool
         Points with a NaN or infinite coordinate are kept in place with their
         labels instead of refused; they mark no bin and are not held to
@@ -531,6 +557,8 @@ def probe(
         The value at points outside the box of the voxel centres (a point on
         its far face is inside, and so is one within 1e-9 voxel spacings of
         it, which takes the face's value).
+    threads : int, optional
+        Worker threads (None: all cores).
     keep_non_finite : bool
         A point with a NaN coordinate is outside instead of refused (one with
         an infinite coordinate is outside either way).
