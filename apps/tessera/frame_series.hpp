@@ -8,6 +8,7 @@
 
 #include <initializer_list>
 #include <string>
+#include <vector>
 
 #include "commands.hpp"
 
@@ -56,11 +57,15 @@ int run_frames(const Args& a, std::initializer_list<SeriesOutput<Args>> outputs,
       throw InputError("--frame " + a.compute.frame + " writes one file per frame: " + o.option +
                        "'s name must hold {frame} (e.g. out_{frame}" + extension(path) + ")");
   }
+  // Each frame's arguments are copied from one without the list of frames
+  // (a trajectory may have 10^5 of them).
+  Args base = a;
+  const std::vector<io::FramePlace> frames = std::move(base.compute.frames);
+  base.compute.frames.clear();
   int rc = kExitOk;
-  for (std::size_t k = 0; k < a.compute.frames.size(); ++k) {
-    const io::FramePlace& place = a.compute.frames[k];
-    Args f = a;
-    f.compute.frames.clear();
+  for (std::size_t k = 0; k < frames.size(); ++k) {
+    const io::FramePlace& place = frames[k];
+    Args f = base;
     f.compute.frame_place = place;
     try {
       if (!a.compute.domain_given) {  // the file's box, where it has one: this frame's own
