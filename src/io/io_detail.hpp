@@ -182,6 +182,16 @@ struct FrameTruncated : InputError {
   throw FrameTruncated(path + ": " + what);
 }
 
+/// A frame's atom lines ran out after `read` of its `atoms`, the text's
+/// last line being `last_line` (frame_ended, in both readers' words).
+[[noreturn]] inline void atoms_ended(const std::string& path, std::size_t last_line, std::size_t read,
+                                     std::size_t atoms, bool whole) {
+  frame_ended(path,
+              "the file ends at line " + std::to_string(last_line) + ", after " + std::to_string(read) +
+                  " of the frame's " + std::to_string(atoms) + " atoms",
+              whole);
+}
+
 /// frame_at the file's start.
 template <class Parse>
 auto first_frame(const std::string& path, Parse&& parse) {

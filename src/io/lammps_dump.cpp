@@ -221,10 +221,7 @@ std::vector<double> atom_values(const std::string& path, Lines& lines, std::size
   std::size_t number = 0;
   for (std::size_t k = 0; k < h.atoms; ++k) {
     if (!lines.next(line, number))
-      frame_ended(path,
-                  "the file ends at line " + std::to_string(lines.line_number()) + ", after " + std::to_string(k) +
-                      " of the frame's " + std::to_string(h.atoms) + " atoms",
-                  whole);
+      atoms_ended(path, lines.line_number(), k, h.atoms, whole);
     if (cols.empty()) {  // a frame skipped (find_frame): its lines counted, not split
       if (starts_with(trim(line), item))
         fail(path, "line " + std::to_string(number) + ": found the next item: fewer atoms than NUMBER OF ATOMS");

@@ -263,10 +263,7 @@ std::vector<double> atom_values(const std::string& path, RawLines& lines, std::s
   const bool plain = h.properties.size() == 2 && h.properties[0].name == "species" && h.columns == 4;
   for (std::size_t k = 0; k < h.atoms; ++k) {
     if (!lines.next(line))
-      frame_ended(path,
-                  "the file ends at line " + std::to_string(lines.number()) + ", after " + std::to_string(k) +
-                      " of the frame's " + std::to_string(h.atoms) + " atoms",
-                  whole);
+      atoms_ended(path, lines.number(), k, h.atoms, whole);
     if (cols.empty()) continue;  // a frame skipped (find_frame): its lines counted, not split
     out.resize(out.size() + cols.size());
     const std::size_t got = split_fields(line, f);
