@@ -72,6 +72,9 @@ void check_delaunay_outputs(const DelaunayArgs& a) {
   if (!a.compute.periodic.empty() && (a.no_hull_completion || a.skip_cells >= 0 || a.method != "auto"))
     throw InputError("--periodic: a periodic triangulation has no hull (--no-hull-completion, --skip-cells and "
                      "--method do not apply)");
+  if (a.method == "insertion" && a.no_hull_completion)
+    throw InputError("--method insertion triangulates the whole convex hull: it cannot be combined with "
+                     "--no-hull-completion");
   if (a.output.empty() && a.simplices.empty() && a.simplex_shifts.empty() && !a.validate)
     throw InputError("nothing to do: give -o OUTPUT.vtu|.vtp, --simplices FILE.npy or --validate");
   for (const std::string* p : {&a.output, &a.simplices, &a.simplex_shifts})

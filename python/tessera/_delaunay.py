@@ -387,6 +387,9 @@ def delaunay(
     lab = _inputs.as_labels(labels, pts.shape[0])
     per, tilts = periodic_box(periodic, tilt, bounds, dim)
     rad = _inputs.as_radii(radii, pts.shape[0])
+    full_hull = _inputs.as_flag(complete_hull, "complete_hull")
+    if str(method) == "insertion" and not full_hull:
+        raise ValueError("method='insertion' triangulates the whole convex hull: it needs complete_hull=True")
     dt = _inputs.call(
         _core.delaunay,
         pts,
@@ -395,7 +398,7 @@ def delaunay(
         _inputs.as_padding(padding),
         _inputs.as_flag(ignore_outside, "ignore_outside"),
         _inputs.as_threads(threads),
-        _inputs.as_flag(complete_hull, "complete_hull"),
+        full_hull,
         str(method),
         per,
         tilts,

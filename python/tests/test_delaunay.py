@@ -126,7 +126,7 @@ def test_insertion_method_gives_the_same_simplices():
         by_insertion = tessera.delaunay(p2, method="insertion")
         assert np.array_equal(by_cells.simplices, by_insertion.simplices)
         assert by_insertion.from_insertion == by_insertion.nsimplex and by_cells.from_insertion == 0
-    with pytest.raises(ValueError, match="whole convex hull"):
+    with pytest.raises(ValueError, match="whole convex hull: it needs complete_hull=True"):
         tessera.delaunay(random_points(100, 2, seed=1), method="insertion", complete_hull=False)
 
 

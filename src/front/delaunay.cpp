@@ -688,7 +688,7 @@ Delaunay delaunay(std::span<const double> input, int dim, std::span<const std::i
   const std::span<const double> points = in.points;
   const DelaunayOptions& options = in.options;
   if (options.method == DelaunayMethod::insertion && !options.complete_hull)
-    throw InputError("the insertion method triangulates the whole convex hull: it needs hull completion");
+    throw InputError("the insertion method triangulates the whole convex hull: it needs complete_hull");
   if (!(options.skip_cells < 1))
     throw InputError("skip_cells must be below 1 (a fraction of the points; negative: automatic), got " +
                      std::to_string(options.skip_cells));

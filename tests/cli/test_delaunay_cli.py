@@ -207,6 +207,8 @@ class DelaunayCommand(unittest.TestCase):
         self.fails(["bench", "delaunay", self.path("p3.npy"), "--repeat", "0"])
         self.fails(["delaunay", self.path("p2.npy"), "-o", out, "--method", "insertion", "--no-hull-completion"], [out])
         self.fails(["delaunay", self.path("p3.npy"), "-o", out, "--method", "insertion", "--no-hull-completion"], [out])
+        r = run(["delaunay", self.path("p3.npy"), "-o", out, "--method", "insertion", "--no-hull-completion"])
+        self.assertIn("--no-hull-completion", r.stderr)  # the option the user gave, not the library's field
         self.fails(["delaunay", self.path("p3.npy"), "-o", out, "--method", "qhull"], [out])
 
 
