@@ -6,6 +6,7 @@
 // as one).
 #pragma once
 
+#include <cstdio>
 #include <initializer_list>
 #include <string>
 #include <vector>
@@ -42,8 +43,10 @@ Args with_frame_names(Args a, std::initializer_list<SeriesOutput<Args>> outputs,
 /// Every output given must hold {frame} (standard output is refused:
 /// several tables in one stream). Each frame's files are whole when
 /// written; an error in a frame names it, and the files of the frames
-/// before it stay. The exit code is the worst of the frames' (a failed
-/// --validate goes on to the next frame).
+/// before it stay. A frame of no atoms (a dump of a group that was empty
+/// then) is skipped with a note on standard error and gets no files; a
+/// series of such frames alone is an error. The exit code is the worst of
+/// the frames' (a failed --validate goes on to the next frame).
 template <class Args, class Run>
 int run_frames(const Args& a, std::initializer_list<SeriesOutput<Args>> outputs, Run&& run_one) {
   if (a.compute.frames.empty())
@@ -63,8 +66,15 @@ int run_frames(const Args& a, std::initializer_list<SeriesOutput<Args>> outputs,
   const std::vector<io::FramePlace> frames = std::move(base.compute.frames);
   base.compute.frames.clear();
   int rc = kExitOk;
+  std::size_t computed = 0;
   for (std::size_t k = 0; k < frames.size(); ++k) {
     const io::FramePlace& place = frames[k];
+    if (place.atoms == 0) {
+      std::fprintf(stderr, "tessera: frame %zu of %s (from line %zu) holds no atoms: skipped, no files for it\n",
+                   place.index, a.compute.input.c_str(), place.line);
+      continue;
+    }
+    ++computed;
     Args f = base;
     f.compute.frame_place = place;
     try {
@@ -79,9 +89,11 @@ int run_frames(const Args& a, std::initializer_list<SeriesOutput<Args>> outputs,
       if (r != kExitOk) rc = r;
     } catch (const InputError& e) {
       throw InputError("frame " + std::to_string(place.index) + ": " + e.what() +
-                       (k == 0 ? "" : "; the frames before it were written"));
+                       (computed == 1 ? "" : "; the frames before it were written"));
     }
   }
+  if (computed == 0)
+    throw InputError("--frame " + a.compute.frame + ": every frame selected holds no atoms; nothing was written");
   return rc;
 }
 

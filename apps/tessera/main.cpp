@@ -79,8 +79,8 @@ void add_compute_options(CLI::App* app, ComputeArgs& c, std::vector<std::string>
                   "would be; --labels and --radii columns are read from it (a .npy file serves every frame). Also "
                   "a series (not in bench), all or START:STOP[:STEP] as Python's slices (-10: the last ten, ::5 "
                   "every fifth): each frame is computed in turn, and every output's name must hold {frame}, "
-                  "replaced by the frame's index (-o cells_{frame}.vtu, a series ParaView opens as one); with one "
-                  "INDEX, {frame} in a name is replaced alike")
+                  "replaced by the frame's index (-o cells_{frame}.vtu, a series ParaView opens as one), and a "
+                  "frame of no atoms is skipped with a note; with one INDEX, {frame} in a name is replaced alike")
       ->type_name("INDEX")
       ->check(CLI::Validator(
           [](std::string& v) {

@@ -96,10 +96,11 @@ std::vector<double> read_text_column(const std::string& path, const std::string&
 
 /// Where a trajectory's frame ended: the bytes of the parsed text it took
 /// (up to the next frame's first line), that line's number, and whether no
-/// frame follows.
+/// frame follows; and the frame's atoms (its header's count).
 struct FrameEnd {
   std::size_t bytes = 0, next_line = 1;
   bool last = true;
+  std::size_t atoms = 0;
 };
 
 /// LAMMPS dumps (.dump, .lammpstrj; lammps_dump.cpp): a frame's atoms

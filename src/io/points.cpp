@@ -214,7 +214,7 @@ std::vector<FramePlace> walk_frames(const std::string& path, Stop&& stop) {
   if (!is_trajectory(path))
     detail::fail(path, "not a trajectory: frames are read from LAMMPS dumps (.dump, .lammpstrj) and XYZ files");
   const bool dump = detail::is_dump_extension(detail::lower_extension(path));
-  std::vector<FramePlace> starts;  // 24 bytes a frame
+  std::vector<FramePlace> starts;  // 32 bytes a frame
   FramePlace at;
   for (;;) {
     starts.push_back(at);
@@ -225,6 +225,7 @@ std::vector<FramePlace> walk_frames(const std::string& path, Stop&& stop) {
     } catch (const detail::FrameTruncated&) {
       break;  // the last frame, cut short (still being written): listed, and reading it says so
     }
+    starts.back().atoms = static_cast<std::int64_t>(end.atoms);
     if (end.last) break;
     at.offset += end.bytes;
     at.line = end.next_line;

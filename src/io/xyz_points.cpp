@@ -381,7 +381,9 @@ FrameEnd skip_xyz_frame(const std::string& path, std::uint64_t offset, std::size
   return frame_at(path, offset, [&](std::string_view text, std::optional<std::string_view> tail) {
     RawLines lines(text, line);
     FrameEnd end;
-    atom_values(path, lines, text.size(), read_header(path, lines, !tail), {}, tail, &end);
+    const auto header = read_header(path, lines, !tail);
+    atom_values(path, lines, text.size(), header, {}, tail, &end);
+    end.atoms = header.atoms;
     return end;
   });
 }

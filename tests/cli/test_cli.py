@@ -1315,6 +1315,25 @@ class FileBoxes(TempDirCase):
                 self.ok(["voronoi", self.p("mixed.xyz"), "--frame", str(k), "--cell-table", self.p("one.csv"), "-q"])
                 self.assertEqual(read_bytes(self.p("x_%d.csv" % k)), read_bytes(self.p("one.csv")), (sel, k))
         self.assertAlmostEqual(np.loadtxt(self.p("x_1.csv"), delimiter=",", skiprows=1)[:, 2].sum(), 8.0, delta=1e-12)
+        # A frame of no atoms (a dump of a group empty then) is skipped in a
+        # series, with a note; asked for alone, or a series of only such
+        # frames, it is an error.
+        empty = texts[1].split("ITEM: NUMBER OF ATOMS\n")[0] + "ITEM: NUMBER OF ATOMS\n0\n" + \
+            "ITEM: BOX BOUNDS pp pp pp\n0 1\n0 1\n0 1\nITEM: ATOMS id type x y z radius\n"
+        with open(self.p("gap.dump"), "w") as f:
+            f.write("\n".join([texts[0], empty, texts[2], empty]))
+        r = self.ok(["voronoi", self.p("gap.dump"), "--frame", "all", "--cell-table", self.p("e_{frame}.csv"), "-q"])
+        self.assertEqual(r.stderr.count("holds no atoms: skipped, no files for it"), 2, r.stderr)
+        self.assertIn("frame 1 of %s (from line " % self.p("gap.dump"), r.stderr)
+        self.assertEqual(sorted(f for f in os.listdir(self.dir) if f.startswith("e_")), ["e_0.csv", "e_2.csv"])
+        self.ok(["voronoi", traj, "--frame", "2", "--cell-table", self.p("one.csv"), "-q"])
+        self.assertEqual(read_bytes(self.p("e_2.csv")), read_bytes(self.p("one.csv")))
+        for sel, fragment in (("1", "frame 1: %s: no points" % self.p("gap.dump")),
+                              ("1::2", "--frame 1::2: every frame selected holds no atoms; nothing was written")):
+            r = run(["voronoi", self.p("gap.dump"), "--frame", sel, "--cell-table", self.p("g_{frame}.csv")])
+            self.assertEqual(r.returncode, 2, sel)
+            self.assertIn(fragment, r.stderr)
+            self.assertFalse(os.path.exists(self.p("g_1.csv")))
         # A trajectory still being written: its last frame cut short. The
         # frames before it are read; the cut one is named, with its line.
         with open(traj) as f:

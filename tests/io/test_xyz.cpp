@@ -217,7 +217,11 @@ TEST(Xyz, FramesByIndex) {
 TEST(Xyz, FrameOfNoAtoms) {
   TempDir dir;
   const std::string p = dir.write("z.xyz", "2\n\nC 0 0 0\nC 1 1 1\n0\nempty frame\n3\n\nC 0 0 0\nC 1 1 1\nC 2 0 1\n");
-  EXPECT_EQ(tessera::io::find_frames(p).size(), 3u);
+  const auto all = tessera::io::find_frames(p);
+  ASSERT_EQ(all.size(), 3u);
+  EXPECT_EQ(all[0].atoms, 2);  // the walk went past every frame
+  EXPECT_EQ(all[1].atoms, 0);
+  EXPECT_EQ(all[2].atoms, 3);
   const auto at = tessera::io::find_frame(p, -1);
   EXPECT_EQ(at.index, 2u);
   EXPECT_EQ(at.line, 7u);

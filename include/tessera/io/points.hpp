@@ -32,6 +32,9 @@ struct FramePlace {
   std::uint64_t offset = 0;
   std::size_t line = 1;
   std::size_t index = 0;
+  /// The frame's number of atoms, where the walk that found it went past
+  /// it (find_frames: every frame but one cut short); -1 where it did not.
+  std::int64_t atoms = -1;
 };
 
 struct ReadOptions {
