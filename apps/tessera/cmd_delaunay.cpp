@@ -172,8 +172,8 @@ int run_delaunay_frame(const DelaunayArgs& a) {
     if (!dt.ignored_outside_bounds.empty())
       std::fprintf(stderr, "tessera: %zu points outside --bounds (or not finite) ignored\n",
                    dt.ignored_outside_bounds.size());
-    std::fprintf(stderr, "tessera: read %.3f s, triangulate %.3f s (%d threads), write %.3f s\n", read_s, compute_s,
-                 dt.threads_used, write_s);
+    std::fprintf(stderr, "tessera: read %.3f s, triangulate %.3f s (%d thread%s), write %.3f s\n", read_s, compute_s,
+                 dt.threads_used, dt.threads_used == 1 ? "" : "s", write_s);
     for (const auto& w : written) std::fprintf(stderr, "tessera: wrote %s\n", w.c_str());
   }
   if (a.validate) {

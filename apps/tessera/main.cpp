@@ -64,6 +64,8 @@ constexpr const char* kExitCodes =
 void add_compute_options(CLI::App* app, ComputeArgs& c, std::vector<std::string>& raw_bounds) {
   // INPUT is checked after parsing (finish_compute_args), not ->required():
   // "--bounds 0 1 0 1 pts.npy" hands pts.npy to --bounds, which gives it back.
+  const CLI::App* parent = app->get_parent();
+  const std::string command = (parent && parent->get_parent() ? parent->get_name() + " " : "") + app->get_name();
   app->add_option("INPUT", c.input,
                   "Point file (required): .npy (float array, shape (N,2) or (N,3), or records with fields "
                   "x,y[,z]), .csv/.xyz/.txt (the columns a header names x,y[,z], else the first 2 or 3 "
@@ -72,7 +74,7 @@ void add_compute_options(CLI::App* app, ComputeArgs& c, std::vector<std::string>
                   "points, as ParaView saves them), .pcd (PCL's point clouds) or .dump/.lammpstrj (a LAMMPS dump's first "
                   "frame, or --frame's: x y z, xu yu zu or scaled xs ys zs, atoms in file order; its box and periodic axes are the "
                   "domain unless --bounds, --periodic or --tilt is given); - reads standard input, in any of these "
-                  "formats (rbox 1000 D3 | tessera voronoi - ...)");
+                  "formats (rbox 1000 D3 | tessera " + command + " - ...)");
   app->add_option("--frame", c.frame,
                   "Of a trajectory (a LAMMPS dump, an XYZ file): the frame to read, 0 the first (default), 1 the "
                   "next; negative counts from the end, -1 the last. Its box is the domain, as the first frame's "
@@ -136,16 +138,18 @@ void add_cell_method_option(CLI::App* app, ComputeArgs& c) {
       ->capture_default_str();
 }
 
-/// --radii of the commands that take power cells.
-void add_radii_option(CLI::App* app, ComputeArgs& c) {
+/// --radii of the commands that take power cells (`with_method`: the
+/// command has --method).
+void add_radii_option(CLI::App* app, ComputeArgs& c, bool with_method) {
   app->add_option("--radii", c.radii,
                   "Sphere radii for power cells (the radical tessellation of polydisperse spheres, as Voro++'s "
                   "container_poly): FILE.npy (float array, length N) or the name of a numeric .ply vertex property / "
                   ".csv column / .vtp or .vtu point data array / LAMMPS dump column / .pcd or structured .npy field. Each cell is where "
                   "its point's power |x-p|^2 - r^2 is the least; a point may own no cell (listed as empty), and of "
-                  "coincident points the largest radius owns it. Radii must be finite and >= 0; either --method "
-                  "(the search, or the regular triangulation's stars); with --periodic every image has its point's "
-                  "radius")
+                  "coincident points the largest radius owns it. Radii must be finite and >= 0" +
+                      std::string(with_method ? "; either --method (the search, or the regular triangulation's stars)"
+                                              : "") +
+                      "; with --periodic every image has its point's radius")
       ->type_name("FILE|NAME");
 }
 
@@ -163,20 +167,28 @@ void add_regular_radii_option(CLI::App* app, ComputeArgs& c) {
       ->type_name("FILE|NAME");
 }
 
-/// --periodic of the commands whose product is the cells themselves.
-void add_periodic_option(CLI::App* app, ComputeArgs& c) {
+constexpr const char* kAnyAxes = "e.g. xyz (a simulation's or a crystal's periodic box), xy or x";
+constexpr const char* kEveryAxis = "every axis: xyz (xy in 2D)";
+constexpr const char* kPeriodicTriangulation =
+    "The triangulation of the points among all their images, each simplex once (--simplex-shifts: its vertices' "
+    "images); walls on some axes are refused (the periodic cells with walls serve such boxes)";
+
+/// --periodic and --tilt. `images`: where the command's output names the
+/// images a cell meets across the box (e.g. "neighbours may be images
+/// (--neighbor-shifts)"), or what it says of them.
+void add_periodic_option(CLI::App* app, ComputeArgs& c, const std::string& images, const char* axes_example) {
   app->add_option("--periodic", c.periodic,
-                  "Periodic axes, e.g. xyz (a simulation's or a crystal's periodic box), xy or x: --bounds is the "
-                  "box, which repeats along them, with no walls there; points outside it are wrapped in. The box "
-                  "and the coordinates along those axes are rounded to the spacing of doubles at a few box "
-                  "lengths (2^-51 for a unit box) so that every image is exact. Cells keep their shape across the "
-                  "box's faces; neighbours may be images (--neighbor-shifts)")
+                  std::string("Periodic axes, ") + axes_example +
+                      ": --bounds is the box, which repeats along them, with no walls there; points outside it are "
+                      "wrapped in. The box and the coordinates along those axes are rounded to the spacing of "
+                      "doubles at a few box lengths (2^-51 for a unit box) so that every image is exact. " +
+                      images)
       ->type_name("AXES");
   app->add_option("--tilt", c.tilt,
                   "With --periodic: a triclinic (sheared) box's tilt factors as lengths, as LAMMPS and Voro++ give "
                   "them: XY in 2D, XY XZ YZ in 3D. The box is the parallelepiped spanned from --bounds' lower "
                   "corner by a = (Lx,0,0), b = (XY,Ly,0), c = (XZ,YZ,Lz), L the extents of --bounds; a tilt needs "
-                  "both its axes periodic. Points are wrapped into it, and --neighbor-shifts count a, b, c")
+                  "both its axes periodic. Points are wrapped into it, and shifts count a, b, c")
       ->type_name("XY [XZ YZ]")
       ->expected(1, 3);
 }
@@ -231,8 +243,8 @@ int main(int argc, char** argv) {
   std::vector<std::string> vor_bounds, bench_bounds;
   add_compute_options(vor, va.compute, vor_bounds);
   add_cell_method_option(vor, va.compute);
-  add_radii_option(vor, va.compute);
-  add_periodic_option(vor, va.compute);
+  add_radii_option(vor, va.compute, true);
+  add_periodic_option(vor, va.compute, "Cells keep their shape across the box's faces; neighbours may be images (--neighbor-shifts)", kAnyAxes);
   vor->add_option("-o,--output", va.output,
                   "Cells as VTK XML: .vtu (3D, one polyhedron per cell) or .vtp (2D, one polygon per cell), "
                   "with cell data GeneratorId, Region, Volume/Area, NumberOfFaces/Edges, NumberOfNeighbors");
@@ -262,7 +274,8 @@ int main(int argc, char** argv) {
       "  tessera voronoi points.csv --dim 2 --bounds 0 1 0 1 -o cells.vtp\n"
       "  tessera voronoi grains.ply --labels grain --neighbors nb.npy --validate\n"
       "  tessera voronoi frame.npy --bounds 0 10 0 10 0 10 --periodic xyz --cell-table cells.csv --neighbors nb.npy "
-      "--neighbor-shifts shifts.npy");
+      "--neighbor-shifts shifts.npy\n" +
+      std::string(kExitCodes));
 
   DelaunayArgs dla;
   std::vector<std::string> del_bounds, bench_del_bounds;
@@ -275,7 +288,7 @@ int main(int argc, char** argv) {
   del->add_option("--simplices", dla.simplices,
                   "Simplices as an int64 .npy array of shape (M, D+1), point ids; tetrahedra positively oriented, "
                   "triangles counter-clockwise; - writes it to standard output");
-  add_periodic_option(del, dla.compute);
+  add_periodic_option(del, dla.compute, kPeriodicTriangulation, kEveryAxis);
   add_regular_radii_option(del, dla.compute);
   del->add_option("--simplex-shifts", dla.simplex_shifts,
                   "With --periodic (every axis): which image each vertex of --simplices is, as an int8 .npy array "
@@ -315,7 +328,8 @@ int main(int argc, char** argv) {
       "Examples:\n"
       "  tessera delaunay points.npy -o tets.vtu --simplices tets.npy\n"
       "  tessera delaunay points.csv --dim 2 -o triangles.vtp --validate\n"
-      "  tessera delaunay spheres.ply --radii radius --simplices tets.npy --validate");
+      "  tessera delaunay spheres.ply --radii radius --simplices tets.npy --validate\n" +
+      std::string(kExitCodes));
 
   // Products read off the merged cells (cmd_dual.cpp).
   GraphArgs ga;
@@ -323,7 +337,7 @@ int main(int argc, char** argv) {
   CLI::App* graph = app.add_subcommand(
       "graph", "The adjacency graph: each generator's face neighbours (wheels and spokes) with spoke classes");
   add_compute_options(graph, ga.compute, graph_bounds);
-  add_radii_option(graph, ga.compute);
+  add_radii_option(graph, ga.compute, false);
   graph->add_option("-o,--output", ga.output,
                     "Graph as VTK PolyData lines (.vtp): points = input points, one line per undirected edge, "
                     "cell data SpokeClass (0 same region, 1 region boundary, 3 outside) and FaceArea/FaceLength. "
@@ -338,7 +352,7 @@ int main(int argc, char** argv) {
   graph->add_option("--spoke-measures", ga.spoke_measures,
                     "Area (3D) or length (2D) of the face behind every spoke of --csr, as a float64 .npy array: "
                     "face-area weights for neighbour statistics; both directions of a face get the same value");
-  add_periodic_option(graph, ga.compute);
+  add_periodic_option(graph, ga.compute, "Cells keep their shape across the box's faces; a spoke may lead to an image (--spoke-shifts)", kAnyAxes);
   graph->add_option("--spoke-shifts", ga.spoke_shifts,
                     "With --periodic: which image every spoke of --csr leads to, as an int8 .npy array of shape "
                     "(spokes, D) in box lengths (lattice vectors with --tilt); the twin of i -> (j, s) is j -> (i, -s)");
@@ -352,7 +366,7 @@ int main(int argc, char** argv) {
   CLI::App* faces = app.add_subcommand(
       "faces", "Voronoi faces (3D polygons, 2D segments), each once, oriented, with BoundaryLabels per face");
   add_compute_options(faces, fa.compute, faces_bounds);
-  add_radii_option(faces, fa.compute);
+  add_radii_option(faces, fa.compute, false);
   faces->add_option("-o,--output", fa.output,
                     "Faces as VTK PolyData (.vtp), cell data BoundaryLabels, Sides, SpokeClass; with --periodic "
                     "also SideShift (which image of side 1 the face meets; each face lies where side 0's cell "
@@ -362,7 +376,7 @@ int main(int argc, char** argv) {
                     "surface-net: faces between different regions")
       ->required();
   faces->add_flag("--capping", fa.capping, "surface-net: also the boundary faces, closing every region");
-  add_periodic_option(faces, fa.compute);
+  add_periodic_option(faces, fa.compute, "Cells keep their shape across the box's faces; a face is placed where its side-0 cell is, and side 1 may be an image (cell data SideShift)", kAnyAxes);
   faces->add_flag("-q,--quiet", fa.quiet, "No summary and no progress bar");
 
   FlowerArgs wa;
@@ -378,7 +392,7 @@ int main(int argc, char** argv) {
                      "the cell lies where its point is wrapped to, and each neighbour is drawn at the image across "
                      "its face");
   flower->add_flag("--glyphs", wa.glyphs, "Also draw each petal and the circumflower as a circle (2D) / sphere (3D)");
-  add_periodic_option(flower, wa.compute);
+  add_periodic_option(flower, wa.compute, "Cells keep their shape across the box's faces; the site is the point as wrapped, each neighbour at its image across the face", kAnyAxes);
   flower->add_flag("-q,--quiet", wa.quiet, "No summary and no progress bar");
 
   // Generalized surface nets (cmd_surface_nets.cpp).
@@ -390,7 +404,7 @@ int main(int argc, char** argv) {
       "label image");
   add_compute_options(snets, sna.compute, sn_bounds);
   add_surface_nets_options(snets, sna, false);
-  add_periodic_option(snets, sna.compute);
+  add_periodic_option(snets, sna.compute, "Cells keep their shape across the box's faces; the surfaces close up across the box (their pieces fit by lattice translations; an image's default box is its voxels)", kAnyAxes);
 
   BenchArgs ba;
   CLI::App* bench = app.add_subcommand("bench", "Benchmarks printing one JSON line per run on stdout");
@@ -403,8 +417,8 @@ int main(int argc, char** argv) {
       "volume_sum,repeat}}; seconds is wall time of the computation only");
   add_compute_options(bench_vor, ba.compute, bench_bounds);
   add_cell_method_option(bench_vor, ba.compute);
-  add_radii_option(bench_vor, ba.compute);
-  add_periodic_option(bench_vor, ba.compute);
+  add_radii_option(bench_vor, ba.compute, true);
+  add_periodic_option(bench_vor, ba.compute, "Cells keep their shape across the box's faces", kAnyAxes);
   bench_vor->add_option("--repeat", ba.repeat, "Number of timed runs")
       ->check(Positive)
       ->capture_default_str();
@@ -418,7 +432,7 @@ int main(int argc, char** argv) {
       "{\"tool\":\"tessera\",\"op\":\"delaunay3\"|\"delaunay2\",\"n\",\"threads\",\"seconds\",\"simplices\","
       "\"extra\":{cpu_user_s,cpu_sys_s,minflt,peak_rss_bytes,from_cells,from_hull_completion,from_insertion,skipped_cells,hidden,exact_calls,repeat}}");
   add_compute_options(bench_del, bda.compute, bench_del_bounds);
-  add_periodic_option(bench_del, bda.compute);
+  add_periodic_option(bench_del, bda.compute, kPeriodicTriangulation, kEveryAxis);
   add_regular_radii_option(bench_del, bda.compute);
   bench_del->add_option("--repeat", bda.repeat, "Number of timed runs")
       ->check(Positive)
@@ -440,7 +454,7 @@ int main(int argc, char** argv) {
       "triangulation_s,repeat}}");
   add_compute_options(bench_sn, bsna.compute, bench_sn_bounds);
   add_surface_nets_options(bench_sn, bsna, true);
-  add_periodic_option(bench_sn, bsna.compute);
+  add_periodic_option(bench_sn, bsna.compute, "Cells keep their shape across the box's faces", kAnyAxes);
 
   DemoArgs da;
   CLI::App* demo = app.add_subcommand(

@@ -170,6 +170,11 @@ void write_simplices_vtk(const std::string& path, const Delaunay& dt, std::span<
   if (!radii.empty() && radii.size() != dt.n_points)
     throw InputError("cannot write " + path + ": " + std::to_string(radii.size()) + " radii for " +
                      std::to_string(dt.n_points) + " points");
+  // The rows index the points: a span of another input would be read past
+  // its end (a periodic triangulation carries its wrapped points itself).
+  if (!dt.is_periodic() && points.size() != dt.n_points * static_cast<std::size_t>(dt.dim))
+    throw InputError("cannot write " + path + ": " + std::to_string(points.size()) + " coordinates for the " +
+                     std::to_string(dt.n_points) + " points of a " + std::to_string(dt.dim) + "D triangulation");
   if (dt.is_periodic() && (ext == ".vtu" || (ext == ".vtp" && dt.dim == 2))) {
     const Unrolled u = unroll(dt);
     return ext == ".vtu" ? write_vtu(path, u.dt, u.points, u.point_id, radii)

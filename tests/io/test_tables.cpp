@@ -1,13 +1,18 @@
-// Cell tables (.csv/.npy) and the CSR neighbour array, from hand-made Cells.
+// Cell tables (.csv/.npy) and the CSR neighbour array, from hand-made Cells;
+// the triangulation writer's check of its points.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdint>
+#include <span>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "io/io_test_util.hpp"
 #include "tessera/io/npy.hpp"
 #include "tessera/io/tables.hpp"
+#include "tessera/io/vtk_simplices.hpp"
 
 using namespace tessera_test;
 
@@ -141,4 +146,26 @@ TEST(Tables, InconsistentCellsIsAProgrammingError) {
   auto c = make_cells3();
   c.volume.pop_back();
   EXPECT_THROW(tessera::io::write_cell_table(dir.file("x.csv"), c), std::invalid_argument);
+}
+
+// The triangulation's writer reads its points by the rows' ids: points of
+// another input (too few) are refused, not read past their end, and nothing
+// is written.
+TEST(SimplicesVtk, PointsMustBeTheTriangulations) {
+  TempDir dir;
+  tessera::Delaunay dt;
+  dt.dim = 2;
+  dt.n_points = 4;
+  dt.simplices = {0, 1, 2, 1, 3, 2};
+  const std::vector<double> points = {0, 0, 1, 0, 0, 1, 1, 1};
+  const std::string path = dir.file("t.vtu");
+  for (const std::size_t n : {0, 2, 6, 10}) {
+    const std::span<const double> some(points.data(), std::min(n, points.size()));
+    const std::vector<double> more(n, 0.5);
+    const std::string msg = input_error([&] { tessera::io::write_simplices_vtk(path, dt, n > 8 ? more : some); });
+    EXPECT_NE(msg.find("coordinates for the 4 points of a 2D triangulation"), std::string::npos) << msg;
+    EXPECT_FALSE(fs::exists(path));
+  }
+  tessera::io::write_simplices_vtk(path, dt, points);
+  EXPECT_TRUE(fs::exists(path));
 }
