@@ -79,6 +79,7 @@ void check_delaunay_outputs(const DelaunayArgs& a) {
     throw InputError("nothing to do: give -o OUTPUT.vtu|.vtp, --simplices FILE.npy or --validate");
   for (const std::string* p : {&a.output, &a.simplices, &a.simplex_shifts})
     if (!p->empty()) io::check_writable(*p);
+  check_distinct_outputs({{"-o", &a.output}, {"--simplices", &a.simplices}, {"--simplex-shifts", &a.simplex_shifts}});
   route_standard_output({&a.simplices, &a.simplex_shifts});
 }
 

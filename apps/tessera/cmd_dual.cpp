@@ -94,6 +94,11 @@ int run_graph_frame(const GraphArgs& a) {
   if (!(a.prune_tolerance >= 0) || !std::isfinite(a.prune_tolerance))
     throw InputError("--prune-tolerance must be a finite number >= 0");
   check_bounds_arg(a.compute.bounds);
+  check_distinct_outputs({{"-o", &a.output},
+                          {"--csr", &a.csr},
+                          {"--spoke-classes", &a.spoke_classes},
+                          {"--spoke-measures", &a.spoke_measures},
+                          {"--spoke-shifts", &a.spoke_shifts}});
   for (const std::string* p : {&a.output, &a.csr, &a.spoke_classes, &a.spoke_measures, &a.spoke_shifts})
     if (!p->empty()) io::check_writable(*p);
 

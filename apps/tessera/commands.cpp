@@ -72,6 +72,26 @@ void route_standard_output(std::initializer_list<const std::string*> outputs) {
   stdout = stderr;
 }
 
+void check_distinct_outputs(std::initializer_list<std::pair<const char*, const std::string*>> outputs) {
+  // The same file by another spelling (./a.npy, a link to it) is the same
+  // output: compared as the paths resolve, where they can be.
+  auto resolved = [](const std::string& p) {
+    std::error_code ec;
+    const std::filesystem::path r = std::filesystem::weakly_canonical(p, ec);
+    return ec ? std::filesystem::path(p).lexically_normal() : r;
+  };
+  std::vector<std::pair<const char*, std::filesystem::path>> seen;
+  for (const auto& [option, path] : outputs) {
+    if (path->empty() || *path == "-") continue;
+    const std::filesystem::path r = resolved(*path);
+    for (const auto& [other, before] : seen)
+      if (before == r)
+        throw InputError(std::string(other) + " and " + option + " name the same file, " + *path +
+                         ": each output needs its own");
+    seen.emplace_back(option, r);
+  }
+}
+
 namespace {
 
 const char* axis_name(int axis) { return axis == 0 ? "x" : axis == 1 ? "y" : "z"; }
@@ -570,6 +590,10 @@ int run_voronoi_frame(const VoronoiArgs& a) {
   // Fail before the (possibly long) read and computation, not after.
   for (const std::string* p : {&a.output, &a.cell_table, &a.neighbors, &a.neighbor_shifts})
     if (!p->empty()) io::check_writable(*p);
+  check_distinct_outputs({{"-o", &a.output},
+                          {"--cell-table", &a.cell_table},
+                          {"--neighbors", &a.neighbors},
+                          {"--neighbor-shifts", &a.neighbor_shifts}});
   route_standard_output({&a.cell_table, &a.neighbors});
 
   auto t0 = Clock::now();

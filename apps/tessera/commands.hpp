@@ -301,6 +301,11 @@ std::string extension(const std::string& path);  ///< lower-cased, with the dot;
 /// command's summary then goes to standard error instead.
 void route_standard_output(std::initializer_list<const std::string*> outputs);
 
+/// A command's output files (option as the messages name it, path; empty
+/// and "-" skipped) must be distinct files: two options naming one file
+/// would leave only the one written last. InputError naming both options.
+void check_distinct_outputs(std::initializer_list<std::pair<const char*, const std::string*>> outputs);
+
 /// How to name output `path` in a summary: "stdout" for "-".
 inline std::string shown_output(const std::string& path) { return path == "-" ? "stdout" : path; }
 

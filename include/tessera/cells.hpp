@@ -308,6 +308,9 @@ struct ValidationReport {
 /// cell's radius (plus the rounding of adding the generator's coordinates),
 /// or one of whose corners lies farther than that from its exact position.
 inline constexpr double measure_tolerance = 0x1p-28;
+/// `labels`: those the cells were computed with (empty: none), which say
+/// whether outside points carve the domain (then the volumes are not summed
+/// against it); std::invalid_argument where not empty and not n_points long.
 /// `points` (n_points x dim, the coordinates the cells were computed from)
 /// enables the exact check of sampled cells' measures; an empty span skips
 /// it. std::invalid_argument where its size is not n_points x dim. Cells of

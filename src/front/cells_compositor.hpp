@@ -611,7 +611,9 @@ class CellsCompositor {
         const std::int32_t c = cell_at(b.gen[t]);
         if (c < 0) continue;
         const std::size_t cu = static_cast<std::size_t>(c);
-        auto [v0, v1] = range_of(b.vert_end, t);
+        // Not a structured binding: the lambdas below capture v0, which
+        // Clang before 16 does not allow for bindings.
+        const std::uint32_t v0 = range_of(b.vert_end, t).first, v1 = range_of(b.vert_end, t).second;
         gid.resize(v1 - v0);
         if (sought.size() < v1 - v0) sought.resize(v1 - v0);
         slot.clear();

@@ -318,6 +318,9 @@ ValidationReport validate_in_arena(const Cells& c, std::span<const std::int32_t>
 
 ValidationReport validate(const Cells& c, std::span<const std::int32_t> labels, std::span<const double> points,
                           std::span<const double> radii) {
+  if (!labels.empty() && labels.size() != c.n_points)
+    throw std::invalid_argument("validate: " + std::to_string(labels.size()) + " labels given for " +
+                                std::to_string(c.n_points) + " points");
   if (!points.empty() && points.size() != c.n_points * static_cast<std::size_t>(c.dim))
     throw std::invalid_argument("validate: " + std::to_string(points.size()) + " coordinates given for " +
                                 std::to_string(c.n_points) + " points in " + std::to_string(c.dim) + "D");

@@ -170,6 +170,9 @@ TEST(Invariants, ValidateChecksSampledMeasuresExactly) {
     }
     const std::vector<double> fewer(pts.begin(), pts.end() - dim);
     EXPECT_THROW(tessera::validate(good, {}, fewer), std::invalid_argument);
+    // Labels of another input (10 for these points) were taken as none.
+    const std::vector<std::int32_t> ten(10, 0);
+    EXPECT_THROW(tessera::validate(good, ten, pts), std::invalid_argument);
   }
 }
 

@@ -1895,6 +1895,22 @@ class BadInput(TempDirCase):
         self.assertEqual(r.returncode, 2)
         self.assertTrue(r.stderr.startswith("tessera: error:"))
 
+    def test_outputs_name_distinct_files(self):
+        # Two options naming one file kept only the one written last (the
+        # neighbours over the cell table), and the summary listed it twice.
+        same = self.p("same.npy")
+        self.fails(["voronoi", self.good3, "--cell-table", same, "--neighbors", same],
+                   "--cell-table and --neighbors name the same file", outputs=[same])
+        os.mkdir(self.p("sub"))
+        self.fails(["voronoi", self.good3, "--neighbors", same, "--cell-table", self.p("sub/../same.npy")],
+                   "--cell-table and --neighbors name the same file", outputs=[same])
+        self.fails(["delaunay", self.good3, "--simplices", same, "--simplex-shifts", same, "--periodic", "xyz",
+                    "--bounds", "0", "1", "0", "1", "0", "1"], "--simplices and --simplex-shifts", outputs=[same])
+        self.fails(["graph", self.good3, "--csr", same, "--spoke-measures", same], "--csr and --spoke-measures",
+                   outputs=[same])
+        r = run(["voronoi", self.good3, "--cell-table", "-", "--neighbors", same])  # standard output is no file
+        self.assertEqual(r.returncode, 0, r.stderr)
+
     def test_output_extensions(self):
         self.fails(["voronoi", self.good3, "-o", self.out("c.vtp")], ".vtu")
         self.fails(["voronoi", self.good2, "-o", self.out("c.vtu")], ".vtp")

@@ -290,7 +290,9 @@ namespace detail {
 // Two lanes of doubles in GCC's vector extension: one SSE2 register, the
 // default x86-64-v2 target's width. Comparisons yield 0 / -1 per lane.
 using Lane = double __attribute__((vector_size(16)));
-using LaneMask = std::int64_t __attribute__((vector_size(16)));
+// The comparisons' own type: vectors of long in GCC, of long long in Clang,
+// whose vector conditionals need both arms of one type.
+using LaneMask = decltype(Lane{} < Lane{});
 inline Lane load(const double* p) {
   Lane v;
   std::memcpy(&v, p, sizeof v);
@@ -372,7 +374,7 @@ std::size_t classify(const FilterLanes<D>& f, const double* n, double d, double 
     const Lane e = n1 * detail::load(E + t) + de;
     const LaneMask near = 4.0 * detail::load(R + t) < q2lo;  // never cut
     const LaneMask s0 = near ? LaneMask{1, 1} : (P < -e) - (P > e);
-    const LaneMask s = Unbounded ? (near | (P - P == 0) ? s0 : LaneMask{0, 0}) : s0;
+    const LaneMask s = Unbounded ? ((near | (P - P == 0)) ? s0 : LaneMask{0, 0}) : s0;
     for (int k = 0; k < 2; ++k) {
       sign[t + static_cast<std::size_t>(k)] = static_cast<Sign>(s[k]);
       removed += s[k] < 0;
