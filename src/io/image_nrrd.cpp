@@ -16,9 +16,11 @@
 //
 // Supported: 2D/3D scalar images, every integer and float type, raw, gzip and
 // ascii encodings, "line skip" and "byte skip" (-1 for raw: data at the end of
-// the file), axis-aligned space directions with positive steps. Rejected with
-// a one-line error: other encodings (hex, bzip2), multi-file data ("LIST",
-// formats), non-spatial (vector, colour) axes, rotated or flipped directions.
+// the file), axis-aligned space directions with positive steps, or spacings
+// with axis mins (and maxs) placed by their centering. Rejected with a
+// one-line error: other encodings (hex, bzip2), multi-file data ("LIST",
+// formats), non-spatial (vector, colour) axes, rotated or flipped directions,
+// and fields NRRD does not define (a misspelt field was silently ignored).
 #include <algorithm>
 #include <bit>
 #include <charconv>
@@ -161,6 +163,17 @@ Header parse_header(const std::string& path, const std::string& bytes) {
     if (name == "centerings") name = "centers";
     if (name == "byteskip") name = "byte skip";
     if (name == "lineskip") name = "line skip";
+    if (name == "blocksize") name = "block size";
+    // teem refuses what it does not know; so do we, as a misspelt
+    // "spacing" or "space orign" silently left a unit grid at 0.
+    static const char* const known[] = {
+        "dimension", "type",       "encoding",    "endian",        "content",          "min",
+        "max",       "old min",    "old max",     "sizes",         "spacings",         "thicknesses",
+        "axis mins", "axis maxs",  "centers",     "labels",        "units",            "kinds",
+        "space",     "space dimension", "space units", "space origin", "space directions", "measurement frame",
+        "block size", "data file", "line skip",   "byte skip",     "sample units",     "number"};
+    if (std::find(std::begin(known), std::end(known), name) == std::end(known))
+      fail(path, "unknown NRRD field '" + name + "' (a misspelling?)");
     if (h.fields.count(name)) fail(path, "NRRD field '" + name + "' given twice");
     h.fields[name] = std::string(trim(line.substr(colon + 2)));
   }
@@ -249,11 +262,52 @@ RawImage read_nrrd_image(const std::string& path) {
       for (std::size_t c = 0; c < sdim; ++c) g.origin[c] = o[0][c];
     }
     if (field("spacings")) fail(path, "NRRD header gives both 'spacings' and 'space directions'");
+    if (field("axis mins") || field("axis maxs"))
+      fail(path, "NRRD header gives both 'axis mins' or 'axis maxs' and 'space directions'");
   } else {
     if (field("space origin")) fail(path, "NRRD header gives 'space origin' without 'space directions'");
+    const std::size_t d = static_cast<std::size_t>(dim);
     if (const std::string* sp = field("spacings")) {
-      if (!parse_doubles(*sp, static_cast<std::size_t>(dim), g.spacing.data()))
+      if (!parse_doubles(*sp, d, g.spacing.data()))
         fail(path, "NRRD field 'spacings' must give " + std::to_string(dim) + " finite numbers, got '" + *sp + "'");
+    }
+    // Axis mins place the grid as teem does: a cell-centred axis (teem's
+    // default) has its first sample half a spacing above its min, a
+    // node-centred one at it; without spacings, axis maxs give them.
+    if (const std::string* mins = field("axis mins")) {
+      double lo[3], hi[3];
+      if (!parse_doubles(*mins, d, lo))
+        fail(path, "NRRD field 'axis mins' must give " + std::to_string(dim) + " finite numbers, got '" + *mins + "'");
+      const std::string* maxs = field("axis maxs");
+      if (maxs && !parse_doubles(*maxs, d, hi))
+        fail(path, "NRRD field 'axis maxs' must give " + std::to_string(dim) + " finite numbers, got '" + *maxs + "'");
+      std::vector<std::string> centers(d, "cell");
+      if (const std::string* c = field("centers")) {
+        std::vector<std::string> words;
+        for (std::string_view rest = *c; !trim(rest).empty();) {
+          rest = trim(rest);
+          const std::size_t e = std::min(rest.find(' '), rest.size());
+          words.push_back(lower(rest.substr(0, e)));
+          rest.remove_prefix(e);
+        }
+        if (words.size() != d) fail(path, "NRRD field 'centers' must give " + std::to_string(dim) + " centerings");
+        for (std::size_t a = 0; a < d; ++a) {
+          if (words[a] != "cell" && words[a] != "node" && words[a] != "???" && words[a] != "none")
+            fail(path, "NRRD axis " + std::to_string(a) + " has centering '" + words[a] + "' (cell or node)");
+          if (words[a] == "node") centers[a] = "node";
+        }
+      }
+      for (std::size_t a = 0; a < d; ++a) {
+        const bool cell = centers[a] == "cell";
+        if (!field("spacings") && maxs) {
+          const double steps = static_cast<double>(cell ? g.size[a] : g.size[a] - 1);
+          g.spacing[a] = steps > 0 ? (hi[a] - lo[a]) / steps : 1;
+        }
+        g.origin[a] = lo[a] + (cell ? 0.5 * g.spacing[a] : 0.0);
+      }
+    } else if (field("axis maxs")) {
+      fail(path, "NRRD header gives 'axis maxs' without 'axis mins' (give both, or 'space origin' with 'space "
+                 "directions')");
     }
   }
 
@@ -303,6 +357,10 @@ RawImage read_nrrd_image(const std::string& path) {
   }
 
   if (enc == "ascii") {
+    // (teem skips the bytes in every encoding but the compressed ones)
+    const std::size_t skip = static_cast<std::size_t>(byte_skip);
+    if (data.size() < skip) fail(data_path, "data shorter than the NRRD 'byte skip' of the header " + path);
+    data.remove_prefix(skip);
     raw.bytes = parse_ascii_values(data_path, data, raw.type, n);
     raw.big_endian = std::endian::native == std::endian::big;
     return raw;

@@ -77,18 +77,38 @@ RawImage read_vti_image(const std::string& path, const std::string& array) {
   const std::vector<std::size_t> pieces = file.children(id, "Piece");
   if (pieces.empty()) fail(path, "no <Piece> in <ImageData>");
 
-  std::string chosen;  // the array name, fixed by the first piece
+  // What the image is sized by is checked before it is allocated: a file
+  // of 500 bytes claiming 10^10 voxels took 20 GB before it was refused.
+  // Any encoding takes at least 1/1032 of a byte per voxel (zlib's most),
+  // and the pieces must hold as many voxels as the whole (they may share
+  // their borders).
   const std::size_t n = g.n_voxels();
-  std::vector<std::uint8_t> covered(pieces.size() > 1 ? n : 0);
-  bool type_set = false;
-
-  for (std::size_t piece : pieces) {
+  if (n / 1100 > file.size())
+    fail(path, "WholeExtent '" + *we + "' has " + std::to_string(n) + " voxels, more than the file's " +
+                   std::to_string(file.size()) + " bytes can hold");
+  auto piece_extent = [&](std::size_t piece) {
     std::array<std::int64_t, 6> ext{};
     const std::string* pe = attr(piece, "Extent");
     if (!pe || !parse_extent(*pe, ext)) fail(path, "missing or malformed Piece Extent");
     for (std::size_t a = 0; a < 3; ++a)
       if (ext[2 * a] < whole[2 * a] || ext[2 * a + 1] > whole[2 * a + 1])
         fail(path, "Piece Extent '" + *pe + "' lies outside WholeExtent '" + *we + "'");
+    return ext;
+  };
+  std::size_t in_pieces = 0;
+  for (std::size_t piece : pieces) {
+    const auto ext = piece_extent(piece);
+    in_pieces += static_cast<std::size_t>((ext[1] - ext[0] + 1) * (ext[3] - ext[2] + 1) * (ext[5] - ext[4] + 1));
+    if (in_pieces >= n) break;  // (and the sum stays below the whole's, far from overflow)
+  }
+  if (in_pieces < n) fail(path, "the Pieces do not cover WholeExtent");
+
+  std::string chosen;  // the array name, fixed by the first piece
+  std::vector<std::uint8_t> covered;  // sized with the image, once the first piece's data is read
+  bool type_set = false;
+
+  for (std::size_t piece : pieces) {
+    const std::array<std::int64_t, 6> ext = piece_extent(piece);
     const std::size_t pd = child(piece, "PointData");
     std::vector<std::size_t> arrays;
     if (pd) arrays = file.children(pd, "DataArray");
@@ -141,6 +161,7 @@ RawImage read_vti_image(const std::string& path, const std::string& array) {
     }
     if (raw.bytes.empty()) {
       raw.bytes.assign(n * item, '\0');
+      covered.assign(n, 0);
       raw.big_endian = big;
     }
     if (big != raw.big_endian)  // ascii piece among binary ones: swap to the common order

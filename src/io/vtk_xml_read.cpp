@@ -156,10 +156,12 @@ class Base64Source {
  public:
   Base64Source(const std::string& path, std::string_view text) : path_(path), s_(text) {}
 
+  /// At most this many bytes are left to read (four characters give at most three).
+  std::size_t most_left() const { return (s_.size() - i_) / 4 * 3 + 3 + (pending_.size() - pend_pos_); }
+
   std::string read(std::size_t n) {
-    // Four characters give at most three bytes: a size the text cannot hold
-    // is refused before anything is sized by it.
-    if (n > (s_.size() - i_) / 4 * 3 + 3 + (pending_.size() - pend_pos_))
+    // A size the text cannot hold is refused before anything is sized by it.
+    if (n > most_left())
       fail(path_, "base64 data ends before the " + std::to_string(n) +
                       " bytes the header gives (data shorter than the header says)");
     std::string out;
@@ -221,6 +223,7 @@ class Base64Source {
 class RawSource {
  public:
   RawSource(const std::string& path, std::string_view bytes) : path_(path), s_(bytes) {}
+  std::size_t most_left() const { return s_.size() - i_; }
   std::string read(std::size_t n) {
     if (n > s_.size() - i_)
       fail(path_, "appended data ends after " + std::to_string(s_.size() - i_) + " of " + std::to_string(n) +
@@ -267,9 +270,16 @@ std::string read_binary(const std::string& path, Source& src, const BinaryLayout
                    std::to_string(need) + " (mismatched sizes)");
   const std::string sizes = src.read(static_cast<std::size_t>(nblocks) * l.header_size);
   // zlib inflates at most ~1032 times: blocks claiming more are corrupt,
-  // and are refused before anything is sized by them.
+  // and are refused before anything is sized by them, as are blocks
+  // longer than the data left (a header claiming 10^11 bytes in a file of
+  // 500 reserved them: "out of memory").
   std::uint64_t compressed = 0;
-  for (std::uint64_t b = 0; b < nblocks; ++b) compressed += std::min<std::uint64_t>(header_int(sizes, static_cast<std::size_t>(b), l), std::uint64_t(1) << 40);
+  for (std::uint64_t b = 0; b < nblocks; ++b) {
+    compressed += std::min<std::uint64_t>(header_int(sizes, static_cast<std::size_t>(b), l), std::uint64_t(1) << 40);
+    if (compressed > src.most_left())  // (checked per block: the sum stays far from overflow)
+      fail(path, "array '" + array + "': its compressed blocks take more than the " +
+                     std::to_string(src.most_left()) + " bytes left (data shorter than the header says)");
+  }
   if (need / 1100 > compressed + 64)
     fail(path, "array '" + array + "': malformed compressed-data header (more data than its blocks can hold)");
   std::string out;

@@ -48,6 +48,7 @@ class VtkXmlFile {
   VtkXmlFile(const std::string& path, std::initializer_list<std::string_view> types);
 
   const std::string& path() const { return path_; }
+  std::size_t size() const { return text_.size(); }  ///< the file's bytes
   const std::string& type() const { return type_; }
   std::size_t root() const { return root_; }  ///< the <VTKFile> element
   /// The first child of `parent` named `name`; 0 (the root) when none.

@@ -198,6 +198,36 @@ TEST_F(image_readers, VtiMalformed) {
   expect_error(input_error([&] { read_scalar_image(cz, {{}, {}, "field"}); }), {"corrupt.vti"});
 }
 
+// What sizes the image is checked before it is allocated (an image fuzz: a
+// file of 480 bytes claiming 10^10 voxels in pieces took 20 GB before its
+// refusal, and a block header claiming 10^11 bytes ended "out of memory").
+TEST_F(image_readers, VtiClaimsBeyondTheFileRefusedFirst) {
+  TempDir d;
+  auto pieces = [](const std::string& whole) {
+    std::string s = "<?xml version=\"1.0\"?>\n<VTKFile type=\"ImageData\" version=\"1.0\" byte_order=\"LittleEndian\">\n"
+                    "<ImageData WholeExtent=\"" + whole + "\" Origin=\"0 0 0\" Spacing=\"1 1 1\">\n";
+    for (const char* e : {"0 0 0 0 0 0", "1 1 0 0 0 0"})
+      s += std::string("<Piece Extent=\"") + e + "\"><PointData Scalars=\"s\"><DataArray type=\"UInt8\" Name=\"s\" "
+           "format=\"ascii\">1</DataArray></PointData></Piece>\n";
+    return s + "</ImageData>\n</VTKFile>\n";
+  };
+  expect_error(input_error([&] { read_label_image(d.write("huge.vti", pieces("0 9999 0 9999 0 99"))); }),
+               {"huge.vti", "has 10000000000 voxels, more than the file's"});
+  expect_error(input_error([&] { read_label_image(d.write("gaps.vti", pieces("0 9 0 9 0 0"))); }),
+               {"gaps.vti", "the Pieces do not cover WholeExtent"});
+  // One zlib block of 100,000 bytes whose compressed size claims 2^40.
+  std::string head = "<?xml version=\"1.0\"?>\n<VTKFile type=\"ImageData\" version=\"1.0\" byte_order=\"LittleEndian\" "
+                     "header_type=\"UInt64\" compressor=\"vtkZLibDataCompressor\">\n<ImageData WholeExtent=\"0 99 0 99 0 9\" "
+                     "Origin=\"0 0 0\" Spacing=\"1 1 1\">\n<Piece Extent=\"0 99 0 99 0 9\"><PointData Scalars=\"s\">"
+                     "<DataArray type=\"UInt8\" Name=\"s\" format=\"appended\" offset=\"0\"/></PointData></Piece>\n"
+                     "</ImageData>\n<AppendedData encoding=\"raw\">_";
+  for (const std::uint64_t v : {std::uint64_t{1}, std::uint64_t{100000}, std::uint64_t{0}, std::uint64_t{1} << 40})
+    for (int k = 0; k < 8; ++k) head += static_cast<char>((v >> (8 * k)) & 0xff);
+  const std::string claim = d.write("claim.vti", head + std::string(300, 'x') + "\n</AppendedData>\n</VTKFile>\n");
+  expect_error(input_error([&] { read_label_image(claim); }),
+               {"claim.vti", "its compressed blocks take more than the", "data shorter than the header says"});
+}
+
 // ------------------------------------------------------------------ MetaImage
 
 TEST_F(image_readers, MetaImageRawAndCompressed) {
@@ -279,6 +309,11 @@ TEST_F(image_readers, NrrdMalformed) {
   check("type.nrrd", replace(header, "type: short", "type: block") + data, {"unsupported NRRD type", "block"});
   check("line.nrrd", replace(header, "type: short", "type short") + data, {"malformed NRRD header line"});
   check("twice.nrrd", replace(header, "type: short", "type: short\ntype: int") + data, {"given twice"});
+  // Fields NRRD does not define (a misspelling) were ignored: a unit grid at 0.
+  check("typo.nrrd", replace(header, "type: short", "type: short\nspacing: 2 2 2") + data,
+        {"unknown NRRD field 'spacing' (a misspelling?)"});
+  check("mins.nrrd", replace(header, "type: short", "type: short\naxis mins: 1 2 3") + data,
+        {"both 'axis mins' or 'axis maxs' and 'space directions'"});
   const std::string gz = slurp(f("nrrd_gzip.nrrd"));
   check("gzcut.nrrd", gz.substr(0, gz.size() - 12), {"gzip data"});
   const std::size_t gzb = gz.find("\n\n") + 2;
@@ -298,6 +333,35 @@ TEST_F(image_readers, NrrdMalformed) {
   ImageReadOptions o;
   o.array = "x";
   expect_error(input_error([&] { read_label_image(f("nrrd_raw.nrrd"), o); }), {"nrrd_raw.nrrd", "array"});
+}
+
+// Axis mins place the grid as teem does (cell-centred by default: the first
+// sample half a spacing above the min; node-centred at it); without
+// spacings, axis maxs give them. And teem's byte skip in ascii data.
+TEST_F(image_readers, NrrdAxisMinsAndAsciiByteSkip) {
+  TempDir d;
+  const std::string head = "NRRD0004\ntype: uchar\ndimension: 2\nsizes: 3 2\nencoding: ascii\n";
+  auto geometry = [&](const std::string& name, const std::string& fields) {
+    return tessera::io::read_scalar_image(d.write(name, head + fields + "\n1 2 3 4 5 6\n")).geometry;
+  };
+  auto g = geometry("node.nrrd", "spacings: 0.5 2\naxis mins: 10 20\ncenters: node node\n");
+  EXPECT_EQ(g.origin[0], 10);
+  EXPECT_EQ(g.origin[1], 20);
+  EXPECT_EQ(g.spacing[0], 0.5);
+  g = geometry("cell.nrrd", "spacings: 0.5 2\naxis mins: 10 20\n");
+  EXPECT_EQ(g.origin[0], 10.25);
+  EXPECT_EQ(g.origin[1], 21);
+  g = geometry("maxs.nrrd", "axis mins: 0 0\naxis maxs: 3 1\ncenters: cell node\n");
+  EXPECT_EQ(g.spacing[0], 1);  // 3 cells over [0, 3]
+  EXPECT_EQ(g.spacing[1], 1);  // 2 nodes over [0, 1]
+  EXPECT_EQ(g.origin[0], 0.5);
+  EXPECT_EQ(g.origin[1], 0);
+  expect_error(input_error([&] { geometry("half.nrrd", "axis maxs: 3 1\n"); }), {"'axis maxs' without 'axis mins'"});
+  expect_error(input_error([&] { geometry("ctr.nrrd", "axis mins: 0 0\ncenters: cell edge\n"); }),
+               {"centering 'edge'"});
+  const std::string skip = d.write("skip.nrrd", "NRRD0004\ntype: int\ndimension: 2\nsizes: 2 2\nbyte skip: 4\n"
+                                                "encoding: ascii\n\n99991 2 3 4\n");
+  EXPECT_EQ(tessera::io::read_scalar_image(skip).values, (std::vector<double>{1, 2, 3, 4}));
 }
 
 // ------------------------------------------------------------------ .npy and options
