@@ -56,8 +56,9 @@ void print_error(const std::string& message) {
 
 constexpr const char* kExitCodes =
     "Exit status: 0 success; 1 failure (an internal error, or a failed --validate where the command has one);\n"
-    "2 bad command line or bad input; 130 interrupted (Ctrl-C). Killed by SIGTERM, SIGHUP or a second\n"
-    "Ctrl-C, it removes the outputs it was writing and ends by that signal.\n"
+    "2 bad command line or bad input; 130 interrupted (Ctrl-C during the computation: nothing written).\n"
+    "Ctrl-C while writing (or a second one), SIGTERM or SIGHUP remove the outputs being written and end\n"
+    "it by that signal. Signals ignored where it starts (nohup, a background job) stay ignored.\n"
     "Environment: TESSERA_NUM_THREADS sets the thread count when --threads is not given.";
 
 /// Options shared by the commands that compute cells (`voronoi`, `bench voronoi`, `graph`, ...).

@@ -109,6 +109,9 @@ InterruptGuard::InterruptGuard() {
   sigemptyset(&sa.sa_mask);
   // g_before_guard is set before on_sigint can run, so it never reads it half-written.
   if (::sigaction(SIGINT, nullptr, &g_before_guard) != 0) return;
+  // Ignored by whoever started us (a shell's background job, nohup): it
+  // stays ignored here too, as it is while writing (install_fatal_signal_cleanup).
+  if (g_before_guard.sa_handler == SIG_IGN) return;
   installed_ = ::sigaction(SIGINT, &sa, &previous_) == 0;
 }
 

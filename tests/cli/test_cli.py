@@ -683,6 +683,25 @@ class Interrupt(TempDirCase):
         self.assertIn(b"tessera: error: interrupted", text)
         self.assertEqual(sorted(os.listdir(self.dir)), ["p.npy"])
 
+    def test_ignored_ctrl_c_stays_ignored(self):
+        """Started with SIGINT ignored (a shell's background job, nohup), a
+        Ctrl-C during the computation is ignored too: it was taken as an
+        interruption there, and ignored while writing."""
+        import signal
+        import time
+        inp = self.save("p.npy", np.random.default_rng(4).random((300000, 3)))
+        out = self.p("c.vtu")
+        proc = subprocess.Popen([TESSERA, "voronoi", inp, "-o", out, "-q"], stderr=subprocess.PIPE,
+                                preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_IGN))
+        time.sleep(0.3)
+        for _ in range(3):
+            if proc.poll() is None:
+                proc.send_signal(signal.SIGINT)
+            time.sleep(0.1)
+        err = proc.communicate(timeout=120)[1]
+        self.assertEqual(proc.returncode, 0, err)
+        self.assertTrue(os.path.exists(out))
+
     def kill_while_writing(self, sig, message):
         """Signal `sig` once the output's temporary exists: the run ends by that
         signal, prints one error line, and leaves neither the output nor its
