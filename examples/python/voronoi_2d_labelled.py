@@ -5,9 +5,9 @@ Points in the unit square carry region labels (three bands bent by a wave);
 the points inside a disc are outside points (label -1): they clip their
 neighbours but own no cell, so the cells leave a hole. Left: the cells coloured
 by region. Right: the Delaunay triangles between inside points, coloured by
-region where all three corners agree. With labels the triangulation is not
-closed up to the convex hull: it holds the triangles whose circumcentres lie
-in the domain box, hence the ragged outline.
+region where all three corners agree. With labels the triangulation is the
+whole one's triangles whose three corners are inside points, so the disc of
+outside points leaves a hole in it too.
 
     /usr/bin/python3 examples/python/voronoi_2d_labelled.py --out docs/images
 

@@ -89,7 +89,9 @@ enum class CellMethod {
 };
 
 struct VoronoiOptions {
-  int dim = 3;                          ///< 2 or 3
+  /// 2 or 3: read by surface_nets(); voronoi() and delaunay() take their
+  /// `dim` argument instead (and ignore this one).
+  int dim = 3;
   std::optional<Bounds> bounds;         ///< explicit domain; default: padded bbox
   double padding = 0.01;                ///< relative margin of the default domain (fraction of the largest extent)
   /// With explicit bounds: drop points outside instead of failing. Also,
@@ -97,7 +99,8 @@ struct VoronoiOptions {
   /// default domain then comes from the others). Ids stay the input's; the
   /// dropped points are listed in Cells::ignored_outside_bounds.
   bool ignore_outside_points = false;
-  int threads = 0;                      ///< 0: TESSERA_NUM_THREADS, else all cores
+  /// 0 (or negative): TESSERA_NUM_THREADS, else all cores; at most max_threads.
+  int threads = 0;
   double points_per_bin = 0;            ///< locator bin occupancy; 0 = automatic
   bool build_mesh = true;               ///< merged vertices + per-cell faces (needed for VTK output)
   CellMethod cell_method = CellMethod::automatic;  ///< tessera::voronoi only (Delaunay has its own)
@@ -109,9 +112,10 @@ struct VoronoiOptions {
   /// spacing of doubles at a few box lengths from the origin, so that every
   /// image is exact (for a unit box 2^-51: each moves by at most 2^-52).
   /// Cells straddle the box's faces where their points lie near them.
-  /// Cells::neighbor_shifts says which image each neighbour is. Face sets,
-  /// flowers and surface nets refuse periodic input; the adjacency graph
-  /// takes it, and delaunay() where every axis is periodic.
+  /// Cells::neighbor_shifts says which image each neighbour is. The
+  /// adjacency graph, face sets, flowers and surface nets take periodic
+  /// cells (faces.hpp: a face across the box names its side's image), and
+  /// delaunay() takes periodic input where every axis is periodic.
   std::array<bool, 3> periodic{false, false, false};
   /// Tilt factors of a triclinic (sheared) periodic box, as lengths in
   /// LAMMPS's and Voro++'s convention: {xy, xz, yz}. The box repeats by the
@@ -131,10 +135,11 @@ struct VoronoiOptions {
   /// may then own no cell (Cells::empty_cells), or lie outside its own;
   /// of exactly coincident points the largest radius owns the cell (ties:
   /// the lowest id). All radii equal give the ordinary cells. In a periodic
-  /// box every image has its point's radius. Not with CellMethod::insertion
-  /// (the automatic method takes the search), nor input that no power-of-two
-  /// frame fits (coordinates spanning more than ~1e-150..1e150 of each
-  /// other); delaunay() takes none.
+  /// box every image has its point's radius. Either cell method builds
+  /// them (the insertion from the regular triangulation's stars), and
+  /// delaunay() takes them for the regular triangulation. Not for input
+  /// that no power-of-two frame fits (coordinates spanning more than
+  /// ~1e-150..1e150 of each other: InputError).
   std::span<const double> radii;
   /// Some axis periodic, or a tilt given (which needs periodic axes).
   bool periodic_box() const {

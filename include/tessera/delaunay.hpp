@@ -136,6 +136,8 @@ Delaunay delaunay(std::span<const double> points, int dim, std::span<const std::
 
 /// Adjacent simplices, as scipy.spatial.Delaunay.neighbors: entry r*(dim+1)+k is
 /// the simplex sharing the facet opposite vertex k of simplex r, or -1.
+/// InputError for a periodic triangulation (its facets match by ids and
+/// shifts, not by ids alone).
 std::vector<std::int32_t> simplex_neighbors(const Delaunay& dt);
 
 /// For each point the lowest index of a simplex having it as a vertex, or -1

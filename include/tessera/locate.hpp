@@ -37,7 +37,8 @@ class SimplexLocator {
 
   /// Index the simplices of `dt`, whose vertex coordinates are `points`
   /// (dt.n_points * dt.dim, row-major: the triangulated points). Throws
-  /// InputError when `points` does not match `dt`. A walk needs
+  /// InputError when `points` does not match `dt`, or for a periodic
+  /// triangulation (its simplices span images, not the points). A walk needs
   /// simplex_neighbors(dt): pass it as `neighbors` when the caller already
   /// has it (it is shared, not copied), else the walk computes it. An
   /// adjacency of the wrong size, or naming a simplex that does not exist,
