@@ -32,8 +32,11 @@ constexpr const char* kOutputHelp =
     "the .ply to standard output (rbox 1000 D3 | tessera joggle - -o - | tessera voronoi - --cell-table -)";
 
 /// The flag's help, per command: what it does to those points there.
-void add_input_options(CLI::App* app, PrepInput& p, bool labels, const char* keep_help) {
-  app->add_option("INPUT", p.input, "Point file: .npy, .csv/.xyz/.txt (or Qhull's format), .ply, .vtp/.vtu, .pcd or .dump/.lammpstrj (as for `voronoi`); - reads standard input")->required();
+/// `input_required` false: the command checks INPUT itself (fill, whose
+/// --bounds may have taken it: "--bounds 0 1 0 1 pts.npy").
+void add_input_options(CLI::App* app, PrepInput& p, bool labels, const char* keep_help, bool input_required = true) {
+  CLI::Option* input = app->add_option("INPUT", p.input, "Point file: .npy, .csv/.xyz/.txt (or Qhull's format), .ply, .vtp/.vtu, .pcd or .dump/.lammpstrj (as for `voronoi`); - reads standard input");
+  if (input_required) input->required();
   app->add_option("-o,--output", p.output, kOutputHelp)->required();
   app->add_option("--dim", p.dim, "Dimension: 2 or 3 (default: the number of columns or fields; .ply, .vtp and .vtu are 3D)")
       ->check(CLI::IsMember({2, 3}));
@@ -127,7 +130,8 @@ void add_prep_commands(CLI::App& app, PrepCommands& c) {
   add_input_options(f, c.fill.io, true,
                     "Points with a NaN or infinite coordinate (an organized cloud's missing returns) are kept in "
                     "place with their labels instead of refused; they mark no bin, and the box is the finite "
-                    "points'. `voronoi --ignore-outside` sets them aside");
+                    "points'. `voronoi --ignore-outside` sets them aside",
+                    false);
   f->add_option("--strategy", c.fill.strategy,
                 "uniform: one point at the centre of every empty bin; adaptive: every empty bin next to the "
                 "data, sparser (exponentially) further away")
@@ -137,11 +141,15 @@ void add_prep_commands(CLI::App& app, PrepCommands& c) {
       ->capture_default_str();
   f->add_option("--in-label", c.fill.in_label, "Label of the input points when --labels is not given")
       ->capture_default_str();
-  f->add_option("--bin-points", c.fill.bin_points, "Average input points per bin: sets the bin size")
+  f->add_option("--bin-points", c.fill.bin_points, "Average input points per bin (> 0): sets the bin size")
       ->capture_default_str();
   f->add_option("--bounds", c.fill.bounds,
-                "Region to fill, x0,x1,y0,y1[,z0,z1] (default: the bounding box of the points); must contain "
-                "every point");
+                "Region to fill, X0 X1 Y0 Y1 [Z0 Z1] or X0,X1,Y0,Y1[,Z0,Z1] (default: the bounding box of the "
+                "points); must contain every point")
+      ->expected(4, 6)
+      ->allow_extra_args(false)
+      ->delimiter(',')
+      ->type_name("X0 X1 Y0 Y1 [Z0 Z1]");
   f->add_option("--joggle", c.fill.joggle,
                 "Joggle of the added points, a fraction (<= 0.5) of the smallest bin edge (default 0: exact bin "
                 "centres)")
@@ -263,16 +271,26 @@ int run_fill(const FillArgs& a) {
   o.seed = a.seed;
   o.threads = a.threads;
   o.keep_non_finite = a.io.keep_non_finite;
-  std::vector<double> bounds;
-  if (!a.bounds.empty()) {
-    for (const std::string& w : split_commas(a.bounds)) bounds.push_back(parse_number(w, "--bounds", false));
-    if (bounds.size() != 4 && bounds.size() != 6)
-      throw InputError("--bounds needs x0,x1,y0,y1 (2D) or x0,x1,y0,y1,z0,z1 (3D), got " +
-                       std::to_string(bounds.size()) + " numbers");
+  // "--bounds 0 1 0 1 pts.npy": --bounds (up to six words) took INPUT, and gives it back.
+  PrepInput io = a.io;
+  std::vector<std::string> words = a.bounds;
+  if (io.input.empty() && words.size() == 5) {
+    try {
+      parse_number(words[4], "--bounds", false);
+    } catch (const InputError&) {
+      io.input = words[4];
+      words.pop_back();
+    }
   }
-  check_output(a.io.output);
+  if (io.input.empty()) throw InputError("INPUT is required: the point file to fill");
+  std::vector<double> bounds;
+  for (const std::string& w : words) bounds.push_back(parse_number(w, "--bounds", false));
+  if (!bounds.empty() && bounds.size() != 4 && bounds.size() != 6)
+    throw InputError("--bounds needs x0 x1 y0 y1 (2D) or x0 x1 y0 y1 z0 z1 (3D), got " +
+                     std::to_string(bounds.size()) + " numbers");
+  check_output(io.output);
 
-  const io::PointCloud pc = read_prep_input(a.io, true);
+  const io::PointCloud pc = read_prep_input(io, true);
   if (!bounds.empty()) {
     if (static_cast<int>(bounds.size()) != 2 * pc.dim)
       throw InputError("--bounds has " + std::to_string(bounds.size()) + " numbers but the points are " +
@@ -285,10 +303,10 @@ int run_fill(const FillArgs& a) {
     o.bounds = b;
   }
   const LabelledPoints out = fill(pc.coords, pc.dim, pc.labels, o);
-  const std::vector<std::string> written = io::write_points(a.io.output, out);
-  if (!a.io.quiet)
+  const std::vector<std::string> written = io::write_points(io.output, out);
+  if (!io.quiet)
     std::printf("tessera fill: %zu points (%dD) from %s, %zu background points added (%s, label %d)%s; wrote %s\n",
-                pc.n, pc.dim, shown_path(a.io.input).c_str(), out.size() - pc.n, a.strategy.c_str(),
+                pc.n, pc.dim, shown_path(io.input).c_str(), out.size() - pc.n, a.strategy.c_str(),
                 static_cast<int>(a.background_label),
                 non_finite_note(a.io.keep_non_finite ? count_non_finite(pc.coords, pc.dim) : 0).c_str(), written_list(written).c_str());
   return kExitOk;

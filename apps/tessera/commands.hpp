@@ -153,7 +153,7 @@ struct FillArgs {
   std::int32_t background_label = -1;
   std::int32_t in_label = 0;
   double bin_points = 2.0;
-  std::string bounds;          ///< "" or x0,x1,y0,y1[,z0,z1]
+  std::vector<std::string> bounds;  ///< none, or the words of x0 x1 y0 y1 [z0 z1] (or comma-separated)
   double joggle = 0.0;         ///< fraction of the bin edge, <= 0.5
   std::uint64_t seed = 0;
   int threads = 0;

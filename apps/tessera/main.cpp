@@ -266,7 +266,7 @@ int main(int argc, char** argv) {
                 "Check the result (volume sum, neighbour symmetry, vertex degrees, Euler characteristic, and "
                 "the volumes and centroids of up to 128 sampled cells against exact arithmetic), print the report, "
                 "exit 1 if a check fails");
-  vor->add_flag("-q,--quiet", va.quiet, "No summary and no progress bar");
+  vor->add_flag("-q,--quiet", va.quiet, "No summary, no progress bar and no --validate report (a failed check still prints its error line)");
   vor->footer(
       "At least one of -o, --cell-table, --neighbors or --validate is required. Output paths are checked\n"
       "before computing; files are written atomically (never partially).\n"
@@ -316,7 +316,7 @@ int main(int argc, char** argv) {
   del->add_flag("--validate", dla.validate,
                 "Check the triangulation (orientation, conformity, closed convex hull, every point used, local "
                 "Delaunay, volumes), print the report, exit 1 if a check fails");
-  del->add_flag("-q,--quiet", dla.quiet, "No summary and no progress bar");
+  del->add_flag("-q,--quiet", dla.quiet, "No summary, no progress bar and no --validate report (a failed check still prints its error line)");
   del->footer(
       "Without labels the triangulation covers the convex hull (CGAL's on points in general position; a valid\n"
       "one chosen by symbolic perturbation on degenerate input). With --labels: that triangulation's simplices\n"
@@ -414,8 +414,9 @@ int main(int argc, char** argv) {
       "voronoi",
       "Time tessera::voronoi (cells, volumes and neighbour lists; no mesh, no output files) K times. "
       "Each run prints {\"tool\":\"tessera\",\"op\":\"voronoi3\"|\"voronoi2\",\"n\",\"threads\",\"seconds\","
-      "\"simplices\" (= cells),\"extra\":{cpu_user_s,cpu_sys_s,minflt,peak_rss_bytes,neighbors,from_insertion,assembled,exact_calls,"
-      "volume_sum,repeat}}; seconds is wall time of the computation only");
+      "\"simplices\" (= cells),\"extra\":{cpu_user_s,cpu_sys_s,minflt,peak_rss_bytes,neighbors,empty_cells (power "
+      "cells),from_insertion,assembled (cells from their Delaunay stars),from_pilot (the method's sample, kept),"
+      "exact_calls,volume_sum,repeat}}; seconds is wall time of the computation only");
   add_compute_options(bench_vor, ba.compute, bench_bounds);
   add_cell_method_option(bench_vor, ba.compute);
   add_radii_option(bench_vor, ba.compute, true);
@@ -450,9 +451,10 @@ int main(int argc, char** argv) {
       "surface-nets",
       "Time the surface-nets pipeline (image sampling + cells + faces + smoothing [+ triangles]; no output files) "
       "K times. Each run prints {\"tool\":\"tessera\",\"op\":\"surface-nets\",\"n\" (points),\"threads\","
-      "\"seconds\",\"simplices\" (= output faces),\"extra\":{...,voxels,points,cells,polygons,triangles,vertices,"
-      "labels,watertight,open_labels,boundary_edges,nonmanifold_edges,sample_s,cells_s,faces_s,smoothing_s,"
-      "triangulation_s,repeat}}");
+      "\"seconds\",\"simplices\" (= output faces),\"extra\":{cpu_user_s,cpu_sys_s,minflt,peak_rss_bytes,voxels,"
+      "points,cells,polygons,triangles (those of --triangles, or that the polygons would make),vertices,labels,"
+      "watertight,open_labels,boundary_edges,nonmanifold_edges,sample_s,cells_s,faces_s,smoothing_s,"
+      "triangulation_s,smooth (iterations),capping,repeat}}");
   add_compute_options(bench_sn, bsna.compute, bench_sn_bounds);
   add_surface_nets_options(bench_sn, bsna, true);
   add_periodic_option(bench_sn, bsna.compute, "Cells keep their shape across the box's faces", kAnyAxes);

@@ -98,6 +98,10 @@ class Fill(Case):
         self.assertIn("2 background points added", r.stdout)
         q = np.load(self.p("f.npy"))
         self.assertTrue(np.array_equal(q, [[0.1, 0.1], [0.9, 0.9], [0.75, 0.25], [0.25, 0.75]]))
+        # --bounds as voronoi's: spaced words too, before or after INPUT.
+        for args in (["fill", inp, "--bounds", "0", "1", "0", "1"], ["fill", "--bounds", "0", "1", "0", "1", inp]):
+            self.ok(args + ["--bin-points", "0.5", "-o", self.p("g.npy")])
+            self.assertTrue(np.array_equal(np.load(self.p("g.npy")), q))
         self.assertTrue(np.array_equal(np.load(self.p("f_labels.npy")), [0, 0, -1, -1]))
 
     def test_labels_vtp_and_concave_voronoi(self):
@@ -153,6 +157,7 @@ class Fill(Case):
         self.fails(["fill", inp, "--bounds", "0,0.5,0,1", "-o", out], "outside")
         self.fails(["fill", inp, "--bounds", "0,a,0,1", "-o", out], "'a'")
         self.fails(["fill", inp, "--strategy", "random", "-o", out])
+        self.fails(["fill", "--bounds", "0", "1", "0", "1", "-o", out], "INPUT is required")
         self.fails(["fill", self.save("flat.npy", np.array([[0.0, 1.0], [1.0, 1.0]])), "-o", out], "y =")
 
 
