@@ -129,7 +129,7 @@ NetInput read_net_input(const SurfaceNetsArgs& a) {
     in.coords = std::move(pc.coords);
     in.labels = std::move(pc.labels);
     if (in.labels.empty())
-      throw InputError("surface nets need region labels: give --labels FILE.npy or the name of a .ply/.csv/.vtp/.vtu/.pcd/structured .npy label column");
+      throw InputError("surface nets need region labels: give --labels FILE.npy or the name of a .ply/.csv/.vtp/.vtu/.vtk/.pcd/structured .npy label column");
   }
   return in;
 }
@@ -306,7 +306,7 @@ void add_surface_nets_options(CLI::App* app, SurfaceNetsArgs& a, bool bench) {
                   "BoundaryLabels value for the domain-box side of capping faces (must be < 0)")
       ->capture_default_str();
   app->footer(
-      "INPUT: labelled points (.npy/.csv/.ply/.vtp/.vtu/.pcd with --labels) or a label image (.nrrd/.nhdr/.mha/.mhd/.vti,\n"
+      "INPUT: labelled points (.npy/.csv/.ply/.vtp/.vtu/.vtk/.pcd with --labels) or a label image (.nrrd/.nhdr/.mha/.mhd/.vti,\n"
       "or .npy with --image), which is sampled first (the sampler options: see tessera sample-image --help; the\n"
       "domain is then the image's voxels). BoundaryLabels = (side 0, side 1): side 0 is always a selected\n"
       "label; between two selected labels (lower, higher); a capping face carries the other point's own label\n"

@@ -7,6 +7,7 @@
 
 #include <unistd.h>
 
+#include <cctype>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -32,6 +33,10 @@ std::string sniff(std::string_view head) {
   if (head.substr(0, 6) == "\x93NUMPY") return ".npy";
   if (head.substr(0, 4) == "ply\n" || head.substr(0, 5) == "ply\r\n") return ".ply";
   if (head.substr(0, 4) == "NRRD") return ".nrrd";
+  // Legacy VTK (before the PCD test, whose comment lines also start with '#').
+  std::string first(head.substr(0, 22));
+  for (char& c : first) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (first == "# vtk datafile version") return ".vtk";
   std::size_t k = head.substr(0, 3) == "\xEF\xBB\xBF" ? 3 : 0;
   while (k < head.size() && (head[k] == ' ' || head[k] == '\t' || head[k] == '\r' || head[k] == '\n')) ++k;
   const std::string_view body = head.substr(k);

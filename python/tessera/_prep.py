@@ -123,7 +123,8 @@ def read_points(
     (N, 2) or (N, 3) array in C or Fortran order, or a structured array with
     fields x, y[, z]), ``.csv`` / ``.xyz`` / ``.txt`` (the columns a header
     names x, y[, z], else the first ones), ``.ply``, ``.vtp`` / ``.vtu``
-    (VTK XML points), ``.pcd`` (PCL's point clouds) or ``.dump`` /
+    (VTK XML points), ``.vtk`` (legacy VTK points), ``.pcd`` (PCL's point
+    clouds) or ``.dump`` /
     ``.lammpstrj`` (a LAMMPS dump's frame: columns x y z, xu yu zu or
     scaled xs ys zs; atoms in file order; its box: :func:`read_box`). An
     ``.xyz`` / ``.txt`` that starts with a lone count is XYZ (count,

@@ -221,6 +221,16 @@ inline bool is_dump_extension(const std::string& ext) { return ext == ".dump" ||
 /// name of an integer point data array holding labels.
 PointCloud read_vtk_points(const std::string& path, const ReadOptions& options, const std::string& label_array);
 
+/// Legacy VTK files (.vtk; vtk_legacy_points.cpp): the POINTS of a
+/// POLYDATA, UNSTRUCTURED_GRID or STRUCTURED_GRID, ASCII or BINARY;
+/// `label_array` is empty, or the name of an integer one-component
+/// POINT_DATA attribute (SCALARS, or a FIELD's array).
+PointCloud read_vtk_legacy_points(const std::string& path, const ReadOptions& options, const std::string& label_array);
+/// The values of the one-component POINT_DATA attribute `name`, in point order.
+std::vector<double> read_vtk_legacy_point_array(const std::string& path, const std::string& name);
+/// Whether a file's first bytes are a legacy VTK header.
+bool looks_like_legacy_vtk(std::string_view head);
+
 /// PCD files (the Point Cloud Library's; ascii, binary, binary_compressed):
 /// the fields x, y (and z). `label_field` is empty, or an integer field.
 PointCloud read_pcd_points(const std::string& path, const ReadOptions& options, const std::string& label_field);

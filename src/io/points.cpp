@@ -297,13 +297,15 @@ PointCloud read_points(const std::string& path, const ReadOptions& options) {
     pc = detail::read_ply_points(path, options, label_name);
   } else if (ext == ".vtp" || ext == ".vtu") {
     pc = detail::read_vtk_points(path, options, label_name);
+  } else if (ext == ".vtk") {
+    pc = detail::read_vtk_legacy_points(path, options, label_name);
   } else if (ext == ".pcd") {
     pc = detail::read_pcd_points(path, options, label_name);
   } else if (detail::is_dump_extension(ext)) {
     pc = detail::read_dump_points(path, options, label_name);
   } else {
     detail::fail(path, "unknown input extension '" + ext +
-                           "' (expected .npy, .csv, .xyz, .txt, .ply, .vtp, .vtu, .pcd, .dump, .lammpstrj)");
+                           "' (expected .npy, .csv, .xyz, .txt, .ply, .vtp, .vtu, .vtk, .pcd, .dump, .lammpstrj)");
   }
 
   if (pc.n == 0) detail::fail(path, "no points");

@@ -577,6 +577,85 @@ class Voronoi3D(TempDirCase):
         self.assertIn("floating-point", r.stderr)
         self.assertFalse(os.path.exists(self.p("x.vtu")))
 
+    def test_legacy_vtk_point_files(self):
+        # Points saved by VTK's legacy writers (.vtk: ParaView's "Legacy VTK",
+        # LAMMPS's dump vtk, OpenFOAM's foamToVTK), as PolyData and as an
+        # unstructured grid, ASCII and binary, file versions 4.2 and 5.1
+        # (OFFSETS and CONNECTIVITY), with cell data and vectors on the way:
+        # the same cells as the points, labels and radii VTK's own legacy
+        # reader reads from them; standard input too.
+        rng = np.random.default_rng(8)
+        labels = rng.integers(-1, 3, self.N).astype(np.int32)
+        radii = rng.random(self.N) * 0.02
+        for kind in ("poly", "ugrid"):
+            for binary in (False, True):
+                for version in (42, 51):
+                    d = vtk.vtkPolyData() if kind == "poly" else vtk.vtkUnstructuredGrid()
+                    p = vtk.vtkPoints()
+                    p.SetData(numpy_to_vtk(self.pts, deep=1))
+                    d.SetPoints(p)
+                    if kind == "poly":
+                        cells = vtk.vtkCellArray()
+                        for i in range(self.N):
+                            cells.InsertNextCell(1)
+                            cells.InsertCellPoint(i)
+                        d.SetVerts(cells)
+                    else:
+                        for i in range(self.N):
+                            d.InsertNextCell(vtk.VTK_VERTEX, 1, [i])
+                    for name, values in (("grain", labels), ("radius", radii), ("vel", rng.random((self.N, 3)))):
+                        a = numpy_to_vtk(values, deep=1)
+                        a.SetName(name)
+                        d.GetPointData().AddArray(a)
+                    d.GetPointData().SetActiveScalars("radius")  # a SCALARS attribute; the others in a FIELD
+                    c = numpy_to_vtk(np.arange(self.N, dtype=np.float32), deep=1)
+                    c.SetName("cell")
+                    d.GetCellData().AddArray(c)
+                    w = vtk.vtkPolyDataWriter() if kind == "poly" else vtk.vtkUnstructuredGridWriter()
+                    name = self.p("%s_%d_%d.vtk" % (kind, binary, version))
+                    w.SetFileName(name)
+                    w.SetInputData(d)
+                    w.SetFileTypeToBinary() if binary else w.SetFileTypeToASCII()
+                    w.SetFileVersion(version)
+                    self.assertEqual(w.Write(), 1)
+                    # What VTK reads back (ASCII keeps 11 digits) is the reference.
+                    rd = vtk.vtkDataSetReader()
+                    rd.SetFileName(name)
+                    rd.ReadAllScalarsOn()
+                    rd.ReadAllFieldsOn()
+                    rd.Update()
+                    got = rd.GetOutput()
+                    pts = vtk_to_numpy(got.GetPoints().GetData()).astype(np.float64)
+                    lab = vtk_to_numpy(got.GetPointData().GetArray("grain")).astype(np.int32)
+                    rad = vtk_to_numpy(got.GetPointData().GetArray("radius")).astype(np.float64)
+                    common = ["--cell-table", self.p("t.csv"), "-q", "--bounds"] + BOX3
+                    self.ok(["voronoi", self.save("p.npy", pts), "--labels", self.save("l.npy", lab), "--radii",
+                             self.save("r.npy", rad)] + common)
+                    ref = read_bytes(self.p("t.csv"))
+                    self.ok(["voronoi", name, "--labels", "grain", "--radii", "radius"] + common)
+                    self.assertEqual(read_bytes(self.p("t.csv")), ref, name)
+                    with open(name, "rb") as f:
+                        r = run_bytes(["voronoi", "-", "--labels", "grain", "--radii", "radius", "--cell-table", "-",
+                                       "-q", "--bounds"] + BOX3, f.read())
+                    self.assertEqual(r.returncode, 0, r.stderr)
+                    self.assertEqual(r.stdout, ref, name)
+        def fails(args, fragment):
+            r = run(args)
+            self.assertEqual(r.returncode, 2, args)
+            self.assertEqual(len(r.stderr.strip().splitlines()), 1, r.stderr)
+            self.assertIn(fragment, r.stderr)
+            self.assertFalse(os.path.exists(self.p("x.csv")))
+
+        for args, fragment in ((["--labels", "radius"], "labels array 'radius' holds floating-point values"),
+                               (["--labels", "vel"], "point data 'vel' has 3 components, expected 1"),
+                               (["--labels", "none"], "no point data array 'none' (arrays: 'radius', 'grain', 'vel')")):
+            fails(["voronoi", self.p("poly_1_51.vtk"), "--cell-table", self.p("x.csv")] + args, fragment)
+        with open(self.p("poly_1_51.vtk"), "rb") as f:
+            whole = f.read()
+        with open(self.p("cut.vtk"), "wb") as f:
+            f.write(whole[:1000])
+        fails(["voronoi", self.p("cut.vtk"), "--cell-table", self.p("x.csv")], "cut.vtk: POINTS: the file ends before its")
+
     def test_summary_names_far_points(self):
         # Two points far beyond the bulk are reported (outliers?); none otherwise.
         pts = np.vstack([self.pts, [[5e3, 0.5, 0.5], [0.5, -2e4, 0.5]]])
