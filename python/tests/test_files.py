@@ -251,7 +251,13 @@ def test_read_points_reads_what_the_command_reads(tmp_path):
         for i, (p, l) in enumerate(zip(pts, lab)):
             f.write("%d,%d,%r,%r,%r\n" % (i, l, p[0], p[1], p[2]))
     np.save(tmp_path / "lab.npy", lab)
-    for name, labels in (("f.npy", tmp_path / "lab.npy"), ("r.npy", "region"), ("p.csv", "region")):
+    with open(tmp_path / "p.vtk", "w") as f:  # legacy VTK, as LAMMPS's dump vtk writes it
+        f.write("# vtk DataFile Version 3.0\nLAMMPS\nASCII\nDATASET POLYDATA\nPOINTS 200 double\n")
+        f.write("\n".join("%r %r %r" % tuple(p) for p in pts))
+        f.write("\nPOINT_DATA 200\nSCALARS region int 1\nLOOKUP_TABLE default\n")
+        f.write(" ".join(str(v) for v in lab) + "\n")
+    for name, labels in (("f.npy", tmp_path / "lab.npy"), ("r.npy", "region"), ("p.csv", "region"),
+                         ("p.vtk", "region")):
         p, l = tessera.read_points(tmp_path / name, labels=labels)
         assert p.shape == (200, 3) and p.dtype == np.float64 and p.flags.writeable
         np.testing.assert_array_equal(p, pts)
