@@ -26,9 +26,12 @@
 namespace tessera::cli {
 namespace {
 
-constexpr const char* kImageHelp =
-    "Image: .npy (integer/float array, shape (ny, nx) or (nz, ny, nx)), .nrrd/.nhdr (raw, gzip, ascii), "
-    ".mha/.mhd (MetaImage, raw or compressed) or .vti (VTK XML ImageData, any data mode)";
+/// `what`: which data the command takes (labels: integer types only).
+std::string image_help(const char* what) {
+  return std::string("Image of ") + what +
+         ": .npy (shape (ny, nx) or (nz, ny, nx)), .nrrd/.nhdr (raw, gzip, ascii), .mha/.mhd (MetaImage, raw or "
+         "compressed) or .vti (VTK XML ImageData, any data mode)";
+}
 
 void add_read_options(CLI::App* app, ImageReadArgs& r) {
   // One comma-separated word each: with 2 or 3 values expected, CLI11 also
@@ -219,7 +222,9 @@ void add_image_commands(CLI::App& app, ImageCommands& c) {
       "sample-image",
       "Sample a label image into labelled points at voxel centres, dense near label boundaries and sparse inside");
   CLI::App* s = c.sample_app;
-  s->add_option("IMAGE", c.sample.image, kImageHelp)->required();
+  s->add_option("IMAGE", c.sample.image,
+                image_help("labels, an integer type (a float image is refused: cast it, or `threshold` it)"))
+      ->required();
   s->add_option("-o", c.sample.output,
                 "Output points with labels: .npy (float64 (N, D); labels in OUT_labels.npy), .ply (binary, double "
                 "x y z, int property 'label') or .vtp (VTK vertices, point data 'label')")
@@ -249,7 +254,7 @@ void add_image_commands(CLI::App& app, ImageCommands& c) {
   c.probe_app = app.add_subcommand(
       "probe", "Interpolate an image's values at points (bilinear in 2D, trilinear in 3D between voxel centres)");
   CLI::App* p = c.probe_app;
-  p->add_option("IMAGE", c.probe.image, kImageHelp)->required();
+  p->add_option("IMAGE", c.probe.image, image_help("values, any integer or float type"))->required();
   p->add_option("POINTS", c.probe.points,
                 "Point file: .npy, .csv/.xyz/.txt (or Qhull's format), .ply, .vtp/.vtu, .vtk (legacy VTK), .pcd or .dump/.lammpstrj (2D images take x,y of 3-column points); - reads standard input")
       ->required();

@@ -327,6 +327,21 @@ void bind_prep(py::module_& m) {
       "A point file as the command line reads it: (points (n, dim), labels (n,) or None); a trajectory's frame "
       "(0 the first, negative from the end).");
 
+  // ---- read_scalars -----------------------------------------------------------
+  m.def(
+      "read_scalars",
+      [](const std::string& path, const std::string& name, std::int64_t frame) {
+        std::vector<double> v = without_gil([&] {
+          io::FramePlace at;
+          if (frame != 0) at = io::find_frame(path, frame);
+          return io::read_point_scalars(path, name, at);
+        });
+        return adopt_flat(std::move(v));
+      },
+      py::arg("path"), py::arg("name"), py::arg("frame"),
+      "One number per point, as the command line's --radii NAME or threshold --scalars NAME read them: a .npy "
+      "file, or a named column, property, point data array or field of the point file (a trajectory's frame).");
+
   // ---- read_frame -------------------------------------------------------------
   m.def(
       "read_frame",

@@ -54,7 +54,8 @@ from ._core import (
 )
 from ._delaunay import Delaunay, delaunay
 from ._dual import AdjacencyGraph, FaceSet, Flower, Flowers, adjacency, faces, flower
-from ._prep import Frame, fill, joggle, probe, read_box, read_frames, read_image, read_points, sample_image, threshold
+from ._prep import (Frame, fill, joggle, probe, read_box, read_frames, read_image, read_points, read_scalars,
+                    sample_image, threshold)
 from ._scipy import ScipyVoronoi
 from ._surface_nets import NET_CORNER, NET_JUNCTION, NET_SURFACE, SurfaceNet, surface_nets
 from ._voronoi import Voronoi, voronoi
@@ -81,6 +82,7 @@ __all__ = [
     "sample_image",
     "read_image",
     "read_points",
+    "read_scalars",
     "read_box",
     "read_frames",
     "Frame",

@@ -158,6 +158,27 @@ def read_points(
                         _inputs.as_flag(keep_non_finite, "keep_non_finite"), _inputs.as_frame(frame))
 
 
+def read_scalars(path: PathLike, name: PathLike, frame: int = 0) -> np.ndarray:
+    """One number per point of a point file, as the command line reads
+    ``--radii NAME`` and ``threshold --scalars NAME``: ``name`` is a numeric
+    column of a ``.csv`` or a LAMMPS dump (its ``frame``), a ``.ply``
+    property, a ``.vtp`` / ``.vtu`` / ``.vtk`` point data array, a ``.pcd``
+    or structured ``.npy`` field, or a ``.npy`` file of its own. Returns
+    float64 (N,) in the points' order (:func:`read_points`), NaN and
+    infinities kept; ValueError (:class:`tessera.InputError`) for a missing
+    name or a malformed file.
+
+    >>> p, types = tessera.read_points("run.dump", labels="type")    # doctest: +SKIP
+    >>> r = tessera.read_scalars("run.dump", "radius")               # doctest: +SKIP
+    >>> cells = tessera.voronoi(p, radii=r, **tessera.read_box("run.dump"))  # doctest: +SKIP
+    """
+    if not _is_path(path):
+        raise ValueError(f"path: expected a file name, got {type(path).__name__}")
+    if not _is_path(name):
+        raise ValueError(f"name: expected a field name or a .npy file, got {type(name).__name__}")
+    return _inputs.call(_core.read_scalars, _inputs.as_path(path), _inputs.as_path(name), _inputs.as_frame(frame))
+
+
 class Frame(NamedTuple):
     """One frame of a trajectory (:func:`read_frames`)."""
 

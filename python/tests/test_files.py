@@ -293,6 +293,10 @@ def test_lammps_dump_points_and_box(tmp_path):
     p, types = tessera.read_points(path, labels="type")
     np.testing.assert_allclose(p, lo + frac @ vec, rtol=0, atol=1e-14)
     np.testing.assert_array_equal(types, 1 + np.arange(300) % 2)
+    # Per-atom numbers by column name, as --radii NAME reads them.
+    np.testing.assert_array_equal(tessera.read_scalars(path, "type"), 1 + np.arange(300) % 2)
+    with pytest.raises(ValueError, match="radius"):
+        tessera.read_scalars(path, "radius")
     box = tessera.read_box(path)
     assert box == {"bounds": (0.0, 3.0, -1.0, 1.5, 2.0, 4.0), "periodic": (True, True, True), "tilt": (0.5, 0.25, -0.75)}
     vor = tessera.voronoi(p, labels=types, **box)
