@@ -2,6 +2,7 @@
 // checks its arguments and output path before reading anything, reads the
 // image (io/image.hpp), runs the library function, writes atomically and
 // prints a one-line summary.
+#include <cctype>
 #include <cerrno>
 #include <chrono>
 #include <cmath>
@@ -30,7 +31,8 @@ namespace {
 std::string image_help(const char* what) {
   return std::string("Image of ") + what +
          ": .npy (shape (ny, nx) or (nz, ny, nx)), .nrrd/.nhdr (raw, gzip, ascii), .mha/.mhd (MetaImage, raw or "
-         "compressed) or .vti (VTK XML ImageData, any data mode)";
+         "compressed), .vti (VTK XML ImageData, any data mode) or .nii/.nii.gz/.hdr (NIfTI-1 or -2; flipped axes "
+         "are reversed, rotated ones refused)";
 }
 
 void add_read_options(CLI::App* app, ImageReadArgs& r) {
@@ -168,7 +170,11 @@ LabelledPoints sample_named(const std::string& path, const LabelImage& img, cons
 
 bool is_image_path(const std::string& path) {
   const std::string e = extension(path);
-  return e == ".nrrd" || e == ".nhdr" || e == ".mha" || e == ".mhd" || e == ".vti";
+  if (e == ".nrrd" || e == ".nhdr" || e == ".mha" || e == ".mhd" || e == ".vti" || e == ".nii" || e == ".hdr")
+    return true;
+  std::string lower = path.size() >= 7 ? path.substr(path.size() - 7) : path;
+  for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return lower == ".nii.gz";
 }
 
 void add_sampler_options(CLI::App* app, SamplerArgs& s) {

@@ -55,7 +55,7 @@ bool is_image_input(const SurfaceNetsArgs& a) {
   if (is_image_path(a.compute.input)) return true;
   if (!a.image) return false;
   if (extension(a.compute.input) != ".npy")
-    throw InputError("--image: INPUT must be a label image (.npy, .nrrd, .nhdr, .mha, .mhd or .vti), got '" +
+    throw InputError("--image: INPUT must be a label image (.npy, .nrrd, .nhdr, .mha, .mhd, .vti, .nii, .nii.gz or .hdr), got '" +
                      extension(a.compute.input) + "'");
   return true;
 }
@@ -92,7 +92,7 @@ void check_args(const SurfaceNetsArgs& a, bool output) {
         s.step != defaults.step || s.no_randomize || !s.probability.empty() || s.seed != defaults.seed ||
         s.joggle != defaults.joggle)
       throw InputError("the sampler options (--spacing, --origin, --array, --schedule, --step, --no-randomize, "
-                       "--probability, --seed, --joggle) apply to an image INPUT (.nrrd/.nhdr/.mha/.mhd/.vti, or .npy "
+                       "--probability, --seed, --joggle) apply to an image INPUT (.nrrd/.nhdr/.mha/.mhd/.vti/.nii/.nii.gz, or .npy "
                        "with --image)");
   }
 }
@@ -306,8 +306,8 @@ void add_surface_nets_options(CLI::App* app, SurfaceNetsArgs& a, bool bench) {
                   "BoundaryLabels value for the domain-box side of capping faces (must be < 0)")
       ->capture_default_str();
   app->footer(
-      "INPUT: labelled points (.npy/.csv/.ply/.vtp/.vtu/.vtk/.pcd with --labels) or a label image (.nrrd/.nhdr/.mha/.mhd/.vti,\n"
-      "or .npy with --image), which is sampled first (the sampler options: see tessera sample-image --help; the\n"
+      "INPUT: labelled points (.npy/.csv/.ply/.vtp/.vtu/.vtk/.pcd with --labels) or a label image (.nrrd/.nhdr/.mha/.mhd/.vti/\n"
+      ".nii/.nii.gz, or .npy with --image), which is sampled first (the sampler options: see tessera sample-image --help; the\n"
       "domain is then the image's voxels). BoundaryLabels = (side 0, side 1): side 0 is always a selected\n"
       "label; between two selected labels (lower, higher); a capping face carries the other point's own label\n"
       "or --background-label for the box. Faces point from side 0 into side 1, so each label's surface (its\n"

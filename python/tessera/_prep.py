@@ -88,7 +88,9 @@ def read_image(
     path: PathLike, spacing: Any = None, origin: Any = None
 ) -> Tuple[np.ndarray, Tuple[float, ...], Tuple[float, ...]]:
     """Read an image file: ``.npy``, NRRD (``.nrrd`` / ``.nhdr``, raw or
-    gzip), MetaImage (``.mha`` / ``.mhd``) or VTK XML image data (``.vti``).
+    gzip), MetaImage (``.mha`` / ``.mhd``), VTK XML image data (``.vti``) or
+    NIfTI (``.nii``, ``.nii.gz``, ``.hdr`` with its ``.img``; an axis stored
+    with a negative step is reversed, so spacings are positive).
 
     Returns ``(array, spacing, origin)``: the voxels as a C-ordered array of
     shape (ny, nx) or (nz, ny, nx) — int32 for integer data that fits, else

@@ -133,6 +133,70 @@ std::string inflate_exact(const std::string& path, std::string_view what, std::s
   return out;
 }
 
+std::string inflate_prefix(const std::string& path, std::string_view what, std::string_view src, std::size_t limit) {
+  // Grown as the stream gives bytes, never sized by the caller's limit alone.
+  std::string out;
+  z_stream z{};
+  if (inflateInit2(&z, 15 + 32) != Z_OK) fail(path, "zlib initialisation failed");
+  std::size_t in_pos = 0;
+  int rc = Z_OK;
+  char buf[1 << 16];
+  while (out.size() < limit) {
+    const std::size_t in_chunk = std::min<std::size_t>(src.size() - in_pos, 1u << 30);
+    z.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(src.data() + in_pos));
+    z.avail_in = static_cast<uInt>(in_chunk);
+    z.next_out = reinterpret_cast<Bytef*>(buf);
+    z.avail_out = static_cast<uInt>(std::min<std::size_t>(sizeof buf, limit - out.size()));
+    const uInt before = z.avail_out;
+    rc = inflate(&z, Z_NO_FLUSH);
+    out.append(buf, before - z.avail_out);
+    in_pos += in_chunk - z.avail_in;
+    if (rc == Z_STREAM_END) {
+      if (in_pos >= src.size() || inflateReset(&z) != Z_OK) break;  // (concatenated members go on)
+      continue;
+    }
+    if (rc == Z_BUF_ERROR && z.avail_in == 0 && in_pos >= src.size()) break;  // input ended early
+    if (rc != Z_OK) break;
+  }
+  inflateEnd(&z);
+  if (rc != Z_STREAM_END && rc != Z_OK && rc != Z_BUF_ERROR)
+    fail(path, std::string(what) + " is corrupt (zlib: " + (z.msg ? z.msg : "error " + std::to_string(rc)) + ")");
+  return out;
+}
+
+void flip_axis(RawImage& raw, int axis) {
+  const ImageGeometry& g = raw.geometry;
+  const std::size_t nx = static_cast<std::size_t>(g.size[0]), ny = static_cast<std::size_t>(g.size[1]),
+                    nz = static_cast<std::size_t>(g.size[2]);
+  // Voxel (x, y, z) takes the item of its mirror along `axis`, in place:
+  // the first half of each line swaps with the second.
+  auto swap_all = [&](auto&& swap_items) {
+    const std::size_t n[3] = {nx, ny, nz};
+    const std::size_t stride[3] = {1, nx, nx * ny};
+    const std::size_t a = static_cast<std::size_t>(axis);
+    const std::size_t len = n[a], step = stride[a];
+    for (std::size_t z = 0; z < (a == 2 ? 1 : nz); ++z)
+      for (std::size_t y = 0; y < (a == 1 ? 1 : ny); ++y)
+        for (std::size_t x = 0; x < (a == 0 ? 1 : nx); ++x) {
+          const std::size_t base = x + nx * (y + ny * z);
+          for (std::size_t i = 0; i < len / 2; ++i) swap_items(base + i * step, base + (len - 1 - i) * step);
+        }
+  };
+  if (raw.converted) {
+    if (is_float(raw.type))
+      swap_all([&](std::size_t p, std::size_t q) { std::swap(raw.doubles[p], raw.doubles[q]); });
+    else
+      swap_all([&](std::size_t p, std::size_t q) { std::swap(raw.ints[p], raw.ints[q]); });
+    return;
+  }
+  const std::size_t item = scalar_size(raw.type);
+  swap_all([&](std::size_t p, std::size_t q) {
+    std::swap_ranges(raw.bytes.begin() + static_cast<std::ptrdiff_t>(p * item),
+                     raw.bytes.begin() + static_cast<std::ptrdiff_t>((p + 1) * item),
+                     raw.bytes.begin() + static_cast<std::ptrdiff_t>(q * item));
+  });
+}
+
 std::string printable(std::string_view s, std::size_t max) {
   std::string r(s.substr(0, max));
   for (char& c : r)
@@ -291,7 +355,9 @@ void dispatch(const RawImage& raw, F&& f) {
 RawImage read_raw(const std::string& path, const ImageReadOptions& options, bool want_labels) {
   const std::string ext = detail::lower_extension(path);
   RawImage raw;
-  if (ext == ".npy") {
+  if (detail::is_nifti_path(path)) {
+    raw = detail::read_nifti_image(path, want_labels);
+  } else if (ext == ".npy") {
     raw = detail::read_npy_image(path, want_labels);
   } else if (ext == ".nrrd" || ext == ".nhdr") {
     raw = detail::read_nrrd_image(path);
@@ -300,8 +366,11 @@ RawImage read_raw(const std::string& path, const ImageReadOptions& options, bool
   } else if (ext == ".vti") {
     raw = detail::read_vti_image(path, options.array);
   } else {
-    detail::fail(path, "unknown image extension '" + ext + "' (expected .npy, .nrrd, .nhdr, .mha, .mhd or .vti)");
+    detail::fail(path, "unknown image extension '" + ext +
+                           "' (expected .npy, .nrrd, .nhdr, .mha, .mhd, .vti, .nii, .nii.gz or .hdr)");
   }
+  for (int a = 0; a < 3; ++a)
+    if (raw.flip[static_cast<std::size_t>(a)]) detail::flip_axis(raw, a);
   if (!options.array.empty() && ext != ".vti")
     detail::fail(path, "an array name ('" + options.array + "') can only be chosen in .vti files");
   ImageGeometry& g = raw.geometry;
@@ -359,21 +428,25 @@ LabelImage read_label_image(const std::string& path, const ImageReadOptions& opt
   return img;
 }
 
+namespace detail {
+
+std::vector<double> raw_as_doubles(const RawImage& raw) {
+  if (raw.converted && is_float(raw.type)) return raw.doubles;
+  std::vector<double> out(raw.geometry.n_voxels());
+  if (raw.converted)
+    for (std::size_t k = 0; k < raw.ints.size(); ++k) out[k] = static_cast<double>(raw.ints[k]);
+  else
+    dispatch(raw, [&](std::size_t k, auto v) { out[k] = static_cast<double>(v); });
+  return out;
+}
+
+}  // namespace detail
+
 ScalarImage read_scalar_image(const std::string& path, const ImageReadOptions& options) {
   RawImage raw = read_raw(path, options, false);
   ScalarImage img;
   img.geometry = raw.geometry;
-  if (raw.converted) {
-    if (detail::is_float(raw.type)) {
-      img.values = std::move(raw.doubles);
-    } else {
-      img.values.resize(raw.ints.size());
-      for (std::size_t k = 0; k < raw.ints.size(); ++k) img.values[k] = static_cast<double>(raw.ints[k]);
-    }
-    return img;
-  }
-  img.values.resize(raw.geometry.n_voxels());
-  dispatch(raw, [&](std::size_t k, auto v) { img.values[k] = static_cast<double>(v); });
+  img.values = raw.converted && detail::is_float(raw.type) ? std::move(raw.doubles) : detail::raw_as_doubles(raw);
   return img;
 }
 

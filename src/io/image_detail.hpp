@@ -6,6 +6,7 @@
 // or to doubles, and applies the ImageReadOptions overrides.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <string>
@@ -36,12 +37,20 @@ struct RawImage {
   bool converted = false;
   std::vector<std::int64_t> ints;
   std::vector<double> doubles;
+  /// Axes the file stores with a negative step (a flipped direction): the
+  /// reader has set `geometry` as the image will be (positive spacing, the
+  /// origin at the lowest voxel), and read_raw reverses the voxels along them.
+  std::array<bool, 3> flip{false, false, false};
 };
 
 RawImage read_npy_image(const std::string& path, bool want_labels);
 RawImage read_nrrd_image(const std::string& path);
 RawImage read_metaimage(const std::string& path);
 RawImage read_vti_image(const std::string& path, const std::string& array);
+/// (`want_labels`: scaled values, scl_slope/scl_inter, are refused.)
+RawImage read_nifti_image(const std::string& path, bool want_labels);
+/// Whether `path` names a NIfTI file: .nii, .nii.gz or .hdr (with its .img).
+bool is_nifti_path(const std::string& path);
 
 // ---- shared by the readers ----
 
@@ -58,6 +67,19 @@ std::size_t data_bytes(const ImageGeometry& g, ScalarType t);
 /// the stream is corrupt, shorter or longer than `expected`.
 std::string inflate_exact(const std::string& path, std::string_view what, std::string_view src,
                           std::size_t expected);
+
+/// At most the first `limit` bytes a zlib or gzip stream inflates to (fewer
+/// where it ends first); InputError naming `path` where it is corrupt. For
+/// formats whose header lies inside the compressed stream (.nii.gz).
+std::string inflate_prefix(const std::string& path, std::string_view what, std::string_view src,
+                           std::size_t limit);
+
+/// Every voxel's value as a double (converted or not).
+std::vector<double> raw_as_doubles(const RawImage& raw);
+
+/// Reverses the voxels along `axis` (0 x, 1 y, 2 z), for images stored with
+/// a negative step along it; the caller moves the geometry's origin.
+void flip_axis(RawImage& raw, int axis);
 
 /// Parse whitespace-separated numbers into `count` values of type `t`
 /// (native byte order), for ascii encodings. Throws InputError on a bad

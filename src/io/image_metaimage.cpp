@@ -15,8 +15,9 @@
 //
 // Supported: 2D/3D, one channel, every MET_ integer and float type, binary
 // (raw or zlib-compressed) and ascii data, HeaderSize for external files
-// (-1: the data is at the end). Rejected with a one-line error: several
-// channels, a rotated or flipped TransformMatrix, file lists and patterns.
+// (-1: the data is at the end), a TransformMatrix that flips axes (read
+// reversed). Rejected with a one-line error: several channels, a rotated or
+// permuted TransformMatrix, file lists and patterns.
 #include <algorithm>
 #include <bit>
 #include <cctype>
@@ -124,11 +125,14 @@ RawImage read_metaimage(const std::string& path) {
     double m[9];
     if (!parse_doubles(*tm, d * d, m))
       fail(path, "MetaImage TransformMatrix must give " + std::to_string(d * d) + " numbers, got '" + *tm + "'");
+    // The identity, up to axes stored flipped (a -1 on the diagonal: read
+    // reversed, the origin moved to the lowest voxel once the sizes are known).
     for (std::size_t r = 0; r < d; ++r)
       for (std::size_t c = 0; c < d; ++c)
-        if (std::abs(m[r * d + c] - (r == c ? 1.0 : 0.0)) > 1e-9)
-          fail(path, "MetaImage TransformMatrix is not the identity (rotated or flipped images are not supported; "
+        if (std::abs(std::abs(m[r * d + c]) - (r == c ? 1.0 : 0.0)) > 1e-9)
+          fail(path, "MetaImage TransformMatrix is not axis-aligned (rotated or permuted images are not supported; "
                      "resample first)");
+    for (std::size_t a = 0; a < d; ++a) raw.flip[a] = m[a * d + a] < 0;
   }
   if (const std::string* ch = field("elementnumberofchannels"); ch && trim(*ch) != "1")
     fail(path, "MetaImage ElementNumberOfChannels = " + *ch + ": multi-component data is not supported");
@@ -158,6 +162,8 @@ RawImage read_metaimage(const std::string& path) {
     if (t.empty() || ec != std::errc() || p != t.data() + t.size() || compressed_size < 0)
       fail(path, "MetaImage CompressedDataSize must be an integer >= 0, got '" + *cs + "'");
   }
+  for (std::size_t a = 0; a < 3; ++a)  // Offset is voxel 0's place; a flipped axis runs down from it
+    if (raw.flip[a]) g.origin[a] -= static_cast<double>(g.size[a] - 1) * g.spacing[a];
   check_geometry(path, g);
   const std::size_t n = g.n_voxels();
   const std::size_t need = data_bytes(g, raw.type);

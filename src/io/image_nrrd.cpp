@@ -16,10 +16,11 @@
 //
 // Supported: 2D/3D scalar images, every integer and float type, raw, gzip and
 // ascii encodings, "line skip" and "byte skip" (-1 for raw: data at the end of
-// the file), axis-aligned space directions with positive steps, or spacings
+// the file), axis-aligned space directions (a negative step: the axis read
+// reversed), or spacings
 // with axis mins (and maxs) placed by their centering. Rejected with a
 // one-line error: other encodings (hex, bzip2), multi-file data ("LIST",
-// formats), non-spatial (vector, colour) axes, rotated or flipped directions,
+// formats), non-spatial (vector, colour) axes, rotated or permuted directions,
 // and fields NRRD does not define (a misspelt field was silently ignored).
 #include <algorithm>
 #include <bit>
@@ -248,11 +249,13 @@ RawImage read_nrrd_image(const std::string& path) {
         fail(path, "NRRD 'space directions' vectors have inconsistent lengths");
       for (std::size_t c = 0; c < sdim; ++c) {
         const double x = vs[a][c];
-        if ((c == a && !(x > 0)) || (c != a && x != 0))
-          fail(path, "NRRD 'space directions' are not axis-aligned with positive steps (rotated or flipped images are "
-                     "not supported; resample first)");
+        if ((c == a && !(x != 0)) || (c != a && x != 0))
+          fail(path, "NRRD 'space directions' are not axis-aligned (rotated or permuted images are not supported; "
+                     "resample first)");
       }
-      g.spacing[a] = vs[a][a];
+      // A negative step: the axis is stored flipped, and read reversed.
+      raw.flip[a] = vs[a][a] < 0;
+      g.spacing[a] = std::fabs(vs[a][a]);
     }
     if (const std::string* org = field("space origin")) {
       std::vector<std::vector<double>> o;
@@ -261,6 +264,8 @@ RawImage read_nrrd_image(const std::string& path) {
                        *org + "'");
       for (std::size_t c = 0; c < sdim; ++c) g.origin[c] = o[0][c];
     }
+    for (std::size_t a = 0; a < static_cast<std::size_t>(dim); ++a)
+      if (raw.flip[a]) g.origin[a] += static_cast<double>(g.size[a] - 1) * vs[a][a];
     if (field("spacings")) fail(path, "NRRD header gives both 'spacings' and 'space directions'");
     if (field("axis mins") || field("axis maxs"))
       fail(path, "NRRD header gives both 'axis mins' or 'axis maxs' and 'space directions'");

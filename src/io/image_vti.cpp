@@ -63,13 +63,18 @@ RawImage read_vti_image(const std::string& path, const std::string& array) {
   if (const std::string* d = attr(id, "Direction")) {
     double m[9];
     if (!parse_doubles(*d, 9, m)) fail(path, "malformed Direction '" + *d + "'");
+    // The identity, up to axes stored flipped (-1 on the diagonal: read reversed).
     for (int k = 0; k < 9; ++k)
-      if (std::abs(m[k] - (k % 4 == 0 ? 1.0 : 0.0)) > 1e-9)
-        fail(path, "Direction is not the identity (rotated or flipped images are not supported; resample first)");
+      if (std::abs(std::abs(m[k]) - (k % 4 == 0 ? 1.0 : 0.0)) > 1e-9)
+        fail(path, "Direction is not axis-aligned (rotated or permuted images are not supported; resample first)");
+    for (std::size_t a = 0; a < 3; ++a) raw.flip[a] = m[4 * a] < 0;
   }
   for (std::size_t a = 0; a < 3; ++a) {
     g.size[a] = whole[2 * a + 1] - whole[2 * a] + 1;
-    g.origin[a] = origin[a] + static_cast<double>(whole[2 * a]) * g.spacing[a];
+    // Voxel i along an axis lies at Origin + i * spacing, or at Origin - i *
+    // spacing where the Direction flips it (its last voxel is then the lowest).
+    g.origin[a] = raw.flip[a] ? origin[a] - static_cast<double>(whole[2 * a + 1]) * g.spacing[a]
+                              : origin[a] + static_cast<double>(whole[2 * a]) * g.spacing[a];
   }
   g.dim = g.size[2] == 1 ? 2 : 3;
   check_geometry(path, g);

@@ -19,6 +19,7 @@ VTK origin (1, -2, 3), which puts voxel (0, 0, 0) at (2, -2, 5) as well.
 """
 import gzip
 import os
+import struct
 import sys
 
 import numpy as np
@@ -114,6 +115,60 @@ def nrrd_header(type_name, sizes, encoding, endian="little", extra=()):
     return "\n".join(lines) + "\n"
 
 
+NIFTI_TYPES = {"uint8": 2, "int16": 4, "int32": 8, "float32": 16, "float64": 64}
+
+
+def nifti_header(a, version=1, endian="<", magic=None, sform=None, qform=None, pixdim=None, vox_offset=None,
+                 slope=0.0, inter=0.0, dims=None):
+    """A NIfTI-1 (348 bytes) or NIfTI-2 (540) header for array a (nz, ny, nx),
+    written field by field from the standard's layout (nifti1.h, nifti2.h).
+    sform: 3x4 rows; qform: (b, c, d, qx, qy, qz, qfac)."""
+    e = endian
+    dt = NIFTI_TYPES[a.dtype.name]
+    bitpix = a.dtype.itemsize * 8
+    dims = dims or ([3, NX, NY, NZ, 1, 1, 1, 1] if a.ndim == 3 else [2, a.shape[1], a.shape[0], 1, 1, 1, 1, 1])
+    pd = [1.0] + list(pixdim or SPACING) + [0, 0, 0, 0]
+    if qform is not None:
+        pd[0] = qform[6]
+    qb, qc, qd, qx, qy, qz = qform[:6] if qform is not None else (0, 0, 0, 0, 0, 0)
+    srow = sform if sform is not None else [[0] * 4] * 3
+    if version == 1:
+        h = bytearray(348)
+        struct.pack_into(e + "i", h, 0, 348)
+        struct.pack_into(e + "8h", h, 40, *dims)
+        struct.pack_into(e + "hh", h, 70, dt, bitpix)
+        struct.pack_into(e + "8f", h, 76, *pd)
+        struct.pack_into(e + "f", h, 108, 352.0 if vox_offset is None else vox_offset)
+        struct.pack_into(e + "ff", h, 112, slope, inter)
+        struct.pack_into(e + "hh", h, 252, 1 if qform is not None else 0, 1 if sform is not None else 0)
+        struct.pack_into(e + "6f", h, 256, qb, qc, qd, qx, qy, qz)
+        for r in range(3):
+            struct.pack_into(e + "4f", h, 280 + 16 * r, *srow[r])
+        h[344:348] = (magic or b"n+1") + b"\0"
+        return bytes(h) + b"\0" * 4  # the extension flag: none
+    h = bytearray(540)
+    struct.pack_into(e + "i", h, 0, 540)
+    h[4:12] = (magic or b"n+2") + b"\0\r\n\x1a\n"
+    struct.pack_into(e + "hh", h, 12, dt, bitpix)
+    struct.pack_into(e + "8q", h, 16, *dims)
+    struct.pack_into(e + "8d", h, 104, *pd)
+    struct.pack_into(e + "q", h, 168, 544 if vox_offset is None else vox_offset)
+    struct.pack_into(e + "dd", h, 176, slope, inter)
+    struct.pack_into(e + "ii", h, 344, 1 if qform is not None else 0, 1 if sform is not None else 0)
+    struct.pack_into(e + "6d", h, 352, qb, qc, qd, qx, qy, qz)
+    for r in range(3):
+        struct.pack_into(e + "4d", h, 400 + 32 * r, *srow[r])
+    return bytes(h) + b"\0" * 4
+
+
+def write_nifti(path, a, **kw):
+    """a: (nz, ny, nx) as stored; .gz names are gzipped whole."""
+    e = kw.get("endian", "<")
+    data = nifti_header(a, **kw) + np.ascontiguousarray(a).astype(a.dtype.newbyteorder(e)).tobytes()
+    with (gzip.open(path, "wb") if path.endswith(".gz") else open(path, "wb")) as f:
+        f.write(data)
+
+
 def main():
     out = sys.argv[1]
     os.makedirs(out, exist_ok=True)
@@ -169,10 +224,54 @@ def main():
         write_meta(p("meta_%s.mhd" % tag), img_lab, comp)
         write_meta(p("meta_field_%s.mha" % tag), img_fld, comp)
 
+    # ---- NIfTI, hand-made: the test geometry stored with and without flipped
+    # axes (negative steps), read back to the same image.
+    ox, oy, oz = ORIGIN
+    sx, sy, sz = SPACING
+    diag = lambda fx, fy, fz, t: [[fx * sx, 0, 0, t[0]], [0, fy * sy, 0, t[1]], [0, 0, fz * sz, t[2]]]  # noqa: E731
+    write_nifti(p("nifti1_sform.nii"), lab, sform=diag(1, 1, 1, ORIGIN))
+    # x stored backwards: its first voxel is the last one, at x = 2 + 4 * 0.5
+    write_nifti(p("nifti1_flipx.nii.gz"), lab[:, :, ::-1], sform=diag(-1, 1, 1, (ox + 4 * sx, oy, oz)))
+    # big-endian, qform only: the identity rotation with qfac -1 (z backwards)
+    write_nifti(p("nifti1_qfac_be.nii"), lab[::-1], endian=">", qform=(0, 0, 0, ox, oy, oz + 2 * sz, -1.0))
+    # a header/image pair whose qform is 180 degrees about x: y and z backwards
+    with open(p("nifti1_pair.hdr"), "wb") as f:
+        f.write(nifti_header(lab, magic=b"ni1", vox_offset=0, qform=(1, 0, 0, ox, oy + 3 * sy, oz + 2 * sz, 1.0))[:348])
+    with open(p("nifti1_pair.img"), "wb") as f:
+        f.write(np.ascontiguousarray(lab[::-1, ::-1]).tobytes())
+    write_nifti(p("nifti2_field.nii"), fld, version=2, sform=diag(1, 1, 1, ORIGIN))
+    # stored float32 values scaled by scl_slope / scl_inter into the field
+    write_nifti(p("nifti1_scaled.nii.gz"), ((fld - 0.125) / 0.5).astype(np.float32), sform=diag(1, 1, 1, ORIGIN),
+                slope=0.5, inter=0.125)
+    # refused: a rotation, a time series, an Analyze header
+    c, s_ = np.cos(0.3), np.sin(0.3)
+    write_nifti(p("nifti1_rotated.nii"), lab, sform=[[c * sx, -s_ * sy, 0, 0], [s_ * sx, c * sy, 0, 0], [0, 0, sz, 0]])
+    write_nifti(p("nifti1_4d.nii"), np.concatenate([lab, lab]), sform=diag(1, 1, 1, ORIGIN),
+                dims=[4, NX, NY, NZ, 2, 1, 1, 1])
+    write_nifti(p("analyze.nii"), lab, magic=b"\0\0\0")
+
     # ---- NRRD, hand-made
     raw16 = lab.astype("<i2").tobytes()
     with open(p("nrrd_raw.nrrd"), "wb") as f:
         f.write(nrrd_header("short", (NX, NY, NZ), "raw").encode() + b"\n" + raw16)
+    # Axes stored flipped (negative steps) in each format, read back to the
+    # same image: NRRD x, MetaImage y (by TransformMatrix), .vti x and z (by Direction).
+    flipped = nrrd_header("short", (NX, NY, NZ), "raw").replace(
+        "(%r,0,0) (0,%r,0)" % SPACING[:2], "(%r,0,0) (0,%r,0)" % (-SPACING[0], SPACING[1])).replace(
+        "space origin: (%r," % ORIGIN[0], "space origin: (%r," % (ORIGIN[0] + 4 * SPACING[0]))
+    with open(p("nrrd_flipx.nrrd"), "wb") as f:
+        f.write(flipped.encode() + b"\n" + lab[:, :, ::-1].astype("<i2").tobytes())
+    with open(p("meta_flipy.mha"), "wb") as f:
+        f.write(("ObjectType = Image\nNDims = 3\nBinaryData = True\nBinaryDataByteOrderMSB = False\n"
+                 "TransformMatrix = 1 0 0 0 -1 0 0 0 1\nOffset = %r %r %r\nElementSpacing = %r %r %r\n"
+                 "DimSize = %d %d %d\nElementType = MET_SHORT\nElementDataFile = LOCAL\n" %
+                 ((ORIGIN[0], ORIGIN[1] + 3 * SPACING[1], ORIGIN[2]) + SPACING + (NX, NY, NZ))).encode() +
+                lab[:, ::-1, :].astype("<i2").tobytes())
+    fimg = vtk_image([("labels", np.ascontiguousarray(lab[::-1, :, ::-1]))],
+                     origin=(ORIGIN[0] + (EXT0[0] + NX - 1) * SPACING[0], VTK_ORIGIN[1],
+                             ORIGIN[2] + (EXT0[2] + NZ - 1) * SPACING[2]))
+    fimg.SetDirectionMatrix(-1, 0, 0, 0, 1, 0, 0, 0, -1)
+    write_vti(p("vti_flipxz.vti"), fimg, "binary", 0)
     with open(p("nrrd_gzip.nrrd"), "wb") as f:
         f.write(nrrd_header("int16", (NX, NY, NZ), "gzip").encode() + b"\n" + gzip.compress(raw16))
     with open(p("nrrd_big.nrrd"), "wb") as f:
