@@ -274,11 +274,11 @@ int run_fill(const FillArgs& a) {
   // "--bounds 0 1 0 1 pts.npy": --bounds (up to six words) took INPUT, and gives it back.
   PrepInput io = a.io;
   std::vector<std::string> words = a.bounds;
-  if (io.input.empty() && words.size() == 5) {
+  if (io.input.empty() && !words.empty()) {  // (any count: an odd one is then refused by its count)
     try {
-      parse_number(words[4], "--bounds", false);
+      parse_number(words.back(), "--bounds", false);
     } catch (const InputError&) {
-      io.input = words[4];
+      io.input = words.back();
       words.pop_back();
     }
   }

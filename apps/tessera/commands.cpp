@@ -75,10 +75,15 @@ void route_standard_output(std::initializer_list<const std::string*> outputs) {
 void check_distinct_outputs(std::initializer_list<std::pair<const char*, const std::string*>> outputs) {
   // The same file by another spelling (./a.npy, a link to it) is the same
   // output: compared as the paths resolve, where they can be.
+  // Made absolute first: weakly_canonical leaves a bare name that does not
+  // exist yet relative ("x.npy"), while "./x.npy" resolves (a fuzz found the
+  // two taken for different files).
   auto resolved = [](const std::string& p) {
     std::error_code ec;
-    const std::filesystem::path r = std::filesystem::weakly_canonical(p, ec);
-    return ec ? std::filesystem::path(p).lexically_normal() : r;
+    const std::filesystem::path a = std::filesystem::absolute(p, ec);
+    if (ec) return std::filesystem::path(p).lexically_normal();
+    const std::filesystem::path r = std::filesystem::weakly_canonical(a, ec);
+    return ec ? a.lexically_normal() : r;
   };
   std::vector<std::pair<const char*, std::filesystem::path>> seen;
   for (const auto& [option, path] : outputs) {

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "stdin_input.hpp"  // shown_path
 
 namespace tessera::cli {
 
@@ -71,7 +72,7 @@ int run_frames(const Args& a, std::initializer_list<SeriesOutput<Args>> outputs,
     const io::FramePlace& place = frames[k];
     if (place.atoms == 0) {
       std::fprintf(stderr, "tessera: frame %zu of %s (from line %zu) holds no atoms: skipped, no files for it\n",
-                   place.index, a.compute.input.c_str(), place.line);
+                   place.index, shown_path(a.compute.input).c_str(), place.line);
       continue;
     }
     ++computed;

@@ -54,6 +54,20 @@ void print_error(const std::string& message) {
   std::fprintf(stderr, "tessera: error: %s\n", line.c_str());
 }
 
+/// The first option of the command run that was given an empty value
+/// (-o "", --cell-table ""), or "". Such an option was taken as not given:
+/// `--cell-table "" --neighbors nb.npy` wrote the neighbours alone, exit 0.
+std::string option_given_empty(const CLI::App& app) {
+  for (const CLI::App* sub : app.get_subcommands()) {
+    for (const CLI::Option* o : sub->get_options())
+      if (o->count() > 0 && o->get_expected_min() > 0)  // (not a flag)
+        for (const std::string& r : o->results())
+          if (r.empty()) return o->get_name();
+    if (std::string inner = option_given_empty(*sub); !inner.empty()) return inner;
+  }
+  return "";
+}
+
 constexpr const char* kExitCodes =
     "Exit status: 0 success; 1 failure (an internal error, or a failed --validate where the command has one);\n"
     "2 bad command line or bad input; 130 interrupted (Ctrl-C during the computation: nothing written).\n"
@@ -483,6 +497,10 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) return app.exit(e);  // --help
     print_error(std::string(e.what()) + " (run with --help for usage)");
+    return kExitInputError;
+  }
+  if (const std::string empty = option_given_empty(app); !empty.empty()) {
+    print_error(empty + ": an empty value (a file name, a number or a list was expected)");
     return kExitInputError;
   }
 

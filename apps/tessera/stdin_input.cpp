@@ -33,6 +33,7 @@ std::string sniff(std::string_view head) {
   if (head.substr(0, 6) == "\x93NUMPY") return ".npy";
   if (head.substr(0, 4) == "ply\n" || head.substr(0, 5) == "ply\r\n") return ".ply";
   if (head.substr(0, 4) == "NRRD") return ".nrrd";
+  if (head.substr(0, 4) == "LASF") return ".las";
   // Legacy VTK (before the PCD test, whose comment lines also start with '#').
   std::string first(head.substr(0, 22));
   for (char& c : first) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));

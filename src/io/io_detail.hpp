@@ -231,6 +231,13 @@ std::vector<double> read_vtk_legacy_point_array(const std::string& path, const s
 /// Whether a file's first bytes are a legacy VTK header.
 bool looks_like_legacy_vtk(std::string_view head);
 
+/// LAS lidar files (.las 1.0-1.4, point formats 0-10; las.cpp): x, y, z
+/// from the records' scaled integers; `label_field` is empty, or an integer
+/// field (classification, intensity, return_number, ...).
+PointCloud read_las_points(const std::string& path, const ReadOptions& options, const std::string& label_field);
+/// The values of LAS field `name` (classification, intensity, gps_time, ...).
+std::vector<double> read_las_field(const std::string& path, const std::string& name);
+
 /// PCD files (the Point Cloud Library's; ascii, binary, binary_compressed):
 /// the fields x, y (and z). `label_field` is empty, or an integer field.
 PointCloud read_pcd_points(const std::string& path, const ReadOptions& options, const std::string& label_field);

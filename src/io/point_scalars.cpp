@@ -28,6 +28,7 @@ std::vector<double> read_point_scalars(const std::string& points_path, const std
   if (ext == ".vtp" || ext == ".vtu") return detail::read_vtk_point_array(points_path, source);
   if (ext == ".vtk") return detail::read_vtk_legacy_point_array(points_path, source);
   if (ext == ".pcd") return detail::read_pcd_field(points_path, source);
+  if (ext == ".las" || ext == ".laz") return detail::read_las_field(points_path, source);
   if (detail::is_dump_extension(ext)) return detail::read_dump_column(points_path, source, frame);
   if (ext == ".csv" || ext == ".xyz" || ext == ".txt") return detail::read_text_column(points_path, source, frame);
   if (ext == ".npy") {  // a field of a structured array
@@ -37,7 +38,7 @@ std::vector<double> read_point_scalars(const std::string& points_path, const std
     if (r.structured) detail::fail(points_path, "no field '" + source + "' for scalars");
   }
   detail::fail(points_path, "scalars '" + source + "': name a .ply property, a .csv column, a .vtp/.vtu/.vtk point data "
-                            "array, a LAMMPS dump's column or a field of a .pcd or a structured .npy, or give a .npy file");
+                            "array, a LAMMPS dump's column or a field of a .pcd, a .las or a structured .npy, or give a .npy file");
 }
 
 }  // namespace tessera::io

@@ -297,6 +297,8 @@ PointCloud read_points(const std::string& path, const ReadOptions& options) {
     pc = detail::read_ply_points(path, options, label_name);
   } else if (ext == ".vtp" || ext == ".vtu") {
     pc = detail::read_vtk_points(path, options, label_name);
+  } else if (ext == ".las" || ext == ".laz") {
+    pc = detail::read_las_points(path, options, label_name);
   } else if (ext == ".vtk") {
     pc = detail::read_vtk_legacy_points(path, options, label_name);
   } else if (ext == ".pcd") {
@@ -305,7 +307,7 @@ PointCloud read_points(const std::string& path, const ReadOptions& options) {
     pc = detail::read_dump_points(path, options, label_name);
   } else {
     detail::fail(path, "unknown input extension '" + ext +
-                           "' (expected .npy, .csv, .xyz, .txt, .ply, .vtp, .vtu, .vtk, .pcd, .dump, .lammpstrj)");
+                           "' (expected .npy, .csv, .xyz, .txt, .ply, .vtp, .vtu, .vtk, .pcd, .las, .dump, .lammpstrj)");
   }
 
   if (pc.n == 0) detail::fail(path, "no points");

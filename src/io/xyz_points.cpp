@@ -306,7 +306,12 @@ bool looks_like_xyz(std::string_view text) {
   // A second count is Qhull's header (dimension, then count: rbox's output).
   RawLines lines(text);
   std::string_view first, comment, atom;
-  if (!lines.next(first) || !lone_count(first) || !lines.next(comment) || !lines.next(atom)) return false;
+  if (!lines.next(first) || !lone_count(first) || !lines.next(comment)) return false;
+  // Frames of no atoms (a trajectory of a group empty at first) lead straight
+  // to the next frame's count (a fuzz found such a file taken for no XYZ).
+  for (int empty = 0; *lone_count(first) == 0; ++empty)
+    if (empty == 64 || !lines.next(first) || !lone_count(first) || !lines.next(comment)) return false;
+  if (!lines.next(atom)) return false;
   Fields fs(atom, ' ');
   std::string_view f;
   std::size_t fields = 0;
@@ -395,7 +400,8 @@ bool is_xyz_file(const std::string& path) {
     RawLines lines(text);
     std::string_view first;
     if (lines.next(first) && !lone_count(first)) return false;
-    if (tail && std::count(text.begin(), text.end(), '\n') < 3) throw FrameCut{};
+    // (Three lines, or past empty frames two more for each, up to 64 of them.)
+    if (tail && std::count(text.begin(), text.end(), '\n') < 3 + 2 * 64 && !looks_like_xyz(text)) throw FrameCut{};
     return looks_like_xyz(text);
   });
 }

@@ -1432,6 +1432,18 @@ class FileBoxes(TempDirCase):
             self.assertEqual(r.returncode, 2, sel)
             self.assertIn(fragment, r.stderr)
             self.assertFalse(os.path.exists(self.p("g_1.csv")))
+        # From standard input the note names stdin, not the spooled copy.
+        with open(self.p("gap.dump"), "rb") as f:
+            r = run_bytes(["voronoi", "-", "--frame", "all", "--cell-table", self.p("i_{frame}.csv"), "-q"], f.read())
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertIn(b"frame 1 of stdin (from line ", r.stderr)
+        # An XYZ trajectory whose first frames hold no atoms is still one (it was
+        # "not a trajectory").
+        with open(self.p("late.xyz"), "w") as f:
+            f.write("0\nnothing yet\n0\nstill nothing\n3\nthree\nC 0.1 0.2 0.3\nC 0.5 0.6 0.7\nC 0.9 0.1 0.5\n")
+        r = self.ok(["voronoi", self.p("late.xyz"), "--frame", "all", "--cell-table", self.p("late_{frame}.csv"), "-q"])
+        self.assertEqual(r.stderr.count("holds no atoms"), 2)
+        self.assertEqual(sorted(f for f in os.listdir(self.dir) if f.startswith("late_")), ["late_2.csv"])
         # A trajectory still being written: its last frame cut short. The
         # frames before it are read; the cut one is named, with its line.
         with open(traj) as f:
@@ -2008,6 +2020,23 @@ class BadInput(TempDirCase):
                    outputs=[same])
         r = run(["voronoi", self.good3, "--cell-table", "-", "--neighbors", same])  # standard output is no file
         self.assertEqual(r.returncode, 0, r.stderr)
+        # A bare name and ./name of a file not there yet (a fuzz found them
+        # taken for two files; the neighbours replaced the table).
+        r = subprocess.run([TESSERA, "voronoi", self.good3, "--cell-table", "new.npy", "--neighbors", "./new.npy"],
+                           cwd=self.dir, capture_output=True, text=True)
+        self.assertEqual(r.returncode, 2, r.stderr)
+        self.assertIn("name the same file", r.stderr)
+        self.assertFalse(os.path.exists(self.p("new.npy")))
+
+    def test_empty_option_values_refused(self):
+        # An empty value was taken as the option not given: `--cell-table ""
+        # --neighbors nb.npy` wrote the neighbours alone, exit 0.
+        for args, name in ((["--cell-table", "", "--neighbors", self.p("nb.npy")], "--cell-table"),
+                           (["-o", "", "--validate"], "--output"),
+                           (["--labels", "", "--validate"], "--labels")):
+            self.fails(["voronoi", self.good3] + args, name + ": an empty value", outputs=[self.p("nb.npy")])
+        self.fails(["voronoi", "", "--validate"], "INPUT: an empty value")
+        self.fails(["delaunay", self.good3, "--simplices", "", "--validate"], "--simplices: an empty value")
 
     def test_output_extensions(self):
         self.fails(["voronoi", self.good3, "-o", self.out("c.vtp")], ".vtu")

@@ -158,6 +158,7 @@ class Fill(Case):
         self.fails(["fill", inp, "--bounds", "0,a,0,1", "-o", out], "'a'")
         self.fails(["fill", inp, "--strategy", "random", "-o", out])
         self.fails(["fill", "--bounds", "0", "1", "0", "1", "-o", out], "INPUT is required")
+        self.fails(["fill", "--bounds", "0", "1", "0", "1", "0", inp, "-o", out], "got 5 numbers")
         self.fails(["fill", self.save("flat.npy", np.array([[0.0, 1.0], [1.0, 1.0]])), "-o", out], "y =")
 
 

@@ -16,7 +16,7 @@ TEST(ReadPoints, UnknownExtension) {
   TempDir dir;
   const std::string p = dir.write("points.foo", "1,2,3\n");
   auto msg = input_error([&] { read_points(p); });
-  EXPECT_EQ(msg, p + ": unknown input extension '.foo' (expected .npy, .csv, .xyz, .txt, .ply, .vtp, .vtu, .vtk, .pcd, .dump, .lammpstrj)");
+  EXPECT_EQ(msg, p + ": unknown input extension '.foo' (expected .npy, .csv, .xyz, .txt, .ply, .vtp, .vtu, .vtk, .pcd, .las, .dump, .lammpstrj)");
 }
 
 TEST(ReadPoints, MissingFile) {
