@@ -262,7 +262,7 @@ void add_image_commands(CLI::App& app, ImageCommands& c) {
   CLI::App* p = c.probe_app;
   p->add_option("IMAGE", c.probe.image, image_help("values, any integer or float type"))->required();
   p->add_option("POINTS", c.probe.points,
-                "Point file: .npy, .csv/.xyz/.txt (or Qhull's format), .ply, .vtp/.vtu, .vtk (legacy VTK), .pcd or .dump/.lammpstrj (2D images take x,y of 3-column points); - reads standard input")
+                "Point file: .npy, .csv/.xyz/.txt (or Qhull's format), .ply, .vtp/.vtu, .vtk (legacy VTK), .pcd, .las or .dump/.lammpstrj (2D images take x,y of 3-column points); - reads standard input")
       ->required();
   p->add_option("-o,--output", c.probe.output,
                 ".npy: the values, float64 of shape (N,); .ply/.vtp: the points with a double array 'scalars' "
@@ -270,7 +270,7 @@ void add_image_commands(CLI::App& app, ImageCommands& c) {
       ->required();
   add_read_options(p, c.probe.read);
   p->add_option("--labels", c.probe.labels,
-                "Per-point integer labels carried to .ply/.vtp output: FILE.npy or a .ply property / .csv column / .vtp, .vtu or .vtk point data array / LAMMPS dump column / .pcd or structured .npy field");
+                "Per-point integer labels carried to .ply/.vtp output: FILE.npy or a .ply property / .csv column / .vtp, .vtu or .vtk point data array / LAMMPS dump column / .pcd, .las or structured .npy field");
   p->add_option("--outside-value", c.probe.outside_value,
                 "Value for points outside the box of voxel centres (a number, nan, inf or -inf)")
       ->capture_default_str();

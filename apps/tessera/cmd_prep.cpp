@@ -35,7 +35,7 @@ constexpr const char* kOutputHelp =
 /// `input_required` false: the command checks INPUT itself (fill, whose
 /// --bounds may have taken it: "--bounds 0 1 0 1 pts.npy").
 void add_input_options(CLI::App* app, PrepInput& p, bool labels, const char* keep_help, bool input_required = true) {
-  CLI::Option* input = app->add_option("INPUT", p.input, "Point file: .npy, .csv/.xyz/.txt (or Qhull's format), .ply, .vtp/.vtu, .vtk (legacy VTK), .pcd or .dump/.lammpstrj (as for `voronoi`); - reads standard input");
+  CLI::Option* input = app->add_option("INPUT", p.input, "Point file: .npy, .csv/.xyz/.txt (or Qhull's format), .ply, .vtp/.vtu, .vtk (legacy VTK), .pcd, .las or .dump/.lammpstrj (as for `voronoi`); - reads standard input");
   if (input_required) input->required();
   app->add_option("-o,--output", p.output, kOutputHelp)->required();
   app->add_option("--dim", p.dim, "Dimension: 2 or 3 (default: the number of columns or fields; .ply, .vtp and .vtu are 3D)")
@@ -43,7 +43,7 @@ void add_input_options(CLI::App* app, PrepInput& p, bool labels, const char* kee
   if (labels)
     app->add_option("--labels", p.labels,
                     "Per-point integer labels, carried to the output: FILE.npy, or the name of an integer .ply "
-                    "vertex property / .csv column / .vtp, .vtu or .vtk point data array / LAMMPS dump column / .pcd or structured .npy field");
+                    "vertex property / .csv column / .vtp, .vtu or .vtk point data array / LAMMPS dump column / .pcd, .las or structured .npy field");
   app->add_flag("--keep-non-finite", p.keep_non_finite, keep_help);
   app->add_flag("-q,--quiet", p.quiet, "No summary line");
 }
@@ -171,7 +171,7 @@ void add_prep_commands(CLI::App& app, PrepCommands& c) {
                     "them aside");
   t->add_option("--scalars", c.threshold.scalars,
                 "S.npy (one number per point), or the name of a .ply vertex property / .csv column / .vtp or .vtu "
-                "point data array / LAMMPS dump column / .pcd or structured .npy field of INPUT "
+                "point data array / LAMMPS dump column / .pcd, .las or structured .npy field of INPUT "
                 "(with a .csv whose header does not name x,y[,z], use --dim so that the column is not taken "
                 "as a coordinate)")
       ->required();

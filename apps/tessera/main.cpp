@@ -87,7 +87,8 @@ void add_compute_options(CLI::App* app, ComputeArgs& c, std::vector<std::string>
                   "numeric columns; also Qhull's format, as rbox writes it, and XYZ: a count, a comment, then species x y z; "
                   "extended XYZ's Lattice and pbc are the domain as a dump's box), .ply (vertex x,y,z), .vtp/.vtu (VTK XML "
                   "points, as ParaView saves them), .vtk (legacy VTK: the POINTS of PolyData, an unstructured or a structured grid, "
-                  "ASCII or binary), .pcd (PCL's point clouds) or .dump/.lammpstrj (a LAMMPS dump's first "
+                  "ASCII or binary), .pcd (PCL's point clouds), .las (lidar: LAS 1.0-1.4, point formats 0-10; fields such as "
+                  "classification for --labels; LAZ refused) or .dump/.lammpstrj (a LAMMPS dump's first "
                   "frame, or --frame's: x y z, xu yu zu or scaled xs ys zs, atoms in file order; its box and periodic axes are the "
                   "domain unless --bounds, --periodic or --tilt is given); - reads standard input, in any of these "
                   "formats (rbox 1000 D3 | tessera " + command + " - ...)");
@@ -111,7 +112,7 @@ void add_compute_options(CLI::App* app, ComputeArgs& c, std::vector<std::string>
       ->check(CLI::IsMember({2, 3}));
   app->add_option("--labels", c.labels,
                   "Per-point integer labels: FILE.npy (length N), or the name of an integer .ply vertex "
-                  "property / .csv column / .vtp, .vtu or .vtk point data array / LAMMPS dump column / .pcd or structured .npy field. Cells get "
+                  "property / .csv column / .vtp, .vtu or .vtk point data array / LAMMPS dump column / .pcd, .las or structured .npy field. Cells get "
                   "their point's label as Region; points labelled < 0 own no cell and clip their neighbours");
   // Collected as text: CLI11 cannot know whether 4 (2D) or 6 (3D) numbers
   // follow, so in 2D it also takes the next word; finish_compute_args sorts it out.
@@ -160,7 +161,7 @@ void add_radii_option(CLI::App* app, ComputeArgs& c, bool with_method) {
   app->add_option("--radii", c.radii,
                   "Sphere radii for power cells (the radical tessellation of polydisperse spheres, as Voro++'s "
                   "container_poly): FILE.npy (float array, length N) or the name of a numeric .ply vertex property / "
-                  ".csv column / .vtp, .vtu or .vtk point data array / LAMMPS dump column / .pcd or structured .npy field. Each cell is where "
+                  ".csv column / .vtp, .vtu or .vtk point data array / LAMMPS dump column / .pcd, .las or structured .npy field. Each cell is where "
                   "its point's power |x-p|^2 - r^2 is the least; a point may own no cell (listed as empty), and of "
                   "coincident points the largest radius owns it. Radii must be finite and >= 0" +
                       std::string(with_method ? "; either --method (the search, or the regular triangulation's stars)"
@@ -175,7 +176,7 @@ void add_regular_radii_option(CLI::App* app, ComputeArgs& c) {
                   "Sphere radii for the regular (weighted Delaunay) triangulation, the dual of the power cells "
                   "(weights r^2, as CGAL's Regular_triangulation): FILE.npy (float array, length N) or the name of "
                   "a numeric .ply vertex property / .csv column / .vtp, .vtu or .vtk point data array / LAMMPS dump "
-                  "column / .pcd or structured .npy field. A simplex is regular when no point's power |x-p|^2 - r^2 at its "
+                  "column / .pcd, .las or structured .npy field. A simplex is regular when no point's power |x-p|^2 - r^2 at its "
                   "orthocentre is below its vertices'; a point whose power cell is empty is hidden (in no "
                   "simplex), and of coincident points the largest radius is the vertex. Radii must be finite and "
                   ">= 0; either --method gives the same simplices; with --periodic every image has its point's "

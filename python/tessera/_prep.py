@@ -126,7 +126,7 @@ def read_points(
     fields x, y[, z]), ``.csv`` / ``.xyz`` / ``.txt`` (the columns a header
     names x, y[, z], else the first ones), ``.ply``, ``.vtp`` / ``.vtu``
     (VTK XML points), ``.vtk`` (legacy VTK points), ``.pcd`` (PCL's point
-    clouds) or ``.dump`` /
+    clouds), ``.las`` (lidar; ``labels="classification"``) or ``.dump`` /
     ``.lammpstrj`` (a LAMMPS dump's frame: columns x y z, xu yu zu or
     scaled xs ys zs; atoms in file order; its box: :func:`read_box`). An
     ``.xyz`` / ``.txt`` that starts with a lone count is XYZ (count,

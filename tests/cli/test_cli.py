@@ -16,6 +16,7 @@ import json
 import os
 import re
 import shutil
+import struct
 import subprocess
 import sys
 import tempfile
@@ -655,6 +656,79 @@ class Voronoi3D(TempDirCase):
         with open(self.p("cut.vtk"), "wb") as f:
             f.write(whole[:1000])
         fails(["voronoi", self.p("cut.vtk"), "--cell-table", self.p("x.csv")], "cut.vtk: POINTS: the file ends before its")
+
+    def test_las_point_files(self):
+        # LAS lidar files written field by field from the specification (1.2
+        # with format 1, 1.4 with format 6 and extra bytes per record, a VLR
+        # before the points): the coordinates are the records' integers
+        # times the scale plus the offset (in doubles, as PDAL and laspy
+        # compute them), the labels a field by name (classification).
+        rng = np.random.default_rng(9)
+        n = self.N
+        ints = rng.integers(0, 1000000, (n, 3)).astype(np.int32)
+        scale, offset = np.array([0.001, 0.001, 0.0005]), np.array([512000.0, 4100000.0, 120.0])
+        xyz = ints * scale + offset
+        cls = rng.integers(1, 7, n).astype(np.uint8)
+        intensity = rng.integers(0, 65535, n).astype(np.uint16)
+
+        def las(name, minor, fmt, extra):
+            header_size = 375 if minor == 4 else 227
+            vlr = struct.pack("<H16sHH32s", 0, b"tessera-test", 1, 4, b"a record before the points") + b"abcd"
+            record = {1: 28, 6: 30}[fmt] + extra
+            h = bytearray(header_size)
+            h[0:4] = b"LASF"
+            h[24], h[25] = 1, minor
+            struct.pack_into("<HIIBHI", h, 94, header_size, header_size + len(vlr), 1, fmt, record,
+                             0 if minor == 4 else n)
+            struct.pack_into("<3d3d", h, 131, *scale, *offset)
+            struct.pack_into("<6d", h, 179, *np.ravel([xyz.max(0), xyz.min(0)], order="F"))
+            if minor == 4:
+                struct.pack_into("<Q", h, 247, n)
+            recs = bytearray()
+            for i in range(n):
+                r = bytearray(record)
+                struct.pack_into("<3iH", r, 0, *ints[i], intensity[i])
+                if fmt == 1:
+                    r[14], r[15] = 0x09, cls[i] | 0x20  # return 1 of 1; classification with a flag bit above
+                    struct.pack_into("<d", r, 20, float(i))
+                else:
+                    r[14], r[16] = 0x11, cls[i]
+                    struct.pack_into("<d", r, 22, float(i))
+                recs += r
+            with open(self.p(name), "wb") as f:
+                f.write(bytes(h) + vlr + bytes(recs))
+
+        common = ["--cell-table", self.p("t.csv"), "-q"]
+        self.ok(["voronoi", self.save("ref.npy", xyz), "--labels", self.save("cls.npy", cls.astype(np.int32))] + common)
+        ref = read_bytes(self.p("t.csv"))
+        for name, minor, fmt, extra in (("a.las", 2, 1, 0), ("b.las", 4, 6, 3)):
+            las(name, minor, fmt, extra)
+            self.ok(["voronoi", self.p(name), "--labels", "classification"] + common)
+            self.assertEqual(read_bytes(self.p("t.csv")), ref, name)
+            with open(self.p(name), "rb") as f:
+                r = run_bytes(["voronoi", "-", "--labels", "classification", "--cell-table", "-", "-q"], f.read())
+            self.assertEqual(r.stdout, ref, name)
+            self.ok(["threshold", self.p(name), "--scalars", "intensity", "--interval", "0,30000,1", "-o",
+                     self.p("th.npy"), "-q"])
+            np.testing.assert_array_equal(np.load(self.p("th_labels.npy")), np.where(intensity < 30000, 1, -1))
+        r = run(["voronoi", self.p("b.las"), "--labels", "gps_time", "--cell-table", self.p("x.csv")])
+        self.assertIn("holds floating-point values", r.stderr)
+        r = run(["voronoi", self.p("a.las"), "--labels", "color", "--cell-table", self.p("x.csv")])
+        self.assertIn("no LAS field 'color' (point format 1 has 'intensity', 'return_number'", r.stderr)
+        with open(self.p("a.las"), "rb") as f:
+            whole = bytearray(f.read())
+        whole[104] |= 0x80  # LAZ's compressed formats
+        with open(self.p("c.laz"), "wb") as f:
+            f.write(whole)
+        r = run(["voronoi", self.p("c.laz"), "--cell-table", self.p("x.csv")])
+        self.assertEqual(r.returncode, 2)
+        self.assertIn("LAZ (compressed LAS) is not supported: decompress it first", r.stderr)
+        whole[104] &= 0x7F
+        with open(self.p("cut.las"), "wb") as f:
+            f.write(bytes(whole[:-100]))
+        r = run(["voronoi", self.p("cut.las"), "--cell-table", self.p("x.csv")])
+        self.assertIn("(data shorter than the header says)", r.stderr)
+        self.assertFalse(os.path.exists(self.p("x.csv")))
 
     def test_summary_names_far_points(self):
         # Two points far beyond the bulk are reported (outliers?); none otherwise.
