@@ -1506,6 +1506,14 @@ class FileBoxes(TempDirCase):
             self.assertEqual(r.returncode, 2, sel)
             self.assertIn(fragment, r.stderr)
             self.assertFalse(os.path.exists(self.p("g_1.csv")))
+        # Every frame's output folder is checked before the first frame is
+        # computed ({frame} naming a folder): nothing is written when a later
+        # frame's folder is missing.
+        os.mkdir(self.p("d0"))
+        r = run(["voronoi", traj, "--frame", "all", "--cell-table", self.p("d{frame}/c.csv"), "-q"])
+        self.assertEqual(r.returncode, 2)
+        self.assertIn("d1' does not exist", r.stderr)
+        self.assertEqual(os.listdir(self.p("d0")), [])
         # From standard input the note names stdin, not the spooled copy.
         with open(self.p("gap.dump"), "rb") as f:
             r = run_bytes(["voronoi", "-", "--frame", "all", "--cell-table", self.p("i_{frame}.csv"), "-q"], f.read())
