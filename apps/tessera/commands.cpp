@@ -73,11 +73,10 @@ void route_standard_output(std::initializer_list<const std::string*> outputs) {
 }
 
 void check_distinct_outputs(std::initializer_list<std::pair<const char*, const std::string*>> outputs) {
-  // The same file by another spelling (./a.npy, a link to it) is the same
-  // output: compared as the paths resolve, where they can be.
-  // Made absolute first: weakly_canonical leaves a bare name that does not
-  // exist yet relative ("x.npy"), while "./x.npy" resolves (a fuzz found the
-  // two taken for different files).
+  // The same file by another spelling (./a.npy, dir/../a.npy, a link to it)
+  // is the same output: compared as the paths resolve, made absolute first
+  // (weakly_canonical left a bare name of a file not there yet relative,
+  // "x.npy", and resolved "./x.npy": a fuzz found them taken for two files).
   auto resolved = [](const std::string& p) {
     std::error_code ec;
     const std::filesystem::path a = std::filesystem::absolute(p, ec);

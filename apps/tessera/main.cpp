@@ -187,8 +187,8 @@ void add_regular_radii_option(CLI::App* app, ComputeArgs& c) {
 constexpr const char* kAnyAxes = "e.g. xyz (a simulation's or a crystal's periodic box), xy or x";
 constexpr const char* kEveryAxis = "every axis: xyz (xy in 2D)";
 constexpr const char* kPeriodicTriangulation =
-    "The triangulation of the points among all their images, each simplex once (--simplex-shifts: its vertices' "
-    "images); walls on some axes are refused (the periodic cells with walls serve such boxes)";
+    "The triangulation of the points among all their images, each simplex once (delaunay --simplex-shifts: its "
+    "vertices' images); walls on some axes are refused (the periodic cells with walls serve such boxes)";
 
 /// --periodic and --tilt. `images`: where the command's output names the
 /// images a cell meets across the box (e.g. "neighbours may be images

@@ -226,6 +226,12 @@ RawImage read_nifti_image(const std::string& path, bool want_labels) {
   std::array<bool, 3>& flip = raw.flip;
   for (int a = 0; a < g.dim; ++a) {
     const double step = m[a][a];
+    // One slice: its column places no second voxel (pixdim 0 is common there).
+    if (g.size[static_cast<std::size_t>(a)] == 1 && !(std::fabs(step) > 0)) {
+      g.spacing[static_cast<std::size_t>(a)] = 1;
+      g.origin[static_cast<std::size_t>(a)] = t[a];
+      continue;
+    }
     for (int r = 0; r < 3; ++r)
       if (r != a && !(std::fabs(m[r][a]) <= 1e-6 * std::fabs(step)))
         fail(path, "NIfTI orientation (" + std::string(h.sform > 0 ? "sform" : "qform") +
