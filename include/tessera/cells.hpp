@@ -177,6 +177,10 @@ struct Cells {
   Buffer<std::int32_t> num_faces;   ///< faces (3D) / edges (2D), box faces included
   /// Face neighbours of each cell as CSR: the generator ids across its faces,
   /// ascending; box faces are not listed (they are counted in num_faces).
+  /// Exact ties keep the faces of zero area the symbolic perturbation makes
+  /// (a cubic lattice's cell lists its 6 face neighbours and up to 8 more
+  /// across faces of area 0): the topology is a valid one, exactly. The
+  /// adjacency graph's prune_tolerance drops them (graph.hpp).
   Buffer<std::int64_t> neighbor_offsets;  ///< n_cells + 1
   Buffer<std::int32_t> neighbors;
   /// Periodic boxes only (VoronoiOptions::periodic), else empty: for each
