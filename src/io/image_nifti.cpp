@@ -275,6 +275,8 @@ RawImage read_nifti_image(const std::string& path, bool want_labels) {
 
   // Scaled values: the scalar image's own; labels cannot be scaled.
   const bool scaled = h.slope != 0 && std::isfinite(h.slope) && (h.slope != 1 || h.inter != 0);
+  if (scaled && !std::isfinite(h.inter))  // (nibabel refuses it too: every voxel would be NaN)
+    fail(path, "NIfTI scl_slope " + number_text(h.slope) + " with an intercept scl_inter that is not finite");
   if (scaled) {
     if (want_labels)
       fail(path, "NIfTI scl_slope/scl_inter scale the values (" + number_text(h.slope) + ", " +

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "../message_text.hpp"
 #include "io_detail.hpp"
 
 namespace tessera::io::detail {
@@ -52,6 +53,11 @@ std::vector<std::int32_t> labels_from_values(const std::string& path, const std:
   for (std::size_t i = 0; i < v.size(); ++i) {
     if (!(v[i] >= std::numeric_limits<std::int32_t>::min() && v[i] <= std::numeric_limits<std::int32_t>::max()))
       fail(path, "label in '" + name + "' at point " + std::to_string(i) + " does not fit in int32");
+    // An integer column holding 2.7 (a text file's, a legacy VTK file's) was
+    // truncated to label 2, silently.
+    if (v[i] != std::floor(v[i]))
+      fail(path, "label in '" + name + "' at point " + std::to_string(i) + " is " + tessera::detail::number_text(v[i]) +
+                     ", not a whole number");
     labels[i] = static_cast<std::int32_t>(v[i]);
   }
   return labels;

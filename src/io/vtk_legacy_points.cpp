@@ -38,6 +38,24 @@
 namespace tessera::io::detail {
 namespace {
 
+/// A name as VTK's writer encodes it: "%20" for a space, "%25" for '%', and
+/// so for any byte that is not printable or would split the line.
+std::string decoded(std::string_view s) {
+  std::string out;
+  for (std::size_t k = 0; k < s.size(); ++k) {
+    auto hex = [](char c) {
+      return c >= '0' && c <= '9' ? c - '0' : c >= 'a' && c <= 'f' ? c - 'a' + 10 : c >= 'A' && c <= 'F' ? c - 'A' + 10 : -1;
+    };
+    if (s[k] == '%' && k + 2 < s.size() && hex(s[k + 1]) >= 0 && hex(s[k + 2]) >= 0) {
+      out += static_cast<char>(16 * hex(s[k + 1]) + hex(s[k + 2]));
+      k += 2;
+    } else {
+      out += s[k];
+    }
+  }
+  return out;
+}
+
 std::string lower_word(std::string_view s) {
   std::string out(s);
   for (char& c : out) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
@@ -50,6 +68,7 @@ struct LegacyType {
   std::size_t bytes = 0;  // 0: bit
   bool integer = true;
   bool is_signed = true;
+  bool string = false;    // strings: skipped, never numbers
 };
 
 bool legacy_type(const std::string& name, LegacyType& t) {
@@ -62,10 +81,13 @@ bool legacy_type(const std::string& name, LegacyType& t) {
   else if (n == "unsigned_int" || n == "vtktypeuint32") t = {4, true, false};
   else if (n == "int" || n == "vtktypeint32") t = {4, true, true};
   // VTK writes `long` with the writer's sizeof(long): 8 on the 64-bit
-  // systems that write such files today.
+  // systems that write such files today; `vtkIdType` as 4-byte ints (its
+  // legacy writer narrows ids, and its reader reads them so).
   else if (n == "unsigned_long" || n == "unsigned_long_long" || n == "vtktypeuint64") t = {8, true, false};
-  else if (n == "long" || n == "long_long" || n == "vtkidtype" || n == "vtktypeint64") t = {8, true, true};
+  else if (n == "long" || n == "long_long" || n == "vtktypeint64") t = {8, true, true};
+  else if (n == "vtkidtype") t = {4, true, true};
   else if (n == "float" || n == "vtktypefloat32") t = {4, false, true};
+  else if (n == "string" || n == "utf8_string") t = {0, false, false, true};
   else if (n == "double" || n == "vtktypefloat64") t = {8, false, true};
   else return false;
   return true;
@@ -128,10 +150,39 @@ class Legacy {
   LegacyType type(const std::string& what) {
     const std::string_view w = word();
     LegacyType t;
-    if (lower_word(w) == "string" || lower_word(w) == "utf8_string" || lower_word(w) == "variant")
-      fail(path_, what + ": " + std::string(w) + " arrays are not supported");
+    if (lower_word(w) == "variant") fail(path_, what + ": variant arrays are not supported");
     if (!legacy_type(std::string(w), t)) fail(path_, what + ": unknown data type '" + printable(w) + "'");
     return t;
+  }
+  bool binary() const { return binary_; }
+
+  /// `n` strings skipped: a line each in ASCII; in BINARY each after its
+  /// length, whose first byte's two high bits say how many bytes hold it
+  /// (11: one, 10: two, 01: four, 00: eight; big-endian, VTK's writer).
+  void skip_strings(std::size_t n, const std::string& what) {
+    if (!binary_) {
+      rest_of_line();
+      for (std::size_t k = 0; k < n; ++k) {
+        if (i_ >= s_.size()) fail(path_, what + ": the file ends after " + std::to_string(k) + " of " +
+                                             std::to_string(n) + " strings");
+        rest_of_line();
+      }
+      return;
+    }
+    while (i_ < s_.size() && (s_[i_] == ' ' || s_[i_] == '\t')) ++i_;
+    if (i_ < s_.size() && s_[i_] == '\r') ++i_;
+    if (i_ < s_.size() && s_[i_] == '\n') ++i_;
+    for (std::size_t k = 0; k < n; ++k) {
+      if (i_ >= s_.size()) fail(path_, what + ": the file ends inside its strings");
+      const unsigned char b0 = static_cast<unsigned char>(s_[i_]);
+      const std::size_t width = (b0 >> 6) == 3 ? 1 : (b0 >> 6) == 2 ? 2 : (b0 >> 6) == 1 ? 4 : 8;
+      if (width > s_.size() - i_) fail(path_, what + ": the file ends inside its strings");
+      std::uint64_t len = b0 & (width == 8 ? 0xFF : 0x3F);
+      for (std::size_t b = 1; b < width; ++b) len = (len << 8) | static_cast<unsigned char>(s_[i_ + b]);
+      i_ += width;
+      if (len > s_.size() - i_) fail(path_, what + ": the file ends inside its strings");
+      i_ += static_cast<std::size_t>(len);
+    }
   }
 
   /// `n` values of type `t` as doubles (`keep` false: skipped).
@@ -149,7 +200,9 @@ class Legacy {
         if (!keep && t.integer) continue;  // (floats are parsed: a word that is no number is an error anyway)
         double v = 0;
         if (!parse_number(w, v)) fail(path_, what + ": '" + printable(w) + "' is not a number");
-        if (keep) out.push_back(v);
+        // A float array's text is rounded to float, as its binary twin and
+        // VTK's reader hold it.
+        if (keep) out.push_back(!t.integer && t.bytes == 4 ? static_cast<double>(static_cast<float>(v)) : v);
       }
       return out;
     }
@@ -253,10 +306,15 @@ void skip_cells(Legacy& f, const std::string& section) {
 /// is `wanted` (a POINT_DATA attribute of one component).
 void read_attribute(Legacy& f, const std::string& kw, std::size_t n, bool point_data, const std::string& wanted,
                     LegacyPoints& out) {
-  const std::string name(f.word());
+  const std::string name = decoded(f.word());
   auto take = [&](const std::string& array, std::size_t components, std::size_t tuples, const LegacyType& t) {
     const bool keep = point_data && !wanted.empty() && array == wanted;
     if (point_data) out.names.push_back(array);
+    if (t.string) {
+      if (keep) fail(f.path(), "point data '" + array + "' holds strings, not numbers");
+      f.skip_strings(components * tuples, "array '" + array + "'");
+      return;
+    }
     if (keep && components != 1)
       fail(f.path(), "point data '" + array + "' has " + std::to_string(components) + " components, expected 1");
     if (keep && tuples != n)
@@ -286,8 +344,15 @@ void read_attribute(Legacy& f, const std::string& kw, std::size_t n, bool point_
     }
     take(name, components, n, t);
   } else if (kw == "color_scalars") {
+    // Bytes in BINARY files; in ASCII each byte written as byte / 255, which
+    // VTK's reader turns back into the byte.
     const std::size_t components = f.count("COLOR_SCALARS " + name);
-    take(name, components, n, LegacyType{1, true, false});  // floats in ASCII files (read as numbers alike)
+    const bool keep = point_data && !wanted.empty() && name == wanted;
+    take(name, components, n, f.binary() ? LegacyType{1, true, false} : LegacyType{8, false, true});
+    if (keep && !f.binary()) {
+      for (double& v : out.values) v = std::floor(255.0 * v + 0.5);
+      out.is_float = false;
+    }
   } else if (kw == "lookup_table") {
     const std::size_t size = f.count("LOOKUP_TABLE " + name);
     f.values(4 * size, LegacyType{1, true, false}, "LOOKUP_TABLE " + name, false);
@@ -304,7 +369,7 @@ void read_attribute(Legacy& f, const std::string& kw, std::size_t n, bool point_
   } else if (kw == "field") {
     const std::size_t arrays = f.count("FIELD " + name);
     for (std::size_t k = 0; k < arrays; ++k) {
-      const std::string array(f.word());
+      const std::string array = decoded(f.word());
       if (lower_word(array) == "null_array") continue;
       const std::size_t components = f.count("array '" + array + "'");
       const std::size_t tuples = f.count("array '" + array + "'");

@@ -640,12 +640,56 @@ class Voronoi3D(TempDirCase):
                                        "-q", "--bounds"] + BOX3, f.read())
                     self.assertEqual(r.returncode, 0, r.stderr)
                     self.assertEqual(r.stdout, ref, name)
+        # What a fuzz against VTK's reader found: vtkIdType arrays (4 bytes in
+        # BINARY files), string arrays and names VTK encodes (a space as %20)
+        # on the way, and byte colours (COLOR_SCALARS, byte / 255 in ASCII).
+        for binary in (False, True):
+            d = vtk.vtkPolyData()
+            p = vtk.vtkPoints()
+            p.SetData(numpy_to_vtk(self.pts, deep=1))
+            d.SetPoints(p)
+            grade = (np.arange(self.N) * 37 % 256).astype(np.uint8)
+            g = numpy_to_vtk(grade, deep=1)
+            g.SetName("grade")
+            d.GetPointData().SetScalars(g)  # written as COLOR_SCALARS
+            ids = vtk.vtkIdTypeArray()
+            ids.SetName("ids")
+            tags = vtk.vtkStringArray()
+            tags.SetName("tag")
+            for i in range(self.N):
+                ids.InsertNextValue(3 * i)
+                tags.InsertNextValue("t" * (i % 90))
+            d.GetPointData().AddArray(ids)
+            d.GetPointData().AddArray(tags)
+            spaced = numpy_to_vtk(labels, deep=1)
+            spaced.SetName("grain id")
+            d.GetPointData().AddArray(spaced)
+            w = vtk.vtkPolyDataWriter()
+            name = self.p("extra_%d.vtk" % binary)
+            w.SetFileName(name)
+            w.SetInputData(d)
+            w.SetFileTypeToBinary() if binary else w.SetFileTypeToASCII()
+            self.assertEqual(w.Write(), 1)
+            rd = vtk.vtkDataSetReader()
+            rd.SetFileName(name)
+            rd.Update()
+            back = self.save("back.npy", vtk_to_numpy(rd.GetOutput().GetPoints().GetData()).astype(np.float64))
+            common = ["--cell-table", self.p("t.csv"), "-q", "--bounds"] + BOX3
+            for array, values in (("grade", grade), ("ids", 3 * np.arange(self.N)), ("grain id", labels)):
+                self.ok(["voronoi", back, "--labels", self.save("l.npy", values.astype(np.int32))] + common)
+                ref = read_bytes(self.p("t.csv"))
+                self.ok(["voronoi", name, "--labels", array] + common)
+                self.assertEqual(read_bytes(self.p("t.csv")), ref, (name, array))
+
         def fails(args, fragment):
             r = run(args)
             self.assertEqual(r.returncode, 2, args)
             self.assertEqual(len(r.stderr.strip().splitlines()), 1, r.stderr)
             self.assertIn(fragment, r.stderr)
             self.assertFalse(os.path.exists(self.p("x.csv")))
+
+        fails(["voronoi", self.p("extra_1.vtk"), "--labels", "tag", "--cell-table", self.p("x.csv")],
+              "point data 'tag' holds strings, not numbers")
 
         for args, fragment in ((["--labels", "radius"], "labels array 'radius' holds floating-point values"),
                                (["--labels", "vel"], "point data 'vel' has 3 components, expected 1"),

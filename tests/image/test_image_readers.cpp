@@ -277,6 +277,10 @@ TEST_F(image_readers, NiftiMalformed) {
   check("offset.nii", patched(108, std::string("\0\0\x80\x42", 4)), {"vox_offset 64 lies inside the header"});
   check("dim0.nii", patched(40, std::string("\x09\0", 2)), {"dim[0] must be 1 to 7, got 9"});
   check("zero.nii", patched(280, std::string(4, '\0')), {"voxel size along x is 0"});
+  // A slope with a NaN intercept made every voxel NaN (nibabel refuses it).
+  const std::string nan_inter = d.write("nan.nii", patched(112, std::string("\0\0\0\x40\0\0\xc0\x7f", 8)));
+  expect_error(input_error([&] { tessera::io::read_scalar_image(nan_inter); }),
+               {"nan.nii", "scl_slope 2 with an intercept scl_inter that is not finite"});
   // A header claiming a huge image over no data: refused, nothing sized by it.
   std::string huge = good.substr(0, 352);
   huge.replace(42, 6, std::string("\xff\x7f\xff\x7f\x01\0", 6));  // 32767 x 32767 x 1

@@ -122,6 +122,22 @@ TEST(VtkLegacy, BinaryBigEndianAndAStructuredGrid) {
   EXPECT_EQ(read_point_scalars(p, "c"), (std::vector<double>{-1, 2}));
 }
 
+// ASCII floats are rounded to float as VTK's reader and the binary twin hold
+// them; an integer array holding 2.7 is no labels (it became label 2).
+TEST(VtkLegacy, AsciiFloatsAndLabelsAsStored) {
+  TempDir dir;
+  const std::string p = dir.write("f.vtk", "# vtk DataFile Version 3.0\nf\nASCII\nDATASET POLYDATA\nPOINTS 2 float\n"
+                                           "0.1 0.2 0.3 1 2 3\nPOINT_DATA 2\nSCALARS d double\n0.1 0.2\n"
+                                           "SCALARS i int\n1 2.7\n");
+  const auto pc = read_points(p);
+  EXPECT_EQ(pc.coords[0], static_cast<double>(0.1f));
+  EXPECT_EQ(read_point_scalars(p, "d"), (std::vector<double>{0.1, 0.2}));  // doubles kept
+  ReadOptions o;
+  o.labels = "i";
+  EXPECT_NE(input_error([&] { read_points(p, o); }).find("label in 'i' at point 1 is 2.7, not a whole number"),
+            std::string::npos);
+}
+
 TEST(VtkLegacy, Errors) {
   TempDir dir;
   const std::string head = "# vtk DataFile Version 3.0\nx\nASCII\n";
@@ -144,8 +160,12 @@ TEST(VtkLegacy, Errors) {
   expect(head + "DATASET POLYDATA\nPOINTS 1 float\n0 0 x\n", "'x' is not a number");
   expect(head + "DATASET POLYDATA\nPOINTS 1 float\n0 0 0\nWHATEVER 3\n", "unexpected keyword 'whatever'");
   expect(head + "DATASET POLYDATA\nPOINTS 1 float\n0 0 0\nPOINT_DATA 2\n", "POINT_DATA has 2 values for 1 points");
-  expect(head + "DATASET POLYDATA\nPOINTS 1 float\n0 0 0\nPOINT_DATA 1\nFIELD f 1\nname 1 1 string\nabc\n",
-         "string arrays are not supported");
+  // String arrays are stepped over, and are no numbers.
+  const std::string strings = dir.write("s.vtk", head + "DATASET POLYDATA\nPOINTS 1 float\n0 0 0\nPOINT_DATA 1\n"
+                                                       "FIELD f 2\nname 1 1 string\nabc def\nn 1 1 int\n7\n");
+  EXPECT_EQ(read_point_scalars(strings, "n"), (std::vector<double>{7}));
+  EXPECT_NE(input_error([&] { read_point_scalars(strings, "name"); }).find("'name' holds strings, not numbers"),
+            std::string::npos);
   expect(head + "DATASET POLYDATA\nPOINTS 1 float\n0 0 0\nPOINT_DATA 1\nGLYPHS g float\n1\n", "unknown attribute");
   // Binary data shorter than its count says, refused before it is sized.
   expect("# vtk DataFile Version 3.0\nx\nBINARY\nDATASET POLYDATA\nPOINTS 99999999 float\n" + std::string(12, '\0'),
