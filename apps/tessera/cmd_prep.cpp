@@ -170,7 +170,7 @@ void add_prep_commands(CLI::App& app, PrepCommands& c) {
                     "labelled by their scalar as any other, instead of refused. `voronoi --ignore-outside` sets "
                     "them aside");
   t->add_option("--scalars", c.threshold.scalars,
-                "S.npy (one number per point), or the name of a .ply vertex property / .csv column / .vtp or .vtu "
+                "S.npy (one number per point), or the name of a .ply vertex property / .csv column / .vtp, .vtu or .vtk "
                 "point data array / LAMMPS dump column / .pcd, .las or structured .npy field of INPUT "
                 "(with a .csv whose header does not name x,y[,z], use --dim so that the column is not taken "
                 "as a coordinate)")

@@ -306,8 +306,8 @@ void add_surface_nets_options(CLI::App* app, SurfaceNetsArgs& a, bool bench) {
                   "BoundaryLabels value for the domain-box side of capping faces (must be < 0)")
       ->capture_default_str();
   app->footer(
-      "INPUT: labelled points (.npy/.csv/.ply/.vtp/.vtu/.vtk/.pcd with --labels) or a label image (.nrrd/.nhdr/.mha/.mhd/.vti/\n"
-      ".nii/.nii.gz, or .npy with --image), which is sampled first (the sampler options: see tessera sample-image --help; the\n"
+      "INPUT: labelled points (any point file of voronoi's, with --labels) or a label image (.nrrd/.nhdr/.mha/.mhd/\n"
+      ".vti/.nii/.nii.gz/.hdr, or .npy with --image), which is sampled first (the sampler options: see tessera sample-image --help; the\n"
       "domain is then the image's voxels). BoundaryLabels = (side 0, side 1): side 0 is always a selected\n"
       "label; between two selected labels (lower, higher); a capping face carries the other point's own label\n"
       "or --background-label for the box. Faces point from side 0 into side 1, so each label's surface (its\n"

@@ -111,7 +111,7 @@ int run_frames(const Args& a, std::initializer_list<SeriesOutput<Args>> outputs,
     }
   }
   if (computed == 0)
-    throw InputError("--frame " + a.compute.frame + ": every frame selected holds no atoms; nothing was written");
+    throw InputError("--frame " + a.compute.frame + " selects only frames of no atoms; nothing was written");
   return rc;
 }
 

@@ -160,15 +160,16 @@ def read_points(
                         _inputs.as_flag(keep_non_finite, "keep_non_finite"), _inputs.as_frame(frame))
 
 
-def read_scalars(path: PathLike, name: PathLike, frame: int = 0) -> np.ndarray:
+def read_scalars(path: PathLike, name: str, frame: int = 0) -> np.ndarray:
     """One number per point of a point file, as the command line reads
     ``--radii NAME`` and ``threshold --scalars NAME``: ``name`` is a numeric
     column of a ``.csv`` or a LAMMPS dump (its ``frame``), a ``.ply``
-    property, a ``.vtp`` / ``.vtu`` / ``.vtk`` point data array, a ``.pcd``
-    or structured ``.npy`` field, or a ``.npy`` file of its own. Returns
-    float64 (N,) in the points' order (:func:`read_points`), NaN and
-    infinities kept; ValueError (:class:`tessera.InputError`) for a missing
-    name or a malformed file.
+    property, a ``.vtp`` / ``.vtu`` / ``.vtk`` point data array, a ``.las``
+    field (``intensity``, ``gps_time``, ...) or a ``.pcd`` or structured
+    ``.npy`` field. (A separate ``.npy`` of values is ``np.load``'s.)
+    Returns float64 (N,) in the points' order (:func:`read_points`), NaN
+    and infinities kept; ValueError (:class:`tessera.InputError`) for a
+    missing name or a malformed file.
 
     >>> p, types = tessera.read_points("run.dump", labels="type")    # doctest: +SKIP
     >>> r = tessera.read_scalars("run.dump", "radius")               # doctest: +SKIP
@@ -176,9 +177,11 @@ def read_scalars(path: PathLike, name: PathLike, frame: int = 0) -> np.ndarray:
     """
     if not _is_path(path):
         raise ValueError(f"path: expected a file name, got {type(path).__name__}")
-    if not _is_path(name):
-        raise ValueError(f"name: expected a field name or a .npy file, got {type(name).__name__}")
-    return _inputs.call(_core.read_scalars, _inputs.as_path(path), _inputs.as_path(name), _inputs.as_frame(frame))
+    if not isinstance(name, str):
+        raise ValueError(f"name: expected the name of a column, property, array or field, got {type(name).__name__}")
+    if name.lower().endswith(".npy"):
+        raise ValueError(f"name: {name!r} is a file, not a field of {_inputs.as_path(path)!r} (np.load reads it)")
+    return _inputs.call(_core.read_scalars, _inputs.as_path(path), name, _inputs.as_frame(frame))
 
 
 class Frame(NamedTuple):

@@ -297,6 +297,8 @@ def test_lammps_dump_points_and_box(tmp_path):
     np.testing.assert_array_equal(tessera.read_scalars(path, "type"), 1 + np.arange(300) % 2)
     with pytest.raises(ValueError, match="radius"):
         tessera.read_scalars(path, "radius")
+    with pytest.raises(ValueError, match="np.load reads it"):  # its length would go unchecked
+        tessera.read_scalars(path, "radii.npy")
     box = tessera.read_box(path)
     assert box == {"bounds": (0.0, 3.0, -1.0, 1.5, 2.0, 4.0), "periodic": (True, True, True), "tilt": (0.5, 0.25, -0.75)}
     vor = tessera.voronoi(p, labels=types, **box)

@@ -7,7 +7,10 @@
 // coordinates (x = X * scale + offset, in double, as PDAL and laspy compute
 // it). Per-point fields by name, for --labels (integers) and scalars:
 // classification, intensity, return_number, number_of_returns, user_data,
-// point_source_id, scan_angle, gps_time (formats 1, 3 to 10). A record may be
+// point_source_id, scan_angle, gps_time (formats 1, 3 to 10), in any case
+// and with or without underscores (PDAL's Classification, ReturnNumber).
+// scan_angle is the record's value: degrees in formats 0 to 5, units of
+// 0.006 degrees in 6 to 10. A record may be
 // longer than its format (extra bytes): the tail is skipped. LAZ (compressed
 // LAS) is refused with a hint, as are point counts the file cannot hold.
 //
@@ -15,6 +18,7 @@
 // libraries that read LAS (PDAL, LASlib) are large and not in the
 // dependencies.
 #include <bit>
+#include <cctype>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -116,6 +120,16 @@ LasHeader parse_header(const std::string& path, const std::string& s) {
   return h;
 }
 
+/// A field name as compared: lower case, without underscores, so that PDAL's
+/// and LAStools' spellings (Classification, ReturnNumber, ScanAngleRank) name
+/// the same fields.
+std::string folded(const std::string& name) {
+  std::string out;
+  for (const char c : name)
+    if (c != '_') out += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return out == "scananglerank" ? "scanangle" : out;
+}
+
 std::string field_names(int format) {
   std::string names;
   for (const LasField& f : fields_of(format)) names += (names.empty() ? "'" : ", '") + std::string(f.name) + "'";
@@ -127,7 +141,7 @@ std::string field_names(int format) {
 std::vector<double> field_values(const std::string& path, const std::string& s, const LasHeader& h,
                                  const std::string& name, bool& is_float) {
   for (const LasField& f : fields_of(h.format)) {
-    if (name != f.name) continue;
+    if (folded(name) != folded(f.name)) continue;
     is_float = f.kind == 'd';
     std::vector<double> v(h.points);
     for (std::size_t i = 0; i < h.points; ++i) {

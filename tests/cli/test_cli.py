@@ -1545,7 +1545,7 @@ class FileBoxes(TempDirCase):
         self.ok(["voronoi", traj, "--frame", "2", "--cell-table", self.p("one.csv"), "-q"])
         self.assertEqual(read_bytes(self.p("e_2.csv")), read_bytes(self.p("one.csv")))
         for sel, fragment in (("1", "frame 1: %s: no points" % self.p("gap.dump")),
-                              ("1::2", "--frame 1::2: every frame selected holds no atoms; nothing was written")):
+                              ("1::2", "--frame 1::2 selects only frames of no atoms; nothing was written")):
             r = run(["voronoi", self.p("gap.dump"), "--frame", sel, "--cell-table", self.p("g_{frame}.csv")])
             self.assertEqual(r.returncode, 2, sel)
             self.assertIn(fragment, r.stderr)

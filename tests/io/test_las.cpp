@@ -77,6 +77,8 @@ TEST(Las, CoordinatesAndFields) {
                                               -7 * 0.01 + 1000, 0 * 0.01 - 2000, -1 * 0.001 + 0.5}));
     EXPECT_EQ(pc.labels, fmt == 1 ? (std::vector<std::int32_t>{3, 4}) : (std::vector<std::int32_t>{200, 201}));
     EXPECT_EQ(read_point_scalars(p, "intensity"), (std::vector<double>{100, 101}));
+    EXPECT_EQ(read_point_scalars(p, "Intensity"), read_point_scalars(p, "intensity"));  // PDAL's spelling
+    EXPECT_EQ(read_point_scalars(p, "ReturnNumber"), read_point_scalars(p, "return_number"));
     EXPECT_EQ(read_point_scalars(p, "gps_time"), (std::vector<double>{0, 0.25}));
     EXPECT_EQ(read_point_scalars(p, "return_number"), (fmt == 1 ? std::vector<double>{2, 2} : std::vector<double>{3, 3}));
     EXPECT_EQ(read_point_scalars(p, "scan_angle"),
