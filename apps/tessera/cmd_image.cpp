@@ -31,8 +31,8 @@ namespace {
 std::string image_help(const char* what) {
   return std::string("Image of ") + what +
          ": .npy (shape (ny, nx) or (nz, ny, nx)), .nrrd/.nhdr (raw, gzip, ascii), .mha/.mhd (MetaImage, raw or "
-         "compressed), .vti (VTK XML ImageData, any data mode) or .nii/.nii.gz/.hdr (NIfTI-1 or -2; flipped axes "
-         "are reversed, rotated ones refused)";
+         "compressed), .vti (VTK XML ImageData, any data mode), .vtk (legacy VTK STRUCTURED_POINTS) or .nii/.nii.gz/.hdr "
+         "(NIfTI-1 or -2; flipped axes are reversed, rotated ones refused)";
 }
 
 void add_read_options(CLI::App* app, ImageReadArgs& r) {
@@ -59,7 +59,7 @@ void add_read_options(CLI::App* app, ImageReadArgs& r) {
          "--origin", numbers(r.origin, "--origin"),
          "Position ox,oy[,oz] of the centre of voxel (0,0,0) (default: from the image file; 0 for .npy)")
       ->type_name("OX,OY[,OZ]");
-  app->add_option("--array", r.array, ".vti: the point-data array to read (default: the active scalars, else the first)");
+  app->add_option("--array", r.array, ".vti and legacy .vtk: the point-data array to read (default: the active scalars, else the first (.vtk: the first of one component))");
 }
 
 void check_points_output(const std::string& path) {

@@ -54,8 +54,9 @@ struct NetInput {
 bool is_image_input(const SurfaceNetsArgs& a) {
   if (is_image_path(a.compute.input)) return true;
   if (!a.image) return false;
-  if (extension(a.compute.input) != ".npy")
-    throw InputError("--image: INPUT must be a label image (.npy, .nrrd, .nhdr, .mha, .mhd, .vti, .nii, .nii.gz or .hdr), got '" +
+  // (.npy and .vtk hold points or an image: --image says which.)
+  if (extension(a.compute.input) != ".npy" && extension(a.compute.input) != ".vtk")
+    throw InputError("--image: INPUT must be a label image (.npy, .nrrd, .nhdr, .mha, .mhd, .vti, .vtk, .nii, .nii.gz or .hdr), got '" +
                      extension(a.compute.input) + "'");
   return true;
 }
@@ -307,7 +308,7 @@ void add_surface_nets_options(CLI::App* app, SurfaceNetsArgs& a, bool bench) {
       ->capture_default_str();
   app->footer(
       "INPUT: labelled points (any point file of voronoi's, with --labels) or a label image (.nrrd/.nhdr/.mha/.mhd/\n"
-      ".vti/.nii/.nii.gz/.hdr, or .npy with --image), which is sampled first (the sampler options: see tessera sample-image --help; the\n"
+      ".vti/.nii/.nii.gz/.hdr, or .npy or legacy .vtk with --image), which is sampled first (the sampler options: see tessera sample-image --help; the\n"
       "domain is then the image's voxels). BoundaryLabels = (side 0, side 1): side 0 is always a selected\n"
       "label; between two selected labels (lower, higher); a capping face carries the other point's own label\n"
       "or --background-label for the box. Faces point from side 0 into side 1, so each label's surface (its\n"

@@ -88,7 +88,8 @@ def read_image(
     path: PathLike, spacing: Any = None, origin: Any = None
 ) -> Tuple[np.ndarray, Tuple[float, ...], Tuple[float, ...]]:
     """Read an image file: ``.npy``, NRRD (``.nrrd`` / ``.nhdr``, raw or
-    gzip), MetaImage (``.mha`` / ``.mhd``), VTK XML image data (``.vti``) or
+    gzip), MetaImage (``.mha`` / ``.mhd``), VTK XML image data (``.vti``),
+    legacy VTK structured points (``.vtk``) or
     NIfTI (``.nii``, ``.nii.gz``, ``.hdr`` with its ``.img``; an axis stored
     with a negative step is reversed, so spacings are positive).
 

@@ -365,14 +365,16 @@ RawImage read_raw(const std::string& path, const ImageReadOptions& options, bool
     raw = detail::read_metaimage(path);
   } else if (ext == ".vti") {
     raw = detail::read_vti_image(path, options.array);
+  } else if (ext == ".vtk") {
+    raw = detail::read_vtk_legacy_image(path, options.array);
   } else {
     detail::fail(path, "unknown image extension '" + ext +
-                           "' (expected .npy, .nrrd, .nhdr, .mha, .mhd, .vti, .nii, .nii.gz or .hdr)");
+                           "' (expected .npy, .nrrd, .nhdr, .mha, .mhd, .vti, .vtk, .nii, .nii.gz or .hdr)");
   }
   for (int a = 0; a < 3; ++a)
     if (raw.flip[static_cast<std::size_t>(a)]) detail::flip_axis(raw, a);
-  if (!options.array.empty() && ext != ".vti")
-    detail::fail(path, "an array name ('" + options.array + "') can only be chosen in .vti files");
+  if (!options.array.empty() && ext != ".vti" && ext != ".vtk")
+    detail::fail(path, "an array name ('" + options.array + "') can only be chosen in .vti and .vtk files");
   ImageGeometry& g = raw.geometry;
   if (options.spacing) g.spacing = *options.spacing;
   if (options.origin) g.origin = *options.origin;

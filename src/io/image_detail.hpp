@@ -49,6 +49,9 @@ RawImage read_metaimage(const std::string& path);
 RawImage read_vti_image(const std::string& path, const std::string& array);
 /// (`want_labels`: scaled values, scl_slope/scl_inter, are refused.)
 RawImage read_nifti_image(const std::string& path, bool want_labels);
+/// A legacy VTK image (.vtk, DATASET STRUCTURED_POINTS; vtk_legacy.cpp): the
+/// POINT_DATA attribute `array`, else the first of one component.
+RawImage read_vtk_legacy_image(const std::string& path, const std::string& array);
 /// Whether `path` names a NIfTI file: .nii, .nii.gz or .hdr (with its .img).
 bool is_nifti_path(const std::string& path);
 

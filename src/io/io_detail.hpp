@@ -221,7 +221,7 @@ inline bool is_dump_extension(const std::string& ext) { return ext == ".dump" ||
 /// name of an integer point data array holding labels.
 PointCloud read_vtk_points(const std::string& path, const ReadOptions& options, const std::string& label_array);
 
-/// Legacy VTK files (.vtk; vtk_legacy_points.cpp): the POINTS of a
+/// Legacy VTK files (.vtk; vtk_legacy.cpp): the POINTS of a
 /// POLYDATA, UNSTRUCTURED_GRID or STRUCTURED_GRID, ASCII or BINARY;
 /// `label_array` is empty, or the name of an integer one-component
 /// POINT_DATA attribute (SCALARS, or a FIELD's array).

@@ -224,6 +224,23 @@ def main():
         write_meta(p("meta_%s.mhd" % tag), img_lab, comp)
         write_meta(p("meta_field_%s.mha" % tag), img_fld, comp)
 
+    # ---- legacy VTK images (vtkStructuredPointsWriter), both modes
+    for mode in ("ascii", "binary"):
+        sp = vtk.vtkImageData()
+        sp.SetDimensions(NX, NY, NZ)
+        sp.SetSpacing(*SPACING)
+        sp.SetOrigin(*ORIGIN)
+        for k, (name, a) in enumerate((("labels", lab), ("field", fld))):
+            va = numpy_to_vtk(np.ascontiguousarray(a.ravel()), deep=1)
+            va.SetName(name)
+            sp.GetPointData().AddArray(va)
+        sp.GetPointData().SetActiveScalars("labels")
+        w = vtk.vtkStructuredPointsWriter()
+        w.SetInputData(sp)
+        w.SetFileName(p("legacy_%s.vtk" % mode))
+        w.SetFileTypeToBinary() if mode == "binary" else w.SetFileTypeToASCII()
+        w.Write()
+
     # ---- NIfTI, hand-made: the test geometry stored with and without flipped
     # axes (negative steps), read back to the same image.
     ox, oy, oz = ORIGIN

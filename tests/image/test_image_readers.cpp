@@ -242,6 +242,20 @@ TEST_F(image_readers, FlippedAxesReadReversed) {
   for (const char* name : {"nrrd_flipx.nrrd", "meta_flipy.mha", "vti_flipxz.vti"}) expect_labels(name);
 }
 
+// Legacy VTK images (STRUCTURED_POINTS, VTK's own writer in both modes):
+// the first array of one component (the active scalars), or the one named.
+TEST_F(image_readers, LegacyVtkImages) {
+  ImageReadOptions o;
+  o.array = "field";
+  for (const char* name : {"legacy_ascii.vtk", "legacy_binary.vtk"}) {
+    expect_labels(name);
+    expect_field(name, o);
+  }
+  o.array = "none";
+  expect_error(input_error([&] { read_label_image(f("legacy_binary.vtk"), o); }),
+               {"legacy_binary.vtk", "no point data array 'none' (arrays: 'labels', 'field')"});
+}
+
 TEST_F(image_readers, NiftiFlipsVersionsAndEncodings) {
   for (const char* name : {"nifti1_sform.nii", "nifti1_flipx.nii.gz", "nifti1_qfac_be.nii", "nifti1_pair.hdr"})
     expect_labels(name);

@@ -137,6 +137,14 @@ class Legacy {
     return k;
   }
 
+  /// A finite number, named `what` in the message.
+  double number(const std::string& what) {
+    const std::string_view w = word();
+    double v = 0;
+    if (!parse_number(w, v) || !std::isfinite(v)) fail(path_, what + ": expected a number, got '" + printable(w) + "'");
+    return v;
+  }
+
   /// A non-negative count, named `what` in the message.
   std::size_t count(const std::string& what) {
     const std::string_view w = word();
@@ -284,6 +292,10 @@ struct LegacyPoints {
   bool is_float = false;
   std::vector<double> values;
   std::vector<std::string> names;  // POINT_DATA attributes, for the message
+  std::vector<std::size_t> components;  // of each of them
+  // STRUCTURED_POINTS (an image): its grid
+  std::int64_t dims[3] = {0, 0, 0};
+  double spacing[3] = {1, 1, 1}, origin[3] = {0, 0, 0};
 };
 
 /// Cells of the 5.1 format (OFFSETS and CONNECTIVITY blocks) or of the
@@ -309,7 +321,10 @@ void read_attribute(Legacy& f, const std::string& kw, std::size_t n, bool point_
   const std::string name = decoded(f.word());
   auto take = [&](const std::string& array, std::size_t components, std::size_t tuples, const LegacyType& t) {
     const bool keep = point_data && !wanted.empty() && array == wanted;
-    if (point_data) out.names.push_back(array);
+    if (point_data) {
+      out.names.push_back(array);
+      out.components.push_back(components);
+    }
     if (t.string) {
       if (keep) fail(f.path(), "point data '" + array + "' holds strings, not numbers");
       f.skip_strings(components * tuples, "array '" + array + "'");
@@ -391,14 +406,18 @@ void read_attribute(Legacy& f, const std::string& kw, std::size_t n, bool point_
                  (names.empty() ? std::string(" (the file has none)") : " (arrays: " + names + ")"));
 }
 
-LegacyPoints walk(const std::string& path, const std::string& wanted) {
+/// The file's points (`image` false) or its image (STRUCTURED_POINTS: `image`
+/// true), with the POINT_DATA attribute `wanted` where named.
+LegacyPoints walk(const std::string& path, const std::string& wanted, bool image = false) {
   Legacy f(path, read_file_bytes(path));
   if (f.keyword() != "dataset") fail(path, "legacy VTK: expected DATASET after the file's header");
   const std::string ds = f.keyword();
-  if (ds == "structured_points")
-    fail(path, "a legacy VTK image (STRUCTURED_POINTS) holds no point set: sample it with `sample-image` from a "
-               ".vti, .nrrd or .mha, or give its voxel centres as points");
-  if (ds != "polydata" && ds != "unstructured_grid" && ds != "structured_grid")
+  if (ds == "structured_points" && !image)
+    fail(path, "a legacy VTK image (STRUCTURED_POINTS) holds no point set: give it to `sample-image` (or "
+               "`surface-nets --image`), or its voxel centres as points");
+  if (image && ds != "structured_points")
+    fail(path, "a legacy VTK " + ds + " holds points, not an image (images are STRUCTURED_POINTS)");
+  if (!image && ds != "polydata" && ds != "unstructured_grid" && ds != "structured_grid")
     fail(path, "legacy VTK DATASET '" + ds + "' is not supported (POLYDATA, UNSTRUCTURED_GRID or STRUCTURED_GRID)");
   LegacyPoints out;
   bool have_points = false;
@@ -413,7 +432,10 @@ LegacyPoints walk(const std::string& path, const std::string& wanted) {
       out.xyz = f.values(3 * out.n, f.type("POINTS"), "POINTS", true);
       have_points = true;
     } else if (kw == "dimensions") {
-      for (int k = 0; k < 3; ++k) f.count("DIMENSIONS");
+      for (int k = 0; k < 3; ++k) out.dims[k] = static_cast<std::int64_t>(f.count("DIMENSIONS"));
+    } else if (image && (kw == "spacing" || kw == "aspect_ratio" || kw == "origin")) {
+      double* to = kw == "origin" ? out.origin : out.spacing;
+      for (int k = 0; k < 3; ++k) to[k] = f.number(kw);
     } else if (kw == "vertices" || kw == "lines" || kw == "polygons" || kw == "triangle_strips" || kw == "cells") {
       skip_cells(f, kw);
     } else if (kw == "cell_types") {
@@ -426,6 +448,11 @@ LegacyPoints walk(const std::string& path, const std::string& wanted) {
       tuples = f.count(kw);
       if (in_points && have_points && tuples != out.n)
         fail(path, "POINT_DATA has " + std::to_string(tuples) + " values for " + std::to_string(out.n) + " points");
+      const std::uint64_t voxels = static_cast<std::uint64_t>(out.dims[0]) * static_cast<std::uint64_t>(out.dims[1]) *
+                                   static_cast<std::uint64_t>(out.dims[2]);
+      if (in_points && image && tuples != voxels)
+        fail(path, "POINT_DATA has " + std::to_string(tuples) + " values for DIMENSIONS of " + std::to_string(voxels) +
+                       " voxels");
     } else if (kw == "field" && !in_data) {
       // Field data of the whole dataset (a TIME, a CYCLE), not per point.
       read_attribute(f, kw, 0, false, std::string(), out);
@@ -435,7 +462,9 @@ LegacyPoints walk(const std::string& path, const std::string& wanted) {
       fail(path, "legacy VTK: unexpected keyword '" + printable(kw) + "'");
     }
   }
-  if (!have_points) fail(path, "legacy VTK file without POINTS");
+  if (!have_points && !image) fail(path, "legacy VTK file without POINTS");
+  if (image && (out.dims[0] == 0 || out.dims[1] == 0 || out.dims[2] == 0))
+    fail(path, "legacy VTK image without DIMENSIONS (or with a dimension of 0)");
   return out;
 }
 
@@ -461,6 +490,39 @@ PointCloud read_vtk_legacy_points(const std::string& path, const ReadOptions& op
     pc.labels = labels_from_values(path, label_array, lp.values);
   }
   return pc;
+}
+
+RawImage read_vtk_legacy_image(const std::string& path, const std::string& array) {
+  // The array asked for, else the first of one component (VTK writes the
+  // active scalars first): a first walk names them, a second reads it.
+  std::string name = array;
+  if (name.empty()) {
+    const LegacyPoints all = walk(path, std::string(), true);
+    for (std::size_t k = 0; k < all.names.size() && name.empty(); ++k)
+      if (all.components[k] == 1) name = all.names[k];
+    if (name.empty()) fail(path, "a legacy VTK image without point data of one component");
+  }
+  const LegacyPoints lp = walk(path, name, true);
+  if (!lp.found) no_array(path, name, lp);
+  RawImage raw;
+  ImageGeometry& g = raw.geometry;
+  for (std::size_t a = 0; a < 3; ++a) {
+    g.size[a] = lp.dims[a];
+    g.spacing[a] = lp.spacing[a];
+    g.origin[a] = lp.origin[a];
+  }
+  g.dim = g.size[2] == 1 ? 2 : 3;  // one slice: a 2D image, as a .vti's
+  check_geometry(path, g);
+  raw.converted = true;
+  if (lp.is_float) {
+    raw.type = ScalarType::f64;
+    raw.doubles = lp.values;
+  } else {
+    raw.type = ScalarType::i64;
+    raw.ints.reserve(lp.values.size());
+    for (const double v : lp.values) raw.ints.push_back(static_cast<std::int64_t>(v));
+  }
+  return raw;
 }
 
 std::vector<double> read_vtk_legacy_point_array(const std::string& path, const std::string& name) {
