@@ -1,12 +1,13 @@
-// Point sets from legacy VTK files (.vtk), as VTK's legacy writers, ParaView,
+// Legacy VTK files (.vtk): point sets, as VTK's legacy writers, ParaView,
 // LAMMPS's and LIGGGHTS's `dump vtk`, OpenFOAM's foamToVTK and CloudCompare
-// save them:
+// save them, and images (STRUCTURED_POINTS, as ITK's VTKImageIO writes them):
 //
 //   # vtk DataFile Version 3.0        (2.0 to 5.1)
 //   any title
 //   ASCII | BINARY                    (binary data is big-endian)
-//   DATASET POLYDATA | UNSTRUCTURED_GRID | STRUCTURED_GRID
+//   DATASET POLYDATA | UNSTRUCTURED_GRID | STRUCTURED_GRID | STRUCTURED_POINTS
 //   POINTS n float|double|int|...     then 3n values
+//   DIMENSIONS, SPACING (ASPECT_RATIO), ORIGIN: an image's grid
 //   VERTICES/LINES/POLYGONS/TRIANGLE_STRIPS, CELLS, CELL_TYPES, METADATA: skipped
 //   POINT_DATA n                      SCALARS name type [components]
 //                                     [LOOKUP_TABLE table], or FIELD name k
@@ -15,9 +16,10 @@
 //
 // The points are the input (cells are not read); labels and per-point
 // scalars come from a named one-component POINT_DATA attribute: a SCALARS
-// attribute or an array of a FIELD. Images (STRUCTURED_POINTS) and
-// rectilinear grids are refused with a one-line error, as are string arrays
-// on the way.
+// attribute or an array of a FIELD (string arrays are stepped over). An
+// image's voxels are such an attribute, the one named or the first of one
+// component. Images are no points, points no image, and rectilinear grids
+// are refused: one-line errors.
 //
 // Written here (not VTK's reader): the core does not link VTK, and what is
 // read is small (docs/design.md, "Input files from users' tools").
