@@ -11,6 +11,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstring>
+#include <filesystem>
 #include <limits>
 #include <string>
 #include <type_traits>
@@ -286,6 +287,11 @@ std::string parse_ascii_values(const std::string& path, std::string_view text, S
 }
 
 std::string read_detached(const std::string& path, const std::string& data_path) {
+  // A FIFO named by a header (not by the user, who may pass <(command) as an
+  // input) blocks until something writes to it: refused.
+  std::error_code ec;
+  if (std::filesystem::is_fifo(data_path, ec))
+    fail(path, "cannot open data file " + data_path + ": a FIFO, not a file");
   try {
     return read_file_bytes(data_path);
   } catch (const InputError& e) {

@@ -6,6 +6,7 @@
 // headers, truncated data and mismatched sizes must give one-line errors
 // naming the file.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <cstdlib>
 #include <fstream>
@@ -400,6 +401,10 @@ TEST_F(image_readers, NrrdMalformed) {
   // once, where it was read until memory ran out.
   d.write("zero.nhdr", replace(nhdr, "nhdr_gzip.raw.gz", "/dev/zero"));
   expect_error(input_error([&] { read_label_image(d.file("zero.nhdr")); }), {"zero.nhdr", "/dev/zero", "a device"});
+  // A FIFO named as the data file blocked until something wrote to it.
+  ASSERT_EQ(::mkfifo(d.file("pipe.raw").c_str(), 0600), 0);
+  d.write("fifo.nhdr", replace(nhdr, "nhdr_gzip.raw.gz", "pipe.raw"));
+  expect_error(input_error([&] { read_label_image(d.file("fifo.nhdr")); }), {"fifo.nhdr", "pipe.raw", "a FIFO"});
   std::filesystem::create_symlink("/dev/zero", d.path() / "endless.nrrd");
   expect_error(input_error([&] { read_label_image(d.file("endless.nrrd")); }), {"endless.nrrd", "a device"});
   std::filesystem::create_symlink("/dev/zero", d.path() / "endless.npy");
