@@ -330,11 +330,13 @@ int run_surface_nets_frame(const SurfaceNetsArgs& a) {
   io::check_writable(a.output);
   const NetInput in = read_net_input(a);
   const SurfaceNet net = run_pipeline(in, net_options(a, in), !a.quiet && stderr_is_terminal());
-  auto t0 = Clock::now();
-  io::write_surface_net_vtp(a.output, net);
-  const double write_s = seconds_since(t0);
-  if (a.quiet) return kExitOk;
-
+  if (a.quiet) {
+    io::write_surface_net_vtp(a.output, net);
+    return kExitOk;
+  }
+  // The summary's checks (watertightness: the vertex copies, every edge)
+  // run before the file is written: a failure there (memory, on a net of
+  // hundreds of MB) left a whole file behind an exit status of 1.
   const FaceSet& m = net.mesh;
   std::size_t kinds[3] = {0, 0, 0};
   for (NetVertexKind k : net.vertex_kind) ++kinds[static_cast<int>(k)];
@@ -344,6 +346,9 @@ int run_surface_nets_frame(const SurfaceNetsArgs& a) {
   pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
   const VertexCopies copies = vertex_copies(m);
   const Watertight w = check_watertight(net, copies);
+  auto t0 = Clock::now();
+  io::write_surface_net_vtp(a.output, net);
+  const double write_s = seconds_since(t0);
 
   std::printf("tessera surface-nets: %zu points (%dD) from %s%s\n", in.size(), in.dim, shown_input(a.compute).c_str(),
               in.from_image ? " (sampled image)" : "");

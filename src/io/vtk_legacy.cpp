@@ -33,6 +33,7 @@
 #include <string_view>
 #include <vector>
 
+#include "../message_text.hpp"
 #include "image_detail.hpp"  // printable, trim
 #include "io_detail.hpp"
 #include "tessera/io/points.hpp"
@@ -71,6 +72,7 @@ struct LegacyType {
   bool integer = true;
   bool is_signed = true;
   bool string = false;    // strings: skipped, never numbers
+  std::string name;       // as the file spells it, for messages
 };
 
 bool legacy_type(const std::string& name, LegacyType& t) {
@@ -92,6 +94,7 @@ bool legacy_type(const std::string& name, LegacyType& t) {
   else if (n == "string" || n == "utf8_string") t = {0, false, false, true};
   else if (n == "double" || n == "vtktypefloat64") t = {8, false, true};
   else return false;
+  t.name = n;
   return true;
 }
 
@@ -209,6 +212,14 @@ class Legacy {
           fail(path_, what + ": the file ends after " + std::to_string(k) + " of " + std::to_string(n) + " values");
         if (!keep && t.integer) continue;  // (floats are parsed: a word that is no number is an error anyway)
         double v = 0;
+        if (t.integer) {
+          // A whole number in the type's range: "2.5" or "nan" in an int
+          // array was truncated, 300 in an unsigned_char taken as is.
+          if (!integer_text(w, t, v))
+            fail(path_, what + ": '" + printable(w) + "' is not a value of its type (" + t.name + ")");
+          out.push_back(v);
+          continue;
+        }
         if (!parse_number(w, v)) fail(path_, what + ": '" + printable(w) + "' is not a number");
         // A float array's text is rounded to float, as its binary twin and
         // VTK's reader hold it.
@@ -269,7 +280,28 @@ class Legacy {
     if (i_ >= s_.size()) fail(path_, "not a legacy VTK file (it ends within its first three lines)");
     return rest_of_line();
   }
+  /// An integer type's word: whole, and within the type's range (`bit`: 0 or 1).
+  static bool integer_text(std::string_view w, const LegacyType& t, double& v) {
+    if (!w.empty() && w.front() == '+') w.remove_prefix(1);
+    const unsigned bits = t.bytes == 0 ? 1 : static_cast<unsigned>(8 * t.bytes);
+    if (t.is_signed) {
+      std::int64_t x = 0;
+      const auto [p, ec] = std::from_chars(w.data(), w.data() + w.size(), x);
+      if (w.empty() || ec != std::errc() || p != w.data() + w.size()) return false;
+      if (bits < 64 && (x < -(std::int64_t(1) << (bits - 1)) || x >= (std::int64_t(1) << (bits - 1)))) return false;
+      v = static_cast<double>(x);
+      return true;
+    }
+    std::uint64_t x = 0;
+    const auto [p, ec] = std::from_chars(w.data(), w.data() + w.size(), x);
+    if (w.empty() || ec != std::errc() || p != w.data() + w.size()) return false;
+    if (bits < 64 && x >= (std::uint64_t(1) << bits)) return false;
+    v = static_cast<double>(x);
+    return true;
+  }
+
   static bool parse_number(std::string_view w, double& v) {
+    if (w.size() > 1 && w.front() == '+') w.remove_prefix(1);  // (VTK's reader takes a sign)
     const auto [p, ec] = std::from_chars(w.data(), w.data() + w.size(), v);
     if (ec == std::errc() && p == w.data() + w.size()) return true;
     // VTK writes non-finite values as nan, inf, -inf (and some writers 1.#INF).
@@ -292,6 +324,7 @@ struct LegacyPoints {
   std::vector<double> xyz;  // 3n
   bool found = false;       // the attribute named
   bool is_float = false;
+  std::size_t type_bytes = 0;  // of the attribute named
   std::vector<double> values;
   std::vector<std::string> names;  // POINT_DATA attributes, for the message
   std::vector<std::size_t> components;  // of each of them
@@ -341,6 +374,7 @@ void read_attribute(Legacy& f, const std::string& kw, std::size_t n, bool point_
     if (keep) {
       out.found = true;
       out.is_float = !t.integer;
+      out.type_bytes = t.bytes;
       out.values = std::move(v);
     }
   };
@@ -417,10 +451,12 @@ LegacyPoints walk(const std::string& path, const std::string& wanted, bool image
   if (ds == "structured_points" && !image)
     fail(path, "a legacy VTK image (STRUCTURED_POINTS) holds no point set: give it to `sample-image` (or "
                "`surface-nets --image`), or its voxel centres as points");
+  std::string upper = ds;
+  for (char& c : upper) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
   if (image && ds != "structured_points")
-    fail(path, "a legacy VTK " + ds + " holds points, not an image (images are STRUCTURED_POINTS)");
+    fail(path, "a legacy VTK " + upper + " is not an image (images are STRUCTURED_POINTS)");
   if (!image && ds != "polydata" && ds != "unstructured_grid" && ds != "structured_grid")
-    fail(path, "legacy VTK DATASET '" + ds + "' is not supported (POLYDATA, UNSTRUCTURED_GRID or STRUCTURED_GRID)");
+    fail(path, "legacy VTK DATASET '" + upper + "' is not supported (POLYDATA, UNSTRUCTURED_GRID or STRUCTURED_GRID)");
   LegacyPoints out;
   bool have_points = false;
   bool in_data = false;    // after a POINT_DATA or CELL_DATA header
@@ -517,12 +553,18 @@ RawImage read_vtk_legacy_image(const std::string& path, const std::string& array
   check_geometry(path, g);
   raw.converted = true;
   if (lp.is_float) {
-    raw.type = ScalarType::f64;
+    raw.type = lp.type_bytes == 4 ? ScalarType::f32 : ScalarType::f64;  // (named so in messages)
     raw.doubles = lp.values;
   } else {
     raw.type = ScalarType::i64;
     raw.ints.reserve(lp.values.size());
-    for (const double v : lp.values) raw.ints.push_back(static_cast<std::int64_t>(v));
+    for (std::size_t k = 0; k < lp.values.size(); ++k) {
+      const double v = lp.values[k];
+      if (!(v >= -0x1p63 && v < 0x1p63))  // (an unsigned 64-bit value past int64: the cast would wrap)
+        fail(path, "voxel " + std::to_string(k) + " holds " + tessera::detail::number_text(v) +
+                       ", beyond 64-bit signed integers");
+      raw.ints.push_back(static_cast<std::int64_t>(v));
+    }
   }
   return raw;
 }

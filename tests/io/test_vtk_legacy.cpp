@@ -123,7 +123,8 @@ TEST(VtkLegacy, BinaryBigEndianAndAStructuredGrid) {
 }
 
 // ASCII floats are rounded to float as VTK's reader and the binary twin hold
-// them; an integer array holding 2.7 is no labels (it became label 2).
+// them; an integer array's text must be a whole number of its type (2.7
+// became label 2, 300 an unsigned_char).
 TEST(VtkLegacy, AsciiFloatsAndLabelsAsStored) {
   TempDir dir;
   const std::string p = dir.write("f.vtk", "# vtk DataFile Version 3.0\nf\nASCII\nDATASET POLYDATA\nPOINTS 2 float\n"
@@ -134,7 +135,10 @@ TEST(VtkLegacy, AsciiFloatsAndLabelsAsStored) {
   EXPECT_EQ(read_point_scalars(p, "d"), (std::vector<double>{0.1, 0.2}));  // doubles kept
   ReadOptions o;
   o.labels = "i";
-  EXPECT_NE(input_error([&] { read_points(p, o); }).find("label in 'i' at point 1 is 2.7, not a whole number"),
+  EXPECT_NE(input_error([&] { read_points(p, o); }).find("'2.7' is not a value of its type (int)"), std::string::npos);
+  const std::string q = dir.write("u.vtk", "# vtk DataFile Version 3.0\nu\nASCII\nDATASET POLYDATA\nPOINTS 2 float\n"
+                                           "0 0 0 1 1 1\nPOINT_DATA 2\nSCALARS c unsigned_char\n+7 300\n");
+  EXPECT_NE(input_error([&] { read_point_scalars(q, "c"); }).find("'300' is not a value of its type (unsigned_char)"),
             std::string::npos);
 }
 
@@ -151,7 +155,7 @@ TEST(VtkLegacy, Errors) {
   expect("# vtk DataFile Version 3.0\nx\n", "ends within its first three lines");
   expect("# vtk DataFile Version 3.0\nx\nTEXT\n", "line 3 must be ASCII or BINARY");
   expect(head + "DATASET STRUCTURED_POINTS\nDIMENSIONS 2 2 2\n", "a legacy VTK image (STRUCTURED_POINTS)");
-  expect(head + "DATASET RECTILINEAR_GRID\n", "DATASET 'rectilinear_grid' is not supported");
+  expect(head + "DATASET RECTILINEAR_GRID\n", "DATASET 'RECTILINEAR_GRID' is not supported");
   expect(head + "DATASET POLYDATA\n", "without POINTS");
   expect(head + "DATASET POLYDATA\nPOINTS 2 float\n0 0 0 1 1\n", "POINTS: the file ends after 5 of 6 values");
   expect(head + "DATASET POLYDATA\nPOINTS 2 quad\n0 0 0 1 1 1\n", "unknown data type 'quad'");
