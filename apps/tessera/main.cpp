@@ -10,6 +10,7 @@
 #include <exception>
 #include <new>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <CLI/CLI.hpp>
@@ -493,6 +494,17 @@ int main(int argc, char** argv) {
   add_image_commands(app, image_cmds);
   require_number_syntax(app);
 
+  // "--radii=" with nothing after '=' makes CLI11 take the next word as the
+  // value, and the error then names another problem: refused as empty here.
+  for (int k = 1; k < argc; ++k) {
+    const std::string_view w = argv[k];
+    if (w == "--") break;
+    if (w.size() > 3 && w.substr(0, 2) == "--" && w.back() == '=' && w.find('=') == w.size() - 1) {
+      print_error(std::string(w.substr(0, w.size() - 1)) + ": an empty value (a file name, a number or a list was "
+                  "expected)");
+      return kExitInputError;
+    }
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

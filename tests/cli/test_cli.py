@@ -2162,6 +2162,7 @@ class BadInput(TempDirCase):
                            (["--labels", "", "--validate"], "--labels")):
             self.fails(["voronoi", self.good3] + args, name + ": an empty value", outputs=[self.p("nb.npy")])
         self.fails(["voronoi", "", "--validate"], "INPUT: an empty value")
+        self.fails(["voronoi", self.good3, "--radii=", "--validate"], "--radii: an empty value")
         self.fails(["delaunay", self.good3, "--simplices", "", "--validate"], "--simplices: an empty value")
 
     def test_output_extensions(self):
