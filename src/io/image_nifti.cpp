@@ -16,11 +16,10 @@
 #include <algorithm>
 #include <array>
 #include <bit>
-#include <cctype>
 #include <cmath>
-#include <cstdio>
 #include <cstdint>
 #include <cstring>
+#include <filesystem>
 #include <string>
 #include <string_view>
 
@@ -33,13 +32,6 @@ namespace {
 
 using tessera::detail::axis_name;
 using tessera::detail::number_text;
-
-bool ends_with(const std::string& s, std::string_view tail) {
-  if (s.size() < tail.size()) return false;
-  for (std::size_t k = 0; k < tail.size(); ++k)
-    if (std::tolower(static_cast<unsigned char>(s[s.size() - tail.size() + k])) != tail[k]) return false;
-  return true;
-}
 
 bool gzipped(std::string_view bytes) {
   return bytes.size() >= 2 && static_cast<unsigned char>(bytes[0]) == 0x1f && static_cast<unsigned char>(bytes[1]) == 0x8b;
@@ -155,13 +147,10 @@ bool nifti_type(int code, ScalarType& t) {
 
 /// The data file of a header/image pair: NAME.img (or .img.gz) beside NAME.hdr.
 std::string image_file_of(const std::string& path) {
-  const std::string base = path.substr(0, path.size() - (ends_with(path, ".hdr.gz") ? 7 : 4));
+  const std::string base = path.substr(0, path.size() - (ends_with_ci(path, ".hdr.gz") ? 7 : 4));
   for (const char* ext : {".img", ".img.gz", ".IMG"}) {
-    const std::string p = base + ext;
-    if (FILE* f = std::fopen(p.c_str(), "rb")) {
-      std::fclose(f);
-      return p;
-    }
+    std::error_code ec;
+    if (std::filesystem::exists(base + ext, ec)) return base + ext;
   }
   return base + ".img";  // read_detached names it in its error
 }
@@ -169,8 +158,8 @@ std::string image_file_of(const std::string& path) {
 }  // namespace
 
 bool is_nifti_path(const std::string& path) {
-  return ends_with(path, ".nii") || ends_with(path, ".nii.gz") || ends_with(path, ".hdr") ||
-         ends_with(path, ".hdr.gz");
+  return ends_with_ci(path, ".nii") || ends_with_ci(path, ".nii.gz") || ends_with_ci(path, ".hdr") ||
+         ends_with_ci(path, ".hdr.gz");
 }
 
 RawImage read_nifti_image(const std::string& path, bool want_labels) {

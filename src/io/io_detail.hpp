@@ -36,6 +36,11 @@ inline std::string lower(std::string_view s) {
   return r;
 }
 
+/// Whether `s` ends with `suffix` (lower case), in any case: ".nii.gz" names.
+inline bool ends_with_ci(std::string_view s, std::string_view suffix) {
+  return s.size() >= suffix.size() && lower(s.substr(s.size() - suffix.size())) == suffix;
+}
+
 /// The item of type T stored at `p` (any alignment), byte-swapped when the
 /// file's byte order is not ours.
 template <class T>

@@ -59,12 +59,6 @@ std::string decoded(std::string_view s) {
   return out;
 }
 
-std::string lower_word(std::string_view s) {
-  std::string out(s);
-  for (char& c : out) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return out;
-}
-
 /// A data type of the legacy format: its size in binary files and whether
 /// it holds integers. `bit` packs eight values in a byte.
 struct LegacyType {
@@ -76,7 +70,7 @@ struct LegacyType {
 };
 
 bool legacy_type(const std::string& name, LegacyType& t) {
-  const std::string n = lower_word(name);
+  const std::string n = lower(name);
   if (n == "bit") t = {0, true, false};
   else if (n == "unsigned_char" || n == "vtktypeuint8") t = {1, true, false};
   else if (n == "char" || n == "signed_char" || n == "vtktypeint8") t = {1, true, true};
@@ -103,10 +97,10 @@ class Legacy {
  public:
   Legacy(const std::string& path, std::string text) : path_(path), s_(std::move(text)) {
     std::string_view line = next_line();
-    if (lower_word(line.substr(0, 22)) != "# vtk datafile version")
+    if (lower(line.substr(0, 22)) != "# vtk datafile version")
       fail(path_, "not a legacy VTK file (the first line must be '# vtk DataFile Version ...')");
     next_line();  // the title
-    const std::string mode = lower_word(trim(next_line()));
+    const std::string mode = lower(trim(next_line()));
     if (mode != "ascii" && mode != "binary")
       fail(path_, "legacy VTK line 3 must be ASCII or BINARY, got '" + printable(mode) + "'");
     binary_ = mode == "binary";
@@ -125,7 +119,7 @@ class Legacy {
     while (i_ < s_.size() && !std::isspace(static_cast<unsigned char>(s_[i_]))) ++i_;
     return std::string_view(s_).substr(b, i_ - b);
   }
-  std::string keyword() { return lower_word(word()); }
+  std::string keyword() { return lower(word()); }
   /// The rest of the current line (a name may hold spaces in no writer we
   /// know; a FIELD array's line is split by words).
   std::string_view rest_of_line() {
@@ -163,7 +157,7 @@ class Legacy {
   LegacyType type(const std::string& what) {
     const std::string_view w = word();
     LegacyType t;
-    if (lower_word(w) == "variant") fail(path_, what + ": variant arrays are not supported");
+    if (lower(w) == "variant") fail(path_, what + ": variant arrays are not supported");
     if (!legacy_type(std::string(w), t)) fail(path_, what + ": unknown data type '" + printable(w) + "'");
     return t;
   }
@@ -305,7 +299,7 @@ class Legacy {
     const auto [p, ec] = std::from_chars(w.data(), w.data() + w.size(), v);
     if (ec == std::errc() && p == w.data() + w.size()) return true;
     // VTK writes non-finite values as nan, inf, -inf (and some writers 1.#INF).
-    const std::string l = lower_word(w);
+    const std::string l = lower(w);
     if (l == "nan" || l == "-nan") return v = std::nan(""), true;
     if (l == "inf" || l == "infinity") return v = HUGE_VAL, true;
     if (l == "-inf" || l == "-infinity") return v = -HUGE_VAL, true;
@@ -318,8 +312,10 @@ class Legacy {
   bool binary_ = false;
 };
 
-/// What the walk keeps: the points, and one POINT_DATA attribute by name.
+/// What the walk keeps: the points, and one POINT_DATA attribute by name
+/// (or, `take_first`, the first of one component: an image's default).
 struct LegacyPoints {
+  bool take_first = false;
   std::size_t n = 0;
   std::vector<double> xyz;  // 3n
   bool found = false;       // the attribute named
@@ -327,7 +323,6 @@ struct LegacyPoints {
   std::size_t type_bytes = 0;  // of the attribute named
   std::vector<double> values;
   std::vector<std::string> names;  // POINT_DATA attributes, for the message
-  std::vector<std::size_t> components;  // of each of them
   // STRUCTURED_POINTS (an image): its grid
   std::int64_t dims[3] = {0, 0, 0};
   double spacing[3] = {1, 1, 1}, origin[3] = {0, 0, 0};
@@ -340,7 +335,7 @@ void skip_cells(Legacy& f, const std::string& section) {
   const std::size_t b = f.count(section);
   if (f.peek_keyword() == "offsets") {
     for (const char* block : {"offsets", "connectivity"}) {
-      if (f.keyword() != block) fail(f.path(), section + ": expected " + lower_word(block) + " data");
+      if (f.keyword() != block) fail(f.path(), section + ": expected " + lower(block) + " data");
       const LegacyType t = f.type(section);
       f.values(std::string(block) == "offsets" ? a : b, t, section, false);
     }
@@ -355,11 +350,9 @@ void read_attribute(Legacy& f, const std::string& kw, std::size_t n, bool point_
                     LegacyPoints& out) {
   const std::string name = decoded(f.word());
   auto take = [&](const std::string& array, std::size_t components, std::size_t tuples, const LegacyType& t) {
-    const bool keep = point_data && !wanted.empty() && array == wanted;
-    if (point_data) {
-      out.names.push_back(array);
-      out.components.push_back(components);
-    }
+    const bool keep = point_data && (out.take_first ? !out.found && components == 1 && tuples == n && !t.string
+                                                    : !wanted.empty() && array == wanted);
+    if (point_data) out.names.push_back(array);
     if (t.string) {
       if (keep) fail(f.path(), "point data '" + array + "' holds strings, not numbers");
       f.skip_strings(components * tuples, "array '" + array + "'");
@@ -398,9 +391,9 @@ void read_attribute(Legacy& f, const std::string& kw, std::size_t n, bool point_
     // Bytes in BINARY files; in ASCII each byte written as byte / 255, which
     // VTK's reader turns back into the byte.
     const std::size_t components = f.count("COLOR_SCALARS " + name);
-    const bool keep = point_data && !wanted.empty() && name == wanted;
+    const bool found_before = out.found;
     take(name, components, n, f.binary() ? LegacyType{1, true, false} : LegacyType{8, false, true});
-    if (keep && !f.binary()) {
+    if (!found_before && out.found && !f.binary()) {
       for (double& v : out.values) v = std::floor(255.0 * v + 0.5);
       out.is_float = false;
     }
@@ -421,7 +414,7 @@ void read_attribute(Legacy& f, const std::string& kw, std::size_t n, bool point_
     const std::size_t arrays = f.count("FIELD " + name);
     for (std::size_t k = 0; k < arrays; ++k) {
       const std::string array = decoded(f.word());
-      if (lower_word(array) == "null_array") continue;
+      if (lower(array) == "null_array") continue;
       const std::size_t components = f.count("array '" + array + "'");
       const std::size_t tuples = f.count("array '" + array + "'");
       const LegacyType t = f.type("array '" + array + "'");
@@ -443,7 +436,8 @@ void read_attribute(Legacy& f, const std::string& kw, std::size_t n, bool point_
 }
 
 /// The file's points (`image` false) or its image (STRUCTURED_POINTS: `image`
-/// true), with the POINT_DATA attribute `wanted` where named.
+/// true), with the POINT_DATA attribute `wanted` where named (an image
+/// without a name: its first attribute of one component).
 LegacyPoints walk(const std::string& path, const std::string& wanted, bool image = false) {
   Legacy f(path, read_file_bytes(path));
   if (f.keyword() != "dataset") fail(path, "legacy VTK: expected DATASET after the file's header");
@@ -458,6 +452,7 @@ LegacyPoints walk(const std::string& path, const std::string& wanted, bool image
   if (!image && ds != "polydata" && ds != "unstructured_grid" && ds != "structured_grid")
     fail(path, "legacy VTK DATASET '" + upper + "' is not supported (POLYDATA, UNSTRUCTURED_GRID or STRUCTURED_GRID)");
   LegacyPoints out;
+  out.take_first = image && wanted.empty();
   bool have_points = false;
   bool in_data = false;    // after a POINT_DATA or CELL_DATA header
   bool in_points = false;  // inside POINT_DATA (or CELL_DATA: false)
@@ -509,7 +504,7 @@ LegacyPoints walk(const std::string& path, const std::string& wanted, bool image
 }  // namespace
 
 bool looks_like_legacy_vtk(std::string_view head) {
-  return lower_word(head.substr(0, 22)) == "# vtk datafile version";
+  return lower(head.substr(0, 22)) == "# vtk datafile version";
 }
 
 PointCloud read_vtk_legacy_points(const std::string& path, const ReadOptions& options,
@@ -532,16 +527,10 @@ PointCloud read_vtk_legacy_points(const std::string& path, const ReadOptions& op
 
 RawImage read_vtk_legacy_image(const std::string& path, const std::string& array) {
   // The array asked for, else the first of one component (VTK writes the
-  // active scalars first): a first walk names them, a second reads it.
-  std::string name = array;
-  if (name.empty()) {
-    const LegacyPoints all = walk(path, std::string(), true);
-    for (std::size_t k = 0; k < all.names.size() && name.empty(); ++k)
-      if (all.components[k] == 1) name = all.names[k];
-    if (name.empty()) fail(path, "a legacy VTK image without point data of one component");
-  }
-  const LegacyPoints lp = walk(path, name, true);
-  if (!lp.found) no_array(path, name, lp);
+  // active scalars first).
+  const LegacyPoints lp = walk(path, array, true);
+  if (!lp.found && array.empty()) fail(path, "a legacy VTK image without point data of one component");
+  if (!lp.found) no_array(path, array, lp);
   RawImage raw;
   ImageGeometry& g = raw.geometry;
   for (std::size_t a = 0; a < 3; ++a) {

@@ -38,6 +38,7 @@
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
+#include "io_detail.hpp"  // ends_with_ci
 #include "ordered_chunks.hpp"
 #include "tessera/io/atomic_file.hpp"
 
@@ -53,13 +54,6 @@ const char* byte_order() {
   return std::endian::native == std::endian::little ? "LittleEndian" : "BigEndian";
 }
 
-bool ends_with_ci(const std::string& s, const char* suffix) {
-  const std::size_t n = std::strlen(suffix);
-  if (s.size() < n) return false;
-  for (std::size_t i = 0; i < n; ++i)
-    if (std::tolower(static_cast<unsigned char>(s[s.size() - n + i])) != suffix[i]) return false;
-  return true;
-}
 
 /// Buffered raw writer: values are appended to a fixed buffer that is flushed
 /// with one ostream::write per block. Once the stream has failed (disk full...)
@@ -353,7 +347,7 @@ void write_vtp(const std::string& path, const Cells& c) {
 
 void write_cells_vtk(const std::string& path, const Cells& cells) {
   // Extension first: it is the caller's input, and the cheapest check.
-  const bool vtu = ends_with_ci(path, ".vtu"), vtp = ends_with_ci(path, ".vtp");
+  const bool vtu = detail::ends_with_ci(path, ".vtu"), vtp = detail::ends_with_ci(path, ".vtp");
   if (cells.dim == 3 && !vtu)
     throw InputError("cannot write " + path + ": 3D cells are written as VTK UnstructuredGrid (.vtu)" +
                      (vtp ? "; .vtp is for 2D" : ""));
