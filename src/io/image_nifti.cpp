@@ -246,20 +246,23 @@ RawImage read_nifti_image(const std::string& path, bool want_labels) {
     fail(path, "NIfTI vox_offset " + std::to_string(offset) + " lies inside the header");
   const std::string detached = h.pair ? read_detached(path, data_path) : std::string();
   const std::string& source = h.pair ? detached : file;
-  std::string bytes;
-  if (gzipped(source)) {
-    if ((offset + need) / 1100 > source.size() + 64)
-      fail(data_path, "gzip data is " + std::to_string(source.size()) + " bytes, far too short for the " +
-                          std::to_string(need) + " bytes of the image the header gives");
-    bytes = inflate_prefix(data_path, "gzip data", source, offset + need);
-  } else {
-    bytes = source.substr(0, std::min(source.size(), offset + need));
-  }
-  if (bytes.size() < offset + need)
-    fail(data_path, "the data ends " + std::to_string(offset + need - bytes.size()) +
+  // (The voxels are copied once: out of the file, or inflated in place.)
+  const bool data_gz = gzipped(source);
+  if (data_gz && (offset + need) / 1100 > source.size() + 64)
+    fail(data_path, "gzip data is " + std::to_string(source.size()) + " bytes, far too short for the " +
+                        std::to_string(need) + " bytes of the image the header gives");
+  std::string inflated = data_gz ? inflate_prefix(data_path, "gzip data", source, offset + need) : std::string();
+  const std::string& whole = data_gz ? inflated : source;
+  if (whole.size() < offset + need)
+    fail(data_path, "the data ends " + std::to_string(offset + need - whole.size()) +
                         " bytes short of the image the header gives (" + std::to_string(g.n_voxels()) + " voxels of " +
                         scalar_name(raw.type) + ")");
-  raw.bytes = bytes.substr(offset);
+  if (data_gz) {
+    inflated.erase(0, offset);
+    raw.bytes = std::move(inflated);
+  } else {
+    raw.bytes.assign(source, offset, need);
+  }
   raw.big_endian = h.big_endian;
 
   // Scaled values: the scalar image's own; labels cannot be scaled.
