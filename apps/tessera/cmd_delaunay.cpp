@@ -39,19 +39,14 @@ DelaunayMethod delaunay_method(const std::string& name) {
 }
 
 Delaunay triangulate(const io::PointCloud& pc, DelaunayOptions opt, bool show_progress, double& seconds) {
-  ProgressBar bar("tessera: computing the triangulation", show_progress);
-  InterruptGuard guard;
-  opt.progress = [&bar](double f) {
-    if (InterruptGuard::interrupted()) throw Cancelled();
-    bar.update(f);
-  };
   opt.radii = pc.radii;
-  const auto t0 = Clock::now();
-  Delaunay dt = delaunay(pc.coords, pc.dim, pc.labels, opt);
-  seconds = seconds_since(t0);
-  bar.finish();
-  if (InterruptGuard::interrupted()) throw Cancelled();
-  return dt;
+  return run_cancellable("tessera: computing the triangulation", show_progress, [&](auto progress) {
+    opt.progress = progress;
+    const auto t0 = Clock::now();
+    Delaunay dt = delaunay(pc.coords, pc.dim, pc.labels, opt);
+    seconds = seconds_since(t0);
+    return dt;
+  });
 }
 
 void check_delaunay_outputs(const DelaunayArgs& a) {

@@ -257,16 +257,10 @@ std::size_t polygon_count(const SurfaceNet& net) {
 
 /// surface_nets with a progress bar (when wanted) and Ctrl-C cancellation.
 SurfaceNet run_pipeline(const NetInput& in, SurfaceNetsOptions o, bool show_progress) {
-  ProgressBar bar("tessera: surface nets", show_progress);
-  InterruptGuard guard;
-  o.voronoi.progress = [&bar](double f) {
-    if (InterruptGuard::interrupted()) throw Cancelled();
-    bar.update(f);
-  };
-  SurfaceNet net = surface_nets(in.coords, in.labels, o);
-  bar.finish();
-  if (InterruptGuard::interrupted()) throw Cancelled();
-  return net;
+  return run_cancellable("tessera: surface nets", show_progress, [&](auto progress) {
+    o.voronoi.progress = progress;
+    return surface_nets(in.coords, in.labels, o);
+  });
 }
 
 }  // namespace

@@ -404,23 +404,17 @@ std::string no_cells_reason(const io::PointCloud& pc, const Cells& c) {
               pc.labels.empty() ? "" : " with a label >= 0");
 }
 
-/// Runs the engine with a progress bar (when wanted) and Ctrl-C cancellation.
-/// A Ctrl-C that arrives after the engine's last progress call still cancels,
-/// so an interrupted run never writes output.
+/// Runs the engine with a progress bar (when wanted) and Ctrl-C cancellation
+/// (run_cancellable).
 Cells compute(const io::PointCloud& pc, VoronoiOptions opt, bool show_progress, double& seconds) {
-  ProgressBar bar("tessera: computing cells", show_progress);
-  InterruptGuard guard;
-  opt.progress = [&bar](double f) {
-    if (InterruptGuard::interrupted()) throw Cancelled();
-    bar.update(f);
-  };
   opt.radii = pc.radii;
-  const auto t0 = Clock::now();
-  Cells cells = voronoi(pc.coords, pc.dim, pc.labels, opt);
-  seconds = seconds_since(t0);
-  bar.finish();
-  if (InterruptGuard::interrupted()) throw Cancelled();
-  return cells;
+  return run_cancellable("tessera: computing cells", show_progress, [&](auto progress) {
+    opt.progress = progress;
+    const auto t0 = Clock::now();
+    Cells cells = voronoi(pc.coords, pc.dim, pc.labels, opt);
+    seconds = seconds_since(t0);
+    return cells;
+  });
 }
 
 namespace {

@@ -4,6 +4,9 @@
 #include <chrono>
 #include <csignal>
 #include <string>
+#include <utility>
+
+#include "tessera/cells.hpp"  // tessera::Cancelled
 
 namespace tessera::cli {
 
@@ -64,5 +67,23 @@ class InterruptGuard {
   struct sigaction previous_ {};
   bool installed_ = false;
 };
+
+/// Runs `compute(progress)`, a library call given `progress` as its progress
+/// callback, with a progress bar labelled `label` (when `show_progress`) and
+/// Ctrl-C cancellation: the callback throws tessera::Cancelled once Ctrl-C was
+/// pressed, so the library stops between batches. A Ctrl-C after the last
+/// callback still cancels, so an interrupted run never writes output.
+template <class Compute>
+auto run_cancellable(std::string label, bool show_progress, Compute&& compute) {
+  ProgressBar bar(std::move(label), show_progress);
+  InterruptGuard guard;
+  auto result = std::forward<Compute>(compute)([&bar](double f) {
+    if (InterruptGuard::interrupted()) throw Cancelled();
+    bar.update(f);
+  });
+  bar.finish();
+  if (InterruptGuard::interrupted()) throw Cancelled();
+  return result;
+}
 
 }  // namespace tessera::cli
