@@ -21,7 +21,7 @@ double seconds_since(Clock::time_point t0) { return std::chrono::duration<double
 
 DelaunayOptions delaunay_options(const ComputeArgs& c, int dim, bool complete_hull) {
   // A dump's box with walls: say where the periodic axes came from.
-  if (!c.box_source.empty() && !c.periodic.empty() && c.periodic.size() != static_cast<std::size_t>(dim))
+  if (c.periodic_from_file && !c.periodic.empty() && c.periodic.size() != static_cast<std::size_t>(dim))
     throw InputError(c.box_source + " is periodic along " + c.periodic +
                      " only, and a periodic triangulation needs every axis periodic: give --bounds (walls "
                      "everywhere) for the triangulation of the points as they lie");

@@ -269,16 +269,28 @@ std::string shown_input(const ComputeArgs& a) {
 }
 
 void apply_file_box(ComputeArgs& a) {
-  a.domain_given = !a.bounds.empty() || !a.periodic.empty() || !a.tilt.empty();
+  // --bounds makes the domain the command line's, whole. --periodic and
+  // --tilt alone take the file's box with their own axes and tilts: a user
+  // restating a dump's periodicity, or choosing other axes, means that box.
+  a.domain_given = !a.bounds.empty();
   if (a.domain_given) return;
   const std::optional<io::FileBox> box = io::read_file_box(a.input, a.frame_place);
-  if (!box) return;
+  if (!box) return;  // (make_options then asks --periodic for --bounds)
   const int dim = a.dim == 0 ? 3 : a.dim;
+  a.periodic_from_file = a.periodic.empty();
   for (int d = 0; d < dim; ++d) {
     const auto k = static_cast<std::size_t>(d);
     a.bounds.push_back(box->lo[k]);
     a.bounds.push_back(box->hi[k]);
-    if (box->periodic[k]) a.periodic += "xyz"[d];
+    if (a.periodic_from_file && box->periodic[k]) a.periodic += "xyz"[d];
+  }
+  a.tilt_from_file = a.tilt.empty();
+  a.box_source = "the box of " + (a.frame.empty() ? "" : strf("frame %zu of ", a.frame_place.index)) +
+                 shown_path(a.input) + " (" + box->declared_by + ")";
+  if (!a.periodic_from_file) a.box_source += ", periodic along --periodic's axes";
+  if (!a.tilt_from_file) {
+    a.box_source += ", tilted by --tilt";
+    return;
   }
   static const char* const tilt_name[3] = {"xy", "xz", "yz"};
   static const int tilt_axes[3][2] = {{0, 1}, {0, 2}, {1, 2}};
@@ -289,15 +301,14 @@ void apply_file_box(ComputeArgs& a) {
     if (box->tilt[k] == 0) continue;
     tilted = true;
     for (const int axis : tilt_axes[t])
-      if (!box->periodic[static_cast<std::size_t>(axis)])
-        throw InputError(strf("%s: the box tilts by %s = %.17g, but %s is a wall there; give the domain yourself "
+      if (a.periodic.find("xyz"[axis]) == std::string::npos)
+        throw InputError(strf("%s: the box tilts by %s = %.17g, but %s is a wall there%s; give the domain yourself "
                               "(--bounds, with --periodic and --tilt)",
-                              shown_path(a.input).c_str(), tilt_name[t], box->tilt[k], axis_name(axis)));
+                              shown_path(a.input).c_str(), tilt_name[t], box->tilt[k], axis_name(axis),
+                              a.periodic_from_file ? "" : (" (--periodic " + a.periodic + ")").c_str()));
   }
   if (tilted)
     for (int t = 0; t < tilts; ++t) a.tilt.push_back(box->tilt[static_cast<std::size_t>(t)]);
-  a.box_source = "the box of " + (a.frame.empty() ? "" : strf("frame %zu of ", a.frame_place.index)) +
-                 shown_path(a.input) + " (" + box->declared_by + ")";
 }
 
 io::PointCloud read_input(const ComputeArgs& a) {

@@ -42,13 +42,16 @@ struct ComputeArgs {
   std::string cell_method = "auto";  ///< auto | search | insertion (voronoi only; add_cell_method_option)
   std::string periodic;         ///< "" or periodic axes, e.g. "xyz" (voronoi only; add_periodic_option)
   std::vector<double> tilt;     ///< triclinic tilts: xy (2D), or xy xz yz (3D); empty: orthogonal
-  /// Set where INPUT's own box (a LAMMPS dump's) gave bounds, periodic and
-  /// tilt (apply_file_box): what the summary says of it, e.g. "the box of
+  /// Set where INPUT's own box (a LAMMPS dump's) gave the bounds
+  /// (apply_file_box): what the summary says of it, e.g. "the box of
   /// run.dump (timestep 100)".
   std::string box_source;
-  /// Whether the command line gave the domain (--bounds, --periodic or
-  /// --tilt): otherwise each frame of a series takes its own file's box.
+  /// Whether the command line gave the domain (--bounds): otherwise each
+  /// frame of a series takes its own file's box.
   bool domain_given = false;
+  /// Whether the periodic axes, and the tilts, are the file's box's (not
+  /// --periodic's and --tilt's): a series takes each frame's own.
+  bool periodic_from_file = false, tilt_from_file = false;
   /// --frame as given ("" when not): a trajectory's frame, 0 the first,
   /// negative from the end; finish_compute_args finds where it starts.
   std::string frame;
@@ -319,8 +322,9 @@ double parse_number(const std::string& word, const std::string& what, bool allow
 /// The comma-separated words of `s`, spaces dropped ("" gives one empty word).
 std::vector<std::string> split_commas(const std::string& s);
 void check_bounds_arg(const std::vector<double>& bounds);  ///< InputError unless 4 or 6 valid numbers
-/// Where INPUT declares its box (a LAMMPS dump) and the command line gives
-/// none of --bounds, --periodic and --tilt: those from the file's box.
+/// Where INPUT declares its box (a LAMMPS dump) and the command line gives no
+/// --bounds: the bounds from the file's box, and its periodic axes and tilts
+/// where --periodic and --tilt do not give them.
 void apply_file_box(ComputeArgs& args);
 
 /// Whether --frame's text asks for a series (all, START:STOP[:STEP]), not

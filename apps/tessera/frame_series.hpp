@@ -98,8 +98,8 @@ int run_frames(const Args& a, std::initializer_list<SeriesOutput<Args>> outputs,
     try {
       if (!a.compute.domain_given) {  // the file's box, where it has one: this frame's own
         f.compute.bounds.clear();
-        f.compute.periodic.clear();
-        f.compute.tilt.clear();
+        if (f.compute.periodic_from_file) f.compute.periodic.clear();  // else --periodic's axes
+        if (f.compute.tilt_from_file) f.compute.tilt.clear();
         f.compute.box_source.clear();
         apply_file_box(f.compute);
       }

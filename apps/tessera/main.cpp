@@ -91,7 +91,7 @@ void add_compute_options(CLI::App* app, ComputeArgs& c, std::vector<std::string>
                   "ASCII or binary), .pcd (PCL's point clouds), .las (lidar: LAS 1.0-1.4, point formats 0-10; fields such as "
                   "classification for --labels; LAZ refused) or .dump/.lammpstrj (a LAMMPS dump's first "
                   "frame, or --frame's: x y z, xu yu zu or scaled xs ys zs, atoms in file order; its box and periodic axes are the "
-                  "domain unless --bounds, --periodic or --tilt is given); - reads standard input, in any of these "
+                  "domain unless --bounds is given; --periodic and --tilt replace its axes and tilts); - reads standard input, in any of these "
                   "formats (rbox 1000 D3 | tessera " + command + " - ...)");
   app->add_option("--frame", c.frame,
                   "Of a trajectory (a LAMMPS dump, an XYZ file): the frame to read, 0 the first (default), 1 the "
@@ -197,7 +197,7 @@ constexpr const char* kPeriodicTriangulation =
 void add_periodic_option(CLI::App* app, ComputeArgs& c, const std::string& images, const char* axes_example) {
   app->add_option("--periodic", c.periodic,
                   std::string("Periodic axes, ") + axes_example +
-                      ": --bounds is the box, which repeats along them, with no walls there; points outside it are "
+                      ": --bounds is the box (else the box a LAMMPS dump or extended XYZ INPUT declares), which repeats along them, with no walls there; points outside it are "
                       "wrapped in. The box and the coordinates along those axes are rounded to the spacing of "
                       "doubles at a few box lengths (2^-51 for a unit box) so that every image is exact. " +
                       images)

@@ -1341,11 +1341,40 @@ class FileBoxes(TempDirCase):
         self.assertIn("periodic           xz (", r.stdout)
         self.assertIn("power cells", r.stdout)
         self.assertIn("domain             [-1, 3] x [0.5, 5.5] x [2, 8]", r.stdout)
-        # Any of --bounds, --periodic, --tilt: the command line's domain alone.
+        # --bounds: the command line's domain alone.
         r = self.ok(["voronoi", inp, "--bounds", "-2", "4", "0", "6", "1", "9", "--cell-table", t])
         self.assertNotIn("domain from", r.stdout)
         self.assertNotIn("periodic", r.stdout)
         self.assertAlmostEqual(np.loadtxt(t, delimiter=",", skiprows=1)[:, 2].sum(), 6 * 6 * 8, delta=1e-9)
+        # --periodic alone: the file's box along the option's axes, the same
+        # cells as that box given in full.
+        r = self.ok(["voronoi", inp, "--periodic", "xyz", "--cell-table", t])
+        self.assertIn("periodic along --periodic's axes", r.stdout)
+        self.assertIn("periodic           xyz (", r.stdout)
+        t2 = self.p("t2.csv")
+        self.ok(["voronoi", inp, "--bounds", "-1", "3", "0.5", "5.5", "2", "8", "--periodic", "xyz", "--cell-table",
+                 t2, "-q"])
+        self.assertEqual(read_bytes(t), read_bytes(t2))
+        # Each frame of a series keeps the option's axes with its own box.
+        with open(inp) as f:
+            text = f.read()
+        with open(self.p("two.dump"), "w") as f:
+            f.write(text + text)
+        self.ok(["voronoi", self.p("two.dump"), "--frame", "all", "--periodic", "xyz", "--cell-table",
+                 self.p("s{frame}.csv"), "-q"])
+        for k in range(2):
+            self.assertEqual(read_bytes(self.p("s%d.csv" % k)), read_bytes(t2))
+        # ... and the periodic triangulation of that box.
+        r = self.ok(["delaunay", inp, "--periodic", "xyz", "--validate"])
+        self.assertIn("validation passed", r.stderr)
+        # A file's tilt along an axis --periodic makes a wall: refused, naming both.
+        tilted, _ = self.dump("tw.dump", frac)
+        r = run(["voronoi", tilted, "--periodic", "xy", "--cell-table", t])
+        self.assertEqual(r.returncode, 2)
+        self.assertIn("but z is a wall there (--periodic xy)", r.stderr)
+        self.assertEqual(len(r.stderr.strip().splitlines()), 1)
+        r = self.ok(["voronoi", tilted, "--periodic", "xy", "--tilt", "0.5", "0", "0", "--cell-table", t])
+        self.assertIn("tilted by --tilt", r.stdout)
         # A triangulation needs every axis periodic: the dump's walls are named.
         r = run(["delaunay", inp, "--validate"])
         self.assertEqual(r.returncode, 2)
