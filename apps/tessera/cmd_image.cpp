@@ -231,7 +231,7 @@ void add_image_commands(CLI::App& app, ImageCommands& c) {
   s->add_option("IMAGE", c.sample.image,
                 image_help("labels, an integer type (a float image is refused: cast it, or `threshold` it)"))
       ->required();
-  s->add_option("-o", c.sample.output,
+  s->add_option("-o,--output", c.sample.output,
                 "Output points with labels: .npy (float64 (N, D); labels in OUT_labels.npy), .ply (binary, double "
                 "x y z, int property 'label') or .vtp (VTK vertices, point data 'label')")
       ->required();
@@ -244,8 +244,9 @@ void add_image_commands(CLI::App& app, ImageCommands& c) {
                 "Worker threads (default 0: $TESSERA_NUM_THREADS, else all cores). Results are identical for any "
                 "thread count")
       ->check(NonNegative);
-  s->add_option("--output", c.sample.sampler.output,
-                "Which points: all, labelled (voxels of selected labels) or background (the others)")
+  s->add_option("--output-type", c.sample.sampler.output,
+                "Which points: all, labelled (voxels of selected labels) or background (the others); VTK's "
+                "OutputType")
       ->check(CLI::IsMember({"all", "labelled", "background"}))
       ->capture_default_str();
   s->add_flag("-q,--quiet", c.sample.quiet, "No summary line");
@@ -297,6 +298,10 @@ int run_image_command(const ImageCommands& c) {
 // ------------------------------------------------------------------ sample-image
 
 int run_sample_image(const SampleImageArgs& a) {
+  // Until stop 83 --output chose these points (-o was the file): name the
+  // option it now is rather than "unknown extension".
+  if (a.output == "all" || a.output == "labelled" || a.output == "background")
+    throw InputError("--output is the output file; which points to keep is --output-type " + a.output);
   check_points_output(a.output);
   const auto t0 = std::chrono::steady_clock::now();
   // Read here (not through sample_image_file) to report the image size.

@@ -196,7 +196,7 @@ class SampleImage(base.TempDirCase):
         for mode in ("all", "labelled", "background"):
             out = self.p(mode + ".npy")
             self.sample(self.vti, out, "--no-randomize", "--select", "1", "--background-label", "-9",
-                        "--output", mode)
+                        "--output-type", mode)
             outs[mode] = (np.load(out), np.load(self.p(mode + "_labels.npy")))
         self.assertTrue(np.all(outs["labelled"][1] == 1))
         self.assertTrue(np.all(outs["background"][1] == -9))
@@ -276,7 +276,12 @@ class BadImageInput(base.TempDirCase):
         self.fails(["sample-image", self.vti, "-o", out, "--step", "1"], "--step")
         self.fails(["sample-image", self.vti, "-o", out, "--probability", "0.8,0.2"], "--probability")
         self.fails(["sample-image", self.vti, "-o", self.p("o.txt")], ".txt")
-        self.fails(["sample-image", self.vti, "-o", out, "--output", "nope"], "--output")
+        self.fails(["sample-image", self.vti, "-o", out, "--output-type", "nope"], "--output-type")
+        # --output is the file, as in every command; the selection's old
+        # spelling is pointed to its option.
+        self.fails(["sample-image", self.vti, "--output", "labelled"], "--output-type labelled")
+        self.ok(["sample-image", self.vti, "--output", self.p("long.ply"), "-q"])
+        self.assertTrue(os.path.getsize(self.p("long.ply")) > 0)
         lab = self.save("lab_in.npy", self.lab.astype(np.int32))
         self.fails(["sample-image", lab, "-o", out, "--spacing", "1,2"], "3 values")
         # --spacing / --origin take one comma-separated word: two values no
