@@ -69,24 +69,34 @@ struct LegacyType {
   std::string name;       // as the file spells it, for messages
 };
 
+/// A type of no name (the name is set where the file names one).
+LegacyType type_of(std::size_t bytes, bool integer, bool is_signed, bool string = false) {
+  LegacyType t;
+  t.bytes = bytes;
+  t.integer = integer;
+  t.is_signed = is_signed;
+  t.string = string;
+  return t;
+}
+
 bool legacy_type(const std::string& name, LegacyType& t) {
   const std::string n = lower(name);
-  if (n == "bit") t = {0, true, false};
-  else if (n == "unsigned_char" || n == "vtktypeuint8") t = {1, true, false};
-  else if (n == "char" || n == "signed_char" || n == "vtktypeint8") t = {1, true, true};
-  else if (n == "unsigned_short" || n == "vtktypeuint16") t = {2, true, false};
-  else if (n == "short" || n == "vtktypeint16") t = {2, true, true};
-  else if (n == "unsigned_int" || n == "vtktypeuint32") t = {4, true, false};
-  else if (n == "int" || n == "vtktypeint32") t = {4, true, true};
+  if (n == "bit") t = type_of(0, true, false);
+  else if (n == "unsigned_char" || n == "vtktypeuint8") t = type_of(1, true, false);
+  else if (n == "char" || n == "signed_char" || n == "vtktypeint8") t = type_of(1, true, true);
+  else if (n == "unsigned_short" || n == "vtktypeuint16") t = type_of(2, true, false);
+  else if (n == "short" || n == "vtktypeint16") t = type_of(2, true, true);
+  else if (n == "unsigned_int" || n == "vtktypeuint32") t = type_of(4, true, false);
+  else if (n == "int" || n == "vtktypeint32") t = type_of(4, true, true);
   // VTK writes `long` with the writer's sizeof(long): 8 on the 64-bit
   // systems that write such files today; `vtkIdType` as 4-byte ints (its
   // legacy writer narrows ids, and its reader reads them so).
-  else if (n == "unsigned_long" || n == "unsigned_long_long" || n == "vtktypeuint64") t = {8, true, false};
-  else if (n == "long" || n == "long_long" || n == "vtktypeint64") t = {8, true, true};
-  else if (n == "vtkidtype") t = {4, true, true};
-  else if (n == "float" || n == "vtktypefloat32") t = {4, false, true};
-  else if (n == "string" || n == "utf8_string") t = {0, false, false, true};
-  else if (n == "double" || n == "vtktypefloat64") t = {8, false, true};
+  else if (n == "unsigned_long" || n == "unsigned_long_long" || n == "vtktypeuint64") t = type_of(8, true, false);
+  else if (n == "long" || n == "long_long" || n == "vtktypeint64") t = type_of(8, true, true);
+  else if (n == "vtkidtype") t = type_of(4, true, true);
+  else if (n == "float" || n == "vtktypefloat32") t = type_of(4, false, true);
+  else if (n == "string" || n == "utf8_string") t = type_of(0, false, false, true);
+  else if (n == "double" || n == "vtktypefloat64") t = type_of(8, false, true);
   else return false;
   t.name = n;
   return true;
@@ -341,7 +351,7 @@ void skip_cells(Legacy& f, const std::string& section) {
     }
     return;
   }
-  f.values(b, LegacyType{4, true, true}, section, false);
+  f.values(b, type_of(4, true, true), section, false);
 }
 
 /// One attribute of POINT_DATA or CELL_DATA over `n` tuples; kept where it
@@ -350,8 +360,10 @@ void read_attribute(Legacy& f, const std::string& kw, std::size_t n, bool point_
                     LegacyPoints& out) {
   const std::string name = decoded(f.word());
   auto take = [&](const std::string& array, std::size_t components, std::size_t tuples, const LegacyType& t) {
-    const bool keep = point_data && (out.take_first ? !out.found && components == 1 && tuples == n && !t.string
-                                                    : !wanted.empty() && array == wanted);
+    // The first array that qualifies, as VTK's GetArray(name) takes the first
+    // of arrays sharing a name.
+    const bool keep = point_data && !out.found &&
+                      (out.take_first ? components == 1 && tuples == n && !t.string : !wanted.empty() && array == wanted);
     if (point_data) out.names.push_back(array);
     if (t.string) {
       if (keep) fail(f.path(), "point data '" + array + "' holds strings, not numbers");
@@ -392,14 +404,14 @@ void read_attribute(Legacy& f, const std::string& kw, std::size_t n, bool point_
     // VTK's reader turns back into the byte.
     const std::size_t components = f.count("COLOR_SCALARS " + name);
     const bool found_before = out.found;
-    take(name, components, n, f.binary() ? LegacyType{1, true, false} : LegacyType{8, false, true});
+    take(name, components, n, f.binary() ? type_of(1, true, false) : type_of(8, false, true));
     if (!found_before && out.found && !f.binary()) {
       for (double& v : out.values) v = std::floor(255.0 * v + 0.5);
       out.is_float = false;
     }
   } else if (kw == "lookup_table") {
     const std::size_t size = f.count("LOOKUP_TABLE " + name);
-    f.values(4 * size, LegacyType{1, true, false}, "LOOKUP_TABLE " + name, false);
+    f.values(4 * size, type_of(1, true, false), "LOOKUP_TABLE " + name, false);
   } else if (kw == "vectors" || kw == "normals") {
     take(name, 3, n, f.type(kw + " " + name));
   } else if (kw == "texture_coordinates") {
@@ -472,7 +484,7 @@ LegacyPoints walk(const std::string& path, const std::string& wanted, bool image
     } else if (kw == "vertices" || kw == "lines" || kw == "polygons" || kw == "triangle_strips" || kw == "cells") {
       skip_cells(f, kw);
     } else if (kw == "cell_types") {
-      f.values(f.count("CELL_TYPES"), LegacyType{4, true, true}, "CELL_TYPES", false);
+      f.values(f.count("CELL_TYPES"), type_of(4, true, true), "CELL_TYPES", false);
     } else if (kw == "metadata") {
       f.skip_metadata();
     } else if (kw == "point_data" || kw == "cell_data") {
