@@ -46,12 +46,14 @@ class Delaunay:
 
     @property
     def points(self) -> np.ndarray:
-        """float64 (N, D): the input points."""
+        """float64 (N, D): the input points, the caller's array itself when it was
+        one (not copied: changed before the first ``find_simplex``, it changes
+        what the locator finds)."""
         return self._points
 
     @property
     def labels(self) -> Optional[np.ndarray]:
-        """The region labels given (int32 (N,)), or None."""
+        """The region labels given (int32 (N,), a read-only copy), or None."""
         return self._labels
 
     @property
@@ -99,11 +101,20 @@ class Delaunay:
         (2D: counter-clockwise), lowest id first, rows in ascending order."""
         return self._dt.simplices
 
+    def _refuse_periodic(self, attribute: str) -> None:
+        """What matches simplices by point ids alone (the library's adjacency,
+        edges and locator, scipy's attributes) is refused in a periodic box,
+        whose rows name images: in this attribute's words, not the library's
+        function's."""
+        if self.is_periodic:
+            raise ValueError(f"{attribute}: not available for a periodic triangulation (its simplices meet images)")
+
     @property
     def neighbors(self) -> np.ndarray:
         """int32 (nsimplex, D+1): ``neighbors[r, k]`` is the simplex across the
         facet opposite vertex ``k`` of simplex ``r``, -1 on the boundary (as scipy).
         Computed on first use."""
+        self._refuse_periodic("neighbors")
         return self._dt.neighbors
 
     @property
@@ -113,6 +124,7 @@ class Delaunay:
         counter-clockwise seen from outside; 2D: the interior on the left).
         Without labels this is the convex hull, as scipy's; with labels, the
         boundary of the labelled regions. Computed on first use."""
+        self._refuse_periodic("convex_hull")
         if self._hull is None:
             nb = self.neighbors
             s, k = np.nonzero(nb < 0)
@@ -162,6 +174,7 @@ class Delaunay:
         """``(indptr, indices)``: the Delaunay edges as CSR, as scipy's; the
         neighbours of point ``v`` are ``indices[indptr[v]:indptr[v + 1]]``,
         ascending. Computed on first use (in parallel)."""
+        self._refuse_periodic("vertex_neighbor_vertices")
         return self._dt.vertex_neighbors
 
     @property
@@ -173,8 +186,7 @@ class Delaunay:
         A simplex too thin for its matrix to be inverted in doubles (points
         an ulp apart: exactly non-flat, singular once rounded) gets NaN rows,
         as scipy gives its degenerate simplices."""
-        if self.is_periodic:
-            raise ValueError("transform: not available for a periodic triangulation (its simplices meet images)")
+        self._refuse_periodic("transform")
         if self._transform is None:
             d = self.ndim
             v = self.points[self.simplices]  # (m, D+1, D)
@@ -208,6 +220,7 @@ class Delaunay:
         :attr:`neighbors`, computed once for both."""
         if tol is not None:
             raise ValueError("find_simplex: tol is not supported; containment is decided exactly")
+        self._refuse_periodic("find_simplex")
         q, shape = _inputs.as_queries(xi, self.ndim)
         found = _inputs.call(_core.locate, self._dt, self._points, q, self._dt.threads_used)
         return found.reshape(shape)

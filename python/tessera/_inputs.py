@@ -54,7 +54,11 @@ def as_points(points: Any) -> np.ndarray:
 
 
 def as_labels(labels: Any, n: int) -> Optional[np.ndarray]:
-    """Labels as ``None`` or an int32 C-contiguous (n,) array.
+    """Labels as ``None`` or an int32 C-contiguous (n,) array, always a copy:
+    results keep their labels (``faces`` and ``adjacency`` of a Voronoi read
+    them later), and a caller refilling one buffer frame after frame changed
+    the labels of every earlier result (4 bytes a point; points and radii,
+    8 to 24, are the caller's arrays as documented).
 
     A label < 0 marks an outside point: it clips its neighbours but owns no cell.
     """
@@ -71,7 +75,9 @@ def as_labels(labels: Any, n: int) -> Optional[np.ndarray]:
     info = np.iinfo(np.int32)
     if n and (a.min() < info.min or a.max() > info.max):
         raise ValueError(f"labels: values must fit in 32 bits ([{info.min}, {info.max}])")
-    return np.ascontiguousarray(a, dtype=np.int32)
+    out = np.array(a, dtype=np.int32, order="C", copy=True)
+    out.setflags(write=False)
+    return out
 
 
 def as_radii(radii: Any, n: int) -> Optional[np.ndarray]:
@@ -199,7 +205,12 @@ def as_flag(value: Any, name: str) -> bool:
 # flags; a Python caller sets keywords instead.
 _CLI_WORDING = (
     ("--bounds", "bounds="),
+    # A reader's words (read_points has dim=) before the computation's.
+    ("--dim 2 or 3", "dim=2 or dim=3"),
+    ("--dim 2: ", "dim=2: "),
     ("--dim 2", "(N, 2) points"),
+    ("give it to `sample-image` (or `surface-nets --image`)",
+     "read it with tessera.read_image (or give it to tessera.sample_image)"),
     ("--ignore-outside", "ignore_outside=True"),
     ("--method insertion", "method='insertion'"),
     ("--padding", "padding="),

@@ -56,12 +56,13 @@ class Voronoi:
     # ---- input and domain -------------------------------------------------
     @property
     def points(self) -> np.ndarray:
-        """The input points, float64 (N, D): the caller's array itself when it was one."""
+        """The input points, float64 (N, D): the caller's array itself when it was
+        one (not copied: changed later, it changes what ``validate`` checks)."""
         return self._points
 
     @property
     def labels(self) -> Optional[np.ndarray]:
-        """The region labels given (int32 (N,)), or None."""
+        """The region labels given (int32 (N,), a read-only copy), or None."""
         return self._labels
 
     @property

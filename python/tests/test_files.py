@@ -272,6 +272,17 @@ def test_read_points_reads_what_the_command_reads(tmp_path):
         tessera.read_points(tmp_path / "missing.pcd")
     with pytest.raises(ValueError, match="dim"):
         tessera.read_points(tmp_path / "r.npy", dim=4)
+    # The readers' words for the command line are put in Python's.
+    with open(tmp_path / "q4.txt", "w") as f:
+        f.write("4 rbox 5 D4\n5\n0 0 0 0\n1 0 0 1\n0 1 0 2\n0 0 1 0\n1 1 1 1\n")
+    with pytest.raises(ValueError, match=r"\(dim=2 or dim=3 keeps the first coordinates\)$"):
+        tessera.read_points(tmp_path / "q4.txt")
+    with open(tmp_path / "img.vtk", "w") as f:
+        f.write("# vtk DataFile Version 3.0\nimg\nASCII\nDATASET STRUCTURED_POINTS\nDIMENSIONS 2 2 1\n"
+                "ORIGIN 0 0 0\nSPACING 1 1 1\nPOINT_DATA 4\nSCALARS s int 1\n0 1 0 1\n")
+    with pytest.raises(ValueError, match="tessera.read_image") as e:
+        tessera.read_points(tmp_path / "img.vtk")
+    assert "`" not in str(e.value) and "--" not in str(e.value)
 
 
 def test_lammps_dump_points_and_box(tmp_path):

@@ -49,6 +49,22 @@ def test_a_view_keeps_its_buffer_alive():
     del junk
 
 
+def test_labels_are_copied():
+    # A result keeps its labels: a buffer refilled for the next frame left
+    # faces() of the earlier cells with the new labels (an outside face's
+    # side got a region's label).
+    rng = np.random.default_rng(7)
+    pts = rng.random((500, 3))
+    lab = (pts[:, 0] * 3).astype(np.int32)
+    lab[np.linalg.norm(pts - 0.5, axis=1) < 0.2] = -1
+    vor = tessera.voronoi(pts, labels=lab)
+    before = tessera.faces(vor, kind="boundary").boundary_labels.copy()
+    lab[:] = np.where(lab >= 0, -2, 4)
+    assert np.array_equal(tessera.faces(vor, kind="boundary").boundary_labels, before)
+    assert vor.labels is not lab and not vor.labels.flags.writeable
+    assert not np.shares_memory(tessera.delaunay(pts, labels=lab).labels, lab)
+
+
 def test_float64_points_are_not_copied():
     pts = random_points(100, 2)
     assert tessera.voronoi(pts).points is pts
