@@ -16,6 +16,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <span>
 #include <vector>
@@ -50,8 +51,11 @@ class SimplexLocator {
   /// index of a simplex whose closed region holds it, or -1 (outside every
   /// simplex, or a NaN coordinate). `dt` and `points` must be the ones the
   /// locator was built from. Threads as in VoronoiOptions (0: automatic).
+  /// `progress`, as VoronoiOptions::progress: called between chunks of
+  /// queries, it may throw Cancelled to stop.
   std::vector<std::int32_t> locate(const Delaunay& dt, std::span<const double> points,
-                                   std::span<const double> queries, int threads = 0) const;
+                                   std::span<const double> queries, int threads = 0,
+                                   const std::function<void(double)>& progress = {}) const;
 
   /// The method chosen (never automatic).
   LocateMethod method() const { return method_; }

@@ -81,7 +81,8 @@ py::array locate_points(DelaunayResult& r, const Points& points, const Points& q
     if (!r.locator) r.locator = loc;
     if (!r.neighbors) r.neighbors = loc->neighbors();
   }
-  return adopt_flat(without_gil([&] { return loc->locate(r.dt, pts, q, threads); }));
+  auto check = interrupt_check();
+  return adopt_flat(without_gil([&] { return loc->locate(r.dt, pts, q, threads, check); }));
 }
 
 }  // namespace

@@ -232,6 +232,7 @@ void bind_prep(py::module_& m) {
         opt.background_label = background_label;
         opt.joggle = joggle;
         opt.threads = threads;
+        opt.progress = interrupt_check();
         return labelled_points(without_gil([&] { return sample_image(image, opt); }));
       },
       py::arg("image"), py::arg("select"), py::arg("schedule"), py::arg("step"), py::arg("randomize"),
@@ -262,6 +263,7 @@ void bind_prep(py::module_& m) {
         opt.mode = joggle_mode(mode);
         opt.seed = seed;
         opt.threads = threads;
+        opt.progress = interrupt_check();
         std::span<const std::uint8_t> mask_span;
         if (!mask.is_none()) {
           if (!py::isinstance<py::array_t<std::uint8_t, py::array::c_style>>(mask))
@@ -296,6 +298,7 @@ void bind_prep(py::module_& m) {
         opt.joggle = joggle;
         opt.seed = seed;
         opt.threads = threads;
+        opt.progress = interrupt_check();
         const auto pts = as_span(points);
         const auto lab = as_labels(labels);
         return labelled_points(without_gil([&] { return tessera::fill(pts, dim, lab, opt); }));
@@ -415,6 +418,7 @@ void bind_prep(py::module_& m) {
         opt.outside_value = outside_value;
         opt.threads = threads;
         opt.keep_non_finite = keep_non_finite;
+        opt.progress = interrupt_check();
         const auto pts = as_span(points);
         ProbeResult r = without_gil([&] { return tessera::probe(image, pts, opt); });
         return py::make_tuple(adopt_flat(std::move(r.values)), adopt_flat(std::move(r.valid)));

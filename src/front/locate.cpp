@@ -12,6 +12,7 @@
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 
+#include "../progress_chunks.hpp"
 #include "point_buckets.hpp"
 #include "tessera/engine/thread_arena.hpp"
 #include "tessera/kernels/delaunay_predicates.hpp"
@@ -337,7 +338,8 @@ std::int32_t SimplexLocator::walk(const Delaunay& dt, std::span<const double> po
 }
 
 std::vector<std::int32_t> SimplexLocator::locate(const Delaunay& dt, std::span<const double> points,
-                                                 std::span<const double> queries, int threads) const {
+                                                 std::span<const double> queries, int threads,
+                                                 const std::function<void(double)>& progress) const {
   check_points(dt, points, "locate");
   if (dt.dim != dim_ || dt.n_simplices() != n_simplices_ || dt.n_points != n_points_)
     throw InputError("locate: the triangulation is not the one this locator was built for");
@@ -349,15 +351,18 @@ std::vector<std::int32_t> SimplexLocator::locate(const Delaunay& dt, std::span<c
   const std::size_t nq = queries.size() / du;
   std::vector<std::int32_t> found(nq, -1);
   if (n_simplices_ == 0) return found;
-  engine::ThreadArena(resolve_threads(threads)).execute([&] {
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nq, 1024), [&](const tbb::blocked_range<std::size_t>& r) {
-      for (std::size_t q = r.begin(); q != r.end(); ++q) {
-        const double* x = queries.data() + q * du;
-        bool inside = true;  // in the vertices' box (false on NaN): else outside every simplex
-        for (int d = 0; d < D; ++d) inside &= x[d] >= lo_[d] && x[d] <= hi_[d];
-        if (!inside) continue;
-        found[q] = method_ == LocateMethod::walk ? walk(dt, points, x, q) : scan_bin(dt, points, x);
-      }
+  engine::ThreadArena arena(resolve_threads(threads));
+  detail::in_progress_chunks(nq, progress, [&](std::size_t begin, std::size_t end) {
+    arena.execute([&] {
+      tbb::parallel_for(tbb::blocked_range<std::size_t>(begin, end, 1024), [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t q = r.begin(); q != r.end(); ++q) {
+          const double* x = queries.data() + q * du;
+          bool inside = true;  // in the vertices' box (false on NaN): else outside every simplex
+          for (int d = 0; d < D; ++d) inside &= x[d] >= lo_[d] && x[d] <= hi_[d];
+          if (!inside) continue;
+          found[q] = method_ == LocateMethod::walk ? walk(dt, points, x, q) : scan_bin(dt, points, x);
+        }
+      });
     });
   });
   return found;

@@ -32,6 +32,7 @@
 #include "tessera/image.hpp"
 #include "tessera/prep/sample_image.hpp"
 #include "../message_text.hpp"
+#include "../progress_chunks.hpp"
 
 namespace tessera {
 namespace {
@@ -142,14 +143,18 @@ Grid make_grid(int dim, const double* lo, const double* hi, std::size_t n, doubl
   return g;
 }
 
+/// `body` over [0, n) in parallel, in chunks between which `progress` (may
+/// be empty) is called.
 template <class F>
-void parallel_range(std::size_t n, int threads, F&& body) {
-  if (threads == 1 || n <= kGrain) {
-    body(tbb::blocked_range<std::size_t>(0, n));
-    return;
-  }
+void parallel_range(std::size_t n, int threads, const std::function<void(double)>& progress, F&& body) {
   engine::ThreadArena arena(threads);
-  arena.execute([&] { tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, kGrain), body); });
+  detail::in_progress_chunks(n, progress, [&](std::size_t begin, std::size_t end) {
+    if (threads == 1 || end - begin <= kGrain) {
+      body(tbb::blocked_range<std::size_t>(begin, end));
+      return;
+    }
+    arena.execute([&] { tbb::parallel_for(tbb::blocked_range<std::size_t>(begin, end, kGrain), body); });
+  });
 }
 
 }  // namespace
@@ -231,7 +236,7 @@ LabelledPoints fill(std::span<const double> coords, int dim, std::span<const std
 
   // Occupancy, one byte per bin; concurrent stores of the same value.
   std::vector<std::uint8_t> occupied(grid.n_bins(), 0);
-  parallel_range(n, threads, [&](const tbb::blocked_range<std::size_t>& r) {
+  parallel_range(n, threads, options.progress, [&](const tbb::blocked_range<std::size_t>& r) {
     for (std::size_t i = r.begin(); i != r.end(); ++i)
       if (takes_part(i))
         std::atomic_ref<std::uint8_t>(occupied[grid.bin_of(&coords[i * sdim])]).store(1, std::memory_order_relaxed);
@@ -252,7 +257,7 @@ LabelledPoints fill(std::span<const double> coords, int dim, std::span<const std
     const double radius = options.joggle * grid.min_edge();
     out.coords.resize((n + empty.size()) * sdim);
     double* added = out.coords.data() + n * sdim;
-    parallel_range(empty.size(), threads, [&](const tbb::blocked_range<std::size_t>& r) {
+    parallel_range(empty.size(), threads, options.progress, [&](const tbb::blocked_range<std::size_t>& r) {
       double u[3];
       for (std::size_t k = r.begin(); k != r.end(); ++k) {
         double* p = added + k * sdim;

@@ -18,6 +18,7 @@
 #include "tessera/engine/thread_arena.hpp"
 #include "tessera/finite_points.hpp"
 #include "../message_text.hpp"
+#include "../progress_chunks.hpp"
 
 namespace tessera {
 namespace {
@@ -104,12 +105,14 @@ std::vector<double> joggle(std::span<const double> coords, int dim, const Joggle
     }
   };
   const int threads = resolve_threads(options.threads);
-  if (threads == 1 || n <= kGrain) {
-    body(tbb::blocked_range<std::size_t>(0, n));
-  } else {
-    engine::ThreadArena arena(threads);
-    arena.execute([&] { tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, kGrain), body); });
-  }
+  engine::ThreadArena arena(threads);
+  detail::in_progress_chunks(n, options.progress, [&](std::size_t begin, std::size_t end) {
+    if (threads == 1 || end - begin <= kGrain) {
+      body(tbb::blocked_range<std::size_t>(begin, end));
+      return;
+    }
+    arena.execute([&] { tbb::parallel_for(tbb::blocked_range<std::size_t>(begin, end, kGrain), body); });
+  });
   for (std::size_t k = 0; k < out.size(); ++k)
     if (!std::isfinite(out[k]) && std::isfinite(coords[k]))
       throw InputError("joggle: point " + std::to_string(k / stride) + " moved past double's range (radius " +

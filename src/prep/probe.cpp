@@ -19,6 +19,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include "../progress_chunks.hpp"
 #include "tessera/cells.hpp"
 #include "tessera/engine/thread_arena.hpp"
 
@@ -89,16 +90,18 @@ ProbeResult probe(const ScalarImage& image, std::span<const double> coords, cons
 
   constexpr std::size_t kGrain = 4096;
   const int threads = resolve_threads(options.threads);
-  if (threads == 1 || n <= kGrain) {
-    for (std::size_t p = 0; p < n; ++p) one(p);
-  } else {
-    engine::ThreadArena arena(threads);
+  engine::ThreadArena arena(threads);
+  detail::in_progress_chunks(n, options.progress, [&](std::size_t begin, std::size_t end) {
+    if (threads == 1 || end - begin <= kGrain) {
+      for (std::size_t p = begin; p < end; ++p) one(p);
+      return;
+    }
     arena.execute([&] {
-      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, kGrain), [&](const tbb::blocked_range<std::size_t>& r) {
+      tbb::parallel_for(tbb::blocked_range<std::size_t>(begin, end, kGrain), [&](const tbb::blocked_range<std::size_t>& r) {
         for (std::size_t p = r.begin(); p != r.end(); ++p) one(p);
       });
     });
-  }
+  }, std::size_t{1} << 18);
   return res;
 }
 

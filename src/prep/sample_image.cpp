@@ -18,6 +18,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <string>
 
@@ -25,6 +26,7 @@
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 
+#include "../progress_chunks.hpp"
 #include "random.hpp"
 #include "tessera/cells.hpp"
 #include "tessera/engine/thread_arena.hpp"
@@ -115,8 +117,13 @@ Selection make_selection(const LabelImage& image, const std::vector<std::int32_t
 }
 
 /// The distance field (1 + L1 distance; kInf without boundaries). Runs in
-/// the caller's arena.
-std::vector<std::int32_t> distance_field(const LabelImage& image, const Selection& sel) {
+/// the caller's arena. `progress` (may be empty) is called between its
+/// passes over the image, with fractions up to `upto` of the whole run.
+std::vector<std::int32_t> distance_field(const LabelImage& image, const Selection& sel,
+                                         const std::function<void(double)>& progress = {}, double upto = 1.0) {
+  auto passed = [&](int k) {
+    if (progress) progress(upto * k / 4.0);
+  };
   const ImageGeometry& g = image.geometry;
   const std::int64_t nx = g.size[0], ny = g.size[1], nz = g.size[2];
   const std::size_t n = g.n_voxels();
@@ -146,6 +153,7 @@ std::vector<std::int32_t> distance_field(const LabelImage& image, const Selectio
       for (std::int64_t i = nx - 2; i >= 0; --i) line[i] = std::min(line[i], step_up(line[i + 1]));
     }
   });
+  passed(1);
 
   // A sweep along an axis of stride `stride` (elements) and length `len`,
   // over strips [x0, x1) of rows starting at `start`.
@@ -170,6 +178,7 @@ std::vector<std::int32_t> distance_field(const LabelImage& image, const Selectio
         sweep(static_cast<std::size_t>(k * nx * ny + x0), static_cast<std::size_t>(nx), ny, std::min(kStrip, nx - x0));
       }
     });
+  passed(2);
   // z pass: per y row and x strip.
   if (nz > 1)
     tbb::parallel_for(tbb::blocked_range<std::int64_t>(0, ny * strips), [&](const tbb::blocked_range<std::int64_t>& r) {
@@ -178,6 +187,7 @@ std::vector<std::int32_t> distance_field(const LabelImage& image, const Selectio
         sweep(static_cast<std::size_t>(j * nx + x0), static_cast<std::size_t>(nx * ny), nz, std::min(kStrip, nx - x0));
       }
     });
+  passed(3);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, kBlock), [&](const tbb::blocked_range<std::size_t>& r) {
     for (std::size_t v = r.begin(); v != r.end(); ++v) d[v] = d[v] == kInf ? kInf : d[v] + 1;
   });
@@ -242,7 +252,8 @@ LabelledPoints sample_image(const LabelImage& image, const SampleImageOptions& o
     for (std::size_t i = 0; i < sel.labels.size(); ++i)
       if (!sel.found[i]) throw InputError("unknown label " + std::to_string(sel.labels[i]) + " in the selection: no voxel has it");
     if (!sel.any) throw InputError("empty selection: no voxel has a label >= 0");
-    const std::vector<std::int32_t> dist = distance_field(image, sel);
+    if (o.progress) o.progress(0.0);
+    const std::vector<std::int32_t> dist = distance_field(image, sel, o.progress, 0.5);
 
     const std::int32_t step = o.step;
     auto scheduled = [&](std::int32_t d) {
@@ -271,39 +282,50 @@ LabelledPoints sample_image(const LabelImage& image, const SampleImageOptions& o
       return r.uniform() < p;
     };
 
+    // The two passes over the voxels, by blocks, in chunks of blocks for
+    // the progress callback (the second half of the run).
     const std::size_t blocks = (n + kBlock - 1) / kBlock;
+    auto halfway = [&](double from) -> std::function<void(double)> {
+      if (!o.progress) return {};
+      return [&, from](double f) { o.progress(from + 0.25 * f); };
+    };
+    const std::size_t chunk = std::max<std::size_t>(1, detail::kProgressChunk * 16 / kBlock);
     std::vector<std::size_t> offset(blocks + 1, 0);
-    tbb::parallel_for(std::size_t(0), blocks, [&](std::size_t b) {
-      std::size_t c = 0;
-      const std::size_t end = std::min(n, (b + 1) * kBlock);
-      for (std::size_t v = b * kBlock; v < end; ++v) c += keep(v);
-      offset[b + 1] = c;
-    });
+    detail::in_progress_chunks(blocks, halfway(0.5), [&](std::size_t b0, std::size_t b1) {
+      tbb::parallel_for(b0, b1, [&](std::size_t b) {
+        std::size_t c = 0;
+        const std::size_t end = std::min(n, (b + 1) * kBlock);
+        for (std::size_t v = b * kBlock; v < end; ++v) c += keep(v);
+        offset[b + 1] = c;
+      });
+    }, chunk);
     for (std::size_t b = 0; b < blocks; ++b) offset[b + 1] += offset[b];
     const std::size_t total = offset[blocks];
     out.coords.resize(total * static_cast<std::size_t>(dim));
     out.labels.resize(total);
-    tbb::parallel_for(std::size_t(0), blocks, [&](std::size_t b) {
-      std::size_t k = offset[b];
-      const std::size_t end = std::min(n, (b + 1) * kBlock);
-      for (std::size_t v = b * kBlock; v < end; ++v) {
-        if (!keep(v)) continue;
-        const std::int64_t iv = static_cast<std::int64_t>(v);
-        const std::int64_t idx[3] = {iv % nx, (iv / nx) % ny, iv / (nx * ny)};
-        double* c = out.coords.data() + k * static_cast<std::size_t>(dim);
-        for (int a = 0; a < dim; ++a)
-          c[a] = g.origin[static_cast<std::size_t>(a)] +
-                 static_cast<double>(idx[a]) * g.spacing[static_cast<std::size_t>(a)];
-        if (jog > 0) {
-          double off[3];
-          detail::RandomStream r(o.seed, v, detail::kStreamSamplerJoggle);
-          r.in_unit_ball(dim, off);
-          for (int a = 0; a < dim; ++a) c[a] += jog * off[a];
+    detail::in_progress_chunks(blocks, halfway(0.75), [&](std::size_t b0, std::size_t b1) {
+      tbb::parallel_for(b0, b1, [&](std::size_t b) {
+        std::size_t k = offset[b];
+        const std::size_t end = std::min(n, (b + 1) * kBlock);
+        for (std::size_t v = b * kBlock; v < end; ++v) {
+          if (!keep(v)) continue;
+          const std::int64_t iv = static_cast<std::int64_t>(v);
+          const std::int64_t idx[3] = {iv % nx, (iv / nx) % ny, iv / (nx * ny)};
+          double* c = out.coords.data() + k * static_cast<std::size_t>(dim);
+          for (int a = 0; a < dim; ++a)
+            c[a] = g.origin[static_cast<std::size_t>(a)] +
+                   static_cast<double>(idx[a]) * g.spacing[static_cast<std::size_t>(a)];
+          if (jog > 0) {
+            double off[3];
+            detail::RandomStream r(o.seed, v, detail::kStreamSamplerJoggle);
+            r.in_unit_ball(dim, off);
+            for (int a = 0; a < dim; ++a) c[a] += jog * off[a];
+          }
+          out.labels[k] = (sel.voxel[v] == 0 && o.background_label) ? *o.background_label : image.labels[v];
+          ++k;
         }
-        out.labels[k] = (sel.voxel[v] == 0 && o.background_label) ? *o.background_label : image.labels[v];
-        ++k;
-      }
-    });
+      });
+    }, chunk);
   });
   return out;
 }

@@ -14,6 +14,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <span>
 
@@ -41,6 +42,9 @@ struct FillOptions {
   /// refused; they mark no bin and are not held to the bounds. The bounding
   /// box is then the finite points', of which there must be one.
   bool keep_non_finite = false;
+  /// As VoronoiOptions::progress: called between chunks of points, it may
+  /// throw Cancelled to stop.
+  std::function<void(double)> progress;
 };
 
 /// Throws InputError on empty input, a NaN or infinite coordinate (unless

@@ -8,6 +8,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <span>
 #include <vector>
 
@@ -31,6 +32,9 @@ struct JoggleOptions {
   /// point's id; the relative radius then measures the finite points' box.
   /// VoronoiOptions::ignore_outside_points sets such points aside later.
   bool keep_non_finite = false;
+  /// As VoronoiOptions::progress: called between chunks of points, it may
+  /// throw Cancelled to stop.
+  std::function<void(double)> progress;
 };
 
 /// Joggled copy of `coords` (n * dim, dim 2 or 3). With a non-empty `mask`

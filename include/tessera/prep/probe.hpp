@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <span>
 #include <vector>
@@ -22,6 +23,9 @@ struct ProbeOptions {
   /// outside (outside_value, not valid) instead of refused. An infinite
   /// coordinate is outside either way.
   bool keep_non_finite = false;
+  /// As VoronoiOptions::progress: called between chunks of points, it may
+  /// throw Cancelled to stop.
+  std::function<void(double)> progress;
 };
 
 struct ProbeResult {

@@ -22,6 +22,7 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <vector>
 
@@ -53,6 +54,9 @@ struct SampleImageOptions {
   /// Capped at 0.5 so points never leave their voxel. Seeded per voxel.
   double joggle = 0.0;
   int threads = 0;                     ///< 0: TESSERA_NUM_THREADS, else all cores
+  /// As VoronoiOptions::progress: called between the passes over the image
+  /// (and chunks of them), it may throw Cancelled to stop.
+  std::function<void(double)> progress;
 };
 
 /// Per-voxel boundary distance of step 1 (exposed for tests and tools).
