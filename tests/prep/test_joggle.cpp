@@ -1,6 +1,7 @@
 // tessera::joggle: displacement bounds, determinism, masks, plane modes, threads.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -181,6 +182,29 @@ TEST(PrepJoggle, SameResultForAnyThreadCount) {
   const auto c = tessera::joggle(p, 3, o);
   EXPECT_EQ(std::memcmp(a.data(), b.data(), a.size() * sizeof(double)), 0);
   EXPECT_EQ(std::memcmp(a.data(), c.data(), a.size() * sizeof(double)), 0);
+}
+
+// A progress callback sees chunks of points and the end, and changes
+// nothing; one that throws Cancelled stops the run (Python's Ctrl-C).
+TEST(PrepJoggle, ProgressInChunksAndCancelled) {
+  const auto p = random_points(200000, 3, 6);
+  JoggleOptions o;
+  o.radius = 1e-3;
+  const auto a = tessera::joggle(p, 3, o);
+  std::vector<double> seen;
+  o.progress = [&](double f) { seen.push_back(f); };
+  const auto b = tessera::joggle(p, 3, o);
+  EXPECT_EQ(std::memcmp(a.data(), b.data(), a.size() * sizeof(double)), 0);
+  ASSERT_GE(seen.size(), 3u);
+  EXPECT_EQ(seen.front(), 0.0);
+  EXPECT_EQ(seen.back(), 1.0);
+  EXPECT_TRUE(std::is_sorted(seen.begin(), seen.end()));
+  int calls = 0;
+  o.progress = [&](double) {
+    if (++calls == 2) throw tessera::Cancelled();
+  };
+  EXPECT_THROW(tessera::joggle(p, 3, o), tessera::Cancelled);
+  EXPECT_EQ(calls, 2);
 }
 
 TEST(PrepJoggle, ZeroRadiusAndEmptyInput) {
