@@ -5,6 +5,7 @@
 // or input, 1: anything else or a failed --validate, 130: Ctrl-C). Outputs are
 // written atomically by the IO layer, so a failed run leaves no partial file.
 #include <cerrno>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
@@ -216,9 +217,12 @@ void add_periodic_option(CLI::App* app, ComputeArgs& c, const std::string& image
 /// missing). Throws InputError for anything else that is not a number, and
 /// for a series of frames (--frame all, A:B) where `series` is false.
 void finish_compute_args(ComputeArgs& c, const std::vector<std::string>& raw_bounds, bool series = false) {
+  // strtod's ERANGE means overflow (inf) or underflow: a subnormal such as
+  // 1e-310 (a domain Python takes, and the default domain may be) or 0, as
+  // Python's float() reads them too; only overflow is refused.
   auto parse = [](const std::string& w, double& v) {
     errno = 0;
-    return whole_number(w, v) && errno != ERANGE;
+    return whole_number(w, v) && !(errno == ERANGE && std::isinf(v));
   };
   c.bounds.clear();
   for (std::size_t i = 0; i < raw_bounds.size(); ++i) {
@@ -227,6 +231,8 @@ void finish_compute_args(ComputeArgs& c, const std::vector<std::string>& raw_bou
       c.bounds.push_back(v);
       continue;
     }
+    if (errno == ERANGE)
+      throw tessera::InputError("--bounds: '" + raw_bounds[i] + "' is beyond double's range");
     if (i == 4 && c.input.empty() && raw_bounds.size() == 5) {
       c.input = raw_bounds[i];
       break;

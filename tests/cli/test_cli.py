@@ -842,6 +842,17 @@ class Voronoi2D(TempDirCase):
         self.ok(["voronoi", "--bounds=0,2,0,1", self.inp, "-o", out, "-q"])
         self.assertEqual(read_vtp(out).GetNumberOfPolys(), self.N)
 
+    def test_bounds_of_subnormal_size(self):
+        # strtod's ERANGE for a subnormal made "'1e-310' is not a number",
+        # where Python's bounds= and the default domain take such values.
+        pts = self.save("sub.npy", np.array([[1e-311, 2e-311], [5e-311, 6e-311], [3e-311, 9e-311]]))
+        t = self.p("t.csv")
+        self.ok(["voronoi", pts, "--bounds", "0", "1e-310", "0", "1e-310", "--cell-table", t, "-q"])
+        self.assertEqual(len(np.loadtxt(t, delimiter=",", skiprows=1)), 3)
+        r = run(["voronoi", pts, "--bounds", "0", "1e400", "0", "1", "--cell-table", t])
+        self.assertEqual(r.returncode, 2)
+        self.assertIn("'1e400' is beyond double's range", r.stderr)
+
     def test_threads_byte_identical(self):
         a, b = self.p("a.vtp"), self.p("b.vtp")
         self.ok(["voronoi", self.inp, "-o", a, "--threads", "1", "-q"])
