@@ -411,6 +411,10 @@ std::string no_cells_reason(const io::PointCloud& pc, const Cells& c) {
     return strf("no cells: every point that could own one (%zu%s) has an empty power cell: other spheres' powers "
                 "are less everywhere",
                 c.empty_cells.size(), pc.labels.empty() ? "" : ", label >= 0");
+  if (!pc.labels.empty() && !c.duplicates.empty())  // a duplicate of an outside point: its cell is the outside's
+    return strf("no cells: of the %zu points, those inside the domain with a label >= 0 all duplicate an outside "
+                "point (label < 0), which owns their place (the lowest id of coincident points does)",
+                pc.n);
   return strf("no cells: none of the %zu points is inside the domain%s", pc.n,
               pc.labels.empty() ? "" : " with a label >= 0");
 }

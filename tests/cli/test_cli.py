@@ -2021,6 +2021,14 @@ class BadInput(TempDirCase):
     def test_single_point(self):
         self.fails(["voronoi", self.save("one.npy", np.array([[0.5, 0.5, 0.5]])), "-o", self.out()], "--bounds")
 
+    def test_no_cells_by_duplicates_of_outside_points(self):
+        # The one point with a label >= 0 duplicates outside point 0, which
+        # owns their place: no cells, and the message says why (it said no
+        # point was inside with a label >= 0).
+        pts = self.save("dp.npy", np.array([[0.2, 0.3], [0.7, 0.6], [0.2, 0.3]]))
+        lab = self.save("dl.npy", np.array([-1, -1, 0], dtype=np.int32))
+        self.fails(["voronoi", pts, "--labels", lab, "-o", self.out("c.vtp")], "all duplicate an outside point")
+
     def test_nan_inf(self):
         for name, bad in (("nan.npy", np.nan), ("inf.npy", np.inf)):
             pts = np.random.default_rng(1).random((20, 3))
