@@ -103,7 +103,9 @@ int run_graph_frame(const GraphArgs& a) {
     if (!p->empty()) io::check_writable(*p);
 
   const Computed r = read_and_compute(a.compute, a.quiet);
-  const AdjacencyGraph g = adjacency_graph(r.cells, {a.prune_tolerance});
+  GraphOptions go;
+  go.prune_tolerance = a.prune_tolerance;
+  const AdjacencyGraph g = adjacency_graph(r.cells, go);
   std::vector<std::string> written;
   if (!a.output.empty()) {
     io::write_graph_vtp(a.output, g, r.cells.is_periodic() ? std::span<const double>(r.cells.periodic_points)

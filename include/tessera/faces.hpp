@@ -35,6 +35,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <span>
 #include <string_view>
@@ -64,6 +65,9 @@ struct FaceSetOptions {
   FaceSetKind kind = FaceSetKind::boundary;
   bool capping = false;              ///< surface_net: add the boundary faces
   std::int32_t background_label = -1;  ///< BoundaryLabels value of a domain-box side (must be < 0)
+  /// As VoronoiOptions::progress: called between chunks of cells (once per
+  /// pass over them), it may throw Cancelled to stop.
+  std::function<void(double)> progress;
 };
 
 struct FaceSet {

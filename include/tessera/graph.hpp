@@ -10,6 +10,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "tessera/cells.hpp"
@@ -25,6 +26,9 @@ struct GraphOptions {
   /// face use one measure (computed in the lower generator's cell), so the
   /// decision is the same from either side and the graph stays symmetric.
   double prune_tolerance = 0;
+  /// As VoronoiOptions::progress: called between chunks of cells (once per
+  /// pass over them), it may throw Cancelled to stop.
+  std::function<void(double)> progress;
 };
 
 /// Wheels and spokes as CSR over all n input points: the wheel of generator

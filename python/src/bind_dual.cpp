@@ -84,6 +84,7 @@ void bind_dual(py::module_& m) {
         const Cells& c = with_mesh(cells, "adjacency");
         GraphOptions opt;
         opt.prune_tolerance = prune_tolerance;
+        opt.progress = interrupt_check();
         return GraphResult{without_gil([&] { return adjacency_graph(c, opt); }), std::nullopt};
       },
       py::arg("cells"), py::arg("prune_tolerance"), "The adjacency graph of cells computed with merge=True.");
@@ -103,6 +104,7 @@ void bind_dual(py::module_& m) {
         opt.kind = *k;
         opt.capping = capping;
         opt.background_label = background_label;
+        opt.progress = interrupt_check();
         const auto lab = as_labels(labels);
         return without_gil([&] { return extract_faces(c, lab, opt); });
       },

@@ -113,7 +113,7 @@ FaceSet extract_faces(const Cells& c, std::span<const std::int32_t> labels, cons
     }
     face_start[k + 1] = faces;
     corner_start[k + 1] = corners;
-  });
+  }, options.progress);
   std::partial_sum(face_start.begin(), face_start.end(), face_start.begin());
   std::partial_sum(corner_start.begin(), corner_start.end(), corner_start.begin());
 
@@ -167,7 +167,7 @@ FaceSet extract_faces(const Cells& c, std::span<const std::int32_t> labels, cons
       if (periodic) std::copy_n(&c.face_shift[fu * dn], dn, &out.side_shifts[o * dn]);
       ++o;
     }
-  });
+  }, options.progress);
   return out;
 }
 

@@ -67,7 +67,7 @@ AdjacencyGraph adjacency_graph(const Cells& c, const GraphOptions& options) {
     std::iota(b, e, cfo[k]);
     std::sort(b, e, before);
     for (auto f = cfo[k]; f < cfo[k + 1]; ++f) measure[static_cast<std::size_t>(f)] = front::face_measure(c, f);
-  });
+  }, options.progress);
 
   if (options.prune_tolerance > 0 && nc > 0) {
     double total = 0;
@@ -108,7 +108,7 @@ AdjacencyGraph adjacency_graph(const Cells& c, const GraphOptions& options) {
       if (!(m < g.prune_threshold)) ++kept;
     }
     counts[static_cast<std::size_t>(gen) + 1] = kept;
-  });
+  }, options.progress);
   std::partial_sum(counts.begin(), counts.end(), counts.begin());
   g.wheel_offsets = std::move(counts);
   const std::size_t ns = static_cast<std::size_t>(g.wheel_offsets.back());
@@ -131,7 +131,7 @@ AdjacencyGraph adjacency_graph(const Cells& c, const GraphOptions& options) {
         for (std::size_t a = 0; a < du; ++a) g.spoke_shift[s * du + a] = c.face_shift[f * du + a];
       ++s;
     }
-  });
+  }, options.progress);
   return g;
 }
 

@@ -6,12 +6,14 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <stdexcept>
 #include <string>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include "../progress_chunks.hpp"
 #include "tessera/cells.hpp"
 #include "tessera/engine/thread_arena.hpp"
 
@@ -67,16 +69,18 @@ inline double face_measure(const Cells& c, std::int64_t f) {
 
 /// body(cell index) for every cell, on the thread count the cells were
 /// computed with. Bodies write only per-cell slots, so results never depend
-/// on the schedule.
+/// on the schedule. `progress` (may be empty) is called between chunks of
+/// cells (detail::in_progress_chunks): Ctrl-C from Python.
 template <class Body>
-void for_each_cell(const Cells& c, Body&& body) {
+void for_each_cell(const Cells& c, Body&& body, const std::function<void(double)>& progress = {}) {
   engine::ThreadArena arena(c.threads_used);  // 0 (never computed): one thread
-  arena.execute([&] {
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, c.n_cells(), 256),
-                      [&](const tbb::blocked_range<std::size_t>& r) {
-                        for (std::size_t k = r.begin(); k != r.end(); ++k) body(k);
-                      });
-  });
+  detail::in_progress_chunks(c.n_cells(), progress, [&](std::size_t begin, std::size_t end) {
+    arena.execute([&] {
+      tbb::parallel_for(tbb::blocked_range<std::size_t>(begin, end, 256), [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t k = r.begin(); k != r.end(); ++k) body(k);
+      });
+    });
+  }, std::size_t{1} << 15);
 }
 
 }  // namespace tessera::front
