@@ -143,7 +143,8 @@ int run_delaunay_frame(const DelaunayArgs& a) {
       // Only with hull completion and no labels does an empty result mean
       // flat input; otherwise say what else leaves none.
       const char* flat =
-          pc.dim == 3 ? "coplanar (for a 2D triangulation use --dim 2 on in-plane coordinates)" : "collinear";
+          pc.dim == 3 ? "coplanar or collinear (for a 2D triangulation use --dim 2 on in-plane coordinates)"
+                      : "collinear";
       if (a.no_hull_completion)
         std::fprintf(stderr,
                      "tessera: no simplices: none has its circumcentre in the domain box (hull completion is off), "
