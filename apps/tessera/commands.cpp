@@ -507,11 +507,22 @@ void print_summary(const VoronoiArgs& a, const io::PointCloud& pc, const Cells& 
       }
     std::printf("  %-18s %s (%zu images of points, within %s beyond the box)\n", "periodic", axes.c_str(),
                 c.periodic_images, reach.c_str());
-    if (c.tilt[0] != 0 || c.tilt[1] != 0 || c.tilt[2] != 0) {
+    // Tilts of more than a box length are reduced by whole lengths (the
+    // same lattice): say so, since the shifts then count that basis.
+    bool reduced = false;
+    for (std::size_t t = 0; t < a.compute.tilt.size() && t < 3; ++t) {
+      const std::size_t lo = t == 2 ? 1 : 0;  // xy, xz along x; yz along y
+      reduced |= std::fabs(a.compute.tilt[t] - c.tilt[t]) > 0.5 * (c.bounds.hi[lo] - c.bounds.lo[lo]);
+    }
+    const std::string note = reduced ? " (the given tilts reduced by whole box lengths: the same lattice, "
+                                       "and the basis the shifts count)"
+                                     : "";
+    if (reduced || c.tilt[0] != 0 || c.tilt[1] != 0 || c.tilt[2] != 0) {
       if (c.dim == 2)
-        std::printf("  %-18s xy %.17g\n", "tilt (triclinic)", c.tilt[0]);
+        std::printf("  %-18s xy %.17g%s\n", "tilt (triclinic)", c.tilt[0], note.c_str());
       else
-        std::printf("  %-18s xy %.17g, xz %.17g, yz %.17g\n", "tilt (triclinic)", c.tilt[0], c.tilt[1], c.tilt[2]);
+        std::printf("  %-18s xy %.17g, xz %.17g, yz %.17g%s\n", "tilt (triclinic)", c.tilt[0], c.tilt[1], c.tilt[2],
+                    note.c_str());
     }
   }
   if (c.far_points != 0)

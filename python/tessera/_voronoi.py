@@ -153,8 +153,10 @@ class Voronoi:
 
     @property
     def tilt(self) -> Tuple[float, ...]:
-        """A triclinic box's tilts as rounded: ``(xy,)`` in 2D, ``(xy, xz, yz)``
-        in 3D; all zero for an orthogonal box (see :func:`voronoi`'s ``tilt``)."""
+        """A triclinic box's tilts as rounded, and reduced by whole box lengths
+        where one was more than a length (the same lattice): ``(xy,)`` in 2D,
+        ``(xy, xz, yz)`` in 3D; all zero for an orthogonal box (see
+        :func:`voronoi`'s ``tilt``)."""
         t = self._cells.tilt
         return (t[0],) if self._cells.dim == 2 else (t[0], t[1], t[2])
 

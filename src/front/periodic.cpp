@@ -44,6 +44,27 @@ int geometry_exponent(const PeriodicInput& in) {
   return kernels::filter::binary_exponent(m);  // the lengths are finite and positive (checked)
 }
 
+/// Tilts (xy, xz, yz) of more than a box length, reduced by whole box lengths
+/// to within half of one: b - k a for xy, then c - k b for yz (which moves xz
+/// by k times the reduced xy), then c - k a for xz. The same lattice, so the
+/// same cells, in a box whose heights are near its lengths. A tilt of many
+/// lengths makes the parallelepiped thin across its faces, and the layer of
+/// images, counted in lattice vectors of the given basis, passed the int8
+/// shifts: one point at tilts of 10.3 was refused ("some cell reaches past
+/// 127 box lengths"), 1,000 points at an xy of 640. Tilts within a length
+/// are kept as given (LAMMPS keeps its own within half by flipping the box).
+/// The tilts used are what Cells::tilt reports, and the shifts count the
+/// vectors of that basis.
+std::array<double, 3> reduced_tilts(std::array<double, 3> t, const std::array<double, 3>& length) {
+  auto whole_lengths = [](double v, double l) { return std::fabs(v) > l ? std::nearbyint(v / l) : 0.0; };
+  t[0] -= whole_lengths(t[0], length[0]) * length[0];
+  const double k = whole_lengths(t[2], length[1]);
+  t[2] -= k * length[1];
+  t[1] -= k * t[0];
+  t[1] -= whole_lengths(t[1], length[0]) * length[0];
+  return t;
+}
+
 }  // namespace
 
 PeriodicInput periodic_input(std::span<const double> points, int dim, std::span<const std::int32_t> labels,
@@ -91,7 +112,8 @@ PeriodicInput periodic_input(std::span<const double> points, int dim, std::span<
       throw InputError(std::string("tilt ") + tilt_name[t] + " " + num(v) + " is over 1024 box lengths along " +
                        detail::axis_name(tilt_lo[t]) + "; reduce it by whole box lengths (the same lattice)");
   }
-  in.sheared = options.tilt[0] != 0 || options.tilt[1] != 0 || options.tilt[2] != 0;
+  const std::array<double, 3> tilt = reduced_tilts(options.tilt, in.length);
+  in.sheared = tilt[0] != 0 || tilt[1] != 0 || tilt[2] != 0;
   // The extreme radii of power cells (0 without radii): r_max^2 - r_min^2
   // bounds their slack (below, in the geometry's frame).
   double rmin = 0, rmax = 0;
@@ -112,7 +134,7 @@ PeriodicInput periodic_input(std::span<const double> points, int dim, std::span<
   const Bounds given = in.box;
   for (int attempt = 0;; ++attempt) {
     in.box = given;
-    in.tilt = options.tilt;
+    in.tilt = tilt;
     for (std::size_t a = 0; a < du; ++a) {
       if (grid[a] == 0) continue;
       in.box.lo[a] = snap(given.lo[a], grid[a]);

@@ -152,8 +152,8 @@ auto run_in_final_layer(const PeriodicInput& in, std::span<const std::int32_t> l
         if (in.reach_clamped[a])
           throw InputError(std::string("periodic along ") + "xyz"[a] + ": some cell reaches past " +
                            std::to_string(max_periodic_shift) +
-                           " box lengths (a few points in a box far longer along its walls than its period, or tilts of many "
-                           "box lengths: reduce them by whole box lengths first)");
+                           " box lengths (a few points in a box far longer along its walls than its period, or in a thin "
+                           "sheared one)");
         continue;
       }
       enough = false;
