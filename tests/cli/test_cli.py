@@ -1241,6 +1241,17 @@ class Periodic(TempDirCase):
             self.assertEqual(tables[0], tables[1])
             vol = np.loadtxt(self.p("t.npy.csv"), delimiter=",", skiprows=1)[:, 2]
             self.assertAlmostEqual(vol.sum(), float(np.prod(hi - lo)), delta=1e-12 * float(np.prod(hi - lo)))
+            # The same lattice by b + 7 a and c + 7 b + 7 a: tilts reduced to
+            # the ones above (the summary says so), the same table.
+            t = [float(x) for x in tilt]
+            more = [t[0] + 7 * vec[0, 0]]
+            if dim == 3:
+                more += [t[1] + 7 * t[0] + 7 * vec[0, 0], t[2] + 7 * vec[1, 1]]
+            more = [repr(x) for x in more]
+            r = self.ok(["voronoi", self.p("t.npy"), "--bounds"] + box + ["--periodic", "xyz"[:dim], "--tilt"] + more +
+                        ["--cell-table", self.p("r.csv")])
+            self.assertIn("the given tilts reduced by whole box lengths", r.stdout)
+            self.assertEqual(read_bytes(self.p("r.csv")), tables[0])
 
     def test_periodic_delaunay(self):
         # delaunay --periodic: every simplex once with its vertices' images,
