@@ -116,6 +116,31 @@ def test_ctrl_c_interrupts_a_long_call(func):
     assert tessera.voronoi(pts[:1000], threads=1).n_cells == 1000  # usable afterwards
 
 
+def test_ctrl_c_interrupts_find_simplex():
+    """The calls outside the engine check too (between chunks of queries):
+    find_simplex on 15M queries ran 51 s past Ctrl-C."""
+    dt = tessera.delaunay(random_points(20_000, 3, seed=4), threads=1)
+    queries = random_points(4_000_000, 3, seed=5)  # ~10 s on one thread
+
+    def handler(signum, frame):
+        raise Interrupted()
+
+    dt.find_simplex(queries[:10])  # the locator is built before the clock starts
+    old = signal.signal(signal.SIGINT, handler)
+    timer = threading.Timer(0.3, os.kill, (os.getpid(), signal.SIGINT))
+    try:
+        timer.start()
+        t0 = time.perf_counter()
+        with pytest.raises(Interrupted):
+            dt.find_simplex(queries)
+        elapsed = time.perf_counter() - t0
+    finally:
+        timer.cancel()
+        signal.signal(signal.SIGINT, old)
+    assert elapsed < 3.0
+    assert np.array_equal(dt.find_simplex(queries[:1000]), tessera.delaunay(dt.points).find_simplex(queries[:1000]))
+
+
 def test_ctrl_c_with_the_default_handler_raises_keyboard_interrupt():
     pts = random_points(300_000, 3, seed=3)
     old = signal.signal(signal.SIGINT, signal.default_int_handler)
