@@ -360,10 +360,12 @@ void read_attribute(Legacy& f, const std::string& kw, std::size_t n, bool point_
                     LegacyPoints& out) {
   const std::string name = decoded(f.word());
   auto take = [&](const std::string& array, std::size_t components, std::size_t tuples, const LegacyType& t) {
-    // The first array that qualifies, as VTK's GetArray(name) takes the first
-    // of arrays sharing a name.
-    const bool keep = point_data && !out.found &&
-                      (out.take_first ? components == 1 && tuples == n && !t.string : !wanted.empty() && array == wanted);
+    // Of arrays sharing the name asked for, the last: VTK's legacy readers
+    // add each array to the point data, where one of the same name replaces
+    // the one before (its XML readers keep the first). take_first: the first
+    // of one component.
+    const bool keep = point_data && (out.take_first ? !out.found && components == 1 && tuples == n && !t.string
+                                                    : !wanted.empty() && array == wanted);
     if (point_data) out.names.push_back(array);
     if (t.string) {
       if (keep) fail(f.path(), "point data '" + array + "' holds strings, not numbers");

@@ -142,17 +142,17 @@ TEST(VtkLegacy, AsciiFloatsAndLabelsAsStored) {
             std::string::npos);
 }
 
-// Arrays sharing a name: the first is read, as VTK's GetArray(name) finds
-// it (the last was, until stop 83), also when a FIELD array follows.
-TEST(VtkLegacy, FirstOfArraysSharingAName) {
+// Arrays sharing a name: the last is read, as VTK's legacy readers keep it
+// (each replaces the one before in the point data), SCALARS or FIELD.
+TEST(VtkLegacy, LastOfArraysSharingAName) {
   TempDir dir;
   const std::string p = dir.write("s.vtk", "# vtk DataFile Version 3.0\ns\nASCII\nDATASET POLYDATA\nPOINTS 2 float\n"
                                            "0 0 0 1 1 1\nPOINT_DATA 2\nSCALARS t int\n1 2\nSCALARS t int\n3 4\n"
                                            "FIELD more 1\nt 1 2 int\n5 6\n");
-  EXPECT_EQ(read_point_scalars(p, "t"), (std::vector<double>{1, 2}));
+  EXPECT_EQ(read_point_scalars(p, "t"), (std::vector<double>{5, 6}));
   ReadOptions o;
   o.labels = "t";
-  EXPECT_EQ(read_points(p, o).labels, (std::vector<std::int32_t>{1, 2}));
+  EXPECT_EQ(read_points(p, o).labels, (std::vector<std::int32_t>{5, 6}));
 }
 
 TEST(VtkLegacy, Errors) {
