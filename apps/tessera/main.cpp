@@ -220,19 +220,23 @@ void finish_compute_args(ComputeArgs& c, const std::vector<std::string>& raw_bou
   // strtod's ERANGE means overflow (inf) or underflow: a subnormal such as
   // 1e-310 (a domain Python takes, and the default domain may be) or 0, as
   // Python's float() reads them too; only overflow is refused.
-  auto parse = [](const std::string& w, double& v) {
+  // (A word that is not wholly a number may have set ERANGE on its numeric
+  // prefix: `1e-400.npy` is the INPUT, not an overflow.)
+  auto parse = [](const std::string& w, double& v, bool& overflow) {
     errno = 0;
-    return whole_number(w, v) && !(errno == ERANGE && std::isinf(v));
+    const bool whole = whole_number(w, v);
+    overflow = whole && errno == ERANGE && std::isinf(v);
+    return whole && !overflow;
   };
   c.bounds.clear();
   for (std::size_t i = 0; i < raw_bounds.size(); ++i) {
     double v = 0;
-    if (parse(raw_bounds[i], v)) {
+    bool overflow = false;
+    if (parse(raw_bounds[i], v, overflow)) {
       c.bounds.push_back(v);
       continue;
     }
-    if (errno == ERANGE)
-      throw tessera::InputError("--bounds: '" + raw_bounds[i] + "' is beyond double's range");
+    if (overflow) throw tessera::InputError("--bounds: '" + raw_bounds[i] + "' is beyond double's range");
     if (i == 4 && c.input.empty() && raw_bounds.size() == 5) {
       c.input = raw_bounds[i];
       break;

@@ -852,6 +852,15 @@ class Voronoi2D(TempDirCase):
         r = run(["voronoi", pts, "--bounds", "0", "1e400", "0", "1", "--cell-table", t])
         self.assertEqual(r.returncode, 2)
         self.assertIn("'1e400' is beyond double's range", r.stderr)
+        # A word that is not wholly a number: the INPUT after a 2D --bounds,
+        # or not a number, even where its numeric prefix overflows.
+        import shutil
+        shutil.copy(pts, self.p("1e-400.npy"))
+        r = subprocess.run([TESSERA, "voronoi", "--bounds", "0", "1e-310", "0", "1e-310", "1e-400.npy", "--cell-table",
+                            t, "-q"], capture_output=True, text=True, cwd=self.dir)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        r = run(["voronoi", pts, "--bounds", "0", "1", "0", "1e400abc", "--cell-table", t])
+        self.assertIn("'1e400abc' is not a number", r.stderr)
 
     def test_threads_byte_identical(self):
         a, b = self.p("a.vtp"), self.p("b.vtp")
