@@ -298,10 +298,6 @@ int run_image_command(const ImageCommands& c) {
 // ------------------------------------------------------------------ sample-image
 
 int run_sample_image(const SampleImageArgs& a) {
-  // Until stop 83 --output chose these points (-o was the file): name the
-  // option it now is rather than "unknown extension".
-  if (a.output == "all" || a.output == "labelled" || a.output == "background")
-    throw InputError("--output is the output file; which points to keep is --output-type " + a.output);
   check_points_output(a.output);
   const auto t0 = std::chrono::steady_clock::now();
   // Read here (not through sample_image_file) to report the image size.

@@ -515,6 +515,21 @@ int main(int argc, char** argv) {
       return kExitInputError;
     }
   }
+  // sample-image chose its points with --output until stop 83 (-o was the
+  // file): the old spelling, where CLI11 would report -o and --output given
+  // together ("At Most 1 required"), names the option it now is.
+  if (argc > 1 && std::string_view(argv[1]) == "sample-image")
+    for (int k = 2; k < argc; ++k) {
+      const std::string_view w = argv[k];
+      if (w == "--") break;
+      const std::string_view v = w == "--output" && k + 1 < argc ? std::string_view(argv[k + 1])
+                                 : w.substr(0, 9) == "--output="  ? w.substr(9)
+                                                                  : std::string_view();
+      if (v == "all" || v == "labelled" || v == "background") {
+        print_error("--output is the output file; which points to keep is --output-type " + std::string(v));
+        return kExitInputError;
+      }
+    }
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

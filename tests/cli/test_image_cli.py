@@ -280,6 +280,8 @@ class BadImageInput(base.TempDirCase):
         # --output is the file, as in every command; the selection's old
         # spelling is pointed to its option.
         self.fails(["sample-image", self.vti, "--output", "labelled"], "--output-type labelled")
+        self.fails(["sample-image", self.vti, "-o", out, "--output", "background"], "--output-type background")
+        self.fails(["sample-image", self.vti, "--output=all", "-o", out], "--output-type all")
         self.ok(["sample-image", self.vti, "--output", self.p("long.ply"), "-q"])
         self.assertTrue(os.path.getsize(self.p("long.ply")) > 0)
         lab = self.save("lab_in.npy", self.lab.astype(np.int32))
