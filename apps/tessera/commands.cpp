@@ -288,13 +288,20 @@ void apply_file_box(ComputeArgs& a) {
   a.box_source = "the box of " + (a.frame.empty() ? "" : strf("frame %zu of ", a.frame_place.index)) +
                  shown_path(a.input) + " (" + box->declared_by + ")";
   if (!a.periodic_from_file) a.box_source += ", periodic along --periodic's axes";
-  if (!a.tilt_from_file) {
-    a.box_source += ", tilted by --tilt";
-    return;
-  }
   static const char* const tilt_name[3] = {"xy", "xz", "yz"};
   static const int tilt_axes[3][2] = {{0, 1}, {0, 2}, {1, 2}};
   const int tilts = dim == 3 ? 3 : 1;
+  if (!a.tilt_from_file) {
+    // --tilt on the file's axes: a wall there is the file's, so say so.
+    if (a.periodic_from_file)
+      for (int t = 0; t < tilts && static_cast<std::size_t>(t) < a.tilt.size(); ++t)
+        for (const int axis : tilt_axes[t])
+          if (a.tilt[static_cast<std::size_t>(t)] != 0 && a.periodic.find("xyz"[axis]) == std::string::npos)
+            throw InputError(strf("--tilt: %s needs %s periodic, and %s has a wall there; give --periodic",
+                                  tilt_name[t], axis_name(axis), a.box_source.c_str()));
+    a.box_source += ", tilted by --tilt";
+    return;
+  }
   bool tilted = false;
   for (int t = 0; t < tilts; ++t) {
     const auto k = static_cast<std::size_t>(t);

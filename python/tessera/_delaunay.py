@@ -105,9 +105,9 @@ class Delaunay:
         """What matches simplices by point ids alone (the library's adjacency,
         edges and locator, scipy's attributes) is refused in a periodic box,
         whose rows name images: in this attribute's words, not the library's
-        function's."""
+        function's. An InputError (a ValueError), as the library's own refusal was."""
         if self.is_periodic:
-            raise ValueError(f"{attribute}: not available for a periodic triangulation (its simplices meet images)")
+            raise _core.InputError(f"{attribute}: not available for a periodic triangulation (its simplices meet images)")
 
     @property
     def neighbors(self) -> np.ndarray:

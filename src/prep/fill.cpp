@@ -298,6 +298,7 @@ LabelledPoints fill(std::span<const double> coords, int dim, std::span<const std
   so.background_label = options.background_label;
   so.joggle = options.joggle;
   so.threads = threads;
+  so.progress = options.progress;
   const LabelledPoints bg = sample_image(image, so);
   out.coords.insert(out.coords.end(), bg.coords.begin(), bg.coords.end());
   out.labels.resize(n + bg.size(), options.background_label);

@@ -1406,6 +1406,10 @@ class FileBoxes(TempDirCase):
         self.assertEqual(len(r.stderr.strip().splitlines()), 1)
         r = self.ok(["voronoi", tilted, "--periodic", "xy", "--tilt", "0.5", "0", "0", "--cell-table", t])
         self.assertIn("tilted by --tilt", r.stdout)
+        # --tilt alone along an axis the file walls: the file's wall is named.
+        r = run(["voronoi", inp, "--tilt", "0.5", "0", "0", "--cell-table", t])
+        self.assertEqual(r.returncode, 2)
+        self.assertIn("--tilt: xy needs y periodic, and the box of %s" % inp, r.stderr)
         # A triangulation needs every axis periodic: the dump's walls are named.
         r = run(["delaunay", inp, "--validate"])
         self.assertEqual(r.returncode, 2)

@@ -42,7 +42,9 @@ struct FillOptions {
   /// refused; they mark no bin and are not held to the bounds. The bounding
   /// box is then the finite points', of which there must be one.
   bool keep_non_finite = false;
-  /// As VoronoiOptions::progress: called between chunks of points, it may
+  /// As VoronoiOptions::progress: called between chunks of points (its
+  /// fraction runs from 0 to 1 again for each pass: over the points, then
+  /// over the added ones or the adaptive strategy's bins), it may
   /// throw Cancelled to stop.
   std::function<void(double)> progress;
 };
