@@ -120,7 +120,11 @@ int run_delaunay_frame(const DelaunayArgs& a) {
   }
   const double write_s = seconds_since(t0);
 
-  if (!a.quiet) {
+  if (!a.quiet && a.compute.brief) {
+    print_frame_line("delaunay", a.compute,
+                     strf("%zu points, %zu %s", pc.n, dt.n_simplices(), pc.dim == 3 ? "tetrahedra" : "triangles"),
+                     compute_s, written, stderr);
+  } else if (!a.quiet) {
     // With labels, where the whole triangulation was built, the counts by
     // method are of it (Delaunay::outside_simplices).
     const std::string outside =

@@ -131,7 +131,11 @@ int run_graph_frame(const GraphArgs& a) {
     written.push_back(a.spoke_shifts);
   }
 
-  if (!a.quiet) {
+  if (!a.quiet && a.compute.brief) {
+    print_frame_line("graph", a.compute, strf("%zu points, %zu cells, %zu spokes", r.pc.n, r.cells.n_cells(),
+                                              g.n_spokes()),
+                     r.seconds, written);
+  } else if (!a.quiet) {
     std::size_t by_class[4] = {0, 0, 0, 0};
     for (SpokeClass s : g.spoke_class) ++by_class[static_cast<int>(s)];
     print_header("graph", a.compute, r);
@@ -180,7 +184,11 @@ int run_faces_frame(const FacesArgs& a) {
   const FaceSet fs = extract_faces(r.cells, r.pc.labels, fo);
   io::write_faces_vtp(a.output, fs);
 
-  if (!a.quiet) {
+  if (!a.quiet && a.compute.brief) {
+    print_frame_line("faces", a.compute, strf("%zu points, %zu cells, %zu faces", r.pc.n, r.cells.n_cells(),
+                                              fs.n_faces()),
+                     r.seconds, {a.output});
+  } else if (!a.quiet) {
     print_header("faces", a.compute, r);
     std::printf("  %-18s %s%s\n", "kind", face_set_kind_name(fs.kind), a.capping ? " (capped)" : "");
     std::printf("  %-18s %zu %s\n", "faces", fs.n_faces(), fs.dim == 3 ? "polygons" : "segments");
@@ -223,7 +231,11 @@ int run_flower_frame(const FlowerArgs& a) {
   const std::vector<Flower> fl = flowers(r.cells, r.pc.coords, ids);
   io::write_flowers_vtp(a.output, fl, r.pc.coords, a.glyphs);
 
-  if (!a.quiet) {
+  if (!a.quiet && a.compute.brief) {
+    print_frame_line("flower", a.compute, strf("%zu points, %zu cells, %zu flower%s", r.pc.n, r.cells.n_cells(),
+                                               fl.size(), fl.size() == 1 ? "" : "s"),
+                     r.seconds, {a.output});
+  } else if (!a.quiet) {
     print_header("flower", a.compute, r);
     for (const Flower& f : fl)
       std::printf("  point %-12" PRId32 " %zu petals, circumflower radius %.6g, %zu clipping neighbours\n",

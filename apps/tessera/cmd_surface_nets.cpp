@@ -343,6 +343,17 @@ int run_surface_nets_frame(const SurfaceNetsArgs& a) {
   auto t0 = Clock::now();
   io::write_surface_net_vtp(a.output, net);
   const double write_s = seconds_since(t0);
+  if (a.compute.brief) {
+    const std::string closed =
+        w.open_labels.empty() ? "watertight" : "open: label" + std::string(w.open_labels.size() == 1 ? " " : "s ") +
+                                                   label_list(w.open_labels);
+    print_frame_line("surface-nets", a.compute,
+                     strf("%zu points, %zu %s, %s", in.size(), m.n_faces(), m.dim == 3 ? "polygons" : "segments",
+                          closed.c_str()),
+                     net.seconds.cells + net.seconds.faces + net.seconds.smoothing + net.seconds.triangulation,
+                     {a.output});
+    return kExitOk;
+  }
 
   std::printf("tessera surface-nets: %zu points (%dD) from %s%s\n", in.size(), in.dim, shown_input(a.compute).c_str(),
               in.from_image ? " (sampled image)" : "");

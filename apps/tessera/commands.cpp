@@ -28,16 +28,8 @@
 #include "tessera/io/vtk_xml.hpp"
 
 namespace tessera::cli {
-namespace {
 
-using Clock = std::chrono::steady_clock;
-
-double seconds_since(Clock::time_point t0) {
-  return std::chrono::duration<double>(Clock::now() - t0).count();
-}
-
-/// printf into a std::string (g++ 12's libstdc++ has no <format>).
-[[gnu::format(printf, 1, 2)]] std::string strf(const char* fmt, ...) {
+std::string strf(const char* fmt, ...) {
   va_list ap;
   va_start(ap, fmt);
   va_list ap2;
@@ -48,6 +40,14 @@ double seconds_since(Clock::time_point t0) {
   if (n > 0) std::vsnprintf(s.data(), s.size() + 1, fmt, ap2);
   va_end(ap2);
   return s;
+}
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
 }
 
 }  // namespace
@@ -318,6 +318,15 @@ void apply_file_box(ComputeArgs& a) {
     for (int t = 0; t < tilts; ++t) a.tilt.push_back(box->tilt[static_cast<std::size_t>(t)]);
 }
 
+void print_frame_line(const char* command, const ComputeArgs& a, const std::string& what, double seconds,
+                      const std::vector<std::string>& written, std::FILE* to) {
+  std::string files;
+  for (const std::string& w : written) files += (files.empty() ? "" : ", ") + w;
+  std::fprintf(to, "tessera %s: %s: %s; %.3f s; wrote %s\n", command, shown_input(a).c_str(), what.c_str(), seconds,
+               files.empty() ? "(nothing)" : files.c_str());
+  std::fflush(to);
+}
+
 io::PointCloud read_input(const ComputeArgs& a) {
   io::ReadOptions ro;
   ro.dim = a.dim;
@@ -483,6 +492,10 @@ void print_volume_line(const Cells& c, const char* name) {
 
 void print_summary(const VoronoiArgs& a, const io::PointCloud& pc, const Cells& c, double read_s,
                    double compute_s, double write_s, const std::vector<std::string>& written) {
+  if (a.compute.brief) {
+    print_frame_line("voronoi", a.compute, strf("%zu points, %zu cells", pc.n, c.n_cells()), compute_s, written);
+    return;
+  }
   const bool d3 = c.dim == 3;
   std::printf("tessera voronoi: %zu points (%dD) from %s\n", pc.n, c.dim, shown_input(a.compute).c_str());
   std::printf("  %-18s %zu\n", "cells", c.n_cells());
@@ -667,7 +680,8 @@ int run_voronoi_frame(const VoronoiArgs& a) {
   const double write_s = seconds_since(t0);
 
   if (!a.quiet) print_summary(a, pc, cells, read_s, compute_s, write_s, written);
-  if (a.validate && !report_validation(cells, pc, a.quiet)) return kExitFailure;
+  // (A series' later frames report a failed validation only, as -q does.)
+  if (a.validate && !report_validation(cells, pc, a.quiet || a.compute.brief)) return kExitFailure;
   return kExitOk;
 }
 

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <cstdio>
 #include <initializer_list>
 #include <string>
 #include <vector>
@@ -52,6 +53,10 @@ struct ComputeArgs {
   /// Whether the periodic axes, and the tilts, are the file's box's (not
   /// --periodic's and --tilt's): a series takes each frame's own.
   bool periodic_from_file = false, tilt_from_file = false;
+  /// A series' frame after its first: the summary is one line
+  /// (print_frame_line), where a trajectory of thousands of frames printed
+  /// a dozen lines each.
+  bool brief = false;
   /// --frame as given ("" when not): a trajectory's frame, 0 the first,
   /// negative from the end; finish_compute_args finds where it starts.
   std::string frame;
@@ -338,9 +343,17 @@ bool is_frame_series(const std::string& frame);
 /// selects none.
 void find_input_frame(ComputeArgs& args);
 
+/// printf into a std::string (g++ 12's libstdc++ has no <format>).
+[[gnu::format(printf, 1, 2)]] std::string strf(const char* fmt, ...);
+
 /// INPUT as the summaries name it: "stdin" for standard input, and the frame
 /// read where --frame was given ("run.dump, frame 3 (from line 4017)").
 std::string shown_input(const ComputeArgs& args);
+/// A series' later frame's summary, one line: "tessera COMMAND: INPUT, frame
+/// K (from line L): WHAT; T s; wrote A, B" (to `to`: delaunay's summary is
+/// on standard error).
+void print_frame_line(const char* command, const ComputeArgs& args, const std::string& what, double seconds,
+                      const std::vector<std::string>& written, std::FILE* to = stdout);
 io::PointCloud read_input(const ComputeArgs& args);        ///< read and check INPUT (InputError)
 VoronoiOptions make_options(const ComputeArgs& args, int dim);
 /// tessera::voronoi with a progress bar (when `show_progress`) and Ctrl-C cancellation.

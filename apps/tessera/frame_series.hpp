@@ -95,6 +95,7 @@ int run_frames(const Args& a, std::initializer_list<SeriesOutput<Args>> outputs,
     ++computed;
     Args f = base;
     f.compute.frame_place = place;
+    f.compute.brief = computed > 1;  // the first frame's summary in full, then a line each
     try {
       if (!a.compute.domain_given) {  // the file's box, where it has one: this frame's own
         f.compute.bounds.clear();
