@@ -132,10 +132,13 @@ int run_delaunay_frame(const DelaunayArgs& a) {
                                   : "; " + std::to_string(dt.outside_simplices) + " with an outside vertex left out";
     if (!a.compute.frame.empty()) std::fprintf(stderr, "tessera: points from %s\n", shown_input(a.compute).c_str());
     if (!a.compute.box_source.empty()) std::fprintf(stderr, "tessera: domain from %s\n", a.compute.box_source.c_str());
-    if (dt.is_periodic())
+    if (dt.is_periodic()) {
       std::fprintf(stderr, "tessera: %zu points (%dD) -> %zu %s of the periodic box%s (each once, with its images)\n",
                    pc.n, pc.dim, dt.n_simplices(), pc.dim == 3 ? "tetrahedra" : "triangles",
                    dt.tilt[0] != 0 || dt.tilt[1] != 0 || dt.tilt[2] != 0 ? " (triclinic)" : "");
+      if (const std::string t = tilt_text(a.compute, dt.tilt, dt.bounds, dt.dim); !t.empty())
+        std::fprintf(stderr, "tessera: tilts %s\n", t.c_str());
+    }
     else if (dt.from_insertion > 0)
       std::fprintf(stderr, "tessera: %zu points (%dD) -> %zu %s (by incremental insertion%s)\n", pc.n, pc.dim,
                    dt.n_simplices(), pc.dim == 3 ? "tetrahedra" : "triangles", outside.c_str());
@@ -179,7 +182,7 @@ int run_delaunay_frame(const DelaunayArgs& a) {
   }
   if (a.validate) {
     const DelaunayReport r = validate(dt, pc.coords, pc.labels, radii);
-    if (!a.quiet || !r.ok) {
+    if ((!a.quiet && !a.compute.brief) || !r.ok) {  // a series' later frames: failures only, as -q
       const std::string hidden =
           dt.power ? ", " + std::to_string(dt.hidden.size()) + " hidden points (" + std::to_string(r.hidden_in_conflict) +
                          " in conflict)"

@@ -55,9 +55,9 @@ void print_header(const char* command, const ComputeArgs& a, const Computed& r) 
     std::string axes;
     for (int k = 0; k < r.cells.dim; ++k)
       if (r.cells.periodic[static_cast<std::size_t>(k)]) axes += "xyz"[k];
-    const bool tilted = r.cells.tilt[0] != 0 || r.cells.tilt[1] != 0 || r.cells.tilt[2] != 0;
-    std::printf("  %-18s %s%s (%zu images of points)\n", "periodic", axes.c_str(), tilted ? ", triclinic" : "",
-                r.cells.periodic_images);
+    std::printf("  %-18s %s (%zu images of points)\n", "periodic", axes.c_str(), r.cells.periodic_images);
+    if (const std::string t = tilt_text(a, r.cells.tilt, r.cells.bounds, r.cells.dim); !t.empty())
+      std::printf("  %-18s %s\n", "tilt (triclinic)", t.c_str());
   }
 }
 

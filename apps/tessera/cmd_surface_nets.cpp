@@ -368,9 +368,14 @@ int run_surface_nets_frame(const SurfaceNetsArgs& a) {
     std::string axes;
     for (int k = 0; k < m.dim; ++k)
       if (m.periodic[static_cast<std::size_t>(k)]) axes += "xyz"[k];
-    std::printf("  %-18s %s%s; %zu of the %zu vertices repeat others across the box's faces\n",
-                "periodic", axes.c_str(), a.compute.tilt.empty() ? "" : ", triclinic",
-                m.n_vertices() - copies.n_groups(), m.n_vertices());
+    std::printf("  %-18s %s; %zu of the %zu vertices repeat others across the box's faces\n", "periodic",
+                axes.c_str(), m.n_vertices() - copies.n_groups(), m.n_vertices());
+    // The tilts used are the lattice's (reduced where given past a length).
+    const std::array<double, 3> used{m.lattice[1][0], m.lattice[2][0], m.lattice[2][1]};
+    Bounds lengths;
+    for (std::size_t d = 0; d < 3; ++d) lengths.hi[d] = m.lattice[d][d];
+    if (const std::string t = tilt_text(a.compute, used, lengths, m.dim); !t.empty())
+      std::printf("  %-18s %s\n", "tilt (triclinic)", t.c_str());
   }
   if (m.dim == 3 && a.triangles)
     std::printf("  %-18s %zu triangles from %zu polygons\n", "faces", m.n_faces(), polygon_count(net));

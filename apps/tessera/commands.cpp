@@ -318,6 +318,20 @@ void apply_file_box(ComputeArgs& a) {
     for (int t = 0; t < tilts; ++t) a.tilt.push_back(box->tilt[static_cast<std::size_t>(t)]);
 }
 
+std::string tilt_text(const ComputeArgs& a, const std::array<double, 3>& used, const Bounds& box, int dim) {
+  // Tilts of more than a box length are reduced by whole lengths (the same
+  // lattice): say so, since the shifts then count that basis.
+  bool reduced = false;
+  for (std::size_t t = 0; t < a.tilt.size() && t < 3; ++t) {
+    const std::size_t lo = t == 2 ? 1 : 0;  // xy, xz along x; yz along y
+    reduced |= std::fabs(a.tilt[t] - used[t]) > 0.5 * (box.hi[lo] - box.lo[lo]);
+  }
+  if (!reduced && used[0] == 0 && used[1] == 0 && used[2] == 0) return "";
+  std::string s = dim == 2 ? strf("xy %.17g", used[0]) : strf("xy %.17g, xz %.17g, yz %.17g", used[0], used[1], used[2]);
+  if (reduced) s += " (the given tilts reduced by whole box lengths: the same lattice, and the basis the shifts count)";
+  return s;
+}
+
 void print_frame_line(const char* command, const ComputeArgs& a, const std::string& what, double seconds,
                       const std::vector<std::string>& written, std::FILE* to) {
   std::string files;
@@ -527,23 +541,8 @@ void print_summary(const VoronoiArgs& a, const io::PointCloud& pc, const Cells& 
       }
     std::printf("  %-18s %s (%zu images of points, within %s beyond the box)\n", "periodic", axes.c_str(),
                 c.periodic_images, reach.c_str());
-    // Tilts of more than a box length are reduced by whole lengths (the
-    // same lattice): say so, since the shifts then count that basis.
-    bool reduced = false;
-    for (std::size_t t = 0; t < a.compute.tilt.size() && t < 3; ++t) {
-      const std::size_t lo = t == 2 ? 1 : 0;  // xy, xz along x; yz along y
-      reduced |= std::fabs(a.compute.tilt[t] - c.tilt[t]) > 0.5 * (c.bounds.hi[lo] - c.bounds.lo[lo]);
-    }
-    const std::string note = reduced ? " (the given tilts reduced by whole box lengths: the same lattice, "
-                                       "and the basis the shifts count)"
-                                     : "";
-    if (reduced || c.tilt[0] != 0 || c.tilt[1] != 0 || c.tilt[2] != 0) {
-      if (c.dim == 2)
-        std::printf("  %-18s xy %.17g%s\n", "tilt (triclinic)", c.tilt[0], note.c_str());
-      else
-        std::printf("  %-18s xy %.17g, xz %.17g, yz %.17g%s\n", "tilt (triclinic)", c.tilt[0], c.tilt[1], c.tilt[2],
-                    note.c_str());
-    }
+    if (const std::string t = tilt_text(a.compute, c.tilt, c.bounds, c.dim); !t.empty())
+      std::printf("  %-18s %s\n", "tilt (triclinic)", t.c_str());
   }
   if (c.far_points != 0)
     std::printf("  %-18s %zu (beyond the bulk of the points; they stretch the default domain: outliers?)\n",

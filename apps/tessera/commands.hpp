@@ -349,6 +349,10 @@ void find_input_frame(ComputeArgs& args);
 /// INPUT as the summaries name it: "stdin" for standard input, and the frame
 /// read where --frame was given ("run.dump, frame 3 (from line 4017)").
 std::string shown_input(const ComputeArgs& args);
+/// The tilts used ("xy A, xz B, yz C"), with a note where the given ones
+/// (args.tilt) were reduced by whole box lengths; "" for an orthogonal box
+/// given as one.
+std::string tilt_text(const ComputeArgs& args, const std::array<double, 3>& used, const Bounds& box, int dim);
 /// A series' later frame's summary, one line: "tessera COMMAND: INPUT, frame
 /// K (from line L): WHAT; T s; wrote A, B" (to `to`: delaunay's summary is
 /// on standard error).

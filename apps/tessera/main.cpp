@@ -207,7 +207,10 @@ void add_periodic_option(CLI::App* app, ComputeArgs& c, const std::string& image
                   "With --periodic: a triclinic (sheared) box's tilt factors as lengths, as LAMMPS and Voro++ give "
                   "them: XY in 2D, XY XZ YZ in 3D. The box is the parallelepiped spanned from --bounds' lower "
                   "corner by a = (Lx,0,0), b = (XY,Ly,0), c = (XZ,YZ,Lz), L the extents of --bounds; a tilt needs "
-                  "both its axes periodic. Points are wrapped into it, and shifts count a, b, c")
+                  "both its axes periodic. A tilt of more than one box length is reduced by whole lengths (XY by Lx; YZ by "
+                  "Ly, moving XZ by as many XY; XZ by Lx): the same lattice, in a box that is not thin; the summary "
+                  "then gives the tilts used. Points are wrapped into the box of the tilts used, and shifts count "
+                  "its a, b, c")
       ->type_name("XY [XZ YZ]")
       ->expected(1, 3);
 }

@@ -123,9 +123,13 @@ struct VoronoiOptions {
   /// L the extents of `bounds`; it is the parallelepiped spanned by them
   /// from bounds' lower corner (2D: a = (Lx, 0), b = (xy, Ly); xz and yz
   /// must be 0). A tilt needs both of its axes periodic (xy: x and y).
-  /// Points are wrapped into the parallelepiped, and the tilts are rounded
-  /// to the same grid as the coordinates. Cells::neighbor_shifts then count
-  /// lattice vectors. All zero: an orthogonal box.
+  /// A tilt of more than one box length (|xy| or |xz| > Lx, |yz| > Ly) is
+  /// reduced by whole lengths first (xy by Lx; yz by Ly, which moves xz by
+  /// as many xy; then xz by Lx): the same lattice, in a box that is not thin
+  /// (Cells::tilt reports the tilts used). Points are wrapped into the
+  /// parallelepiped of the tilts used, rounded to the same grid as the
+  /// coordinates, and Cells::neighbor_shifts count its lattice vectors.
+  /// All zero: an orthogonal box.
   std::array<double, 3> tilt{0, 0, 0};
   /// Radii of spheres at the points (one per point, finite, >= 0; viewed,
   /// not copied: it must outlive the call), or empty. With them each cell is
@@ -187,7 +191,7 @@ struct Cells {
   /// entry of `neighbors`, dim shifts: the face is shared with the image of
   /// that point moved by shift[a] box lengths along axis a (0 on axes that
   /// are not periodic); in a triclinic box by shift[0] a + shift[1] b +
-  /// shift[2] c (VoronoiOptions::tilt's lattice vectors). A point may be listed more than once (several of
+  /// shift[2] c (the lattice vectors of Cells::tilt, the tilts used). A point may be listed more than once (several of
   /// its images, in a box only a few cells wide), even as its own
   /// neighbour; entries are ascending by id, then by shift.
   Buffer<std::int8_t> neighbor_shifts;
@@ -258,7 +262,9 @@ struct Cells {
   /// is then the box as rounded), the images of points that took part, and
   /// how far beyond the box they reached along each periodic axis.
   std::array<bool, 3> periodic{false, false, false};
-  /// A triclinic box's tilts {xy, xz, yz} as rounded (VoronoiOptions::tilt).
+  /// A triclinic box's tilts {xy, xz, yz} as used: VoronoiOptions::tilt
+  /// rounded, and reduced by whole box lengths where one was more than a
+  /// length. The shifts count the lattice vectors of these (lattice()).
   std::array<double, 3> tilt{0, 0, 0};
   /// Periodic boxes only, else empty: the points as the cells took them,
   /// n_points * dim, wrapped into the box and rounded to its grid (rows of

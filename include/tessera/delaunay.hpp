@@ -116,7 +116,7 @@ struct Delaunay {
   /// shift . lattice).
   Buffer<std::int8_t> simplex_shifts;
   std::array<bool, 3> periodic{false, false, false};
-  std::array<double, 3> tilt{0, 0, 0};     ///< as rounded (Cells::tilt)
+  std::array<double, 3> tilt{0, 0, 0};     ///< as used, rounded and reduced (Cells::tilt): the shifts' basis
   std::vector<double> periodic_points;     ///< the points as wrapped and rounded (Cells::periodic_points)
 
   bool is_periodic() const { return periodic[0] || periodic[1] || periodic[2]; }

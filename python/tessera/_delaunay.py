@@ -291,7 +291,9 @@ class Delaunay:
 
     @property
     def tilt(self) -> Tuple[float, ...]:
-        """A triclinic box's tilts as rounded (``(xy,)`` in 2D)."""
+        """A triclinic box's tilts as used (``(xy,)`` in 2D): rounded, and
+        reduced by whole box lengths where one was more than a length; the
+        basis :attr:`simplex_shifts` count."""
         t = self._dt.tilt
         return (t[0],) if self.ndim == 2 else (t[0], t[1], t[2])
 

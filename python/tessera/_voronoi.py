@@ -403,9 +403,12 @@ def voronoi(
         LAMMPS and Voro++ give them, ``(xy,)`` in 2D and ``(xy, xz, yz)`` in
         3D. The box is the parallelepiped spanned from ``bounds``' lower
         corner by a = (Lx, 0, 0), b = (xy, Ly, 0), c = (xz, yz, Lz), L the
-        extents of ``bounds``; a tilt needs both of its axes periodic. Points
-        are wrapped into it, the tilts are rounded like the coordinates, and
-        :attr:`Voronoi.neighbor_shifts` count a, b and c.
+        extents of ``bounds``; a tilt needs both of its axes periodic. A tilt
+        of more than one box length is reduced by whole lengths first (xy by
+        Lx; yz by Ly, moving xz by as many xy; xz by Lx): the same lattice, in
+        a box that is not thin. Points are wrapped into the box of the tilts
+        used (:attr:`Voronoi.tilt`, rounded like the coordinates), and
+        :attr:`Voronoi.neighbor_shifts` count its a, b and c.
     radii : array_like of float, shape (N,), optional
         Radii of spheres at the points (finite, >= 0): power cells (the
         radical or Laguerre tessellation of polydisperse spheres, as Voro++'s

@@ -46,7 +46,8 @@ int geometry_exponent(const PeriodicInput& in) {
 
 /// Tilts (xy, xz, yz) of more than a box length, reduced by whole box lengths
 /// to within half of one: b - k a for xy, then c - k b for yz (which moves xz
-/// by k times the reduced xy), then c - k a for xz. The same lattice, so the
+/// by k times the reduced xy, where it may end within a length and stay),
+/// then c - k a for xz. Nothing changes where k is 0 (not even -0.0's sign). The same lattice, so the
 /// same cells, in a box whose heights are near its lengths. A tilt of many
 /// lengths makes the parallelepiped thin across its faces, and the layer of
 /// images, counted in lattice vectors of the given basis, passed the int8
@@ -57,11 +58,12 @@ int geometry_exponent(const PeriodicInput& in) {
 /// vectors of that basis.
 std::array<double, 3> reduced_tilts(std::array<double, 3> t, const std::array<double, 3>& length) {
   auto whole_lengths = [](double v, double l) { return std::fabs(v) > l ? std::nearbyint(v / l) : 0.0; };
-  t[0] -= whole_lengths(t[0], length[0]) * length[0];
-  const double k = whole_lengths(t[2], length[1]);
-  t[2] -= k * length[1];
-  t[1] -= k * t[0];
-  t[1] -= whole_lengths(t[1], length[0]) * length[0];
+  if (const double k = whole_lengths(t[0], length[0]); k != 0) t[0] -= k * length[0];
+  if (const double k = whole_lengths(t[2], length[1]); k != 0) {
+    t[2] -= k * length[1];
+    t[1] -= k * t[0];
+  }
+  if (const double k = whole_lengths(t[1], length[0]); k != 0) t[1] -= k * length[0];
   return t;
 }
 
