@@ -1,8 +1,6 @@
 """surface_nets(): closed, consistently oriented region surfaces with the
 documented BoundaryLabels; smoothing within its constraint; files; bad input."""
 
-import os
-import signal
 import threading
 import time
 from collections import Counter
@@ -13,7 +11,7 @@ from vtkmodules.util.numpy_support import vtk_to_numpy
 from vtkmodules.vtkIOXML import vtkXMLPolyDataReader
 
 import tessera
-from conftest import UNIT_BOX, random_points
+from conftest import UNIT_BOX, random_points, sigint_after
 
 CENTRES = {2: np.array([[0.35, 0.4], [0.65, 0.4], [0.5, 0.66]]),
            3: np.array([[0.35, 0.4, 0.5], [0.65, 0.4, 0.5], [0.5, 0.66, 0.5]])}
@@ -298,17 +296,11 @@ def test_ctrl_c_interrupts_surface_nets():
     def handler(signum, frame):
         raise Interrupted()
 
-    old = signal.signal(signal.SIGINT, handler)
-    timer = threading.Timer(0.3, os.kill, (os.getpid(), signal.SIGINT))
-    try:
-        timer.start()
+    with sigint_after(0.3, handler):
         t0 = time.perf_counter()
         with pytest.raises(Interrupted):
             tessera.surface_nets(pts, lab, threads=1)
         elapsed = time.perf_counter() - t0
-    finally:
-        timer.cancel()
-        signal.signal(signal.SIGINT, old)
     assert elapsed < 3.0
 
 

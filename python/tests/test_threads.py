@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import tessera
-from conftest import random_points
+from conftest import random_points, sigint_after
 
 
 def arrays_of(result, names):
@@ -101,17 +101,11 @@ def test_ctrl_c_interrupts_a_long_call(func):
     def handler(signum, frame):
         raise Interrupted()
 
-    old = signal.signal(signal.SIGINT, handler)
-    timer = threading.Timer(0.3, os.kill, (os.getpid(), signal.SIGINT))
-    try:
-        timer.start()
+    with sigint_after(0.3, handler):
         t0 = time.perf_counter()
         with pytest.raises(Interrupted):
             func(pts, threads=1)
         elapsed = time.perf_counter() - t0
-    finally:
-        timer.cancel()
-        signal.signal(signal.SIGINT, old)
     assert elapsed < 3.0  # stopped soon after the signal, not at the end
     assert tessera.voronoi(pts[:1000], threads=1).n_cells == 1000  # usable afterwards
 
@@ -126,32 +120,20 @@ def test_ctrl_c_interrupts_find_simplex():
         raise Interrupted()
 
     dt.find_simplex(queries[:10])  # the locator is built before the clock starts
-    old = signal.signal(signal.SIGINT, handler)
-    timer = threading.Timer(0.3, os.kill, (os.getpid(), signal.SIGINT))
-    try:
-        timer.start()
+    with sigint_after(0.3, handler):
         t0 = time.perf_counter()
         with pytest.raises(Interrupted):
             dt.find_simplex(queries)
         elapsed = time.perf_counter() - t0
-    finally:
-        timer.cancel()
-        signal.signal(signal.SIGINT, old)
     assert elapsed < 2.0
     assert np.array_equal(dt.find_simplex(queries[:1000]), tessera.delaunay(dt.points).find_simplex(queries[:1000]))
 
 
 def test_ctrl_c_with_the_default_handler_raises_keyboard_interrupt():
     pts = random_points(300_000, 3, seed=3)
-    old = signal.signal(signal.SIGINT, signal.default_int_handler)
-    timer = threading.Timer(0.3, os.kill, (os.getpid(), signal.SIGINT))
-    try:
-        timer.start()
+    with sigint_after(0.3, signal.default_int_handler):
         with pytest.raises(KeyboardInterrupt):
             tessera.voronoi(pts, threads=1)
-    finally:
-        timer.cancel()
-        signal.signal(signal.SIGINT, old)
 
 
 def test_calls_from_other_threads_run_concurrently():
