@@ -441,7 +441,11 @@ std::string no_cells_reason(const io::PointCloud& pc, const Cells& c) {
     return strf("no cells: every point that could own one (%zu%s) has an empty power cell: other spheres' powers "
                 "are less everywhere",
                 c.empty_cells.size(), pc.labels.empty() ? "" : ", label >= 0");
-  if (!pc.labels.empty() && !c.duplicates.empty())  // a duplicate of an outside point: its cell is the outside's
+  // An inside point (label >= 0) duplicating an outside one, which owns their place.
+  const auto inside_under_outside = [&](const std::pair<std::int32_t, std::int32_t>& d) {
+    return pc.labels[static_cast<std::size_t>(d.first)] >= 0 && pc.labels[static_cast<std::size_t>(d.second)] < 0;
+  };
+  if (!pc.labels.empty() && std::any_of(c.duplicates.begin(), c.duplicates.end(), inside_under_outside))
     return strf("no cells: of the %zu points, those inside the domain with a label >= 0 all duplicate an outside "
                 "point (label < 0), which owns their place (the lowest id of coincident points does)",
                 pc.n);
