@@ -138,14 +138,14 @@ int run_delaunay_frame(const DelaunayArgs& a) {
                    dt.tilt[0] != 0 || dt.tilt[1] != 0 || dt.tilt[2] != 0 ? " (triclinic)" : "");
       if (const std::string t = tilt_text(a.compute, dt.tilt, dt.bounds, dt.dim); !t.empty())
         std::fprintf(stderr, "tessera: tilts %s\n", t.c_str());
-    }
-    else if (dt.from_insertion > 0)
+    } else if (dt.from_insertion > 0) {
       std::fprintf(stderr, "tessera: %zu points (%dD) -> %zu %s (by incremental insertion%s)\n", pc.n, pc.dim,
                    dt.n_simplices(), pc.dim == 3 ? "tetrahedra" : "triangles", outside.c_str());
-    else
+    } else {
       std::fprintf(stderr, "tessera: %zu points (%dD) -> %zu %s (%zu from the cells, %zu by hull completion%s%s)\n",
                    pc.n, pc.dim, dt.n_simplices(), pc.dim == 3 ? "tetrahedra" : "triangles", dt.from_cells,
                    dt.from_hull_completion, a.no_hull_completion ? ": off" : "", outside.c_str());
+    }
     if (dt.n_simplices() == 0) {
       // Only with hull completion and no labels does an empty result mean
       // flat input; otherwise say what else leaves none.
