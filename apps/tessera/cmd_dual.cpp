@@ -62,9 +62,7 @@ void print_header(const char* command, const ComputeArgs& a, const Computed& r) 
 }
 
 void print_written(const std::vector<std::string>& written) {
-  std::string out;
-  for (const auto& w : written) out += (out.empty() ? "" : ", ") + w;
-  std::printf("  %-18s %s\n", "wrote", out.c_str());
+  std::printf("  %-18s %s\n", "wrote", written_list(written).c_str());
   std::fflush(stdout);
 }
 

@@ -102,12 +102,6 @@ std::string size_string(const ImageGeometry& g) {
   return s;
 }
 
-std::string written_list(const std::vector<std::string>& written) {
-  std::string s;
-  for (const auto& w : written) s += (s.empty() ? "" : ", ") + w;
-  return s;
-}
-
 double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }

@@ -85,12 +85,6 @@ std::int32_t parse_label(const std::string& word, const std::string& what) {
   return static_cast<std::int32_t>(v);
 }
 
-std::string written_list(const std::vector<std::string>& written) {
-  std::string s;
-  for (const auto& w : written) s += (s.empty() ? "" : ", ") + shown_output(w);
-  return s;
-}
-
 }  // namespace
 
 // ------------------------------------------------------------------ registration

@@ -288,34 +288,33 @@ void apply_file_box(ComputeArgs& a) {
   a.box_source = "the box of " + (a.frame.empty() ? "" : strf("frame %zu of ", a.frame_place.index)) +
                  shown_path(a.input) + " (" + box->declared_by + ")";
   if (!a.periodic_from_file) a.box_source += ", periodic along --periodic's axes";
+  // A tilt along a wall, where the file decided either: the file's tilt
+  // against its own or --periodic's walls, or --tilt against the file's
+  // walls (--tilt against --periodic is the library's to refuse).
   static const char* const tilt_name[3] = {"xy", "xz", "yz"};
   static const int tilt_axes[3][2] = {{0, 1}, {0, 2}, {1, 2}};
   const int tilts = dim == 3 ? 3 : 1;
+  if (a.tilt_from_file || a.periodic_from_file)
+    for (int t = 0; t < tilts; ++t) {
+      const auto k = static_cast<std::size_t>(t);
+      const double v = a.tilt_from_file ? box->tilt[k] : k < a.tilt.size() ? a.tilt[k] : 0.0;
+      for (const int axis : tilt_axes[t]) {
+        if (v == 0 || a.periodic.find("xyz"[axis]) != std::string::npos) continue;
+        if (!a.tilt_from_file)
+          throw InputError(strf("--tilt: %s needs %s periodic, and %s has a wall there; give --periodic",
+                                tilt_name[t], axis_name(axis), a.box_source.c_str()));
+        throw InputError(strf("%s: the box tilts by %s = %.17g, but %s is a wall there%s; give the domain yourself "
+                              "(--bounds, with --periodic and --tilt)",
+                              shown_path(a.input).c_str(), tilt_name[t], v, axis_name(axis),
+                              a.periodic_from_file ? "" : (" (--periodic " + a.periodic + ")").c_str()));
+      }
+    }
   if (!a.tilt_from_file) {
-    // --tilt on the file's axes: a wall there is the file's, so say so.
-    if (a.periodic_from_file)
-      for (int t = 0; t < tilts && static_cast<std::size_t>(t) < a.tilt.size(); ++t)
-        for (const int axis : tilt_axes[t])
-          if (a.tilt[static_cast<std::size_t>(t)] != 0 && a.periodic.find("xyz"[axis]) == std::string::npos)
-            throw InputError(strf("--tilt: %s needs %s periodic, and %s has a wall there; give --periodic",
-                                  tilt_name[t], axis_name(axis), a.box_source.c_str()));
     a.box_source += ", tilted by --tilt";
     return;
   }
-  bool tilted = false;
-  for (int t = 0; t < tilts; ++t) {
-    const auto k = static_cast<std::size_t>(t);
-    if (box->tilt[k] == 0) continue;
-    tilted = true;
-    for (const int axis : tilt_axes[t])
-      if (a.periodic.find("xyz"[axis]) == std::string::npos)
-        throw InputError(strf("%s: the box tilts by %s = %.17g, but %s is a wall there%s; give the domain yourself "
-                              "(--bounds, with --periodic and --tilt)",
-                              shown_path(a.input).c_str(), tilt_name[t], box->tilt[k], axis_name(axis),
-                              a.periodic_from_file ? "" : (" (--periodic " + a.periodic + ")").c_str()));
-  }
-  if (tilted)
-    for (int t = 0; t < tilts; ++t) a.tilt.push_back(box->tilt[static_cast<std::size_t>(t)]);
+  const auto used = box->tilt.begin() + tilts;  // (2D: xy alone)
+  if (std::any_of(box->tilt.begin(), used, [](double v) { return v != 0; })) a.tilt.assign(box->tilt.begin(), used);
 }
 
 std::string tilt_text(const ComputeArgs& a, const std::array<double, 3>& used, const Bounds& box, int dim) {
@@ -334,8 +333,7 @@ std::string tilt_text(const ComputeArgs& a, const std::array<double, 3>& used, c
 
 void print_frame_line(const char* command, const ComputeArgs& a, const std::string& what, double seconds,
                       const std::vector<std::string>& written, std::FILE* to) {
-  std::string files;
-  for (const std::string& w : written) files += (files.empty() ? "" : ", ") + w;
+  const std::string files = written_list(written);
   std::fprintf(to, "tessera %s: %s: %s; %.3f s; wrote %s\n", command, shown_input(a).c_str(), what.c_str(), seconds,
                files.empty() ? "(nothing)" : files.c_str());
   std::fflush(to);
@@ -571,8 +569,7 @@ void print_summary(const VoronoiArgs& a, const io::PointCloud& pc, const Cells& 
               tie_heavy ? " (over 1000 per cell: near-degenerate input, e.g. points on one sphere; "
                           "`--method insertion` avoids the search, `tessera joggle` removes such ties)"
                         : "");
-  std::string out;
-  for (const auto& w : written) out += (out.empty() ? "" : ", ") + w;
+  const std::string out = written_list(written);
   std::printf("  %-18s %s\n", "wrote", out.empty() ? "(nothing)" : out.c_str());
   std::fflush(stdout);
 }

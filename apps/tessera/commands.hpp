@@ -316,6 +316,12 @@ void check_distinct_outputs(std::initializer_list<std::pair<const char*, const s
 
 /// How to name output `path` in a summary: "stdout" for "-".
 inline std::string shown_output(const std::string& path) { return path == "-" ? "stdout" : path; }
+/// The outputs written, as the summaries list them: "a.vtu, stdout".
+inline std::string written_list(const std::vector<std::string>& written) {
+  std::string s;
+  for (const auto& w : written) s += (s.empty() ? "" : ", ") + shown_output(w);
+  return s;
+}
 
 /// Whether `word` is one whole number in strtod's syntax (no leading space,
 /// nothing after it; "inf" and "nan" included), and its value. Every reader
