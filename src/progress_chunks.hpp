@@ -13,6 +13,11 @@
 #include <cstddef>
 #include <functional>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include "tessera/engine/thread_arena.hpp"
+
 namespace tessera::detail {
 
 /// Items per chunk: a few milliseconds of the cheapest per-item work on two
@@ -36,6 +41,24 @@ void in_progress_chunks(std::size_t n, const std::function<void(double)>& progre
     body(begin, std::min(n, begin + chunk));
   }
   progress(1.0);
+}
+
+/// `body(tbb::blocked_range<std::size_t>)` over [0, n) in parallel on
+/// `threads` threads (resolved), in chunks of `chunk` items with `progress`
+/// between them (in_progress_chunks); ranges of `grain` items. A chunk of
+/// at most `grain` items, or one thread, runs on the caller alone.
+template <class Body>
+void parallel_in_progress_chunks(int threads, std::size_t n, std::size_t grain,
+                                 const std::function<void(double)>& progress, Body&& body,
+                                 std::size_t chunk = kProgressChunk) {
+  engine::ThreadArena arena(threads);
+  in_progress_chunks(n, progress, [&](std::size_t begin, std::size_t end) {
+    if (threads <= 1 || end - begin <= grain) {
+      body(tbb::blocked_range<std::size_t>(begin, end));
+      return;
+    }
+    arena.execute([&] { tbb::parallel_for(tbb::blocked_range<std::size_t>(begin, end, grain), body); });
+  }, chunk);
 }
 
 }  // namespace tessera::detail

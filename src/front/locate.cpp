@@ -351,20 +351,18 @@ std::vector<std::int32_t> SimplexLocator::locate(const Delaunay& dt, std::span<c
   const std::size_t nq = queries.size() / du;
   std::vector<std::int32_t> found(nq, -1);
   if (n_simplices_ == 0) return found;
-  engine::ThreadArena arena(resolve_threads(threads));
-  detail::in_progress_chunks(nq, progress, [&](std::size_t begin, std::size_t end) {
-    arena.execute([&] {
-      tbb::parallel_for(tbb::blocked_range<std::size_t>(begin, end, 1024), [&](const tbb::blocked_range<std::size_t>& r) {
-        for (std::size_t q = r.begin(); q != r.end(); ++q) {
-          const double* x = queries.data() + q * du;
-          bool inside = true;  // in the vertices' box (false on NaN): else outside every simplex
-          for (int d = 0; d < D; ++d) inside &= x[d] >= lo_[d] && x[d] <= hi_[d];
-          if (!inside) continue;
-          found[q] = method_ == LocateMethod::walk ? walk(dt, points, x, q) : scan_bin(dt, points, x);
-        }
-      });
-    });
-  });
+  detail::parallel_in_progress_chunks(resolve_threads(threads), nq, 1024, progress,
+                                      [&](const tbb::blocked_range<std::size_t>& r) {
+                                        for (std::size_t q = r.begin(); q != r.end(); ++q) {
+                                          const double* x = queries.data() + q * du;
+                                          // in the vertices' box (false on NaN): else outside every simplex
+                                          bool inside = true;
+                                          for (int d = 0; d < D; ++d) inside &= x[d] >= lo_[d] && x[d] <= hi_[d];
+                                          if (!inside) continue;
+                                          found[q] = method_ == LocateMethod::walk ? walk(dt, points, x, q)
+                                                                                   : scan_bin(dt, points, x);
+                                        }
+                                      });
   return found;
 }
 

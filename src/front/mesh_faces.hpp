@@ -73,14 +73,13 @@ inline double face_measure(const Cells& c, std::int64_t f) {
 /// cells (detail::in_progress_chunks): Ctrl-C from Python.
 template <class Body>
 void for_each_cell(const Cells& c, Body&& body, const std::function<void(double)>& progress = {}) {
-  engine::ThreadArena arena(c.threads_used);  // 0 (never computed): one thread
-  detail::in_progress_chunks(c.n_cells(), progress, [&](std::size_t begin, std::size_t end) {
-    arena.execute([&] {
-      tbb::parallel_for(tbb::blocked_range<std::size_t>(begin, end, 256), [&](const tbb::blocked_range<std::size_t>& r) {
+  // (threads_used 0, never computed: one thread)
+  detail::parallel_in_progress_chunks(
+      c.threads_used, c.n_cells(), 256, progress,
+      [&](const tbb::blocked_range<std::size_t>& r) {
         for (std::size_t k = r.begin(); k != r.end(); ++k) body(k);
-      });
-    });
-  }, std::size_t{1} << 15);
+      },
+      std::size_t{1} << 15);
 }
 
 }  // namespace tessera::front

@@ -147,14 +147,7 @@ Grid make_grid(int dim, const double* lo, const double* hi, std::size_t n, doubl
 /// be empty) is called.
 template <class F>
 void parallel_range(std::size_t n, int threads, const std::function<void(double)>& progress, F&& body) {
-  engine::ThreadArena arena(threads);
-  detail::in_progress_chunks(n, progress, [&](std::size_t begin, std::size_t end) {
-    if (threads == 1 || end - begin <= kGrain) {
-      body(tbb::blocked_range<std::size_t>(begin, end));
-      return;
-    }
-    arena.execute([&] { tbb::parallel_for(tbb::blocked_range<std::size_t>(begin, end, kGrain), body); });
-  });
+  detail::parallel_in_progress_chunks(threads, n, kGrain, progress, body);
 }
 
 }  // namespace

@@ -104,15 +104,7 @@ std::vector<double> joggle(std::span<const double> coords, int dim, const Joggle
       for (int k = 0; k < moving; ++k) out[i * stride + static_cast<std::size_t>(axes[k])] += radius * u[k];
     }
   };
-  const int threads = resolve_threads(options.threads);
-  engine::ThreadArena arena(threads);
-  detail::in_progress_chunks(n, options.progress, [&](std::size_t begin, std::size_t end) {
-    if (threads == 1 || end - begin <= kGrain) {
-      body(tbb::blocked_range<std::size_t>(begin, end));
-      return;
-    }
-    arena.execute([&] { tbb::parallel_for(tbb::blocked_range<std::size_t>(begin, end, kGrain), body); });
-  });
+  detail::parallel_in_progress_chunks(resolve_threads(options.threads), n, kGrain, options.progress, body);
   for (std::size_t k = 0; k < out.size(); ++k)
     if (!std::isfinite(out[k]) && std::isfinite(coords[k]))
       throw InputError("joggle: point " + std::to_string(k / stride) + " moved past double's range (radius " +

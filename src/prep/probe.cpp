@@ -90,18 +90,12 @@ ProbeResult probe(const ScalarImage& image, std::span<const double> coords, cons
 
   constexpr std::size_t kGrain = 4096;
   const int threads = resolve_threads(options.threads);
-  engine::ThreadArena arena(threads);
-  detail::in_progress_chunks(n, options.progress, [&](std::size_t begin, std::size_t end) {
-    if (threads == 1 || end - begin <= kGrain) {
-      for (std::size_t p = begin; p < end; ++p) one(p);
-      return;
-    }
-    arena.execute([&] {
-      tbb::parallel_for(tbb::blocked_range<std::size_t>(begin, end, kGrain), [&](const tbb::blocked_range<std::size_t>& r) {
+  detail::parallel_in_progress_chunks(
+      threads, n, kGrain, options.progress,
+      [&](const tbb::blocked_range<std::size_t>& r) {
         for (std::size_t p = r.begin(); p != r.end(); ++p) one(p);
-      });
-    });
-  }, std::size_t{1} << 18);
+      },
+      std::size_t{1} << 18);
   return res;
 }
 
