@@ -13,6 +13,27 @@ from ._voronoi import periodic_box
 PathLike = Union[str, "os.PathLike[str]"]
 
 
+_TRANSFORM_BLOCK = 1 << 16
+
+
+def _transform_block(v: np.ndarray, t: np.ndarray) -> None:
+    """Fills ``t`` (m, D+1, D) with the barycentric maps of the simplices
+    whose corners are ``v`` (m, D+1, D); see :attr:`Delaunay.transform`."""
+    d = v.shape[2]
+    t[:, d, :] = v[:, d, :]
+    # Columns v_k - v_D. A positively oriented simplex is never flat, but its
+    # LU factors may round to a zero pivot, where inv would raise: slogdet (the
+    # same factorisation, and no underflow at tiny scales) has sign 0 exactly
+    # there.
+    m = np.transpose(v[:, :d, :] - v[:, d:, :], (0, 2, 1))
+    ok = np.linalg.slogdet(m)[0] != 0
+    t[:, :d, :] = np.nan
+    if ok.all():
+        t[:, :d, :] = np.linalg.inv(m)
+    elif ok.any():
+        t[ok, :d, :] = np.linalg.inv(m[ok])
+
+
 class Delaunay:
     """The Delaunay triangulation of a point set (triangles in 2D, tetrahedra in 3D).
 
@@ -189,20 +210,14 @@ class Delaunay:
         self._refuse_periodic("transform")
         if self._transform is None:
             d = self.ndim
-            v = self.points[self.simplices]  # (m, D+1, D)
-            t = np.empty((len(v), d + 1, d))
-            t[:, d, :] = v[:, d, :]
-            # Columns v_k - v_D. A positively oriented simplex is never flat,
-            # but its LU factors may round to a zero pivot, where inv would
-            # raise: slogdet (the same factorisation, and no underflow at
-            # tiny scales) has sign 0 exactly there.
-            m = np.transpose(v[:, :d, :] - v[:, d:, :], (0, 2, 1))
-            ok = np.linalg.slogdet(m)[0] != 0 if len(m) else np.zeros(0, dtype=bool)
-            t[:, :d, :] = np.nan
-            if ok.all():
-                t[:, :d, :] = np.linalg.inv(m)
-            elif ok.any():
-                t[ok, :d, :] = np.linalg.inv(m[ok])
+            simplices = self.simplices
+            t = np.empty((len(simplices), d + 1, d))
+            # In blocks: Ctrl-C is taken between them (numpy's batched calls
+            # cannot be interrupted: 7 s at 1M points), and the corner
+            # coordinates are never gathered for all simplices at once.
+            for lo in range(0, len(simplices), _TRANSFORM_BLOCK):
+                _transform_block(self.points[simplices[lo:lo + _TRANSFORM_BLOCK]],
+                                 t[lo:lo + _TRANSFORM_BLOCK])
             t.setflags(write=False)
             self._transform = t
         return self._transform

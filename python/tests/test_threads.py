@@ -129,6 +129,31 @@ def test_ctrl_c_interrupts_find_simplex():
     assert np.array_equal(dt.find_simplex(queries[:1000]), tessera.delaunay(dt.points).find_simplex(queries[:1000]))
 
 
+def test_ctrl_c_interrupts_transform():
+    """transform is computed in blocks, with Ctrl-C taken between them: one
+    batched numpy call ran 7 s at 1M points past it. Interrupted, nothing is
+    kept, and the next use computes the whole of it."""
+    pts = random_points(200_000, 3, seed=6)
+    first = tessera.delaunay(pts, threads=1)
+    t0 = time.perf_counter()
+    whole = first.transform
+    uninterrupted = time.perf_counter() - t0
+
+    def handler(signum, frame):
+        raise Interrupted()
+
+    dt = tessera.delaunay(pts, threads=1)
+    # Near halfway is inside numpy's batched inverse, which alone took half of the
+    # time when it ran on all simplices at once.
+    with sigint_after(0.45 * uninterrupted, handler):
+        t0 = time.perf_counter()
+        with pytest.raises(Interrupted):
+            dt.transform
+        elapsed = time.perf_counter() - t0
+    assert elapsed < 0.6 * uninterrupted
+    assert np.array_equal(dt.transform, whole, equal_nan=True)
+
+
 def test_ctrl_c_with_the_default_handler_raises_keyboard_interrupt():
     pts = random_points(300_000, 3, seed=3)
     with sigint_after(0.3, signal.default_int_handler):
