@@ -44,13 +44,16 @@ Flower flower_of(const Cells& c, std::span<const double> points, std::int32_t id
 
   double r_max = 0;
   for (std::int32_t v : fl.vertex_ids) {
-    double r2 = 0;
+    double r2 = 0, d[3] = {0, 0, 0};
     for (std::size_t a = 0; a < D; ++a) {
       const double x = c.vertices[static_cast<std::size_t>(v) * D + a];
       fl.petal_centres.push_back(x);
-      r2 += (x - fl.site[a]) * (x - fl.site[a]);
+      d[a] = x - fl.site[a];
+      r2 += d[a] * d[a];
     }
-    fl.petal_radii.push_back(std::sqrt(r2));
+    // std::hypot (which scales) where a square under- or overflowed: petals
+    // past ~1e154 were inf, below ~1e-154 wrong or zero.
+    fl.petal_radii.push_back(r2 >= 0x1p-900 && r2 <= 0x1p900 ? std::sqrt(r2) : std::hypot(d[0], d[1], d[2]));
     r_max = std::max(r_max, fl.petal_radii.back());
   }
   fl.circumflower_radius = 2 * r_max;

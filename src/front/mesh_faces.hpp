@@ -3,10 +3,12 @@
 // and the parallel loop over cells.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -16,6 +18,7 @@
 #include "../progress_chunks.hpp"
 #include "tessera/cells.hpp"
 #include "tessera/engine/thread_arena.hpp"
+#include "tessera/kernels/filter.hpp"
 
 namespace tessera::front {
 
@@ -53,18 +56,30 @@ inline double face_measure(const Cells& c, std::int64_t f) {
     const double* q = at(b + 1);
     return std::hypot(q[0] - p[0], q[1] - p[1]);
   }
+  // The fan's cross products are of coordinates relative to the first vertex,
+  // scaled by a power of two that brings the largest near 1 where they are
+  // beyond 2^±200: their products, and the squares of the sum, would over- or
+  // underflow (faces past ~1e77 were inf, below ~1e-77 zero). A power of two
+  // changes no rounding, and within that range nothing is scaled.
   const double* o = at(b);
+  double m = 0;
+  for (std::size_t k = b + 1; k < e; ++k)
+    for (int d = 0; d < 3; ++d) m = std::max(m, std::fabs(at(k)[d] - o[d]));
+  std::int32_t x = 0;
+  if (m > 0 && m <= std::numeric_limits<double>::max() && !(m >= 0x1p-200 && m <= 0x1p200))
+    x = kernels::filter::binary_exponent(m);
+  const double sc = kernels::filter::pow2(-x);
   double s[3] = {0, 0, 0};
   for (std::size_t k = b + 1; k + 1 < e; ++k) {
     const double* p = at(k);
     const double* q = at(k + 1);
-    const double u[3] = {p[0] - o[0], p[1] - o[1], p[2] - o[2]};
-    const double v[3] = {q[0] - o[0], q[1] - o[1], q[2] - o[2]};
+    const double u[3] = {(p[0] - o[0]) * sc, (p[1] - o[1]) * sc, (p[2] - o[2]) * sc};
+    const double v[3] = {(q[0] - o[0]) * sc, (q[1] - o[1]) * sc, (q[2] - o[2]) * sc};
     s[0] += u[1] * v[2] - u[2] * v[1];
     s[1] += u[2] * v[0] - u[0] * v[2];
     s[2] += u[0] * v[1] - u[1] * v[0];
   }
-  return 0.5 * std::sqrt(s[0] * s[0] + s[1] * s[1] + s[2] * s[2]);
+  return std::ldexp(0.5 * std::sqrt(s[0] * s[0] + s[1] * s[1] + s[2] * s[2]), 2 * x);
 }
 
 /// body(cell index) for every cell, on the thread count the cells were

@@ -4,6 +4,8 @@
 // cell's faces come through unchanged.
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "cells/helpers.hpp"
 #include "tessera/flower.hpp"
 
@@ -86,6 +88,33 @@ TEST(Flower, PetalsCircumflowerAndNeighbours) {
   check_flower(c, lattice, fl[0], "lattice");
   for (double r : fl[0].petal_radii) EXPECT_NEAR(r, std::sqrt(3.0) / 2, 1e-15);
   EXPECT_NEAR(fl[0].circumflower_radius, std::sqrt(3.0), 1e-15);
+}
+
+// Petal radii far from 1: |v - p| is taken with std::hypot where its
+// squares leave double's range (beyond ~1e154 they were inf, below ~1e-154
+// wrong or zero). Points scaled by a power of two give the same flower scaled.
+TEST(Flower, RadiiAtExtremeScales) {
+  for (int dim : {2, 3}) {
+    const auto pts = random_points(300, dim, 811 + dim);
+    const std::vector<std::int32_t> ids{0, 150, 299};
+    const auto ref = tessera::flowers(run(pts, dim), pts, ids);
+    for (int e : {-600, 600}) {
+      std::vector<double> scaled(pts);
+      for (double& x : scaled) x = std::ldexp(x, e);
+      const auto fl = tessera::flowers(run(scaled, dim), scaled, ids);
+      for (std::size_t i = 0; i < ids.size(); ++i) {
+        const std::string what = std::to_string(dim) + "D flower of " + std::to_string(ids[i]) + " at 2^" +
+                                 std::to_string(e);
+        ASSERT_EQ(fl[i].n_petals(), ref[i].n_petals()) << what;
+        for (std::size_t v = 0; v < fl[i].n_petals(); ++v)
+          ASSERT_NEAR(std::ldexp(fl[i].petal_radii[v], -e), ref[i].petal_radii[v], 1e-12 * ref[i].petal_radii[v])
+              << what << ", petal " << v;
+        EXPECT_NEAR(std::ldexp(fl[i].circumflower_radius, -e), ref[i].circumflower_radius,
+                    1e-12 * ref[i].circumflower_radius)
+            << what;
+      }
+    }
+  }
 }
 
 TEST(Flower, PointsWithoutCellsAreRejected) {

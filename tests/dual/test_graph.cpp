@@ -189,6 +189,29 @@ TEST(Graph, PruneLeavesTheLatticeGraph) {
   }
 }
 
+// Face measures far from 1: the fan's cross products are scaled (mesh_faces.hpp).
+// Points scaled by a power of two give the same cells scaled by it, so each
+// face's measure is the unit-scale one times its square (its first power in
+// 2D); at 2^±300 the squares of the cross products used to leave double's
+// range (3D areas inf above ~1e77, zero below ~1e-77).
+TEST(Graph, FaceMeasuresAtExtremeScales) {
+  for (int dim : {2, 3}) {
+    const auto pts = random_points(200, dim, 733 + dim);
+    const auto ref = tessera::adjacency_graph(run(pts, dim), {});
+    for (int e : {-300, 300, -500, 500}) {
+      std::vector<double> scaled(pts);
+      for (double& x : scaled) x = std::ldexp(x, e);
+      const auto g = tessera::adjacency_graph(run(scaled, dim), {});
+      const std::string what = std::to_string(dim) + "D at 2^" + std::to_string(e);
+      ASSERT_EQ(g.spokes, ref.spokes) << what;
+      for (std::size_t s = 0; s < g.n_spokes(); ++s) {
+        const double m = std::ldexp(g.spoke_measure[s], -(dim - 1) * e);
+        ASSERT_NEAR(m, ref.spoke_measure[s], 1e-12 * ref.spoke_measure[s]) << what << ", spoke " << s;
+      }
+    }
+  }
+}
+
 TEST(Graph, BadInput) {
   const auto pts = random_points(100, 3, 331);
   const auto c = run(pts, 3);
