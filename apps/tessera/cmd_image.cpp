@@ -277,7 +277,8 @@ void add_image_commands(CLI::App& app, ImageCommands& c) {
   p->add_flag("-q,--quiet", c.probe.quiet, "No summary line");
   p->footer(
       "A point is inside when it lies in the box spanned by the voxel centres, far faces included, or\n"
-      "within 1e-9 voxel spacings of it (the rounding of (p - origin) / spacing); it then takes the face's value.\n"
+      "within 1e-9 voxel spacings of it (the rounding of (p - origin) / spacing), plus a few ulps of the image's\n"
+      "largest coordinate; it then takes the face's value.\n"
       "Examples:\n"
       "  tessera probe field.vti pts.npy -o values.npy\n"
       "  tessera probe density.nrrd pts.ply --outside-value 0 -o probed.ply");

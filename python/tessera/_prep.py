@@ -584,7 +584,8 @@ def probe(
     outside_value : float
         The value at points outside the box of the voxel centres (a point on
         its far face is inside, and so is one within 1e-9 voxel spacings of
-        it, which takes the face's value).
+        it, plus a few ulps of the image's largest coordinate, which takes
+        the face's value).
     threads : int, optional
         Worker threads (None: all cores).
     keep_non_finite : bool

@@ -3,11 +3,13 @@
 //
 // A point's continuous index along axis a is t = (p - origin) / spacing. It
 // is inside when 0 <= t <= size - 1 on every axis, with a slack of 1e-9
-// voxel so that a point computed as origin + (size - 1) * spacing (the far
-// face) is inside despite rounding; t is then clamped into the box, and
-// snapped to the nearest integer when within the same slack (so a voxel
-// centre computed as origin + i * spacing hits voxel i exactly). Corners
-// of zero weight are skipped, so a point at a voxel centre returns exactly
+// voxel plus the rounding of coordinates of the image's magnitude, so that a
+// point computed as origin + (size - 1) * spacing (the far face) is inside
+// despite rounding, also far from the origin of coordinates (a raster at
+// northing 4.5e6 m with 0.1 m voxels: one ulp is 9e-9 voxel); t is then
+// clamped into the box, and snapped to the nearest integer when within the
+// same slack (so a voxel centre computed as origin + i * spacing hits voxel
+// i exactly). Corners of zero weight are skipped, so a point at a voxel centre returns exactly
 // that voxel's value (a NaN in a neighbouring voxel does not leak in), and a
 // degenerate axis (size 1) needs no neighbour.
 #include "tessera/prep/probe.hpp"
@@ -51,7 +53,16 @@ ProbeResult probe(const ScalarImage& image, std::span<const double> coords, cons
   ProbeResult res;
   res.values.assign(n, options.outside_value);
   res.valid.assign(n, 0);
-  constexpr double kSlack = 1e-9;
+  // Per axis: 1e-9 voxel, plus what computing origin + i * spacing and then
+  // (p - origin) / spacing may round away: a few ulps of the largest
+  // coordinate in the image, in voxels.
+  double slack[3] = {0, 0, 0};
+  for (int a = 0; a < dim; ++a) {
+    const auto au = static_cast<std::size_t>(a);
+    const double far = g.origin[au] + static_cast<double>(g.size[au] - 1) * g.spacing[au];
+    const double magnitude = std::max(std::fabs(g.origin[au]), std::fabs(far));
+    slack[a] = 1e-9 + 8 * 0x1p-53 * magnitude / g.spacing[au];
+  }
   const double* vals = image.values.data();
 
   auto one = [&](std::size_t p) {
@@ -61,11 +72,11 @@ ProbeResult probe(const ScalarImage& image, std::span<const double> coords, cons
       const std::size_t au = static_cast<std::size_t>(a);
       const double hi = static_cast<double>(g.size[au] - 1);
       double t = (coords[p * static_cast<std::size_t>(dim) + au] - g.origin[au]) / g.spacing[au];
-      if (!(t >= -kSlack && t <= hi + kSlack)) return;  // outside (also +-inf, and NaN)
+      if (!(t >= -slack[a] && t <= hi + slack[a])) return;  // outside (also +-inf, and NaN)
       t = std::clamp(t, 0.0, hi);
       // Snap to a voxel index within the slack: (p - origin) / spacing at a
       // voxel centre is off by rounding, and exactness there matters more.
-      if (const double r = std::round(t); std::abs(t - r) <= kSlack) t = r;
+      if (const double r = std::round(t); std::abs(t - r) <= slack[a]) t = r;
       std::int64_t i = static_cast<std::int64_t>(std::floor(t));
       if (i > g.size[au] - 2) i = std::max<std::int64_t>(0, g.size[au] - 2);
       i0[a] = i;

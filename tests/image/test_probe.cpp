@@ -92,6 +92,35 @@ TEST(image_probe, VoxelCentresGiveTheVoxelValueExactly) {
   }
 }
 
+// Voxel centres of a raster far from 0 (UTM northing 4.5e6 m, 0.1 m voxels:
+// one ulp of a coordinate is 9e-9 voxel, past the 1e-9 slack alone): every
+// centre computed as origin + i * spacing is inside and exact, the far row
+// and column included, and half a voxel beyond is outside.
+TEST(image_probe, VoxelCentresOfARasterFarFromZero) {
+  ScalarImage img;
+  img.geometry.dim = 2;
+  img.geometry.size = {100, 100, 1};
+  img.geometry.spacing = {0.1, 0.1, 1.0};
+  img.geometry.origin = {600000.05, 4500000.05, 0.0};
+  const auto& g = img.geometry;
+  img.values.resize(g.n_voxels());
+  for (std::size_t v = 0; v < img.values.size(); ++v) img.values[v] = static_cast<double>(v);
+  std::vector<double> pts;
+  for (std::int64_t j = 0; j < g.size[1]; ++j)
+    for (std::int64_t i = 0; i < g.size[0]; ++i) {
+      pts.push_back(g.origin[0] + static_cast<double>(i) * g.spacing[0]);
+      pts.push_back(g.origin[1] + static_cast<double>(j) * g.spacing[1]);
+    }
+  pts.push_back(g.origin[0] + 99.5 * g.spacing[0]);
+  pts.push_back(g.origin[1]);
+  const auto r = probe(img, pts);
+  for (std::size_t v = 0; v < g.n_voxels(); ++v) {
+    ASSERT_EQ(r.valid[v], 1) << "voxel " << v;
+    ASSERT_EQ(r.values[v], img.values[v]) << "voxel " << v;
+  }
+  EXPECT_EQ(r.valid.back(), 0);
+}
+
 TEST(image_probe, OutsidePointsAndFarFaces) {
   const ScalarImage img = linear_image(3, {1, 0, 0, 0});  // constant 1
   const auto& g = img.geometry;

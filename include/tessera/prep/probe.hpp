@@ -16,7 +16,8 @@ namespace tessera {
 
 struct ProbeOptions {
   /// Value for points outside the image's voxel-centre box (farther than
-  /// 1e-9 voxel spacings from it: nearer, a point takes the face's value).
+  /// 1e-9 voxel spacings from it, plus a few ulps of the image's largest
+  /// coordinate: nearer, a point takes the face's value).
   double outside_value = std::numeric_limits<double>::quiet_NaN();
   int threads = 0;
   /// A point with a NaN coordinate (an organized cloud's missing return) is
