@@ -69,6 +69,13 @@ RawImage read_vti_image(const std::string& path, const std::string& array) {
         fail(path, "Direction is not axis-aligned (rotated or permuted images are not supported; resample first)");
     for (std::size_t a = 0; a < 3; ++a) raw.flip[a] = m[4 * a] < 0;
   }
+  // A negative Spacing flips its axis as a Direction of -1 does (VTK places
+  // voxel i at Origin + Direction i Spacing): both together cancel.
+  for (std::size_t a = 0; a < 3; ++a)
+    if (g.spacing[a] < 0) {
+      g.spacing[a] = -g.spacing[a];
+      raw.flip[a] = !raw.flip[a];
+    }
   for (std::size_t a = 0; a < 3; ++a) {
     g.size[a] = whole[2 * a + 1] - whole[2 * a] + 1;
     // Voxel i along an axis lies at Origin + i * spacing, or at Origin - i *

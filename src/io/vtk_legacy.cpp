@@ -551,6 +551,14 @@ RawImage read_vtk_legacy_image(const std::string& path, const std::string& array
     g.size[a] = lp.dims[a];
     g.spacing[a] = lp.spacing[a];
     g.origin[a] = lp.origin[a];
+    // Voxel i lies at ORIGIN + i SPACING: a negative spacing is an axis
+    // stored flipped (VTK's writers keep it so), read reversed from the
+    // lowest voxel, as the other formats' flips are.
+    if (g.spacing[a] < 0) {
+      raw.flip[a] = true;
+      g.origin[a] += static_cast<double>(g.size[a] - 1) * g.spacing[a];
+      g.spacing[a] = -g.spacing[a];
+    }
   }
   g.dim = g.size[2] == 1 ? 2 : 3;  // one slice: a 2D image, as a .vti's
   check_geometry(path, g);

@@ -289,6 +289,25 @@ def main():
                              ORIGIN[2] + (EXT0[2] + NZ - 1) * SPACING[2]))
     fimg.SetDirectionMatrix(-1, 0, 0, 0, 1, 0, 0, 0, -1)
     write_vti(p("vti_flipxz.vti"), fimg, "binary", 0)
+    # The same flips stored as negative spacings, which VTK's writers keep
+    # (voxel i at Origin + i Spacing): .vti x and z, legacy .vtk y.
+    nimg = vtk_image([("labels", np.ascontiguousarray(lab[::-1, :, ::-1]))],
+                     origin=(ORIGIN[0] + (EXT0[0] + NX - 1) * SPACING[0], VTK_ORIGIN[1],
+                             ORIGIN[2] + (EXT0[2] + NZ - 1) * SPACING[2]))
+    nimg.SetSpacing(-SPACING[0], SPACING[1], -SPACING[2])
+    write_vti(p("vti_negspacing.vti"), nimg, "binary", 0)
+    nsp = vtk.vtkImageData()
+    nsp.SetDimensions(NX, NY, NZ)
+    nsp.SetSpacing(SPACING[0], -SPACING[1], SPACING[2])
+    nsp.SetOrigin(ORIGIN[0], ORIGIN[1] + (NY - 1) * SPACING[1], ORIGIN[2])
+    nva = numpy_to_vtk(np.ascontiguousarray(lab[:, ::-1, :].ravel()), deep=1)
+    nva.SetName("labels")
+    nsp.GetPointData().SetScalars(nva)
+    nw = vtk.vtkStructuredPointsWriter()
+    nw.SetInputData(nsp)
+    nw.SetFileName(p("legacy_negspacing.vtk"))
+    nw.SetFileTypeToASCII()
+    nw.Write()
     with open(p("nrrd_gzip.nrrd"), "wb") as f:
         f.write(nrrd_header("int16", (NX, NY, NZ), "gzip").encode() + b"\n" + gzip.compress(raw16))
     with open(p("nrrd_big.nrrd"), "wb") as f:

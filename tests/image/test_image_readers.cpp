@@ -238,9 +238,13 @@ TEST_F(image_readers, VtiClaimsBeyondTheFileRefusedFirst) {
 // Axes stored with negative steps in the other formats (NRRD's space
 // directions, MetaImage's TransformMatrix, .vti's Direction, checked against
 // VTK's own index-to-world map in make_images.py's geometry): reversed on
-// reading, the same image. They were refused as "flipped".
+// reading, the same image. They were refused as "flipped". So are VTK
+// images with negative spacings (until stop 84 refused as "spacing ... must
+// be > 0"), which VTK's readers place at Origin + i Spacing.
 TEST_F(image_readers, FlippedAxesReadReversed) {
-  for (const char* name : {"nrrd_flipx.nrrd", "meta_flipy.mha", "vti_flipxz.vti"}) expect_labels(name);
+  for (const char* name :
+       {"nrrd_flipx.nrrd", "meta_flipy.mha", "vti_flipxz.vti", "vti_negspacing.vti", "legacy_negspacing.vtk"})
+    expect_labels(name);
 }
 
 // Legacy VTK images (STRUCTURED_POINTS, VTK's own writer in both modes):
