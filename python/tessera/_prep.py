@@ -65,7 +65,8 @@ def _label_image(image: Any, spacing: Any, origin: Any) -> Any:
     if _is_path(image):
         sp, org = _geometry(spacing, origin, None)
         return _inputs.call(_core.read_label_image, _inputs.as_path(image), sp, org)
-    a = _image_array(image, "iu", "integer labels (a label image); threshold a scalar image first")
+    # A boolean mask is the labels 0 and 1, as a bool .npy read from its file.
+    a = _image_array(image, "biu", "integer labels (a label image); threshold a scalar image first")
     info = np.iinfo(np.int32)
     if a.min() < info.min or a.max() > info.max:
         raise ValueError(f"image: labels must fit in 32 bits ([{info.min}, {info.max}])")
@@ -77,7 +78,7 @@ def _scalar_image(image: Any, spacing: Any, origin: Any) -> Any:
     if _is_path(image):
         sp, org = _geometry(spacing, origin, None)
         return _inputs.call(_core.read_scalar_image, _inputs.as_path(image), sp, org)
-    a = _image_array(image, "fiu", "real numbers")
+    a = _image_array(image, "bfiu", "real numbers")
     sp, org = _geometry(spacing, origin, a.ndim)
     return _core.scalar_image(np.ascontiguousarray(a, dtype=np.float64), sp, org)
 

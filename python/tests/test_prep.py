@@ -179,6 +179,20 @@ def test_sample_image_exponential_schedule(select):
     assert np.array_equal(np.sort(flat), np.flatnonzero(want.ravel()))
 
 
+def test_bool_masks_are_the_labels_0_and_1(tmp_path):
+    """A boolean mask in memory is what the same array read from its .npy is
+    (and what the command line reads): labels 0 and 1, values 0.0 and 1.0."""
+    m = np.zeros((6, 7), bool)
+    m[2:4, 2:5] = True
+    np.save(tmp_path / "mask.npy", m)
+    pts, labels = tessera.sample_image(m, randomize=False)
+    ref_pts, ref_labels = tessera.sample_image(tmp_path / "mask.npy", randomize=False)
+    assert np.array_equal(pts, ref_pts) and np.array_equal(labels, ref_labels)
+    assert np.array_equal(pts, tessera.sample_image(m.astype(np.uint8), randomize=False)[0])
+    values, valid = tessera.probe(m, [[2.0, 2.0], [0.0, 0.0], [2.5, 2.0]])
+    assert valid.all() and list(values) == [1.0, 0.0, 1.0]
+
+
 def test_sample_image_outputs_selection_and_background_label():
     im = label_volume()
     pts, lab = tessera.sample_image(im, select=[1], background_label=-9, seed=3)
@@ -316,7 +330,7 @@ BAD = {
     "fill bounds length": (lambda: tessera.fill(P3, bounds=(0, 1)), r"bounds: expected 6 numbers"),
     # sample_image
     "sample float image": (lambda: tessera.sample_image(np.zeros((4, 4))), r"image: expected integer labels"),
-    "sample bool image": (lambda: tessera.sample_image(np.zeros((4, 4), bool)), r"image: expected integer labels"),
+    "sample complex image": (lambda: tessera.sample_image(np.zeros((4, 4), complex)), r"image: expected integer labels"),
     "sample 4-D image": (lambda: tessera.sample_image(np.zeros((2, 2, 2, 2), int)), r"image: expected shape"),
     "sample unknown label": (lambda: tessera.sample_image(IM, select=[1, 4]), r"unknown label 4"),
     "sample empty select": (lambda: tessera.sample_image(IM, select=[]), r"select: empty selection"),
