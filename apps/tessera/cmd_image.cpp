@@ -285,6 +285,13 @@ void add_image_commands(CLI::App& app, ImageCommands& c) {
 }
 
 int run_image_command(const ImageCommands& c) {
+  // No output may replace a file the command reads (io::protect_from_writes).
+  if (c.sample_app && c.sample_app->parsed()) io::protect_from_writes(c.sample.image, "the IMAGE");
+  if (c.probe_app && c.probe_app->parsed()) {
+    io::protect_from_writes(c.probe.image, "the IMAGE");
+    io::protect_from_writes(c.probe.points, "the POINTS");
+    io::protect_from_writes(c.probe.labels, "--labels");
+  }
   if (c.sample_app && c.sample_app->parsed()) return run_sample_image(c.sample);
   if (c.probe_app && c.probe_app->parsed()) return run_probe(c.probe);
   return -1;

@@ -182,7 +182,23 @@ void add_prep_commands(CLI::App& app, PrepCommands& c) {
             "  tessera threshold scan.ply --scalars intensity --interval 0,10,1 --interval 10,20,2 -o out.vtp");
 }
 
+/// No output may replace a file the command reads (io::protect_from_writes):
+/// `joggle p.npy -o p.npy` replaced the points it read.
+void protect_inputs(const PrepInput& p) {
+  io::protect_from_writes(p.input, "the INPUT");
+  io::protect_from_writes(p.labels, "--labels");
+}
+
 int run_prep_command(const PrepCommands& c) {
+  if (c.joggle_app && c.joggle_app->parsed()) {
+    protect_inputs(c.joggle.io);
+    io::protect_from_writes(c.joggle.mask, "--mask");
+  }
+  if (c.fill_app && c.fill_app->parsed()) protect_inputs(c.fill.io);
+  if (c.threshold_app && c.threshold_app->parsed()) {
+    protect_inputs(c.threshold.io);
+    io::protect_from_writes(c.threshold.scalars, "--scalars");
+  }
   if (c.joggle_app && c.joggle_app->parsed()) return run_joggle(c.joggle);
   if (c.fill_app && c.fill_app->parsed()) return run_fill(c.fill);
   if (c.threshold_app && c.threshold_app->parsed()) return run_threshold(c.threshold);

@@ -758,8 +758,12 @@ int run_default(const DemoArgs& a) {
   const Cells cells = compute(pc, opt, !a.quiet && stderr_is_terminal(), compute_s);
 
   const auto t0 = Clock::now();
-  io::write_cells_vtk(vtu, cells);
-  io::write_cell_table(csv, cells);
+  {
+    io::OutputGroup outputs;  // both or neither
+    io::write_cells_vtk(vtu, cells);
+    io::write_cell_table(csv, cells);
+    outputs.commit();
+  }
   const double write_s = seconds_since(t0);
 
   if (!a.quiet) {

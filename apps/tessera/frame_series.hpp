@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "commands.hpp"
-#include "tessera/io/atomic_file.hpp"  // check_writable
+#include "tessera/io/atomic_file.hpp"  // check_writable, OutputGroup
 #include "stdin_input.hpp"  // shown_path
 
 namespace tessera::cli {
@@ -38,6 +38,17 @@ Args with_frame_names(Args a, std::initializer_list<SeriesOutput<Args>> outputs,
   return a;
 }
 
+/// `run_one(a)`, its outputs renamed into place together once it returns
+/// (io::OutputGroup): a failure in any of them leaves every one of the
+/// frame's targets as it was (a new cells file beside the old table).
+template <class Args, class Run>
+int run_committed(const Args& a, Run& run_one) {
+  io::OutputGroup outputs;
+  const int rc = run_one(a);
+  outputs.commit();
+  return rc;
+}
+
 /// A command's run: `run_one(args)` once, or for each frame of a series.
 /// One frame asked for by its INDEX: {frame} in an output's name is its
 /// index (from the start, also for -1), as in a series, so that a loop
@@ -47,14 +58,15 @@ Args with_frame_names(Args a, std::initializer_list<SeriesOutput<Args>> outputs,
 /// Every output given must hold {frame} (standard output is refused:
 /// several tables in one stream). Each frame's files are whole when
 /// written; an error in a frame names it, and the files of the frames
-/// before it stay. A frame of no atoms (a dump of a group that was empty
+/// before it stay (each frame's are renamed into place together). A frame of no atoms (a dump of a group that was empty
 /// then) is skipped with a note on standard error and gets no files; a
 /// series of such frames alone is an error. The exit code is the worst of
 /// the frames' (a failed --validate goes on to the next frame).
 template <class Args, class Run>
 int run_frames(const Args& a, std::initializer_list<SeriesOutput<Args>> outputs, Run&& run_one) {
   if (a.compute.frames.empty())
-    return run_one(a.compute.frame.empty() ? a : with_frame_names(a, outputs, a.compute.frame_place.index));
+    return run_committed(a.compute.frame.empty() ? a : with_frame_names(a, outputs, a.compute.frame_place.index),
+                         run_one);
   for (const SeriesOutput<Args>& o : outputs) {
     const std::string& path = a.*(o.path);
     if (path == "-")
@@ -104,7 +116,7 @@ int run_frames(const Args& a, std::initializer_list<SeriesOutput<Args>> outputs,
         f.compute.box_source.clear();
         apply_file_box(f.compute);
       }
-      const int r = run_one(with_frame_names(f, outputs, place.index));
+      const int r = run_committed(with_frame_names(f, outputs, place.index), run_one);
       if (r != kExitOk) rc = r;
     } catch (const InputError& e) {
       throw InputError("frame " + std::to_string(place.index) + ": " + e.what() +

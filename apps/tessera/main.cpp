@@ -21,6 +21,7 @@
 #include "progress.hpp"
 #include "stdin_input.hpp"
 #include "tessera/cells.hpp"
+#include "tessera/io/atomic_file.hpp"
 
 namespace {
 
@@ -249,6 +250,11 @@ void finish_compute_args(ComputeArgs& c, const std::vector<std::string>& raw_bou
   }
   if (c.input.empty()) throw tessera::InputError("INPUT is required (run with --help for usage)");
   c.input = input_path(c.input);
+  // No output may replace a file the command reads (a slip such as
+  // `voronoi p.npy --cell-table p.npy` replaced the points).
+  tessera::io::protect_from_writes(c.input, "the INPUT");
+  tessera::io::protect_from_writes(c.labels, "--labels");
+  tessera::io::protect_from_writes(c.radii, "--radii");
   if (!series && is_frame_series(c.frame))
     throw tessera::InputError("--frame " + c.frame + ": a bench runs on one frame; give its INDEX");
   find_input_frame(c);

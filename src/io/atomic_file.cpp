@@ -160,13 +160,27 @@ FillResult fill_fd(int fd, const std::function<void(std::ostream&)>& fill) {
 /// umask, like a plain new file). Returns its fd, sets `tmp` and arms `slot`
 /// with it; throws on failure. The name is armed before the file exists, so
 /// no moment of the file's life is hidden from remove_pending_temporaries().
+/// A file name too long for that (within 11 bytes of the folder's limit,
+/// NAME_MAX) is cut short in the temporary's name: legal names of 245-255
+/// bytes failed with "File name too long" after the whole computation.
 int create_temp(const std::string& path, std::string& tmp, int& slot, const std::string& suffix = {}) {
   static std::atomic<unsigned> counter{0};
   static const char kAlnum[] = "abcdefghijklmnopqrstuvwxyz0123456789";
   std::random_device rd;
   std::mt19937 gen(rd() ^ (static_cast<unsigned>(::getpid()) << 16) ^ counter.fetch_add(1));
+  std::string stem = path;
+  {
+    const fs::path p(path);
+    const fs::path dir = p.parent_path().empty() ? fs::path(".") : p.parent_path();
+    const long limit = ::pathconf(dir.c_str(), _PC_NAME_MAX);
+    const std::size_t name_max = limit > 0 ? static_cast<std::size_t>(limit) : 255;
+    const std::size_t extra = 11 + suffix.size();  // ".tmp-XXXXXX" and the suffix
+    const std::string name = p.filename().string();
+    if (name.size() + extra > name_max && name_max > extra)
+      stem = (p.parent_path() / name.substr(0, name_max - extra)).string();
+  }
   for (int attempt = 0; attempt < 100; ++attempt) {
-    tmp = path + ".tmp-";
+    tmp = stem + ".tmp-";
     for (int k = 0; k < 6; ++k) tmp += kAlnum[gen() % (sizeof kAlnum - 1)];
     tmp += suffix;
     slot = pending().arm(tmp);
@@ -180,7 +194,51 @@ int create_temp(const std::string& path, std::string& tmp, int& slot, const std:
   cannot_write(path, "could not create a unique temporary file");
 }
 
+/// The files no write may replace (protect_from_writes), by device and inode.
+struct Protected {
+  dev_t dev;
+  ino_t ino;
+  std::string role;
+};
+std::vector<Protected>& protected_files() {
+  static std::vector<Protected> files;
+  return files;
+}
+
+/// What writing `path` must not do: replace a protected file, or a file that
+/// is not a regular one (a FIFO, a device: renaming over it would take it
+/// away from whoever uses it). A link is replaced, not followed (its target
+/// is left as it is), as rename(2) does; so is a regular file. Returns the
+/// existing file's mode (0 if there is none) for the new one to keep.
+mode_t check_target(const std::string& path) {
+  struct stat st {};
+  if (::lstat(path.c_str(), &st) != 0) return 0;  // not there (or unreadable: the write says why)
+  if (S_ISDIR(st.st_mode)) cannot_write(path, "is a directory");
+  if (!S_ISREG(st.st_mode) && !S_ISLNK(st.st_mode))
+    cannot_write(path, std::string("is not a regular file (") +
+                           (S_ISFIFO(st.st_mode)   ? "a FIFO"
+                            : S_ISSOCK(st.st_mode) ? "a socket"
+                                                   : "a device") +
+                           "), which a file written in its place would replace");
+  struct stat target {};
+  if (::stat(path.c_str(), &target) != 0) return 0;  // a dangling link
+  if (S_ISDIR(target.st_mode)) cannot_write(path, "is a directory");
+  for (const Protected& p : protected_files())
+    if (p.dev == target.st_dev && p.ino == target.st_ino)
+      cannot_write(path, "it is " + p.role + ", which this run reads; an output may not replace it (give another name)");
+  return S_ISREG(st.st_mode) ? st.st_mode & 07777 : 0;
+}
+
+/// The group whose renames wait for its commit on this thread (OutputGroup).
+thread_local OutputGroup* t_group = nullptr;
+
 }  // namespace
+
+void protect_from_writes(const std::string& path, const std::string& role) {
+  struct stat st {};
+  if (path.empty() || path == "-" || ::stat(path.c_str(), &st) != 0 || !S_ISREG(st.st_mode)) return;
+  protected_files().push_back({st.st_dev, st.st_ino, role});
+}
 
 void write_file_atomic(const std::string& path, const std::function<void(std::ostream&)>& fill) {
   if (path.empty()) throw InputError("cannot write an empty path");
@@ -198,11 +256,15 @@ void write_file_atomic(const std::string& path, const std::function<void(std::os
     return;
   }
   std::error_code ec;
-  if (fs::is_directory(path, ec)) cannot_write(path, "is a directory");
+  const mode_t keep_mode = check_target(path);
 
   std::string tmp;
   int slot = -1;
   const int fd = create_temp(path, tmp, slot);
+  // A file replaced keeps its permissions (as a shell's redirection, cp or
+  // sed -i leave them): one made private stayed readable by all. New files
+  // take 0666 less the umask.
+  if (keep_mode != 0) ::fchmod(fd, keep_mode);
   // From here on every exit path must close fd and remove tmp unless renamed,
   // and disarm the slot after the file is gone (renamed or unlinked).
   auto discard = [&](int open_fd) {
@@ -232,12 +294,50 @@ void write_file_atomic(const std::string& path, const std::function<void(std::os
     discard(-1);
     cannot_write(path, std::strerror(err));
   }
+  if (t_group != nullptr) {  // renamed with the group's other files, at its commit
+    t_group->staged_.push_back({tmp, path, slot});
+    return;
+  }
   fs::rename(tmp, path, ec);
   if (ec) {
     discard(-1);
     cannot_write(path, ec.message());
   }
   pending().disarm(slot);
+}
+
+OutputGroup::OutputGroup() : outer_(t_group) {
+  if (outer_ == nullptr) t_group = this;
+}
+
+OutputGroup::~OutputGroup() {
+  if (outer_ != nullptr) return;
+  t_group = nullptr;
+  discard_from(0);
+}
+
+void OutputGroup::discard_from(std::size_t k) noexcept {
+  for (; k < staged_.size(); ++k) {
+    ::unlink(staged_[k].tmp.c_str());
+    pending().disarm(staged_[k].slot);
+  }
+  staged_.clear();
+}
+
+void OutputGroup::commit() {
+  if (outer_ != nullptr) return;  // the outermost group commits
+  t_group = nullptr;
+  for (std::size_t k = 0; k < staged_.size(); ++k) {
+    std::error_code ec;
+    fs::rename(staged_[k].tmp, staged_[k].path, ec);
+    if (ec) {
+      const std::string path = staged_[k].path;
+      discard_from(k);
+      cannot_write(path, ec.message() + (k > 0 ? " (the outputs before it were replaced)" : ""));
+    }
+    pending().disarm(staged_[k].slot);
+  }
+  staged_.clear();
 }
 
 void write_file_atomic(const std::string& path, std::string_view bytes) {
@@ -282,7 +382,7 @@ void check_writable(const std::string& path) {
   if (path.empty()) throw InputError("cannot write an empty path");
   if (path == "-") return;  // standard output
   std::error_code ec;
-  if (fs::is_directory(path, ec)) cannot_write(path, "is a directory");
+  check_target(path);
   fs::path dir = fs::path(path).parent_path();
   if (dir.empty()) dir = ".";
   const auto st = fs::status(dir, ec);

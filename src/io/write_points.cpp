@@ -135,10 +135,13 @@ std::vector<std::string> write_points(const std::string& path, const LabelledPoi
         if (paths[a] == paths[b]) throw InputError("cannot write " + paths[a] + ": the same file twice");
       check_writable(paths[a]);
     }
+    // All or none: a new points file beside the old labels would pair wrongly.
+    OutputGroup group;
     std::size_t k = 0;
     write_file_atomic(paths[k++], npy_bytes(points.coords.data(), {n, static_cast<std::size_t>(points.dim)}));
     if (labelled) write_file_atomic(paths[k++], npy_bytes(points.labels.data(), {n}));
     for (const auto& s : options.scalars) write_file_atomic(paths[k++], npy_bytes(s.second.data(), {n}));
+    group.commit();
     return paths;
   }
   if (ext == ".ply") {

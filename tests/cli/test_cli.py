@@ -2241,6 +2241,34 @@ class BadInput(TempDirCase):
         self.assertIn("name the same file", r.stderr)
         self.assertFalse(os.path.exists(self.p("new.npy")))
 
+    def test_outputs_may_not_replace_inputs(self):
+        # An output naming a file the command reads replaced it, exit 0: the
+        # points by the cell table, the labels by the neighbours, a threshold's
+        # scalars by its points. Refused now, by any spelling, before any work,
+        # and the input is left as it was.
+        def intact(path, fn):
+            with open(path, "rb") as f:
+                before = f.read()
+            line = fn()
+            with open(path, "rb") as f:
+                self.assertEqual(f.read(), before, "%s was changed" % path)
+            return line
+        pts = self.good3
+        labels = self.save("lab.npy", np.arange(50, dtype=np.int32) % 3)
+        scal = self.save("s.npy", np.linspace(0, 1, 50))
+        os.mkdir(self.p("sub"))
+        for args, fragment, path in (
+                (["voronoi", pts, "--cell-table", pts], "it is the INPUT, which this run reads", pts),
+                (["voronoi", pts, "--labels", labels, "--neighbors", self.p("sub/../lab.npy")], "it is --labels", labels),
+                (["graph", pts, "--csr", pts], "the INPUT", pts),
+                (["delaunay", pts, "--simplices", pts], "the INPUT", pts),
+                (["joggle", pts, "-o", pts], "the INPUT", pts),
+                (["threshold", pts, "--scalars", scal, "--interval", "0,0.5,1", "-o", scal], "--scalars", scal)):
+            line = intact(path, lambda: self.fails(args))
+            self.assertIn(fragment, line)
+        os.symlink(pts, self.p("link.npy"))
+        intact(pts, lambda: self.fails(["voronoi", self.p("link.npy"), "--cell-table", pts], "the INPUT"))
+
     def test_empty_option_values_refused(self):
         # An empty value was taken as the option not given: `--cell-table ""
         # --neighbors nb.npy` wrote the neighbours alone, exit 0.

@@ -1,5 +1,6 @@
 // Atomic writes: success, overwrite, and failures that leave nothing behind.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -167,4 +168,82 @@ TEST(AtomicFile, TemporaryFile) {
   }  // its own removal finds the file gone, harmlessly
   if (old != nullptr) ::setenv("TMPDIR", saved.c_str(), 1);
   else ::unsetenv("TMPDIR");
+}
+
+// An OutputGroup renames its files at commit, all together: a failure in one
+// (here an exception while the second is written) leaves every target as it
+// was, and no temporary; a group made inside another joins it.
+TEST(AtomicFile, OutputGroupIsAllOrNothing) {
+  TempDir dir;
+  const std::string a = dir.file("points.npy"), b = dir.file("points_labels.npy");
+  write_file_atomic(a, std::string_view("old points"));
+  write_file_atomic(b, std::string_view("old labels"));
+  auto msg = input_error([&] {
+    tessera::io::OutputGroup group;
+    write_file_atomic(a, std::string_view("new points"));
+    EXPECT_EQ(read_all(a), "old points");  // not renamed before the commit
+    write_file_atomic(b, [](std::ostream&) { throw std::runtime_error("disk full"); });
+    group.commit();
+  });
+  EXPECT_NE(msg.find("disk full"), std::string::npos) << msg;
+  EXPECT_EQ(read_all(a), "old points");
+  EXPECT_EQ(read_all(b), "old labels");
+  EXPECT_EQ(dir.entries(), (std::vector<std::string>{"points.npy", "points_labels.npy"}));
+  {
+    tessera::io::OutputGroup group;
+    write_file_atomic(a, std::string_view("new points"));
+    {
+      tessera::io::OutputGroup inner;  // joins the outer group
+      write_file_atomic(b, std::string_view("new labels"));
+      inner.commit();
+    }
+    EXPECT_EQ(read_all(b), "old labels");
+    group.commit();
+  }
+  EXPECT_EQ(read_all(a), "new points");
+  EXPECT_EQ(read_all(b), "new labels");
+  EXPECT_EQ(dir.entries(), (std::vector<std::string>{"points.npy", "points_labels.npy"}));
+  {  // destroyed uncommitted: the temporaries go, the targets stay
+    tessera::io::OutputGroup group;
+    write_file_atomic(a, std::string_view("third"));
+  }
+  EXPECT_EQ(read_all(a), "new points");
+  EXPECT_EQ(dir.entries(), (std::vector<std::string>{"points.npy", "points_labels.npy"}));
+}
+
+// A replaced file keeps its permissions (a private one stayed readable by all
+// under umask 022); a FIFO or a protected input is refused, by any spelling;
+// a name within 11 bytes of NAME_MAX still gets its temporary.
+TEST(AtomicFile, WhatAReplacedFileKeepsAndWhatIsRefused) {
+  TempDir dir;
+  const std::string p = dir.file("private.csv");
+  write_file_atomic(p, std::string_view("one"));
+  ASSERT_EQ(::chmod(p.c_str(), 0600), 0);
+  write_file_atomic(p, std::string_view("two"));
+  EXPECT_EQ(fs::status(p).permissions() & fs::perms::mask, fs::perms::owner_read | fs::perms::owner_write);
+
+  const std::string fifo = dir.file("pipe.npy");
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0644), 0);
+  auto msg = input_error([&] { check_writable(fifo); });
+  EXPECT_NE(msg.find("is not a regular file (a FIFO)"), std::string::npos) << msg;
+  msg = input_error([&] { write_file_atomic(fifo, std::string_view("x")); });
+  EXPECT_NE(msg.find("a FIFO"), std::string::npos) << msg;
+  EXPECT_TRUE(fs::is_fifo(fifo));
+
+  const std::string input = dir.file("points.npy");
+  write_file_atomic(input, std::string_view("the points"));
+  tessera::io::protect_from_writes(input, "the INPUT");
+  const std::string other_spelling = (dir.path() / "." / "points.npy").string();
+  msg = input_error([&] { check_writable(other_spelling); });
+  EXPECT_NE(msg.find("it is the INPUT, which this run reads"), std::string::npos) << msg;
+  msg = input_error([&] { write_file_atomic(input, std::string_view("a table")); });
+  EXPECT_NE(msg.find("the INPUT"), std::string::npos) << msg;
+  EXPECT_EQ(read_all(input), "the points");
+
+  const long name_max = ::pathconf(dir.path().c_str(), _PC_NAME_MAX);
+  const std::string longest = dir.file(std::string(static_cast<std::size_t>(name_max > 0 ? name_max : 255) - 4, 'n') + ".npy");
+  check_writable(longest);
+  write_file_atomic(longest, std::string_view("long"));
+  EXPECT_EQ(read_all(longest), "long");
+  EXPECT_EQ(dir.entries().size(), 4u);  // private.csv, pipe.npy, points.npy and the long one: no temporaries
 }

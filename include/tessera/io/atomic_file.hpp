@@ -1,10 +1,12 @@
 // Whole-file writes that never leave a partial file behind.
 #pragma once
 
+#include <cstddef>
 #include <functional>
 #include <ostream>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace tessera::io {
 
@@ -12,15 +14,59 @@ namespace tessera::io {
 /// renaming it over `path` once complete. On any failure (directory missing,
 /// not writable, disk full, exception from `fill`) the temporary is removed,
 /// `path` is untouched, and tessera::InputError("cannot write PATH: reason") is thrown.
+/// An existing `path` keeps its permission bits; one that is not a regular
+/// file or a link (a FIFO, a device) or is protected (protect_from_writes)
+/// is refused. Within an OutputGroup the rename waits for its commit.
 /// `-` is standard output, written in place: not atomically (a pipe cannot
 /// be renamed over), so a failure leaves what was written.
 void write_file_atomic(const std::string& path, const std::function<void(std::ostream&)>& fill);
 void write_file_atomic(const std::string& path, std::string_view bytes);
 
 /// Fail early (before a long computation) if `path` cannot be created:
-/// its directory must exist and be writable (`-`, standard output, passes).
+/// its directory must exist and be writable, and an existing `path` must be
+/// one write_file_atomic may replace (`-`, standard output, passes).
 /// Throws InputError.
 void check_writable(const std::string& path);
+
+/// Protect the file `path` (if it exists as a regular file; compared by
+/// device and inode, so any spelling or link of it counts) from
+/// check_writable and write_file_atomic, which refuse it with "cannot write
+/// PATH: it is ROLE, which this run reads". Empty unless a program adds to
+/// it: the tessera command lists its inputs (the points, --labels,
+/// --radii, ...), so that a slip such as `voronoi p.npy --cell-table p.npy`
+/// cannot replace what it read. Add before writing (not thread-safe).
+void protect_from_writes(const std::string& path, const std::string& role);
+
+/// Outputs written together: while one lives on this thread,
+/// write_file_atomic leaves each complete file under its temporary name, and
+/// commit() renames them all over their targets in the order written. A
+/// failure before the commit (a full disk in the third file, an exception,
+/// Ctrl-C) therefore leaves every target as it was, where the files written
+/// before it had already replaced theirs: a new points file beside the old
+/// labels. Destroyed uncommitted, it removes the temporaries (as does
+/// remove_pending_temporaries on a signal). A group made while another
+/// lives on the thread joins it: the outermost commits. A rename failing in
+/// the commit (rare: each temporary is in its target's folder) leaves the
+/// targets before it replaced, and says so. Standard output ("-") is
+/// written at once.
+class OutputGroup {
+ public:
+  OutputGroup();
+  ~OutputGroup();
+  OutputGroup(const OutputGroup&) = delete;
+  OutputGroup& operator=(const OutputGroup&) = delete;
+  void commit();
+
+ private:
+  friend void write_file_atomic(const std::string& path, const std::function<void(std::ostream&)>& fill);
+  struct Staged {
+    std::string tmp, path;
+    int slot;
+  };
+  void discard_from(std::size_t k) noexcept;
+  OutputGroup* outer_;
+  std::vector<Staged> staged_;
+};
 
 /// A file of this process's own in the temporary directory ($TMPDIR, else
 /// /tmp), named tessera-NAME.tmp-XXXXXX then `suffix`, written by `fill`
