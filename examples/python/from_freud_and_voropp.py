@@ -150,8 +150,10 @@ def main():
     # Qhull's vertices are rounded doubles: a tiny face's area is only good
     # to rounding of the cell's size, hence the absolute floor.
     floor = 1e-9 * vor.volumes.mean() ** (2 / 3)
-    # Qhull lists faces of zero area (four points cospherical to rounding)
-    # that exact topology does not; random points have none.
+    # Random points have no faces of zero area. (Exact ties, as on a
+    # lattice, give such faces in both: Qhull's from rounding, ours from
+    # symbolic perturbation, not necessarily the same ones; prune_tolerance
+    # drops them.)
     assert got.keys() == ridges.keys(), len(set(got) ^ set(ridges))
     for key, a in got.items():
         assert abs(a - ridges[key]) <= max(1e-9 * a, floor), (key, a, ridges[key])
