@@ -64,6 +64,7 @@ class Delaunay:
         self._hull: Optional[np.ndarray] = None
         self._vertex_to_simplex: Optional[np.ndarray] = None
         self._transform: Optional[np.ndarray] = None
+        self._vertex_neighbors: Optional[Tuple[np.ndarray, np.ndarray]] = None
 
     @property
     def points(self) -> np.ndarray:
@@ -119,7 +120,9 @@ class Delaunay:
     @property
     def simplices(self) -> np.ndarray:
         """int32 (nsimplex, D+1): point ids of each simplex; positively oriented
-        (2D: counter-clockwise), lowest id first, rows in ascending order."""
+        (2D: counter-clockwise), lowest id first. Rows are ordered by their
+        sorted vertex sets (ascending), which, after the orientation's swap
+        of two ids, is not the rows' own lexicographic order."""
         return self._dt.simplices
 
     def _refuse_periodic(self, attribute: str) -> None:
@@ -194,9 +197,16 @@ class Delaunay:
     def vertex_neighbor_vertices(self) -> Tuple[np.ndarray, np.ndarray]:
         """``(indptr, indices)``: the Delaunay edges as CSR, as scipy's; the
         neighbours of point ``v`` are ``indices[indptr[v]:indptr[v + 1]]``,
-        ascending. Computed on first use (in parallel)."""
+        ascending. Both int32, as scipy's, while the edges fit (``indptr``
+        is int64 past 2^31 - 1 entries). Computed on first use (in parallel)."""
         self._refuse_periodic("vertex_neighbor_vertices")
-        return self._dt.vertex_neighbors
+        if self._vertex_neighbors is None:
+            indptr, indices = self._dt.vertex_neighbors
+            if len(indptr) and indptr[-1] <= np.iinfo(np.int32).max:
+                indptr = indptr.astype(np.int32)
+                indptr.setflags(write=False)
+            self._vertex_neighbors = (indptr, indices)
+        return self._vertex_neighbors
 
     @property
     def transform(self) -> np.ndarray:

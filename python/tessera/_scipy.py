@@ -111,12 +111,15 @@ class ScipyVoronoi:
         verts = keys % max(v.n_vertices, 1)
         return [r.tolist() for r in np.split(verts, np.cumsum(counts)[:-1])]
 
-    @property
+    @cached_property
     def point_region(self) -> np.ndarray:
-        """int32 (N,): the region (cell) of each point, -1 for a point without one
-        (outside label, dropped outside the bounds, a duplicate, or an empty
-        power cell)."""
-        return self._vor.cell_of
+        """intp (N,), as scipy's: the region (cell) of each point, -1 for a
+        point without one (outside label, dropped outside the bounds, a
+        duplicate, or an empty power cell). A copy of :attr:`Voronoi.cell_of`
+        (int32), read-only."""
+        region = self._vor.cell_of.astype(np.intp)
+        region.setflags(write=False)
+        return region
 
     @cached_property
     def ridge_dict(self) -> Dict[Tuple[int, int], List[int]]:

@@ -242,9 +242,11 @@ class Voronoi:
 
     @property
     def empty_cells(self) -> np.ndarray:
-        """int32, ascending: of power cells, the points whose cell is empty (their
-        sphere's power is nowhere the least); they own no cell (``cell_of`` -1)
-        and are nobody's neighbour. Empty for ordinary cells."""
+        """int32, ascending: of power cells, the points whose cell within the
+        domain is empty: their sphere's power is nowhere in the box the least
+        (the regular triangulation's :attr:`Delaunay.hidden`), or only outside
+        the box. They own no cell (``cell_of`` -1) and are nobody's
+        neighbour. Empty for ordinary cells."""
         return self._cells.empty_cells
 
     @property
@@ -296,8 +298,8 @@ class Voronoi:
         (``measures_checked``, ``measure_rel_error``, ``vertex_rel_error``).
         The report is truthy when all pass; ``report.messages`` says what
         failed. In a periodic box neighbours must pair up with opposite
-        shifts, and the vertex and exact-measure checks are left out (the
-        keys name points without their images' shifts). Power cells are
+        shifts, and the vertex and exact-measure checks place each key's
+        points at their images (:attr:`vertex_key_shifts`). Power cells are
         checked with their radii (a vertex has equal powers, not distances,
         to its key's points)."""
         return _core.validate_cells(self._cells, self._labels, self._points, self._radii)

@@ -63,6 +63,7 @@ def test_scipy_view_shapes_and_meanings(dim):
     assert len(view.ridge_vertices) == len(view.ridge_points)
     assert len(view.regions) == vor.n_cells
     assert view.point_region.shape == (400,)
+    assert view.point_region.dtype == ScipyVoronoi(pts).point_region.dtype  # intp, as scipy's
     # Each pair of adjacent cells is one ridge.
     assert len(view.ridge_points) == len(vor.neighbors) // 2
     assert sorted_pairs(view.ridge_points) == {
@@ -135,6 +136,7 @@ def test_delaunay_derived_attributes_match_scipy(dim):
     assert (np.einsum("ij,ij->i", normal, f.mean(axis=1) - pts.mean(axis=0)) > 0).all()
     indptr, indices = dt.vertex_neighbor_vertices
     sindptr, sindices = sp.vertex_neighbor_vertices
+    assert (indptr.dtype, indices.dtype) == (sindptr.dtype, sindices.dtype)  # int32, as scipy's
     for v in range(len(pts)):
         ours = indices[indptr[v] : indptr[v + 1]]
         assert (np.diff(ours) > 0).all()
