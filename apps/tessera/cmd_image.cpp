@@ -327,6 +327,8 @@ int run_probe(const ProbeArgs& a) {
   double outside = 0;
   if (!whole_number(a.outside_value, outside))  // nan and inf allowed
     throw InputError("--outside-value: '" + a.outside_value + "' is not a number");
+  if (beyond_range(a.outside_value, outside))
+    throw InputError("--outside-value: '" + a.outside_value + "' is beyond double's range");
   const auto t0 = std::chrono::steady_clock::now();
   const ScalarImage img = io::read_scalar_image(a.image, read_options(a.read));
   check_read_dims(a.read, img.geometry, a.image);

@@ -789,9 +789,18 @@ bool whole_number(const std::string& word, double& value) {
   return end == word.c_str() + word.size();
 }
 
+bool beyond_range(const std::string& word, double value) {
+  if (!std::isinf(value)) return false;
+  std::string lower(word);
+  for (char& ch : lower) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+  return lower.find("inf") == std::string::npos;
+}
+
 double parse_number(const std::string& word, const std::string& what, bool allow_inf) {
   double v = 0;
-  if (!whole_number(word, v) || std::isnan(v) || (!allow_inf && !std::isfinite(v)))
+  const bool whole = whole_number(word, v);
+  if (whole && beyond_range(word, v)) throw InputError(what + ": '" + word + "' is beyond double's range");
+  if (!whole || std::isnan(v) || (!allow_inf && !std::isfinite(v)))
     throw InputError(what + ": '" + word + "' is not a " + (allow_inf ? "number" : "finite number"));
   return v;
 }

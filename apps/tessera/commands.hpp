@@ -327,8 +327,12 @@ inline std::string written_list(const std::vector<std::string>& written) {
 /// nothing after it; "inf" and "nan" included), and its value. Every reader
 /// of a number from the command line goes through this.
 bool whole_number(const std::string& word, double& value);
+/// Whether `value`, read from `word`, is an infinity the word does not spell
+/// (1e400): strtod's overflow, which an option should refuse, not take as inf.
+bool beyond_range(const std::string& word, double value);
 /// A number as the user wrote it ("inf", "-inf" allowed when `allow_inf`);
-/// InputError("WHAT: 'WORD' is not a ...") otherwise.
+/// InputError("WHAT: 'WORD' is not a ...", or "... is beyond double's
+/// range" for an overflowing one) otherwise.
 double parse_number(const std::string& word, const std::string& what, bool allow_inf);
 /// The comma-separated words of `s`, spaces dropped ("" gives one empty word).
 std::vector<std::string> split_commas(const std::string& s);

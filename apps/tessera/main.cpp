@@ -4,6 +4,7 @@
 // "tessera: error: MESSAGE" on stderr and exits non-zero (2: bad command line
 // or input, 1: anything else or a failed --validate, 130: Ctrl-C). Outputs are
 // written atomically by the IO layer, so a failed run leaves no partial file.
+#include <cctype>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -539,8 +540,17 @@ int main(int argc, char** argv) {
         return kExitInputError;
       }
     }
+  // A number such as -.5 is taken by CLI11 for an option (`--bounds -.5 1
+  // ...` said "At least 4 required but received 2"), where -0.5 is a
+  // value: written so before parsing. No option begins with "-.".
+  std::vector<std::string> words(argv, argv + argc);
+  for (std::string& w : words)
+    if (w.size() > 2 && w[0] == '-' && w[1] == '.' && std::isdigit(static_cast<unsigned char>(w[2])))
+      w.insert(1, "0");
+  std::vector<const char*> word_ptrs;
+  for (const std::string& w : words) word_ptrs.push_back(w.c_str());
   try {
-    app.parse(argc, argv);
+    app.parse(argc, word_ptrs.data());
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) return app.exit(e);  // --help
     print_error(std::string(e.what()) + " (run with --help for usage)");

@@ -862,6 +862,16 @@ class Voronoi2D(TempDirCase):
         r = run(["voronoi", pts, "--bounds", "0", "1", "0", "1e400abc", "--cell-table", t])
         self.assertIn("'1e400abc' is not a number", r.stderr)
 
+    def test_numbers_without_a_leading_zero(self):
+        # CLI11 took -.5 for an option: "--bounds: At least 4 required but
+        # received 2"; -0.5 was a value. Both are now, in every command.
+        t, a = self.p("t.csv"), self.p("a.csv")
+        self.ok(["voronoi", self.inp, "--bounds", "-.5", "2", "-.25", "1", "--cell-table", t, "-q"])
+        self.ok(["voronoi", self.inp, "--bounds", "-0.5", "2", "-0.25", "1", "--cell-table", a, "-q"])
+        self.assertEqual(read_bytes(t), read_bytes(a))
+        f = self.p("f.npy")
+        self.ok(["fill", self.inp, "-o", f, "--bounds", "-.5", "2", "-.25", "1", "-q"])
+
     def test_threads_byte_identical(self):
         a, b = self.p("a.vtp"), self.p("b.vtp")
         self.ok(["voronoi", self.inp, "-o", a, "--threads", "1", "-q"])

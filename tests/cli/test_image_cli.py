@@ -240,6 +240,12 @@ class Probe(base.TempDirCase):
         out = self.p("v.npy")
         r = self.ok(["probe", self.vti, self.inp, "-o", out, "--outside-value", "-1"])
         self.assertIn("2 outside", r.stdout)
+        # An overflowing value was taken as inf; "inf" itself is a value.
+        r = run(["probe", self.vti, self.inp, "-o", self.p("o.npy"), "--outside-value", "1e400"])
+        self.assertEqual(r.returncode, 2)
+        self.assertIn("--outside-value: '1e400' is beyond double's range", r.stderr)
+        self.assertFalse(os.path.exists(self.p("o.npy")))
+        self.ok(["probe", self.vti, self.inp, "-o", self.p("o.npy"), "--outside-value", "-inf"])
         v = np.load(out)
         self.assertEqual(v.shape, (len(self.pts),))
         e = self.expected()
