@@ -53,6 +53,11 @@
 // normal (2D: every segment keeps its direction); the vertices of a polygon
 // that has none keep their previous positions for that step (decided in
 // rounds, deterministically). So no output face flips, whatever the options.
+// Untangling (3D): where output triangles cross (share a point interior to
+// one of them, exactly), the polygons around both are pinned where they
+// started and the smoothing runs again from the start, until none do; so no
+// face passes through another (voxel label maps of many touching labels had
+// such crossings at junction curves).
 //
 // Defaults (iterations 20, relaxation 0.5, constraint 0.5), chosen on
 // nested spheres, touching boxes and three sectors sampled as exact and
@@ -66,12 +71,10 @@
 //     within 0.43 voxel of where it started (inside its dual cube, as classic
 //     SurfaceNets does), brings the area of a sphere from +45..50% to within
 //     ~5-8% and its volume within a few % (shrinkage falls with
-//     resolution). No flipped triangle in any run (the guard); no
-//     self-intersection except 3 triangle pairs in one of ~200 runs, on
-//     points jittered by half a spacing (nearly random), at a tiny face
-//     along a junction curve. 0.6-1.0 smooth further (normals within ~10
-//     degrees of a sphere's instead of ~20) but make such crossings more
-//     frequent, and shrink small features more.
+//     resolution). No flipped triangle in any run (the guard). 0.6-1.0
+//     smooth further (normals within ~10 degrees of a sphere's instead of
+//     ~20) but make crossings more frequent (the untangling pins more), and
+//     shrink small features more.
 //   * 20 iterations: enough to reach the constraint-bound state (10 leave
 //     visibly more roughness, 40 change the area by < 1% and only shrink).
 // Triangulation (`triangles`): each polygon is split by a "ladder" (a strip

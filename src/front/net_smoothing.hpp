@@ -182,4 +182,30 @@ double ladder_score(Pos&& pos, const double* x0, const std::int32_t* loop, std::
   return turned_over ? -std::numeric_limits<double>::infinity() : worst;
 }
 
+/// The ladder rotation a 3D polygon is triangulated by: the best
+/// ladder_score of its n rotations (0 for a triangle). A rotation replaces an
+/// earlier one only if it scores better by more than rounding (1e-9
+/// relative): rotations that tie exactly on a lattice differ by noise off it,
+/// which must not choose the triangles. (triangulate_ladder, and the
+/// smoothing's crossing check, which must see the triangles that are output.)
+template <class Pos>
+std::size_t best_ladder_rotation(Pos&& pos, const double* x0, const std::int32_t* loop, std::size_t n,
+                                 const double* ref) {
+  std::size_t best = 0;
+  if (n <= 3) return best;
+  // (best = -inf makes the bound NaN: then any larger score is better)
+  auto better = [](double score, double best_score) {
+    return score > best_score && !(score <= best_score + 1e-9 * std::fabs(best_score));
+  };
+  double best_score = -std::numeric_limits<double>::infinity();
+  for (std::size_t start = 0; start < n; ++start) {
+    const double score = ladder_score(pos, x0, loop, n, start, ref);
+    if (better(score, best_score)) {
+      best_score = score;
+      best = start;
+    }
+  }
+  return best;
+}
+
 }  // namespace tessera::front

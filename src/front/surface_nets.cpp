@@ -94,24 +94,7 @@ void triangulate_ladder(FaceSet& m, std::vector<double> before, std::span<const 
       front::reference_orientation(3, before.data(), petal.data(), loop, n, ref);
       if (ref[0] == 0 && ref[1] == 0 && ref[2] == 0) front::newell(xyz, loop, n, ref);
       auto pos = [&](std::int32_t v) { return xyz + 3 * static_cast<std::size_t>(v); };
-      // A rotation replaces an earlier one only if it scores better by more
-      // than rounding (1e-9 relative): rotations that tie exactly on a
-      // lattice differ by noise off it, which must not choose the triangles.
-      auto better = [](double score, double best) {
-        // (best = -inf makes the bound NaN: then any larger score is better)
-        return score > best && !(score <= best + 1e-9 * std::fabs(best));
-      };
-      std::size_t best = 0;
-      if (n > 3) {
-        double best_score = -std::numeric_limits<double>::infinity();
-        for (std::size_t start = 0; start < n; ++start) {
-          const double score = front::ladder_score(pos, before.data(), loop, n, start, ref);
-          if (better(score, best_score)) {
-            best_score = score;
-            best = start;
-          }
-        }
-      }
+      const std::size_t best = front::best_ladder_rotation(pos, before.data(), loop, n, ref);
       std::size_t t = b - 2 * p;
       front::ladder(n, best, [&](std::size_t i, std::size_t j, std::size_t k) {
         corners[3 * t] = loop[i], corners[3 * t + 1] = loop[j], corners[3 * t + 2] = loop[k];

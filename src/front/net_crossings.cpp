@@ -1,0 +1,286 @@
+// Crossing triangles of a smoothed surface net (see net_crossings.hpp).
+//
+// Broad phase: a uniform grid of cells about twice the mean triangle's size,
+// each triangle listed in every cell its bounding box meets; a pair is tested
+// once, in the cell holding the lower corner of their boxes' overlap. Narrow
+// phase: exact orientation signs (in 3D, and in 2D projections for what lies
+// in a plane). The intersection of two triangles is bounded by points on
+// their edges, so it holds a point interior to one of them iff some edge of
+// one meets the other's interior: crossing its plane inside it, lying in its
+// plane across it, or ending in its plane inside it.
+#include "net_crossings.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+
+#include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+
+#include "tessera/kernels/delaunay_predicates.hpp"
+
+namespace tessera::front {
+namespace {
+
+using Pair = std::pair<std::size_t, std::size_t>;
+
+int orient(const double* a, const double* b, const double* c, const double* d) {
+  const double* p[4] = {a, b, c, d};
+  return kernels::orientation(3, p);
+}
+
+/// Whether the points q[0..m) lie certainly strictly on one side of the
+/// plane of triangle t, by a float filter: each signed distance n . (q - t0)
+/// kept only where it exceeds 1e-10 of |n| |q - t0|, far above its rounding
+/// (a few ulps of those products). Most candidate pairs end here, without an
+/// exact orientation.
+bool surely_one_side(const double* const t[3], const double* const* q, int m) {
+  const double u[3] = {t[1][0] - t[0][0], t[1][1] - t[0][1], t[1][2] - t[0][2]};
+  const double w[3] = {t[2][0] - t[0][0], t[2][1] - t[0][1], t[2][2] - t[0][2]};
+  const double n[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]};
+  const double nn = std::fabs(n[0]) + std::fabs(n[1]) + std::fabs(n[2]);
+  int side = 0;
+  for (int k = 0; k < m; ++k) {
+    const double d[3] = {q[k][0] - t[0][0], q[k][1] - t[0][1], q[k][2] - t[0][2]};
+    const double s = n[0] * d[0] + n[1] * d[1] + n[2] * d[2];
+    const double bound = 1e-10 * nn * (std::fabs(d[0]) + std::fabs(d[1]) + std::fabs(d[2]));
+    const int sk = s > bound ? 1 : s < -bound ? -1 : 0;
+    if (sk == 0 || (side != 0 && sk != side)) return false;
+    side = sk;
+  }
+  return true;
+}
+
+/// Float filter for triangles lying nearly in one plane (a flat stretch of a
+/// net, where the plane test above cannot decide): projected on the
+/// coordinate plane that both face (each normal's component along the
+/// dropped axis at least 1e-3 of its largest, so the projection is one to
+/// one on each), an edge of one separates them by a margin (1e-10 of the
+/// products, far above rounding), the corners on that edge that both share
+/// excepted. Then a common point would project onto the edge, so lie on the
+/// boundary of both: they do not cross.
+bool surely_apart_in_plane(const double* const a[3], const std::int32_t* ca, const double* const b[3],
+                           const std::int32_t* cb) {
+  auto normal = [](const double* const t[3], double* n) {
+    const double u[3] = {t[1][0] - t[0][0], t[1][1] - t[0][1], t[1][2] - t[0][2]};
+    const double w[3] = {t[2][0] - t[0][0], t[2][1] - t[0][1], t[2][2] - t[0][2]};
+    n[0] = u[1] * w[2] - u[2] * w[1], n[1] = u[2] * w[0] - u[0] * w[2], n[2] = u[0] * w[1] - u[1] * w[0];
+  };
+  double na[3], nb[3];
+  normal(a, na);
+  normal(b, nb);
+  const int drop = std::fabs(na[0]) >= std::fabs(na[1]) && std::fabs(na[0]) >= std::fabs(na[2]) ? 0
+                   : std::fabs(na[1]) >= std::fabs(na[2])                                       ? 1
+                                                                                                : 2;
+  auto faces = [&](const double* n) {
+    return std::fabs(n[drop]) > 1e-3 * std::max({std::fabs(n[0]), std::fabs(n[1]), std::fabs(n[2])});
+  };
+  if (!faces(na) || !faces(nb)) return false;
+  const int x = drop == 0 ? 1 : 0, y = drop == 2 ? 1 : 2;
+  // Does the line through t's edge k separate u from t's third corner?
+  auto separates = [&](const double* const t[3], const std::int32_t* ct, int k, const double* const u[3],
+                       const std::int32_t* cu) {
+    const double* p = t[k];
+    const double* q = t[(k + 1) % 3];
+    const double ex = q[x] - p[x], ey = q[y] - p[y], e1 = std::fabs(ex) + std::fabs(ey);
+    auto side = [&](const double* r, double& margin) {
+      const double dx = r[x] - p[x], dy = r[y] - p[y];
+      margin = 1e-10 * e1 * (std::fabs(dx) + std::fabs(dy));
+      return ex * dy - ey * dx;
+    };
+    double m = 0;
+    const double inner = side(t[(k + 2) % 3], m);
+    if (!(std::fabs(inner) > m)) return false;
+    for (int j = 0; j < 3; ++j) {
+      if (cu[j] == ct[k] || cu[j] == ct[(k + 1) % 3]) continue;  // on the edge itself, and in both
+      const double s = side(u[j], m);
+      if (!(std::fabs(s) > m) || (s > 0) == (inner > 0)) return false;
+    }
+    return true;
+  };
+  for (int k = 0; k < 3; ++k)
+    if (separates(a, ca, k, b, cb) || separates(b, cb, k, a, ca)) return true;
+  return false;
+}
+
+/// Exact 2D orientation of p, q, r projected on the coordinate plane that
+/// leaves out axis `drop`.
+int orient2(const double* p, const double* q, const double* r, int drop) {
+  const int x = drop == 0 ? 1 : 0, y = drop == 2 ? 1 : 2;
+  const double pp[2] = {p[x], p[y]}, qq[2] = {q[x], q[y]}, rr[2] = {r[x], r[y]};
+  const double* pts[3] = {pp, qq, rr};
+  return kernels::orientation(2, pts);
+}
+
+/// Whether point p, in the plane of triangle t, lies strictly inside it.
+bool strictly_inside(const double* p, const double* const t[3], int drop) {
+  const int s = orient2(t[0], t[1], p, drop);
+  return s != 0 && orient2(t[1], t[2], p, drop) == s && orient2(t[2], t[0], p, drop) == s;
+}
+
+/// Whether segment pq, in the plane of triangle t, meets t's interior: an end
+/// strictly inside, or a proper crossing of one of its edges (a segment that
+/// enters through a corner leaves through an edge or ends inside).
+bool segment_meets_interior(const double* p, const double* q, const double* const t[3], int drop) {
+  if (strictly_inside(p, t, drop) || strictly_inside(q, t, drop)) return true;
+  for (int k = 0; k < 3; ++k) {
+    const double* u = t[k];
+    const double* w = t[(k + 1) % 3];
+    if (orient2(p, q, u, drop) * orient2(p, q, w, drop) < 0 && orient2(u, w, p, drop) * orient2(u, w, q, drop) < 0)
+      return true;
+  }
+  return false;
+}
+
+/// Whether some edge of triangle b meets the (relative) interior of triangle
+/// a: crossing a's plane strictly inside it, lying in a's plane through its
+/// interior, or ending (in the plane) strictly inside it. A degenerate a
+/// (collinear corners: exact lattices make such zero-area faces) has no
+/// interior.
+bool edges_meet_interior(const double* const a[3], const double* const b[3]) {
+  if (kernels::collinear3(a[0], a[1], a[2])) return false;
+  int s[3];
+  for (int k = 0; k < 3; ++k) s[k] = orient(a[0], a[1], a[2], b[k]);
+  // The plane to project on: a's normal's largest coordinate (in floats; any
+  // coordinate whose normal component is not zero projects a faithfully).
+  const double u[3] = {a[1][0] - a[0][0], a[1][1] - a[0][1], a[1][2] - a[0][2]};
+  const double w[3] = {a[2][0] - a[0][0], a[2][1] - a[0][1], a[2][2] - a[0][2]};
+  const double n[3] = {std::fabs(u[1] * w[2] - u[2] * w[1]), std::fabs(u[2] * w[0] - u[0] * w[2]),
+                       std::fabs(u[0] * w[1] - u[1] * w[0])};
+  const int drop = n[0] >= n[1] && n[0] >= n[2] ? 0 : n[1] >= n[2] ? 1 : 2;
+  for (int k = 0; k < 3; ++k) {
+    const int l = (k + 1) % 3;
+    const double* p = b[k];
+    const double* q = b[l];
+    if (s[k] * s[l] < 0) {  // across the plane: through the interior?
+      const int o = orient(p, q, a[0], a[1]);
+      if (o != 0 && orient(p, q, a[1], a[2]) == o && orient(p, q, a[2], a[0]) == o) return true;
+    } else if (s[k] == 0 && s[l] == 0) {  // in the plane
+      if (segment_meets_interior(p, q, a, drop)) return true;
+    } else if (s[k] == 0 ? strictly_inside(p, a, drop) : s[l] == 0 && strictly_inside(q, a, drop)) {
+      return true;  // touching the plane at an end inside a
+    }
+  }
+  return false;
+}
+
+}  // namespace
+
+bool triangle_pair_crosses(const double* const a[3], const std::int32_t* ca, const double* const b[3],
+                           const std::int32_t* cb) {
+  // The corners of each that the other lacks. If those of one lie strictly
+  // on one side of the other's plane, the two meet at most at their shared
+  // corners or edge (no exact sign needed): most candidate pairs end here.
+  const double* only_a[3];
+  const double* only_b[3];
+  int na = 0, nb = 0;
+  for (int k = 0; k < 3; ++k) {
+    if (ca[k] != cb[0] && ca[k] != cb[1] && ca[k] != cb[2]) only_a[na++] = a[k];
+    if (cb[k] != ca[0] && cb[k] != ca[1] && cb[k] != ca[2]) only_b[nb++] = b[k];
+  }
+  if (na == 0 || nb == 0) return false;  // (the same corners)
+  if (surely_one_side(a, only_b, nb) || surely_one_side(b, only_a, na)) return false;
+  if (surely_apart_in_plane(a, ca, b, cb)) return false;
+  return edges_meet_interior(a, b) || edges_meet_interior(b, a);
+}
+
+std::vector<Pair> crossing_triangles(std::span<const double> xyz, std::span<const std::int32_t> corners,
+                                     std::span<const std::uint8_t> changed) {
+  const std::size_t nt = corners.size() / 3;
+  std::vector<Pair> out;
+  if (nt < 2) return out;
+  auto at = [&](std::size_t t, int k) { return &xyz[3 * static_cast<std::size_t>(corners[3 * t + static_cast<std::size_t>(k)])]; };
+
+  // Bounding boxes, then the whole extent and the mean triangle size.
+  std::vector<std::array<double, 6>> box(nt);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nt, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t t = r.begin(); t != r.end(); ++t)
+      for (int d = 0; d < 3; ++d) {
+        box[t][d] = std::min({at(t, 0)[d], at(t, 1)[d], at(t, 2)[d]});
+        box[t][d + 3] = std::max({at(t, 0)[d], at(t, 1)[d], at(t, 2)[d]});
+      }
+  });
+  double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY}, size = 0;
+  for (const auto& b : box) {
+    double extent = 0;
+    for (int d = 0; d < 3; ++d) {
+      lo[d] = std::min(lo[d], b[d]);
+      hi[d] = std::max(hi[d], b[d + 3]);
+      extent = std::max(extent, b[d + 3] - b[d]);
+    }
+    size += extent;
+  }
+  for (int d = 0; d < 3; ++d)
+    if (!std::isfinite(lo[d]) || !std::isfinite(hi[d])) return out;  // (positions are finite by construction)
+  // Cells about twice the mean triangle, at most ~4 per triangle in all.
+  double h = 2 * size / static_cast<double>(nt);
+  auto cells_along = [&](double cell, int d) {
+    return static_cast<std::int64_t>(std::floor((hi[d] - lo[d]) / cell)) + 1;
+  };
+  for (;;) {
+    if (!(h > 0)) h = std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2], std::numeric_limits<double>::min()});
+    const double cells = static_cast<double>(cells_along(h, 0)) * static_cast<double>(cells_along(h, 1)) *
+                         static_cast<double>(cells_along(h, 2));
+    if (cells <= 4.0 * static_cast<double>(nt) + 64) break;
+    h *= 1.5;
+  }
+  const std::int64_t n[3] = {cells_along(h, 0), cells_along(h, 1), cells_along(h, 2)};
+  auto cell = [&](double x, int d) {
+    return std::clamp<std::int64_t>(static_cast<std::int64_t>(std::floor((x - lo[d]) / h)), 0, n[d] - 1);
+  };
+  auto index = [&](std::int64_t i, std::int64_t j, std::int64_t k) {
+    return static_cast<std::size_t>((k * n[1] + j) * n[0] + i);
+  };
+  // The cells' triangle lists (CSR, ascending triangles in each).
+  const auto ncell = static_cast<std::size_t>(n[0] * n[1] * n[2]);
+  std::vector<std::int64_t> offset(ncell + 1, 0);
+  auto for_cells = [&](std::size_t t, auto&& body) {
+    const auto& b = box[t];
+    for (std::int64_t k = cell(b[2], 2); k <= cell(b[5], 2); ++k)
+      for (std::int64_t j = cell(b[1], 1); j <= cell(b[4], 1); ++j)
+        for (std::int64_t i = cell(b[0], 0); i <= cell(b[3], 0); ++i) body(index(i, j, k));
+  };
+  for (std::size_t t = 0; t < nt; ++t) for_cells(t, [&](std::size_t c) { ++offset[c + 1]; });
+  for (std::size_t c = 0; c < ncell; ++c) offset[c + 1] += offset[c];
+  std::vector<std::uint32_t> members(static_cast<std::size_t>(offset[ncell]));
+  {
+    std::vector<std::int64_t> fill(offset.begin(), offset.end() - 1);
+    for (std::size_t t = 0; t < nt; ++t)
+      for_cells(t, [&](std::size_t c) { members[static_cast<std::size_t>(fill[c]++)] = static_cast<std::uint32_t>(t); });
+  }
+
+  tbb::enumerable_thread_specific<std::vector<Pair>> found;
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, ncell, 256), [&](const tbb::blocked_range<std::size_t>& r) {
+    std::vector<Pair>& mine = found.local();
+    for (std::size_t c = r.begin(); c != r.end(); ++c) {
+      const auto b0 = static_cast<std::size_t>(offset[c]), b1 = static_cast<std::size_t>(offset[c + 1]);
+      const bool filtered = !changed.empty();
+      if (filtered && std::none_of(members.begin() + offset[c], members.begin() + offset[c + 1],
+                                   [&](std::uint32_t t) { return changed[t] != 0; }))
+        continue;
+      for (std::size_t x = b0; x < b1; ++x)
+        for (std::size_t y = x + 1; y < b1; ++y) {
+          const std::size_t s = members[x], t = members[y];
+          if (filtered && !changed[s] && !changed[t]) continue;
+          const auto &bs = box[s], &bt = box[t];
+          bool overlap = true;
+          for (int d = 0; d < 3 && overlap; ++d) overlap = bs[d] <= bt[d + 3] && bt[d] <= bs[d + 3];
+          if (!overlap) continue;
+          // Tested in one cell only: the one holding the overlap's lower corner.
+          if (index(cell(std::max(bs[0], bt[0]), 0), cell(std::max(bs[1], bt[1]), 1), cell(std::max(bs[2], bt[2]), 2)) != c)
+            continue;
+          const double* a[3] = {at(s, 0), at(s, 1), at(s, 2)};
+          const double* b[3] = {at(t, 0), at(t, 1), at(t, 2)};
+          if (triangle_pair_crosses(a, &corners[3 * s], b, &corners[3 * t]))
+            mine.emplace_back(std::min(s, t), std::max(s, t));
+        }
+    }
+  });
+  for (const auto& v : found) out.insert(out.end(), v.begin(), v.end());
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+}  // namespace tessera::front

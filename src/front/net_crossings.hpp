@@ -1,0 +1,37 @@
+// Crossing triangles of a smoothed surface net: the check behind the
+// smoothing's untangling rounds (net_smoothing.cpp). Private to the library.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <utility>
+#include <vector>
+
+namespace tessera::front {
+
+/// The pairs (i, j), i < j, ascending, of triangles that cross: they share a
+/// point interior to one of them (so a triangle passing through another,
+/// touching its interior with a corner or an edge, or overlapping it in one
+/// plane), decided by exact orientation signs of the doubles
+/// (kernels::orientation). Triangles that meet only on their boundaries (at
+/// shared or coincident corners, along an edge) do not cross: a net before
+/// smoothing, whose faces meet along edges and at distinct vertices that
+/// coincide on exact lattices, has none. A triangle of zero area (collinear
+/// corners) has no interior of its own, but crosses one whose interior it
+/// meets. `xyz` holds 3
+/// coordinates per vertex, `corners` 3 vertex indices per triangle.
+/// Candidates come from a uniform grid over the triangles' bounding boxes;
+/// the result does not depend on the thread count. With `changed` (one flag
+/// per triangle) only pairs with a changed triangle are tested: the others
+/// were found apart before.
+/// The test crossing_triangles applies to one pair: corner positions `a`,
+/// `b` and their vertex ids `ca`, `cb` (3 each).
+bool triangle_pair_crosses(const double* const a[3], const std::int32_t* ca, const double* const b[3],
+                           const std::int32_t* cb);
+
+std::vector<std::pair<std::size_t, std::size_t>> crossing_triangles(std::span<const double> xyz,
+                                                                     std::span<const std::int32_t> corners,
+                                                                     std::span<const std::uint8_t> changed = {});
+
+}  // namespace tessera::front
