@@ -171,10 +171,12 @@ SurfaceNetsOptions net_options(const SurfaceNetsArgs& a, const NetInput& in) {
 struct Watertight {
   std::size_t boundary_edges = 0, nonmanifold_edges = 0;
   std::vector<std::int32_t> open_labels;  ///< ascending
-  bool closed() const { return boundary_edges == 0 && nonmanifold_edges == 0; }
+  bool closed() const { return open_labels.empty(); }
 };
 
-Watertight check_watertight(const SurfaceNet& net, const VertexCopies& copies) {
+/// `one_region`: every point has one label in a box periodic along every
+/// axis, so its region has no boundary and no face (closed, though empty).
+Watertight check_watertight(const SurfaceNet& net, const VertexCopies& copies, bool one_region) {
   const FaceSet& m = net.mesh;
   const auto& sel = net.selected;
   auto selected = [&](std::int32_t l) { return std::binary_search(sel.begin(), sel.end(), l); };
@@ -232,7 +234,25 @@ Watertight check_watertight(const SurfaceNet& net, const VertexCopies& copies) {
     }
     i = j;
   }
+  // A selected label on no face at all: its whole surface was left out (its
+  // neighbours are all unselected, or the box, without --capping), which is
+  // open, not closed (an empty net was reported watertight).
+  if (!one_region) {
+    std::vector<std::int32_t> faced;
+    for (const auto& x : e) faced.push_back(std::get<0>(x));
+    faced.erase(std::unique(faced.begin(), faced.end()), faced.end());  // (e is sorted by label first)
+    for (const std::int32_t l : sel)
+      if (!std::binary_search(faced.begin(), faced.end(), l)) w.open_labels.push_back(l);
+    std::sort(w.open_labels.begin(), w.open_labels.end());
+  }
   return w;
+}
+
+/// Whether the points are one region filling a box periodic on every axis.
+bool one_region(const FaceSet& m, std::span<const std::int32_t> labels) {
+  for (int a = 0; a < m.dim; ++a)
+    if (!m.periodic[static_cast<std::size_t>(a)]) return false;
+  return std::adjacent_find(labels.begin(), labels.end(), std::not_equal_to<>()) == labels.end();
 }
 
 // ------------------------------------------------------------------ output
@@ -339,7 +359,7 @@ int run_surface_nets_frame(const SurfaceNetsArgs& a) {
   std::sort(pairs.begin(), pairs.end());
   pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
   const VertexCopies copies = vertex_copies(m);
-  const Watertight w = check_watertight(net, copies);
+  const Watertight w = check_watertight(net, copies, one_region(m, in.labels));
   auto t0 = Clock::now();
   io::write_surface_net_vtp(a.output, net);
   const double write_s = seconds_since(t0);
@@ -387,9 +407,11 @@ int run_surface_nets_frame(const SurfaceNetsArgs& a) {
   if (w.open_labels.empty())
     std::printf("  %-18s every selected label's surface is closed and manifold\n", "watertight");
   else
-    std::printf("  %-18s open: label%s %s (%zu boundary, %zu non-manifold edges)%s\n", "watertight",
-                w.open_labels.size() == 1 ? "" : "s", label_list(w.open_labels).c_str(), w.boundary_edges,
-                w.nonmanifold_edges,
+    std::printf("  %-18s open: label%s %s (%s)%s\n", "watertight", w.open_labels.size() == 1 ? "" : "s",
+                label_list(w.open_labels).c_str(),
+                w.boundary_edges + w.nonmanifold_edges == 0
+                    ? "no faces"
+                    : strf("%zu boundary, %zu non-manifold edges", w.boundary_edges, w.nonmanifold_edges).c_str(),
                 a.capping ? "" : "; they reach the domain box or unselected points (--capping closes them)");
   if (a.smooth > 0)
     std::printf("  %-18s %d iterations, relaxation %g, constraint %g%s; largest move %.6g\n", "smoothing", a.smooth,
@@ -433,7 +455,7 @@ int run_bench_surface_nets(const SurfaceNetsArgs& a) {
     const SurfaceNet net = surface_nets(in.coords, in.labels, net_options(a, in));
     const double secs = seconds_since(t0);
     const Usage u1 = usage_now();
-    const Watertight w = check_watertight(net, vertex_copies(net.mesh));
+    const Watertight w = check_watertight(net, vertex_copies(net.mesh), one_region(net.mesh, in.labels));
     const std::size_t tris = net.mesh.dim == 3 && a.triangles ? net.mesh.n_faces() : triangle_count(net);
     std::printf(
         "{\"tool\":\"tessera\",\"op\":\"surface-nets\",\"n\":%zu,\"threads\":%d,\"seconds\":%.6f,\"simplices\":%zu,"

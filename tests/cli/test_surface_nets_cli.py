@@ -160,6 +160,21 @@ class SurfaceNetsCLI(base.TempDirCase):
         self.assertEqual({(int(a), int(b)) for a, b in labels}, {(1, 0), (1, 2)})
         self.assertEqual(label_surface(faces, labels, 1, pts, 3)[:2], (0, 0))
 
+    def test_empty_net_is_open_not_watertight(self):
+        # One label, every neighbour unselected, no --capping: no face at all,
+        # which the summary and the bench called closed and manifold.
+        rng = np.random.default_rng(0)
+        p = self.save("p.npy", rng.random((200, 3)))
+        l = self.save("l.npy", rng.integers(0, 3, 200).astype(np.int32))
+        r = self.ok(["surface-nets", p, "--labels", l, "--select", "1", "-o", self.p("net.vtp")])
+        self.assertIn("0 polygons", r.stdout)
+        self.assertIn("open: label 1 (no faces); they reach the domain box or unselected points (--capping closes them)",
+                      r.stdout)
+        r = self.ok(["bench", "surface-nets", p, "--labels", l, "--select", "1"])
+        self.assertFalse(json.loads(r.stdout.splitlines()[0])["extra"]["watertight"])
+        r = self.ok(["surface-nets", p, "--labels", l, "--select", "1", "--capping", "-o", self.p("net.vtp")])
+        self.assertIn("every selected label's surface is closed and manifold", r.stdout)
+
     def test_points_2d(self):
         p, l = nested_points(3000, 2, 3)
         args = [self.save("p.npy", p), "--labels", self.save("l.npy", l), "--capping", "-q", "--bounds", *base.BOX2]
