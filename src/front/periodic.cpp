@@ -28,6 +28,12 @@ std::string num(double v) {
   return buf;
 }
 
+std::string short_num(double v) {  // (an estimate, to 3 digits)
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3g", v);
+  return buf;
+}
+
 /// x rounded to the nearest multiple of g (a power of two), ties to even.
 double snap(double x, double g) { return std::nearbyint(x / g) * g; }
 
@@ -383,11 +389,18 @@ PeriodicImages periodic_images(const PeriodicInput& in, std::span<const std::int
   // the Python module.)
   const std::size_t taking = in.n - in.ignored.size();
   const double image_budget = 64.0 * static_cast<double>(taking) + 0x1p20;
+  // The message names the cells' reach in box heights and the three ways to
+  // get there: a cubic box whose points fill a thousandth of it (a blob in
+  // a void) was said to be "far thinner than wide".
+  double reach = 0;
+  for (std::size_t a = 0; a < du; ++a)
+    if (in.periodic[a]) reach = std::max(reach, im.width[a] / in.height[a]);
   auto refuse_images = [&](double count) {
     throw InputError("the periodic box would need ~" + num(count) + " images of its " + std::to_string(taking) +
-                     " points: its heights (distances between opposite faces) are tiny next to its cells' reach "
-                     "(a box far thinner than wide, or sheared nearly flat); give a thicker box, or a less sheared "
-                     "box of the same lattice");
+                     " points: its cells reach ~" + short_num(reach) +
+                     " box heights (distances between opposite faces) across it (points gathered in a small part of "
+                     "the box, whose outer cells span it; a box far thinner than wide; or one sheared nearly flat); "
+                     "spread the points over the box, or give a thicker or less sheared box of the same lattice");
   };
   double walked = static_cast<double>(taking);
   for (std::size_t a = 0; a < du; ++a) walked *= 2.0 * k[a] + 1;

@@ -925,6 +925,19 @@ TEST(Periodic, BoxesNeedingMillionsOfImagesRefusedAtOnce) {
   } catch (const tessera::InputError& e) {
     EXPECT_NE(std::string(e.what()).find("images of its 30 points"), std::string::npos) << e.what();
   }
+  // A blob filling a millionth of a unit cube: its outer cells span the box,
+  // and the refusal says so (it said the cube was "far thinner than wide").
+  std::vector<double> blob = random_points(20000, 3, 2, make_bounds({0, 0, 0}, {1, 1, 1}));
+  for (double& x : blob) x = 0.5 + 1e-3 * x;
+  try {
+    tessera::voronoi(blob, 3, {}, periodic_options(3, make_bounds({0, 0, 0}, {1, 1, 1}), {true, true, true}, 1));
+    ADD_FAILURE() << "not refused";
+  } catch (const tessera::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("box heights (distances between opposite faces) across it (points gathered "
+                                         "in a small part of the box, whose outer cells span it"),
+              std::string::npos)
+        << e.what();
+  }
 }
 
 TEST(Triclinic, LargeTiltsReducedByWholeBoxLengths) {
