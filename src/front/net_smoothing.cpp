@@ -395,6 +395,8 @@ std::vector<NetVertexKind> smooth_surface_net(FaceSet& mesh, std::span<const dou
     front::reference_orientation(D, x0.data(), petal.data(), &mesh.face_vertices[b], e - b, &ref[dn * f]);
   });
 
+  // The polygons at each vertex (CSR, 3D): the untangling rounds below pin
+  // the ring of polygons around crossing ones.
   std::vector<std::int64_t> around_off;
   std::vector<std::int32_t> around;
   if (D == 3) {
