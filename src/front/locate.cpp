@@ -200,17 +200,24 @@ void SimplexLocator::build_walk(const Delaunay& dt, std::span<const double> poin
   const int D = dim_;
   const std::vector<std::int32_t> start = vertex_to_simplex(dt);
   const std::size_t used = static_cast<std::size_t>(std::count_if(start.begin(), start.end(), [](std::int32_t s) { return s >= 0; }));
-  // Seeds: bins of about two vertices, each holding a simplex of its
-  // lowest-id vertex; empty bins take the seed of a nearest filled bin
-  // (breadth-first over the grid), so a walk starts a few simplices away.
+  // Seeds: bins of about two vertices, each holding the lowest simplex
+  // whose centroid lies in it; empty bins take the seed of a nearest filled
+  // bin (breadth-first over the grid), so a walk starts a few simplices
+  // away. (A simplex of the bin's lowest vertex, the seed until stop 84, may
+  // lie across that vertex's star: a fan's centre has all N triangles, and
+  // each query near it walked O(N) of them, quadratic over N queries.)
   size_bins(2, static_cast<double>(used));
   seed_.assign(static_cast<std::size_t>(bins_[0] * bins_[1] * bins_[2]), -1);
-  for (std::size_t v = n_points_; v-- > 0;) {
-    if (start[v] < 0) continue;
-    const double* x = points.data() + v * static_cast<std::size_t>(D);
+  const std::size_t w = static_cast<std::size_t>(D + 1);
+  for (std::size_t s = n_simplices_; s-- > 0;) {
+    const std::int32_t* row = dt.simplices.data() + s * w;
     std::int64_t b[3] = {0, 0, 0};
-    for (int d = 0; d < D; ++d) b[d] = bin_of(d, x[d]);
-    seed_[bin_index(b[0], b[1], b[2])] = start[v];
+    for (int d = 0; d < D; ++d) {
+      double c = 0;
+      for (std::size_t k = 0; k < w; ++k) c += points[static_cast<std::size_t>(row[k]) * static_cast<std::size_t>(D) + static_cast<std::size_t>(d)];
+      b[d] = bin_of(d, c / static_cast<double>(w));
+    }
+    seed_[bin_index(b[0], b[1], b[2])] = static_cast<std::int32_t>(s);
   }
   std::vector<std::size_t> queue;
   for (std::size_t b = 0; b < seed_.size(); ++b)
