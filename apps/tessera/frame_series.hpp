@@ -7,9 +7,7 @@
 #pragma once
 
 #include <cstdio>
-#include <filesystem>
 #include <initializer_list>
-#include <set>
 #include <string>
 #include <vector>
 
@@ -81,19 +79,15 @@ int run_frames(const Args& a, std::initializer_list<SeriesOutput<Args>> outputs,
   Args base = a;
   const std::vector<io::FramePlace> frames = std::move(base.compute.frames);
   base.compute.frames.clear();
-  // Every frame's output folders are checked before the first frame is
-  // computed, as a single run checks its outputs ({frame} may name a folder);
-  // each folder once.
-  std::set<std::string> folders;
+  // Every frame's outputs are checked before the first frame is computed,
+  // as a single run checks its outputs ({frame} may name a folder): each
+  // folder, and each name (a FIFO or an input named by a later frame was
+  // refused only when that frame was written).
   for (const io::FramePlace& place : frames) {
     if (place.atoms == 0) continue;
     const Args named = with_frame_names(base, outputs, place.index);
-    for (const SeriesOutput<Args>& o : outputs) {
-      const std::string& path = named.*(o.path);
-      if (path.empty()) continue;
-      const std::string folder = std::filesystem::path(path).parent_path().string();
-      if (folders.insert(folder).second) io::check_writable(path);
-    }
+    for (const SeriesOutput<Args>& o : outputs)
+      if (const std::string& path = named.*(o.path); !path.empty()) io::check_writable(path);
   }
   int rc = kExitOk;
   std::size_t computed = 0;

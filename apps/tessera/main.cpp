@@ -250,10 +250,11 @@ void finish_compute_args(ComputeArgs& c, const std::vector<std::string>& raw_bou
                               (i >= 4 ? " (put INPUT before --bounds)" : ""));
   }
   if (c.input.empty()) throw tessera::InputError("INPUT is required (run with --help for usage)");
-  c.input = input_path(c.input);
   // No output may replace a file the command reads (a slip such as
-  // `voronoi p.npy --cell-table p.npy` replaced the points).
+  // `voronoi p.npy --cell-table p.npy` replaced the points); `-` is the file
+  // standard input comes from, if it is one.
   tessera::io::protect_from_writes(c.input, "the INPUT");
+  c.input = input_path(c.input);
   tessera::io::protect_from_writes(c.labels, "--labels");
   tessera::io::protect_from_writes(c.radii, "--radii");
   if (!series && is_frame_series(c.frame))
@@ -540,6 +541,9 @@ int main(int argc, char** argv) {
         return kExitInputError;
       }
     }
+  // Files that readers open beyond those named (an image header's data file)
+  // are protected from outputs, as the named inputs are.
+  tessera::io::protect_files_read(true);
   // A number such as -.5 is taken by CLI11 for an option (`--bounds -.5 1
   // ...` said "At least 4 required but received 2"), where -0.5 is a
   // value: written so before parsing. No option begins with "-.".

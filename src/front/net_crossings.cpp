@@ -6,8 +6,10 @@
 // phase: exact orientation signs (in 3D, and in 2D projections for what lies
 // in a plane). The intersection of two triangles is bounded by points on
 // their edges, so it holds a point interior to one of them iff some edge of
-// one meets the other's interior: crossing its plane inside it, lying in its
-// plane across it, or ending in its plane inside it.
+// one meets the other's interior (crossing its plane inside it, lying in its
+// plane across it, or ending in its plane inside it), or, in one plane, one
+// lies over the other with its corners on the other's boundary (the same
+// corners: a fold), which its centroid shows.
 #include "net_crossings.hpp"
 
 #include <algorithm>
@@ -150,6 +152,15 @@ bool edges_meet_interior(const double* const a[3], const double* const b[3]) {
   const double n[3] = {std::fabs(u[1] * w[2] - u[2] * w[1]), std::fabs(u[2] * w[0] - u[0] * w[2]),
                        std::fabs(u[0] * w[1] - u[1] * w[0])};
   const int drop = n[0] >= n[1] && n[0] >= n[2] ? 0 : n[1] >= n[2] ? 1 : 2;
+  if (s[0] == 0 && s[1] == 0 && s[2] == 0 && !kernels::collinear3(b[0], b[1], b[2])) {
+    // b in a's plane with every corner on a's boundary (the same corners, or
+    // one on an edge: a fold that no edge shows) lies over a's interior,
+    // and then so does its centroid (a double within rounding of it, which
+    // lies well inside b).
+    const double c[3] = {(b[0][0] + b[1][0] + b[2][0]) / 3, (b[0][1] + b[1][1] + b[2][1]) / 3,
+                         (b[0][2] + b[1][2] + b[2][2]) / 3};
+    if (strictly_inside(c, a, drop)) return true;
+  }
   for (int k = 0; k < 3; ++k) {
     const int l = (k + 1) % 3;
     const double* p = b[k];

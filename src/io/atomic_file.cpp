@@ -209,10 +209,11 @@ std::vector<Protected>& protected_files() {
 /// is not a regular one (a FIFO, a device: renaming over it would take it
 /// away from whoever uses it). A link is replaced, not followed (its target
 /// is left as it is), as rename(2) does; so is a regular file. Returns the
-/// existing file's mode (0 if there is none) for the new one to keep.
-mode_t check_target(const std::string& path) {
+/// existing regular file's permission bits for the new one to keep, or -1
+/// (none there, or a link).
+int check_target(const std::string& path) {
   struct stat st {};
-  if (::lstat(path.c_str(), &st) != 0) return 0;  // not there (or unreadable: the write says why)
+  if (::lstat(path.c_str(), &st) != 0) return -1;  // not there (or unreadable: the write says why)
   if (S_ISDIR(st.st_mode)) cannot_write(path, "is a directory");
   if (!S_ISREG(st.st_mode) && !S_ISLNK(st.st_mode))
     cannot_write(path, std::string("is not a regular file (") +
@@ -221,12 +222,12 @@ mode_t check_target(const std::string& path) {
                                                    : "a device") +
                            "), which a file written in its place would replace");
   struct stat target {};
-  if (::stat(path.c_str(), &target) != 0) return 0;  // a dangling link
+  if (::stat(path.c_str(), &target) != 0) return -1;  // a dangling link
   if (S_ISDIR(target.st_mode)) cannot_write(path, "is a directory");
   for (const Protected& p : protected_files())
     if (p.dev == target.st_dev && p.ino == target.st_ino)
       cannot_write(path, "it is " + p.role + ", which this run reads; an output may not replace it (give another name)");
-  return S_ISREG(st.st_mode) ? st.st_mode & 07777 : 0;
+  return S_ISREG(st.st_mode) ? static_cast<int>(st.st_mode & 07777) : -1;
 }
 
 /// The group whose renames wait for its commit on this thread (OutputGroup).
@@ -236,8 +237,20 @@ thread_local OutputGroup* t_group = nullptr;
 
 void protect_from_writes(const std::string& path, const std::string& role) {
   struct stat st {};
-  if (path.empty() || path == "-" || ::stat(path.c_str(), &st) != 0 || !S_ISREG(st.st_mode)) return;
-  protected_files().push_back({st.st_dev, st.st_ino, role});
+  if (path.empty()) return;
+  // Standard input redirected from a file (`joggle - -o p.npy < p.npy`): that file.
+  if (path == "-" ? ::fstat(STDIN_FILENO, &st) != 0 : ::stat(path.c_str(), &st) != 0) return;
+  if (S_ISREG(st.st_mode)) protected_files().push_back({st.st_dev, st.st_ino, role});
+}
+
+namespace {
+std::atomic<bool> g_protect_read_files{false};
+}  // namespace
+
+void protect_files_read(bool on) { g_protect_read_files.store(on, std::memory_order_relaxed); }
+
+void note_file_read(const std::string& path, const std::string& role) {
+  if (g_protect_read_files.load(std::memory_order_relaxed)) protect_from_writes(path, role);
 }
 
 void write_file_atomic(const std::string& path, const std::function<void(std::ostream&)>& fill) {
@@ -256,7 +269,7 @@ void write_file_atomic(const std::string& path, const std::function<void(std::os
     return;
   }
   std::error_code ec;
-  const mode_t keep_mode = check_target(path);
+  const int keep_mode = check_target(path);
 
   std::string tmp;
   int slot = -1;
@@ -264,7 +277,7 @@ void write_file_atomic(const std::string& path, const std::function<void(std::os
   // A file replaced keeps its permissions (as a shell's redirection, cp or
   // sed -i leave them): one made private stayed readable by all. New files
   // take 0666 less the umask.
-  if (keep_mode != 0) ::fchmod(fd, keep_mode);
+  if (keep_mode >= 0) ::fchmod(fd, static_cast<mode_t>(keep_mode));
   // From here on every exit path must close fd and remove tmp unless renamed,
   // and disarm the slot after the file is gone (renamed or unlinked).
   auto discard = [&](int open_fd) {

@@ -19,6 +19,7 @@
 #include "image_detail.hpp"
 #include "io_detail.hpp"
 #include "tessera/cells.hpp"
+#include "tessera/io/atomic_file.hpp"
 
 namespace tessera::io {
 namespace detail {
@@ -287,6 +288,7 @@ std::string parse_ascii_values(const std::string& path, std::string_view text, S
 }
 
 std::string read_detached(const std::string& path, const std::string& data_path) {
+  note_file_read(data_path, "the data file of " + path);
   // A FIFO named by a header (not by the user, who may pass <(command) as an
   // input) blocks until something writes to it: refused.
   std::error_code ec;

@@ -2278,6 +2278,29 @@ class BadInput(TempDirCase):
             self.assertIn(fragment, line)
         os.symlink(pts, self.p("link.npy"))
         intact(pts, lambda: self.fails(["voronoi", self.p("link.npy"), "--cell-table", pts], "the INPUT"))
+        # Standard input redirected from the file the output names.
+        for args in (["joggle", "-", "-o", pts], ["voronoi", "-", "--cell-table", self.p("t.csv")]):
+            target = args[-1]
+            if not os.path.exists(target):
+                shutil.copy(pts, target)
+            def refused():
+                with open(target, "rb") as f:
+                    r = subprocess.run([TESSERA] + args, stdin=f, capture_output=True, text=True)
+                self.assertEqual(r.returncode, 2, r.stderr)
+                self.assertIn("it is the INPUT, which this run reads", r.stderr)
+            intact(target, refused)
+        # An image header's data file (NRRD `data file:`), read beside the
+        # header (named .npy here only so that -o, a points file, may name it).
+        img = np.zeros((8, 9, 10), np.int32)
+        img[2:6, 2:7, 3:8] = 1
+        img.tofile(self.p("vol.npy"))
+        with open(self.p("vol.nhdr"), "w") as f:
+            f.write("NRRD0004\ntype: int32\ndimension: 3\nsizes: 10 9 8\nendian: little\nencoding: raw\n"
+                    "data file: vol.npy\n")
+        probe_pts = self.save("probe.npy", np.random.default_rng(0).random((20, 3)) * 7)
+        line = intact(self.p("vol.npy"), lambda: self.fails(["probe", self.p("vol.nhdr"), probe_pts, "-o",
+                                                            self.p("vol.npy")]))
+        self.assertIn("it is the data file of", line)
 
     def test_empty_option_values_refused(self):
         # An empty value was taken as the option not given: `--cell-table ""

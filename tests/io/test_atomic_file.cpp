@@ -221,6 +221,12 @@ TEST(AtomicFile, WhatAReplacedFileKeepsAndWhatIsRefused) {
   ASSERT_EQ(::chmod(p.c_str(), 0600), 0);
   write_file_atomic(p, std::string_view("two"));
   EXPECT_EQ(fs::status(p).permissions() & fs::perms::mask, fs::perms::owner_read | fs::perms::owner_write);
+  // None at all (it came back 0644: 0 meant "no file"). Replacing needs
+  // only the folder's permission.
+  ASSERT_EQ(::chmod(p.c_str(), 0), 0);
+  write_file_atomic(p, std::string_view("three"));
+  EXPECT_EQ(fs::status(p).permissions() & fs::perms::mask, fs::perms::none);
+  ASSERT_EQ(::chmod(p.c_str(), 0600), 0);
 
   const std::string fifo = dir.file("pipe.npy");
   ASSERT_EQ(::mkfifo(fifo.c_str(), 0644), 0);

@@ -330,6 +330,11 @@ TEST(SurfaceNets, CrossingTestOnHandMadeTriangles) {
   // Sharing an edge: folded onto it in its plane counts, a hinge does not.
   EXPECT_TRUE(crosses(floor, {{{4, 0, 0}, {0, 4, 0}, {1, 1, 0}}}, {0, 1, 2, 1, 2, 8}));
   EXPECT_FALSE(crosses(floor, {{{4, 0, 0}, {0, 4, 0}, {4, 4, 1}}}, {0, 1, 2, 1, 2, 8}));
+  // In its plane with every corner on its boundary, no edge through it: the
+  // same corners (distinct vertices that coincide), or one on an edge.
+  EXPECT_TRUE(crosses(floor, {{{0, 0, 0}, {0, 4, 0}, {4, 0, 0}}}, apart));
+  EXPECT_TRUE(crosses(floor, {{{4, 0, 0}, {0, 4, 0}, {0, 1, 0}}}, {0, 1, 2, 1, 2, 8}));
+  EXPECT_FALSE(crosses(floor, {{{4, 0, 0}, {0, 4, 0}, {4, 4, 0}}}, {0, 1, 2, 1, 2, 8}));  // beside it
 }
 
 // Triangles of zero area before smoothing (coincident corners of exact

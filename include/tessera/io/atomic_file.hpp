@@ -34,8 +34,17 @@ void check_writable(const std::string& path);
 /// PATH: it is ROLE, which this run reads". Empty unless a program adds to
 /// it: the tessera command lists its inputs (the points, --labels,
 /// --radii, ...), so that a slip such as `voronoi p.npy --cell-table p.npy`
-/// cannot replace what it read. Add before writing (not thread-safe).
+/// cannot replace what it read. `-` is standard input: the file it is
+/// redirected from, if it is one. Add before writing (not thread-safe).
 void protect_from_writes(const std::string& path, const std::string& role);
+
+/// Files a reader opens beyond the one it was given (an image header's
+/// detached data: NRRD's `data file`, MetaImage's `ElementDataFile`, a NIfTI
+/// pair's `.img`) are noted with note_file_read, which protects them
+/// (protect_from_writes) only once protect_files_read(true) was called: the
+/// tessera command does; a library user (Python) reads and writes as it likes.
+void protect_files_read(bool on);
+void note_file_read(const std::string& path, const std::string& role);
 
 /// Outputs written together: while one lives on this thread,
 /// write_file_atomic leaves each complete file under its temporary name, and
