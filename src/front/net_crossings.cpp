@@ -9,7 +9,7 @@
 // one meets the other's interior (crossing its plane inside it, lying in its
 // plane across it, or ending in its plane inside it), or, in one plane, one
 // lies over the other with its corners on the other's boundary (the same
-// corners: a fold), which its centroid shows.
+// corners: a fold).
 #include "net_crossings.hpp"
 
 #include <algorithm>
@@ -153,13 +153,17 @@ bool edges_meet_interior(const double* const a[3], const double* const b[3]) {
                        std::fabs(u[0] * w[1] - u[1] * w[0])};
   const int drop = n[0] >= n[1] && n[0] >= n[2] ? 0 : n[1] >= n[2] ? 1 : 2;
   if (s[0] == 0 && s[1] == 0 && s[2] == 0 && !kernels::collinear3(b[0], b[1], b[2])) {
-    // b in a's plane with every corner on a's boundary (the same corners, or
-    // one on an edge: a fold that no edge shows) lies over a's interior,
-    // and then so does its centroid (a double within rounding of it, which
-    // lies well inside b).
-    const double c[3] = {(b[0][0] + b[1][0] + b[2][0]) / 3, (b[0][1] + b[1][1] + b[2][1]) / 3,
-                         (b[0][2] + b[1][2] + b[2][2]) / 3};
-    if (strictly_inside(c, a, drop)) return true;
+    // b in a's plane, not flat, with every corner in a or on its boundary
+    // (the same corners, or one on an edge: a fold that no edge shows):
+    // then b's interior lies in a's (a point of it on a's boundary would
+    // put all of b on that edge's line).
+    const int turn = orient2(a[0], a[1], a[2], drop);  // a's orientation in the projection
+    auto in_closure = [&](const double* p) {
+      for (int k = 0; k < 3; ++k)
+        if (orient2(a[k], a[(k + 1) % 3], p, drop) == -turn) return false;
+      return true;
+    };
+    if (turn != 0 && in_closure(b[0]) && in_closure(b[1]) && in_closure(b[2])) return true;
   }
   for (int k = 0; k < 3; ++k) {
     const int l = (k + 1) % 3;
