@@ -406,9 +406,10 @@ std::vector<NetVertexKind> smooth_surface_net(FaceSet& mesh, std::span<const dou
     around.resize(mesh.face_vertices.size());
     std::vector<std::int64_t> fill(around_off.begin(), around_off.end() - 1);
     for (std::size_t f = 0; f < nf; ++f)
-      for (auto q = mesh.face_offsets[f]; q < mesh.face_offsets[f + 1]; ++q)
-        around[static_cast<std::size_t>(fill[static_cast<std::size_t>(mesh.face_vertices[static_cast<std::size_t>(q)])]++)] =
-            static_cast<std::int32_t>(f);
+      for (auto q = mesh.face_offsets[f]; q < mesh.face_offsets[f + 1]; ++q) {
+        auto& slot = fill[static_cast<std::size_t>(mesh.face_vertices[static_cast<std::size_t>(q)])];
+        around[static_cast<std::size_t>(slot++)] = static_cast<std::int32_t>(f);
+      }
   }
   // The smoothing from the start (x0), with `pinned` as it stands: every
   // copy's final position.
@@ -478,7 +479,8 @@ std::vector<NetVertexKind> smooth_surface_net(FaceSet& mesh, std::span<const dou
           const auto b = static_cast<std::size_t>(mesh.face_offsets[f]);
           const auto n = static_cast<std::size_t>(mesh.face_offsets[f + 1]) - b;
           const std::int32_t* loop = &mesh.face_vertices[b];
-          if (!first && std::none_of(loop, loop + n, [&](std::int32_t v) { return newly[static_cast<std::size_t>(v)]; }))
+          auto newly_frozen = [&](std::int32_t v) { return newly[static_cast<std::size_t>(v)] != 0; };
+          if (!first && std::none_of(loop, loop + n, newly_frozen))
             return;
           auto at = [&](std::int32_t v) {
             const auto u = static_cast<std::size_t>(v);
@@ -488,7 +490,8 @@ std::vector<NetVertexKind> smooth_surface_net(FaceSet& mesh, std::span<const dou
           if (D == 2) {
             const double* p = at(loop[0]);
             const double* q = at(loop[1]);
-            ok = (q[0] - p[0]) * ref[2 * f] + (q[1] - p[1]) * ref[2 * f + 1] > 0 || (ref[2 * f] == 0 && ref[2 * f + 1] == 0);
+            ok = (q[0] - p[0]) * ref[2 * f] + (q[1] - p[1]) * ref[2 * f + 1] > 0 ||
+                 (ref[2 * f] == 0 && ref[2 * f + 1] == 0);
           } else {
             ok = front::ladder_score(at, x0.data(), loop, n, rotation[f], &ref[3 * f]) > 0;
             for (std::size_t start = 0; start < n && !ok; ++start)
@@ -499,15 +502,19 @@ std::vector<NetVertexKind> smooth_surface_net(FaceSet& mesh, std::span<const dou
           }
           if (ok) return;
           for (std::size_t q = 0; q < n; ++q)
-            std::atomic_ref<std::uint8_t>(freeze[static_cast<std::size_t>(loop[q])]).store(1, std::memory_order_relaxed);
+            std::atomic_ref<std::uint8_t>(freeze[static_cast<std::size_t>(loop[q])])
+                .store(1, std::memory_order_relaxed);
         });
         if (periodic) {  // a frozen copy freezes every copy of its vertex
           front::parallel_range(ng, 4096, [&](std::size_t g) {
             std::uint8_t any = 0;
-            for (auto m = member_off[g]; m < member_off[g + 1]; ++m) any |= freeze[static_cast<std::size_t>(members[static_cast<std::size_t>(m)])];
+            for (auto m = member_off[g]; m < member_off[g + 1]; ++m)
+              any |= freeze[static_cast<std::size_t>(members[static_cast<std::size_t>(m)])];
             group_frozen[g] = any;
           });
-          front::parallel_range(nv, 4096, [&](std::size_t v) { freeze[v] = group_frozen[static_cast<std::size_t>(copies.group[v])]; });
+          front::parallel_range(nv, 4096, [&](std::size_t v) {
+            freeze[v] = group_frozen[static_cast<std::size_t>(copies.group[v])];
+          });
         }
         grew = freeze != frozen;
         frozen.swap(freeze);
@@ -552,7 +559,8 @@ std::vector<NetVertexKind> smooth_surface_net(FaceSet& mesh, std::span<const dou
       const auto b = static_cast<std::size_t>(mesh.face_offsets[f]);
       const auto n = static_cast<std::size_t>(mesh.face_offsets[f + 1]) - b;
       const std::int32_t* loop = &mesh.face_vertices[b];
-      if (round > 0 && std::none_of(loop, loop + n, [&](std::int32_t v) { return moved_since(static_cast<std::size_t>(v)); }))
+      auto has_moved = [&](std::int32_t v) { return moved_since(static_cast<std::size_t>(v)); };
+      if (round > 0 && std::none_of(loop, loop + n, has_moved))
         return;
       double r[3] = {ref[3 * f], ref[3 * f + 1], ref[3 * f + 2]};
       if (r[0] == 0 && r[1] == 0 && r[2] == 0) front::newell(cur.data(), loop, n, r);
@@ -570,7 +578,7 @@ std::vector<NetVertexKind> smooth_surface_net(FaceSet& mesh, std::span<const dou
     if (round > 0) {
       changed.resize(nt);
       front::parallel_range(nt, 4096, [&](std::size_t t) {
-        for (int k = 0; k < 3; ++k) changed[t] |= moved_since(static_cast<std::size_t>(corners[3 * t + static_cast<std::size_t>(k)]));
+        for (std::size_t k = 0; k < 3; ++k) changed[t] |= moved_since(static_cast<std::size_t>(corners[3 * t + k]));
       });
     }
     // Pairs that cross where the net started are left alone: rounding can
