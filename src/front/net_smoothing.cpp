@@ -600,8 +600,8 @@ std::vector<NetVertexKind> smooth_surface_net(FaceSet& mesh, std::span<const dou
     std::size_t newly_pinned = 0;
     auto pin_polygon = [&](std::size_t f) {
       for (auto q = mesh.face_offsets[f]; q < mesh.face_offsets[f + 1]; ++q) {
-        const auto first = static_cast<std::size_t>(
-            copies.first[static_cast<std::size_t>(copies.group[static_cast<std::size_t>(mesh.face_vertices[static_cast<std::size_t>(q)])])]);
+        const auto v = static_cast<std::size_t>(mesh.face_vertices[static_cast<std::size_t>(q)]);
+        const auto first = static_cast<std::size_t>(copies.first[static_cast<std::size_t>(copies.group[v])]);
         if (pinned[first] != 7) ++newly_pinned;
         pinned[first] = 7;  // every axis: the group stays where it started
       }
@@ -610,7 +610,8 @@ std::vector<NetVertexKind> smooth_surface_net(FaceSet& mesh, std::span<const dou
       for (const std::size_t f : {polygon_of[s], polygon_of[t]})
         for (auto q = mesh.face_offsets[f]; q < mesh.face_offsets[f + 1]; ++q) {
           const auto v = static_cast<std::size_t>(mesh.face_vertices[static_cast<std::size_t>(q)]);
-          for (auto e = around_off[v]; e < around_off[v + 1]; ++e) pin_polygon(static_cast<std::size_t>(around[static_cast<std::size_t>(e)]));
+          for (auto e = around_off[v]; e < around_off[v + 1]; ++e)
+            pin_polygon(static_cast<std::size_t>(around[static_cast<std::size_t>(e)]));
         }
     if (newly_pinned == 0) {  // (cannot happen: crossings need a moved corner)
       cur = x0;
