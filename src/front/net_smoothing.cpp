@@ -581,21 +581,47 @@ std::vector<NetVertexKind> smooth_surface_net(FaceSet& mesh, std::span<const dou
         for (std::size_t k = 0; k < 3; ++k) changed[t] |= moved_since(static_cast<std::size_t>(corners[3 * t + k]));
       });
     }
-    // Pairs that cross where the net started are left alone: rounding can
-    // set vertices that should coincide ulps apart, so that the unsmoothed
-    // net itself overlaps by ulps (far from the origin, with anisotropic
-    // voxels), which no pinning undoes (all of a 2-label box was pinned).
-    auto crosses_at_start = [&](std::size_t s, std::size_t t) {
-      const double* a[3];
-      const double* b[3];
-      for (std::size_t k = 0; k < 3; ++k) {
-        a[k] = &x0[3 * static_cast<std::size_t>(corners[3 * s + k])];
-        b[k] = &x0[3 * static_cast<std::size_t>(corners[3 * t + k])];
-      }
+    // Rounding can set vertices that should coincide ulps apart, so that the
+    // unsmoothed net itself overlaps by ulps (far from the origin, with
+    // anisotropic voxels: hundreds of pairs). Pinning cannot undo those (a
+    // first version pinned all of a 2-label box), so a pair that crosses
+    // where it started is left alone while it stays that small: unless it
+    // still crosses with each triangle shrunk by 1e-6 of its size (an ulp
+    // sliver that smoothing opened into a fold does). A pair whose corners
+    // are all where they started is left alone in any case: it is as good as
+    // it gets, and the rounds end.
+    auto corner = [&](const std::vector<double>& at, std::size_t t, std::size_t k) {
+      return &at[3 * static_cast<std::size_t>(corners[3 * t + k])];
+    };
+    auto crosses_at = [&](const std::vector<double>& at, std::size_t s, std::size_t t) {
+      const double* a[3] = {corner(at, s, 0), corner(at, s, 1), corner(at, s, 2)};
+      const double* b[3] = {corner(at, t, 0), corner(at, t, 1), corner(at, t, 2)};
       return front::triangle_pair_crosses(a, &corners[3 * s], b, &corners[3 * t]);
     };
+    auto crosses_shrunk = [&](std::size_t s, std::size_t t) {
+      double pts[2][3][3];
+      for (int side = 0; side < 2; ++side) {
+        const std::size_t u = side == 0 ? s : t;
+        for (std::size_t d = 0; d < 3; ++d) {
+          const double c = (corner(cur, u, 0)[d] + corner(cur, u, 1)[d] + corner(cur, u, 2)[d]) / 3;
+          for (std::size_t k = 0; k < 3; ++k) pts[side][k][d] = c + (1 - 1e-6) * (corner(cur, u, k)[d] - c);
+        }
+      }
+      const double* a[3] = {pts[0][0], pts[0][1], pts[0][2]};
+      const double* b[3] = {pts[1][0], pts[1][1], pts[1][2]};
+      const std::int32_t ids[6] = {-1, -2, -3, -4, -5, -6};  // apart: no corner shared
+      return front::triangle_pair_crosses(a, ids, b, ids + 3);
+    };
+    auto at_start = [&](std::size_t t) {
+      for (std::size_t k = 0; k < 3; ++k)
+        if (!std::equal(corner(cur, t, k), corner(cur, t, k) + 3, corner(x0, t, k))) return false;
+      return true;
+    };
     auto crossings = front::crossing_triangles(cur, corners, changed);
-    std::erase_if(crossings, [&](const auto& st) { return crosses_at_start(st.first, st.second); });
+    std::erase_if(crossings, [&](const auto& st) {
+      const auto [s, t] = st;
+      return (at_start(s) && at_start(t)) || (crosses_at(x0, s, t) && !crosses_shrunk(s, t));
+    });
     if (crossings.empty()) break;
     std::size_t newly_pinned = 0;
     auto pin_polygon = [&](std::size_t f) {
