@@ -537,9 +537,10 @@ std::vector<NetVertexKind> smooth_surface_net(FaceSet& mesh, std::span<const dou
   // 64^3, 1,005 of 405,000 with 40. Where the triangles that will be output
   // (each polygon's best ladder, as triangulate_ladder takes it) cross
   // (front::crossing_triangles, exact), the polygons around both polygons'
-  // corners are pinned where they started and the smoothing runs again from
-  // the start; pinning less (the two polygons alone) took more rounds, as
-  // their neighbours then folded against them. Pairs that cross at the start
+  // corners are pinned where they started (from the second round, the ring
+  // around that ring too) and the smoothing runs again from the start;
+  // pinning less (the two polygons alone) took more rounds, as their
+  // neighbours then folded against them, and so did two rings at once. Pairs that cross at the start
   // already (rounding artefacts) are not counted, so pinning converges (3-4
   // rounds on those images); past 16 rounds every vertex keeps its start.
   std::vector<double> cur = smooth_from_start();
@@ -632,13 +633,24 @@ std::vector<NetVertexKind> smooth_surface_net(FaceSet& mesh, std::span<const dou
         pinned[first] = 7;  // every axis: the group stays where it started
       }
     };
-    for (const auto& [s, t] : crossings)
-      for (const std::size_t f : {polygon_of[s], polygon_of[t]})
+    // The ring of polygons around both polygons' corners; from the second
+    // round on, the ring around that ring too (crossings left after a round
+    // sit beside the places pinned, and a wider ring ends the rounds sooner).
+    std::vector<std::size_t> ring;
+    for (const auto& [s, t] : crossings) ring.insert(ring.end(), {polygon_of[s], polygon_of[t]});
+    for (int width = 0; width < (round == 0 ? 1 : 2); ++width) {
+      std::vector<std::size_t> wider;
+      for (const std::size_t f : ring)
         for (auto q = mesh.face_offsets[f]; q < mesh.face_offsets[f + 1]; ++q) {
           const auto v = static_cast<std::size_t>(mesh.face_vertices[static_cast<std::size_t>(q)]);
           for (auto e = around_off[v]; e < around_off[v + 1]; ++e)
-            pin_polygon(static_cast<std::size_t>(around[static_cast<std::size_t>(e)]));
+            wider.push_back(static_cast<std::size_t>(around[static_cast<std::size_t>(e)]));
         }
+      std::sort(wider.begin(), wider.end());
+      wider.erase(std::unique(wider.begin(), wider.end()), wider.end());
+      ring = std::move(wider);
+    }
+    for (const std::size_t f : ring) pin_polygon(f);
     if (newly_pinned == 0) {  // (cannot happen: crossings need a moved corner)
       cur = x0;
       break;
