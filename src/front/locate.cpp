@@ -198,8 +198,10 @@ void SimplexLocator::build_grid(const Delaunay& dt, std::span<const double> poin
 
 void SimplexLocator::build_walk(const Delaunay& dt, std::span<const double> points, int threads) {
   const int D = dim_;
-  const std::vector<std::int32_t> start = vertex_to_simplex(dt);
-  const std::size_t used = static_cast<std::size_t>(std::count_if(start.begin(), start.end(), [](std::int32_t s) { return s >= 0; }));
+  // The vertices in use (those of some simplex) size the bins.
+  std::vector<std::uint8_t> in_use(n_points_, 0);
+  for (const std::int32_t v : dt.simplices) in_use[static_cast<std::size_t>(v)] = 1;
+  const auto used = static_cast<std::size_t>(std::count(in_use.begin(), in_use.end(), std::uint8_t{1}));
   // Seeds: bins of about two vertices, each holding the lowest simplex
   // whose centroid lies in it; empty bins take the seed of a nearest filled
   // bin (breadth-first over the grid), so a walk starts a few simplices

@@ -563,11 +563,8 @@ std::vector<NetVertexKind> smooth_surface_net(FaceSet& mesh, std::span<const dou
       auto has_moved = [&](std::int32_t v) { return moved_since(static_cast<std::size_t>(v)); };
       if (round > 0 && std::none_of(loop, loop + n, has_moved))
         return;
-      double r[3] = {ref[3 * f], ref[3 * f + 1], ref[3 * f + 2]};
-      if (r[0] == 0 && r[1] == 0 && r[2] == 0) front::newell(cur.data(), loop, n, r);
-      auto pos = [&](std::int32_t v) { return &cur[3 * static_cast<std::size_t>(v)]; };
       std::size_t t = b - 2 * f;
-      front::ladder(n, front::best_ladder_rotation(pos, x0.data(), loop, n, r),
+      front::ladder(n, front::output_ladder_rotation(cur.data(), x0.data(), loop, n, &ref[3 * f]),
                     [&](std::size_t i, std::size_t j, std::size_t q) {
                       corners[3 * t] = loop[i], corners[3 * t + 1] = loop[j], corners[3 * t + 2] = loop[q];
                       polygon_of[t++] = f;

@@ -182,17 +182,22 @@ double ladder_score(Pos&& pos, const double* x0, const std::int32_t* loop, std::
   return turned_over ? -std::numeric_limits<double>::infinity() : worst;
 }
 
-/// The ladder rotation a 3D polygon is triangulated by: the best
-/// ladder_score of its n rotations (0 for a triangle). A rotation replaces an
-/// earlier one only if it scores better by more than rounding (1e-9
-/// relative): rotations that tie exactly on a lattice differ by noise off it,
-/// which must not choose the triangles. (triangulate_ladder, and the
-/// smoothing's crossing check, which must see the triangles that are output.)
-template <class Pos>
-std::size_t best_ladder_rotation(Pos&& pos, const double* x0, const std::int32_t* loop, std::size_t n,
-                                 const double* ref) {
+/// The ladder rotation a 3D polygon is triangulated by, its corners at
+/// xyz: the best ladder_score of its n rotations (0 for a triangle) against
+/// `ref`, its unsmoothed orientation (reference_orientation), or, for a
+/// polygon degenerate before smoothing (ref zero), its Newell normal at xyz.
+/// A rotation replaces an earlier one only if it scores better by more than
+/// rounding (1e-9 relative): rotations that tie exactly on a lattice differ
+/// by noise off it, which must not choose the triangles. One function for
+/// triangulate_ladder and the smoothing's crossing check, which must see the
+/// triangles that are output.
+inline std::size_t output_ladder_rotation(const double* xyz, const double* x0, const std::int32_t* loop,
+                                          std::size_t n, const double* ref_given) {
   std::size_t best = 0;
   if (n <= 3) return best;
+  double ref[3] = {ref_given[0], ref_given[1], ref_given[2]};
+  if (ref[0] == 0 && ref[1] == 0 && ref[2] == 0) newell(xyz, loop, n, ref);
+  auto pos = [&](std::int32_t v) { return xyz + 3 * static_cast<std::size_t>(v); };
   // (best = -inf makes the bound NaN: then any larger score is better)
   auto better = [](double score, double best_score) {
     return score > best_score && !(score <= best_score + 1e-9 * std::fabs(best_score));

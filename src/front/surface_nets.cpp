@@ -92,9 +92,7 @@ void triangulate_ladder(FaceSet& m, std::vector<double> before, std::span<const 
       const std::int32_t* loop = &m.face_vertices[b];
       double ref[3];
       front::reference_orientation(3, before.data(), petal.data(), loop, n, ref);
-      if (ref[0] == 0 && ref[1] == 0 && ref[2] == 0) front::newell(xyz, loop, n, ref);
-      auto pos = [&](std::int32_t v) { return xyz + 3 * static_cast<std::size_t>(v); };
-      const std::size_t best = front::best_ladder_rotation(pos, before.data(), loop, n, ref);
+      const std::size_t best = front::output_ladder_rotation(xyz, before.data(), loop, n, ref);
       std::size_t t = b - 2 * p;
       front::ladder(n, best, [&](std::size_t i, std::size_t j, std::size_t k) {
         corners[3 * t] = loop[i], corners[3 * t + 1] = loop[j], corners[3 * t + 2] = loop[k];
