@@ -14,6 +14,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <limits>
 
@@ -36,8 +37,13 @@ int orient(const double* a, const double* b, const double* c, const double* d) {
 /// Whether the points q[0..m) lie certainly strictly on one side of the
 /// plane of triangle t, by a float filter: each signed distance n . (q - t0)
 /// kept only where it exceeds 1e-10 of |n| |q - t0|, far above its rounding
-/// (a few ulps of those products). Most candidate pairs end here, without an
-/// exact orientation.
+/// (a few ulps of those products). A point exactly at a corner of t is
+/// passed over, as long as one other is certainly off the plane: then the
+/// triangle of the q (and the corners it shares with t) meets t's plane in
+/// the hull of at most two of t's corners, an edge of both or a corner.
+/// Most candidate pairs end here, without an exact orientation; the
+/// exception counts for the distinct vertices that coincide on exact
+/// lattices (the unsmoothed net, where the untangling pins it).
 bool surely_one_side(const double* const t[3], const double* const* q, int m) {
   const double u[3] = {t[1][0] - t[0][0], t[1][1] - t[0][1], t[1][2] - t[0][2]};
   const double w[3] = {t[2][0] - t[0][0], t[2][1] - t[0][1], t[2][2] - t[0][2]};
@@ -45,6 +51,8 @@ bool surely_one_side(const double* const t[3], const double* const* q, int m) {
   const double nn = std::fabs(n[0]) + std::fabs(n[1]) + std::fabs(n[2]);
   int side = 0;
   for (int k = 0; k < m; ++k) {
+    if (std::equal(q[k], q[k] + 3, t[0]) || std::equal(q[k], q[k] + 3, t[1]) || std::equal(q[k], q[k] + 3, t[2]))
+      continue;
     const double d[3] = {q[k][0] - t[0][0], q[k][1] - t[0][1], q[k][2] - t[0][2]};
     const double s = n[0] * d[0] + n[1] * d[1] + n[2] * d[2];
     const double bound = 1e-10 * nn * (std::fabs(d[0]) + std::fabs(d[1]) + std::fabs(d[2]));
@@ -52,7 +60,7 @@ bool surely_one_side(const double* const t[3], const double* const* q, int m) {
     if (sk == 0 || (side != 0 && sk != side)) return false;
     side = sk;
   }
-  return true;
+  return side != 0;
 }
 
 /// Float filter for triangles lying nearly in one plane (a flat stretch of a
@@ -61,8 +69,9 @@ bool surely_one_side(const double* const t[3], const double* const* q, int m) {
 /// dropped axis at least 1e-3 of its largest, so the projection is one to
 /// one on each), an edge of one separates them by a margin (1e-10 of the
 /// products, far above rounding), the corners on that edge that both share
-/// excepted. Then a common point would project onto the edge, so lie on the
-/// boundary of both: they do not cross.
+/// or that project exactly onto its ends excepted. Then a common point would
+/// project onto the edge and onto the hull of the other's excepted corners,
+/// so lie on the boundary of both: they do not cross.
 bool surely_apart_in_plane(const double* const a[3], const std::int32_t* ca, const double* const b[3],
                            const std::int32_t* cb) {
   auto normal = [](const double* const t[3], double* n) {
@@ -97,6 +106,7 @@ bool surely_apart_in_plane(const double* const a[3], const std::int32_t* ca, con
     if (!(std::fabs(inner) > m)) return false;
     for (int j = 0; j < 3; ++j) {
       if (cu[j] == ct[k] || cu[j] == ct[(k + 1) % 3]) continue;  // on the edge itself, and in both
+      if ((u[j][x] == p[x] && u[j][y] == p[y]) || (u[j][x] == q[x] && u[j][y] == q[y])) continue;
       const double s = side(u[j], m);
       if (!(std::fabs(s) > m) || (s > 0) == (inner > 0)) return false;
     }
@@ -198,27 +208,42 @@ bool triangle_pair_crosses(const double* const a[3], const std::int32_t* ca, con
   if (na == 0 || nb == 0) return false;  // (the same corners)
   if (surely_one_side(a, only_b, nb) || surely_one_side(b, only_a, na)) return false;
   if (surely_apart_in_plane(a, ca, b, cb)) return false;
-  return edges_meet_interior(a, b) || edges_meet_interior(b, a);
+  // A triangle with two corners at one place (the coincident vertices of
+  // exact lattices) is flat, with no interior of its own: it crosses the
+  // other only through the other's interior, and not if its corners are all
+  // at the other's corners (then it lies on an edge of the other, or at a
+  // corner).
+  auto same = [](const double* p, const double* q) { return std::equal(p, p + 3, q); };
+  auto pinched = [&](const double* const t[3]) { return same(t[0], t[1]) || same(t[1], t[2]) || same(t[2], t[0]); };
+  auto on_corners = [&](const double* const t[3], const double* const u[3]) {
+    for (int k = 0; k < 3; ++k)
+      if (!same(t[k], u[0]) && !same(t[k], u[1]) && !same(t[k], u[2])) return false;
+    return true;
+  };
+  const bool flat_a = pinched(a), flat_b = pinched(b);
+  if ((flat_a && (flat_b || on_corners(a, b))) || (flat_b && on_corners(b, a))) return false;
+  return (!flat_a && edges_meet_interior(a, b)) || (!flat_b && edges_meet_interior(b, a));
 }
 
 std::vector<Pair> crossing_triangles(std::span<const double> xyz, std::span<const std::int32_t> corners,
-                                     std::span<const std::uint8_t> changed) {
+                                     std::span<const std::uint8_t> changed, std::span<const std::uint8_t> settled) {
   const std::size_t nt = corners.size() / 3;
   std::vector<Pair> out;
   if (nt < 2) return out;
   auto at = [&](std::size_t t, int k) { return &xyz[3 * static_cast<std::size_t>(corners[3 * t + static_cast<std::size_t>(k)])]; };
+  using Range = tbb::blocked_range<std::size_t>;
 
-  // Bounding boxes, then the whole extent and the mean triangle size.
-  std::vector<std::array<double, 6>> box(nt);
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nt, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
-    for (std::size_t t = r.begin(); t != r.end(); ++t)
-      for (int d = 0; d < 3; ++d) {
-        box[t][d] = std::min({at(t, 0)[d], at(t, 1)[d], at(t, 2)[d]});
-        box[t][d + 3] = std::max({at(t, 0)[d], at(t, 1)[d], at(t, 2)[d]});
-      }
-  });
+  // The whole extent and the mean triangle size.
+  auto bounding_box = [&](std::size_t t, double* b) {
+    for (int d = 0; d < 3; ++d) {
+      b[d] = std::min({at(t, 0)[d], at(t, 1)[d], at(t, 2)[d]});
+      b[d + 3] = std::max({at(t, 0)[d], at(t, 1)[d], at(t, 2)[d]});
+    }
+  };
   double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY}, size = 0;
-  for (const auto& b : box) {
+  for (std::size_t t = 0; t < nt; ++t) {
+    double b[6];
+    bounding_box(t, b);
     double extent = 0;
     for (int d = 0; d < 3; ++d) {
       lo[d] = std::min(lo[d], b[d]);
@@ -242,55 +267,111 @@ std::vector<Pair> crossing_triangles(std::span<const double> xyz, std::span<cons
     h *= 1.5;
   }
   const std::int64_t n[3] = {cells_along(h, 0), cells_along(h, 1), cells_along(h, 2)};
-  auto cell = [&](double x, int d) {
-    return std::clamp<std::int64_t>(static_cast<std::int64_t>(std::floor((x - lo[d]) / h)), 0, n[d] - 1);
-  };
   auto index = [&](std::int64_t i, std::int64_t j, std::int64_t k) {
     return static_cast<std::size_t>((k * n[1] + j) * n[0] + i);
   };
-  // The cells' triangle lists (CSR, ascending triangles in each).
-  const auto ncell = static_cast<std::size_t>(n[0] * n[1] * n[2]);
-  std::vector<std::int64_t> offset(ncell + 1, 0);
+  // Each box in floats, rounded outwards (half the memory; a box that
+  // grew only makes a candidate more), and its cells: the lowest and highest
+  // along each axis, from the box in doubles. A pair whose boxes meet in
+  // floats but not in doubles may be tested in no cell: it cannot cross.
+  std::vector<std::array<float, 6>> box(nt);
+  std::vector<std::array<std::int32_t, 6>> span(nt);
+  tbb::parallel_for(Range(0, nt, 4096), [&](const Range& r) {
+    for (std::size_t t = r.begin(); t != r.end(); ++t) {
+      double b[6];
+      bounding_box(t, b);
+      for (int d = 0; d < 6; ++d) {
+        const auto f = static_cast<float>(b[d]);
+        box[t][d] = d < 3 ? (f > b[d] ? std::nextafter(f, -INFINITY) : f) : (f < b[d] ? std::nextafter(f, INFINITY) : f);
+        span[t][d] = static_cast<std::int32_t>(std::clamp<std::int64_t>(
+            static_cast<std::int64_t>(std::floor((b[d] - lo[d % 3]) / h)), 0, n[d % 3] - 1));
+      }
+    }
+  });
   auto for_cells = [&](std::size_t t, auto&& body) {
-    const auto& b = box[t];
-    for (std::int64_t k = cell(b[2], 2); k <= cell(b[5], 2); ++k)
-      for (std::int64_t j = cell(b[1], 1); j <= cell(b[4], 1); ++j)
-        for (std::int64_t i = cell(b[0], 0); i <= cell(b[3], 0); ++i) body(index(i, j, k));
+    const auto& c = span[t];
+    for (std::int64_t k = c[2]; k <= c[5]; ++k)
+      for (std::int64_t j = c[1]; j <= c[4]; ++j)
+        for (std::int64_t i = c[0]; i <= c[3]; ++i) body(index(i, j, k));
   };
-  for (std::size_t t = 0; t < nt; ++t) for_cells(t, [&](std::size_t c) { ++offset[c + 1]; });
+  // With `changed`, only the cells a changed triangle meets can hold a pair
+  // to test: only those are filled.
+  const auto ncell = static_cast<std::size_t>(n[0] * n[1] * n[2]);
+  const bool filtered = !changed.empty();
+  std::vector<std::uint8_t> wanted;
+  if (filtered) {
+    wanted.assign(ncell, 0);
+    tbb::parallel_for(Range(0, nt, 4096), [&](const Range& r) {
+      for (std::size_t t = r.begin(); t != r.end(); ++t)
+        if (changed[t])
+          for_cells(t, [&](std::size_t c) { std::atomic_ref<std::uint8_t>(wanted[c]).store(1, std::memory_order_relaxed); });
+    });
+  }
+  // The cells' triangle lists (CSR; within a cell in no fixed order, which
+  // only orders the tests: the result is sorted).
+  std::vector<std::int64_t> offset(ncell + 1, 0);
+  tbb::parallel_for(Range(0, nt, 4096), [&](const Range& r) {
+    for (std::size_t t = r.begin(); t != r.end(); ++t)
+      for_cells(t, [&](std::size_t c) {
+        if (!filtered || wanted[c]) std::atomic_ref<std::int64_t>(offset[c + 1]).fetch_add(1, std::memory_order_relaxed);
+      });
+  });
   for (std::size_t c = 0; c < ncell; ++c) offset[c + 1] += offset[c];
   std::vector<std::uint32_t> members(static_cast<std::size_t>(offset[ncell]));
   {
     std::vector<std::int64_t> fill(offset.begin(), offset.end() - 1);
-    for (std::size_t t = 0; t < nt; ++t)
-      for_cells(t, [&](std::size_t c) { members[static_cast<std::size_t>(fill[c]++)] = static_cast<std::uint32_t>(t); });
+    tbb::parallel_for(Range(0, nt, 4096), [&](const Range& r) {
+      for (std::size_t t = r.begin(); t != r.end(); ++t)
+        for_cells(t, [&](std::size_t c) {
+          if (filtered && !wanted[c]) return;
+          const auto slot = std::atomic_ref<std::int64_t>(fill[c]).fetch_add(1, std::memory_order_relaxed);
+          members[static_cast<std::size_t>(slot)] = static_cast<std::uint32_t>(t);
+        });
+    });
   }
 
+  // Each cell's pairs by a sweep along x over its boxes, copied out and
+  // sorted by their lower x: a box meets only the boxes after it that start
+  // before it ends.
+  struct Item {
+    std::array<float, 6> box;
+    std::array<std::int32_t, 3> low;  // its lowest cell along each axis
+    std::uint32_t t;
+  };
   tbb::enumerable_thread_specific<std::vector<Pair>> found;
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, ncell, 256), [&](const tbb::blocked_range<std::size_t>& r) {
+  tbb::enumerable_thread_specific<std::vector<Item>> items;
+  tbb::parallel_for(Range(0, ncell, 256), [&](const Range& r) {
     std::vector<Pair>& mine = found.local();
+    std::vector<Item>& local = items.local();
     for (std::size_t c = r.begin(); c != r.end(); ++c) {
       const auto b0 = static_cast<std::size_t>(offset[c]), b1 = static_cast<std::size_t>(offset[c + 1]);
-      const bool filtered = !changed.empty();
-      if (filtered && std::none_of(members.begin() + offset[c], members.begin() + offset[c + 1],
-                                   [&](std::uint32_t t) { return changed[t] != 0; }))
-        continue;
-      for (std::size_t x = b0; x < b1; ++x)
-        for (std::size_t y = x + 1; y < b1; ++y) {
-          const std::size_t s = members[x], t = members[y];
+      if (b1 - b0 < 2) continue;
+      local.clear();
+      for (std::size_t x = b0; x < b1; ++x) {
+        const std::uint32_t t = members[x];
+        local.push_back({box[t], {span[t][0], span[t][1], span[t][2]}, t});
+      }
+      std::sort(local.begin(), local.end(), [](const Item& p, const Item& q) {
+        return p.box[0] < q.box[0] || (p.box[0] == q.box[0] && p.t < q.t);
+      });
+      for (std::size_t x = 0; x < local.size(); ++x) {
+        const Item& is = local[x];
+        for (std::size_t y = x + 1; y < local.size() && local[y].box[0] <= is.box[3]; ++y) {
+          const Item& it = local[y];
+          const std::size_t s = is.t, t = it.t;
           if (filtered && !changed[s] && !changed[t]) continue;
-          const auto &bs = box[s], &bt = box[t];
-          bool overlap = true;
-          for (int d = 0; d < 3 && overlap; ++d) overlap = bs[d] <= bt[d + 3] && bt[d] <= bs[d + 3];
-          if (!overlap) continue;
+          if (!settled.empty() && settled[s] && settled[t]) continue;
+          if (!(is.box[1] <= it.box[4] && it.box[1] <= is.box[4] && is.box[2] <= it.box[5] && it.box[2] <= is.box[5]))
+            continue;
           // Tested in one cell only: the one holding the overlap's lower corner.
-          if (index(cell(std::max(bs[0], bt[0]), 0), cell(std::max(bs[1], bt[1]), 1), cell(std::max(bs[2], bt[2]), 2)) != c)
+          if (index(std::max(is.low[0], it.low[0]), std::max(is.low[1], it.low[1]), std::max(is.low[2], it.low[2])) != c)
             continue;
           const double* a[3] = {at(s, 0), at(s, 1), at(s, 2)};
           const double* b[3] = {at(t, 0), at(t, 1), at(t, 2)};
           if (triangle_pair_crosses(a, &corners[3 * s], b, &corners[3 * t]))
             mine.emplace_back(std::min(s, t), std::max(s, t));
         }
+      }
     }
   });
   for (const auto& v : found) out.insert(out.end(), v.begin(), v.end());

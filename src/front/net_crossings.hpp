@@ -24,7 +24,8 @@ namespace tessera::front {
 /// Candidates come from a uniform grid over the triangles' bounding boxes;
 /// the result does not depend on the thread count. With `changed` (one flag
 /// per triangle) only pairs with a changed triangle are tested: the others
-/// were found apart before.
+/// were found apart before. With `settled` (one flag per triangle) pairs of
+/// two settled triangles are not tested: the caller takes them as they are.
 /// The test crossing_triangles applies to one pair: corner positions `a`,
 /// `b` and their vertex ids `ca`, `cb` (3 each).
 bool triangle_pair_crosses(const double* const a[3], const std::int32_t* ca, const double* const b[3],
@@ -32,6 +33,7 @@ bool triangle_pair_crosses(const double* const a[3], const std::int32_t* ca, con
 
 std::vector<std::pair<std::size_t, std::size_t>> crossing_triangles(std::span<const double> xyz,
                                                                      std::span<const std::int32_t> corners,
-                                                                     std::span<const std::uint8_t> changed = {});
+                                                                     std::span<const std::uint8_t> changed = {},
+                                                                     std::span<const std::uint8_t> settled = {});
 
 }  // namespace tessera::front

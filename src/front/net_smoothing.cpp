@@ -411,14 +411,43 @@ std::vector<NetVertexKind> smooth_surface_net(FaceSet& mesh, std::span<const dou
         around[static_cast<std::size_t>(slot++)] = static_cast<std::int32_t>(f);
       }
   }
-  // The smoothing from the start (x0), with `pinned` as it stands: every
-  // copy's final position.
-  auto smooth_from_start = [&]() {
-    // Group positions (gcur, gnxt) and, for periodic sets, every copy's (cur, nxt).
-    std::vector<double> gcur(ng * dn), gnxt(ng * dn);
+  // The smoothing with `pinned` as it stands; every copy's final position.
+  // Without a zone every group runs from the start (x0). With one (groups,
+  // ascending), the zone's groups run from the start and the others stay
+  // where `held` (every copy's position) has them: a rerun of the places the
+  // untangling rounds below pin, whose cost is the zone's, not the net's.
+  auto smooth = [&](const std::vector<std::int32_t>* zone, const std::vector<double>* held) {
+    const std::size_t nz = zone ? zone->size() : ng;
+    auto zone_group = [&](std::size_t i) { return zone ? static_cast<std::size_t>((*zone)[i]) : i; };
+    // Group positions (gcur, gnxt) and, for periodic sets, every copy's (cur,
+    // nxt); groups outside the zone are never written, so both buffers keep them.
+    std::vector<double> gcur(ng * dn);
+    const std::vector<double>& start = held ? *held : x0;
     front::parallel_range(ng, 4096, [&](std::size_t g) {
-      std::copy_n(&x0[static_cast<std::size_t>(copies.first[g]) * dn], dn, &gcur[g * dn]);
+      std::copy_n(&start[static_cast<std::size_t>(copies.first[g]) * dn], dn, &gcur[g * dn]);
     });
+    if (zone)
+      front::parallel_range(nz, 4096, [&](std::size_t i) {
+        const std::size_t g = zone_group(i);
+        std::copy_n(&x0[static_cast<std::size_t>(copies.first[g]) * dn], dn, &gcur[g * dn]);
+      });
+    std::vector<double> gnxt = gcur;
+    // The polygons the guard evaluates: those with a corner in the zone (the
+    // others keep every corner, so their verdict stands).
+    std::vector<std::int32_t> zone_faces;
+    if (zone) {
+      std::vector<std::uint8_t> in_zone(ng, 0), face_in(nf, 0);
+      for (const std::int32_t g : *zone) in_zone[static_cast<std::size_t>(g)] = 1;
+      front::parallel_range(nf, 1024, [&](std::size_t f) {
+        for (auto q = mesh.face_offsets[f]; q < mesh.face_offsets[f + 1]; ++q)
+          face_in[f] |= in_zone[static_cast<std::size_t>(
+              copies.group[static_cast<std::size_t>(mesh.face_vertices[static_cast<std::size_t>(q)])])];
+      });
+      for (std::size_t f = 0; f < nf; ++f)
+        if (face_in[f]) zone_faces.push_back(static_cast<std::int32_t>(f));
+    }
+    const std::size_t nzf = zone ? zone_faces.size() : nf;
+    auto zone_face = [&](std::size_t i) { return zone ? static_cast<std::size_t>(zone_faces[i]) : i; };
     std::vector<double> cur_copies, nxt_copies;
     if (periodic) {
       cur_copies.resize(nv * dn);
@@ -428,7 +457,8 @@ std::vector<NetVertexKind> smooth_surface_net(FaceSet& mesh, std::span<const dou
     std::vector<std::uint8_t> frozen(nv), freeze(nv), newly(nv), group_frozen(periodic ? ng : 0);
     const double lambda = options.relaxation;
     for (int it = 0; it < options.iterations; ++it) {
-      front::parallel_range(ng, 2048, [&](std::size_t g) {
+      front::parallel_range(nz, 2048, [&](std::size_t i) {
+        const std::size_t g = zone_group(i);
         const auto v = static_cast<std::size_t>(copies.first[g]);
         double* out = &gnxt[g * dn];
         const double* x = &gcur[g * dn];
@@ -475,7 +505,8 @@ std::vector<NetVertexKind> smooth_surface_net(FaceSet& mesh, std::span<const dou
         // rotations; `freeze` holds the round before's set here).
         if (!first) front::parallel_range(nv, 4096, [&](std::size_t v) { newly[v] = frozen[v] & ~freeze[v]; });
         std::copy(frozen.begin(), frozen.end(), freeze.begin());
-        front::parallel_range(nf, 1024, [&](std::size_t f) {
+        front::parallel_range(nzf, 1024, [&](std::size_t i) {
+          const std::size_t f = zone_face(i);
           const auto b = static_cast<std::size_t>(mesh.face_offsets[f]);
           const auto n = static_cast<std::size_t>(mesh.face_offsets[f + 1]) - b;
           const std::int32_t* loop = &mesh.face_vertices[b];
@@ -520,7 +551,8 @@ std::vector<NetVertexKind> smooth_surface_net(FaceSet& mesh, std::span<const dou
         frozen.swap(freeze);
       }
       // Frozen groups keep their positions (a group is frozen iff its first copy is).
-      front::parallel_range(ng, 4096, [&](std::size_t g) {
+      front::parallel_range(nz, 4096, [&](std::size_t i) {
+        const std::size_t g = zone_group(i);
         if (frozen[static_cast<std::size_t>(copies.first[g])]) std::copy_n(&gcur[g * dn], dn, &gnxt[g * dn]);
       });
       gcur.swap(gnxt);
@@ -538,12 +570,14 @@ std::vector<NetVertexKind> smooth_surface_net(FaceSet& mesh, std::span<const dou
   // (each polygon's best ladder, as triangulate_ladder takes it) cross
   // (front::crossing_triangles, exact), the polygons around both polygons'
   // corners are pinned where they started (from the second round, the ring
-  // around that ring too) and the smoothing runs again from the start;
-  // pinning less (the two polygons alone) took more rounds, as their
-  // neighbours then folded against them, and so did two rings at once. Pairs that cross at the start
-  // already (rounding artefacts) are not counted, so pinning converges (3-4
-  // rounds on those images); past 16 rounds every vertex keeps its start.
-  std::vector<double> cur = smooth_from_start();
+  // around that ring too) and the smoothing runs again from the start around
+  // them (zone_around), the rest of the net held where the last round left
+  // it; pinning less (the two polygons alone) took more rounds, as their
+  // neighbours then folded against them, and so did two rings at once. Pairs
+  // that cross at the start already (rounding artefacts) are not counted, so
+  // pinning converges (4-5 rounds on those images); past 16 rounds every
+  // vertex keeps its start.
+  std::vector<double> cur = smooth(nullptr, nullptr);
   std::vector<double> before_round;  // the positions the last check saw
   // Polygon f's n - 2 triangles start at triangle face_offsets[f] - 2 f.
   const std::size_t nt = D == 3 ? mesh.face_vertices.size() - 2 * nf : 0;
@@ -552,6 +586,52 @@ std::vector<NetVertexKind> smooth_surface_net(FaceSet& mesh, std::span<const dou
   auto moved_since = [&](std::size_t v) {  // (3D)
     return cur[3 * v] != before_round[3 * v] || cur[3 * v + 1] != before_round[3 * v + 1] ||
            cur[3 * v + 2] != before_round[3 * v + 2];
+  };
+  // The groups a rerun smooths again: those within zone_steps steps (across
+  // polygons) of the newly pinned ones, ascending. A Laplacian step carries
+  // a change one step, and over the iterations it spreads as a diffusion of
+  // variance relaxation * iterations (in steps squared): within twice its
+  // deviation a rerun of the whole net would change positions, beyond it
+  // hardly. The whole net's rerun (the first version) cost a full smoothing
+  // per round and made every triangle one to check again: on a 256^3 map
+  // with 12 labels 1.0 s a round (four rounds), against 0.02-0.4 s now; the
+  // positions differ from it by more than 0.01 voxel at 2% of the vertices
+  // (where one pinned and the other did not), the pinned vertices 4% more.
+  const int zone_steps = static_cast<int>(std::ceil(2 * std::sqrt(options.iterations * options.relaxation)));
+  auto zone_around = [&](const std::vector<std::int32_t>& seeds) {
+    std::vector<std::uint8_t> in(ng, 0);
+    std::vector<std::int32_t> zone, frontier, next;
+    for (const std::int32_t g : seeds)
+      if (!in[static_cast<std::size_t>(g)]) {
+        in[static_cast<std::size_t>(g)] = 1;
+        frontier.push_back(g);
+      }
+    zone = frontier;
+    auto copies_of = [&](std::int32_t g, auto&& body) {
+      if (!periodic) return body(static_cast<std::size_t>(g));
+      for (auto m = member_off[static_cast<std::size_t>(g)]; m < member_off[static_cast<std::size_t>(g) + 1]; ++m)
+        body(static_cast<std::size_t>(members[static_cast<std::size_t>(m)]));
+    };
+    for (int step = 0; step < zone_steps && !frontier.empty(); ++step) {
+      next.clear();
+      for (const std::int32_t g : frontier)
+        copies_of(g, [&](std::size_t v) {
+          for (auto e = around_off[v]; e < around_off[v + 1]; ++e) {
+            const auto f = static_cast<std::size_t>(around[static_cast<std::size_t>(e)]);
+            for (auto q = mesh.face_offsets[f]; q < mesh.face_offsets[f + 1]; ++q) {
+              const std::int32_t w = copies.group[static_cast<std::size_t>(mesh.face_vertices[static_cast<std::size_t>(q)])];
+              if (!in[static_cast<std::size_t>(w)]) {
+                in[static_cast<std::size_t>(w)] = 1;
+                next.push_back(w);
+              }
+            }
+          }
+        });
+      zone.insert(zone.end(), next.begin(), next.end());
+      frontier.swap(next);
+    }
+    std::sort(zone.begin(), zone.end());
+    return zone;
   };
   for (int round = 0; D == 3 && round < 16; ++round) {
     // The output triangles; after the first round only those of polygons
@@ -586,8 +666,8 @@ std::vector<NetVertexKind> smooth_surface_net(FaceSet& mesh, std::span<const dou
     // where it started is left alone while it stays that small: unless it
     // still crosses with each triangle shrunk by 1e-6 of its size (an ulp
     // sliver that smoothing opened into a fold does). A pair whose corners
-    // are all where they started is left alone in any case: it is as good as
-    // it gets, and the rounds end.
+    // are all where they started is left alone in any case (not tested: it
+    // is as good as it gets, and the rounds end).
     auto corner = [&](const std::vector<double>& at, std::size_t t, std::size_t k) {
       return &at[3 * static_cast<std::size_t>(corners[3 * t + k])];
     };
@@ -610,23 +690,25 @@ std::vector<NetVertexKind> smooth_surface_net(FaceSet& mesh, std::span<const dou
       const std::int32_t ids[6] = {-1, -2, -3, -4, -5, -6};  // apart: no corner shared
       return front::triangle_pair_crosses(a, ids, b, ids + 3);
     };
-    auto at_start = [&](std::size_t t) {
-      for (std::size_t k = 0; k < 3; ++k)
-        if (!std::equal(corner(cur, t, k), corner(cur, t, k) + 3, corner(x0, t, k))) return false;
-      return true;
-    };
-    auto crossings = front::crossing_triangles(cur, corners, changed);
+    std::vector<std::uint8_t> at_start(nt);
+    front::parallel_range(nt, 4096, [&](std::size_t t) {
+      bool same = true;
+      for (std::size_t k = 0; k < 3; ++k) same = same && std::equal(corner(cur, t, k), corner(cur, t, k) + 3, corner(x0, t, k));
+      at_start[t] = same;
+    });
+    auto crossings = front::crossing_triangles(cur, corners, changed, at_start);
     std::erase_if(crossings, [&](const auto& st) {
       const auto [s, t] = st;
-      return (at_start(s) && at_start(t)) || (crosses_at(x0, s, t) && !crosses_shrunk(s, t));
+      return crosses_at(x0, s, t) && !crosses_shrunk(s, t);
     });
     if (crossings.empty()) break;
-    std::size_t newly_pinned = 0;
+    std::vector<std::int32_t> newly_pinned;  // groups
     auto pin_polygon = [&](std::size_t f) {
       for (auto q = mesh.face_offsets[f]; q < mesh.face_offsets[f + 1]; ++q) {
         const auto v = static_cast<std::size_t>(mesh.face_vertices[static_cast<std::size_t>(q)]);
-        const auto first = static_cast<std::size_t>(copies.first[static_cast<std::size_t>(copies.group[v])]);
-        if (pinned[first] != 7) ++newly_pinned;
+        const std::int32_t g = copies.group[v];
+        const auto first = static_cast<std::size_t>(copies.first[static_cast<std::size_t>(g)]);
+        if (pinned[first] != 7) newly_pinned.push_back(g);
         pinned[first] = 7;  // every axis: the group stays where it started
       }
     };
@@ -648,12 +730,13 @@ std::vector<NetVertexKind> smooth_surface_net(FaceSet& mesh, std::span<const dou
       ring = std::move(wider);
     }
     for (const std::size_t f : ring) pin_polygon(f);
-    if (newly_pinned == 0) {  // (cannot happen: crossings need a moved corner)
+    if (newly_pinned.empty()) {  // (cannot happen: crossings need a moved corner)
       cur = x0;
       break;
     }
+    const std::vector<std::int32_t> zone = zone_around(newly_pinned);
     before_round = std::move(cur);
-    cur = round + 1 < 16 ? smooth_from_start() : x0;
+    cur = round + 1 < 16 ? smooth(&zone, &before_round) : x0;
   }
 
   moved = 0;

@@ -7,10 +7,13 @@
 // not depend on the thread count; bad input gives one-line errors.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <limits>
 #include <map>
 #include <numbers>
+#include <random>
 #include <set>
 #include <string>
 #include <tuple>
@@ -335,6 +338,63 @@ TEST(SurfaceNets, CrossingTestOnHandMadeTriangles) {
   EXPECT_TRUE(crosses(floor, {{{0, 0, 0}, {0, 4, 0}, {4, 0, 0}}}, apart));
   EXPECT_TRUE(crosses(floor, {{{4, 0, 0}, {0, 4, 0}, {0, 1, 0}}}, {0, 1, 2, 1, 2, 8}));
   EXPECT_FALSE(crosses(floor, {{{4, 0, 0}, {0, 4, 0}, {4, 4, 0}}}, {0, 1, 2, 1, 2, 8}));  // beside it
+  // Distinct corners at one place (exact lattices): a pinched triangle is a
+  // segment, crossing only through the other's interior; a corner at
+  // another's corner is on its boundary, wherever the rest lies.
+  EXPECT_TRUE(crosses(floor, {{{1, 1, -1}, {1, 1, -1}, {1, 1, 1}}}, apart));
+  EXPECT_TRUE(crosses(floor, {{{1, 1, 0}, {1, 1, 0}, {3, 0.5, 0}}}, apart));
+  EXPECT_FALSE(crosses(floor, {{{4, 0, 0}, {4, 0, 0}, {0, 4, 0}}}, apart));  // along its edge
+  EXPECT_FALSE(crosses({{{1, 1, -1}, {1, 1, -1}, {1, 1, 1}}}, {{{0, 1, 0}, {0, 1, 0}, {2, 1, 0}}}, apart));
+  EXPECT_FALSE(crosses(floor, {{{4, 0, 0}, {5, 0, 1}, {4, 1, 1}}}, apart));
+  EXPECT_TRUE(crosses(floor, {{{4, 0, 0}, {1, 1, -1}, {1, 1, 1}}}, apart));
+  EXPECT_FALSE(crosses(floor, {{{0, 4, 0}, {4, 0, 0}, {4, 4, 1e-30}}}, apart));  // an edge on its edge
+  EXPECT_FALSE(crosses(floor, {{{0, 4, 0}, {4, 0, 0}, {1, 1, 1e-30}}}, apart));  // a hinge, nearly shut
+  EXPECT_TRUE(crosses(floor, {{{0, 4, 0}, {4, 0, 0}, {1, 1, 0}}}, apart));       // folded onto it
+}
+
+// The broad phase (a grid, a sweep per cell, boxes in floats) finds every
+// pair the pair test finds, once: triangle soups against all pairs, some
+// sharing vertices, some on a coarse lattice so that corners and planes
+// coincide exactly, with the `changed` and `settled` filters.
+TEST(SurfaceNets, CrossingTrianglesFindsEveryCrossingPair) {
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> u(0, 1);
+  for (int soup = 0; soup < 4; ++soup) {
+    const bool lattice = soup % 2 == 1;
+    std::vector<double> xyz;
+    const int nv = 900;
+    for (int v = 0; v < nv; ++v)
+      for (int d = 0; d < 3; ++d) xyz.push_back(lattice ? std::floor(u(rng) * 12) / 4 : 3 * u(rng));
+    // Triangles from nearby vertices (sorted along x, a window of 12).
+    std::vector<std::int32_t> order(nv);
+    for (int v = 0; v < nv; ++v) order[v] = v;
+    std::sort(order.begin(), order.end(), [&](int a, int b) { return xyz[3 * a] < xyz[3 * b]; });
+    std::vector<std::int32_t> corners;
+    std::uniform_int_distribution<int> step(1, 12);
+    for (int i = 0; i + 24 < nv; ++i)
+      for (int rep = 0; rep < 2; ++rep) {
+        const int j = i + step(rng), k = j + step(rng);
+        corners.insert(corners.end(), {order[i], order[j], order[k]});
+      }
+    const std::size_t nt = corners.size() / 3;
+    std::vector<std::uint8_t> changed(nt), settled(nt);
+    for (std::size_t t = 0; t < nt; ++t) {
+      changed[t] = u(rng) < 0.3;
+      settled[t] = u(rng) < 0.5;
+    }
+    std::vector<std::pair<std::size_t, std::size_t>> all, filtered;
+    for (std::size_t s = 0; s < nt; ++s)
+      for (std::size_t t = s + 1; t < nt; ++t) {
+        const double* a[3] = {&xyz[3 * corners[3 * s]], &xyz[3 * corners[3 * s + 1]], &xyz[3 * corners[3 * s + 2]]};
+        const double* b[3] = {&xyz[3 * corners[3 * t]], &xyz[3 * corners[3 * t + 1]], &xyz[3 * corners[3 * t + 2]]};
+        if (!tessera::front::triangle_pair_crosses(a, &corners[3 * s], b, &corners[3 * t])) continue;
+        all.emplace_back(s, t);
+        if ((changed[s] || changed[t]) && !(settled[s] && settled[t])) filtered.emplace_back(s, t);
+      }
+    EXPECT_GT(all.size(), 100u) << soup;
+    EXPECT_EQ(tessera::front::crossing_triangles(xyz, corners), all) << soup;
+    EXPECT_EQ(tessera::front::crossing_triangles(xyz, corners, changed, settled), filtered) << soup;
+  }
 }
 
 // Triangles of zero area before smoothing (coincident corners of exact
