@@ -227,6 +227,12 @@ bool triangle_pair_crosses(const double* const a[3], const std::int32_t* ca, con
 
 std::vector<Pair> crossing_triangles(std::span<const double> xyz, std::span<const std::int32_t> corners,
                                      std::span<const std::uint8_t> changed, std::span<const std::uint8_t> settled) {
+  return CrossingCheck()(xyz, corners, changed, settled);
+}
+
+std::vector<Pair> CrossingCheck::operator()(std::span<const double> xyz, std::span<const std::int32_t> corners,
+                                            std::span<const std::uint8_t> changed,
+                                            std::span<const std::uint8_t> settled) {
   const std::size_t nt = corners.size() / 3;
   std::vector<Pair> out;
   if (nt < 2) return out;
@@ -274,16 +280,18 @@ std::vector<Pair> crossing_triangles(std::span<const double> xyz, std::span<cons
   // grew only makes a candidate more), and its cells: the lowest and highest
   // along each axis, from the box in doubles. A pair whose boxes meet in
   // floats but not in doubles may be tested in no cell: it cannot cross.
-  std::vector<std::array<float, 6>> box(nt);
-  std::vector<std::array<std::int32_t, 6>> span(nt);
+  box_.resize(nt);
+  span_.resize(nt);
+  const auto& box = box_;
+  const auto& span = span_;
   tbb::parallel_for(Range(0, nt, 4096), [&](const Range& r) {
     for (std::size_t t = r.begin(); t != r.end(); ++t) {
       double b[6];
       bounding_box(t, b);
       for (int d = 0; d < 6; ++d) {
         const auto f = static_cast<float>(b[d]);
-        box[t][d] = d < 3 ? (f > b[d] ? std::nextafter(f, -INFINITY) : f) : (f < b[d] ? std::nextafter(f, INFINITY) : f);
-        span[t][d] = static_cast<std::int32_t>(std::clamp<std::int64_t>(
+        box_[t][d] = d < 3 ? (f > b[d] ? std::nextafter(f, -INFINITY) : f) : (f < b[d] ? std::nextafter(f, INFINITY) : f);
+        span_[t][d] = static_cast<std::int32_t>(std::clamp<std::int64_t>(
             static_cast<std::int64_t>(std::floor((b[d] - lo[d % 3]) / h)), 0, n[d % 3] - 1));
       }
     }
@@ -298,9 +306,15 @@ std::vector<Pair> crossing_triangles(std::span<const double> xyz, std::span<cons
   // to test: only those are filled.
   const auto ncell = static_cast<std::size_t>(n[0] * n[1] * n[2]);
   const bool filtered = !changed.empty();
-  std::vector<std::uint8_t> wanted;
+  auto zero = [](auto& buffer, std::size_t n) {  // in parallel: the buffers are large
+    buffer.resize(n);
+    tbb::parallel_for(Range(0, n, std::size_t{1} << 16), [&](const Range& r) {
+      std::fill(buffer.begin() + static_cast<std::ptrdiff_t>(r.begin()), buffer.begin() + static_cast<std::ptrdiff_t>(r.end()), 0);
+    });
+  };
+  auto& wanted = wanted_;
   if (filtered) {
-    wanted.assign(ncell, 0);
+    zero(wanted, ncell);
     tbb::parallel_for(Range(0, nt, 4096), [&](const Range& r) {
       for (std::size_t t = r.begin(); t != r.end(); ++t)
         if (changed[t])
@@ -309,7 +323,8 @@ std::vector<Pair> crossing_triangles(std::span<const double> xyz, std::span<cons
   }
   // The cells' triangle lists (CSR; within a cell in no fixed order, which
   // only orders the tests: the result is sorted).
-  std::vector<std::int64_t> offset(ncell + 1, 0);
+  auto& offset = offset_;
+  zero(offset, ncell + 1);
   tbb::parallel_for(Range(0, nt, 4096), [&](const Range& r) {
     for (std::size_t t = r.begin(); t != r.end(); ++t)
       for_cells(t, [&](std::size_t c) {
@@ -317,9 +332,11 @@ std::vector<Pair> crossing_triangles(std::span<const double> xyz, std::span<cons
       });
   });
   for (std::size_t c = 0; c < ncell; ++c) offset[c + 1] += offset[c];
-  std::vector<std::uint32_t> members(static_cast<std::size_t>(offset[ncell]));
+  auto& members = members_;
+  members.resize(static_cast<std::size_t>(offset[ncell]));
   {
-    std::vector<std::int64_t> fill(offset.begin(), offset.end() - 1);
+    auto& fill = fill_;
+    fill.assign(offset.begin(), offset.end() - 1);
     tbb::parallel_for(Range(0, nt, 4096), [&](const Range& r) {
       for (std::size_t t = r.begin(); t != r.end(); ++t)
         for_cells(t, [&](std::size_t c) {

@@ -2,11 +2,14 @@
 // smoothing's untangling rounds (net_smoothing.cpp). Private to the library.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <span>
 #include <utility>
 #include <vector>
+
+#include "tessera/buffer.hpp"
 
 namespace tessera::front {
 
@@ -35,5 +38,24 @@ std::vector<std::pair<std::size_t, std::size_t>> crossing_triangles(std::span<co
                                                                      std::span<const std::int32_t> corners,
                                                                      std::span<const std::uint8_t> changed = {},
                                                                      std::span<const std::uint8_t> settled = {});
+
+/// crossing_triangles with its arrays kept from call to call: the rounds of
+/// one untangling check nets of millions of triangles, whose grid arrays
+/// (~90 bytes per triangle) would otherwise be mapped and faulted in afresh
+/// each time.
+class CrossingCheck {
+ public:
+  std::vector<std::pair<std::size_t, std::size_t>> operator()(std::span<const double> xyz,
+                                                              std::span<const std::int32_t> corners,
+                                                              std::span<const std::uint8_t> changed = {},
+                                                              std::span<const std::uint8_t> settled = {});
+
+ private:
+  Buffer<std::array<float, 6>> box_;         // per triangle, rounded outwards
+  Buffer<std::array<std::int32_t, 6>> span_;  // per triangle: its cells along each axis
+  Buffer<std::int64_t> offset_, fill_;       // per cell (CSR)
+  Buffer<std::uint32_t> members_;
+  Buffer<std::uint8_t> wanted_;              // per cell
+};
 
 }  // namespace tessera::front

@@ -20,6 +20,7 @@
 #include "net_crossings.hpp"
 #include "net_smoothing.hpp"
 #include "pass.hpp"
+#include "tessera/buffer.hpp"
 #include "tessera/surface_nets.hpp"
 
 namespace tessera {
@@ -373,7 +374,7 @@ std::vector<NetVertexKind> smooth_surface_net(FaceSet& mesh, std::span<const dou
     offset.resize(nv * dn);
     front::parallel_range(nv, 4096, [&](std::size_t v) { translation(&copies.shift[v * dn], &offset[v * dn]); });
   }
-  auto place = [&](const std::vector<double>& group_pos, std::vector<double>& out) {
+  auto place = [&](std::span<const double> group_pos, std::span<double> out) {
     front::parallel_range(nv, 4096, [&](std::size_t v) {
       const double* x = &group_pos[static_cast<std::size_t>(copies.group[v]) * dn];
       for (std::size_t a = 0; a < dn; ++a) out[v * dn + a] = x[a] + offset[v * dn + a];
@@ -416,12 +417,17 @@ std::vector<NetVertexKind> smooth_surface_net(FaceSet& mesh, std::span<const dou
   // ascending), the zone's groups run from the start and the others stay
   // where `held` (every copy's position) has them: a rerun of the places the
   // untangling rounds below pin, whose cost is the zone's, not the net's.
-  auto smooth = [&](const std::vector<std::int32_t>* zone, const std::vector<double>* held) {
+  // The result goes to `out`. The arrays are kept from run to run (a fresh
+  // page costs ~10 us to fault in on the VMs measured: design.md, "Large
+  // arrays on transparent huge pages").
+  Buffer<double> gcur, gnxt, cur_copies, nxt_copies;
+  std::vector<std::uint8_t> frozen, freeze, newly, group_frozen;
+  auto smooth = [&](const std::vector<std::int32_t>* zone, const std::vector<double>* held, std::vector<double>& out) {
     const std::size_t nz = zone ? zone->size() : ng;
     auto zone_group = [&](std::size_t i) { return zone ? static_cast<std::size_t>((*zone)[i]) : i; };
     // Group positions (gcur, gnxt) and, for periodic sets, every copy's (cur,
     // nxt); groups outside the zone are never written, so both buffers keep them.
-    std::vector<double> gcur(ng * dn);
+    gcur.resize(ng * dn);
     const std::vector<double>& start = held ? *held : x0;
     front::parallel_range(ng, 4096, [&](std::size_t g) {
       std::copy_n(&start[static_cast<std::size_t>(copies.first[g]) * dn], dn, &gcur[g * dn]);
@@ -431,7 +437,7 @@ std::vector<NetVertexKind> smooth_surface_net(FaceSet& mesh, std::span<const dou
         const std::size_t g = zone_group(i);
         std::copy_n(&x0[static_cast<std::size_t>(copies.first[g]) * dn], dn, &gcur[g * dn]);
       });
-    std::vector<double> gnxt = gcur;
+    gnxt.assign(gcur.begin(), gcur.end());
     // The polygons the guard evaluates: those with a corner in the zone (the
     // others keep every corner, so their verdict stands).
     std::vector<std::int32_t> zone_faces;
@@ -448,13 +454,15 @@ std::vector<NetVertexKind> smooth_surface_net(FaceSet& mesh, std::span<const dou
     }
     const std::size_t nzf = zone ? zone_faces.size() : nf;
     auto zone_face = [&](std::size_t i) { return zone ? static_cast<std::size_t>(zone_faces[i]) : i; };
-    std::vector<double> cur_copies, nxt_copies;
     if (periodic) {
       cur_copies.resize(nv * dn);
       nxt_copies.resize(nv * dn);
       place(gcur, cur_copies);
     }
-    std::vector<std::uint8_t> frozen(nv), freeze(nv), newly(nv), group_frozen(periodic ? ng : 0);
+    frozen.assign(nv, 0);
+    freeze.assign(nv, 0);
+    newly.assign(nv, 0);
+    group_frozen.assign(periodic ? ng : 0, 0);
     const double lambda = options.relaxation;
     for (int it = 0; it < options.iterations; ++it) {
       front::parallel_range(nz, 2048, [&](std::size_t i) {
@@ -494,8 +502,8 @@ std::vector<NetVertexKind> smooth_surface_net(FaceSet& mesh, std::span<const dou
           out[a] = (pinned[v] >> a) & 1u ? x0[v * dn + a] : x0[v * dn + a] + scale * d[a];
       });
       if (periodic) place(gnxt, nxt_copies);
-      const std::vector<double>& cur = periodic ? cur_copies : gcur;
-      const std::vector<double>& nxt = periodic ? nxt_copies : gnxt;
+      const Buffer<double>& cur = periodic ? cur_copies : gcur;
+      const Buffer<double>& nxt = periodic ? nxt_copies : gnxt;
 
       std::fill(frozen.begin(), frozen.end(), 0);
       for (bool grew = true, first = true; grew; first = false) {
@@ -558,7 +566,8 @@ std::vector<NetVertexKind> smooth_surface_net(FaceSet& mesh, std::span<const dou
       gcur.swap(gnxt);
       if (periodic) place(gcur, cur_copies);
     }
-    return periodic ? std::move(cur_copies) : std::move(gcur);
+    const Buffer<double>& result = periodic ? cur_copies : gcur;
+    out.assign(result.begin(), result.end());
   };
 
   // Untangling rounds (3D): the guard keeps each polygon from turning over,
@@ -577,8 +586,8 @@ std::vector<NetVertexKind> smooth_surface_net(FaceSet& mesh, std::span<const dou
   // that cross at the start already (rounding artefacts) are not counted, so
   // pinning converges (4-5 rounds on those images); past 16 rounds every
   // vertex keeps its start.
-  std::vector<double> cur = smooth(nullptr, nullptr);
-  std::vector<double> before_round;  // the positions the last check saw
+  std::vector<double> cur, before_round;  // the positions now, and those the last check saw
+  smooth(nullptr, nullptr, cur);
   // Polygon f's n - 2 triangles start at triangle face_offsets[f] - 2 f.
   const std::size_t nt = D == 3 ? mesh.face_vertices.size() - 2 * nf : 0;
   std::vector<std::int32_t> corners(3 * nt);
@@ -633,6 +642,7 @@ std::vector<NetVertexKind> smooth_surface_net(FaceSet& mesh, std::span<const dou
     std::sort(zone.begin(), zone.end());
     return zone;
   };
+  front::CrossingCheck check;
   for (int round = 0; D == 3 && round < 16; ++round) {
     // The output triangles; after the first round only those of polygons
     // with a moved corner can differ.
@@ -696,7 +706,7 @@ std::vector<NetVertexKind> smooth_surface_net(FaceSet& mesh, std::span<const dou
       for (std::size_t k = 0; k < 3; ++k) same = same && std::equal(corner(cur, t, k), corner(cur, t, k) + 3, corner(x0, t, k));
       at_start[t] = same;
     });
-    auto crossings = front::crossing_triangles(cur, corners, changed, at_start);
+    auto crossings = check(cur, corners, changed, at_start);
     std::erase_if(crossings, [&](const auto& st) {
       const auto [s, t] = st;
       return crosses_at(x0, s, t) && !crosses_shrunk(s, t);
@@ -735,8 +745,9 @@ std::vector<NetVertexKind> smooth_surface_net(FaceSet& mesh, std::span<const dou
       break;
     }
     const std::vector<std::int32_t> zone = zone_around(newly_pinned);
-    before_round = std::move(cur);
-    cur = round + 1 < 16 ? smooth(&zone, &before_round) : x0;
+    before_round.swap(cur);
+    if (round + 1 < 16) smooth(&zone, &before_round, cur);
+    else cur = x0;
   }
 
   moved = 0;
