@@ -17,6 +17,7 @@
 #include <atomic>
 #include <cmath>
 #include <limits>
+#include <optional>
 
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
@@ -230,22 +231,11 @@ std::vector<Pair> crossing_triangles(std::span<const double> xyz, std::span<cons
   return CrossingCheck()(xyz, corners, changed, settled);
 }
 
-std::vector<Pair> CrossingCheck::operator()(std::span<const double> xyz, std::span<const std::int32_t> corners,
-                                            std::span<const std::uint8_t> changed,
-                                            std::span<const std::uint8_t> settled) {
-  const std::size_t nt = corners.size() / 3;
-  std::vector<Pair> out;
-  if (nt < 2) return out;
-  auto at = [&](std::size_t t, int k) { return &xyz[3 * static_cast<std::size_t>(corners[3 * t + static_cast<std::size_t>(k)])]; };
-  using Range = tbb::blocked_range<std::size_t>;
-
-  // The whole extent and the mean triangle size.
-  auto bounding_box = [&](std::size_t t, double* b) {
-    for (int d = 0; d < 3; ++d) {
-      b[d] = std::min({at(t, 0)[d], at(t, 1)[d], at(t, 2)[d]});
-      b[d + 3] = std::max({at(t, 0)[d], at(t, 1)[d], at(t, 2)[d]});
-    }
-  };
+// The grid over the triangles' boxes: cells about twice the mean triangle,
+// at most ~4 per triangle in all. None when a box is not finite (positions
+// are finite by construction).
+template <class BoxOf>
+std::optional<CrossingCheck::Grid> CrossingCheck::make_grid(std::size_t nt, BoxOf&& bounding_box) {
   double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY}, size = 0;
   for (std::size_t t = 0; t < nt; ++t) {
     double b[6];
@@ -259,8 +249,7 @@ std::vector<Pair> CrossingCheck::operator()(std::span<const double> xyz, std::sp
     size += extent;
   }
   for (int d = 0; d < 3; ++d)
-    if (!std::isfinite(lo[d]) || !std::isfinite(hi[d])) return out;  // (positions are finite by construction)
-  // Cells about twice the mean triangle, at most ~4 per triangle in all.
+    if (!std::isfinite(lo[d]) || !std::isfinite(hi[d])) return std::nullopt;
   double h = 2 * size / static_cast<double>(nt);
   auto cells_along = [&](double cell, int d) {
     return static_cast<std::int64_t>(std::floor((hi[d] - lo[d]) / cell)) + 1;
@@ -272,7 +261,34 @@ std::vector<Pair> CrossingCheck::operator()(std::span<const double> xyz, std::sp
     if (cells <= 4.0 * static_cast<double>(nt) + 64) break;
     h *= 1.5;
   }
-  const std::int64_t n[3] = {cells_along(h, 0), cells_along(h, 1), cells_along(h, 2)};
+  return Grid{{lo[0], lo[1], lo[2]}, h, {cells_along(h, 0), cells_along(h, 1), cells_along(h, 2)}};
+}
+
+std::vector<Pair> CrossingCheck::operator()(std::span<const double> xyz, std::span<const std::int32_t> corners,
+                                            std::span<const std::uint8_t> changed,
+                                            std::span<const std::uint8_t> settled) {
+  const std::size_t nt = corners.size() / 3;
+  std::vector<Pair> out;
+  if (nt < 2) return out;
+  auto at = [&](std::size_t t, int k) { return &xyz[3 * static_cast<std::size_t>(corners[3 * t + static_cast<std::size_t>(k)])]; };
+  using Range = tbb::blocked_range<std::size_t>;
+
+  auto bounding_box = [&](std::size_t t, double* b) {
+    for (int d = 0; d < 3; ++d) {
+      b[d] = std::min({at(t, 0)[d], at(t, 1)[d], at(t, 2)[d]});
+      b[d + 3] = std::max({at(t, 0)[d], at(t, 1)[d], at(t, 2)[d]});
+    }
+  };
+  const bool filtered = !changed.empty();
+  // With `changed` and the same number of triangles as last time, the grid
+  // and the boxes of the triangles not changed are kept (a changed one that
+  // left the grid lies in its border cells).
+  const bool keep = filtered && grid_ && box_.size() == nt;
+  if (!keep) grid_ = make_grid(nt, bounding_box);
+  if (!grid_) return out;
+  const double* lo = grid_->lo;
+  const double h = grid_->h;
+  const std::int64_t* n = grid_->n;
   auto index = [&](std::int64_t i, std::int64_t j, std::int64_t k) {
     return static_cast<std::size_t>((k * n[1] + j) * n[0] + i);
   };
@@ -286,6 +302,7 @@ std::vector<Pair> CrossingCheck::operator()(std::span<const double> xyz, std::sp
   const auto& span = span_;
   tbb::parallel_for(Range(0, nt, 4096), [&](const Range& r) {
     for (std::size_t t = r.begin(); t != r.end(); ++t) {
+      if (keep && !changed[t]) continue;
       double b[6];
       bounding_box(t, b);
       for (int d = 0; d < 6; ++d) {
@@ -305,7 +322,6 @@ std::vector<Pair> CrossingCheck::operator()(std::span<const double> xyz, std::sp
   // With `changed`, only the cells a changed triangle meets can hold a pair
   // to test: only those are filled.
   const auto ncell = static_cast<std::size_t>(n[0] * n[1] * n[2]);
-  const bool filtered = !changed.empty();
   auto zero = [](auto& buffer, std::size_t n) {  // in parallel: the buffers are large
     buffer.resize(n);
     tbb::parallel_for(Range(0, n, std::size_t{1} << 16), [&](const Range& r) {

@@ -5,6 +5,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <utility>
 #include <vector>
@@ -42,7 +43,9 @@ std::vector<std::pair<std::size_t, std::size_t>> crossing_triangles(std::span<co
 /// crossing_triangles with its arrays kept from call to call: the rounds of
 /// one untangling check nets of millions of triangles, whose grid arrays
 /// (~90 bytes per triangle) would otherwise be mapped and faulted in afresh
-/// each time.
+/// each time. A call with `changed` after one with as many triangles takes
+/// the others to be as they were then (the same corners, where they were):
+/// it keeps their boxes and the grid.
 class CrossingCheck {
  public:
   std::vector<std::pair<std::size_t, std::size_t>> operator()(std::span<const double> xyz,
@@ -56,6 +59,14 @@ class CrossingCheck {
   Buffer<std::int64_t> offset_, fill_;       // per cell (CSR)
   Buffer<std::uint32_t> members_;
   Buffer<std::uint8_t> wanted_;              // per cell
+  struct Grid {
+    double lo[3];
+    double h;  // cell size
+    std::int64_t n[3];
+  };
+  std::optional<Grid> grid_;
+  template <class BoxOf>
+  static std::optional<Grid> make_grid(std::size_t nt, BoxOf&& bounding_box);
 };
 
 }  // namespace tessera::front

@@ -645,7 +645,11 @@ std::vector<NetVertexKind> smooth_surface_net(FaceSet& mesh, std::span<const dou
   front::CrossingCheck check;
   for (int round = 0; D == 3 && round < 16; ++round) {
     // The output triangles; after the first round only those of polygons
-    // with a moved corner can differ.
+    // with a moved corner can differ, and only pairs with one of those can
+    // cross (the others were checked apart before). All of such a polygon's
+    // triangles count as changed: another ladder may make one of corners
+    // that did not move.
+    std::vector<std::uint8_t> changed(round > 0 ? nt : 0);
     front::parallel_range(nf, 1024, [&](std::size_t f) {
       const auto b = static_cast<std::size_t>(mesh.face_offsets[f]);
       const auto n = static_cast<std::size_t>(mesh.face_offsets[f + 1]) - b;
@@ -657,18 +661,10 @@ std::vector<NetVertexKind> smooth_surface_net(FaceSet& mesh, std::span<const dou
       front::ladder(n, front::output_ladder_rotation(cur.data(), x0.data(), loop, n, &ref[3 * f]),
                     [&](std::size_t i, std::size_t j, std::size_t q) {
                       corners[3 * t] = loop[i], corners[3 * t + 1] = loop[j], corners[3 * t + 2] = loop[q];
+                      if (round > 0) changed[t] = 1;
                       polygon_of[t++] = f;
                     });
     });
-    // After the first round only pairs with a triangle that moved can cross:
-    // the others were checked apart before.
-    std::vector<std::uint8_t> changed;
-    if (round > 0) {
-      changed.resize(nt);
-      front::parallel_range(nt, 4096, [&](std::size_t t) {
-        for (std::size_t k = 0; k < 3; ++k) changed[t] |= moved_since(static_cast<std::size_t>(corners[3 * t + k]));
-      });
-    }
     // Rounding can set vertices that should coincide ulps apart, so that the
     // unsmoothed net itself overlaps by ulps (far from the origin, with
     // anisotropic voxels: hundreds of pairs). Pinning cannot undo those (a

@@ -355,7 +355,9 @@ TEST(SurfaceNets, CrossingTestOnHandMadeTriangles) {
 // The broad phase (a grid, a sweep per cell, boxes in floats) finds every
 // pair the pair test finds, once: triangle soups against all pairs, some
 // sharing vertices, some on a coarse lattice so that corners and planes
-// coincide exactly, with the `changed` and `settled` filters.
+// coincide exactly, with the `changed` and `settled` filters, and a second
+// call of one CrossingCheck after some vertices moved (some out of the
+// first call's grid), which keeps the others' boxes.
 TEST(SurfaceNets, CrossingTrianglesFindsEveryCrossingPair) {
   std::mt19937_64 rng(7);
   std::uniform_real_distribution<double> u(0, 1);
@@ -394,6 +396,27 @@ TEST(SurfaceNets, CrossingTrianglesFindsEveryCrossingPair) {
     EXPECT_GT(all.size(), 100u) << soup;
     EXPECT_EQ(tessera::front::crossing_triangles(xyz, corners), all) << soup;
     EXPECT_EQ(tessera::front::crossing_triangles(xyz, corners, changed, settled), filtered) << soup;
+
+    tessera::front::CrossingCheck check;
+    EXPECT_EQ(check(xyz, corners), all) << soup;
+    std::vector<std::uint8_t> moved(nv, 0);
+    for (int v = 0; v < nv; ++v)
+      if (u(rng) < 0.05) {
+        moved[v] = 1;
+        for (int d = 0; d < 3; ++d) xyz[3 * v + d] += (u(rng) < 0.2 ? 4.0 : 0.3) * (u(rng) - 0.5);
+      }
+    for (std::size_t t = 0; t < nt; ++t)
+      changed[t] = moved[corners[3 * t]] || moved[corners[3 * t + 1]] || moved[corners[3 * t + 2]];
+    std::vector<std::pair<std::size_t, std::size_t>> after;
+    for (std::size_t s = 0; s < nt; ++s)
+      for (std::size_t t = s + 1; t < nt; ++t) {
+        if (!(changed[s] || changed[t]) || (settled[s] && settled[t])) continue;
+        const double* a[3] = {&xyz[3 * corners[3 * s]], &xyz[3 * corners[3 * s + 1]], &xyz[3 * corners[3 * s + 2]]};
+        const double* b[3] = {&xyz[3 * corners[3 * t]], &xyz[3 * corners[3 * t + 1]], &xyz[3 * corners[3 * t + 2]]};
+        if (tessera::front::triangle_pair_crosses(a, &corners[3 * s], b, &corners[3 * t])) after.emplace_back(s, t);
+      }
+    EXPECT_GT(after.size(), 10u) << soup;
+    EXPECT_EQ(check(xyz, corners, changed, settled), after) << soup;
   }
 }
 
