@@ -55,9 +55,9 @@
 // rounds, deterministically). So no output face flips, whatever the options.
 // Untangling (3D): where output triangles cross (share a point interior to
 // one of them, exactly), the polygons around both are pinned where they
-// started and the smoothing runs again from the start, until none do; so no
-// face passes through another (voxel label maps of many touching labels had
-// such crossings at junction curves).
+// started and the smoothing runs again from the start around them (the rest
+// of the net held), until none do; so no face passes through another (voxel
+// label maps of many touching labels had such crossings at junction curves).
 //
 // Defaults (iterations 20, relaxation 0.5, constraint 0.5), chosen on
 // nested spheres, touching boxes and three sectors sampled as exact and

@@ -350,18 +350,18 @@ std::vector<Pair> CrossingCheck::operator()(std::span<const double> xyz, std::sp
   for (std::size_t c = 0; c < ncell; ++c) offset[c + 1] += offset[c];
   auto& members = members_;
   members.resize(static_cast<std::size_t>(offset[ncell]));
-  {
-    auto& fill = fill_;
-    fill.assign(offset.begin(), offset.end() - 1);
-    tbb::parallel_for(Range(0, nt, 4096), [&](const Range& r) {
-      for (std::size_t t = r.begin(); t != r.end(); ++t)
-        for_cells(t, [&](std::size_t c) {
-          if (filtered && !wanted[c]) return;
-          const auto slot = std::atomic_ref<std::int64_t>(fill[c]).fetch_add(1, std::memory_order_relaxed);
-          members[static_cast<std::size_t>(slot)] = static_cast<std::uint32_t>(t);
-        });
-    });
-  }
+  // Filled through offset[c] as the cursor of cell c, which ends at c's end,
+  // the next cell's start: shifted back by one place afterwards.
+  tbb::parallel_for(Range(0, nt, 4096), [&](const Range& r) {
+    for (std::size_t t = r.begin(); t != r.end(); ++t)
+      for_cells(t, [&](std::size_t c) {
+        if (filtered && !wanted[c]) return;
+        const auto slot = std::atomic_ref<std::int64_t>(offset[c]).fetch_add(1, std::memory_order_relaxed);
+        members[static_cast<std::size_t>(slot)] = static_cast<std::uint32_t>(t);
+      });
+  });
+  std::copy_backward(offset.begin(), offset.end() - 1, offset.end());
+  offset[0] = 0;
 
   // Each cell's pairs by a sweep along x over its boxes, copied out and
   // sorted by their lower x: a box meets only the boxes after it that start

@@ -56,7 +56,7 @@ class CrossingCheck {
  private:
   Buffer<std::array<float, 6>> box_;         // per triangle, rounded outwards
   Buffer<std::array<std::int32_t, 6>> span_;  // per triangle: its cells along each axis
-  Buffer<std::int64_t> offset_, fill_;       // per cell (CSR)
+  Buffer<std::int64_t> offset_;              // per cell (CSR)
   Buffer<std::uint32_t> members_;
   Buffer<std::uint8_t> wanted_;              // per cell
   struct Grid {
