@@ -11,11 +11,13 @@
 #include <cstdlib>
 #include <exception>
 #include <new>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
 
 #include <CLI/CLI.hpp>
+#include <tbb/global_control.h>
 
 #include "commands.hpp"
 #include "option_checks.hpp"
@@ -266,6 +268,15 @@ void finish_compute_args(ComputeArgs& c, const std::vector<std::string>& raw_bou
     if (c.frame.empty()) throw;
     throw tessera::InputError("frame " + std::to_string(c.frame_place.index) + ": " + e.what());
   }
+}
+
+/// The value of --threads of the command that ran (its deepest parsed
+/// subcommand), 0 when not given or when it has none.
+int threads_given(const CLI::App& app) {
+  const CLI::App* command = &app;
+  while (!command->get_subcommands().empty()) command = command->get_subcommands().front();
+  const CLI::Option* o = command->get_option_no_throw("--threads");
+  return o != nullptr && o->count() > 0 ? o->as<int>() : 0;
 }
 
 }  // namespace
@@ -566,6 +577,11 @@ int main(int argc, char** argv) {
   }
 
   try {
+    // --threads (or TESSERA_NUM_THREADS) bounds every parallel loop of the
+    // command, the writers' included, which run outside the library's
+    // arenas (a .vtu written with --threads 1 used both cores).
+    const tbb::global_control threads(tbb::global_control::max_allowed_parallelism,
+                                      static_cast<std::size_t>(tessera::resolve_threads(threads_given(app))));
     if (vor->parsed()) {
       finish_compute_args(va.compute, vor_bounds, true);
       return run_voronoi(va);

@@ -20,6 +20,7 @@ import struct
 import subprocess
 import sys
 import tempfile
+import time
 import unittest
 
 import numpy as np
@@ -298,6 +299,39 @@ class Voronoi3D(TempDirCase):
         self.assertNotIn("TBB", r.stderr)
         self.assertIn("on %d threads" % many, r.stdout)
         self.assertTrue(read_bytes(vtu) == outs[1][0])
+
+    def test_one_thread_means_one_thread(self):
+        # --threads 1 (and TESSERA_NUM_THREADS=1) bounds the writers too: the
+        # .vtu writer formatted its chunks on every core (a second thread
+        # with ~0.1 s of CPU on 200k points). Per-thread CPU from /proc.
+        pts = np.random.default_rng(12).random((200000, 3))
+        inp = self.save("one.npy", pts)
+
+        def busy_threads(args, env):
+            full_env = dict(os.environ)
+            full_env.pop("TESSERA_NUM_THREADS", None)
+            full_env.update(env)
+            p = subprocess.Popen([TESSERA] + args, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, env=full_env)
+            cpu = {}
+            while p.poll() is None:
+                try:
+                    for tid in os.listdir("/proc/%d/task" % p.pid):
+                        try:
+                            with open("/proc/%d/task/%s/stat" % (p.pid, tid)) as f:
+                                fields = f.read().rsplit(")", 1)[1].split()
+                            cpu[tid] = (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+                        except (OSError, IndexError, ValueError):
+                            pass
+                except OSError:
+                    pass
+                time.sleep(0.01)
+            self.assertEqual(p.returncode, 0)
+            return sorted(cpu.values(), reverse=True)
+
+        for args, env in ((["--threads", "1"], {}), ([], {"TESSERA_NUM_THREADS": "1"})):
+            cpu = busy_threads(["voronoi", inp, "-o", self.p("one.vtu"), "--cell-table", self.p("one.csv"), "-q"] + args, env)
+            self.assertGreater(cpu[0], 0.3, cpu)
+            self.assertTrue(all(c < 0.03 for c in cpu[1:]), "more than one thread worked: %s (%s %s)" % (cpu, args, env))
 
     def test_chunked_writers_read_back(self):
         # The .vtu's connectivity and faces, and the .csv's rows, are written
