@@ -9,13 +9,41 @@ are indexed by cell (``point_region`` maps points to them), not by qhull's order
 
 from __future__ import annotations
 
+import gc
+from contextlib import contextmanager
 from functools import cached_property
-from typing import TYPE_CHECKING, Dict, List, Tuple
+from typing import TYPE_CHECKING, Dict, Iterator, List, Optional, Tuple
 
 import numpy as np
 
 if TYPE_CHECKING:  # pragma: no cover
     from ._voronoi import Voronoi
+
+
+@contextmanager
+def _collector_paused() -> Iterator[None]:
+    """Python's cyclic garbage collector off for a while, as it was after.
+    Building millions of lists (a 3D ridge per face) set it off again and
+    again, each time scanning every list made so far: two thirds of the time
+    at 200k points, and the share grew with the count."""
+    was = gc.isenabled()
+    gc.disable()
+    try:
+        yield
+    finally:
+        if was:
+            gc.enable()
+
+
+def _lists(flat: np.ndarray, offsets: np.ndarray, select: Optional[np.ndarray] = None) -> List[List[int]]:
+    """``flat[offsets[i]:offsets[i + 1]]`` as a list, for every i (or every i
+    in ``select``): one ``tolist`` and slices of it, not a numpy slice and
+    ``tolist`` per list."""
+    values = flat.tolist()
+    starts = offsets[:-1] if select is None else offsets[select]
+    ends = offsets[1:] if select is None else offsets[select + 1]
+    with _collector_paused():
+        return [values[a:b] for a, b in zip(starts.tolist(), ends.tolist())]
 
 
 class ScipyVoronoi:
@@ -91,8 +119,9 @@ class ScipyVoronoi:
         faces = self._ridge_faces
         fvo, fv = v.face_vertex_offsets, v.face_vertices
         if v.ndim == 2:  # every face is an edge of two vertices
-            return fv.reshape(-1, 2)[faces].tolist()
-        return [fv[fvo[f]:fvo[f + 1]].tolist() for f in faces]
+            with _collector_paused():
+                return fv.reshape(-1, 2)[faces].tolist()
+        return _lists(fv, fvo, faces)
 
     @cached_property
     def regions(self) -> List[List[int]]:
@@ -102,14 +131,14 @@ class ScipyVoronoi:
         cfo, fvo, fv = v.cell_face_offsets, v.face_vertex_offsets, v.face_vertices
         if v.ndim == 2:
             first = fv[fvo[:-1]]  # first vertex of each edge, in polygon order
-            return [r.tolist() for r in np.split(first, cfo[1:-1])]
+            return _lists(first, cfo)
         # 3D: the distinct vertices of each cell's faces, via one sort of (cell, vertex) keys.
         per_cell = np.diff(fvo[cfo])
         cell = np.repeat(np.arange(v.n_cells, dtype=np.int64), per_cell)
         keys = np.unique(cell * max(v.n_vertices, 1) + fv)
         counts = np.bincount(keys // max(v.n_vertices, 1), minlength=v.n_cells)
         verts = keys % max(v.n_vertices, 1)
-        return [r.tolist() for r in np.split(verts, np.cumsum(counts)[:-1])]
+        return _lists(verts, np.concatenate([[0], np.cumsum(counts)]))
 
     @cached_property
     def point_region(self) -> np.ndarray:
@@ -124,7 +153,10 @@ class ScipyVoronoi:
     @cached_property
     def ridge_dict(self) -> Dict[Tuple[int, int], List[int]]:
         """{(p, q): ridge vertices}, as scipy's."""
-        return {(int(p), int(q)): rv for (p, q), rv in zip(self.ridge_points, self.ridge_vertices)}
+        vertices = self.ridge_vertices
+        first, second = self.ridge_points[:, 0].tolist(), self.ridge_points[:, 1].tolist()
+        with _collector_paused():
+            return {(p, q): rv for p, q, rv in zip(first, second, vertices)}
 
     def __repr__(self) -> str:
         return f"<tessera scipy view of {self._vor!r}>"
