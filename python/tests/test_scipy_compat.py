@@ -81,6 +81,30 @@ def test_scipy_view_shapes_and_meanings(dim):
     assert d[(p, q)] == rv and q in vor.cell_neighbors(vor.cell_of[p]).tolist()
 
 
+@pytest.mark.parametrize("dim", [2, 3])
+def test_scipy_view_lists_match_the_cells_and_leave_the_collector_as_it_was(dim):
+    # The lists are built from one tolist with the garbage collector paused:
+    # each is the cell's or face's own, and the collector is left as found.
+    import gc
+
+    vor = tessera.voronoi(random_points(300, dim, seed=4))
+    for enabled in (True, False):
+        (gc.enable if enabled else gc.disable)()
+        try:
+            view = tessera._scipy.ScipyVoronoi(vor)
+            rv, regions, d = view.ridge_vertices, view.regions, view.ridge_dict
+            assert gc.isenabled() == enabled
+        finally:
+            gc.enable()
+        faces = view._ridge_faces
+        fvo = vor.face_vertex_offsets
+        assert rv == [vor.face_vertices[fvo[f]:fvo[f + 1]].tolist() for f in faces]
+        for c in (0, 7, vor.n_cells - 1):
+            cell_vertices = vor.face_vertices[fvo[vor.cell_face_offsets[c]]:fvo[vor.cell_face_offsets[c + 1]]]
+            assert sorted(set(regions[c])) == sorted(set(cell_vertices.tolist()))
+        assert list(d.values()) == rv and list(d) == [tuple(r) for r in view.ridge_points.tolist()]
+
+
 def test_ridges_towards_outside_points_are_kept_once():
     pts = random_points(500, 2, seed=5)
     labels = np.where(pts[:, 0] < 0.2, -1, 0)
