@@ -76,30 +76,21 @@ def cells_to_vtk(vor: "Voronoi") -> Any:
     else:
         out = vtkUnstructuredGrid()
         out.SetPoints(_points(vor.vertices))
-        n_faces = len(fvo) - 1
-        faces_per_cell = np.diff(cfo)
-        verts_per_face = np.diff(fvo)
-        # VTK's face stream, per cell: [n_faces, n_pts, ids..., n_pts, ids...];
-        # face_locations[c] is where cell c's record starts.
-        cell_len = 1 + faces_per_cell + np.diff(fvo[cfo])
-        face_locations = np.zeros(n_cells, dtype=np.int64)
-        np.cumsum(cell_len[:-1], out=face_locations[1:])
-        stream = np.empty(int(cell_len.sum()), dtype=np.int64)
-        stream[face_locations] = faces_per_cell
-        face_cell = np.repeat(np.arange(n_cells), faces_per_cell)
-        local_face = np.arange(n_faces) - cfo[face_cell]
-        header = face_locations[face_cell] + 1 + local_face + (fvo[:-1] - fvo[cfo[face_cell]])
-        stream[header] = verts_per_face
-        entry_face = np.repeat(np.arange(n_faces), verts_per_face)
-        stream[header[entry_face] + 1 + (np.arange(len(fv)) - fvo[entry_face])] = fv
-        # Cell connectivity: the distinct vertices of each cell.
-        n_v = max(vor.n_vertices, 1)
-        keys = np.unique(np.repeat(np.arange(n_cells, dtype=np.int64), np.diff(fvo[cfo])) * n_v + fv)
-        offsets = np.zeros(n_cells + 1, dtype=np.int64)
-        np.cumsum(np.bincount(keys // n_v, minlength=n_cells), out=offsets[1:])
+        # VTK's face stream (per cell: [n_faces, n_pts, ids..., n_pts, ids...]),
+        # where each cell's record starts, and each cell's distinct vertices:
+        # built in C++, without numpy's temporaries.
+        # Each is copied into VTK (_ids) and let go at once, so the peak holds
+        # one copy of the largest, the stream, beside VTK's.
+        arrays = list(vor._cells._polyhedron_arrays())
+        vtk_arrays = []
+        while arrays:
+            vtk_arrays.append(_ids(arrays.pop(0)))
+        stream, face_locations, offsets, ids = vtk_arrays
+        connectivity = vtkCellArray()
+        connectivity.SetData(offsets, ids)
         types = numpy_to_vtk(np.full(n_cells, VTK_POLYHEDRON, dtype=np.uint8), deep=1,
                              array_type=VTK_UNSIGNED_CHAR)
-        out.SetCells(types, _cell_array(offsets, keys % n_v), _ids(face_locations), _ids(stream))
+        out.SetCells(types, connectivity, face_locations, stream)
         names = ("Volume", "NumberOfFaces")
     _add_cell_data(out, "GeneratorId", vor.generators)
     _add_cell_data(out, "Region", vor.regions)
