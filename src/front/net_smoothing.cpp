@@ -602,10 +602,10 @@ std::vector<NetVertexKind> smooth_surface_net(FaceSet& mesh, std::span<const dou
   // variance relaxation * iterations (in steps squared): within twice its
   // deviation a rerun of the whole net would change positions, beyond it
   // hardly. The whole net's rerun (the first version) cost a full smoothing
-  // per round and made every triangle one to check again: on a 256^3 map
-  // with 12 labels 1.0 s a round (four rounds), against 0.02-0.4 s now; the
-  // positions differ from it by more than 0.01 voxel at 2% of the vertices
-  // (where one pinned and the other did not), the pinned vertices 4% more.
+  // per round and made every triangle one to check again. On a 128^3 map of
+  // 12 labels the zone's result differs from the whole rerun's by more than
+  // 0.01 voxel at 1.6% of the vertices (where one pinned and the other did
+  // not), and pins 2.3% more vertices (docs/design.md, "Untangling").
   const int zone_steps = static_cast<int>(std::ceil(2 * std::sqrt(options.iterations * options.relaxation)));
   auto zone_around = [&](const std::vector<std::int32_t>& seeds) {
     std::vector<std::uint8_t> in(ng, 0);
