@@ -3,13 +3,11 @@
 // Broad phase: a uniform grid of cells about twice the mean triangle's size,
 // each triangle listed in every cell its bounding box meets; a pair is tested
 // once, in the cell holding the lower corner of their boxes' overlap. Narrow
-// phase: exact orientation signs (in 3D, and in 2D projections for what lies
-// in a plane). The intersection of two triangles is bounded by points on
-// their edges, so it holds a point interior to one of them iff some edge of
-// one meets the other's interior (crossing its plane inside it, lying in its
-// plane across it, or ending in its plane inside it), or, in one plane, one
-// lies over the other with its corners on the other's boundary (the same
-// corners: a fold).
+// phase: float filters that settle most pairs apart with a bound far above
+// their rounding, then exact orientation signs (in 3D, and in 2D projections
+// for what lies in a plane): the interior of one triangle meets the other iff
+// no line in its plane separates it from the other's section by that plane
+// (interior_meets).
 #include "net_crossings.hpp"
 
 #include <algorithm>
@@ -36,9 +34,11 @@ int orient(const double* a, const double* b, const double* c, const double* d) {
 }
 
 /// Whether the points q[0..m) lie certainly strictly on one side of the
-/// plane of triangle t, by a float filter: each signed distance n . (q - t0)
-/// kept only where it exceeds 1e-10 of |n| |q - t0|, far above its rounding
-/// (a few ulps of those products). A point exactly at a corner of t is
+/// plane of triangle t, by a float filter: each signed distance n . (q - t0),
+/// n = u x w from t's edge vectors, kept only where it exceeds 1e-10 of
+/// |u| |w| |q - t0|, far above its rounding (a few ulps of those products;
+/// not of |n| |q - t0|: a nearly flat triangle's n is a difference of
+/// products that may be mostly rounding). A point exactly at a corner of t is
 /// passed over, as long as one other is certainly off the plane: then the
 /// triangle of the q (and the corners it shares with t) meets t's plane in
 /// the hull of at most two of t's corners, an edge of both or a corner.
@@ -49,14 +49,15 @@ bool surely_one_side(const double* const t[3], const double* const* q, int m) {
   const double u[3] = {t[1][0] - t[0][0], t[1][1] - t[0][1], t[1][2] - t[0][2]};
   const double w[3] = {t[2][0] - t[0][0], t[2][1] - t[0][1], t[2][2] - t[0][2]};
   const double n[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]};
-  const double nn = std::fabs(n[0]) + std::fabs(n[1]) + std::fabs(n[2]);
+  const double uw = (std::fabs(u[0]) + std::fabs(u[1]) + std::fabs(u[2])) *
+                    (std::fabs(w[0]) + std::fabs(w[1]) + std::fabs(w[2]));
   int side = 0;
   for (int k = 0; k < m; ++k) {
     if (std::equal(q[k], q[k] + 3, t[0]) || std::equal(q[k], q[k] + 3, t[1]) || std::equal(q[k], q[k] + 3, t[2]))
       continue;
     const double d[3] = {q[k][0] - t[0][0], q[k][1] - t[0][1], q[k][2] - t[0][2]};
     const double s = n[0] * d[0] + n[1] * d[1] + n[2] * d[2];
-    const double bound = 1e-10 * nn * (std::fabs(d[0]) + std::fabs(d[1]) + std::fabs(d[2]));
+    const double bound = 1e-10 * uw * (std::fabs(d[0]) + std::fabs(d[1]) + std::fabs(d[2]));
     const int sk = s > bound ? 1 : s < -bound ? -1 : 0;
     if (sk == 0 || (side != 0 && sk != side)) return false;
     side = sk;
@@ -67,29 +68,32 @@ bool surely_one_side(const double* const t[3], const double* const* q, int m) {
 /// Float filter for triangles lying nearly in one plane (a flat stretch of a
 /// net, where the plane test above cannot decide): projected on the
 /// coordinate plane that both face (each normal's component along the
-/// dropped axis at least 1e-3 of its largest, so the projection is one to
-/// one on each), an edge of one separates them by a margin (1e-10 of the
+/// dropped axis at least 1e-3 of its largest, and certainly not zero: above
+/// 1e-10 of the products it comes from, so the projection is one to one on
+/// each), an edge of one separates them by a margin (1e-10 of the
 /// products, far above rounding), the corners on that edge that both share
 /// or that project exactly onto its ends excepted. Then a common point would
 /// project onto the edge and onto the hull of the other's excepted corners,
 /// so lie on the boundary of both: they do not cross.
 bool surely_apart_in_plane(const double* const a[3], const std::int32_t* ca, const double* const b[3],
                            const std::int32_t* cb) {
+  // n = u x w and the size of the products behind it, |u| |w|.
   auto normal = [](const double* const t[3], double* n) {
     const double u[3] = {t[1][0] - t[0][0], t[1][1] - t[0][1], t[1][2] - t[0][2]};
     const double w[3] = {t[2][0] - t[0][0], t[2][1] - t[0][1], t[2][2] - t[0][2]};
     n[0] = u[1] * w[2] - u[2] * w[1], n[1] = u[2] * w[0] - u[0] * w[2], n[2] = u[0] * w[1] - u[1] * w[0];
+    return (std::fabs(u[0]) + std::fabs(u[1]) + std::fabs(u[2])) * (std::fabs(w[0]) + std::fabs(w[1]) + std::fabs(w[2]));
   };
   double na[3], nb[3];
-  normal(a, na);
-  normal(b, nb);
+  const double uwa = normal(a, na), uwb = normal(b, nb);
   const int drop = std::fabs(na[0]) >= std::fabs(na[1]) && std::fabs(na[0]) >= std::fabs(na[2]) ? 0
                    : std::fabs(na[1]) >= std::fabs(na[2])                                       ? 1
                                                                                                 : 2;
-  auto faces = [&](const double* n) {
-    return std::fabs(n[drop]) > 1e-3 * std::max({std::fabs(n[0]), std::fabs(n[1]), std::fabs(n[2])});
+  auto faces = [&](const double* n, double uw) {
+    return std::fabs(n[drop]) > 1e-3 * std::max({std::fabs(n[0]), std::fabs(n[1]), std::fabs(n[2])}) &&
+           std::fabs(n[drop]) > 1e-10 * uw;
   };
-  if (!faces(na) || !faces(nb)) return false;
+  if (!faces(na, uwa) || !faces(nb, uwb)) return false;
   const int x = drop == 0 ? 1 : 0, y = drop == 2 ? 1 : 2;
   // Does the line through t's edge k separate u from t's third corner?
   auto separates = [&](const double* const t[3], const std::int32_t* ct, int k, const double* const u[3],
@@ -127,69 +131,100 @@ int orient2(const double* p, const double* q, const double* r, int drop) {
   return kernels::orientation(2, pts);
 }
 
-/// Whether point p, in the plane of triangle t, lies strictly inside it.
-bool strictly_inside(const double* p, const double* const t[3], int drop) {
-  const int s = orient2(t[0], t[1], p, drop);
-  return s != 0 && orient2(t[1], t[2], p, drop) == s && orient2(t[2], t[0], p, drop) == s;
-}
-
-/// Whether segment pq, in the plane of triangle t, meets t's interior: an end
-/// strictly inside, or a proper crossing of one of its edges (a segment that
-/// enters through a corner leaves through an edge or ends inside).
-bool segment_meets_interior(const double* p, const double* q, const double* const t[3], int drop) {
-  if (strictly_inside(p, t, drop) || strictly_inside(q, t, drop)) return true;
-  for (int k = 0; k < 3; ++k) {
-    const double* u = t[k];
-    const double* w = t[(k + 1) % 3];
-    if (orient2(p, q, u, drop) * orient2(p, q, w, drop) < 0 && orient2(u, w, p, drop) * orient2(u, w, q, drop) < 0)
-      return true;
-  }
-  return false;
-}
-
-/// Whether some edge of triangle b meets the (relative) interior of triangle
-/// a: crossing a's plane strictly inside it, lying in a's plane through its
-/// interior, or ending (in the plane) strictly inside it. A degenerate a
-/// (collinear corners: exact lattices make such zero-area faces) has no
-/// interior.
-bool edges_meet_interior(const double* const a[3], const double* const b[3]) {
-  if (kernels::collinear3(a[0], a[1], a[2])) return false;
-  int s[3];
-  for (int k = 0; k < 3; ++k) s[k] = orient(a[0], a[1], a[2], b[k]);
-  // The plane to project on: a's normal's largest coordinate (in floats; any
-  // coordinate whose normal component is not zero projects a faithfully).
-  const double u[3] = {a[1][0] - a[0][0], a[1][1] - a[0][1], a[1][2] - a[0][2]};
-  const double w[3] = {a[2][0] - a[0][0], a[2][1] - a[0][1], a[2][2] - a[0][2]};
+/// An axis to leave out so that triangle t (corners not collinear) projects
+/// one to one: one along which its exact projected orientation is not zero,
+/// its float normal's largest component tried first.
+int projection_axis(const double* const t[3]) {
+  const double u[3] = {t[1][0] - t[0][0], t[1][1] - t[0][1], t[1][2] - t[0][2]};
+  const double w[3] = {t[2][0] - t[0][0], t[2][1] - t[0][1], t[2][2] - t[0][2]};
   const double n[3] = {std::fabs(u[1] * w[2] - u[2] * w[1]), std::fabs(u[2] * w[0] - u[0] * w[2]),
                        std::fabs(u[0] * w[1] - u[1] * w[0])};
-  const int drop = n[0] >= n[1] && n[0] >= n[2] ? 0 : n[1] >= n[2] ? 1 : 2;
-  if (s[0] == 0 && s[1] == 0 && s[2] == 0 && !kernels::collinear3(b[0], b[1], b[2])) {
-    // b in a's plane, not flat, with every corner in a or on its boundary
-    // (the same corners, or one on an edge: a fold that no edge shows):
-    // then b's interior lies in a's (a point of it on a's boundary would
-    // put all of b on that edge's line).
-    const int turn = orient2(a[0], a[1], a[2], drop);  // a's orientation in the projection
-    auto in_closure = [&](const double* p) {
-      for (int k = 0; k < 3; ++k)
-        if (orient2(a[k], a[(k + 1) % 3], p, drop) == -turn) return false;
-      return true;
-    };
-    if (turn != 0 && in_closure(b[0]) && in_closure(b[1]) && in_closure(b[2])) return true;
-  }
+  const int first = n[0] >= n[1] && n[0] >= n[2] ? 0 : n[1] >= n[2] ? 1 : 2;
   for (int k = 0; k < 3; ++k) {
+    const int drop = (first + k) % 3;
+    if (orient2(t[0], t[1], t[2], drop) != 0) return drop;
+  }
+  return first;  // (not reached for a triangle that is not collinear)
+}
+
+/// Whether the interior of triangle t (corners not collinear) meets the
+/// closed triangle u (of any shape). That set is the interior of t met with
+/// K = u ∩ plane(t), a convex set in t's plane: the other triangle when both
+/// lie in one plane, else a segment or a point whose ends are u's corners in
+/// the plane and the points where u's edges cross it. An open triangle and a
+/// closed convex polygon in one plane are apart iff a line along an edge of
+/// either has the other on its closed outer side (the separating axis
+/// theorem: the edges of t - K are those of t and of K), and for a segment
+/// K, a side of K's line is a side of u's plane. Each side is an exact sign:
+/// of a projection for points in t's plane, and for the point X where edge
+/// pq of u crosses it, orient(p, q, t_i, t_j) = side(X, t_i t_j) * s(q),
+/// s(q) the side of t's plane that q lies on (expand the determinant with
+/// p = X - h (q - p)).
+bool interior_meets(const double* const t[3], const double* const u[3]) {
+  int s[3];
+  for (int k = 0; k < 3; ++k) s[k] = orient(t[0], t[1], t[2], u[k]);
+  if ((s[0] > 0 && s[1] > 0 && s[2] > 0) || (s[0] < 0 && s[1] < 0 && s[2] < 0)) return false;
+  const int drop = projection_axis(t);
+  const int turn = orient2(t[0], t[1], t[2], drop);
+  const bool u_flat = kernels::collinear3(u[0], u[1], u[2]);
+  if (s[0] == 0 && s[1] == 0 && s[2] == 0) {  // one plane: K = u
+    for (int e = 0; e < 3; ++e) {
+      const double* p = t[e];
+      const double* q = t[(e + 1) % 3];
+      if (orient2(p, q, u[0], drop) * turn <= 0 && orient2(p, q, u[1], drop) * turn <= 0 &&
+          orient2(p, q, u[2], drop) * turn <= 0)
+        return false;
+    }
+    if (!u_flat) {
+      const int u_turn = orient2(u[0], u[1], u[2], drop);
+      for (int e = 0; e < 3; ++e) {
+        const double* p = u[e];
+        const double* q = u[(e + 1) % 3];
+        if (orient2(p, q, t[0], drop) * u_turn <= 0 && orient2(p, q, t[1], drop) * u_turn <= 0 &&
+            orient2(p, q, t[2], drop) * u_turn <= 0)
+          return false;
+      }
+      return true;
+    }
+    // u a segment (or a point, which the edges above settled): t's corners
+    // all on one closed side of its line?
+    const double* p = u[0];
+    const double* q = std::equal(u[1], u[1] + 3, p) ? u[2] : u[1];
+    if (std::equal(q, q + 3, p)) return true;
+    int lo = 0, hi = 0;
+    for (int k = 0; k < 3; ++k) {
+      const int o = orient2(p, q, t[k], drop);
+      lo += o < 0, hi += o > 0;
+    }
+    return lo > 0 && hi > 0;
+  }
+  // The ends of K (at most two: not all of u's corners are on one side).
+  int side[2][3];
+  int ends = 0;
+  for (int k = 0; k < 3 && ends < 2; ++k) {
     const int l = (k + 1) % 3;
-    const double* p = b[k];
-    const double* q = b[l];
-    if (s[k] * s[l] < 0) {  // across the plane: through the interior?
-      const int o = orient(p, q, a[0], a[1]);
-      if (o != 0 && orient(p, q, a[1], a[2]) == o && orient(p, q, a[2], a[0]) == o) return true;
-    } else if (s[k] == 0 && s[l] == 0) {  // in the plane
-      if (segment_meets_interior(p, q, a, drop)) return true;
-    } else if (s[k] == 0 ? strictly_inside(p, a, drop) : s[l] == 0 && strictly_inside(q, a, drop)) {
-      return true;  // touching the plane at an end inside a
+    if (s[k] == 0) {
+      for (int e = 0; e < 3; ++e) side[ends][e] = orient2(t[e], t[(e + 1) % 3], u[k], drop) * turn;
+      ++ends;
+    }
+    if (s[k] * s[l] < 0 && ends < 2) {
+      for (int e = 0; e < 3; ++e) side[ends][e] = orient(u[k], u[l], t[e], t[(e + 1) % 3]) * s[l];
+      ++ends;
     }
   }
-  return false;
+  for (int e = 0; e < 3; ++e)
+    if (side[0][e] <= 0 && (ends == 1 || side[1][e] <= 0)) return false;
+  // A segment K (u not flat: a flat u meets a plane it does not lie in at
+  // one point): t's corners on one closed side of u's plane?
+  if (ends == 2 && !u_flat) {
+    int lo = 0, hi = 0;
+    for (int k = 0; k < 3; ++k) {
+      const int o = orient(u[0], u[1], u[2], t[k]);
+      lo += o < 0, hi += o > 0;
+    }
+    return lo > 0 && hi > 0;
+  }
+  return true;
 }
 
 }  // namespace
@@ -223,7 +258,13 @@ bool triangle_pair_crosses(const double* const a[3], const std::int32_t* ca, con
   };
   const bool flat_a = pinched(a), flat_b = pinched(b);
   if ((flat_a && (flat_b || on_corners(a, b))) || (flat_b && on_corners(b, a))) return false;
-  return (!flat_a && edges_meet_interior(a, b)) || (!flat_b && edges_meet_interior(b, a));
+  return triangle_pair_crosses_exactly(a, b, flat_a, flat_b);
+}
+
+bool triangle_pair_crosses_exactly(const double* const a[3], const double* const b[3], bool flat_a, bool flat_b) {
+  flat_a = flat_a || kernels::collinear3(a[0], a[1], a[2]);
+  flat_b = flat_b || kernels::collinear3(b[0], b[1], b[2]);
+  return (!flat_a && interior_meets(a, b)) || (!flat_b && interior_meets(b, a));
 }
 
 std::vector<Pair> crossing_triangles(std::span<const double> xyz, std::span<const std::int32_t> corners,

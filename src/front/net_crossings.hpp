@@ -35,6 +35,12 @@ namespace tessera::front {
 bool triangle_pair_crosses(const double* const a[3], const std::int32_t* ca, const double* const b[3],
                            const std::int32_t* cb);
 
+/// The same decision by exact signs alone, without triangle_pair_crosses's
+/// float filters and shortcuts by vertex id (which tests compare it with):
+/// `flat_a`, `flat_b` may tell that a triangle is known to have no interior.
+bool triangle_pair_crosses_exactly(const double* const a[3], const double* const b[3], bool flat_a = false,
+                                   bool flat_b = false);
+
 std::vector<std::pair<std::size_t, std::size_t>> crossing_triangles(std::span<const double> xyz,
                                                                      std::span<const std::int32_t> corners,
                                                                      std::span<const std::uint8_t> changed = {},

@@ -350,6 +350,16 @@ TEST(SurfaceNets, CrossingTestOnHandMadeTriangles) {
   EXPECT_FALSE(crosses(floor, {{{0, 4, 0}, {4, 0, 0}, {4, 4, 1e-30}}}, apart));  // an edge on its edge
   EXPECT_FALSE(crosses(floor, {{{0, 4, 0}, {4, 0, 0}, {1, 1, 1e-30}}}, apart));  // a hinge, nearly shut
   EXPECT_TRUE(crosses(floor, {{{0, 4, 0}, {4, 0, 0}, {1, 1, 0}}}, apart));       // folded onto it
+  // Meeting along a chord whose ends are on both boundaries (no edge of
+  // either crosses the other's interior): an edge across it from corner to
+  // edge or from edge to edge, and two triangles with a common corner whose
+  // edges meet where they pass through each other.
+  EXPECT_TRUE(crosses(floor, {{{0, 0, 0}, {2, 2, 0}, {1, 0, 3}}}, {0, 1, 2, 0, 5, 6}));
+  EXPECT_TRUE(crosses(floor, {{{2, 0, 0}, {0, 2, 0}, {1, 1, 3}}}, apart));
+  EXPECT_TRUE(crosses(floor, {{{2, 0, 0}, {0, 2, 0}, {1, 1, -3}}}, apart));
+  EXPECT_TRUE(crosses({{{0.5, 1, 0.5}, {1, 0, 0.5}, {1.25, 0.15, 0.3}}}, {{{0.5, 0, 0}, {1.25, 0.15, 0.3}, {1, 1, 1}}},
+                      {0, 1, 2, 3, 2, 4}));
+  EXPECT_FALSE(crosses(floor, {{{0, 0, 0}, {4, 0, 0}, {1, 0, 3}}}, {0, 1, 2, 0, 1, 6}));  // a hinge at its edge
 }
 
 // The broad phase (a grid, a sweep per cell, boxes in floats) finds every
