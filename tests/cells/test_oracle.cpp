@@ -10,6 +10,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <random>
+#include <set>
 #include <string>
 
 #include "helpers.hpp"
@@ -328,6 +330,61 @@ TEST(Oracle, FarOutliers) {
     // Without the outliers, none.
     const auto bulk = random_points(cs.n, dim, cs.seed, make_bounds({-3, 2, 10}, {7, 2.5, 11}));
     EXPECT_EQ(run(bulk, dim).far_points, 0u) << "dim " << dim;
+  }
+}
+
+// A point beside 2,500 points on a line (all on one plane: no tetrahedron,
+// so the search is the only method) sees every one of them, and a point
+// above a jittered sheet of 72 x 72 most of it: cells of thousands of faces,
+// whose sign passes go by blocks of vertex slots (Hull, LaneBlocks;
+// test_kernels checks that they do). The search builds them (the sheet's
+// cells would come from the insertion). The lone point's cell and a sample
+// of the others against the oracle (volume, centroid, neighbours, faces, the mesh's face
+// areas), and two threads give the bits of one.
+TEST(Oracle, HugeCellsBesideALineAndAboveASheet) {
+  std::mt19937_64 g(29);
+  std::uniform_real_distribution<double> u(0, 1);
+  for (int kind = 0; kind < 2; ++kind) {
+    SCOPED_TRACE(kind == 0 ? "beside a line" : "above a sheet");
+    std::vector<double> pts;
+    tessera::Bounds b;
+    if (kind == 0) {
+      for (int k = 0; k < 2500; ++k) pts.insert(pts.end(), {k + 0.8 * u(g), 0.0, 0.0});
+      pts.insert(pts.end(), {1250.3, 900.0, 0.0});
+      b = make_bounds({-1, -10, -40}, {2501, 1400, 40});
+    } else {
+      for (int a = 0; a < 72; ++a)
+        for (int c = 0; c < 72; ++c) pts.insert(pts.end(), {a + 0.4 * u(g), c + 0.4 * u(g), 0.01 * u(g)});
+      pts.insert(pts.end(), {35.7, 36.2, 40.0});
+      b = make_bounds({-1, -1, -2}, {73, 73, 50});
+    }
+    const std::size_t n = pts.size() / 3, lone = n - 1;
+    auto opt = options(3, b, 1);
+    opt.cell_method = tessera::CellMethod::search;
+    const tessera::Cells c = tessera::voronoi(pts, 3, {}, opt);
+    opt.threads = 2;
+    expect_same_cells(c, tessera::voronoi(pts, 3, {}, opt), "one thread against two");
+    const double L = box_size(b, 3);
+    for (std::size_t i = 0; i < n; i += (i + 1 == lone ? 1 : 97)) {
+      SCOPED_TRACE(::testing::Message() << "point " << i);
+      const auto o = oracle::cell(pts, 3, i, b.lo, b.hi);
+      const auto k = static_cast<std::size_t>(c.cell_of[i]);
+      EXPECT_NEAR(c.volume[k], o.volume, 1e-9 * o.volume);
+      for (int a = 0; a < 3; ++a) EXPECT_NEAR(c.centroid[3 * k + a], o.centroid[a], 1e-9 * L);
+      std::set<int> on, tn;
+      for (auto [lab, m] : o.face)
+        if (lab >= 0) on.insert(lab);
+      for (const std::int32_t j : neighbours_of(c, k)) tn.insert(j);
+      EXPECT_EQ(tn, on);
+      EXPECT_EQ(c.num_faces[k], static_cast<std::int32_t>(o.face.size()));
+      const auto mm = mesh_face_measures(c, k);
+      const double scale = std::pow(o.volume, 2.0 / 3.0);
+      for (auto [lab, m] : o.face) {
+        const double t = mm.count(lab) ? mm.at(lab) : 0.0;
+        EXPECT_NEAR(t, m, 1e-9 * scale + 1e-13 * L * std::sqrt(scale)) << "face " << lab;
+      }
+      if (i == lone) EXPECT_GT(c.num_faces[k], kind == 0 ? 2500 : 2100);
+    }
   }
 }
 

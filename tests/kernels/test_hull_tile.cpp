@@ -334,6 +334,88 @@ TEST(Hull, ManyRandomClips) {
   }
 }
 
+// The security radius as update_radius computes it, from the vertices.
+double security_radius2_of(const Hull& h) {
+  double m = 0;
+  for (const auto& v : h.vertices()) m = std::max(m, v.r2);
+  return 4.0 * m * (1 + 1e-12);
+}
+
+// A cell of thousands of faces takes its sign passes by blocks of slots
+// (LaneBlocks): a point beside 2,500 points on a line sees every one of
+// them (a face each, ~5,000 vertices), one above a sheet of 72 x 72 sees
+// most, and with twins 1e-4 apart along the line its vertices between a
+// twin's bisectors are too ill-conditioned for the float solve (deferred,
+// then solved exactly). Clipped nearest first and in a random order, the
+// cell is the same (its vertices' plane triples), it keeps every invariant
+// along the way, its security radius is its vertices' and no vertex is
+// left deferred, and no point is nearer to one of its vertices than its
+// own (checked against every point: the brute-force oracle).
+TEST(Hull, HugeCellSignPassesByBlocks) {
+  std::mt19937_64 g(23);
+  std::uniform_real_distribution<double> u(0, 1);
+  for (int kind = 0; kind < 3; ++kind) {
+    std::vector<double> pts;
+    std::array<double, 3> lo, hi;
+    if (kind != 1) {  // the line (x, 0, 0), x in [0, 2500), and one point off it, all on z = 0
+      for (int k = 0; k < 2500; ++k) {
+        const double x = k + 0.8 * u(g);
+        pts.insert(pts.end(), {x, 0.0, 0.0});
+        if (kind == 2 && k % 10 == 0) pts.insert(pts.end(), {x + 1e-4, 0.0, 0.0});
+      }
+      pts.insert(pts.end(), {1250.3, 900.0, 0.0});
+      lo = {-1, -10, -40};
+      hi = {2501, 1400, 40};
+    } else {  // a sheet jittered off z = 0, and one point above its middle
+      for (int a = 0; a < 72; ++a)
+        for (int b = 0; b < 72; ++b) pts.insert(pts.end(), {a + 0.4 * u(g), b + 0.4 * u(g), 0.01 * u(g)});
+      pts.insert(pts.end(), {35.7, 36.2, 40.0});
+      lo = {-1, -1, -2};
+      hi = {73, 73, 50};
+    }
+    Scene<3> s(std::move(pts), lo, hi);
+    const std::int32_t lone = s.size() - 1;
+    SCOPED_TRACE(kind == 0 ? "beside a line" : kind == 1 ? "above a sheet" : "beside a line with twins");
+    std::vector<std::pair<double, std::int32_t>> near;
+    for (std::int32_t j = 0; j < lone; ++j) {
+      double r2 = 0;
+      for (int d = 0; d < 3; ++d) r2 += (s.p(j)[d] - s.p(lone)[d]) * (s.p(j)[d] - s.p(lone)[d]);
+      near.push_back({r2, j});
+    }
+    std::sort(near.begin(), near.end());
+    Hull first, shuffled;
+    s.reset(first, lone);
+    for (const auto& [r2, j] : near) s.clip(first, j);
+    std::vector<std::int32_t> order(static_cast<std::size_t>(lone));
+    std::iota(order.begin(), order.end(), 0);
+    std::shuffle(order.begin(), order.end(), g);
+    s.reset(shuffled, lone);
+    std::size_t clips = 0;
+    for (const std::int32_t j : order) {
+      if (s.clip(shuffled, j) != ClipResult::clipped || !shuffled.blocked()) continue;
+      if (++clips % 200 == 0) {
+        shuffled.solve_deferred();  // (as a clip may: their float positions are only bounded)
+        check_hull(shuffled, "shuffled, clip " + std::to_string(clips));
+      }
+      ASSERT_EQ(shuffled.security_radius2(), security_radius2_of(shuffled)) << "clip " << clips;
+    }
+    EXPECT_GT(clips, 200u);
+    for (Hull* h : {&first, &shuffled}) {
+      h->solve_deferred();
+      EXPECT_TRUE(h->blocked());
+      EXPECT_GT(h->num_vertices(), std::size_t{4096});
+      EXPECT_EQ(h->security_radius2(), security_radius2_of(*h));
+      for (const auto& v : h->vertices()) ASSERT_EQ(v.deferred, 0u);
+      if (kind == 2) EXPECT_GT(h->exact_solves(), 0u);
+    }
+    EXPECT_EQ(keys(first), keys(shuffled));
+    const double v1 = check_hull(first, "nearest first"), v2 = check_hull(shuffled, "shuffled");
+    EXPECT_NEAR(v1, v2, 1e-9 * v1);
+    check_voronoi(s, first);
+    check_voronoi(s, shuffled);
+  }
+}
+
 // ------------------------------------------------------------------ 2D checks
 
 /// Structural invariants of a tile; returns its area (shoelace).

@@ -31,6 +31,7 @@
 #include "tessera/kernels/dual_faces.hpp"
 #include "tessera/kernels/exact_predicates.hpp"
 #include "tessera/kernels/filter.hpp"
+#include "tessera/kernels/lane_blocks.hpp"
 #include "tessera/kernels/power.hpp"
 #include "tessera/kernels/prepared_signs.hpp"
 
@@ -112,9 +113,11 @@ class Hull {
     if (weighted_) [[unlikely]] weigh(b, *exact_, gen_, j);  // a power diagram's plane (power.hpp)
     const std::size_t nv = verts_.size();
     auto exact = [&](std::size_t t) { return exact_sign(t, j); };
-    // Where no frame fits, n.y may overflow (filter::classify).
-    const std::size_t removed = may_underflow_ ? filter::classify_unbounded<3>(lanes_, b, sign_, exact)
-                                               : filter::classify<3>(lanes_, b.n, b.d, b.n1, b.d_unscaled, sign_, exact);
+    std::size_t removed;
+    if (other_pass_) [[unlikely]]
+      removed = other_sign_pass(b, j);
+    else
+      removed = filter::classify<3>(lanes_, b.n, b.d, b.n1, b.d_unscaled, sign_, exact);
     if (removed == 0) return ClipResult::unchanged;
     if (removed == nv) {
       resize_vertices(0);
@@ -134,26 +137,31 @@ class Hull {
     scaled_planes_ |= b.scale != 0;
     if (planes_.size() > cap_) [[unlikely]] grow_table();
     if (hashed_) [[unlikely]]
-      cut_hashed(pn, nv);
+      cut_huge(pn, nv, removed);
     else
-      cut<false>(pn, nv);
+      cut<false>(pn, nv, removed);
     return ClipResult::clipped;
   }
 
  private:
-  // Replace the vertices sign_ marks removed (-1; some, not all, of the nv)
+  // Replace the vertices sign_ marks removed (-1; `removed` of the nv)
   // by the new face on local plane pn: a clip's work after its sign pass.
   // Hashed: the edge map is the hash (grow_table), in a huge cell only; the
-  // ordinary instantiation has no test of it.
+  // ordinary instantiation has no test of it, nor of blocked_ (a blocked
+  // cell is hashed).
   template <bool Hashed>
-  [[gnu::always_inline]] void cut(Index pn, std::size_t nv) {
+  [[gnu::always_inline]] void cut(Index pn, std::size_t nv, std::size_t removed) {
     // The removed slots, ascending: holes_[0, nh) (never shrunk, so growing
-    // it value-initializes nothing per clip).
-    if (holes_.size() < nv) holes_.resize(nv);
+    // it value-initializes nothing per clip). A blocked pass listed them.
     std::size_t nh = 0;
-    for (std::size_t t = 0; t < nv; ++t) {
-      holes_[nh] = static_cast<std::uint32_t>(t);
-      nh += sign_[t] < 0;
+    if (Hashed && blocked_) {
+      nh = removed;
+    } else {
+      if (holes_.size() < nv) holes_.resize(nv);
+      for (std::size_t t = 0; t < nv; ++t) {
+        holes_[nh] = static_cast<std::uint32_t>(t);
+        nh += sign_[t] < 0;
+      }
     }
     // Boundary of the removed region: edges (a -> b) of removed triangles whose
     // twin (b -> a) lies in a kept triangle. Each gets a new triangle (a, b, pn).
@@ -187,6 +195,7 @@ class Hull {
       Vertex& v = verts_[t];  // built in place (see reset)
       v.p[0] = border_[k].a; v.p[1] = border_[k].b; v.p[2] = pn;
       solve(v, filter::SolveMode::deferrable);
+      if (Hashed && blocked_ && v.deferred != 0) deferred_slots_.push_back(t);
       if (k < nh) sign_[t] = 1;  // kept from now on
       settle<Hashed>(t);
     }
@@ -200,8 +209,12 @@ class Hull {
         --end;
       }
       resize_vertices(end);
+      if (Hashed && blocked_) {
+        blocks_.touch_range(end, nv);
+        keep_signs(end, nv);  // the holes dropped at the tail
+      }
     }
-    update_radius();
+    update_radius<Hashed>();
   }
 
  public:
@@ -312,6 +325,9 @@ class Hull {
   void reset_stage_gates() { signs_.reset_gates(); }
   /// Vertices of this cell solved exactly (too ill-conditioned for the float solve).
   std::uint64_t exact_solves() const { return exact_solves_; }
+  /// Whether this cell's sign passes go by blocks of slots (blocked_from
+  /// vertices reached: LaneBlocks): for tests.
+  bool blocked() const { return blocked_; }
 
   /// The cell's last step once no clip is to come: the vertices whose exact
   /// solve a clip or the assembly deferred (filter::deferred_vertex_
@@ -322,9 +338,13 @@ class Hull {
   /// vertices were asked filter::deferred_ask_limit exact questions.
   void solve_deferred() {
     if (deferred_ == 0) return;
-    for (std::size_t t = 0; t < verts_.size(); ++t)
-      if (verts_[t].deferred != 0) solve_now(t);
-    update_radius();
+    if (blocked_) [[unlikely]] {
+      solve_deferred_slots();
+    } else {
+      for (std::size_t t = 0; t < verts_.size(); ++t)
+        if (verts_[t].deferred != 0) solve_now(t);
+    }
+    update_radius<true>();  // (this cell may be blocked)
   }
   /// The input's exact context (null in bare kernel tests).
   const ExactContext* exact_context() const { return exact_; }
@@ -380,8 +400,8 @@ class Hull {
                                                              sign_, exact_, gen_, [&] { solve_near(k); });
       if (removed == assembly::undecided || removed == nv) return false;
       if (removed == 0) continue;
-      if (hashed_) cut_hashed(k, nv);  // a star of more than dense_planes neighbours
-      else cut<false>(k, nv);
+      if (hashed_) cut_hashed(k, nv, removed);  // a star of more than dense_planes neighbours
+      else cut<false>(k, nv, removed);
     }
     return true;
   }
@@ -396,6 +416,7 @@ class Hull {
     v.e = err + filter::plane_eps * ymax;
     set_radius(v, err);
     lanes_.set(static_cast<std::uint32_t>(t), v);
+    if (blocked_) blocks_.touch(t);
   }
 
   // The vertices box plane k cannot place, solved exactly
@@ -534,6 +555,8 @@ class Hull {
     slack_ = weighted_ ? kernels::power_slack(exact->max_radius, exact->radii[gen]) : 0.0;
     scaled_planes_ = false;
     if (hashed_) [[unlikely]] leave_hash();
+    blocked_ = false;
+    other_pass_ = may_underflow_;
     signs_.start_cell();
     exact_solves_ = 0;
     deferred_ = 0;
@@ -568,6 +591,7 @@ class Hull {
   template <bool Hashed = false>
   void place(std::uint32_t t, const Vertex& v) {  // into an existing slot, kept from now on
     verts_[t] = v;
+    if (Hashed && blocked_ && v.deferred != 0) deferred_slots_.push_back(t);
     sign_[t] = 1;
     settle<Hashed>(t);
   }
@@ -580,6 +604,7 @@ class Hull {
   template <bool Hashed = false>
   void settle(std::uint32_t t) {  // slot t was written in place
     lanes_.set(t, verts_[t]);
+    if (Hashed && blocked_) blocks_.touch(t);
     link<Hashed>(t);
   }
 
@@ -694,7 +719,63 @@ class Hull {
       if (e.a != no_plane) hash_link(e.a, e.b, e.tri);
   }
 
-  [[gnu::noinline, gnu::cold]] void cut_hashed(Index pn, std::size_t nv) { cut<true>(pn, nv); }
+  [[gnu::noinline, gnu::cold]] void cut_hashed(Index pn, std::size_t nv, std::size_t removed) {
+    cut<true>(pn, nv, removed);
+  }
+  // A clip's cut in a huge cell (the edge map hashed), which from
+  // blocked_from vertices on takes its sign passes by blocks. (The box cut
+  // of an assembled star never does: it is one pass per box plane.)
+  [[gnu::noinline, gnu::cold]] void cut_huge(Index pn, std::size_t nv, std::size_t removed) {
+    cut<true>(pn, nv, removed);
+    if (!blocked_ && verts_.size() >= blocked_from && !may_underflow_) enter_blocks();
+  }
+
+  // A cell of this many vertices or more (thousands of faces: hashed)
+  // takes its sign passes by blocks of slots (LaneBlocks), the rest of
+  // its life: on points on a line and one off it, the off point's cell
+  // grows by a face per clip, and each clip's pass read every vertex.
+  static constexpr std::size_t blocked_from = 4096;
+
+  // The sign pass of a cell that is not an ordinary one: where no frame fits
+  // (may_underflow), n.y may overflow (filter::classify<3, true>); a huge
+  // cell's by blocks, which lists the removed slots in holes_ for cut().
+  // Either gives classify's signs. One test of other_pass_ in the clip.
+  [[gnu::noinline]] std::size_t other_sign_pass(const filter::Bisector<3>& b, std::int32_t j) {
+    auto exact = [&](std::size_t t) { return exact_sign(t, j); };
+    if (may_underflow_) return filter::classify_unbounded<3>(lanes_, b, sign_, exact);
+    return blocks_.classify(lanes_, b.n, b.d, b.n1, b.d_unscaled, sign_, holes_, exact);
+  }
+
+  // From now on this cell's passes go by blocks. A blocked pass writes the
+  // signs of the slots it evaluates only, and cut() reads the sign of any
+  // slot (a removed triangle's twin, wherever it lies), so between clips no
+  // entry of sign_ may be -1 (a slot appended later reads the entry it
+  // finds): set here for all, and a clip's removed slots are each refilled
+  // (+1) or dropped from the tail (keep_signs).
+  [[gnu::noinline, gnu::cold]] void enter_blocks() {
+    blocked_ = true;
+    other_pass_ = true;
+    blocks_.start(verts_.size());
+    keep_signs(0, std::max(sign_.size(), lanes_.padded()));
+    deferred_slots_.clear();
+    for (std::size_t t = 0; t < verts_.size(); ++t)
+      if (verts_[t].deferred != 0) deferred_slots_.push_back(static_cast<std::uint32_t>(t));
+  }
+  // solve_deferred() of a blocked cell: the slots noted since the last
+  // (those a deferred vertex was written to; a slot since reused or cut
+  // away is passed over) instead of every slot, as the long search of a
+  // cell whose deferred vertices are asked often calls it every few clips.
+  // Each vertex is solved alone, so the order changes nothing.
+  void solve_deferred_slots() {
+    for (const std::uint32_t t : deferred_slots_)
+      if (t < verts_.size() && verts_[t].deferred != 0) solve_now(t);
+    deferred_slots_.clear();
+  }
+  void keep_signs(std::size_t a, std::size_t e) {
+    if (sign_.size() < e) sign_.resize(e);
+    std::fill(sign_.begin() + static_cast<std::ptrdiff_t>(a), sign_.begin() + static_cast<std::ptrdiff_t>(e),
+              filter::Sign{1});
+  }
 
   // cut()'s border collection in hashed mode (see there). A copy with the
   // hash lookup, not one loop with both: that loop (the lookup chosen by
@@ -814,14 +895,19 @@ class Hull {
     out[2] = a[0] * b[1] - a[1] * b[0];
   }
 
+  // Blocked: the maximum from the blocks' (the same value).
+  template <bool MayBeBlocked = false>
   void update_radius() {
-    security2_ = 4.0 * lanes_.max_r2() * (1 + 1e-12);
+    const double m = MayBeBlocked && blocked_ ? blocks_.max_r2(lanes_) : lanes_.max_r2();
+    security2_ = 4.0 * m * (1 + 1e-12);
   }
 
   std::int32_t gen_ = -1;
   double site_[3] = {};  // the generator's coordinates
   const ExactContext* exact_ = nullptr;
   bool may_underflow_ = false;  // exact_->may_underflow: solve() adds filter::underflow_slack
+  bool blocked_ = false;        // the sign passes go by blocks_ (blocked_from)
+  bool other_pass_ = false;     // may_underflow_ or blocked_: other_sign_pass
   bool weighted_ = false;       // exact_->radii: a power cell (power.hpp)
   double slack_ = 0;            // power_slack of this cell (0 without radii), in every r2
   bool scaled_planes_ = false;  // has_scaled_planes()
@@ -833,6 +919,8 @@ class Hull {
   std::vector<Plane> planes_;
   VertexList verts_;
   filter::FilterLanes<3> lanes_;  // verts_' filter data, for the sign pass
+  LaneBlocks<3> blocks_;          // a huge cell's summaries of lanes_ (blocked_)
+  std::vector<std::uint32_t> deferred_slots_;  // blocked_: slots given a deferred vertex (solve_deferred_slots)
   struct Edge { Index a, b; };
   std::vector<Edge> border_;   // a clip's boundary edges (its first slots)
   std::vector<std::uint32_t> holes_;
