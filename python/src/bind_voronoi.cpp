@@ -16,11 +16,11 @@
 #include "bindings.hpp"
 #include "interrupt.hpp"
 #include "options.hpp"
+#include "tessera/cell_vertex_lists.hpp"
 #include "tessera/cells.hpp"
 #include "tessera/engine/thread_arena.hpp"
 
 #include <tbb/blocked_range.h>
-#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
 namespace tessera::python {
@@ -70,47 +70,32 @@ const Cells& mesh_of(const py::object& self) {
 /// VTK's arrays of 3D cells as VTK_POLYHEDRON (Python's to_vtk): the face
 /// stream (per cell its number of faces, then per face its size and vertex
 /// ids), where each cell's record starts, and each cell's distinct vertices
-/// as CSR (offsets, ids; in first-appearance order, as the .vtu writer lists
+/// as CSR (offsets, ids; CellVertexLists' order, as the .vtu writer lists
 /// them), all int64 (vtkIdType). Built here in parallel, on the cells'
 /// thread count: numpy's version needed ~3.5 KB of int64 temporaries per
 /// cell (9.3 GB at 2M cells) and took longer than the cells.
 py::tuple polyhedron_arrays(const Cells& c) {
-  const std::size_t nc = c.n_cells(), nv = c.n_vertices();
+  const std::size_t nc = c.n_cells();
   const auto& cfo = c.cell_face_offsets;
   const auto& fvo = c.face_vertex_offsets;
   const auto& fv = c.face_vertices;
-  std::vector<std::int64_t> stream, locations(nc), offsets(nc + 1, 0), ids;
+  std::vector<std::int64_t> stream, locations(nc), offsets, ids;
   without_gil([&] {
     engine::ThreadArena arena(c.threads_used);
     arena.execute([&] {
       using Range = tbb::blocked_range<std::size_t>;
-      // A cell's record length, and its distinct vertices by a stamp per
-      // vertex (per thread): the counting pass marks cell ci as ci, the
-      // filling pass as -2 - ci, so neither takes the other's marks.
-      tbb::enumerable_thread_specific<std::vector<std::int32_t>> stamps(nv, std::int32_t{-1});
-      auto distinct = [&](std::size_t ci, std::int32_t mark, auto&& emit) {
-        std::vector<std::int32_t>& stamp = stamps.local();
-        for (std::int64_t k = fvo[cfo[ci]]; k < fvo[cfo[ci + 1]]; ++k)
-          if (const std::int32_t v = fv[static_cast<std::size_t>(k)]; stamp[static_cast<std::size_t>(v)] != mark) {
-            stamp[static_cast<std::size_t>(v)] = mark;
-            emit(v);
-          }
+      const CellVertexLists corners(c);
+      offsets = corners.offsets();
+      // Cell ci's record (1 + its faces + their vertex ids) starts after
+      // those of the ci cells before it.
+      auto record_start = [&](std::size_t ci) {
+        return static_cast<std::int64_t>(ci) + cfo[ci] + fvo[cfo[ci]];
       };
-      tbb::parallel_for(Range(0, nc), [&](const Range& r) {
-        for (std::size_t ci = r.begin(); ci != r.end(); ++ci) {
-          locations[ci] = 1 + (cfo[ci + 1] - cfo[ci]) + (fvo[cfo[ci + 1]] - fvo[cfo[ci]]);
-          std::int64_t m = 0;
-          distinct(ci, static_cast<std::int32_t>(ci), [&](std::int32_t) { ++m; });
-          offsets[ci + 1] = m;
-        }
-      });
-      std::int64_t at = 0;  // record lengths -> starts
-      for (std::int64_t& l : locations) at += std::exchange(l, at);
-      for (std::size_t ci = 0; ci < nc; ++ci) offsets[ci + 1] += offsets[ci];
-      stream.resize(static_cast<std::size_t>(at));
+      stream.resize(static_cast<std::size_t>(record_start(nc)));
       ids.resize(static_cast<std::size_t>(offsets[nc]));
       tbb::parallel_for(Range(0, nc), [&](const Range& r) {
         for (std::size_t ci = r.begin(); ci != r.end(); ++ci) {
+          locations[ci] = record_start(ci);
           auto s = stream.begin() + locations[ci];
           *s++ = cfo[ci + 1] - cfo[ci];
           for (std::int64_t f = cfo[ci]; f < cfo[ci + 1]; ++f) {
@@ -118,7 +103,7 @@ py::tuple polyhedron_arrays(const Cells& c) {
             s = std::copy(fv.begin() + fvo[f], fv.begin() + fvo[f + 1], s);
           }
           auto d = ids.begin() + offsets[ci];
-          distinct(ci, -2 - static_cast<std::int32_t>(ci), [&](std::int32_t v) { *d++ = v; });
+          corners.for_each(ci, [&](std::int32_t v) { *d++ = v; });
         }
       });
     });

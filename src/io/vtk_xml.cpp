@@ -7,8 +7,9 @@
 // computed first (cheap: they follow from the CSR offsets) and the arrays are then
 // streamed through a 4 MiB buffer. The two largest 3D arrays (connectivity and
 // faces) are formatted by chunks of cells in parallel and written in order
-// (ordered_chunks.hpp); besides their chunk buffers, 3D allocates one int32 per
-// vertex per thread (duplicate-vertex stamps) and one int64 per cell (offsets).
+// (ordered_chunks.hpp); besides their chunk buffers, 3D allocates one uint32 per
+// vertex per thread (the stamps of cell_vertex_lists.hpp, which lists each
+// cell's distinct vertices) and one int64 per cell (offsets).
 //
 // 3D (.vtu, UnstructuredGrid, file version 1.0 as written by VTK 9.0-9.3):
 //   connectivity  Int32  unique vertex ids of each cell (first-appearance order)
@@ -28,18 +29,14 @@
 #include <cctype>
 #include <cstdint>
 #include <cstring>
-#include <numeric>
 #include <ostream>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
-#include <tbb/blocked_range.h>
-#include <tbb/enumerable_thread_specific.h>
-#include <tbb/parallel_for.h>
-
 #include "io_detail.hpp"  // ends_with_ci
 #include "ordered_chunks.hpp"
+#include "tessera/cell_vertex_lists.hpp"
 #include "tessera/io/atomic_file.hpp"
 
 namespace tessera::io {
@@ -190,32 +187,11 @@ void write_vtu(const std::string& path, const Cells& c) {
   const auto& fvo = c.face_vertex_offsets;
   const auto& fv = c.face_vertices;
 
-  // Connectivity: each cell's distinct vertices in first-appearance order,
-  // found with a per-vertex stamp (the last cell that emitted it). The
-  // stamps are per thread, since cells are handled in parallel; the counting
-  // pass stamps cell ci as ci, the streaming pass as -2 - ci, so neither
-  // mistakes the other's marks for its own.
-  tbb::enumerable_thread_specific<std::vector<std::int32_t>> stamps(nv, std::int32_t{-1});
-  auto distinct = [&](std::size_t ci, std::int32_t mark, auto&& emit) {
-    std::vector<std::int32_t>& stamp = stamps.local();
-    for (std::int64_t k = fvo[cfo[ci]]; k < fvo[cfo[ci + 1]]; ++k) {
-      const std::int32_t v = fv[k];
-      if (stamp[v] != mark) {
-        stamp[v] = mark;
-        emit(v);
-      }
-    }
-  };
-  std::vector<std::int64_t> conn_end(nc);
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nc), [&](const tbb::blocked_range<std::size_t>& r) {
-    for (std::size_t ci = r.begin(); ci != r.end(); ++ci) {
-      std::int64_t m = 0;
-      distinct(ci, static_cast<std::int32_t>(ci), [&](std::int32_t) { ++m; });
-      conn_end[ci] = m;
-    }
-  });
-  std::partial_sum(conn_end.begin(), conn_end.end(), conn_end.begin());
-  const std::int64_t total_conn = nc == 0 ? 0 : conn_end.back();
+  // Connectivity: each cell's distinct vertices in first-appearance order
+  // (cell_vertex_lists.hpp), counted first for the offsets, then streamed.
+  const CellVertexLists corners(c);
+  const std::vector<std::int64_t> conn_offsets = corners.offsets();
+  const std::int64_t total_conn = conn_offsets[nc];
   const std::uint64_t n_faces = static_cast<std::uint64_t>(cfo.back());
   const std::uint64_t faces_len = nc + n_faces + fv.size();
 
@@ -253,14 +229,13 @@ void write_vtu(const std::string& path, const Cells& c) {
 
     begin_block(w, conn);
     detail::write_ordered_chunks(nc, kCellsPerChunk, [&](std::size_t c0, std::size_t c1, std::vector<char>& out) {
-      const std::int64_t first = c0 == 0 ? 0 : conn_end[c0 - 1];
-      out.resize(static_cast<std::size_t>(conn_end[c1 - 1] - first) * 4);
+      out.resize(static_cast<std::size_t>(conn_offsets[c1] - conn_offsets[c0]) * 4);
       char* p = out.data();
       for (std::size_t ci = c0; ci < c1; ++ci)
-        distinct(ci, -2 - static_cast<std::int32_t>(ci), [&](std::int32_t v) { p = store<std::int32_t>(p, v); });
+        corners.for_each(ci, [&](std::int32_t v) { p = store<std::int32_t>(p, v); });
     }, [&](const char* data, std::size_t size) { w.put_bytes(data, size); });
     begin_block(w, offs);
-    w.put_bytes(conn_end.data(), nc * sizeof(std::int64_t));
+    w.put_bytes(conn_offsets.data() + 1, nc * sizeof(std::int64_t));  // each cell's end
     begin_block(w, types);
     const std::vector<std::uint8_t> type_chunk(std::min<std::size_t>(nc, 1 << 16), kVtkPolyhedron);
     for (std::size_t done = 0; done < nc; done += type_chunk.size())
