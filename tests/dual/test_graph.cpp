@@ -5,9 +5,12 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
+#include <random>
 #include <set>
 
 #include "cells/helpers.hpp"
+#include "front/mesh_faces.hpp"
 #include "tessera/graph.hpp"
 #ifdef TESSERA_HAVE_CGAL
 #include "delaunay_oracle.hpp"
@@ -125,6 +128,89 @@ TEST(Graph, MatchesCellsAndIsSymmetric) {
   const auto lattice = grid_points(6, 3);
   const auto cl = run(lattice, 3);
   check_graph(cl, tessera::adjacency_graph(cl), {}, "lattice 6^3");
+}
+
+// Each spoke's measure, bit for bit, is front::face_measure of the copy of
+// its face in the cell that speaks for it: the lower generator's, in a
+// periodic box the lower of (i, j, s) and (j, i, -s); the cell's own copy for
+// box planes and outside points. Found here by scanning the mesh's faces, the
+// reference for adjacency_graph's wheel-ordered passes and twin lookup.
+void expect_speaking_measures(const tessera::Cells& c, const tessera::AdjacencyGraph& g, const std::string& what) {
+  Failures fail(what);
+  const auto du = std::size_t(c.dim);
+  const bool periodic = c.is_periodic();
+  using Shift = std::array<int, 3>;
+  auto spoke_shift = [&](std::size_t s) {
+    Shift sh{0, 0, 0};
+    if (periodic)
+      for (std::size_t a = 0; a < du; ++a) sh[a] = g.spoke_shift[s * du + a];
+    return sh;
+  };
+  auto face_of = [&](std::int32_t cell, std::int32_t j, const Shift& sh) -> std::int64_t {
+    for (auto f = c.cell_face_offsets[cell]; f < c.cell_face_offsets[cell + 1]; ++f) {
+      if (c.face_neighbor[f] != j) continue;
+      bool same = true;
+      for (std::size_t a = 0; periodic && a < du; ++a) same = same && c.face_shift[std::size_t(f) * du + a] == sh[a];
+      if (same) return f;
+    }
+    return -1;
+  };
+  std::size_t twins = 0;
+  for (std::size_t p = 0; p < g.n_points; ++p) {
+    const auto i = std::int32_t(p);
+    for (auto s = g.wheel_offsets[p]; s < g.wheel_offsets[p + 1]; ++s) {
+      const auto su = std::size_t(s);
+      const std::int32_t j = g.spokes[su];
+      const Shift sh = spoke_shift(su);
+      const Shift back{-sh[0], -sh[1], -sh[2]};
+      const bool lower = i < j || (i == j && !(back < sh));
+      std::int64_t f = -1;
+      if (j >= 0 && c.cell_of[j] >= 0 && !lower) {
+        f = face_of(c.cell_of[j], i, back);
+        ++twins;
+      } else {
+        f = face_of(c.cell_of[p], j, sh);
+      }
+      if (f < 0) { fail.add("spoke ", i, " -> ", j, ": no face"); continue; }
+      const double want = tessera::front::face_measure(c, f);
+      if (std::memcmp(&want, &g.spoke_measure[su], sizeof want) != 0)
+        fail.add("spoke ", i, " -> ", j, ": measure ", g.spoke_measure[su], " is not the speaking face's ", want);
+    }
+  }
+  EXPECT_GT(twins, 0u) << what;
+}
+
+TEST(Graph, MeasuresAreTheSpeakingFaces) {
+  for (int dim : {2, 3}) {
+    const std::string d = std::to_string(dim) + "D";
+    const auto pts = random_points(dim == 3 ? 2000 : 3000, dim, 351 + dim);
+    const auto c = run(pts, dim, std::nullopt, {}, 2);
+    expect_speaking_measures(c, tessera::adjacency_graph(c), "random " + d);
+    expect_speaking_measures(c, tessera::adjacency_graph(c, {0.1}), "random, pruned " + d);
+    std::vector<std::int32_t> labels(pts.size() / std::size_t(dim));
+    std::mt19937 rng(11);
+    for (auto& l : labels) l = std::int32_t(rng() % 4) - 1;
+    const auto cl = run(pts, dim, std::nullopt, labels);
+    expect_speaking_measures(cl, tessera::adjacency_graph(cl), "labelled " + d);
+    // An exact lattice: ties, zero-area faces between diagonal neighbours.
+    const auto lattice = grid_points(dim == 3 ? 6 : 12, dim);
+    const auto cg = run(lattice, dim);
+    expect_speaking_measures(cg, tessera::adjacency_graph(cg), "lattice " + d);
+    expect_speaking_measures(cg, tessera::adjacency_graph(cg, {1e-9}), "lattice, pruned " + d);
+    // Periodic boxes, triclinic too, and two points whose cells face their
+    // own images.
+    for (double tilt : {0.0, 0.3}) {
+      auto o = options(dim, make_bounds({0, 0, 0}, {1, 1, 1}), 2);
+      o.periodic = {true, true, dim == 3};
+      o.tilt = {tilt, 0, dim == 3 ? -tilt / 2 : 0};
+      const auto cp = tessera::voronoi(std::span<const double>(pts), dim, {}, o);
+      expect_speaking_measures(cp, tessera::adjacency_graph(cp), "periodic " + d + " tilt " + std::to_string(tilt));
+      const std::vector<double> two{0.1, 0.2, 0.3, 0.6, 0.5, 0.4};
+      const std::vector<double> pair(two.begin(), two.begin() + 2 * dim);
+      const auto c2 = tessera::voronoi(std::span<const double>(pair), dim, {}, o);
+      expect_speaking_measures(c2, tessera::adjacency_graph(c2), "two points, periodic " + d);
+    }
+  }
 }
 
 TEST(Graph, ThreadCountDoesNotMatter) {
