@@ -164,7 +164,9 @@ struct VoronoiOptions {
   /// built only (each cell's vertices keep their relative order);
   /// Cells::generators counts every generator. A point asked for that owns
   /// no cell (outside label, duplicate, set aside) is left out. Viewed, not
-  /// copied. For flowers of a few cells (flower.hpp), at a few cells' cost.
+  /// copied. For flowers of a few cells (flower.hpp), at a few cells' cost;
+  /// not for validate(), which checks a whole tessellation (the volumes
+  /// sum to the domain's, every vertex has all its cells).
   std::span<const std::int32_t> only;
   /// Some axis periodic, or a tilt given (which needs periodic axes).
   bool periodic_box() const {
