@@ -5,6 +5,7 @@
 #include <cinttypes>
 #include <cmath>
 #include <cstdio>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -32,21 +33,34 @@ struct Computed {
   io::PointCloud pc;
   Cells cells;
   double seconds = 0;
+  std::size_t n_cells = 0;  ///< the cells of all points (also where `cells` holds some only)
 };
 
-Computed read_and_compute(const ComputeArgs& a, bool quiet) {
+/// `asked` (flower): only the cells of those points are built, with their
+/// neighbours' (VoronoiOptions::only), each as among all cells, not all N.
+/// Ids that are no point are left to the caller to refuse, after the cells
+/// as when all were built (input errors first); where none is one, point
+/// 0's cell stands in. The summary's count is still all cells'
+/// (Cells::generators: flower takes no radii, so none is an empty power cell).
+Computed read_and_compute(const ComputeArgs& a, bool quiet, std::span<const std::int64_t> asked = {}) {
   Computed r;
   r.pc = read_input(a);
   VoronoiOptions opt = make_options(a, r.pc.dim);
   opt.build_mesh = true;
+  std::vector<std::int32_t> only;
+  for (const std::int64_t id : asked)
+    if (id >= 0 && static_cast<std::uint64_t>(id) < r.pc.n) only.push_back(static_cast<std::int32_t>(id));
+  if (!asked.empty() && only.empty()) only.push_back(0);
+  opt.only = only;
   r.cells = compute(r.pc, opt, !quiet && stderr_is_terminal(), r.seconds);
-  if (r.cells.n_cells() == 0) throw InputError(no_cells_reason(r.pc, r.cells));
+  r.n_cells = only.empty() ? r.cells.n_cells() : r.cells.generators;
+  if (r.n_cells == 0) throw InputError(no_cells_reason(r.pc, r.cells));
   return r;
 }
 
 void print_header(const char* command, const ComputeArgs& a, const Computed& r) {
   std::printf("tessera %s: %zu points (%dD) from %s\n", command, r.pc.n, r.cells.dim, shown_input(a).c_str());
-  std::printf("  %-18s %zu\n", "cells", r.cells.n_cells());
+  std::printf("  %-18s %zu\n", "cells", r.n_cells);
   std::printf("  %-18s %.3f s on %d thread%s\n", "compute", r.seconds, r.cells.threads_used,
               r.cells.threads_used == 1 ? "" : "s");
   if (r.cells.power) print_power_line(r.pc, r.cells);
@@ -130,7 +144,7 @@ int run_graph_frame(const GraphArgs& a) {
   }
 
   if (!a.quiet && a.compute.brief) {
-    print_frame_line("graph", a.compute, strf("%zu points, %zu cells, %zu spokes", r.pc.n, r.cells.n_cells(),
+    print_frame_line("graph", a.compute, strf("%zu points, %zu cells, %zu spokes", r.pc.n, r.n_cells,
                                               g.n_spokes()),
                      r.seconds, written);
   } else if (!a.quiet) {
@@ -183,7 +197,7 @@ int run_faces_frame(const FacesArgs& a) {
   io::write_faces_vtp(a.output, fs);
 
   if (!a.quiet && a.compute.brief) {
-    print_frame_line("faces", a.compute, strf("%zu points, %zu cells, %zu faces", r.pc.n, r.cells.n_cells(),
+    print_frame_line("faces", a.compute, strf("%zu points, %zu cells, %zu faces", r.pc.n, r.n_cells,
                                               fs.n_faces()),
                      r.seconds, {a.output});
   } else if (!a.quiet) {
@@ -218,7 +232,9 @@ int run_flower_frame(const FlowerArgs& a) {
   check_bounds_arg(a.compute.bounds);
   io::check_writable(a.output);
 
-  const Computed r = read_and_compute(a.compute, a.quiet);
+  // The cells asked for (and their neighbours', which place the merged
+  // vertices they share), not all N: the same flowers (read_and_compute).
+  const Computed r = read_and_compute(a.compute, a.quiet, a.points);
   std::vector<std::int32_t> ids;
   for (std::int64_t id : a.points) {
     if (static_cast<std::uint64_t>(id) >= r.pc.n)
@@ -230,7 +246,7 @@ int run_flower_frame(const FlowerArgs& a) {
   io::write_flowers_vtp(a.output, fl, r.pc.coords, a.glyphs);
 
   if (!a.quiet && a.compute.brief) {
-    print_frame_line("flower", a.compute, strf("%zu points, %zu cells, %zu flower%s", r.pc.n, r.cells.n_cells(),
+    print_frame_line("flower", a.compute, strf("%zu points, %zu cells, %zu flower%s", r.pc.n, r.n_cells,
                                                fl.size(), fl.size() == 1 ? "" : "s"),
                      r.seconds, {a.output});
   } else if (!a.quiet) {

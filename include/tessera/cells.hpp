@@ -145,6 +145,29 @@ struct VoronoiOptions {
   /// that no power-of-two frame fits (coordinates spanning more than
   /// ~1e-150..1e150 of each other: InputError).
   std::span<const double> radii;
+  /// Build only some cells (empty: all): those of these point ids (any
+  /// order, repeats allowed; each in [0, n), InputError otherwise) and of
+  /// the generators across their faces, whose cells place the merged
+  /// vertices they share (the mesh takes a vertex from the cell of its
+  /// lowest generator). Nothing else changes: every point takes part as
+  /// without it (it sets the default domain, is located and clips, is
+  /// checked; of duplicates the same one owns the cell; labels and radii
+  /// count), and the cell method is chosen as for all the cells (the pilot
+  /// samples them all; where it picks the insertion, all points are
+  /// triangulated), so each cell built is bit for bit the cell of the whole
+  /// computation, its merged vertices placed as there. In a periodic box
+  /// the layer of images is the one the built cells need, which is
+  /// narrower than all cells' where some other cell widened it
+  /// (Cells::periodic_images): the same cells, whose vertices may then come
+  /// in another order and differ in the last bits (the search meets the
+  /// points in another order). The mesh numbers the merged vertices of the cells
+  /// built only (each cell's vertices keep their relative order);
+  /// Cells::generators counts every generator. A point asked for that owns
+  /// no cell (outside label, duplicate, set aside) is left out. Viewed, not
+  /// copied. For flowers of a few cells (flower.hpp), at a few cells' cost;
+  /// not for validate(), which checks a whole tessellation (the volumes
+  /// sum to the domain's, every vertex has all its cells).
+  std::span<const std::int32_t> only;
   /// Some axis periodic, or a tilt given (which needs periodic axes).
   bool periodic_box() const {
     return periodic[0] || periodic[1] || periodic[2] || tilt[0] != 0 || tilt[1] != 0 || tilt[2] != 0;
@@ -245,6 +268,11 @@ struct Cells {
   /// likely outliers). The search grid spans the bulk, and their cells come
   /// from a k-d tree; reported so that a user can spot them.
   std::size_t far_points = 0;
+  /// The generators of the whole computation: the points that take part
+  /// with a label >= 0 (or no labels) and are no duplicate. n_cells() but
+  /// for power cells found empty, and with VoronoiOptions::only, which
+  /// builds some of their cells.
+  std::size_t generators = 0;
   int threads_used = 1;
   /// The cells came from the Delaunay triangulation by insertion (CellMethod).
   bool from_insertion = false;

@@ -31,7 +31,7 @@ using Points = py::array_t<double, py::array::c_style>;
 Cells run_voronoi(const Points& points, const py::object& labels, const std::optional<std::vector<double>>& bounds,
                   double padding, bool ignore_outside, int threads, bool merge, const std::string& method,
                   const std::array<bool, 3>& periodic, const std::array<double, 3>& tilt,
-                  const py::object& radii) {
+                  const py::object& radii, const py::object& only) {
   const int dim = checked_dim(points);
   VoronoiOptions opt;
   fill_common(opt, dim, bounds, padding, ignore_outside, threads);
@@ -39,6 +39,12 @@ Cells run_voronoi(const Points& points, const py::object& labels, const std::opt
   opt.tilt = tilt;
   opt.radii = as_radii(radii);  // views the caller's array, alive through the call
   opt.build_mesh = merge;
+  // Some cells only (flower of points): None, or int32 ids, viewed as labels are.
+  if (!only.is_none()) {
+    if (!py::isinstance<py::array_t<std::int32_t, py::array::c_style>>(only))
+      throw py::type_error("only must be None or a C-contiguous int32 array");
+    opt.only = as_labels(only);
+  }
   if (method == "auto") opt.cell_method = CellMethod::automatic;
   else if (method == "search") opt.cell_method = CellMethod::search;
   else if (method == "insertion") opt.cell_method = CellMethod::insertion;
@@ -231,8 +237,10 @@ void bind_voronoi(py::module_& m) {
   m.def("voronoi", &run_voronoi, py::arg("points").noconvert(), py::arg("labels").none(true), py::arg("bounds"),
         py::arg("padding"), py::arg("ignore_outside"), py::arg("threads"), py::arg("merge"),
         py::arg("method"), py::arg("periodic"), py::arg("tilt"), py::arg("radii").none(true) = py::none(),
+        py::arg("only").none(true) = py::none(),
         "Cells of float64 C-ordered (N, D) points; labels None or int32 (N,); radii None or float64 (N,) "
-        "(power cells). Runs without the GIL.");
+        "(power cells); only None or int32 ids: those cells and their neighbours' (VoronoiOptions::only). "
+        "Runs without the GIL.");
 
   m.def(
       "validate_cells",

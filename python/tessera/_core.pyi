@@ -133,6 +133,7 @@ def voronoi(
     periodic: Tuple[bool, bool, bool],
     tilt: Tuple[float, float, float],
     radii: Optional[npt.NDArray[np.float64]] = ...,
+    only: Optional[npt.NDArray[np.int32]] = ...,
 ) -> Cells: ...
 def validate_cells(
     cells: Cells,

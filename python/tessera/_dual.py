@@ -13,7 +13,7 @@ from typing import Any, Iterator, List, Optional, Sequence, Tuple, Union
 import numpy as np
 
 from . import _core, _inputs
-from ._voronoi import Voronoi, voronoi
+from ._voronoi import Voronoi, cells_of, voronoi
 
 PathLike = Union[str, "os.PathLike[str]"]
 
@@ -626,6 +626,20 @@ def as_ids(ids: Any, n: int) -> np.ndarray:
     return np.ascontiguousarray(a, dtype=np.int32)
 
 
+def _existing_ids(ids: Any, n: int) -> np.ndarray:
+    """The ids in [0, n) among ``ids`` (int32), or [0] where there are none
+    (or ``ids`` are no integers: :func:`as_ids` names what is wrong)."""
+    try:
+        a = np.asarray(ids)
+    except (ValueError, TypeError):
+        a = np.zeros(0, dtype=np.int64)
+    if a.dtype.kind not in "iu" or a.ndim > 1:
+        a = np.zeros(0, dtype=np.int64)
+    a = a.reshape(-1)
+    a = a[(a >= 0) & (a < n)]
+    return np.ascontiguousarray(a if a.size else [0], dtype=np.int32)
+
+
 def flower(
     source: Any,
     ids: Union[int, Sequence[int]],
@@ -644,7 +658,14 @@ def flower(
     Parameters
     ----------
     source : Voronoi or array_like, shape (N, 2) or (N, 3)
-        A :class:`Voronoi` computed with ``merge=True`` (reused), or points.
+        A :class:`Voronoi` computed with ``merge=True`` (reused), or points:
+        then only the cells of ``ids`` and of their neighbours are built
+        (each cell on its own, as the meshless method does; every point
+        still clips and sets the box), the same cells as all N cells give.
+        :attr:`Flowers.voronoi` is then that partial result (its
+        ``n_cells`` the cells built), in which :attr:`Flower.vertex_ids`
+        index ``vertices``; in a periodic box the layer of images is the one
+        these cells need.
         Not power cells (``voronoi(..., radii=...)``: ``tessera.InputError``):
         a petal is a ball through the generator, which holds for ordinary
         cells only.
@@ -662,7 +683,17 @@ def flower(
     Flowers
         ``flowers[k]`` is the :class:`Flower` of ``ids[k]``.
     """
-    vor = cells_for("flower", source, labels, bounds, padding, threads, ignore_outside, periodic, tilt)
+    if isinstance(source, Voronoi):
+        vor = cells_for("flower", source, labels, bounds, padding, threads, ignore_outside, periodic, tilt)
+    else:
+        # The cells of the ids asked for (and their neighbours'), not all N.
+        # Ids that are no point are refused below, after the cells, as
+        # before; where none is one, point 0's cell stands in (input errors,
+        # and the cells' own, still come first).
+        pts = _inputs.as_points(source)
+        vor = cells_of(pts, labels=labels, bounds=bounds, padding=0.01 if padding is None else padding,
+                       threads=threads, merge=True, ignore_outside=ignore_outside, periodic=periodic, tilt=tilt,
+                       only=_existing_ids(ids, pts.shape[0]))
     idx = as_ids(ids, vor.points.shape[0])
     fs = _inputs.call(_core.flowers, vor._cells, vor.points, idx)
     return Flowers(fs, vor, _inputs.as_flag(glyphs, "glyphs"))

@@ -387,6 +387,92 @@ def test_flower_petals_and_circumflower(dim):
     assert tessera.flower(pts, 17)[0].n_petals == fl[1].n_petals
 
 
+FLOWER_FIELDS = ["petal_centres", "petal_radii", "face_offsets", "face_vertices", "face_neighbor", "neighbors",
+                 "neighbor_positions", "neighbor_shifts", "face_shifts"]
+
+
+def _lattice(k, dim):
+    g = np.arange(k) * 0.125
+    return np.array(np.meshgrid(*[g] * dim, indexing="ij")).reshape(dim, -1).T.copy()
+
+
+def _dup(pts):
+    pts = pts.copy()
+    pts[9] = pts[4]  # 9 duplicates 4, which owns the cell
+    return pts
+
+
+FEW_CELLS = {  # name: (points, ids, keyword arguments)
+    "uniform3": (lambda: random_points(3000, 3, seed=861), [5, 0, 2999], {}),
+    "uniform2": (lambda: random_points(3000, 2, seed=862), [5, 0, 2999], {}),
+    "lattice3": (lambda: _lattice(9, 3), [0, 364], {}),
+    "lattice2": (lambda: _lattice(20, 2), [0, 210], {}),
+    "duplicates": (lambda: _dup(random_points(2000, 3, seed=863)), [4], {}),
+    "labels": (lambda: random_points(2000, 3, seed=864), [11, 12],
+               {"labels": np.where(np.arange(2000) % 3 == 1, -1, np.arange(2000) % 4)}),
+    "periodic": (lambda: random_points(2000, 3, seed=865), [0, 77], {"bounds": UNIT_BOX[3], "periodic": True}),
+    "tilted": (lambda: random_points(2000, 3, seed=866), [0, 77],
+               {"bounds": UNIT_BOX[3], "periodic": True, "tilt": (0.25, -0.125, 0.5)}),
+}
+
+
+@pytest.mark.parametrize("case", sorted(FEW_CELLS))
+def test_flower_of_points_builds_a_few_cells(tmp_path, case):
+    # flower(points) builds the cells asked for and their neighbours' only
+    # (VoronoiOptions::only): the same flowers as from all cells, file for
+    # file; the vertex ids index the partial result's vertices.
+    make, ids, kw = FEW_CELLS[case]
+    pts = make()
+    full = tessera.voronoi(pts, merge=True, **kw)
+    ref = tessera.flower(full, ids)
+    few = tessera.flower(pts, ids, **kw)
+    assert few.voronoi.n_cells < full.n_cells
+    for a, b in zip(ref, few):
+        assert a.generator == b.generator and a.circumflower_radius == b.circumflower_radius
+        assert np.array_equal(a.site, b.site)
+        for name in FLOWER_FIELDS:
+            assert np.array_equal(getattr(a, name), getattr(b, name)), name
+        assert np.array_equal(b.petal_centres, few.voronoi.vertices[b.vertex_ids])
+    ref.save(tmp_path / "all.vtp")
+    few.save(tmp_path / "few.vtp")
+    assert (tmp_path / "all.vtp").read_bytes() == (tmp_path / "few.vtp").read_bytes()
+
+
+def test_flower_of_points_in_a_layer_widened_by_other_cells():
+    # Half a periodic box empty: the cells facing the gap reach far, and all
+    # cells need a wider layer of images than these few do. The same cells
+    # (neighbours, petals as a set, to the last bits or nearly); the petals
+    # may come in another order (VoronoiOptions::only).
+    pts = random_points(5000, 3, seed=5)
+    pts[:, 0] *= 0.5
+    kw = {"bounds": UNIT_BOX[3], "periodic": True}
+    full = tessera.voronoi(pts, **kw)
+    ids = [1, 2, 3]
+    few = tessera.flower(pts, ids, **kw)
+    assert few.voronoi.periodic_images < full.periodic_images
+    for a, b in zip(tessera.flower(full, ids), few):
+        assert np.array_equal(a.neighbors, b.neighbors) and np.array_equal(a.neighbor_shifts, b.neighbor_shifts)
+        order = [np.lexsort(f.petal_centres.T) for f in (a, b)]
+        np.testing.assert_allclose(a.petal_centres[order[0]], b.petal_centres[order[1]], rtol=0, atol=1e-15)
+        assert a.circumflower_radius == pytest.approx(b.circumflower_radius, rel=1e-15)
+
+
+def test_flower_of_points_refuses_as_before():
+    pts = _dup(random_points(500, 3, seed=867))
+    lab = np.zeros(500, dtype=np.int32)
+    lab[10] = -1
+    for ids, words in (([9], "duplicates point 4"), ([3, 10], "outside point (label < 0)")):
+        with pytest.raises(tessera.InputError, match=r"owns no cell: it (duplicates|is an)"):
+            tessera.flower(pts, ids, labels=lab)
+        with pytest.raises(tessera.InputError) as e:
+            tessera.flower(pts, ids, labels=lab)
+        assert words in str(e.value)
+    with pytest.raises(ValueError, match="point 500 does not exist"):
+        tessera.flower(pts, [0, 500])
+    with pytest.raises(ValueError, match="ids"):
+        tessera.flower(pts, [0.5])
+
+
 @pytest.mark.parametrize("glyphs", [False, True])
 def test_flower_vtp_read_by_vtk(tmp_path, glyphs):
     pts = random_points(300, 3, seed=13)

@@ -109,6 +109,15 @@ inline constexpr std::uint64_t tie_weight = 2;
 /// The share of the generators the pilot may build: on small inputs too.
 inline constexpr double pilot_share = 0.5;
 
+/// InputError unless every id of VoronoiOptions::only is one of the n
+/// points' (after the input's own checks: an empty input says so first).
+void check_only(std::span<const std::int32_t> only, std::size_t n) {
+  for (const std::int32_t g : only)
+    if (g < 0 || static_cast<std::size_t>(g) >= n)
+      throw InputError("only: point " + std::to_string(g) + " does not exist (there are " + std::to_string(n) +
+                       " points)");
+}
+
 /// `reach`, when given (sized for every point, zeros): each built cell's
 /// security radius, in the input's units, at its generator's index.
 template <class CellT>
@@ -124,6 +133,7 @@ Cells run(std::span<const double> input, std::span<const std::int32_t> labels, c
   out.threads_used = pass.engine_options.threads;
   out.far_points = pass.locator->outside_core();
   out.power = !pass.radii.empty();
+  out.generators = pass.order.size();
 
   front::report_duplicates(pass, labels, out.duplicates);
   // Cells whose search would cost far more than on uniform points (points
@@ -182,6 +192,16 @@ Cells run(std::span<const double> input, std::span<const std::int32_t> labels, c
       if (opt.progress) pass.engine_options.progress = [&opt](double f) { opt.progress(0.5 + 0.5 * f); };
     }
   }
+  // VoronoiOptions::only: the cells asked for, then with their neighbours
+  // (below). The pilot's cells are left (the same cells, built again).
+  std::vector<std::uint64_t> only;
+  if (!opt.only.empty()) {
+    kept.batches.clear();
+    kept.exact_calls = 0;
+    only.assign((out.n_points + 63) / 64, 0);
+    for (const std::int32_t g : opt.only)  // (< 0: a periodic pass's point that takes no part)
+      if (g >= 0) only[static_cast<std::size_t>(g) >> 6] |= std::uint64_t{1} << (g & 63);
+  }
   // The search's pass leaves out the cells its pilot built whole.
   std::vector<std::uint64_t> built;
   if (stars || kept.batches.empty()) {
@@ -195,7 +215,39 @@ Cells run(std::span<const double> input, std::span<const std::int32_t> labels, c
     }
     pass.gens.skip = built;
   }
-  out.exact_predicate_calls =
+  std::vector<std::int32_t> only_order;
+  std::vector<std::uint32_t> only_slots;
+  if (!only.empty()) {
+    // The generators of `only`, in bin order as the pass lists them (its
+    // order and slots, restricted).
+    auto restrict_order = [&] {
+      only_order.clear();
+      only_slots.clear();
+      for (std::size_t q = 0; q < pass.order.size(); ++q) {
+        const std::int32_t g = pass.order[q];
+        if ((only[static_cast<std::size_t>(g) >> 6] >> (g & 63) & 1) == 0) continue;
+        only_order.push_back(g);
+        only_slots.push_back(pass.slots[q]);
+      }
+      pass.gens.order = only_order;
+      pass.gens.slots = only_slots;
+    };
+    // First the cells asked for, for their neighbours (a few cells, no
+    // mesh); then those with their neighbours, whose cells own the merged
+    // vertices the cells asked for share with them.
+    restrict_order();
+    Cells first;
+    first.dim = D;
+    first.n_points = out.n_points;
+    front::CellsCompositor<CellT> scout(first, labels, false, pass.k, pass.bounds);
+    engine::EngineOptions quiet = pass.engine_options;
+    quiet.progress = nullptr;
+    out.exact_predicate_calls += engine::tessellate<CellT>(pass.gens, scout, quiet);
+    for (const std::int32_t j : first.neighbors) only[static_cast<std::size_t>(j) >> 6] |= std::uint64_t{1} << (j & 63);
+    restrict_order();
+    comp.build_only(only);
+  }
+  out.exact_predicate_calls +=
       engine::tessellate<CellT>(pass.gens, comp, pass.engine_options, std::move(kept.batches)) + kept.exact_calls;
   std::sort(out.duplicates.begin(), out.duplicates.end());
   if (pass.k != 0) {
@@ -217,6 +269,7 @@ template <class CellT>
 Cells run_periodic(std::span<const double> input, int dim, std::span<const std::int32_t> labels,
                    const VoronoiOptions& opt) {
   const front::PeriodicInput in = front::periodic_input(input, dim, labels, opt);
+  check_only(opt.only, in.n);
   const int threads = resolve_threads(opt.threads);
   VoronoiOptions o = opt;
   o.periodic = {false, false, false};
@@ -231,9 +284,18 @@ Cells run_periodic(std::span<const double> input, int dim, std::span<const std::
       for (std::size_t k = 0; k < radii.size(); ++k) radii[k] = opt.radii[static_cast<std::size_t>(images.base[k])];
       o.radii = radii;
     }
+    // VoronoiOptions::only names points: here their augmented ids (at shift 0).
+    std::vector<std::int32_t> only;
+    for (const std::int32_t g : opt.only)
+      if (const std::int32_t a = images.original[static_cast<std::size_t>(g)]; a >= 0) only.push_back(a);
+    if (!opt.only.empty() && only.empty()) only.push_back(-1);  // none takes part: build none (run)
+    o.only = only;
     return run<CellT>(images.points, images.labels, o, &reach);
   });
-  return front::periodic_cells(std::move(aug), in, im, labels, threads);
+  const std::size_t generators = aug.generators;
+  Cells out = front::periodic_cells(std::move(aug), in, im, labels, threads);
+  out.generators = generators;
+  return out;
 }
 
 }  // namespace
@@ -249,6 +311,7 @@ Cells voronoi(std::span<const double> input, int dim, std::span<const std::int32
                     : run_periodic<kernels::Tile>(input, dim, labels, options);
   }
   const front::CheckedInput<VoronoiOptions> in(input, dim, labels, options);
+  check_only(options.only, in.points.size() / static_cast<std::size_t>(dim));
   return dim == 3 ? run<kernels::Hull>(in.points, labels, in.options)
                   : run<kernels::Tile>(in.points, labels, in.options);
 }

@@ -118,6 +118,14 @@ class CellsCompositor {
   /// placed reach far enough.
   void record_reach(std::vector<double>* reach) { reach_ = reach; }
 
+  /// Build some cells only (VoronoiOptions::only): bit g of `built` set
+  /// (built[g / 64] >> g % 64) for each generator whose cell the pass
+  /// builds, and those alone own merged vertices: a vertex belongs to the
+  /// lowest generator of its key that is built, which is its owner in the
+  /// whole computation wherever that one is built (the vertices of the
+  /// cells asked for, whose neighbours are built with them).
+  void build_only(std::span<const std::uint64_t> built) { built_ = built; }
+
   void add(Batch& b, std::int32_t gen, const kernels::BuildStatus& st, CellT& cell) {
     Store& s = b.gen.empty() ? start_batch(b) : *b.store;
     Buffer<std::int32_t>& nbrs = s.nbrs;
@@ -425,9 +433,13 @@ class CellsCompositor {
     return lowest_generator(key, [&](std::int32_t id) { return dense_ || out_.cell_of[static_cast<std::size_t>(id)] >= 0; });
   }
 
-  // The key's lowest inside generator (label >= 0): its owner, as no
-  // located points coincide.
+  // The key's lowest inside generator (label >= 0; with build_only, also
+  // built): its owner, as no located points coincide.
   std::int32_t first_inside(const Key<D>& key) const {
+    if (!built_.empty()) [[unlikely]]
+      return lowest_generator(key, [&](std::int32_t id) {
+        return labels_at(id) >= 0 && (built_[static_cast<std::size_t>(id) >> 6] >> (id & 63) & 1) != 0;
+      });
     return lowest_generator(key, [&](std::int32_t id) { return labels_at(id) >= 0; });
   }
 
@@ -692,6 +704,7 @@ class CellsCompositor {
   engine::RegionClassifier classify_;
   bool mesh_;
   std::vector<double>* reach_ = nullptr;  // record_reach
+  std::span<const std::uint64_t> built_;  // build_only (empty: every generator)
   int frame_k_;  // the scaled frame's 2^k (front/pass.cpp)
   Bounds box_;    // the domain in that frame
   bool dense_ = false;  // set by finish: every generator owns a cell, cell g = generator g

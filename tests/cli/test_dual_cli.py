@@ -460,6 +460,100 @@ class Flower(base.TempDirCase):
             self.assertGreaterEqual(np.linalg.norm(P[neigh] - c, axis=1).min(), r * (1 - 1e-9))
 
 
+def python_module():
+    """The tessera module built beside the binary (build/python), or None."""
+    path = os.path.join(os.path.dirname(base.TESSERA), "python")
+    if path not in sys.path:
+        sys.path.insert(0, path)
+    try:
+        import tessera
+    except ImportError:
+        return None
+    return tessera
+
+
+class FlowerOfAFewCells(base.TempDirCase):
+    """`flower` builds the cells asked for and their neighbours' only, not all N
+    (VoronoiOptions::only): its .vtp equals byte for byte the one written from
+    all cells (Python's flower of a computed Voronoi, which reads the whole
+    mesh), and its summary names all cells."""
+
+    def check(self, name, pts, ids, args=(), labels=None, **kw):
+        tessera = python_module()
+        if tessera is None:
+            self.skipTest("the tessera Python module is not built")
+        dim = pts.shape[1]
+        inp = self.save(name + ".npy", pts)
+        extra = list(args)
+        if labels is not None:
+            extra += ["--labels", self.save(name + "_labels.npy", labels.astype(np.int32))]
+        out, ref = self.p(name + ".vtp"), self.p(name + "_all.vtp")
+        point_args = [a for i in ids for a in ("--point", str(i))]
+        r = self.ok(["flower", inp, "-o", out, "--threads", "2"] + point_args + extra)
+        vor = tessera.voronoi(pts, labels=labels, merge=True, threads=2, **kw)
+        fl = tessera.flower(vor, ids)
+        fl.save(ref)
+        self.assertTrue(read_bytes(out) == read_bytes(ref), name + ": the flowers differ from all cells'")
+        lines = r.stdout.splitlines()
+        self.assertIn("  %-18s %d" % ("cells", vor.n_cells), lines, name)
+        for f in fl:
+            self.assertIn("  point %-12d %d petals, circumflower radius %.6g, %d clipping neighbours"
+                          % (f.generator, f.n_petals, f.circumflower_radius, len(f.neighbors)), lines, name)
+        # Python's flower of points builds a few cells too: the same flowers.
+        few = tessera.flower(pts, ids, labels=labels, threads=2, **kw)
+        self.assertLess(few.voronoi.n_cells, vor.n_cells, name)
+        few.save(self.p(name + "_py.vtp"))
+        self.assertTrue(read_bytes(self.p(name + "_py.vtp")) == read_bytes(ref), name + ": Python's flowers differ")
+        return vor
+
+    def test_uniform_and_lattice(self):
+        rng = np.random.default_rng(861)
+        self.check("u3", rng.random((3000, 3)), [5, 0, 2999])
+        self.check("u2", rng.random((4000, 2)), [5, 1234, 3999])
+        g = np.arange(9) * 0.125
+        self.check("lat3", np.array(np.meshgrid(g, g, g, indexing="ij")).reshape(3, -1).T.copy(), [0, 364, 100])
+        self.check("lat2", np.array(np.meshgrid(g, g, indexing="ij")).reshape(2, -1).T.copy(), [0, 40, 80])
+
+    def test_duplicates_and_labels(self):
+        rng = np.random.default_rng(862)
+        for dim in (3, 2):
+            pts = rng.random((2000, dim))
+            pts[9] = pts[4]  # 9 duplicates 4: 4 owns the cell
+            self.check("dup%d" % dim, pts, [4])
+            r = run(["flower", self.save("dup.npy", pts), "--point", "9", "-o", self.p("d.vtp")])
+            self.assertEqual(r.returncode, 2)
+            self.assertIn("owns no cell: it duplicates point 4", r.stderr)
+            labels = rng.integers(-1, 3, 2000)
+            labels[[11, 12]] = [2, 0]
+            labels[10] = -1
+            self.check("lab%d" % dim, pts, [11, 12], labels=labels)
+            r = run(["flower", self.save("l.npy", pts), "--labels", self.save("ll.npy", labels.astype(np.int32)),
+                     "--point", "11", "--point", "10", "-o", self.p("l.vtp")])
+            self.assertEqual(r.returncode, 2)
+            self.assertIn("point 10 owns no cell: it is an outside point (label < 0)", r.stderr)
+
+    def test_bounds_and_boxes(self):
+        rng = np.random.default_rng(863)
+        pts = rng.random((3000, 3))
+        pts[0] = [2, 0.5, 0.5]  # set aside
+        self.check("ign", pts, [1, 2], ["--bounds", *BOX3, "--ignore-outside"], bounds=(0, 1, 0, 1, 0, 1),
+                   ignore_outside=True)
+        pts = rng.random((3000, 3))
+        pts[0] = [0.001, 0.002, 0.999]  # near a corner: its neighbours are images
+        self.check("per3", pts, [0, 77], ["--bounds", *BOX3, "--periodic", "xyz"], bounds=(0, 1, 0, 1, 0, 1),
+                   periodic=True)
+        self.check("tilt3", pts, [0, 77], ["--bounds", *BOX3, "--periodic", "xyz", "--tilt", "0.25", "-0.125", "0.5"],
+                   bounds=(0, 1, 0, 1, 0, 1), periodic=True, tilt=(0.25, -0.125, 0.5))
+        p2 = rng.random((3000, 2))
+        self.check("per2", p2, [0, 5], ["--bounds", *BOX2, "--periodic", "x"], bounds=(0, 1, 0, 1), periodic="x")
+
+    def test_insertion_path(self):
+        # Points on a sphere: the automatic method takes the insertion.
+        v = np.random.default_rng(864).normal(size=(5000, 3))
+        vor = self.check("sphere", v / np.linalg.norm(v, axis=1)[:, None], [1, 4999])
+        self.assertTrue(vor.from_insertion)
+
+
 class HelpAndSummary(base.TempDirCase):
     def test_help(self):
         top = run(["--help"]).stdout
