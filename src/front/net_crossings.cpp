@@ -168,24 +168,20 @@ bool interior_meets(const double* const t[3], const double* const u[3]) {
   const int turn = orient2(t[0], t[1], t[2], drop);
   const bool u_flat = kernels::collinear3(u[0], u[1], u[2]);
   if (s[0] == 0 && s[1] == 0 && s[2] == 0) {  // one plane: K = u
-    for (int e = 0; e < 3; ++e) {
-      const double* p = t[e];
-      const double* q = t[(e + 1) % 3];
-      if (orient2(p, q, u[0], drop) * turn <= 0 && orient2(p, q, u[1], drop) * turn <= 0 &&
-          orient2(p, q, u[2], drop) * turn <= 0)
-        return false;
-    }
-    if (!u_flat) {
-      const int u_turn = orient2(u[0], u[1], u[2], drop);
+    // Has a line along an edge of triangle p (of orientation p_turn in the
+    // projection) every corner of q on its closed outer side?
+    auto edge_apart = [drop](const double* const p[3], int p_turn, const double* const q[3]) {
       for (int e = 0; e < 3; ++e) {
-        const double* p = u[e];
-        const double* q = u[(e + 1) % 3];
-        if (orient2(p, q, t[0], drop) * u_turn <= 0 && orient2(p, q, t[1], drop) * u_turn <= 0 &&
-            orient2(p, q, t[2], drop) * u_turn <= 0)
-          return false;
+        const double* a = p[e];
+        const double* b = p[(e + 1) % 3];
+        if (orient2(a, b, q[0], drop) * p_turn <= 0 && orient2(a, b, q[1], drop) * p_turn <= 0 &&
+            orient2(a, b, q[2], drop) * p_turn <= 0)
+          return true;
       }
-      return true;
-    }
+      return false;
+    };
+    if (edge_apart(t, turn, u)) return false;
+    if (!u_flat) return !edge_apart(u, orient2(u[0], u[1], u[2], drop), t);
     // u a segment (or a point, which the edges above settled): t's corners
     // all on one closed side of its line?
     const double* p = u[0];
