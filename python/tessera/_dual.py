@@ -50,6 +50,9 @@ def cells_for(
         if not source.has_mesh:
             raise ValueError(f"{what}: the Voronoi result was computed with merge=False (no mesh); "
                              "compute it with merge=True")
+        if source._partial:  # a graph, faces or flowers of it would silently miss the other cells
+            raise ValueError(f"{what}: this Voronoi result holds some cells only (Flowers.voronoi of "
+                             "tessera.flower(points, ...)); compute all of them with tessera.voronoi(points)")
         return source
     return voronoi(source, labels=labels, bounds=bounds, padding=0.01 if padding is None else padding,
                    threads=threads, merge=True, ignore_outside=ignore_outside, periodic=periodic, tilt=tilt,
@@ -664,8 +667,9 @@ def flower(
         still clips and sets the box), the same cells as all N cells give.
         :attr:`Flowers.voronoi` is then that partial result (its
         ``n_cells`` the cells built), in which :attr:`Flower.vertex_ids`
-        index ``vertices``; in a periodic box the layer of images is the one
-        these cells need.
+        index ``vertices`` (:func:`adjacency`, :func:`faces` and
+        :func:`flower` refuse it: they need every cell); in a periodic box
+        the layer of images is the one these cells need.
         Not power cells (``voronoi(..., radii=...)``: ``tessera.InputError``):
         a petal is a ball through the generator, which holds for ordinary
         cells only.

@@ -52,6 +52,7 @@ class Voronoi:
         self._points = points
         self._labels = labels
         self._radii = radii  # kept: validate() measures power cells with them
+        self._partial = False  # some cells only (cells_of with `only`): the products refuse it
 
     # ---- input and domain -------------------------------------------------
     @property
@@ -485,7 +486,9 @@ def cells_of(
         rad,
         only,
     )
-    return Voronoi(cells, pts, lab, rad)
+    vor = Voronoi(cells, pts, lab, rad)
+    vor._partial = only is not None
+    return vor
 
 
 def periodic_box(periodic: Any, tilt: Any, bounds: Any, dim: int) -> Tuple[Tuple[bool, bool, bool],

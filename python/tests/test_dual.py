@@ -473,6 +473,21 @@ def test_flower_of_points_refuses_as_before():
         tessera.flower(pts, [0.5])
 
 
+def test_partial_result_of_flower_is_refused_by_the_products():
+    # Flowers.voronoi of flower(points, ...) holds the asked cells and their
+    # neighbours only: a graph of it was asymmetric, its boundary faces those
+    # of a few cells, and a flower of another point called it an outside one.
+    pts = random_points(3000, 3, seed=10)
+    few = tessera.flower(pts, [0])
+    assert few.voronoi.n_cells < 100
+    for call in (lambda v: tessera.adjacency(v), lambda v: tessera.faces(v, "boundary"),
+                 lambda v: tessera.flower(v, [1])):
+        with pytest.raises(ValueError, match="holds some cells only"):
+            call(few.voronoi)
+    whole = tessera.voronoi(pts)
+    assert tessera.flower(whole, [1])[0].generator == 1  # (a whole result is taken as before)
+
+
 @pytest.mark.parametrize("glyphs", [False, True])
 def test_flower_vtp_read_by_vtk(tmp_path, glyphs):
     pts = random_points(300, 3, seed=13)
