@@ -695,9 +695,8 @@ def flower(
         # before; where none is one, point 0's cell stands in (input errors,
         # and the cells' own, still come first).
         pts = _inputs.as_points(source)
-        vor = cells_of(pts, labels=labels, bounds=bounds, padding=0.01 if padding is None else padding,
-                       threads=threads, merge=True, ignore_outside=ignore_outside, periodic=periodic, tilt=tilt,
-                       only=_existing_ids(ids, pts.shape[0]))
+        vor = cells_of(pts, labels, bounds, 0.01 if padding is None else padding, threads, True, ignore_outside,
+                       "auto", periodic, tilt, None, _existing_ids(ids, pts.shape[0]))
     idx = as_ids(ids, vor.points.shape[0])
     fs = _inputs.call(_core.flowers, vor._cells, vor.points, idx)
     return Flowers(fs, vor, _inputs.as_flag(glyphs, "glyphs"))

@@ -443,29 +443,17 @@ def voronoi(
 
     The computation runs with the GIL released: other Python threads go on.
     """
-    return cells_of(points, labels, bounds, padding, threads, merge, ignore_outside=ignore_outside, method=method,
-                    periodic=periodic, tilt=tilt, radii=radii)
+    return cells_of(points, labels, bounds, padding, threads, merge, ignore_outside, method, periodic, tilt, radii,
+                    None)
 
 
-def cells_of(
-    points: Any,
-    labels: Any = None,
-    bounds: Optional[Sequence[float]] = None,
-    padding: float = 0.01,
-    threads: Optional[int] = None,
-    merge: bool = True,
-    *,
-    ignore_outside: bool = False,
-    method: str = "auto",
-    periodic: Any = False,
-    tilt: Optional[Sequence[float]] = None,
-    radii: Any = None,
-    only: Optional[np.ndarray] = None,
-) -> Voronoi:
-    """:func:`voronoi`, or with ``only`` (int32 ids that exist) the cells of
-    those points and their neighbours alone, each as :func:`voronoi` computes
-    it among all the points (``VoronoiOptions::only``; :func:`tessera.flower`
-    of points)."""
+def cells_of(points: Any, labels: Any, bounds: Any, padding: float, threads: Any, merge: bool, ignore_outside: bool,
+             method: str, periodic: Any, tilt: Any, radii: Any, only: Optional[np.ndarray]) -> Voronoi:
+    """:func:`voronoi`'s work, on its arguments (every one given: the
+    defaults are voronoi's alone); with ``only`` (int32 ids that exist) the
+    cells of those points and their neighbours alone, each as :func:`voronoi`
+    computes it among all the points (``VoronoiOptions::only``;
+    :func:`tessera.flower` of points)."""
     pts = _inputs.as_points(points)
     dim = pts.shape[1]
     lab = _inputs.as_labels(labels, pts.shape[0])
