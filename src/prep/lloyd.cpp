@@ -1,0 +1,132 @@
+// Lloyd relaxation (include/tessera/prep/lloyd.hpp): iterations of one cells
+// pass each (no mesh), every point that owns a cell moved to its centroid.
+#include "tessera/prep/lloyd.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <string>
+
+#include "../front/pass.hpp"
+#include "../front/periodic.hpp"
+#include "../message_text.hpp"
+
+namespace tessera {
+namespace {
+
+/// The shape checks that hold whatever the iterations (voronoi() repeats
+/// them, with the rest, on the first iteration's input).
+void check_shape(std::span<const double> points, int dim, std::span<const std::int32_t> labels,
+                 const VoronoiOptions& o) {
+  if (dim != 2 && dim != 3) throw InputError("dimension must be 2 or 3, got " + std::to_string(dim));
+  if (points.empty()) throw InputError("no input points");
+  if (points.size() % static_cast<std::size_t>(dim) != 0)
+    throw InputError("point array length " + std::to_string(points.size()) + " is not a multiple of dimension " +
+                     std::to_string(dim));
+  const std::size_t n = points.size() / static_cast<std::size_t>(dim);
+  if (!labels.empty() && labels.size() != n)
+    throw InputError("labels: " + std::to_string(labels.size()) + " values for " + std::to_string(n) + " points");
+  front::check_radii(o.radii, n);
+}
+
+/// (volume / generators)^(1 / dim), from the extents' logarithms: a domain
+/// whose volume overflows or underflows double (extents near 1e120 or
+/// 1e-120 in 3D) still has a spacing. (Half extents: a whole one may
+/// overflow.)
+double mean_spacing(const Bounds& domain, int dim, std::size_t generators) {
+  double log_sum = -std::log(static_cast<double>(std::max<std::size_t>(generators, 1)));
+  for (int a = 0; a < dim; ++a) {
+    const auto k = static_cast<std::size_t>(a);
+    log_sum += std::log(0.5 * domain.hi[k] - 0.5 * domain.lo[k]) + std::log(2.0);
+  }
+  return std::exp(log_sum / dim);
+}
+
+}  // namespace
+
+LloydResult lloyd(std::span<const double> points, int dim, std::span<const std::int32_t> labels,
+                  const LloydOptions& options) {
+  if (options.iterations < 0)
+    throw InputError("lloyd: iterations must be >= 0, not " + std::to_string(options.iterations));
+  if (!(options.tolerance >= 0) || !std::isfinite(options.tolerance))
+    throw InputError("lloyd: tolerance must be a finite number >= 0, not " + detail::number_text(options.tolerance));
+  if (!options.voronoi.only.empty())
+    throw InputError("lloyd: every cell moves its point; VoronoiOptions::only must be empty");
+  check_shape(points, dim, labels, options.voronoi);
+
+  LloydResult result;
+  result.points.assign(points.begin(), points.end());
+  const int iterations = options.iterations;
+  if (iterations == 0) return result;
+
+  const auto du = static_cast<std::size_t>(dim);
+  VoronoiOptions vo = options.voronoi;
+  vo.build_mesh = false;
+  const std::function<void(double)> progress = options.voronoi.progress;
+  std::vector<double> next, displacement;
+  for (int it = 0; it < iterations; ++it) {
+    if (progress)
+      vo.progress = [&progress, it, iterations](double f) {
+        progress((it + std::clamp(f, 0.0, 1.0)) / iterations);
+      };
+    const Cells cells = voronoi(result.points, dim, labels, vo);
+    if (it == 0) {
+      // The domain of every later iteration (lloyd.hpp): the default one
+      // would shrink with the points.
+      result.domain = cells.bounds;
+      if (!vo.bounds) vo.bounds = cells.bounds;
+      result.spacing = mean_spacing(cells.bounds, dim, cells.generators);
+      result.threads_used = cells.threads_used;
+    }
+    const Bounds& box = *vo.bounds;
+    const bool periodic = cells.is_periodic();
+    // Displacements are measured from the points as the cells took them:
+    // wrapped into a periodic box.
+    const std::vector<double>& from = periodic ? cells.periodic_points : result.points;
+    const std::size_t moved = cells.n_cells();
+    next = result.points;
+    displacement.resize(moved);
+    for (std::size_t c = 0; c < moved; ++c) {
+      const auto i = static_cast<std::size_t>(cells.generator[c]);
+      double d[3] = {0, 0, 0};
+      for (std::size_t a = 0; a < du; ++a) {
+        double x = cells.centroid[c * du + a];
+        // Held within the walls (a centroid on one may round past it).
+        if (!cells.periodic[a]) x = std::clamp(x, box.lo[a], box.hi[a]);
+        d[a] = x - from[i * du + a];
+        next[i * du + a] = x;
+      }
+      // (std::hypot: squares of displacements past ~1e154 overflow)
+      displacement[c] = std::hypot(d[0], d[1], d[2]);
+    }
+    if (periodic && moved != 0) {
+      // Back into the box as the cells wrap points (by whole lattice
+      // vectors, rounded to the box's grid); the points that did not move
+      // keep their bits.
+      const front::PeriodicInput wrapped = front::periodic_input(next, dim, labels, vo);
+      for (std::size_t c = 0; c < moved; ++c) {
+        const auto i = static_cast<std::size_t>(cells.generator[c]);
+        std::copy_n(wrapped.points.begin() + static_cast<std::ptrdiff_t>(i * du), du,
+                    next.begin() + static_cast<std::ptrdiff_t>(i * du));
+      }
+    }
+    result.points.swap(next);
+    // In point order, on this thread: the same sums for any thread count.
+    // The mean square is taken relative to the largest, which neither
+    // overflows nor underflows.
+    const double largest = displacement.empty() ? 0.0 : *std::max_element(displacement.begin(), displacement.end());
+    double relative_squares = 0;
+    if (largest > 0)
+      for (const double d : displacement) relative_squares += (d / largest) * (d / largest);
+    result.largest_displacement.push_back(largest);
+    result.rms_displacement.push_back(moved == 0 ? 0.0
+                                                 : largest * std::sqrt(relative_squares / static_cast<double>(moved)));
+    result.moved.push_back(moved);
+    result.iterations = it + 1;
+    if (progress) progress(static_cast<double>(it + 1) / iterations);
+    if (options.tolerance > 0 && result.largest_displacement.back() <= options.tolerance * result.spacing) break;
+  }
+  return result;
+}
+
+}  // namespace tessera
