@@ -53,20 +53,6 @@ std::string non_finite_note(std::size_t count) {
   return count == 0 ? std::string() : ", " + std::to_string(count) + " with a non-finite coordinate kept in place";
 }
 
-/// Checks the output path before any work: a points extension and a
-/// writable directory, or "-" (binary .ply on standard output; the summary
-/// then goes to standard error).
-void check_output(const std::string& path) {
-  if (path == "-") {
-    route_standard_output({&path});
-    return;
-  }
-  const std::string e = extension(path);
-  if (e != ".npy" && e != ".ply" && e != ".vtp")
-    throw InputError("output " + path + ": points are written as .npy, .ply or .vtp (got '" + e + "')");
-  io::check_writable(path);
-}
-
 io::PointCloud read_prep_input(const PrepInput& p, bool with_labels) {
   io::ReadOptions ro;
   ro.dim = p.dim;
@@ -86,6 +72,17 @@ std::int32_t parse_label(const std::string& word, const std::string& what) {
 }
 
 }  // namespace
+
+void check_prep_output(const std::string& path) {
+  if (path == "-") {
+    route_standard_output({&path});
+    return;
+  }
+  const std::string e = extension(path);
+  if (e != ".npy" && e != ".ply" && e != ".vtp")
+    throw InputError("output " + path + ": points are written as .npy, .ply or .vtp (got '" + e + "')");
+  io::check_writable(path);
+}
 
 // ------------------------------------------------------------------ registration
 
@@ -219,7 +216,7 @@ int run_joggle(const JoggleArgs& a) {
   o.seed = a.seed;
   o.threads = a.threads;
   o.keep_non_finite = a.io.keep_non_finite;
-  check_output(a.io.output);
+  check_prep_output(a.io.output);
 
   const io::PointCloud pc = read_prep_input(a.io, true);
   if (o.mode != JoggleMode::ball && pc.dim != 3)
@@ -298,7 +295,7 @@ int run_fill(const FillArgs& a) {
   if (!bounds.empty() && bounds.size() != 4 && bounds.size() != 6)
     throw InputError("--bounds needs x0 x1 y0 y1 (2D) or x0 x1 y0 y1 z0 z1 (3D), got " +
                      std::to_string(bounds.size()) + " numbers");
-  check_output(io.output);
+  check_prep_output(io.output);
 
   const io::PointCloud pc = read_prep_input(io, true);
   if (!bounds.empty()) {
@@ -340,7 +337,7 @@ int run_threshold(const ThresholdArgs& a) {
   // Overlaps and the rest are checked once more by the library; check them
   // here too so that bad intervals fail before reading the input.
   (void)threshold({}, o);
-  check_output(a.io.output);
+  check_prep_output(a.io.output);
 
   const io::PointCloud pc = read_prep_input(a.io, false);
   const std::vector<double> s = io::read_point_scalars(input_path(a.io.input), a.scalars);

@@ -12,6 +12,7 @@
 #include "tessera/cells.hpp"
 #include "tessera/delaunay.hpp"
 #include "tessera/image.hpp"
+#include "tessera/prep/lloyd.hpp"
 #include "tessera/surface_nets.hpp"
 #include "tessera/io/points.hpp"
 
@@ -174,6 +175,18 @@ struct ThresholdArgs {
   std::int32_t background_label = -1;
 };
 
+/// `lloyd` (cmd_lloyd.cpp): Lloyd relaxation of INPUT's points, which are
+/// written moved (labelled points, io::write_points). main.cpp registers its
+/// options: the compute options, --method, --radii, --periodic/--tilt and
+/// these.
+struct LloydArgs {
+  ComputeArgs compute;
+  std::string output;                              ///< .npy / .ply / .vtp, or - (.ply on standard output)
+  int iterations = LloydOptions{}.iterations;
+  double tolerance = LloydOptions{}.tolerance;     ///< relative to the mean spacing; 0: every iteration
+  bool quiet = false;
+};
+
 int run_voronoi(const VoronoiArgs& args);
 int run_delaunay(const DelaunayArgs& args);
 int run_bench_delaunay(const BenchArgs& args);
@@ -185,6 +198,12 @@ int run_flower(const FlowerArgs& args);
 int run_joggle(const JoggleArgs& args);
 int run_fill(const FillArgs& args);
 int run_threshold(const ThresholdArgs& args);
+int run_lloyd(const LloydArgs& args);
+/// A command that writes points (joggle, fill, threshold, lloyd) checks its
+/// output path before any work: a points extension (.npy, .ply, .vtp) and a
+/// writable directory, or "-" (binary .ply on standard output; the summary
+/// then goes to standard error). InputError otherwise (cmd_prep.cpp).
+void check_prep_output(const std::string& path);
 /// `joggle`, `fill`, `threshold` with their options (cmd_prep.cpp); main.cpp
 /// calls add_prep_commands before parsing and run_prep_command after it
 /// (-1: none of them was given).

@@ -2382,7 +2382,7 @@ class BadInput(TempDirCase):
         option. CLI11 alone read '' as 0, wrapped '--seed -1' and took seeds
         past 2^64 (stop 17's fuzz); its range check printed DBL_MAX in full."""
         commands = [["voronoi"], ["delaunay"], ["graph"], ["faces"], ["flower"], ["surface-nets"],
-                    ["joggle"], ["fill"], ["threshold"], ["sample-image"], ["probe"], ["run-default"],
+                    ["joggle"], ["fill"], ["threshold"], ["lloyd"], ["sample-image"], ["probe"], ["run-default"],
                     ["bench", "voronoi"], ["bench", "delaunay"], ["bench", "surface-nets"]]
         option = re.compile(r"^\s+(?:-\w,)?(--[\w-]+) (INT|UINT|FLOAT)\b")
         seen = {"INT": 0, "UINT": 0, "FLOAT": 0}

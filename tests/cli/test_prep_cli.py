@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""End-to-end tests of `tessera joggle`, `tessera fill` and `tessera threshold`.
+"""End-to-end tests of `tessera joggle`, `tessera fill`, `tessera threshold` and `tessera lloyd`.
 
 Usage: /usr/bin/python3 tests/cli/test_prep_cli.py PATH_TO_tessera [unittest args...]
 
@@ -17,7 +17,7 @@ import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import test_cli as base  # noqa: E402  (helpers only; its test classes are not collected here)
-from test_cli import read_vtp, read_bytes, read_ply  # noqa: E402
+from test_cli import read_vtp, read_bytes, read_ply, run_bytes  # noqa: E402
 
 from vtk.util.numpy_support import vtk_to_numpy  # noqa: E402
 
@@ -293,6 +293,119 @@ class NonFinite(Case):
         self.assertTrue(np.all(v[self.missing] == -1))
         # The others lie in [0, 1]^3, inside the voxel-centre box [0, 3]^3.
         self.assertTrue(np.all(v[self.kept] >= 0))
+
+
+class Lloyd(Case):
+    def setUp(self):
+        super().setUp()
+        self.pts = np.random.default_rng(4).random((400, 3))
+        self.inp = self.save("pts.npy", self.pts)
+
+    def files(self):
+        return sorted(os.listdir(self.dir))
+
+    def test_one_iteration_is_the_cells_centroids(self):
+        # The moved points are the centroids `voronoi --cell-table` reports,
+        # bit for bit; the summary says what ran.
+        box = ["--bounds", "0", "1", "0", "1", "0", "1"]
+        r = self.ok(["lloyd", self.inp, "--iterations", "1", "-o", self.p("r.npy")] + box)
+        self.assertIn("tessera lloyd: 400 points (3D) from", r.stdout)
+        self.assertIn("iterations         1 of 1\n", r.stdout)
+        self.assertIn("moved              400 in every iteration", r.stdout)
+        self.assertIn("domain             [0, 1] x [0, 1] x [0, 1]", r.stdout)
+        self.assertEqual(r.stderr, "")
+        self.ok(["voronoi", self.inp, "--cell-table", self.p("t.npy"), "-q"] + box)
+        t = np.load(self.p("t.npy"))
+        q = np.load(self.p("r.npy"))
+        self.assertTrue(np.array_equal(q[t[:, 0].astype(int)], t[:, 3:6]))
+        # Nothing but the output was written (atomically: no temporaries left).
+        self.assertEqual(self.files(), ["pts.npy", "r.npy", "t.npy"])
+
+    def test_labels_radii_formats_and_the_fixed_domain(self):
+        labels = np.where(np.arange(400) % 10 == 0, -1, 2).astype(np.int32)
+        lab = self.save("lab.npy", labels)
+        radii = self.save("rad.npy", np.random.default_rng(5).random(400) * 0.05)
+        r = self.ok(["lloyd", self.inp, "--labels", lab, "--radii", radii, "--iterations", "4", "-o",
+                     self.p("r.ply")])
+        self.assertIn("moved              360 in every iteration", r.stdout)
+        self.assertIn("power cells", r.stdout)
+        v = read_ply(self.p("r.ply"))
+        q = np.stack([v["x"], v["y"], v["z"]], axis=1)
+        self.assertTrue(np.array_equal(v["label"], labels))
+        self.assertTrue(np.array_equal(v["radius"], np.load(radii)))
+        self.assertTrue(np.array_equal(q[labels < 0], self.pts[labels < 0]))  # outside points stay
+        self.assertFalse(np.any(np.all(q[labels >= 0] == self.pts[labels >= 0], axis=1)))
+        # The same iterations from the .npy, and as .vtp; the default domain
+        # is the first iteration's, so giving it as --bounds changes nothing.
+        dom = [w.strip("[],") for w in r.stdout.split("domain             ")[1].split("(")[0].split()
+               if w != "x"]
+        self.ok(["lloyd", self.inp, "--labels", lab, "--radii", radii, "--iterations", "4", "-q", "-o",
+                 self.p("r.npy")])
+        self.assertTrue(np.array_equal(np.load(self.p("r.npy")), q))
+        self.assertTrue(np.array_equal(np.load(self.p("r_labels.npy")), labels))
+        self.ok(["lloyd", self.inp, "--labels", lab, "--radii", radii, "--iterations", "4", "-q", "-o",
+                 self.p("b.vtp"), "--bounds"] + dom)
+        pd = read_vtp(self.p("b.vtp"))
+        self.assertTrue(np.array_equal(vtk_to_numpy(pd.GetPoints().GetData()), q))
+        self.assertTrue(np.array_equal(vtk_to_numpy(pd.GetPointData().GetArray("label")), labels))
+        # 2D: z = 0 in the .ply, read back with --dim 2.
+        two = self.save("p2.npy", self.pts[:, :2])
+        self.ok(["lloyd", two, "--iterations", "2", "-q", "-o", self.p("r2.ply")])
+        v2 = read_ply(self.p("r2.ply"))
+        self.assertTrue(np.all(v2["z"] == 0))
+        self.ok(["lloyd", self.p("r2.ply"), "--dim", "2", "--iterations", "0", "-q", "-o", self.p("same.npy")])
+        self.assertTrue(np.array_equal(np.load(self.p("same.npy")), np.stack([v2["x"], v2["y"]], axis=1)))
+
+    def test_tolerance_threads_periodic_and_stdout(self):
+        r = self.ok(["lloyd", self.inp, "--iterations", "1000", "--tolerance", "0.03", "-o", self.p("a.npy")])
+        done = int(r.stdout.split("iterations         ")[1].split()[0])
+        self.assertGreater(done, 1)
+        self.assertLess(done, 1000)
+        self.assertIn("of 1000 (stopped: the largest displacement is within --tolerance 0.03", r.stdout)
+        q = self.ok(["lloyd", self.inp, "--iterations", str(done), "--threads", "1", "-o", self.p("b.npy"), "-q"])
+        self.assertEqual(q.stdout, "")
+        self.assertEqual(read_bytes(self.p("a.npy")), read_bytes(self.p("b.npy")))
+        # Periodic: points given periods away come back in the box.
+        far = self.save("far.npy", self.pts + [3.0, -1.0, 0.0])
+        r = self.ok(["lloyd", far, "--bounds", "0", "1", "0", "1", "0", "1", "--periodic", "xy", "--iterations", "3",
+                     "-o", self.p("per.npy")])
+        self.assertIn("periodic           xy", r.stdout)
+        per = np.load(self.p("per.npy"))
+        self.assertTrue(np.all((per >= 0) & (per <= 1)) and np.all(per[:, :2] < 1))
+        # Standard output: the .ply, the summary on standard error.
+        self.ok(["lloyd", self.inp, "--iterations", "2", "-o", self.p("s.ply"), "-q"])
+        out = run_bytes(["lloyd", self.inp, "--iterations", "2", "-o", "-"])
+        self.assertEqual(out.returncode, 0, out.stderr)
+        self.assertIn(b"wrote              stdout", out.stderr)
+        self.assertEqual(out.stdout, read_bytes(self.p("s.ply")))
+
+    def test_help(self):
+        r = self.ok(["lloyd", "--help"])
+        for opt in ("INPUT", "--output", "--iterations", "--tolerance", "--dim", "--labels", "--bounds", "--padding",
+                    "--ignore-outside", "--periodic", "--tilt", "--radii", "--method", "--threads", "--frame",
+                    "--quiet", "Examples:", "tessera lloyd points.npy"):
+            self.assertIn(opt, r.stdout)
+        self.assertIn("lloyd", run(["--help"]).stdout)
+
+    def test_bad_input(self):
+        out = self.p("r.npy")
+        self.fails(["lloyd", self.inp, "--iterations", "-1", "-o", out], "--iterations")
+        self.fails(["lloyd", self.inp, "--iterations", "2.5", "-o", out], "--iterations")
+        self.fails(["lloyd", self.inp, "--tolerance", "-1", "-o", out], "--tolerance")
+        self.fails(["lloyd", self.inp, "--tolerance", "nan", "-o", out], "--tolerance")
+        self.fails(["lloyd", self.inp, "-o", self.p("r.txt")], ".npy, .ply or .vtp")
+        self.fails(["lloyd", self.inp])
+        self.fails(["lloyd", self.p("nope.npy"), "-o", out], "nope.npy")
+        self.fails(["lloyd", self.inp, "-o", self.p("missing/r.npy")], "missing")
+        self.fails(["lloyd", self.inp, "--periodic", "xyz", "-o", out], "--bounds")
+        self.fails(["lloyd", self.inp, "--bounds", "0", "0.5", "0", "1", "0", "1", "-o", out], "outside the bounds")
+        self.fails(["lloyd", self.inp, "--radii", self.save("r5.npy", np.ones(5)), "-o", out], "--radii")
+        self.fails(["lloyd", self.inp, "--labels", self.save("l5.npy", np.zeros(5, np.int32)), "-o", out])
+        self.fails(["lloyd", self.inp, "-o", self.inp], "the INPUT")
+        # No point owns a cell: every inside point duplicates an outside one.
+        dup = self.save("dup.npy", np.vstack([self.pts[:20], self.pts[:20]]))
+        lab = self.save("duplab.npy", np.r_[np.full(20, -1), np.zeros(20)].astype(np.int32))
+        self.fails(["lloyd", dup, "--labels", lab, "-o", out], "no cells")
 
 
 def main():
