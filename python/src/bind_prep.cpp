@@ -1,6 +1,6 @@
 // tessera._core: images (LabelImage, ScalarImage, their readers) and the point
 // preparation tools (include/tessera/prep/: sample_image, joggle, fill,
-// threshold, probe). The tools' outputs are plain arrays: the vectors the
+// threshold, probe, lloyd). The tools' outputs are plain arrays: the vectors the
 // library returns are moved into numpy arrays (arrays.hpp, adopt), not copied.
 // Images keep their buffer in the bound object, which numpy views.
 #include <array>
@@ -26,6 +26,7 @@
 #include "tessera/labelled_points.hpp"
 #include "tessera/prep/fill.hpp"
 #include "tessera/prep/joggle.hpp"
+#include "tessera/prep/lloyd.hpp"
 #include "tessera/prep/probe.hpp"
 #include "tessera/prep/sample_image.hpp"
 #include "tessera/prep/threshold.hpp"
@@ -307,6 +308,40 @@ void bind_prep(py::module_& m) {
       py::arg("in_label"), py::arg("points_per_bin"), py::arg("bounds").none(true), py::arg("joggle"),
       py::arg("seed"), py::arg("threads"), py::arg("keep_non_finite"),
       "The points followed by background points in empty bins: (points, labels).");
+
+  // ---- lloyd ------------------------------------------------------------------
+  m.def(
+      "lloyd",
+      [](const Points& points, const py::object& labels, const std::optional<std::vector<double>>& bounds,
+         double padding, bool ignore_outside, int threads, const std::string& method,
+         const std::array<bool, 3>& periodic, const std::array<double, 3>& tilt, const py::object& radii,
+         int iterations, double tolerance) {
+        const int dim = checked_dim(points);
+        LloydOptions opt;
+        fill_common(opt.voronoi, dim, bounds, padding, ignore_outside, threads);
+        opt.voronoi.periodic = periodic;
+        opt.voronoi.tilt = tilt;
+        opt.voronoi.radii = as_radii(radii);  // views the caller's array, alive through the call
+        if (method == "auto") opt.voronoi.cell_method = CellMethod::automatic;
+        else if (method == "search") opt.voronoi.cell_method = CellMethod::search;
+        else if (method == "insertion") opt.voronoi.cell_method = CellMethod::insertion;
+        else throw py::value_error("method: expected 'auto', 'search' or 'insertion', got '" + method + "'");
+        opt.iterations = iterations;
+        opt.tolerance = tolerance;
+        const auto pts = as_span(points);
+        const auto lab = as_labels(labels);
+        LloydResult r = without_gil([&] { return tessera::lloyd(pts, dim, lab, opt); });
+        std::vector<std::int64_t> moved(r.moved.begin(), r.moved.end());
+        const py::object domain = r.domain ? py::object(bounds_tuple(*r.domain, dim)) : py::none();
+        return py::make_tuple(adopt(std::move(r.points), {points.shape(0), dim}), r.iterations,
+                              adopt_flat(std::move(r.largest_displacement)), adopt_flat(std::move(r.rms_displacement)),
+                              adopt_flat(std::move(moved)), domain, r.spacing, r.threads_used);
+      },
+      py::arg("points").noconvert(), py::arg("labels").none(true), py::arg("bounds").none(true), py::arg("padding"),
+      py::arg("ignore_outside"), py::arg("threads"), py::arg("method"), py::arg("periodic"), py::arg("tilt"),
+      py::arg("radii").none(true), py::arg("iterations"), py::arg("tolerance"),
+      "Lloyd relaxation: (points (n, dim), iterations done, largest and rms displacement per iteration, points "
+      "moved per iteration, domain or None, spacing, threads used). Runs without the GIL.");
 
   // ---- read_points -----------------------------------------------------------
   m.def(

@@ -24,7 +24,8 @@ numpy in, numpy out::
   surfaces of labelled points, with ``vertex_kind``.
 * Point preparation: :func:`sample_image` (label image -> labelled points),
   :func:`read_image`, :func:`read_points`, :func:`read_box`, :func:`read_frames`, :func:`fill`, :func:`joggle`, :func:`threshold`,
-  :func:`probe`.
+  :func:`probe`, :func:`lloyd` (Lloyd relaxation towards a centroidal Voronoi
+  tessellation -> :class:`LloydResult`).
 
 :func:`adjacency`, :func:`faces` and :func:`flower` take points or a
 :class:`Voronoi` computed with ``merge=True`` (reused, nothing recomputed).
@@ -54,6 +55,7 @@ from ._core import (
 )
 from ._delaunay import Delaunay, delaunay
 from ._dual import AdjacencyGraph, FaceSet, Flower, Flowers, adjacency, faces, flower
+from ._lloyd import LloydResult, lloyd
 from ._prep import (Frame, fill, joggle, probe, read_box, read_frames, read_image, read_points, read_scalars,
                     sample_image, threshold)
 from ._scipy import ScipyVoronoi
@@ -90,6 +92,8 @@ __all__ = [
     "fill",
     "threshold",
     "probe",
+    "lloyd",
+    "LloydResult",
     "InputError",
     "SAME_REGION",
     "REGION_BOUNDARY",

@@ -506,6 +506,29 @@ def fill(
     threads: int,
     keep_non_finite: bool,
 ) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.int32]]: ...
+def lloyd(
+    points: npt.NDArray[np.float64],
+    labels: Optional[npt.NDArray[np.int32]],
+    bounds: Optional[Sequence[float]],
+    padding: float,
+    ignore_outside: bool,
+    threads: int,
+    method: str,
+    periodic: Tuple[bool, bool, bool],
+    tilt: Tuple[float, float, float],
+    radii: Optional[npt.NDArray[np.float64]],
+    iterations: int,
+    tolerance: float,
+) -> Tuple[
+    npt.NDArray[np.float64],
+    int,
+    npt.NDArray[np.float64],
+    npt.NDArray[np.float64],
+    npt.NDArray[np.int64],
+    Optional[Tuple[float, ...]],
+    float,
+    int,
+]: ...
 def threshold(
     scalars: npt.NDArray[np.float64], intervals: Sequence[Tuple[float, float, int]], background_label: int
 ) -> npt.NDArray[np.int32]: ...
