@@ -18,6 +18,7 @@
 #include "pass.hpp"
 #include "periodic.hpp"
 #include "pilot.hpp"
+#include "spoke_class_marker.hpp"
 #include "tessera/engine/tessellate.hpp"
 #include "tessera/kernels/hull.hpp"
 #include "tessera/kernels/tile.hpp"
@@ -202,6 +203,16 @@ Cells run(std::span<const double> input, std::span<const std::int32_t> labels, c
     for (const std::int32_t g : opt.only)  // (< 0: a periodic pass's point that takes no part)
       if (g >= 0) only[static_cast<std::size_t>(g) >> 6] |= std::uint64_t{1} << (g & 63);
   }
+  // VoronoiOptions::only_with_faces: the cells found by a first pass over
+  // all (below); same_region asks for every cell. The pilot's cells are
+  // left here too: its kept batches are the mesh compositor's, with owners
+  // decided before the cells to build were known.
+  const SpokeClassSet with_faces = opt.only_with_faces;
+  const bool find_with_faces = with_faces != 0 && (with_faces & spoke_class_bit(SpokeClass::same_region)) == 0;
+  if (find_with_faces) {
+    kept.batches.clear();
+    kept.exact_calls = 0;
+  }
   // The search's pass leaves out the cells its pilot built whole.
   std::vector<std::uint64_t> built;
   if (stars || kept.batches.empty()) {
@@ -215,27 +226,27 @@ Cells run(std::span<const double> input, std::span<const std::int32_t> labels, c
     }
     pass.gens.skip = built;
   }
+  // The generators of a set (bit g of `set`), in bin order as the pass
+  // lists them (its order and slots, restricted).
   std::vector<std::int32_t> only_order;
   std::vector<std::uint32_t> only_slots;
+  auto restrict_order = [&](std::span<const std::uint64_t> set) {
+    only_order.clear();
+    only_slots.clear();
+    for (std::size_t q = 0; q < pass.order.size(); ++q) {
+      const std::int32_t g = pass.order[q];
+      if ((set[static_cast<std::size_t>(g) >> 6] >> (g & 63) & 1) == 0) continue;
+      only_order.push_back(g);
+      only_slots.push_back(pass.slots[q]);
+    }
+    pass.gens.order = only_order;
+    pass.gens.slots = only_slots;
+  };
   if (!only.empty()) {
-    // The generators of `only`, in bin order as the pass lists them (its
-    // order and slots, restricted).
-    auto restrict_order = [&] {
-      only_order.clear();
-      only_slots.clear();
-      for (std::size_t q = 0; q < pass.order.size(); ++q) {
-        const std::int32_t g = pass.order[q];
-        if ((only[static_cast<std::size_t>(g) >> 6] >> (g & 63) & 1) == 0) continue;
-        only_order.push_back(g);
-        only_slots.push_back(pass.slots[q]);
-      }
-      pass.gens.order = only_order;
-      pass.gens.slots = only_slots;
-    };
     // First the cells asked for, for their neighbours (a few cells, no
     // mesh); then those with their neighbours, whose cells own the merged
     // vertices the cells asked for share with them.
-    restrict_order();
+    restrict_order(only);
     Cells first;
     first.dim = D;
     first.n_points = out.n_points;
@@ -244,8 +255,33 @@ Cells run(std::span<const double> input, std::span<const std::int32_t> labels, c
     quiet.progress = nullptr;
     out.exact_predicate_calls += engine::tessellate<CellT>(pass.gens, scout, quiet);
     for (const std::int32_t j : first.neighbors) only[static_cast<std::size_t>(j) >> 6] |= std::uint64_t{1} << (j & 63);
-    restrict_order();
+    restrict_order(only);
+    out.partial = only_order.size() < pass.order.size();
     comp.build_only(only);
+  }
+  std::vector<std::uint64_t> found;  // only_with_faces: the cells to build
+  if (find_with_faces) {
+    // Every cell without the mesh, for its spokes' classes (no measures,
+    // no neighbour lists kept: a bit per generator); then the cells marked,
+    // with the mesh (VoronoiOptions::only_with_faces says why they suffice).
+    // The progress bar gives the first pass the first half of what is left
+    // after the insertion, the cells marked the second.
+    front::SpokeClassMarker<CellT> marker(labels, with_faces, out.n_points);
+    const double from = stars ? 0.5 : 0.0, share = 0.5 * (1 - from);
+    engine::EngineOptions first = pass.engine_options;
+    first.progress = nullptr;
+    if (opt.progress) first.progress = [&opt, from, share](double f) { opt.progress(from + share * f); };
+    out.exact_predicate_calls += engine::tessellate<CellT>(pass.gens, marker, first);
+    if (opt.progress)
+      pass.engine_options.progress = [&opt, from, share](double f) { opt.progress(from + share * (1 + f)); };
+    found = std::move(marker.marked());
+    out.empty_cells = std::move(marker.empty_cells());  // every generator's (the compositor adds none of its own)
+    restrict_order(found);
+    if (marker.count() + out.empty_cells.size() < pass.order.size()) {
+      out.partial = true;
+      out.with_faces_of = with_faces;
+    }
+    comp.build_only(found);
   }
   out.exact_predicate_calls +=
       engine::tessellate<CellT>(pass.gens, comp, pass.engine_options, std::move(kept.batches)) + kept.exact_calls;
@@ -275,6 +311,7 @@ Cells run_periodic(std::span<const double> input, int dim, std::span<const std::
   o.periodic = {false, false, false};
   o.tilt = {0, 0, 0};
   o.ignore_outside_points = false;  // set aside already; every image lies in the layer
+  o.only_with_faces = 0;            // every cell (VoronoiOptions::only_with_faces)
   std::vector<double> radii;  // power cells: each image has its point's radius
   auto [aug, im] = front::run_in_final_layer(in, labels, threads, [&](const front::PeriodicImages& images,
                                                                       std::vector<double>& reach) {
@@ -293,8 +330,10 @@ Cells run_periodic(std::span<const double> input, int dim, std::span<const std::
     return run<CellT>(images.points, images.labels, o, &reach);
   });
   const std::size_t generators = aug.generators;
+  const bool partial = aug.partial;  // (only)
   Cells out = front::periodic_cells(std::move(aug), in, im, labels, threads);
   out.generators = generators;
+  out.partial = partial;
   return out;
 }
 
@@ -304,6 +343,8 @@ Cells voronoi(std::span<const double> input, int dim, std::span<const std::int32
               const VoronoiOptions& options) {
   if (!options.radii.empty() && (dim == 2 || dim == 3))
     front::check_radii(options.radii, input.size() / static_cast<std::size_t>(dim));
+  if (!options.only.empty() && options.only_with_faces != 0)
+    throw InputError("only and only_with_faces cannot be combined: give the cells wanted by one of them");
   if (options.periodic_box()) {
     if (!options.periodic[0] && !options.periodic[1] && !options.periodic[2])
       throw InputError("a tilt (triclinic box) needs periodic axes");
