@@ -510,15 +510,19 @@ def expect_faces_of_some_cells(tmp_path, pts, name, **kw):
         assert (tmp_path / "few.vtp").read_bytes() == (tmp_path / "full.vtp").read_bytes(), what
         built = few.voronoi
         assert built._partial == (built.n_cells < vor.n_cells), what
-        if kind == "complex":
+        # The cells with a face of the set's classes: built alone where they
+        # are at most about half (a sample says, above 2,048 cells; all are
+        # built otherwise).
+        classes = tessera._core.face_set_classes(kind, capping)
+        owner = np.repeat(np.arange(vor.n_cells), np.diff(vor.cell_face_offsets))
+        has = np.zeros(vor.n_cells, bool)
+        has[owner[((classes >> vor.face_class.astype(int)) & 1) == 1]] = True
+        if kind == "complex" or (vor.n_cells > 2048 and has.mean() > 0.6) or any(vor.periodic):
             assert not built._partial, what
+        elif has.mean() < 0.4:
+            assert built._partial, what
         if built._partial:
             partial += 1
-            # The cells built: those with a face of the set's classes.
-            classes = tessera._core.face_set_classes(kind, capping)
-            owner = np.repeat(np.arange(vor.n_cells), np.diff(vor.cell_face_offsets))
-            has = np.zeros(vor.n_cells, bool)
-            has[owner[((classes >> vor.face_class.astype(int)) & 1) == 1]] = True
             assert np.array_equal(built.generators, vor.generators[has]), what
             assert np.array_equal(built.volumes, vor.volumes[has]), what
             for call in (lambda v: v.validate(), lambda v: tessera.adjacency(v),
@@ -533,8 +537,8 @@ def test_faces_of_points_build_the_cells_with_such_faces_alone(tmp_path, dim):
     pts, lab = labelled(4000, dim, seed=20 + dim)
     for threads in (1, 2):
         assert expect_faces_of_some_cells(tmp_path, pts, f"{dim}D, {threads} threads", labels=lab,
-                                          threads=threads) == 3
-    assert expect_faces_of_some_cells(tmp_path, pts, f"{dim}D unlabelled") == 3  # (a net of no cells)
+                                          threads=threads) >= 2
+    assert expect_faces_of_some_cells(tmp_path, pts, f"{dim}D unlabelled") >= 2  # (a net of no cells)
     # Exact ties (a lattice), points set aside outside the bounds, power cells.
     g = np.arange(10) * 0.1
     lattice = np.array(np.meshgrid(*[g] * dim, indexing="ij")).reshape(dim, -1).T.copy()
@@ -544,7 +548,7 @@ def test_faces_of_points_build_the_cells_with_such_faces_alone(tmp_path, dim):
                                ignore_outside=True)
     radii = np.random.default_rng(dim).random(len(pts)) * (0.06 if dim == 3 else 0.02)
     assert expect_faces_of_some_cells(tmp_path, pts, f"{dim}D power", labels=lab, bounds=UNIT_BOX[dim],
-                                      radii=radii) == 3
+                                      radii=radii) >= 2
 
 
 def test_faces_of_points_in_a_periodic_box_build_every_cell(tmp_path):

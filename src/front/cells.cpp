@@ -110,6 +110,22 @@ inline constexpr std::uint64_t tie_weight = 2;
 /// The share of the generators the pilot may build: on small inputs too.
 inline constexpr double pilot_share = 0.5;
 
+/// VoronoiOptions::only_with_faces: the cells with such faces alone are
+/// built where at most this share of them has some (only_with_faces_up_to
+/// 0). The first pass over every cell without the mesh costs about half of
+/// what the mesh pass of every cell does (1M uniform points on two threads:
+/// 3D 0.47, 2D 0.38 of it, as the whole `faces --kind boundary` with 3% and
+/// 0.1% of the cells built), so building a share f of the cells after it
+/// costs about 0.47 + f of the whole mesh pass: more from f ~ 0.5. The
+/// surface nets of the sampled label volume (bench/surface_nets, 256^3 and
+/// 12 labels, capped: 67% of the cells) took 15-25% longer so (docs/
+/// design.md, "Face sets of some cells").
+inline constexpr double with_faces_share = 0.5;
+/// The cells sampled to estimate that share: spread over the generators
+/// (every k-th in bin order), ~0.2% of the first pass on 1M points; an
+/// estimate within ~0.01 of the share (its standard error at one half).
+inline constexpr std::size_t with_faces_sample = 2048;
+
 /// InputError unless every id of VoronoiOptions::only is one of the n
 /// points' (after the input's own checks: an empty input says so first).
 void check_only(std::span<const std::int32_t> only, std::size_t n) {
@@ -208,7 +224,29 @@ Cells run(std::span<const double> input, std::span<const std::int32_t> labels, c
   // left here too: its kept batches are the mesh compositor's, with owners
   // decided before the cells to build were known.
   const SpokeClassSet with_faces = opt.only_with_faces;
-  const bool find_with_faces = with_faces != 0 && (with_faces & spoke_class_bit(SpokeClass::same_region)) == 0;
+  bool find_with_faces = with_faces != 0 && (with_faces & spoke_class_bit(SpokeClass::same_region)) == 0;
+  if (find_with_faces && pass.order.size() > with_faces_sample) {
+    // Where most cells have such faces, all are built: a sample of them,
+    // spread over the generators (every k-th in bin order), says which.
+    const double up_to = opt.only_with_faces_up_to > 0 ? opt.only_with_faces_up_to : with_faces_share;
+    std::vector<std::int32_t> sample_order;
+    std::vector<std::uint32_t> sample_slots;
+    const std::size_t step = pass.order.size() / with_faces_sample;
+    for (std::size_t q = step / 2; q < pass.order.size(); q += step) {
+      sample_order.push_back(pass.order[q]);
+      sample_slots.push_back(pass.slots[q]);
+    }
+    pass.gens.order = sample_order;
+    pass.gens.slots = sample_slots;
+    front::SpokeClassMarker<CellT> sample(labels, with_faces, out.n_points);
+    engine::EngineOptions quiet = pass.engine_options;
+    quiet.progress = nullptr;
+    out.exact_predicate_calls += engine::tessellate<CellT>(pass.gens, sample, quiet);
+    pass.gens.order = pass.order;
+    pass.gens.slots = pass.slots;
+    const std::size_t cells = sample_order.size() - sample.empty_cells().size();
+    find_with_faces = static_cast<double>(sample.count()) <= up_to * static_cast<double>(cells);
+  }
   if (find_with_faces) {
     kept.batches.clear();
     kept.exact_calls = 0;
