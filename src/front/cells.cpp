@@ -113,13 +113,14 @@ inline constexpr double pilot_share = 0.5;
 /// VoronoiOptions::only_with_faces: the cells with such faces alone are
 /// built where at most this share of them has some (only_with_faces_up_to
 /// 0). The first pass over every cell without the mesh costs about half of
-/// what the mesh pass of every cell does (1M uniform points on two threads:
-/// 3D 0.47, 2D 0.38 of it, as the whole `faces --kind boundary` with 3% and
-/// 0.1% of the cells built), so building a share f of the cells after it
-/// costs about 0.47 + f of the whole mesh pass: more from f ~ 0.5. The
-/// surface nets of the sampled label volume (bench/surface_nets, 256^3 and
-/// 12 labels, capped: 67% of the cells) took 15-25% longer so (docs/
-/// design.md, "Face sets of some cells").
+/// what the mesh pass of every cell does (1M uniform points, as the whole
+/// `faces --kind boundary` with 3% (3D) and 0.1% (2D) of the cells built:
+/// 3D 0.43 of it on one thread, 0.50 on two; 2D 0.41 and 0.49), so building
+/// a share f of the cells after it costs about 0.5 + f of the whole mesh
+/// pass: more from f ~ 0.5. The cells of the surface nets' sampled label
+/// volume (bench/surface_nets, 256^3 and 12 labels, capped: 67% of them
+/// with faces of the net) took 28% longer so (docs/design.md, "Face sets of
+/// some cells").
 inline constexpr double with_faces_share = 0.5;
 /// The cells sampled to estimate that share: spread over the generators
 /// (every k-th in bin order), ~0.2% of the first pass on 1M points; an
