@@ -184,7 +184,9 @@ struct VoronoiOptions {
   /// such cells (Cells::partial).
   std::span<const std::int32_t> only;
   /// Build only the cells that have a face of one of these spoke classes
-  /// (0: every cell): those whose faces a face set of such faces reads
+  /// (0: every cell), where at most half the cells have one (else every
+  /// cell, which is then faster: only_with_faces_up_to): the cells whose
+  /// faces a face set of such faces reads
   /// (face_set_classes, faces.hpp: a boundary's are on the box or against
   /// outside points, a surface net's between regions). A first pass builds
   /// every cell without the mesh and finds them by their spokes; the pass
@@ -215,8 +217,9 @@ struct VoronoiOptions {
   /// built (Cells::partial false), which is then faster: the first pass
   /// costs about half of what the mesh of every cell does (docs/design.md,
   /// "Face sets of some cells"). The share is estimated from a sample of
-  /// about 2,000 cells spread over the generators (above 2,000: fewer go
-  /// straight to the first pass). 0: automatic (one half); 1: always some.
+  /// about 2,000 cells spread over the generators (up to 2,048 generators
+  /// go straight to the first pass, and then their cells with such faces
+  /// alone are built). 0: automatic (one half); 1: always some.
   double only_with_faces_up_to = 0;
   /// Some axis periodic, or a tilt given (which needs periodic axes).
   bool periodic_box() const {
@@ -312,8 +315,8 @@ struct Cells {
   std::size_t far_points = 0;
   /// The generators of the whole computation: the points that take part
   /// with a label >= 0 (or no labels) and are no duplicate. n_cells() but
-  /// for power cells found empty, and with VoronoiOptions::only, which
-  /// builds some of their cells.
+  /// for power cells found empty, and with VoronoiOptions::only or
+  /// only_with_faces, which build some of their cells.
   std::size_t generators = 0;
   /// Some cells only, not a whole tessellation: VoronoiOptions::only or
   /// only_with_faces left some generator's cell out. validate() and
