@@ -40,9 +40,13 @@ struct Computed {
 /// neighbours' (VoronoiOptions::only), each as among all cells, not all N.
 /// Ids that are no point are left to the caller to refuse, after the cells
 /// as when all were built (input errors first); where none is one, point
-/// 0's cell stands in. The summary's count is still all cells'
-/// (Cells::generators: flower takes no radii, so none is an empty power cell).
-Computed read_and_compute(const ComputeArgs& a, bool quiet, std::span<const std::int64_t> asked = {}) {
+/// 0's cell stands in. `with_faces` (faces): only the cells with a face of
+/// these classes (VoronoiOptions::only_with_faces), which give the face set
+/// of all cells. The summary's count is still all cells' (Cells::generators
+/// less the empty power cells: with only_with_faces Cells::empty_cells are
+/// all of them, and flower takes no radii, so none is empty).
+Computed read_and_compute(const ComputeArgs& a, bool quiet, std::span<const std::int64_t> asked = {},
+                          SpokeClassSet with_faces = 0) {
   Computed r;
   r.pc = read_input(a);
   VoronoiOptions opt = make_options(a, r.pc.dim);
@@ -52,8 +56,9 @@ Computed read_and_compute(const ComputeArgs& a, bool quiet, std::span<const std:
     if (id >= 0 && static_cast<std::uint64_t>(id) < r.pc.n) only.push_back(static_cast<std::int32_t>(id));
   if (!asked.empty() && only.empty()) only.push_back(0);
   opt.only = only;
+  opt.only_with_faces = with_faces;
   r.cells = compute(r.pc, opt, !quiet && stderr_is_terminal(), r.seconds);
-  r.n_cells = only.empty() ? r.cells.n_cells() : r.cells.generators;
+  r.n_cells = r.cells.partial ? r.cells.generators - r.cells.empty_cells.size() : r.cells.n_cells();
   if (r.n_cells == 0) throw InputError(no_cells_reason(r.pc, r.cells));
   return r;
 }
@@ -189,10 +194,11 @@ int run_faces_frame(const FacesArgs& a) {
   check_bounds_arg(a.compute.bounds);
   io::check_writable(a.output);
 
-  const Computed r = read_and_compute(a.compute, a.quiet);
   FaceSetOptions fo;
   fo.kind = *kind;
   fo.capping = a.capping;
+  // The cells with a face of the set only (for the complex, all of them).
+  const Computed r = read_and_compute(a.compute, a.quiet, {}, face_set_classes(fo));
   const FaceSet fs = extract_faces(r.cells, r.pc.labels, fo);
   io::write_faces_vtp(a.output, fs);
 

@@ -460,13 +460,13 @@ int run_bench_surface_nets(const SurfaceNetsArgs& a) {
     std::printf(
         "{\"tool\":\"tessera\",\"op\":\"surface-nets\",\"n\":%zu,\"threads\":%d,\"seconds\":%.6f,\"simplices\":%zu,"
         "\"extra\":{\"cpu_user_s\":%.6f,\"cpu_sys_s\":%.6f,\"minflt\":%lld,\"peak_rss_bytes\":%lld,\"voxels\":%zu,"
-        "\"points\":%zu,\"cells\":%zu,\"polygons\":%zu,\"triangles\":%zu,\"vertices\":%zu,\"labels\":%zu,"
-        "\"watertight\":%s,\"open_labels\":%zu,\"boundary_edges\":%zu,\"nonmanifold_edges\":%zu,"
+        "\"points\":%zu,\"cells\":%zu,\"cells_built\":%zu,\"polygons\":%zu,\"triangles\":%zu,\"vertices\":%zu,"
+        "\"labels\":%zu,\"watertight\":%s,\"open_labels\":%zu,\"boundary_edges\":%zu,\"nonmanifold_edges\":%zu,"
         "\"sample_s\":%.6f,\"cells_s\":%.6f,\"faces_s\":%.6f,\"smoothing_s\":%.6f,\"triangulation_s\":%.6f,"
         "\"smooth\":%d,\"capping\":%s,\"repeat\":%d}}\n",
         in.size(), threads, secs, net.mesh.n_faces(), u1.user_s - u0.user_s, u1.sys_s - u0.sys_s,
         u1.minflt - u0.minflt, u1.maxrss_bytes, in.from_image ? in.geometry.n_voxels() : std::size_t{0}, in.size(),
-        net.n_cells, polygon_count(net), tris, net.mesh.n_vertices(), net.selected.size(),
+        net.n_cells, net.cells_built, polygon_count(net), tris, net.mesh.n_vertices(), net.selected.size(),
         w.closed() ? "true" : "false", w.open_labels.size(), w.boundary_edges, w.nonmanifold_edges, sample_s,
         net.seconds.cells, net.seconds.faces, net.seconds.smoothing, net.seconds.triangulation, a.smooth,
         a.capping ? "true" : "false", rep);

@@ -72,6 +72,20 @@ inline void periodic_image(const std::array<std::array<double, 3>, 3>& lattice, 
   }
 }
 
+/// Spoke classes (DESIGN §2, the classifier): the kind of each cell face.
+enum class SpokeClass : std::uint8_t {
+  same_region = 0,     ///< neighbour is an inside point with the same label
+  region_boundary = 1, ///< neighbour is an inside point with another label
+  domain_boundary = 2, ///< face lies on the domain box
+  outside = 3,         ///< neighbour is an outside point (label < 0)
+};
+
+/// A set of spoke classes: bit 1 << c for each SpokeClass c in it.
+using SpokeClassSet = std::uint8_t;
+constexpr SpokeClassSet spoke_class_bit(SpokeClass c) {
+  return static_cast<SpokeClassSet>(1u << static_cast<unsigned>(c));
+}
+
 /// How a cell finds the points that clip it (tessera::voronoi).
 enum class CellMethod {
   /// The search, unless a pilot of a few hundred cells finds them far
@@ -166,8 +180,47 @@ struct VoronoiOptions {
   /// no cell (outside label, duplicate, set aside) is left out. Viewed, not
   /// copied. For flowers of a few cells (flower.hpp), at a few cells' cost;
   /// not for validate(), which checks a whole tessellation (the volumes
-  /// sum to the domain's, every vertex has all its cells).
+  /// sum to the domain's, every vertex has all its cells) and refuses
+  /// such cells (Cells::partial).
   std::span<const std::int32_t> only;
+  /// Build only the cells that have a face of one of these spoke classes
+  /// (0: every cell), where at most half the cells have one (else every
+  /// cell, which is then faster: only_with_faces_up_to): the cells whose
+  /// faces a face set of such faces reads
+  /// (face_set_classes, faces.hpp: a boundary's are on the box or against
+  /// outside points, a surface net's between regions). A first pass builds
+  /// every cell without the mesh and finds them by their spokes; the pass
+  /// set-up is shared as with `only` (the pilot and, where it picks the
+  /// insertion, the triangulation, once), and each cell built is bit for
+  /// bit the cell of the whole computation. Built alone, not with their
+  /// neighbours: the merged vertices of their faces of these classes keep
+  /// their owners, and so their positions and relative order. Such a
+  /// vertex's key holds the D + 1 points (or box planes) around it, which
+  /// pairwise share a face (also where exact ties are settled by the
+  /// symbolic perturbation); each cell of the key faces the box plane or
+  /// the outside point in it, or, the key holding two cells of different
+  /// regions, faces a cell of another region: every cell of the key is
+  /// built, and the lowest (the owner, CellsCompositor) is the whole
+  /// computation's. So extract_faces of these cells gives the face set of
+  /// all cells, byte for byte (docs/design.md, "Face sets of some cells").
+  /// Cells::partial says whether some cell was left out, and then
+  /// Cells::empty_cells lists every generator's empty power cell (the
+  /// first pass saw them all). A set with same_region builds every cell:
+  /// faces inside a region have no such closure (a cell of another region
+  /// around their vertex may have none), and the face set that needs them,
+  /// the complex, has faces in every cell. Not with `only` (InputError).
+  /// In a periodic box every cell is built (some cells' images may differ
+  /// in the last bits, see `only`).
+  SpokeClassSet only_with_faces = 0;
+  /// With only_with_faces: the largest share of the cells with such faces
+  /// at which those alone are built; where more have them, every cell is
+  /// built (Cells::partial false), which is then faster: the first pass
+  /// costs about half of what the mesh of every cell does (docs/design.md,
+  /// "Face sets of some cells"). The share is estimated from a sample of
+  /// about 2,000 cells spread over the generators (up to 2,048 generators
+  /// go straight to the first pass, and then their cells with such faces
+  /// alone are built). 0: automatic (one half); 1: always some.
+  double only_with_faces_up_to = 0;
   /// Some axis periodic, or a tilt given (which needs periodic axes).
   bool periodic_box() const {
     return periodic[0] || periodic[1] || periodic[2] || tilt[0] != 0 || tilt[1] != 0 || tilt[2] != 0;
@@ -175,14 +228,6 @@ struct VoronoiOptions {
   /// Called from the calling thread with the fraction done, in [0,1]; may throw
   /// Cancelled to stop the run (the engine stops between batches).
   std::function<void(double)> progress;
-};
-
-/// Spoke classes (DESIGN §2, the classifier): the kind of each cell face.
-enum class SpokeClass : std::uint8_t {
-  same_region = 0,     ///< neighbour is an inside point with the same label
-  region_boundary = 1, ///< neighbour is an inside point with another label
-  domain_boundary = 2, ///< face lies on the domain box
-  outside = 3,         ///< neighbour is an outside point (label < 0)
 };
 
 /// The Voronoi tessellation of the inside points, clipped to the domain box.
@@ -270,9 +315,18 @@ struct Cells {
   std::size_t far_points = 0;
   /// The generators of the whole computation: the points that take part
   /// with a label >= 0 (or no labels) and are no duplicate. n_cells() but
-  /// for power cells found empty, and with VoronoiOptions::only, which
-  /// builds some of their cells.
+  /// for power cells found empty, and with VoronoiOptions::only or
+  /// only_with_faces, which build some of their cells.
   std::size_t generators = 0;
+  /// Some cells only, not a whole tessellation: VoronoiOptions::only or
+  /// only_with_faces left some generator's cell out. validate() and
+  /// adjacency_graph() refuse such cells (std::invalid_argument), and
+  /// extract_faces() takes them only where with_faces_of covers its face
+  /// set; flowers() takes them.
+  bool partial = false;
+  /// VoronoiOptions::only_with_faces where it left cells out (else 0):
+  /// every cell with a face of one of these classes is here.
+  SpokeClassSet with_faces_of = 0;
   int threads_used = 1;
   /// The cells came from the Delaunay triangulation by insertion (CellMethod).
   bool from_insertion = false;
@@ -362,6 +416,8 @@ inline constexpr double measure_tolerance = 0x1p-28;
 /// (Cells::vertex_key_shifts), and the exact-measure check is left out.
 /// Power cells (Cells::power) measure exactly with their `radii`, which
 /// must then come with the points (std::invalid_argument otherwise).
+/// Cells that are some only (Cells::partial) are refused
+/// (std::invalid_argument): the checks are of a whole tessellation.
 ValidationReport validate(const Cells& cells, std::span<const std::int32_t> labels,
                           std::span<const double> points = {}, std::span<const double> radii = {});
 

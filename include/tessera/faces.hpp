@@ -128,8 +128,17 @@ struct VertexCopies {
 /// face set without a shift per key entry.
 VertexCopies vertex_copies(const FaceSet& faces);
 
+/// The spoke classes of the faces of a face set: domain_boundary and
+/// outside for the boundary; region_boundary for a surface net, with
+/// capping those two as well; every class for the complex. The cells
+/// computed with VoronoiOptions::only_with_faces = face_set_classes(options)
+/// are those with a face of the set, and their face set is the one of all
+/// cells, byte for byte (for the complex every cell is built).
+SpokeClassSet face_set_classes(const FaceSetOptions& options);
+
 /// Extract a face set from cells computed with VoronoiOptions::build_mesh
-/// (std::invalid_argument otherwise). `labels` are the labels the cells were
+/// (std::invalid_argument otherwise, and for cells that are some only,
+/// Cells::partial, unless Cells::with_faces_of holds face_set_classes). `labels` are the labels the cells were
 /// computed with (empty or one per point); they give outside points' labels.
 /// Faces are listed in cell (generator-id) order, each cell's faces in its
 /// mesh order. Throws InputError for labels of the wrong length or a

@@ -61,7 +61,8 @@ struct AdjacencyGraph {
 };
 
 /// The graph of a tessellation computed with VoronoiOptions::build_mesh
-/// (std::invalid_argument otherwise), periodic boxes included. Throws InputError for a negative or
+/// (std::invalid_argument otherwise, and for cells that are some only,
+/// Cells::partial), periodic boxes included. Throws InputError for a negative or
 /// non-finite prune tolerance.
 AdjacencyGraph adjacency_graph(const Cells& cells, const GraphOptions& options = {});
 

@@ -100,7 +100,9 @@ struct SmoothingOptions {
 };
 
 struct SurfaceNetsOptions {
-  VoronoiOptions voronoi;           ///< dim 2 or 3; build_mesh is forced on
+  /// dim 2 or 3; build_mesh is forced on, and only_with_faces set to the
+  /// net's classes (face_set_classes).
+  VoronoiOptions voronoi;
   /// Selected (inside) labels; empty = every label >= 0 present. Points with
   /// other labels are outside points: they clip, and own no cell.
   std::vector<std::int32_t> select;
@@ -120,7 +122,11 @@ struct SurfaceNet {
   /// Per output face: the index of the Voronoi face (polygon) it came from
   /// (identity without triangulation).
   std::vector<std::int64_t> polygon_of_face;
-  std::size_t n_cells = 0;                 ///< cells computed (selected points)
+  /// The cells of the selected points.
+  std::size_t n_cells = 0;
+  /// Of those, the cells built with the mesh: those with a face of the net
+  /// (VoronoiOptions::only_with_faces), or all n_cells.
+  std::size_t cells_built = 0;
   double max_displacement = 0;             ///< largest distance a vertex moved
   std::vector<std::int32_t> selected;      ///< the selected labels, ascending
   /// Wall time of each stage, seconds.

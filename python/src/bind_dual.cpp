@@ -111,6 +111,19 @@ void bind_dual(py::module_& m) {
       py::arg("cells"), py::arg("labels").none(true), py::arg("kind"), py::arg("capping"),
       py::arg("background_label"), "A face set of cells computed with merge=True; labels as given to voronoi().");
 
+  m.def(
+      "face_set_classes",
+      [](const std::string& kind, bool capping) {
+        const auto k = parse_face_set_kind(kind);
+        if (!k) throw py::value_error("kind: expected 'boundary', 'complex' or 'surface-net', got '" + kind + "'");
+        FaceSetOptions opt;
+        opt.kind = *k;
+        opt.capping = capping;
+        return static_cast<int>(face_set_classes(opt));
+      },
+      py::arg("kind"), py::arg("capping"),
+      "The spoke classes of a face set's faces, as voronoi()'s only_with_faces takes them.");
+
   // ---- flowers ------------------------------------------------------------
   // A Flower is an element of its FlowerSet (returned by reference, keeping
   // the set alive); its arrays view the set's buffers through it.

@@ -31,7 +31,7 @@ using Points = py::array_t<double, py::array::c_style>;
 Cells run_voronoi(const Points& points, const py::object& labels, const std::optional<std::vector<double>>& bounds,
                   double padding, bool ignore_outside, int threads, bool merge, const std::string& method,
                   const std::array<bool, 3>& periodic, const std::array<double, 3>& tilt,
-                  const py::object& radii, const py::object& only) {
+                  const py::object& radii, const py::object& only, int only_with_faces) {
   const int dim = checked_dim(points);
   VoronoiOptions opt;
   fill_common(opt, dim, bounds, padding, ignore_outside, threads);
@@ -45,6 +45,11 @@ Cells run_voronoi(const Points& points, const py::object& labels, const std::opt
       throw py::type_error("only must be None or a C-contiguous int32 array");
     opt.only = as_labels(only);
   }
+  // Some cells only (faces of points): a set of spoke classes (face_set_classes).
+  if (only_with_faces < 0 || only_with_faces > 15)
+    throw py::value_error("only_with_faces must be a set of spoke classes (0..15), got " +
+                          std::to_string(only_with_faces));
+  opt.only_with_faces = static_cast<SpokeClassSet>(only_with_faces);
   if (method == "auto") opt.cell_method = CellMethod::automatic;
   else if (method == "search") opt.cell_method = CellMethod::search;
   else if (method == "insertion") opt.cell_method = CellMethod::insertion;
@@ -164,6 +169,9 @@ void bind_voronoi(py::module_& m) {
       .def_readonly("from_insertion", &Cells::from_insertion)
       .def_readonly("assembled_from_stars", &Cells::assembled_from_stars)
       .def_readonly("cells_from_pilot", &Cells::cells_from_pilot)
+      .def_readonly("generators", &Cells::generators)
+      .def_readonly("partial", &Cells::partial)
+      .def_readonly("with_faces_of", &Cells::with_faces_of)
       // per cell
       .def_property_readonly("generator", [](py::object s) { return view_flat(s.cast<const Cells&>().generator, s); })
       .def_property_readonly("region", [](py::object s) { return view_flat(s.cast<const Cells&>().region, s); })
@@ -237,10 +245,11 @@ void bind_voronoi(py::module_& m) {
   m.def("voronoi", &run_voronoi, py::arg("points").noconvert(), py::arg("labels").none(true), py::arg("bounds"),
         py::arg("padding"), py::arg("ignore_outside"), py::arg("threads"), py::arg("merge"),
         py::arg("method"), py::arg("periodic"), py::arg("tilt"), py::arg("radii").none(true) = py::none(),
-        py::arg("only").none(true) = py::none(),
+        py::arg("only").none(true) = py::none(), py::arg("only_with_faces") = 0,
         "Cells of float64 C-ordered (N, D) points; labels None or int32 (N,); radii None or float64 (N,) "
-        "(power cells); only None or int32 ids: those cells and their neighbours' (VoronoiOptions::only). "
-        "Runs without the GIL.");
+        "(power cells); only None or int32 ids: those cells and their neighbours' (VoronoiOptions::only); "
+        "only_with_faces: a set of spoke classes (face_set_classes), the cells with a face of one of them "
+        "(VoronoiOptions::only_with_faces). Runs without the GIL.");
 
   m.def(
       "validate_cells",

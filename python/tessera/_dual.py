@@ -13,7 +13,7 @@ from typing import Any, Iterator, List, Optional, Sequence, Tuple, Union
 import numpy as np
 
 from . import _core, _inputs
-from ._voronoi import Voronoi, cells_of, voronoi
+from ._voronoi import Voronoi, cells_of
 
 PathLike = Union[str, "os.PathLike[str]"]
 
@@ -32,10 +32,13 @@ def cells_for(
     periodic: Any = False,
     tilt: Optional[Sequence[float]] = None,
     radii: Any = None,
+    only_with_faces: int = 0,
 ) -> Voronoi:
     """The Voronoi result a product is read from: `source` itself when it is
     one (the cell options must then be left out: they were fixed when it was
-    computed), else the cells of the points `source`, with the mesh."""
+    computed), else the cells of the points `source`, with the mesh; with
+    ``only_with_faces`` (a set of spoke classes) those with a face of one of
+    them alone (``VoronoiOptions::only_with_faces``)."""
     if isinstance(source, Voronoi):
         given = [n for n, v in (("labels", labels), ("bounds", bounds), ("padding", padding), ("threads", threads),
                                 ("tilt", tilt), ("radii", radii)) if v is not None]
@@ -51,12 +54,12 @@ def cells_for(
             raise ValueError(f"{what}: the Voronoi result was computed with merge=False (no mesh); "
                              "compute it with merge=True")
         if source._partial:  # a graph, faces or flowers of it would silently miss the other cells
-            raise ValueError(f"{what}: this Voronoi result holds some cells only (Flowers.voronoi of "
-                             "tessera.flower(points, ...)); compute all of them with tessera.voronoi(points)")
+            raise ValueError(f"{what}: this Voronoi result holds some cells only (the voronoi of "
+                             "tessera.faces or tessera.flower of points); compute all of them with "
+                             "tessera.voronoi(points)")
         return source
-    return voronoi(source, labels=labels, bounds=bounds, padding=0.01 if padding is None else padding,
-                   threads=threads, merge=True, ignore_outside=ignore_outside, periodic=periodic, tilt=tilt,
-                   radii=radii)
+    return cells_of(source, labels, bounds, 0.01 if padding is None else padding, threads, True, ignore_outside,
+                    "auto", periodic, tilt, radii, None, only_with_faces)
 
 
 def _check_vtp(path: PathLike, what: str) -> str:
@@ -299,7 +302,10 @@ class FaceSet:
 
     @property
     def voronoi(self) -> Optional[Voronoi]:
-        """The cells the faces were read from."""
+        """The cells the faces were read from: the Voronoi given, or of points
+        the cells with a face of the set alone (all of them for ``complex``):
+        a partial result, whose ``n_cells`` are the cells built, and which
+        :meth:`Voronoi.validate` and the products refuse."""
         return self._vor
 
     @property
@@ -435,7 +441,11 @@ def faces(
     ----------
     source : Voronoi or array_like, shape (N, 2) or (N, 3)
         A :class:`Voronoi` computed with ``merge=True`` (reused as is, with the
-        labels it was computed with), or points whose cells are computed first.
+        labels it was computed with), or points whose cells are computed first:
+        of a ``boundary`` or a ``surface-net`` only the cells with a face of
+        the set are built with the mesh (after a pass over all cells without
+        it), the same faces byte for byte (:attr:`FaceSet.voronoi` is then
+        that partial result).
     kind : {'boundary', 'complex', 'surface-net'}
         ``boundary``: the faces on the domain box or against outside points,
         the outward boundary of the union of the cells. ``complex``: every
@@ -458,7 +468,10 @@ def faces(
     if capping and kind != "surface-net":
         raise ValueError(f"capping: applies to kind='surface-net' only, got kind={kind!r}")
     bg = _inputs.as_label_value(background_label, "background_label", negative=True)
-    vor = cells_for("faces", source, labels, bounds, padding, threads, ignore_outside, periodic, tilt, radii)
+    # Of points: the cells with a face of the set alone (their faces are the
+    # set of all cells, byte for byte; for the complex every cell is built).
+    vor = cells_for("faces", source, labels, bounds, padding, threads, ignore_outside, periodic, tilt, radii,
+                    _core.face_set_classes(kind, capping))
     fs = _inputs.call(_core.extract_faces, vor._cells, vor.labels, kind, capping, bg)
     return FaceSet(fs, vor, capping, bg)
 
@@ -696,7 +709,7 @@ def flower(
         # and the cells' own, still come first).
         pts = _inputs.as_points(source)
         vor = cells_of(pts, labels, bounds, 0.01 if padding is None else padding, threads, True, ignore_outside,
-                       "auto", periodic, tilt, None, _existing_ids(ids, pts.shape[0]))
+                       "auto", periodic, tilt, None, _existing_ids(ids, pts.shape[0]), 0)
     idx = as_ids(ids, vor.points.shape[0])
     fs = _inputs.call(_core.flowers, vor._cells, vor.points, idx)
     return Flowers(fs, vor, _inputs.as_flag(glyphs, "glyphs"))

@@ -52,7 +52,7 @@ class Voronoi:
         self._points = points
         self._labels = labels
         self._radii = radii  # kept: validate() measures power cells with them
-        self._partial = False  # some cells only (cells_of with `only`): the products refuse it
+        self._partial = False  # some cells only (cells_of, Cells::partial): the products and validate refuse it
 
     # ---- input and domain -------------------------------------------------
     @property
@@ -302,7 +302,11 @@ class Voronoi:
         shifts, and the vertex and exact-measure checks place each key's
         points at their images (:attr:`vertex_key_shifts`). Power cells are
         checked with their radii (a vertex has equal powers, not distances,
-        to its key's points)."""
+        to its key's points). ValueError for a result that holds some cells
+        only (:attr:`FaceSet.voronoi` and :attr:`Flowers.voronoi` of points)."""
+        if self._partial:
+            raise ValueError("validate: this Voronoi result holds some cells only (the voronoi of tessera.faces or "
+                             "tessera.flower of points); compute all of them with tessera.voronoi(points)")
         return _core.validate_cells(self._cells, self._labels, self._points, self._radii)
 
     @cached_property
@@ -444,16 +448,21 @@ def voronoi(
     The computation runs with the GIL released: other Python threads go on.
     """
     return cells_of(points, labels, bounds, padding, threads, merge, ignore_outside, method, periodic, tilt, radii,
-                    None)
+                    None, 0)
 
 
 def cells_of(points: Any, labels: Any, bounds: Any, padding: float, threads: Any, merge: bool, ignore_outside: bool,
-             method: str, periodic: Any, tilt: Any, radii: Any, only: Optional[np.ndarray]) -> Voronoi:
+             method: str, periodic: Any, tilt: Any, radii: Any, only: Optional[np.ndarray],
+             only_with_faces: int) -> Voronoi:
     """:func:`voronoi`'s work, on its arguments (every one given: the
     defaults are voronoi's alone); with ``only`` (int32 ids that exist) the
     cells of those points and their neighbours alone, each as :func:`voronoi`
     computes it among all the points (``VoronoiOptions::only``;
-    :func:`tessera.flower` of points)."""
+    :func:`tessera.flower` of points); with ``only_with_faces`` (a set of
+    spoke classes, ``_core.face_set_classes``; 0: none) the cells with a
+    face of one of them alone (``VoronoiOptions::only_with_faces``;
+    :func:`tessera.faces` of points). The result is partial where some
+    cell was left out (``Cells::partial``): the products refuse it."""
     pts = _inputs.as_points(points)
     dim = pts.shape[1]
     lab = _inputs.as_labels(labels, pts.shape[0])
@@ -473,9 +482,10 @@ def cells_of(points: Any, labels: Any, bounds: Any, padding: float, threads: Any
         tilts,
         rad,
         only,
+        only_with_faces,
     )
     vor = Voronoi(cells, pts, lab, rad)
-    vor._partial = only is not None
+    vor._partial = cells.partial
     return vor
 
 

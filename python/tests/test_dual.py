@@ -488,6 +488,75 @@ def test_partial_result_of_flower_is_refused_by_the_products():
     assert tessera.flower(whole, [1])[0].generator == 1  # (a whole result is taken as before)
 
 
+FACE_ARRAYS = ("vertices", "vertex_keys", "face_offsets", "face_vertices", "sides", "boundary_labels", "face_class")
+FACE_SETS = (("boundary", False), ("surface-net", False), ("surface-net", True), ("complex", False))
+
+
+def expect_faces_of_some_cells(tmp_path, pts, name, **kw):
+    """faces(points, ...) builds the cells with a face of the set alone
+    (VoronoiOptions::only_with_faces): the face set, and its .vtp, are those
+    of all cells byte for byte; the partial result is refused where every
+    cell is needed. Returns how many kinds left some cell out."""
+    vor = tessera.voronoi(pts, merge=True, **kw)
+    partial = 0
+    for kind, capping in FACE_SETS:
+        what = f"{name}, {kind}{' capped' if capping else ''}"
+        few = tessera.faces(pts, kind=kind, capping=capping, background_label=-4, **kw)
+        full = tessera.faces(vor, kind=kind, capping=capping, background_label=-4)
+        for a in FACE_ARRAYS:
+            assert getattr(few, a).tobytes() == getattr(full, a).tobytes(), (what, a)
+        few.save(tmp_path / "few.vtp")
+        full.save(tmp_path / "full.vtp")
+        assert (tmp_path / "few.vtp").read_bytes() == (tmp_path / "full.vtp").read_bytes(), what
+        built = few.voronoi
+        assert built._partial == (built.n_cells < vor.n_cells), what
+        # The cells with a face of the set's classes: built alone where they
+        # are at most about half (a sample says, above 2,048 cells; all are
+        # built otherwise).
+        classes = tessera._core.face_set_classes(kind, capping)
+        owner = np.repeat(np.arange(vor.n_cells), np.diff(vor.cell_face_offsets))
+        has = np.zeros(vor.n_cells, bool)
+        has[owner[((classes >> vor.face_class.astype(int)) & 1) == 1]] = True
+        if kind == "complex" or (vor.n_cells > 2048 and has.mean() > 0.6) or any(vor.periodic):
+            assert not built._partial, what
+        elif has.mean() < 0.4:
+            assert built._partial, what
+        if built._partial:
+            partial += 1
+            assert np.array_equal(built.generators, vor.generators[has]), what
+            assert np.array_equal(built.volumes, vor.volumes[has]), what
+            for call in (lambda v: v.validate(), lambda v: tessera.adjacency(v),
+                         lambda v: tessera.faces(v, "boundary")):
+                with pytest.raises(ValueError, match="holds some cells only"):
+                    call(built)
+    return partial
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_faces_of_points_build_the_cells_with_such_faces_alone(tmp_path, dim):
+    pts, lab = labelled(4000, dim, seed=20 + dim)
+    for threads in (1, 2):
+        assert expect_faces_of_some_cells(tmp_path, pts, f"{dim}D, {threads} threads", labels=lab,
+                                          threads=threads) >= 2
+    assert expect_faces_of_some_cells(tmp_path, pts, f"{dim}D unlabelled") >= 2  # (a net of no cells)
+    # Exact ties (a lattice), points set aside outside the bounds, power cells.
+    g = np.arange(10) * 0.1
+    lattice = np.array(np.meshgrid(*[g] * dim, indexing="ij")).reshape(dim, -1).T.copy()
+    expect_faces_of_some_cells(tmp_path, lattice, f"{dim}D lattice", labels=(lattice[:, 0] < 0.45).astype(np.int32))
+    wide = pts * 1.2 - 0.1
+    expect_faces_of_some_cells(tmp_path, wide, f"{dim}D set aside", labels=lab, bounds=UNIT_BOX[dim],
+                               ignore_outside=True)
+    radii = np.random.default_rng(dim).random(len(pts)) * (0.06 if dim == 3 else 0.02)
+    assert expect_faces_of_some_cells(tmp_path, pts, f"{dim}D power", labels=lab, bounds=UNIT_BOX[dim],
+                                      radii=radii) >= 2
+
+
+def test_faces_of_points_in_a_periodic_box_build_every_cell(tmp_path):
+    pts, lab = labelled(1500, 3, seed=23)
+    assert expect_faces_of_some_cells(tmp_path, pts, "periodic", labels=lab, bounds=UNIT_BOX[3],
+                                      periodic="xy") == 0
+
+
 @pytest.mark.parametrize("glyphs", [False, True])
 def test_flower_vtp_read_by_vtk(tmp_path, glyphs):
     pts = random_points(300, 3, seed=13)

@@ -18,6 +18,7 @@
 #include "pass.hpp"
 #include "periodic.hpp"
 #include "pilot.hpp"
+#include "spoke_class_marker.hpp"
 #include "tessera/engine/tessellate.hpp"
 #include "tessera/kernels/hull.hpp"
 #include "tessera/kernels/tile.hpp"
@@ -108,6 +109,23 @@ inline constexpr double far_box_tie_limit = 10;
 inline constexpr std::uint64_t tie_weight = 2;
 /// The share of the generators the pilot may build: on small inputs too.
 inline constexpr double pilot_share = 0.5;
+
+/// VoronoiOptions::only_with_faces: the cells with such faces alone are
+/// built where at most this share of them has some (only_with_faces_up_to
+/// 0). The first pass over every cell without the mesh costs about half of
+/// what the mesh pass of every cell does (1M uniform points, as the whole
+/// `faces --kind boundary` with 3% (3D) and 0.1% (2D) of the cells built:
+/// 3D 0.43 of it on one thread, 0.50 on two; 2D 0.41 and 0.49), so building
+/// a share f of the cells after it costs about 0.5 + f of the whole mesh
+/// pass: more from f ~ 0.5. The cells of the surface nets' sampled label
+/// volume (bench/surface_nets, 256^3 and 12 labels, capped: 67% of them
+/// with faces of the net) took 28% longer so (docs/design.md, "Face sets of
+/// some cells").
+inline constexpr double with_faces_share = 0.5;
+/// The cells sampled to estimate that share: spread over the generators
+/// (every k-th in bin order), ~0.2% of the first pass on 1M points; an
+/// estimate within ~0.01 of the share (its standard error at one half).
+inline constexpr std::size_t with_faces_sample = 2048;
 
 /// InputError unless every id of VoronoiOptions::only is one of the n
 /// points' (after the input's own checks: an empty input says so first).
@@ -202,6 +220,38 @@ Cells run(std::span<const double> input, std::span<const std::int32_t> labels, c
     for (const std::int32_t g : opt.only)  // (< 0: a periodic pass's point that takes no part)
       if (g >= 0) only[static_cast<std::size_t>(g) >> 6] |= std::uint64_t{1} << (g & 63);
   }
+  // VoronoiOptions::only_with_faces: the cells found by a first pass over
+  // all (below); same_region asks for every cell. The pilot's cells are
+  // left here too: its kept batches are the mesh compositor's, with owners
+  // decided before the cells to build were known.
+  const SpokeClassSet with_faces = opt.only_with_faces;
+  bool find_with_faces = with_faces != 0 && (with_faces & spoke_class_bit(SpokeClass::same_region)) == 0;
+  if (find_with_faces && pass.order.size() > with_faces_sample) {
+    // Where most cells have such faces, all are built: a sample of them,
+    // spread over the generators (every k-th in bin order), says which.
+    const double up_to = opt.only_with_faces_up_to > 0 ? opt.only_with_faces_up_to : with_faces_share;
+    std::vector<std::int32_t> sample_order;
+    std::vector<std::uint32_t> sample_slots;
+    const std::size_t step = pass.order.size() / with_faces_sample;
+    for (std::size_t q = step / 2; q < pass.order.size(); q += step) {
+      sample_order.push_back(pass.order[q]);
+      sample_slots.push_back(pass.slots[q]);
+    }
+    pass.gens.order = sample_order;
+    pass.gens.slots = sample_slots;
+    front::SpokeClassMarker<CellT> sample(labels, with_faces, out.n_points);
+    engine::EngineOptions quiet = pass.engine_options;
+    quiet.progress = nullptr;
+    out.exact_predicate_calls += engine::tessellate<CellT>(pass.gens, sample, quiet);
+    pass.gens.order = pass.order;
+    pass.gens.slots = pass.slots;
+    const std::size_t cells = sample_order.size() - sample.empty_cells().size();
+    find_with_faces = static_cast<double>(sample.count()) <= up_to * static_cast<double>(cells);
+  }
+  if (find_with_faces) {
+    kept.batches.clear();
+    kept.exact_calls = 0;
+  }
   // The search's pass leaves out the cells its pilot built whole.
   std::vector<std::uint64_t> built;
   if (stars || kept.batches.empty()) {
@@ -215,27 +265,27 @@ Cells run(std::span<const double> input, std::span<const std::int32_t> labels, c
     }
     pass.gens.skip = built;
   }
+  // The generators of a set (bit g of `set`), in bin order as the pass
+  // lists them (its order and slots, restricted).
   std::vector<std::int32_t> only_order;
   std::vector<std::uint32_t> only_slots;
+  auto restrict_order = [&](std::span<const std::uint64_t> set) {
+    only_order.clear();
+    only_slots.clear();
+    for (std::size_t q = 0; q < pass.order.size(); ++q) {
+      const std::int32_t g = pass.order[q];
+      if ((set[static_cast<std::size_t>(g) >> 6] >> (g & 63) & 1) == 0) continue;
+      only_order.push_back(g);
+      only_slots.push_back(pass.slots[q]);
+    }
+    pass.gens.order = only_order;
+    pass.gens.slots = only_slots;
+  };
   if (!only.empty()) {
-    // The generators of `only`, in bin order as the pass lists them (its
-    // order and slots, restricted).
-    auto restrict_order = [&] {
-      only_order.clear();
-      only_slots.clear();
-      for (std::size_t q = 0; q < pass.order.size(); ++q) {
-        const std::int32_t g = pass.order[q];
-        if ((only[static_cast<std::size_t>(g) >> 6] >> (g & 63) & 1) == 0) continue;
-        only_order.push_back(g);
-        only_slots.push_back(pass.slots[q]);
-      }
-      pass.gens.order = only_order;
-      pass.gens.slots = only_slots;
-    };
     // First the cells asked for, for their neighbours (a few cells, no
     // mesh); then those with their neighbours, whose cells own the merged
     // vertices the cells asked for share with them.
-    restrict_order();
+    restrict_order(only);
     Cells first;
     first.dim = D;
     first.n_points = out.n_points;
@@ -244,8 +294,33 @@ Cells run(std::span<const double> input, std::span<const std::int32_t> labels, c
     quiet.progress = nullptr;
     out.exact_predicate_calls += engine::tessellate<CellT>(pass.gens, scout, quiet);
     for (const std::int32_t j : first.neighbors) only[static_cast<std::size_t>(j) >> 6] |= std::uint64_t{1} << (j & 63);
-    restrict_order();
+    restrict_order(only);
+    out.partial = only_order.size() < pass.order.size();
     comp.build_only(only);
+  }
+  std::vector<std::uint64_t> found;  // only_with_faces: the cells to build
+  if (find_with_faces) {
+    // Every cell without the mesh, for its spokes' classes (no measures,
+    // no neighbour lists kept: a bit per generator); then the cells marked,
+    // with the mesh (VoronoiOptions::only_with_faces says why they suffice).
+    // The progress bar gives the first pass the first half of what is left
+    // after the insertion, the cells marked the second.
+    front::SpokeClassMarker<CellT> marker(labels, with_faces, out.n_points);
+    const double from = stars ? 0.5 : 0.0, share = 0.5 * (1 - from);
+    engine::EngineOptions first = pass.engine_options;
+    first.progress = nullptr;
+    if (opt.progress) first.progress = [&opt, from, share](double f) { opt.progress(from + share * f); };
+    out.exact_predicate_calls += engine::tessellate<CellT>(pass.gens, marker, first);
+    if (opt.progress)
+      pass.engine_options.progress = [&opt, from, share](double f) { opt.progress(from + share * (1 + f)); };
+    found = std::move(marker.marked());
+    out.empty_cells = std::move(marker.empty_cells());  // every generator's (the compositor adds none of its own)
+    restrict_order(found);
+    if (marker.count() + out.empty_cells.size() < pass.order.size()) {
+      out.partial = true;
+      out.with_faces_of = with_faces;
+    }
+    comp.build_only(found);
   }
   out.exact_predicate_calls +=
       engine::tessellate<CellT>(pass.gens, comp, pass.engine_options, std::move(kept.batches)) + kept.exact_calls;
@@ -275,6 +350,7 @@ Cells run_periodic(std::span<const double> input, int dim, std::span<const std::
   o.periodic = {false, false, false};
   o.tilt = {0, 0, 0};
   o.ignore_outside_points = false;  // set aside already; every image lies in the layer
+  o.only_with_faces = 0;            // every cell (VoronoiOptions::only_with_faces)
   std::vector<double> radii;  // power cells: each image has its point's radius
   auto [aug, im] = front::run_in_final_layer(in, labels, threads, [&](const front::PeriodicImages& images,
                                                                       std::vector<double>& reach) {
@@ -293,8 +369,10 @@ Cells run_periodic(std::span<const double> input, int dim, std::span<const std::
     return run<CellT>(images.points, images.labels, o, &reach);
   });
   const std::size_t generators = aug.generators;
+  const bool partial = aug.partial;  // (only)
   Cells out = front::periodic_cells(std::move(aug), in, im, labels, threads);
   out.generators = generators;
+  out.partial = partial;
   return out;
 }
 
@@ -304,6 +382,8 @@ Cells voronoi(std::span<const double> input, int dim, std::span<const std::int32
               const VoronoiOptions& options) {
   if (!options.radii.empty() && (dim == 2 || dim == 3))
     front::check_radii(options.radii, input.size() / static_cast<std::size_t>(dim));
+  if (!options.only.empty() && options.only_with_faces != 0)
+    throw InputError("only and only_with_faces cannot be combined: give the cells wanted by one of them");
   if (options.periodic_box()) {
     if (!options.periodic[0] && !options.periodic[1] && !options.periodic[2])
       throw InputError("a tilt (triclinic box) needs periodic axes");

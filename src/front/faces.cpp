@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <atomic>
 #include <numeric>
+#include <stdexcept>
 #include <string>
 #include <utility>
 
@@ -28,9 +29,23 @@ const char* face_set_kind_name(FaceSetKind kind) {
   return "?";
 }
 
+SpokeClassSet face_set_classes(const FaceSetOptions& options) {
+  const SpokeClassSet bounding =
+      spoke_class_bit(SpokeClass::domain_boundary) | spoke_class_bit(SpokeClass::outside);
+  switch (options.kind) {
+    case FaceSetKind::boundary: return bounding;
+    case FaceSetKind::complex: return bounding | spoke_class_bit(SpokeClass::same_region) |
+                                      spoke_class_bit(SpokeClass::region_boundary);
+    case FaceSetKind::surface_net:
+      return spoke_class_bit(SpokeClass::region_boundary) | (options.capping ? bounding : SpokeClassSet{0});
+  }
+  return 0;
+}
+
 namespace {
 
-/// Which faces of a cell belong to the set. Every face of the tessellation is
+/// Which faces of a cell belong to the set: faces of the classes
+/// face_set_classes names, each once. Every face of the tessellation is
 /// seen from each cell on its sides; a face between two cells is taken from
 /// side 0 only, so each face is listed once and already oriented from side 0
 /// to side 1 (cell faces are counter-clockwise seen from outside their cell).
@@ -74,6 +89,13 @@ class FaceSelector {
 
 FaceSet extract_faces(const Cells& c, std::span<const std::int32_t> labels, const FaceSetOptions& options) {
   front::require_mesh(c, "extract_faces", true);
+  // Some cells only: those with a face of the set's classes suffice
+  // (VoronoiOptions::only_with_faces), others (VoronoiOptions::only) miss faces.
+  if (c.partial && (c.with_faces_of == 0 || (face_set_classes(options) & ~c.with_faces_of) != 0))
+    throw std::invalid_argument(std::string("extract_faces: these cells are some only (Cells::partial), not every "
+                                            "cell with a face of a ") +
+                                face_set_kind_name(options.kind) +
+                                " face set (VoronoiOptions::only_with_faces = face_set_classes)");
   if (!labels.empty() && labels.size() != c.n_points)
     throw InputError("labels: " + std::to_string(labels.size()) + " values for " + std::to_string(c.n_points) +
                      " points");

@@ -40,6 +40,7 @@ bool speaks(std::int32_t i, std::int32_t j, const std::array<int, 3>& s) {
 
 AdjacencyGraph adjacency_graph(const Cells& c, const GraphOptions& options) {
   front::require_mesh(c, "adjacency_graph", true);
+  front::refuse_partial(c, "adjacency_graph");
   if (!(options.prune_tolerance >= 0) || !std::isfinite(options.prune_tolerance))
     throw InputError("prune tolerance must be a finite number >= 0, got " + std::to_string(options.prune_tolerance));
   const std::size_t nc = c.n_cells();

@@ -45,6 +45,16 @@ inline void require_mesh(const Cells& c, const char* who, bool periodic_too = fa
   if (c.is_periodic() && c.face_shift.size() != nf * static_cast<std::size_t>(c.dim)) fail("periodic cells without face shifts");
 }
 
+/// Cells that are some only (Cells::partial: VoronoiOptions::only or
+/// only_with_faces) are no whole tessellation: what needs every cell (the
+/// adjacency graph, validate) refuses them, as a caller's mistake.
+inline void refuse_partial(const Cells& c, const char* who) {
+  if (c.partial)
+    throw std::invalid_argument(std::string(who) +
+                                ": these cells are some only (Cells::partial: VoronoiOptions::only or "
+                                "only_with_faces), not a whole tessellation");
+}
+
 /// Area of a 3D face (a planar convex polygon, via the fan from its first
 /// vertex) or length of a 2D face (an edge).
 inline double face_measure(const Cells& c, std::int64_t f) {

@@ -153,9 +153,16 @@ SurfaceNet surface_nets(std::span<const double> points, std::span<const std::int
     });
   });
 
+  FaceSetOptions fo;
+  fo.kind = FaceSetKind::surface_net;
+  fo.capping = options.capping;
+  fo.background_label = options.background_label;
   auto t0 = Clock::now();
   VoronoiOptions vo = options.voronoi;
   vo.build_mesh = true;
+  // The cells with a face of the net only (VoronoiOptions::only_with_faces):
+  // the same net.
+  vo.only_with_faces = face_set_classes(fo);
   // In a periodic box the faces lie where the cells took the points (wrapped
   // into the box): smoothing and triangulation measure against those.
   std::vector<double> wrapped;
@@ -165,14 +172,11 @@ SurfaceNet surface_nets(std::span<const double> points, std::span<const std::int
       wrapped.assign(cells.periodic_points.begin(), cells.periodic_points.end());
       points = wrapped;
     }
-    out.n_cells = cells.n_cells();
+    out.n_cells = cells.partial ? cells.generators : cells.n_cells();  // (no radii: no empty cells)
+    out.cells_built = cells.n_cells();
     out.seconds.cells = since(t0);
     std::vector<std::int32_t>().swap(cell_labels);
     t0 = Clock::now();
-    FaceSetOptions fo;
-    fo.kind = FaceSetKind::surface_net;
-    fo.capping = options.capping;
-    fo.background_label = options.background_label;
     out.mesh = extract_faces(cells, labels, fo);
     out.seconds.faces = since(t0);
   }  // the cells are freed here

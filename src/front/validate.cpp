@@ -318,6 +318,11 @@ ValidationReport validate_in_arena(const Cells& c, std::span<const std::int32_t>
 
 ValidationReport validate(const Cells& c, std::span<const std::int32_t> labels, std::span<const double> points,
                           std::span<const double> radii) {
+  // Some cells only (VoronoiOptions::only, only_with_faces): their volumes
+  // do not tile the domain, and their vertices miss cells.
+  if (c.partial)
+    throw std::invalid_argument("validate: these cells are some only (Cells::partial: VoronoiOptions::only or "
+                                "only_with_faces), not a whole tessellation");
   if (!labels.empty() && labels.size() != c.n_points)
     throw std::invalid_argument("validate: " + std::to_string(labels.size()) + " labels given for " +
                                 std::to_string(c.n_points) + " points");
