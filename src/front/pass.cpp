@@ -18,7 +18,7 @@ namespace tessera::front {
 namespace {
 }  // namespace
 
-void check_input(std::span<const double> points, int dim, std::span<const std::int32_t> labels) {
+void check_shape(std::span<const double> points, int dim, std::span<const std::int32_t> labels) {
   if (dim != 2 && dim != 3) throw InputError("dimension must be 2 or 3, got " + std::to_string(dim));
   if (points.empty()) throw InputError("no input points");
   if (points.size() % static_cast<std::size_t>(dim) != 0)
@@ -26,12 +26,16 @@ void check_input(std::span<const double> points, int dim, std::span<const std::i
                      std::to_string(dim));
   const std::size_t n = points.size() / static_cast<std::size_t>(dim);
   if (n > static_cast<std::size_t>(INT32_MAX - 1)) throw InputError("too many points (ids are 32-bit)");
+  if (!labels.empty() && labels.size() != n)
+    throw InputError("labels: " + std::to_string(labels.size()) + " values for " + std::to_string(n) + " points");
+}
+
+void check_input(std::span<const double> points, int dim, std::span<const std::int32_t> labels) {
+  check_shape(points, dim, labels);
   for (std::size_t k = 0; k < points.size(); ++k)
     if (!std::isfinite(points[k]))
       throw InputError("point " + std::to_string(k / static_cast<std::size_t>(dim)) +
                        " has a NaN or infinite coordinate (ignore_outside sets such points aside)");
-  if (!labels.empty() && labels.size() != n)
-    throw InputError("labels: " + std::to_string(labels.size()) + " values for " + std::to_string(n) + " points");
   if (!labels.empty() && std::none_of(labels.begin(), labels.end(), [](std::int32_t l) { return l >= 0; }))
     throw InputError("labels: every point is outside (label < 0); nothing to tessellate");
 }

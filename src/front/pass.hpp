@@ -19,6 +19,10 @@
 
 namespace tessera::front {
 
+/// Throws InputError unless points (n * dim values, n >= 1, ids 32-bit) and
+/// labels (empty or n) have a valid shape; their values are not read.
+void check_shape(std::span<const double> points, int dim, std::span<const std::int32_t> labels);
+
 /// Throws InputError unless points/labels are a valid input of dimension dim.
 void check_input(std::span<const double> points, int dim, std::span<const std::int32_t> labels);
 

@@ -18,15 +18,8 @@ namespace {
 /// them, with the rest, on the first iteration's input).
 void check_shape(std::span<const double> points, int dim, std::span<const std::int32_t> labels,
                  const VoronoiOptions& o) {
-  if (dim != 2 && dim != 3) throw InputError("dimension must be 2 or 3, got " + std::to_string(dim));
-  if (points.empty()) throw InputError("no input points");
-  if (points.size() % static_cast<std::size_t>(dim) != 0)
-    throw InputError("point array length " + std::to_string(points.size()) + " is not a multiple of dimension " +
-                     std::to_string(dim));
-  const std::size_t n = points.size() / static_cast<std::size_t>(dim);
-  if (!labels.empty() && labels.size() != n)
-    throw InputError("labels: " + std::to_string(labels.size()) + " values for " + std::to_string(n) + " points");
-  front::check_radii(o.radii, n);
+  front::check_shape(points, dim, labels);
+  front::check_radii(o.radii, points.size() / static_cast<std::size_t>(dim));
 }
 
 /// (volume / generators)^(1 / dim), from the extents' logarithms: a domain
