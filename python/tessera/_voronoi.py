@@ -52,7 +52,12 @@ class Voronoi:
         self._points = points
         self._labels = labels
         self._radii = radii  # kept: validate() measures power cells with them
-        self._partial = False  # some cells only (cells_of, Cells::partial): the products and validate refuse it
+
+    @property
+    def _partial(self) -> bool:
+        """Some cells only (Cells::partial: cells_of with `only` or
+        `only_with_faces`): the products and validate refuse it."""
+        return bool(self._cells.partial)
 
     # ---- input and domain -------------------------------------------------
     @property
@@ -484,9 +489,7 @@ def cells_of(points: Any, labels: Any, bounds: Any, padding: float, threads: Any
         only,
         only_with_faces,
     )
-    vor = Voronoi(cells, pts, lab, rad)
-    vor._partial = cells.partial
-    return vor
+    return Voronoi(cells, pts, lab, rad)
 
 
 def periodic_box(periodic: Any, tilt: Any, bounds: Any, dim: int) -> Tuple[Tuple[bool, bool, bool],

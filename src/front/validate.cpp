@@ -25,6 +25,7 @@
 
 #include "tessera/cells.hpp"
 #include "tessera/engine/thread_arena.hpp"
+#include "mesh_faces.hpp"
 #include "validate_measures.hpp"
 
 namespace tessera {
@@ -318,11 +319,9 @@ ValidationReport validate_in_arena(const Cells& c, std::span<const std::int32_t>
 
 ValidationReport validate(const Cells& c, std::span<const std::int32_t> labels, std::span<const double> points,
                           std::span<const double> radii) {
-  // Some cells only (VoronoiOptions::only, only_with_faces): their volumes
-  // do not tile the domain, and their vertices miss cells.
-  if (c.partial)
-    throw std::invalid_argument("validate: these cells are some only (Cells::partial: VoronoiOptions::only or "
-                                "only_with_faces), not a whole tessellation");
+  // Some cells only: their volumes do not tile the domain, and their
+  // vertices miss cells.
+  front::refuse_partial(c, "validate");
   if (!labels.empty() && labels.size() != c.n_points)
     throw std::invalid_argument("validate: " + std::to_string(labels.size()) + " labels given for " +
                                 std::to_string(c.n_points) + " points");

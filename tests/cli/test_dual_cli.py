@@ -472,6 +472,23 @@ def python_module():
     return tessera
 
 
+def saved_case(case, name, pts, args=(), labels=None, radii=None):
+    """For a comparison with the Python module's result of all cells: the
+    module (the test skipped where it is not built), the points saved as
+    NAME.npy, and the command's arguments: `args`, then --labels and --radii
+    files where given."""
+    tessera = python_module()
+    if tessera is None:
+        case.skipTest("the tessera Python module is not built")
+    inp = case.save(name + ".npy", pts)
+    extra = list(args)
+    if labels is not None:
+        extra += ["--labels", case.save(name + "_labels.npy", labels.astype(np.int32))]
+    if radii is not None:
+        extra += ["--radii", case.save(name + "_radii.npy", radii)]
+    return tessera, inp, extra
+
+
 class FlowerOfAFewCells(base.TempDirCase):
     """`flower` builds the cells asked for and their neighbours' only, not all N
     (VoronoiOptions::only): its .vtp equals byte for byte the one written from
@@ -479,14 +496,7 @@ class FlowerOfAFewCells(base.TempDirCase):
     mesh), and its summary names all cells."""
 
     def check(self, name, pts, ids, args=(), labels=None, **kw):
-        tessera = python_module()
-        if tessera is None:
-            self.skipTest("the tessera Python module is not built")
-        dim = pts.shape[1]
-        inp = self.save(name + ".npy", pts)
-        extra = list(args)
-        if labels is not None:
-            extra += ["--labels", self.save(name + "_labels.npy", labels.astype(np.int32))]
+        tessera, inp, extra = saved_case(self, name, pts, args, labels)
         out, ref = self.p(name + ".vtp"), self.p(name + "_all.vtp")
         point_args = [a for i in ids for a in ("--point", str(i))]
         r = self.ok(["flower", inp, "-o", out, "--threads", "2"] + point_args + extra)
@@ -562,16 +572,7 @@ class FacesOfSomeCells(base.TempDirCase):
     and its summary counts all cells."""
 
     def check(self, name, pts, args=(), labels=None, radii=None, **kw):
-        tessera = python_module()
-        if tessera is None:
-            self.skipTest("the tessera Python module is not built")
-        dim = pts.shape[1]
-        inp = self.save(name + ".npy", pts)
-        extra = list(args)
-        if labels is not None:
-            extra += ["--labels", self.save(name + "_labels.npy", labels.astype(np.int32))]
-        if radii is not None:
-            extra += ["--radii", self.save(name + "_radii.npy", radii)]
+        tessera, inp, extra = saved_case(self, name, pts, args, labels, radii)
         vor = tessera.voronoi(pts, labels=labels, merge=True, threads=2, radii=radii, **kw)
         for kind, capping in (("boundary", False), ("surface-net", False), ("surface-net", True)):
             what = "%s, %s%s" % (name, kind, " capped" if capping else "")
