@@ -72,13 +72,26 @@ inline void periodic_image(const std::array<std::array<double, 3>, 3>& lattice, 
   }
 }
 
+/// A wall: the half-space normal . x <= offset, which cuts the domain box
+/// down to a convex polytope (VoronoiOptions::walls). In 2D normal[2] must be 0.
+struct Wall {
+  std::array<double, 3> normal{0, 0, 0};
+  double offset = 0;
+};
+
 /// Spoke classes (DESIGN §2, the classifier): the kind of each cell face.
 enum class SpokeClass : std::uint8_t {
   same_region = 0,     ///< neighbour is an inside point with the same label
   region_boundary = 1, ///< neighbour is an inside point with another label
-  domain_boundary = 2, ///< face lies on the domain box
+  domain_boundary = 2, ///< face lies on the domain box or a wall
   outside = 3,         ///< neighbour is an outside point (label < 0)
 };
+
+/// The spoke id of wall k (VoronoiOptions::walls) in neighbour lists,
+/// faces and vertex keys: -7 - k, below the box planes' -1..-6 in 2D and 3D.
+constexpr std::int32_t wall_spoke(int k) { return -7 - k; }
+/// Whether a negative spoke id is a wall's (else a box plane's).
+constexpr bool is_wall_spoke(std::int32_t id) { return id <= -7; }
 
 /// A set of spoke classes: bit 1 << c for each SpokeClass c in it.
 using SpokeClassSet = std::uint8_t;
@@ -221,6 +234,19 @@ struct VoronoiOptions {
   /// go straight to the first pass, and then their cells with such faces
   /// alone are built). 0: automatic (one half); 1: always some.
   double only_with_faces_up_to = 0;
+  /// Walls (tessera::voronoi only): half-spaces that cut the domain box
+  /// down to a convex polytope, the box's part inside every wall (a convex
+  /// polygon in 2D: one wall per edge). Each cell is its box cell's part
+  /// inside the walls, cut with the same exact predicates, so the cells
+  /// stay conformal and their volumes sum to the polytope's; a wall's faces
+  /// have spoke id wall_spoke(k) = -7 - k (below the box planes', -1..-6)
+  /// and class domain_boundary. Every point must lie inside or on every
+  /// wall (InputError, or set aside with ignore_outside_points, listed in
+  /// Cells::ignored_outside_bounds). A normal must be finite and non-zero,
+  /// an offset finite; both are scaled by one power of two, exactly, so
+  /// that the largest normal component is in [1, 2). Not with a periodic
+  /// box, nor for delaunay() (InputError). At most 2^20 walls.
+  std::vector<Wall> walls;
   /// Some axis periodic, or a tilt given (which needs periodic axes).
   bool periodic_box() const {
     return periodic[0] || periodic[1] || periodic[2] || tilt[0] != 0 || tilt[1] != 0 || tilt[2] != 0;
@@ -240,6 +266,8 @@ struct Cells {
   int dim = 3;
   std::size_t n_points = 0;
   Bounds bounds;
+  /// VoronoiOptions::walls as given: the domain is `bounds` inside them.
+  std::vector<Wall> walls;
 
   // ---- per cell (size n_cells, in generator-id order) ----
   Buffer<std::int32_t> generator;   ///< generator id of each cell
@@ -248,7 +276,7 @@ struct Cells {
   Buffer<double> centroid;          ///< n_cells * dim
   Buffer<std::int32_t> num_faces;   ///< faces (3D) / edges (2D), box faces included
   /// Face neighbours of each cell as CSR: the generator ids across its faces,
-  /// ascending; box faces are not listed (they are counted in num_faces).
+  /// ascending; box and wall faces are not listed (they are counted in num_faces).
   /// Exact ties keep the faces of zero area the symbolic perturbation makes
   /// (a cubic lattice's cell lists its 6 face neighbours and up to 8 more
   /// across faces of area 0): the topology is a valid one, exactly. The
@@ -271,7 +299,8 @@ struct Cells {
   /// Merged vertices: one per topological coordinate.
   Buffer<double> vertices;          ///< n_vertices * dim
   /// Topological coordinate of each vertex: dim+1 ids, ascending; domain-box
-  /// planes are negative (-1-axis*2 for lo, -2-axis*2 for hi: x0=-1, x1=-2, y0=-3, ...).
+  /// planes are negative (-1-axis*2 for lo, -2-axis*2 for hi: x0=-1, x1=-2, y0=-3, ...),
+  /// walls below them (wall k: wall_spoke(k) = -7-k).
   /// In a periodic box the ids are those of the points whose images meet
   /// there, without the shifts: a vertex shared by cells on opposite sides
   /// of the box is listed once beside each, and keys need not be unique.
@@ -284,7 +313,7 @@ struct Cells {
   /// 3D: faces of each cell: cell_face_offsets (n_cells+1) into faces; each face
   /// has face_vertex_offsets (n_faces_total+1) into face_vertices (global vertex
   /// ids, counter-clockwise seen from outside the cell) and face_neighbor (the
-  /// spoke: generator id, or the negative box-plane id).
+  /// spoke: generator id, or the negative box-plane id, or a wall's wall_spoke).
   /// 2D: one face per edge; face_vertices holds the edge's two vertices (the
   /// polygon's vertices, counter-clockwise, are the first vertex of each edge in order).
   Buffer<std::int64_t> cell_face_offsets;

@@ -109,7 +109,7 @@ inline void unit_normal(const double* n, double* out) {
 // (a power of two; Scaled false: 1, without the multiplications), and
 // emax, the largest Vertex::e (unscaled), for sums_uncertain.
 // ScaledPlanes: some bisector's foot is not n / 2: it is stored scaled
-// (Hull::has_scaled_planes), or the cell is a power cell (Hull::weighted),
+// (Hull::has_scaled_planes, also set by a wall), or the cell is a power cell (Hull::weighted),
 // whose bisectors' feet are n d / |n|^2 (power.hpp); otherwise every
 // bisector's foot is n / 2 without reading Plane::scale.
 //
@@ -172,12 +172,16 @@ void hull_sums(const kernels::Hull& hull, double sc, double& vol, double& mag, d
       const auto face = v.p[(k + 1) % 3];
       const auto& pl = planes[face];
       // The foot n d / |n|^2: d = |n|^2 / 2 on a bisector (2^scale times
-      // that on a scaled one), |n| = 1 on a box plane.
+      // that on a scaled one), |n| = 1 on a box plane; a wall's (a cell
+      // with one has_scaled_planes) is computed.
       double w = pl.id < 0 ? pl.d : 0.5;
-      if constexpr (ScaledPlanes)
+      if constexpr (ScaledPlanes) {
         if (pl.id >= 0 && (weighted || pl.scale != 0))
           w = weighted ? pl.d / (pl.n[0] * pl.n[0] + pl.n[1] * pl.n[1] + pl.n[2] * pl.n[2])  // scale-free
                        : std::ldexp(0.5, pl.scale);
+        else if (kernels::is_wall_plane(pl.id))
+          w = pl.d / (pl.n[0] * pl.n[0] + pl.n[1] * pl.n[1] + pl.n[2] * pl.n[2]);
+      }
       if constexpr (Scaled) w *= sc;
       const double f[3] = {pl.n[0] * w, pl.n[1] * w, pl.n[2] * w};
       double bs[3];

@@ -147,6 +147,7 @@ Cells run(std::span<const double> input, std::span<const std::int32_t> labels, c
   out.dim = D;
   out.n_points = input.size() / D;
   out.bounds = pass.bounds;
+  out.walls = opt.walls;
   out.ignored_outside_bounds = pass.ignored_outside;
   out.threads_used = pass.engine_options.threads;
   out.far_points = pass.locator->outside_core();
@@ -387,6 +388,7 @@ Cells voronoi(std::span<const double> input, int dim, std::span<const std::int32
   if (options.periodic_box()) {
     if (!options.periodic[0] && !options.periodic[1] && !options.periodic[2])
       throw InputError("a tilt (triclinic box) needs periodic axes");
+    if (!options.walls.empty()) throw InputError("walls cut a box with walls: not a periodic one");
     return dim == 3 ? run_periodic<kernels::Hull>(input, dim, labels, options)
                     : run_periodic<kernels::Tile>(input, dim, labels, options);
   }

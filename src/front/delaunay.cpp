@@ -679,6 +679,8 @@ Delaunay delaunay(std::span<const double> input, int dim, std::span<const std::i
       return delaunay(input, dim, labels, plain);
     }
   }
+  if (!given.walls.empty())
+    throw InputError("delaunay takes no walls: the triangulation's domain is the box (--bounds)");
   if (given.periodic_box()) {
     if (!given.periodic[0] && !given.periodic[1] && !given.periodic[2])
       throw InputError("a tilt (triclinic box) needs periodic axes");

@@ -1,5 +1,6 @@
 // The shared set-up of a cells pass; see pass.hpp.
 #include "pass.hpp"
+#include "walls.hpp"
 
 #include <algorithm>
 #include <array>
@@ -248,6 +249,7 @@ Pass<D>::Pass(std::span<const double> input, std::span<const std::int32_t> label
     points = scaled;
   }
   set_radii(opt.radii, n, scaling);
+  walls = kernel_walls(opt.walls, D, k);
 
   // Which points take part (inside the box) and which get cells (also label >= 0).
   in_box.assign(n, 1);
@@ -274,9 +276,19 @@ Pass<D>::Pass(std::span<const double> input, std::span<const std::int32_t> label
       }
       ignored_outside.push_back(static_cast<std::int32_t>(i));
       --n_in;
+      continue;
+    }
+    if (walls.empty()) continue;
+    if (const int w = outside_wall(points.data() + i * D, D, walls); w >= 0) {
+      if (!opt.ignore_outside_points)
+        throw InputError("point " + std::to_string(i) + " lies outside wall " + std::to_string(w) +
+                         " (use --ignore-outside to drop such points)");
+      in_box[i] = 0;
+      ignored_outside.push_back(static_cast<std::int32_t>(i));
+      --n_in;
     }
   }
-  if (n_in == 0) throw InputError("all points lie outside the bounds");
+  if (n_in == 0) throw InputError(walls.empty() ? "all points lie outside the bounds" : "all points lie outside the domain (the bounds and the walls)");
 
   std::array<double, D> lo, hi;
   for (int d = 0; d < D; ++d) {
@@ -380,6 +392,10 @@ Pass<D>::Pass(std::span<const double> input, std::span<const std::int32_t> label
   for (int d = 0; d < 3; ++d) {
     exact.lo[static_cast<std::size_t>(d)] = bounds.lo[static_cast<std::size_t>(d)];
     exact.hi[static_cast<std::size_t>(d)] = bounds.hi[static_cast<std::size_t>(d)];
+  }
+  if (!walls.empty()) {
+    exact.walls = walls.data();
+    exact.num_walls = static_cast<int>(walls.size());
   }
   kernels::make_grid(exact, n, grid);  // lattices and voxel grids: integer exact predicates
   gens.coords = points.data();

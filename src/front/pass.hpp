@@ -113,6 +113,7 @@ struct Pass {
   Buffer<std::uint32_t> slots;               ///< their slots in the locator
   kernels::ExactContext exact;
   std::vector<std::int32_t> grid;            ///< exact.grid's storage, when the input has one
+  std::vector<kernels::Wall> walls;          ///< VoronoiOptions::walls in this frame (exact.walls)
   engine::Generators<D> gens;
   engine::EngineOptions engine_options;
 

@@ -13,6 +13,7 @@
 // and the most elongated, whose float terms cancel: stop 63's columns,
 // stop 64's strips) and a spread over the rest.
 #include "validate_measures.hpp"
+#include "walls.hpp"
 
 #include <algorithm>
 #include <array>
@@ -268,6 +269,9 @@ void check_measures(const Cells& c, std::span<const double> points, std::span<co
   ctx.lo = c.bounds.lo;
   ctx.hi = c.bounds.hi;
   if (!radii.empty()) ctx.radii = radii.data();
+  const std::vector<kernels::Wall> walls = kernel_walls(c.walls, D, 0);  // the user's frame, as the points
+  ctx.walls = walls.data();
+  ctx.num_walls = static_cast<int>(walls.size());
   std::vector<Outcome> outcomes(measured.size());
   tbb::parallel_for(std::size_t{0}, measured.size(),
                     [&](std::size_t s) { outcomes[s] = measure_cell(c, ctx, points, radius2, measured[s]); });

@@ -60,7 +60,7 @@ int build_rows(const ExactContext& ctx, std::int32_t i, const std::int32_t* gen,
     if (gen[r] >= 0) {
       const double* pk = ctx.points + static_cast<std::size_t>(gen[r]) * dim;
       for (int d = 0; d < dim; ++d) grid.see(pk[d]);
-    } else {
+    } else if (!is_wall_plane(gen[r])) {  // a wall's row is cleared of its own denominators below
       int axis = box_plane_axis(gen[r]);
       grid.see(box_plane_upper(gen[r]) ? ctx.hi[axis] : ctx.lo[axis]);
     }
@@ -99,6 +99,18 @@ int build_rows(const ExactContext& ctx, std::int32_t i, const std::int32_t* gen,
         mpz_submul(s.b[r], s.t2, s.t2);                   // - r_k^2
       }
       mpz_sub(s.b[r], s.b[r], s.t1);                      // |p_k|^2 - |p_i|^2 (- r_k^2 + r_i^2)
+    } else if (is_wall_plane(gen[r])) {
+      // n.x = d reads n.X = d 2^-shift in these integers (x = X 2^shift).
+      const Wall& w = ctx.walls[wall_index(gen[r])];
+      thread_local struct Rhs {
+        mpq_t q;
+        Rhs() { mpq_init(q); }
+        ~Rhs() { mpq_clear(q); }
+      } rhs;
+      mpq_set_d(rhs.q, w.d);
+      if (shift > 0) mpq_div_2exp(rhs.q, rhs.q, static_cast<mp_bitcnt_t>(shift));
+      else if (shift < 0) mpq_mul_2exp(rhs.q, rhs.q, static_cast<mp_bitcnt_t>(-shift));
+      set_plane_row(s, r, dim, w.n, rhs.q);
     } else {
       int axis = box_plane_axis(gen[r]);
       for (int d = 0; d < dim; ++d) mpz_set_ui(s.a[r][d], d == axis ? 1 : 0);
@@ -107,6 +119,26 @@ int build_rows(const ExactContext& ctx, std::int32_t i, const std::int32_t* gen,
   }
 
   return shift;
+}
+
+void set_plane_row(Scratch& s, int row, int dim, const double* n, mpq_srcptr rhs) {
+  thread_local struct Rationals {
+    mpq_t v[Scratch::kMaxDim];
+    Rationals() {
+      for (auto& q : v) mpq_init(q);
+    }
+    ~Rationals() {
+      for (auto& q : v) mpq_clear(q);
+    }
+  } r;
+  for (int k = 0; k < dim; ++k) mpq_set_d(r.v[k], n[k]);
+  // Every value is canonical with a power of two below: the largest clears them all.
+  auto den_exponent = [](mpq_srcptr q) { return mpz_sizeinbase(mpq_denref(q), 2) - 1; };
+  std::size_t top = den_exponent(rhs);
+  for (int k = 0; k < dim; ++k) top = std::max(top, den_exponent(r.v[k]));
+  for (int k = 0; k < dim; ++k)
+    mpz_mul_2exp(s.a[row][k], mpq_numref(r.v[k]), top - den_exponent(r.v[k]));
+  mpz_mul_2exp(s.b[row], mpq_numref(rhs), top - den_exponent(rhs));
 }
 
 void row_parts(const ExactContext& ctx, std::int32_t i, const std::int32_t* gen, int rows, DoubleParts (*pv)[3],
@@ -446,6 +478,22 @@ int exact_box_sign(const ExactContext& ctx, std::int32_t i, const std::int32_t* 
   // sign(c - v_axis); inside is v_axis <= c on an upper plane, >= c on a lower one.
   const int side = sign_m * sign_det_a;
   return box_plane_upper(box) ? side : -side;
+}
+
+int exact_wall_sign(const ExactContext& ctx, std::int32_t i, const std::int32_t* planes, int wall) {
+  const int dim = ctx.dim;
+  std::int32_t gen[Scratch::kRows];
+  for (int r = 0; r < dim; ++r) {
+    if (planes[r] == wall_plane_id(wall)) return 1;  // on it
+    gen[r] = planes[r];
+  }
+  gen[dim] = wall_plane_id(wall);
+  // GMP alone: asked of the vertices within rounding of a wall, and of
+  // those on another wall (few: the cells at the domain's edges).
+  ClipSigns sg;
+  signs_gmp(ctx, i, gen, sg);
+  const int side = sg.det_m0 * sg.minor[dim];  // sign(d - n.v)
+  return side >= 0 ? 1 : -1;
 }
 
 // The prepared form (see VertexPredicate in the header). With the query row

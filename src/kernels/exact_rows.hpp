@@ -104,12 +104,19 @@ inline void cofactors(const std::int64_t (*a)[3], int dim, __int128 (*cof)[3]) {
   }
 }
 
+// Row `row` of s.a / s.b as the plane n.X = rhs in build_rows' integers (n
+// any finite doubles, rhs an exact rational whose denominator is a power of
+// two): both multiplied by the one power of two that clears every
+// denominator, a positive scale that changes no sign or solution.
+void set_plane_row(Scratch& s, int row, int dim, const double* n, mpq_srcptr rhs);
+
 // det of the k x k matrix formed by rows `rows` of a (k = 2 or 3).
 void det_rows(mpz_t out, mpz_t (*a)[Scratch::kMaxDim], const int* rows, int k, Scratch& s);
 
 // Fill s.a / s.b with the rows of gen[0..rows) on the input scaled to
 // integers: a bisector's row is a = 2 (p_k - p_i), b = |p_k|^2 - |p_i|^2; a
-// box plane's is the unit axis and its bound. Returns the scale exponent
+// box plane's is the unit axis and its bound; a wall's its normal and
+// offset (set_plane_row). Returns the scale exponent
 // (coordinates = integers * 2^shift) and leaves the scaled p_i in
 // s.coord[kRows].
 int build_rows(const ExactContext& ctx, std::int32_t i, const std::int32_t* gen, int rows, Scratch& s);

@@ -213,6 +213,8 @@ void vertex_numerators_wide(const DoubleParts (*pv)[Scratch::kMaxDim], const std
 bool grid_numerators(const ExactContext& ctx, std::int32_t i, const std::int32_t* planes, GridNumerators& g) {
   const int dim = ctx.dim;
   if ((dim != 2 && dim != 3) || ctx.radii != nullptr) return false;  // the integer rows know no radii
+  for (int r = 0; r < dim; ++r)
+    if (is_wall_plane(planes[r])) return false;  // nor walls
   DoubleParts pv[Scratch::kRows][Scratch::kMaxDim];
   GridScale span;
   exact_rows::row_parts(ctx, i, planes, dim, pv, span);
@@ -366,37 +368,31 @@ void exact_vertex_on_plane(const ExactContext& ctx, std::int32_t i, const std::i
   for (int r = 0; r < dim; ++r) ids[r] = r == row ? box_plane_id(0, false) : planes[r];
   const int shift = build_rows(ctx, i, ids, dim, s);
   // The given row n.y = d, y relative to p_i, reads n.X = (d + n.p_i) 2^-shift
-  // in build_rows' integers (x = X 2^shift). Every double is a rational with
-  // a power of two below, so one power of two, the largest, clears them.
+  // in build_rows' integers (x = X 2^shift).
   thread_local struct Rationals {
-    mpq_t v[Scratch::kMaxDim + 1], t, u;
+    mpq_t rhs, t, u;
     Rationals() {
-      for (auto& q : v) mpq_init(q);
+      mpq_init(rhs);
       mpq_init(t);
       mpq_init(u);
     }
     ~Rationals() {
-      for (auto& q : v) mpq_clear(q);
+      mpq_clear(rhs);
       mpq_clear(t);
       mpq_clear(u);
     }
   } r;
   const double* pi = ctx.points + static_cast<std::size_t>(i) * static_cast<std::size_t>(dim);
-  mpq_set_d(r.v[dim], d);
+  mpq_set_d(r.rhs, d);
   for (int k = 0; k < dim; ++k) {
-    mpq_set_d(r.v[k], n[k]);
-    mpq_set_d(r.t, pi[k]);
-    mpq_mul(r.u, r.v[k], r.t);
-    mpq_add(r.v[dim], r.v[dim], r.u);
+    mpq_set_d(r.t, n[k]);
+    mpq_set_d(r.u, pi[k]);
+    mpq_mul(r.u, r.u, r.t);
+    mpq_add(r.rhs, r.rhs, r.u);
   }
-  if (shift > 0) mpq_div_2exp(r.v[dim], r.v[dim], static_cast<mp_bitcnt_t>(shift));
-  else if (shift < 0) mpq_mul_2exp(r.v[dim], r.v[dim], static_cast<mp_bitcnt_t>(-shift));
-  std::size_t top = 0;  // the largest denominator's exponent (canonical: each a power of two)
-  for (int k = 0; k <= dim; ++k) top = std::max(top, mpz_sizeinbase(mpq_denref(r.v[k]), 2) - 1);
-  for (int k = 0; k <= dim; ++k) {
-    mpz_ptr out = k < dim ? s.a[row][k] : s.b[row];
-    mpz_mul_2exp(out, mpq_numref(r.v[k]), top - (mpz_sizeinbase(mpq_denref(r.v[k]), 2) - 1));
-  }
+  if (shift > 0) mpq_div_2exp(r.rhs, r.rhs, static_cast<mp_bitcnt_t>(shift));
+  else if (shift < 0) mpq_mul_2exp(r.rhs, r.rhs, static_cast<mp_bitcnt_t>(-shift));
+  exact_rows::set_plane_row(s, row, dim, n, r.rhs);
   cramer_numerators(dim, s);
   for (int c = 0; c < dim; ++c) y[c] = quotient_to_double(s.minor[c], s.minor[dim], shift, s.t0);
 }
@@ -477,7 +473,7 @@ double rational_cell_measure(const ExactContext& ctx, std::int32_t i, std::span<
   }
   const double* pi = ctx.points + static_cast<std::size_t>(i) * du;
   thread_local CellPlanes planes;
-  if (dim == 3 && ctx.radii != nullptr) planes.build(vertex_planes, dim);
+  if (dim == 3 && (ctx.radii != nullptr || ctx.num_walls > 0)) planes.build(vertex_planes, dim);
   // As measure() in front/cell_geometry.hpp: each term's weight w, summed,
   // and w times the sum of its points (foot and both vertices in 3D, both
   // vertices in 2D) for the centroid.
@@ -492,8 +488,8 @@ double rational_cell_measure(const ExactContext& ctx, std::int32_t i, std::span<
     } else {
       // The foot of the plane from p_i: (p_j - p_i) / 2 on a bisector,
       // (bound - p_i) along the axis on a box plane.
-      if (term.plane >= 0 && ctx.radii != nullptr) {
-        // A power bisector's foot is no simple point; any point of the
+      if ((term.plane >= 0 && ctx.radii != nullptr) || is_wall_plane(term.plane)) {
+        // A power bisector's or a wall's foot is no simple point; any point of the
         // plane serves (a face's terms sum to its cone whatever point of its
         // plane they share): one of the cell's vertices on it.
         const std::size_t v = planes.first_vertex(planes.slot(term.plane));
@@ -755,8 +751,8 @@ bool fixed_point_cell_measure(const ExactContext& ctx, std::int32_t i, std::span
     mpz_ptr f[3] = {z[feet + 3 * k], z[feet + 3 * k + 1], z[feet + 3 * k + 2]};
     if (!have_foot[k]) {
       have_foot[k] = 1;
-      if (plane >= 0 && ctx.radii != nullptr) {
-        // A power bisector's: one of the cell's vertices on the plane
+      if ((plane >= 0 && ctx.radii != nullptr) || is_wall_plane(plane)) {
+        // A power bisector's or a wall's: one of the cell's vertices on the plane
         // (rational_cell_measure). Truncated as every vertex is, it lies
         // within one unit of a point of the plane, as a truncated foot does,
         // and below 2^(bits + 1): the bounds below hold.

@@ -12,7 +12,7 @@
 // <= |y|^2 - r_i^2, i.e. y.d <= (|d|^2 + r_i^2 - r_j^2) / 2.
 //
 // Labels follow tessera's spoke convention: generator id >= 0, or a box plane
-// -1-2*axis (lo) / -2-2*axis (hi).
+// -1-2*axis (lo) / -2-2*axis (hi), or wall k -7-k (walls clip after the points).
 #pragma once
 
 #include <algorithm>
@@ -32,6 +32,9 @@ struct Cell {
 };
 
 using P3 = std::array<double, 3>;
+/// A wall: keep x with (w[0], w[1], w[2]) . x <= w[3] (2D: w[2] = 0); its
+/// faces are labelled -7 - k, as tessera's wall spokes.
+using Wall = std::array<double, 4>;
 
 namespace detail {
 
@@ -70,7 +73,8 @@ inline std::vector<std::size_t> by_distance(const std::vector<double>& pts, int 
 
 /// The 2D cell of point i in the box [lo, hi].
 inline Cell cell2d(const std::vector<double>& pts, std::size_t i, const std::array<double, 3>& lo,
-                   const std::array<double, 3>& hi, const std::vector<double>& radii = {}) {
+                   const std::array<double, 3>& hi, const std::vector<double>& radii = {},
+                   const std::vector<Wall>& walls = {}) {
   using detail::cut;
   const double px = pts[2 * i], py = pts[2 * i + 1];
   // Vertices relative to the generator; lab[k] labels the edge v[k] -> v[k+1]. CCW.
@@ -79,17 +83,15 @@ inline Cell cell2d(const std::vector<double>& pts, std::size_t i, const std::arr
                        {hi[0] - px, hi[1] - py, 0},
                        {lo[0] - px, hi[1] - py, 0}};
   std::vector<int> lab = {-3, -2, -4, -1};
-  for (std::size_t j : detail::by_distance(pts, 2, i)) {
-    const double dx = pts[2 * j] - px, dy = pts[2 * j + 1] - py;
-    double h = 0.5 * (dx * dx + dy * dy);  // keep y with y.d <= |d|^2/2
-    if (!radii.empty()) h += 0.5 * (radii[i] * radii[i] - radii[j] * radii[j]);
+  // Keep y with y.(dx, dy) <= h; the new edge gets `label`.
+  auto clip = [&](double dx, double dy, double h, int label) {
     std::vector<double> s(v.size());
     bool any_out = false;
     for (std::size_t k = 0; k < v.size(); ++k) {
       s[k] = v[k][0] * dx + v[k][1] * dy - h;
       any_out |= s[k] > 0;
     }
-    if (!any_out) continue;
+    if (!any_out) return;
     std::vector<P3> nv;
     std::vector<int> nl;
     for (std::size_t k = 0; k < v.size(); ++k) {
@@ -100,7 +102,7 @@ inline Cell cell2d(const std::vector<double>& pts, std::size_t i, const std::arr
         nl.push_back(lab[k]);
         if (!bin) {  // leaving: the edge from the exit point runs along the bisector
           nv.push_back(cut(v[k], s[k], v[m], s[m]));
-          nl.push_back(int(j));
+          nl.push_back(label);
         }
       } else if (bin) {  // entering: the rest of the original edge
         nv.push_back(cut(v[m], s[m], v[k], s[k]));
@@ -109,7 +111,15 @@ inline Cell cell2d(const std::vector<double>& pts, std::size_t i, const std::arr
     }
     v.swap(nv);
     lab.swap(nl);
+  };
+  for (std::size_t j : detail::by_distance(pts, 2, i)) {
+    const double dx = pts[2 * j] - px, dy = pts[2 * j + 1] - py;
+    double h = 0.5 * (dx * dx + dy * dy);  // keep y with y.d <= |d|^2/2
+    if (!radii.empty()) h += 0.5 * (radii[i] * radii[i] - radii[j] * radii[j]);
+    clip(dx, dy, h, int(j));
   }
+  for (std::size_t k = 0; k < walls.size(); ++k)
+    clip(walls[k][0], walls[k][1], walls[k][3] - walls[k][0] * px - walls[k][1] * py, -7 - int(k));
   Cell c;
   double a2 = 0, cx = 0, cy = 0;
   for (std::size_t k = 0; k < v.size(); ++k) {
@@ -129,7 +139,8 @@ inline Cell cell2d(const std::vector<double>& pts, std::size_t i, const std::arr
 
 /// The 3D cell of point i in the box [lo, hi].
 inline Cell cell3d(const std::vector<double>& pts, std::size_t i, const std::array<double, 3>& lo,
-                   const std::array<double, 3>& hi, const std::vector<double>& radii = {}) {
+                   const std::array<double, 3>& hi, const std::vector<double>& radii = {},
+                   const std::vector<Wall>& walls = {}) {
   using namespace detail;
   const P3 p{pts[3 * i], pts[3 * i + 1], pts[3 * i + 2]};
   const P3 a = sub(lo, p), b = sub(hi, p);  // box relative to the generator
@@ -146,14 +157,12 @@ inline Cell cell3d(const std::vector<double>& pts, std::size_t i, const std::arr
       {-5, {corner(0, 0, 0), corner(0, 1, 0), corner(1, 1, 0), corner(1, 0, 0)}},
       {-6, {corner(0, 0, 1), corner(1, 0, 1), corner(1, 1, 1), corner(0, 1, 1)}},
   };
-  for (std::size_t j : by_distance(pts, 3, i)) {
-    const P3 d = sub({pts[3 * j], pts[3 * j + 1], pts[3 * j + 2]}, p);
-    double h = 0.5 * dot(d, d);
-    if (!radii.empty()) h += 0.5 * (radii[i] * radii[i] - radii[j] * radii[j]);
+  // Keep y with y.d <= h; the cap face gets `label`.
+  auto clip = [&](const P3& d, double h, int label) {
     bool any_out = false;
     for (auto& f : faces)
       for (auto& x : f.v) any_out |= dot(x, d) - h > 0;
-    if (!any_out) continue;
+    if (!any_out) return;
     std::vector<Face> kept;
     std::vector<P3> cap;  // points on the plane
     for (auto& f : faces) {
@@ -193,11 +202,21 @@ inline Cell cell3d(const std::vector<double>& pts, std::size_t i, const std::arr
         ang.push_back({std::atan2(dot(r, w), dot(r, u)), x});
       }
       std::sort(ang.begin(), ang.end());
-      Face capf{int(j), {}};
+      Face capf{label, {}};
       for (auto& e : ang) capf.v.push_back(e.second);
       kept.push_back(std::move(capf));
     }
     faces.swap(kept);
+  };
+  for (std::size_t j : by_distance(pts, 3, i)) {
+    const P3 d = sub({pts[3 * j], pts[3 * j + 1], pts[3 * j + 2]}, p);
+    double h = 0.5 * dot(d, d);
+    if (!radii.empty()) h += 0.5 * (radii[i] * radii[i] - radii[j] * radii[j]);
+    clip(d, h, int(j));
+  }
+  for (std::size_t k = 0; k < walls.size(); ++k) {
+    const P3 n{walls[k][0], walls[k][1], walls[k][2]};
+    clip(n, walls[k][3] - dot(n, p), -7 - int(k));
   }
   // Volume and centroid: fan of tetrahedra from the mean o of the vertices
   // (inside the convex cell; a power cell need not hold its generator), so
@@ -238,8 +257,9 @@ inline Cell cell3d(const std::vector<double>& pts, std::size_t i, const std::arr
 }
 
 inline Cell cell(const std::vector<double>& pts, int dim, std::size_t i, const std::array<double, 3>& lo,
-                 const std::array<double, 3>& hi, const std::vector<double>& radii = {}) {
-  return dim == 2 ? cell2d(pts, i, lo, hi, radii) : cell3d(pts, i, lo, hi, radii);
+                 const std::array<double, 3>& hi, const std::vector<double>& radii = {},
+                 const std::vector<Wall>& walls = {}) {
+  return dim == 2 ? cell2d(pts, i, lo, hi, radii, walls) : cell3d(pts, i, lo, hi, radii, walls);
 }
 
 }  // namespace oracle

@@ -73,6 +73,19 @@ struct EngineOptions {
   ThreadArena* arena = nullptr;
 };
 
+/// Cut a built cell by the exact context's walls (kernels/walls.hpp), in
+/// ascending order; a cell they leave empty has none (st.has_cell false).
+/// The cut may have deferred new vertices' exact solves: solved here.
+template <class CellT>
+[[gnu::noinline]] void clip_walls(CellT& cell, kernels::BuildStatus& st, int num_walls) {
+  for (int k = 0; k < num_walls; ++k)
+    if (cell.clip_wall(k) == kernels::ClipResult::emptied) {
+      st.has_cell = false;
+      return;
+    }
+  cell.solve_deferred();
+}
+
 /// Build every cell of `gens.order` and hand each to the compositor; returns
 /// the number of exact predicate evaluations. `earlier`: batches the same
 /// compositor was given before, by another loop over other generators (the
@@ -138,6 +151,8 @@ std::uint64_t tessellate(const Generators<CellT::dim>& gens, Comp& comp, const E
       } else {
         st = ws.builder.build_any(gen, p, ws.cell);
       }
+      if (gens.exact != nullptr && gens.exact->num_walls > 0 && st.has_cell) [[unlikely]]
+        clip_walls(ws.cell, st, gens.exact->num_walls);
       ws.exact_calls += ws.cell.exact_calls();
       comp.add(batch, gen, st, ws.cell);
     }

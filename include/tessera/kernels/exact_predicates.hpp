@@ -46,6 +46,20 @@ constexpr std::int32_t box_plane_id(int axis, bool upper) { return -1 - 2 * axis
 constexpr int box_plane_axis(std::int32_t id) { return (-1 - id) / 2; }
 constexpr bool box_plane_upper(std::int32_t id) { return ((-1 - id) & 1) != 0; }
 
+/// Walls: half-spaces n.x <= d (absolute coordinates) that cut the domain
+/// box down to a convex polytope (VoronoiOptions::walls). Wall k's plane id
+/// is -7 - k in both dimensions, below every box plane's; the far plane of
+/// an assembled cell (assembly::far_plane_id, INT32_MIN) is none.
+struct Wall {
+  double n[3];  ///< normal, |n|_inf in [1, 2) (front/walls.cpp scales it so, exactly)
+  double d;     ///< offset
+};
+/// At most this many walls (their ids stay far above INT32_MIN).
+constexpr int max_walls = 1 << 20;
+constexpr std::int32_t wall_plane_id(int k) { return -7 - k; }
+constexpr bool is_wall_plane(std::int32_t id) { return id <= -7 && id > -7 - max_walls; }
+constexpr int wall_index(std::int32_t id) { return -7 - id; }
+
 /// Exponent of the lowest set bit of x != 0: x is an odd integer times 2^that.
 int lowest_bit_exponent(double x);
 
@@ -143,6 +157,13 @@ struct ExactContext {
   /// integer vertex solves assume |q|^2 alone. `max_radius` is the largest.
   const double* radii = nullptr;
   double max_radius = 0;
+  /// The walls (num_walls of them), in the computation's frame, or null.
+  /// Cells are clipped by them after their neighbours (Hull/Tile::
+  /// clip_wall), so the only exact questions about them are a vertex's side
+  /// of a wall (exact_wall_sign), a vertex on walls solved exactly, and the
+  /// exact measure of a cell with wall faces: all through the GMP rows.
+  const Wall* walls = nullptr;
+  int num_walls = 0;
 };
 
 /// The offset d of the power bisector of points i and j relative to p_i:
@@ -183,6 +204,16 @@ int exact_clip_sign_by_arithmetic(const ExactContext& ctx, std::int32_t i, const
 /// With the box row (e_axis, c) as M's last row, det M = det A (c - v_axis)
 /// (Schur complement), and the box row carries no weight.
 int exact_box_sign(const ExactContext& ctx, std::int32_t i, const std::int32_t* planes, std::int32_t box);
+/// The side of wall `wall` (an index into ctx.walls) on which the vertex of
+/// cell i where planes[0..dim) meet (generators, box planes or walls) lies:
+/// +1 inside or exactly on the wall's plane, -1 outside. A tie counts as
+/// inside: it is the symbolic perturbation that moves every wall outwards
+/// by an infinitesimal far larger than the points' weights, later walls
+/// by more than earlier ones (each wall's decisions are taken with the
+/// walls before it already cut), so every cell that holds a vertex takes
+/// the same decision, and the cut polytopes stay conformal. With the wall
+/// row (n, d) as M's last row, det M = det A (d - n.v) (Schur complement).
+int exact_wall_sign(const ExactContext& ctx, std::int32_t i, const std::int32_t* planes, int wall);
 
 /// The exact sign of n . ((p_a - p_i) x (p_b - p_i)) in 3D (n any finite
 /// doubles): whether a plane of normal n crosses, going outwards, the ray of

@@ -1,0 +1,85 @@
+// Walls: half-spaces n.x <= d that cut a finished cell (Hull/Tile::
+// clip_wall), so that the domain is the box cut down to a convex polytope.
+//
+// A cell is built in the box as ever (its neighbours, its security radius),
+// then cut by each wall in turn: the cell inside the walls is the box cell's
+// part inside them, since a wall does not depend on the other points. The
+// only question a wall asks is a vertex's side of it, decided by the float
+// filter below and else exactly (exact_wall_sign), as a function of the
+// vertex's planes alone: every cell holding a vertex takes the same decision,
+// and the cut cells stay conformal. The new vertices lie on the wall (plane
+// id wall_plane_id(k)), each the meeting point of its planes as any other.
+#pragma once
+
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "tessera/kernels/exact_predicates.hpp"
+#include "tessera/kernels/filter.hpp"
+
+namespace tessera::kernels::walls {
+
+/// A wall relative to a generator p: n.y <= d for y = x - p, with |n|_1 = n1
+/// and d_err bounding the rounding of d = d_wall - n.p.
+template <int D>
+struct RelativeWall {
+  double n[D];
+  double d;
+  double n1;
+  double d_err;
+};
+
+template <int D>
+RelativeWall<D> relative(const Wall& w, const double* p) {
+  RelativeWall<D> r;
+  double d = w.d, mag = std::fabs(w.d);
+  r.n1 = 0;
+  for (int k = 0; k < D; ++k) {
+    r.n[k] = w.n[k];
+    r.n1 += std::fabs(w.n[k]);
+    const double t = w.n[k] * p[k];
+    d -= t;
+    mag += std::fabs(t);
+  }
+  r.d = d;
+  // D products and D differences, each rounded once: within gamma_{2D} of
+  // the magnitudes' sum (itself rounded; doubled for margin).
+  r.d_err = 4 * D * filter::u * mag + filter::abs_eps;
+  return r;
+}
+
+/// Each vertex's side of wall k (relative: `w`) into `sign`: +1 keep (inside
+/// or on it), -1 remove; returns the number removed. A vertex is decided by
+/// the float filter where P = d - n.y clears its bound (the vertex's own
+/// bound e, the plane's rounding as a clip's, and d's), else exactly. A
+/// vertex on an earlier wall always goes to the exact sign: its bound e
+/// assumed its planes' offsets rounded once, and a wall's d, a difference
+/// of products, may carry more (a point near a wall far from the origin).
+template <int D, class Vertex, class Plane>
+std::size_t signs(const Vertex* verts, std::size_t nv, const Plane* planes, const RelativeWall<D>& w, int k,
+                  const ExactContext& ctx, std::int32_t gen, std::vector<filter::Sign>& sign) {
+  const double de = filter::plane_eps * std::fabs(w.d) + w.d_err;
+  std::size_t removed = 0;
+  for (std::size_t t = 0; t < nv; ++t) {
+    const Vertex& v = verts[t];
+    std::int32_t ids[D];
+    bool on_wall = false;
+    for (int c = 0; c < D; ++c) {
+      ids[c] = planes[v.p[c]].id;
+      on_wall |= is_wall_plane(ids[c]);
+    }
+    double dot = w.n[0] * v.y[0];
+    for (int c = 1; c < D; ++c) dot += w.n[c] * v.y[c];
+    const double P = w.d - dot, e = w.n1 * v.e + de;
+    int s = 0;
+    if (!on_wall && P - P == 0) s = (P > e) - (P < -e);  // (not where n.y overflowed)
+    if (s == 0) s = exact_wall_sign(ctx, gen, ids, k);
+    sign[t] = static_cast<filter::Sign>(s);
+    removed += s < 0;
+  }
+  return removed;
+}
+
+}  // namespace tessera::kernels::walls

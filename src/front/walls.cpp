@@ -1,0 +1,125 @@
+// Walls in the kernels' form, and points against them (walls.hpp).
+#include "walls.hpp"
+
+#include <gmp.h>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "../message_text.hpp"
+#include "cell_geometry.hpp"
+#include "tessera/kernels/filter.hpp"
+#include "tessera/kernels/hull.hpp"
+#include "tessera/kernels/tile.hpp"
+
+namespace tessera::front {
+
+std::vector<kernels::Wall> kernel_walls(const std::vector<Wall>& given, int dim, int k) {
+  if (given.size() > static_cast<std::size_t>(kernels::max_walls))
+    throw InputError(std::to_string(given.size()) + " walls: at most " + std::to_string(kernels::max_walls));
+  std::vector<kernels::Wall> out;
+  out.reserve(given.size());
+  for (std::size_t w = 0; w < given.size(); ++w) {
+    const Wall& g = given[w];
+    const std::string name = "wall " + std::to_string(w);
+    double top = 0;
+    for (int a = 0; a < 3; ++a) {
+      const double x = g.normal[static_cast<std::size_t>(a)];
+      if (!std::isfinite(x)) throw InputError(name + ": its normal is not finite");
+      if (a >= dim && x != 0)
+        throw InputError(name + ": a 2D wall's normal has two components (its third must be 0)");
+      top = std::max(top, std::fabs(x));
+    }
+    if (top == 0) throw InputError(name + ": its normal is zero");
+    if (!std::isfinite(g.offset)) throw InputError(name + ": its offset is not finite");
+    // Scale by 2^-e so that the largest component lies in [1, 2): exact for
+    // the normal (its largest component is normal), and for the offset
+    // unless it leaves double's range, which is refused.
+    const int e = std::ilogb(top);
+    kernels::Wall kw{};
+    for (int a = 0; a < dim; ++a) {
+      kw.n[a] = std::ldexp(g.normal[static_cast<std::size_t>(a)], -e);
+      if (std::ldexp(kw.n[a], e) != g.normal[static_cast<std::size_t>(a)])
+        throw InputError(name + ": its normal's components differ by more than a double's range");
+    }
+    kw.d = std::ldexp(g.offset, k - e);
+    if (!std::isfinite(kw.d) || std::ldexp(kw.d, e - k) != g.offset)
+      throw InputError(name + ": its offset " + tessera::detail::number_text(g.offset) +
+                       " is out of range beside its normal (the two differ by more than a double's range)");
+    out.push_back(kw);
+  }
+  return out;
+}
+
+namespace {
+// sign(d - n.p) exactly, in rationals (the float test could not decide).
+int exact_side(const double* p, int dim, const kernels::Wall& w) {
+  mpq_t acc, t, u;
+  mpq_init(acc);
+  mpq_init(t);
+  mpq_init(u);
+  mpq_set_d(acc, w.d);
+  for (int a = 0; a < dim; ++a) {
+    mpq_set_d(t, w.n[a]);
+    mpq_set_d(u, p[a]);
+    mpq_mul(t, t, u);
+    mpq_sub(acc, acc, t);
+  }
+  const int s = mpq_sgn(acc);
+  mpq_clear(acc);
+  mpq_clear(t);
+  mpq_clear(u);
+  return s;
+}
+}  // namespace
+
+int outside_wall(const double* p, int dim, std::span<const kernels::Wall> walls) {
+  for (std::size_t k = 0; k < walls.size(); ++k) {
+    const kernels::Wall& w = walls[k];
+    double s = w.d, mag = std::fabs(w.d);
+    for (int a = 0; a < dim; ++a) {
+      const double t = w.n[a] * p[a];
+      s -= t;
+      mag += std::fabs(t);
+    }
+    const double err = 4 * dim * kernels::filter::u * mag;  // as walls::relative's bound
+    const int side = s > err ? 1 : s < -err ? -1 : exact_side(p, dim, w);
+    if (side < 0) return static_cast<int>(k);
+  }
+  return -1;
+}
+
+namespace {
+template <class CellT>
+double polytope_measure(const Bounds& box, const std::vector<Wall>& given) {
+  constexpr int D = CellT::dim;
+  // The box's centre as the one generator: the cell is the box, then cut.
+  double centre[3];
+  for (int a = 0; a < D; ++a) centre[a] = box.lo[static_cast<std::size_t>(a)] / 2 + box.hi[static_cast<std::size_t>(a)] / 2;
+  const std::vector<kernels::Wall> walls = kernel_walls(given, D, 0);
+  kernels::ExactContext ctx;
+  ctx.points = centre;
+  ctx.dim = D;
+  ctx.lo = box.lo;
+  ctx.hi = box.hi;
+  ctx.walls = walls.data();
+  ctx.num_walls = static_cast<int>(walls.size());
+  CellT cell;
+  cell.reset(0, centre, box.lo.data(), box.hi.data(), &ctx);
+  for (int k = 0; k < ctx.num_walls; ++k)
+    if (cell.clip_wall(k) == kernels::ClipResult::emptied) return 0;
+  cell.solve_deferred();
+  double volume;
+  std::array<double, D> centroid;
+  const std::int32_t shift = measure(cell, volume, centroid);
+  return std::ldexp(volume, D * shift);
+}
+}  // namespace
+
+double domain_volume(const Bounds& box, const std::vector<Wall>& walls, int dim) {
+  if (walls.empty()) return box.volume(dim);
+  return dim == 3 ? polytope_measure<kernels::Hull>(box, walls) : polytope_measure<kernels::Tile>(box, walls);
+}
+
+}  // namespace tessera::front

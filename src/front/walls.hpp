@@ -1,0 +1,31 @@
+// Walls (VoronoiOptions::walls) as the kernels take them: checked, each
+// scaled exactly to a normal whose largest component is in [1, 2), and put
+// in the computation's frame; and the exact test of a point against them.
+#pragma once
+
+#include <span>
+#include <vector>
+
+#include "tessera/cells.hpp"
+#include "tessera/kernels/exact_predicates.hpp"
+
+namespace tessera::front {
+
+/// The walls in the computation's frame (coordinates scaled by 2^k: the
+/// offsets are scaled alike). Throws InputError naming the wall where a
+/// normal is not finite or is zero (in 2D: or normal[2] != 0), an offset is
+/// not finite, a scaled offset is not exact (beyond double's range), or
+/// there are more than kernels::max_walls.
+std::vector<kernels::Wall> kernel_walls(const std::vector<Wall>& given, int dim, int k);
+
+/// The first wall that point p (dim coordinates, the computation's frame)
+/// lies strictly outside of (n.p > d, decided exactly), or -1.
+int outside_wall(const double* p, int dim, std::span<const kernels::Wall> walls);
+
+/// The volume (area in 2D) of the domain: `box` inside the walls (as
+/// given: the user's frame), 0 where they leave nothing; in double
+/// precision, by the cell kernels (a cell with no neighbours, cut by the
+/// walls) and their measure. For validate().
+double domain_volume(const Bounds& box, const std::vector<Wall>& walls, int dim);
+
+}  // namespace tessera::front
