@@ -399,6 +399,15 @@ VoronoiOptions make_options(const ComputeArgs& a, int dim) {
   }
   if (!a.periodic.empty() && a.bounds.empty())
     throw InputError("--periodic needs --bounds: the box that repeats");
+  for (const auto& w : a.walls) {
+    if (w.size() != static_cast<std::size_t>(dim + 1))
+      throw InputError(dim == 3 ? "--wall: expected four values, NX NY NZ D, for 3D points"
+                                : "--wall: expected three values, NX NY D, for 2D points");
+    Wall wall;
+    for (int d = 0; d < dim; ++d) wall.normal[static_cast<std::size_t>(d)] = w[static_cast<std::size_t>(d)];
+    wall.offset = w.back();
+    o.walls.push_back(wall);
+  }
   if (!a.tilt.empty()) {
     if (a.periodic.empty()) throw InputError("--tilt needs --periodic (a triclinic box repeats along its tilted axes)");
     if (a.tilt.size() != (dim == 3 ? 3u : 1u))
@@ -490,11 +499,12 @@ std::string domain_string(const Cells& c) {
   std::string s;
   for (int d = 0; d < c.dim; ++d)
     s += strf("%s[%.10g, %.10g]", d ? " x " : "", c.bounds.lo[d], c.bounds.hi[d]);
+  if (!c.walls.empty()) s += strf(", inside %zu wall%s", c.walls.size(), c.walls.size() == 1 ? "" : "s");
   return s;
 }
 
 void print_volume_line(const Cells& c, const char* name) {
-  const double sum = accurate_sum(c.volume), dom = c.bounds.volume(c.dim);
+  const double sum = accurate_sum(c.volume), dom = domain_volume(c.bounds, c.walls, c.dim);
   // Beyond the validator's rule the volumes in the input's units over- or
   // underflow, and comparing them says nothing.
   if (!volumes_representable(dom, c.n_cells()))

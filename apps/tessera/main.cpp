@@ -66,7 +66,8 @@ void print_error(const std::string& message) {
 std::string option_given_empty(const CLI::App& app) {
   for (const CLI::App* sub : app.get_subcommands()) {
     for (const CLI::Option* o : sub->get_options())
-      if (o->count() > 0 && o->get_expected_min() > 0)  // (not a flag)
+      // (not a flag; nor --wall, whose repeats CLI11 keeps apart by empty entries)
+      if (o->count() > 0 && o->get_expected_min() > 0 && o->get_name() != "--wall")
         for (const std::string& r : o->results())
           if (r.empty()) return o->get_name();
     if (std::string inner = option_given_empty(*sub); !inner.empty()) return inner;
@@ -219,6 +220,20 @@ void add_periodic_option(CLI::App* app, ComputeArgs& c, const std::string& image
       ->expected(1, 3);
 }
 
+/// --wall, repeatable, of the commands whose cells may lie in a convex domain.
+void add_walls_option(CLI::App* app, ComputeArgs& c) {
+  app->add_option("--wall", c.walls,
+                  "A wall: the half-space NX*x + NY*y (+ NZ*z) <= D, which cuts the domain box (--bounds, or the "
+                  "default) down to a convex polygon or polyhedron; repeat it, one per side (e.g. --wall 1,1,1.5 "
+                  "keeps x + y <= 1.5). Cells are cut exactly where they cross it; a face on wall k is listed as "
+                  "spoke -7-k, below the box planes' -1..-6. Every point must lie inside every wall (or "
+                  "--ignore-outside drops it). Not with --periodic")
+      ->type_name("NX NY [NZ] D")
+      ->expected(3, 4)
+      ->allow_extra_args(false)
+      ->delimiter(',');
+}
+
 /// Converts the --bounds words to numbers. A fifth word that is not a number
 /// is the INPUT that CLI11 attached to a 2D --bounds (when INPUT is otherwise
 /// missing). Throws InputError for anything else that is not a number, and
@@ -295,6 +310,7 @@ int main(int argc, char** argv) {
   add_cell_method_option(vor, va.compute);
   add_radii_option(vor, va.compute, true);
   add_periodic_option(vor, va.compute, "Cells keep their shape across the box's faces; neighbours may be images (--neighbor-shifts)", kAnyAxes);
+  add_walls_option(vor, va.compute);
   vor->add_option("-o,--output", va.output,
                   "Cells as VTK XML: .vtu (3D, one polyhedron per cell) or .vtp (2D, one polygon per cell), "
                   "with cell data GeneratorId, Region, Volume/Area, NumberOfFaces/Edges, NumberOfNeighbors");
@@ -403,6 +419,7 @@ int main(int argc, char** argv) {
                     "Area (3D) or length (2D) of the face behind every spoke of --csr, as a float64 .npy array: "
                     "face-area weights for neighbour statistics; both directions of a face get the same value");
   add_periodic_option(graph, ga.compute, "Cells keep their shape across the box's faces; a spoke may lead to an image (--spoke-shifts)", kAnyAxes);
+  add_walls_option(graph, ga.compute);
   graph->add_option("--spoke-shifts", ga.spoke_shifts,
                     "With --periodic: which image every spoke of --csr leads to, as an int8 .npy array of shape "
                     "(spokes, D) in box lengths (lattice vectors with --tilt); the twin of i -> (j, s) is j -> (i, -s)");
@@ -427,6 +444,7 @@ int main(int argc, char** argv) {
       ->required();
   faces->add_flag("--capping", fa.capping, "surface-net: also the boundary faces, closing every region");
   add_periodic_option(faces, fa.compute, "Cells keep their shape across the box's faces; a face is placed where its side-0 cell is, and side 1 may be an image (cell data SideShift)", kAnyAxes);
+  add_walls_option(faces, fa.compute);
   faces->add_flag("-q,--quiet", fa.quiet, "No summary and no progress bar");
 
   FlowerArgs wa;
@@ -455,6 +473,7 @@ int main(int argc, char** argv) {
   add_compute_options(snets, sna.compute, sn_bounds);
   add_surface_nets_options(snets, sna, false);
   add_periodic_option(snets, sna.compute, "Cells keep their shape across the box's faces; the surfaces close up across the box (their pieces fit by lattice translations; an image's default box is its voxels)", kAnyAxes);
+  add_walls_option(snets, sna.compute);
 
   BenchArgs ba;
   CLI::App* bench = app.add_subcommand("bench", "Benchmarks printing one JSON line per run on stdout");
@@ -470,6 +489,7 @@ int main(int argc, char** argv) {
   add_cell_method_option(bench_vor, ba.compute);
   add_radii_option(bench_vor, ba.compute, true);
   add_periodic_option(bench_vor, ba.compute, "Cells keep their shape across the box's faces", kAnyAxes);
+  add_walls_option(bench_vor, ba.compute);
   bench_vor->add_option("--repeat", ba.repeat, "Number of timed runs")
       ->check(Positive)
       ->capture_default_str();
@@ -536,6 +556,7 @@ int main(int argc, char** argv) {
                       "Each cell is its point's periodic cell, whose centroid may lie across a face: the moved point "
                       "is wrapped back into the box",
                       kAnyAxes);
+  add_walls_option(lloyd_app, la.compute);
   lloyd_app->add_option("-o,--output", la.output,
                         "The moved points, in input order, with their labels: .npy (float64 (N, D); labels in "
                         "OUT_labels.npy), .ply (binary, double x y z, int property 'label') or .vtp (VTK vertices, "

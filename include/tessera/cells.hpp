@@ -397,6 +397,12 @@ struct Cells {
 Cells voronoi(std::span<const double> points, int dim, std::span<const std::int32_t> labels,
               const VoronoiOptions& options);
 
+/// The domain's volume (area in 2D): `box` inside `walls` (VoronoiOptions::
+/// walls), 0 where they leave nothing; the box's volume without walls.
+/// Computed in double precision by the cell kernels. Throws InputError for
+/// walls voronoi() refuses.
+double domain_volume(const Bounds& box, const std::vector<Wall>& walls, int dim);
+
 /// Invariant checks on a result (the CLI's --validate).
 struct ValidationReport {
   bool ok = true;

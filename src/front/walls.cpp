@@ -123,3 +123,9 @@ double domain_volume(const Bounds& box, const std::vector<Wall>& walls, int dim)
 }
 
 }  // namespace tessera::front
+
+namespace tessera {
+double domain_volume(const Bounds& box, const std::vector<Wall>& walls, int dim) {
+  return front::domain_volume(box, walls, dim);
+}
+}  // namespace tessera
