@@ -31,10 +31,22 @@ using Points = py::array_t<double, py::array::c_style>;
 Cells run_voronoi(const Points& points, const py::object& labels, const std::optional<std::vector<double>>& bounds,
                   double padding, bool ignore_outside, int threads, bool merge, const std::string& method,
                   const std::array<bool, 3>& periodic, const std::array<double, 3>& tilt,
-                  const py::object& radii, const py::object& only, int only_with_faces) {
+                  const py::object& radii, const py::object& only, int only_with_faces, const py::object& walls) {
   const int dim = checked_dim(points);
   VoronoiOptions opt;
   fill_common(opt, dim, bounds, padding, ignore_outside, threads);
+  // Walls: None, or float64 (k, dim + 1) rows (normal..., offset), checked in Python.
+  if (!walls.is_none()) {
+    const auto w = walls.cast<py::array_t<double, py::array::c_style>>();
+    if (w.ndim() != 2 || w.shape(1) != dim + 1)
+      throw py::value_error("walls must be a float64 array of shape (k, " + std::to_string(dim + 1) + ")");
+    for (py::ssize_t k = 0; k < w.shape(0); ++k) {
+      Wall wall;
+      for (int a = 0; a < dim; ++a) wall.normal[static_cast<std::size_t>(a)] = w.at(k, a);
+      wall.offset = w.at(k, dim);
+      opt.walls.push_back(wall);
+    }
+  }
   opt.periodic = periodic;
   opt.tilt = tilt;
   opt.radii = as_radii(radii);  // views the caller's array, alive through the call
@@ -191,6 +203,18 @@ void bind_voronoi(py::module_& m) {
                                return view_rows(c.neighbor_shifts, static_cast<std::size_t>(c.dim), s);
                              })
       .def_property_readonly("periodic", [](const Cells& c) { return per_axis(c.periodic, c.dim); })
+      .def_property_readonly("walls",
+                             [](const Cells& c) {
+                               py::array_t<double> a({static_cast<py::ssize_t>(c.walls.size()),
+                                                      static_cast<py::ssize_t>(c.dim + 1)});
+                               auto m = a.mutable_unchecked<2>();
+                               for (std::size_t k = 0; k < c.walls.size(); ++k) {
+                                 for (int d = 0; d < c.dim; ++d)
+                                   m(static_cast<py::ssize_t>(k), d) = c.walls[k].normal[static_cast<std::size_t>(d)];
+                                 m(static_cast<py::ssize_t>(k), c.dim) = c.walls[k].offset;
+                               }
+                               return a;
+                             })
       .def_readonly("periodic_images", &Cells::periodic_images)
       .def_property_readonly("tilt", [](const Cells& c) { return c.tilt; })
       .def_property_readonly("periodic_points",
@@ -246,10 +270,12 @@ void bind_voronoi(py::module_& m) {
         py::arg("padding"), py::arg("ignore_outside"), py::arg("threads"), py::arg("merge"),
         py::arg("method"), py::arg("periodic"), py::arg("tilt"), py::arg("radii").none(true) = py::none(),
         py::arg("only").none(true) = py::none(), py::arg("only_with_faces") = 0,
+        py::arg("walls").none(true) = py::none(),
         "Cells of float64 C-ordered (N, D) points; labels None or int32 (N,); radii None or float64 (N,) "
         "(power cells); only None or int32 ids: those cells and their neighbours' (VoronoiOptions::only); "
         "only_with_faces: a set of spoke classes (face_set_classes), the cells with a face of one of them "
-        "(VoronoiOptions::only_with_faces). Runs without the GIL.");
+        "(VoronoiOptions::only_with_faces); walls None or float64 (k, D + 1) rows (normal, offset): "
+        "half-spaces normal . x <= offset cutting the box (VoronoiOptions::walls). Runs without the GIL.");
 
   m.def(
       "validate_cells",

@@ -94,6 +94,8 @@ class Cells:
     def neighbor_shifts(self) -> npt.NDArray[np.int8]: ...
     @property
     def periodic(self) -> Tuple[bool, ...]: ...
+    @property
+    def walls(self) -> npt.NDArray[np.float64]: ...
     periodic_images: int
     @property
     def tilt(self) -> Tuple[float, float, float]: ...
@@ -141,6 +143,7 @@ def voronoi(
     radii: Optional[npt.NDArray[np.float64]] = ...,
     only: Optional[npt.NDArray[np.int32]] = ...,
     only_with_faces: int = ...,
+    walls: Optional[npt.NDArray[np.float64]] = ...,
 ) -> Cells: ...
 def validate_cells(
     cells: Cells,

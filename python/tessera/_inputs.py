@@ -97,6 +97,25 @@ def as_radii(radii: Any, n: int) -> Optional[np.ndarray]:
     return np.ascontiguousarray(a, dtype=np.float64)
 
 
+def as_walls(walls: Any, dim: int) -> Optional[np.ndarray]:
+    """Walls as ``None`` or a float64 C-contiguous (k, dim + 1) array, each
+    row a half-space ``normal . x <= offset`` as (normal..., offset). One
+    wall may be given as a flat row. Finite and non-zero normals are checked
+    by the front end (InputError naming the wall)."""
+    if walls is None:
+        return None
+    try:
+        a = numbers_array(walls)
+    except (TypeError, ValueError):
+        raise TypeError(f"walls: expected rows (normal..., offset) of numbers, got {walls!r}") from None
+    if a.ndim == 1 and a.shape[0] == dim + 1:
+        a = a.reshape(1, dim + 1)
+    if a.ndim != 2 or a.shape[1] != dim + 1:
+        raise ValueError(f"walls: expected rows of {dim + 1} numbers (normal..., offset) for {dim}D points, "
+                         f"got shape {a.shape}")
+    return np.ascontiguousarray(a, dtype=np.float64)
+
+
 def numbers_array(values: Any) -> np.ndarray:
     """`values` as a float64 array, refusing strings, bools, None and
     complex numbers among them as the scalar arguments do (np.asarray(

@@ -158,6 +158,14 @@ class Voronoi:
         return self._cells.periodic
 
     @property
+    def walls(self) -> np.ndarray:
+        """The walls as given to :func:`voronoi`, shape (k, D + 1): rows
+        (normal..., offset) of the half-spaces ``normal . x <= offset`` that
+        cut the box; (0, D + 1) without walls. Wall k's faces have spoke
+        ``-7 - k``."""
+        return self._cells.walls
+
+    @property
     def tilt(self) -> Tuple[float, ...]:
         """A triclinic box's tilts as rounded, and reduced by whole box lengths
         where one was more than a length (the same lattice): ``(xy,)`` in 2D,
@@ -364,6 +372,7 @@ def voronoi(
     periodic: Any = False,
     tilt: Optional[Sequence[float]] = None,
     radii: Any = None,
+    walls: Any = None,
 ) -> Voronoi:
     """Voronoi cells of 2D or 3D points, clipped to a box, with exact topology.
 
@@ -435,6 +444,15 @@ def voronoi(
         (``method="insertion"``; automatically where the search is costly).
         The array is kept (:attr:`Voronoi.radii`, no copy when it is float64
         and contiguous) for :meth:`Voronoi.validate`.
+    walls : array_like, shape (k, D + 1), optional
+        Half-spaces ``normal . x <= offset``, one per row as (normal...,
+        offset), that cut the box down to a convex polygon or polyhedron (a
+        convex domain: one wall per side). Each cell is its box cell's part
+        inside them, cut exactly, so the cells stay conformal and their
+        volumes sum to the domain's. A face on wall k has spoke ``-7 - k``
+        (below the box planes' -1..-6). Every point must lie inside or on
+        every wall (ValueError; ``ignore_outside`` drops such points). Not
+        with ``periodic``. Kept as :attr:`Voronoi.walls`.
 
     Returns
     -------
@@ -453,12 +471,12 @@ def voronoi(
     The computation runs with the GIL released: other Python threads go on.
     """
     return cells_of(points, labels, bounds, padding, threads, merge, ignore_outside, method, periodic, tilt, radii,
-                    None, 0)
+                    None, 0, walls)
 
 
 def cells_of(points: Any, labels: Any, bounds: Any, padding: float, threads: Any, merge: bool, ignore_outside: bool,
              method: str, periodic: Any, tilt: Any, radii: Any, only: Optional[np.ndarray],
-             only_with_faces: int) -> Voronoi:
+             only_with_faces: int, walls: Any = None) -> Voronoi:
     """:func:`voronoi`'s work, on its arguments (every one given: the
     defaults are voronoi's alone); with ``only`` (int32 ids that exist) the
     cells of those points and their neighbours alone, each as :func:`voronoi`
@@ -488,6 +506,7 @@ def cells_of(points: Any, labels: Any, bounds: Any, padding: float, threads: Any
         rad,
         only,
         only_with_faces,
+        _inputs.as_walls(walls, dim),
     )
     return Voronoi(cells, pts, lab, rad)
 
