@@ -9,6 +9,7 @@
 
 #include "../front/pass.hpp"
 #include "../front/periodic.hpp"
+#include "../front/walls.hpp"
 #include "../message_text.hpp"
 
 namespace tessera {
@@ -57,6 +58,8 @@ LloydResult lloyd(std::span<const double> points, int dim, std::span<const std::
   vo.build_mesh = false;
   const std::function<void(double)> progress = options.voronoi.progress;
   std::vector<double> next, displacement;
+  // The walls in the points' frame, for the test of each centroid.
+  const std::vector<kernels::Wall> walls = front::kernel_walls(vo.walls, dim, 0);
   for (int it = 0; it < iterations; ++it) {
     if (progress)
       vo.progress = [&progress, it, iterations](double f) {
@@ -69,6 +72,10 @@ LloydResult lloyd(std::span<const double> points, int dim, std::span<const std::
       result.domain = cells.bounds;
       if (!vo.bounds) vo.bounds = cells.bounds;
       result.spacing = mean_spacing(cells.bounds, dim, cells.generators);
+      if (!vo.walls.empty()) {  // the polytope's spacing: its volume per generator, rooted
+        const double v = front::domain_volume(cells.bounds, vo.walls, dim);
+        if (v > 0) result.spacing = std::pow(v / static_cast<double>(std::max<std::size_t>(cells.generators, 1)), 1.0 / dim);
+      }
       result.threads_used = cells.threads_used;
     }
     const Bounds& box = *vo.bounds;
@@ -88,6 +95,13 @@ LloydResult lloyd(std::span<const double> points, int dim, std::span<const std::
         if (!cells.periodic[a]) x = std::clamp(x, box.lo[a], box.hi[a]);
         d[a] = x - from[i * du + a];
         next[i * du + a] = x;
+      }
+      // A centroid on a wall may round past it: that point stays where it
+      // was (within rounding of the same place), as the next cells pass
+      // would refuse it.
+      if (!walls.empty() && front::outside_wall(next.data() + i * du, dim, walls) >= 0) {
+        for (std::size_t a = 0; a < du; ++a) next[i * du + a] = result.points[i * du + a];
+        d[0] = d[1] = d[2] = 0;
       }
       // (std::hypot: squares of displacements past ~1e154 overflow)
       displacement[c] = std::hypot(d[0], d[1], d[2]);

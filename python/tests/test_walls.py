@@ -1,0 +1,65 @@
+"""tessera.voronoi(walls=...): cells in a convex domain, the box cut by
+half-spaces. Measures against domains known by hand (a triangle of area 1/2,
+half the unit cube), the walls' spokes in the graph and the boundary face
+set, validation with exact measures, 1 vs 2 threads, bad walls."""
+
+import math
+
+import numpy as np
+import pytest
+
+import tessera
+from conftest import UNIT_BOX
+
+
+def inside_points(n, dim, offset, seed):
+    p = np.random.default_rng(seed).random((n, dim))
+    return p[p.sum(axis=1) <= offset]
+
+
+def test_triangle_and_half_cube():
+    for dim, offset, measure in ((2, 1.0, 0.5), (3, 1.5, 0.5)):
+        pts = inside_points(3000, dim, offset, dim)
+        wall = [1.0] * dim + [offset]
+        vor = tessera.voronoi(pts, bounds=UNIT_BOX[dim], walls=[wall])
+        assert vor.n_cells == len(pts)
+        assert vor.volumes.sum() == pytest.approx(measure, rel=1e-13)
+        assert vor.walls.tolist() == [wall]
+        report = vor.validate()
+        assert report.ok, report
+        # One flat row is one wall; the same cells.
+        again = tessera.voronoi(pts, bounds=UNIT_BOX[dim], walls=np.array(wall), threads=2)
+        assert np.array_equal(again.volumes, vor.volumes)
+        assert np.array_equal(again.centroids, vor.centroids)
+        # The wall is spoke -7, a domain boundary.
+        g = tessera.adjacency(vor)
+        assert np.any(g.spokes == -7)
+        assert np.all(g.spoke_class[g.spokes == -7] == 2)
+        # Without walls: an empty (0, D + 1) array.
+        assert tessera.voronoi(pts, bounds=UNIT_BOX[dim]).walls.shape == (0, dim + 1)
+
+
+def test_boundary_of_the_triangle():
+    pts = inside_points(2000, 2, 1.0, 7)
+    vor = tessera.voronoi(pts, bounds=UNIT_BOX[2], walls=[(1, 1, 1)])
+    fs = tessera.faces(vor, "boundary")
+    v = fs.vertices
+    seg = fs.face_vertices.reshape(-1, 2)
+    length = np.linalg.norm(v[seg[:, 1]] - v[seg[:, 0]], axis=1).sum()
+    assert length == pytest.approx(2 + math.sqrt(2), rel=1e-13)
+
+
+def test_bad_walls_and_points_outside():
+    pts = inside_points(500, 3, 1.5, 3)
+    with pytest.raises(ValueError, match="lies outside wall 0"):
+        tessera.voronoi(pts, bounds=UNIT_BOX[3], walls=[(1, 1, 1, 1.0)])
+    vor = tessera.voronoi(pts, bounds=UNIT_BOX[3], walls=[(1, 1, 1, 1.0)], ignore_outside=True)
+    assert len(vor.ignored_outside_bounds) == int(np.sum(pts.sum(axis=1) > 1.0))
+    with pytest.raises(ValueError, match="its normal is zero"):
+        tessera.voronoi(pts, bounds=UNIT_BOX[3], walls=[(0, 0, 0, 1.0)])
+    with pytest.raises(ValueError, match="rows of 4 numbers"):
+        tessera.voronoi(pts, bounds=UNIT_BOX[3], walls=[(1, 1, 1.0)])
+    with pytest.raises(TypeError):
+        tessera.voronoi(pts, bounds=UNIT_BOX[3], walls=[("a", 1, 1, 1.0)])
+    with pytest.raises(ValueError, match="periodic"):
+        tessera.voronoi(pts, bounds=UNIT_BOX[3], walls=[(1, 1, 1, 2.5)], periodic=True)

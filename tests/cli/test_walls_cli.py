@@ -1,0 +1,147 @@
+#!/usr/bin/python3
+"""End-to-end tests of --wall: cells in a convex domain (the box cut by half-spaces).
+
+Usage: /usr/bin/python3 tests/cli/test_walls_cli.py PATH_TO_tessera [unittest args...]
+
+Domains whose measures are known by hand: the unit square cut by x + y <= 1
+(a triangle of area 1/2 and perimeter 2 + sqrt 2), the unit cube cut by
+x + y + z <= 3/2 (volume 1/2, by the symmetry x -> 1 - x). Every file is read
+back (VTK's readers, numpy); bad input: exit 2, one error line, nothing
+written. Shares its helpers with test_cli.py.
+
+Prints "N passed, M failed" last; exits 1 if anything failed.
+"""
+import json
+import math
+import os
+import sys
+from fractions import Fraction
+
+import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import test_cli as base  # noqa: E402  (helpers only; its test classes are not collected here)
+from test_cli import read_vtp, read_vtu, cell_array  # noqa: E402
+
+from vtk.util.numpy_support import vtk_to_numpy  # noqa: E402
+
+run = base.run
+
+
+def inside(points, normal, offset):
+    """Exactly: normal . p <= offset for every row (fractions: no rounding)."""
+    n = [Fraction(x) for x in normal]
+    return all(sum(Fraction(float(x)) * a for x, a in zip(p, n)) <= Fraction(offset) for p in points)
+
+
+class Case(base.TempDirCase):
+    def fails(self, args, fragment=None):
+        before = set(os.listdir(self.dir))
+        r = run(args)
+        after = set(os.listdir(self.dir))
+        cmd = "tessera " + " ".join(map(str, args))
+        self.assertEqual(r.returncode, 2, "%s: exit %d\nstdout: %s\nstderr: %s" % (cmd, r.returncode, r.stdout, r.stderr))
+        lines = r.stderr.splitlines()
+        self.assertEqual(len(lines), 1, "%s: stderr must be one line, got %r" % (cmd, r.stderr))
+        self.assertTrue(lines[0].startswith("tessera: error: "), "%s: %r" % (cmd, lines[0]))
+        if fragment:
+            self.assertIn(fragment, lines[0], cmd)
+        self.assertEqual(after - before, set(), "%s left files behind" % cmd)
+        return lines[0]
+
+
+class Walls(Case):
+    def setUp(self):
+        super().setUp()
+        rng = np.random.default_rng(8)
+        p2 = rng.random((3000, 2))
+        self.p2 = p2[p2.sum(axis=1) <= 1]
+        p3 = rng.random((4000, 3))
+        self.p3 = p3[p3.sum(axis=1) <= 1.5]
+        self.in2 = self.save("p2.npy", self.p2)
+        self.in3 = self.save("p3.npy", self.p3)
+
+    def test_triangle_2d(self):
+        r = self.ok(["voronoi", self.in2, "--bounds", "0", "1", "0", "1", "--wall", "1,1,1", "-o", self.p("c.vtp"),
+                     "--cell-table", self.p("t.csv"), "--neighbors", self.p("nb.npy"), "--validate"])
+        self.assertIn("domain             [0, 1] x [0, 1], inside 1 wall\n", r.stdout)
+        self.assertIn("validation: OK", r.stdout)
+        n = len(self.p2)
+        out = read_vtp(self.p("c.vtp"))
+        self.assertEqual(out.GetNumberOfCells(), n)
+        area = vtk_to_numpy(cell_array(out, "Area"))
+        self.assertAlmostEqual(float(area.sum()), 0.5, delta=1e-12)
+        t = np.loadtxt(self.p("t.csv"), delimiter=",", skiprows=1)
+        self.assertEqual(len(t), n)
+        self.assertTrue(np.array_equal(t[:, 2], area))
+        nb = np.load(self.p("nb.npy"))
+        ids = nb[2 + n:]
+        self.assertTrue(np.all(ids >= 0))  # walls, as the box, are not neighbours
+        # The boundary is the triangle's perimeter, every face of class 2.
+        self.ok(["faces", self.in2, "--kind", "boundary", "--bounds", "0,1,0,1", "--wall", "1", "1", "1",
+                 "-o", self.p("b.vtp"), "-q"])
+        b = read_vtp(self.p("b.vtp"))
+        pts = vtk_to_numpy(b.GetPoints().GetData())
+        length = 0.0
+        for c in range(b.GetNumberOfCells()):
+            ids = b.GetCell(c).GetPointIds()
+            length += float(np.linalg.norm(pts[ids.GetId(1)] - pts[ids.GetId(0)]))
+        self.assertAlmostEqual(length, 2 + math.sqrt(2), delta=1e-12)
+        self.assertTrue(np.all(vtk_to_numpy(cell_array(b, "SpokeClass")) == 2))
+
+    def test_half_cube_3d(self):
+        r = self.ok(["voronoi", self.in3, "--bounds", "0", "1", "0", "1", "0", "1", "--wall", "1", "1", "1", "1.5",
+                     "-o", self.p("c.vtu"), "--validate"])
+        self.assertIn("inside 1 wall", r.stdout)
+        self.assertIn("validation: OK", r.stdout)
+        out = read_vtu(self.p("c.vtu"))
+        self.assertEqual(out.GetNumberOfCells(), len(self.p3))
+        self.assertEqual({out.GetCellType(c) for c in range(out.GetNumberOfCells())}, {42})  # VTK_POLYHEDRON
+        self.assertAlmostEqual(float(vtk_to_numpy(cell_array(out, "Volume")).sum()), 0.5, delta=1e-12)
+        # The graph lists the wall as spoke -7, a domain boundary (class 2).
+        self.ok(["graph", self.in3, "--bounds", "0,1,0,1,0,1", "--wall", "1,1,1,1.5", "--csr", self.p("g.npy"),
+                 "--spoke-classes", self.p("k.npy"), "-q"])
+        g = np.load(self.p("g.npy"))
+        n = int(g[0])
+        spokes = g[2 + n:]
+        k = np.load(self.p("k.npy"))
+        self.assertGreater(int(np.sum(spokes == -7)), 0)
+        self.assertTrue(np.all(k[spokes == -7] == 2))
+        # bench voronoi takes walls too.
+        r = self.ok(["bench", "voronoi", self.in3, "--bounds", "0,1,0,1,0,1", "--wall", "1,1,1,1.5"])
+        line = json.loads(r.stdout.splitlines()[0])
+        self.assertEqual(line["n"], len(self.p3))
+
+    def test_lloyd_keeps_points_inside(self):
+        self.ok(["lloyd", self.in3, "--bounds", "0,1,0,1,0,1", "--wall", "1,1,1,1.5", "--wall", "-1,0,0,0",
+                 "--iterations", "3", "-o", self.p("r.npy"), "-q"])
+        q = np.load(self.p("r.npy"))
+        self.assertEqual(q.shape, self.p3.shape)
+        self.assertTrue(inside(q, (1, 1, 1), 1.5))
+        self.assertFalse(np.array_equal(q, self.p3))
+
+    def test_points_outside_and_bad_walls(self):
+        out = self.p("c.vtp")
+        box = ["--bounds", "0,1,0,1"]
+        self.fails(["voronoi", self.in2, "--wall", "1,1,0.5", "-o", out] + box, "lies outside wall 0")
+        self.fails(["voronoi", self.in2, "--wall", "1,1,1,1", "-o", out] + box, "expected three values")
+        self.fails(["voronoi", self.in3, "--wall", "1,1,1", "-o", self.p("c.vtu")], "expected four values")
+        self.fails(["voronoi", self.in2, "--wall", "0,0,1", "-o", out] + box, "wall 0: its normal is zero")
+        self.fails(["voronoi", self.in2, "--wall", "1,1,1", "--wall", "1,0,inf", "-o", out] + box,
+                   "wall 1: its offset is not finite")
+        self.fails(["voronoi", self.in2, "--wall", "1,1,1", "--periodic", "xy", "-o", out] + box, "periodic")
+        self.fails(["delaunay", self.in2, "--wall", "1,1,1", "-o", out] + box)
+        self.fails(["surface-nets", self.in2, "--wall", "1,1,1", "-o", out] + box)
+        # Dropped instead, and listed.
+        r = self.ok(["voronoi", self.in2, "--wall", "1,1,0.5", "--ignore-outside", "-o", out] + box)
+        outside = int(np.sum(self.p2.sum(axis=1) > 0.5))
+        self.assertIn("ignored (outside)  %d (points" % outside, r.stdout)
+        self.assertEqual(read_vtp(out).GetNumberOfCells(), len(self.p2) - outside)
+
+
+def main():
+    return base.cli_main("test_walls_cli.py", [(base.vtk is not None, "python3-vtk9 is required (run with /usr/bin/python3)")])
+
+
+if __name__ == "__main__":
+    sys.exit(main())
