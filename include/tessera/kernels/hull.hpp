@@ -150,6 +150,7 @@ class Hull {
   /// generators outside a wall).
   ClipResult clip_wall(int k) {
     const walls::RelativeWall<3> w = walls::relative<3>(exact_->walls[k], site_);
+    if (walls::misses(w, 0.25 * security2_)) return ClipResult::unchanged;
     const std::size_t nv = verts_.size();
     if (sign_.size() < std::max(nv, lanes_.padded())) sign_.resize(std::max(nv, lanes_.padded()));
     const std::size_t removed = walls::signs<3>(verts_.data(), nv, planes_.data(), w, k, *exact_, gen_, sign_);

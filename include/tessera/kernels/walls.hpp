@@ -50,6 +50,18 @@ RelativeWall<D> relative(const Wall& w, const double* p) {
   return r;
 }
 
+/// Whether wall `w` surely cuts nothing of a cell whose vertices lie within
+/// sqrt(r2) of its generator (r2: an upper bound on every |y|^2, as the
+/// cell's security radius holds four times it): n.y <= |n| sqrt(r2) < d for
+/// every vertex, with room for d's rounding and the norm's. Most cells of a
+/// many-sided domain lie far inside most of its walls.
+template <int D>
+bool misses(const RelativeWall<D>& w, double r2) {
+  double nn = 0;
+  for (int c = 0; c < D; ++c) nn += w.n[c] * w.n[c];
+  return w.d - w.d_err > std::sqrt(nn * r2) * (1 + 1e-12);
+}
+
 /// Each vertex's side of wall k (relative: `w`) into `sign`: +1 keep (inside
 /// or on it), -1 remove; returns the number removed. A vertex is decided by
 /// the float filter where P = d - n.y clears its bound (the vertex's own
