@@ -480,6 +480,30 @@ int exact_box_sign(const ExactContext& ctx, std::int32_t i, const std::int32_t* 
   return box_plane_upper(box) ? side : -side;
 }
 
+double exact_wall_offset(const Wall& w, const double* p, int dim) {
+  thread_local struct Rationals {
+    mpq_t acc, t, u;
+    Rationals() {
+      mpq_init(acc);
+      mpq_init(t);
+      mpq_init(u);
+    }
+    ~Rationals() {
+      mpq_clear(acc);
+      mpq_clear(t);
+      mpq_clear(u);
+    }
+  } r;
+  mpq_set_d(r.acc, w.d);
+  for (int a = 0; a < dim; ++a) {
+    mpq_set_d(r.t, w.n[a]);
+    mpq_set_d(r.u, p[a]);
+    mpq_mul(r.t, r.t, r.u);
+    mpq_sub(r.acc, r.acc, r.t);
+  }
+  return mpq_get_d(r.acc);  // truncated toward zero
+}
+
 int exact_wall_sign(const ExactContext& ctx, std::int32_t i, const std::int32_t* planes, int wall) {
   const int dim = ctx.dim;
   std::int32_t gen[Scratch::kRows];

@@ -204,6 +204,13 @@ int exact_clip_sign_by_arithmetic(const ExactContext& ctx, std::int32_t i, const
 /// With the box row (e_axis, c) as M's last row, det M = det A (c - v_axis)
 /// (Schur complement), and the box row carries no weight.
 int exact_box_sign(const ExactContext& ctx, std::int32_t i, const std::int32_t* planes, std::int32_t box);
+/// The offset of wall w relative to point p (dim coordinates), d - n.p,
+/// computed exactly and truncated to a double (within one ulp): a clipping
+/// plane's offset must be as accurate as a rounded difference's (the
+/// filters' plane_eps), which the float d - n.p is not where it cancels (a
+/// point near a wall far from the origin: the vertices of a slab between
+/// two walls 1e-9 apart were placed 1e-16 off, and measured 1e-8 off).
+double exact_wall_offset(const Wall& w, const double* p, int dim);
 /// The side of wall `wall` (an index into ctx.walls) on which the vertex of
 /// cell i where planes[0..dim) meet (generators, box planes or walls) lies:
 /// +1 inside or exactly on the wall's plane, -1 outside. A tie counts as

@@ -149,8 +149,9 @@ class Hull {
   /// where the whole cell lies outside (a power cell; the front end refuses
   /// generators outside a wall).
   ClipResult clip_wall(int k) {
-    const walls::RelativeWall<3> w = walls::relative<3>(exact_->walls[k], site_);
+    walls::RelativeWall<3> w = walls::relative<3>(exact_->walls[k], site_);
     if (walls::misses(w, 0.25 * security2_)) return ClipResult::unchanged;
+    walls::refine(w, exact_->walls[k], site_);
     const std::size_t nv = verts_.size();
     if (sign_.size() < std::max(nv, lanes_.padded())) sign_.resize(std::max(nv, lanes_.padded()));
     const std::size_t removed = walls::signs<3>(verts_.data(), nv, planes_.data(), w, k, *exact_, gen_, sign_);

@@ -114,8 +114,9 @@ class Tile {
 
   /// As Hull::clip_wall: cut the finished tile by wall k (walls.hpp).
   ClipResult clip_wall(int k) {
-    const walls::RelativeWall<2> w = walls::relative<2>(exact_->walls[k], site_);
+    walls::RelativeWall<2> w = walls::relative<2>(exact_->walls[k], site_);
     if (walls::misses(w, 0.25 * security2_)) return ClipResult::unchanged;
+    walls::refine(w, exact_->walls[k], site_);
     const std::size_t nv = verts_.size();
     if (sign_.size() < nv) sign_.resize(nv);
     const std::size_t removed = walls::signs<2>(verts_.data(), nv, planes_.data(), w, k, *exact_, gen_, sign_);

@@ -50,6 +50,15 @@ RelativeWall<D> relative(const Wall& w, const double* p) {
   return r;
 }
 
+/// `relative`'s wall with its offset computed exactly and truncated
+/// (exact_wall_offset), so that it is as accurate as a clipping plane's
+/// must be: for a wall that may cut the cell (a few cells of many).
+template <int D>
+void refine(RelativeWall<D>& r, const Wall& w, const double* p) {
+  r.d = exact_wall_offset(w, p, D);
+  r.d_err = 2 * filter::u * std::fabs(r.d) + filter::abs_eps;
+}
+
 /// Whether wall `w` surely cuts nothing of a cell whose vertices lie within
 /// sqrt(r2) of its generator (r2: an upper bound on every |y|^2, as the
 /// cell's security radius holds four times it): n.y <= |n| sqrt(r2) < d for
@@ -62,13 +71,13 @@ bool misses(const RelativeWall<D>& w, double r2) {
   return w.d - w.d_err > std::sqrt(nn * r2) * (1 + 1e-12);
 }
 
-/// Each vertex's side of wall k (relative: `w`) into `sign`: +1 keep (inside
-/// or on it), -1 remove; returns the number removed. A vertex is decided by
-/// the float filter where P = d - n.y clears its bound (the vertex's own
-/// bound e, the plane's rounding as a clip's, and d's), else exactly. A
-/// vertex on an earlier wall always goes to the exact sign: its bound e
-/// assumed its planes' offsets rounded once, and a wall's d, a difference
-/// of products, may carry more (a point near a wall far from the origin).
+/// Each vertex's side of wall k (relative: `w`, refined) into `sign`: +1
+/// keep (inside or on it), -1 remove; returns the number removed. A vertex
+/// is decided by the float filter where P = d - n.y clears its bound (the
+/// vertex's own bound e, the plane's rounding as a clip's, and d's), else
+/// exactly. A vertex on an earlier wall always goes to the exact sign (few:
+/// the cells at the domain's edges), a margin against any bound the wall's
+/// slanted rows may strain.
 template <int D, class Vertex, class Plane>
 std::size_t signs(const Vertex* verts, std::size_t nv, const Plane* planes, const RelativeWall<D>& w, int k,
                   const ExactContext& ctx, std::int32_t gen, std::vector<filter::Sign>& sign) {
