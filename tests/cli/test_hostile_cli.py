@@ -31,8 +31,9 @@ sheared a third of the time where x and y are periodic): the cells by both
 methods, the periodic triangulation, graph and faces; a third of the
 orthogonal ones again with the box declared by the file itself (a LAMMPS
 dump or an extended XYZ), which must give the same cells. Labelled cases also
-build their surface net; one in eight runs fill -> joggle -> voronoi, and
-one in eight cuts --bounds through the points (--ignore-outside).
+build their surface net; one in eight runs fill -> joggle -> voronoi, one in
+eight cuts --bounds through the points (--ignore-outside), and one in eight
+cuts the box by walls through the points (--wall, --ignore-outside).
 The only accepted failures are input errors: a zero extent (all points on
 an axis plane, or one point); with radii, input no frame fits and labelled
 input whose inside points all have empty power cells; a periodic box's own
@@ -324,6 +325,45 @@ class Hostile(base.TempDirCase):
                 self.check_pipeline(case, kind, d, inp, labels, threads)
             if case % 8 == 2:
                 self.check_cut_bounds(case, kind, d, pts, inp, labels, common, rng)
+            if case % 8 == 4:
+                self.check_walls(case, kind, d, pts, inp, labels, common, rng)
+
+    def check_walls(self, case, kind, d, pts, inp, labels, common, rng):
+        """One to four walls through the point cloud (random normals, each
+        offset at a quantile of the points along it; half the time a wall
+        through a point, whose offset is then exact only where its products
+        are) with --ignore-outside: the cells by both methods, validated
+        (the volumes against the polytope's, sampled cells exactly), the
+        same neighbours; the graph and the boundary."""
+        walls = []
+        for _ in range(int(rng.integers(1, 5))):
+            n = rng.normal(size=d)
+            if rng.random() < 0.3:
+                n[int(rng.integers(0, d))] = 0.0  # parallel to an axis
+            if not np.any(n):
+                n[0] = 1.0
+            along = pts @ n
+            finite = along[np.isfinite(along)]
+            if len(finite) == 0:
+                return
+            if rng.random() < 0.5:
+                off = float(np.quantile(finite, rng.uniform(0.3, 1.0)))
+            else:
+                off = float(finite[int(rng.integers(0, len(finite)))])
+            walls += ["--wall", ",".join(repr(float(x)) for x in list(n) + [off])]
+        wc = common + walls + ["--ignore-outside"]
+        accept = CUT_REFUSALS + ("its offset", "its normal's components")
+        nb = {}
+        for method in ("search", "insertion"):
+            nb[method] = self.p("wnb_%s.npy" % method)
+            if not self.check(["voronoi"] + wc + ["--method", method, "--neighbors", nb[method], "--validate"],
+                              inp, labels, kind, d, case, accept=accept):
+                return
+        self.assertTrue(np.array_equal(np.load(nb["search"]), np.load(nb["insertion"])),
+                        "case %d (%s, walls %s): neighbours by search and by insertion differ" % (case, kind, walls))
+        self.check(["graph"] + wc + ["-o", self.p("wg.vtp")], inp, labels, kind, d, case, accept=accept)
+        self.check(["faces"] + wc + ["-o", self.p("wf.vtp"), "--kind", "boundary"], inp, labels, kind, d, case,
+                   accept=accept)
 
     def check_cut_bounds(self, case, kind, d, pts, inp, labels, common, rng):
         """--bounds through the point cloud with --ignore-outside: the
