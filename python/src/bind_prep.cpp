@@ -315,10 +315,11 @@ void bind_prep(py::module_& m) {
       [](const Points& points, const py::object& labels, const std::optional<std::vector<double>>& bounds,
          double padding, bool ignore_outside, int threads, const std::string& method,
          const std::array<bool, 3>& periodic, const std::array<double, 3>& tilt, const py::object& radii,
-         int iterations, double tolerance) {
+         int iterations, double tolerance, const py::object& walls) {
         const int dim = checked_dim(points);
         LloydOptions opt;
         fill_common(opt.voronoi, dim, bounds, padding, ignore_outside, threads);
+        opt.voronoi.walls = walls_from(walls, dim);
         opt.voronoi.periodic = periodic;
         opt.voronoi.tilt = tilt;
         opt.voronoi.radii = as_radii(radii);  // views the caller's array, alive through the call
@@ -339,7 +340,7 @@ void bind_prep(py::module_& m) {
       },
       py::arg("points").noconvert(), py::arg("labels").none(true), py::arg("bounds").none(true), py::arg("padding"),
       py::arg("ignore_outside"), py::arg("threads"), py::arg("method"), py::arg("periodic"), py::arg("tilt"),
-      py::arg("radii").none(true), py::arg("iterations"), py::arg("tolerance"),
+      py::arg("radii").none(true), py::arg("iterations"), py::arg("tolerance"), py::arg("walls").none(true) = py::none(),
       "Lloyd relaxation: (points (n, dim), iterations done, largest and rms displacement per iteration, points "
       "moved per iteration, domain or None, spacing, threads used). Runs without the GIL.");
 

@@ -35,18 +35,7 @@ Cells run_voronoi(const Points& points, const py::object& labels, const std::opt
   const int dim = checked_dim(points);
   VoronoiOptions opt;
   fill_common(opt, dim, bounds, padding, ignore_outside, threads);
-  // Walls: None, or float64 (k, dim + 1) rows (normal..., offset), checked in Python.
-  if (!walls.is_none()) {
-    const auto w = walls.cast<py::array_t<double, py::array::c_style>>();
-    if (w.ndim() != 2 || w.shape(1) != dim + 1)
-      throw py::value_error("walls must be a float64 array of shape (k, " + std::to_string(dim + 1) + ")");
-    for (py::ssize_t k = 0; k < w.shape(0); ++k) {
-      Wall wall;
-      for (int a = 0; a < dim; ++a) wall.normal[static_cast<std::size_t>(a)] = w.at(k, a);
-      wall.offset = w.at(k, dim);
-      opt.walls.push_back(wall);
-    }
-  }
+  opt.walls = walls_from(walls, dim);
   opt.periodic = periodic;
   opt.tilt = tilt;
   opt.radii = as_radii(radii);  // views the caller's array, alive through the call

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
 #include "interrupt.hpp"
@@ -51,6 +52,23 @@ inline void fill_common(VoronoiOptions& opt, int dim, const std::optional<std::v
   opt.ignore_outside_points = ignore_outside;
   opt.threads = threads;
   opt.progress = interrupt_check();
+}
+
+/// Walls (VoronoiOptions::walls) from None or a float64 (k, dim + 1) array of
+/// rows (normal..., offset), as the Python layer passes them (_inputs.as_walls).
+inline std::vector<Wall> walls_from(const py::object& walls, int dim) {
+  std::vector<Wall> out;
+  if (walls.is_none()) return out;
+  const auto w = walls.cast<py::array_t<double, py::array::c_style>>();
+  if (w.ndim() != 2 || w.shape(1) != dim + 1)
+    throw py::value_error("walls must be a float64 array of shape (k, " + std::to_string(dim + 1) + ")");
+  for (py::ssize_t k = 0; k < w.shape(0); ++k) {
+    Wall wall;
+    for (int a = 0; a < dim; ++a) wall.normal[static_cast<std::size_t>(a)] = w.at(k, a);
+    wall.offset = w.at(k, dim);
+    out.push_back(wall);
+  }
+  return out;
 }
 
 }  // namespace tessera::python

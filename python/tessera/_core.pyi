@@ -530,6 +530,7 @@ def lloyd(
     radii: Optional[npt.NDArray[np.float64]],
     iterations: int,
     tolerance: float,
+    walls: Optional[npt.NDArray[np.float64]] = ...,
 ) -> Tuple[
     npt.NDArray[np.float64],
     int,

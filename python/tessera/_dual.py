@@ -33,6 +33,7 @@ def cells_for(
     tilt: Optional[Sequence[float]] = None,
     radii: Any = None,
     only_with_faces: int = 0,
+    walls: Any = None,
 ) -> Voronoi:
     """The Voronoi result a product is read from: `source` itself when it is
     one (the cell options must then be left out: they were fixed when it was
@@ -41,7 +42,7 @@ def cells_for(
     them alone (``VoronoiOptions::only_with_faces``)."""
     if isinstance(source, Voronoi):
         given = [n for n, v in (("labels", labels), ("bounds", bounds), ("padding", padding), ("threads", threads),
-                                ("tilt", tilt), ("radii", radii)) if v is not None]
+                                ("tilt", tilt), ("radii", radii), ("walls", walls)) if v is not None]
         if _inputs.as_flag(ignore_outside, "ignore_outside"):
             given.append("ignore_outside")
         if periodic is not None and periodic is not False and not (isinstance(periodic, np.bool_) and not periodic):
@@ -59,7 +60,7 @@ def cells_for(
                              "tessera.voronoi(points)")
         return source
     return cells_of(source, labels, bounds, 0.01 if padding is None else padding, threads, True, ignore_outside,
-                    "auto", periodic, tilt, radii, None, only_with_faces)
+                    "auto", periodic, tilt, radii, None, only_with_faces, walls)
 
 
 def _check_vtp(path: PathLike, what: str) -> str:
@@ -225,6 +226,7 @@ def adjacency(
     periodic: Any = False,
     tilt: Optional[Sequence[float]] = None,
     radii: Any = None,
+    walls: Any = None,
 ) -> AdjacencyGraph:
     """The adjacency graph (wheels and spokes) of a tessellation.
 
@@ -233,7 +235,7 @@ def adjacency(
     source : Voronoi or array_like, shape (N, 2) or (N, 3)
         A :class:`Voronoi` computed with ``merge=True`` (reused as is), or
         points whose cells are computed first.
-    labels, bounds, padding, threads, ignore_outside, periodic, tilt, radii
+    labels, bounds, padding, threads, ignore_outside, periodic, tilt, radii, walls
         As in :func:`tessera.voronoi`, for points only (ValueError with a
         Voronoi: its cells are already computed). The graph is read off in
         parallel on the thread count the cells were computed with. With
@@ -257,7 +259,8 @@ def adjacency(
     tol = _inputs.as_float(prune_tolerance, "prune_tolerance", "a finite number >= 0")
     if not (np.isfinite(tol) and tol >= 0):
         raise ValueError(f"prune_tolerance: expected a finite number >= 0, got {prune_tolerance!r}")
-    vor = cells_for("adjacency", source, labels, bounds, padding, threads, ignore_outside, periodic, tilt, radii)
+    vor = cells_for("adjacency", source, labels, bounds, padding, threads, ignore_outside, periodic, tilt, radii,
+                    walls=walls)
     return AdjacencyGraph(_inputs.call(_core.adjacency_graph, vor._cells, tol), vor, tol)
 
 
@@ -433,6 +436,7 @@ def faces(
     periodic: Any = False,
     tilt: Optional[Sequence[float]] = None,
     radii: Any = None,
+    walls: Any = None,
 ) -> FaceSet:
     """A face set of a tessellation: its boundary, the whole polygonal complex,
     or the surface net between regions.
@@ -454,10 +458,11 @@ def faces(
     capping : bool
         surface-net only: add the boundary faces, so every region is enclosed.
     background_label : int
-        The side-1 label of faces on the domain box; must be < 0.
-    labels, bounds, padding, threads, ignore_outside, periodic, tilt, radii
+        The side-1 label of faces on the domain box (and walls); must be < 0.
+    labels, bounds, padding, threads, ignore_outside, periodic, tilt, radii, walls
         As in :func:`tessera.voronoi`, for points only (ValueError with a
-        Voronoi). With ``radii`` the faces are those of the power cells.
+        Voronoi). With ``radii`` the faces are those of the power cells;
+        with ``walls`` the boundary includes the faces on them.
 
     Returns
     -------
@@ -471,7 +476,7 @@ def faces(
     # Of points: the cells with a face of the set alone (their faces are the
     # set of all cells, byte for byte; for the complex every cell is built).
     vor = cells_for("faces", source, labels, bounds, padding, threads, ignore_outside, periodic, tilt, radii,
-                    _core.face_set_classes(kind, capping))
+                    _core.face_set_classes(kind, capping), walls)
     fs = _inputs.call(_core.extract_faces, vor._cells, vor.labels, kind, capping, bg)
     return FaceSet(fs, vor, capping, bg)
 

@@ -50,6 +50,7 @@ def lloyd(
     periodic: Any = False,
     tilt: Optional[Sequence[float]] = None,
     radii: Any = None,
+    walls: Any = None,
 ) -> LloydResult:
     """Lloyd relaxation: move every point to its cell's centroid, iteration
     after iteration, towards a centroidal Voronoi tessellation (Lloyd 1982;
@@ -77,11 +78,12 @@ def lloyd(
     threads : int, optional
         Worker threads (None: ``TESSERA_NUM_THREADS``, else every core). The
         result is identical for any count.
-    ignore_outside, method, periodic, tilt, radii :
+    ignore_outside, method, periodic, tilt, radii, walls :
         As :func:`voronoi`'s. In a periodic box a centroid may lie across a
         face: the moved point is wrapped back into the box (and rounded to
         its grid). With ``radii`` each point moves to its power cell's
-        centroid; the radii stay as given.
+        centroid; the radii stay as given. With ``walls`` (a convex domain)
+        a centroid that rounds past a wall leaves its point where it was.
 
     Points that own no cell stay where they are, bit for bit: outside points,
     the copies of exact duplicates that do not own their cell (the owner
@@ -123,5 +125,6 @@ def lloyd(
         rad,
         its,
         tol,
+        _inputs.as_walls(walls, dim),
     )
     return LloydResult(moved_points, done, largest, rms, moved, domain, spacing)

@@ -63,3 +63,23 @@ def test_bad_walls_and_points_outside():
         tessera.voronoi(pts, bounds=UNIT_BOX[3], walls=[("a", 1, 1, 1.0)])
     with pytest.raises(ValueError, match="periodic"):
         tessera.voronoi(pts, bounds=UNIT_BOX[3], walls=[(1, 1, 1, 2.5)], periodic=True)
+
+
+def test_products_of_points_take_walls():
+    pts = inside_points(1500, 3, 1.5, 11)
+    wall = [(1, 1, 1, 1.5)]
+    vor = tessera.voronoi(pts, bounds=UNIT_BOX[3], walls=wall)
+    g = tessera.adjacency(pts, bounds=UNIT_BOX[3], walls=wall)
+    assert np.array_equal(g.spokes, tessera.adjacency(vor).spokes)
+    f = tessera.faces(pts, "boundary", bounds=UNIT_BOX[3], walls=wall)
+    whole = tessera.faces(vor, "boundary")
+    assert np.array_equal(f.face_vertices, whole.face_vertices)
+    assert np.array_equal(f.vertices, whole.vertices)
+    with pytest.raises(ValueError, match="walls"):
+        tessera.adjacency(vor, walls=wall)  # already computed
+    # Lloyd in the convex domain: every point stays inside the wall, exactly.
+    r = tessera.lloyd(pts, 3, bounds=UNIT_BOX[3], walls=wall)
+    from fractions import Fraction
+    assert all(sum(Fraction(float(x)) for x in p) <= Fraction(3, 2) for p in r.points)
+    assert not np.array_equal(r.points, pts)
+    assert r.spacing == pytest.approx((0.5 / len(pts)) ** (1 / 3), rel=1e-12)
