@@ -80,7 +80,7 @@ class AdjacencyGraph:
     across it; a generator's *wheel* is all of its spokes. CSR over all ``N``
     input points: the spokes of point ``i`` are
     ``spokes[wheel_offsets[i]:wheel_offsets[i+1]]``, ascending, the box planes
-    first as negative ids (x0=-1, x1=-2, y0=-3, y1=-4, z0=-5, z1=-6); points
+    first as negative ids (x0=-1, x1=-2, y0=-3, y1=-4, z0=-5, z1=-6; wall k -7-k); points
     without a cell (outside points, duplicates, points dropped outside the
     bounds, empty power cells) have empty wheels. The graph is exactly
     symmetric: every spoke ``i -> j`` between two cells has its twin ``j -> i``.
@@ -131,7 +131,7 @@ class AdjacencyGraph:
 
     @property
     def spokes(self) -> np.ndarray:
-        """int32: the neighbour across each spoke (point id), or a negative box-plane id."""
+        """int32: the neighbour across each spoke (point id), or a negative box-plane or wall id."""
         return self._g.spokes
 
     @property
@@ -360,7 +360,7 @@ class FaceSet:
 
     @property
     def sides(self) -> np.ndarray:
-        """int32 (n_faces, 2): side 0's generator, side 1's generator or negative box-plane id."""
+        """int32 (n_faces, 2): side 0's generator, side 1's generator or negative box-plane (or wall) id."""
         return self._fs.sides
 
     @property
@@ -546,7 +546,7 @@ class Flower:
 
     @property
     def face_neighbor(self) -> np.ndarray:
-        """int32 (n_faces,): the point across each face, or the negative box-plane id."""
+        """int32 (n_faces,): the point across each face, or the negative box-plane (or wall) id."""
         return self._fl.face_neighbor
 
     @property

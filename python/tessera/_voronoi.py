@@ -38,7 +38,7 @@ class Voronoi:
     vertices of face ``f`` are
     ``face_vertices[face_vertex_offsets[f]:face_vertex_offsets[f+1]]``
     (counter-clockwise seen from outside the cell); :attr:`face_neighbor` is
-    the point across face ``f``, or the negative box-plane id for a face on the
+    the point across face ``f``, or the negative box-plane id (a wall's ``-7 - k``) for a face on the
     domain box (x0=-1, x1=-2, y0=-3, y1=-4, z0=-5, z1=-6). In 2D a face is an
     edge of two vertices, and the first vertex of each edge, in order, walks the
     polygon counter-clockwise.
@@ -207,7 +207,7 @@ class Voronoi:
     @property
     def vertex_keys(self) -> np.ndarray:
         """int32 (n_vertices, D+1): topological coordinate of each vertex: the ids of
-        the D+1 points (or negative box planes) whose bisectors meet there, ascending."""
+        the D+1 points (or negative box planes and walls) whose bisectors meet there, ascending."""
         return self._cells.vertex_keys
 
     @property
@@ -227,7 +227,7 @@ class Voronoi:
 
     @property
     def face_neighbor(self) -> np.ndarray:
-        """int32 (n_faces,): the point across each face, or the negative box-plane id."""
+        """int32 (n_faces,): the point across each face, or the negative box-plane id (wall k: -7 - k)."""
         return self._cells.face_neighbor
 
     @property

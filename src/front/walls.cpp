@@ -44,6 +44,10 @@ std::vector<kernels::Wall> kernel_walls(const std::vector<Wall>& given, int dim,
         throw InputError(name + ": its normal's components differ by more than a double's range");
     }
     kw.d = std::ldexp(g.offset, k - e);
+    // |n|_2 rounded up: each square and sum within u, the root within u.
+    double nn = 0;
+    for (int a = 0; a < dim; ++a) nn += kw.n[a] * kw.n[a];
+    kw.norm = std::sqrt(nn) * (1 + 8 * kernels::filter::u);
     if (!std::isfinite(kw.d) || std::ldexp(kw.d, e - k) != g.offset)
       throw InputError(name + ": its offset " + tessera::detail::number_text(g.offset) +
                        " is out of range beside its normal (the two differ by more than a double's range)");
@@ -107,8 +111,9 @@ double polytope_measure(const Bounds& box, const std::vector<Wall>& given) {
   ctx.num_walls = static_cast<int>(walls.size());
   CellT cell;
   cell.reset(0, centre, box.lo.data(), box.hi.data(), &ctx);
+  const double reach = cell.vertex_reach();
   for (int k = 0; k < ctx.num_walls; ++k)
-    if (cell.clip_wall(k) == kernels::ClipResult::emptied) return 0;
+    if (cell.clip_wall(k, reach) == kernels::ClipResult::emptied) return 0;
   cell.solve_deferred();
   double volume;
   std::array<double, D> centroid;

@@ -78,8 +78,9 @@ struct EngineOptions {
 /// The cut may have deferred new vertices' exact solves: solved here.
 template <class CellT>
 [[gnu::noinline]] void clip_walls(CellT& cell, kernels::BuildStatus& st, int num_walls) {
+  const double reach = cell.vertex_reach();
   for (int k = 0; k < num_walls; ++k)
-    if (cell.clip_wall(k) == kernels::ClipResult::emptied) {
+    if (cell.clip_wall(k, reach) == kernels::ClipResult::emptied) {
       st.has_cell = false;
       return;
     }

@@ -53,6 +53,7 @@ constexpr bool box_plane_upper(std::int32_t id) { return ((-1 - id) & 1) != 0; }
 struct Wall {
   double n[3];  ///< normal, |n|_inf in [1, 2) (front/walls.cpp scales it so, exactly)
   double d;     ///< offset
+  double norm;  ///< an upper bound on |n|_2 (walls::misses)
 };
 /// At most this many walls (their ids stay far above INT32_MIN).
 constexpr int max_walls = 1 << 20;

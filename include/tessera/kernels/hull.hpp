@@ -145,12 +145,14 @@ class Hull {
   }
 
   /// Cut the finished cell by wall k of the exact context (walls.hpp): after
-  /// every clip by a neighbour, the walls in ascending order. Emptied only
-  /// where the whole cell lies outside (a power cell; the front end refuses
-  /// generators outside a wall).
-  ClipResult clip_wall(int k) {
+  /// every clip by a neighbour, the walls in ascending order. `reach`: an
+  /// upper bound on every vertex's |y| (vertex_reach() before the first
+  /// wall: each cut only shortens them). Emptied only where the whole cell
+  /// lies outside (a power cell; the front end refuses generators outside a
+  /// wall).
+  ClipResult clip_wall(int k, double reach) {
     walls::RelativeWall<3> w = walls::relative<3>(exact_->walls[k], site_);
-    if (walls::misses(w, 0.25 * security2_)) return ClipResult::unchanged;
+    if (walls::misses(w, exact_->walls[k].norm, reach)) return ClipResult::unchanged;
     walls::refine(w, exact_->walls[k], site_);
     const std::size_t nv = verts_.size();
     if (sign_.size() < std::max(nv, lanes_.padded())) sign_.resize(std::max(nv, lanes_.padded()));
@@ -345,6 +347,9 @@ class Hull {
   /// Upper bound on (2R)^2, R = the largest distance from the generator to a
   /// vertex: a neighbour farther than 2R cannot clip (security radius).
   double security_radius2() const { return security2_; }
+  /// An upper bound on every vertex's distance from the generator (half the
+  /// security radius); a cut by a wall never raises it (clip_wall's `reach`).
+  double vertex_reach() const { return 0.5 * std::sqrt(security2_); }
   /// power_slack (power.hpp) of a power cell, in every vertex's r2; 0 without radii.
   double power_slack() const { return slack_; }
 

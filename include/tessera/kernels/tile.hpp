@@ -113,9 +113,9 @@ class Tile {
   }
 
   /// As Hull::clip_wall: cut the finished tile by wall k (walls.hpp).
-  ClipResult clip_wall(int k) {
+  ClipResult clip_wall(int k, double reach) {
     walls::RelativeWall<2> w = walls::relative<2>(exact_->walls[k], site_);
-    if (walls::misses(w, 0.25 * security2_)) return ClipResult::unchanged;
+    if (walls::misses(w, exact_->walls[k].norm, reach)) return ClipResult::unchanged;
     walls::refine(w, exact_->walls[k], site_);
     const std::size_t nv = verts_.size();
     if (sign_.size() < nv) sign_.resize(nv);
@@ -258,6 +258,9 @@ class Tile {
   }
 
   double security_radius2() const { return security2_; }
+  /// An upper bound on every vertex's distance from the generator (half the
+  /// security radius); a cut by a wall never raises it (clip_wall's `reach`).
+  double vertex_reach() const { return 0.5 * std::sqrt(security2_); }
   /// power_slack (power.hpp) of a power cell, in every vertex's r2; 0 without radii.
   double power_slack() const { return slack_; }
   std::int32_t generator() const { return gen_; }

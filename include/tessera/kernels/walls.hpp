@@ -59,16 +59,13 @@ void refine(RelativeWall<D>& r, const Wall& w, const double* p) {
   r.d_err = 2 * filter::u * std::fabs(r.d) + filter::abs_eps;
 }
 
-/// Whether wall `w` surely cuts nothing of a cell whose vertices lie within
-/// sqrt(r2) of its generator (r2: an upper bound on every |y|^2, as the
-/// cell's security radius holds four times it): n.y <= |n| sqrt(r2) < d for
-/// every vertex, with room for d's rounding and the norm's. Most cells of a
-/// many-sided domain lie far inside most of its walls.
+/// Whether wall `w` (of norm at most `norm`: Wall::norm) surely cuts nothing
+/// of a cell whose vertices lie within `reach` of its generator: n.y <=
+/// |n| reach < d for every vertex, with room for d's rounding and the
+/// product's. Most cells of a many-sided domain lie far inside most walls.
 template <int D>
-bool misses(const RelativeWall<D>& w, double r2) {
-  double nn = 0;
-  for (int c = 0; c < D; ++c) nn += w.n[c] * w.n[c];
-  return w.d - w.d_err > std::sqrt(nn * r2) * (1 + 1e-12);
+bool misses(const RelativeWall<D>& w, double norm, double reach) {
+  return w.d - w.d_err > norm * reach * (1 + 1e-12);
 }
 
 /// Each vertex's side of wall k (relative: `w`, refined) into `sign`: +1
