@@ -11,6 +11,9 @@
 #include <string>
 #include <unordered_map>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include "tessera/engine/thread_arena.hpp"
 #include "tessera/finite_points.hpp"
 #include "../message_text.hpp"
@@ -251,7 +254,18 @@ Pass<D>::Pass(std::span<const double> input, std::span<const std::int32_t> label
   set_radii(opt.radii, n, scaling);
   walls = kernel_walls(opt.walls, D, k);
 
-  // Which points take part (inside the box) and which get cells (also label >= 0).
+  // Which points take part (inside the box and the walls) and which get
+  // cells (also label >= 0). Each point's first wall it lies outside of
+  // (-1: none), in parallel: 1M points against 64 walls cost 0.5 s alone.
+  std::vector<std::int32_t> outside(walls.empty() ? 0 : n);
+  if (!walls.empty()) {
+    const WallTest test(walls, D, largest_magnitude(points));
+    engine::ThreadArena(resolve_threads(opt.threads)).execute([&] {
+      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t i = r.begin(); i != r.end(); ++i) outside[i] = test.outside(points.data() + i * D);
+      });
+    });
+  }
   in_box.assign(n, 1);
   std::size_t n_in = n;
   for (std::size_t i = 0; i < n; ++i) {
@@ -279,7 +293,7 @@ Pass<D>::Pass(std::span<const double> input, std::span<const std::int32_t> label
       continue;
     }
     if (walls.empty()) continue;
-    if (const int w = outside_wall(points.data() + i * D, D, walls); w >= 0) {
+    if (const int w = outside[i]; w >= 0) {
       if (!opt.ignore_outside_points)
         throw InputError("point " + std::to_string(i) + " lies outside wall " + std::to_string(w) +
                          " (use --ignore-outside to drop such points)");

@@ -78,20 +78,33 @@ int exact_side(const double* p, int dim, const kernels::Wall& w) {
 }
 }  // namespace
 
-int outside_wall(const double* p, int dim, std::span<const kernels::Wall> walls) {
+WallTest::WallTest(std::span<const kernels::Wall> walls, int dim, double largest)
+    : walls_(walls), dim_(dim), error_(walls.size()) {
+  // d - n.p in D products and D differences, each rounded once: within
+  // gamma_{2D} of |d| + |n|_1 max|p| (doubled for margin and the bound's own
+  // rounding).
   for (std::size_t k = 0; k < walls.size(); ++k) {
-    const kernels::Wall& w = walls[k];
-    double s = w.d, mag = std::fabs(w.d);
-    for (int a = 0; a < dim; ++a) {
-      const double t = w.n[a] * p[a];
-      s -= t;
-      mag += std::fabs(t);
-    }
-    const double err = 4 * dim * kernels::filter::u * mag;  // as walls::relative's bound
-    const int side = s > err ? 1 : s < -err ? -1 : exact_side(p, dim, w);
+    double n1 = 0;
+    for (int a = 0; a < dim; ++a) n1 += std::fabs(walls[k].n[a]);
+    error_[k] = 4 * dim * kernels::filter::u * (std::fabs(walls[k].d) + n1 * largest);
+  }
+}
+
+int WallTest::outside(const double* p) const {
+  for (std::size_t k = 0; k < walls_.size(); ++k) {
+    const kernels::Wall& w = walls_[k];
+    double s = w.d;
+    for (int a = 0; a < dim_; ++a) s -= w.n[a] * p[a];
+    const int side = s > error_[k] ? 1 : s < -error_[k] ? -1 : exact_side(p, dim_, w);
     if (side < 0) return static_cast<int>(k);
   }
   return -1;
+}
+
+double largest_magnitude(std::span<const double> values) {
+  double m = 0;
+  for (const double x : values) m = std::max(m, std::fabs(x));
+  return m;
 }
 
 namespace {

@@ -18,9 +18,25 @@ namespace tessera::front {
 /// there are more than kernels::max_walls.
 std::vector<kernels::Wall> kernel_walls(const std::vector<Wall>& given, int dim, int k);
 
-/// The first wall that point p (dim coordinates, the computation's frame)
-/// lies strictly outside of (n.p > d, decided exactly), or -1.
-int outside_wall(const double* p, int dim, std::span<const kernels::Wall> walls);
+/// Which points lie outside walls, decided exactly: the float n.p - d where
+/// its rounding, bounded once for all points of the largest magnitude given,
+/// cannot change its sign, else in rationals.
+class WallTest {
+ public:
+  /// For points whose coordinates are at most `largest` in magnitude.
+  WallTest(std::span<const kernels::Wall> walls, int dim, double largest);
+  /// The first wall that point p (dim coordinates, at most `largest` each)
+  /// lies strictly outside of (n.p > d), or -1.
+  int outside(const double* p) const;
+
+ private:
+  std::span<const kernels::Wall> walls_;
+  int dim_;
+  std::vector<double> error_;  // per wall: a bound on the float d - n.p's error
+};
+
+/// The largest magnitude among the values (for WallTest).
+double largest_magnitude(std::span<const double> values);
 
 /// The volume (area in 2D) of the domain: `box` inside the walls (as
 /// given: the user's frame), 0 where they leave nothing; in double

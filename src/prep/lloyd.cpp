@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <optional>
 #include <string>
 
 #include "../front/pass.hpp"
@@ -84,6 +85,13 @@ LloydResult lloyd(std::span<const double> points, int dim, std::span<const std::
     // wrapped into a periodic box.
     const std::vector<double>& from = periodic ? cells.periodic_points : result.points;
     const std::size_t moved = cells.n_cells();
+    // The centroids are clamped into the box: the box's corners bound them.
+    std::optional<front::WallTest> inside_walls;
+    if (!walls.empty()) {
+      double largest = 0;
+      for (std::size_t a = 0; a < du; ++a) largest = std::max({largest, std::fabs(box.lo[a]), std::fabs(box.hi[a])});
+      inside_walls.emplace(walls, dim, largest);
+    }
     next = result.points;
     displacement.resize(moved);
     for (std::size_t c = 0; c < moved; ++c) {
@@ -99,7 +107,7 @@ LloydResult lloyd(std::span<const double> points, int dim, std::span<const std::
       // A centroid on a wall may round past it: that point stays where it
       // was (within rounding of the same place), as the next cells pass
       // would refuse it.
-      if (!walls.empty() && front::outside_wall(next.data() + i * du, dim, walls) >= 0) {
+      if (!walls.empty() && inside_walls->outside(next.data() + i * du) >= 0) {
         for (std::size_t a = 0; a < du; ++a) next[i * du + a] = result.points[i * du + a];
         d[0] = d[1] = d[2] = 0;
       }

@@ -206,7 +206,7 @@ int exact_clip_sign_by_arithmetic(const ExactContext& ctx, std::int32_t i, const
 /// (Schur complement), and the box row carries no weight.
 int exact_box_sign(const ExactContext& ctx, std::int32_t i, const std::int32_t* planes, std::int32_t box);
 /// The offset of wall w relative to point p (dim coordinates), d - n.p,
-/// computed exactly and truncated to a double (within one ulp): a clipping
+/// computed exactly and rounded to a double (within two ulps): a clipping
 /// plane's offset must be as accurate as a rounded difference's (the
 /// filters' plane_eps), which the float d - n.p is not where it cancels (a
 /// point near a wall far from the origin: the vertices of a slab between

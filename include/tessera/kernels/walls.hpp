@@ -50,13 +50,14 @@ RelativeWall<D> relative(const Wall& w, const double* p) {
   return r;
 }
 
-/// `relative`'s wall with its offset computed exactly and truncated
+/// `relative`'s wall with its offset computed exactly and rounded
 /// (exact_wall_offset), so that it is as accurate as a clipping plane's
-/// must be: for a wall that may cut the cell (a few cells of many).
+/// must be (within plane_eps |d|: the vertices solved on it then keep their
+/// bounds): for a wall that may cut the cell (a few cells of many).
 template <int D>
 void refine(RelativeWall<D>& r, const Wall& w, const double* p) {
   r.d = exact_wall_offset(w, p, D);
-  r.d_err = 2 * filter::u * std::fabs(r.d) + filter::abs_eps;
+  r.d_err = 4 * filter::u * std::fabs(r.d) + filter::abs_eps;
 }
 
 /// Whether wall `w` (of norm at most `norm`: Wall::norm) surely cuts nothing
@@ -72,9 +73,8 @@ bool misses(const RelativeWall<D>& w, double norm, double reach) {
 /// keep (inside or on it), -1 remove; returns the number removed. A vertex
 /// is decided by the float filter where P = d - n.y clears its bound (the
 /// vertex's own bound e, the plane's rounding as a clip's, and d's), else
-/// exactly. A vertex on an earlier wall always goes to the exact sign (few:
-/// the cells at the domain's edges), a margin against any bound the wall's
-/// slanted rows may strain.
+/// exactly. A vertex on an earlier wall is decided alike: that wall's
+/// offset was refined, so the vertex's bound holds as a clip's does.
 template <int D, class Vertex, class Plane>
 std::size_t signs(const Vertex* verts, std::size_t nv, const Plane* planes, const RelativeWall<D>& w, int k,
                   const ExactContext& ctx, std::int32_t gen, std::vector<filter::Sign>& sign) {
@@ -82,18 +82,15 @@ std::size_t signs(const Vertex* verts, std::size_t nv, const Plane* planes, cons
   std::size_t removed = 0;
   for (std::size_t t = 0; t < nv; ++t) {
     const Vertex& v = verts[t];
-    std::int32_t ids[D];
-    bool on_wall = false;
-    for (int c = 0; c < D; ++c) {
-      ids[c] = planes[v.p[c]].id;
-      on_wall |= is_wall_plane(ids[c]);
-    }
     double dot = w.n[0] * v.y[0];
     for (int c = 1; c < D; ++c) dot += w.n[c] * v.y[c];
     const double P = w.d - dot, e = w.n1 * v.e + de;
-    int s = 0;
-    if (!on_wall && P - P == 0) s = (P > e) - (P < -e);  // (not where n.y overflowed)
-    if (s == 0) s = exact_wall_sign(ctx, gen, ids, k);
+    int s = P - P == 0 ? (P > e) - (P < -e) : 0;  // (undecided where n.y overflowed)
+    if (s == 0) {
+      std::int32_t ids[D];
+      for (int c = 0; c < D; ++c) ids[c] = planes[v.p[c]].id;
+      s = exact_wall_sign(ctx, gen, ids, k);
+    }
     sign[t] = static_cast<filter::Sign>(s);
     removed += s < 0;
   }
