@@ -83,3 +83,36 @@ def test_products_of_points_take_walls():
     assert all(sum(Fraction(float(x)) for x in p) <= Fraction(3, 2) for p in r.points)
     assert not np.array_equal(r.points, pts)
     assert r.spacing == pytest.approx((0.5 / len(pts)) ** (1 / 3), rel=1e-12)
+
+
+def test_polygon_walls():
+    # A regular hexagon, either way round: its cells tile it, and every
+    # corner lies inside every wall exactly.
+    ang = np.arange(6) * np.pi / 3
+    hexagon = np.c_[0.5 + 0.4 * np.cos(ang), 0.5 + 0.4 * np.sin(ang)]
+    for corners in (hexagon, hexagon[::-1]):
+        w = tessera.polygon_walls(corners)
+        assert w.shape == (6, 3)
+        from fractions import Fraction
+        for nx, ny, d in w:
+            for x, y in corners:
+                assert Fraction(nx) * Fraction(float(x)) + Fraction(ny) * Fraction(float(y)) <= Fraction(d)
+        pts = np.random.default_rng(5).random((4000, 2))
+        vor = tessera.voronoi(pts, bounds=UNIT_BOX[2], walls=w, ignore_outside=True)
+        area = 1.5 * math.sqrt(3) * 0.4 ** 2
+        assert vor.volumes.sum() == pytest.approx(area, rel=1e-12)
+        assert vor.validate().ok
+    # The unit square's own walls change no cell.
+    sq = tessera.polygon_walls([(0, 0), (1, 0), (1, 1), (0, 1)])
+    pts = np.random.default_rng(6).random((500, 2))
+    a = tessera.voronoi(pts, bounds=UNIT_BOX[2], walls=sq)
+    b = tessera.voronoi(pts, bounds=UNIT_BOX[2])
+    assert np.array_equal(a.volumes, b.volumes)
+    with pytest.raises(ValueError, match="not convex"):
+        tessera.polygon_walls([(0, 0), (1, 0), (0.2, 0.2), (0, 1)])
+    with pytest.raises(ValueError, match="k >= 3"):
+        tessera.polygon_walls([(0, 0), (1, 0)])
+    with pytest.raises(ValueError, match="repeats"):
+        tessera.polygon_walls([(0, 0), (1, 0), (1, 0), (0, 1)])
+    with pytest.raises(ValueError, match="no area"):
+        tessera.polygon_walls([(0, 0), (1, 1), (2, 2)])
