@@ -22,6 +22,7 @@ import numpy as np
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import test_cli as base  # noqa: E402  (helpers only; its test classes are not collected here)
 from test_cli import read_vtp, read_vtu, cell_array  # noqa: E402
+from test_prep_cli import Case  # noqa: E402  (its fails(): exit 2, one error line, nothing written)
 
 from vtk.util.numpy_support import vtk_to_numpy  # noqa: E402
 
@@ -32,22 +33,6 @@ def inside(points, normal, offset):
     """Exactly: normal . p <= offset for every row (fractions: no rounding)."""
     n = [Fraction(x) for x in normal]
     return all(sum(Fraction(float(x)) * a for x, a in zip(p, n)) <= Fraction(offset) for p in points)
-
-
-class Case(base.TempDirCase):
-    def fails(self, args, fragment=None):
-        before = set(os.listdir(self.dir))
-        r = run(args)
-        after = set(os.listdir(self.dir))
-        cmd = "tessera " + " ".join(map(str, args))
-        self.assertEqual(r.returncode, 2, "%s: exit %d\nstdout: %s\nstderr: %s" % (cmd, r.returncode, r.stdout, r.stderr))
-        lines = r.stderr.splitlines()
-        self.assertEqual(len(lines), 1, "%s: stderr must be one line, got %r" % (cmd, r.stderr))
-        self.assertTrue(lines[0].startswith("tessera: error: "), "%s: %r" % (cmd, lines[0]))
-        if fragment:
-            self.assertIn(fragment, lines[0], cmd)
-        self.assertEqual(after - before, set(), "%s left files behind" % cmd)
-        return lines[0]
 
 
 class Walls(Case):
