@@ -461,6 +461,7 @@ int main(int argc, char** argv) {
                      "its face");
   flower->add_flag("--glyphs", wa.glyphs, "Also draw each petal and the circumflower as a circle (2D) / sphere (3D)");
   add_periodic_option(flower, wa.compute, "Cells keep their shape across the box's faces; the site is the point as wrapped, each neighbour at its image across the face", kAnyAxes);
+  add_walls_option(flower, wa.compute);
   flower->add_flag("-q,--quiet", wa.quiet, "No summary and no progress bar");
 
   // Generalized surface nets (cmd_surface_nets.cpp).

@@ -673,6 +673,7 @@ def flower(
     ignore_outside: bool = False,
     periodic: Any = False,
     tilt: Optional[Sequence[float]] = None,
+    walls: Any = None,
 ) -> Flowers:
     """The flowers of the cells of points ``ids``, for debugging and teaching.
 
@@ -697,7 +698,7 @@ def flower(
     glyphs : bool
         Default for :meth:`Flowers.save`: add a circle (2D) / sphere (3D) per
         petal and for the circumflower.
-    labels, bounds, padding, threads, ignore_outside, periodic, tilt
+    labels, bounds, padding, threads, ignore_outside, periodic, tilt, walls
         As in :func:`tessera.voronoi`, for points only (ValueError with a Voronoi).
 
     Returns
@@ -706,7 +707,8 @@ def flower(
         ``flowers[k]`` is the :class:`Flower` of ``ids[k]``.
     """
     if isinstance(source, Voronoi):
-        vor = cells_for("flower", source, labels, bounds, padding, threads, ignore_outside, periodic, tilt)
+        vor = cells_for("flower", source, labels, bounds, padding, threads, ignore_outside, periodic, tilt,
+                        walls=walls)
     else:
         # The cells of the ids asked for (and their neighbours'), not all N.
         # Ids that are no point are refused below, after the cells, as
@@ -714,7 +716,7 @@ def flower(
         # and the cells' own, still come first).
         pts = _inputs.as_points(source)
         vor = cells_of(pts, labels, bounds, 0.01 if padding is None else padding, threads, True, ignore_outside,
-                       "auto", periodic, tilt, None, _existing_ids(ids, pts.shape[0]), 0)
+                       "auto", periodic, tilt, None, _existing_ids(ids, pts.shape[0]), 0, walls)
     idx = as_ids(ids, vor.points.shape[0])
     fs = _inputs.call(_core.flowers, vor._cells, vor.points, idx)
     return Flowers(fs, vor, _inputs.as_flag(glyphs, "glyphs"))

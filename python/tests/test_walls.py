@@ -77,6 +77,11 @@ def test_products_of_points_take_walls():
     assert np.array_equal(f.vertices, whole.vertices)
     with pytest.raises(ValueError, match="walls"):
         tessera.adjacency(vor, walls=wall)  # already computed
+    # A flower of points: the cells asked for and their neighbours', as all cells give them.
+    i = int(np.argmax(pts.sum(axis=1)))  # the point nearest the wall
+    fl = tessera.flower(pts, [i], bounds=UNIT_BOX[3], walls=wall)[0]
+    assert np.any(fl.face_neighbor == -7)
+    assert np.array_equal(fl.face_neighbor, tessera.flower(vor, [i])[0].face_neighbor)
     # Lloyd in the convex domain: every point stays inside the wall, exactly.
     r = tessera.lloyd(pts, 3, bounds=UNIT_BOX[3], walls=wall)
     from fractions import Fraction
