@@ -34,7 +34,6 @@
 #include "tessera/kernels/lane_blocks.hpp"
 #include "tessera/kernels/power.hpp"
 #include "tessera/kernels/prepared_signs.hpp"
-#include "tessera/kernels/walls.hpp"
 
 namespace tessera::kernels {
 
@@ -150,43 +149,8 @@ class Hull {
   /// wall: each cut only shortens them). Emptied only where the whole cell
   /// lies outside (a power cell; the front end refuses generators outside a
   /// wall).
-  ClipResult clip_wall(int k, double reach) {
-    walls::RelativeWall<3> w = walls::relative<3>(exact_->walls[k], site_);
-    if (walls::misses(w, exact_->walls[k].norm, reach)) return ClipResult::unchanged;
-    walls::refine(w, exact_->walls[k], site_);
-    const std::size_t nv = verts_.size();
-    if (sign_.size() < std::max(nv, lanes_.padded())) sign_.resize(std::max(nv, lanes_.padded()));
-    const std::size_t removed = walls::signs<3>(verts_.data(), nv, planes_.data(), w, k, *exact_, gen_, sign_);
-    if (removed == 0) return ClipResult::unchanged;
-    if (removed == nv) {
-      resize_vertices(0);
-      security2_ = 0;
-      return ClipResult::emptied;
-    }
-    const Index pn = static_cast<Index>(planes_.size());
-    if (planes_.size() + 1 >= max_planes) [[unlikely]]
-      throw std::length_error("a cell has more than 4294967294 faces (one point with that many neighbours)");
-    Plane& pl = planes_.emplace_back();
-    for (int a = 0; a < 3; ++a) pl.n[a] = w.n[a];
-    pl.d = w.d;
-    pl.n1 = w.n1;
-    pl.id = wall_plane_id(k);
-    pl.scale = 0;
-    scaled_planes_ = true;  // the measure computes a wall's foot (front/cell_geometry.hpp)
-    if (planes_.size() > cap_) [[unlikely]] grow_table();
-    if (hashed_) [[unlikely]] {
-      if (blocked_) {  // cut() takes a blocked cell's removed slots from holes_, as its pass lists them
-        if (holes_.size() < removed) holes_.resize(removed);
-        std::size_t h = 0;
-        for (std::size_t t = 0; t < nv; ++t)
-          if (sign_[t] < 0) holes_[h++] = static_cast<std::uint32_t>(t);
-      }
-      cut_huge(pn, nv, removed);
-    } else {
-      cut<false>(pn, nv, removed);
-    }
-    return ClipResult::clipped;
-  }
+  ClipResult clip_wall(int k, double reach);  // (kernels/clip_walls.cpp)
+
 
  private:
   // Replace the vertices sign_ marks removed (-1; `removed` of the nv)

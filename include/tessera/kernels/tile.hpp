@@ -25,7 +25,6 @@
 #include "tessera/kernels/hull.hpp"  // ClipResult
 #include "tessera/kernels/power.hpp"
 #include "tessera/kernels/prepared_signs.hpp"
-#include "tessera/kernels/walls.hpp"
 
 namespace tessera::kernels {
 
@@ -113,30 +112,8 @@ class Tile {
   }
 
   /// As Hull::clip_wall: cut the finished tile by wall k (walls.hpp).
-  ClipResult clip_wall(int k, double reach) {
-    walls::RelativeWall<2> w = walls::relative<2>(exact_->walls[k], site_);
-    if (walls::misses(w, exact_->walls[k].norm, reach)) return ClipResult::unchanged;
-    walls::refine(w, exact_->walls[k], site_);
-    const std::size_t nv = verts_.size();
-    if (sign_.size() < nv) sign_.resize(nv);
-    const std::size_t removed = walls::signs<2>(verts_.data(), nv, planes_.data(), w, k, *exact_, gen_, sign_);
-    if (removed == 0) return ClipResult::unchanged;
-    if (removed == nv) {
-      verts_.clear();
-      lanes_.clear();
-      security2_ = 0;
-      return ClipResult::emptied;
-    }
-    const Index pn = static_cast<Index>(planes_.size());
-    Plane& pl = planes_.emplace_back();
-    pl.n[0] = w.n[0]; pl.n[1] = w.n[1];
-    pl.d = w.d;
-    pl.n1 = w.n1;
-    pl.id = wall_plane_id(k);
-    pl.scale = 0;
-    cut(pn, nv, removed);
-    return ClipResult::clipped;
-  }
+  ClipResult clip_wall(int k, double reach);  // (kernels/clip_walls.cpp)
+
 
  private:
   // Replace the run of vertices sign_ marks removed (-1; `removed` of the
