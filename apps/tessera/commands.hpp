@@ -44,9 +44,12 @@ struct ComputeArgs {
   std::string cell_method = "auto";  ///< auto | search | insertion (voronoi only; add_cell_method_option)
   std::string periodic;         ///< "" or periodic axes, e.g. "xyz" (voronoi only; add_periodic_option)
   std::vector<double> tilt;     ///< triclinic tilts: xy (2D), or xy xz yz (3D); empty: orthogonal
-  /// --wall, each as given: NX NY D (2D) or NX NY NZ D (3D) (add_walls_option;
-  /// make_options checks the count against the dimension).
+  /// --wall, each as given: NX NY D (2D) or NX NY NZ D (3D) (make_options
+  /// checks the count against the dimension), from raw_walls' words
+  /// (finish_compute_args: in 2D CLI11 also takes the next word, which may
+  /// be INPUT, as for --bounds).
   std::vector<std::vector<double>> walls;
+  std::vector<std::vector<std::string>> raw_walls;
   /// Set where INPUT's own box (a LAMMPS dump's) gave the bounds
   /// (apply_file_box): what the summary says of it, e.g. "the box of
   /// run.dump (timestep 100)".

@@ -222,7 +222,7 @@ void add_periodic_option(CLI::App* app, ComputeArgs& c, const std::string& image
 
 /// --wall, repeatable, of the commands whose cells may lie in a convex domain.
 void add_walls_option(CLI::App* app, ComputeArgs& c) {
-  app->add_option("--wall", c.walls,
+  app->add_option("--wall", c.raw_walls,
                   "A wall: the half-space NX*x + NY*y (+ NZ*z) <= D, which cuts the domain box (--bounds, or the "
                   "default) down to a convex polygon or polyhedron; repeat it, one per side (e.g. --wall 1,1,1.5 "
                   "keeps x + y <= 1.5). Cells are cut exactly where they cross it; a face on wall k is listed as "
@@ -265,6 +265,24 @@ void finish_compute_args(ComputeArgs& c, const std::vector<std::string>& raw_bou
     }
     throw tessera::InputError("--bounds: '" + raw_bounds[i] + "' is not a number" +
                               (i >= 4 ? " (put INPUT before --bounds)" : ""));
+  }
+  c.walls.clear();
+  for (const auto& words : c.raw_walls) {
+    std::vector<double>& wall = c.walls.emplace_back();
+    for (std::size_t i = 0; i < words.size(); ++i) {
+      double v = 0;
+      bool overflow = false;
+      if (parse(words[i], v, overflow)) {
+        wall.push_back(v);
+        continue;
+      }
+      if (overflow) throw tessera::InputError("--wall: '" + words[i] + "' is beyond double's range");
+      if (i == 3 && c.input.empty()) {  // a 2D wall's three numbers, then INPUT
+        c.input = words[i];
+        break;
+      }
+      throw tessera::InputError("--wall: '" + words[i] + "' is not a number" + (i == 3 ? " (put INPUT before --wall)" : ""));
+    }
   }
   if (c.input.empty()) throw tessera::InputError("INPUT is required (run with --help for usage)");
   // No output may replace a file the command reads (a slip such as

@@ -21,7 +21,7 @@ import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import test_cli as base  # noqa: E402  (helpers only; its test classes are not collected here)
-from test_cli import read_vtp, read_vtu, cell_array  # noqa: E402
+from test_cli import read_bytes, read_vtp, read_vtu, cell_array  # noqa: E402
 from test_prep_cli import Case  # noqa: E402  (its fails(): exit 2, one error line, nothing written)
 
 from vtk.util.numpy_support import vtk_to_numpy  # noqa: E402
@@ -59,6 +59,10 @@ class Walls(Case):
         t = np.loadtxt(self.p("t.csv"), delimiter=",", skiprows=1)
         self.assertEqual(len(t), n)
         self.assertTrue(np.array_equal(t[:, 2], area))
+        # INPUT right after a 2D wall's three numbers (which CLI11 reads as a fourth) is INPUT.
+        self.ok(["voronoi", "--bounds", "0", "1", "0", "1", "--wall", "1", "1", "1", self.in2,
+                 "--cell-table", self.p("t2.csv"), "-q"])
+        self.assertEqual(read_bytes(self.p("t2.csv")), read_bytes(self.p("t.csv")))
         nb = np.load(self.p("nb.npy"))
         ids = nb[2 + n:]
         self.assertTrue(np.all(ids >= 0))  # walls, as the box, are not neighbours
@@ -112,6 +116,7 @@ class Walls(Case):
         self.fails(["voronoi", self.in2, "--wall", "1,1,1,1", "-o", out] + box, "expected three values")
         self.fails(["voronoi", self.in3, "--wall", "1,1,1", "-o", self.p("c.vtu")], "expected four values")
         self.fails(["voronoi", self.in2, "--wall", "0,0,1", "-o", out] + box, "wall 0: its normal is zero")
+        self.fails(["voronoi", self.in2, "--wall", "1", "x", "1", "-o", out] + box, "--wall: 'x' is not a number")
         self.fails(["voronoi", self.in2, "--wall", "1,1,1", "--wall", "1,0,inf", "-o", out] + box,
                    "wall 1: its offset is not finite")
         self.fails(["voronoi", self.in2, "--wall", "1,1,1", "--periodic", "xy", "-o", out] + box, "periodic")
