@@ -492,6 +492,7 @@ int main(int argc, char** argv) {
   add_compute_options(snets, sna.compute, sn_bounds);
   add_surface_nets_options(snets, sna, false);
   add_periodic_option(snets, sna.compute, "Cells keep their shape across the box's faces; the surfaces close up across the box (their pieces fit by lattice translations; an image's default box is its voxels)", kAnyAxes);
+  add_walls_option(snets, sna.compute);
 
   BenchArgs ba;
   CLI::App* bench = app.add_subcommand("bench", "Benchmarks printing one JSON line per run on stdout");

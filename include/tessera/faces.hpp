@@ -96,6 +96,9 @@ struct FaceSet {
   /// The periodic axes and the lattice vectors (Cells::periodic, lattice()).
   std::array<bool, 3> periodic{false, false, false};
   std::array<std::array<double, 3>, 3> lattice{};
+  /// The cells' walls (Cells::walls): a vertex key's id -7-k names wall k
+  /// (the surface nets' smoothing keeps such vertices on their walls).
+  std::vector<Wall> walls;
 
   std::size_t n_faces() const { return face_offsets.empty() ? 0 : face_offsets.size() - 1; }
   std::size_t n_vertices() const { return vertex_keys.size() / static_cast<std::size_t>(dim + 1); }

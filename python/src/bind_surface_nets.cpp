@@ -27,10 +27,12 @@ SurfaceNet run_surface_nets(const Points& points, const py::object& labels, cons
                             std::int32_t background_label, bool capping, int iterations, double relaxation,
                             double constraint, bool constraint_is_absolute, bool triangles,
                             const std::optional<std::vector<double>>& bounds, double padding, bool ignore_outside,
-                            int threads, const std::array<bool, 3>& periodic, const std::array<double, 3>& tilt) {
+                            int threads, const std::array<bool, 3>& periodic, const std::array<double, 3>& tilt,
+                            const py::object& walls) {
   const int dim = checked_dim(points);
   SurfaceNetsOptions opt;
   fill_common(opt.voronoi, dim, bounds, padding, ignore_outside, threads);
+  opt.voronoi.walls = walls_from(walls, dim);
   opt.voronoi.periodic = periodic;
   opt.voronoi.tilt = tilt;
   opt.select = select;
@@ -74,7 +76,8 @@ void bind_surface_nets(py::module_& m) {
         py::arg("select"), py::arg("background_label"), py::arg("capping"), py::arg("iterations"),
         py::arg("relaxation"), py::arg("constraint"), py::arg("constraint_is_absolute"), py::arg("triangles"),
         py::arg("bounds"), py::arg("padding"), py::arg("ignore_outside"), py::arg("threads"), py::arg("periodic"),
-        py::arg("tilt"), "Surface nets of float64 (N, D) points with int32 labels. Runs without the GIL.");
+        py::arg("tilt"), py::arg("walls").none(true) = py::none(),
+        "Surface nets of float64 (N, D) points with int32 labels. Runs without the GIL.");
 }
 
 }  // namespace tessera::python

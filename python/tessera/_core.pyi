@@ -425,6 +425,7 @@ def surface_nets(
     threads: int,
     periodic: Tuple[bool, bool, bool],
     tilt: Tuple[float, float, float],
+    walls: Optional[npt.NDArray[np.float64]] = ...,
 ) -> SurfaceNet: ...
 def write_surface_net_vtp(path: str, net: SurfaceNet) -> None: ...
 

@@ -149,6 +149,7 @@ def surface_nets(
     ignore_outside: bool = False,
     periodic: Any = False,
     tilt: Optional[Sequence[float]] = None,
+    walls: Any = None,
 ) -> SurfaceNet:
     """Generalized surface nets: the surfaces between the regions of labelled points.
 
@@ -189,6 +190,9 @@ def surface_nets(
         (:attr:`side_shifts` names side 1's image), and the copies of a vertex
         seen from several frames are smoothed as one, so every region's
         surface closes up across the box's faces.
+    walls
+        A convex domain, as in :func:`tessera.voronoi`: capped regions close
+        on the walls, and a vertex on a wall stays on it through the smoothing.
 
     Returns
     -------
@@ -228,5 +232,5 @@ def surface_nets(
     net = _inputs.call(
         _core.surface_nets, pts, lab, sel, bg, cap, iterations, relaxation, limit, absolute, tri,
         _inputs.as_bounds(bounds, dim), _inputs.as_padding(padding), _inputs.as_flag(ignore_outside, "ignore_outside"),
-        _inputs.as_threads(threads), per, tilts)
+        _inputs.as_threads(threads), per, tilts, _inputs.as_walls(walls, dim))
     return SurfaceNet(net, pts, lab, options)

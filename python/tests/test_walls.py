@@ -121,3 +121,14 @@ def test_polygon_walls():
         tessera.polygon_walls([(0, 0), (1, 0), (1, 0), (0, 1)])
     with pytest.raises(ValueError, match="no area"):
         tessera.polygon_walls([(0, 0), (1, 1), (2, 2)])
+
+
+def test_surface_nets_in_walls():
+    rng = np.random.default_rng(12)
+    pts = rng.random((6000, 3))
+    pts = pts[pts.sum(axis=1) <= 2.0]
+    labels = (np.linalg.norm(pts - 0.5, axis=1) < 0.3).astype(np.int32)
+    net = tessera.surface_nets(pts, labels, capping=True, bounds=UNIT_BOX[3], walls=[(1, 1, 1, 2.0)])
+    on = np.any(net.vertex_keys == -7, axis=1)  # the vertices on the wall
+    assert on.sum() > 10
+    assert np.abs(net.vertices[on].sum(axis=1) - 2.0).max() < 1e-12

@@ -118,6 +118,7 @@ FaceSet extract_faces(const Cells& c, std::span<const std::int32_t> labels, cons
     out.periodic = c.periodic;
     out.lattice = c.lattice();
   }
+  out.walls = c.walls;
 
   // Pass 1: per cell, the faces and corners it contributes; mark used vertices.
   std::vector<std::int64_t> face_start(nc + 1, 0), corner_start(nc + 1, 0);

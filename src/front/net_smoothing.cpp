@@ -79,6 +79,68 @@ int distinct(const std::int64_t* r, int n) {
   return k;
 }
 
+/// The step of a vertex on walls (a key id -7-k), projected onto the walls'
+/// planes and the box planes it is pinned to: the vertex slides within
+/// them, as a box-plane vertex slides within its plane. Orthonormal
+/// constraint directions per such vertex (the walls' normals and the
+/// pinned axes, by Gram-Schmidt; none left free: the vertex stays).
+class WallSlide {
+ public:
+  WallSlide(const FaceSet& mesh, const std::vector<std::uint8_t>& pinned, const std::vector<std::uint8_t>& on_wall)
+      : dn_(static_cast<std::size_t>(mesh.dim)) {
+    if (on_wall.empty()) return;
+    const std::size_t kn = dn_ + 1, nv = on_wall.size();
+    first_.assign(nv + 1, 0);
+    for (std::size_t v = 0; v < nv; ++v) {
+      first_[v + 1] = first_[v];
+      if (!on_wall[v]) continue;
+      std::vector<std::array<double, 3>> normals;
+      for (std::size_t a = 0; a < dn_; ++a)
+        if ((pinned[v] >> a) & 1u) {
+          std::array<double, 3> e{0, 0, 0};
+          e[a] = 1;
+          normals.push_back(e);
+        }
+      for (std::size_t a = 0; a < kn; ++a) {
+        const std::int32_t id = mesh.vertex_keys[v * kn + a];
+        if (!is_wall_spoke(id)) continue;
+        const Wall& w = mesh.walls[static_cast<std::size_t>(-7 - id)];
+        normals.push_back({w.normal[0], w.normal[1], dn_ == 3 ? w.normal[2] : 0.0});
+      }
+      for (auto q : normals) {  // Gram-Schmidt, twice for accuracy
+        for (int pass = 0; pass < 2; ++pass)
+          for (std::size_t b = first_[v]; b < first_[v + 1]; ++b) {
+            const double* u = &basis_[3 * b];
+            const double t = q[0] * u[0] + q[1] * u[1] + q[2] * u[2];
+            for (int c = 0; c < 3; ++c) q[c] -= t * u[c];
+          }
+        const double len = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2]);
+        if (!(len > 1e-9)) continue;  // dependent on the earlier ones
+        for (int c = 0; c < 3; ++c) basis_.push_back(q[c] / len);
+        ++first_[v + 1];
+      }
+    }
+  }
+  /// d (dn components) less its components along v's constraint directions.
+  void operator()(std::size_t v, double* d) const {
+    if (first_[v + 1] - first_[v] >= dn_) {  // no direction left free
+      for (std::size_t a = 0; a < dn_; ++a) d[a] = 0;
+      return;
+    }
+    for (std::size_t b = first_[v]; b < first_[v + 1]; ++b) {
+      const double* u = &basis_[3 * b];
+      double t = 0;
+      for (std::size_t a = 0; a < dn_; ++a) t += d[a] * u[a];
+      for (std::size_t a = 0; a < dn_; ++a) d[a] -= t * u[a];
+    }
+  }
+
+ private:
+  std::size_t dn_;
+  std::vector<std::size_t> first_;  // per vertex: its directions are basis_[3 first_[v], 3 first_[v + 1])
+  std::vector<double> basis_;
+};
+
 template <class Body>
 void parallel_range(std::size_t n, std::size_t grain, Body&& body) {
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, grain), [&](const tbb::blocked_range<std::size_t>& r) {
@@ -283,14 +345,21 @@ std::vector<NetVertexKind> smooth_surface_net(FaceSet& mesh, std::span<const dou
   const std::vector<double> petal = front::petal_radii(mesh, x0, points, k);
   std::vector<double> radius(nv);
   std::vector<std::uint8_t> pinned(nv, 0);
+  std::vector<std::uint8_t> on_wall(mesh.walls.empty() ? 0 : nv, 0);
   front::parallel_range(nv, 4096, [&](std::size_t v) {
     const std::int32_t* key = &mesh.vertex_keys[v * kn];
     std::uint8_t pin = 0;
-    for (std::size_t a = 0; a < kn; ++a)
-      if (key[a] < 0) pin |= static_cast<std::uint8_t>(1u << ((-key[a] - 1) / 2));
+    for (std::size_t a = 0; a < kn; ++a) {
+      if (key[a] >= 0) continue;
+      if (is_wall_spoke(key[a])) on_wall[v] = 1;
+      else pin |= static_cast<std::uint8_t>(1u << ((-key[a] - 1) / 2));
+    }
     pinned[v] = pin;
     radius[v] = options.constraint_is_absolute ? options.constraint : options.constraint * petal[v];
   });
+  // A vertex on walls moves within them: its step loses its components
+  // along the walls' normals and the pinned axes (wall_slide).
+  const front::WallSlide slide(mesh, pinned, on_wall);
 
   // The Jacobi step moves groups of copies of one vertex (a periodic face
   // set's; every vertex alone otherwise: vertex_copies, faces.hpp), each by
@@ -486,11 +555,9 @@ std::vector<NetVertexKind> smooth_surface_net(FaceSet& mesh, std::span<const dou
         }
         const double inv = 1.0 / static_cast<double>(e - b);
         double d[3] = {0, 0, 0}, d2 = 0;
-        for (std::size_t a = 0; a < dn; ++a) {
-          const double p = x[a] + lambda * (mean[a] * inv - x[a]);
-          d[a] = p - x0[v * dn + a];
-          d2 += d[a] * d[a];
-        }
+        for (std::size_t a = 0; a < dn; ++a) d[a] = x[a] + lambda * (mean[a] * inv - x[a]) - x0[v * dn + a];
+        if (!on_wall.empty() && on_wall[v]) [[unlikely]] slide(v, d);
+        for (std::size_t a = 0; a < dn; ++a) d2 += d[a] * d[a];
         const double r = radius[v], r2 = r * r;
         double scale = 1.0;
         if (d2 >= 0x1p-900 && d2 <= 0x1p900 && r2 >= 0x1p-900 && r2 <= 0x1p900) {

@@ -122,9 +122,6 @@ SurfaceNet surface_nets(std::span<const double> points, std::span<const std::int
   const int D = options.voronoi.dim;
   if (D != 2 && D != 3) throw InputError("dim must be 2 or 3, got " + std::to_string(D));
   if (!options.voronoi.radii.empty()) throw InputError("surface nets of power cells (radii) are not supported");
-  // The smoothing pins a vertex on a box plane to it, and has no such
-  // constraint for a wall's slanted plane (docs/design.md, "Walls").
-  if (!options.voronoi.walls.empty()) throw InputError("surface nets within walls are not supported");
   if (points.size() % static_cast<std::size_t>(D) != 0)
     throw InputError("points: " + std::to_string(points.size()) + " coordinates is not a multiple of dim " +
                      std::to_string(D));

@@ -96,6 +96,13 @@ class Walls(Case):
         k = np.load(self.p("k.npy"))
         self.assertGreater(int(np.sum(spokes == -7)), 0)
         self.assertTrue(np.all(k[spokes == -7] == 2))
+        # Surface nets close on the wall (capping): every face's vertices inside it.
+        lab = self.save("lab.npy", (np.linalg.norm(self.p3 - 0.5, axis=1) < 0.3).astype(np.int32))
+        self.ok(["surface-nets", self.in3, "--labels", lab, "--capping", "--bounds", "0,1,0,1,0,1",
+                 "--wall", "1,1,1,1.5", "-o", self.p("sn.vtp"), "-q"])
+        sn = vtk_to_numpy(read_vtp(self.p("sn.vtp")).GetPoints().GetData())
+        self.assertLessEqual(float(sn.sum(axis=1).max()), 1.5 + 1e-12)
+        self.assertGreater(int(np.sum(np.abs(sn.sum(axis=1) - 1.5) < 1e-12)), 10)
         # bench voronoi takes walls too.
         r = self.ok(["bench", "voronoi", self.in3, "--bounds", "0,1,0,1,0,1", "--wall", "1,1,1,1.5"])
         line = json.loads(r.stdout.splitlines()[0])
@@ -121,7 +128,6 @@ class Walls(Case):
                    "wall 1: its offset is not finite")
         self.fails(["voronoi", self.in2, "--wall", "1,1,1", "--periodic", "xy", "-o", out] + box, "periodic")
         self.fails(["delaunay", self.in2, "--wall", "1,1,1", "-o", out] + box)
-        self.fails(["surface-nets", self.in2, "--wall", "1,1,1", "-o", out] + box)
         # Dropped instead, and listed.
         r = self.ok(["voronoi", self.in2, "--wall", "1,1,0.5", "--ignore-outside", "-o", out] + box)
         outside = int(np.sum(self.p2.sum(axis=1) > 0.5))
