@@ -1,8 +1,6 @@
 // Walls in the kernels' form, and points against them (walls.hpp).
 #include "walls.hpp"
 
-#include <gmp.h>
-
 #include <algorithm>
 #include <cmath>
 #include <string>
@@ -56,28 +54,6 @@ std::vector<kernels::Wall> kernel_walls(const std::vector<Wall>& given, int dim,
   return out;
 }
 
-namespace {
-// sign(d - n.p) exactly, in rationals (the float test could not decide).
-int exact_side(const double* p, int dim, const kernels::Wall& w) {
-  mpq_t acc, t, u;
-  mpq_init(acc);
-  mpq_init(t);
-  mpq_init(u);
-  mpq_set_d(acc, w.d);
-  for (int a = 0; a < dim; ++a) {
-    mpq_set_d(t, w.n[a]);
-    mpq_set_d(u, p[a]);
-    mpq_mul(t, t, u);
-    mpq_sub(acc, acc, t);
-  }
-  const int s = mpq_sgn(acc);
-  mpq_clear(acc);
-  mpq_clear(t);
-  mpq_clear(u);
-  return s;
-}
-}  // namespace
-
 WallTest::WallTest(std::span<const kernels::Wall> walls, int dim, double largest)
     : walls_(walls), dim_(dim), error_(walls.size()) {
   // d - n.p in D products and D differences, each rounded once: within
@@ -95,7 +71,7 @@ int WallTest::outside(const double* p) const {
     const kernels::Wall& w = walls_[k];
     double s = w.d;
     for (int a = 0; a < dim_; ++a) s -= w.n[a] * p[a];
-    const int side = s > error_[k] ? 1 : s < -error_[k] ? -1 : exact_side(p, dim_, w);
+    const int side = s > error_[k] ? 1 : s < -error_[k] ? -1 : kernels::exact_wall_point_side(w, p, dim_);
     if (side < 0) return static_cast<int>(k);
   }
   return -1;

@@ -481,6 +481,36 @@ int exact_box_sign(const ExactContext& ctx, std::int32_t i, const std::int32_t* 
   return box_plane_upper(box) ? side : -side;
 }
 
+namespace {
+// d - n.p exactly, in a rational of this thread's (the offset's fallback and
+// the point's side).
+mpq_srcptr wall_offset_rational(const Wall& w, const double* p, int dim) {
+  thread_local struct Rationals {
+    mpq_t acc, t, u;
+    Rationals() {
+      mpq_init(acc);
+      mpq_init(t);
+      mpq_init(u);
+    }
+    ~Rationals() {
+      mpq_clear(acc);
+      mpq_clear(t);
+      mpq_clear(u);
+    }
+  } r;
+  mpq_set_d(r.acc, w.d);
+  for (int a = 0; a < dim; ++a) {
+    mpq_set_d(r.t, w.n[a]);
+    mpq_set_d(r.u, p[a]);
+    mpq_mul(r.t, r.t, r.u);
+    mpq_sub(r.acc, r.acc, r.t);
+  }
+  return r.acc;
+}
+}  // namespace
+
+int exact_wall_point_side(const Wall& w, const double* p, int dim) { return mpq_sgn(wall_offset_rational(w, p, dim)); }
+
 double exact_wall_offset(const Wall& w, const double* p, int dim) {
   // In expansions where nothing can over- or underflow (every cell a wall
   // may cut asks this: GMP's rationals cost 10% of the cells of a
@@ -513,27 +543,7 @@ double exact_wall_offset(const Wall& w, const double* p, int dim) {
       if (bound <= 2 * std::fabs(sum)) return sum;  // error <= u bound <= 2u |sum|
     }
   }
-  thread_local struct Rationals {
-    mpq_t acc, t, u;
-    Rationals() {
-      mpq_init(acc);
-      mpq_init(t);
-      mpq_init(u);
-    }
-    ~Rationals() {
-      mpq_clear(acc);
-      mpq_clear(t);
-      mpq_clear(u);
-    }
-  } r;
-  mpq_set_d(r.acc, w.d);
-  for (int a = 0; a < dim; ++a) {
-    mpq_set_d(r.t, w.n[a]);
-    mpq_set_d(r.u, p[a]);
-    mpq_mul(r.t, r.t, r.u);
-    mpq_sub(r.acc, r.acc, r.t);
-  }
-  return mpq_get_d(r.acc);  // truncated toward zero
+  return mpq_get_d(wall_offset_rational(w, p, dim));  // truncated toward zero
 }
 
 int exact_wall_sign(const ExactContext& ctx, std::int32_t i, const std::int32_t* planes, int wall) {

@@ -56,12 +56,10 @@ std::vector<double> points_inside(std::size_t n, int dim, std::uint64_t seed, co
 }
 
 tessera::Cells run_walls(const std::vector<double>& pts, int dim, const std::vector<oracle::Wall>& walls,
-                         int threads = 1, std::vector<double> radii = {}) {
+                         int threads = 1, const std::vector<double>& radii = {}) {
   tessera::VoronoiOptions o = options(dim, unit_box(), threads);
   o.walls = to_walls(walls);
-  static thread_local std::vector<double> keep;
-  keep = std::move(radii);
-  o.radii = keep;
+  o.radii = radii;  // (viewed during the call)
   return tessera::voronoi(std::span<const double>(pts), dim, {}, o);
 }
 

@@ -1,6 +1,6 @@
 // The walls' exact questions (kernels/walls.hpp) against an oracle in GMP
 // rationals: a wall's offset relative to a point (exact_wall_offset, within
-// two ulps), and a vertex's side of a wall (exact_wall_sign: ties inside),
+// two ulps; exact_wall_point_side, its sign), and a vertex's side of a wall (exact_wall_sign: ties inside),
 // for vertices of bisectors, box planes and other walls, on small integer
 // coordinates where ties are common.
 #include <gmpxx.h>
@@ -17,7 +17,7 @@ namespace {
 using namespace tessera::kernels;
 using Q = mpq_class;
 
-TEST(WallPredicates, OffsetIsWithinTwoUlpsOfTheExactValue) {
+TEST(WallPredicates, OffsetIsWithinTwoUlpsAndSideIsExact) {
   std::mt19937_64 rng(88);
   std::uniform_real_distribution<double> u(-1, 1);
   for (int trial = 0; trial < 20000; ++trial) {
@@ -36,6 +36,7 @@ TEST(WallPredicates, OffsetIsWithinTwoUlpsOfTheExactValue) {
     w.d = trial % 3 == 0 ? u(rng) * scale : dot * (1 + u(rng) * 1e-12 * (trial % 5));
     Q exact = Q(w.d);
     for (int a = 0; a < dim; ++a) exact -= Q(w.n[a]) * Q(p[a]);
+    EXPECT_EQ(exact_wall_point_side(w, p, dim), sgn(exact)) << "trial " << trial;
     const double got = exact_wall_offset(w, p, dim);
     const Q err = abs(Q(got) - exact);
     EXPECT_LE(err, abs(exact) * Q(std::ldexp(1.0, -51)))

@@ -212,6 +212,9 @@ int exact_box_sign(const ExactContext& ctx, std::int32_t i, const std::int32_t* 
 /// point near a wall far from the origin: the vertices of a slab between
 /// two walls 1e-9 apart were placed 1e-16 off, and measured 1e-8 off).
 double exact_wall_offset(const Wall& w, const double* p, int dim);
+/// The exact sign of d - n.p: +1 p lies strictly inside wall w, 0 on it, -1
+/// outside (the front end's test of the points, where floats cannot tell).
+int exact_wall_point_side(const Wall& w, const double* p, int dim);
 /// The side of wall `wall` (an index into ctx.walls) on which the vertex of
 /// cell i where planes[0..dim) meet (generators, box planes or walls) lies:
 /// +1 inside or exactly on the wall's plane, -1 outside. A tie counts as
