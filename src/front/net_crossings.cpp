@@ -1,13 +1,18 @@
 // Crossing triangles of a smoothed surface net (see net_crossings.hpp).
 //
-// Broad phase: a uniform grid of cells about twice the mean triangle's size,
-// each triangle listed in every cell its bounding box meets; a pair is tested
-// once, in the cell holding the lower corner of their boxes' overlap. Narrow
-// phase: float filters that settle most pairs apart with a bound far above
-// their rounding, then exact orientation signs (in 3D, and in 2D projections
-// for what lies in a plane): the interior of one triangle meets the other iff
-// no line in its plane separates it from the other's section by that plane
-// (interior_meets).
+// Broad phase: a bounding volume hierarchy over the triangles' boxes (in
+// doubles), split at the median of the boxes' centres along their widest
+// axis; each triangle asks it for the boxes that meet its own. A uniform grid
+// (stop 84) failed where the triangles' sizes or places spread over many
+// orders of magnitude (a net of points with outliers: 800 triangles 1e277
+// long among 32,000 of size 0.07): its cells, sized by the mean triangle,
+// held the whole bulk in one, and its float boxes rounded the bulk's to one
+// point, so every pair was a candidate (5e8). The hierarchy adapts to any
+// spread. Narrow phase: float filters that settle most pairs apart with a
+// bound far above their rounding, then exact orientation signs (in 3D, and
+// in 2D projections for what lies in a plane): the interior of one triangle
+// meets the other iff no line in its plane separates it from the other's
+// section by that plane (interior_meets).
 #include "net_crossings.hpp"
 
 #include <algorithm>
@@ -20,6 +25,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
 
 #include "tessera/kernels/delaunay_predicates.hpp"
 
@@ -31,6 +37,27 @@ using Pair = std::pair<std::size_t, std::size_t>;
 int orient(const double* a, const double* b, const double* c, const double* d) {
   const double* p[4] = {a, b, c, d};
   return kernels::orientation(3, p);
+}
+
+/// The float filters below bound their rounding relative to products of
+/// the vectors they take (edges, differences), which holds while no product
+/// overflows or underflows: while those products lie in [1/safe, safe].
+/// Where they do not (nets of points no frame fits: coordinates from 1 to
+/// 1e277, whose long triangles' normals overflow), each vector is scaled by
+/// a power of two to its largest component's exponent first (`normalize`):
+/// that changes no sign, and the products are then at least 1e-10 (a
+/// component that underflows on the way errs by 2^-1074, far below). Without
+/// it every such pair fell to the exact orientation: minutes for 1,800
+/// points.
+constexpr double safe = 1e250;
+bool in_safe_range(double x) { return x >= 1 / safe && x <= safe; }
+
+void normalize(double* v, int n) {
+  double m = 0;
+  for (int k = 0; k < n; ++k) m = std::max(m, std::fabs(v[k]));
+  if (!(m > 0) || !std::isfinite(m)) return;  // (then nothing is decided)
+  const int e = std::ilogb(m);
+  for (int k = 0; k < n; ++k) v[k] = std::ldexp(v[k], -e);
 }
 
 /// Whether the points q[0..m) lie certainly strictly on one side of the
@@ -46,23 +73,33 @@ int orient(const double* a, const double* b, const double* c, const double* d) {
 /// exception counts for the distinct vertices that coincide on exact
 /// lattices (the unsmoothed net, where the untangling pins it).
 bool surely_one_side(const double* const t[3], const double* const* q, int m) {
-  const double u[3] = {t[1][0] - t[0][0], t[1][1] - t[0][1], t[1][2] - t[0][2]};
-  const double w[3] = {t[2][0] - t[0][0], t[2][1] - t[0][1], t[2][2] - t[0][2]};
-  const double n[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]};
-  const double uw = (std::fabs(u[0]) + std::fabs(u[1]) + std::fabs(u[2])) *
-                    (std::fabs(w[0]) + std::fabs(w[1]) + std::fabs(w[2]));
-  int side = 0;
-  for (int k = 0; k < m; ++k) {
-    if (std::equal(q[k], q[k] + 3, t[0]) || std::equal(q[k], q[k] + 3, t[1]) || std::equal(q[k], q[k] + 3, t[2]))
-      continue;
-    const double d[3] = {q[k][0] - t[0][0], q[k][1] - t[0][1], q[k][2] - t[0][2]};
-    const double s = n[0] * d[0] + n[1] * d[1] + n[2] * d[2];
-    const double bound = 1e-10 * uw * (std::fabs(d[0]) + std::fabs(d[1]) + std::fabs(d[2]));
-    const int sk = s > bound ? 1 : s < -bound ? -1 : 0;
-    if (sk == 0 || (side != 0 && sk != side)) return false;
-    side = sk;
+  double u[3] = {t[1][0] - t[0][0], t[1][1] - t[0][1], t[1][2] - t[0][2]};
+  double w[3] = {t[2][0] - t[0][0], t[2][1] - t[0][1], t[2][2] - t[0][2]};
+  for (const bool scaled : {false, true}) {
+    if (scaled) normalize(u, 3), normalize(w, 3);
+    const double n[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]};
+    const double uw = (std::fabs(u[0]) + std::fabs(u[1]) + std::fabs(u[2])) *
+                      (std::fabs(w[0]) + std::fabs(w[1]) + std::fabs(w[2]));
+    int side = 0;
+    bool out_of_range = false;
+    for (int k = 0; k < m; ++k) {
+      if (std::equal(q[k], q[k] + 3, t[0]) || std::equal(q[k], q[k] + 3, t[1]) || std::equal(q[k], q[k] + 3, t[2]))
+        continue;
+      double d[3] = {q[k][0] - t[0][0], q[k][1] - t[0][1], q[k][2] - t[0][2]};
+      if (scaled) normalize(d, 3);
+      const double s = n[0] * d[0] + n[1] * d[1] + n[2] * d[2];
+      const double bound = 1e-10 * uw * (std::fabs(d[0]) + std::fabs(d[1]) + std::fabs(d[2]));
+      if (!scaled && !(in_safe_range(uw) && in_safe_range(bound))) {
+        out_of_range = true;
+        break;
+      }
+      const int sk = s > bound ? 1 : s < -bound ? -1 : 0;
+      if (sk == 0 || (side != 0 && sk != side)) return false;
+      side = sk;
+    }
+    if (!out_of_range) return side != 0;
   }
-  return side != 0;
+  return false;
 }
 
 /// Float filter for triangles lying nearly in one plane (a flat stretch of a
@@ -77,48 +114,65 @@ bool surely_one_side(const double* const t[3], const double* const* q, int m) {
 /// so lie on the boundary of both: they do not cross.
 bool surely_apart_in_plane(const double* const a[3], const std::int32_t* ca, const double* const b[3],
                            const std::int32_t* cb) {
-  // n = u x w and the size of the products behind it, |u| |w|.
-  auto normal = [](const double* const t[3], double* n) {
-    const double u[3] = {t[1][0] - t[0][0], t[1][1] - t[0][1], t[1][2] - t[0][2]};
-    const double w[3] = {t[2][0] - t[0][0], t[2][1] - t[0][1], t[2][2] - t[0][2]};
-    n[0] = u[1] * w[2] - u[2] * w[1], n[1] = u[2] * w[0] - u[0] * w[2], n[2] = u[0] * w[1] - u[1] * w[0];
-    return (std::fabs(u[0]) + std::fabs(u[1]) + std::fabs(u[2])) * (std::fabs(w[0]) + std::fabs(w[1]) + std::fabs(w[2]));
-  };
-  double na[3], nb[3];
-  const double uwa = normal(a, na), uwb = normal(b, nb);
-  const int drop = std::fabs(na[0]) >= std::fabs(na[1]) && std::fabs(na[0]) >= std::fabs(na[2]) ? 0
-                   : std::fabs(na[1]) >= std::fabs(na[2])                                       ? 1
-                                                                                                : 2;
-  auto faces = [&](const double* n, double uw) {
-    return std::fabs(n[drop]) > 1e-3 * std::max({std::fabs(n[0]), std::fabs(n[1]), std::fabs(n[2])}) &&
-           std::fabs(n[drop]) > 1e-10 * uw;
-  };
-  if (!faces(na, uwa) || !faces(nb, uwb)) return false;
-  const int x = drop == 0 ? 1 : 0, y = drop == 2 ? 1 : 2;
-  // Does the line through t's edge k separate u from t's third corner?
-  auto separates = [&](const double* const t[3], const std::int32_t* ct, int k, const double* const u[3],
-                       const std::int32_t* cu) {
-    const double* p = t[k];
-    const double* q = t[(k + 1) % 3];
-    const double ex = q[x] - p[x], ey = q[y] - p[y], e1 = std::fabs(ex) + std::fabs(ey);
-    auto side = [&](const double* r, double& margin) {
-      const double dx = r[x] - p[x], dy = r[y] - p[y];
-      margin = 1e-10 * e1 * (std::fabs(dx) + std::fabs(dy));
-      return ex * dy - ey * dx;
+  // Once unscaled, then (if a product left the safe range) scaled.
+  for (const bool scaled : {false, true}) {
+    bool out_of_range = false;
+    auto check = [&](double product) {
+      if (!scaled && !in_safe_range(product)) out_of_range = true;
     };
-    double m = 0;
-    const double inner = side(t[(k + 2) % 3], m);
-    if (!(std::fabs(inner) > m)) return false;
-    for (int j = 0; j < 3; ++j) {
-      if (cu[j] == ct[k] || cu[j] == ct[(k + 1) % 3]) continue;  // on the edge itself, and in both
-      if ((u[j][x] == p[x] && u[j][y] == p[y]) || (u[j][x] == q[x] && u[j][y] == q[y])) continue;
-      const double s = side(u[j], m);
-      if (!(std::fabs(s) > m) || (s > 0) == (inner > 0)) return false;
-    }
-    return true;
-  };
-  for (int k = 0; k < 3; ++k)
-    if (separates(a, ca, k, b, cb) || separates(b, cb, k, a, ca)) return true;
+    // n = u x w and the size of the products behind it, |u| |w|.
+    auto normal = [&](const double* const t[3], double* n) {
+      double u[3] = {t[1][0] - t[0][0], t[1][1] - t[0][1], t[1][2] - t[0][2]};
+      double w[3] = {t[2][0] - t[0][0], t[2][1] - t[0][1], t[2][2] - t[0][2]};
+      if (scaled) normalize(u, 3), normalize(w, 3);
+      n[0] = u[1] * w[2] - u[2] * w[1], n[1] = u[2] * w[0] - u[0] * w[2], n[2] = u[0] * w[1] - u[1] * w[0];
+      const double uw =
+          (std::fabs(u[0]) + std::fabs(u[1]) + std::fabs(u[2])) * (std::fabs(w[0]) + std::fabs(w[1]) + std::fabs(w[2]));
+      check(uw);
+      return uw;
+    };
+    double na[3], nb[3];
+    const double uwa = normal(a, na), uwb = normal(b, nb);
+    if (out_of_range) continue;
+    const int drop = std::fabs(na[0]) >= std::fabs(na[1]) && std::fabs(na[0]) >= std::fabs(na[2]) ? 0
+                     : std::fabs(na[1]) >= std::fabs(na[2])                                       ? 1
+                                                                                                  : 2;
+    auto faces = [&](const double* n, double uw) {
+      return std::fabs(n[drop]) > 1e-3 * std::max({std::fabs(n[0]), std::fabs(n[1]), std::fabs(n[2])}) &&
+             std::fabs(n[drop]) > 1e-10 * uw;
+    };
+    if (!faces(na, uwa) || !faces(nb, uwb)) return false;
+    const int x = drop == 0 ? 1 : 0, y = drop == 2 ? 1 : 2;
+    // Does the line through t's edge k separate u from t's third corner?
+    auto separates = [&](const double* const t[3], const std::int32_t* ct, int k, const double* const u[3],
+                         const std::int32_t* cu) {
+      const double* p = t[k];
+      const double* q = t[(k + 1) % 3];
+      double e[2] = {q[x] - p[x], q[y] - p[y]};
+      if (scaled) normalize(e, 2);
+      const double e1 = std::fabs(e[0]) + std::fabs(e[1]);
+      auto side = [&](const double* r, double& margin) {
+        double d[2] = {r[x] - p[x], r[y] - p[y]};
+        if (scaled) normalize(d, 2);
+        margin = 1e-10 * e1 * (std::fabs(d[0]) + std::fabs(d[1]));
+        check(e1), check(margin);
+        return e[0] * d[1] - e[1] * d[0];
+      };
+      double m = 0;
+      const double inner = side(t[(k + 2) % 3], m);
+      if (!(std::fabs(inner) > m)) return false;
+      for (int j = 0; j < 3; ++j) {
+        if (cu[j] == ct[k] || cu[j] == ct[(k + 1) % 3]) continue;  // on the edge itself, and in both
+        if ((u[j][x] == p[x] && u[j][y] == p[y]) || (u[j][x] == q[x] && u[j][y] == q[y])) continue;
+        const double s = side(u[j], m);
+        if (!(std::fabs(s) > m) || (s > 0) == (inner > 0)) return false;
+      }
+      return !out_of_range;
+    };
+    for (int k = 0; k < 3 && !out_of_range; ++k)
+      if (separates(a, ca, k, b, cb) || separates(b, cb, k, a, ca)) return true;
+    if (!out_of_range) return false;
+  }
   return false;
 }
 
@@ -268,37 +322,70 @@ std::vector<Pair> crossing_triangles(std::span<const double> xyz, std::span<cons
   return CrossingCheck()(xyz, corners, changed, settled);
 }
 
-// The grid over the triangles' boxes: cells about twice the mean triangle,
-// at most ~4 per triangle in all. None when a box is not finite (positions
-// are finite by construction).
-template <class BoxOf>
-std::optional<CrossingCheck::Grid> CrossingCheck::make_grid(std::size_t nt, BoxOf&& bounding_box) {
-  double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY}, size = 0;
-  for (std::size_t t = 0; t < nt; ++t) {
-    double b[6];
-    bounding_box(t, b);
-    double extent = 0;
-    for (int d = 0; d < 3; ++d) {
-      lo[d] = std::min(lo[d], b[d]);
-      hi[d] = std::max(hi[d], b[d + 3]);
-      extent = std::max(extent, b[d + 3] - b[d]);
+namespace {
+constexpr std::uint32_t leaf_size = 4;  // triangles per leaf, at most
+
+bool boxes_meet(const double* a, const double* b) {
+  return a[0] <= b[3] && b[0] <= a[3] && a[1] <= b[4] && b[1] <= a[4] && a[2] <= b[5] && b[2] <= a[5];
+}
+}  // namespace
+
+// Splits items[b, e) (the subtree of `node`) at the median of the boxes'
+// centres along the axis they spread most on. The left part gets ceil(L/2)
+// of the subtree's L leaves (whole leaves), so a subtree of L leaves holds
+// 2L - 1 nodes, depth first: the left child follows its parent and the right
+// child comes 2 * (the left's leaves) after it, and subtrees build in
+// parallel with no shared counter. Ties break by triangle index: the split
+// is a function of the boxes (std::nth_element with a total order). The
+// items are the centres with their triangle, contiguous: moved by
+// nth_element rather than reached through indices (3x faster).
+void CrossingCheck::build(std::size_t node, std::uint32_t b, std::uint32_t e, Item* items) {
+  Node& nd = nodes_[node];
+  nd.begin = b, nd.end = e, nd.right = 0;
+  const std::uint32_t leaves = (e - b + leaf_size - 1) / leaf_size;
+  if (leaves <= 1) return;
+  double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+  for (std::uint32_t i = b; i < e; ++i)
+    for (int d = 0; d < 3; ++d) lo[d] = std::min(lo[d], items[i].centre[d]), hi[d] = std::max(hi[d], items[i].centre[d]);
+  const int axis = hi[0] - lo[0] >= hi[1] - lo[1] && hi[0] - lo[0] >= hi[2] - lo[2] ? 0
+                   : hi[1] - lo[1] >= hi[2] - lo[2]                                ? 1
+                                                                                   : 2;
+  const std::uint32_t left_leaves = (leaves + 1) / 2, mid = b + left_leaves * leaf_size;
+  std::nth_element(items + b, items + mid, items + e, [axis](const Item& s, const Item& t) {
+    return s.centre[axis] < t.centre[axis] || (s.centre[axis] == t.centre[axis] && s.t < t.t);
+  });
+  nd.right = static_cast<std::uint32_t>(node + 2 * left_leaves);
+  const std::size_t right = nd.right;
+  if (e - b >= 16384)
+    tbb::parallel_invoke([&] { build(node + 1, b, mid, items); }, [&] { build(right, mid, e, items); });
+  else {
+    build(node + 1, b, mid, items);
+    build(right, mid, e, items);
+  }
+}
+
+// Every node's box, the union of its triangles', and whether it holds a
+// changed one (children before parents: a child's index is above its
+// parent's).
+void CrossingCheck::fit(std::span<const std::uint8_t> changed) {
+  for (std::size_t node = nodes_.size(); node-- > 0;) {
+    Node& nd = nodes_[node];
+    double box[6] = {INFINITY, INFINITY, INFINITY, -INFINITY, -INFINITY, -INFINITY};
+    auto unite = [&](const double* o) {
+      for (int d = 0; d < 3; ++d) box[d] = std::min(box[d], o[d]), box[d + 3] = std::max(box[d + 3], o[d + 3]);
+    };
+    if (nd.right == 0) {
+      nd.changed = changed.empty();
+      for (std::uint32_t i = nd.begin; i < nd.end; ++i) {
+        unite(box_[i].data());
+        nd.changed = nd.changed || changed[order_[i]];
+      }
+    } else {
+      unite(nodes_[node + 1].box), unite(nodes_[nd.right].box);
+      nd.changed = nodes_[node + 1].changed || nodes_[nd.right].changed;
     }
-    size += extent;
+    std::copy_n(box, 6, nd.box);
   }
-  for (int d = 0; d < 3; ++d)
-    if (!std::isfinite(lo[d]) || !std::isfinite(hi[d])) return std::nullopt;
-  double h = 2 * size / static_cast<double>(nt);
-  auto cells_along = [&](double cell, int d) {
-    return static_cast<std::int64_t>(std::floor((hi[d] - lo[d]) / cell)) + 1;
-  };
-  for (;;) {
-    if (!(h > 0)) h = std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2], std::numeric_limits<double>::min()});
-    const double cells = static_cast<double>(cells_along(h, 0)) * static_cast<double>(cells_along(h, 1)) *
-                         static_cast<double>(cells_along(h, 2));
-    if (cells <= 4.0 * static_cast<double>(nt) + 64) break;
-    h *= 1.5;
-  }
-  return Grid{{lo[0], lo[1], lo[2]}, h, {cells_along(h, 0), cells_along(h, 1), cells_along(h, 2)}};
 }
 
 std::vector<Pair> CrossingCheck::operator()(std::span<const double> xyz, std::span<const std::int32_t> corners,
@@ -309,141 +396,113 @@ std::vector<Pair> CrossingCheck::operator()(std::span<const double> xyz, std::sp
   if (nt < 2) return out;
   auto at = [&](std::size_t t, int k) { return &xyz[3 * static_cast<std::size_t>(corners[3 * t + static_cast<std::size_t>(k)])]; };
   using Range = tbb::blocked_range<std::size_t>;
-
   auto bounding_box = [&](std::size_t t, double* b) {
     for (int d = 0; d < 3; ++d) {
       b[d] = std::min({at(t, 0)[d], at(t, 1)[d], at(t, 2)[d]});
       b[d + 3] = std::max({at(t, 0)[d], at(t, 1)[d], at(t, 2)[d]});
     }
   };
+  // Positions are finite by construction; a box that is not has no pairs
+  // found (as the grid before it).
+  auto finite = [](const Box& b) { return std::all_of(b.begin(), b.end(), [](double v) { return std::isfinite(v); }); };
   const bool filtered = !changed.empty();
-  // With `changed` and the same number of triangles as last time, the grid
-  // and the boxes of the triangles not changed are kept (a changed one that
-  // left the grid lies in its border cells).
-  const bool keep = filtered && grid_ && box_.size() == nt;
-  if (!keep) grid_ = make_grid(nt, bounding_box);
-  if (!grid_) return out;
-  const double* lo = grid_->lo;
-  const double h = grid_->h;
-  const std::int64_t* n = grid_->n;
-  auto index = [&](std::int64_t i, std::int64_t j, std::int64_t k) {
-    return static_cast<std::size_t>((k * n[1] + j) * n[0] + i);
-  };
-  // Each box in floats, rounded outwards (half the memory; a box that
-  // grew only makes a candidate more), and its cells: the lowest and highest
-  // along each axis, from the box in doubles. A pair whose boxes meet in
-  // floats but not in doubles may be tested in no cell: it cannot cross.
-  box_.resize(nt);
-  span_.resize(nt);
-  const auto& box = box_;
-  const auto& span = span_;
-  tbb::parallel_for(Range(0, nt, 4096), [&](const Range& r) {
-    for (std::size_t t = r.begin(); t != r.end(); ++t) {
-      if (keep && !changed[t]) continue;
-      double b[6];
-      bounding_box(t, b);
-      for (int d = 0; d < 6; ++d) {
-        const auto f = static_cast<float>(b[d]);
-        box_[t][d] = d < 3 ? (f > b[d] ? std::nextafter(f, -INFINITY) : f) : (f < b[d] ? std::nextafter(f, INFINITY) : f);
-        span_[t][d] = static_cast<std::int32_t>(std::clamp<std::int64_t>(
-            static_cast<std::int64_t>(std::floor((b[d] - lo[d % 3]) / h)), 0, n[d % 3] - 1));
-      }
-    }
-  });
-  auto for_cells = [&](std::size_t t, auto&& body) {
-    const auto& c = span[t];
-    for (std::int64_t k = c[2]; k <= c[5]; ++k)
-      for (std::int64_t j = c[1]; j <= c[4]; ++j)
-        for (std::int64_t i = c[0]; i <= c[3]; ++i) body(index(i, j, k));
-  };
-  // With `changed`, only the cells a changed triangle meets can hold a pair
-  // to test: only those are filled.
-  const auto ncell = static_cast<std::size_t>(n[0] * n[1] * n[2]);
-  auto zero = [](auto& buffer, std::size_t n) {  // in parallel: the buffers are large
-    buffer.resize(n);
-    tbb::parallel_for(Range(0, n, std::size_t{1} << 16), [&](const Range& r) {
-      std::fill(buffer.begin() + static_cast<std::ptrdiff_t>(r.begin()), buffer.begin() + static_cast<std::ptrdiff_t>(r.end()), 0);
-    });
-  };
-  auto& wanted = wanted_;
-  if (filtered) {
-    zero(wanted, ncell);
+  // With `changed` and the same number of triangles as last time, the tree
+  // is kept: the changed triangles' boxes are replaced and the nodes' refit.
+  const bool keep = filtered && nodes_.size() > 0 && box_.size() == nt;
+  std::atomic<bool> all_finite{true};
+  if (keep) {
     tbb::parallel_for(Range(0, nt, 4096), [&](const Range& r) {
-      for (std::size_t t = r.begin(); t != r.end(); ++t)
-        if (changed[t])
-          for_cells(t, [&](std::size_t c) { std::atomic_ref<std::uint8_t>(wanted[c]).store(1, std::memory_order_relaxed); });
+      for (std::size_t i = r.begin(); i != r.end(); ++i)
+        if (changed[order_[i]]) {
+          bounding_box(order_[i], box_[i].data());
+          if (!finite(box_[i])) all_finite.store(false, std::memory_order_relaxed);
+        }
+    });
+  } else {
+    Buffer<Item> items(nt);
+    tbb::parallel_for(Range(0, nt, 4096), [&](const Range& r) {
+      for (std::size_t t = r.begin(); t != r.end(); ++t) {
+        Box box;
+        bounding_box(t, box.data());
+        if (!finite(box)) all_finite.store(false, std::memory_order_relaxed);
+        for (int d = 0; d < 3; ++d) items[t].centre[d] = box[d] / 2 + box[d + 3] / 2;  // (no overflow)
+        items[t].t = static_cast<std::uint32_t>(t);
+      }
+    });
+    if (!all_finite) {
+      nodes_.clear(), box_.clear();
+      return out;
+    }
+    const std::size_t leaves = (nt + leaf_size - 1) / leaf_size;
+    nodes_.resize(2 * leaves - 1);
+    build(0, 0, static_cast<std::uint32_t>(nt), items.data());
+    order_.resize(nt);
+    box_.resize(nt);
+    tbb::parallel_for(Range(0, nt, 4096), [&](const Range& r) {
+      for (std::size_t i = r.begin(); i != r.end(); ++i) {
+        order_[i] = items[i].t;
+        bounding_box(order_[i], box_[i].data());
+      }
     });
   }
-  // The cells' triangle lists (CSR; within a cell in no fixed order, which
-  // only orders the tests: the result is sorted).
-  auto& offset = offset_;
-  zero(offset, ncell + 1);
-  tbb::parallel_for(Range(0, nt, 4096), [&](const Range& r) {
-    for (std::size_t t = r.begin(); t != r.end(); ++t)
-      for_cells(t, [&](std::size_t c) {
-        if (!filtered || wanted[c]) std::atomic_ref<std::int64_t>(offset[c + 1]).fetch_add(1, std::memory_order_relaxed);
-      });
-  });
-  for (std::size_t c = 0; c < ncell; ++c) offset[c + 1] += offset[c];
-  auto& members = members_;
-  members.resize(static_cast<std::size_t>(offset[ncell]));
-  // Filled through offset[c] as the cursor of cell c, which ends at c's end,
-  // the next cell's start: shifted back by one place afterwards.
-  tbb::parallel_for(Range(0, nt, 4096), [&](const Range& r) {
-    for (std::size_t t = r.begin(); t != r.end(); ++t)
-      for_cells(t, [&](std::size_t c) {
-        if (filtered && !wanted[c]) return;
-        const auto slot = std::atomic_ref<std::int64_t>(offset[c]).fetch_add(1, std::memory_order_relaxed);
-        members[static_cast<std::size_t>(slot)] = static_cast<std::uint32_t>(t);
-      });
-  });
-  std::copy_backward(offset.begin(), offset.end() - 1, offset.end());
-  offset[0] = 0;
+  if (!all_finite) return out;
+  fit(changed);
 
-  // Each cell's pairs by a sweep along x over its boxes, copied out and
-  // sorted by their lower x: a box meets only the boxes after it that start
-  // before it ends.
-  struct Item {
-    std::array<float, 6> box;
-    std::array<std::int32_t, 3> low;  // its lowest cell along each axis
-    std::uint32_t t;
-  };
+  // The pairs of nodes whose boxes meet, walked down both at once from
+  // (root, root): each pair of triangles is met once, at the pair of leaves
+  // holding them. With `changed`, a pair of nodes with no changed triangle
+  // is passed over (fit marks them).
   tbb::enumerable_thread_specific<std::vector<Pair>> found;
-  tbb::enumerable_thread_specific<std::vector<Item>> items;
-  tbb::parallel_for(Range(0, ncell, 256), [&](const Range& r) {
-    std::vector<Pair>& mine = found.local();
-    std::vector<Item>& local = items.local();
-    for (std::size_t c = r.begin(); c != r.end(); ++c) {
-      const auto b0 = static_cast<std::size_t>(offset[c]), b1 = static_cast<std::size_t>(offset[c + 1]);
-      if (b1 - b0 < 2) continue;
-      local.clear();
-      for (std::size_t x = b0; x < b1; ++x) {
-        const std::uint32_t t = members[x];
-        local.push_back({box[t], {span[t][0], span[t][1], span[t][2]}, t});
+  auto test = [&](std::uint32_t i, std::uint32_t j, std::vector<Pair>& mine) {
+    const std::size_t s = order_[i], t = order_[j];
+    if (filtered && !changed[s] && !changed[t]) return;
+    if (!settled.empty() && settled[s] && settled[t]) return;
+    if (!boxes_meet(box_[i].data(), box_[j].data())) return;
+    const double* a[3] = {at(s, 0), at(s, 1), at(s, 2)};
+    const double* b[3] = {at(t, 0), at(t, 1), at(t, 2)};
+    if (triangle_pair_crosses(a, &corners[3 * s], b, &corners[3 * t])) mine.emplace_back(std::min(s, t), std::max(s, t));
+  };
+  auto walk = [&](auto&& self, std::uint32_t x, std::uint32_t y) -> void {
+    const Node& a = nodes_[x];
+    const Node& b = nodes_[y];
+    if (filtered && !a.changed && !b.changed) return;
+    const bool parallel = a.end - a.begin + b.end - b.begin >= 8192;
+    if (x == y) {
+      if (a.right == 0) {
+        std::vector<Pair>& mine = found.local();
+        for (std::uint32_t i = a.begin; i < a.end; ++i)
+          for (std::uint32_t j = i + 1; j < a.end; ++j) test(i, j, mine);
+        return;
       }
-      std::sort(local.begin(), local.end(), [](const Item& p, const Item& q) {
-        return p.box[0] < q.box[0] || (p.box[0] == q.box[0] && p.t < q.t);
-      });
-      for (std::size_t x = 0; x < local.size(); ++x) {
-        const Item& is = local[x];
-        for (std::size_t y = x + 1; y < local.size() && local[y].box[0] <= is.box[3]; ++y) {
-          const Item& it = local[y];
-          const std::size_t s = is.t, t = it.t;
-          if (filtered && !changed[s] && !changed[t]) continue;
-          if (!settled.empty() && settled[s] && settled[t]) continue;
-          if (!(is.box[1] <= it.box[4] && it.box[1] <= is.box[4] && is.box[2] <= it.box[5] && it.box[2] <= is.box[5]))
-            continue;
-          // Tested in one cell only: the one holding the overlap's lower corner.
-          if (index(std::max(is.low[0], it.low[0]), std::max(is.low[1], it.low[1]), std::max(is.low[2], it.low[2])) != c)
-            continue;
-          const double* a[3] = {at(s, 0), at(s, 1), at(s, 2)};
-          const double* b[3] = {at(t, 0), at(t, 1), at(t, 2)};
-          if (triangle_pair_crosses(a, &corners[3 * s], b, &corners[3 * t]))
-            mine.emplace_back(std::min(s, t), std::max(s, t));
-        }
-      }
+      const std::uint32_t l = x + 1, r = a.right;
+      if (parallel)
+        tbb::parallel_invoke([&] { self(self, l, l); }, [&] { self(self, r, r); }, [&] { self(self, l, r); });
+      else
+        self(self, l, l), self(self, r, r), self(self, l, r);
+      return;
     }
-  });
+    if (!boxes_meet(a.box, b.box)) return;
+    if (a.right == 0 && b.right == 0) {
+      std::vector<Pair>& mine = found.local();
+      for (std::uint32_t i = a.begin; i < a.end; ++i)
+        if (boxes_meet(box_[i].data(), b.box))
+          for (std::uint32_t j = b.begin; j < b.end; ++j) test(i, j, mine);
+      return;
+    }
+    // Down the larger (a leaf stays).
+    if (b.right == 0 || (a.right != 0 && a.end - a.begin >= b.end - b.begin)) {
+      if (parallel)
+        tbb::parallel_invoke([&] { self(self, x + 1, y); }, [&] { self(self, a.right, y); });
+      else
+        self(self, x + 1, y), self(self, a.right, y);
+    } else {
+      if (parallel)
+        tbb::parallel_invoke([&] { self(self, x, y + 1); }, [&] { self(self, x, b.right); });
+      else
+        self(self, x, y + 1), self(self, x, b.right);
+    }
+  };
+  walk(walk, 0, 0);
   for (const auto& v : found) out.insert(out.end(), v.begin(), v.end());
   std::sort(out.begin(), out.end());
   return out;

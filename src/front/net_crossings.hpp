@@ -5,7 +5,6 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
-#include <optional>
 #include <span>
 #include <utility>
 #include <vector>
@@ -25,8 +24,8 @@ namespace tessera::front {
 /// corners) has no interior of its own, but crosses one whose interior it
 /// meets. `xyz` holds 3
 /// coordinates per vertex, `corners` 3 vertex indices per triangle.
-/// Candidates come from a uniform grid over the triangles' bounding boxes;
-/// the result does not depend on the thread count. With `changed` (one flag
+/// Candidates come from a bounding volume hierarchy over the triangles'
+/// boxes; the result does not depend on the thread count. With `changed` (one flag
 /// per triangle) only pairs with a changed triangle are tested: the others
 /// were found apart before. With `settled` (one flag per triangle) pairs of
 /// two settled triangles are not tested: the caller takes them as they are.
@@ -47,11 +46,11 @@ std::vector<std::pair<std::size_t, std::size_t>> crossing_triangles(std::span<co
                                                                      std::span<const std::uint8_t> settled = {});
 
 /// crossing_triangles with its arrays kept from call to call: the rounds of
-/// one untangling check nets of millions of triangles, whose grid arrays
-/// (~90 bytes per triangle) would otherwise be mapped and faulted in afresh
-/// each time. A call with `changed` after one with as many triangles takes
-/// the others to be as they were then (the same corners, where they were):
-/// it keeps their boxes and the grid.
+/// one untangling check nets of millions of triangles, whose arrays (~90
+/// bytes per triangle) would otherwise be mapped and faulted in afresh each
+/// time. A call with `changed` after one with as many triangles takes the
+/// others to be as they were then (the same corners, where they were): it
+/// keeps their boxes and the tree, refit to the changed boxes.
 class CrossingCheck {
  public:
   std::vector<std::pair<std::size_t, std::size_t>> operator()(std::span<const double> xyz,
@@ -60,19 +59,23 @@ class CrossingCheck {
                                                               std::span<const std::uint8_t> settled = {});
 
  private:
-  Buffer<std::array<float, 6>> box_;         // per triangle, rounded outwards
-  Buffer<std::array<std::int32_t, 6>> span_;  // per triangle: its cells along each axis
-  Buffer<std::int64_t> offset_;              // per cell (CSR)
-  Buffer<std::uint32_t> members_;
-  Buffer<std::uint8_t> wanted_;              // per cell
-  struct Grid {
-    double lo[3];
-    double h;  // cell size
-    std::int64_t n[3];
+  using Box = std::array<double, 6>;  // lowest x, y, z, then highest
+  /// A node of the bounding volume hierarchy over the triangles' boxes.
+  struct Node {
+    double box[6];
+    std::uint32_t begin, end;  // its triangles: order_[begin, end)
+    std::uint32_t right;       // its right child (the left is the next node); 0: a leaf
+    std::uint32_t changed;     // holds a changed triangle (or all count as changed)
   };
-  std::optional<Grid> grid_;
-  template <class BoxOf>
-  static std::optional<Grid> make_grid(std::size_t nt, BoxOf&& bounding_box);
+  Buffer<Node> nodes_;
+  Buffer<std::uint32_t> order_;  // the triangles in leaf order
+  Buffer<Box> box_;              // their boxes, in that order
+  struct Item {
+    double centre[3];  // of its box
+    std::uint32_t t;
+  };
+  void build(std::size_t node, std::uint32_t b, std::uint32_t e, Item* items);
+  void fit(std::span<const std::uint8_t> changed);
 };
 
 }  // namespace tessera::front

@@ -175,6 +175,28 @@ TEST(NetCrossings, PairTestMatchesRationalOracleFarFromTheOrigin) {
   EXPECT_GT(in_planes, 2000);
 }
 
+// Corners of wildly different magnitudes: lattice points scaled by 2^e,
+// e from -600 to 600 per vertex (a net of points no frame fits mixes
+// triangles 1e277 long with ones of 0.07), in space and in one plane. The
+// float filters' products overflow or underflow there; they must scale
+// their vectors (net_crossings.cpp, normalize) or leave the pair to the
+// exact signs, and never decide wrongly.
+TEST(NetCrossings, PairTestMatchesRationalOracleAcrossMagnitudes) {
+  std::uniform_int_distribution<int> k(-3, 3), e(0, 6);
+  std::uniform_real_distribution<double> fraction(0, 1);
+  // (2^-530: products of two differences are subnormal, rounded to a few
+  // bits, and a far point's 2^530 lifts them above any unscaled bound.)
+  const int exponents[7] = {-600, -530, -300, 0, 300, 530, 600};
+  for (const int kind : {0, 1, 2}) {  // lattice points, in one plane, off the lattice
+    const int crossing = compare_with_oracle(6 + static_cast<std::uint64_t>(kind), 4000, 8, [&](std::mt19937_64& rng) {
+      const int x = exponents[e(rng)];
+      auto c = [&] { return std::ldexp(k(rng) + (kind == 2 ? fraction(rng) : 0.0), x); };
+      return std::array<double, 3>{c(), c(), kind == 1 ? 0.0 : c()};
+    });
+    EXPECT_GT(crossing, kind == 1 ? 1600 : 300) << kind;
+  }
+}
+
 // Where rounding decides: lattice positions 1e6 + k h, with h a few ulps of
 // 1e6, each nudged by up to 2 ulps at random, and triangles nearly flat
 // (corners near one line through the pool). The float filters must let

@@ -362,21 +362,27 @@ TEST(SurfaceNets, CrossingTestOnHandMadeTriangles) {
   EXPECT_FALSE(crosses(floor, {{{0, 0, 0}, {4, 0, 0}, {1, 0, 3}}}, {0, 1, 2, 0, 1, 6}));  // a hinge at its edge
 }
 
-// The broad phase (a grid, a sweep per cell, boxes in floats) finds every
-// pair the pair test finds, once: triangle soups against all pairs, some
-// sharing vertices, some on a coarse lattice so that corners and planes
-// coincide exactly, with the `changed` and `settled` filters, and a second
-// call of one CrossingCheck after some vertices moved (some out of the
-// first call's grid), which keeps the others' boxes.
+// The broad phase (a bounding volume hierarchy) finds every pair the pair
+// test finds, once: triangle soups against all pairs, some sharing vertices,
+// some on a coarse lattice so that corners and planes coincide exactly, some
+// spread over 1,400 orders of magnitude (a cluster 2^-700 wide among
+// triangles 2^700 long across it, as outliers make: the grid before the
+// hierarchy put such a cluster in one cell, its float boxes at one point),
+// with the `changed` and `settled` filters, and a second call of one
+// CrossingCheck after some vertices moved (some far), which keeps the
+// others' boxes and refits the tree.
 TEST(SurfaceNets, CrossingTrianglesFindsEveryCrossingPair) {
   std::mt19937_64 rng(7);
   std::uniform_real_distribution<double> u(0, 1);
-  for (int soup = 0; soup < 4; ++soup) {
-    const bool lattice = soup % 2 == 1;
+  for (int soup = 0; soup < 6; ++soup) {
+    const bool lattice = soup % 2 == 1, spread = soup >= 4;
     std::vector<double> xyz;
     const int nv = 900;
     for (int v = 0; v < nv; ++v)
-      for (int d = 0; d < 3; ++d) xyz.push_back(lattice ? std::floor(u(rng) * 12) / 4 : 3 * u(rng));
+      for (int d = 0; d < 3; ++d) {
+        const double c = lattice ? std::floor(u(rng) * 12) / 4 : 3 * u(rng);
+        xyz.push_back(spread ? std::ldexp(c, v % 10 == 0 ? 700 : -700) : c);
+      }
     // Triangles from nearby vertices (sorted along x, a window of 12).
     std::vector<std::int32_t> order(nv);
     for (int v = 0; v < nv; ++v) order[v] = v;
@@ -388,7 +394,8 @@ TEST(SurfaceNets, CrossingTrianglesFindsEveryCrossingPair) {
         const int j = i + step(rng), k = j + step(rng);
         corners.insert(corners.end(), {order[i], order[j], order[k]});
       }
-    const std::size_t nt = corners.size() / 3;
+    if (spread)  // long triangles from a corner in the cluster
+      for (int v = 1; v + 20 < nv; v += 3) corners.insert(corners.end(), {v, 10 * (v / 30), 10 * (v / 30) + 20});    const std::size_t nt = corners.size() / 3;
     std::vector<std::uint8_t> changed(nt), settled(nt);
     for (std::size_t t = 0; t < nt; ++t) {
       changed[t] = u(rng) < 0.3;
@@ -413,7 +420,8 @@ TEST(SurfaceNets, CrossingTrianglesFindsEveryCrossingPair) {
     for (int v = 0; v < nv; ++v)
       if (u(rng) < 0.05) {
         moved[v] = 1;
-        for (int d = 0; d < 3; ++d) xyz[3 * v + d] += (u(rng) < 0.2 ? 4.0 : 0.3) * (u(rng) - 0.5);
+        const double scale = spread ? std::ldexp(1.0, v % 10 == 0 ? 700 : -700) : 1.0;
+        for (int d = 0; d < 3; ++d) xyz[3 * v + d] += scale * (u(rng) < 0.2 ? 4.0 : 0.3) * (u(rng) - 0.5);
       }
     for (std::size_t t = 0; t < nt; ++t)
       changed[t] = moved[corners[3 * t]] || moved[corners[3 * t + 1]] || moved[corners[3 * t + 2]];
