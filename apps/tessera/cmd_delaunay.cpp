@@ -26,7 +26,7 @@ DelaunayOptions delaunay_options(const ComputeArgs& c, int dim, bool complete_hu
                      " only, and a periodic triangulation needs every axis periodic: give --bounds (walls "
                      "everywhere) for the triangulation of the points as they lie");
   DelaunayOptions o;
-  static_cast<VoronoiOptions&>(o) = make_options(c, dim);
+  static_cast<VoronoiOptions&>(o) = make_options(c, dim, {});  // (no --hull-walls here)
   o.complete_hull = complete_hull;
   return o;
 }

@@ -49,7 +49,7 @@ Computed read_and_compute(const ComputeArgs& a, bool quiet, std::span<const std:
                           SpokeClassSet with_faces = 0) {
   Computed r;
   r.pc = read_input(a);
-  VoronoiOptions opt = make_options(a, r.pc.dim);
+  VoronoiOptions opt = make_options(a, r.pc.dim, r.pc.coords);
   opt.build_mesh = true;
   std::vector<std::int32_t> only;
   for (const std::int64_t id : asked)

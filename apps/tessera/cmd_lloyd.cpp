@@ -117,7 +117,7 @@ int run_lloyd_frame(const LloydArgs& a) {
   const double read_s = seconds_since(t0);
 
   LloydOptions o;
-  o.voronoi = make_options(a.compute, pc.dim);
+  o.voronoi = make_options(a.compute, pc.dim, pc.coords);
   o.voronoi.radii = pc.radii;
   o.iterations = a.iterations;
   o.tolerance = a.tolerance;

@@ -148,7 +148,7 @@ SurfaceNetsOptions net_options(const SurfaceNetsArgs& a, const NetInput& in) {
       compute.bounds.push_back(o0 + (static_cast<double>(in.geometry.size[d]) - 0.5) * h);
     }
   }
-  o.voronoi = make_options(compute, in.dim);
+  o.voronoi = make_options(compute, in.dim, in.coords);
   o.select = a.select;
   o.background_label = a.background_label;
   o.capping = a.capping;

@@ -371,7 +371,7 @@ io::PointCloud read_input(const ComputeArgs& a) {
   return pc;
 }
 
-VoronoiOptions make_options(const ComputeArgs& a, int dim) {
+VoronoiOptions make_options(const ComputeArgs& a, int dim, std::span<const double> points) {
   VoronoiOptions o;
   o.dim = dim;
   if (!a.bounds.empty()) {
@@ -407,6 +407,19 @@ VoronoiOptions make_options(const ComputeArgs& a, int dim) {
     for (int d = 0; d < dim; ++d) wall.normal[static_cast<std::size_t>(d)] = w[static_cast<std::size_t>(d)];
     wall.offset = w.back();
     o.walls.push_back(wall);
+  }
+  if (a.hull_walls) {
+    std::vector<double> finite;  // (--ignore-outside keeps points with a NaN, to drop them)
+    for (std::size_t i = 0; i + static_cast<std::size_t>(dim) <= points.size(); i += static_cast<std::size_t>(dim))
+      if (std::all_of(&points[i], &points[i] + dim, [](double v) { return std::isfinite(v); }))
+        finite.insert(finite.end(), &points[i], &points[i] + dim);
+    try {
+      for (const Wall& w : hull_walls(finite, dim, a.hull_dilation, a.threads)) o.walls.push_back(w);
+    } catch (const InputError& e) {
+      std::string m = e.what();
+      if (m.rfind("hull_walls: ", 0) == 0) m = m.substr(12);
+      throw InputError("--hull-walls: " + m);
+    }
   }
   if (!a.tilt.empty()) {
     if (a.periodic.empty()) throw InputError("--tilt needs --periodic (a triclinic box repeats along its tilted axes)");
@@ -661,7 +674,7 @@ int run_voronoi_frame(const VoronoiArgs& a) {
     if (pc.dim == 2 && e != ".vtp") throw InputError("output " + a.output + ": 2D cells are written as .vtp");
   }
 
-  VoronoiOptions opt = make_options(a.compute, pc.dim);
+  VoronoiOptions opt = make_options(a.compute, pc.dim, pc.coords);
   opt.build_mesh = !a.output.empty() || a.validate;
   double compute_s = 0;
   const Cells cells = compute(pc, opt, !a.quiet && stderr_is_terminal(), compute_s);
@@ -712,7 +725,7 @@ int run_bench_voronoi(const BenchArgs& a) {
   check_bounds_arg(a.compute.bounds);
   if (a.repeat < 1) throw InputError("--repeat must be at least 1");
   const io::PointCloud pc = read_input(a.compute);
-  VoronoiOptions opt = make_options(a.compute, pc.dim);
+  VoronoiOptions opt = make_options(a.compute, pc.dim, pc.coords);
   opt.build_mesh = a.mesh;
   opt.radii = pc.radii;
   const char* op = pc.dim == 3 ? (a.mesh ? "voronoi3_mesh" : "voronoi3") : (a.mesh ? "voronoi2_mesh" : "voronoi2");

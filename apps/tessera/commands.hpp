@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <initializer_list>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -50,6 +51,10 @@ struct ComputeArgs {
   /// be INPUT, as for --bounds).
   std::vector<std::vector<double>> walls;
   std::vector<std::vector<std::string>> raw_walls;
+  /// --hull-walls: the points' convex hull as walls too (tessera::hull_walls),
+  /// pushed out by --hull-dilation.
+  bool hull_walls = false;
+  double hull_dilation = 0;
   /// Set where INPUT's own box (a LAMMPS dump's) gave the bounds
   /// (apply_file_box): what the summary says of it, e.g. "the box of
   /// run.dump (timestep 100)".
@@ -394,7 +399,9 @@ std::string tilt_text(const ComputeArgs& args, const std::array<double, 3>& used
 void print_frame_line(const char* command, const ComputeArgs& args, const std::string& what, double seconds,
                       const std::vector<std::string>& written, std::FILE* to = stdout);
 io::PointCloud read_input(const ComputeArgs& args);        ///< read and check INPUT (InputError)
-VoronoiOptions make_options(const ComputeArgs& args, int dim);
+/// The options of a cells pass over `points` (n x dim), whose convex hull
+/// --hull-walls adds as walls (its finite points').
+VoronoiOptions make_options(const ComputeArgs& args, int dim, std::span<const double> points);
 /// tessera::voronoi with a progress bar (when `show_progress`) and Ctrl-C cancellation.
 Cells compute(const io::PointCloud& pc, VoronoiOptions options, bool show_progress, double& seconds);
 /// Why a computation gave no cells, as an error line (points outside, or every power cell empty).

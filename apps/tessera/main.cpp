@@ -232,6 +232,14 @@ void add_walls_option(CLI::App* app, ComputeArgs& c) {
       ->expected(3, 4)
       ->allow_extra_args(false)
       ->delimiter(',');
+  CLI::Option* hull = app->add_flag("--hull-walls", c.hull_walls,
+                                    "The points' convex hull as walls (one per hull facet, facets in one plane merged): "
+                                    "cells bounded by the hull instead of the box (the box and any --wall cut too). "
+                                    "Every point lies inside it exactly; hull points sit on it or an ulp inside");
+  app->add_option("--hull-dilation", c.hull_dilation,
+                  "With --hull-walls: push each hull wall out by this distance (>= 0), a dilated hull")
+      ->check(CLI::NonNegativeNumber)
+      ->needs(hull);
 }
 
 /// Converts the --bounds words to numbers. A fifth word that is not a number

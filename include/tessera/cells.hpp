@@ -403,6 +403,19 @@ Cells voronoi(std::span<const double> points, int dim, std::span<const std::int3
 /// walls voronoi() refuses.
 double domain_volume(const Bounds& box, const std::vector<Wall>& walls, int dim);
 
+/// The convex hull of `points` (n x dim, row-major; dim 2 or 3) as walls,
+/// for VoronoiOptions::walls: cells bounded by the hull instead of a box. One
+/// wall per hull facet (an edge in 2D), facets in one plane merged; each
+/// wall's normal points outwards (not unit length) and its offset is such
+/// that every point lies inside it exactly, the wall passing within a few
+/// ulps of the facet's plane, pushed out by `dilation` (a distance >= 0
+/// along the normal). From the Delaunay triangulation of the points that
+/// may be hull vertices (threads as VoronoiOptions::threads). Throws
+/// InputError for fewer than dim + 1 points, a non-finite coordinate, points
+/// that span no area (volume), or coordinates whose normals or offsets over-
+/// or underflow.
+std::vector<Wall> hull_walls(std::span<const double> points, int dim, double dilation = 0, int threads = 0);
+
 /// Invariant checks on a result (the CLI's --validate).
 struct ValidationReport {
   bool ok = true;

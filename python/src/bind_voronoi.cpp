@@ -267,6 +267,24 @@ void bind_voronoi(py::module_& m) {
         "half-spaces normal . x <= offset cutting the box (VoronoiOptions::walls). Runs without the GIL.");
 
   m.def(
+      "hull_walls",
+      [](const Points& points, double dilation, int threads) {
+        const int dim = checked_dim(points);
+        const auto pts = as_span(points);
+        const std::vector<Wall> walls = without_gil([&] { return hull_walls(pts, dim, dilation, threads); });
+        py::array_t<double> out({static_cast<py::ssize_t>(walls.size()), static_cast<py::ssize_t>(dim + 1)});
+        auto o = out.mutable_unchecked<2>();
+        for (std::size_t k = 0; k < walls.size(); ++k) {
+          for (int a = 0; a < dim; ++a) o(static_cast<py::ssize_t>(k), a) = walls[k].normal[static_cast<std::size_t>(a)];
+          o(static_cast<py::ssize_t>(k), dim) = walls[k].offset;
+        }
+        return out;
+      },
+      py::arg("points").noconvert(), py::arg("dilation"), py::arg("threads"),
+      "The convex hull of float64 C-ordered (N, D) points as walls, float64 (k, D + 1) rows (normal, offset) "
+      "(tessera::hull_walls). Runs without the GIL.");
+
+  m.def(
       "validate_cells",
       [](const Cells& c, const py::object& labels, const py::object& points, const py::object& radii) {
         const auto lab = as_labels(labels);

@@ -61,13 +61,14 @@ from ._prep import (Frame, fill, joggle, probe, read_box, read_frames, read_imag
 from ._scipy import ScipyVoronoi
 from ._surface_nets import NET_CORNER, NET_JUNCTION, NET_SURFACE, SurfaceNet, surface_nets
 from ._voronoi import Voronoi, voronoi
-from ._walls import polygon_walls
+from ._walls import hull_walls, polygon_walls
 
 __version__: str = _core.__version__
 
 __all__ = [
     "voronoi",
     "Voronoi",
+    "hull_walls",
     "polygon_walls",
     "ScipyVoronoi",
     "delaunay",

@@ -129,6 +129,7 @@ class Cells:
     @property
     def ignored_outside_bounds(self) -> npt.NDArray[np.int32]: ...
 
+def hull_walls(points: npt.NDArray[np.float64], dilation: float, threads: int) -> npt.NDArray[np.float64]: ...
 def voronoi(
     points: npt.NDArray[np.float64],
     labels: Optional[npt.NDArray[np.int32]],

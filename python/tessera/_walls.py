@@ -1,15 +1,16 @@
-"""Walls from a convex polygon: the ``walls`` argument of :func:`tessera.voronoi`
-for cells clipped to a convex polygon (one wall per edge)."""
+"""Walls for the ``walls`` argument of :func:`tessera.voronoi`: from a convex
+polygon (one wall per edge), or from the convex hull of points (one per
+facet)."""
 
 from __future__ import annotations
 
 import math
 from fractions import Fraction
-from typing import Any
+from typing import Any, Optional
 
 import numpy as np
 
-from . import _inputs
+from . import _core, _inputs
 
 
 def polygon_walls(vertices: Any) -> np.ndarray:
@@ -70,3 +71,37 @@ def polygon_walls(vertices: Any) -> np.ndarray:
             d = math.nextafter(d, math.inf)
         out[i] = (nx, ny, d)
     return out
+
+
+def hull_walls(points: Any, dilation: float = 0.0, threads: Optional[int] = None) -> np.ndarray:
+    """The convex hull of ``points`` as walls, for ``voronoi(points, walls=...)``:
+    cells bounded by the hull of their points instead of a box (optionally a
+    dilated hull).
+
+    Parameters
+    ----------
+    points : array_like, shape (n, 2) or (n, 3)
+        At least dim + 1 points spanning an area (2D) or a volume (3D).
+    dilation : float
+        Push each wall out by this distance (>= 0) along its normal.
+    threads : int, optional
+        Worker threads (default: TESSERA_NUM_THREADS, else every core).
+
+    Returns
+    -------
+    numpy.ndarray, float64 (k, dim + 1)
+        One row (normal..., d) per hull facet (edge in 2D; facets in one
+        plane merged), the half-space ``normal . x <= d``, normal outwards
+        and not of unit length. Every point lies inside every wall exactly;
+        each wall passes within a few ulps of its facet's plane (so hull
+        points sit on or an ulp inside it), plus ``dilation``.
+
+    Raises
+    ------
+    ValueError
+        Fewer than dim + 1 points, a non-finite coordinate, points that span
+        no area (volume), or a negative dilation.
+    """
+    p = _inputs.as_points(points)
+    d = _inputs.as_float(dilation, "dilation", "a distance >= 0")
+    return _inputs.call(_core.hull_walls, p, d, _inputs.as_threads(threads))

@@ -259,7 +259,8 @@ Pass<D>::Pass(std::span<const double> input, std::span<const std::int32_t> label
   // (-1: none), in parallel: 1M points against 64 walls cost 0.5 s alone.
   std::vector<std::int32_t> outside(walls.empty() ? 0 : n);
   if (!walls.empty()) {
-    const WallTest test(walls, D, largest_magnitude(points));
+    wall_index = make_wall_index(walls, D, bounds, n);
+    const WallTest test(walls, D, largest_magnitude(points), wall_index.get());
     engine::ThreadArena(resolve_threads(opt.threads)).execute([&] {
       tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
         for (std::size_t i = r.begin(); i != r.end(); ++i) outside[i] = test.outside(points.data() + i * D);
@@ -410,6 +411,7 @@ Pass<D>::Pass(std::span<const double> input, std::span<const std::int32_t> label
   if (!walls.empty()) {
     exact.walls = walls.data();
     exact.num_walls = static_cast<int>(walls.size());
+    exact.wall_index = wall_index.get();
   }
   kernels::make_grid(exact, n, grid);  // lattices and voxel grids: integer exact predicates
   gens.coords = points.data();

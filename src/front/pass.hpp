@@ -6,6 +6,7 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <span>
 #include <utility>
@@ -114,6 +115,7 @@ struct Pass {
   kernels::ExactContext exact;
   std::vector<std::int32_t> grid;            ///< exact.grid's storage, when the input has one
   std::vector<kernels::Wall> walls;          ///< VoronoiOptions::walls in this frame (exact.walls)
+  std::unique_ptr<const kernels::walls::Index> wall_index;  ///< where walls are many (exact.wall_index)
   engine::Generators<D> gens;
   engine::EngineOptions engine_options;
 

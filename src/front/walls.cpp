@@ -54,8 +54,8 @@ std::vector<kernels::Wall> kernel_walls(const std::vector<Wall>& given, int dim,
   return out;
 }
 
-WallTest::WallTest(std::span<const kernels::Wall> walls, int dim, double largest)
-    : walls_(walls), dim_(dim), error_(walls.size()) {
+WallTest::WallTest(std::span<const kernels::Wall> walls, int dim, double largest, const kernels::walls::Index* index)
+    : walls_(walls), dim_(dim), error_(walls.size()), index_(index) {
   // d - n.p in D products and D differences, each rounded once: within
   // gamma_{2D} of |d| + |n|_1 max|p| (doubled for margin and the bound's own
   // rounding), plus what products in the subnormal range lose.
@@ -66,15 +66,37 @@ WallTest::WallTest(std::span<const kernels::Wall> walls, int dim, double largest
   }
 }
 
+int WallTest::side(std::size_t k, const double* p) const {
+  const kernels::Wall& w = walls_[k];
+  double s = w.d;
+  for (int a = 0; a < dim_; ++a) s -= w.n[a] * p[a];
+  return s > error_[k] ? 1 : s < -error_[k] ? -1 : kernels::exact_wall_point_side(w, p, dim_);
+}
+
 int WallTest::outside(const double* p) const {
-  for (std::size_t k = 0; k < walls_.size(); ++k) {
-    const kernels::Wall& w = walls_[k];
-    double s = w.d;
-    for (int a = 0; a < dim_; ++a) s -= w.n[a] * p[a];
-    const int side = s > error_[k] ? 1 : s < -error_[k] ? -1 : kernels::exact_wall_point_side(w, p, dim_);
-    if (side < 0) return static_cast<int>(k);
-  }
+  bool all = index_ == nullptr;
+  if (!all)
+    for (const std::int32_t k : index_->may_hold_outside(p, all))
+      if (side(static_cast<std::size_t>(k), p) < 0) return k;
+  if (all)
+    for (std::size_t k = 0; k < walls_.size(); ++k)
+      if (side(k, p) < 0) return static_cast<int>(k);
   return -1;
+}
+
+std::unique_ptr<const kernels::walls::Index> make_wall_index(std::span<const kernels::Wall> walls, int dim,
+                                                             const Bounds& box, std::size_t n) {
+  if (walls.size() < 16) return nullptr;
+  // Leaves about two points' spacing wide: a cell reaches about that far.
+  double volume = 1, extent = 0;
+  for (int a = 0; a < dim; ++a) {
+    const double e = box.hi[static_cast<std::size_t>(a)] - box.lo[static_cast<std::size_t>(a)];
+    volume *= e;
+    extent = std::max(extent, e);
+  }
+  const double spacing = std::pow(volume / static_cast<double>(std::max<std::size_t>(n, 1)), 1.0 / dim);
+  const double leaf = std::isfinite(spacing) && spacing > 0 ? 2 * spacing : extent;
+  return std::make_unique<const kernels::walls::Index>(walls, dim, box.lo.data(), box.hi.data(), leaf);
 }
 
 double largest_magnitude(std::span<const double> values) {

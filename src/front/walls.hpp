@@ -3,11 +3,13 @@
 // in the computation's frame; and the exact test of a point against them.
 #pragma once
 
+#include <memory>
 #include <span>
 #include <vector>
 
 #include "tessera/cells.hpp"
 #include "tessera/kernels/exact_predicates.hpp"
+#include "tessera/kernels/wall_index.hpp"
 
 namespace tessera::front {
 
@@ -23,8 +25,11 @@ std::vector<kernels::Wall> kernel_walls(const std::vector<Wall>& given, int dim,
 /// cannot change its sign, else in rationals.
 class WallTest {
  public:
-  /// For points whose coordinates are at most `largest` in magnitude.
-  WallTest(std::span<const kernels::Wall> walls, int dim, double largest);
+  /// For points whose coordinates are at most `largest` in magnitude; with
+  /// `index` (over the box the points lie in), only the walls it lists near
+  /// a point are tested.
+  WallTest(std::span<const kernels::Wall> walls, int dim, double largest,
+           const kernels::walls::Index* index = nullptr);
   /// The first wall that point p (dim coordinates, at most `largest` each)
   /// lies strictly outside of (n.p > d), or -1.
   int outside(const double* p) const;
@@ -33,7 +38,14 @@ class WallTest {
   std::span<const kernels::Wall> walls_;
   int dim_;
   std::vector<double> error_;  // per wall: a bound on the float d - n.p's error
+  const kernels::walls::Index* index_;
+  int side(std::size_t k, const double* p) const;
 };
+
+/// An index over `walls` in the box (computation frame) for `n` points, or
+/// none where they are few (below 16 walls a test of each is as quick).
+std::unique_ptr<const kernels::walls::Index> make_wall_index(std::span<const kernels::Wall> walls, int dim,
+                                                             const Bounds& box, std::size_t n);
 
 /// The largest magnitude among the values (for WallTest).
 double largest_magnitude(std::span<const double> values);

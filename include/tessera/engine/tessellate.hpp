@@ -20,6 +20,7 @@
 #include "tessera/kernels/cell_builder.hpp"
 #include "tessera/kernels/exact_predicates.hpp"
 #include "tessera/kernels/locator.hpp"
+#include "tessera/kernels/wall_index.hpp"
 
 namespace tessera::engine {
 
@@ -73,17 +74,44 @@ struct EngineOptions {
   ThreadArena* arena = nullptr;
 };
 
-/// Cut a built cell by the exact context's walls (kernels/walls.hpp), in
-/// ascending order; a cell they leave empty has none (st.has_cell false).
+/// Cut a built cell of generator p by the exact context's walls
+/// (kernels/walls.hpp) in ascending order: those its wall index lists near
+/// p, where it has one; a cell they leave empty has none (st.has_cell false).
 /// The cut may have deferred new vertices' exact solves: solved here.
 template <class CellT>
-[[gnu::noinline]] void clip_walls(CellT& cell, kernels::BuildStatus& st, int num_walls) {
-  const double reach = cell.vertex_reach();
-  for (int k = 0; k < num_walls; ++k)
-    if (cell.clip_wall(k, reach) == kernels::ClipResult::emptied) {
+[[gnu::noinline]] void clip_walls(CellT& cell, kernels::BuildStatus& st, const kernels::ExactContext& ctx,
+                                  const double* p) {
+  // Each cut shrinks the cell: the reach is read again after it, so that
+  // later walls are passed over sooner; with an index, a reach under half
+  // the one the list was taken for takes a shorter list (from the next wall
+  // on: the list's order is the walls'). A boundary cell of a ball's hull
+  // reaches into the box's empty corners before its first cut.
+  double reach = cell.vertex_reach();
+  auto cut = [&](int k) {
+    const kernels::ClipResult r = cell.clip_wall(k, reach);
+    if (r == kernels::ClipResult::emptied) {
       st.has_cell = false;
-      return;
+      return false;
     }
+    if (r == kernels::ClipResult::clipped) reach = cell.vertex_reach();
+    return true;
+  };
+  if (ctx.wall_index != nullptr) {
+    double listed_for = reach;
+    std::span<const std::int32_t> list = ctx.wall_index->candidates(p, reach);
+    for (std::size_t i = 0; i < list.size(); ++i) {
+      const std::int32_t k = list[i];
+      if (!cut(k)) return;
+      if (reach < 0.5 * listed_for) {
+        listed_for = reach;
+        list = ctx.wall_index->candidates(p, reach);
+        i = static_cast<std::size_t>(std::upper_bound(list.begin(), list.end(), k) - list.begin()) - 1;  // (++i next)
+      }
+    }
+  } else {
+    for (int k = 0; k < ctx.num_walls; ++k)
+      if (!cut(k)) return;
+  }
   cell.solve_deferred();
 }
 
@@ -153,7 +181,7 @@ std::uint64_t tessellate(const Generators<CellT::dim>& gens, Comp& comp, const E
         st = ws.builder.build_any(gen, p, ws.cell);
       }
       if (gens.exact != nullptr && gens.exact->num_walls > 0 && st.has_cell) [[unlikely]]
-        clip_walls(ws.cell, st, gens.exact->num_walls);
+        clip_walls(ws.cell, st, *gens.exact, p);
       ws.exact_calls += ws.cell.exact_calls();
       comp.add(batch, gen, st, ws.cell);
     }

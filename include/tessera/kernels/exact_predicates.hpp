@@ -133,6 +133,10 @@ inline bool GridScale::scaled(double x, int bits, std::int64_t& out) const {
   return grid_integer(x, scale(), bits, out);
 }
 
+namespace walls {
+class Index;  // (wall_index.hpp)
+}
+
 /// Everything the exact predicate needs to know about the input.
 struct ExactContext {
   const double* points = nullptr;   ///< n * dim input coordinates
@@ -165,6 +169,9 @@ struct ExactContext {
   /// exact measure of a cell with wall faces: all through the GMP rows.
   const Wall* walls = nullptr;
   int num_walls = 0;
+  /// Where the walls are many, which of them matter near a point (or null:
+  /// all of them everywhere).
+  const walls::Index* wall_index = nullptr;
 };
 
 /// The offset d of the power bisector of points i and j relative to p_i:
