@@ -409,6 +409,22 @@ VoronoiOptions make_options(const ComputeArgs& a, int dim, std::span<const doubl
     o.walls.push_back(wall);
   }
   if (a.hull_walls) {
+    // A dilated hull reaches past the default box (the points' bounding box
+    // grown by --padding): the box grows by the dilation too.
+    if (!o.bounds && a.hull_dilation > 0) {
+      Bounds b;
+      for (int d = 0; d < dim; ++d) {
+        double lo = INFINITY, hi = -INFINITY;
+        for (std::size_t i = static_cast<std::size_t>(d); i < points.size(); i += static_cast<std::size_t>(dim))
+          if (std::isfinite(points[i])) lo = std::min(lo, points[i]), hi = std::max(hi, points[i]);
+        b.lo[static_cast<std::size_t>(d)] = lo, b.hi[static_cast<std::size_t>(d)] = hi;
+      }
+      double extent = 0;
+      for (int d = 0; d < dim; ++d) extent = std::max(extent, b.hi[static_cast<std::size_t>(d)] - b.lo[static_cast<std::size_t>(d)]);
+      const double grow = a.padding * extent + 2 * a.hull_dilation;
+      for (int d = 0; d < dim; ++d) b.lo[static_cast<std::size_t>(d)] -= grow, b.hi[static_cast<std::size_t>(d)] += grow;
+      if (std::isfinite(grow) && extent > 0) o.bounds = b;
+    }
     std::vector<double> finite;  // (--ignore-outside keeps points with a NaN, to drop them)
     for (std::size_t i = 0; i + static_cast<std::size_t>(dim) <= points.size(); i += static_cast<std::size_t>(dim))
       if (std::all_of(&points[i], &points[i] + dim, [](double v) { return std::isfinite(v); }))

@@ -235,9 +235,10 @@ void add_walls_option(CLI::App* app, ComputeArgs& c) {
   CLI::Option* hull = app->add_flag("--hull-walls", c.hull_walls,
                                     "The points' convex hull as walls (one per hull facet, facets in one plane merged): "
                                     "cells bounded by the hull instead of the box (the box and any --wall cut too). "
-                                    "Every point lies inside it exactly; hull points sit on it or an ulp inside");
+                                    "Every point lies inside it exactly; hull points sit on it (lattices) or within ~1e-14 of the "
+                                    "coordinates' size inside");
   app->add_option("--hull-dilation", c.hull_dilation,
-                  "With --hull-walls: push each hull wall out by this distance (>= 0), a dilated hull")
+                  "With --hull-walls: push each hull wall out by this distance (>= 0), a dilated hull (the default box grows to hold it)")
       ->check(CLI::NonNegativeNumber)
       ->needs(hull);
 }

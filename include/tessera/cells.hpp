@@ -407,9 +407,10 @@ double domain_volume(const Bounds& box, const std::vector<Wall>& walls, int dim)
 /// for VoronoiOptions::walls: cells bounded by the hull instead of a box. One
 /// wall per hull facet (an edge in 2D), facets in one plane merged; each
 /// wall's normal points outwards (not unit length) and its offset is such
-/// that every point lies inside it exactly, the wall passing within a few
-/// ulps of the facet's plane, pushed out by `dilation` (a distance >= 0
-/// along the normal). From the Delaunay triangulation of the points that
+/// that every point lies inside it exactly, the wall passing within ~1e-14
+/// of the coordinates' magnitude of the facet's plane (exactly on it where
+/// the arithmetic is exact, as on lattices), pushed out by `dilation` (a
+/// distance >= 0 along the normal). From the Delaunay triangulation of the points that
 /// may be hull vertices (threads as VoronoiOptions::threads). Throws
 /// InputError for fewer than dim + 1 points, a non-finite coordinate, points
 /// that span no area (volume), or coordinates whose normals or offsets over-

@@ -93,8 +93,11 @@ def hull_walls(points: Any, dilation: float = 0.0, threads: Optional[int] = None
         One row (normal..., d) per hull facet (edge in 2D; facets in one
         plane merged), the half-space ``normal . x <= d``, normal outwards
         and not of unit length. Every point lies inside every wall exactly;
-        each wall passes within a few ulps of its facet's plane (so hull
-        points sit on or an ulp inside it), plus ``dilation``.
+        each wall passes within ~1e-14 of the coordinates' size of its
+        facet's plane (through it exactly on lattices), plus ``dilation``.
+        The default box (the points' bounding box grown by ``padding``)
+        still cuts: give ``bounds`` or a larger ``padding`` to hold a
+        dilated hull.
 
     Raises
     ------

@@ -18,8 +18,11 @@
 // n . p = n . a + m . (p - a) + (n - m) . (p - a), with m the exact normal
 // (m . (p - a) <= 0 on the hull), so the offset is the largest rounded-up
 // n . a of the facet's corners plus a bound of |n - m|_1 times the points'
-// largest extent. The wall then lies within a few ulps of the facet's plane,
-// outside it; where every operation is exact (lattices), on it.
+// largest extent. The wall then lies within ~1e-14 of the coordinates' size
+// outside the facet's plane; where every operation is exact (lattices), on
+// it. (No test input has needed the extent term: the offset over the
+// group's corners, rounded up, held every point; it covers what a normal
+// tilted by rounding may reach far along the facet.)
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
