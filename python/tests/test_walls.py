@@ -1,7 +1,8 @@
 """tessera.voronoi(walls=...): cells in a convex domain, the box cut by
 half-spaces. Measures against domains known by hand (a triangle of area 1/2,
 half the unit cube), the walls' spokes in the graph and the boundary face
-set, validation with exact measures, 1 vs 2 threads, bad walls."""
+set, validation with exact measures, 1 vs 2 threads, bad walls; hull_walls
+(the points' convex hull as walls)."""
 
 import math
 
@@ -132,3 +133,37 @@ def test_surface_nets_in_walls():
     on = np.any(net.vertex_keys == -7, axis=1)  # the vertices on the wall
     assert on.sum() > 10
     assert np.abs(net.vertices[on].sum(axis=1) - 2.0).max() < 1e-12
+
+
+def test_hull_walls():
+    rng = np.random.default_rng(12)
+    for dim in (2, 3):
+        b = rng.normal(size=(2000, dim))
+        pts = b * (rng.random((2000, 1)) ** (1 / dim)) / np.linalg.norm(b, axis=1)[:, None]
+        walls = tessera.hull_walls(pts)
+        assert walls.dtype == np.float64 and walls.shape[1] == dim + 1 and len(walls) > 16
+        # Every point inside (floats: exactly, the C++ tests check in 113 bits).
+        assert np.all(pts @ walls[:, :dim].T <= walls[:, dim])
+        vor = tessera.voronoi(pts, walls=walls, threads=2)
+        assert vor.n_cells == len(pts)
+        report = vor.validate()
+        assert report.ok, report
+        # Dilated: every wall moves out by the distance (the box must hold it).
+        grown = tessera.hull_walls(pts, dilation=0.5)
+        norm = np.linalg.norm(walls[:, :dim], axis=1)
+        assert np.allclose((grown[:, dim] - walls[:, dim]) / norm, 0.5, rtol=1e-12)
+        wide = tessera.voronoi(pts, walls=grown, bounds=[-2, 2] * dim)
+        assert wide.volumes.sum() > vor.volumes.sum() * 1.5
+    # A lattice's hull: one wall per face, through its border points exactly.
+    g = np.stack(np.meshgrid(*[np.arange(5.0)] * 3, indexing="ij"), -1).reshape(-1, 3)
+    walls = tessera.hull_walls(g, threads=1)
+    assert len(walls) == 6
+    assert tessera.voronoi(g, walls=walls).volumes.sum() == 64.0
+    with pytest.raises(ValueError, match="at least 3 points"):
+        tessera.hull_walls([[0.0, 0.0], [1.0, 0.0]])
+    with pytest.raises(ValueError, match="no area"):
+        tessera.hull_walls([[0.0, 0.0], [1.0, 1.0], [2.0, 2.0], [5.0, 5.0]])
+    with pytest.raises(ValueError, match="dilation"):
+        tessera.hull_walls(g, dilation=-1)
+    with pytest.raises(ValueError, match="not finite"):
+        tessera.hull_walls([[0.0, 0.0], [1.0, 0.0], [0.0, np.nan]])

@@ -135,6 +135,40 @@ class Walls(Case):
         self.assertEqual(read_vtp(out).GetNumberOfCells(), len(self.p2) - outside)
 
 
+class HullWalls(Case):
+    """--hull-walls: the points' convex hull as walls (tessera::hull_walls)."""
+
+    def test_lattice_hull_and_dilation(self):
+        g = np.stack(np.meshgrid(np.arange(8.0), np.arange(8.0), indexing="ij"), -1).reshape(-1, 2)
+        lat = self.save("lat.npy", g)
+        r = self.ok(["voronoi", lat, "--hull-walls", "--validate", "-o", self.p("c.vtp")])
+        self.assertIn("inside 4 walls", r.stdout)  # the square's 28 hull edges, merged by line
+        self.assertIn("validation: OK", r.stdout)
+        area = vtk_to_numpy(cell_array(read_vtp(self.p("c.vtp")), "Area"))
+        self.assertEqual(float(area.sum()), 49.0)  # exactly: the walls pass through the lattice's border
+        # Dilated by 0.5: the square of side 8, the default box grown to hold it.
+        r = self.ok(["voronoi", lat, "--hull-walls", "--hull-dilation", "0.5", "-o", self.p("d.vtp"), "-q"])
+        area = vtk_to_numpy(cell_array(read_vtp(self.p("d.vtp")), "Area"))
+        self.assertAlmostEqual(float(area.sum()), 64.0, delta=1e-12)
+        # Points in a ball: many walls, every cell inside the hull, sum = the hull's volume.
+        rng = np.random.default_rng(3)
+        b = rng.normal(size=(3000, 3))
+        b *= (rng.random((3000, 1)) ** (1 / 3)) / np.linalg.norm(b, axis=1)[:, None]
+        ball = self.save("ball.npy", b)
+        r = self.ok(["voronoi", ball, "--hull-walls", "--validate", "-o", self.p("b.vtu")])
+        self.assertIn("validation: OK", r.stdout)
+        self.assertRegex(r.stdout, r"inside \d{3,} walls")
+        self.ok(["graph", ball, "--hull-walls", "-o", self.p("g.vtp"), "-q"])
+
+    def test_refusals(self):
+        flat = self.save("flat.npy", np.array([[0.0, 0, 0], [1, 0, 1], [0, 1, 1], [1, 1, 2], [0.5, 0.25, 0.75]]))
+        self.fails(["voronoi", flat, "--hull-walls", "-o", self.p("c.vtu")], "--hull-walls: ")
+        self.fails(["voronoi", self.save("p.npy", np.random.default_rng(1).random((20, 2))), "--hull-dilation",
+                    "0.5", "-o", self.p("c.vtp")], "--hull-dilation requires --hull-walls")
+        self.fails(["voronoi", self.save("q.npy", np.random.default_rng(1).random((20, 2))), "--hull-walls",
+                    "--hull-dilation", "-1", "-o", self.p("c.vtp")])
+
+
 def main():
     return base.cli_main("test_walls_cli.py", [(base.vtk is not None, "python3-vtk9 is required (run with /usr/bin/python3)")])
 
