@@ -5,9 +5,12 @@ convex polyhedron, and its walls as a (k, 4) float64 array (nx, ny, nz, d).
 usage: gen_walls.py KIND N POINTS.npy WALLS.npy
   KIND: halfcube (x + y + z <= 1.5: one wall, half the cube),
         ball (64 tangent planes of the ball of radius 0.45 at the cube's
-        centre: a polyhedron of 64 faces)
+        centre: a polyhedron of 64 faces),
+        hull (points uniform in that ball, walls their convex hull's facets,
+        from tessera.hull_walls: thousands; needs PYTHONPATH=BUILD/python)
 Points are drawn in the cube (seed 88) and those outside the walls dropped
-(with a margin of 1e-12, so that no tool's rounding puts one outside)."""
+(with a margin of 1e-12, so that no tool's rounding puts one outside); the
+hull's points are inside its walls exactly, by construction."""
 import math
 import sys
 
@@ -26,8 +29,17 @@ elif kind == "ball":
         nrm = np.array([r * math.cos(a), r * math.sin(a), z])
         rows.append(list(nrm) + [0.45 + float(nrm @ np.array([0.5, 0.5, 0.5]))])
     walls = np.array(rows)
+elif kind == "hull":
+    import tessera
+
+    rng = np.random.default_rng(88)
+    b = rng.normal(size=(n, 3))
+    pts = 0.5 + 0.45 * b * (rng.random((n, 1)) ** (1 / 3)) / np.linalg.norm(b, axis=1)[:, None]
+    np.save(out_p, np.ascontiguousarray(pts))
+    np.save(out_w, np.ascontiguousarray(tessera.hull_walls(pts)))
+    sys.exit(0)
 else:
-    sys.exit("gen_walls.py: KIND is halfcube or ball")
+    sys.exit("gen_walls.py: KIND is halfcube, ball or hull")
 rng = np.random.default_rng(88)
 pts = np.empty((0, 3))
 while len(pts) < n:

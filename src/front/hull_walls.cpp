@@ -8,7 +8,8 @@
 // the extreme points along 26 directions (8 in 2D) span a polytope inside the
 // hull, and a point strictly inside each of that polytope's facets (exact
 // orientations) is no hull vertex; only the rest are triangulated (of a
-// million uniform points in a cube, ~0.1%).
+// million uniform points in a cube, ~0.1%). (S. G. Akl and G. T. Toussaint,
+// "A fast convex hull algorithm", Information Processing Letters 7(5), 1978.)
 //
 // Facets in one plane (lattices: a cube's face is hundreds of triangles)
 // make one wall: adjacent hull facets are merged where the exact orientation

@@ -69,6 +69,24 @@ bool misses(const RelativeWall<D>& w, double norm, double reach) {
   return w.d - w.d_err > norm * reach * (1 + 1e-12);
 }
 
+/// Whether every vertex lies surely inside wall `w` by the float filter of
+/// `signs` below, before `refine`: its bound holds with the unrefined
+/// offset's larger d_err too. A cell whose reach crosses a wall's plane
+/// mostly lies inside it all the same (a boundary cell of a convex hull's
+/// thousands of walls meets dozens that way): this spares each such wall
+/// the exact offset (exact_wall_offset: 5% of a 100k-point hull run).
+template <int D, class Vertex>
+bool all_inside(const Vertex* verts, std::size_t nv, const RelativeWall<D>& w) {
+  const double de = filter::plane_eps * std::fabs(w.d) + w.d_err;
+  for (std::size_t t = 0; t < nv; ++t) {
+    const Vertex& v = verts[t];
+    double dot = w.n[0] * v.y[0];
+    for (int c = 1; c < D; ++c) dot += w.n[c] * v.y[c];
+    if (!(w.d - dot > w.n1 * v.e + de)) return false;  // (NaN: not surely)
+  }
+  return true;
+}
+
 /// Each vertex's side of wall k (relative: `w`, refined) into `sign`: +1
 /// keep (inside or on it), -1 remove; returns the number removed. A vertex
 /// is decided by the float filter where P = d - n.y clears its bound (the
