@@ -239,7 +239,7 @@ void add_walls_option(CLI::App* app, ComputeArgs& c) {
                                     "coordinates' size inside");
   app->add_option("--hull-dilation", c.hull_dilation,
                   "With --hull-walls: push each hull wall out by this distance (>= 0), a dilated hull (the default box grows to hold it)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(NonNegative)
       ->needs(hull);
 }
 
