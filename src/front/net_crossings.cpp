@@ -2,7 +2,8 @@
 //
 // Broad phase: a bounding volume hierarchy over the triangles' boxes (in
 // doubles), split at the median of the boxes' centres along their widest
-// axis; each triangle asks it for the boxes that meet its own. A uniform grid
+// axis, walked as pairs of nodes whose boxes meet, from (root, root) down
+// both at once, so each pair of triangles is met once. A uniform grid
 // (stop 84) failed where the triangles' sizes or places spread over many
 // orders of magnitude (a net of points with outliers: 800 triangles 1e277
 // long among 32,000 of size 0.07): its cells, sized by the mean triangle,
