@@ -73,6 +73,22 @@ double difference(double a, double b, bool& exact) {
   return s;
 }
 
+/// v scaled by a power of two to a largest component in [1, 2) (a normal's
+/// direction does not change, and its products can then neither overflow
+/// nor underflow: points at 1e-200 have normals of 1e-400 in 3D); `exact`
+/// stays true only where no component lost a bit on the way.
+void normalize(double* v, int n, bool& exact) {
+  double m = 0;
+  for (int k = 0; k < n; ++k) m = std::max(m, std::fabs(v[k]));
+  if (!(m > 0) || !std::isfinite(m)) return;
+  const int e = std::ilogb(m);
+  for (int k = 0; k < n; ++k) {
+    const double x = std::ldexp(v[k], -e);
+    exact = exact && std::ldexp(x, e) == v[k];
+    v[k] = x;
+  }
+}
+
 /// a * b - c * d, and whether it is exact.
 double cross_term(double a, double b, double c, double d, bool& exact) {
   const double p = a * b, q = c * d;
@@ -227,6 +243,7 @@ std::vector<Wall> hull_walls(std::span<const double> points, int dim, double dil
     bool exact = true;
     double u[3] = {0, 0, 0}, w[3] = {0, 0, 0};
     for (int d = 0; d < dim; ++d) u[d] = difference(at(facet(f)[1])[d], a[d], exact);
+    normalize(u, dim, exact);
     if (dim == 2) {
       // Outward: the far vertex lies to the right of a -> b.
       r.n[0] = -u[1], r.n[1] = u[0];
@@ -234,6 +251,7 @@ std::vector<Wall> hull_walls(std::span<const double> points, int dim, double dil
       r.quality = 1;
     } else {
       for (int d = 0; d < 3; ++d) w[d] = difference(at(facet(f)[2])[d], a[d], exact);
+      normalize(w, 3, exact);
       r.n[0] = cross_term(u[1], w[2], u[2], w[1], exact);
       r.n[1] = cross_term(u[2], w[0], u[0], w[2], exact);
       r.n[2] = cross_term(u[0], w[1], u[1], w[0], exact);

@@ -85,6 +85,26 @@ TEST(HullWalls, EveryPointInsideAndEveryWallOnTheHull) {
   }
 }
 
+// Far from 1: a facet's normal is a product of two differences (3D), 1e-400
+// or 1e400 unscaled; the walls still hold every point, tightly.
+TEST(HullWalls, TinyAndHugeCoordinates) {
+  for (const int dim : {2, 3})
+    for (const double scale : {1e-200, 1e-300, 1e200, 1e300}) {
+      auto pts = ball_points(500, dim, 11);
+      for (double& x : pts) x *= scale;
+      const std::string what = std::to_string(dim) + "D at " + std::to_string(std::log10(scale));
+      const auto walls = tessera::hull_walls(pts, dim);
+      EXPECT_GT(walls.size(), 10u) << what;
+      check_tight(pts, dim, walls, 0, what);
+      tessera::VoronoiOptions o = options(dim);
+      o.walls = walls;
+      const auto c = tessera::voronoi(pts, dim, {}, o);
+      EXPECT_EQ(c.n_cells(), 500u) << what;
+      const auto v = tessera::validate(c, {}, pts);
+      EXPECT_TRUE(v.ok) << what << ": " << (v.messages.empty() ? "" : v.messages[0]);
+    }
+}
+
 TEST(HullWalls, LatticeHullIsExactAndItsCellsTileIt) {
   for (const int dim : {2, 3}) {
     const auto pts = grid_points(dim == 3 ? 6 : 12, dim, 0.5, 1.0);  // 1 .. 3.5 (6.5)

@@ -33,7 +33,8 @@ orthogonal ones again with the box declared by the file itself (a LAMMPS
 dump or an extended XYZ), which must give the same cells. Labelled cases also
 build their surface net; one in eight runs fill -> joggle -> voronoi, one in
 eight cuts --bounds through the points (--ignore-outside), and one in eight
-cuts the box by walls through the points (--wall, --ignore-outside).
+cuts the box by walls through the points (--wall, --ignore-outside), or by the
+points' convex hull (--hull-walls).
 The only accepted failures are input errors: a zero extent (all points on
 an axis plane, or one point); with radii, input no frame fits and labelled
 input whose inside points all have empty power cells; a periodic box's own
@@ -334,9 +335,17 @@ class Hostile(base.TempDirCase):
         through a point, whose offset is then exact only where its products
         are) with --ignore-outside: the cells by both methods, validated
         (the volumes against the polytope's, sampled cells exactly), the
-        same neighbours; the graph and the boundary."""
+        same neighbours; the graph and the boundary. Two cases in five take
+        the points' convex hull as walls instead (--hull-walls, dilated half
+        the time: thousands of walls go through the wall index)."""
         walls = []
-        for _ in range(int(rng.integers(1, 5))):
+        if rng.random() < 0.4:
+            walls = ["--hull-walls"]
+            finite = pts[np.all(np.isfinite(pts), axis=1)]
+            extent = float(np.max(np.ptp(finite, axis=0))) if len(finite) else 0.0
+            if rng.random() < 0.5 and np.isfinite(extent) and extent > 0:
+                walls += ["--hull-dilation", repr(float(rng.uniform(0, 0.05)) * extent)]
+        for _ in range(0 if walls else int(rng.integers(1, 5))):
             n = rng.normal(size=d)
             if rng.random() < 0.3:
                 n[int(rng.integers(0, d))] = 0.0  # parallel to an axis
@@ -352,7 +361,8 @@ class Hostile(base.TempDirCase):
                 off = float(finite[int(rng.integers(0, len(finite)))])
             walls += ["--wall", ",".join(repr(float(x)) for x in list(n) + [off])]
         wc = common + walls + ["--ignore-outside"]
-        accept = CUT_REFUSALS + ("its offset", "its normal's components")
+        accept = CUT_REFUSALS + ("its offset", "its normal's components", "--hull-walls: the points span no",
+                                 "--hull-walls: a hull facet's normal", "--hull-walls: a wall's offset")
         nb = {}
         for method in ("search", "insertion"):
             nb[method] = self.p("wnb_%s.npy" % method)
