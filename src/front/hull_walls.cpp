@@ -38,6 +38,7 @@
 
 #include "tessera/cells.hpp"
 #include "tessera/delaunay.hpp"
+#include "tessera/engine/thread_arena.hpp"
 #include "tessera/kernels/delaunay_predicates.hpp"
 
 namespace tessera {
@@ -172,16 +173,18 @@ std::vector<Wall> hull_walls(std::span<const double> points, int dim, double dil
     std::iota(candidates.begin(), candidates.end(), 0);
   } else {
     std::vector<std::uint8_t> keep(n);
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
-      for (std::size_t i = r.begin(); i != r.end(); ++i) {
-        const auto id = static_cast<std::int32_t>(i);
-        bool inside = true;
-        for (std::size_t f = 0; f < inner.size() && inside; f += static_cast<std::size_t>(dim)) {
-          const double* p[4] = {at(inner[f]), at(inner[f + 1]), dim == 3 ? at(inner[f + 2]) : at(id), at(id)};
-          inside = kernels::orientation(dim, p) < 0;
+    engine::ThreadArena(resolve_threads(threads)).execute([&] {
+      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t i = r.begin(); i != r.end(); ++i) {
+          const auto id = static_cast<std::int32_t>(i);
+          bool inside = true;
+          for (std::size_t f = 0; f < inner.size() && inside; f += static_cast<std::size_t>(dim)) {
+            const double* p[4] = {at(inner[f]), at(inner[f + 1]), dim == 3 ? at(inner[f + 2]) : at(id), at(id)};
+            inside = kernels::orientation(dim, p) < 0;
+          }
+          keep[i] = !inside;
         }
-        keep[i] = !inside;
-      }
+      });
     });
     for (std::size_t i = 0; i < n; ++i)
       if (keep[i]) candidates.push_back(static_cast<std::int32_t>(i));
