@@ -25,6 +25,7 @@
 // group's corners, rounded up, held every point; it covers what a normal
 // tilted by rounding may reach far along the facet.)
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -203,13 +204,13 @@ std::vector<Wall> hull_walls(std::span<const double> points, int dim, double dil
   // edge, a 2D hull vertex) the two facets holding it, one plane where the
   // second's far corner lies in the first's.
   UnionFind groups(nf);
-  std::map<std::vector<std::int32_t>, std::size_t> first_at;  // ridge -> a facet holding it
+  std::map<std::array<std::int32_t, 2>, std::size_t> first_at;  // ridge (ascending; 2D: one id, -1) -> a facet
   for (std::size_t f = 0; f < nf; ++f)
     for (int k = 0; k < dim; ++k) {
-      std::vector<std::int32_t> ridge;
-      for (int j = 0; j < dim; ++j)
-        if (j != k) ridge.push_back(facet(f)[j]);
-      std::sort(ridge.begin(), ridge.end());
+      std::array<std::int32_t, 2> ridge{-1, -1};
+      for (int j = 0, r = 0; j < dim; ++j)
+        if (j != k) ridge[static_cast<std::size_t>(r++)] = facet(f)[j];
+      if (dim == 3 && ridge[0] > ridge[1]) std::swap(ridge[0], ridge[1]);
       const auto [it, fresh] = first_at.emplace(ridge, f);
       if (fresh) continue;
       const std::size_t g = it->second;

@@ -13,11 +13,9 @@
 namespace tessera::kernels {
 
 ClipResult Hull::clip_wall(int k, double reach) {
-  walls::RelativeWall<3> w = walls::relative<3>(exact_->walls[k], site_);
-  if (walls::misses(w, exact_->walls[k].norm, reach)) return ClipResult::unchanged;
   const std::size_t nv = verts_.size();
-  if (walls::all_inside<3>(verts_.data(), nv, w)) return ClipResult::unchanged;
-  walls::refine(w, exact_->walls[k], site_);
+  walls::RelativeWall<3> w;
+  if (!walls::may_cut<3>(exact_->walls[k], site_, reach, verts_.data(), nv, w)) return ClipResult::unchanged;
   if (sign_.size() < std::max(nv, lanes_.padded())) sign_.resize(std::max(nv, lanes_.padded()));
   const std::size_t removed = walls::signs<3>(verts_.data(), nv, planes_.data(), w, k, *exact_, gen_, sign_);
   if (removed == 0) return ClipResult::unchanged;
@@ -52,11 +50,9 @@ ClipResult Hull::clip_wall(int k, double reach) {
 }
 
 ClipResult Tile::clip_wall(int k, double reach) {
-  walls::RelativeWall<2> w = walls::relative<2>(exact_->walls[k], site_);
-  if (walls::misses(w, exact_->walls[k].norm, reach)) return ClipResult::unchanged;
   const std::size_t nv = verts_.size();
-  if (walls::all_inside<2>(verts_.data(), nv, w)) return ClipResult::unchanged;
-  walls::refine(w, exact_->walls[k], site_);
+  walls::RelativeWall<2> w;
+  if (!walls::may_cut<2>(exact_->walls[k], site_, reach, verts_.data(), nv, w)) return ClipResult::unchanged;
   if (sign_.size() < nv) sign_.resize(nv);
   const std::size_t removed = walls::signs<2>(verts_.data(), nv, planes_.data(), w, k, *exact_, gen_, sign_);
   if (removed == 0) return ClipResult::unchanged;

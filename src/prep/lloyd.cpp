@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 
@@ -59,8 +60,11 @@ LloydResult lloyd(std::span<const double> points, int dim, std::span<const std::
   vo.build_mesh = false;
   const std::function<void(double)> progress = options.voronoi.progress;
   std::vector<double> next, displacement;
-  // The walls in the points' frame, for the test of each centroid.
+  // The walls in the points' frame, for the test of each centroid, and
+  // (many walls: a hull's) their index over the domain, built once it is
+  // known: each centroid then tests the walls near it, not all of them.
   const std::vector<kernels::Wall> walls = front::kernel_walls(vo.walls, dim, 0);
+  std::unique_ptr<const kernels::walls::Index> wall_index;
   for (int it = 0; it < iterations; ++it) {
     if (progress)
       vo.progress = [&progress, it, iterations](double f) {
@@ -78,6 +82,11 @@ LloydResult lloyd(std::span<const double> points, int dim, std::span<const std::
         if (v > 0) result.spacing = std::pow(v / static_cast<double>(std::max<std::size_t>(cells.generators, 1)), 1.0 / dim);
       }
       result.threads_used = cells.threads_used;
+      if (!walls.empty()) {
+        engine::ThreadArena(resolve_threads(vo.threads)).execute([&] {
+          wall_index = front::make_wall_index(walls, dim, *vo.bounds, cells.generators);
+        });
+      }
     }
     const Bounds& box = *vo.bounds;
     const bool periodic = cells.is_periodic();
@@ -90,7 +99,7 @@ LloydResult lloyd(std::span<const double> points, int dim, std::span<const std::
     if (!walls.empty()) {
       double largest = 0;
       for (std::size_t a = 0; a < du; ++a) largest = std::max({largest, std::fabs(box.lo[a]), std::fabs(box.hi[a])});
-      inside_walls.emplace(walls, dim, largest);
+      inside_walls.emplace(walls, dim, largest, wall_index.get());  // (centroids are clamped into the box)
     }
     next = result.points;
     displacement.resize(moved);

@@ -240,6 +240,26 @@ ZERO_EXTENT = ("zero extent", "coplanar", "collinear", "--dim 2", "single point"
 
 
 class Hostile(base.TempDirCase):
+    def both_methods(self, args, tag, inp, labels, what, d, case, extra_out=(), **check_kw):
+        """voronoi ARGS by --method search and by insertion, validated, each
+        writing --neighbors (and every option of extra_out, such as
+        --neighbor-shifts) to files of its own: they must agree. Returns the
+        search run's files by option, or None where the input was refused."""
+        out = {}
+        for method in ("search", "insertion"):
+            files = {o: self.p("%s%s_%s.npy" % (tag, o.strip("-").replace("-", "_"), method))
+                     for o in ("--neighbors",) + tuple(extra_out)}
+            run_args = ["voronoi"] + args + ["--method", method, "--validate"]
+            for o, f in files.items():
+                run_args += [o, f]
+            if not self.check(run_args, inp, labels, what, d, case, **check_kw):
+                return None
+            out[method] = files
+        for o in out["search"]:
+            self.assertTrue(np.array_equal(np.load(out["search"][o]), np.load(out["insertion"][o])),
+                            "case %d (%s): %s by search and by insertion differ" % (case, what, o))
+        return out["search"]
+
     def check(self, args, inp, labels, kind, d, case, radii=None, periodic=False, accept=()):
         r = run(args)
         if r.returncode == 2 and any(w in r.stderr for w in ZERO_EXTENT + tuple(accept)):
@@ -296,13 +316,7 @@ class Hostile(base.TempDirCase):
                                     "case %d (%s): labelled simplices are not the whole triangulation's inside ones"
                                     % (case, kind))
             # The cells from the Delaunay triangulation are the searched ones.
-            nb = {}
-            for method in ("search", "insertion"):
-                nb[method] = self.p("nb_%s.npy" % method)
-                self.check(["voronoi"] + common + ["--method", method, "--neighbors", nb[method], "--validate"],
-                           inp, labels, kind, d, case)
-            self.assertTrue(np.array_equal(np.load(nb["search"]), np.load(nb["insertion"])),
-                            "case %d (%s): neighbours by search and by insertion differ" % (case, kind))
+            self.both_methods(common, "", inp, labels, kind, d, case)
             if case % 4 == 0:
                 self.check(["graph"] + common + ["-o", self.p("g.vtp")], inp, labels, kind, d, case)
                 for k in ("complex", "boundary", "surface-net"):
@@ -363,14 +377,8 @@ class Hostile(base.TempDirCase):
         wc = common + walls + ["--ignore-outside"]
         accept = CUT_REFUSALS + ("its offset", "its normal's components", "--hull-walls: the points span no",
                                  "--hull-walls: a hull facet's normal", "--hull-walls: a wall's offset")
-        nb = {}
-        for method in ("search", "insertion"):
-            nb[method] = self.p("wnb_%s.npy" % method)
-            if not self.check(["voronoi"] + wc + ["--method", method, "--neighbors", nb[method], "--validate"],
-                              inp, labels, kind, d, case, accept=accept):
-                return
-        self.assertTrue(np.array_equal(np.load(nb["search"]), np.load(nb["insertion"])),
-                        "case %d (%s, walls %s): neighbours by search and by insertion differ" % (case, kind, walls))
+        if self.both_methods(wc, "w", inp, labels, "%s, walls %s" % (kind, walls), d, case, accept=accept) is None:
+            return
         self.check(["graph"] + wc + ["-o", self.p("wg.vtp")], inp, labels, kind, d, case, accept=accept)
         self.check(["faces"] + wc + ["-o", self.p("wf.vtp"), "--kind", "boundary"], inp, labels, kind, d, case,
                    accept=accept)
@@ -386,16 +394,10 @@ class Hostile(base.TempDirCase):
         cut = rng.uniform(0.05, 0.4, size=(2, d)) * ext
         bounds = [str(float(x)) for a in range(d) for x in (lo[a] + cut[0][a], hi[a] - cut[1][a])]
         bc = common + ["--bounds"] + bounds + ["--ignore-outside"]
-        nb = {}
-        for method in ("search", "insertion"):
-            nb[method] = self.p("bnb_%s.npy" % method)
-            # All points outside the cut box (a cluster at one end), or all that
-            # the cut keeps labelled outside, is an input error.
-            if not self.check(["voronoi"] + bc + ["--method", method, "--neighbors", nb[method], "--validate"],
-                              inp, labels, kind, d, case, accept=CUT_REFUSALS):
-                return
-        self.assertTrue(np.array_equal(np.load(nb["search"]), np.load(nb["insertion"])),
-                        "case %d (%s, cut bounds): neighbours by search and by insertion differ" % (case, kind))
+        # All points outside the cut box (a cluster at one end), or all that
+        # the cut keeps labelled outside, is an input error.
+        if self.both_methods(bc, "b", inp, labels, kind + ", cut bounds", d, case, accept=CUT_REFUSALS) is None:
+            return
         self.check(["delaunay"] + bc + ["--simplices", self.p("bt.npy"), "--validate"], inp, labels, kind, d, case,
                    accept=CUT_REFUSALS)
 
@@ -435,18 +437,13 @@ class Hostile(base.TempDirCase):
                                                 [str(0.2 * lx) if "z" in axes else "0", str(-0.25 * ly) if "z" in axes else "0"])
         lab = ["--labels", labels] if labels else []
         what = "%s, periodic %s" % (kind, " ".join(pc[pc.index("--periodic") + 1:]))
-        nb, sh = {}, {}
-        for method in ("search", "insertion"):
-            nb[method], sh[method] = self.p("qnb_%s.npy" % method), self.p("qsh_%s.npy" % method)
-            if not self.check(["voronoi"] + pc + lab + ["--method", method, "--neighbors", nb[method],
-                                                        "--neighbor-shifts", sh[method], "--validate"],
-                              inp, labels, what, d, case, periodic=True):
-                return
-        for out in (nb, sh):
-            self.assertTrue(np.array_equal(np.load(out["search"]), np.load(out["insertion"])),
-                            "case %d (%s): periodic cells by search and by insertion differ" % (case, what))
+        files = self.both_methods(pc + lab, "q", inp, labels, what, d, case, extra_out=("--neighbor-shifts",),
+                                  periodic=True)
+        if files is None:
+            return
         if "--tilt" not in pc and case % 3 == 0 and np.all(np.isfinite(pts)):
-            self.check_file_box(case, d, pts, labels, bounds, axes, threads, nb["search"], sh["search"], what)
+            self.check_file_box(case, d, pts, labels, bounds, axes, threads, files["--neighbors"],
+                                files["--neighbor-shifts"], what)
         if len(axes) == d and (labels is None or (np.load(labels) >= 0).all()):
             self.check(["delaunay"] + pc + ["--simplices", self.p("qt.npy"), "--validate"],
                        inp, labels, what, d, case, periodic=True)
@@ -504,14 +501,8 @@ class Hostile(base.TempDirCase):
         radii = self.save("case%d_radii.npy" % case, np.ascontiguousarray(hostile_radii(rkind, rng, pts), dtype="<f8"))
         what = "%s, radii %s" % (kind, rkind)
         pc = common + ["--radii", radii]
-        nb = {}
-        for method in ("search", "insertion"):
-            nb[method] = self.p("pnb_%s.npy" % method)
-            if not self.check(["voronoi"] + pc + ["--method", method, "--neighbors", nb[method], "--validate"],
-                              inp, labels, what, d, case, radii):
-                return  # refused (no frame, or a zero extent): every product refuses it alike
-        self.assertTrue(np.array_equal(np.load(nb["search"]), np.load(nb["insertion"])),
-                        "case %d (%s): power cells' neighbours by search and by insertion differ" % (case, what))
+        if self.both_methods(pc, "p", inp, labels, what, d, case, radii=radii) is None:
+            return  # refused (no frame, or a zero extent): every product refuses it alike
         rows = {}
         for method in ("cells", "insertion"):
             rows[method] = self.p("prt_%s.npy" % method)

@@ -69,6 +69,14 @@ bool misses(const RelativeWall<D>& w, double norm, double reach) {
   return w.d - w.d_err > norm * reach * (1 + 1e-12);
 }
 
+/// Wall `wall` relative to a cell's generator `site`, refined, into `w`;
+/// false where it surely cuts nothing of the cell (vertices within `reach`
+/// of the site, `verts[0..nv)`): by `misses`, else by `all_inside`. The
+/// first steps of Hull::clip_wall and Tile::clip_wall alike.
+template <int D, class Vertex>
+bool may_cut(const Wall& wall, const double* site, double reach, const Vertex* verts, std::size_t nv,
+             RelativeWall<D>& w);
+
 /// Whether every vertex lies surely inside wall `w` by the float filter of
 /// `signs` below, before `refine`: its bound holds with the unrefined
 /// offset's larger d_err too. A cell whose reach crosses a wall's plane
@@ -84,6 +92,15 @@ bool all_inside(const Vertex* verts, std::size_t nv, const RelativeWall<D>& w) {
     for (int c = 1; c < D; ++c) dot += w.n[c] * v.y[c];
     if (!(w.d - dot > w.n1 * v.e + de)) return false;  // (NaN: not surely)
   }
+  return true;
+}
+
+template <int D, class Vertex>
+bool may_cut(const Wall& wall, const double* site, double reach, const Vertex* verts, std::size_t nv,
+             RelativeWall<D>& w) {
+  w = relative<D>(wall, site);
+  if (misses(w, wall.norm, reach) || all_inside<D>(verts, nv, w)) return false;
+  refine(w, wall, site);
   return true;
 }
 
