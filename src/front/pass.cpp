@@ -260,7 +260,7 @@ Pass<D>::Pass(std::span<const double> input, std::span<const std::int32_t> label
   std::vector<std::int32_t> outside(walls.empty() ? 0 : n);
   if (!walls.empty()) {
     engine::ThreadArena(resolve_threads(opt.threads)).execute([&] {
-      wall_index = make_wall_index(walls, D, bounds, n);  // (its build is parallel: in the arena)
+      wall_index = make_wall_index(walls, D, bounds);
       const WallTest test(walls, D, largest_magnitude(points), wall_index.get());
       tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
         for (std::size_t i = r.begin(); i != r.end(); ++i) outside[i] = test.outside(points.data() + i * D);

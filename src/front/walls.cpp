@@ -74,29 +74,26 @@ int WallTest::side(std::size_t k, const double* p) const {
 }
 
 int WallTest::outside(const double* p) const {
-  bool all = index_ == nullptr;
-  if (!all)
-    for (const std::int32_t k : index_->may_hold_outside(p, all))
-      if (side(static_cast<std::size_t>(k), p) < 0) return k;
-  if (all)
-    for (std::size_t k = 0; k < walls_.size(); ++k)
-      if (side(k, p) < 0) return static_cast<int>(k);
+  if (index_ != nullptr) {  // the first wall p lies outside of, among those that p may
+    int first = -1;
+    index_->visit(p, 0.0, [&](std::int32_t k) {
+      if ((first < 0 || k < first) && side(static_cast<std::size_t>(k), p) < 0) first = k;
+      return true;
+    });
+    return first;
+  }
+  for (std::size_t k = 0; k < walls_.size(); ++k)
+    if (side(k, p) < 0) return static_cast<int>(k);
   return -1;
 }
 
 std::unique_ptr<const kernels::walls::Index> make_wall_index(std::span<const kernels::Wall> walls, int dim,
-                                                             const Bounds& box, std::size_t n) {
+                                                             const Bounds& box) {
   if (walls.size() < 16) return nullptr;
-  // Leaves about two points' spacing wide: a cell reaches about that far.
-  double volume = 1, extent = 0;
-  for (int a = 0; a < dim; ++a) {
-    const double e = box.hi[static_cast<std::size_t>(a)] - box.lo[static_cast<std::size_t>(a)];
-    volume *= e;
-    extent = std::max(extent, e);
-  }
-  const double spacing = std::pow(volume / static_cast<double>(std::max<std::size_t>(n, 1)), 1.0 / dim);
-  const double leaf = std::isfinite(spacing) && spacing > 0 ? 2 * spacing : extent;
-  return std::make_unique<const kernels::walls::Index>(walls, dim, box.lo.data(), box.hi.data(), leaf);
+  double centre[3] = {0, 0, 0};
+  for (int a = 0; a < dim; ++a)
+    centre[a] = box.lo[static_cast<std::size_t>(a)] / 2 + box.hi[static_cast<std::size_t>(a)] / 2;
+  return std::make_unique<const kernels::walls::Index>(walls, dim, centre);
 }
 
 double largest_magnitude(std::span<const double> values) {
@@ -122,9 +119,8 @@ double polytope_measure(const Bounds& box, const std::vector<Wall>& given) {
   ctx.num_walls = static_cast<int>(walls.size());
   CellT cell;
   cell.reset(0, centre, box.lo.data(), box.hi.data(), &ctx);
-  const double reach = cell.vertex_reach();
   for (int k = 0; k < ctx.num_walls; ++k)
-    if (cell.clip_wall(k, reach) == kernels::ClipResult::emptied) return 0;
+    if (cell.clip_wall(k, cell.vertex_ball()) == kernels::ClipResult::emptied) return 0;
   cell.solve_deferred();
   double volume;
   std::array<double, D> centroid;

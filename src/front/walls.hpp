@@ -26,8 +26,8 @@ std::vector<kernels::Wall> kernel_walls(const std::vector<Wall>& given, int dim,
 class WallTest {
  public:
   /// For points whose coordinates are at most `largest` in magnitude; with
-  /// `index` (over the box the points lie in), only the walls it lists near
-  /// a point are tested.
+  /// `index`, only the walls it finds that a point may lie outside of are
+  /// tested.
   WallTest(std::span<const kernels::Wall> walls, int dim, double largest,
            const kernels::walls::Index* index = nullptr);
   /// The first wall that point p (dim coordinates, at most `largest` each)
@@ -42,10 +42,11 @@ class WallTest {
   int side(std::size_t k, const double* p) const;
 };
 
-/// An index over `walls` in the box (computation frame) for `n` points, or
-/// none where they are few (below 16 walls a test of each is as quick).
+/// An index over `walls` (offsets from the box's centre, computation
+/// frame), or none where they are few (below 16 walls a test of each is as
+/// quick).
 std::unique_ptr<const kernels::walls::Index> make_wall_index(std::span<const kernels::Wall> walls, int dim,
-                                                             const Bounds& box, std::size_t n);
+                                                             const Bounds& box);
 
 /// The largest magnitude among the values (for WallTest).
 double largest_magnitude(std::span<const double> values);

@@ -12,10 +12,10 @@
 
 namespace tessera::kernels {
 
-ClipResult Hull::clip_wall(int k, double reach) {
+ClipResult Hull::clip_wall(int k, const walls::Ball<3>& b) {
   const std::size_t nv = verts_.size();
   walls::RelativeWall<3> w;
-  if (!walls::may_cut<3>(exact_->walls[k], site_, reach, verts_.data(), nv, w)) return ClipResult::unchanged;
+  if (!walls::may_cut<3>(exact_->walls[k], site_, b, verts_.data(), nv, w)) return ClipResult::unchanged;
   if (sign_.size() < std::max(nv, lanes_.padded())) sign_.resize(std::max(nv, lanes_.padded()));
   const std::size_t removed = walls::signs<3>(verts_.data(), nv, planes_.data(), w, k, *exact_, gen_, sign_);
   if (removed == 0) return ClipResult::unchanged;
@@ -49,10 +49,10 @@ ClipResult Hull::clip_wall(int k, double reach) {
   return ClipResult::clipped;
 }
 
-ClipResult Tile::clip_wall(int k, double reach) {
+ClipResult Tile::clip_wall(int k, const walls::Ball<2>& b) {
   const std::size_t nv = verts_.size();
   walls::RelativeWall<2> w;
-  if (!walls::may_cut<2>(exact_->walls[k], site_, reach, verts_.data(), nv, w)) return ClipResult::unchanged;
+  if (!walls::may_cut<2>(exact_->walls[k], site_, b, verts_.data(), nv, w)) return ClipResult::unchanged;
   if (sign_.size() < nv) sign_.resize(nv);
   const std::size_t removed = walls::signs<2>(verts_.data(), nv, planes_.data(), w, k, *exact_, gen_, sign_);
   if (removed == 0) return ClipResult::unchanged;

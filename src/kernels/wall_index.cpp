@@ -1,103 +1,135 @@
-// The nested grids of walls::Index (kernels/wall_index.hpp), built level by
-// level: each node filters its parent's list, in parallel over the nodes
-// (a count pass, then a fill pass into the level's CSR).
+// The tree of walls::Index (kernels/wall_index.hpp): built top down, each
+// node splitting its walls at the median of their unit normals' widest
+// coordinate, and bounding the cone of its normals and its least offset.
 #include "tessera/kernels/wall_index.hpp"
 
 #include <algorithm>
-#include <limits>
-
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
+#include <numeric>
 
 namespace tessera::kernels::walls {
 
-Index::Index(std::span<const Wall> walls, int dim, const double* lo, const double* hi, double leaf) : dim_(dim) {
-  double extent = 0;
-  for (int a = 0; a < dim; ++a) {
-    lo_[a] = lo[a];
-    extent = std::max(extent, hi[a] - lo[a]);
-  }
-  const int max_depth = 18 / dim;  // at most 2^18 leaves
-  while (depth_ < max_depth && extent / static_cast<double>(std::int64_t{1} << depth_) > leaf) ++depth_;
-  levels_.resize(static_cast<std::size_t>(depth_) + 1);
+namespace {
+constexpr std::int32_t leaf_size = 8;
+}
 
-  for (int l = 0; l <= depth_; ++l) {
-    Level& lv = levels_[static_cast<std::size_t>(l)];
-    const std::int64_t side = std::int64_t{1} << l;
-    double diag2 = 0;
-    for (int a = 0; a < dim; ++a) {
-      lv.size[a] = (hi[a] - lo[a]) / static_cast<double>(side);
-      diag2 += lv.size[a] * lv.size[a];
+struct IndexBuilder {
+  Index& ix;
+  std::vector<std::int32_t> order;  // positions into the per-wall arrays being sorted
+  std::vector<double> nu, delta, slack;
+
+  // Node for order[b, e), appended depth first.
+  void build(std::int32_t b, std::int32_t e, int depth) {
+    const std::size_t at = ix.nodes_.size();
+    ix.nodes_.emplace_back();
+    Index::Node nd{};
+    // The axis: the normals' mean direction (any unit vector would do; a
+    // node whose normals spread past a right angle from it is wide).
+    double m[3] = {0, 0, 0};
+    double lo[3] = {2, 2, 2}, hi[3] = {-2, -2, -2};
+    double least = std::numeric_limits<double>::infinity();
+    for (std::int32_t i = b; i < e; ++i) {
+      const double* v = nu.data() + 3 * static_cast<std::size_t>(order[static_cast<std::size_t>(i)]);
+      for (int a = 0; a < 3; ++a) {
+        m[a] += v[a];
+        lo[a] = std::min(lo[a], v[a]);
+        hi[a] = std::max(hi[a], v[a]);
+      }
+      const std::size_t w = static_cast<std::size_t>(order[static_cast<std::size_t>(i)]);
+      least = std::min(least, delta[w] - slack[w]);
     }
-    const double h = 0.5 * std::sqrt(diag2) * (1 + 1e-12);
-    lv.cap = l == 0 ? std::numeric_limits<double>::infinity() : 2 * h;
-    std::size_t nodes = 1;
-    for (int a = 0; a < dim; ++a) nodes *= static_cast<std::size_t>(side);
-    lv.offset.assign(nodes + 1, 0);
-    lv.outside.assign(nodes, 0);
-
-    // Node `at`'s walls, from its parent's list (every wall at the root):
-    // each kept one passed to `keep`; false where the node lies wholly
-    // outside a wall.
-    auto filter = [&](std::size_t at, auto&& keep) {
-      double x[3] = {0, 0, 0};
-      std::size_t parent = 0, rest = at;
-      for (int a = 0, stride = 1; a < dim; ++a, stride *= static_cast<int>(side / 2 > 0 ? side / 2 : 1)) {
-        const auto i = static_cast<std::int64_t>(rest % static_cast<std::size_t>(side));
-        rest /= static_cast<std::size_t>(side);
-        x[a] = lo[a] + (static_cast<double>(i) + 0.5) * lv.size[a];
-        parent += static_cast<std::size_t>(i / 2) * static_cast<std::size_t>(stride);
-      }
-      auto test = [&](std::int32_t k) {
-        const Wall& w = walls[static_cast<std::size_t>(k)];
-        double s = w.d, mag = std::fabs(w.d);
-        for (int a = 0; a < dim; ++a) {
-          s -= w.n[a] * x[a];
-          mag += std::fabs(w.n[a] * x[a]);
-        }
-        const double m = 1e-12 * mag + 1e-300;  // (far above s's rounding)
-        s /= w.norm;  // (norm >= |n|_2 >= 1: |s| at most the distance)
-        if (s + m < -h) return -1;              // the node lies outside the wall
-        return s - m > h + lv.cap ? 0 : 1;      // too far inside to matter, or listed
-      };
-      if (l == 0) {
-        for (std::int32_t k = 0; k < static_cast<std::int32_t>(walls.size()); ++k) {
-          const int t = test(k);
-          if (t < 0) return false;
-          if (t > 0) keep(k);
-        }
-        return true;
-      }
-      const Level& up = levels_[static_cast<std::size_t>(l - 1)];
-      if (up.outside[parent]) return false;
-      for (std::int64_t e = up.offset[parent]; e < up.offset[parent + 1]; ++e) {
-        const std::int32_t k = up.ids[static_cast<std::size_t>(e)];
-        const int t = test(k);
-        if (t < 0) return false;
-        if (t > 0) keep(k);
-      }
-      return true;
-    };
-    using Range = tbb::blocked_range<std::size_t>;
-    tbb::parallel_for(Range(0, nodes, 1024), [&](const Range& r) {
-      for (std::size_t at = r.begin(); at != r.end(); ++at) {
-        std::int64_t count = 0;
-        if (filter(at, [&](std::int32_t) { ++count; }))
-          lv.offset[at + 1] = count;
-        else
-          lv.outside[at] = 1;
-      }
-    });
-    for (std::size_t at = 0; at < nodes; ++at) lv.offset[at + 1] += lv.offset[at];
-    lv.ids.resize(static_cast<std::size_t>(lv.offset[nodes]));
-    tbb::parallel_for(Range(0, nodes, 1024), [&](const Range& r) {
-      for (std::size_t at = r.begin(); at != r.end(); ++at) {
-        if (lv.outside[at]) continue;
-        auto slot = lv.offset[at];
-        filter(at, [&](std::int32_t k) { lv.ids[static_cast<std::size_t>(slot++)] = k; });
-      }
-    });
+    const double mn = std::sqrt(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]);
+    if (mn > 0) {
+      for (int a = 0; a < 3; ++a) nd.axis[a] = m[a] / mn;
+    } else {
+      nd.axis[0] = 1;
+    }
+    double cmin = 1, smax = 0;
+    for (std::int32_t i = b; i < e; ++i) {
+      const double* v = nu.data() + 3 * static_cast<std::size_t>(order[static_cast<std::size_t>(i)]);
+      const double* u = nd.axis;
+      const double vn = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+      const double c = (u[0] * v[0] + u[1] * v[1] + u[2] * v[2]) / vn;
+      const double cx = u[1] * v[2] - u[2] * v[1], cy = u[2] * v[0] - u[0] * v[2], cz = u[0] * v[1] - u[1] * v[0];
+      cmin = std::min(cmin, c);
+      smax = std::max(smax, std::sqrt(cx * cx + cy * cy + cz * cz) / vn);
+    }
+    // Each cosine and sine within a few ulps: 1e-12 is far outside them.
+    nd.cos_lo = cmin - 1e-12;
+    nd.cos_hi = std::min(1.0, cmin + 1e-12);
+    nd.sin_hi = std::min(1.0, smax + 1e-12);
+    nd.offset = least;
+    nd.begin = b;
+    nd.end = e;
+    nd.right = -1;
+    if (e - b > leaf_size && depth < 60) {
+      int axis = 0;
+      for (int a = 1; a < 3; ++a)
+        if (hi[a] - lo[a] > hi[axis] - lo[axis]) axis = a;
+      const std::int32_t mid = b + (e - b) / 2;
+      // Ties broken by position, so that the tree does not depend on the
+      // library's nth_element.
+      std::nth_element(order.begin() + b, order.begin() + mid, order.begin() + e, [&](std::int32_t s, std::int32_t t) {
+        const double vs = nu[3 * static_cast<std::size_t>(s) + static_cast<std::size_t>(axis)];
+        const double vt = nu[3 * static_cast<std::size_t>(t) + static_cast<std::size_t>(axis)];
+        return vs < vt || (vs == vt && s < t);
+      });
+      build(b, mid, depth + 1);
+      nd.right = static_cast<std::int32_t>(ix.nodes_.size());
+      build(mid, e, depth + 1);
+    }
+    ix.nodes_[at] = nd;
   }
+};
+
+Index::Index(std::span<const Wall> walls, int dim, const double* origin) : dim_(dim) {
+  for (int a = 0; a < dim; ++a) origin_[a] = origin[a];
+  const std::size_t n = walls.size();
+  IndexBuilder bld{*this, {}, std::vector<double>(3 * n, 0.0), std::vector<double>(n), std::vector<double>(n)};
+  for (std::size_t k = 0; k < n; ++k) {
+    const Wall& w = walls[k];
+    // delta = (d - n.o) / norm: D products and D differences, each rounded
+    // once, then the quotient; within gamma_{2D+1} of the magnitudes' sum
+    // over norm (norm >= |n|_2 >= 1 for kernel walls, whose largest normal
+    // component lies in [1, 2)). The slack is far above that.
+    double d = w.d, mag = std::fabs(w.d);
+    for (int a = 0; a < dim; ++a) {
+      const double t = w.n[a] * origin_[a];
+      d -= t;
+      mag += std::fabs(t);
+      bld.nu[3 * k + static_cast<std::size_t>(a)] = w.n[a] / w.norm;
+    }
+    bld.delta[k] = d / w.norm;
+    bld.slack[k] = 1e-12 * mag / w.norm + 1e-300;
+  }
+  bld.order.resize(n);
+  std::iota(bld.order.begin(), bld.order.end(), 0);
+  if (n > 0) bld.build(0, static_cast<std::int32_t>(n), 0);
+  nu_.resize(3 * n);
+  delta_.resize(n);
+  slack_.resize(n);
+  ids_.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto k = static_cast<std::size_t>(bld.order[i]);
+    for (int a = 0; a < 3; ++a) nu_[3 * i + static_cast<std::size_t>(a)] = bld.nu[3 * k + static_cast<std::size_t>(a)];
+    delta_[i] = bld.delta[k];
+    slack_[i] = bld.slack[k];
+    ids_[i] = static_cast<std::int32_t>(k);
+  }
+}
+
+bool Index::near(const double* q, double r, std::vector<std::int32_t>& out, std::size_t limit) const {
+  out.clear();
+  bool fits = true;
+  visit(q, r, [&](std::int32_t k) {
+    out.push_back(k);
+    if (out.size() > limit) {
+      fits = false;
+      return false;
+    }
+    return true;
+  });
+  std::sort(out.begin(), out.end());
+  return fits;
 }
 
 }  // namespace tessera::kernels::walls

@@ -61,8 +61,8 @@ LloydResult lloyd(std::span<const double> points, int dim, std::span<const std::
   const std::function<void(double)> progress = options.voronoi.progress;
   std::vector<double> next, displacement;
   // The walls in the points' frame, for the test of each centroid, and
-  // (many walls: a hull's) their index over the domain, built once it is
-  // known: each centroid then tests the walls near it, not all of them.
+  // (many walls: a hull's) their index, built once the domain is known:
+  // each centroid then tests the walls it may lie outside of, not all.
   const std::vector<kernels::Wall> walls = front::kernel_walls(vo.walls, dim, 0);
   std::unique_ptr<const kernels::walls::Index> wall_index;
   for (int it = 0; it < iterations; ++it) {
@@ -82,11 +82,7 @@ LloydResult lloyd(std::span<const double> points, int dim, std::span<const std::
         if (v > 0) result.spacing = std::pow(v / static_cast<double>(std::max<std::size_t>(cells.generators, 1)), 1.0 / dim);
       }
       result.threads_used = cells.threads_used;
-      if (!walls.empty()) {
-        engine::ThreadArena(resolve_threads(vo.threads)).execute([&] {
-          wall_index = front::make_wall_index(walls, dim, *vo.bounds, cells.generators);
-        });
-      }
+      if (!walls.empty()) wall_index = front::make_wall_index(walls, dim, *vo.bounds);
     }
     const Bounds& box = *vo.bounds;
     const bool periodic = cells.is_periodic();

@@ -7,8 +7,8 @@
 // facet's plane, not a loose bound); facets in one plane make one wall (a cube lattice: 6), which
 // then passes through the lattice points exactly, so the cells tile the cube
 // exactly; the cells inside the hull are the brute-force oracle's cells
-// clipped by the same walls (more than 16 walls: the wall index decides which
-// walls each cell tests); a dilation moves every wall out by that distance;
+// clipped by the same walls, in a ball and on a sphere (more than 16 walls:
+// the wall index decides which walls each cell tests); a dilation moves every wall out by that distance;
 // bad input is refused.
 #include <gtest/gtest.h>
 
@@ -127,12 +127,34 @@ TEST(HullWalls, LatticeHullIsExactAndItsCellsTileIt) {
   }
 }
 
+/// Points on the sphere (circle) of radius 1 about (2, 3, 4), rounded: all
+/// of them hull vertices, nearly co-spherical.
+std::vector<double> sphere_points(std::size_t n, int dim, std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> g;
+  std::vector<double> pts;
+  const double c[3] = {2, 3, 4};
+  for (std::size_t i = 0; i < n; ++i) {
+    double p[3] = {g(rng), g(rng), dim == 3 ? g(rng) : 0.0};
+    const double r = std::sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
+    for (int a = 0; a < dim; ++a) pts.push_back(c[a] + p[a] / r);
+  }
+  return pts;
+}
+
+// In a ball, and on a sphere: there every cell is a cone from the centre
+// out to the box before its cuts, reaching past hundreds of the hull's
+// walls, and engine::clip_walls cuts it by the walls through its generator
+// and then by those its vertices lie beyond (the index's point queries).
 TEST(HullWalls, CellsInTheHullAreTheOraclesCells) {
-  for (const int dim : {2, 3}) {
+  for (const int dim : {2, 3})
+  for (const bool sphere : {false, true}) {
     const std::size_t n = dim == 3 ? 250 : 400;
-    const auto pts = ball_points(n, dim, 33 + static_cast<std::uint64_t>(dim));
+    const auto pts = sphere ? sphere_points(n, dim, 35 + static_cast<std::uint64_t>(dim))
+                            : ball_points(n, dim, 33 + static_cast<std::uint64_t>(dim));
     const auto walls = tessera::hull_walls(pts, dim);
     ASSERT_GE(walls.size(), 16u) << dim << "D: the wall index takes part from 16 walls";
+    if (sphere) EXPECT_GE(walls.size(), dim == 3 ? 2 * n - 4 : n) << "every point a hull vertex";
     tessera::VoronoiOptions o = options(dim);
     o.walls = walls;
     const auto c = tessera::voronoi(pts, dim, {}, o);
@@ -143,20 +165,20 @@ TEST(HullWalls, CellsInTheHullAreTheOraclesCells) {
     for (std::size_t i = 0; i < n; ++i) {
       const auto want = oracle::cell(pts, dim, i, c.bounds.lo, c.bounds.hi, {}, ow);
       const std::size_t k = static_cast<std::size_t>(c.cell_of[i]);
-      EXPECT_NEAR(c.volume[k], want.volume, 1e-9 * want.volume) << dim << "D: cell " << i;
+      EXPECT_NEAR(c.volume[k], want.volume, 1e-9 * want.volume) << dim << (sphere ? "D sphere" : "D ball") << ": cell " << i;
       for (int a = 0; a < dim; ++a)
-        EXPECT_NEAR(c.centroid[k * dim + a], want.centroid[a], 1e-9) << dim << "D: cell " << i;
+        EXPECT_NEAR(c.centroid[k * dim + a], want.centroid[a], 1e-9) << dim << (sphere ? "D sphere" : "D ball") << ": cell " << i;
       sum += c.volume[k];
     }
     const double hull = tessera::domain_volume(c.bounds, walls, dim);
-    EXPECT_NEAR(sum, hull, 1e-12 * hull) << dim;
+    EXPECT_NEAR(sum, hull, 1e-12 * hull) << dim << sphere;
     const auto v = tessera::validate(c, {}, pts);
-    EXPECT_TRUE(v.ok) << dim << "D: " << (v.messages.empty() ? "" : v.messages[0]);
+    EXPECT_TRUE(v.ok) << dim << (sphere ? "D sphere: " : "D ball: ") << (v.messages.empty() ? "" : v.messages[0]);
     // Two threads: the same cells.
     o.threads = 2;
     const auto c2 = tessera::voronoi(pts, dim, {}, o);
-    EXPECT_EQ(c2.volume, c.volume) << dim;
-    EXPECT_EQ(c2.vertices, c.vertices) << dim;
+    EXPECT_EQ(c2.volume, c.volume) << dim << sphere;
+    EXPECT_EQ(c2.vertices, c.vertices) << dim << sphere;
   }
 }
 

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <functional>
 #include <limits>
@@ -74,45 +75,122 @@ struct EngineOptions {
   ThreadArena* arena = nullptr;
 };
 
+/// clip_walls' lists, one set per thread (the engine's workspace).
+struct WallScratch {
+  std::vector<std::int32_t> list, done;
+};
+
 /// Cut a built cell of generator p by the exact context's walls
-/// (kernels/walls.hpp) in ascending order: those its wall index lists near
-/// p, where it has one; a cell they leave empty has none (st.has_cell false).
-/// The cut may have deferred new vertices' exact solves: solved here.
+/// (kernels/walls.hpp): every wall, in ascending order, or with a wall index
+/// those it finds near the cell; a cell they leave empty has none
+/// (st.has_cell false). The cut may have deferred new vertices' exact
+/// solves: solved here.
 template <class CellT>
 [[gnu::noinline]] void clip_walls(CellT& cell, kernels::BuildStatus& st, const kernels::ExactContext& ctx,
-                                  const double* p) {
-  // Each cut shrinks the cell: the reach is read again after it, so that
-  // later walls are passed over sooner; with an index, a reach under half
-  // the one the list was taken for takes a shorter list (from the next wall
-  // on: the list's order is the walls'). A boundary cell of a ball's hull
-  // reaches into the box's empty corners before its first cut.
-  double reach = cell.vertex_reach();
-  auto cut = [&](int k) {
-    const kernels::ClipResult r = cell.clip_wall(k, reach);
+                                  const double* p, WallScratch& scratch) {
+  constexpr int D = CellT::dim;
+  // Each cut shrinks the cell: its ball is taken again after it, so that
+  // later walls are passed over sooner.
+  auto ball = cell.vertex_ball();
+  auto cut = [&](std::int32_t k) {
+    const kernels::ClipResult r = cell.clip_wall(k, ball);
     if (r == kernels::ClipResult::emptied) {
       st.has_cell = false;
       return false;
     }
-    if (r == kernels::ClipResult::clipped) reach = cell.vertex_reach();
+    if (r == kernels::ClipResult::clipped) ball = cell.vertex_ball();
     return true;
   };
-  if (ctx.wall_index != nullptr) {
-    double listed_for = reach;
-    std::span<const std::int32_t> list = ctx.wall_index->candidates(p, reach);
+  const kernels::walls::Index* index = ctx.wall_index;
+  if (index == nullptr) {
+    for (std::int32_t k = 0; k < ctx.num_walls; ++k)
+      if (!cut(k)) return;
+    cell.solve_deferred();
+    return;
+  }
+  // Most cells lie deep inside: no wall comes within their reach.
+  bool any = false;
+  index->visit(p, cell.vertex_reach(), [&](std::int32_t) { return !(any = true); });
+  if (!any) {
+    cell.solve_deferred();
+    return;
+  }
+
+  // The index is asked about the ball's centre p + c (rounded: the radius
+  // grows by that rounding).
+  double q[3] = {0, 0, 0}, qr = 0;
+  auto centre = [&] {
+    double m = 0;
+    for (int a = 0; a < D; ++a) {
+      q[a] = p[a] + ball.c[a];
+      m = std::fmax(m, std::fabs(q[a]));
+    }
+    qr = ball.r + 4 * kernels::filter::u * m;
+  };
+  std::vector<std::int32_t>& list = scratch.list;
+  centre();
+  if (index->near(q, qr, list, 64)) {
+    double listed_for = ball.r;
     for (std::size_t i = 0; i < list.size(); ++i) {
       const std::int32_t k = list[i];
       if (!cut(k)) return;
-      if (reach < 0.5 * listed_for) {
-        listed_for = reach;
-        list = ctx.wall_index->candidates(p, reach);
+      // A ball under half the one the list was taken for takes a shorter
+      // list (from the next wall on: walls before k are behind the cell).
+      if (ball.r < 0.5 * listed_for) {
+        listed_for = ball.r;
+        centre();
+        index->near(q, qr, list);
         i = static_cast<std::size_t>(std::upper_bound(list.begin(), list.end(), k) - list.begin()) - 1;  // (++i next)
       }
     }
-  } else {
-    for (int k = 0; k < ctx.num_walls; ++k)
-      if (!cut(k)) return;
+    cell.solve_deferred();
+    return;
   }
-  cell.solve_deferred();
+  // Many walls pass near the ball: the cell is long, or reaches far. The
+  // cell of a point on a sphere, cut by the hull of the samples, is a cone
+  // from the centre out to the box, and after its cuts a needle from the
+  // point to the centre, whose ball is tangent to the sphere inside:
+  // hundreds of the hull's tangent planes pass through that ball, where
+  // none but the point's own facets meets the needle. By convexity a wall
+  // cuts the cell only where some vertex lies outside it. So the cell is
+  // cut first by the walls through its generator (a hull point's facets),
+  // then, round by round, by the wall each vertex lies farthest beyond
+  // (Index::deepest), until no vertex lies beyond any wall not cut by yet.
+  // A wall cut by stays out of the later rounds: the cell lies inside it
+  // (its vertices on it would be found again). A vertex that a round found
+  // beyond no wall is beyond none in the later rounds either: only the
+  // vertices of the round's new faces are asked again.
+  std::vector<std::int32_t>& done = scratch.done;
+  index->near(p, 0.0, done);
+  for (const std::int32_t k : done)
+    if (!cut(k)) return;
+  auto is_done = [&](std::int32_t k) { return std::binary_search(done.begin(), done.end(), k); };
+  for (std::size_t old_planes = 0;;) {
+    cell.solve_deferred();  // (a deferred vertex's bound is wide)
+    list.clear();
+    for (const auto& v : cell.vertices()) {
+      bool fresh = false;
+      for (int a = 0; a < D; ++a) fresh |= v.p[a] >= old_planes;
+      if (!fresh) continue;
+      double x[3] = {0, 0, 0}, m = 0;
+      for (int a = 0; a < D; ++a) {
+        x[a] = p[a] + v.y[a];
+        m = std::fmax(m, std::fabs(x[a]));
+      }
+      const double r = std::isfinite(v.e) ? v.e * std::sqrt(static_cast<double>(D)) + 4 * kernels::filter::u * m
+                                          : std::numeric_limits<double>::infinity();
+      const std::int32_t k = index->deepest(x, r, is_done);
+      if (k >= 0) list.push_back(k);
+    }
+    if (list.empty()) break;
+    old_planes = cell.planes().size();
+    std::sort(list.begin(), list.end());
+    list.erase(std::unique(list.begin(), list.end()), list.end());
+    for (const std::int32_t k : list) {
+      done.insert(std::lower_bound(done.begin(), done.end(), k), k);
+      if (!cut(k)) return;
+    }
+  }
 }
 
 /// Build every cell of `gens.order` and hand each to the compositor; returns
@@ -145,11 +223,12 @@ std::uint64_t tessellate(const Generators<CellT::dim>& gens, Comp& comp, const E
     kernels::CellBuilder<CellT> builder;
     CellT cell;
     std::uint64_t exact_calls = 0;
+    WallScratch walls;
   };
   tbb::enumerable_thread_specific<Workspace> workspaces([&] {
     Workspace ws{kernels::CellBuilder<CellT>(*gens.locator, gens.coords, gens.lo.data(), gens.hi.data(),
                                              gens.exact, gens.tree),
-                 CellT{}, 0};
+                 CellT{}, 0, {}};
     ws.builder.set_work_cap(opt.work_cap);
     return ws;
   });
@@ -181,7 +260,7 @@ std::uint64_t tessellate(const Generators<CellT::dim>& gens, Comp& comp, const E
         st = ws.builder.build_any(gen, p, ws.cell);
       }
       if (gens.exact != nullptr && gens.exact->num_walls > 0 && st.has_cell) [[unlikely]]
-        clip_walls(ws.cell, st, *gens.exact, p);
+        clip_walls(ws.cell, st, *gens.exact, p, ws.walls);
       ws.exact_calls += ws.cell.exact_calls();
       comp.add(batch, gen, st, ws.cell);
     }

@@ -30,6 +30,7 @@
 #include "tessera/kernels/assembly.hpp"
 #include "tessera/kernels/dual_faces.hpp"
 #include "tessera/kernels/exact_predicates.hpp"
+#include "tessera/kernels/walls.hpp"  // walls::Ball
 #include "tessera/kernels/filter.hpp"
 #include "tessera/kernels/lane_blocks.hpp"
 #include "tessera/kernels/power.hpp"
@@ -144,12 +145,13 @@ class Hull {
   }
 
   /// Cut the finished cell by wall k of the exact context (walls.hpp): after
-  /// every clip by a neighbour, the walls in ascending order. `reach`: an
-  /// upper bound on every vertex's |y| (vertex_reach() before the first
-  /// wall: each cut only shortens them). Emptied only where the whole cell
-  /// lies outside (a power cell; the front end refuses generators outside a
-  /// wall).
-  ClipResult clip_wall(int k, double reach);  // (kernels/clip_walls.cpp)
+  /// every clip by a neighbour, the walls in any order (engine::clip_walls
+  /// takes a hull's nearest first). `b`: a ball holding every vertex
+  /// (vertex_ball(); a cut only shrinks the cell, so an older ball stays
+  /// true). Emptied only where the whole cell lies outside (a power cell;
+  /// the front end refuses generators outside a wall).
+  ClipResult clip_wall(int k, const walls::Ball<3>& b);  // (kernels/clip_walls.cpp)
+  walls::Ball<3> vertex_ball() const { return walls::vertex_ball<3>(verts_.data(), verts_.size()); }
 
 
  private:
@@ -312,7 +314,7 @@ class Hull {
   /// vertex: a neighbour farther than 2R cannot clip (security radius).
   double security_radius2() const { return security2_; }
   /// An upper bound on every vertex's distance from the generator (half the
-  /// security radius); a cut by a wall never raises it (clip_wall's `reach`).
+  /// security radius); a cut by a wall never raises it.
   double vertex_reach() const { return 0.5 * std::sqrt(security2_); }
   /// power_slack (power.hpp) of a power cell, in every vertex's r2; 0 without radii.
   double power_slack() const { return slack_; }

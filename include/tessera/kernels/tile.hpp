@@ -21,6 +21,7 @@
 #include "tessera/kernels/assembly.hpp"
 #include "tessera/kernels/deferred_solves.hpp"
 #include "tessera/kernels/exact_predicates.hpp"
+#include "tessera/kernels/walls.hpp"  // walls::Ball
 #include "tessera/kernels/filter.hpp"
 #include "tessera/kernels/hull.hpp"  // ClipResult
 #include "tessera/kernels/power.hpp"
@@ -112,7 +113,8 @@ class Tile {
   }
 
   /// As Hull::clip_wall: cut the finished tile by wall k (walls.hpp).
-  ClipResult clip_wall(int k, double reach);  // (kernels/clip_walls.cpp)
+  ClipResult clip_wall(int k, const walls::Ball<2>& b);  // (kernels/clip_walls.cpp)
+  walls::Ball<2> vertex_ball() const { return walls::vertex_ball<2>(verts_.data(), verts_.size()); }
 
 
  private:
@@ -236,7 +238,7 @@ class Tile {
 
   double security_radius2() const { return security2_; }
   /// An upper bound on every vertex's distance from the generator (half the
-  /// security radius); a cut by a wall never raises it (clip_wall's `reach`).
+  /// security radius); a cut by a wall never raises it.
   double vertex_reach() const { return 0.5 * std::sqrt(security2_); }
   /// power_slack (power.hpp) of a power cell, in every vertex's r2; 0 without radii.
   double power_slack() const { return slack_; }

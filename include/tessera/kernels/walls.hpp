@@ -14,6 +14,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include "tessera/kernels/exact_predicates.hpp"
@@ -60,21 +61,73 @@ void refine(RelativeWall<D>& r, const Wall& w, const double* p) {
   r.d_err = 4 * filter::u * std::fabs(r.d) + filter::abs_eps;
 }
 
-/// Whether wall `w` (of norm at most `norm`: Wall::norm) surely cuts nothing
-/// of a cell whose vertices lie within `reach` of its generator: n.y <=
-/// |n| reach < d for every vertex, with room for d's rounding and the
-/// product's. Most cells of a many-sided domain lie far inside most walls.
+/// A ball holding a cell's vertices, exact ones included: centre c
+/// relative to the generator, radius r. Where a cell is long and thin (the
+/// cell of a point on a sphere, cut by its hull: a needle from the point to
+/// the centre), it lies far tighter than the ball of the vertices' reach
+/// around the generator.
 template <int D>
-bool misses(const RelativeWall<D>& w, double norm, double reach) {
-  return w.d - w.d_err > norm * reach * (1 + 1e-12);
+struct Ball {
+  double c[D];
+  double r;
+};
+
+/// The ball around the vertices' bounding box's centre through the farthest
+/// vertex, widened by the vertices' error bounds (e, along each axis) and
+/// by 1e-12 for its own rounding. Squares that would under- or overflow
+/// take the farthest coordinate difference times sqrt(D) instead; a vertex
+/// not finite makes it infinite (no wall is missed).
+template <int D, class Vertex>
+Ball<D> vertex_ball(const Vertex* verts, std::size_t nv) {
+  Ball<D> b;
+  double lo[D], hi[D], e = 0;
+  bool finite = true;
+  for (int a = 0; a < D; ++a) lo[a] = hi[a] = nv > 0 ? verts[0].y[a] : 0;
+  for (std::size_t t = 0; t < nv; ++t) {
+    for (int a = 0; a < D; ++a) {
+      lo[a] = std::fmin(lo[a], verts[t].y[a]);
+      hi[a] = std::fmax(hi[a], verts[t].y[a]);
+      finite &= std::isfinite(verts[t].y[a]);
+    }
+    e = std::fmax(e, verts[t].e);
+    finite &= std::isfinite(verts[t].e);
+  }
+  for (int a = 0; a < D; ++a) b.c[a] = 0.5 * lo[a] + 0.5 * hi[a];
+  double r2 = 0, far = 0;
+  for (std::size_t t = 0; t < nv; ++t) {
+    double s = 0;
+    for (int a = 0; a < D; ++a) {
+      const double g = verts[t].y[a] - b.c[a];
+      s += g * g;
+      far = std::fmax(far, std::fabs(g));
+    }
+    r2 = std::fmax(r2, s);
+  }
+  const double r = r2 > 1e-280 && r2 < 1e280 ? std::sqrt(r2) : far * std::sqrt(static_cast<double>(D));
+  b.r = finite ? (r + e * std::sqrt(static_cast<double>(D))) * (1 + 1e-12) : std::numeric_limits<double>::infinity();
+  return b;
+}
+
+/// Whether wall `w` (of norm at most `norm`: Wall::norm) surely cuts nothing
+/// of a cell within ball `b`: n.y <= n.c + |n| r < d for every vertex, with
+/// room for d's rounding and n.c's. Most cells of a many-sided domain lie
+/// far inside most walls.
+template <int D>
+bool misses(const RelativeWall<D>& w, double norm, const Ball<D>& b) {
+  double dot = 0, mag = std::fabs(w.d);
+  for (int a = 0; a < D; ++a) {
+    dot += w.n[a] * b.c[a];
+    mag += std::fabs(w.n[a] * b.c[a]);
+  }
+  return w.d - dot - w.d_err - 4 * D * filter::u * mag > norm * b.r * (1 + 1e-12);
 }
 
 /// Wall `wall` relative to a cell's generator `site`, refined, into `w`;
-/// false where it surely cuts nothing of the cell (vertices within `reach`
-/// of the site, `verts[0..nv)`): by `misses`, else by `all_inside`. The
-/// first steps of Hull::clip_wall and Tile::clip_wall alike.
+/// false where it surely cuts nothing of the cell (vertices within ball
+/// `b`, `verts[0..nv)`): by `misses`, else by `all_inside`. The first steps
+/// of Hull::clip_wall and Tile::clip_wall alike.
 template <int D, class Vertex>
-bool may_cut(const Wall& wall, const double* site, double reach, const Vertex* verts, std::size_t nv,
+bool may_cut(const Wall& wall, const double* site, const Ball<D>& b, const Vertex* verts, std::size_t nv,
              RelativeWall<D>& w);
 
 /// Whether every vertex lies surely inside wall `w` by the float filter of
@@ -96,10 +149,10 @@ bool all_inside(const Vertex* verts, std::size_t nv, const RelativeWall<D>& w) {
 }
 
 template <int D, class Vertex>
-bool may_cut(const Wall& wall, const double* site, double reach, const Vertex* verts, std::size_t nv,
+bool may_cut(const Wall& wall, const double* site, const Ball<D>& b, const Vertex* verts, std::size_t nv,
              RelativeWall<D>& w) {
   w = relative<D>(wall, site);
-  if (misses(w, wall.norm, reach) || all_inside<D>(verts, nv, w)) return false;
+  if (misses(w, wall.norm, b) || all_inside<D>(verts, nv, w)) return false;
   refine(w, wall, site);
   return true;
 }
