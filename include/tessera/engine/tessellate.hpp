@@ -90,8 +90,12 @@ template <class CellT>
                                   const double* p, WallScratch& scratch) {
   constexpr int D = CellT::dim;
   // Each cut shrinks the cell: its ball is taken again after it, so that
-  // later walls are passed over sooner.
-  auto ball = cell.vertex_ball();
+  // later walls are passed over sooner. Until then the ball of its reach
+  // about the generator serves (a bound the cell keeps already): most cells
+  // are cut by no wall.
+  kernels::walls::Ball<D> ball;
+  for (int a = 0; a < D; ++a) ball.c[a] = 0;
+  ball.r = cell.vertex_reach();
   auto cut = [&](std::int32_t k) {
     const kernels::ClipResult r = cell.clip_wall(k, ball);
     if (r == kernels::ClipResult::emptied) {
@@ -110,11 +114,12 @@ template <class CellT>
   }
   // Most cells lie deep inside: no wall comes within their reach.
   bool any = false;
-  index->visit(p, cell.vertex_reach(), [&](std::int32_t) { return !(any = true); });
+  index->visit(p, ball.r, [&](std::int32_t) { return !(any = true); });
   if (!any) {
     cell.solve_deferred();
     return;
   }
+  ball = cell.vertex_ball();
 
   // The index is asked about the ball's centre p + c (rounded: the radius
   // grows by that rounding).
