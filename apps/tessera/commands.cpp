@@ -1,5 +1,6 @@
 // Implementation of the tessera subcommands (see commands.hpp).
 #include "commands.hpp"
+#include "walls_file.hpp"
 #include "frame_series.hpp"
 #include "stdin_input.hpp"
 
@@ -399,15 +400,18 @@ VoronoiOptions make_options(const ComputeArgs& a, int dim, std::span<const doubl
   }
   if (!a.periodic.empty() && a.bounds.empty())
     throw InputError("--periodic needs --bounds: the box that repeats");
-  for (const auto& w : a.walls) {
+  auto add_wall = [&](const std::vector<double>& w, const std::string& what) {
     if (w.size() != static_cast<std::size_t>(dim + 1))
-      throw InputError(dim == 3 ? "--wall: expected four values, NX NY NZ D, for 3D points"
-                                : "--wall: expected three values, NX NY D, for 2D points");
+      throw InputError(what + (dim == 3 ? ": expected four values, NX NY NZ D, for 3D points"
+                                        : ": expected three values, NX NY D, for 2D points"));
     Wall wall;
     for (int d = 0; d < dim; ++d) wall.normal[static_cast<std::size_t>(d)] = w[static_cast<std::size_t>(d)];
     wall.offset = w.back();
     o.walls.push_back(wall);
-  }
+  };
+  for (const auto& w : a.walls) add_wall(w, "--wall");
+  if (!a.walls_file.empty())
+    for (const auto& w : read_walls_file(a.walls_file)) add_wall(w, "--walls " + a.walls_file);
   if (a.hull_walls) {
     // A dilated hull reaches past the default box (the points' bounding box
     // grown by --padding): the box grows by the dilation too.

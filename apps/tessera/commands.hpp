@@ -51,6 +51,8 @@ struct ComputeArgs {
   /// be INPUT, as for --bounds).
   std::vector<std::vector<double>> walls;
   std::vector<std::vector<std::string>> raw_walls;
+  /// --walls FILE: more walls, read by make_options (walls_file.hpp).
+  std::string walls_file;
   /// --hull-walls: the points' convex hull as walls too (tessera::hull_walls),
   /// pushed out by --hull-dilation.
   bool hull_walls = false;

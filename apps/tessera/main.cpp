@@ -232,6 +232,11 @@ void add_walls_option(CLI::App* app, ComputeArgs& c) {
       ->expected(3, 4)
       ->allow_extra_args(false)
       ->delimiter(',');
+  app->add_option("--walls", c.walls_file,
+                  "Walls from a file, as --wall gives one (both may be used): a .npy array of shape (k, 3) in 2D or "
+                  "(k, 4) in 3D (NX NY [NZ] D per row; tessera.hull_walls' output, saved), or text with one wall "
+                  "a line (numbers separated by commas or spaces; '#' lines skipped)")
+      ->type_name("FILE");
   CLI::Option* hull = app->add_flag("--hull-walls", c.hull_walls,
                                     "The points' convex hull as walls (one per hull facet, facets in one plane merged): "
                                     "cells bounded by the hull instead of the box (the box and any --wall cut too). "
@@ -301,6 +306,7 @@ void finish_compute_args(ComputeArgs& c, const std::vector<std::string>& raw_bou
   c.input = input_path(c.input);
   tessera::io::protect_from_writes(c.labels, "--labels");
   tessera::io::protect_from_writes(c.radii, "--radii");
+  tessera::io::protect_from_writes(c.walls_file, "--walls");
   if (!series && is_frame_series(c.frame))
     throw tessera::InputError("--frame " + c.frame + ": a bench runs on one frame; give its INDEX");
   find_input_frame(c);

@@ -169,6 +169,72 @@ class HullWalls(Case):
                     "--hull-dilation", "-1", "-o", self.p("c.vtp")])
 
 
+class WallsFile(Case):
+    """--walls FILE: many walls from a .npy array or a text file, as --wall gives them."""
+
+    def setUp(self):
+        super().setUp()
+        rng = np.random.default_rng(6)
+        p = rng.random((500, 2))
+        self.in2 = self.save("p2.npy", p[p.sum(axis=1) <= 1])
+
+    def test_npy_and_text(self):
+        # 64 planes tangent to a ball (bench/walls' polyhedron): the same cells
+        # from the array as from 64 --wall options.
+        k = np.arange(64) + 0.5
+        z = 1 - 2 * k / 64
+        a = k * np.pi * (3 - np.sqrt(5))
+        n = np.stack([np.sqrt(1 - z * z) * np.cos(a), np.sqrt(1 - z * z) * np.sin(a), z], axis=1)
+        walls = np.hstack([n, (0.45 + n @ np.array([0.5, 0.5, 0.5]))[:, None]])
+        rng = np.random.default_rng(7)
+        p = rng.random((6000, 3))
+        p = p[np.all(p @ walls[:, :3].T <= walls[:, 3] - 1e-12, axis=1)]
+        pts = self.save("p3.npy", p)
+        box = ["--bounds", "0,1,0,1,0,1"]
+        args = [w for row in walls for w in ("--wall", ",".join(repr(float(x)) for x in row))]
+        self.ok(["voronoi", pts, "--cell-table", self.p("a.csv"), "-q"] + box + args)
+        r = self.ok(["voronoi", pts, "--walls", self.save("w.npy", walls), "--cell-table", self.p("b.csv"),
+                     "--validate"] + box)
+        self.assertIn("inside 64 walls", r.stdout)
+        self.assertIn("validation: OK", r.stdout)
+        self.assertEqual(read_bytes(self.p("a.csv")), read_bytes(self.p("b.csv")))
+        # One wall as a 1-D array.
+        r = self.ok(["voronoi", pts, "--walls", self.save("one.npy", np.array([1.0, 1, 1, 3])), "-o",
+                     self.p("c.vtu")] + box)
+        self.assertIn("inside 1 wall\n", r.stdout)
+        # Text: comments, blank lines, commas and spaces, with --wall beside it.
+        with open(self.p("w.txt"), "w") as f:
+            f.write("# nx ny d\n\n1, 1, 1\n\t-1 0 0\n")
+        r = self.ok(["voronoi", self.in2, "--bounds", "0,1,0,1", "--walls", self.p("w.txt"), "--wall", "0,-1,0",
+                     "--cell-table", self.p("t.csv")])
+        self.assertIn("inside 3 walls", r.stdout)
+        area = np.loadtxt(self.p("t.csv"), delimiter=",", skiprows=1)[:, 2]
+        self.assertAlmostEqual(float(area.sum()), 0.5, delta=1e-12)
+        self.ok(["graph", self.in2, "--bounds", "0,1,0,1", "--walls", self.p("w.txt"), "-o", self.p("g.vtp"), "-q"])
+
+    def test_refusals(self):
+        pts = self.in2
+        out = self.p("c.vtp")
+        self.fails(["voronoi", pts, "--walls", self.p("none.npy"), "-o", out], "--walls: ")
+        self.fails(["voronoi", pts, "--walls", self.p("none.txt"), "-o", out], "cannot open")
+        self.fails(["voronoi", pts, "--walls", self.save("w5.npy", np.ones((3, 5))), "-o", out],
+                   "expected an array of shape (k, 3) or (k, 4)")
+        self.fails(["voronoi", pts, "--walls", self.save("w4.npy", np.ones((3, 4))), "-o", out],
+                   "expected three values, NX NY D, for 2D points")
+        for name, text, says in [("e.txt", "# nothing\n", "no walls in the file"),
+                                 ("b.txt", "1 1 1\n1 x 1\n", "line 2: 'x' is not a finite number"),
+                                 ("c.txt", "1 1 1 # a comment after a wall\n", "line 1: '#' is not a finite number"),
+                                 ("n.txt", "1 1 1\n1 1\n", "line 2: 2 values"),
+                                 ("i.txt", "1 1 1e999\n", "beyond double's range"),
+                                 ("z.txt", "0 0 1\n", "its normal is zero")]:
+            with open(self.p(name), "w") as f:
+                f.write(text)
+            self.fails(["voronoi", pts, "--walls", self.p(name), "-o", out], says)
+        with open(self.p("w.csv"), "w") as f:
+            f.write("1 1 1\n")
+        self.fails(["voronoi", pts, "--walls", self.p("w.csv"), "--cell-table", self.p("w.csv")], "--walls")
+
+
 def main():
     return base.cli_main("test_walls_cli.py", [(base.vtk is not None, "python3-vtk9 is required (run with /usr/bin/python3)")])
 
