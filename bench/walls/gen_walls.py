@@ -7,7 +7,9 @@ usage: gen_walls.py KIND N POINTS.npy WALLS.npy
         ball (64 tangent planes of the ball of radius 0.45 at the cube's
         centre: a polyhedron of 64 faces),
         hull (points uniform in that ball, walls their convex hull's facets,
-        from tessera.hull_walls: thousands; needs PYTHONPATH=BUILD/python)
+        from tessera.hull_walls: thousands; needs PYTHONPATH=BUILD/python),
+        sphere (points on that ball's sphere, every one a hull vertex: about
+        two walls per point, the hull's facets as for hull)
 Points are drawn in the cube (seed 88) and those outside the walls dropped
 (with a margin of 1e-12, so that no tool's rounding puts one outside); the
 hull's points are inside its walls exactly, by construction."""
@@ -29,17 +31,18 @@ elif kind == "ball":
         nrm = np.array([r * math.cos(a), r * math.sin(a), z])
         rows.append(list(nrm) + [0.45 + float(nrm @ np.array([0.5, 0.5, 0.5]))])
     walls = np.array(rows)
-elif kind == "hull":
+elif kind in ("hull", "sphere"):
     import tessera
 
     rng = np.random.default_rng(88)
     b = rng.normal(size=(n, 3))
-    pts = 0.5 + 0.45 * b * (rng.random((n, 1)) ** (1 / 3)) / np.linalg.norm(b, axis=1)[:, None]
+    radius = rng.random((n, 1)) ** (1 / 3) if kind == "hull" else 1.0
+    pts = 0.5 + 0.45 * b * radius / np.linalg.norm(b, axis=1)[:, None]
     np.save(out_p, np.ascontiguousarray(pts))
     np.save(out_w, np.ascontiguousarray(tessera.hull_walls(pts)))
     sys.exit(0)
 else:
-    sys.exit("gen_walls.py: KIND is halfcube, ball or hull")
+    sys.exit("gen_walls.py: KIND is halfcube, ball, hull or sphere")
 rng = np.random.default_rng(88)
 pts = np.empty((0, 3))
 while len(pts) < n:

@@ -5,7 +5,7 @@
 # Writes JSON lines and a Markdown table (summarize.py).
 #
 # usage: bench/walls/run.sh [BUILD_DIR] [N...]
-#   env: KINDS (default "halfcube ball"; also hull: gen_walls.py), REPEAT (default 3),
+#   env: KINDS (default "halfcube ball"; also hull, sphere: gen_walls.py), REPEAT (default 3),
 #        DATA (default bench/data, git-ignored), OUT (default bench/walls/results/walls.jsonl)
 # Needs Debian's voro++-dev (the driver voro_walls.cpp is compiled here).
 set -euo pipefail
@@ -37,11 +37,9 @@ for n in $sizes; do
   for kind in $kinds; do
     p=$data/walls_${kind}_$n.npy w=$data/walls_${kind}_${n}_walls.npy
     [[ -f $p && -f $w ]] || PYTHONPATH=$build/python $py "$here/gen_walls.py" "$kind" "$n" "$p" "$w"
-    mapfile -t wall_args < <($py -c "import numpy as np, sys
-for r in np.load(sys.argv[1]): print('--wall'); print(','.join(repr(float(x)) for x in r))" "$w")
     for t in 1 2; do
       note "$kind $n: tessera, $t thread(s)"
-      run "$kind $n" tessera-walls "$build/tessera" bench voronoi "$p" --bounds 0 1 0 1 0 1 "${wall_args[@]}" \
+      run "$kind $n" tessera-walls "$build/tessera" bench voronoi "$p" --bounds 0 1 0 1 0 1 --walls "$w" \
         --threads $t --repeat 1
       run "$kind $n" tessera-box "$build/tessera" bench voronoi "$p" --bounds 0 1 0 1 0 1 --threads $t --repeat 1
     done

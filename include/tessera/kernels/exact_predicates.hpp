@@ -56,7 +56,7 @@ struct Wall {
   double norm;  ///< an upper bound on |n|_2 (walls::misses)
 };
 /// At most this many walls (their ids stay far above INT32_MIN).
-constexpr int max_walls = 1 << 20;
+constexpr int max_walls = 1 << 26;
 constexpr std::int32_t wall_plane_id(int k) { return -7 - k; }
 constexpr bool is_wall_plane(std::int32_t id) { return id <= -7 && id > -7 - max_walls; }
 constexpr int wall_index(std::int32_t id) { return -7 - id; }
