@@ -83,6 +83,7 @@ class Index {
   struct Query {
     double x[3] = {0, 0, 0};
     double xn = 0;
+    double inv = 0;  // 1 / xn (0 where xn is)
     double room = 0;
     double reach = 0;
   };
@@ -94,6 +95,7 @@ class Index {
       xx += z.x[a] * z.x[a];
     }
     z.xn = std::sqrt(xx);
+    z.inv = z.xn > 0 ? 1 / z.xn : 0;
     // Room for every rounding below: the products with unit vectors, the
     // angle's sine and cosine (each within a few ulps), r.
     z.room = 1e-12 * (z.xn + r) + 1e-300;
@@ -106,11 +108,11 @@ class Index {
     double c = 1;  // an upper bound on cos(max(0, phi - alpha))
     if (nd.cos_lo > 0 && z.xn > 0) {
       const double* u = nd.axis;
-      const double cphi = (u[0] * z.x[0] + u[1] * z.x[1] + u[2] * z.x[2]) / z.xn;
+      const double cphi = (u[0] * z.x[0] + u[1] * z.x[1] + u[2] * z.x[2]) * z.inv;
       if (cphi < nd.cos_lo) {  // phi > alpha: cos(phi - alpha) = cos phi cos alpha + sin phi sin alpha
         const double cx = u[1] * z.x[2] - u[2] * z.x[1], cy = u[2] * z.x[0] - u[0] * z.x[2],
                      cz = u[0] * z.x[1] - u[1] * z.x[0];
-        const double sphi = std::sqrt(cx * cx + cy * cy + cz * cz) / z.xn;
+        const double sphi = std::sqrt(cx * cx + cy * cy + cz * cz) * z.inv;
         c = cphi * (cphi >= 0 ? nd.cos_hi : nd.cos_lo) + sphi * nd.sin_hi;
       }
     }
@@ -160,19 +162,24 @@ std::int32_t Index::deepest(const double* q, double r, Skip&& skip) const {
   const Query z = query(q, r);
   std::int32_t best = -1;
   double top_t = -std::numeric_limits<double>::infinity();
-  std::int32_t stack[64];
+  struct Entry {
+    std::int32_t at;
+    double u;  // its bound, computed when its parent was split
+  };
+  Entry stack[64];
   int top = 0;
-  stack[top++] = 0;
+  stack[top++] = {0, bound(nodes_[0], z)};
   while (top > 0) {
-    const std::int32_t at = stack[--top];
-    const Node& nd = nodes_[static_cast<std::size_t>(at)];
-    const double u = bound(nd, z);
-    if (u + z.reach < -z.room) continue;       // (NaN: visited)
-    if (best >= 0 && u + z.room < top_t) continue;  // nothing here beats the best
+    const Entry e = stack[--top];
+    const Node& nd = nodes_[static_cast<std::size_t>(e.at)];
+    if (e.u + z.reach < -z.room) continue;            // (NaN: visited)
+    if (best >= 0 && e.u + z.room < top_t) continue;  // nothing here beats the best
     if (nd.right >= 0) {  // the child bounding higher first
-      const bool right_first = bound(nodes_[static_cast<std::size_t>(nd.right)], z) > bound(nodes_[static_cast<std::size_t>(at + 1)], z);
-      stack[top++] = right_first ? at + 1 : nd.right;
-      stack[top++] = right_first ? nd.right : at + 1;
+      const Entry l{e.at + 1, bound(nodes_[static_cast<std::size_t>(e.at + 1)], z)};
+      const Entry r{nd.right, bound(nodes_[static_cast<std::size_t>(nd.right)], z)};
+      const bool right_first = r.u > l.u;
+      stack[top++] = right_first ? l : r;
+      stack[top++] = right_first ? r : l;
       continue;
     }
     for (std::int32_t j = nd.begin; j < nd.end; ++j) {

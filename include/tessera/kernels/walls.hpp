@@ -84,12 +84,13 @@ Ball<D> vertex_ball(const Vertex* verts, std::size_t nv) {
   bool finite = true;
   for (int a = 0; a < D; ++a) lo[a] = hi[a] = nv > 0 ? verts[0].y[a] : 0;
   for (std::size_t t = 0; t < nv; ++t) {
-    for (int a = 0; a < D; ++a) {
-      lo[a] = std::fmin(lo[a], verts[t].y[a]);
-      hi[a] = std::fmax(hi[a], verts[t].y[a]);
-      finite &= std::isfinite(verts[t].y[a]);
+    for (int a = 0; a < D; ++a) {  // (a NaN or an infinity clears `finite`: then no comparison matters)
+      const double y = verts[t].y[a];
+      lo[a] = y < lo[a] ? y : lo[a];
+      hi[a] = y > hi[a] ? y : hi[a];
+      finite &= std::isfinite(y);
     }
-    e = std::fmax(e, verts[t].e);
+    e = verts[t].e > e ? verts[t].e : e;
     finite &= std::isfinite(verts[t].e);
   }
   for (int a = 0; a < D; ++a) b.c[a] = 0.5 * lo[a] + 0.5 * hi[a];
@@ -99,9 +100,9 @@ Ball<D> vertex_ball(const Vertex* verts, std::size_t nv) {
     for (int a = 0; a < D; ++a) {
       const double g = verts[t].y[a] - b.c[a];
       s += g * g;
-      far = std::fmax(far, std::fabs(g));
+      far = std::fabs(g) > far ? std::fabs(g) : far;
     }
-    r2 = std::fmax(r2, s);
+    r2 = s > r2 ? s : r2;
   }
   const double r = r2 > 1e-280 && r2 < 1e280 ? std::sqrt(r2) : far * std::sqrt(static_cast<double>(D));
   b.r = finite ? (r + e * std::sqrt(static_cast<double>(D))) * (1 + 1e-12) : std::numeric_limits<double>::infinity();
