@@ -3,6 +3,7 @@
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <functional>
@@ -78,6 +79,7 @@ struct EngineOptions {
 /// clip_walls' lists, one set per thread (the engine's workspace).
 struct WallScratch {
   std::vector<std::int32_t> list, done;
+  std::vector<std::array<std::uint32_t, 3>> kept;  // vertices a round found a wall for, by their planes
 };
 
 /// Cut a built cell of generator p by the exact context's walls
@@ -164,19 +166,33 @@ template <class CellT>
   // A wall cut by stays out of the later rounds: the cell lies inside it
   // (its vertices on it would be found again). A vertex that a round found
   // beyond no wall is beyond none in the later rounds either: only the
-  // vertices of the round's new faces are asked again.
+  // vertices of the round's new faces are asked again, and those a round
+  // found a wall for that its cut kept (found within the index's margins,
+  // not beyond: it may lie beyond another).
   std::vector<std::int32_t>& done = scratch.done;
   index->near(p, 0.0, done);
   for (const std::int32_t k : done)
     if (!cut(k)) return;
   auto is_done = [&](std::int32_t k) { return std::binary_search(done.begin(), done.end(), k); };
+  auto key = [](const auto& v) {  // a vertex by its planes (a simple polytope's vertex has its own)
+    std::array<std::uint32_t, 3> k{0, 0, 0};
+    for (int a = 0; a < D; ++a) k[static_cast<std::size_t>(a)] = static_cast<std::uint32_t>(v.p[a]);
+    std::sort(k.begin(), k.begin() + D);
+    return k;
+  };
+  auto& kept = scratch.kept;
+  kept.clear();
   for (std::size_t old_planes = 0;;) {
     cell.solve_deferred();  // (a deferred vertex's bound is wide)
     list.clear();
+    std::size_t asked_again = kept.size();  // kept[0, asked_again): last round's; this round's appended
     for (const auto& v : cell.vertices()) {
       bool fresh = false;
       for (int a = 0; a < D; ++a) fresh |= v.p[a] >= old_planes;
-      if (!fresh) continue;
+      const auto vk = key(v);
+      if (!fresh && std::find(kept.begin(), kept.begin() + static_cast<std::ptrdiff_t>(asked_again), vk) ==
+                        kept.begin() + static_cast<std::ptrdiff_t>(asked_again))
+        continue;
       double x[3] = {0, 0, 0}, m = 0;
       for (int a = 0; a < D; ++a) {
         x[a] = p[a] + v.y[a];
@@ -185,8 +201,12 @@ template <class CellT>
       const double r = std::isfinite(v.e) ? v.e * std::sqrt(static_cast<double>(D)) + 4 * kernels::filter::u * m
                                           : std::numeric_limits<double>::infinity();
       const std::int32_t k = index->deepest(x, r, is_done);
-      if (k >= 0) list.push_back(k);
+      if (k >= 0) {
+        list.push_back(k);
+        kept.push_back(vk);
+      }
     }
+    kept.erase(kept.begin(), kept.begin() + static_cast<std::ptrdiff_t>(asked_again));
     if (list.empty()) break;
     old_planes = cell.planes().size();
     std::sort(list.begin(), list.end());

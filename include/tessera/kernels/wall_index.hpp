@@ -5,7 +5,10 @@
 // for a million points in a ball, two per point for points on a sphere),
 // and every cell testing every wall made that run 5x slower than the box
 // alone. With the index a cell tests only the walls whose plane passes
-// within its vertices' ball: none inside the domain, tens near its boundary.
+// within its vertices' ball (none inside the domain, tens near its
+// boundary), or, where that ball is a poor fit (a needle from a sphere's
+// point to its centre), the walls its vertices lie beyond
+// (engine::clip_walls).
 //
 // The question asked is: which walls n.x <= d have a point of the ball
 // B(q, r) outside (n.q + |n| r > d)? With every wall's normal scaled to unit
