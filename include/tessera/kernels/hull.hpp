@@ -146,7 +146,8 @@ class Hull {
 
   /// Cut the finished cell by wall k of the exact context (walls.hpp): after
   /// every clip by a neighbour, the walls in any order (engine::clip_walls
-  /// takes a hull's nearest first). `b`: a ball holding every vertex
+  /// takes those through the generator first where the cell is long). `b`:
+  /// a ball holding every vertex
   /// (vertex_ball(); a cut only shrinks the cell, so an older ball stays
   /// true). Emptied only where the whole cell lies outside (a power cell;
   /// the front end refuses generators outside a wall).
