@@ -351,7 +351,8 @@ class Hostile(base.TempDirCase):
         (the volumes against the polytope's, sampled cells exactly), the
         same neighbours; the graph and the boundary. Two cases in five take
         the points' convex hull as walls instead (--hull-walls, dilated half
-        the time: thousands of walls go through the wall index)."""
+        the time: thousands of walls go through the wall index); half the
+        others give their walls in a file (--walls, .npy or text)."""
         walls = []
         if rng.random() < 0.4:
             walls = ["--hull-walls"]
@@ -374,6 +375,15 @@ class Hostile(base.TempDirCase):
             else:
                 off = float(finite[int(rng.integers(0, len(finite)))])
             walls += ["--wall", ",".join(repr(float(x)) for x in list(n) + [off])]
+        if walls and walls[0] == "--wall" and rng.random() < 0.5:  # the same walls from a file (--walls)
+            rows = np.array([[float(x) for x in w.split(",")] for w in walls[1::2]])
+            if rng.random() < 0.5:
+                np.save(self.p("walls.npy"), rows)
+                walls = ["--walls", self.p("walls.npy")]
+            else:
+                with open(self.p("walls.txt"), "w") as f:
+                    f.write("# nx ny [nz] d\n" + "".join(" ".join(repr(x) for x in r) + "\n" for r in rows))
+                walls = ["--walls", self.p("walls.txt")]
         wc = common + walls + ["--ignore-outside"]
         accept = CUT_REFUSALS + ("its offset", "its normal's components", "--hull-walls: the points span no",
                                  "--hull-walls: a hull facet's normal", "--hull-walls: a wall's offset")
