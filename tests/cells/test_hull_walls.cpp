@@ -170,6 +170,8 @@ TEST(HullWalls, CellsInTheHullAreTheOraclesCells) {
         EXPECT_NEAR(c.centroid[k * dim + a], want.centroid[a], 1e-9) << dim << (sphere ? "D sphere" : "D ball") << ": cell " << i;
       sum += c.volume[k];
     }
+    // (Past 256 walls, as on the sphere, domain_volume sums sub-boxes of
+    // the box, each cut as a cell is.)
     const double hull = tessera::domain_volume(c.bounds, walls, dim);
     EXPECT_NEAR(sum, hull, 1e-12 * hull) << dim << sphere;
     const auto v = tessera::validate(c, {}, pts);

@@ -135,8 +135,9 @@ template <class CellT>
     qr = ball.r + 4 * kernels::filter::u * m;
   };
   std::vector<std::int32_t>& list = scratch.list;
+  constexpr std::size_t limit_near = 64;
   centre();
-  if (index->near(q, qr, list, 64)) {
+  if (index->near(q, qr, list, limit_near)) {
     double listed_for = ball.r;
     for (std::size_t i = 0; i < list.size(); ++i) {
       const std::int32_t k = list[i];
@@ -170,9 +171,12 @@ template <class CellT>
   // found a wall for that its cut kept (found within the index's margins,
   // not beyond: it may lie beyond another).
   std::vector<std::int32_t>& done = scratch.done;
-  index->near(p, 0.0, done);
-  for (const std::int32_t k : done)
-    if (!cut(k)) return;
+  if (index->near(p, 0.0, done, limit_near)) {
+    for (const std::int32_t k : done)
+      if (!cut(k)) return;
+  } else {  // p lies beyond many walls (domain_volume's boxes outside the domain): the rounds alone
+    done.clear();
+  }
   auto is_done = [&](std::int32_t k) { return std::binary_search(done.begin(), done.end(), k); };
   auto key = [](const auto& v) {  // a vertex by its planes (a simple polytope's vertex has its own)
     std::array<std::uint32_t, 3> k{0, 0, 0};
