@@ -537,7 +537,7 @@ std::string domain_string(const Cells& c) {
 }
 
 void print_volume_line(const Cells& c, const char* name) {
-  const double sum = accurate_sum(c.volume), dom = domain_volume(c.bounds, c.walls, c.dim);
+  const double sum = accurate_sum(c.volume), dom = domain_volume(c.bounds, c.walls, c.dim, c.threads_used);
   // Beyond the validator's rule the volumes in the input's units over- or
   // underflow, and comparing them says nothing.
   if (!volumes_representable(dom, c.n_cells()))

@@ -399,9 +399,10 @@ Cells voronoi(std::span<const double> points, int dim, std::span<const std::int3
 
 /// The domain's volume (area in 2D): `box` inside `walls` (VoronoiOptions::
 /// walls), 0 where they leave nothing; the box's volume without walls.
-/// Computed in double precision by the cell kernels. Throws InputError for
-/// walls voronoi() refuses.
-double domain_volume(const Bounds& box, const std::vector<Wall>& walls, int dim);
+/// Computed in double precision by the cell kernels; past 256 walls on
+/// `threads` threads (0: TESSERA_NUM_THREADS or all cores), the same result
+/// on any number. Throws InputError for walls voronoi() refuses.
+double domain_volume(const Bounds& box, const std::vector<Wall>& walls, int dim, int threads = 0);
 
 /// The convex hull of `points` (n x dim, row-major; dim 2 or 3) as walls,
 /// for VoronoiOptions::walls: cells bounded by the hull instead of a box. One

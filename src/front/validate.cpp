@@ -126,7 +126,7 @@ ValidationReport validate_in_arena(const Cells& c, std::span<const std::int32_t>
   // double can hold. Summed serially: the sum's rounding must not depend on
   // the thread count.
   for (double v : c.volume) r.volume_sum += v;
-  r.domain_volume = front::domain_volume(c.bounds, c.walls, D);  // the box inside the walls
+  r.domain_volume = front::domain_volume(c.bounds, c.walls, D, c.threads_used);  // the box inside the walls
   r.volume_rel_error = std::fabs(r.volume_sum - r.domain_volume) / r.domain_volume;
   r.volumes_checked = volumes_representable(r.domain_volume, nc);
   const bool all_inside = c.ignored_outside_bounds.empty() &&

@@ -6,9 +6,14 @@
 #include <cmath>
 #include <string>
 
+#include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+
 #include "../message_text.hpp"
 #include "cell_geometry.hpp"
 #include "tessera/engine/tessellate.hpp"  // clip_walls
+#include "tessera/engine/thread_arena.hpp"
 #include "tessera/kernels/filter.hpp"
 #include "tessera/kernels/hull.hpp"
 #include "tessera/kernels/tile.hpp"
@@ -127,7 +132,7 @@ double cut_box_measure(kernels::ExactContext& ctx, const double* c, const double
 }
 
 template <class CellT>
-double polytope_measure(const Bounds& box, const std::vector<Wall>& given) {
+double polytope_measure(const Bounds& box, const std::vector<Wall>& given, int threads) {
   constexpr int D = CellT::dim;
   const std::vector<kernels::Wall> walls = kernel_walls(given, D, 0);
   kernels::ExactContext ctx;
@@ -136,16 +141,19 @@ double polytope_measure(const Bounds& box, const std::vector<Wall>& given) {
   ctx.num_walls = static_cast<int>(walls.size());
   double centre[3] = {0, 0, 0};
   for (int a = 0; a < D; ++a) centre[a] = box.lo[static_cast<std::size_t>(a)] / 2 + box.hi[static_cast<std::size_t>(a)] / 2;
-  engine::WallScratch scratch;
   // Few walls: the box's centre as the one generator, its cell the box, cut
   // by every wall.
-  if (walls.size() <= 256) return cut_box_measure<CellT>(ctx, centre, box.lo.data(), box.hi.data(), scratch);
+  if (walls.size() <= 256) {
+    engine::WallScratch scratch;
+    return cut_box_measure<CellT>(ctx, centre, box.lo.data(), box.hi.data(), scratch);
+  }
   // Many (a hull's: two per point on a sphere): one cell cut by every wall
   // tests each cut's every vertex, O(walls^2) (40k walls 13 s). The box is
   // split into g^D sub-boxes, about 8 walls each, each cut as a cell is by
-  // the walls the index finds near it (engine::clip_walls). The sub-boxes
-  // share their faces' coordinates, so they partition the box; their
-  // measures are summed with compensation (Neumaier).
+  // the walls the index finds near it (engine::clip_walls), in parallel.
+  // The sub-boxes share their faces' coordinates, so they partition the
+  // box; their measures are summed in their order with compensation
+  // (Neumaier): the same sum on any number of threads.
   const kernels::walls::Index index(walls, D, centre);
   ctx.wall_index = &index;
   const int g = std::min(D == 3 ? 64 : 512, static_cast<int>(std::ceil(std::pow(static_cast<double>(walls.size()) / 8, 1.0 / D))));
@@ -153,19 +161,32 @@ double polytope_measure(const Bounds& box, const std::vector<Wall>& given) {
     const double lo = box.lo[static_cast<std::size_t>(a)], hi = box.hi[static_cast<std::size_t>(a)];
     return i == g ? hi : lo + (hi - lo) * (static_cast<double>(i) / g);
   };
+  const std::size_t cells = static_cast<std::size_t>(std::lround(std::pow(g, D)));
+  std::vector<double> part(cells);
+  struct Local {
+    kernels::ExactContext ctx;
+    engine::WallScratch scratch;
+  };
+  tbb::enumerable_thread_specific<Local> locals([&] { return Local{ctx, {}}; });
+  engine::ThreadArena(resolve_threads(threads)).execute([&] {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cells, 64), [&](const tbb::blocked_range<std::size_t>& r) {
+      Local& local = locals.local();
+      for (std::size_t cellno = r.begin(); cellno != r.end(); ++cellno) {
+        std::size_t rest = cellno;
+        double lo[3], hi[3], c[3];
+        for (int a = 0; a < D; ++a) {
+          const int i = static_cast<int>(rest % static_cast<std::size_t>(g));
+          rest /= static_cast<std::size_t>(g);
+          lo[a] = at(a, i);
+          hi[a] = at(a, i + 1);
+          c[a] = lo[a] / 2 + hi[a] / 2;
+        }
+        part[cellno] = cut_box_measure<CellT>(local.ctx, c, lo, hi, local.scratch);
+      }
+    });
+  });
   double sum = 0, carry = 0;
-  int idx[3] = {0, 0, 0};
-  for (long cellno = 0, cells = std::lround(std::pow(g, D)); cellno < cells; ++cellno) {
-    long rest = cellno;
-    double lo[3], hi[3], c[3];
-    for (int a = 0; a < D; ++a) {
-      idx[a] = static_cast<int>(rest % g);
-      rest /= g;
-      lo[a] = at(a, idx[a]);
-      hi[a] = at(a, idx[a] + 1);
-      c[a] = lo[a] / 2 + hi[a] / 2;
-    }
-    const double v = cut_box_measure<CellT>(ctx, c, lo, hi, scratch);
+  for (const double v : part) {
     const double t = sum + v;
     carry += std::fabs(sum) >= std::fabs(v) ? (sum - t) + v : (v - t) + sum;
     sum = t;
@@ -174,15 +195,16 @@ double polytope_measure(const Bounds& box, const std::vector<Wall>& given) {
 }
 }  // namespace
 
-double domain_volume(const Bounds& box, const std::vector<Wall>& walls, int dim) {
+double domain_volume(const Bounds& box, const std::vector<Wall>& walls, int dim, int threads) {
   if (walls.empty()) return box.volume(dim);
-  return dim == 3 ? polytope_measure<kernels::Hull>(box, walls) : polytope_measure<kernels::Tile>(box, walls);
+  return dim == 3 ? polytope_measure<kernels::Hull>(box, walls, threads)
+                  : polytope_measure<kernels::Tile>(box, walls, threads);
 }
 
 }  // namespace tessera::front
 
 namespace tessera {
-double domain_volume(const Bounds& box, const std::vector<Wall>& walls, int dim) {
-  return front::domain_volume(box, walls, dim);
+double domain_volume(const Bounds& box, const std::vector<Wall>& walls, int dim, int threads) {
+  return front::domain_volume(box, walls, dim, threads);
 }
 }  // namespace tessera

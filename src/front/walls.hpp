@@ -54,7 +54,9 @@ double largest_magnitude(std::span<const double> values);
 /// The volume (area in 2D) of the domain: `box` inside the walls (as
 /// given: the user's frame), 0 where they leave nothing; in double
 /// precision, by the cell kernels (a cell with no neighbours, cut by the
-/// walls) and their measure. For validate().
-double domain_volume(const Bounds& box, const std::vector<Wall>& walls, int dim);
+/// walls; past 256 walls, sub-boxes of the box cut so on `threads`
+/// threads, 0: TESSERA_NUM_THREADS or all) and their measure. For
+/// validate(), the CLI's summary and Lloyd.
+double domain_volume(const Bounds& box, const std::vector<Wall>& walls, int dim, int threads = 0);
 
 }  // namespace tessera::front

@@ -78,7 +78,7 @@ LloydResult lloyd(std::span<const double> points, int dim, std::span<const std::
       if (!vo.bounds) vo.bounds = cells.bounds;
       result.spacing = mean_spacing(cells.bounds, dim, cells.generators);
       if (!vo.walls.empty()) {  // the polytope's spacing: its volume per generator, rooted
-        const double v = front::domain_volume(cells.bounds, vo.walls, dim);
+        const double v = front::domain_volume(cells.bounds, vo.walls, dim, cells.threads_used);
         if (v > 0) result.spacing = std::pow(v / static_cast<double>(std::max<std::size_t>(cells.generators, 1)), 1.0 / dim);
       }
       result.threads_used = cells.threads_used;
