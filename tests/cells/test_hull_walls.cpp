@@ -171,8 +171,9 @@ TEST(HullWalls, CellsInTheHullAreTheOraclesCells) {
       sum += c.volume[k];
     }
     // (Past 256 walls, as on the sphere, domain_volume sums sub-boxes of
-    // the box, each cut as a cell is.)
-    const double hull = tessera::domain_volume(c.bounds, walls, dim);
+    // the box, each cut as a cell is, in parallel: the same on 1 and 2.)
+    const double hull = tessera::domain_volume(c.bounds, walls, dim, 1);
+    EXPECT_EQ(tessera::domain_volume(c.bounds, walls, dim, 2), hull) << dim << sphere;
     EXPECT_NEAR(sum, hull, 1e-12 * hull) << dim << sphere;
     const auto v = tessera::validate(c, {}, pts);
     EXPECT_TRUE(v.ok) << dim << (sphere ? "D sphere: " : "D ball: ") << (v.messages.empty() ? "" : v.messages[0]);
