@@ -114,12 +114,11 @@ namespace {
 // [lo, hi] cut by the context's walls (engine::clip_walls: every wall, or
 // with the context's index those it finds).
 template <class CellT>
-double cut_box_measure(kernels::ExactContext& ctx, const double* c, const double* lo, const double* hi,
+double cut_box_measure(kernels::ExactContext& ctx, const double* c, const double* lo, const double* hi, CellT& cell,
                        engine::WallScratch& scratch) {
   constexpr int D = CellT::dim;
   for (int a = 0; a < D; ++a) ctx.lo[static_cast<std::size_t>(a)] = lo[a], ctx.hi[static_cast<std::size_t>(a)] = hi[a];
   ctx.points = c;
-  CellT cell;
   cell.reset(0, c, lo, hi, &ctx);
   kernels::BuildStatus st;
   st.has_cell = true;
@@ -144,8 +143,9 @@ double polytope_measure(const Bounds& box, const std::vector<Wall>& given, int t
   // Few walls: the box's centre as the one generator, its cell the box, cut
   // by every wall.
   if (walls.size() <= 256) {
+    CellT cell;
     engine::WallScratch scratch;
-    return cut_box_measure<CellT>(ctx, centre, box.lo.data(), box.hi.data(), scratch);
+    return cut_box_measure<CellT>(ctx, centre, box.lo.data(), box.hi.data(), cell, scratch);
   }
   // Many (a hull's: two per point on a sphere): one cell cut by every wall
   // tests each cut's every vertex, O(walls^2) (40k walls 13 s). The box is
@@ -163,11 +163,12 @@ double polytope_measure(const Bounds& box, const std::vector<Wall>& given, int t
   };
   const std::size_t cells = static_cast<std::size_t>(std::lround(std::pow(g, D)));
   std::vector<double> part(cells);
-  struct Local {
+  struct Local {  // per thread: the context (its box and generator change with each sub-box), the cell, lists
     kernels::ExactContext ctx;
+    CellT cell;
     engine::WallScratch scratch;
   };
-  tbb::enumerable_thread_specific<Local> locals([&] { return Local{ctx, {}}; });
+  tbb::enumerable_thread_specific<Local> locals([&] { return Local{ctx, CellT{}, {}}; });
   engine::ThreadArena(resolve_threads(threads)).execute([&] {
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cells, 64), [&](const tbb::blocked_range<std::size_t>& r) {
       Local& local = locals.local();
@@ -181,7 +182,7 @@ double polytope_measure(const Bounds& box, const std::vector<Wall>& given, int t
           hi[a] = at(a, i + 1);
           c[a] = lo[a] / 2 + hi[a] / 2;
         }
-        part[cellno] = cut_box_measure<CellT>(local.ctx, c, lo, hi, local.scratch);
+        part[cellno] = cut_box_measure<CellT>(local.ctx, c, lo, hi, local.cell, local.scratch);
       }
     });
   });
