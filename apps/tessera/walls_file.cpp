@@ -4,23 +4,13 @@
 #include <fstream>
 #include <string>
 
-#include "commands.hpp"  // parse_number
+#include "commands.hpp"  // extension, parse_number
 #include "tessera/cells.hpp"  // InputError
 #include "tessera/io/npy.hpp"
 
 namespace tessera::cli {
 
 namespace {
-
-bool ends_with(const std::string& s, const std::string& tail) {
-  if (s.size() < tail.size()) return false;
-  for (std::size_t i = 0; i < tail.size(); ++i) {
-    char c = s[s.size() - tail.size() + i];
-    if (c >= 'A' && c <= 'Z') c = static_cast<char>(c - 'A' + 'a');
-    if (c != tail[i]) return false;
-  }
-  return true;
-}
 
 std::vector<std::vector<double>> from_npy(const std::string& path) {
   io::NpyArray a;
@@ -77,7 +67,7 @@ std::vector<std::vector<double>> from_text(const std::string& path) {
 }  // namespace
 
 std::vector<std::vector<double>> read_walls_file(const std::string& path) {
-  std::vector<std::vector<double>> walls = ends_with(path, ".npy") ? from_npy(path) : from_text(path);
+  std::vector<std::vector<double>> walls = extension(path) == ".npy" ? from_npy(path) : from_text(path);
   if (walls.empty()) throw InputError("--walls " + path + ": no walls in the file");
   return walls;
 }

@@ -82,6 +82,90 @@ struct WallScratch {
   std::vector<std::array<std::uint32_t, 3>> kept;  // vertices a round found a wall for, by their planes
 };
 
+namespace detail {
+
+/// p + y (a point relative to generator p) rounded into x; returns r grown
+/// by that rounding, so that the ball B(x, result) holds B(p + y, r).
+template <int D>
+double absolute(const double* p, const double* y, double r, double* x) {
+  double m = 0;
+  for (int a = 0; a < D; ++a) {
+    x[a] = p[a] + y[a];
+    m = std::fmax(m, std::fabs(x[a]));
+  }
+  return r + 4 * kernels::filter::u * m;
+}
+
+/// The cut of a cell that reaches past many walls (clip_walls: the ball of
+/// its vertices lists more than a few). The cell of a point on a sphere,
+/// cut by the hull of the samples, is a cone from the centre out to the
+/// box, and after its cuts a needle from the point to the centre, whose
+/// ball is tangent to the sphere inside: hundreds of the hull's tangent
+/// planes pass through that ball, where none but the point's own facets
+/// meets the needle. By convexity a wall cuts the cell only where some
+/// vertex lies beyond it. So the cell is cut first by the walls through its
+/// generator (a hull point's facets), then, round by round, by the wall
+/// each vertex lies farthest beyond (Index::deepest), until no vertex lies
+/// beyond any wall not cut by yet. A wall cut by stays out of the later
+/// rounds: the cell lies inside it (its vertices on it would be found
+/// again). A vertex that a round found beyond no wall is beyond none in the
+/// later rounds either: only the vertices of the round's new faces are
+/// asked again, and those a round found a wall for that its cut kept (found
+/// within the index's margins, not beyond: it may lie beyond another).
+/// `cut(k)` cuts by wall k, false where that empties the cell; returns
+/// false then.
+template <class CellT, class Cut>
+bool cut_by_vertex_rounds(CellT& cell, Cut&& cut, const kernels::walls::Index& index, const double* p,
+                          std::size_t limit, WallScratch& scratch) {
+  constexpr int D = CellT::dim;
+  std::vector<std::int32_t>& done = scratch.done;
+  if (index.near(p, 0.0, done, limit)) {
+    for (const std::int32_t k : done)
+      if (!cut(k)) return false;
+  } else {  // p lies beyond many walls (domain_volume's boxes outside the domain): the rounds alone
+    done.clear();
+  }
+  auto is_done = [&](std::int32_t k) { return std::binary_search(done.begin(), done.end(), k); };
+  auto key = [](const auto& v) {  // a vertex by its planes (a simple polytope's vertex has its own)
+    std::array<std::uint32_t, 3> k{0, 0, 0};
+    for (int a = 0; a < D; ++a) k[static_cast<std::size_t>(a)] = static_cast<std::uint32_t>(v.p[a]);
+    std::sort(k.begin(), k.begin() + D);
+    return k;
+  };
+  auto& kept = scratch.kept;
+  auto& list = scratch.list;
+  kept.clear();
+  for (std::size_t old_planes = 0;;) {
+    cell.solve_deferred();  // (a deferred vertex's bound is wide)
+    list.clear();
+    const auto last_round = static_cast<std::ptrdiff_t>(kept.size());  // kept[0, last_round); this round's appended
+    for (const auto& v : cell.vertices()) {
+      bool fresh = false;
+      for (int a = 0; a < D; ++a) fresh |= v.p[a] >= old_planes;
+      const auto vk = key(v);
+      if (!fresh && std::find(kept.begin(), kept.begin() + last_round, vk) == kept.begin() + last_round) continue;
+      double x[3] = {0, 0, 0};
+      const double r = absolute<D>(p, v.y, v.e * std::sqrt(static_cast<double>(D)), x);
+      const std::int32_t k = index.deepest(x, std::isfinite(r) ? r : std::numeric_limits<double>::infinity(), is_done);
+      if (k >= 0) {
+        list.push_back(k);
+        kept.push_back(vk);
+      }
+    }
+    kept.erase(kept.begin(), kept.begin() + last_round);
+    if (list.empty()) return true;
+    old_planes = cell.planes().size();
+    std::sort(list.begin(), list.end());
+    list.erase(std::unique(list.begin(), list.end()), list.end());
+    for (const std::int32_t k : list) {
+      done.insert(std::lower_bound(done.begin(), done.end(), k), k);
+      if (!cut(k)) return false;
+    }
+  }
+}
+
+}  // namespace detail
+
 /// Cut a built cell of generator p by the exact context's walls
 /// (kernels/walls.hpp): every wall, in ascending order, or with a wall index
 /// those it finds near the cell; a cell they leave empty has none
@@ -117,109 +201,31 @@ template <class CellT>
   // Most cells lie deep inside: no wall comes within their reach.
   bool any = false;
   index->visit(p, ball.r, [&](std::int32_t) { return !(any = true); });
-  if (!any) {
-    cell.solve_deferred();
-    return;
-  }
-  ball = cell.vertex_ball();
-
-  // The index is asked about the ball's centre p + c (rounded: the radius
-  // grows by that rounding).
-  double q[3] = {0, 0, 0}, qr = 0;
-  auto centre = [&] {
-    double m = 0;
-    for (int a = 0; a < D; ++a) {
-      q[a] = p[a] + ball.c[a];
-      m = std::fmax(m, std::fabs(q[a]));
-    }
-    qr = ball.r + 4 * kernels::filter::u * m;
-  };
-  std::vector<std::int32_t>& list = scratch.list;
-  constexpr std::size_t limit_near = 64;
-  centre();
-  if (index->near(q, qr, list, limit_near)) {
-    double listed_for = ball.r;
-    for (std::size_t i = 0; i < list.size(); ++i) {
-      const std::int32_t k = list[i];
-      if (!cut(k)) return;
-      // A ball under half the one the list was taken for takes a shorter
-      // list (from the next wall on: walls before k are behind the cell).
-      if (ball.r < 0.5 * listed_for) {
-        listed_for = ball.r;
-        centre();
-        index->near(q, qr, list);
-        i = static_cast<std::size_t>(std::upper_bound(list.begin(), list.end(), k) - list.begin()) - 1;  // (++i next)
+  if (any) {
+    // The walls near the vertices' ball (asked about its centre p + c),
+    // ascending; a ball under half the one the list was taken for takes a
+    // shorter list (from the next wall on: walls before k are behind the
+    // cell). Where they are many, the vertices are asked instead.
+    constexpr std::size_t few = 64;
+    ball = cell.vertex_ball();
+    double q[3] = {0, 0, 0};
+    std::vector<std::int32_t>& list = scratch.list;
+    if (!index->near(q, detail::absolute<D>(p, ball.c, ball.r, q), list, few)) {
+      if (!detail::cut_by_vertex_rounds(cell, cut, *index, p, few, scratch)) return;
+    } else {
+      double listed_for = ball.r;
+      for (std::size_t i = 0; i < list.size(); ++i) {
+        const std::int32_t k = list[i];
+        if (!cut(k)) return;
+        if (ball.r < 0.5 * listed_for) {
+          listed_for = ball.r;
+          index->near(q, detail::absolute<D>(p, ball.c, ball.r, q), list);
+          i = static_cast<std::size_t>(std::upper_bound(list.begin(), list.end(), k) - list.begin()) - 1;  // (++i next)
+        }
       }
     }
-    cell.solve_deferred();
-    return;
   }
-  // Many walls pass near the ball: the cell is long, or reaches far. The
-  // cell of a point on a sphere, cut by the hull of the samples, is a cone
-  // from the centre out to the box, and after its cuts a needle from the
-  // point to the centre, whose ball is tangent to the sphere inside:
-  // hundreds of the hull's tangent planes pass through that ball, where
-  // none but the point's own facets meets the needle. By convexity a wall
-  // cuts the cell only where some vertex lies outside it. So the cell is
-  // cut first by the walls through its generator (a hull point's facets),
-  // then, round by round, by the wall each vertex lies farthest beyond
-  // (Index::deepest), until no vertex lies beyond any wall not cut by yet.
-  // A wall cut by stays out of the later rounds: the cell lies inside it
-  // (its vertices on it would be found again). A vertex that a round found
-  // beyond no wall is beyond none in the later rounds either: only the
-  // vertices of the round's new faces are asked again, and those a round
-  // found a wall for that its cut kept (found within the index's margins,
-  // not beyond: it may lie beyond another).
-  std::vector<std::int32_t>& done = scratch.done;
-  if (index->near(p, 0.0, done, limit_near)) {
-    for (const std::int32_t k : done)
-      if (!cut(k)) return;
-  } else {  // p lies beyond many walls (domain_volume's boxes outside the domain): the rounds alone
-    done.clear();
-  }
-  auto is_done = [&](std::int32_t k) { return std::binary_search(done.begin(), done.end(), k); };
-  auto key = [](const auto& v) {  // a vertex by its planes (a simple polytope's vertex has its own)
-    std::array<std::uint32_t, 3> k{0, 0, 0};
-    for (int a = 0; a < D; ++a) k[static_cast<std::size_t>(a)] = static_cast<std::uint32_t>(v.p[a]);
-    std::sort(k.begin(), k.begin() + D);
-    return k;
-  };
-  auto& kept = scratch.kept;
-  kept.clear();
-  for (std::size_t old_planes = 0;;) {
-    cell.solve_deferred();  // (a deferred vertex's bound is wide)
-    list.clear();
-    std::size_t asked_again = kept.size();  // kept[0, asked_again): last round's; this round's appended
-    for (const auto& v : cell.vertices()) {
-      bool fresh = false;
-      for (int a = 0; a < D; ++a) fresh |= v.p[a] >= old_planes;
-      const auto vk = key(v);
-      if (!fresh && std::find(kept.begin(), kept.begin() + static_cast<std::ptrdiff_t>(asked_again), vk) ==
-                        kept.begin() + static_cast<std::ptrdiff_t>(asked_again))
-        continue;
-      double x[3] = {0, 0, 0}, m = 0;
-      for (int a = 0; a < D; ++a) {
-        x[a] = p[a] + v.y[a];
-        m = std::fmax(m, std::fabs(x[a]));
-      }
-      const double r = std::isfinite(v.e) ? v.e * std::sqrt(static_cast<double>(D)) + 4 * kernels::filter::u * m
-                                          : std::numeric_limits<double>::infinity();
-      const std::int32_t k = index->deepest(x, r, is_done);
-      if (k >= 0) {
-        list.push_back(k);
-        kept.push_back(vk);
-      }
-    }
-    kept.erase(kept.begin(), kept.begin() + static_cast<std::ptrdiff_t>(asked_again));
-    if (list.empty()) break;
-    old_planes = cell.planes().size();
-    std::sort(list.begin(), list.end());
-    list.erase(std::unique(list.begin(), list.end()), list.end());
-    for (const std::int32_t k : list) {
-      done.insert(std::lower_bound(done.begin(), done.end(), k), k);
-      if (!cut(k)) return;
-    }
-  }
+  cell.solve_deferred();
 }
 
 /// Build every cell of `gens.order` and hand each to the compositor; returns
