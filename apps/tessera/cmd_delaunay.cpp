@@ -1,5 +1,8 @@
 // `tessera delaunay` and `tessera bench delaunay` (see commands.hpp).
+#include <algorithm>
 #include <chrono>
+#include <limits>
+#include <optional>
 #include <span>
 #include <cstdio>
 #include <string>
@@ -8,6 +11,7 @@
 #include "commands.hpp"
 #include "frame_series.hpp"
 #include "progress.hpp"
+#include "tessera/alpha_shape.hpp"
 #include "tessera/delaunay.hpp"
 #include "tessera/io/atomic_file.hpp"
 #include "tessera/io/npy.hpp"
@@ -67,15 +71,84 @@ void check_delaunay_outputs(const DelaunayArgs& a) {
   if (!a.compute.periodic.empty() && (a.no_hull_completion || a.skip_cells >= 0 || a.method != "auto"))
     throw InputError("--periodic: a periodic triangulation has no hull (--no-hull-completion, --skip-cells and "
                      "--method do not apply)");
+  if (!a.boundary.empty() && a.boundary != "-") {
+    const std::string e = extension(a.boundary);
+    if (e != ".vtp" && e != ".npy")
+      throw InputError("--boundary " + a.boundary + ": unknown extension '" + e + "' (use .vtp or .npy)");
+  }
+  if (a.regularized && (a.boundary.empty() || !a.alpha))
+    throw InputError("--regularized: only with --alpha and --boundary (it leaves the alpha complex's singular facets "
+                     "out of the boundary)");
+  if (!a.compute.periodic.empty() && (a.alpha || !a.boundary.empty()))
+    throw InputError(std::string(a.alpha ? "--alpha" : "--boundary") +
+                     ": not available with --periodic (the facets of a periodic triangulation meet images)");
   if (a.method == "insertion" && a.no_hull_completion)
     throw InputError("--method insertion triangulates the whole convex hull: it cannot be combined with "
                      "--no-hull-completion");
-  if (a.output.empty() && a.simplices.empty() && a.simplex_shifts.empty() && !a.validate)
-    throw InputError("nothing to do: give -o OUTPUT.vtu|.vtp, --simplices FILE.npy or --validate");
-  for (const std::string* p : {&a.output, &a.simplices, &a.simplex_shifts})
+  if (a.output.empty() && a.simplices.empty() && a.simplex_shifts.empty() && a.boundary.empty() && !a.validate)
+    throw InputError("nothing to do: give -o OUTPUT.vtu|.vtp, --simplices FILE.npy, --boundary FILE or --validate");
+  for (const std::string* p : {&a.output, &a.simplices, &a.simplex_shifts, &a.boundary})
     if (!p->empty()) io::check_writable(*p);
-  check_distinct_outputs({{"-o", &a.output}, {"--simplices", &a.simplices}, {"--simplex-shifts", &a.simplex_shifts}});
-  route_standard_output({&a.simplices, &a.simplex_shifts});
+  check_distinct_outputs({{"-o", &a.output},
+                          {"--simplices", &a.simplices},
+                          {"--simplex-shifts", &a.simplex_shifts},
+                          {"--boundary", &a.boundary}});
+  route_standard_output({&a.simplices, &a.simplex_shifts, &a.boundary});
+}
+
+/// The triangulation of the rows kept (what -o and --simplices write with --alpha).
+Delaunay simplices_kept(const Delaunay& dt, const std::vector<std::int32_t>& rows) {
+  Delaunay k;
+  k.dim = dt.dim;
+  k.n_points = dt.n_points;
+  k.bounds = dt.bounds;
+  k.power = dt.power;
+  const std::size_t w = static_cast<std::size_t>(dt.dim + 1);
+  k.simplices.resize(rows.size() * w);
+  for (std::size_t i = 0; i < rows.size(); ++i)
+    std::copy_n(dt.simplices.data() + static_cast<std::size_t>(rows[i]) * w, w, k.simplices.data() + i * w);
+  return k;
+}
+
+/// --boundary: .vtp, or .npy int64 (B, D): the boundary facets, then (with
+/// `singular`) the singular ones. A boundary facet's SimplexId is the row
+/// of what --simplices writes that it bounds: the kept simplices' order
+/// with --alpha (`filtered`), the triangulation's without; -1 for singular ones.
+void write_boundary(const std::string& path, const AlphaShape& shape, bool filtered, bool singular,
+                    std::span<const double> coords) {
+  std::vector<std::int32_t> facets(shape.boundary);
+  if (singular) facets.insert(facets.end(), shape.singular.begin(), shape.singular.end());
+  const std::size_t nf = facets.size() / static_cast<std::size_t>(shape.dim);
+  if (path != "-" && extension(path) == ".vtp") {
+    std::vector<std::int64_t> simplex(nf, -1);
+    std::vector<std::uint8_t> is_singular(nf, 1);
+    for (std::size_t f = 0; f < shape.n_boundary(); ++f) {
+      const std::int32_t r = shape.boundary_simplex[f];
+      simplex[f] = filtered ? std::lower_bound(shape.simplex_rows.begin(), shape.simplex_rows.end(), r) -
+                                  shape.simplex_rows.begin()
+                            : r;
+      is_singular[f] = 0;
+    }
+    io::write_boundary_vtp(path, shape.dim, facets, simplex, is_singular, coords);
+    return;
+  }
+  std::vector<std::int64_t> ids(facets.begin(), facets.end());
+  io::write_file_atomic(path, io::npy_bytes(ids.data(), {nf, static_cast<std::size_t>(shape.dim)}));
+}
+
+void print_alpha_line(const AlphaShape& s, bool filtered, std::size_t all) {
+  const bool d3 = s.dim == 3;
+  const std::string kept =
+      filtered ? strf("alpha %.17g: %zu of %zu %s kept", s.alpha, s.n_simplices(), all, d3 ? "tetrahedra" : "triangles")
+               : strf("%zu %s", s.n_simplices(), d3 ? "tetrahedra" : "triangles");
+  std::fprintf(stderr,
+               "tessera: %s, %s %.17g; boundary %zu %s, %s %.17g; %zu piece%s, %zu non-manifold %s%s%s\n",
+               kept.c_str(), d3 ? "volume" : "area", s.volume, s.n_boundary(), d3 ? "triangles" : "segments",
+               d3 ? "area" : "length", s.boundary_measure, s.components, s.components == 1 ? "" : "s",
+               s.nonmanifold_ridges, d3 ? (s.nonmanifold_ridges == 1 ? "edge" : "edges")
+                                        : (s.nonmanifold_ridges == 1 ? "vertex" : "vertices"),
+               filtered ? strf("; %zu singular %s", s.n_singular(), d3 ? "triangles" : "segments").c_str() : "",
+               s.exact_tests == 0 ? "" : strf("; %zu tests exact", s.exact_tests).c_str());
 }
 
 }  // namespace
@@ -99,19 +172,36 @@ int run_delaunay_frame(const DelaunayArgs& a) {
   const Delaunay dt = triangulate(pc, opt,
                                   !a.quiet && stderr_is_terminal(), compute_s);
 
-  t0 = Clock::now();
-  std::vector<std::string> written;
   // A regular triangulation's radii (equal radii gave an ordinary one).
   const std::span<const double> radii = dt.power ? std::span<const double>(pc.radii) : std::span<const double>();
+  // The alpha shape, where asked for (alpha_s: its time), and the
+  // triangulation of its simplices that -o and --simplices write.
+  std::optional<AlphaShape> shape;
+  std::optional<Delaunay> kept;
+  double alpha_s = 0;
+  if (a.alpha || !a.boundary.empty()) {
+    t0 = Clock::now();
+    shape = alpha_shape(dt, pc.coords, a.alpha.value_or(std::numeric_limits<double>::infinity()), radii);
+    if (a.alpha) kept = simplices_kept(dt, shape->simplex_rows);
+    alpha_s = seconds_since(t0);
+  }
+  const Delaunay& out = kept ? *kept : dt;
+
+  t0 = Clock::now();
+  std::vector<std::string> written;
   if (!a.output.empty()) {
-    io::write_simplices_vtk(a.output, dt, pc.coords, radii);
+    io::write_simplices_vtk(a.output, out, pc.coords, radii);
     written.push_back(a.output);
   }
   if (!a.simplices.empty()) {
     // int64 (M, D+1), as scipy.spatial.Delaunay.simplices.
-    std::vector<std::int64_t> s(dt.simplices.begin(), dt.simplices.end());
-    io::write_file_atomic(a.simplices, io::npy_bytes(s.data(), {dt.n_simplices(), std::size_t(pc.dim + 1)}));
+    std::vector<std::int64_t> s(out.simplices.begin(), out.simplices.end());
+    io::write_file_atomic(a.simplices, io::npy_bytes(s.data(), {out.n_simplices(), std::size_t(pc.dim + 1)}));
     written.push_back(shown_output(a.simplices));
+  }
+  if (!a.boundary.empty()) {
+    write_boundary(a.boundary, *shape, a.alpha.has_value(), !a.regularized, pc.coords);
+    written.push_back(shown_output(a.boundary));
   }
   if (!a.simplex_shifts.empty()) {
     const auto d = static_cast<std::size_t>(pc.dim);
@@ -176,8 +266,10 @@ int run_delaunay_frame(const DelaunayArgs& a) {
     if (!dt.ignored_outside_bounds.empty())
       std::fprintf(stderr, "tessera: %zu points outside --bounds (or not finite) ignored\n",
                    dt.ignored_outside_bounds.size());
-    std::fprintf(stderr, "tessera: read %.3f s, triangulate %.3f s (%d thread%s), write %.3f s\n", read_s, compute_s,
-                 dt.threads_used, dt.threads_used == 1 ? "" : "s", write_s);
+    if (shape) print_alpha_line(*shape, a.alpha.has_value(), dt.n_simplices());
+    std::fprintf(stderr, "tessera: read %.3f s, triangulate %.3f s (%d thread%s), %swrite %.3f s\n", read_s,
+                 compute_s, dt.threads_used, dt.threads_used == 1 ? "" : "s",
+                 shape ? strf("alpha shape %.3f s, ", alpha_s).c_str() : "", write_s);
     for (const auto& w : written) std::fprintf(stderr, "tessera: wrote %s\n", w.c_str());
   }
   if (a.validate) {
@@ -212,7 +304,8 @@ int run_delaunay(const DelaunayArgs& a) {
   return run_frames(a,
                     {{"-o", &DelaunayArgs::output},
                      {"--simplices", &DelaunayArgs::simplices},
-                     {"--simplex-shifts", &DelaunayArgs::simplex_shifts}},
+                     {"--simplex-shifts", &DelaunayArgs::simplex_shifts},
+                     {"--boundary", &DelaunayArgs::boundary}},
                     run_delaunay_frame);
 }
 

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <initializer_list>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -144,6 +145,9 @@ struct DelaunayArgs {
   bool no_hull_completion = false;
   double skip_cells = -1;      ///< DelaunayOptions::skip_cells (negative: automatic)
   std::string method = "auto"; ///< DelaunayOptions::method: auto|cells|insertion
+  std::optional<double> alpha; ///< keep the simplices of circumradius <= alpha (tessera::alpha_shape)
+  std::string boundary;        ///< .vtp or .npy int64 (B, D): the boundary of the simplices written, or empty
+  bool regularized = false;    ///< --boundary without the alpha complex's singular facets
   bool validate = false;
   bool quiet = false;
 };

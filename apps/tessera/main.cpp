@@ -411,6 +411,25 @@ int main(int argc, char** argv) {
                   "where 3D hull completion stalls; else the cells (lattices). Same result")
       ->check(CLI::IsMember({"auto", "cells", "insertion"}))
       ->capture_default_str();
+  del->add_option("--alpha", dla.alpha,
+                  "Alpha shape: keep only the simplices whose circumsphere's radius is at most R (with --radii: "
+                  "whose orthosphere's squared radius |c-p|^2-r^2 is at most R^2, the dual of the balls grown by R). "
+                  "The union of those simplices is the regularized alpha shape (CGAL's REGULARIZED mode at its "
+                  "alpha = R^2; VTK's Alpha without its leftover triangles, edges and vertices): -o and --simplices "
+                  "hold the kept simplices, --boundary its surface. Decided exactly (lattices' equal radii all one "
+                  "way); inf keeps every simplex")
+      ->check(CLI::NonNegativeNumber);
+  del->add_option("--boundary", dla.boundary,
+                  "The boundary of the simplices written (the alpha shape's with --alpha; else the convex hull, or "
+                  "with --labels the inside region's): 3D triangles counter-clockwise seen from outside, 2D "
+                  "segments with the shape on their left; then, with --alpha, the alpha complex's singular facets "
+                  "(small, empty-sphere triangles or segments no kept simplex holds: a surface scan's reconstructed "
+                  "surface, a curve's samples), unoriented. .vtp (point data PointId; cell data SimplexId: the row "
+                  "of --simplices a facet bounds, -1 for singular ones, and Singular 0/1) or .npy (int64 (B, D) point "
+                  "ids, in that order); - writes the .npy to standard output");
+  del->add_flag("--regularized", dla.regularized,
+                "--boundary without the singular facets: the closed, oriented boundary of the kept simplices only "
+                "(CGAL's REGULARIZED mode)");
   del->add_flag("--validate", dla.validate,
                 "Check the triangulation (orientation, conformity, closed convex hull, every point used, local "
                 "Delaunay, volumes), print the report, exit 1 if a check fails");
@@ -424,8 +443,11 @@ int main(int argc, char** argv) {
       "with its vertices' images in --simplex-shifts; -o writes the points as wrapped into the box and one more\n"
       "point at each image a simplex uses (point data PointId: whose image). With --radii the regular\n"
       "triangulation (CGAL's Regular_triangulation on points in general position), its hidden points listed.\n"
+      "With --alpha R the simplices of circumradius <= R (the alpha shape; --validate checks the whole\n"
+      "triangulation), and --boundary its surface (a concave hull in 2D).\n"
       "Examples:\n"
       "  tessera delaunay points.npy -o tets.vtu --simplices tets.npy\n"
+      "  tessera delaunay scan.ply --alpha 0.05 --boundary surface.vtp\n"
       "  tessera delaunay points.csv --dim 2 -o triangles.vtp --validate\n"
       "  tessera delaunay spheres.ply --radii radius --simplices tets.npy --validate\n" +
       std::string(kExitCodes));

@@ -187,4 +187,37 @@ void write_simplices_vtk(const std::string& path, const Delaunay& dt, std::span<
   throw InputError("cannot write " + path + ": unknown extension '" + ext + "' (use .vtu, or .vtp in 2D)");
 }
 
+void write_boundary_vtp(const std::string& path, int dim, std::span<const std::int32_t> facets,
+                        std::span<const std::int64_t> simplex_id, std::span<const std::uint8_t> singular,
+                        std::span<const double> points) {
+  const auto d = static_cast<std::size_t>(dim);
+  const std::size_t nf = facets.size() / d;
+  // The points the facets use, in ascending id order, renumbered.
+  std::vector<std::int32_t> slot(points.size() / d, -1), point_id;
+  for (const std::int32_t v : facets) slot[static_cast<std::size_t>(v)] = 0;
+  for (std::size_t v = 0; v < slot.size(); ++v)
+    if (slot[v] == 0) {
+      slot[v] = static_cast<std::int32_t>(point_id.size());
+      point_id.push_back(static_cast<std::int32_t>(v));
+    }
+  std::vector<double> xyz;
+  xyz.reserve(point_id.size() * d);
+  for (const std::int32_t v : point_id)
+    xyz.insert(xyz.end(), points.begin() + static_cast<std::ptrdiff_t>(v * d),
+               points.begin() + static_cast<std::ptrdiff_t>((v + 1) * d));
+  std::vector<std::int32_t> conn(facets.size());
+  for (std::size_t e = 0; e < facets.size(); ++e) conn[e] = slot[static_cast<std::size_t>(facets[e])];
+  std::vector<std::int64_t> offsets(nf + 1);
+  for (std::size_t f = 0; f <= nf; ++f) offsets[f] = static_cast<std::int64_t>(f * d);
+  PolyData pd;
+  pd.dim = dim;
+  pd.points = xyz;
+  if (dim == 3) pd.polys = {offsets, conn};
+  else pd.lines = {offsets, conn};
+  pd.point_data.push_back({"PointId", std::span<const std::int32_t>(point_id)});
+  pd.cell_data.push_back({"SimplexId", simplex_id});
+  pd.cell_data.push_back({"Singular", singular});
+  write_polydata(path, pd);
+}
+
 }  // namespace tessera::io

@@ -1,6 +1,7 @@
 // VTK output of a Delaunay triangulation: the input points and the simplices.
 #pragma once
 
+#include <cstdint>
 #include <span>
 #include <string>
 
@@ -20,5 +21,15 @@ namespace tessera::io {
 /// (Float64; an image has its point's), for glyphs in ParaView.
 void write_simplices_vtk(const std::string& path, const Delaunay& dt, std::span<const double> points,
                          std::span<const double> radii = {});
+
+/// .vtp of facets (an alpha shape's boundary and singular facets: `facets`,
+/// dim point ids each): 3D triangles as polygons, 2D segments as lines
+/// (z = 0), over the points they use only (point data PointId: the input
+/// point). Cell data, one per facet: SimplexId (Int64, the row of the
+/// simplices written that it bounds, or -1) and Singular (UInt8). Written
+/// atomically; throws as write_polydata.
+void write_boundary_vtp(const std::string& path, int dim, std::span<const std::int32_t> facets,
+                        std::span<const std::int64_t> simplex_id, std::span<const std::uint8_t> singular,
+                        std::span<const double> points);
 
 }  // namespace tessera::io

@@ -1,0 +1,554 @@
+// tessera::alpha_shape (include/tessera/alpha_shape.hpp): which simplices
+// are small enough, and the boundary of their union.
+//
+// The keep test. With vertex a as origin, e_k = p_k - a and the lifted
+// weights w_k = |e_k|^2 + r_a^2 - r_k^2 (all r = 0 without radii), the
+// circumcentre (orthocentre) c - a solves 2 e_k . (c - a) = w_k, so
+// c - a = n / (2 D), D = det[e_1 .. e_D] and
+//   3D: n = w_1 (e_2 x e_3) + w_2 (e_3 x e_1) + w_3 (e_1 x e_2),
+//   2D: n = (w_1 e_2y - w_2 e_1y, w_2 e_1x - w_1 e_2x).
+// The squared radius |c - a|^2 - r_a^2 is at most alpha^2 iff
+//   |n|^2 <= 4 D^2 (alpha^2 + r_a^2).
+// The float filter evaluates both sides on the differences scaled by a
+// power of two (largest component in [1, 2): nothing overflows or
+// underflows but a far-off alpha or radius) with error bounds from the
+// permanents (the same terms in absolute values): each side's terms are
+// products of at most eight rounded factors and about ten rounded
+// operations, so 64 unit roundoffs of the permanent bound their error with
+// room to spare. Where the two intervals meet, rationals decide (GMP: every
+// double is one). A simplex whose D is zero exactly (flat) is never kept.
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <bit>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <numeric>
+#include <span>
+#include <string>
+#include <vector>
+
+#include <gmpxx.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include "pass.hpp"
+#include "point_buckets.hpp"
+#include "tessera/alpha_shape.hpp"
+#include "tessera/engine/thread_arena.hpp"
+
+namespace tessera {
+namespace {
+
+constexpr double unit = 0x1p-53;  // unit roundoff
+
+/// A simplex's corners (D + 1 pointers to dim doubles) and, with radii, theirs.
+struct Corners {
+  int D = 3;
+  std::array<const double*, 4> p{};
+  std::array<double, 4> r{0, 0, 0, 0};
+};
+
+Corners corners(const Delaunay& dt, std::span<const double> points, std::span<const double> radii, std::size_t row) {
+  Corners c;
+  c.D = dt.dim;
+  const std::size_t w = static_cast<std::size_t>(dt.dim + 1);
+  for (std::size_t k = 0; k < w; ++k) {
+    const auto id = static_cast<std::size_t>(dt.simplices[row * w + k]);
+    c.p[k] = points.data() + id * static_cast<std::size_t>(dt.dim);
+    if (!radii.empty()) c.r[k] = radii[id];
+  }
+  return c;
+}
+
+/// A float value and its permanent (the same expression over the absolute
+/// values of its inputs): the rounding error of the value is at most a few
+/// dozen unit roundoffs of the permanent for the expressions below.
+struct Approx {
+  double v = 0, p = 0;
+  Approx() = default;
+  explicit Approx(double x) : v(x), p(std::fabs(x)) {}
+  Approx(double value, double perm) : v(value), p(perm) {}
+};
+Approx operator+(Approx a, Approx b) { return {a.v + b.v, a.p + b.p}; }
+Approx operator-(Approx a, Approx b) { return {a.v - b.v, a.p + b.p}; }
+Approx operator*(Approx a, Approx b) { return {a.v * b.v, a.p * b.p}; }
+
+/// A corner a and vectors to other points from it, with lifted weights
+/// w = |e|^2 + r_a^2 - r^2, and rhs = alpha^2 + r_a^2: in T = Approx on
+/// differences scaled by 2^scale (the largest in [1, 2)), in T = mpq_class
+/// exactly.
+template <class T>
+struct Frame {
+  int D = 3, m = 0;  ///< dimension; vectors
+  int scale = 0;     ///< Approx: the vectors are the differences times 2^scale
+  std::array<std::array<T, 3>, 5> e;
+  std::array<T, 5> w;
+  T rhs;
+};
+
+/// a, its radius, the other points q[0..m) and theirs. Approx: false when
+/// something is not finite (far radii, a huge spread): rationals then.
+bool make_frame(Frame<Approx>& f, int D, const double* a, double ra, const double* const* q, const double* rq, int m,
+                double alpha) {
+  f.D = D;
+  f.m = m;
+  double x[5][3] = {};
+  double big = 0;
+  for (int k = 0; k < m; ++k)
+    for (int d = 0; d < D; ++d) {
+      x[k][d] = q[k][d] - a[d];
+      big = std::max(big, std::fabs(x[k][d]));
+    }
+  if (!(big > 0) || !std::isfinite(big)) return false;
+  int ex = 0;
+  std::frexp(big, &ex);  // big = f 2^ex, f in [0.5, 1)
+  const int scale = 1 - ex;
+  f.scale = scale;
+  const Approx ras(std::ldexp(ra, scale));
+  const Approx ra2 = ras * ras;
+  for (int k = 0; k < m; ++k) {
+    Approx sq;
+    for (int d = 0; d < D; ++d) {
+      f.e[static_cast<std::size_t>(k)][static_cast<std::size_t>(d)] = Approx(std::ldexp(x[k][d], scale));
+      const Approx& c = f.e[static_cast<std::size_t>(k)][static_cast<std::size_t>(d)];
+      sq = sq + c * c;
+    }
+    const Approx rk(std::ldexp(rq[k], scale));
+    f.w[static_cast<std::size_t>(k)] = sq + ra2 - rk * rk;
+  }
+  // alpha capped at 2^100 (scaled; the vectors are below 2): a test the
+  // capped alpha passes, the true one passes too (callers redo the others).
+  const Approx as(std::min(std::ldexp(alpha, scale), 0x1p100));
+  f.rhs = as * as + ra2;
+  return std::isfinite(f.rhs.p) && std::isfinite(f.w[0].p) && std::isfinite(f.w[static_cast<std::size_t>(m - 1)].p);
+}
+
+bool alpha_capped(double alpha, const double* a, const double* const* q, int m, int D) {
+  double big = 0;
+  for (int k = 0; k < m; ++k)
+    for (int d = 0; d < D; ++d) big = std::max(big, std::fabs(q[k][d] - a[d]));
+  int ex = 0;
+  std::frexp(big, &ex);
+  return std::ldexp(alpha, 1 - ex) > 0x1p100;
+}
+
+void make_frame(Frame<mpq_class>& f, int D, const double* a, double ra, const double* const* q, const double* rq,
+                int m, double alpha) {
+  f.D = D;
+  f.m = m;
+  const mpq_class ra2 = mpq_class(ra) * mpq_class(ra);
+  for (int k = 0; k < m; ++k) {
+    mpq_class sq = 0;
+    for (int d = 0; d < D; ++d) {
+      auto& c = f.e[static_cast<std::size_t>(k)][static_cast<std::size_t>(d)];
+      c = mpq_class(q[k][d]) - mpq_class(a[d]);
+      sq += c * c;
+    }
+    const mpq_class rk(rq[k]);
+    f.w[static_cast<std::size_t>(k)] = sq + ra2 - rk * rk;
+  }
+  f.rhs = mpq_class(alpha) * mpq_class(alpha) + ra2;
+}
+
+template <class T>
+T dot(const Frame<T>& f, int i, int j) {
+  T s = f.e[static_cast<std::size_t>(i)][0] * f.e[static_cast<std::size_t>(j)][0];
+  for (int d = 1; d < f.D; ++d)
+    s = s + f.e[static_cast<std::size_t>(i)][static_cast<std::size_t>(d)] *
+                f.e[static_cast<std::size_t>(j)][static_cast<std::size_t>(d)];
+  return s;
+}
+
+/// A simplex (vectors 0..D-1 its edges from a): 4 det^2 rhs - |n|^2, which
+/// is >= 0 iff its circumsphere (orthosphere) is small enough; and det.
+template <class T>
+T simplex_margin(const Frame<T>& f, T& det) {
+  const auto& e = f.e;
+  const auto& w = f.w;
+  T n2;
+  if (f.D == 3) {
+    std::array<std::array<T, 3>, 3> c;  // e_1 x e_2, e_2 x e_0, e_0 x e_1
+    for (int i = 0; i < 3; ++i) {
+      const auto j = static_cast<std::size_t>((i + 1) % 3), k = static_cast<std::size_t>((i + 2) % 3);
+      for (int d = 0; d < 3; ++d) {
+        const auto d1 = static_cast<std::size_t>((d + 1) % 3), d2 = static_cast<std::size_t>((d + 2) % 3);
+        c[static_cast<std::size_t>(i)][static_cast<std::size_t>(d)] = e[j][d1] * e[k][d2] - e[j][d2] * e[k][d1];
+      }
+    }
+    det = e[0][0] * c[0][0] + e[0][1] * c[0][1] + e[0][2] * c[0][2];
+    for (std::size_t d = 0; d < 3; ++d) {
+      const T n = w[0] * c[0][d] + w[1] * c[1][d] + w[2] * c[2][d];
+      if (d == 0) n2 = n * n;
+      else n2 = n2 + n * n;
+    }
+  } else {
+    det = e[0][0] * e[1][1] - e[0][1] * e[1][0];
+    const T n0 = w[0] * e[1][1] - w[1] * e[0][1], n1 = w[1] * e[0][0] - w[0] * e[1][0];
+    n2 = n0 * n0 + n1 * n1;
+  }
+  const T four(4);
+  return four * det * det * f.rhs - n2;
+}
+
+/// A facet (vectors 0..D-2 its edges from a) with the Gram matrix G of its
+/// edges, g = det G, and u = adj(G) w: its smallest orthosphere (centre in
+/// its affine hull) has centre a + (u . E) / (2 g) and squared radius
+/// w . u / (4 g) - r_a^2.
+template <class T>
+struct FacetTerms {
+  T g;
+  std::array<T, 2> u;
+};
+
+template <class T>
+FacetTerms<T> facet_terms(const Frame<T>& f) {
+  FacetTerms<T> t;
+  if (f.D == 2) {
+    t.g = dot(f, 0, 0);
+    t.u[0] = f.w[0];
+    return t;
+  }
+  const T g11 = dot(f, 0, 0), g12 = dot(f, 0, 1), g22 = dot(f, 1, 1);
+  t.g = g11 * g22 - g12 * g12;
+  t.u[0] = g22 * f.w[0] - g12 * f.w[1];
+  t.u[1] = g11 * f.w[1] - g12 * f.w[0];
+  return t;
+}
+
+/// 4 g rhs - w . u: >= 0 iff the facet's smallest orthosphere is small enough.
+template <class T>
+T facet_margin(const Frame<T>& f, const FacetTerms<T>& t) {
+  const T four(4);
+  T wu = f.w[0] * t.u[0];
+  if (f.D == 3) wu = wu + f.w[1] * t.u[1];
+  return four * t.g * f.rhs - wu;
+}
+
+/// For the apex at vector `k`: u . (E e_k) - w_k g, > 0 iff the apex lies
+/// strictly inside the facet's smallest orthosphere (the facet is attached).
+template <class T>
+T apex_margin(const Frame<T>& f, const FacetTerms<T>& t, int k) {
+  T s = t.u[0] * dot(f, 0, k);
+  if (f.D == 3) s = s + t.u[1] * dot(f, 1, k);
+  return s - f.w[static_cast<std::size_t>(k)] * t.g;
+}
+
+/// The sign of an Approx margin when its float value clears its error
+/// bound, else 0.
+int filtered_sign(const Approx& x) {
+  constexpr double filter_ulps = 64;
+  constexpr double tiny = 0x1p-1000;  // subnormal roundings: far below any scaled term that matters
+  const double err = filter_ulps * unit * x.p + tiny;
+  if (!std::isfinite(x.v) || !std::isfinite(err)) return 0;
+  return x.v > err ? 1 : x.v < -err ? -1 : 0;
+}
+
+/// Whether a simplex is kept: its circumsphere (orthosphere) has a squared
+/// radius at most alpha^2.
+bool keep_simplex(const Corners& s, double alpha, std::size_t& exact) {
+  const double* q[3] = {s.p[1], s.p[2], s.p[3]};
+  const double rq[3] = {s.r[1], s.r[2], s.r[3]};
+  Frame<Approx> f;
+  if (make_frame(f, s.D, s.p[0], s.r[0], q, rq, s.D, alpha)) {
+    Approx det;
+    const int sign = filtered_sign(simplex_margin(f, det));
+    if (sign > 0) return true;
+    if (sign < 0 && !alpha_capped(alpha, s.p[0], q, s.D, s.D)) return false;
+  }
+  ++exact;
+  thread_local Frame<mpq_class> g;
+  make_frame(g, s.D, s.p[0], s.r[0], q, rq, s.D, alpha);
+  mpq_class det;
+  const mpq_class margin = simplex_margin(g, det);
+  return sgn(det) != 0 && sgn(margin) >= 0;
+}
+
+/// Whether a facet (D corners) that no kept simplex holds is a singular face
+/// of the alpha complex: its smallest orthosphere has a squared radius at
+/// most alpha^2 and holds neither apex (the opposite vertices of its one or
+/// two simplices) strictly inside.
+bool singular_facet(int D, const double* const* p, const double* r, int apexes, double alpha, std::size_t& exact) {
+  // Vectors from p[0]: the facet's other corners, then the apexes.
+  const int m = D - 1 + apexes;
+  const double* q[4];
+  double rq[4];
+  for (int k = 0; k < m; ++k) {
+    q[k] = p[k + 1];
+    rq[k] = r[k + 1];
+  }
+  Frame<Approx> f;
+  if (make_frame(f, D, p[0], r[0], q, rq, m, alpha)) {
+    const FacetTerms<Approx> t = facet_terms(f);
+    const int small = filtered_sign(facet_margin(f, t));
+    if (small < 0 && !alpha_capped(alpha, p[0], q, m, D)) return false;
+    if (small > 0) {
+      bool decided = true;
+      for (int k = D - 1; k < m && decided; ++k) {
+        const int in = filtered_sign(apex_margin(f, t, k));
+        if (in > 0) return false;  // attached
+        decided = in < 0;
+      }
+      if (decided) return true;
+    }
+  }
+  ++exact;
+  thread_local Frame<mpq_class> g;
+  make_frame(g, D, p[0], r[0], q, rq, m, alpha);
+  const FacetTerms<mpq_class> t = facet_terms(g);
+  if (sgn(t.g) == 0 || sgn(facet_margin(g, t)) < 0) return false;
+  for (int k = D - 1; k < m; ++k)
+    if (sgn(apex_margin(g, t, k)) > 0) return false;
+  return true;
+}
+
+/// Neumaier's compensated sum, added to in a fixed order.
+struct CompensatedSum {
+  double sum = 0, carry = 0;
+  void add(double x) {
+    const double t = sum + x;
+    carry += std::fabs(sum) >= std::fabs(x) ? (sum - t) + x : (x - t) + sum;
+    sum = t;
+  }
+  double value() const { return sum + carry; }
+};
+
+void check_arguments(const Delaunay& dt, std::span<const double> points, std::span<const double> radii,
+                     const char* who) {
+  front::refuse_periodic(dt, who);
+  front::check_simplex_ids(dt);
+  if (points.size() != dt.n_points * static_cast<std::size_t>(dt.dim))
+    throw InputError(std::string(who) + ": " + std::to_string(points.size()) + " coordinates for a triangulation of " +
+                     std::to_string(dt.n_points) + " points in " + std::to_string(dt.dim) + "D");
+  if (dt.power && radii.size() != dt.n_points)
+    throw InputError(std::string(who) + ": a regular triangulation of " + std::to_string(dt.n_points) +
+                     " points needs their " + std::to_string(dt.n_points) + " radii, got " +
+                     std::to_string(radii.size()));
+  if (!dt.power && !radii.empty())
+    throw InputError(std::string(who) + ": radii given for a triangulation computed without them");
+  if (!radii.empty()) front::check_radii(radii, dt.n_points);
+}
+
+/// The facet of a row opposite its slot k, oriented outward (3D) or with the
+/// simplex on its left (2D). Taking slot k out of a positively oriented row
+/// leaves its vertex on the facet's outer side when k is even (3D: det of
+/// the facet's edges with the far vertex is then negative; 2D: the segment
+/// has the triangle on its left); for odd k two ids swap.
+void outward_facet(const std::int32_t* row, int D, int k, std::int32_t* out) {
+  int m = 0;
+  for (int j = 0; j <= D; ++j)
+    if (j != k) out[m++] = row[j];
+  if (k % 2 == 1) std::swap(out[0], out[1]);
+}
+
+std::size_t find_root(std::vector<std::int32_t>& parent, std::int32_t x) {
+  while (parent[static_cast<std::size_t>(x)] != x) {
+    parent[static_cast<std::size_t>(x)] = parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(x)])];
+    x = parent[static_cast<std::size_t>(x)];
+  }
+  return static_cast<std::size_t>(x);
+}
+
+}  // namespace
+
+std::vector<double> simplex_squared_radii(const Delaunay& dt, std::span<const double> points,
+                                          std::span<const double> radii) {
+  check_arguments(dt, points, radii, "simplex_squared_radii");
+  std::vector<double> out(dt.n_simplices());
+  engine::ThreadArena(dt.threads_used).execute([&] {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, out.size(), 4096), [&](const tbb::blocked_range<std::size_t>& rg) {
+      for (std::size_t r = rg.begin(); r != rg.end(); ++r) {
+        const Corners s = corners(dt, points, radii, r);
+        const double* q[3] = {s.p[1], s.p[2], s.p[3]};
+        const double rq[3] = {s.r[1], s.r[2], s.r[3]};
+        Frame<Approx> f;
+        out[r] = std::numeric_limits<double>::infinity();
+        if (!make_frame(f, s.D, s.p[0], s.r[0], q, rq, s.D, 0.0)) continue;
+        Approx det;
+        const Approx margin = simplex_margin(f, det);  // 4 det^2 r_a^2 - |n|^2
+        const double rho2 = -margin.v / (4 * det.v * det.v);
+        if (det.v != 0 && std::isfinite(rho2)) out[r] = std::ldexp(rho2, -2 * f.scale);
+      }
+    });
+  });
+  return out;
+}
+
+AlphaShape alpha_shape(const Delaunay& dt, std::span<const double> points, double alpha,
+                       std::span<const double> radii) {
+  check_arguments(dt, points, radii, "alpha_shape");
+  if (std::isnan(alpha) || alpha < 0)
+    throw InputError("alpha_shape: alpha must be a radius >= 0 (or +inf for the whole triangulation), got " +
+                     std::to_string(alpha));
+  const int D = dt.dim;
+  const std::size_t w = static_cast<std::size_t>(D + 1), m = dt.n_simplices();
+  AlphaShape shape;
+  shape.dim = D;
+  shape.alpha = alpha;
+
+  // Which simplices are kept.
+  std::vector<std::uint8_t> kept(m, 1);
+  std::atomic<std::size_t> exact{0};
+  engine::ThreadArena arena(dt.threads_used);
+  if (!std::isinf(alpha)) {
+    arena.execute([&] {
+      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, m, 4096), [&](const tbb::blocked_range<std::size_t>& rg) {
+        std::size_t here = 0;
+        for (std::size_t r = rg.begin(); r != rg.end(); ++r) kept[r] = keep_simplex(corners(dt, points, radii, r), alpha, here);
+        exact += here;
+      });
+    });
+  }
+  for (std::size_t r = 0; r < m; ++r)
+    if (kept[r]) shape.simplex_rows.push_back(static_cast<std::int32_t>(r));
+
+  // Per row, which of its facets are on the boundary (bits 0..D: the
+  // simplex is kept, the other side not) and which are singular faces of the
+  // alpha complex (bits 4..4+D: neither side kept, and the facet small and
+  // unattached; a shared facet is decided at its lower row). Then each
+  // kind's facets are counted per block of rows and filled at each block's
+  // offset: row order on any thread count.
+  const std::vector<std::int32_t> nb = m == 0 ? std::vector<std::int32_t>() : simplex_neighbors(dt);
+  std::vector<std::uint8_t> open(m, 0);
+  const bool finite_alpha = !std::isinf(alpha);
+  constexpr std::size_t block = 1 << 14;
+  const std::size_t blocks = (m + block - 1) / block;
+  arena.execute([&] {
+    tbb::parallel_for(std::size_t{0}, blocks, [&](std::size_t b) {
+      std::size_t here = 0;
+      for (std::size_t r = b * block; r < std::min(m, (b + 1) * block); ++r) {
+        std::uint8_t bits = 0;
+        for (std::size_t k = 0; k < w; ++k) {
+          const std::int32_t o = nb[r * w + k];
+          const bool other_kept = o >= 0 && kept[static_cast<std::size_t>(o)];
+          if (kept[r]) {
+            if (!other_kept) bits |= static_cast<std::uint8_t>(1u << k);
+            continue;
+          }
+          if (!finite_alpha || other_kept || (o >= 0 && static_cast<std::size_t>(o) < r)) continue;
+          // The facet's corners, then its apexes: this row's vertex k and
+          // the neighbour's vertex across it.
+          const double* p[5];
+          double rr[5] = {0, 0, 0, 0, 0};
+          int c = 0;
+          auto add = [&](std::int32_t id) {
+            p[c] = points.data() + static_cast<std::size_t>(id) * static_cast<std::size_t>(D);
+            if (!radii.empty()) rr[c] = radii[static_cast<std::size_t>(id)];
+            ++c;
+          };
+          for (std::size_t j = 0; j < w; ++j)
+            if (j != k) add(dt.simplices[r * w + j]);
+          add(dt.simplices[r * w + k]);
+          if (o >= 0) {
+            const auto ou = static_cast<std::size_t>(o);
+            for (std::size_t j = 0; j < w; ++j)
+              if (nb[ou * w + j] == static_cast<std::int32_t>(r)) add(dt.simplices[ou * w + j]);
+          }
+          if (singular_facet(D, p, rr, c - D, alpha, here)) bits |= static_cast<std::uint8_t>(16u << k);
+        }
+        open[r] = bits;
+      }
+      exact += here;
+    });
+  });
+  shape.exact_tests = exact;
+  auto gather = [&](unsigned shift, std::vector<std::int32_t>& facets, std::vector<std::int32_t>* simplex) {
+    std::vector<std::size_t> at(blocks + 1, 0);
+    arena.execute([&] {
+      tbb::parallel_for(std::size_t{0}, blocks, [&](std::size_t b) {
+        std::size_t c = 0;
+        for (std::size_t r = b * block; r < std::min(m, (b + 1) * block); ++r)
+          c += static_cast<std::size_t>(std::popcount(static_cast<unsigned>(open[r] >> shift) & 15u));
+        at[b + 1] = c;
+      });
+    });
+    std::partial_sum(at.begin(), at.end(), at.begin());
+    facets.resize(at[blocks] * static_cast<std::size_t>(D));
+    if (simplex) simplex->resize(at[blocks]);
+    arena.execute([&] {
+      tbb::parallel_for(std::size_t{0}, blocks, [&](std::size_t b) {
+        std::size_t f = at[b];
+        for (std::size_t r = b * block; r < std::min(m, (b + 1) * block); ++r)
+          for (std::size_t k = 0; k < w; ++k) {
+            if (!((open[r] >> shift) & (1u << k))) continue;
+            outward_facet(dt.simplices.data() + r * w, D, static_cast<int>(k), facets.data() + f * static_cast<std::size_t>(D));
+            if (simplex) (*simplex)[f] = static_cast<std::int32_t>(r);
+            ++f;
+          }
+      });
+    });
+  };
+  gather(0, shape.boundary, &shape.boundary_simplex);
+  gather(4, shape.singular, nullptr);
+
+  // Pieces: union-find over the kept simplices through their shared facets.
+  {
+    std::vector<std::int32_t> parent(m);
+    std::iota(parent.begin(), parent.end(), 0);
+    for (const std::int32_t r : shape.simplex_rows)
+      for (std::size_t k = 0; k < w; ++k) {
+        const std::int32_t o = nb[static_cast<std::size_t>(r) * w + k];
+        if (o < r || !kept[static_cast<std::size_t>(o)]) continue;  // each shared facet once (o > r)
+        const std::size_t a = find_root(parent, r), b = find_root(parent, o);
+        if (a != b) parent[std::max(a, b)] = static_cast<std::int32_t>(std::min(a, b));
+      }
+    for (const std::int32_t r : shape.simplex_rows) shape.components += find_root(parent, r) == static_cast<std::size_t>(r);
+  }
+
+  // Where the boundary is not a manifold: 3D edges in more than two
+  // boundary triangles (a closed boundary has each edge an even number of
+  // times), 2D vertices in more than two segments.
+  const std::size_t nf = shape.n_boundary();
+  if (D == 3) {
+    std::vector<std::uint64_t> edges;
+    edges.reserve(3 * nf);
+    for (std::size_t f = 0; f < nf; ++f)
+      for (int j = 0; j < 3; ++j) {
+        auto a = static_cast<std::uint32_t>(shape.boundary[3 * f + static_cast<std::size_t>(j)]);
+        auto b = static_cast<std::uint32_t>(shape.boundary[3 * f + static_cast<std::size_t>((j + 1) % 3)]);
+        if (a > b) std::swap(a, b);
+        edges.push_back(std::uint64_t{a} << 32 | b);
+      }
+    std::sort(edges.begin(), edges.end());
+    for (std::size_t i = 0; i < edges.size();) {
+      std::size_t j = i;
+      while (j < edges.size() && edges[j] == edges[i]) ++j;
+      shape.nonmanifold_ridges += j - i > 2;
+      i = j;
+    }
+  } else {
+    std::vector<std::uint32_t> uses(dt.n_points, 0);
+    for (const std::int32_t v : shape.boundary) ++uses[static_cast<std::size_t>(v)];
+    for (const std::uint32_t u : uses) shape.nonmanifold_ridges += u > 2;
+  }
+
+  // Measures, summed in row order.
+  CompensatedSum volume, measure;
+  for (const std::int32_t r : shape.simplex_rows) {
+    const Corners s = corners(dt, points, radii, static_cast<std::size_t>(r));
+    double e[3][3] = {};
+    for (int k = 0; k < D; ++k)
+      for (int d = 0; d < D; ++d) e[k][d] = s.p[k + 1][d] - s.p[0][d];
+    volume.add(D == 3 ? (e[0][0] * (e[1][1] * e[2][2] - e[1][2] * e[2][1]) -
+                         e[0][1] * (e[1][0] * e[2][2] - e[1][2] * e[2][0]) +
+                         e[0][2] * (e[1][0] * e[2][1] - e[1][1] * e[2][0])) / 6
+                      : (e[0][0] * e[1][1] - e[0][1] * e[1][0]) / 2);
+  }
+  for (std::size_t f = 0; f < nf; ++f) {
+    const double* a = points.data() + static_cast<std::size_t>(shape.boundary[f * static_cast<std::size_t>(D)]) * static_cast<std::size_t>(D);
+    const double* b = points.data() + static_cast<std::size_t>(shape.boundary[f * static_cast<std::size_t>(D) + 1]) * static_cast<std::size_t>(D);
+    if (D == 2) {
+      measure.add(std::hypot(b[0] - a[0], b[1] - a[1]));
+      continue;
+    }
+    const double* c = points.data() + static_cast<std::size_t>(shape.boundary[f * 3 + 2]) * 3;
+    const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+    measure.add(std::hypot(u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]) / 2);
+  }
+  shape.volume = volume.value();
+  shape.boundary_measure = measure.value();
+  return shape;
+}
+
+}  // namespace tessera
