@@ -1,6 +1,7 @@
 // `tessera delaunay` and `tessera bench delaunay` (see commands.hpp).
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <limits>
 #include <optional>
 #include <span>
@@ -76,6 +77,9 @@ void check_delaunay_outputs(const DelaunayArgs& a) {
     if (e != ".vtp" && e != ".npy")
       throw InputError("--boundary " + a.boundary + ": unknown extension '" + e + "' (use .vtp or .npy)");
   }
+  if (a.alpha && !(*a.alpha >= 0))
+    throw InputError("--alpha " + strf("%g", *a.alpha) +
+                     ": must be a radius >= 0 (inf keeps every simplex)");
   if (a.regularized && (a.boundary.empty() || !a.alpha))
     throw InputError("--regularized: only with --alpha and --boundary (it leaves the alpha complex's singular facets "
                      "out of the boundary)");

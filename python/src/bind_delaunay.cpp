@@ -15,6 +15,7 @@
 #include "delaunay_result.hpp"
 #include "interrupt.hpp"
 #include "options.hpp"
+#include "tessera/alpha_shape.hpp"
 #include "tessera/delaunay.hpp"
 
 namespace tessera::python {
@@ -164,6 +165,53 @@ void bind_delaunay(py::module_& m) {
         py::arg("method"), py::arg("periodic"), py::arg("tilt"), py::arg("radii").none(true) = py::none(),
         "Delaunay simplices of float64 C-ordered (N, D) points; labels None or int32 (N,); radii None or float64 "
         "(N,) (the regular triangulation, dual of the power cells). Runs without the GIL.");
+
+  py::class_<AlphaShape>(m, "AlphaShape", "Result of alpha_shape(): owns the arrays its properties view.")
+      .def_property_readonly("dim", [](const AlphaShape& a) { return a.dim; })
+      .def_property_readonly("alpha", [](const AlphaShape& a) { return a.alpha; })
+      .def_property_readonly("simplex_rows", [](py::object s) { return view_flat(s.cast<const AlphaShape&>().simplex_rows, s); })
+      .def_property_readonly("boundary",
+                             [](py::object s) {
+                               const auto& a = s.cast<const AlphaShape&>();
+                               return view_rows(a.boundary, static_cast<std::size_t>(a.dim), s);
+                             })
+      .def_property_readonly("boundary_simplex",
+                             [](py::object s) { return view_flat(s.cast<const AlphaShape&>().boundary_simplex, s); })
+      .def_property_readonly("singular",
+                             [](py::object s) {
+                               const auto& a = s.cast<const AlphaShape&>();
+                               return view_rows(a.singular, static_cast<std::size_t>(a.dim), s);
+                             })
+      .def_readonly("components", &AlphaShape::components)
+      .def_readonly("nonmanifold_ridges", &AlphaShape::nonmanifold_ridges)
+      .def_readonly("volume", &AlphaShape::volume)
+      .def_readonly("boundary_measure", &AlphaShape::boundary_measure)
+      .def_readonly("exact_tests", &AlphaShape::exact_tests);
+
+  m.def(
+      "alpha_shape",
+      [](const DelaunayResult& r, const Points& points, double alpha, const py::object& radii) {
+        if (checked_dim(points) != r.dt.dim || static_cast<std::size_t>(points.shape(0)) != r.dt.n_points)
+          throw py::value_error("alpha_shape: points are not the ones triangulated");
+        const auto pts = as_span(points);
+        const auto rad = as_radii(radii);
+        return without_gil([&] { return alpha_shape(r.dt, pts, alpha, rad); });
+      },
+      py::arg("delaunay"), py::arg("points").noconvert(), py::arg("alpha"), py::arg("radii").none(true) = py::none(),
+      "The alpha shape of a triangulation (include/tessera/alpha_shape.hpp); a regular one needs its radii. "
+      "Runs without the GIL.");
+
+  m.def(
+      "simplex_squared_radii",
+      [](const DelaunayResult& r, const Points& points, const py::object& radii) {
+        if (checked_dim(points) != r.dt.dim || static_cast<std::size_t>(points.shape(0)) != r.dt.n_points)
+          throw py::value_error("simplex_squared_radii: points are not the ones triangulated");
+        const auto pts = as_span(points);
+        const auto rad = as_radii(radii);
+        return adopt_flat(without_gil([&] { return simplex_squared_radii(r.dt, pts, rad); }));
+      },
+      py::arg("delaunay"), py::arg("points").noconvert(), py::arg("radii").none(true) = py::none(),
+      "Per simplex, the squared radius of its circumsphere (orthosphere with radii), in floats; inf where flat.");
 
   m.def("locate", &locate_points, py::arg("delaunay"), py::arg("points").noconvert(), py::arg("queries").noconvert(),
         py::arg("threads"),

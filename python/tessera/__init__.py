@@ -14,7 +14,8 @@ numpy in, numpy out::
 * :func:`voronoi` -> :class:`Voronoi`: cells clipped to a box, with volumes,
   centroids, neighbours, region labels, the merged mesh, ``save()`` (.vtu/.vtp),
   ``to_vtk()``, ``validate()`` and ``.scipy`` (a ``scipy.spatial.Voronoi``-like view).
-* :func:`delaunay` -> :class:`Delaunay`: the dual triangulation.
+* :func:`delaunay` -> :class:`Delaunay`: the dual triangulation (:meth:`Delaunay.alpha_shape`:
+  concave hulls, surfaces of samples).
 * :func:`adjacency` -> :class:`AdjacencyGraph`: wheels and spokes (CSR), spoke
   classes and face measures, ``edges()``.
 * :func:`faces` -> :class:`FaceSet`: the boundary, the polygonal complex or the
@@ -53,7 +54,7 @@ from ._core import (
     InputError,
     ValidationReport,
 )
-from ._delaunay import Delaunay, delaunay
+from ._delaunay import AlphaShape, Delaunay, delaunay
 from ._dual import AdjacencyGraph, FaceSet, Flower, Flowers, adjacency, faces, flower
 from ._lloyd import LloydResult, lloyd
 from ._prep import (Frame, fill, joggle, probe, read_box, read_frames, read_image, read_points, read_scalars,
@@ -72,6 +73,7 @@ __all__ = [
     "polygon_walls",
     "ScipyVoronoi",
     "delaunay",
+    "AlphaShape",
     "Delaunay",
     "ValidationReport",
     "DelaunayReport",

@@ -335,6 +335,30 @@ class Delaunay:
         radii = self._radii if self.power else None
         return _core.validate_delaunay(self._dt, self._points, self._labels, radii)
 
+    def squared_radii(self) -> np.ndarray:
+        """float64 (nsimplex,): each simplex's squared circumradius (for a
+        regular triangulation, :attr:`power`, its orthosphere's
+        ``|c - p|^2 - r_p^2``, which may be negative), in floating point; inf
+        where a simplex is flat in floats. To choose an ``alpha`` for
+        :meth:`alpha_shape` (``np.sqrt(np.quantile(dt.squared_radii(), 0.9))``)."""
+        self._refuse_periodic("squared_radii")
+        radii = self._radii if self.power else None
+        return _core.simplex_squared_radii(self._dt, self._points, radii)
+
+    def alpha_shape(self, alpha: float) -> "AlphaShape":
+        """The alpha shape: the simplices whose circumsphere's radius is at
+        most ``alpha`` (for a regular triangulation, whose orthosphere's
+        squared radius is at most ``alpha**2``: the dual of the balls grown by
+        ``alpha``), the boundary of their union (a concave hull; CGAL's
+        REGULARIZED alpha shape at CGAL's alpha = ``alpha**2``), and the alpha
+        complex's singular facets (small empty-sphere triangles, or segments
+        in 2D, that no kept simplex holds: the surface of a scan's samples).
+        Decided exactly. ``alpha`` >= 0; ``float("inf")`` keeps every simplex
+        (the boundary is then :attr:`convex_hull`)."""
+        self._refuse_periodic("alpha_shape")
+        radii = self._radii if self.power else None
+        return AlphaShape(_core.alpha_shape(self._dt, self._points, float(alpha), radii), self)
+
     def save(self, path: PathLike) -> None:
         """Write the simplices for ParaView: ``.vtu`` (VTK_TETRA / VTK_TRIANGLE
         cells over all input points, 2D points with z = 0) or, in 2D, ``.vtp``
@@ -445,3 +469,81 @@ def delaunay(
         rad,
     )
     return Delaunay(dt, pts, lab, rad)
+
+
+class AlphaShape:
+    """An alpha shape of a :class:`Delaunay` triangulation
+    (:meth:`Delaunay.alpha_shape`). Arrays are read-only views of buffers the
+    compiled result owns."""
+
+    def __init__(self, shape: Any, dt: Delaunay):
+        self._shape = shape
+        self._dt = dt
+
+    @property
+    def alpha(self) -> float:
+        return self._shape.alpha
+
+    @property
+    def simplex_ids(self) -> np.ndarray:
+        """int32 (k,): the triangulation's simplices kept (rows of
+        :attr:`Delaunay.simplices`), ascending."""
+        return self._shape.simplex_rows
+
+    @property
+    def simplices(self) -> np.ndarray:
+        """int32 (k, D+1): the kept simplices' point ids (a copy)."""
+        return self._dt.simplices[self._shape.simplex_rows]
+
+    @property
+    def boundary(self) -> np.ndarray:
+        """int32 (b, D): the boundary of the kept simplices' union, facets of
+        kept simplices whose other side is not kept. 3D triangles
+        counter-clockwise seen from outside; 2D segments with the shape on
+        their left (outer boundaries counter-clockwise, holes clockwise).
+        Closed; where pieces touch along an edge (at a vertex in 2D) not a
+        manifold (:attr:`nonmanifold_ridges`)."""
+        return self._shape.boundary
+
+    @property
+    def boundary_simplices(self) -> np.ndarray:
+        """int32 (b,): per boundary facet, the kept simplex (a row of
+        :attr:`Delaunay.simplices`) it bounds."""
+        return self._shape.boundary_simplex
+
+    @property
+    def singular(self) -> np.ndarray:
+        """int32 (s, D): the alpha complex's singular facets: no kept simplex
+        holds them, their smallest circumsphere has a radius at most
+        ``alpha`` and holds neither opposite vertex. Unoriented."""
+        return self._shape.singular
+
+    @property
+    def components(self) -> int:
+        """Pieces: kept simplices joined through shared facets."""
+        return self._shape.components
+
+    @property
+    def nonmanifold_ridges(self) -> int:
+        """3D: boundary edges in more than two boundary triangles; 2D:
+        boundary vertices in more than two boundary segments."""
+        return self._shape.nonmanifold_ridges
+
+    @property
+    def volume(self) -> float:
+        """Volume (area in 2D) of the kept simplices."""
+        return self._shape.volume
+
+    @property
+    def boundary_measure(self) -> float:
+        """Area (length in 2D) of :attr:`boundary`."""
+        return self._shape.boundary_measure
+
+    @property
+    def exact_tests(self) -> int:
+        """Keep tests the float filter left to exact arithmetic."""
+        return self._shape.exact_tests
+
+    def __repr__(self) -> str:
+        return (f"AlphaShape(alpha={self.alpha!r}, simplices={len(self.simplex_ids)}, "
+                f"boundary={len(self.boundary)}, singular={len(self.singular)}, components={self.components})")

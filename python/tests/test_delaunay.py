@@ -192,3 +192,53 @@ def test_validate_without_hull_completion():
         r = dt.validate()
         assert r, list(r.messages)
         assert dt.nsimplex < tessera.delaunay(p).nsimplex
+
+
+def _circumradii(points, simplices):
+    p = points[simplices]
+    e = p[:, 1:] - p[:, :1]
+    c = np.linalg.solve(e, 0.5 * (e * e).sum(axis=2)[..., None])[..., 0]
+    return np.sqrt((c * c).sum(axis=1))
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_alpha_shape(dim):
+    pts = random_points(2000, dim, seed=91)
+    dt = tessera.delaunay(pts)
+    r = _circumradii(pts, dt.simplices)
+    np.testing.assert_allclose(np.sqrt(dt.squared_radii()), r, rtol=1e-9)
+    alpha = float(np.quantile(r, 0.6))
+    a = dt.alpha_shape(alpha)
+    assert isinstance(a, tessera.AlphaShape) and a.alpha == alpha
+    np.testing.assert_array_equal(a.simplex_ids, np.nonzero(r <= alpha)[0])
+    np.testing.assert_array_equal(a.simplices, dt.simplices[a.simplex_ids])
+    assert a.volume == pytest.approx(np.abs(signed_volumes(pts, a.simplices)).sum() / (2 if dim == 2 else 6), rel=1e-12)
+    # The boundary: facets of one kept simplex, each bounding the simplex named.
+    assert a.boundary.shape[1] == dim and len(a.boundary_simplices) == len(a.boundary)
+    for f, s in zip(a.boundary[:50], a.boundary_simplices[:50]):
+        assert set(f.tolist()) < set(dt.simplices[s].tolist())
+        assert s in set(a.simplex_ids.tolist())
+    assert a.singular.shape[1] == dim
+    assert not a.simplex_ids.flags.writeable
+    # inf: every simplex, and the boundary is the convex hull.
+    whole = dt.alpha_shape(float("inf"))
+    assert len(whole.simplex_ids) == dt.nsimplex and whole.components == 1
+    def rotated(facets):  # each facet turned to start at its lowest id: its orientation kept
+        return {tuple(np.roll(f, -int(np.argmin(f))).tolist()) for f in facets}
+
+    assert rotated(whole.boundary) == rotated(dt.convex_hull)
+    with pytest.raises(tessera.InputError, match="alpha"):
+        dt.alpha_shape(-1.0)
+    with pytest.raises(tessera.InputError, match="alpha"):
+        dt.alpha_shape(float("nan"))
+
+
+def test_alpha_shape_of_a_regular_triangulation():
+    pts = random_points(1500, 3, seed=92)
+    radii = np.random.default_rng(3).uniform(0, 0.05, 1500)
+    dt = tessera.delaunay(pts, radii=radii)
+    assert dt.power
+    rho2 = dt.squared_radii()
+    a = dt.alpha_shape(0.0)  # the dual of the balls' union: orthospheres of negative squared radius
+    np.testing.assert_array_equal(a.simplex_ids, np.nonzero(rho2 <= 0)[0])
+    assert 0 < len(a.simplex_ids) < dt.nsimplex

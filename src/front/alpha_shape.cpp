@@ -32,6 +32,7 @@
 #include <gmpxx.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_sort.h>
 
 #include "pass.hpp"
 #include "point_buckets.hpp"
@@ -88,6 +89,22 @@ struct Frame {
   T rhs;
 };
 
+/// x 2^e, exactly where no result is subnormal (a power of two built from
+/// its bits: ldexp's call cost a tenth of the keep test).
+double times_pow2(double x, int e) {
+  if (e < -1022 || e > 1023) return std::ldexp(x, e);
+  return x * std::bit_cast<double>(static_cast<std::uint64_t>(e + 1023) << 52);
+}
+
+/// The s with the largest |difference| times 2^s in [1, 2) (big > 0, finite).
+int scale_of(double big) {
+  const int biased = static_cast<int>((std::bit_cast<std::uint64_t>(big) >> 52) & 0x7ff);
+  if (biased != 0) return 1023 - biased;  // big = 1.f 2^(biased - 1023)
+  int ex = 0;
+  std::frexp(big, &ex);  // subnormal: big = f 2^ex, f in [0.5, 1)
+  return 1 - ex;
+}
+
 /// a, its radius, the other points q[0..m) and theirs. Approx: false when
 /// something is not finite (far radii, a huge spread): rationals then.
 bool make_frame(Frame<Approx>& f, int D, const double* a, double ra, const double* const* q, const double* rq, int m,
@@ -102,25 +119,23 @@ bool make_frame(Frame<Approx>& f, int D, const double* a, double ra, const doubl
       big = std::max(big, std::fabs(x[k][d]));
     }
   if (!(big > 0) || !std::isfinite(big)) return false;
-  int ex = 0;
-  std::frexp(big, &ex);  // big = f 2^ex, f in [0.5, 1)
-  const int scale = 1 - ex;
+  const int scale = scale_of(big);
   f.scale = scale;
-  const Approx ras(std::ldexp(ra, scale));
+  const Approx ras(times_pow2(ra, scale));
   const Approx ra2 = ras * ras;
   for (int k = 0; k < m; ++k) {
     Approx sq;
     for (int d = 0; d < D; ++d) {
-      f.e[static_cast<std::size_t>(k)][static_cast<std::size_t>(d)] = Approx(std::ldexp(x[k][d], scale));
+      f.e[static_cast<std::size_t>(k)][static_cast<std::size_t>(d)] = Approx(times_pow2(x[k][d], scale));
       const Approx& c = f.e[static_cast<std::size_t>(k)][static_cast<std::size_t>(d)];
       sq = sq + c * c;
     }
-    const Approx rk(std::ldexp(rq[k], scale));
+    const Approx rk(times_pow2(rq[k], scale));
     f.w[static_cast<std::size_t>(k)] = sq + ra2 - rk * rk;
   }
   // alpha capped at 2^100 (scaled; the vectors are below 2): a test the
   // capped alpha passes, the true one passes too (callers redo the others).
-  const Approx as(std::min(std::ldexp(alpha, scale), 0x1p100));
+  const Approx as(std::min(times_pow2(alpha, scale), 0x1p100));
   f.rhs = as * as + ra2;
   return std::isfinite(f.rhs.p) && std::isfinite(f.w[0].p) && std::isfinite(f.w[static_cast<std::size_t>(m - 1)].p);
 }
@@ -129,9 +144,7 @@ bool alpha_capped(double alpha, const double* a, const double* const* q, int m, 
   double big = 0;
   for (int k = 0; k < m; ++k)
     for (int d = 0; d < D; ++d) big = std::max(big, std::fabs(q[k][d] - a[d]));
-  int ex = 0;
-  std::frexp(big, &ex);
-  return std::ldexp(alpha, 1 - ex) > 0x1p100;
+  return big > 0 && std::isfinite(big) && times_pow2(alpha, scale_of(big)) > 0x1p100;
 }
 
 void make_frame(Frame<mpq_class>& f, int D, const double* a, double ra, const double* const* q, const double* rq,
@@ -342,13 +355,37 @@ void outward_facet(const std::int32_t* row, int D, int k, std::int32_t* out) {
   if (k % 2 == 1) std::swap(out[0], out[1]);
 }
 
-std::size_t find_root(std::vector<std::int32_t>& parent, std::int32_t x) {
-  while (parent[static_cast<std::size_t>(x)] != x) {
-    parent[static_cast<std::size_t>(x)] = parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(x)])];
-    x = parent[static_cast<std::size_t>(x)];
+/// A union-find that threads share: roots link under lower roots by a
+/// compare-and-swap (no cycles), finds halve paths as they go. The sets
+/// (and so their count) do not depend on the order of the unions.
+class ConcurrentUnionFind {
+ public:
+  explicit ConcurrentUnionFind(std::size_t n) : parent_(n) { std::iota(parent_.begin(), parent_.end(), 0); }
+  std::int32_t find(std::int32_t x) {
+    for (;;) {
+      std::int32_t p = at(x).load(std::memory_order_acquire);
+      if (p == x) return x;
+      const std::int32_t g = at(p).load(std::memory_order_acquire);
+      if (g != p) at(x).compare_exchange_weak(p, g, std::memory_order_acq_rel);
+      x = g;
+    }
   }
-  return static_cast<std::size_t>(x);
-}
+  void unite(std::int32_t a, std::int32_t b) {
+    for (;;) {
+      a = find(a);
+      b = find(b);
+      if (a == b) return;
+      if (a < b) std::swap(a, b);
+      std::int32_t expected = a;
+      if (at(a).compare_exchange_strong(expected, b, std::memory_order_acq_rel)) return;
+    }
+  }
+  bool is_root(std::int32_t x) { return at(x).load(std::memory_order_acquire) == x; }
+
+ private:
+  std::atomic_ref<std::int32_t> at(std::int32_t x) { return std::atomic_ref<std::int32_t>(parent_[static_cast<std::size_t>(x)]); }
+  std::vector<std::int32_t> parent_;
+};
 
 }  // namespace
 
@@ -484,16 +521,26 @@ AlphaShape alpha_shape(const Delaunay& dt, std::span<const double> points, doubl
 
   // Pieces: union-find over the kept simplices through their shared facets.
   {
-    std::vector<std::int32_t> parent(m);
-    std::iota(parent.begin(), parent.end(), 0);
-    for (const std::int32_t r : shape.simplex_rows)
-      for (std::size_t k = 0; k < w; ++k) {
-        const std::int32_t o = nb[static_cast<std::size_t>(r) * w + k];
-        if (o < r || !kept[static_cast<std::size_t>(o)]) continue;  // each shared facet once (o > r)
-        const std::size_t a = find_root(parent, r), b = find_root(parent, o);
-        if (a != b) parent[std::max(a, b)] = static_cast<std::int32_t>(std::min(a, b));
-      }
-    for (const std::int32_t r : shape.simplex_rows) shape.components += find_root(parent, r) == static_cast<std::size_t>(r);
+    ConcurrentUnionFind sets(m);
+    const std::size_t nk = shape.simplex_rows.size();
+    std::atomic<std::size_t> roots{0};
+    arena.execute([&] {
+      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nk, 4096), [&](const tbb::blocked_range<std::size_t>& rg) {
+        for (std::size_t i = rg.begin(); i != rg.end(); ++i) {
+          const std::int32_t r = shape.simplex_rows[i];
+          for (std::size_t k = 0; k < w; ++k) {
+            const std::int32_t o = nb[static_cast<std::size_t>(r) * w + k];
+            if (o > r && kept[static_cast<std::size_t>(o)]) sets.unite(r, o);  // each shared facet once
+          }
+        }
+      });
+      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nk, 4096), [&](const tbb::blocked_range<std::size_t>& rg) {
+        std::size_t here = 0;
+        for (std::size_t i = rg.begin(); i != rg.end(); ++i) here += sets.is_root(shape.simplex_rows[i]);
+        roots += here;
+      });
+    });
+    shape.components = roots;
   }
 
   // Where the boundary is not a manifold: 3D edges in more than two
@@ -510,7 +557,7 @@ AlphaShape alpha_shape(const Delaunay& dt, std::span<const double> points, doubl
         if (a > b) std::swap(a, b);
         edges.push_back(std::uint64_t{a} << 32 | b);
       }
-    std::sort(edges.begin(), edges.end());
+    arena.execute([&] { tbb::parallel_sort(edges.begin(), edges.end()); });
     for (std::size_t i = 0; i < edges.size();) {
       std::size_t j = i;
       while (j < edges.size() && edges[j] == edges[i]) ++j;
@@ -523,31 +570,42 @@ AlphaShape alpha_shape(const Delaunay& dt, std::span<const double> points, doubl
     for (const std::uint32_t u : uses) shape.nonmanifold_ridges += u > 2;
   }
 
-  // Measures, summed in row order.
-  CompensatedSum volume, measure;
-  for (const std::int32_t r : shape.simplex_rows) {
-    const Corners s = corners(dt, points, radii, static_cast<std::size_t>(r));
+  // Measures: compensated sums over fixed blocks, added up in block order
+  // (the same on any thread count).
+  auto block_sums = [&](std::size_t count, auto&& term) {
+    const std::size_t nb_blocks = (count + block - 1) / block;
+    std::vector<CompensatedSum> part(nb_blocks);
+    arena.execute([&] {
+      tbb::parallel_for(std::size_t{0}, nb_blocks, [&](std::size_t b) {
+        for (std::size_t i = b * block; i < std::min(count, (b + 1) * block); ++i) part[b].add(term(i));
+      });
+    });
+    CompensatedSum total;
+    for (const CompensatedSum& c : part) {
+      total.add(c.sum);
+      total.add(c.carry);
+    }
+    return total.value();
+  };
+  auto coords = [&](std::int32_t id) { return points.data() + static_cast<std::size_t>(id) * static_cast<std::size_t>(D); };
+  shape.volume = block_sums(shape.simplex_rows.size(), [&](std::size_t i) {
+    const std::int32_t* row = dt.simplices.data() + static_cast<std::size_t>(shape.simplex_rows[i]) * w;
+    const double* a = coords(row[0]);
     double e[3][3] = {};
     for (int k = 0; k < D; ++k)
-      for (int d = 0; d < D; ++d) e[k][d] = s.p[k + 1][d] - s.p[0][d];
-    volume.add(D == 3 ? (e[0][0] * (e[1][1] * e[2][2] - e[1][2] * e[2][1]) -
-                         e[0][1] * (e[1][0] * e[2][2] - e[1][2] * e[2][0]) +
-                         e[0][2] * (e[1][0] * e[2][1] - e[1][1] * e[2][0])) / 6
-                      : (e[0][0] * e[1][1] - e[0][1] * e[1][0]) / 2);
-  }
-  for (std::size_t f = 0; f < nf; ++f) {
-    const double* a = points.data() + static_cast<std::size_t>(shape.boundary[f * static_cast<std::size_t>(D)]) * static_cast<std::size_t>(D);
-    const double* b = points.data() + static_cast<std::size_t>(shape.boundary[f * static_cast<std::size_t>(D) + 1]) * static_cast<std::size_t>(D);
-    if (D == 2) {
-      measure.add(std::hypot(b[0] - a[0], b[1] - a[1]));
-      continue;
-    }
-    const double* c = points.data() + static_cast<std::size_t>(shape.boundary[f * 3 + 2]) * 3;
-    const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
-    measure.add(std::hypot(u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]) / 2);
-  }
-  shape.volume = volume.value();
-  shape.boundary_measure = measure.value();
+      for (int d = 0; d < D; ++d) e[k][d] = coords(row[k + 1])[d] - a[d];
+    return D == 3 ? (e[0][0] * (e[1][1] * e[2][2] - e[1][2] * e[2][1]) - e[0][1] * (e[1][0] * e[2][2] - e[1][2] * e[2][0]) +
+                     e[0][2] * (e[1][0] * e[2][1] - e[1][1] * e[2][0])) / 6
+                  : (e[0][0] * e[1][1] - e[0][1] * e[1][0]) / 2;
+  });
+  shape.boundary_measure = block_sums(nf, [&](std::size_t f) {
+    const std::int32_t* v = shape.boundary.data() + f * static_cast<std::size_t>(D);
+    const double *a = coords(v[0]), *b = coords(v[1]);
+    if (D == 2) return std::hypot(b[0] - a[0], b[1] - a[1]);
+    const double* c = coords(v[2]);
+    const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, x[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+    return std::hypot(u[1] * x[2] - u[2] * x[1], u[2] * x[0] - u[0] * x[2], u[0] * x[1] - u[1] * x[0]) / 2;
+  });
   return shape;
 }
 

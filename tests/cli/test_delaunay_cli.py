@@ -212,6 +212,151 @@ class DelaunayCommand(unittest.TestCase):
         self.fails(["delaunay", self.path("p3.npy"), "-o", out, "--method", "qhull"], [out])
 
 
+def circumradii(points, simplices):
+    """Circumradius of each simplex, in floats (numpy's solve)."""
+    p = points[simplices]
+    e = p[:, 1:] - p[:, :1]
+    rhs = 0.5 * (e * e).sum(axis=2)
+    c = np.linalg.solve(e, rhs[..., None])[..., 0]
+    return np.sqrt((c * c).sum(axis=1))
+
+
+def boundary_of(simplices):
+    """Facets (sorted) in exactly one of the simplices."""
+    d = simplices.shape[1] - 1
+    facets = np.concatenate([np.delete(simplices, k, axis=1) for k in range(d + 1)])
+    u, count = np.unique(np.sort(facets, axis=1), axis=0, return_counts=True)
+    return set(map(tuple, u[count == 1]))
+
+
+class AlphaShapeCommand(unittest.TestCase):
+    """delaunay --alpha / --boundary / --regularized."""
+
+    def setUp(self):
+        self.dir = tempfile.mkdtemp(prefix="tessera-alpha-")
+        rng = np.random.default_rng(91)
+        self.p3 = rng.random((3000, 3))
+        a = rng.uniform(0, 2 * np.pi, 4000)
+        r = np.sqrt(rng.uniform(0.25, 1, 4000))
+        self.p2 = np.c_[r * np.cos(a), r * np.sin(a)]  # an annulus: a concave hull with a hole
+        np.save(self.path("p3.npy"), self.p3)
+        np.save(self.path("p2.npy"), self.p2)
+
+    def tearDown(self):
+        shutil.rmtree(self.dir)
+
+    def path(self, name):
+        return os.path.join(self.dir, name)
+
+    def ok(self, args):
+        r = run(args)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        return r
+
+    def test_3d_kept_simplices_boundary_and_vtp(self):
+        alpha = 0.1
+        self.ok(["delaunay", self.path("p3.npy"), "--simplices", self.path("all.npy")])
+        r = self.ok(["delaunay", self.path("p3.npy"), "--alpha", alpha, "--simplices", self.path("k.npy"),
+                     "--boundary", self.path("b.npy"), "-o", self.path("k.vtu")])
+        full = np.load(self.path("all.npy"))
+        radius = circumradii(self.p3, full)
+        self.assertFalse((np.abs(radius - alpha) < 1e-9).any())  # no near ties: floats decide as exactly
+        kept = np.load(self.path("k.npy"))
+        self.assertEqual(simplex_set(kept), simplex_set(full[radius <= alpha]))
+        self.assertGreater(len(kept), 0)
+        self.assertLess(len(kept), len(full))
+        # The boundary .npy: the kept simplices' boundary, then the singular facets.
+        b = np.load(self.path("b.npy"))
+        self.assertEqual(b.dtype, np.int64)
+        regular = boundary_of(kept)
+        self.assertEqual(set(map(tuple, np.sort(b[:len(regular)], axis=1))), regular)
+        self.assertIn("%d singular triangles" % (len(b) - len(regular)), r.stderr)
+        # -o holds the kept simplices only.
+        rd = vtk.vtkXMLUnstructuredGridReader()
+        rd.SetFileName(self.path("k.vtu"))
+        rd.Update()
+        self.assertEqual(rd.GetOutput().GetNumberOfCells(), len(kept))
+        # .vtp: the same facets, oriented out of the simplex SimplexId names.
+        self.ok(["delaunay", self.path("p3.npy"), "--alpha", alpha, "--boundary", self.path("b.vtp")])
+        rd = vtk.vtkXMLPolyDataReader()
+        rd.SetFileName(self.path("b.vtp"))
+        rd.Update()
+        out = rd.GetOutput()
+        self.assertEqual(out.GetNumberOfCells(), len(b))
+        ids = vtk_to_numpy(out.GetPointData().GetArray("PointId"))
+        self.assertEqual(out.GetNumberOfPoints(), len(np.unique(b)))
+        tri = vtk_to_numpy(out.GetPolys().GetConnectivityArray()).reshape(-1, 3)
+        np.testing.assert_array_equal(ids[tri], b)
+        simplex = vtk_to_numpy(out.GetCellData().GetArray("SimplexId"))
+        singular = vtk_to_numpy(out.GetCellData().GetArray("Singular"))
+        n_reg = len(regular)
+        self.assertTrue((singular[:n_reg] == 0).all() and (singular[n_reg:] == 1).all())
+        self.assertTrue((simplex[n_reg:] == -1).all())
+        rows = kept[simplex[:n_reg]]
+        facet = b[:n_reg]
+        apex = np.array([list(set(r) - set(f))[0] for r, f in zip(rows, facet)])
+        a0, a1, a2 = self.p3[facet[:, 0]], self.p3[facet[:, 1]], self.p3[facet[:, 2]]
+        normal = np.cross(a1 - a0, a2 - a0)
+        self.assertTrue(((normal * (self.p3[apex] - a0)).sum(axis=1) < 0).all())
+        # --regularized: the boundary only.
+        self.ok(["delaunay", self.path("p3.npy"), "--alpha", alpha, "--boundary", self.path("r.npy"), "--regularized"])
+        np.testing.assert_array_equal(np.load(self.path("r.npy")), b[:n_reg])
+
+    def test_2d_concave_hull_with_a_hole(self):
+        r = self.ok(["delaunay", self.path("p2.npy"), "--alpha", 0.08, "--boundary", self.path("b.npy"),
+                     "--simplices", self.path("k.npy"), "--regularized"])
+        b = np.load(self.path("b.npy"))
+        kept = np.load(self.path("k.npy"))
+        self.assertEqual(set(map(tuple, np.sort(b, axis=1))), boundary_of(kept))
+        # Shape on the left: the shoelace sum over the segments is the area.
+        x, y = self.p2[:, 0], self.p2[:, 1]
+        area = 0.5 * (x[b[:, 0]] * y[b[:, 1]] - x[b[:, 1]] * y[b[:, 0]]).sum()
+        tri = self.p2[kept]
+        kept_area = 0.5 * np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]).sum()
+        self.assertAlmostEqual(area, kept_area, places=12)
+        self.assertLess(kept_area, np.pi * 0.99)  # the hole (area pi/4) is left out
+        self.assertGreater(kept_area, np.pi * 0.7)
+        self.assertIn("1 piece", r.stderr)
+
+    def test_boundary_without_alpha_is_the_hull(self):
+        from scipy.spatial import ConvexHull
+        self.ok(["delaunay", self.path("p3.npy"), "--boundary", self.path("h.npy")])
+        h = np.load(self.path("h.npy"))
+        self.assertEqual(set(map(tuple, np.sort(h, axis=1))), simplex_set(ConvexHull(self.p3).simplices))
+        r = self.ok(["delaunay", self.path("p3.npy"), "--alpha", "inf", "--boundary", self.path("i.npy")])
+        np.testing.assert_array_equal(np.load(self.path("i.npy")), h)
+        self.assertIn("0 singular triangles", r.stderr)
+
+    def test_threads_identical(self):
+        for t in ("1", "2"):
+            self.ok(["delaunay", self.path("p3.npy"), "--alpha", 0.08, "--boundary", self.path("b%s.vtp" % t),
+                     "--threads", t, "-q"])
+        with open(self.path("b1.vtp"), "rb") as f1, open(self.path("b2.vtp"), "rb") as f2:
+            self.assertEqual(f1.read(), f2.read())
+
+    def fails(self, args, outputs=()):
+        r = run(args)
+        self.assertEqual(r.returncode, 2, r.stderr)
+        lines = r.stderr.strip().splitlines()
+        self.assertEqual(len(lines), 1, r.stderr)
+        self.assertTrue(lines[0].startswith("tessera: error: "), r.stderr)
+        for o in outputs:
+            self.assertFalse(os.path.exists(o), o)
+        return lines[0]
+
+    def test_bad_arguments(self):
+        b = self.path("b.npy")
+        self.assertIn("--alpha -1", self.fails(["delaunay", self.path("p3.npy"), "--alpha", "-1", "--boundary", b], [b]))
+        self.assertIn("--alpha nan", self.fails(["delaunay", self.path("p3.npy"), "--alpha", "nan", "--boundary", b], [b]))
+        self.fails(["delaunay", self.path("p3.npy"), "--alpha", "x", "--boundary", b], [b])
+        self.assertIn("unknown extension", self.fails(["delaunay", self.path("p3.npy"), "--boundary", self.path("b.txt")]))
+        self.assertIn("--regularized", self.fails(["delaunay", self.path("p3.npy"), "--boundary", b, "--regularized"], [b]))
+        self.assertIn("--periodic", self.fails(["delaunay", self.path("p3.npy"), "--alpha", "0.1", "--simplices", b,
+                                                "--bounds", "0", "1", "0", "1", "0", "1", "--periodic", "xyz"], [b]))
+        self.fails(["delaunay", self.path("p3.npy"), "--boundary", b, "--simplices", b], [b])
+        self.fails(["delaunay", self.path("p3.npy"), "--boundary", os.path.join(self.dir, "no", "b.npy")])
+
+
 def main():
     def bind(path):
         global TESSERA
