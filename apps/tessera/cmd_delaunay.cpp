@@ -323,20 +323,36 @@ int run_bench_delaunay(const BenchArgs& a) {
   opt.skip_cells = a.skip_cells;
   opt.method = delaunay_method(a.method);
   opt.radii = pc.radii;
+  if (a.alpha && !(*a.alpha >= 0))
+    throw InputError("--alpha " + strf("%g", *a.alpha) + ": must be a radius >= 0 (inf keeps every simplex)");
+  if (a.alpha && !a.compute.periodic.empty())
+    throw InputError("--alpha: not available with --periodic (the facets of a periodic triangulation meet images)");
+  const std::span<const double> radii(pc.radii);
   for (int rep = 0; rep < a.repeat; ++rep) {
-    // Timed region: the library call only (no I/O), as the peers do.
+    // Timed region: the library calls only (no I/O), as the peers do.
     const Usage u0 = usage_now();
     const auto t0 = Clock::now();
     const Delaunay dt = delaunay(pc.coords, pc.dim, pc.labels, opt);
+    const double tri_s = seconds_since(t0);
+    std::optional<AlphaShape> shape;
+    if (a.alpha) shape = alpha_shape(dt, pc.coords, *a.alpha, dt.power ? radii : std::span<const double>());
     const double secs = seconds_since(t0);
     const Usage u1 = usage_now();
+    const std::string alpha_extra =
+        shape ? strf("\"triangulate_s\":%.6f,\"alpha_s\":%.6f,\"alpha\":%.17g,\"boundary\":%zu,\"singular\":%zu,"
+                     "\"components\":%zu,\"exact_tests\":%zu,\"triangulation_simplices\":%zu,",
+                     tri_s, secs - tri_s, shape->alpha, shape->n_boundary(), shape->n_singular(), shape->components,
+                     shape->exact_tests, dt.n_simplices())
+              : std::string();
     std::printf(
-        "{\"tool\":\"tessera\",\"op\":\"delaunay%d\",\"n\":%zu,\"threads\":%d,\"seconds\":%.6f,\"simplices\":%zu,"
-        "\"extra\":{\"cpu_user_s\":%.6f,\"cpu_sys_s\":%.6f,\"minflt\":%lld,\"peak_rss_bytes\":%lld,"
+        "{\"tool\":\"tessera\",\"op\":\"%s%d\",\"n\":%zu,\"threads\":%d,\"seconds\":%.6f,\"simplices\":%zu,"
+        "\"extra\":{%s\"cpu_user_s\":%.6f,\"cpu_sys_s\":%.6f,\"minflt\":%lld,\"peak_rss_bytes\":%lld,"
         "\"from_cells\":%zu,\"from_hull_completion\":%zu,\"from_insertion\":%zu,\"skipped_cells\":%zu,\"hidden\":%zu,\"exact_calls\":%llu,\"repeat\":%d}}\n",
-        pc.dim, pc.n, dt.threads_used, secs, dt.n_simplices(), u1.user_s - u0.user_s, u1.sys_s - u0.sys_s,
-        u1.minflt - u0.minflt, u1.maxrss_bytes, dt.from_cells, dt.from_hull_completion, dt.from_insertion, dt.skipped_cells, dt.hidden.size(),
-        static_cast<unsigned long long>(dt.exact_predicate_calls), rep);
+        shape ? "alpha" : "delaunay", pc.dim, pc.n, dt.threads_used, secs,
+        shape ? shape->n_simplices() : dt.n_simplices(), alpha_extra.c_str(), u1.user_s - u0.user_s,
+        u1.sys_s - u0.sys_s, u1.minflt - u0.minflt, u1.maxrss_bytes, dt.from_cells, dt.from_hull_completion,
+        dt.from_insertion, dt.skipped_cells, dt.hidden.size(), static_cast<unsigned long long>(dt.exact_predicate_calls),
+        rep);
     std::fflush(stdout);
   }
   return kExitOk;

@@ -98,6 +98,7 @@ struct BenchArgs {
   bool mesh = false;        ///< also build the merged mesh (what VTK output needs)
   double skip_cells = -1;   ///< bench delaunay: DelaunayOptions::skip_cells
   std::string method = "auto";  ///< bench delaunay: DelaunayOptions::method (auto|cells|insertion)
+  std::optional<double> alpha;  ///< bench delaunay: also the alpha shape (op alpha2|alpha3)
 };
 
 struct DemoArgs {

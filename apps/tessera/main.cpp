@@ -568,6 +568,10 @@ int main(int argc, char** argv) {
   bench_del->add_option("--method", bda.method, "As for `tessera delaunay --method`")
       ->check(CLI::IsMember({"auto", "cells", "insertion"}))
       ->capture_default_str();
+  bench_del->add_option("--alpha", bda.alpha,
+                        "Also the alpha shape of radius R (tessera::alpha_shape: kept simplices, boundary, singular "
+                        "facets, pieces): op alpha3|alpha2, seconds the triangulation and the shape, simplices the "
+                        "kept ones; extra adds triangulate_s, alpha_s, boundary, singular");
 
   SurfaceNetsArgs bsna;
   std::vector<std::string> bench_sn_bounds;
