@@ -258,9 +258,33 @@ int filtered_sign(const Approx& x) {
   return x.v > err ? 1 : x.v < -err ? -1 : 0;
 }
 
+/// Without radii, whether some edge among the points p[0..m) is surely
+/// longer than 2 alpha: then every sphere through them is larger than
+/// alpha (a chord is at most a diameter), and neither a simplex nor a facet
+/// of them can be small. Most simplices of surface samples (long, through
+/// the object) and of the outside of a shape end here. The squares of
+/// rounded differences are within 5 unit roundoffs, alpha^2 within one;
+/// alpha^2 near underflow asks nothing.
+bool surely_too_long(const double* const* p, int m, int D, double alpha) {
+  const double a2 = alpha * alpha;
+  if (!(a2 >= 0x1p-1000)) return false;  // also inf: nothing is too long
+  const double limit = 4 * a2 * (1 + 16 * unit);
+  for (int i = 0; i < m; ++i)
+    for (int j = i + 1; j < m; ++j) {
+      double d2 = 0;
+      for (int d = 0; d < D; ++d) {
+        const double x = p[i][d] - p[j][d];
+        d2 += x * x;
+      }
+      if (d2 > limit) return true;
+    }
+  return false;
+}
+
 /// Whether a simplex is kept: its circumsphere (orthosphere) has a squared
 /// radius at most alpha^2.
-bool keep_simplex(const Corners& s, double alpha, std::size_t& exact) {
+bool keep_simplex(const Corners& s, double alpha, bool weighted, std::size_t& exact) {
+  if (!weighted && surely_too_long(s.p.data(), s.D + 1, s.D, alpha)) return false;
   const double* q[3] = {s.p[1], s.p[2], s.p[3]};
   const double rq[3] = {s.r[1], s.r[2], s.r[3]};
   Frame<Approx> f;
@@ -432,7 +456,7 @@ AlphaShape alpha_shape(const Delaunay& dt, std::span<const double> points, doubl
     arena.execute([&] {
       tbb::parallel_for(tbb::blocked_range<std::size_t>(0, m, 4096), [&](const tbb::blocked_range<std::size_t>& rg) {
         std::size_t here = 0;
-        for (std::size_t r = rg.begin(); r != rg.end(); ++r) kept[r] = keep_simplex(corners(dt, points, radii, r), alpha, here);
+        for (std::size_t r = rg.begin(); r != rg.end(); ++r) kept[r] = keep_simplex(corners(dt, points, radii, r), alpha, !radii.empty(), here);
         exact += here;
       });
     });
@@ -476,6 +500,8 @@ AlphaShape alpha_shape(const Delaunay& dt, std::span<const double> points, doubl
           };
           for (std::size_t j = 0; j < w; ++j)
             if (j != k) add(dt.simplices[r * w + j]);
+          // (Before the neighbour's row is read: most facets end here.)
+          if (radii.empty() && surely_too_long(p, D, D, alpha)) continue;
           add(dt.simplices[r * w + k]);
           if (o >= 0) {
             const auto ou = static_cast<std::size_t>(o);

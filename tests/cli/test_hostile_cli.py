@@ -304,8 +304,11 @@ class Hostile(base.TempDirCase):
             if not self.check(["voronoi"] + common + ["-o", out, "--validate"], inp, labels, kind, d, case):
                 continue  # a zero extent: every product refuses it alike
             tri = self.p("t.npy")
-            if self.check(["delaunay"] + common + ["-o", self.p("t.vtu"), "--simplices", tri, "--validate"],
-                          inp, labels, kind, d, case) and labels:
+            made = self.check(["delaunay"] + common + ["-o", self.p("t.vtu"), "--simplices", tri, "--validate"],
+                              inp, labels, kind, d, case)
+            if made and case % 3 == 0:
+                self.check_alpha(case, kind, d, pts, inp, labels, common, tri, rng)
+            if made and labels:
                 # Labelled: the whole triangulation's inside rows, whichever way it came.
                 whole = self.p("whole.npy")
                 unlabelled = [inp, "--threads", threads, "--quiet"]
@@ -342,6 +345,48 @@ class Hostile(base.TempDirCase):
                 self.check_cut_bounds(case, kind, d, pts, inp, labels, common, rng)
             if case % 8 == 4:
                 self.check_walls(case, kind, d, pts, inp, labels, common, rng)
+
+    def check_alpha(self, case, kind, d, pts, inp, labels, common, tri, rng):
+        """The alpha shape at a radius among the simplices' (a quantile of
+        their float circumradii): kept simplices are rows of the
+        triangulation, the boundary is the facets one kept simplex has, each
+        directed edge (2D: each vertex) as often entered as left; with the
+        singular facets after it, none of them a kept simplex's facet."""
+        rows = np.load(tri)
+        if len(rows) == 0:
+            return
+        q = pts[rows]
+        e = q[:, 1:] - q[:, :1]
+        with np.errstate(all="ignore"):
+            try:
+                c = np.linalg.solve(e, 0.5 * (e * e).sum(axis=2)[..., None])[..., 0]
+                r = np.sqrt((c * c).sum(axis=1))
+            except np.linalg.LinAlgError:
+                r = np.full(len(rows), np.nan)
+        r = r[np.isfinite(r)]
+        alpha = float(np.quantile(r, rng.uniform(0.2, 0.9))) if len(r) else 1.0
+        k, b, bs = self.p("ak.npy"), self.p("ab.npy"), self.p("abs.npy")
+        if not self.check(["delaunay"] + common + ["--alpha", repr(alpha), "--simplices", k, "--boundary", b,
+                                                   "--regularized"], inp, labels, kind, d, case):
+            return
+        self.check(["delaunay"] + common + ["--alpha", repr(alpha), "--boundary", bs], inp, labels, kind, d, case)
+        kept, bnd, both = np.load(k), np.load(b), np.load(bs)
+        what = "case %d (%s, %dD, alpha %r)" % (case, kind, d, alpha)
+        all_rows = set(map(tuple, np.sort(rows, axis=1)))
+        self.assertTrue(set(map(tuple, np.sort(kept, axis=1))) <= all_rows, what + ": kept rows not in the triangulation")
+        facets = np.concatenate([np.delete(kept, j, axis=1) for j in range(d + 1)]) if len(kept) else np.zeros((0, d), int)
+        u, count = np.unique(np.sort(facets, axis=1), axis=0, return_counts=True)
+        self.assertEqual(set(map(tuple, np.sort(bnd, axis=1))), set(map(tuple, u[count == 1])), what + ": boundary")
+        if d == 3:
+            directed = np.concatenate([bnd[:, [0, 1]], bnd[:, [1, 2]], bnd[:, [2, 0]]])
+            fwd = sorted(map(tuple, directed))
+            rev = sorted(map(tuple, directed[:, ::-1]))
+            self.assertEqual(fwd, rev, what + ": boundary not closed and oriented")
+        else:
+            self.assertEqual(sorted(bnd[:, 0].tolist()), sorted(bnd[:, 1].tolist()), what + ": rings not closed")
+        np.testing.assert_array_equal(both[:len(bnd)], bnd)
+        singular = set(map(tuple, np.sort(both[len(bnd):], axis=1)))
+        self.assertFalse(singular & set(map(tuple, u)), what + ": a singular facet belongs to a kept simplex")
 
     def check_walls(self, case, kind, d, pts, inp, labels, common, rng):
         """One to four walls through the point cloud (random normals, each
