@@ -74,8 +74,8 @@ void check_delaunay_outputs(const DelaunayArgs& a) {
                      "--method do not apply)");
   if (!a.boundary.empty() && a.boundary != "-") {
     const std::string e = extension(a.boundary);
-    if (e != ".vtp" && e != ".npy")
-      throw InputError("--boundary " + a.boundary + ": unknown extension '" + e + "' (use .vtp or .npy)");
+    if (e != ".vtp" && e != ".npy" && e != ".geojson")
+      throw InputError("--boundary " + a.boundary + ": unknown extension '" + e + "' (use .vtp, .npy or, in 2D, .geojson)");
   }
   if (a.alpha && !(*a.alpha >= 0))
     throw InputError("--alpha " + strf("%g", *a.alpha) +
@@ -114,12 +114,62 @@ Delaunay simplices_kept(const Delaunay& dt, const std::vector<std::int32_t>& row
   return k;
 }
 
+/// --boundary FILE.geojson (2D): a FeatureCollection of one MultiPolygon,
+/// a polygon per piece (outer ring counter-clockwise, holes clockwise, each
+/// closed by repeating its first point, as RFC 7946 asks), and with
+/// `singular` a MultiLineString of the singular segments.
+void write_geojson(const std::string& path, const Delaunay& dt, const AlphaShape& shape, bool singular,
+                   std::span<const double> coords) {
+  const BoundaryPolygons poly = boundary_polygons(dt, coords, shape);
+  std::string s;
+  auto point = [&](std::int32_t id) {
+    s += strf("[%.17g,%.17g]", coords[2 * static_cast<std::size_t>(id)], coords[2 * static_cast<std::size_t>(id) + 1]);
+  };
+  s += "{\"type\":\"FeatureCollection\",\"features\":[{\"type\":\"Feature\",\"properties\":{";
+  s += strf("\"alpha\":%.17g,\"pieces\":%zu,\"area\":%.17g,\"length\":%.17g", shape.alpha, shape.components,
+            shape.volume, shape.boundary_measure);
+  s += "},\"geometry\":{\"type\":\"MultiPolygon\",\"coordinates\":[";
+  for (std::size_t k = 0; k < poly.n_polygons(); ++k) {
+    s += k ? ",[" : "[";
+    for (auto r = poly.polygon_rings[k]; r != poly.polygon_rings[k + 1]; ++r) {
+      s += r != poly.polygon_rings[k] ? ",[" : "[";
+      const auto b = poly.ring_points[static_cast<std::size_t>(r)], e = poly.ring_points[static_cast<std::size_t>(r) + 1];
+      for (auto i = b; i != e; ++i) {
+        point(poly.points[static_cast<std::size_t>(i)]);
+        s += ",";
+      }
+      point(poly.points[static_cast<std::size_t>(b)]);
+      s += "]";
+    }
+    s += "]";
+  }
+  s += "]}}";
+  if (singular && !shape.singular.empty()) {
+    s += ",{\"type\":\"Feature\",\"properties\":{\"singular\":true},\"geometry\":{\"type\":\"MultiLineString\","
+         "\"coordinates\":[";
+    for (std::size_t f = 0; f < shape.n_singular(); ++f) {
+      s += f ? ",[" : "[";
+      point(shape.singular[2 * f]);
+      s += ",";
+      point(shape.singular[2 * f + 1]);
+      s += "]";
+    }
+    s += "]}}";
+  }
+  s += "]}\n";
+  io::write_file_atomic(path, s);
+}
+
 /// --boundary: .vtp, or .npy int64 (B, D): the boundary facets, then (with
 /// `singular`) the singular ones. A boundary facet's SimplexId is the row
 /// of what --simplices writes that it bounds: the kept simplices' order
 /// with --alpha (`filtered`), the triangulation's without; -1 for singular ones.
-void write_boundary(const std::string& path, const AlphaShape& shape, bool filtered, bool singular,
+void write_boundary(const std::string& path, const Delaunay& dt, const AlphaShape& shape, bool filtered, bool singular,
                     std::span<const double> coords) {
+  if (path != "-" && extension(path) == ".geojson") {
+    write_geojson(path, dt, shape, singular, coords);
+    return;
+  }
   std::vector<std::int32_t> facets(shape.boundary);
   if (singular) facets.insert(facets.end(), shape.singular.begin(), shape.singular.end());
   const std::size_t nf = facets.size() / static_cast<std::size_t>(shape.dim);
@@ -168,6 +218,8 @@ int run_delaunay_frame(const DelaunayArgs& a) {
   const double read_s = seconds_since(t0);
   if (!a.output.empty() && pc.dim == 3 && extension(a.output) != ".vtu")
     throw InputError("output " + a.output + ": a 3D triangulation is written as .vtu");
+  if (!a.boundary.empty() && pc.dim == 3 && a.boundary != "-" && extension(a.boundary) == ".geojson")
+    throw InputError("--boundary " + a.boundary + ": GeoJSON polygons are for a 2D shape (use .vtp or .npy in 3D)");
 
   double compute_s = 0;
   DelaunayOptions opt = delaunay_options(a.compute, pc.dim, !a.no_hull_completion);
@@ -204,7 +256,7 @@ int run_delaunay_frame(const DelaunayArgs& a) {
     written.push_back(shown_output(a.simplices));
   }
   if (!a.boundary.empty()) {
-    write_boundary(a.boundary, *shape, a.alpha.has_value(), !a.regularized, pc.coords);
+    write_boundary(a.boundary, dt, *shape, a.alpha.has_value(), !a.regularized, pc.coords);
     written.push_back(shown_output(a.boundary));
   }
   if (!a.simplex_shifts.empty()) {

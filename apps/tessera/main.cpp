@@ -424,8 +424,10 @@ int main(int argc, char** argv) {
                   "segments with the shape on their left; then, with --alpha, the alpha complex's singular facets "
                   "(small, empty-sphere triangles or segments no kept simplex holds: a surface scan's reconstructed "
                   "surface, a curve's samples), unoriented. .vtp (point data PointId; cell data SimplexId: the row "
-                  "of --simplices a facet bounds, -1 for singular ones, and Singular 0/1) or .npy (int64 (B, D) point "
-                  "ids, in that order); - writes the .npy to standard output");
+                  "of --simplices a facet bounds, -1 for singular ones, and Singular 0/1), .npy (int64 (B, D) point "
+                  "ids, in that order; - writes it to standard output) or, in 2D, .geojson (a MultiPolygon, one "
+                  "polygon per piece: its outer ring counter-clockwise, then its holes; the singular segments as a "
+                  "MultiLineString)");
   del->add_flag("--regularized", dla.regularized,
                 "--boundary without the singular facets: the closed, oriented boundary of the kept simplices only "
                 "(CGAL's REGULARIZED mode)");

@@ -53,6 +53,9 @@ struct AlphaShape {
   /// Pieces of the shape: kept simplices joined through shared facets (two
   /// pieces may touch at an edge or a vertex).
   std::size_t components = 0;
+  /// Per kept simplex (as simplex_rows), its piece: 0 .. components - 1,
+  /// numbered in the order of the pieces' lowest rows.
+  std::vector<std::int32_t> piece;
   /// Where the boundary is not a manifold: in 3D boundary edges in more than
   /// two boundary triangles (pieces touching along an edge); in 2D boundary
   /// vertices in more than two boundary segments (pieces touching at a point).
@@ -65,6 +68,32 @@ struct AlphaShape {
   std::size_t n_boundary() const { return boundary.size() / static_cast<std::size_t>(dim); }
   std::size_t n_singular() const { return singular.size() / static_cast<std::size_t>(dim); }
 };
+
+/// A 2D shape's boundary as polygons (boundary_polygons()): polygon k's
+/// rings are rings [polygon_rings[k], polygon_rings[k+1]), ring r's points
+/// are points[ring_points[r] .. ring_points[r+1]) (ids, once around: the
+/// first is not repeated at the end).
+struct BoundaryPolygons {
+  std::vector<std::int64_t> polygon_rings{0};
+  std::vector<std::int64_t> ring_points{0};
+  std::vector<std::int32_t> points;
+
+  std::size_t n_polygons() const { return polygon_rings.size() - 1; }
+  std::size_t n_rings() const { return ring_points.size() - 1; }
+};
+
+/// The boundary of a 2D alpha shape (AlphaShape::boundary, of `dt` and
+/// `points`) chained into polygons, one per piece (in the order of the
+/// pieces' lowest rows): its outer ring, counter-clockwise, then its holes,
+/// clockwise, so the shape lies on each ring's left (GeoJSON's RFC 7946
+/// order; shapely.Polygon(points[outer], [points[h] for h in holes])). At a
+/// vertex where the shape touches itself the ring keeps to the sector it
+/// came through (walking the kept triangles around the vertex), so rings
+/// never cross; a hole may touch its outer ring, or another hole, at a
+/// vertex, as the OGC's simple features allow. A ring's orientation is
+/// decided exactly (at its lowest vertex). Throws InputError for a 3D shape
+/// or one not computed from `dt`.
+BoundaryPolygons boundary_polygons(const Delaunay& dt, std::span<const double> points, const AlphaShape& shape);
 
 /// Per row of `dt`, the squared radius of its circumsphere (with `radii`, a
 /// regular triangulation's: of its orthosphere, |c - p|^2 - r_p^2, which may

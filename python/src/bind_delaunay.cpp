@@ -182,6 +182,7 @@ void bind_delaunay(py::module_& m) {
                                const auto& a = s.cast<const AlphaShape&>();
                                return view_rows(a.singular, static_cast<std::size_t>(a.dim), s);
                              })
+      .def_property_readonly("piece", [](py::object s) { return view_flat(s.cast<const AlphaShape&>().piece, s); })
       .def_readonly("components", &AlphaShape::components)
       .def_readonly("nonmanifold_ridges", &AlphaShape::nonmanifold_ridges)
       .def_readonly("volume", &AlphaShape::volume)
@@ -200,6 +201,17 @@ void bind_delaunay(py::module_& m) {
       py::arg("delaunay"), py::arg("points").noconvert(), py::arg("alpha"), py::arg("radii").none(true) = py::none(),
       "The alpha shape of a triangulation (include/tessera/alpha_shape.hpp); a regular one needs its radii. "
       "Runs without the GIL.");
+
+  m.def(
+      "boundary_polygons",
+      [](const DelaunayResult& r, const Points& points, const AlphaShape& a) {
+        const auto pts = as_span(points);
+        BoundaryPolygons p = without_gil([&] { return boundary_polygons(r.dt, pts, a); });
+        return py::make_tuple(adopt_flat(std::move(p.polygon_rings)), adopt_flat(std::move(p.ring_points)),
+                              adopt_flat(std::move(p.points)));
+      },
+      py::arg("delaunay"), py::arg("points").noconvert(), py::arg("shape"),
+      "A 2D alpha shape's boundary as polygons: (polygon_rings, ring_points, points) offsets and ids.");
 
   m.def(
       "simplex_squared_radii",

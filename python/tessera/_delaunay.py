@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import os
-from typing import Any, Optional, Sequence, Tuple, Union
+from typing import Any, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
@@ -522,6 +522,28 @@ class AlphaShape:
     def components(self) -> int:
         """Pieces: kept simplices joined through shared facets."""
         return self._shape.components
+
+    @property
+    def piece(self) -> np.ndarray:
+        """int32 (k,): per kept simplex (as :attr:`simplex_ids`), its piece,
+        0 .. :attr:`components` - 1, numbered by the pieces' lowest simplices."""
+        return self._shape.piece
+
+    def polygons(self) -> List[List[np.ndarray]]:
+        """2D: the boundary chained into polygons, one per piece (in
+        :attr:`piece` order): a list of rings, the outer one first
+        (counter-clockwise), then the holes (clockwise), each an int32 array
+        of point ids once around (not closed). For shapely::
+
+            polys = [shapely.Polygon(pts[rings[0]], [pts[h] for h in rings[1:]]) for rings in a.polygons()]
+
+        Where the shape touches itself at a point, a ring keeps to the side
+        it came along, so rings touch there but never cross."""
+        if self._dt.ndim != 2:
+            raise _core.InputError("polygons: only for a 2D alpha shape")
+        poly_rings, ring_points, ids = _core.boundary_polygons(self._dt._dt, self._dt.points, self._shape)
+        rings = [ids[ring_points[r]:ring_points[r + 1]] for r in range(len(ring_points) - 1)]
+        return [rings[poly_rings[k]:poly_rings[k + 1]] for k in range(len(poly_rings) - 1)]
 
     @property
     def nonmanifold_ridges(self) -> int:

@@ -233,6 +233,31 @@ def test_alpha_shape(dim):
         dt.alpha_shape(float("nan"))
 
 
+def test_alpha_shape_polygons():
+    rng = np.random.default_rng(5)
+    t = rng.uniform(0, 2 * np.pi, 3000)
+    r = np.sqrt(rng.uniform(0.25, 1, 3000))
+    pts = np.c_[r * np.cos(t), r * np.sin(t)]
+    dt = tessera.delaunay(pts)
+    for alpha in (0.015, 0.03, 0.08):
+        a = dt.alpha_shape(alpha)
+        polys = a.polygons()
+        assert len(polys) == a.components
+        assert a.piece.shape == a.simplex_ids.shape and a.piece.max() == a.components - 1
+
+        def area(ring):
+            x, y = pts[ring, 0], pts[ring, 1]
+            return 0.5 * (x * np.roll(y, -1) - np.roll(x, -1) * y).sum()
+        total = 0.0
+        for rings in polys:
+            assert area(rings[0]) > 0 and all(area(h) < 0 for h in rings[1:])
+            total += sum(area(ring) for ring in rings)
+        assert total == pytest.approx(a.volume, rel=1e-12)
+    assert [len(rings) for rings in dt.alpha_shape(0.08).polygons()] == [2]  # the annulus and its hole
+    with pytest.raises(tessera.InputError, match="2D"):
+        tessera.delaunay(random_points(100, 3, seed=1)).alpha_shape(0.3).polygons()
+
+
 def test_alpha_shape_of_a_regular_triangulation():
     pts = random_points(1500, 3, seed=92)
     radii = np.random.default_rng(3).uniform(0, 0.05, 1500)

@@ -1,22 +1,31 @@
 // tessera::alpha_shape (include/tessera/alpha_shape.hpp): which simplices
-// are small enough, and the boundary of their union.
+// are small enough, which facets no kept simplex holds are singular faces
+// of the alpha complex, and the boundary of the kept simplices' union.
 //
-// The keep test. With vertex a as origin, e_k = p_k - a and the lifted
-// weights w_k = |e_k|^2 + r_a^2 - r_k^2 (all r = 0 without radii), the
-// circumcentre (orthocentre) c - a solves 2 e_k . (c - a) = w_k, so
-// c - a = n / (2 D), D = det[e_1 .. e_D] and
-//   3D: n = w_1 (e_2 x e_3) + w_2 (e_3 x e_1) + w_3 (e_1 x e_2),
-//   2D: n = (w_1 e_2y - w_2 e_1y, w_2 e_1x - w_1 e_2x).
-// The squared radius |c - a|^2 - r_a^2 is at most alpha^2 iff
-//   |n|^2 <= 4 D^2 (alpha^2 + r_a^2).
-// The float filter evaluates both sides on the differences scaled by a
-// power of two (largest component in [1, 2): nothing overflows or
-// underflows but a far-off alpha or radius) with error bounds from the
-// permanents (the same terms in absolute values): each side's terms are
-// products of at most eight rounded factors and about ten rounded
-// operations, so 64 unit roundoffs of the permanent bound their error with
-// room to spare. Where the two intervals meet, rationals decide (GMP: every
-// double is one). A simplex whose D is zero exactly (flat) is never kept.
+// The tests. With corner a as origin, e_k = p_k - a and the lifted weights
+// w_k = |e_k|^2 + r_a^2 - r_k^2 (all r = 0 without radii):
+// * a simplex's circumcentre (orthocentre) is a + n / (2 D), D = det[e], and
+//     3D: n = w_1 (e_2 x e_3) + w_2 (e_3 x e_1) + w_3 (e_1 x e_2),
+//     2D: n = (w_1 e_2y - w_2 e_1y, w_2 e_1x - w_1 e_2x);
+//   its squared radius |c - a|^2 - r_a^2 is at most alpha^2 iff
+//     |n|^2 <= 4 D^2 (alpha^2 + r_a^2);
+// * a facet's smallest orthosphere (centre in its affine hull) has centre
+//   a + (u . E) / (2 g), G the Gram matrix of its edges E, g = det G,
+//   u = adj(G) w; it is small enough iff w . u <= 4 g (alpha^2 + r_a^2), and
+//   an apex d lies strictly inside iff u . (E e_d) > w_d g (the facet is
+//   then attached; in a Delaunay triangulation the one or two apexes are
+//   the only points to ask).
+// Each margin is written once as a template over the number type. The float
+// stage (Approx) evaluates it on the differences scaled by a power of two
+// (the largest in [1, 2): nothing overflows or underflows but a far-off
+// alpha or radius) beside its permanent (the same expression over absolute
+// values): no term has more than ~30 rounded operations along it, so 64
+// unit roundoffs of the permanent bound the error with room to spare. Where
+// the value does not clear that bound, GMP rationals decide (every double is
+// one). A simplex whose D is zero exactly (flat) is never kept. Without
+// radii, an edge surely longer than 2 alpha ends both tests first (a chord
+// is at most a diameter): most simplices of surface samples and of a
+// shape's outside.
 #include <algorithm>
 #include <array>
 #include <atomic>
@@ -549,7 +558,6 @@ AlphaShape alpha_shape(const Delaunay& dt, std::span<const double> points, doubl
   {
     ConcurrentUnionFind sets(m);
     const std::size_t nk = shape.simplex_rows.size();
-    std::atomic<std::size_t> roots{0};
     arena.execute([&] {
       tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nk, 4096), [&](const tbb::blocked_range<std::size_t>& rg) {
         for (std::size_t i = rg.begin(); i != rg.end(); ++i) {
@@ -560,13 +568,21 @@ AlphaShape alpha_shape(const Delaunay& dt, std::span<const double> points, doubl
           }
         }
       });
+    });
+    // Roots are their sets' lowest rows (unions link under the lower root),
+    // so numbering them in row order numbers the pieces by their lowest rows.
+    std::vector<std::int32_t> number(m, -1);
+    for (std::size_t i = 0; i < nk; ++i) {
+      const std::int32_t r = shape.simplex_rows[i];
+      if (sets.is_root(r)) number[static_cast<std::size_t>(r)] = static_cast<std::int32_t>(shape.components++);
+    }
+    shape.piece.resize(nk);
+    arena.execute([&] {
       tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nk, 4096), [&](const tbb::blocked_range<std::size_t>& rg) {
-        std::size_t here = 0;
-        for (std::size_t i = rg.begin(); i != rg.end(); ++i) here += sets.is_root(shape.simplex_rows[i]);
-        roots += here;
+        for (std::size_t i = rg.begin(); i != rg.end(); ++i)
+          shape.piece[i] = number[static_cast<std::size_t>(sets.find(shape.simplex_rows[i]))];
       });
     });
-    shape.components = roots;
   }
 
   // Where the boundary is not a manifold: 3D edges in more than two

@@ -317,6 +317,26 @@ class AlphaShapeCommand(unittest.TestCase):
         self.assertLess(kept_area, np.pi * 0.99)  # the hole (area pi/4) is left out
         self.assertGreater(kept_area, np.pi * 0.7)
         self.assertIn("1 piece", r.stderr)
+        # GeoJSON: one polygon, the outer ring counter-clockwise and the hole
+        # clockwise, closed; their areas add up to the shape's.
+        self.ok(["delaunay", self.path("p2.npy"), "--alpha", 0.08, "--boundary", self.path("b.geojson")])
+        with open(self.path("b.geojson")) as f:
+            g = json.load(f)
+        self.assertEqual(g["type"], "FeatureCollection")
+        geom = g["features"][0]["geometry"]
+        self.assertEqual(geom["type"], "MultiPolygon")
+        self.assertEqual(len(geom["coordinates"]), 1)
+        rings = [np.array(ring) for ring in geom["coordinates"][0]]
+        self.assertEqual(len(rings), 2)
+
+        def signed(ring):
+            self.assertTrue((ring[0] == ring[-1]).all())
+            return 0.5 * (ring[:-1, 0] * ring[1:, 1] - ring[1:, 0] * ring[:-1, 1]).sum()
+        self.assertGreater(signed(rings[0]), 0)
+        self.assertLess(signed(rings[1]), 0)
+        self.assertAlmostEqual(signed(rings[0]) + signed(rings[1]), kept_area, places=12)
+        self.assertEqual(sum(len(ring) - 1 for ring in rings), len(b))
+        self.assertEqual(g["features"][0]["properties"]["pieces"], 1)
 
     def test_boundary_without_alpha_is_the_hull(self):
         from scipy.spatial import ConvexHull
@@ -350,6 +370,8 @@ class AlphaShapeCommand(unittest.TestCase):
         self.assertIn("--alpha nan", self.fails(["delaunay", self.path("p3.npy"), "--alpha", "nan", "--boundary", b], [b]))
         self.fails(["delaunay", self.path("p3.npy"), "--alpha", "x", "--boundary", b], [b])
         self.assertIn("unknown extension", self.fails(["delaunay", self.path("p3.npy"), "--boundary", self.path("b.txt")]))
+        g = self.path("b.geojson")
+        self.assertIn("2D", self.fails(["delaunay", self.path("p3.npy"), "--alpha", "0.1", "--boundary", g], [g]))
         self.assertIn("--regularized", self.fails(["delaunay", self.path("p3.npy"), "--boundary", b, "--regularized"], [b]))
         self.assertIn("--periodic", self.fails(["delaunay", self.path("p3.npy"), "--alpha", "0.1", "--simplices", b,
                                                 "--bounds", "0", "1", "0", "1", "0", "1", "--periodic", "xyz"], [b]))

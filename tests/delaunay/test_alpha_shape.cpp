@@ -26,6 +26,7 @@
 #include <map>
 #include <random>
 #include <set>
+#include <utility>
 #include <vector>
 
 #include "random_points.hpp"
@@ -338,6 +339,81 @@ TEST(AlphaShape, PiecesAndPinches) {
   EXPECT_NEAR(a.volume, 0.9, 1e-15);
   EXPECT_NEAR(a.boundary_measure, 2 + 4 * std::sqrt(1.06), 1e-14);
   expect_closed_outward(dt, p, a);
+}
+
+/// boundary_polygons' rings use every boundary segment once, in its
+/// direction; each piece is one polygon whose first ring is outer
+/// (positive area) and the rest holes; and its rings' signed areas add up to
+/// the piece's triangles' area.
+void expect_polygons(const tessera::Delaunay& dt, const std::vector<double>& p, const tessera::AlphaShape& a) {
+  const tessera::BoundaryPolygons poly = tessera::boundary_polygons(dt, p, a);
+  ASSERT_EQ(poly.n_polygons(), a.components);
+  std::multiset<std::pair<std::int32_t, std::int32_t>> segs, traced;
+  for (std::size_t f = 0; f < a.n_boundary(); ++f) segs.insert({a.boundary[2 * f], a.boundary[2 * f + 1]});
+  std::vector<double> piece_area(a.components, 0);
+  for (std::size_t i = 0; i < a.n_simplices(); ++i) {
+    const std::int32_t* t = dt.simplices.data() + 3 * static_cast<std::size_t>(a.simplex_rows[i]);
+    auto x = [&](int k, int d) { return p[2 * static_cast<std::size_t>(t[k]) + static_cast<std::size_t>(d)]; };
+    piece_area[static_cast<std::size_t>(a.piece[i])] +=
+        ((x(1, 0) - x(0, 0)) * (x(2, 1) - x(0, 1)) - (x(1, 1) - x(0, 1)) * (x(2, 0) - x(0, 0))) / 2;
+  }
+  for (std::size_t k = 0; k < poly.n_polygons(); ++k) {
+    double area = 0;
+    for (auto r = poly.polygon_rings[k]; r != poly.polygon_rings[k + 1]; ++r) {
+      const auto b = poly.ring_points[static_cast<std::size_t>(r)], e = poly.ring_points[static_cast<std::size_t>(r) + 1];
+      double ring = 0;
+      const double* o = &p[2 * static_cast<std::size_t>(poly.points[static_cast<std::size_t>(b)])];
+      for (auto i = b; i != e; ++i) {
+        const std::int32_t u = poly.points[static_cast<std::size_t>(i)];
+        const std::int32_t v = poly.points[static_cast<std::size_t>(i + 1 == e ? b : i + 1)];
+        traced.insert({u, v});
+        const double* pu = &p[2 * static_cast<std::size_t>(u)];
+        const double* pv = &p[2 * static_cast<std::size_t>(v)];
+        ring += ((pu[0] - o[0]) * (pv[1] - o[1]) - (pu[1] - o[1]) * (pv[0] - o[0])) / 2;
+      }
+      EXPECT_EQ(ring > 0, r == poly.polygon_rings[k]) << "polygon " << k << " ring " << r;
+      area += ring;
+    }
+    EXPECT_NEAR(area, piece_area[k], 1e-12 * std::max(1.0, std::fabs(piece_area[k]))) << "polygon " << k;
+  }
+  EXPECT_EQ(traced, segs);
+}
+
+TEST(AlphaShape, BoundaryPolygons) {
+  // An annulus: one piece with a hole, and at smaller alphas many pieces,
+  // holes, and vertices where the shape touches itself.
+  std::mt19937_64 rng(98);
+  std::uniform_real_distribution<double> u(0, 1);
+  std::vector<double> p;
+  for (int i = 0; i < 3000; ++i) {
+    const double t = 2 * M_PI * u(rng), r = std::sqrt(0.25 + 0.75 * u(rng));
+    p.push_back(r * std::cos(t));
+    p.push_back(r * std::sin(t));
+  }
+  const tessera::Delaunay dt = triangulate(p, 2);
+  std::size_t pinched = 0;
+  for (const double alpha : {0.012, 0.016, 0.02, 0.03, 0.06, 1e9}) {
+    const tessera::AlphaShape a = tessera::alpha_shape(dt, p, alpha);
+    expect_polygons(dt, p, a);
+    pinched += a.nonmanifold_ridges;
+  }
+  EXPECT_GT(pinched, 20u);  // the sector walks ran
+  const tessera::AlphaShape one = tessera::alpha_shape(dt, p, 0.06);
+  const tessera::BoundaryPolygons poly = tessera::boundary_polygons(dt, p, one);
+  ASSERT_EQ(poly.n_polygons(), 1u);
+  EXPECT_EQ(poly.n_rings(), 2u);  // the outer circle and the hole
+  // The bow tie: two triangles, two polygons of one ring each.
+  const std::vector<double> q{0, 0, 1, 0, 0.5, 0.9, 0, 1.8, 1, 1.8};
+  const tessera::Delaunay bt = triangulate(q, 2);
+  const tessera::AlphaShape b = tessera::alpha_shape(bt, q, 0.7);
+  expect_polygons(bt, q, b);
+  const tessera::BoundaryPolygons bp = tessera::boundary_polygons(bt, q, b);
+  EXPECT_EQ(bp.n_polygons(), 2u);
+  EXPECT_EQ(bp.n_rings(), 2u);
+  // 3D shapes have no polygons.
+  const std::vector<double> p3 = uniform_points(100, 3, 99);
+  const tessera::Delaunay d3 = triangulate(p3, 3);
+  EXPECT_THROW(tessera::boundary_polygons(d3, p3, tessera::alpha_shape(d3, p3, 0.3)), tessera::InputError);
 }
 
 TEST(AlphaShape, RefusesBadArguments) {
