@@ -211,6 +211,23 @@ TEST(AlphaShape, EqualsCgalIn3D) {
     EXPECT_EQ(a.n_boundary(), ours.regular.size());
     EXPECT_FALSE(ours.interior.empty());
     expect_closed_outward(dt, p, a);
+    // Pieces: numbered in the order of their lowest rows, and kept
+    // simplices sharing a facet in one piece.
+    ASSERT_EQ(a.piece.size(), a.n_simplices());
+    std::int32_t next_piece = 0;
+    std::map<std::int32_t, std::int32_t> piece_of;
+    for (std::size_t i = 0; i < a.n_simplices(); ++i) {
+      if (a.piece[i] == next_piece) ++next_piece;
+      EXPECT_LT(a.piece[i], next_piece);
+      piece_of[a.simplex_rows[i]] = a.piece[i];
+    }
+    EXPECT_EQ(static_cast<std::size_t>(next_piece), a.components);
+    const std::vector<std::int32_t> nb = tessera::simplex_neighbors(dt);
+    for (const auto& [r, piece] : piece_of)
+      for (std::size_t k = 0; k < 4; ++k) {
+        const auto o = piece_of.find(nb[static_cast<std::size_t>(r) * 4 + k]);
+        if (o != piece_of.end()) EXPECT_EQ(o->second, piece);
+      }
   }
 }
 
