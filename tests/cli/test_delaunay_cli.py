@@ -36,14 +36,14 @@ def simplex_set(s):
     return set(map(tuple, np.sort(np.asarray(s), axis=1)))
 
 
-class DelaunayCommand(unittest.TestCase):
-    def setUp(self):
-        self.dir = tempfile.mkdtemp(prefix="tessera-delaunay-")
-        rng = np.random.default_rng(5)
-        self.p3 = rng.random((3000, 3))
-        self.p2 = rng.random((3000, 2))
-        np.save(self.path("p3.npy"), self.p3)
-        np.save(self.path("p2.npy"), self.p2)
+class CommandCase(unittest.TestCase):
+    """A temporary folder with p3.npy and p2.npy (self.p3, self.p2), and runs that must pass or fail cleanly."""
+
+    def make_inputs(self, prefix, p3, p2):
+        self.dir = tempfile.mkdtemp(prefix=prefix)
+        self.p3, self.p2 = p3, p2
+        np.save(self.path("p3.npy"), p3)
+        np.save(self.path("p2.npy"), p2)
 
     def tearDown(self):
         shutil.rmtree(self.dir)
@@ -55,6 +55,24 @@ class DelaunayCommand(unittest.TestCase):
         r = run(args)
         self.assertEqual(r.returncode, 0, r.stderr)
         return r
+
+    def fails(self, args, outputs=()):
+        """Exit 2 with one error line, none of `outputs` and no temporary file left; returns the line."""
+        r = run(args)
+        self.assertEqual(r.returncode, 2, r.stderr)
+        lines = r.stderr.strip().splitlines()
+        self.assertEqual(len(lines), 1, r.stderr)
+        self.assertTrue(lines[0].startswith("tessera: error: "), r.stderr)
+        for o in outputs:
+            self.assertFalse(os.path.exists(o), o)
+        self.assertEqual([f for f in os.listdir(self.dir) if f.startswith(".")], [])
+        return lines[0]
+
+
+class DelaunayCommand(CommandCase):
+    def setUp(self):
+        rng = np.random.default_rng(5)
+        self.make_inputs("tessera-delaunay-", rng.random((3000, 3)), rng.random((3000, 2)))
 
     def test_3d_equals_scipy_and_reads_back(self):
         r = self.ok(["delaunay", self.path("p3.npy"), "-o", self.path("t.vtu"), "--simplices", self.path("t.npy"),
@@ -182,16 +200,6 @@ class DelaunayCommand(unittest.TestCase):
             self.assertEqual(j["threads"], 1)
             self.assertEqual(j["simplices"], len(ScipyDelaunay(self.p2).simplices))
 
-    def fails(self, args, outputs=()):
-        r = run(args)
-        self.assertEqual(r.returncode, 2, r.stderr)
-        lines = r.stderr.strip().splitlines()
-        self.assertEqual(len(lines), 1, r.stderr)
-        self.assertTrue(lines[0].startswith("tessera: error: "), r.stderr)
-        for o in outputs:
-            self.assertFalse(os.path.exists(o), o)
-        self.assertEqual([f for f in os.listdir(self.dir) if f.startswith(".")], [])
-
     def test_bad_input(self):
         out = self.path("t.vtu")
         self.fails(["delaunay", self.path("missing.npy"), "-o", out], [out])
@@ -229,29 +237,15 @@ def boundary_of(simplices):
     return set(map(tuple, u[count == 1]))
 
 
-class AlphaShapeCommand(unittest.TestCase):
+class AlphaShapeCommand(CommandCase):
     """delaunay --alpha / --boundary / --regularized."""
 
     def setUp(self):
-        self.dir = tempfile.mkdtemp(prefix="tessera-alpha-")
         rng = np.random.default_rng(91)
-        self.p3 = rng.random((3000, 3))
+        p3 = rng.random((3000, 3))
         a = rng.uniform(0, 2 * np.pi, 4000)
         r = np.sqrt(rng.uniform(0.25, 1, 4000))
-        self.p2 = np.c_[r * np.cos(a), r * np.sin(a)]  # an annulus: a concave hull with a hole
-        np.save(self.path("p3.npy"), self.p3)
-        np.save(self.path("p2.npy"), self.p2)
-
-    def tearDown(self):
-        shutil.rmtree(self.dir)
-
-    def path(self, name):
-        return os.path.join(self.dir, name)
-
-    def ok(self, args):
-        r = run(args)
-        self.assertEqual(r.returncode, 0, r.stderr)
-        return r
+        self.make_inputs("tessera-alpha-", p3, np.c_[r * np.cos(a), r * np.sin(a)])  # 2D: an annulus, with a hole
 
     def test_3d_kept_simplices_boundary_and_vtp(self):
         alpha = 0.1
@@ -353,16 +347,6 @@ class AlphaShapeCommand(unittest.TestCase):
                      "--threads", t, "-q"])
         with open(self.path("b1.vtp"), "rb") as f1, open(self.path("b2.vtp"), "rb") as f2:
             self.assertEqual(f1.read(), f2.read())
-
-    def fails(self, args, outputs=()):
-        r = run(args)
-        self.assertEqual(r.returncode, 2, r.stderr)
-        lines = r.stderr.strip().splitlines()
-        self.assertEqual(len(lines), 1, r.stderr)
-        self.assertTrue(lines[0].startswith("tessera: error: "), r.stderr)
-        for o in outputs:
-            self.assertFalse(os.path.exists(o), o)
-        return lines[0]
 
     def test_bad_arguments(self):
         b = self.path("b.npy")
