@@ -465,7 +465,8 @@ AlphaShape alpha_shape(const Delaunay& dt, std::span<const double> points, doubl
     arena.execute([&] {
       tbb::parallel_for(tbb::blocked_range<std::size_t>(0, m, 4096), [&](const tbb::blocked_range<std::size_t>& rg) {
         std::size_t here = 0;
-        for (std::size_t r = rg.begin(); r != rg.end(); ++r) kept[r] = keep_simplex(corners(dt, points, radii, r), alpha, !radii.empty(), here);
+        for (std::size_t r = rg.begin(); r != rg.end(); ++r)
+          kept[r] = keep_simplex(corners(dt, points, radii, r), alpha, !radii.empty(), here);
         exact += here;
       });
     });
