@@ -14,6 +14,7 @@
 #include "progress.hpp"
 #include "tessera/alpha_shape.hpp"
 #include "tessera/delaunay.hpp"
+#include "tessera/io/alpha_shape.hpp"
 #include "tessera/io/atomic_file.hpp"
 #include "tessera/io/npy.hpp"
 #include "tessera/io/vtk_simplices.hpp"
@@ -114,82 +115,6 @@ Delaunay simplices_kept(const Delaunay& dt, const std::vector<std::int32_t>& row
   return k;
 }
 
-/// --boundary FILE.geojson (2D): a FeatureCollection of one MultiPolygon,
-/// a polygon per piece (outer ring counter-clockwise, holes clockwise, each
-/// closed by repeating its first point, as RFC 7946 asks), and with
-/// `singular` a MultiLineString of the singular segments.
-void write_geojson(const std::string& path, const Delaunay& dt, const AlphaShape& shape, bool singular,
-                   std::span<const double> coords) {
-  const BoundaryPolygons poly = boundary_polygons(dt, coords, shape);
-  std::string s;
-  auto point = [&](std::int32_t id) {
-    s += strf("[%.17g,%.17g]", coords[2 * static_cast<std::size_t>(id)], coords[2 * static_cast<std::size_t>(id) + 1]);
-  };
-  s += "{\"type\":\"FeatureCollection\",\"features\":[{\"type\":\"Feature\",\"properties\":{";
-  s += strf("\"alpha\":%.17g,\"pieces\":%zu,\"area\":%.17g,\"length\":%.17g", shape.alpha, shape.components,
-            shape.volume, shape.boundary_measure);
-  s += "},\"geometry\":{\"type\":\"MultiPolygon\",\"coordinates\":[";
-  for (std::size_t k = 0; k < poly.n_polygons(); ++k) {
-    s += k ? ",[" : "[";
-    for (auto r = poly.polygon_rings[k]; r != poly.polygon_rings[k + 1]; ++r) {
-      s += r != poly.polygon_rings[k] ? ",[" : "[";
-      const auto b = poly.ring_points[static_cast<std::size_t>(r)], e = poly.ring_points[static_cast<std::size_t>(r) + 1];
-      for (auto i = b; i != e; ++i) {
-        point(poly.points[static_cast<std::size_t>(i)]);
-        s += ",";
-      }
-      point(poly.points[static_cast<std::size_t>(b)]);
-      s += "]";
-    }
-    s += "]";
-  }
-  s += "]}}";
-  if (singular && !shape.singular.empty()) {
-    s += ",{\"type\":\"Feature\",\"properties\":{\"singular\":true},\"geometry\":{\"type\":\"MultiLineString\","
-         "\"coordinates\":[";
-    for (std::size_t f = 0; f < shape.n_singular(); ++f) {
-      s += f ? ",[" : "[";
-      point(shape.singular[2 * f]);
-      s += ",";
-      point(shape.singular[2 * f + 1]);
-      s += "]";
-    }
-    s += "]}}";
-  }
-  s += "]}\n";
-  io::write_file_atomic(path, s);
-}
-
-/// --boundary: .vtp, or .npy int64 (B, D): the boundary facets, then (with
-/// `singular`) the singular ones. A boundary facet's SimplexId is the row
-/// of what --simplices writes that it bounds: the kept simplices' order
-/// with --alpha (`filtered`), the triangulation's without; -1 for singular ones.
-void write_boundary(const std::string& path, const Delaunay& dt, const AlphaShape& shape, bool filtered, bool singular,
-                    std::span<const double> coords) {
-  if (path != "-" && extension(path) == ".geojson") {
-    write_geojson(path, dt, shape, singular, coords);
-    return;
-  }
-  std::vector<std::int32_t> facets(shape.boundary);
-  if (singular) facets.insert(facets.end(), shape.singular.begin(), shape.singular.end());
-  const std::size_t nf = facets.size() / static_cast<std::size_t>(shape.dim);
-  if (path != "-" && extension(path) == ".vtp") {
-    std::vector<std::int64_t> simplex(nf, -1);
-    std::vector<std::uint8_t> is_singular(nf, 1);
-    for (std::size_t f = 0; f < shape.n_boundary(); ++f) {
-      const std::int32_t r = shape.boundary_simplex[f];
-      simplex[f] = filtered ? std::lower_bound(shape.simplex_rows.begin(), shape.simplex_rows.end(), r) -
-                                  shape.simplex_rows.begin()
-                            : r;
-      is_singular[f] = 0;
-    }
-    io::write_boundary_vtp(path, shape.dim, facets, simplex, is_singular, coords);
-    return;
-  }
-  std::vector<std::int64_t> ids(facets.begin(), facets.end());
-  io::write_file_atomic(path, io::npy_bytes(ids.data(), {nf, static_cast<std::size_t>(shape.dim)}));
-}
-
 void print_alpha_line(const AlphaShape& s, bool filtered, std::size_t all) {
   const bool d3 = s.dim == 3;
   const std::string kept =
@@ -256,7 +181,8 @@ int run_delaunay_frame(const DelaunayArgs& a) {
     written.push_back(shown_output(a.simplices));
   }
   if (!a.boundary.empty()) {
-    write_boundary(a.boundary, dt, *shape, a.alpha.has_value(), !a.regularized, pc.coords);
+    // SimplexId: the row of what --simplices writes (the kept ones' order with --alpha).
+    io::write_alpha_boundary(a.boundary, dt, *shape, pc.coords, !a.regularized, a.alpha.has_value());
     written.push_back(shown_output(a.boundary));
   }
   if (!a.simplex_shifts.empty()) {

@@ -20,6 +20,7 @@
 #include "tessera/io/dual.hpp"
 #include "tessera/io/vtk_polydata.hpp"
 #include "tessera/surface_nets.hpp"
+#include "tessera/io/alpha_shape.hpp"
 #include "tessera/io/vtk_simplices.hpp"
 #include "tessera/io/vtk_xml.hpp"
 
@@ -64,6 +65,19 @@ void bind_io(py::module_& m) {
       py::arg("path"), py::arg("delaunay"), py::arg("points").noconvert(), py::arg("radii").none(true) = py::none(),
       "Write simplices as .vtu (VTK_TETRA / VTK_TRIANGLE over all points; 2D also .vtp polygons); radii "
       "(a regular triangulation's) add point data Radius. OSError if the file cannot be written.");
+
+  m.def(
+      "write_alpha_boundary",
+      [](const std::string& path, const DelaunayResult& r, const py::array_t<double, py::array::c_style>& points,
+         const AlphaShape& shape, bool singular) {
+        if (checked_dim(points) != r.dt.dim || static_cast<std::size_t>(points.shape(0)) != r.dt.n_points)
+          throw py::value_error("write_alpha_boundary: points are not the ones triangulated");
+        const auto pts = as_span(points);
+        write_or_oserror([&] { io::write_alpha_boundary(path, r.dt, shape, pts, singular, false); });
+      },
+      py::arg("path"), py::arg("delaunay"), py::arg("points").noconvert(), py::arg("shape"), py::arg("singular"),
+      "Write an alpha shape's boundary (and singular facets) as .vtp, .npy or (2D) .geojson. OSError if the file "
+      "cannot be written.");
 
   m.def(
       "write_graph_vtp",

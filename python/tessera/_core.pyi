@@ -286,6 +286,9 @@ def alpha_shape(
     alpha: float,
     radii: Optional[npt.NDArray[np.float64]] = ...,
 ) -> AlphaShape: ...
+def write_alpha_boundary(
+    path: str, delaunay: Delaunay, points: npt.NDArray[np.float64], shape: AlphaShape, singular: bool
+) -> None: ...
 def boundary_polygons(
     delaunay: Delaunay, points: npt.NDArray[np.float64], shape: AlphaShape
 ) -> Tuple[npt.NDArray[np.int64], npt.NDArray[np.int64], npt.NDArray[np.int32]]: ...

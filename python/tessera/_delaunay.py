@@ -566,6 +566,22 @@ class AlphaShape:
         """Keep tests the float filter left to exact arithmetic."""
         return self._shape.exact_tests
 
+    def save(self, path: PathLike, singular: bool = True) -> None:
+        """Write the boundary (then, with ``singular``, the singular facets):
+        ``.vtp`` for ParaView (triangles, 2D segments; cell data SimplexId,
+        the :attr:`Delaunay.simplices` row a boundary facet bounds or -1, and
+        Singular), ``.npy`` (int64 point ids) or, in 2D, ``.geojson`` (the
+        :meth:`polygons` as a MultiPolygon, and the singular segments as a
+        MultiLineString), for QGIS and geopandas. Written atomically.
+        ValueError for another extension or GeoJSON in 3D, OSError when the
+        file cannot be written."""
+        path = _inputs.as_path(path)
+        allowed = (".vtp", ".npy") if self._dt.ndim == 3 else (".vtp", ".npy", ".geojson")
+        if not path.lower().endswith(allowed):
+            raise ValueError(f"save: a {self._dt.ndim}D alpha shape's boundary is written as "
+                             f"{', '.join(allowed)}, got {path!r}")
+        _core.write_alpha_boundary(path, self._dt._dt, self._dt.points, self._shape, bool(singular))
+
     def __repr__(self) -> str:
         return (f"AlphaShape(alpha={self.alpha!r}, simplices={len(self.simplex_ids)}, "
                 f"boundary={len(self.boundary)}, singular={len(self.singular)}, components={self.components})")

@@ -254,6 +254,34 @@ def test_alpha_shape_polygons():
             total += sum(area(ring) for ring in rings)
         assert total == pytest.approx(a.volume, rel=1e-12)
     assert [len(rings) for rings in dt.alpha_shape(0.08).polygons()] == [2]  # the annulus and its hole
+
+
+def test_alpha_shape_save(tmp_path):
+    import json
+
+    rng = np.random.default_rng(6)
+    t = rng.uniform(0, 2 * np.pi, 2000)
+    r = np.sqrt(rng.uniform(0.25, 1, 2000))
+    pts = np.c_[r * np.cos(t), r * np.sin(t)]
+    a = tessera.delaunay(pts).alpha_shape(0.05)
+    a.save(tmp_path / "b.npy", singular=False)
+    np.testing.assert_array_equal(np.load(tmp_path / "b.npy"), a.boundary)
+    a.save(tmp_path / "all.npy")
+    np.testing.assert_array_equal(np.load(tmp_path / "all.npy"), np.concatenate([a.boundary, a.singular]))
+    a.save(tmp_path / "b.geojson")
+    g = json.loads((tmp_path / "b.geojson").read_text())
+    polys = g["features"][0]["geometry"]["coordinates"]
+    assert [len(p) for p in polys] == [len(rings) for rings in a.polygons()]
+    np.testing.assert_array_equal(np.array(polys[0][0])[:-1], pts[a.polygons()[0][0]])
+    a.save(tmp_path / "b.vtp")
+    assert (tmp_path / "b.vtp").stat().st_size > 0
+    with pytest.raises(ValueError, match="written as"):
+        a.save(tmp_path / "b.txt")
+    a3 = tessera.delaunay(random_points(200, 3, seed=2)).alpha_shape(0.3)
+    with pytest.raises(ValueError, match="3D"):
+        a3.save(tmp_path / "c.geojson")
+    with pytest.raises(OSError):
+        a3.save(tmp_path / "no" / "c.vtp")
     with pytest.raises(tessera.InputError, match="2D"):
         tessera.delaunay(random_points(100, 3, seed=1)).alpha_shape(0.3).polygons()
 
