@@ -176,7 +176,8 @@ def test_periodic_triangulation_against_scipy():
     # simplex_neighbors, vertex_neighbors and locate, were named).
     for name, get in (("neighbors", lambda: dt.neighbors), ("convex_hull", lambda: dt.convex_hull),
                       ("vertex_neighbor_vertices", lambda: dt.vertex_neighbor_vertices),
-                      ("find_simplex", lambda: dt.find_simplex(pts[:1])), ("transform", lambda: dt.transform)):
+                      ("find_simplex", lambda: dt.find_simplex(pts[:1])), ("transform", lambda: dt.transform),
+                      ("alpha_shape", lambda: dt.alpha_shape(0.1)), ("squared_radii", lambda: dt.squared_radii())):
         with pytest.raises(tessera.InputError, match="^" + name + ": not available for a periodic triangulation"):
             get()
     assert tessera.delaunay(pts).simplex_shifts.shape == (0, 3, 2)
