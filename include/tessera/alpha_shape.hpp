@@ -50,6 +50,10 @@ struct AlphaShape {
   /// 2D, a curve's samples give these segments). Facets of the triangulation
   /// in row order; their orientation means nothing.
   std::vector<std::int32_t> singular;
+  /// A periodic triangulation's (else empty): per entry of `boundary` and
+  /// of `singular`, dim shifts of that point's image in lattice vectors, in
+  /// the frame of the facet's simplex (Delaunay::simplex_shifts).
+  std::vector<std::int8_t> boundary_shifts, singular_shifts;
   /// Pieces of the shape: kept simplices joined through shared facets (two
   /// pieces may touch at an edge or a vertex).
   std::size_t components = 0;

@@ -53,23 +53,58 @@ namespace {
 
 constexpr double unit = 0x1p-53;  // unit roundoff
 
-/// A simplex's corners (D + 1 pointers to dim doubles) and, with radii, theirs.
+/// Where a triangulation's entries lie: a row's slot k is its point, or in a
+/// periodic triangulation that point (as wrapped, Delaunay::periodic_points)
+/// moved by the entry's shift in lattice vectors, which the box's rounding
+/// makes exact.
+struct Geometry {
+  const Delaunay& dt;
+  std::span<const double> points;  ///< the input's, or the periodic points
+  std::span<const double> radii;
+  bool periodic;
+  std::array<std::array<double, 3>, 3> lattice{};
+  std::size_t w;
+
+  Geometry(const Delaunay& d, std::span<const double> input_points, std::span<const double> r)
+      : dt(d), points(d.is_periodic() ? std::span<const double>(d.periodic_points) : input_points), radii(r),
+        periodic(d.is_periodic()), w(static_cast<std::size_t>(d.dim + 1)) {
+    if (periodic) lattice = periodic_lattice(d.bounds, d.tilt);
+  }
+  std::int32_t id(std::size_t row, std::size_t k) const { return dt.simplices[row * w + k]; }
+  const std::int8_t* shift(std::size_t row, std::size_t k) const {
+    return dt.simplex_shifts.data() + (row * w + k) * static_cast<std::size_t>(dt.dim);
+  }
+  /// Entry (row, k)'s coordinates: a pointer into the points, or (periodic)
+  /// its image written to `buffer`.
+  const double* at(std::size_t row, std::size_t k, double* buffer) const {
+    const double* p = points.data() + static_cast<std::size_t>(id(row, k)) * static_cast<std::size_t>(dt.dim);
+    if (!periodic) return p;
+    std::array<int, 3> s{0, 0, 0};
+    for (int a = 0; a < dt.dim; ++a) s[static_cast<std::size_t>(a)] = shift(row, k)[a];
+    periodic_image(lattice, dt.dim, p, s, buffer);
+    return buffer;
+  }
+  double radius(std::size_t row, std::size_t k) const {
+    return radii.empty() ? 0.0 : radii[static_cast<std::size_t>(id(row, k))];
+  }
+};
+
+/// A simplex's corners (D + 1 pointers to dim doubles: into the points, or
+/// into `xyz` for a periodic triangulation's images) and, with radii,
+/// theirs. Filled in place (the pointers may point into the object).
 struct Corners {
   int D = 3;
   std::array<const double*, 4> p{};
   std::array<double, 4> r{0, 0, 0, 0};
+  double xyz[4][3] = {};
 };
 
-Corners corners(const Delaunay& dt, std::span<const double> points, std::span<const double> radii, std::size_t row) {
-  Corners c;
-  c.D = dt.dim;
-  const std::size_t w = static_cast<std::size_t>(dt.dim + 1);
-  for (std::size_t k = 0; k < w; ++k) {
-    const auto id = static_cast<std::size_t>(dt.simplices[row * w + k]);
-    c.p[k] = points.data() + id * static_cast<std::size_t>(dt.dim);
-    if (!radii.empty()) c.r[k] = radii[id];
+void corners(const Geometry& g, std::size_t row, Corners& c) {
+  c.D = g.dt.dim;
+  for (std::size_t k = 0; k < g.w; ++k) {
+    c.p[k] = g.at(row, k, c.xyz[k]);
+    c.r[k] = g.radius(row, k);
   }
-  return c;
 }
 
 /// A float value and its permanent (the same expression over the absolute
@@ -362,9 +397,11 @@ struct CompensatedSum {
 
 void check_arguments(const Delaunay& dt, std::span<const double> points, std::span<const double> radii,
                      const char* who) {
-  front::refuse_periodic(dt, who);
   front::check_simplex_ids(dt);
-  if (points.size() != dt.n_points * static_cast<std::size_t>(dt.dim))
+  if (dt.is_periodic() && (dt.simplex_shifts.size() != dt.simplices.size() * static_cast<std::size_t>(dt.dim) ||
+                           dt.periodic_points.size() != dt.n_points * static_cast<std::size_t>(dt.dim)))
+    throw InputError(std::string(who) + ": a periodic triangulation without its shifts or points");
+  if (!dt.is_periodic() && points.size() != dt.n_points * static_cast<std::size_t>(dt.dim))
     throw InputError(std::string(who) + ": " + std::to_string(points.size()) + " coordinates for a triangulation of " +
                      std::to_string(dt.n_points) + " points in " + std::to_string(dt.dim) + "D");
   if (dt.power && radii.size() != dt.n_points)
@@ -374,6 +411,107 @@ void check_arguments(const Delaunay& dt, std::span<const double> points, std::sp
   if (!dt.power && !radii.empty())
     throw InputError(std::string(who) + ": radii given for a triangulation computed without them");
   if (!radii.empty()) front::check_radii(radii, dt.n_points);
+}
+
+/// A triangulation's facet adjacency: nb[s w + k] the simplex across the
+/// facet opposite slot k of s (-1: none); periodic, nbk its slot opposite
+/// that facet (a plain one's is found in its row: slot_across).
+/// simplex_neighbors() for a plain triangulation; a periodic one's facets
+/// match by ids and shifts up to a translation: each facet's entries in
+/// (id, shift) order, translated so that the first is at shift 0, are its
+/// key (a translation keeps that order, so the same corner comes first in
+/// both simplices).
+struct Adjacency {
+  std::vector<std::int32_t> nb;
+  std::vector<std::int8_t> nbk;
+};
+
+Adjacency adjacency(const Geometry& g) {
+  const Delaunay& dt = g.dt;
+  const std::size_t m = dt.n_simplices(), w = g.w, D = static_cast<std::size_t>(dt.dim);
+  Adjacency a;
+  if (m == 0) return a;
+  if (!g.periodic) a.nb = simplex_neighbors(dt);
+  if (g.periodic) {
+    using Entry = std::pair<std::int32_t, std::array<int, 3>>;
+    struct Record {
+      std::array<Entry, 3> key;
+      std::size_t s, k;
+      bool operator<(const Record& o) const { return key != o.key ? key < o.key : (s != o.s ? s < o.s : k < o.k); }
+    };
+    std::vector<Record> recs(m * w);
+    engine::ThreadArena(dt.threads_used).execute([&] {
+      tbb::parallel_for(std::size_t{0}, m, [&](std::size_t s) {
+        for (std::size_t k = 0; k < w; ++k) {
+          Record& rec = recs[s * w + k];
+          rec.s = s;
+          rec.k = k;
+          rec.key.fill({-1, {0, 0, 0}});
+          std::size_t c = 0;
+          for (std::size_t j = 0; j < w; ++j) {
+            if (j == k) continue;
+            Entry e{g.id(s, j), {0, 0, 0}};
+            for (std::size_t x = 0; x < D; ++x) e.second[x] = g.shift(s, j)[x];
+            rec.key[c++] = e;
+          }
+          std::sort(rec.key.begin(), rec.key.begin() + static_cast<std::ptrdiff_t>(D));
+          const std::array<int, 3> base = rec.key[0].second;
+          for (std::size_t c2 = 0; c2 < D; ++c2)
+            for (std::size_t x = 0; x < 3; ++x) rec.key[c2].second[x] -= base[x];
+        }
+      });
+      tbb::parallel_sort(recs.begin(), recs.end());
+    });
+    a.nb.assign(m * w, -1);
+    a.nbk.assign(m * w, -1);
+    for (std::size_t i = 0; i + 1 < recs.size(); ++i) {
+      if (recs[i].key != recs[i + 1].key) continue;
+      const Record &x = recs[i], &y = recs[i + 1];
+      a.nb[x.s * w + x.k] = static_cast<std::int32_t>(y.s);
+      a.nbk[x.s * w + x.k] = static_cast<std::int8_t>(y.k);
+      a.nb[y.s * w + y.k] = static_cast<std::int32_t>(x.s);
+      a.nbk[y.s * w + y.k] = static_cast<std::int8_t>(x.k);
+      ++i;
+    }
+    return a;
+  }
+  return a;
+}
+
+/// The slot of simplex o = nb[r w + k] opposite the facet it shares with r.
+std::size_t slot_across(const Adjacency& a, std::size_t w, std::size_t r, std::size_t k) {
+  if (!a.nbk.empty()) return static_cast<std::size_t>(a.nbk[r * w + k]);
+  const auto o = static_cast<std::size_t>(a.nb[r * w + k]);
+  for (std::size_t j = 0; j < w; ++j)
+    if (a.nb[o * w + j] == static_cast<std::int32_t>(r)) return j;
+  return w;  // (not a conforming triangulation)
+}
+
+/// The apex of simplex o across the facet opposite slot k of row r (o's slot
+/// ok), in r's frame: in a periodic triangulation o's entries are moved by
+/// the translation that takes the facet's first (id, shift) entry in o to
+/// the same entry in r.
+const double* neighbour_apex(const Geometry& g, std::size_t r, std::size_t k, std::size_t o, std::size_t ok,
+                             double* buffer) {
+  if (!g.periodic) return g.at(o, ok, buffer);
+  const int D = g.dt.dim;
+  auto first_entry = [&](std::size_t s, std::size_t skip) {
+    std::pair<std::int32_t, std::array<int, 3>> best{INT32_MAX, {0, 0, 0}};
+    for (std::size_t j = 0; j < g.w; ++j) {
+      if (j == skip) continue;
+      std::pair<std::int32_t, std::array<int, 3>> e{g.id(s, j), {0, 0, 0}};
+      for (int x = 0; x < D; ++x) e.second[static_cast<std::size_t>(x)] = g.shift(s, j)[x];
+      best = std::min(best, e);
+    }
+    return best.second;
+  };
+  const std::array<int, 3> in_r = first_entry(r, k), in_o = first_entry(o, ok);
+  std::array<int, 3> shift{0, 0, 0};
+  for (int x = 0; x < D; ++x)
+    shift[static_cast<std::size_t>(x)] = g.shift(o, ok)[x] + in_r[static_cast<std::size_t>(x)] - in_o[static_cast<std::size_t>(x)];
+  periodic_image(g.lattice, D, g.points.data() + static_cast<std::size_t>(g.id(o, ok)) * static_cast<std::size_t>(D), shift,
+                 buffer);
+  return buffer;
 }
 
 /// The facet of a row opposite its slot k, oriented outward (3D) or with the
@@ -425,11 +563,13 @@ class ConcurrentUnionFind {
 std::vector<double> simplex_squared_radii(const Delaunay& dt, std::span<const double> points,
                                           std::span<const double> radii) {
   check_arguments(dt, points, radii, "simplex_squared_radii");
+  const Geometry g(dt, points, radii);
   std::vector<double> out(dt.n_simplices());
   engine::ThreadArena(dt.threads_used).execute([&] {
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, out.size(), 4096), [&](const tbb::blocked_range<std::size_t>& rg) {
+      Corners s;
       for (std::size_t r = rg.begin(); r != rg.end(); ++r) {
-        const Corners s = corners(dt, points, radii, r);
+        corners(g, r, s);
         const double* q[3] = {s.p[1], s.p[2], s.p[3]};
         const double rq[3] = {s.r[1], s.r[2], s.r[3]};
         Frame<Approx> f;
@@ -452,7 +592,8 @@ AlphaShape alpha_shape(const Delaunay& dt, std::span<const double> points, doubl
     throw InputError("alpha_shape: alpha must be a radius >= 0 (or +inf for the whole triangulation), got " +
                      std::to_string(alpha));
   const int D = dt.dim;
-  const std::size_t w = static_cast<std::size_t>(D + 1), m = dt.n_simplices();
+  const std::size_t w = static_cast<std::size_t>(D + 1), m = dt.n_simplices(), du = static_cast<std::size_t>(D);
+  const Geometry g(dt, points, radii);
   AlphaShape shape;
   shape.dim = D;
   shape.alpha = alpha;
@@ -465,8 +606,11 @@ AlphaShape alpha_shape(const Delaunay& dt, std::span<const double> points, doubl
     arena.execute([&] {
       tbb::parallel_for(tbb::blocked_range<std::size_t>(0, m, 4096), [&](const tbb::blocked_range<std::size_t>& rg) {
         std::size_t here = 0;
-        for (std::size_t r = rg.begin(); r != rg.end(); ++r)
-          kept[r] = keep_simplex(corners(dt, points, radii, r), alpha, !radii.empty(), here);
+        Corners s;
+        for (std::size_t r = rg.begin(); r != rg.end(); ++r) {
+          corners(g, r, s);
+          kept[r] = keep_simplex(s, alpha, !radii.empty(), here);
+        }
         exact += here;
       });
     });
@@ -480,7 +624,8 @@ AlphaShape alpha_shape(const Delaunay& dt, std::span<const double> points, doubl
   // unattached; a shared facet is decided at its lower row). Then each
   // kind's facets are counted per block of rows and filled at each block's
   // offset: row order on any thread count.
-  const std::vector<std::int32_t> nb = m == 0 ? std::vector<std::int32_t>() : simplex_neighbors(dt);
+  const Adjacency adj = adjacency(g);
+  const std::vector<std::int32_t>& nb = adj.nb;
   std::vector<std::uint8_t> open(m, 0);
   const bool finite_alpha = !std::isinf(alpha);
   constexpr std::size_t block = 1 << 14;
@@ -497,26 +642,30 @@ AlphaShape alpha_shape(const Delaunay& dt, std::span<const double> points, doubl
             if (!other_kept) bits |= static_cast<std::uint8_t>(1u << k);
             continue;
           }
+          // Each shared facet once: at its lower row (in a small periodic
+          // box a simplex may meet itself: at its lower slot).
           if (!finite_alpha || other_kept || (o >= 0 && static_cast<std::size_t>(o) < r)) continue;
+          if (o >= 0 && static_cast<std::size_t>(o) == r && adj.nbk[r * w + k] < static_cast<std::int8_t>(k)) continue;
           // The facet's corners, then its apexes: this row's vertex k and
-          // the neighbour's vertex across it.
+          // the neighbour's vertex across it (moved into this row's frame).
           const double* p[5];
-          double rr[5] = {0, 0, 0, 0, 0};
+          double rr[5] = {0, 0, 0, 0, 0}, xyz[5][3];
           int c = 0;
-          auto add = [&](std::int32_t id) {
-            p[c] = points.data() + static_cast<std::size_t>(id) * static_cast<std::size_t>(D);
-            if (!radii.empty()) rr[c] = radii[static_cast<std::size_t>(id)];
-            ++c;
-          };
           for (std::size_t j = 0; j < w; ++j)
-            if (j != k) add(dt.simplices[r * w + j]);
+            if (j != k) {
+              p[c] = g.at(r, j, xyz[c]);
+              rr[c++] = g.radius(r, j);
+            }
           // (Before the neighbour's row is read: most facets end here.)
           if (radii.empty() && surely_too_long(p, D, D, alpha)) continue;
-          add(dt.simplices[r * w + k]);
+          p[c] = g.at(r, k, xyz[c]);
+          rr[c++] = g.radius(r, k);
           if (o >= 0) {
             const auto ou = static_cast<std::size_t>(o);
-            for (std::size_t j = 0; j < w; ++j)
-              if (nb[ou * w + j] == static_cast<std::int32_t>(r)) add(dt.simplices[ou * w + j]);
+            const std::size_t ok = slot_across(adj, w, r, k);
+            if (ok == w) throw InputError("alpha_shape: the triangulation does not conform (a facet in one simplex only on one side)");
+            p[c] = neighbour_apex(g, r, k, ou, ok, xyz[c]);
+            rr[c++] = g.radius(ou, ok);
           }
           if (singular_facet(D, p, rr, c - D, alpha, here)) bits |= static_cast<std::uint8_t>(16u << k);
         }
@@ -526,7 +675,10 @@ AlphaShape alpha_shape(const Delaunay& dt, std::span<const double> points, doubl
     });
   });
   shape.exact_tests = exact;
-  auto gather = [&](unsigned shift, std::vector<std::int32_t>& facets, std::vector<std::int32_t>* simplex) {
+  // (Periodic: each facet's entries' shifts too, in its simplex's frame.)
+  static constexpr std::int32_t slots[4] = {0, 1, 2, 3};
+  auto gather = [&](unsigned shift, std::vector<std::int32_t>& facets, std::vector<std::int32_t>* simplex,
+                    std::vector<std::int8_t>& shifts) {
     std::vector<std::size_t> at(blocks + 1, 0);
     arena.execute([&] {
       tbb::parallel_for(std::size_t{0}, blocks, [&](std::size_t b) {
@@ -537,23 +689,30 @@ AlphaShape alpha_shape(const Delaunay& dt, std::span<const double> points, doubl
       });
     });
     std::partial_sum(at.begin(), at.end(), at.begin());
-    facets.resize(at[blocks] * static_cast<std::size_t>(D));
+    facets.resize(at[blocks] * du);
     if (simplex) simplex->resize(at[blocks]);
+    if (g.periodic) shifts.resize(at[blocks] * du * du);
     arena.execute([&] {
       tbb::parallel_for(std::size_t{0}, blocks, [&](std::size_t b) {
         std::size_t f = at[b];
         for (std::size_t r = b * block; r < std::min(m, (b + 1) * block); ++r)
           for (std::size_t k = 0; k < w; ++k) {
             if (!((open[r] >> shift) & (1u << k))) continue;
-            outward_facet(dt.simplices.data() + r * w, D, static_cast<int>(k), facets.data() + f * static_cast<std::size_t>(D));
+            std::int32_t sl[3];
+            outward_facet(slots, D, static_cast<int>(k), sl);
+            for (std::size_t i = 0; i < du; ++i) {
+              const auto j = static_cast<std::size_t>(sl[i]);
+              facets[f * du + i] = g.id(r, j);
+              if (g.periodic) std::copy_n(g.shift(r, j), du, shifts.data() + (f * du + i) * du);
+            }
             if (simplex) (*simplex)[f] = static_cast<std::int32_t>(r);
             ++f;
           }
       });
     });
   };
-  gather(0, shape.boundary, &shape.boundary_simplex);
-  gather(4, shape.singular, nullptr);
+  gather(0, shape.boundary, &shape.boundary_simplex, shape.boundary_shifts);
+  gather(4, shape.singular, nullptr, shape.singular_shifts);
 
   // Pieces: union-find over the kept simplices through their shared facets.
   {
@@ -590,7 +749,33 @@ AlphaShape alpha_shape(const Delaunay& dt, std::span<const double> points, doubl
   // boundary triangles (a closed boundary has each edge an even number of
   // times), 2D vertices in more than two segments.
   const std::size_t nf = shape.n_boundary();
-  if (D == 3) {
+  if (D == 3 && g.periodic) {
+    // Edges match by ids and the shift between their ends (up to a translation).
+    using Edge = std::pair<std::array<std::int32_t, 2>, std::array<int, 3>>;
+    std::vector<Edge> edges;
+    edges.reserve(3 * nf);
+    for (std::size_t f = 0; f < nf; ++f)
+      for (std::size_t j = 0; j < 3; ++j) {
+        std::size_t ia = 3 * f + j, ib = 3 * f + (j + 1) % 3;
+        auto entry = [&](std::size_t i) {
+          std::pair<std::int32_t, std::array<int, 3>> e{shape.boundary[i], {0, 0, 0}};
+          for (std::size_t x = 0; x < 3; ++x) e.second[x] = shape.boundary_shifts[i * 3 + x];
+          return e;
+        };
+        auto a = entry(ia), b = entry(ib);
+        if (b < a) std::swap(a, b);
+        Edge e{{a.first, b.first}, {0, 0, 0}};
+        for (std::size_t x = 0; x < 3; ++x) e.second[x] = b.second[x] - a.second[x];
+        edges.push_back(e);
+      }
+    arena.execute([&] { tbb::parallel_sort(edges.begin(), edges.end()); });
+    for (std::size_t i = 0; i < edges.size();) {
+      std::size_t j = i;
+      while (j < edges.size() && edges[j] == edges[i]) ++j;
+      shape.nonmanifold_ridges += j - i > 2;
+      i = j;
+    }
+  } else if (D == 3) {
     std::vector<std::uint64_t> edges;
     edges.reserve(3 * nf);
     for (std::size_t f = 0; f < nf; ++f)
@@ -630,22 +815,30 @@ AlphaShape alpha_shape(const Delaunay& dt, std::span<const double> points, doubl
     }
     return total.value();
   };
-  auto coords = [&](std::int32_t id) { return points.data() + static_cast<std::size_t>(id) * static_cast<std::size_t>(D); };
   shape.volume = block_sums(shape.simplex_rows.size(), [&](std::size_t i) {
-    const std::int32_t* row = dt.simplices.data() + static_cast<std::size_t>(shape.simplex_rows[i]) * w;
-    const double* a = coords(row[0]);
+    Corners s;
+    corners(g, static_cast<std::size_t>(shape.simplex_rows[i]), s);
     double e[3][3] = {};
     for (int k = 0; k < D; ++k)
-      for (int d = 0; d < D; ++d) e[k][d] = coords(row[k + 1])[d] - a[d];
+      for (int d = 0; d < D; ++d) e[k][d] = s.p[static_cast<std::size_t>(k) + 1][d] - s.p[0][d];
     return D == 3 ? (e[0][0] * (e[1][1] * e[2][2] - e[1][2] * e[2][1]) - e[0][1] * (e[1][0] * e[2][2] - e[1][2] * e[2][0]) +
                      e[0][2] * (e[1][0] * e[2][1] - e[1][1] * e[2][0])) / 6
                   : (e[0][0] * e[1][1] - e[0][1] * e[1][0]) / 2;
   });
   shape.boundary_measure = block_sums(nf, [&](std::size_t f) {
-    const std::int32_t* v = shape.boundary.data() + f * static_cast<std::size_t>(D);
-    const double *a = coords(v[0]), *b = coords(v[1]);
+    double xyz[3][3];
+    auto corner = [&](std::size_t i) -> const double* {
+      const std::size_t e = f * du + i;
+      const double* p = g.points.data() + static_cast<std::size_t>(shape.boundary[e]) * du;
+      if (!g.periodic) return p;
+      std::array<int, 3> sh{0, 0, 0};
+      for (std::size_t x = 0; x < du; ++x) sh[x] = shape.boundary_shifts[e * du + x];
+      periodic_image(g.lattice, D, p, sh, xyz[i]);
+      return xyz[i];
+    };
+    const double *a = corner(0), *b = corner(1);
     if (D == 2) return std::hypot(b[0] - a[0], b[1] - a[1]);
-    const double* c = coords(v[2]);
+    const double* c = corner(2);
     const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, x[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
     return std::hypot(u[1] * x[2] - u[2] * x[1], u[2] * x[0] - u[0] * x[2], u[0] * x[1] - u[1] * x[0]) / 2;
   });
