@@ -84,9 +84,9 @@ void check_delaunay_outputs(const DelaunayArgs& a) {
   if (a.regularized && (a.boundary.empty() || !a.alpha))
     throw InputError("--regularized: only with --alpha and --boundary (it leaves the alpha complex's singular facets "
                      "out of the boundary)");
-  if (!a.compute.periodic.empty() && (a.alpha || !a.boundary.empty()))
-    throw InputError(std::string(a.alpha ? "--alpha" : "--boundary") +
-                     ": not available with --periodic (the facets of a periodic triangulation meet images)");
+  if (!a.compute.periodic.empty() && !a.boundary.empty())
+    throw InputError("--boundary: not written with --periodic (its facets meet images; --alpha's summary gives the "
+                     "boundary's area, and -o / --simplices / --simplex-shifts the kept simplices)");
   if (a.method == "insertion" && a.no_hull_completion)
     throw InputError("--method insertion triangulates the whole convex hull: it cannot be combined with "
                      "--no-hull-completion");
@@ -108,10 +108,16 @@ Delaunay simplices_kept(const Delaunay& dt, const std::vector<std::int32_t>& row
   k.n_points = dt.n_points;
   k.bounds = dt.bounds;
   k.power = dt.power;
-  const std::size_t w = static_cast<std::size_t>(dt.dim + 1);
+  k.periodic = dt.periodic;
+  k.tilt = dt.tilt;
+  k.periodic_points = dt.periodic_points;
+  const std::size_t w = static_cast<std::size_t>(dt.dim + 1), ws = dt.is_periodic() ? w * static_cast<std::size_t>(dt.dim) : 0;
   k.simplices.resize(rows.size() * w);
-  for (std::size_t i = 0; i < rows.size(); ++i)
+  k.simplex_shifts.resize(rows.size() * ws);
+  for (std::size_t i = 0; i < rows.size(); ++i) {
     std::copy_n(dt.simplices.data() + static_cast<std::size_t>(rows[i]) * w, w, k.simplices.data() + i * w);
+    std::copy_n(dt.simplex_shifts.data() + static_cast<std::size_t>(rows[i]) * ws, ws, k.simplex_shifts.data() + i * ws);
+  }
   return k;
 }
 
@@ -187,7 +193,7 @@ int run_delaunay_frame(const DelaunayArgs& a) {
   }
   if (!a.simplex_shifts.empty()) {
     const auto d = static_cast<std::size_t>(pc.dim);
-    io::write_file_atomic(a.simplex_shifts, io::npy_bytes(dt.simplex_shifts.data(), {dt.n_simplices(), d + 1, d}));
+    io::write_file_atomic(a.simplex_shifts, io::npy_bytes(out.simplex_shifts.data(), {out.n_simplices(), d + 1, d}));
     written.push_back(shown_output(a.simplex_shifts));
   }
   const double write_s = seconds_since(t0);
@@ -303,8 +309,6 @@ int run_bench_delaunay(const BenchArgs& a) {
   opt.radii = pc.radii;
   if (a.alpha && !(*a.alpha >= 0))
     throw InputError("--alpha " + strf("%g", *a.alpha) + ": must be a radius >= 0 (inf keeps every simplex)");
-  if (a.alpha && !a.compute.periodic.empty())
-    throw InputError("--alpha: not available with --periodic (the facets of a periodic triangulation meet images)");
   const std::span<const double> radii(pc.radii);
   for (int rep = 0; rep < a.repeat; ++rep) {
     // Timed region: the library calls only (no I/O), as the peers do.

@@ -417,7 +417,8 @@ int main(int argc, char** argv) {
                   "The union of those simplices is the regularized alpha shape (CGAL's REGULARIZED mode at its "
                   "alpha = R^2; VTK's Alpha without its leftover triangles, edges and vertices): -o and --simplices "
                   "hold the kept simplices, --boundary its surface. Decided exactly (lattices' equal radii all one "
-                  "way); inf keeps every simplex");
+                  "way); inf keeps every simplex. With --periodic the kept simplices of the periodic triangulation "
+                  "(--simplex-shifts theirs), their volume, boundary area and pieces");
   del->add_option("--boundary", dla.boundary,
                   "The boundary of the simplices written (the alpha shape's with --alpha; else the convex hull, or "
                   "with --labels the inside region's): 3D triangles counter-clockwise seen from outside, 2D "

@@ -99,7 +99,7 @@ struct BoundaryPolygons {
 /// or one not computed from `dt`.
 BoundaryPolygons boundary_polygons(const Delaunay& dt, std::span<const double> points, const AlphaShape& shape);
 
-/// Per row of `dt`, the squared radius of its circumsphere (with `radii`, a
+/// Per row of `dt` (periodic too), the squared radius of its circumsphere (with `radii`, a
 /// regular triangulation's: of its orthosphere, |c - p|^2 - r_p^2, which may
 /// be negative), in floating point; +inf where the simplex is flat in
 /// floating point. For inspection (ParaView, histograms to choose alpha);
@@ -111,9 +111,11 @@ std::vector<double> simplex_squared_radii(const Delaunay& dt, std::span<const do
 /// dt.power, needs the radii it was computed with, and an ordinary one
 /// takes none). alpha >= 0; +inf keeps every simplex, so the boundary is the
 /// triangulation's own: the convex hull, or with labels the inside region's
-/// boundary. Runs on dt.threads_used threads; the result does not depend on
-/// them. Throws InputError on a NaN or negative alpha, radii that do not
-/// match dt, or a periodic triangulation (its facets meet images).
+/// boundary. A periodic triangulation's (dt.is_periodic()) is computed on
+/// its own wrapped points and images (`points` is not read): its facets
+/// match up to translation, and carry their shifts. Runs on dt.threads_used
+/// threads; the result does not depend on them. Throws InputError on a NaN
+/// or negative alpha, or radii that do not match dt.
 AlphaShape alpha_shape(const Delaunay& dt, std::span<const double> points, double alpha,
                        std::span<const double> radii = {});
 

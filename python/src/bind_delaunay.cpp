@@ -183,6 +183,20 @@ void bind_delaunay(py::module_& m) {
                                return view_rows(a.singular, static_cast<std::size_t>(a.dim), s);
                              })
       .def_property_readonly("piece", [](py::object s) { return view_flat(s.cast<const AlphaShape&>().piece, s); })
+      .def_property_readonly("boundary_shifts",
+                             [](py::object s) {
+                               const auto& a = s.cast<const AlphaShape&>();
+                               const auto d = static_cast<py::ssize_t>(a.dim);
+                               return view(std::span<const std::int8_t>(a.boundary_shifts),
+                                           {static_cast<py::ssize_t>(a.boundary_shifts.size()) / (d * d), d, d}, s);
+                             })
+      .def_property_readonly("singular_shifts",
+                             [](py::object s) {
+                               const auto& a = s.cast<const AlphaShape&>();
+                               const auto d = static_cast<py::ssize_t>(a.dim);
+                               return view(std::span<const std::int8_t>(a.singular_shifts),
+                                           {static_cast<py::ssize_t>(a.singular_shifts.size()) / (d * d), d, d}, s);
+                             })
       .def_readonly("components", &AlphaShape::components)
       .def_readonly("nonmanifold_ridges", &AlphaShape::nonmanifold_ridges)
       .def_readonly("volume", &AlphaShape::volume)

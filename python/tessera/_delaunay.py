@@ -341,7 +341,6 @@ class Delaunay:
         ``|c - p|^2 - r_p^2``, which may be negative), in floating point; inf
         where a simplex is flat in floats. To choose an ``alpha`` for
         :meth:`alpha_shape` (``np.sqrt(np.quantile(dt.squared_radii(), 0.9))``)."""
-        self._refuse_periodic("squared_radii")
         radii = self._radii if self.power else None
         return _core.simplex_squared_radii(self._dt, self._points, radii)
 
@@ -354,8 +353,9 @@ class Delaunay:
         complex's singular facets (small empty-sphere triangles, or segments
         in 2D, that no kept simplex holds: the surface of a scan's samples).
         Decided exactly. ``alpha`` >= 0; ``float("inf")`` keeps every simplex
-        (the boundary is then :attr:`convex_hull`)."""
-        self._refuse_periodic("alpha_shape")
+        (the boundary is then :attr:`convex_hull`). Of a periodic
+        triangulation too: the facets then have their images' shifts
+        (:attr:`AlphaShape.boundary_shifts`)."""
         radii = self._radii if self.power else None
         return AlphaShape(_core.alpha_shape(self._dt, self._points, float(alpha), radii), self)
 
@@ -519,6 +519,18 @@ class AlphaShape:
         return self._shape.singular
 
     @property
+    def boundary_shifts(self) -> np.ndarray:
+        """int8 (b, D, D): of a periodic triangulation's shape, each boundary
+        facet's points' images in lattice vectors, in the frame of its
+        simplex (:attr:`Delaunay.simplex_shifts`); else empty."""
+        return self._shape.boundary_shifts
+
+    @property
+    def singular_shifts(self) -> np.ndarray:
+        """int8 (s, D, D): the same for :attr:`singular`."""
+        return self._shape.singular_shifts
+
+    @property
     def components(self) -> int:
         """Pieces: kept simplices joined through shared facets."""
         return self._shape.components
@@ -541,6 +553,7 @@ class AlphaShape:
         it came along, so rings touch there but never cross."""
         if self._dt.ndim != 2:
             raise _core.InputError("polygons: only for a 2D alpha shape")
+        self._dt._refuse_periodic("polygons")
         poly_rings, ring_points, ids = _core.boundary_polygons(self._dt._dt, self._dt.points, self._shape)
         rings = [ids[ring_points[r]:ring_points[r + 1]] for r in range(len(ring_points) - 1)]
         return [rings[poly_rings[k]:poly_rings[k + 1]] for k in range(len(poly_rings) - 1)]
@@ -575,6 +588,7 @@ class AlphaShape:
         MultiLineString), for QGIS and geopandas. Written atomically.
         ValueError for another extension or GeoJSON in 3D, OSError when the
         file cannot be written."""
+        self._dt._refuse_periodic("save")
         path = _inputs.as_path(path)
         allowed = (".vtp", ".npy") if self._dt.ndim == 3 else (".vtp", ".npy", ".geojson")
         if not path.lower().endswith(allowed):

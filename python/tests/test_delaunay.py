@@ -177,7 +177,8 @@ def test_periodic_triangulation_against_scipy():
     for name, get in (("neighbors", lambda: dt.neighbors), ("convex_hull", lambda: dt.convex_hull),
                       ("vertex_neighbor_vertices", lambda: dt.vertex_neighbor_vertices),
                       ("find_simplex", lambda: dt.find_simplex(pts[:1])), ("transform", lambda: dt.transform),
-                      ("alpha_shape", lambda: dt.alpha_shape(0.1)), ("squared_radii", lambda: dt.squared_radii())):
+                      ("polygons", lambda: dt.alpha_shape(0.1).polygons()),
+                      ("save", lambda: dt.alpha_shape(0.1).save("a.vtp"))):
         with pytest.raises(tessera.InputError, match="^" + name + ": not available for a periodic triangulation"):
             get()
     assert tessera.delaunay(pts).simplex_shifts.shape == (0, 3, 2)
@@ -285,6 +286,21 @@ def test_alpha_shape_save(tmp_path):
         a3.save(tmp_path / "no" / "c.vtp")
     with pytest.raises(tessera.InputError, match="2D"):
         tessera.delaunay(random_points(100, 3, seed=1)).alpha_shape(0.3).polygons()
+
+
+def test_alpha_shape_of_a_periodic_triangulation():
+    pts = random_points(2000, 3, seed=93)
+    dt = tessera.delaunay(pts, bounds=(0, 1, 0, 1, 0, 1), periodic=True)
+    r2 = dt.squared_radii()
+    alpha = float(np.sqrt(np.quantile(r2, 0.5)))
+    a = dt.alpha_shape(alpha)
+    np.testing.assert_array_equal(a.simplex_ids, np.nonzero(r2 <= alpha * alpha)[0])
+    assert a.boundary_shifts.shape == (len(a.boundary), 3, 3) and a.boundary_shifts.dtype == np.int8
+    assert a.singular_shifts.shape == (len(a.singular), 3, 3)
+    assert 0 < a.volume < 1
+    assert dt.alpha_shape(float("inf")).volume == pytest.approx(1, rel=1e-12)
+    plain = tessera.delaunay(pts).alpha_shape(alpha)
+    assert plain.boundary_shifts.shape == (0, 3, 3)
 
 
 def test_alpha_shape_of_a_regular_triangulation():

@@ -341,6 +341,26 @@ class AlphaShapeCommand(CommandCase):
         np.testing.assert_array_equal(np.load(self.path("i.npy")), h)
         self.assertIn("0 singular triangles", r.stderr)
 
+    def test_periodic(self):
+        # The periodic triangulation's simplices of circumradius <= alpha, with their shifts.
+        box = ["--bounds", "0", "1", "0", "1", "0", "1", "--periodic", "xyz"]
+        self.ok(["delaunay", self.path("p3.npy"), "--simplices", self.path("all.npy"), "--simplex-shifts",
+                 self.path("alls.npy")] + box)
+        r = self.ok(["delaunay", self.path("p3.npy"), "--alpha", 0.07, "--simplices", self.path("k.npy"),
+                     "--simplex-shifts", self.path("ks.npy"), "-o", self.path("k.vtu")] + box)
+        rows, shifts = np.load(self.path("all.npy")), np.load(self.path("alls.npy"))
+        images = self.p3[rows] + shifts  # the unit box: shifts are lattice vectors
+        radius = circumradii(images.reshape(-1, 3), np.arange(4 * len(rows)).reshape(-1, 4))
+        keep = radius <= 0.07
+        self.assertFalse((np.abs(radius - 0.07) < 1e-9).any())
+        np.testing.assert_array_equal(np.load(self.path("k.npy")), rows[keep])
+        np.testing.assert_array_equal(np.load(self.path("ks.npy")), shifts[keep])
+        self.assertIn("of %d tetrahedra kept" % len(rows), r.stderr)
+        rd = vtk.vtkXMLUnstructuredGridReader()
+        rd.SetFileName(self.path("k.vtu"))
+        rd.Update()
+        self.assertEqual(rd.GetOutput().GetNumberOfCells(), keep.sum())
+
     def test_threads_identical(self):
         for t in ("1", "2"):
             self.ok(["delaunay", self.path("p3.npy"), "--alpha", 0.08, "--boundary", self.path("b%s.vtp" % t),
@@ -357,7 +377,7 @@ class AlphaShapeCommand(CommandCase):
         g = self.path("b.geojson")
         self.assertIn("2D", self.fails(["delaunay", self.path("p3.npy"), "--alpha", "0.1", "--boundary", g], [g]))
         self.assertIn("--regularized", self.fails(["delaunay", self.path("p3.npy"), "--boundary", b, "--regularized"], [b]))
-        self.assertIn("--periodic", self.fails(["delaunay", self.path("p3.npy"), "--alpha", "0.1", "--simplices", b,
+        self.assertIn("--periodic", self.fails(["delaunay", self.path("p3.npy"), "--alpha", "0.1", "--boundary", b,
                                                 "--bounds", "0", "1", "0", "1", "0", "1", "--periodic", "xyz"], [b]))
         self.fails(["delaunay", self.path("p3.npy"), "--boundary", b, "--simplices", b], [b])
         self.fails(["delaunay", self.path("p3.npy"), "--boundary", os.path.join(self.dir, "no", "b.npy")])
