@@ -500,8 +500,18 @@ class Hostile(base.TempDirCase):
             self.check_file_box(case, d, pts, labels, bounds, axes, threads, files["--neighbors"],
                                 files["--neighbor-shifts"], what)
         if len(axes) == d and (labels is None or (np.load(labels) >= 0).all()):
-            self.check(["delaunay"] + pc + ["--simplices", self.p("qt.npy"), "--validate"],
-                       inp, labels, what, d, case, periodic=True)
+            if self.check(["delaunay"] + pc + ["--simplices", self.p("qt.npy"), "--simplex-shifts", self.p("qs.npy"),
+                                               "--validate"], inp, labels, what, d, case, periodic=True):
+                # Its alpha shape at a size among the box's: the kept rows
+                # (with their shifts) are rows of the triangulation.
+                extent = float(np.min(np.asarray(bounds[1::2], float) - np.asarray(bounds[0::2], float)))
+                alpha = extent * float(rng.uniform(0.01, 0.3))
+                if self.check(["delaunay"] + pc + ["--alpha", repr(alpha), "--simplices", self.p("qk.npy"),
+                                                   "--simplex-shifts", self.p("qks.npy")],
+                              inp, labels, what, d, case, periodic=True):
+                    rows = {tuple(r) + tuple(s.ravel()) for r, s in zip(np.load(self.p("qt.npy")), np.load(self.p("qs.npy")))}
+                    kept = [tuple(r) + tuple(s.ravel()) for r, s in zip(np.load(self.p("qk.npy")), np.load(self.p("qks.npy")))]
+                    self.assertTrue(set(kept) <= rows, "case %d (%s): periodic alpha rows not the triangulation's" % (case, what))
         if case % 2 == 1:
             self.check(["graph"] + pc + lab + ["-o", self.p("qg.vtp")], inp, labels, what, d, case, periodic=True)
             self.check(["faces"] + pc + lab + ["-o", self.p("qf.vtp"), "--kind", "complex"],
