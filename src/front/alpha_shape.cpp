@@ -663,7 +663,9 @@ AlphaShape alpha_shape(const Delaunay& dt, std::span<const double> points, doubl
           if (o >= 0) {
             const auto ou = static_cast<std::size_t>(o);
             const std::size_t ok = slot_across(adj, w, r, k);
-            if (ok == w) throw InputError("alpha_shape: the triangulation does not conform (a facet in one simplex only on one side)");
+            if (ok == w)
+              throw InputError("alpha_shape: the triangulation does not conform (simplex " + std::to_string(o) +
+                               " is simplex " + std::to_string(r) + "'s neighbour, not the reverse)");
             p[c] = neighbour_apex(g, r, k, ou, ok, xyz[c]);
             rr[c++] = g.radius(ou, ok);
           }
