@@ -514,6 +514,20 @@ const double* neighbour_apex(const Geometry& g, std::size_t r, std::size_t k, st
   return buffer;
 }
 
+/// How many keys occur more than twice (sorts `keys`, in the calling arena).
+template <class Key>
+std::size_t keys_in_more_than_two(std::vector<Key>& keys) {
+  tbb::parallel_sort(keys.begin(), keys.end());
+  std::size_t count = 0;
+  for (std::size_t i = 0; i < keys.size();) {
+    std::size_t j = i;
+    while (j < keys.size() && keys[j] == keys[i]) ++j;
+    count += j - i > 2;
+    i = j;
+  }
+  return count;
+}
+
 /// The facet of a row opposite its slot k, oriented outward (3D) or with the
 /// simplex on its left (2D). Taking slot k out of a positively oriented row
 /// leaves its vertex on the facet's outer side when k is even (3D: det of
@@ -770,13 +784,7 @@ AlphaShape alpha_shape(const Delaunay& dt, std::span<const double> points, doubl
         for (std::size_t x = 0; x < 3; ++x) e.second[x] = b.second[x] - a.second[x];
         edges.push_back(e);
       }
-    arena.execute([&] { tbb::parallel_sort(edges.begin(), edges.end()); });
-    for (std::size_t i = 0; i < edges.size();) {
-      std::size_t j = i;
-      while (j < edges.size() && edges[j] == edges[i]) ++j;
-      shape.nonmanifold_ridges += j - i > 2;
-      i = j;
-    }
+    shape.nonmanifold_ridges = arena.execute([&] { return keys_in_more_than_two(edges); });
   } else if (D == 3) {
     std::vector<std::uint64_t> edges;
     edges.reserve(3 * nf);
@@ -787,13 +795,7 @@ AlphaShape alpha_shape(const Delaunay& dt, std::span<const double> points, doubl
         if (a > b) std::swap(a, b);
         edges.push_back(std::uint64_t{a} << 32 | b);
       }
-    arena.execute([&] { tbb::parallel_sort(edges.begin(), edges.end()); });
-    for (std::size_t i = 0; i < edges.size();) {
-      std::size_t j = i;
-      while (j < edges.size() && edges[j] == edges[i]) ++j;
-      shape.nonmanifold_ridges += j - i > 2;
-      i = j;
-    }
+    shape.nonmanifold_ridges = arena.execute([&] { return keys_in_more_than_two(edges); });
   } else {
     std::vector<std::uint32_t> uses(dt.n_points, 0);
     for (const std::int32_t v : shape.boundary) ++uses[static_cast<std::size_t>(v)];
