@@ -746,17 +746,18 @@ AlphaShape alpha_shape(const Delaunay& dt, std::span<const double> points, doubl
       });
     });
     // Roots are their sets' lowest rows (unions link under the lower root),
-    // so numbering them in row order numbers the pieces by their lowest rows.
-    std::vector<std::int32_t> number(m, -1);
-    for (std::size_t i = 0; i < nk; ++i) {
-      const std::int32_t r = shape.simplex_rows[i];
-      if (sets.is_root(r)) number[static_cast<std::size_t>(r)] = static_cast<std::int32_t>(shape.components++);
-    }
+    // so the roots in row order number the pieces by their lowest rows; a
+    // piece's number is its root's place among them (few: a binary search).
+    std::vector<std::int32_t> roots;
+    for (std::size_t i = 0; i < nk; ++i)
+      if (sets.is_root(shape.simplex_rows[i])) roots.push_back(shape.simplex_rows[i]);
+    shape.components = roots.size();
     shape.piece.resize(nk);
     arena.execute([&] {
       tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nk, 4096), [&](const tbb::blocked_range<std::size_t>& rg) {
         for (std::size_t i = rg.begin(); i != rg.end(); ++i)
-          shape.piece[i] = number[static_cast<std::size_t>(sets.find(shape.simplex_rows[i]))];
+          shape.piece[i] = static_cast<std::int32_t>(
+              std::lower_bound(roots.begin(), roots.end(), sets.find(shape.simplex_rows[i])) - roots.begin());
       });
     });
   }
@@ -820,11 +821,14 @@ AlphaShape alpha_shape(const Delaunay& dt, std::span<const double> points, doubl
     return total.value();
   };
   shape.volume = block_sums(shape.simplex_rows.size(), [&](std::size_t i) {
-    Corners s;
-    corners(g, static_cast<std::size_t>(shape.simplex_rows[i]), s);
+    const auto r = static_cast<std::size_t>(shape.simplex_rows[i]);
+    double xyz[4][3];
+    const double* a = g.at(r, 0, xyz[0]);
     double e[3][3] = {};
-    for (int k = 0; k < D; ++k)
-      for (int d = 0; d < D; ++d) e[k][d] = s.p[static_cast<std::size_t>(k) + 1][d] - s.p[0][d];
+    for (int k = 0; k < D; ++k) {
+      const double* q = g.at(r, static_cast<std::size_t>(k) + 1, xyz[k + 1]);
+      for (int d = 0; d < D; ++d) e[k][d] = q[d] - a[d];
+    }
     return D == 3 ? (e[0][0] * (e[1][1] * e[2][2] - e[1][2] * e[2][1]) - e[0][1] * (e[1][0] * e[2][2] - e[1][2] * e[2][0]) +
                      e[0][2] * (e[1][0] * e[2][1] - e[1][1] * e[2][0])) / 6
                   : (e[0][0] * e[1][1] - e[0][1] * e[1][0]) / 2;
