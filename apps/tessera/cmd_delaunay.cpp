@@ -55,6 +55,12 @@ Delaunay triangulate(const io::PointCloud& pc, DelaunayOptions opt, bool show_pr
   });
 }
 
+/// --alpha R (delaunay, bench delaunay): a radius >= 0 or inf, before any work.
+void check_alpha(const std::optional<double>& alpha) {
+  if (alpha && !(*alpha >= 0))
+    throw InputError("--alpha " + strf("%g", *alpha) + ": must be a radius >= 0 (inf keeps every simplex)");
+}
+
 void check_delaunay_outputs(const DelaunayArgs& a) {
   if (a.output == "-") throw InputError("-o: the triangulation is written to a .vtu or .vtp file, not to standard output");
   if (!a.output.empty()) {
@@ -78,9 +84,7 @@ void check_delaunay_outputs(const DelaunayArgs& a) {
     if (e != ".vtp" && e != ".npy" && e != ".geojson")
       throw InputError("--boundary " + a.boundary + ": unknown extension '" + e + "' (use .vtp, .npy or, in 2D, .geojson)");
   }
-  if (a.alpha && !(*a.alpha >= 0))
-    throw InputError("--alpha " + strf("%g", *a.alpha) +
-                     ": must be a radius >= 0 (inf keeps every simplex)");
+  check_alpha(a.alpha);
   if (a.regularized && (a.boundary.empty() || !a.alpha))
     throw InputError("--regularized: only with --alpha and --boundary (it leaves the alpha complex's singular facets "
                      "out of the boundary)");
@@ -307,8 +311,7 @@ int run_bench_delaunay(const BenchArgs& a) {
   opt.skip_cells = a.skip_cells;
   opt.method = delaunay_method(a.method);
   opt.radii = pc.radii;
-  if (a.alpha && !(*a.alpha >= 0))
-    throw InputError("--alpha " + strf("%g", *a.alpha) + ": must be a radius >= 0 (inf keeps every simplex)");
+  check_alpha(a.alpha);
   const std::span<const double> radii(pc.radii);
   for (int rep = 0; rep < a.repeat; ++rep) {
     // Timed region: the library calls only (no I/O), as the peers do.

@@ -95,8 +95,8 @@ struct BoundaryPolygons {
 /// came through (walking the kept triangles around the vertex), so rings
 /// never cross; a hole may touch its outer ring, or another hole, at a
 /// vertex, as the OGC's simple features allow. A ring's orientation is
-/// decided exactly (at its lowest vertex). Throws InputError for a 3D shape
-/// or one not computed from `dt`.
+/// decided exactly (at its lowest vertex). Throws InputError for a 3D shape,
+/// a periodic triangulation's, or one not computed from `dt`.
 BoundaryPolygons boundary_polygons(const Delaunay& dt, std::span<const double> points, const AlphaShape& shape);
 
 /// Per row of `dt` (periodic too), the squared radius of its circumsphere (with `radii`, a

@@ -43,6 +43,7 @@
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_sort.h>
 
+#include "compensated_sum.hpp"
 #include "pass.hpp"
 #include "point_buckets.hpp"
 #include "tessera/alpha_shape.hpp"
@@ -52,6 +53,10 @@ namespace tessera {
 namespace {
 
 constexpr double unit = 0x1p-53;  // unit roundoff
+
+/// A row's entry: its point id and (periodic) its image's shift, ordered by
+/// id, then shift (a translation keeps that order).
+using Entry = std::pair<std::int32_t, std::array<int, 3>>;
 
 /// Where a triangulation's entries lie: a row's slot k is its point, or in a
 /// periodic triangulation that point (as wrapped, Delaunay::periodic_points)
@@ -74,15 +79,24 @@ struct Geometry {
   const std::int8_t* shift(std::size_t row, std::size_t k) const {
     return dt.simplex_shifts.data() + (row * w + k) * static_cast<std::size_t>(dt.dim);
   }
-  /// Entry (row, k)'s coordinates: a pointer into the points, or (periodic)
-  /// its image written to `buffer`.
-  const double* at(std::size_t row, std::size_t k, double* buffer) const {
-    const double* p = points.data() + static_cast<std::size_t>(id(row, k)) * static_cast<std::size_t>(dt.dim);
+  Entry entry(std::size_t row, std::size_t k) const {
+    Entry e{id(row, k), {0, 0, 0}};
+    if (periodic)
+      for (int a = 0; a < dt.dim; ++a) e.second[static_cast<std::size_t>(a)] = shift(row, k)[a];
+    return e;
+  }
+  /// The coordinates of point `id` moved by `shift` lattice vectors, in
+  /// `buffer` (periodic), or a pointer into the points.
+  const double* place(std::int32_t point, const std::array<int, 3>& s, double* buffer) const {
+    const double* p = points.data() + static_cast<std::size_t>(point) * static_cast<std::size_t>(dt.dim);
     if (!periodic) return p;
-    std::array<int, 3> s{0, 0, 0};
-    for (int a = 0; a < dt.dim; ++a) s[static_cast<std::size_t>(a)] = shift(row, k)[a];
     periodic_image(lattice, dt.dim, p, s, buffer);
     return buffer;
+  }
+  /// Entry (row, k)'s coordinates.
+  const double* at(std::size_t row, std::size_t k, double* buffer) const {
+    const Entry e = entry(row, k);
+    return place(e.first, e.second, buffer);
   }
   double radius(std::size_t row, std::size_t k) const {
     return radii.empty() ? 0.0 : radii[static_cast<std::size_t>(id(row, k))];
@@ -128,6 +142,7 @@ template <class T>
 struct Frame {
   int D = 3, m = 0;  ///< dimension; vectors
   int scale = 0;     ///< Approx: the vectors are the differences times 2^scale
+  bool capped = false;  ///< Approx: alpha was capped (below)
   std::array<std::array<T, 3>, 5> e;
   std::array<T, 5> w;
   T rhs;
@@ -179,16 +194,11 @@ bool make_frame(Frame<Approx>& f, int D, const double* a, double ra, const doubl
   }
   // alpha capped at 2^100 (scaled; the vectors are below 2): a test the
   // capped alpha passes, the true one passes too (callers redo the others).
-  const Approx as(std::min(times_pow2(alpha, scale), 0x1p100));
+  const double scaled_alpha = times_pow2(alpha, scale);
+  f.capped = scaled_alpha > 0x1p100;
+  const Approx as(std::min(scaled_alpha, 0x1p100));
   f.rhs = as * as + ra2;
   return std::isfinite(f.rhs.p) && std::isfinite(f.w[0].p) && std::isfinite(f.w[static_cast<std::size_t>(m - 1)].p);
-}
-
-bool alpha_capped(double alpha, const double* a, const double* const* q, int m, int D) {
-  double big = 0;
-  for (int k = 0; k < m; ++k)
-    for (int d = 0; d < D; ++d) big = std::max(big, std::fabs(q[k][d] - a[d]));
-  return big > 0 && std::isfinite(big) && times_pow2(alpha, scale_of(big)) > 0x1p100;
 }
 
 void make_frame(Frame<mpq_class>& f, int D, const double* a, double ra, const double* const* q, const double* rq,
@@ -336,7 +346,7 @@ bool keep_simplex(const Corners& s, double alpha, bool weighted, std::size_t& ex
     Approx det;
     const int sign = filtered_sign(simplex_margin(f, det));
     if (sign > 0) return true;
-    if (sign < 0 && !alpha_capped(alpha, s.p[0], q, s.D, s.D)) return false;
+    if (sign < 0 && !f.capped) return false;
   }
   ++exact;
   thread_local Frame<mpq_class> g;
@@ -363,7 +373,7 @@ bool singular_facet(int D, const double* const* p, const double* r, int apexes, 
   if (make_frame(f, D, p[0], r[0], q, rq, m, alpha)) {
     const FacetTerms<Approx> t = facet_terms(f);
     const int small = filtered_sign(facet_margin(f, t));
-    if (small < 0 && !alpha_capped(alpha, p[0], q, m, D)) return false;
+    if (small < 0 && !f.capped) return false;
     if (small > 0) {
       bool decided = true;
       for (int k = D - 1; k < m && decided; ++k) {
@@ -383,17 +393,6 @@ bool singular_facet(int D, const double* const* p, const double* r, int apexes, 
     if (sgn(apex_margin(g, t, k)) > 0) return false;
   return true;
 }
-
-/// Neumaier's compensated sum, added to in a fixed order.
-struct CompensatedSum {
-  double sum = 0, carry = 0;
-  void add(double x) {
-    const double t = sum + x;
-    carry += std::fabs(sum) >= std::fabs(x) ? (sum - t) + x : (x - t) + sum;
-    sum = t;
-  }
-  double value() const { return sum + carry; }
-};
 
 void check_arguments(const Delaunay& dt, std::span<const double> points, std::span<const double> radii,
                      const char* who) {
@@ -433,7 +432,6 @@ Adjacency adjacency(const Geometry& g) {
   if (m == 0) return a;
   if (!g.periodic) a.nb = simplex_neighbors(dt);
   if (g.periodic) {
-    using Entry = std::pair<std::int32_t, std::array<int, 3>>;
     struct Record {
       std::array<Entry, 3> key;
       std::size_t s, k;
@@ -448,12 +446,8 @@ Adjacency adjacency(const Geometry& g) {
           rec.k = k;
           rec.key.fill({-1, {0, 0, 0}});
           std::size_t c = 0;
-          for (std::size_t j = 0; j < w; ++j) {
-            if (j == k) continue;
-            Entry e{g.id(s, j), {0, 0, 0}};
-            for (std::size_t x = 0; x < D; ++x) e.second[x] = g.shift(s, j)[x];
-            rec.key[c++] = e;
-          }
+          for (std::size_t j = 0; j < w; ++j)
+            if (j != k) rec.key[c++] = g.entry(s, j);
           std::sort(rec.key.begin(), rec.key.begin() + static_cast<std::ptrdiff_t>(D));
           const std::array<int, 3> base = rec.key[0].second;
           for (std::size_t c2 = 0; c2 < D; ++c2)
@@ -494,24 +488,16 @@ std::size_t slot_across(const Adjacency& a, std::size_t w, std::size_t r, std::s
 const double* neighbour_apex(const Geometry& g, std::size_t r, std::size_t k, std::size_t o, std::size_t ok,
                              double* buffer) {
   if (!g.periodic) return g.at(o, ok, buffer);
-  const int D = g.dt.dim;
   auto first_entry = [&](std::size_t s, std::size_t skip) {
-    std::pair<std::int32_t, std::array<int, 3>> best{INT32_MAX, {0, 0, 0}};
-    for (std::size_t j = 0; j < g.w; ++j) {
-      if (j == skip) continue;
-      std::pair<std::int32_t, std::array<int, 3>> e{g.id(s, j), {0, 0, 0}};
-      for (int x = 0; x < D; ++x) e.second[static_cast<std::size_t>(x)] = g.shift(s, j)[x];
-      best = std::min(best, e);
-    }
+    Entry best{INT32_MAX, {0, 0, 0}};
+    for (std::size_t j = 0; j < g.w; ++j)
+      if (j != skip) best = std::min(best, g.entry(s, j));
     return best.second;
   };
   const std::array<int, 3> in_r = first_entry(r, k), in_o = first_entry(o, ok);
-  std::array<int, 3> shift{0, 0, 0};
-  for (int x = 0; x < D; ++x)
-    shift[static_cast<std::size_t>(x)] = g.shift(o, ok)[x] + in_r[static_cast<std::size_t>(x)] - in_o[static_cast<std::size_t>(x)];
-  periodic_image(g.lattice, D, g.points.data() + static_cast<std::size_t>(g.id(o, ok)) * static_cast<std::size_t>(D), shift,
-                 buffer);
-  return buffer;
+  Entry apex = g.entry(o, ok);
+  for (std::size_t x = 0; x < 3; ++x) apex.second[x] += in_r[x] - in_o[x];
+  return g.place(apex.first, apex.second, buffer);
 }
 
 /// How many keys occur more than twice (sorts `keys`, in the calling arena).
@@ -775,7 +761,7 @@ AlphaShape alpha_shape(const Delaunay& dt, std::span<const double> points, doubl
       for (std::size_t j = 0; j < 3; ++j) {
         std::size_t ia = 3 * f + j, ib = 3 * f + (j + 1) % 3;
         auto entry = [&](std::size_t i) {
-          std::pair<std::int32_t, std::array<int, 3>> e{shape.boundary[i], {0, 0, 0}};
+          Entry e{shape.boundary[i], {0, 0, 0}};
           for (std::size_t x = 0; x < 3; ++x) e.second[x] = shape.boundary_shifts[i * 3 + x];
           return e;
         };
@@ -807,14 +793,14 @@ AlphaShape alpha_shape(const Delaunay& dt, std::span<const double> points, doubl
   // (the same on any thread count).
   auto block_sums = [&](std::size_t count, auto&& term) {
     const std::size_t nb_blocks = (count + block - 1) / block;
-    std::vector<CompensatedSum> part(nb_blocks);
+    std::vector<front::CompensatedSum> part(nb_blocks);
     arena.execute([&] {
       tbb::parallel_for(std::size_t{0}, nb_blocks, [&](std::size_t b) {
         for (std::size_t i = b * block; i < std::min(count, (b + 1) * block); ++i) part[b].add(term(i));
       });
     });
-    CompensatedSum total;
-    for (const CompensatedSum& c : part) {
+    front::CompensatedSum total;
+    for (const front::CompensatedSum& c : part) {
       total.add(c.sum);
       total.add(c.carry);
     }
@@ -835,14 +821,12 @@ AlphaShape alpha_shape(const Delaunay& dt, std::span<const double> points, doubl
   });
   shape.boundary_measure = block_sums(nf, [&](std::size_t f) {
     double xyz[3][3];
-    auto corner = [&](std::size_t i) -> const double* {
+    auto corner = [&](std::size_t i) {
       const std::size_t e = f * du + i;
-      const double* p = g.points.data() + static_cast<std::size_t>(shape.boundary[e]) * du;
-      if (!g.periodic) return p;
       std::array<int, 3> sh{0, 0, 0};
-      for (std::size_t x = 0; x < du; ++x) sh[x] = shape.boundary_shifts[e * du + x];
-      periodic_image(g.lattice, D, p, sh, xyz[i]);
-      return xyz[i];
+      if (g.periodic)
+        for (std::size_t x = 0; x < du; ++x) sh[x] = shape.boundary_shifts[e * du + x];
+      return g.place(shape.boundary[e], sh, xyz[i]);
     };
     const double *a = corner(0), *b = corner(1);
     if (D == 2) return std::hypot(b[0] - a[0], b[1] - a[1]);

@@ -19,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "point_buckets.hpp"
 #include "tessera/alpha_shape.hpp"
 #include "tessera/kernels/delaunay_predicates.hpp"
 
@@ -26,6 +27,7 @@ namespace tessera {
 
 BoundaryPolygons boundary_polygons(const Delaunay& dt, std::span<const double> points, const AlphaShape& shape) {
   if (shape.dim != 2 || dt.dim != 2) throw InputError("boundary_polygons: only for a 2D alpha shape");
+  front::refuse_periodic(dt, "boundary_polygons");  // (rings of images: ids alone would cross the box)
   if (points.size() != 2 * dt.n_points) throw InputError("boundary_polygons: points are not the triangulation's");
   const std::size_t m = dt.n_simplices(), nf = shape.n_boundary();
   if (shape.piece.size() != shape.simplex_rows.size() || shape.boundary_simplex.size() != nf ||

@@ -1,4 +1,5 @@
 // Walls in the kernels' form, and points against them (walls.hpp).
+#include "compensated_sum.hpp"
 #include "walls.hpp"
 
 #include <algorithm>
@@ -186,13 +187,9 @@ double polytope_measure(const Bounds& box, const std::vector<Wall>& given, int t
       }
     });
   });
-  double sum = 0, carry = 0;
-  for (const double v : part) {
-    const double t = sum + v;
-    carry += std::fabs(sum) >= std::fabs(v) ? (sum - t) + v : (v - t) + sum;
-    sum = t;
-  }
-  return sum + carry;
+  front::CompensatedSum total;
+  for (const double v : part) total.add(v);
+  return total.value();
 }
 }  // namespace
 

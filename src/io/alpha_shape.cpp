@@ -73,6 +73,9 @@ void write_geojson(const std::string& path, const Delaunay& dt, const AlphaShape
 
 void write_alpha_boundary(const std::string& path, const Delaunay& dt, const AlphaShape& shape,
                           std::span<const double> points, bool singular, bool kept_order) {
+  if (dt.is_periodic())
+    throw InputError(path + ": a periodic triangulation's boundary is not written (its facets meet images; "
+                     "AlphaShape::boundary_shifts has them)");
   const bool npy = path == "-" || detail::ends_with_ci(path, ".npy");
   if (detail::ends_with_ci(path, ".geojson")) {
     if (shape.dim != 2) throw InputError(path + ": GeoJSON polygons are for a 2D shape (use .vtp or .npy in 3D)");

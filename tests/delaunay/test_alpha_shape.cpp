@@ -522,10 +522,24 @@ TEST(AlphaShape, PeriodicEqualsTiledCopies) {
     EXPECT_EQ(periodic_keys(pa.boundary, pa.boundary_shifts, du), tiled_keys(ta.boundary, du)) << dim;
     EXPECT_EQ(periodic_keys(pa.singular, pa.singular_shifts, du), tiled_keys(ta.singular, du)) << dim;
     EXPECT_EQ(pa.n_boundary() * du * du, pa.boundary_shifts.size());
-    // Every periodic image is one of 3^D copies of the box: volume and
-    // boundary measure are a third / ninth ... of the tiling's interior; so
-    // compare with the kept simplices' own volumes instead.
-    EXPECT_GT(pa.volume, 0);
+    // The volume: the kept simplices' images, placed by their shifts.
+    double volume = 0;
+    for (std::size_t f = 0; f < kept_rows.size() / w; ++f) {
+      double x[4][3] = {};
+      for (std::size_t j = 0; j < w; ++j)
+        for (std::size_t a = 0; a < du; ++a)
+          x[j][a] = pd.periodic_points[static_cast<std::size_t>(kept_rows[f * w + j]) * du + a] +
+                    kept_shifts[(f * w + j) * du + a];  // the unit box: shifts are lengths
+      double e[3][3] = {};
+      for (std::size_t j = 0; j < du; ++j)
+        for (std::size_t a = 0; a < du; ++a) e[j][a] = x[j + 1][a] - x[0][a];
+      volume += dim == 3 ? (e[0][0] * (e[1][1] * e[2][2] - e[1][2] * e[2][1]) -
+                            e[0][1] * (e[1][0] * e[2][2] - e[1][2] * e[2][0]) +
+                            e[0][2] * (e[1][0] * e[2][1] - e[1][1] * e[2][0])) / 6
+                         : (e[0][0] * e[1][1] - e[0][1] * e[1][0]) / 2;
+    }
+    EXPECT_NEAR(pa.volume, volume, 1e-12);
+    EXPECT_GT(pa.volume, 0.05);
     EXPECT_LT(pa.volume, 1);
     // Thread independence.
     o.threads = 1;

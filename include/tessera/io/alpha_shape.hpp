@@ -22,8 +22,8 @@ namespace tessera::io {
 ///   clockwise, each closed by repeating its first point, as RFC 7946 asks)
 ///   with the shape's alpha, pieces, area and length as properties, and with
 ///   `singular` a MultiLineString of the singular segments.
-/// Throws InputError on another extension, .geojson in 3D, or a path that
-/// cannot be written.
+/// Throws InputError on another extension, .geojson in 3D, a periodic
+/// triangulation, or a path that cannot be written.
 void write_alpha_boundary(const std::string& path, const Delaunay& dt, const AlphaShape& shape,
                           std::span<const double> points, bool singular, bool kept_order);
 
