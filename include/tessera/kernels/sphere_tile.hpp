@@ -1,0 +1,222 @@
+// One spherical Voronoi cell, clipped from the whole sphere by one candidate
+// at a time (the 2D tile's method on the sphere).
+//
+// The cell of generator p is the cone of directions u with u.(p - q) >= 0
+// for every other point q: for points on a sphere, the directions closer to
+// p than to any q (u.p >= u.q is |u - p| <= |u - q| when |p| = |q|); for any
+// points, the normal cone of their convex hull at p, which is what the
+// spherical Delaunay triangulation (the hull) is dual to. Every plane goes
+// through the origin, so the cone needs no centre and the topology is
+// decided on the input coordinates alone (sphere_predicates.hpp).
+//
+// A cell passes through four states: the whole sphere (no candidate yet), a
+// hemisphere (one plane, no vertex), then a polygon: two planes make a lune
+// (two antipodal vertices), every later plane removes a contiguous run of
+// vertices and adds two. Edges are kept counter-clockwise seen from outside
+// the sphere; edge k lies on the plane of neighbour edge_[k], and vertex k is
+// where edge k ends and edge k + 1 begins, the hull facet (p, edge_[k],
+// edge_[k+1]) whose outward normal is (edge_[k] - p) x (edge_[k+1] - p). A
+// clip removes vertex k iff orientation(p, edge_[k], edge_[k+1], s) > 0;
+// the float filter decides that from the normal stored with the vertex, the
+// exact predicate where it cannot. If every vertex goes, p lies inside the
+// hull (in the perturbed sense): its cell is empty.
+//
+// Termination (the security radius of the meshless method): s removes
+// vertex v only if v.(s - p) > 0 with v the unit normal, i.e. s lies in the
+// cap of the ball |x - c| <= R_max above the plane through p normal to v.
+// With h = v.(p - c) >= 0 every point of that cap lies within
+// sqrt(|p - c|^2 - h^2) + sqrt(R_max^2 - h^2) of p (for points on a sphere,
+// twice the chord's half: the circumcircle's diameter); with h < 0, within
+// |p - c| + R_max. Candidates taken nearest first stop at the largest such
+// radius over the vertices.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <span>
+#include <stdexcept>
+#include <vector>
+
+#include "tessera/kernels/filter.hpp"
+#include "tessera/kernels/sphere_predicates.hpp"
+
+namespace tessera::kernels {
+
+class SphereTile {
+ public:
+  enum class State : std::uint8_t { sphere, hemisphere, polygon, empty };
+
+  /// Start the cell of point `id` at `p`; `center` and `r_max` (at least
+  /// the largest |x - center| over all points) serve the security radius.
+  void reset(std::int32_t id, const double* p, const double* center, double r_max) {
+    id_ = id;
+    p_ = p;
+    state_ = State::sphere;
+    edge_.clear();
+    edge_pt_.clear();
+    vert_.clear();
+    for (int d = 0; d < 3; ++d) pc_[d] = p[d] - center[d];
+    pc2_ = pc_[0] * pc_[0] + pc_[1] * pc_[1] + pc_[2] * pc_[2];
+    r_max2_ = r_max * r_max;
+    security2_ = std::numeric_limits<double>::infinity();
+    exact_tests_ = 0;
+  }
+
+  /// Clip by the plane of candidate `sid` at `s` (not p, not a duplicate of
+  /// it). Returns whether the cell changed.
+  bool clip(std::int32_t sid, const double* s) {
+    switch (state_) {
+      case State::sphere:
+        edge_.push_back(sid);
+        edge_pt_.push_back(s);
+        state_ = State::hemisphere;
+        return true;
+      case State::hemisphere:
+        // Two planes through the origin always make a lune (perturbed
+        // points are never collinear): vertices (a -> s) and (s -> a).
+        edge_.push_back(sid);
+        edge_pt_.push_back(s);
+        vert_.resize(2);
+        make_vertex(vert_[0], edge_pt_[0], edge_pt_[1]);
+        make_vertex(vert_[1], edge_pt_[1], edge_pt_[0]);
+        state_ = State::polygon;
+        update_security();
+        return true;
+      case State::empty:
+        return false;
+      case State::polygon:
+        break;
+    }
+    const std::size_t n = vert_.size();
+    std::size_t removed = 0;
+    for (std::size_t k = 0; k < n; ++k) {
+      vert_[k].clipped = removes(k, sid, s);
+      removed += vert_[k].clipped;
+    }
+    if (removed == 0) return false;
+    if (removed == n) {
+      state_ = State::empty;
+      edge_.clear();
+      edge_pt_.clear();
+      vert_.clear();
+      security2_ = 0;
+      return true;
+    }
+    // The removed vertices are one cyclic run i .. j (the cone is convex and
+    // every decision exact). Keep edges j+1 .. i and their vertices j+1 ..
+    // i-1, then edge s between the new vertices (edge_i -> s), (s -> edge_j+1).
+    std::size_t i = 0;
+    while (!(vert_[i].clipped && !vert_[(i + n - 1) % n].clipped)) ++i;
+    const std::size_t j = (i + removed - 1) % n;
+    for (std::size_t k = 0; k < removed; ++k)
+      if (!vert_[(i + k) % n].clipped) throw std::logic_error("SphereTile: removed vertices are not one run");
+    const std::size_t kept = n - removed;
+    new_edge_.clear();
+    new_edge_pt_.clear();
+    new_vert_.clear();
+    for (std::size_t m = 0; m <= kept; ++m) {
+      const std::size_t e = (j + 1 + m) % n;
+      new_edge_.push_back(edge_[e]);
+      new_edge_pt_.push_back(edge_pt_[e]);
+      if (m < kept) new_vert_.push_back(vert_[e]);
+    }
+    new_edge_.push_back(sid);
+    new_edge_pt_.push_back(s);
+    new_vert_.resize(kept + 2);
+    make_vertex(new_vert_[kept], edge_pt_[i], s);
+    make_vertex(new_vert_[kept + 1], s, edge_pt_[(j + 1) % n]);
+    edge_.swap(new_edge_);
+    edge_pt_.swap(new_edge_pt_);
+    vert_.swap(new_vert_);
+    update_security();
+    return true;
+  }
+
+  State state() const { return state_; }
+  /// Squared distance from p beyond which no candidate can change the cell
+  /// (infinite until the cell is a polygon with well-conditioned vertices).
+  double security2() const { return security2_; }
+  /// Neighbours across the edges, counter-clockwise seen from outside.
+  std::span<const std::int32_t> edges() const { return edge_; }
+  std::size_t exact_tests() const { return exact_tests_; }
+
+ private:
+  struct Vertex {
+    double u[3];     // (a - p) x (b - p), from the rounded differences
+    double perm[3];  // per component |a_y b_z| + |a_z b_y| etc.: the filter's scale
+    bool clipped;
+  };
+
+  void make_vertex(Vertex& v, const double* a, const double* b) const {
+    double da[3], db[3];
+    for (int d = 0; d < 3; ++d) {
+      da[d] = a[d] - p_[d];
+      db[d] = b[d] - p_[d];
+    }
+    v.u[0] = da[1] * db[2] - da[2] * db[1];
+    v.u[1] = da[2] * db[0] - da[0] * db[2];
+    v.u[2] = da[0] * db[1] - da[1] * db[0];
+    v.perm[0] = std::fabs(da[1] * db[2]) + std::fabs(da[2] * db[1]);
+    v.perm[1] = std::fabs(da[2] * db[0]) + std::fabs(da[0] * db[2]);
+    v.perm[2] = std::fabs(da[0] * db[1]) + std::fabs(da[1] * db[0]);
+    v.clipped = false;
+  }
+
+  // Does s remove vertex k: orientation(p, edge_k, edge_k+1, s) > 0, which
+  // is det[s - p, a - p, b - p] = (s - p).u. The bound is orientation_filter's
+  // (delaunay_predicates.hpp) on the same rounded rows.
+  bool removes(std::size_t k, std::int32_t sid, const double* s) {
+    const Vertex& v = vert_[k];
+    const double ds[3] = {s[0] - p_[0], s[1] - p_[1], s[2] - p_[2]};
+    const double det = ds[0] * v.u[0] + ds[1] * v.u[1] + ds[2] * v.u[2];
+    const double perm = std::fabs(ds[0]) * v.perm[0] + std::fabs(ds[1]) * v.perm[1] + std::fabs(ds[2]) * v.perm[2];
+    const double growth = 2 * (std::fabs(ds[0]) + std::fabs(ds[1]) + std::fabs(ds[2])) + 3;
+    const double bound = 16 * filter::u * perm + filter::underflow_bound(growth);
+    if (det > bound) return true;
+    if (det < -bound) return false;
+    ++exact_tests_;
+    const std::size_t k1 = (k + 1) % edge_.size();
+    return orientation_sos(p_, edge_pt_[k], edge_pt_[k1], s, id_, edge_[k], edge_[k1], sid) > 0;
+  }
+
+  // The security radius (file comment), with room for the rounding of the
+  // normals: a vertex whose normal is not known to 1e-3 relative (a facet
+  // of nearly collinear points) leaves the radius infinite.
+  void update_security() {
+    double worst = 0;
+    const double pc = std::sqrt(pc2_), r_max = std::sqrt(r_max2_);
+    for (const Vertex& v : vert_) {
+      const double len = std::sqrt(v.u[0] * v.u[0] + v.u[1] * v.u[1] + v.u[2] * v.u[2]);
+      const double err = 8 * filter::u * std::sqrt(v.perm[0] * v.perm[0] + v.perm[1] * v.perm[1] + v.perm[2] * v.perm[2]);
+      if (!(len > 1e3 * err) || !(len > 0)) {
+        security2_ = std::numeric_limits<double>::infinity();
+        return;
+      }
+      // h lowered by what the normal's direction error (err / len radians,
+      // doubled) and the sum's rounding can hide; a smaller h only widens.
+      double h = (v.u[0] * pc_[0] + v.u[1] * pc_[1] + v.u[2] * pc_[2]) / len;
+      h -= (2 * err / len + 8 * filter::u) * pc;
+      double rho;
+      if (h >= 0)
+        rho = std::sqrt(std::max(0.0, pc2_ - h * h)) + std::sqrt(std::max(0.0, r_max2_ - h * h));
+      else
+        rho = pc + r_max;
+      worst = std::max(worst, rho);
+    }
+    worst *= 1 + 1e-12;
+    security2_ = worst * worst;
+  }
+
+  std::int32_t id_ = -1;
+  const double* p_ = nullptr;
+  State state_ = State::sphere;
+  double pc_[3] = {}, pc2_ = 0, r_max2_ = 0, security2_ = 0;
+  std::size_t exact_tests_ = 0;
+  std::vector<std::int32_t> edge_, new_edge_;
+  std::vector<const double*> edge_pt_, new_edge_pt_;
+  std::vector<Vertex> vert_, new_vert_;
+};
+
+}  // namespace tessera::kernels

@@ -1,0 +1,470 @@
+// Spherical Voronoi cells; see spherical_voronoi.hpp.
+//
+// Three passes, each parallel over fixed blocks and independent of the
+// thread count:
+//  1. cells: every point's cell clipped by its neighbours nearest first
+//     (kernels::SphereTile), in the locator's bin order for locality; each
+//     cell's neighbour ring rotated to start at its lowest id, so the result
+//     is a function of the points alone.
+//  2. vertices: a vertex (hull facet) belongs to the cell of its lowest
+//     generator; owners number theirs in id order, and the other two cells
+//     find the number in the owner's ring (the facet (p, a, b) is (a, b, p)
+//     in a's ring and (b, p, a) in b's). A facet that is not in its owner's
+//     ring is a logic_error: the rings disagree.
+//  3. measures: areas as fans of Van Oosterom-Strackee solid angles (A. van
+//     Oosterom and J. Strackee, "The solid angle of a plane triangle", IEEE
+//     Trans. Biomed. Eng. 30(2), 1983) from the vertices as merged, so the
+//     cells tile the sphere to rounding; centroids from the vector area
+//     int x dA = 1/2 sum_edges theta_e n_e (Stokes on the unit sphere: an
+//     arc of angle theta in the plane of unit normal n contributes theta n).
+#include "tessera/spherical_voronoi.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <stdexcept>
+#include <string>
+
+#include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+
+#include "compensated_sum.hpp"
+#include "tessera/cells.hpp"
+#include "tessera/engine/thread_arena.hpp"
+#include "tessera/kernels/locator.hpp"
+#include "tessera/kernels/sphere_tile.hpp"
+
+namespace tessera {
+namespace {
+
+using Locator = kernels::BinLocator<3>;
+
+std::string num(double x) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.17g", x);
+  return buf;
+}
+
+// The sphere's radius and how far the points stray from it (InputError for
+// what the header names).
+void fit_sphere(std::span<const double> pts, const SphericalVoronoiOptions& o, SphericalVoronoi& out) {
+  const std::size_t n = pts.size() / 3;
+  const auto& c = o.center;
+  for (int d = 0; d < 3; ++d)
+    if (!std::isfinite(c[d])) throw InputError("spherical voronoi: the centre has a non-finite coordinate");
+  if (!(o.tolerance >= 0)) throw InputError("spherical voronoi: the tolerance must be >= 0, not " + num(o.tolerance));
+  if (!(o.radius >= 0) || !std::isfinite(o.radius))
+    throw InputError("spherical voronoi: the radius must be positive and finite, not " + num(o.radius));
+  front::CompensatedSum sum;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double* p = &pts[3 * i];
+    for (int d = 0; d < 3; ++d)
+      if (!std::isfinite(p[d]))
+        throw InputError("spherical voronoi: point " + std::to_string(i) + " has a non-finite coordinate");
+    const double r = std::hypot(p[0] - c[0], p[1] - c[1], p[2] - c[2]);
+    if (!(r > 0)) throw InputError("spherical voronoi: point " + std::to_string(i) + " lies at the centre");
+    sum.add(r);
+  }
+  out.radius = o.radius > 0 ? o.radius : sum.value() / static_cast<double>(n);
+  if (!(out.radius > 0) || !std::isfinite(out.radius))
+    throw InputError("spherical voronoi: the points' mean distance from the centre is not a usable radius");
+  std::size_t worst = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double* p = &pts[3 * i];
+    const double dev = std::fabs(std::hypot(p[0] - c[0], p[1] - c[1], p[2] - c[2]) - out.radius) / out.radius;
+    if (dev > out.max_deviation) {
+      out.max_deviation = dev;
+      worst = i;
+    }
+  }
+  if (out.max_deviation > o.tolerance)
+    throw InputError("spherical voronoi: point " + std::to_string(worst) + " lies " +
+                     num(out.max_deviation * out.radius) + " off the sphere of radius " + num(out.radius) +
+                     " (relative " + num(out.max_deviation) + ", tolerance " + num(o.tolerance) +
+                     "); give the sphere's centre and radius, or a larger tolerance");
+}
+
+// Bins for points on a surface: a volume's default (a few points per bin)
+// would make (N / 4 pi)^1.5 bins around a sphere, mostly empty. Aim for bins
+// two spacings wide, at most 4N of them (~12 points in each bin the sphere
+// crosses at 1M, ~27 at 10M).
+double surface_bin_points(std::size_t n) {
+  const double dn = static_cast<double>(n);
+  const double divs = std::sqrt(dn / (4 * std::numbers::pi));
+  const double bins = std::clamp(divs * divs * divs, 1.0, 4 * dn);
+  return dn / bins;
+}
+
+// The outward normal (y - x) x (z - x) of facet (x, y, z), computed from
+// the corner with the largest angle (opposite the longest edge): the normal
+// is the same from every corner of the cyclic order, but its rounding error
+// relative to its length is ~u / sin(angle at the corner), and a facet of
+// two points 1e-13 apart and a third far away (a pole given once per
+// longitude) has two corners of angle ~1e-16. Returns its length.
+double facet_normal(const double* x, const double* y, const double* z, double* u) {
+  double e[3][3];  // e[0] = y - x, e[1] = z - y, e[2] = x - z
+  for (int d = 0; d < 3; ++d) {
+    e[0][d] = y[d] - x[d];
+    e[1][d] = z[d] - y[d];
+    e[2][d] = x[d] - z[d];
+  }
+  double len2[3];
+  for (int k = 0; k < 3; ++k) len2[k] = e[k][0] * e[k][0] + e[k][1] * e[k][1] + e[k][2] * e[k][2];
+  // The longest edge k is opposite corner k + 2 (edge 1, y-z, is opposite
+  // x); the normal is (edge after the corner) x -(edge before it).
+  const int k = static_cast<int>(std::max_element(len2, len2 + 3) - len2);
+  const double* f = e[(k + 2) % 3];  // leaves the corner
+  const double* g = e[(k + 1) % 3];  // arrives at the corner
+  u[0] = -(f[1] * g[2] - f[2] * g[1]);
+  u[1] = -(f[2] * g[0] - f[0] * g[2]);
+  u[2] = -(f[0] * g[1] - f[1] * g[0]);
+  return std::hypot(u[0], u[1], u[2]);
+}
+
+struct Workspace {
+  kernels::SphereTile tile;
+  std::vector<double> gaps;
+  struct Candidate {
+    double d2;
+    std::int32_t id;
+    std::uint32_t slot;
+  };
+  std::vector<Candidate> cands;
+  std::size_t exact_tests = 0;
+};
+
+// One block of the locator's slots: the cells' rings, back to back.
+struct Block {
+  std::vector<std::int32_t> ring;
+  std::vector<std::uint32_t> start;  // per slot of the block, into ring (one past the end last)
+  std::vector<std::uint8_t> state;   // per slot: SphereTile::State
+};
+
+constexpr std::size_t block_slots = 2048;
+
+}  // namespace
+
+std::vector<double> lonlat_to_points(std::span<const double> lonlat, double radius, const std::array<double, 3>& center) {
+  if (lonlat.size() % 2 != 0) throw InputError("lon/lat: the values do not pair up");
+  if (!(radius > 0) || !std::isfinite(radius)) throw InputError("lon/lat: the radius must be positive and finite");
+  const std::size_t n = lonlat.size() / 2;
+  std::vector<double> out(3 * n);
+  constexpr double deg = std::numbers::pi / 180;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double lon = lonlat[2 * i], lat = lonlat[2 * i + 1];
+    if (!std::isfinite(lon) || !std::isfinite(lat))
+      throw InputError("lon/lat: point " + std::to_string(i) + " has a non-finite longitude or latitude");
+    if (lat < -90 || lat > 90)
+      throw InputError("lon/lat: point " + std::to_string(i) + " has latitude " + num(lat) + ", beyond [-90, 90]");
+    const double cl = std::cos(lat * deg);
+    out[3 * i + 0] = center[0] + radius * cl * std::cos(lon * deg);
+    out[3 * i + 1] = center[1] + radius * cl * std::sin(lon * deg);
+    out[3 * i + 2] = center[2] + radius * std::sin(lat * deg);
+  }
+  return out;
+}
+
+SphericalVoronoi spherical_voronoi(std::span<const double> pts, const SphericalVoronoiOptions& o) {
+  if (pts.size() % 3 != 0) throw InputError("spherical voronoi: the coordinates do not make whole 3D points");
+  const std::size_t n = pts.size() / 3;
+  if (n == 0) throw InputError("spherical voronoi: no points");
+  if (n > static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max() / 4))
+    throw InputError("spherical voronoi: too many points (" + std::to_string(n) + ")");
+  SphericalVoronoi out;
+  out.center = o.center;
+  out.n_points = n;
+  fit_sphere(pts, o, out);
+  const auto& c = o.center;
+  double r_max = 0;
+  std::array<double, 3> lo{pts[0], pts[1], pts[2]}, hi = lo;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double* p = &pts[3 * i];
+    r_max = std::max(r_max, std::hypot(p[0] - c[0], p[1] - c[1], p[2] - c[2]));
+    for (int d = 0; d < 3; ++d) {
+      lo[d] = std::min(lo[d], p[d]);
+      hi[d] = std::max(hi[d], p[d]);
+    }
+  }
+  r_max *= 1 + 1e-12;
+  // The grid needs a box of some extent along every axis (one point, a ring
+  // in a coordinate plane); the padding is nothing beside the sphere.
+  for (int d = 0; d < 3; ++d) {
+    const double pad = 1e-6 * r_max + 1e-6 * std::max(std::fabs(lo[d]), std::fabs(hi[d]));
+    lo[d] -= pad;
+    hi[d] += pad;
+  }
+
+  engine::ThreadArena arena(resolve_threads(o.threads));
+  arena.execute([&] {
+    const Locator loc(pts, {}, lo, hi, o.bin_points > 0 ? o.bin_points : surface_bin_points(n));
+    const std::vector<std::int32_t> lowest = loc.lowest_coincident();  // per slot
+    out.duplicate_of.assign(n, -1);
+    for (std::size_t slot = 0; slot < n; ++slot)
+      if (lowest[slot] >= 0) out.duplicate_of[static_cast<std::size_t>(loc.id(slot))] = lowest[slot];
+
+    // ---- pass 1: the cells ----
+    const std::size_t n_blocks = (n + block_slots - 1) / block_slots;
+    std::vector<Block> blocks(n_blocks);
+    tbb::enumerable_thread_specific<Workspace> spaces;
+    tbb::parallel_for(std::size_t{0}, n_blocks, [&](std::size_t bk) {
+      Workspace& ws = spaces.local();
+      Block& block = blocks[bk];
+      const std::size_t first = bk * block_slots, last = std::min(n, first + block_slots);
+      for (std::size_t slot = first; slot < last; ++slot) {
+        block.start.push_back(static_cast<std::uint32_t>(block.ring.size()));
+        if (lowest[slot] >= 0) {
+          block.state.push_back(static_cast<std::uint8_t>(kernels::SphereTile::State::empty));
+          continue;
+        }
+        const double* x = loc.point(slot).data();
+        const std::int32_t id = loc.id(slot);
+        auto& tile = ws.tile;
+        tile.reset(id, x, c.data(), r_max);
+        const auto b = loc.bin_coords(x);
+        const int max_shell = loc.max_shell(b);
+        for (int s = 0; s <= max_shell; ++s) {
+          if (tile.state() == kernels::SphereTile::State::empty) break;
+          if (s > 0) {
+            const double lb = loc.shell_lower_bound(x, b, s);
+            if (lb * lb > tile.security2()) break;
+          }
+          ws.cands.clear();
+          const double r2 = tile.security2();
+          loc.for_each_shell_run_near(x, b, s, r2, ws.gaps, [&](std::uint32_t f, std::uint32_t e) {
+            for (std::uint32_t k = f; k < e; ++k) {
+              if (k == slot || lowest[k] >= 0) continue;
+              const auto& q = loc.point(k);
+              const double d2 = (q[0] - x[0]) * (q[0] - x[0]) + (q[1] - x[1]) * (q[1] - x[1]) + (q[2] - x[2]) * (q[2] - x[2]);
+              if (d2 <= r2) ws.cands.push_back({d2, loc.id(k), k});
+            }
+          });
+          std::sort(ws.cands.begin(), ws.cands.end(), [](const auto& a, const auto& b2) {
+            return a.d2 != b2.d2 ? a.d2 < b2.d2 : a.id < b2.id;
+          });
+          for (const auto& cand : ws.cands) {
+            if (cand.d2 > tile.security2()) break;
+            tile.clip(cand.id, loc.point(cand.slot).data());
+            if (tile.state() == kernels::SphereTile::State::empty) break;
+          }
+        }
+        ws.exact_tests += tile.exact_tests();
+        block.state.push_back(static_cast<std::uint8_t>(tile.state()));
+        const auto ring = tile.edges();
+        const std::size_t rot = static_cast<std::size_t>(std::min_element(ring.begin(), ring.end()) - ring.begin());
+        for (std::size_t k = 0; k < ring.size(); ++k) block.ring.push_back(ring[(rot + k) % ring.size()]);
+      }
+      block.start.push_back(static_cast<std::uint32_t>(block.ring.size()));
+    });
+    for (const auto& ws : spaces) out.exact_tests += ws.exact_tests;
+
+    // Rings by id: counts, offsets, copy.
+    out.status.assign(n, SphereCellStatus::cell);
+    std::vector<std::int64_t> count(n + 1, 0);
+    std::vector<std::uint8_t> state(n);
+    for (std::size_t bk = 0; bk < n_blocks; ++bk)
+      for (std::size_t k = 0; k + 1 < blocks[bk].start.size(); ++k) {
+        const std::size_t id = static_cast<std::size_t>(loc.id(bk * block_slots + k));
+        count[id] = blocks[bk].start[k + 1] - blocks[bk].start[k];
+        state[id] = blocks[bk].state[k];
+      }
+    out.neighbor_offsets.assign(n + 1, 0);
+    for (std::size_t i = 0; i < n; ++i) out.neighbor_offsets[i + 1] = out.neighbor_offsets[i] + count[i];
+    out.neighbors.resize(static_cast<std::size_t>(out.neighbor_offsets[n]));
+    tbb::parallel_for(std::size_t{0}, n_blocks, [&](std::size_t bk) {
+      const Block& block = blocks[bk];
+      for (std::size_t k = 0; k + 1 < block.start.size(); ++k) {
+        const std::size_t id = static_cast<std::size_t>(loc.id(bk * block_slots + k));
+        std::copy(block.ring.begin() + block.start[k], block.ring.begin() + block.start[k + 1],
+                  out.neighbors.begin() + out.neighbor_offsets[id]);
+      }
+    });
+    blocks.clear();
+    blocks.shrink_to_fit();
+    using State = kernels::SphereTile::State;
+    for (std::size_t i = 0; i < n; ++i) {
+      if (out.duplicate_of[i] >= 0) {
+        out.status[i] = SphereCellStatus::duplicate;
+        ++out.duplicates;
+      } else if (static_cast<State>(state[i]) == State::empty) {
+        out.status[i] = SphereCellStatus::hidden;
+        ++out.hidden;
+      }
+    }
+
+    // ---- pass 2: vertices, numbered by their owners ----
+    // Vertex k of a polygon cell is where edge k-1 ends: facet (p, ring[k-1], ring[k]).
+    auto ring_of = [&](std::size_t i) {
+      return std::span<const std::int32_t>(out.neighbors.data() + out.neighbor_offsets[i],
+                                           static_cast<std::size_t>(out.neighbor_offsets[i + 1] - out.neighbor_offsets[i]));
+    };
+    auto polygon = [&](std::size_t i) { return ring_of(i).size() >= 2; };
+    std::vector<std::int64_t> owned(n + 1, 0);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
+      for (std::size_t i = r.begin(); i != r.end(); ++i) {
+        if (!polygon(i)) continue;
+        const auto ring = ring_of(i);
+        const std::int32_t p = static_cast<std::int32_t>(i);
+        std::int64_t k = 0;
+        for (std::size_t e = 0; e < ring.size(); ++e)
+          k += p < ring[(e + ring.size() - 1) % ring.size()] && p < ring[e];
+        owned[i + 1] = k;
+      }
+    });
+    for (std::size_t i = 0; i < n; ++i) owned[i + 1] += owned[i];
+    const std::size_t n_vertices = static_cast<std::size_t>(owned[n]);
+    if (n_vertices > static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max()))
+      throw InputError("spherical voronoi: too many vertices");
+    out.region_offsets.assign(n + 1, 0);
+    for (std::size_t i = 0; i < n; ++i) out.region_offsets[i + 1] = out.region_offsets[i] + (polygon(i) ? ring_of(i).size() : 0);
+    out.region_vertices.resize(static_cast<std::size_t>(out.region_offsets[n]));
+    out.triangles.resize(3 * n_vertices);
+    out.vertices.resize(3 * n_vertices);
+    std::vector<double> unit(3 * n_vertices);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
+      for (std::size_t i = r.begin(); i != r.end(); ++i) {
+        if (!polygon(i)) continue;
+        const auto ring = ring_of(i);
+        const std::size_t m = ring.size();
+        const std::int32_t p = static_cast<std::int32_t>(i);
+        std::int64_t next_owned = owned[i];
+        for (std::size_t e = 0; e < m; ++e) {
+          const std::int32_t a = ring[(e + m - 1) % m], b = ring[e];
+          std::int64_t v;
+          if (p < a && p < b) {
+            v = next_owned++;
+            std::int32_t* t = &out.triangles[3 * static_cast<std::size_t>(v)];
+            t[0] = p, t[1] = a, t[2] = b;
+            const double* x = &pts[3 * i];
+            const double* y = &pts[3 * static_cast<std::size_t>(a)];
+            const double* z = &pts[3 * static_cast<std::size_t>(b)];
+            double u[3];
+            double len = facet_normal(x, y, z, u);
+            if (!(len > 0) || !std::isfinite(len)) {
+              // A facet of (nearly) collinear points, decided by the
+              // perturbation: its normal is not computable; the points'
+              // mean direction stands in (the cell's topology is exact,
+              // its geometry there a tie's).
+              for (int d = 0; d < 3; ++d) u[d] = x[d] + y[d] + z[d] - 3 * c[d];
+              len = std::hypot(u[0], u[1], u[2]);
+              if (!(len > 0)) u[0] = 1, u[1] = u[2] = 0, len = 1;
+            }
+            double* un = &unit[3 * static_cast<std::size_t>(v)];
+            double* pos = &out.vertices[3 * static_cast<std::size_t>(v)];
+            for (int d = 0; d < 3; ++d) {
+              un[d] = u[d] / len;
+              pos[d] = c[d] + out.radius * un[d];
+            }
+          } else {
+            // Owner q = min(a, b): the facet is (a, b, p) in a's ring, (b, p, a) in b's.
+            const std::int32_t q = std::min(a, b);
+            const std::int32_t in = q == a ? b : p, outgoing = q == a ? p : a;
+            const auto oring = ring_of(static_cast<std::size_t>(q));
+            const std::size_t om = oring.size();
+            v = -1;
+            std::int64_t num = owned[static_cast<std::size_t>(q)];
+            for (std::size_t f = 0; f < om; ++f) {
+              const std::int32_t oa = oring[(f + om - 1) % om], ob = oring[f];
+              const bool own = q < oa && q < ob;
+              if (oa == in && ob == outgoing) {
+                v = own ? num : -1;
+                break;
+              }
+              num += own;
+            }
+            if (v < 0) throw std::logic_error("spherical voronoi: cell " + std::to_string(i) + "'s vertex with " + std::to_string(a) + ", " + std::to_string(b) + " is not in cell " + std::to_string(q));
+          }
+          out.region_vertices[static_cast<std::size_t>(out.region_offsets[i]) + e] = static_cast<std::int32_t>(v);
+        }
+      }
+    });
+
+    // ---- pass 3: areas and centroids ----
+    out.areas.assign(n, 0);
+    out.centroids.resize(3 * n);
+    const double R = out.radius, R2 = R * R;
+    constexpr double pi = std::numbers::pi;
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
+      for (std::size_t i = r.begin(); i != r.end(); ++i) {
+        const double* p = &pts[3 * i];
+        double dir[3] = {p[0] - c[0], p[1] - c[1], p[2] - c[2]};  // the centroid's direction
+        const auto ring = ring_of(i);
+        const std::size_t m = ring.size();
+        double omega = 0;
+        if (out.status[i] != SphereCellStatus::cell) {
+          omega = 0;
+        } else if (m == 0) {
+          omega = 4 * pi;
+        } else if (m == 1) {
+          const double* q = &pts[3 * static_cast<std::size_t>(ring[0])];
+          for (int d = 0; d < 3; ++d) dir[d] = p[d] - q[d];
+          omega = 2 * pi;
+        } else {
+          const std::int32_t* rv = &out.region_vertices[static_cast<std::size_t>(out.region_offsets[i])];
+          auto U = [&](std::size_t k) { return &unit[3 * static_cast<std::size_t>(rv[k % m])]; };
+          // Vector area: edge k runs from vertex k to k+1 on the plane of
+          // ring[k], whose unit normal into the cell is (p - q) / |p - q|.
+          double vec[3] = {0, 0, 0};
+          for (std::size_t k = 0; k < m; ++k) {
+            const double* a = U(k);
+            const double* b = U(k + 1);
+            const double cr[3] = {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+            const double theta = std::atan2(std::hypot(cr[0], cr[1], cr[2]), a[0] * b[0] + a[1] * b[1] + a[2] * b[2]);
+            const double* q = &pts[3 * static_cast<std::size_t>(ring[k])];
+            double nq[3] = {p[0] - q[0], p[1] - q[1], p[2] - q[2]};
+            const double ln = std::hypot(nq[0], nq[1], nq[2]);
+            for (int d = 0; d < 3; ++d) vec[d] += 0.5 * theta * nq[d] / ln;
+          }
+          for (int d = 0; d < 3; ++d) dir[d] = vec[d];
+          // A fan of triangles from p's direction (accurate to rounding on
+          // small cells) where p lies inside its cell and no edge is long;
+          // else Gauss-Bonnet: 2 pi less the turns between the edges'
+          // planes, which needs no vertex (a lune's edges are half circles,
+          // a flat hull's cells reach from pole to pole).
+          const double pl = std::hypot(p[0] - c[0], p[1] - c[1], p[2] - c[2]);
+          const double apex[3] = {(p[0] - c[0]) / pl, (p[1] - c[1]) / pl, (p[2] - c[2]) / pl};
+          bool fan = m >= 3;
+          for (std::size_t k = 0; k < m && fan; ++k) {
+            const double* a = U(k);
+            const double* b = U(k + 1);
+            const double* q = &pts[3 * static_cast<std::size_t>(ring[k])];
+            fan = a[0] * b[0] + a[1] * b[1] + a[2] * b[2] > -0.5 &&
+                  apex[0] * (p[0] - q[0]) + apex[1] * (p[1] - q[1]) + apex[2] * (p[2] - q[2]) > 0;
+          }
+          if (fan) {
+            for (std::size_t k = 0; k < m; ++k) {
+              const double* a = U(k);
+              const double* b = U(k + 1);
+              const double det = apex[0] * (a[1] * b[2] - a[2] * b[1]) + apex[1] * (a[2] * b[0] - a[0] * b[2]) +
+                                 apex[2] * (a[0] * b[1] - a[1] * b[0]);
+              const double den = 1 + (apex[0] * a[0] + apex[1] * a[1] + apex[2] * a[2]) + (a[0] * b[0] + a[1] * b[1] + a[2] * b[2]) +
+                                 (b[0] * apex[0] + b[1] * apex[1] + b[2] * apex[2]);
+              omega += 2 * std::atan2(det, den);
+            }
+          } else {
+            omega = 2 * pi;
+            for (std::size_t k = 0; k < m; ++k) {
+              const double* q0 = &pts[3 * static_cast<std::size_t>(ring[k])];
+              const double* q1 = &pts[3 * static_cast<std::size_t>(ring[(k + 1) % m])];
+              const double n0[3] = {p[0] - q0[0], p[1] - q0[1], p[2] - q0[2]};
+              const double n1[3] = {p[0] - q1[0], p[1] - q1[1], p[2] - q1[2]};
+              const double cr[3] = {n0[1] * n1[2] - n0[2] * n1[1], n0[2] * n1[0] - n0[0] * n1[2], n0[0] * n1[1] - n0[1] * n1[0]};
+              omega -= std::atan2(std::hypot(cr[0], cr[1], cr[2]), n0[0] * n1[0] + n0[1] * n1[1] + n0[2] * n1[2]);
+            }
+          }
+        }
+        out.areas[i] = R2 * omega;
+        double ld = std::hypot(dir[0], dir[1], dir[2]);
+        if (!(ld > 0)) dir[0] = p[0] - c[0], dir[1] = p[1] - c[1], dir[2] = p[2] - c[2], ld = std::hypot(dir[0], dir[1], dir[2]);
+        for (int d = 0; d < 3; ++d) out.centroids[3 * i + d] = c[d] + R * dir[d] / ld;
+      }
+    });
+    front::CompensatedSum total;
+    for (double a : out.areas) total.add(a);
+    out.area_sum = total.value();
+  });
+  return out;
+}
+
+}  // namespace tessera
