@@ -331,6 +331,33 @@ void add_surface_nets_options(CLI::App* app, SurfaceNetsArgs& args, bool bench);
 int run_surface_nets(const SurfaceNetsArgs& args);
 int run_bench_surface_nets(const SurfaceNetsArgs& args);
 
+/// `sphere` and `bench sphere` (cmd_sphere.cpp): Voronoi cells on a sphere.
+struct SphereArgs {
+  std::string input;
+  bool lonlat = false;              ///< INPUT's first two columns are longitude, latitude (degrees)
+  std::vector<double> center;       ///< empty or X Y Z
+  double radius = 0;                ///< 0: the points' mean distance (with --lonlat: 1)
+  double tolerance = 1e-6;          ///< SphericalVoronoiOptions::tolerance
+  int threads = 0;
+  std::string output;               ///< .vtp cells, or empty
+  std::string triangles;            ///< .vtp / .npy, or empty
+  std::string cell_table;           ///< .csv / .npy, or empty
+  std::string neighbors;            ///< .npy, or empty
+  bool quiet = false;
+  int repeat = 1;                   ///< bench only
+};
+struct SphereCommands {
+  SphereArgs run, bench;
+  CLI::App* run_app = nullptr;
+  CLI::App* bench_app = nullptr;
+};
+/// Registers `sphere` on `app` and `sphere` on `bench` (main.cpp, before parsing).
+void add_sphere_commands(CLI::App& app, CLI::App& bench, SphereCommands& commands);
+/// Runs the one given, or returns -1 when neither was.
+int run_sphere_command(const SphereCommands& commands);
+int run_sphere(const SphereArgs& args);
+int run_bench_sphere(const SphereArgs& args);
+
 // Shared by the subcommand files (defined in commands.cpp).
 /// Resource usage of this process so far (bench JSON lines).
 struct Usage {

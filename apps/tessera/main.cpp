@@ -655,6 +655,8 @@ int main(int argc, char** argv) {
 
   ImageCommands image_cmds;  // sample-image, probe (cmd_image.cpp)
   add_image_commands(app, image_cmds);
+  SphereCommands sphere_cmds;
+  add_sphere_commands(app, *bench, sphere_cmds);
   require_number_syntax(app);
 
   // "--radii=" with nothing after '=' makes CLI11 take the next word as the
@@ -756,6 +758,7 @@ int main(int argc, char** argv) {
     if (demo->parsed()) return run_default(da);
     if (const int rc = run_prep_command(prep); rc >= 0) return rc;
     if (const int rc = run_image_command(image_cmds); rc >= 0) return rc;
+    if (const int rc = run_sphere_command(sphere_cmds); rc >= 0) return rc;
     print_error("no command given (see tessera --help)");
     return kExitInputError;
   } catch (const tessera::InputError& e) {

@@ -1,22 +1,24 @@
 // Spherical Voronoi cells; see spherical_voronoi.hpp.
 //
-// Three passes, each parallel over fixed blocks and independent of the
+// Two passes over the cells, each parallel over fixed blocks of the
+// locator's slots (spatial order: a cell's neighbours and their rings lie
+// close by in memory, whatever order the ids come in), independent of the
 // thread count:
 //  1. cells: every point's cell clipped by its neighbours nearest first
-//     (kernels::SphereTile), in the locator's bin order for locality; each
-//     cell's neighbour ring rotated to start at its lowest id, so the result
-//     is a function of the points alone.
+//     (kernels::SphereTile); each ring rotated to start at its lowest id, so
+//     the result is a function of the points alone.
 //  2. vertices: a vertex (hull facet) belongs to the cell of its lowest
 //     generator; owners number theirs in id order, and the other two cells
 //     find the number in the owner's ring (the facet (p, a, b) is (a, b, p)
-//     in a's ring and (b, p, a) in b's). A facet that is not in its owner's
-//     ring is a logic_error: the rings disagree.
-//  3. measures: areas as fans of Van Oosterom-Strackee solid angles (A. van
-//     Oosterom and J. Strackee, "The solid angle of a plane triangle", IEEE
-//     Trans. Biomed. Eng. 30(2), 1983) from the vertices as merged, so the
-//     cells tile the sphere to rounding; centroids from the vector area
-//     int x dA = 1/2 sum_edges theta_e n_e (Stokes on the unit sphere: an
-//     arc of angle theta in the plane of unit normal n contributes theta n).
+//     in a's ring and (b, p, a) in b's; one that is not there is a
+//     logic_error: the rings disagree). Each cell computes its vertices'
+//     directions from the facet's lowest id, so the three copies agree to
+//     the bit, and from them its area, as a fan of Van Oosterom-Strackee
+//     solid angles (A. van Oosterom and J. Strackee, "The solid angle of a
+//     plane triangle", IEEE Trans. Biomed. Eng. 30(2), 1983), and its
+//     centroid, from the vector area int x dA = 1/2 sum_edges theta_e n_e
+//     (Stokes on the unit sphere: an arc of angle theta in the plane of
+//     unit normal n contributes theta n).
 #include "tessera/spherical_voronoi.hpp"
 
 #include <algorithm>
@@ -88,13 +90,21 @@ void fit_sphere(std::span<const double> pts, const SphericalVoronoiOptions& o, S
 
 // Bins for points on a surface: a volume's default (a few points per bin)
 // would make (N / 4 pi)^1.5 bins around a sphere, mostly empty. Aim for bins
-// two spacings wide, at most 4N of them (~12 points in each bin the sphere
-// crosses at 1M, ~27 at 10M).
+// two spacings wide, at most 10N of them (~6 points in each bin the sphere
+// crosses at 1M, ~13 at 10M; 4N took 25% longer at 1M, 20N 3% less).
 double surface_bin_points(std::size_t n) {
   const double dn = static_cast<double>(n);
   const double divs = std::sqrt(dn / (4 * std::numbers::pi));
-  const double bins = std::clamp(divs * divs * divs, 1.0, 4 * dn);
+  const double bins = std::clamp(divs * divs * divs, 1.0, 10 * dn);
   return dn / bins;
+}
+
+// |v|: by the sum of squares where that cannot overflow or underflow, else
+// by hypot (several times slower; the cells' sums hit it only for points
+// beyond 1e145 or within 1e-145 of each other).
+double norm3(const double* v) {
+  const double s = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+  return s > 0x1p-960 && s < 0x1p960 ? std::sqrt(s) : std::hypot(v[0], v[1], v[2]);
 }
 
 // The outward normal (y - x) x (z - x) of facet (x, y, z), computed from
@@ -120,7 +130,23 @@ double facet_normal(const double* x, const double* y, const double* z, double* u
   u[0] = -(f[1] * g[2] - f[2] * g[1]);
   u[1] = -(f[2] * g[0] - f[0] * g[2]);
   u[2] = -(f[0] * g[1] - f[1] * g[0]);
-  return std::hypot(u[0], u[1], u[2]);
+  return norm3(u);
+}
+
+// The unit outward normal of facet (x, y, z), given from its lowest id
+// (every cell holding the facet asks the same question and gets the same
+// bits). A facet of (nearly) collinear points, decided by the perturbation,
+// has no computable normal: the points' mean direction from the centre
+// stands in (its topology is exact, its geometry a tie's).
+void unit_normal(const double* x, const double* y, const double* z, const double* c, double* un) {
+  double u[3];
+  double len = facet_normal(x, y, z, u);
+  if (!(len > 0) || !std::isfinite(len)) {
+    for (int d = 0; d < 3; ++d) u[d] = x[d] + y[d] + z[d] - 3 * c[d];
+    len = std::hypot(u[0], u[1], u[2]);
+    if (!(len > 0)) u[0] = 1, u[1] = u[2] = 0, len = 1;
+  }
+  for (int d = 0; d < 3; ++d) un[d] = u[d] / len;
 }
 
 struct Workspace {
@@ -240,13 +266,25 @@ SphericalVoronoi spherical_voronoi(std::span<const double> pts, const SphericalV
               if (d2 <= r2) ws.cands.push_back({d2, loc.id(k), k});
             }
           });
-          std::sort(ws.cands.begin(), ws.cands.end(), [](const auto& a, const auto& b2) {
-            return a.d2 != b2.d2 ? a.d2 < b2.d2 : a.id < b2.id;
-          });
-          for (const auto& cand : ws.cands) {
-            if (cand.d2 > tile.security2()) break;
-            tile.clip(cand.id, loc.point(cand.slot).data());
-            if (tile.state() == kernels::SphereTile::State::empty) break;
+          // Nearest first, a dozen at a time: once a cell has its nearest
+          // neighbours its security radius passes most of the rest unsorted.
+          auto nearer = [](const auto& a, const auto& b2) { return a.d2 != b2.d2 ? a.d2 < b2.d2 : a.id < b2.id; };
+          auto first = ws.cands.begin(), last = ws.cands.end();
+          while (first != last) {
+            const auto stop = last - first > 12 ? first + 12 : last;
+            std::partial_sort(first, stop, last, nearer);
+            bool done = false;
+            for (; first != stop; ++first) {
+              if (first->d2 > tile.security2() || tile.state() == kernels::SphereTile::State::empty) {
+                done = true;
+                break;
+              }
+              tile.clip(first->id, loc.point(first->slot).data());
+            }
+            if (done) break;
+            // Drop what the radius now passes before sorting again.
+            const double r2now = tile.security2();
+            last = std::partition(first, last, [&](const auto& cd) { return cd.d2 <= r2now; });
           }
         }
         ws.exact_tests += tile.exact_tests();
@@ -259,57 +297,63 @@ SphericalVoronoi spherical_voronoi(std::span<const double> pts, const SphericalV
     });
     for (const auto& ws : spaces) out.exact_tests += ws.exact_tests;
 
-    // Rings by id: counts, offsets, copy.
-    out.status.assign(n, SphereCellStatus::cell);
-    std::vector<std::int64_t> count(n + 1, 0);
-    std::vector<std::uint8_t> state(n);
+    // Rings in slot order (the blocks back to back): the passes below walk
+    // the cells in the locator's order, where a cell's neighbours' rings and
+    // points lie close by in memory, whatever order the ids come in.
+    std::vector<std::int64_t> ring_at(n + 1, 0);  // per slot
+    std::vector<std::uint8_t> slot_state(n);
     for (std::size_t bk = 0; bk < n_blocks; ++bk)
       for (std::size_t k = 0; k + 1 < blocks[bk].start.size(); ++k) {
-        const std::size_t id = static_cast<std::size_t>(loc.id(bk * block_slots + k));
-        count[id] = blocks[bk].start[k + 1] - blocks[bk].start[k];
-        state[id] = blocks[bk].state[k];
+        ring_at[bk * block_slots + k + 1] = blocks[bk].start[k + 1] - blocks[bk].start[k];
+        slot_state[bk * block_slots + k] = blocks[bk].state[k];
       }
-    out.neighbor_offsets.assign(n + 1, 0);
-    for (std::size_t i = 0; i < n; ++i) out.neighbor_offsets[i + 1] = out.neighbor_offsets[i] + count[i];
-    out.neighbors.resize(static_cast<std::size_t>(out.neighbor_offsets[n]));
+    for (std::size_t s = 0; s < n; ++s) ring_at[s + 1] += ring_at[s];
+    std::vector<std::int32_t> rings(static_cast<std::size_t>(ring_at[n]));
     tbb::parallel_for(std::size_t{0}, n_blocks, [&](std::size_t bk) {
-      const Block& block = blocks[bk];
-      for (std::size_t k = 0; k + 1 < block.start.size(); ++k) {
-        const std::size_t id = static_cast<std::size_t>(loc.id(bk * block_slots + k));
-        std::copy(block.ring.begin() + block.start[k], block.ring.begin() + block.start[k + 1],
-                  out.neighbors.begin() + out.neighbor_offsets[id]);
-      }
+      std::copy(blocks[bk].ring.begin(), blocks[bk].ring.end(), rings.begin() + ring_at[bk * block_slots]);
     });
     blocks.clear();
     blocks.shrink_to_fit();
+    std::vector<std::uint32_t> slot_of(n);
+    for (std::size_t s = 0; s < n; ++s) slot_of[static_cast<std::size_t>(loc.id(s))] = static_cast<std::uint32_t>(s);
+    auto ring = [&](std::size_t slot) {
+      return std::span<const std::int32_t>(rings.data() + ring_at[slot], static_cast<std::size_t>(ring_at[slot + 1] - ring_at[slot]));
+    };
+    auto point = [&](std::int32_t id) { return loc.point(slot_of[static_cast<std::size_t>(id)]).data(); };
+
     using State = kernels::SphereTile::State;
+    out.status.assign(n, SphereCellStatus::cell);
+    out.neighbor_offsets.assign(n + 1, 0);
     for (std::size_t i = 0; i < n; ++i) {
+      const std::size_t s = slot_of[i];
+      out.neighbor_offsets[i + 1] = out.neighbor_offsets[i] + (ring_at[s + 1] - ring_at[s]);
       if (out.duplicate_of[i] >= 0) {
         out.status[i] = SphereCellStatus::duplicate;
         ++out.duplicates;
-      } else if (static_cast<State>(state[i]) == State::empty) {
+      } else if (static_cast<State>(slot_state[s]) == State::empty) {
         out.status[i] = SphereCellStatus::hidden;
         ++out.hidden;
       }
     }
-
-    // ---- pass 2: vertices, numbered by their owners ----
-    // Vertex k of a polygon cell is where edge k-1 ends: facet (p, ring[k-1], ring[k]).
-    auto ring_of = [&](std::size_t i) {
-      return std::span<const std::int32_t>(out.neighbors.data() + out.neighbor_offsets[i],
-                                           static_cast<std::size_t>(out.neighbor_offsets[i + 1] - out.neighbor_offsets[i]));
-    };
-    auto polygon = [&](std::size_t i) { return ring_of(i).size() >= 2; };
-    std::vector<std::int64_t> owned(n + 1, 0);
+    out.neighbors.resize(rings.size());
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
       for (std::size_t i = r.begin(); i != r.end(); ++i) {
-        if (!polygon(i)) continue;
-        const auto ring = ring_of(i);
-        const std::int32_t p = static_cast<std::int32_t>(i);
+        const auto rg = ring(slot_of[i]);
+        std::copy(rg.begin(), rg.end(), out.neighbors.begin() + out.neighbor_offsets[i]);
+      }
+    });
+
+    // ---- pass 2: vertices, numbered by their owners; areas, centroids ----
+    // Vertex k of a polygon cell is where edge k-1 ends: facet (p, ring[k-1], ring[k]).
+    std::vector<std::int64_t> owned(n + 1, 0);  // by id
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
+      for (std::size_t s = r.begin(); s != r.end(); ++s) {
+        const auto rg = ring(s);
+        if (rg.size() < 2) continue;
+        const std::int32_t p = loc.id(s);
         std::int64_t k = 0;
-        for (std::size_t e = 0; e < ring.size(); ++e)
-          k += p < ring[(e + ring.size() - 1) % ring.size()] && p < ring[e];
-        owned[i + 1] = k;
+        for (std::size_t e = 0; e < rg.size(); ++e) k += p < rg[(e + rg.size() - 1) % rg.size()] && p < rg[e];
+        owned[static_cast<std::size_t>(p) + 1] = k;
       }
     });
     for (std::size_t i = 0; i < n; ++i) owned[i + 1] += owned[i];
@@ -317,103 +361,91 @@ SphericalVoronoi spherical_voronoi(std::span<const double> pts, const SphericalV
     if (n_vertices > static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max()))
       throw InputError("spherical voronoi: too many vertices");
     out.region_offsets.assign(n + 1, 0);
-    for (std::size_t i = 0; i < n; ++i) out.region_offsets[i + 1] = out.region_offsets[i] + (polygon(i) ? ring_of(i).size() : 0);
+    for (std::size_t i = 0; i < n; ++i) {
+      const std::int64_t m = out.neighbor_offsets[i + 1] - out.neighbor_offsets[i];
+      out.region_offsets[i + 1] = out.region_offsets[i] + (m >= 2 ? m : 0);
+    }
     out.region_vertices.resize(static_cast<std::size_t>(out.region_offsets[n]));
     out.triangles.resize(3 * n_vertices);
     out.vertices.resize(3 * n_vertices);
-    std::vector<double> unit(3 * n_vertices);
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
-      for (std::size_t i = r.begin(); i != r.end(); ++i) {
-        if (!polygon(i)) continue;
-        const auto ring = ring_of(i);
-        const std::size_t m = ring.size();
-        const std::int32_t p = static_cast<std::int32_t>(i);
-        std::int64_t next_owned = owned[i];
-        for (std::size_t e = 0; e < m; ++e) {
-          const std::int32_t a = ring[(e + m - 1) % m], b = ring[e];
-          std::int64_t v;
-          if (p < a && p < b) {
-            v = next_owned++;
-            std::int32_t* t = &out.triangles[3 * static_cast<std::size_t>(v)];
-            t[0] = p, t[1] = a, t[2] = b;
-            const double* x = &pts[3 * i];
-            const double* y = &pts[3 * static_cast<std::size_t>(a)];
-            const double* z = &pts[3 * static_cast<std::size_t>(b)];
-            double u[3];
-            double len = facet_normal(x, y, z, u);
-            if (!(len > 0) || !std::isfinite(len)) {
-              // A facet of (nearly) collinear points, decided by the
-              // perturbation: its normal is not computable; the points'
-              // mean direction stands in (the cell's topology is exact,
-              // its geometry there a tie's).
-              for (int d = 0; d < 3; ++d) u[d] = x[d] + y[d] + z[d] - 3 * c[d];
-              len = std::hypot(u[0], u[1], u[2]);
-              if (!(len > 0)) u[0] = 1, u[1] = u[2] = 0, len = 1;
-            }
-            double* un = &unit[3 * static_cast<std::size_t>(v)];
-            double* pos = &out.vertices[3 * static_cast<std::size_t>(v)];
-            for (int d = 0; d < 3; ++d) {
-              un[d] = u[d] / len;
-              pos[d] = c[d] + out.radius * un[d];
-            }
-          } else {
-            // Owner q = min(a, b): the facet is (a, b, p) in a's ring, (b, p, a) in b's.
-            const std::int32_t q = std::min(a, b);
-            const std::int32_t in = q == a ? b : p, outgoing = q == a ? p : a;
-            const auto oring = ring_of(static_cast<std::size_t>(q));
-            const std::size_t om = oring.size();
-            v = -1;
-            std::int64_t num = owned[static_cast<std::size_t>(q)];
-            for (std::size_t f = 0; f < om; ++f) {
-              const std::int32_t oa = oring[(f + om - 1) % om], ob = oring[f];
-              const bool own = q < oa && q < ob;
-              if (oa == in && ob == outgoing) {
-                v = own ? num : -1;
-                break;
-              }
-              num += own;
-            }
-            if (v < 0) throw std::logic_error("spherical voronoi: cell " + std::to_string(i) + "'s vertex with " + std::to_string(a) + ", " + std::to_string(b) + " is not in cell " + std::to_string(q));
-          }
-          out.region_vertices[static_cast<std::size_t>(out.region_offsets[i]) + e] = static_cast<std::int32_t>(v);
-        }
-      }
-    });
-
-    // ---- pass 3: areas and centroids ----
     out.areas.assign(n, 0);
     out.centroids.resize(3 * n);
     const double R = out.radius, R2 = R * R;
     constexpr double pi = std::numbers::pi;
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
-      for (std::size_t i = r.begin(); i != r.end(); ++i) {
-        const double* p = &pts[3 * i];
-        double dir[3] = {p[0] - c[0], p[1] - c[1], p[2] - c[2]};  // the centroid's direction
-        const auto ring = ring_of(i);
-        const std::size_t m = ring.size();
+    tbb::enumerable_thread_specific<std::vector<double>> unit_space;
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 2048), [&](const tbb::blocked_range<std::size_t>& r) {
+      std::vector<double>& unit = unit_space.local();
+      for (std::size_t s = r.begin(); s != r.end(); ++s) {
+        const std::int32_t p = loc.id(s);
+        const std::size_t i = static_cast<std::size_t>(p);
+        const double* x = loc.point(s).data();
+        const auto rg = ring(s);
+        const std::size_t m = rg.size();
+        unit.resize(3 * m);
+        if (m >= 2) {
+          std::int64_t next_owned = owned[i];
+          for (std::size_t e = 0; e < m; ++e) {
+            const std::int32_t a = rg[(e + m - 1) % m], b = rg[e];
+            // The facet from its lowest generator, so that every cell
+            // holding it computes the same normal (facet_normal).
+            const std::int32_t lowest = std::min({p, a, b});
+            const std::int32_t f0 = lowest, f1 = lowest == p ? a : (lowest == a ? b : p), f2 = lowest == p ? b : (lowest == a ? p : a);
+            double* un = &unit[3 * e];
+            unit_normal(point(f0), point(f1), point(f2), c.data(), un);
+            std::int64_t v;
+            if (lowest == p) {
+              v = next_owned++;
+              std::int32_t* t = &out.triangles[3 * static_cast<std::size_t>(v)];
+              t[0] = p, t[1] = a, t[2] = b;
+              double* pos = &out.vertices[3 * static_cast<std::size_t>(v)];
+              for (int d = 0; d < 3; ++d) pos[d] = c[d] + R * un[d];
+            } else {
+              // The owner q = lowest: the facet is (a, b, p) in a's ring, (b, p, a) in b's.
+              const std::int32_t q = lowest;
+              const std::int32_t in = q == a ? b : p, outgoing = q == a ? p : a;
+              const auto oring = ring(slot_of[static_cast<std::size_t>(q)]);
+              const std::size_t om = oring.size();
+              v = -1;
+              std::int64_t num = owned[static_cast<std::size_t>(q)];
+              for (std::size_t f = 0; f < om; ++f) {
+                const std::int32_t oa = oring[(f + om - 1) % om], ob = oring[f];
+                if (oa == in && ob == outgoing) {
+                  v = num;
+                  break;
+                }
+                num += q < oa && q < ob;
+              }
+              if (v < 0)
+                throw std::logic_error("spherical voronoi: cell " + std::to_string(p) + "'s vertex with " + std::to_string(a) +
+                                       ", " + std::to_string(b) + " is not in cell " + std::to_string(q));
+            }
+            out.region_vertices[static_cast<std::size_t>(out.region_offsets[i]) + e] = static_cast<std::int32_t>(v);
+          }
+        }
+        // Areas and centroids.
+        double dir[3] = {x[0] - c[0], x[1] - c[1], x[2] - c[2]};  // the centroid's direction
         double omega = 0;
         if (out.status[i] != SphereCellStatus::cell) {
           omega = 0;
         } else if (m == 0) {
           omega = 4 * pi;
         } else if (m == 1) {
-          const double* q = &pts[3 * static_cast<std::size_t>(ring[0])];
-          for (int d = 0; d < 3; ++d) dir[d] = p[d] - q[d];
+          const double* q = point(rg[0]);
+          for (int d = 0; d < 3; ++d) dir[d] = x[d] - q[d];
           omega = 2 * pi;
         } else {
-          const std::int32_t* rv = &out.region_vertices[static_cast<std::size_t>(out.region_offsets[i])];
-          auto U = [&](std::size_t k) { return &unit[3 * static_cast<std::size_t>(rv[k % m])]; };
+          auto U = [&](std::size_t k) { return &unit[3 * (k % m)]; };
           // Vector area: edge k runs from vertex k to k+1 on the plane of
-          // ring[k], whose unit normal into the cell is (p - q) / |p - q|.
+          // rg[k], whose unit normal into the cell is (p - q) / |p - q|.
           double vec[3] = {0, 0, 0};
           for (std::size_t k = 0; k < m; ++k) {
             const double* a = U(k);
             const double* b = U(k + 1);
             const double cr[3] = {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
-            const double theta = std::atan2(std::hypot(cr[0], cr[1], cr[2]), a[0] * b[0] + a[1] * b[1] + a[2] * b[2]);
-            const double* q = &pts[3 * static_cast<std::size_t>(ring[k])];
-            double nq[3] = {p[0] - q[0], p[1] - q[1], p[2] - q[2]};
-            const double ln = std::hypot(nq[0], nq[1], nq[2]);
+            const double theta = std::atan2(std::sqrt(cr[0] * cr[0] + cr[1] * cr[1] + cr[2] * cr[2]), a[0] * b[0] + a[1] * b[1] + a[2] * b[2]);
+            const double* q = point(rg[k]);
+            const double nq[3] = {x[0] - q[0], x[1] - q[1], x[2] - q[2]};
+            const double ln = norm3(nq);
             for (int d = 0; d < 3; ++d) vec[d] += 0.5 * theta * nq[d] / ln;
           }
           for (int d = 0; d < 3; ++d) dir[d] = vec[d];
@@ -422,15 +454,15 @@ SphericalVoronoi spherical_voronoi(std::span<const double> pts, const SphericalV
           // else Gauss-Bonnet: 2 pi less the turns between the edges'
           // planes, which needs no vertex (a lune's edges are half circles,
           // a flat hull's cells reach from pole to pole).
-          const double pl = std::hypot(p[0] - c[0], p[1] - c[1], p[2] - c[2]);
-          const double apex[3] = {(p[0] - c[0]) / pl, (p[1] - c[1]) / pl, (p[2] - c[2]) / pl};
+          const double pl = std::hypot(x[0] - c[0], x[1] - c[1], x[2] - c[2]);
+          const double apex[3] = {(x[0] - c[0]) / pl, (x[1] - c[1]) / pl, (x[2] - c[2]) / pl};
           bool fan = m >= 3;
           for (std::size_t k = 0; k < m && fan; ++k) {
             const double* a = U(k);
             const double* b = U(k + 1);
-            const double* q = &pts[3 * static_cast<std::size_t>(ring[k])];
+            const double* q = point(rg[k]);
             fan = a[0] * b[0] + a[1] * b[1] + a[2] * b[2] > -0.5 &&
-                  apex[0] * (p[0] - q[0]) + apex[1] * (p[1] - q[1]) + apex[2] * (p[2] - q[2]) > 0;
+                  apex[0] * (x[0] - q[0]) + apex[1] * (x[1] - q[1]) + apex[2] * (x[2] - q[2]) > 0;
           }
           if (fan) {
             for (std::size_t k = 0; k < m; ++k) {
@@ -445,10 +477,10 @@ SphericalVoronoi spherical_voronoi(std::span<const double> pts, const SphericalV
           } else {
             omega = 2 * pi;
             for (std::size_t k = 0; k < m; ++k) {
-              const double* q0 = &pts[3 * static_cast<std::size_t>(ring[k])];
-              const double* q1 = &pts[3 * static_cast<std::size_t>(ring[(k + 1) % m])];
-              const double n0[3] = {p[0] - q0[0], p[1] - q0[1], p[2] - q0[2]};
-              const double n1[3] = {p[0] - q1[0], p[1] - q1[1], p[2] - q1[2]};
+              const double* q0 = point(rg[k]);
+              const double* q1 = point(rg[(k + 1) % m]);
+              const double n0[3] = {x[0] - q0[0], x[1] - q0[1], x[2] - q0[2]};
+              const double n1[3] = {x[0] - q1[0], x[1] - q1[1], x[2] - q1[2]};
               const double cr[3] = {n0[1] * n1[2] - n0[2] * n1[1], n0[2] * n1[0] - n0[0] * n1[2], n0[0] * n1[1] - n0[1] * n1[0]};
               omega -= std::atan2(std::hypot(cr[0], cr[1], cr[2]), n0[0] * n1[0] + n0[1] * n1[1] + n0[2] * n1[2]);
             }
@@ -456,7 +488,7 @@ SphericalVoronoi spherical_voronoi(std::span<const double> pts, const SphericalV
         }
         out.areas[i] = R2 * omega;
         double ld = std::hypot(dir[0], dir[1], dir[2]);
-        if (!(ld > 0)) dir[0] = p[0] - c[0], dir[1] = p[1] - c[1], dir[2] = p[2] - c[2], ld = std::hypot(dir[0], dir[1], dir[2]);
+        if (!(ld > 0)) dir[0] = x[0] - c[0], dir[1] = x[1] - c[1], dir[2] = x[2] - c[2], ld = std::hypot(dir[0], dir[1], dir[2]);
         for (int d = 0; d < 3; ++d) out.centroids[3 * i + d] = c[d] + R * dir[d] / ld;
       }
     });

@@ -59,6 +59,7 @@ class SphereTile {
     vert_.clear();
     for (int d = 0; d < 3; ++d) pc_[d] = p[d] - center[d];
     pc2_ = pc_[0] * pc_[0] + pc_[1] * pc_[1] + pc_[2] * pc_[2];
+    pc_len_ = std::sqrt(pc2_);
     r_max2_ = r_max * r_max;
     security2_ = std::numeric_limits<double>::infinity();
     exact_tests_ = 0;
@@ -146,6 +147,7 @@ class SphereTile {
   struct Vertex {
     double u[3];     // (a - p) x (b - p), from the rounded differences
     double perm[3];  // per component |a_y b_z| + |a_z b_y| etc.: the filter's scale
+    double rho2;     // the squared security radius of this vertex (file comment)
     bool clipped;
   };
 
@@ -162,6 +164,7 @@ class SphereTile {
     v.perm[1] = std::fabs(da[2] * db[0]) + std::fabs(da[0] * db[2]);
     v.perm[2] = std::fabs(da[0] * db[1]) + std::fabs(da[1] * db[0]);
     v.clipped = false;
+    v.rho2 = vertex_security2(v);
   }
 
   // Does s remove vertex k: orientation(p, edge_k, edge_k+1, s) > 0, which
@@ -181,38 +184,38 @@ class SphereTile {
     return orientation_sos(p_, edge_pt_[k], edge_pt_[k1], s, id_, edge_[k], edge_[k1], sid) > 0;
   }
 
-  // The security radius (file comment), with room for the rounding of the
-  // normals: a vertex whose normal is not known to 1e-3 relative (a facet
-  // of nearly collinear points) leaves the radius infinite.
+  // A vertex's security radius (file comment), squared, with room for the
+  // rounding of its normal: a normal not known to 1e-3 relative (a facet of
+  // nearly collinear points) makes it infinite.
+  double vertex_security2(const Vertex& v) const {
+    const double len2 = v.u[0] * v.u[0] + v.u[1] * v.u[1] + v.u[2] * v.u[2];
+    const double err2 = 64 * filter::u * filter::u * (v.perm[0] * v.perm[0] + v.perm[1] * v.perm[1] + v.perm[2] * v.perm[2]);
+    if (!(len2 > 1e6 * err2) || !(len2 > 0) || !(len2 < std::numeric_limits<double>::infinity()))
+      return std::numeric_limits<double>::infinity();
+    const double len = std::sqrt(len2), err = std::sqrt(err2);
+    // h lowered by what the normal's direction error (err / len radians,
+    // doubled) and the sums' rounding can hide; a smaller h only widens.
+    double h = (v.u[0] * pc_[0] + v.u[1] * pc_[1] + v.u[2] * pc_[2]) / len;
+    h -= (2 * err / len + 8 * filter::u) * pc_len_;
+    double rho;
+    if (h >= 0)
+      rho = std::sqrt(std::max(0.0, pc2_ - h * h)) + std::sqrt(std::max(0.0, r_max2_ - h * h));
+    else
+      rho = pc_len_ + std::sqrt(r_max2_);
+    rho *= 1 + 1e-12;
+    return rho * rho;
+  }
+
   void update_security() {
     double worst = 0;
-    const double pc = std::sqrt(pc2_), r_max = std::sqrt(r_max2_);
-    for (const Vertex& v : vert_) {
-      const double len = std::sqrt(v.u[0] * v.u[0] + v.u[1] * v.u[1] + v.u[2] * v.u[2]);
-      const double err = 8 * filter::u * std::sqrt(v.perm[0] * v.perm[0] + v.perm[1] * v.perm[1] + v.perm[2] * v.perm[2]);
-      if (!(len > 1e3 * err) || !(len > 0)) {
-        security2_ = std::numeric_limits<double>::infinity();
-        return;
-      }
-      // h lowered by what the normal's direction error (err / len radians,
-      // doubled) and the sum's rounding can hide; a smaller h only widens.
-      double h = (v.u[0] * pc_[0] + v.u[1] * pc_[1] + v.u[2] * pc_[2]) / len;
-      h -= (2 * err / len + 8 * filter::u) * pc;
-      double rho;
-      if (h >= 0)
-        rho = std::sqrt(std::max(0.0, pc2_ - h * h)) + std::sqrt(std::max(0.0, r_max2_ - h * h));
-      else
-        rho = pc + r_max;
-      worst = std::max(worst, rho);
-    }
-    worst *= 1 + 1e-12;
-    security2_ = worst * worst;
+    for (const Vertex& v : vert_) worst = std::max(worst, v.rho2);
+    security2_ = worst;
   }
 
   std::int32_t id_ = -1;
   const double* p_ = nullptr;
   State state_ = State::sphere;
-  double pc_[3] = {}, pc2_ = 0, r_max2_ = 0, security2_ = 0;
+  double pc_[3] = {}, pc2_ = 0, pc_len_ = 0, r_max2_ = 0, security2_ = 0;
   std::size_t exact_tests_ = 0;
   std::vector<std::int32_t> edge_, new_edge_;
   std::vector<const double*> edge_pt_, new_edge_pt_;
