@@ -11,5 +11,6 @@ void bind_dual(pybind11::module_& m);      // bind_dual.cpp: Graph, FaceSet, Flo
 void bind_surface_nets(pybind11::module_& m);  // bind_surface_nets.cpp: SurfaceNet, surface_nets
 void bind_prep(pybind11::module_& m);      // bind_prep.cpp: images, sample_image, joggle, fill, threshold, probe
 void bind_io(pybind11::module_& m);        // bind_io.cpp: the VTK XML writers
+void bind_sphere(pybind11::module_& m);    // bind_sphere.cpp: SphericalVoronoi, spherical_voronoi, lonlat_to_points
 
 }  // namespace tessera::python

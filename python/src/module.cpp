@@ -43,4 +43,5 @@ PYBIND11_MODULE(_core, m) {
   tessera::python::bind_surface_nets(m);
   tessera::python::bind_prep(m);
   tessera::python::bind_io(m);
+  tessera::python::bind_sphere(m);
 }

@@ -23,6 +23,9 @@ numpy in, numpy out::
 * :func:`flower` -> :class:`Flowers`: petals and circumflower of chosen cells.
 * :func:`surface_nets` -> :class:`SurfaceNet`: smooth, watertight region
   surfaces of labelled points, with ``vertex_kind``.
+* :func:`spherical_voronoi` -> :class:`SphericalVoronoi`: cells on a sphere
+  (points or lon/lat), with areas, centroids, neighbours and the dual
+  spherical Delaunay triangles; scipy's ``SphericalVoronoi`` layout.
 * Point preparation: :func:`sample_image` (label image -> labelled points),
   :func:`read_image`, :func:`read_points`, :func:`read_box`, :func:`read_frames`, :func:`fill`, :func:`joggle`, :func:`threshold`,
   :func:`probe`, :func:`lloyd` (Lloyd relaxation towards a centroidal Voronoi
@@ -61,6 +64,7 @@ from ._prep import (Frame, fill, joggle, probe, read_box, read_frames, read_imag
                     sample_image, threshold)
 from ._scipy import ScipyVoronoi
 from ._surface_nets import NET_CORNER, NET_JUNCTION, NET_SURFACE, SurfaceNet, surface_nets
+from ._sphere import SPHERE_CELL, SPHERE_DUPLICATE, SPHERE_HIDDEN, SphericalVoronoi, spherical_voronoi
 from ._voronoi import Voronoi, voronoi
 from ._walls import hull_walls, polygon_walls
 
@@ -69,6 +73,11 @@ __version__: str = _core.__version__
 __all__ = [
     "voronoi",
     "Voronoi",
+    "spherical_voronoi",
+    "SphericalVoronoi",
+    "SPHERE_CELL",
+    "SPHERE_DUPLICATE",
+    "SPHERE_HIDDEN",
     "hull_walls",
     "polygon_walls",
     "ScipyVoronoi",

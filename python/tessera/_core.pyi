@@ -599,3 +599,34 @@ def probe(
     threads: int,
     keep_non_finite: bool,
 ) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.uint8]]: ...
+
+# ---- spherical Voronoi (bind_sphere.cpp) ------------------------------------
+
+class SphericalVoronoi:
+    center: Tuple[float, float, float]
+    radius: float
+    n_points: int
+    duplicates: int
+    hidden: int
+    max_deviation: float
+    area_sum: float
+    exact_tests: int
+    region_offsets: npt.NDArray[np.int64]
+    region_vertices: npt.NDArray[np.int32]
+    neighbor_offsets: npt.NDArray[np.int64]
+    neighbors: npt.NDArray[np.int32]
+    vertices: npt.NDArray[np.float64]
+    triangles: npt.NDArray[np.int32]
+    areas: npt.NDArray[np.float64]
+    centroids: npt.NDArray[np.float64]
+    status: npt.NDArray[np.uint8]
+    duplicate_of: npt.NDArray[np.int32]
+    def save_cells(self, path: str) -> None: ...
+    def save_triangles(self, path: str, points: npt.NDArray[np.float64]) -> None: ...
+    def save_table(self, path: str) -> None: ...
+    def save_neighbors(self, path: str) -> None: ...
+
+def spherical_voronoi(
+    points: npt.NDArray[np.float64], center: Sequence[float], radius: float, tolerance: float, threads: int
+) -> SphericalVoronoi: ...
+def lonlat_to_points(lonlat: npt.NDArray[np.float64], radius: float, center: Sequence[float]) -> npt.NDArray[np.float64]: ...
