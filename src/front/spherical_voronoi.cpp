@@ -49,6 +49,14 @@ std::string num(double x) {
   return buf;
 }
 
+// |v|: by the sum of squares where that cannot overflow or underflow, else
+// by hypot (several times slower; the cells' sums hit it only for points
+// beyond 1e145 or within 1e-145 of each other).
+double norm3(const double* v) {
+  const double s = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+  return s > 0x1p-960 && s < 0x1p960 ? std::sqrt(s) : std::hypot(v[0], v[1], v[2]);
+}
+
 // The sphere's radius and how far the points stray from it (InputError for
 // what the header names).
 void fit_sphere(std::span<const double> pts, const SphericalVoronoiOptions& o, SphericalVoronoi& out) {
@@ -65,7 +73,8 @@ void fit_sphere(std::span<const double> pts, const SphericalVoronoiOptions& o, S
     for (int d = 0; d < 3; ++d)
       if (!std::isfinite(p[d]))
         throw InputError("spherical voronoi: point " + std::to_string(i) + " has a non-finite coordinate");
-    const double r = std::hypot(p[0] - c[0], p[1] - c[1], p[2] - c[2]);
+    const double pc[3] = {p[0] - c[0], p[1] - c[1], p[2] - c[2]};
+    const double r = norm3(pc);
     if (!(r > 0)) throw InputError("spherical voronoi: point " + std::to_string(i) + " lies at the centre");
     sum.add(r);
   }
@@ -75,7 +84,8 @@ void fit_sphere(std::span<const double> pts, const SphericalVoronoiOptions& o, S
   std::size_t worst = 0;
   for (std::size_t i = 0; i < n; ++i) {
     const double* p = &pts[3 * i];
-    const double dev = std::fabs(std::hypot(p[0] - c[0], p[1] - c[1], p[2] - c[2]) - out.radius) / out.radius;
+    const double pc[3] = {p[0] - c[0], p[1] - c[1], p[2] - c[2]};
+    const double dev = std::fabs(norm3(pc) - out.radius) / out.radius;
     if (dev > out.max_deviation) {
       out.max_deviation = dev;
       worst = i;
@@ -97,14 +107,6 @@ double surface_bin_points(std::size_t n) {
   const double divs = std::sqrt(dn / (4 * std::numbers::pi));
   const double bins = std::clamp(divs * divs * divs, 1.0, 10 * dn);
   return dn / bins;
-}
-
-// |v|: by the sum of squares where that cannot overflow or underflow, else
-// by hypot (several times slower; the cells' sums hit it only for points
-// beyond 1e145 or within 1e-145 of each other).
-double norm3(const double* v) {
-  const double s = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
-  return s > 0x1p-960 && s < 0x1p960 ? std::sqrt(s) : std::hypot(v[0], v[1], v[2]);
 }
 
 // The outward normal (y - x) x (z - x) of facet (x, y, z), computed from
@@ -151,7 +153,6 @@ void unit_normal(const double* x, const double* y, const double* z, const double
 
 struct Workspace {
   kernels::SphereTile tile;
-  std::vector<double> gaps;
   struct Candidate {
     double d2;
     std::int32_t id;
@@ -207,7 +208,8 @@ SphericalVoronoi spherical_voronoi(std::span<const double> pts, const SphericalV
   std::array<double, 3> lo{pts[0], pts[1], pts[2]}, hi = lo;
   for (std::size_t i = 0; i < n; ++i) {
     const double* p = &pts[3 * i];
-    r_max = std::max(r_max, std::hypot(p[0] - c[0], p[1] - c[1], p[2] - c[2]));
+    const double pc[3] = {p[0] - c[0], p[1] - c[1], p[2] - c[2]};
+    r_max = std::max(r_max, norm3(pc));
     for (int d = 0; d < 3; ++d) {
       lo[d] = std::min(lo[d], p[d]);
       hi[d] = std::max(hi[d], p[d]);
@@ -231,6 +233,10 @@ SphericalVoronoi spherical_voronoi(std::span<const double> pts, const SphericalV
       if (lowest[slot] >= 0) out.duplicate_of[static_cast<std::size_t>(loc.id(slot))] = lowest[slot];
 
     // ---- pass 1: the cells ----
+    // The first box's half-width: 1.5 mean spacings of points spread over
+    // the sphere, about the radius a cell's search needs (a larger box
+    // follows where it does not).
+    const double w0 = 1.5 * out.radius * std::sqrt(4 * std::numbers::pi / static_cast<double>(n));
     const std::size_t n_blocks = (n + block_slots - 1) / block_slots;
     std::vector<Block> blocks(n_blocks);
     tbb::enumerable_thread_specific<Workspace> spaces;
@@ -248,34 +254,52 @@ SphericalVoronoi spherical_voronoi(std::span<const double> pts, const SphericalV
         const std::int32_t id = loc.id(slot);
         auto& tile = ws.tile;
         tile.reset(id, x, c.data(), r_max);
-        const auto b = loc.bin_coords(x);
-        const int max_shell = loc.max_shell(b);
-        for (int s = 0; s <= max_shell; ++s) {
+        int clips = 0;
+        // Candidates by boxes of growing half-width w: each round offers the
+        // points whose largest coordinate difference from x (computed the
+        // same way every round) lies in (the last w, w], once each (a cell
+        // clipped twice by one plane would tie with itself). The bins of the
+        // box [x - w, x + w], widened by a few ulps for its rounded corners,
+        // hold them all. The search ends once the cell's radius is within w
+        // (less a rounding margin: a point that near has a difference within
+        // w) or the box holds the whole grid.
+        double covered = -1;
+        for (double w = w0;; w *= 2) {
           if (tile.state() == kernels::SphereTile::State::empty) break;
-          if (s > 0) {
-            const double lb = loc.shell_lower_bound(x, b, s);
-            if (lb * lb > tile.security2()) break;
-          }
+          const double wb = w + 4 * std::numeric_limits<double>::epsilon() *
+                                    (w + std::max({std::fabs(x[0]), std::fabs(x[1]), std::fabs(x[2])}));
+          const double blo[3] = {x[0] - wb, x[1] - wb, x[2] - wb}, bhi[3] = {x[0] + wb, x[1] + wb, x[2] + wb};
+          std::array<std::int32_t, 3> bf, bl;
+          loc.bin_range(blo, bhi, bf, bl);
+          bool whole = true;
+          for (int d = 0; d < 3; ++d) whole = whole && bf[d] == 0 && bl[d] == loc.divisions()[d] - 1;
           ws.cands.clear();
           const double r2 = tile.security2();
-          loc.for_each_shell_run_near(x, b, s, r2, ws.gaps, [&](std::uint32_t f, std::uint32_t e) {
+          loc.for_each_row_run(bf, bl, [&](std::uint32_t f, std::uint32_t e) {
             for (std::uint32_t k = f; k < e; ++k) {
               if (k == slot || lowest[k] >= 0) continue;
               const auto& q = loc.point(k);
-              const double d2 = (q[0] - x[0]) * (q[0] - x[0]) + (q[1] - x[1]) * (q[1] - x[1]) + (q[2] - x[2]) * (q[2] - x[2]);
+              const double dx = q[0] - x[0], dy = q[1] - x[1], dz = q[2] - x[2];
+              const double cheb = std::max({std::fabs(dx), std::fabs(dy), std::fabs(dz)});
+              if (cheb <= covered || cheb > w) continue;  // an earlier round's, or a later one's
+              const double d2 = dx * dx + dy * dy + dz * dz;
               if (d2 <= r2) ws.cands.push_back({d2, loc.id(k), k});
             }
           });
           // Nearest first, a dozen at a time: once a cell has its nearest
           // neighbours its security radius passes most of the rest unsorted.
           auto nearer = [](const auto& a, const auto& b2) { return a.d2 != b2.d2 ? a.d2 < b2.d2 : a.id < b2.id; };
+          // The first few clips of a cell go ahead without asking its
+          // radius (a clip that changes nothing is merely a wasted test).
           auto first = ws.cands.begin(), last = ws.cands.end();
           while (first != last) {
             const auto stop = last - first > 12 ? first + 12 : last;
-            std::partial_sort(first, stop, last, nearer);
+            if (stop != last) std::nth_element(first, stop - 1, last, nearer);
+            std::sort(first, stop, nearer);
             bool done = false;
             for (; first != stop; ++first) {
-              if (first->d2 > tile.security2() || tile.state() == kernels::SphereTile::State::empty) {
+              if (tile.state() == kernels::SphereTile::State::empty ||
+                  (++clips > 6 && first->d2 > tile.security2())) {
                 done = true;
                 break;
               }
@@ -285,6 +309,14 @@ SphericalVoronoi spherical_voronoi(std::span<const double> pts, const SphericalV
             // Drop what the radius now passes before sorting again.
             const double r2now = tile.security2();
             last = std::partition(first, last, [&](const auto& cd) { return cd.d2 <= r2now; });
+          }
+          covered = w;
+          const double sure = w * (1 - 1e-12);
+          if (tile.security2() <= sure * sure) break;
+          if (whole) {
+            // The last round: what lay beyond w in the box's bins.
+            if (covered == std::numeric_limits<double>::infinity()) break;
+            w = std::numeric_limits<double>::infinity() / 2;
           }
         }
         ws.exact_tests += tile.exact_tests();
@@ -454,8 +486,9 @@ SphericalVoronoi spherical_voronoi(std::span<const double> pts, const SphericalV
           // else Gauss-Bonnet: 2 pi less the turns between the edges'
           // planes, which needs no vertex (a lune's edges are half circles,
           // a flat hull's cells reach from pole to pole).
-          const double pl = std::hypot(x[0] - c[0], x[1] - c[1], x[2] - c[2]);
-          const double apex[3] = {(x[0] - c[0]) / pl, (x[1] - c[1]) / pl, (x[2] - c[2]) / pl};
+          const double xc[3] = {x[0] - c[0], x[1] - c[1], x[2] - c[2]};
+          const double pl = norm3(xc);
+          const double apex[3] = {xc[0] / pl, xc[1] / pl, xc[2] / pl};
           bool fan = m >= 3;
           for (std::size_t k = 0; k < m && fan; ++k) {
             const double* a = U(k);
@@ -487,8 +520,8 @@ SphericalVoronoi spherical_voronoi(std::span<const double> pts, const SphericalV
           }
         }
         out.areas[i] = R2 * omega;
-        double ld = std::hypot(dir[0], dir[1], dir[2]);
-        if (!(ld > 0)) dir[0] = x[0] - c[0], dir[1] = x[1] - c[1], dir[2] = x[2] - c[2], ld = std::hypot(dir[0], dir[1], dir[2]);
+        double ld = norm3(dir);
+        if (!(ld > 0)) dir[0] = x[0] - c[0], dir[1] = x[1] - c[1], dir[2] = x[2] - c[2], ld = norm3(dir);
         for (int d = 0; d < 3; ++d) out.centroids[3 * i + d] = c[d] + R * dir[d] / ld;
       }
     });

@@ -62,6 +62,7 @@ class SphereTile {
     pc_len_ = std::sqrt(pc2_);
     r_max2_ = r_max * r_max;
     security2_ = std::numeric_limits<double>::infinity();
+    security_known_ = true;
     exact_tests_ = 0;
   }
 
@@ -103,6 +104,7 @@ class SphereTile {
       edge_pt_.clear();
       vert_.clear();
       security2_ = 0;
+      security_known_ = true;
       return true;
     }
     // The removed vertices are one cyclic run i .. j (the cone is convex and
@@ -138,7 +140,18 @@ class SphereTile {
   State state() const { return state_; }
   /// Squared distance from p beyond which no candidate can change the cell
   /// (infinite until the cell is a polygon with well-conditioned vertices).
-  double security2() const { return security2_; }
+  double security2() {
+    if (!security_known_) {
+      double worst = 0;
+      for (Vertex& v : vert_) {
+        if (v.rho2 < 0) v.rho2 = vertex_security2(v);
+        worst = std::max(worst, v.rho2);
+      }
+      security2_ = worst;
+      security_known_ = true;
+    }
+    return security2_;
+  }
   /// Neighbours across the edges, counter-clockwise seen from outside.
   std::span<const std::int32_t> edges() const { return edge_; }
   std::size_t exact_tests() const { return exact_tests_; }
@@ -164,7 +177,7 @@ class SphereTile {
     v.perm[1] = std::fabs(da[2] * db[0]) + std::fabs(da[0] * db[2]);
     v.perm[2] = std::fabs(da[0] * db[1]) + std::fabs(da[1] * db[0]);
     v.clipped = false;
-    v.rho2 = vertex_security2(v);
+    v.rho2 = -1;  // not yet known (security2 computes it when asked)
   }
 
   // Does s remove vertex k: orientation(p, edge_k, edge_k+1, s) > 0, which
@@ -206,16 +219,15 @@ class SphereTile {
     return rho * rho;
   }
 
-  void update_security() {
-    double worst = 0;
-    for (const Vertex& v : vert_) worst = std::max(worst, v.rho2);
-    security2_ = worst;
-  }
+  // Lazily (security2): most vertices are cut away by the next few clips,
+  // and a vertex's radius costs three square roots.
+  void update_security() { security_known_ = false; }
 
   std::int32_t id_ = -1;
   const double* p_ = nullptr;
   State state_ = State::sphere;
   double pc_[3] = {}, pc2_ = 0, pc_len_ = 0, r_max2_ = 0, security2_ = 0;
+  bool security_known_ = true;  // security2_ is up to date
   std::size_t exact_tests_ = 0;
   std::vector<std::int32_t> edge_, new_edge_;
   std::vector<const double*> edge_pt_, new_edge_pt_;
