@@ -20,6 +20,8 @@
 #include <span>
 #include <vector>
 
+#include "tessera/buffer.hpp"
+
 namespace tessera {
 
 struct SphericalVoronoiOptions {
@@ -40,6 +42,8 @@ enum class SphereCellStatus : std::uint8_t {
   hidden = 2,     ///< inside the hull of the others: no cell
 };
 
+/// Large arrays are tessera::Buffer (a std::vector that leaves resized
+/// elements uninitialized, on huge pages): the cells fill them in parallel.
 struct SphericalVoronoi {
   std::array<double, 3> center{0, 0, 0};
   double radius = 0;
@@ -48,23 +52,23 @@ struct SphericalVoronoi {
   /// region_vertices[region_offsets[i] .. region_offsets[i+1]),
   /// counter-clockwise seen from outside the sphere. Empty for duplicates
   /// and hidden points.
-  std::vector<std::int64_t> region_offsets;
-  std::vector<std::int32_t> region_vertices;
+  Buffer<std::int64_t> region_offsets;
+  Buffer<std::int32_t> region_vertices;
   /// Per point, its neighbours neighbors[neighbor_offsets[i] ..
   /// neighbor_offsets[i+1]): the point across edge k, the edge from vertex k
   /// to vertex k+1. The same offsets as the regions' except where a cell has
   /// no vertex: one point's cell is the whole sphere (no neighbour), two
   /// points' cells are hemispheres (one neighbour each).
-  std::vector<std::int64_t> neighbor_offsets;
-  std::vector<std::int32_t> neighbors;
+  Buffer<std::int64_t> neighbor_offsets;
+  Buffer<std::int32_t> neighbors;
   /// Cell vertices on the sphere, 3 doubles each, numbered by the lowest
   /// generator's cell (in id order) and that cell's order.
-  std::vector<double> vertices;
+  Buffer<double> vertices;
   /// Per vertex its three generators, counter-clockwise seen from outside:
   /// the spherical Delaunay triangles (the convex hull's facets, outward).
-  std::vector<std::int32_t> triangles;
-  std::vector<double> areas;      ///< per point: its cell's area (R^2 x solid angle); 0 without a cell
-  std::vector<double> centroids;  ///< per point: the cell's centroid projected to the sphere (3 each); the point itself without a cell
+  Buffer<std::int32_t> triangles;
+  Buffer<double> areas;      ///< per point: its cell's area (R^2 x solid angle); 0 without a cell
+  Buffer<double> centroids;  ///< per point: the cell's centroid projected to the sphere (3 each); the point itself without a cell
   std::vector<SphereCellStatus> status;  ///< per point
   std::vector<std::int32_t> duplicate_of;  ///< per point: the lowest id at its coordinates, or -1
   std::size_t duplicates = 0, hidden = 0;

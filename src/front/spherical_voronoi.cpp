@@ -239,6 +239,7 @@ SphericalVoronoi spherical_voronoi(std::span<const double> pts, const SphericalV
     const double w0 = 1.5 * out.radius * std::sqrt(4 * std::numbers::pi / static_cast<double>(n));
     const std::size_t n_blocks = (n + block_slots - 1) / block_slots;
     std::vector<Block> blocks(n_blocks);
+    const double* const slot0 = loc.point(0).data();  // slot k's point is slot0 + 3k
     tbb::enumerable_thread_specific<Workspace> spaces;
     tbb::parallel_for(std::size_t{0}, n_blocks, [&](std::size_t bk) {
       Workspace& ws = spaces.local();
@@ -321,18 +322,23 @@ SphericalVoronoi spherical_voronoi(std::span<const double> pts, const SphericalV
         }
         ws.exact_tests += tile.exact_tests();
         block.state.push_back(static_cast<std::uint8_t>(tile.state()));
+        // The ring by the neighbours' slots (the passes below read their
+        // points and rings there), rotated to start at the lowest id.
         const auto ring = tile.edges();
+        const auto ring_pts = tile.edge_points();
         const std::size_t rot = static_cast<std::size_t>(std::min_element(ring.begin(), ring.end()) - ring.begin());
-        for (std::size_t k = 0; k < ring.size(); ++k) block.ring.push_back(ring[(rot + k) % ring.size()]);
+        for (std::size_t k = 0; k < ring.size(); ++k)
+          block.ring.push_back(static_cast<std::int32_t>((ring_pts[(rot + k) % ring.size()] - slot0) / 3));
       }
       block.start.push_back(static_cast<std::uint32_t>(block.ring.size()));
     });
     for (const auto& ws : spaces) out.exact_tests += ws.exact_tests;
 
-    // Rings in slot order (the blocks back to back): the passes below walk
-    // the cells in the locator's order, where a cell's neighbours' rings and
-    // points lie close by in memory, whatever order the ids come in.
-    std::vector<std::int64_t> ring_at(n + 1, 0);  // per slot
+    // Rings in slot order (the blocks back to back), of slots: the pass
+    // below walks the cells in the locator's order, where a cell's
+    // neighbours' rings and points lie close by in memory, whatever order
+    // the ids come in.
+    Buffer<std::int64_t> ring_at(n + 1, 0);  // per slot
     std::vector<std::uint8_t> slot_state(n);
     for (std::size_t bk = 0; bk < n_blocks; ++bk)
       for (std::size_t k = 0; k + 1 < blocks[bk].start.size(); ++k) {
@@ -340,18 +346,19 @@ SphericalVoronoi spherical_voronoi(std::span<const double> pts, const SphericalV
         slot_state[bk * block_slots + k] = blocks[bk].state[k];
       }
     for (std::size_t s = 0; s < n; ++s) ring_at[s + 1] += ring_at[s];
-    std::vector<std::int32_t> rings(static_cast<std::size_t>(ring_at[n]));
+    Buffer<std::int32_t> rings(static_cast<std::size_t>(ring_at[n]));
     tbb::parallel_for(std::size_t{0}, n_blocks, [&](std::size_t bk) {
       std::copy(blocks[bk].ring.begin(), blocks[bk].ring.end(), rings.begin() + ring_at[bk * block_slots]);
     });
     blocks.clear();
     blocks.shrink_to_fit();
-    std::vector<std::uint32_t> slot_of(n);
+    Buffer<std::uint32_t> slot_of(n);
     for (std::size_t s = 0; s < n; ++s) slot_of[static_cast<std::size_t>(loc.id(s))] = static_cast<std::uint32_t>(s);
     auto ring = [&](std::size_t slot) {
       return std::span<const std::int32_t>(rings.data() + ring_at[slot], static_cast<std::size_t>(ring_at[slot + 1] - ring_at[slot]));
     };
-    auto point = [&](std::int32_t id) { return loc.point(slot_of[static_cast<std::size_t>(id)]).data(); };
+    auto point = [&](std::int32_t slot) { return loc.point(static_cast<std::size_t>(slot)).data(); };
+    auto id_at = [&](std::int32_t slot) { return loc.id(static_cast<std::size_t>(slot)); };
 
     using State = kernels::SphereTile::State;
     out.status.assign(n, SphereCellStatus::cell);
@@ -371,20 +378,20 @@ SphericalVoronoi spherical_voronoi(std::span<const double> pts, const SphericalV
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
       for (std::size_t i = r.begin(); i != r.end(); ++i) {
         const auto rg = ring(slot_of[i]);
-        std::copy(rg.begin(), rg.end(), out.neighbors.begin() + out.neighbor_offsets[i]);
+        std::transform(rg.begin(), rg.end(), out.neighbors.begin() + out.neighbor_offsets[i], id_at);
       }
     });
 
     // ---- pass 2: vertices, numbered by their owners; areas, centroids ----
     // Vertex k of a polygon cell is where edge k-1 ends: facet (p, ring[k-1], ring[k]).
-    std::vector<std::int64_t> owned(n + 1, 0);  // by id
+    Buffer<std::int64_t> owned(n + 1, 0);  // by id
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
       for (std::size_t s = r.begin(); s != r.end(); ++s) {
         const auto rg = ring(s);
         if (rg.size() < 2) continue;
         const std::int32_t p = loc.id(s);
         std::int64_t k = 0;
-        for (std::size_t e = 0; e < rg.size(); ++e) k += p < rg[(e + rg.size() - 1) % rg.size()] && p < rg[e];
+        for (std::size_t e = 0; e < rg.size(); ++e) k += p < id_at(rg[(e + rg.size() - 1) % rg.size()]) && p < id_at(rg[e]);
         owned[static_cast<std::size_t>(p) + 1] = k;
       }
     });
@@ -400,7 +407,7 @@ SphericalVoronoi spherical_voronoi(std::span<const double> pts, const SphericalV
     out.region_vertices.resize(static_cast<std::size_t>(out.region_offsets[n]));
     out.triangles.resize(3 * n_vertices);
     out.vertices.resize(3 * n_vertices);
-    out.areas.assign(n, 0);
+    out.areas.resize(n);
     out.centroids.resize(3 * n);
     const double R = out.radius, R2 = R * R;
     constexpr double pi = std::numbers::pi;
@@ -417,11 +424,14 @@ SphericalVoronoi spherical_voronoi(std::span<const double> pts, const SphericalV
         if (m >= 2) {
           std::int64_t next_owned = owned[i];
           for (std::size_t e = 0; e < m; ++e) {
-            const std::int32_t a = rg[(e + m - 1) % m], b = rg[e];
+            const std::int32_t as = rg[(e + m - 1) % m], bs = rg[e], ps = static_cast<std::int32_t>(s);
+            const std::int32_t a = id_at(as), b = id_at(bs);
             // The facet from its lowest generator, so that every cell
             // holding it computes the same normal (facet_normal).
             const std::int32_t lowest = std::min({p, a, b});
-            const std::int32_t f0 = lowest, f1 = lowest == p ? a : (lowest == a ? b : p), f2 = lowest == p ? b : (lowest == a ? p : a);
+            const std::int32_t f0 = lowest == p ? ps : (lowest == a ? as : bs);
+            const std::int32_t f1 = lowest == p ? as : (lowest == a ? bs : ps);
+            const std::int32_t f2 = lowest == p ? bs : (lowest == a ? ps : as);
             double* un = &unit[3 * e];
             unit_normal(point(f0), point(f1), point(f2), c.data(), un);
             std::int64_t v;
@@ -434,8 +444,8 @@ SphericalVoronoi spherical_voronoi(std::span<const double> pts, const SphericalV
             } else {
               // The owner q = lowest: the facet is (a, b, p) in a's ring, (b, p, a) in b's.
               const std::int32_t q = lowest;
-              const std::int32_t in = q == a ? b : p, outgoing = q == a ? p : a;
-              const auto oring = ring(slot_of[static_cast<std::size_t>(q)]);
+              const std::int32_t in = q == a ? bs : ps, outgoing = q == a ? ps : as;  // slots
+              const auto oring = ring(static_cast<std::size_t>(q == a ? as : bs));
               const std::size_t om = oring.size();
               v = -1;
               std::int64_t num = owned[static_cast<std::size_t>(q)];
@@ -445,7 +455,7 @@ SphericalVoronoi spherical_voronoi(std::span<const double> pts, const SphericalV
                   v = num;
                   break;
                 }
-                num += q < oa && q < ob;
+                num += q < id_at(oa) && q < id_at(ob);
               }
               if (v < 0)
                 throw std::logic_error("spherical voronoi: cell " + std::to_string(p) + "'s vertex with " + std::to_string(a) +

@@ -16,7 +16,7 @@ namespace {
 
 bool has_cell(const SphericalVoronoi& sv, std::size_t i) { return sv.status[i] == SphereCellStatus::cell; }
 
-std::int64_t count(const std::vector<std::int64_t>& offsets, std::size_t i) { return offsets[i + 1] - offsets[i]; }
+std::int64_t count(std::span<const std::int64_t> offsets, std::size_t i) { return offsets[i + 1] - offsets[i]; }
 
 }  // namespace
 

@@ -154,6 +154,8 @@ class SphereTile {
   }
   /// Neighbours across the edges, counter-clockwise seen from outside.
   std::span<const std::int32_t> edges() const { return edge_; }
+  /// The candidates' coordinates as given to clip(), per edge.
+  std::span<const double* const> edge_points() const { return edge_pt_; }
   std::size_t exact_tests() const { return exact_tests_; }
 
  private:
