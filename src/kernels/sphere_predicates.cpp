@@ -45,6 +45,21 @@ int orientation_tie_break(const double* const* pts, const std::int32_t* ids) {
   for (int i = 0; i < 4; ++i)
     for (int j = i + 1; j < 4; ++j)
       if (order[i] > order[j]) parity = -parity;
+  // The first three terms (masks 1, 2, 4: the lowest id moved along x, y,
+  // z) are the cofactors of its row, (-1)^axis times the orientation of the
+  // other three points projected on the other two axes: exact 2D
+  // orientations on the doubles, no rationals. Three points of a sphere
+  // are never collinear, so for four cocircular points one of them decides.
+  for (int axis = 0; axis < 3; ++axis) {
+    const int u = axis == 0 ? 1 : 0, v = axis == 2 ? 1 : 2;
+    double q[3][2];
+    for (int r = 1; r < 4; ++r) {
+      q[r - 1][0] = pts[order[r]][u];
+      q[r - 1][1] = pts[order[r]][v];
+    }
+    const double* tri[3] = {q[0], q[1], q[2]};
+    if (const int o = orientation(2, tri)) return -parity * (axis == 1 ? -o : o);
+  }
   std::array<std::array<mpq_class, 4>, 4> rows;
   for (int r = 0; r < 4; ++r) {
     for (int d = 0; d < 3; ++d) rows[r][d] = pts[order[r]][d];
@@ -59,7 +74,7 @@ int orientation_tie_break(const double* const* pts, const std::int32_t* ids) {
   // coefficient. The mask moving three rows along x, y, z leaves the fourth
   // row's 1 alone in the last column: its coefficient is +-1, so the loop
   // always ends.
-  for (unsigned mask = 1; mask < (1u << 12); ++mask) {
+  for (unsigned mask = 8; mask < (1u << 12); ++mask) {  // (1, 2, 4 were zero)
     unsigned axes = 0;
     bool valid = true;
     for (int r = 0; r < 4 && valid; ++r) {

@@ -12,6 +12,7 @@
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Surface_mesh.h>
 #include <CGAL/convex_hull_3.h>
+#include <gmpxx.h>
 
 #include <algorithm>
 #include <array>
@@ -324,6 +325,75 @@ TEST(SphericalVoronoi, TieBreakIsAntisymmetricAndConsistent) {
   const double* cyc[4] = {P[1], P[2], P[0], P[3]};
   const std::int32_t cyci[4] = {2, 9, 5, 4};
   EXPECT_EQ(tessera::kernels::orientation_tie_break(cyc, cyci), s);
+}
+
+// The oracle of the tie break: every term of the perturbed determinant in
+// order, in rationals (sphere_predicates.cpp takes the first three from 2D
+// orientations).
+int reference_tie_break(const double* const* pts, const std::int32_t* ids) {
+  std::array<int, 4> order{0, 1, 2, 3};
+  std::sort(order.begin(), order.end(), [&](int x, int y) { return ids[x] < ids[y]; });
+  int parity = 1;
+  for (int i = 0; i < 4; ++i)
+    for (int j = i + 1; j < 4; ++j)
+      if (order[i] > order[j]) parity = -parity;
+  for (unsigned mask = 1; mask < (1u << 12); ++mask) {
+    std::array<std::array<mpq_class, 4>, 4> m;
+    bool valid = true;
+    unsigned axes = 0;
+    for (int r = 0; r < 4; ++r) {
+      const unsigned bits = (mask >> (3 * r)) & 7u;
+      if (bits != 0 && ((bits & (bits - 1)) != 0 || (axes & bits) != 0)) valid = false;
+      axes |= bits;
+      for (int c = 0; c < 4; ++c) m[r][c] = bits == 0 ? (c < 3 ? mpq_class(pts[order[r]][c]) : mpq_class(1)) : mpq_class(0);
+      if (bits != 0) m[r][bits == 1 ? 0 : (bits == 2 ? 1 : 2)] = 1;
+    }
+    if (!valid) continue;
+    // Laplace along the first row, 3x3 minors by Sarrus.
+    mpq_class det = 0;
+    for (int c = 0; c < 4; ++c) {
+      int k[3], j = 0;
+      for (int e = 0; e < 4; ++e)
+        if (e != c) k[j++] = e;
+      const mpq_class minor = m[1][k[0]] * (m[2][k[1]] * m[3][k[2]] - m[2][k[2]] * m[3][k[1]]) -
+                              m[1][k[1]] * (m[2][k[0]] * m[3][k[2]] - m[2][k[2]] * m[3][k[0]]) +
+                              m[1][k[2]] * (m[2][k[0]] * m[3][k[1]] - m[2][k[1]] * m[3][k[0]]);
+      det += (c % 2 == 0 ? 1 : -1) * m[0][c] * minor;
+    }
+    if (sgn(det) != 0) return -parity * sgn(det);
+  }
+  return 0;
+}
+
+TEST(SphericalVoronoi, TieBreakEqualsEveryTermInRationals) {
+  // Coplanar quadruples: on circles of a sphere, on axis planes, three on a
+  // line (the first three terms vanish), in every id order.
+  std::mt19937_64 rng(4);
+  std::uniform_int_distribution<int> coord(-3, 3);
+  int checked = 0;
+  for (int trial = 0; trial < 3000; ++trial) {
+    double P[4][3];
+    const int kind = trial % 3;
+    for (auto& p : P)
+      for (double& x : p) x = coord(rng);
+    if (kind == 0)
+      for (auto& p : P) p[2] = 1;  // a plane z = 1
+    else if (kind == 1)
+      for (int d = 0; d < 3; ++d) P[3][d] = 2 * P[1][d] - P[0][d];  // P0, P1, P3 on a line
+    else
+      for (int d = 0; d < 3; ++d) P[3][d] = P[1][d] + P[2][d] - P[0][d];  // a parallelogram
+    const double* pts[4] = {P[0], P[1], P[2], P[3]};
+    if (tessera::kernels::orientation(3, pts) != 0) continue;
+    bool distinct = true;
+    for (int i = 0; i < 4; ++i)
+      for (int j = i + 1; j < 4; ++j) distinct = distinct && !std::equal(P[i], P[i] + 3, P[j]);
+    if (!distinct) continue;
+    std::array<std::int32_t, 4> ids{10, 20, 30, 40};
+    std::shuffle(ids.begin(), ids.end(), rng);
+    EXPECT_EQ(tessera::kernels::orientation_tie_break(pts, ids.data()), reference_tie_break(pts, ids.data()));
+    ++checked;
+  }
+  EXPECT_GT(checked, 1000);
 }
 
 TEST(SphericalVoronoi, BadInput) {

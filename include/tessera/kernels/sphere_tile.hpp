@@ -163,14 +163,25 @@ class SphereTile {
     double u[3];     // (a - p) x (b - p), from the rounded differences
     double perm[3];  // per component |a_y b_z| + |a_z b_y| etc.: the filter's scale
     double rho2;     // the squared security radius of this vertex (file comment)
+    const double* a;  // the facet's other two points: (p, a, b)
+    const double* b;
     bool clipped;
   };
 
   void make_vertex(Vertex& v, const double* a, const double* b) const {
+    make_normal(v, p_, a, b);
+    v.clipped = false;
+    v.rho2 = -1;  // not yet known (security2 computes it when asked)
+    v.a = a;
+    v.b = b;
+  }
+
+  // (a - o) x (b - o) and its permanent into v.u, v.perm.
+  static void make_normal(Vertex& v, const double* o, const double* a, const double* b) {
     double da[3], db[3];
     for (int d = 0; d < 3; ++d) {
-      da[d] = a[d] - p_[d];
-      db[d] = b[d] - p_[d];
+      da[d] = a[d] - o[d];
+      db[d] = b[d] - o[d];
     }
     v.u[0] = da[1] * db[2] - da[2] * db[1];
     v.u[1] = da[2] * db[0] - da[0] * db[2];
@@ -178,8 +189,6 @@ class SphereTile {
     v.perm[0] = std::fabs(da[1] * db[2]) + std::fabs(da[2] * db[1]);
     v.perm[1] = std::fabs(da[2] * db[0]) + std::fabs(da[0] * db[2]);
     v.perm[2] = std::fabs(da[0] * db[1]) + std::fabs(da[1] * db[0]);
-    v.clipped = false;
-    v.rho2 = -1;  // not yet known (security2 computes it when asked)
   }
 
   // Does s remove vertex k: orientation(p, edge_k, edge_k+1, s) > 0, which
@@ -203,14 +212,36 @@ class SphereTile {
   // rounding of its normal: a normal not known to 1e-3 relative (a facet of
   // nearly collinear points) makes it infinite.
   double vertex_security2(const Vertex& v) const {
-    const double len2 = v.u[0] * v.u[0] + v.u[1] * v.u[1] + v.u[2] * v.u[2];
-    const double err2 = 64 * filter::u * filter::u * (v.perm[0] * v.perm[0] + v.perm[1] * v.perm[1] + v.perm[2] * v.perm[2]);
+    const double* u = v.u;
+    const double* perm = v.perm;
+    double len2 = u[0] * u[0] + u[1] * u[1] + u[2] * u[2];
+    double err2 = 64 * filter::u * filter::u * (perm[0] * perm[0] + perm[1] * perm[1] + perm[2] * perm[2]);
+    Vertex best;
+    if (!(len2 > 1e6 * err2)) {
+      // The corner at p is too thin (two points 1e-13 apart and a third
+      // far off: a pole given once per longitude): the same normal from
+      // the facet's widest corner, opposite its longest edge.
+      const double* q[3] = {p_, v.a, v.b};
+      double e2[3];
+      for (int k = 0; k < 3; ++k) {
+        const double* x = q[k];
+        const double* y = q[(k + 1) % 3];
+        e2[k] = (y[0] - x[0]) * (y[0] - x[0]) + (y[1] - x[1]) * (y[1] - x[1]) + (y[2] - x[2]) * (y[2] - x[2]);
+      }
+      const int k = static_cast<int>(std::max_element(e2, e2 + 3) - e2);  // edge q[k] -> q[k+1]
+      const double* corner = q[(k + 2) % 3];
+      make_normal(best, corner, q[k], q[(k + 1) % 3]);  // cyclic: (corner, q[k], q[k+1])
+      u = best.u;
+      perm = best.perm;
+      len2 = u[0] * u[0] + u[1] * u[1] + u[2] * u[2];
+      err2 = 64 * filter::u * filter::u * (perm[0] * perm[0] + perm[1] * perm[1] + perm[2] * perm[2]);
+    }
     if (!(len2 > 1e6 * err2) || !(len2 > 0) || !(len2 < std::numeric_limits<double>::infinity()))
       return std::numeric_limits<double>::infinity();
     const double len = std::sqrt(len2), err = std::sqrt(err2);
     // h lowered by what the normal's direction error (err / len radians,
     // doubled) and the sums' rounding can hide; a smaller h only widens.
-    double h = (v.u[0] * pc_[0] + v.u[1] * pc_[1] + v.u[2] * pc_[2]) / len;
+    double h = (u[0] * pc_[0] + u[1] * pc_[1] + u[2] * pc_[2]) / len;
     h -= (2 * err / len + 8 * filter::u) * pc_len_;
     double rho;
     if (h >= 0)
