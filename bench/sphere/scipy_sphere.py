@@ -16,7 +16,13 @@ from scipy.spatial import SphericalVoronoi
 
 p = np.load(sys.argv[1])
 t0 = time.perf_counter()
-sv = SphericalVoronoi(p, radius=1.0)
+try:
+    sv = SphericalVoronoi(p, radius=1.0)
+except ValueError as e:  # e.g. "Duplicate generators present." (pairs within its threshold)
+    print(json.dumps({"tool": "scipy", "op": "sphere", "n": len(p), "threads": 1, "seconds": None,
+                      "simplices": 0, "extra": {"error": str(e), "after_s": time.perf_counter() - t0,
+                                                "scipy": scipy.__version__}}))
+    sys.exit(0)
 t1 = time.perf_counter()
 sv.sort_vertices_of_regions()
 t2 = time.perf_counter()
