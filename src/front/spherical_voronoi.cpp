@@ -114,8 +114,9 @@ double surface_bin_points(std::size_t n) {
 // is the same from every corner of the cyclic order, but its rounding error
 // relative to its length is ~u / sin(angle at the corner), and a facet of
 // two points 1e-13 apart and a third far away (a pole given once per
-// longitude) has two corners of angle ~1e-16. Returns its length.
-double facet_normal(const double* x, const double* y, const double* z, double* u) {
+// longitude) has two corners of angle ~1e-16. Returns its length, and in
+// `err` a bound on the error of u (each difference and product rounded).
+double facet_normal(const double* x, const double* y, const double* z, double* u, double& err) {
   double e[3][3];  // e[0] = y - x, e[1] = z - y, e[2] = x - z
   for (int d = 0; d < 3; ++d) {
     e[0][d] = y[d] - x[d];
@@ -132,6 +133,7 @@ double facet_normal(const double* x, const double* y, const double* z, double* u
   u[0] = -(f[1] * g[2] - f[2] * g[1]);
   u[1] = -(f[2] * g[0] - f[0] * g[2]);
   u[2] = -(f[0] * g[1] - f[1] * g[0]);
+  err = 8 * std::numeric_limits<double>::epsilon() * std::sqrt(len2[(k + 2) % 3] * len2[(k + 1) % 3]);
   return norm3(u);
 }
 
@@ -139,16 +141,20 @@ double facet_normal(const double* x, const double* y, const double* z, double* u
 // (every cell holding the facet asks the same question and gets the same
 // bits). A facet of (nearly) collinear points, decided by the perturbation,
 // has no computable normal: the points' mean direction from the centre
-// stands in (its topology is exact, its geometry a tie's).
-void unit_normal(const double* x, const double* y, const double* z, const double* c, double* un) {
-  double u[3];
-  double len = facet_normal(x, y, z, u);
+// stands in (its topology is exact, its geometry a tie's). Returns whether
+// the normal is known to 1e-6 (a cell with one that is not is measured
+// without its vertices: Gauss-Bonnet).
+bool unit_normal(const double* x, const double* y, const double* z, const double* c, double* un) {
+  double u[3], err = 0;
+  double len = facet_normal(x, y, z, u, err);
+  const bool known = len > 1e6 * err && std::isfinite(len);
   if (!(len > 0) || !std::isfinite(len)) {
     for (int d = 0; d < 3; ++d) u[d] = x[d] + y[d] + z[d] - 3 * c[d];
     len = std::hypot(u[0], u[1], u[2]);
     if (!(len > 0)) u[0] = 1, u[1] = u[2] = 0, len = 1;
   }
   for (int d = 0; d < 3; ++d) un[d] = u[d] / len;
+  return known;
 }
 
 struct Workspace {
@@ -421,6 +427,7 @@ SphericalVoronoi spherical_voronoi(std::span<const double> pts, const SphericalV
         const auto rg = ring(s);
         const std::size_t m = rg.size();
         unit.resize(3 * m);
+        bool all_known = true;  // every vertex's normal (unit_normal)
         if (m >= 2) {
           std::int64_t next_owned = owned[i];
           for (std::size_t e = 0; e < m; ++e) {
@@ -433,7 +440,7 @@ SphericalVoronoi spherical_voronoi(std::span<const double> pts, const SphericalV
             const std::int32_t f1 = lowest == p ? as : (lowest == a ? bs : ps);
             const std::int32_t f2 = lowest == p ? bs : (lowest == a ? ps : as);
             double* un = &unit[3 * e];
-            unit_normal(point(f0), point(f1), point(f2), c.data(), un);
+            all_known = unit_normal(point(f0), point(f1), point(f2), c.data(), un) && all_known;
             std::int64_t v;
             if (lowest == p) {
               v = next_owned++;
@@ -492,14 +499,15 @@ SphericalVoronoi spherical_voronoi(std::span<const double> pts, const SphericalV
           }
           for (int d = 0; d < 3; ++d) dir[d] = vec[d];
           // A fan of triangles from p's direction (accurate to rounding on
-          // small cells) where p lies inside its cell and no edge is long;
-          // else Gauss-Bonnet: 2 pi less the turns between the edges'
-          // planes, which needs no vertex (a lune's edges are half circles,
-          // a flat hull's cells reach from pole to pole).
+          // small cells) where p lies inside its cell, no edge is long and
+          // every vertex is known; else Gauss-Bonnet: 2 pi less the turns
+          // between the edges' planes, which needs no vertex (a lune's edges
+          // are half circles, a flat hull's cells reach from pole to pole, a
+          // facet of collinear points has no normal to compute).
           const double xc[3] = {x[0] - c[0], x[1] - c[1], x[2] - c[2]};
           const double pl = norm3(xc);
           const double apex[3] = {xc[0] / pl, xc[1] / pl, xc[2] / pl};
-          bool fan = m >= 3;
+          bool fan = m >= 3 && all_known;
           for (std::size_t k = 0; k < m && fan; ++k) {
             const double* a = U(k);
             const double* b = U(k + 1);

@@ -400,6 +400,14 @@ int orientation(int D, const double* const* pts) {
   return orientation_exact(D, pts);
 }
 
+int orientation_past_filter(int D, const double* const* pts) {
+  if (const int sign = orientation_long_double(D, pts)) return sign;
+  int sign;
+  if (orientation_int128(D, pts, sign)) return sign;
+  if (orientation_expansion(D, pts, sign)) return sign;
+  return orientation_exact(D, pts);
+}
+
 int orientation(const ExactContext& ctx, const std::int32_t* ids) {
   const double* pts[4] = {};
   for (int k = 0; k <= ctx.dim; ++k) pts[k] = pt(ctx, ids[k]);

@@ -99,7 +99,7 @@ int orientation_tie_break(const double* const* pts, const std::int32_t* ids) {
 int orientation_sos(const double* a, const double* b, const double* c, const double* s, std::int32_t ia,
                     std::int32_t ib, std::int32_t ic, std::int32_t is) {
   const double* pts[4] = {a, b, c, s};
-  if (const int sign = orientation(3, pts)) return sign;
+  if (const int sign = orientation_past_filter(3, pts)) return sign;
   const std::int32_t ids[4] = {ia, ib, ic, is};
   return orientation_tie_break(pts, ids);
 }

@@ -345,6 +345,45 @@ class Hostile(base.TempDirCase):
                 self.check_cut_bounds(case, kind, d, pts, inp, labels, common, rng)
             if case % 8 == 4:
                 self.check_walls(case, kind, d, pts, inp, labels, common, rng)
+            if case % 4 == 2:
+                self.check_sphere(case, kind, d, pts, threads)
+
+    def check_sphere(self, case, kind, d, pts, threads):
+        """The points pushed onto a sphere around their mean (3D), or read as
+        longitudes and latitudes (2D, scaled into range): the cells tile the
+        sphere (areas add to 4 pi R^2), the hull is simplicial (2 cells - 4
+        triangles), the adjacency is symmetric."""
+        if d == 3:
+            c = pts.mean(axis=0)
+            v = pts - c
+            norm = np.linalg.norm(v, axis=1)
+            if not np.isfinite(norm).all() or not (norm > 0).all():
+                return
+            sp = c + v / norm[:, None]
+            args = ["--center"] + [repr(float(x)) for x in c] + ["--radius", "1", "--tolerance", "inf"]
+        else:
+            lo, hi = pts.min(axis=0), pts.max(axis=0)
+            span = np.where(hi > lo, hi - lo, 1.0)
+            sp = (pts - lo) / span * [360.0, 180.0] - [180.0, 90.0]
+            sp = np.clip(sp, [-180.0, -90.0], [180.0, 90.0])
+            args = ["--lonlat"]
+        if not np.isfinite(sp).all():
+            return
+        inp = self.save("case%d_sphere.npy" % case, np.ascontiguousarray(sp, dtype="<f8"))
+        table, nb, tri = self.p("st.npy"), self.p("snb.npy"), self.p("stri.npy")
+        if not self.check(["sphere", inp, "--threads", threads, "--quiet", "--cell-table", table, "--neighbors", nb,
+                           "--triangles", tri] + args, inp, None, kind, d, case, accept=("at the centre",)):
+            return
+        t = np.load(table)
+        what = "case %d (%s, %dD): sphere" % (case, kind, d)
+        self.assertAlmostEqual(t[:, 1].sum() / (4 * np.pi), 1.0, places=9, msg=what)
+        a = np.load(nb)
+        n = int(a[0])
+        off, ids = a[1:n + 2], a[n + 2:]
+        pairs = {(i, int(j)) for i in range(n) for j in ids[off[i]:off[i + 1]]}
+        self.assertEqual(pairs, {(j, i) for i, j in pairs}, what)
+        if len(t) >= 3:
+            self.assertEqual(len(np.load(tri)), 2 * len(t) - 4, what)
 
     def check_alpha(self, case, kind, d, pts, inp, labels, common, tri, rng):
         """The alpha shape at a radius among the simplices' (a quantile of

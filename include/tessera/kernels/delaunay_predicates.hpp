@@ -68,6 +68,13 @@ int orientation(const ExactContext& ctx, const std::int32_t* ids);
 /// need not be input points (hull completion asks it of box corners).
 int orientation(int D, const double* const* pts);
 
+/// The same sign, for a caller whose own float filter was undecided (the
+/// spherical cells' clip): the extended-precision stage first, which
+/// decides a near-tie in a few dozen cycles (a lon/lat grid's trapezoids are
+/// cocircular to a rounding), then the exact stages. Correct whatever the
+/// caller's filter did.
+int orientation_past_filter(int D, const double* const* pts);
+
 /// Do three 3D points lie on one line? Exactly: their projections on all
 /// three coordinate planes are collinear. No perturbation.
 inline bool collinear3(const double* a, const double* b, const double* c) {

@@ -22,12 +22,13 @@
 
 #include <cstdint>
 
-#include "tessera/kernels/filter.hpp"
 
 namespace tessera::kernels {
 
 /// sign det[b - a, c - a, s - a] for the four points (coordinates and ids,
-/// ids distinct), in the perturbed sense above: +1 or -1, never 0.
+/// ids distinct), in the perturbed sense above: +1 or -1, never 0. Meant
+/// for a caller whose float filter was undecided: it starts at the
+/// extended-precision stage (orientation_past_filter).
 int orientation_sos(const double* a, const double* b, const double* c, const double* s, std::int32_t ia,
                     std::int32_t ib, std::int32_t ic, std::int32_t is);
 
