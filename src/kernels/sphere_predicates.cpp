@@ -57,6 +57,9 @@ int orientation_tie_break(const double* const* pts, const std::int32_t* ids) {
       q[r - 1][0] = pts[order[r]][u];
       q[r - 1][1] = pts[order[r]][v];
     }
+    // Three projections on one axis-parallel line (a row of a lon/lat grid
+    // seen along x or y) are collinear without arithmetic.
+    if ((q[0][0] == q[1][0] && q[0][0] == q[2][0]) || (q[0][1] == q[1][1] && q[0][1] == q[2][1])) continue;
     const double* tri[3] = {q[0], q[1], q[2]};
     if (const int o = orientation(2, tri)) return -parity * (axis == 1 ? -o : o);
   }
@@ -99,8 +102,13 @@ int orientation_tie_break(const double* const* pts, const std::int32_t* ids) {
 int orientation_sos(const double* a, const double* b, const double* c, const double* s, std::int32_t ia,
                     std::int32_t ib, std::int32_t ic, std::int32_t is) {
   const double* pts[4] = {a, b, c, s};
-  if (const int sign = orientation_past_filter(3, pts)) return sign;
   const std::int32_t ids[4] = {ia, ib, ic, is};
+  // Four points on one axis-aligned plane are coplanar: no arithmetic (a
+  // lon/lat grid's row shares its z, a pole's points their z = R; most of a
+  // grid's ties are these).
+  for (int d = 0; d < 3; ++d)
+    if (a[d] == b[d] && a[d] == c[d] && a[d] == s[d]) return orientation_tie_break(pts, ids);
+  if (const int sign = orientation_past_filter(3, pts)) return sign;
   return orientation_tie_break(pts, ids);
 }
 
