@@ -8,8 +8,9 @@
 #
 # usage: bench/sphere/run.sh [BUILD_DIR] [N...]
 #   env: REPEAT (default 3), SCIPY_MAX (largest N given to scipy, default
-#        1e6), DATA (default bench/data, git-ignored), OUT (default
-#        bench/sphere/results/sphere.jsonl)
+#        1e6), GRIDS (lon/lat grid steps in degrees, cell centres, default
+#        "1 0.25": 64,800 and 1,036,800 points), DATA (default bench/data,
+#        git-ignored), OUT (default bench/sphere/results/sphere.jsonl)
 # Needs Debian's libcgal-dev (cgal_sphere.cpp is compiled here) and python3-scipy.
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
@@ -34,21 +35,37 @@ run() {
     "$@" 2>/dev/null | grep '^{' | sed "s/^{/{\"input\":\"$label\",/" >>"$out" || { note "FAILED: $*"; return 0; }
   done
 }
+# bench_all LABEL POINTS N: every tool on one input.
+bench_all() {
+  local label=$1 p=$2 n=$3 t
+  for t in 1 2; do
+    note "$label $n: tessera, $t thread(s)"
+    run "$label" "$build/tessera" bench sphere "$p" --threads $t --repeat 1
+  done
+  note "$label $n: CGAL"
+  run "$label" "$cgal" "$p"
+  if $py -c "import sys; sys.exit(0 if float('$n') <= float('$scipy_max') else 1)"; then
+    note "$label $n: scipy"
+    run "$label" "$py" "$here/scipy_sphere.py" "$p"
+  fi
+}
 for n in $sizes; do
   p=$data/sphere_uniform_$n.npy
   [[ -f $p ]] || $py -c "
 import numpy as np, sys
 n = int(float(sys.argv[1])); v = np.random.default_rng(20261202).normal(size=(n, 3))
 np.save(sys.argv[2], v / np.linalg.norm(v, axis=1)[:, None])" "$n" "$p"
-  for t in 1 2; do
-    note "$n: tessera, $t thread(s)"
-    run uniform "$build/tessera" bench sphere "$p" --threads $t --repeat 1
-  done
-  note "$n: CGAL"
-  run uniform "$cgal" "$p"
-  if $py -c "import sys; sys.exit(0 if float('$n') <= float('$scipy_max') else 1)"; then
-    note "$n: scipy"
-    run uniform "$py" "$here/scipy_sphere.py" "$p"
-  fi
+  bench_all uniform "$p" "$n"
+done
+# Regular lon/lat grids (cell centres): every four points of two rows are
+# cocircular, a row shares its z.
+for step in ${GRIDS-1 0.25}; do
+  p=$data/sphere_lonlat_$step.npy
+  [[ -f $p ]] || $py -c "
+import numpy as np, sys
+s = float(sys.argv[1]); lat = np.radians(np.arange(-90 + s / 2, 90, s)); lon = np.radians(np.arange(-180, 180, s))
+la, lo = np.meshgrid(lat, lon, indexing='ij')
+np.save(sys.argv[2], np.column_stack([np.cos(la.ravel()) * np.cos(lo.ravel()), np.cos(la.ravel()) * np.sin(lo.ravel()), np.sin(la.ravel())]))" "$step" "$p"
+  bench_all "lonlat_$step" "$p" "$($py -c "import numpy as np; print(len(np.load('$p', mmap_mode='r')))")"
 done
 $py "$here/summarize.py" "$out"

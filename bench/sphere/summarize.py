@@ -11,18 +11,18 @@ def main():
     best = {}
     for line in open(sys.argv[1]):
         j = json.loads(line)
-        key = (j["n"], j["tool"], j["threads"])
+        key = (j["input"], j["n"], j["tool"], j["threads"])
         if j["seconds"] is None:  # the peer refused the input (its message is kept)
             best.setdefault(key, j)
             continue
         if key not in best or best[key]["seconds"] is None or j["seconds"] < best[key]["seconds"]:
             best[key] = j
-    print("| n | Tessera 1 thread | Tessera 2 threads | CGAL (tri + dual) | scipy (construct + sort + areas) "
+    print("| input | n | Tessera 1 thread | Tessera 2 threads | CGAL (tri + dual) | scipy (construct + sort + areas) "
           "| vs CGAL (1 / 2 threads) | vs scipy (1 / 2 threads) | triangles (Tessera; CGAL; scipy) |")
-    print("|---:|---:|---:|---:|---:|---:|---:|---|")
-    for n in sorted({k[0] for k in best}):
-        t1, t2 = best.get((n, "tessera", 1)), best.get((n, "tessera", 2))
-        cg, sp = best.get((n, "cgal", 1)), best.get((n, "scipy", 1))
+    print("|---|---:|---:|---:|---:|---:|---:|---:|---|")
+    for inp, n in sorted({k[:2] for k in best}, key=lambda x: (x[0] != "uniform", x[0], x[1])):
+        t1, t2 = best.get((inp, n, "tessera", 1)), best.get((inp, n, "tessera", 2))
+        cg, sp = best.get((inp, n, "cgal", 1)), best.get((inp, n, "scipy", 1))
 
         def s(j):
             return "–" if j is None else f"{j['seconds']:.3f} s"
@@ -37,7 +37,7 @@ def main():
             f"{sp['seconds']:.2f} s ({sp['extra']['construct_s']:.2f} + "
                                       f"{sp['extra']['sort_s']:.2f} + {sp['extra']['areas_s']:.2f})")
         tri = "; ".join("?" if j is None or j["seconds"] is None else f"{j['simplices']:,}" for j in (t1, cg, sp))
-        print(f"| {n:,} | {s(t1)} | {s(t2)} | {cgs} | {sps} | {ratio(cg)} | {ratio(sp)} | {tri} |")
+        print(f"| {inp} | {n:,} | {s(t1)} | {s(t2)} | {cgs} | {sps} | {ratio(cg)} | {ratio(sp)} | {tri} |")
 
 
 if __name__ == "__main__":
