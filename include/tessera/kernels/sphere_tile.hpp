@@ -26,9 +26,10 @@
 // cap of the ball |x - c| <= R_max above the plane through p normal to v.
 // With h = v.(p - c) >= 0 every point of that cap lies within
 // sqrt(|p - c|^2 - h^2) + sqrt(R_max^2 - h^2) of p (for points on a sphere,
-// twice the chord's half: the circumcircle's diameter); with h < 0, within
+// the diameter of the facet's circumcircle); with h < 0, within
 // |p - c| + R_max. Candidates taken nearest first stop at the largest such
-// radius over the vertices.
+// radius over the vertices, computed when asked (security2) and, where the
+// facet's corner at p is too thin for its normal, from its widest corner.
 #pragma once
 
 #include <algorithm>
