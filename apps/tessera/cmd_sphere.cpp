@@ -13,6 +13,7 @@
 
 #include "commands.hpp"
 #include "option_checks.hpp"
+#include "stdin_input.hpp"
 #include "tessera/io/atomic_file.hpp"
 #include "tessera/io/points.hpp"
 #include "tessera/io/spherical.hpp"
@@ -42,13 +43,13 @@ std::vector<double> read_sphere_points(const SphereArgs& a) {
   if (!(a.tolerance >= 0)) throw InputError("--tolerance must be >= 0 (inf: no check)");
   io::ReadOptions ro;
   ro.dim = a.lonlat ? 2 : 0;
-  io::PointCloud pc = io::read_points(a.input, ro);
+  io::PointCloud pc = io::read_points(input_path(a.input), ro);
   if (a.lonlat) {
     const auto o = options_of(a);
     return lonlat_to_points(pc.coords, a.radius > 0 ? a.radius : 1.0, o.center);
   }
   if (pc.dim != 3)
-    throw InputError(a.input + ": " + std::to_string(pc.dim) +
+    throw InputError(shown_path(a.input) + ": " + std::to_string(pc.dim) +
                      "D points; the sphere needs x y z (or --lonlat for longitudes and latitudes in degrees)");
   return std::move(pc.coords);
 }
@@ -95,7 +96,7 @@ int run_sphere(const SphereArgs& a) {
   if (a.quiet) return kExitOk;
   auto secs = [](Clock::time_point x, Clock::time_point y) { return std::chrono::duration<double>(y - x).count(); };
   const double full = 4 * std::numbers::pi * sv.radius * sv.radius;
-  std::printf("tessera sphere: %zu points from %s%s\n", sv.n_points, a.input.c_str(),
+  std::printf("tessera sphere: %zu points from %s%s\n", sv.n_points, shown_path(a.input).c_str(),
               a.lonlat ? " (longitude, latitude)" : "");
   std::printf("  %-14s centre (%.10g, %.10g, %.10g), radius %.10g%s; points off it by at most %.3g (relative)\n",
               "sphere", sv.center[0], sv.center[1], sv.center[2], sv.radius,
@@ -139,8 +140,8 @@ int run_bench_sphere(const SphereArgs& a) {
 void add_sphere_commands(CLI::App& app, CLI::App& bench, SphereCommands& c) {
   auto common = [](CLI::App* s, SphereArgs& a) {
     s->add_option("INPUT", a.input,
-                  "Points on a sphere: .npy, .csv/.xyz/.txt, .ply, ... as `voronoi` reads them (x y z; with "
-                  "--lonlat the first two columns are longitude and latitude in degrees)")
+                  "Points on a sphere: .npy, .csv/.xyz/.txt, .ply, ... as `voronoi` reads them, - standard input (x y "
+                  "z; with --lonlat the first two columns are longitude and latitude in degrees)")
         ->required();
     s->add_flag("--lonlat", a.lonlat, "INPUT holds longitudes and latitudes in degrees (GeoJSON's order)");
     s->add_option("--center", a.center, "The sphere's centre X Y Z (default 0 0 0)")->expected(3);

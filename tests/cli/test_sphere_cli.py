@@ -11,6 +11,7 @@ Prints "N passed, M failed" last.
 """
 import json
 import os
+import subprocess
 import sys
 
 import numpy as np
@@ -133,6 +134,13 @@ class SphereCommand(test_delaunay_cli.CommandCase):
         t = np.load(self.path("g.npy"))
         self.assertNotIn(len(ll) - 1, t[:, 0])
         self.assertAlmostEqual(t[:, 1].sum(), 4 * np.pi, places=11)
+        # The same from standard input.
+        with open(self.path("grid.npy"), "rb") as f:
+            r = subprocess.run([test_delaunay_cli.TESSERA, "sphere", "-", "--lonlat", "--cell-table",
+                                self.path("g2.npy")], stdin=f, capture_output=True, text=True, timeout=120)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertIn("from stdin", r.stdout)
+        np.testing.assert_array_equal(np.load(self.path("g2.npy")), t)
 
     def test_bench_prints_json(self):
         r = self.ok(["bench", "sphere", self.path("p3.npy"), "--center", "1", "2", "-1", "--repeat", "2",
