@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <numbers>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -93,7 +94,24 @@ int run_sphere(const SphereArgs& a) {
     group.commit();
   }
   const auto t3 = Clock::now();
-  if (a.quiet) return kExitOk;
+  std::optional<SphereReport> report;
+  if (a.validate) report = validate_spherical_voronoi(sv, pts);
+  // The validation's line: after the summary, or alone under -q when it failed.
+  auto print_validation = [&] {
+    if (!report) return;
+    const SphereReport& r = *report;
+    std::printf("  %-14s %s: %zu asymmetric neighbours, %zu vertices not in their three cells, %zu rings out of "
+                "order, %zu bad statuses, V - E + F = %lld, area error %.2g, %zu of %zu sampled facets with a "
+                "point above\n",
+                "validation", r.ok ? "passed" : "FAILED", r.asymmetric_neighbors, r.bad_vertex_cells, r.bad_rings,
+                r.bad_status, r.euler, r.area_rel_error, r.nonempty_facets, r.vertices_checked);
+    for (const auto& m : r.messages) std::printf("  %-14s %s\n", "", m.c_str());
+  };
+  const int rc = report && !report->ok ? kExitFailure : kExitOk;
+  if (a.quiet) {
+    if (rc != kExitOk) print_validation();
+    return rc;
+  }
   auto secs = [](Clock::time_point x, Clock::time_point y) { return std::chrono::duration<double>(y - x).count(); };
   const double full = 4 * std::numbers::pi * sv.radius * sv.radius;
   std::printf("tessera sphere: %zu points from %s%s\n", sv.n_points, shown_path(a.input).c_str(),
@@ -112,7 +130,8 @@ int run_sphere(const SphereArgs& a) {
   std::printf("  %-14s read %.3f s, cells %.3f s, write %.3f s (%d threads)\n", "time", secs(t0, t1), secs(t1, t2),
               secs(t2, t3), resolve_threads(a.threads));
   if (!written.empty()) std::printf("  %-14s %s\n", "wrote", written_list(written).c_str());
-  return kExitOk;
+  print_validation();
+  return rc;
 }
 
 int run_bench_sphere(const SphereArgs& a) {
@@ -167,7 +186,10 @@ void add_sphere_commands(CLI::App& app, CLI::App& bench, SphereCommands& c) {
   c.run_app->add_option("--neighbors", c.run.neighbors,
                         "Neighbour lists of every point as CSR in one int64 .npy: [n, offsets[0..n], ids...] "
                         "(counter-clockwise, seen from outside)");
-  c.run_app->add_flag("-q,--quiet", c.run.quiet, "No summary");
+  c.run_app->add_flag("--validate", c.run.validate,
+                      "Check the result independently (symmetric neighbours, rings, V - E + F = 2, areas adding to "
+                      "4 pi R^2, 256 facets against every point); exit 1 if a check fails");
+  c.run_app->add_flag("-q,--quiet", c.run.quiet, "No summary (a failed validation is still reported)");
   c.run_app->footer(
       "A cell is the set of directions closer to its point than to any other (for points a rounding off the\n"
       "sphere: the convex hull's normal cone at the point, so the topology is exact whatever the rounding).\n"

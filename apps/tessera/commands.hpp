@@ -343,6 +343,7 @@ struct SphereArgs {
   std::string triangles;            ///< .vtp / .npy, or empty
   std::string cell_table;           ///< .csv / .npy, or empty
   std::string neighbors;            ///< .npy, or empty
+  bool validate = false;            ///< validate_spherical_voronoi
   bool quiet = false;
   int repeat = 1;                   ///< bench only
 };

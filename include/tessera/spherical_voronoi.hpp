@@ -18,6 +18,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <span>
+#include <string>
 #include <vector>
 
 #include "tessera/buffer.hpp"
@@ -86,6 +87,30 @@ struct SphericalVoronoi {
 /// by more than the tolerance. The result does not depend on the thread
 /// count.
 SphericalVoronoi spherical_voronoi(std::span<const double> points, const SphericalVoronoiOptions& options = {});
+
+/// What validate_spherical_voronoi found: counts of each kind of fault (all
+/// zero when ok) and the measures compared.
+struct SphereReport {
+  bool ok = true;
+  std::size_t asymmetric_neighbors = 0;  ///< i lists j but j does not list i (or lists it twice)
+  std::size_t bad_vertex_cells = 0;      ///< vertices not in exactly the cells of their three generators
+  std::size_t bad_rings = 0;             ///< cells whose vertex k is not the facet (i, neighbour k-1, neighbour k)
+  std::size_t bad_status = 0;            ///< duplicates not at their owner's coordinates, cells of points without one
+  std::size_t nonempty_facets = 0;       ///< sampled vertices with a point above their facet (brute force)
+  std::size_t vertices_checked = 0;      ///< vertices whose facet was tested against every point
+  long long euler = 2;                   ///< V - E + F (2 for a sphere tiled by three or more cells)
+  double area_rel_error = 0;             ///< |sum of areas - 4 pi R^2| / (4 pi R^2)
+  std::vector<std::string> messages;     ///< one line each
+};
+
+/// Checks a result independently of the pass that made it: the adjacency
+/// is symmetric, every vertex is in the cells of its three generators and
+/// where their rings say, V - E + F = 2, the areas add to 4 pi R^2 (to
+/// 1e-9), duplicates sit on their owners, and `sample` vertices spread over
+/// the numbering have no point above their facet (every point tested, by
+/// the exact perturbed predicate: the empty-circle property).
+SphereReport validate_spherical_voronoi(const SphericalVoronoi& sv, std::span<const double> points,
+                                        std::size_t sample = 256);
 
 /// Unit vectors (times `radius`, about `center`) from longitudes and
 /// latitudes in degrees (n x 2, lon then lat). InputError on a non-finite

@@ -79,6 +79,28 @@ void bind_sphere(py::module_& m) {
           "save_neighbors",
           [](const SV& s, const std::string& path) { without_gil([&] { io::write_spherical_neighbors(path, s); }); },
           py::arg("path"));
+  py::class_<SphereReport>(m, "SphereReport", "What SphericalVoronoi.validate() found (validate_spherical_voronoi).")
+      .def_readonly("ok", &SphereReport::ok)
+      .def_readonly("asymmetric_neighbors", &SphereReport::asymmetric_neighbors)
+      .def_readonly("bad_vertex_cells", &SphereReport::bad_vertex_cells)
+      .def_readonly("bad_rings", &SphereReport::bad_rings)
+      .def_readonly("bad_status", &SphereReport::bad_status)
+      .def_readonly("nonempty_facets", &SphereReport::nonempty_facets)
+      .def_readonly("vertices_checked", &SphereReport::vertices_checked)
+      .def_readonly("euler", &SphereReport::euler)
+      .def_readonly("area_rel_error", &SphereReport::area_rel_error)
+      .def_readonly("messages", &SphereReport::messages)
+      .def("__bool__", [](const SphereReport& r) { return r.ok; })
+      .def("__repr__", [](const SphereReport& r) {
+        return std::string("<tessera.SphereReport ") + (r.ok ? "ok" : "FAILED: " + (r.messages.empty() ? std::string() : r.messages[0])) + ">";
+      });
+  c.def(
+      "validate",
+      [](const SV& s, const Points& points, std::size_t sample) {
+        const auto pts = as_span(points);
+        return without_gil([&] { return validate_spherical_voronoi(s, pts, sample); });
+      },
+      py::arg("points"), py::arg("sample"));
   m.def("spherical_voronoi", &run, py::arg("points").noconvert(), py::arg("center"), py::arg("radius"),
         py::arg("tolerance"), py::arg("threads"));
   m.def(

@@ -55,6 +55,7 @@ from ._core import (
     REGION_BOUNDARY,
     SAME_REGION,
     InputError,
+    SphereReport,
     ValidationReport,
 )
 from ._delaunay import AlphaShape, Delaunay, delaunay
@@ -86,6 +87,7 @@ __all__ = [
     "Delaunay",
     "ValidationReport",
     "DelaunayReport",
+    "SphereReport",
     "adjacency",
     "AdjacencyGraph",
     "faces",

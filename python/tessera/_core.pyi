@@ -625,6 +625,20 @@ class SphericalVoronoi:
     def save_triangles(self, path: str, points: npt.NDArray[np.float64]) -> None: ...
     def save_table(self, path: str) -> None: ...
     def save_neighbors(self, path: str) -> None: ...
+    def validate(self, points: npt.NDArray[np.float64], sample: int) -> SphereReport: ...
+
+class SphereReport:
+    ok: bool
+    asymmetric_neighbors: int
+    bad_vertex_cells: int
+    bad_rings: int
+    bad_status: int
+    nonempty_facets: int
+    vertices_checked: int
+    euler: int
+    area_rel_error: float
+    messages: List[str]
+    def __bool__(self) -> bool: ...
 
 def spherical_voronoi(
     points: npt.NDArray[np.float64], center: Sequence[float], radius: float, tolerance: float, threads: int

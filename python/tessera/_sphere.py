@@ -134,6 +134,11 @@ class SphericalVoronoi:
     def exact_tests(self) -> int:
         return self._sv.exact_tests
 
+    def validate(self, sample: int = 256) -> Any:
+        """Independent checks (symmetric neighbours, rings, V - E + F = 2, areas adding to 4 pi R^2,
+        ``sample`` facets against every point): a :class:`SphereReport`, truthy when all pass."""
+        return self._sv.validate(self._points, _inputs.as_int(sample, "sample", 0, None, "a count >= 0"))
+
     def save(self, path: PathLike) -> None:
         """The cells as polygons on the sphere (.vtp; cell data GeneratorId, Area, Neighbors)."""
         _inputs.call(self._sv.save_cells, _inputs.as_path(path))

@@ -21,6 +21,8 @@ def test_equals_scipy():
     assert sv.radius == pytest.approx(3.0, rel=1e-14)
     np.testing.assert_allclose(sv.calculate_areas(), ref.calculate_areas(), rtol=1e-9)
     assert sv.area_sum == pytest.approx(4 * np.pi * 9, rel=1e-13)
+    report = sv.validate(sample=500)
+    assert report and report.ok and report.vertices_checked == 500 and report.euler == 2, report.messages
     assert len(sv.vertices) == len(ref.vertices) == 2 * 4000 - 4
     for i in range(0, 4000, 13):
         ours = {tuple(np.round(v, 8)) for v in sv.vertices[sv.regions[i]]}

@@ -49,8 +49,9 @@ class SphereCommand(test_delaunay_cli.CommandCase):
     def test_cells_equal_scipys_and_read_back(self):
         cells, tri, table, nb = (self.path(x) for x in ("c.vtp", "t.vtp", "c.csv", "nb.npy"))
         r = self.ok(["sphere", self.path("p3.npy"), "--center", "1", "2", "-1", "-o", cells, "--triangles", tri,
-                     "--cell-table", table, "--neighbors", nb])
+                     "--cell-table", table, "--neighbors", nb, "--validate"])
         self.assertIn("cells          3000", r.stdout)
+        self.assertIn("validation     passed", r.stdout)
         ref = SphericalVoronoi(self.p3, radius=2.0, center=np.array([1.0, 2.0, -1.0]))
         ref.sort_vertices_of_regions()
         areas = ref.calculate_areas()

@@ -109,6 +109,8 @@ void check_tiling(const SphericalVoronoi& sv, const std::vector<double>& pts, bo
     }
   }
   for (std::size_t v = 0; v < sv.n_vertices(); ++v) EXPECT_EQ(seen[v], 3) << "vertex " << v;
+  const auto report = tessera::validate_spherical_voronoi(sv, pts, 64);
+  EXPECT_TRUE(report.ok) << (report.messages.empty() ? "" : report.messages[0]);
   // Euler on the sphere (cells with vertices: n >= 3 distinct points).
   if (sv.n_vertices() > 0) {
     const long long E = static_cast<long long>(sv.neighbors.size()) / 2;
@@ -394,6 +396,34 @@ TEST(SphericalVoronoi, TieBreakEqualsEveryTermInRationals) {
     ++checked;
   }
   EXPECT_GT(checked, 1000);
+}
+
+// The validator finds each kind of damage (and passes the intact result).
+TEST(SphericalVoronoi, ValidateFindsDamage) {
+  const auto pts = random_sphere(2000, 21);
+  const auto good = tessera::spherical_voronoi(pts);
+  auto r = tessera::validate_spherical_voronoi(good, pts, 2000);
+  EXPECT_TRUE(r.ok);
+  EXPECT_EQ(r.vertices_checked, 2000u);
+  EXPECT_EQ(r.euler, 2);
+  auto bad = good;
+  std::swap(bad.neighbors[0], bad.neighbors[10]);  // two cells' rings
+  EXPECT_FALSE(tessera::validate_spherical_voronoi(bad, pts).ok);
+  bad = good;
+  std::swap(bad.region_vertices[3], bad.region_vertices[4]);  // a ring's order
+  r = tessera::validate_spherical_voronoi(bad, pts);
+  EXPECT_FALSE(r.ok);
+  EXPECT_GT(r.bad_rings, 0u);
+  bad = good;
+  bad.areas[7] *= 1.001;
+  bad.area_sum += good.areas[7] * 0.001;
+  EXPECT_FALSE(tessera::validate_spherical_voronoi(bad, pts).ok);
+  // A facet not of the hull: a point above it (the triangle turned over).
+  bad = good;
+  std::swap(bad.triangles[0], bad.triangles[1]);
+  r = tessera::validate_spherical_voronoi(bad, pts, 2000);
+  EXPECT_FALSE(r.ok);
+  EXPECT_GT(r.nonempty_facets, 0u);
 }
 
 TEST(SphericalVoronoi, BadInput) {
