@@ -67,7 +67,9 @@ void check_outputs(const SphereArgs& a) {
   };
   ext_is(a.output, {".vtp"}, "-o");
   ext_is(a.triangles, {".vtp", ".npy"}, "--triangles");
-  ext_is(a.cell_table, {".csv", ".npy"}, "--cell-table");
+  // `--cell-table -`: the CSV on standard output, the summary on standard error.
+  if (a.cell_table != "-") ext_is(a.cell_table, {".csv", ".npy"}, "--cell-table");
+  route_standard_output({&a.cell_table});
   ext_is(a.neighbors, {".npy"}, "--neighbors");
   check_distinct_outputs({{"-o", &a.output}, {"--triangles", &a.triangles}, {"--cell-table", &a.cell_table},
                           {"--neighbors", &a.neighbors}});
@@ -182,7 +184,8 @@ void add_sphere_commands(CLI::App& app, CLI::App& bench, SphereCommands& c) {
                         "The spherical Delaunay triangles (the convex hull's facets, counter-clockwise seen from "
                         "outside) over the input points: .vtp or .npy (int64 (T, 3))");
   c.run_app->add_option("--cell-table", c.run.cell_table,
-                        "Per cell: id,area,cx,cy,cz,edges,neighbors (.csv or .npy; the centroid on the sphere)");
+                        "Per cell: id,area,cx,cy,cz,edges,neighbors (.csv or .npy; the centroid on the sphere; - the "
+                        "CSV on standard output)");
   c.run_app->add_option("--neighbors", c.run.neighbors,
                         "Neighbour lists of every point as CSR in one int64 .npy: [n, offsets[0..n], ids...] "
                         "(counter-clockwise, seen from outside)");

@@ -142,6 +142,11 @@ class SphereCommand(test_delaunay_cli.CommandCase):
         self.assertEqual(r.returncode, 0, r.stderr)
         self.assertIn("from stdin", r.stdout)
         np.testing.assert_array_equal(np.load(self.path("g2.npy")), t)
+        # And the table to standard output (the summary on standard error).
+        r = self.ok(["sphere", self.path("grid.npy"), "--lonlat", "--cell-table", "-"])
+        self.assertIn("tessera sphere:", r.stderr)
+        rows = np.loadtxt(r.stdout.splitlines(), delimiter=",", skiprows=1)
+        np.testing.assert_allclose(rows, t, rtol=0, atol=0)
 
     def test_bench_prints_json(self):
         r = self.ok(["bench", "sphere", self.path("p3.npy"), "--center", "1", "2", "-1", "--repeat", "2",
