@@ -14,6 +14,7 @@
 
 #include "commands.hpp"
 #include "option_checks.hpp"
+#include "progress.hpp"
 #include "stdin_input.hpp"
 #include "tessera/io/atomic_file.hpp"
 #include "tessera/io/points.hpp"
@@ -84,7 +85,13 @@ int run_sphere(const SphereArgs& a) {
   const auto t0 = Clock::now();
   const std::vector<double> pts = read_sphere_points(a);
   const auto t1 = Clock::now();
-  const SphericalVoronoi sv = spherical_voronoi(pts, options_of(a));
+  // Ctrl-C stops the run between chunks of cells, with nothing written.
+  const SphericalVoronoi sv = run_cancellable("tessera: spherical cells", !a.quiet && stderr_is_terminal(),
+                                              [&](auto progress) {
+                                                SphericalVoronoiOptions o = options_of(a);
+                                                o.progress = progress;
+                                                return spherical_voronoi(pts, o);
+                                              });
   const auto t2 = Clock::now();
   std::vector<std::string> written;
   {

@@ -17,6 +17,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <span>
 #include <string>
 #include <vector>
@@ -34,6 +35,9 @@ struct SphericalVoronoiOptions {
   double tolerance = 1e-6;
   int threads = 0;          ///< 0: TESSERA_NUM_THREADS, else all cores
   double bin_points = 0;    ///< the locator's mean points per bin; 0: automatic (for a surface)
+  /// Called from the calling thread between chunks of cells with the
+  /// fraction done; it may throw tessera::Cancelled to stop the run (Ctrl-C).
+  std::function<void(double)> progress;
 };
 
 /// What became of a point.

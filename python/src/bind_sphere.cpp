@@ -29,6 +29,7 @@ SphericalVoronoi run(const Points& points, const std::array<double, 3>& center, 
   o.radius = radius;
   o.tolerance = tolerance;
   o.threads = threads;
+  o.progress = interrupt_check();  // Ctrl-C: KeyboardInterrupt between chunks of cells
   const auto pts = as_span(points);
   return without_gil([&] { return spherical_voronoi(pts, o); });
 }

@@ -33,6 +33,7 @@
 #include <tbb/parallel_for.h>
 
 #include "compensated_sum.hpp"
+#include "../progress_chunks.hpp"
 #include "tessera/cells.hpp"
 #include "tessera/engine/thread_arena.hpp"
 #include "tessera/kernels/locator.hpp"
@@ -249,97 +250,106 @@ SphericalVoronoi spherical_voronoi(std::span<const double> pts, const SphericalV
     std::vector<Block> blocks(n_blocks);
     const double* const slot0 = loc.point(0).data();  // slot k's point is slot0 + 3k
     tbb::enumerable_thread_specific<Workspace> spaces;
-    tbb::parallel_for(std::size_t{0}, n_blocks, [&](std::size_t bk) {
-      Workspace& ws = spaces.local();
-      Block& block = blocks[bk];
-      const std::size_t first = bk * block_slots, last = std::min(n, first + block_slots);
-      for (std::size_t slot = first; slot < last; ++slot) {
-        block.start.push_back(static_cast<std::uint32_t>(block.ring.size()));
-        if (lowest[slot] >= 0) {
-          block.state.push_back(static_cast<std::uint8_t>(kernels::SphereTile::State::empty));
-          continue;
-        }
-        const double* x = loc.point(slot).data();
-        const std::int32_t id = loc.id(slot);
-        auto& tile = ws.tile;
-        tile.reset(id, x, c.data(), r_max);
-        int clips = 0;
-        // Candidates by boxes of growing half-width w: each round offers the
-        // points whose largest coordinate difference from x (computed the
-        // same way every round) lies in (the last w, w], once each (a cell
-        // clipped twice by one plane would tie with itself). The bins of the
-        // box [x - w, x + w], widened by a few ulps for its rounded corners,
-        // hold them all. The search ends once the cell's radius is within w
-        // (less a rounding margin: a point that near has a difference within
-        // w) or the box holds the whole grid.
-        double covered = -1;
-        for (double w = w0;; w *= 2) {
-          if (tile.state() == kernels::SphereTile::State::empty) break;
-          const double wb = w + 4 * std::numeric_limits<double>::epsilon() *
-                                    (w + std::max({std::fabs(x[0]), std::fabs(x[1]), std::fabs(x[2])}));
-          const double blo[3] = {x[0] - wb, x[1] - wb, x[2] - wb}, bhi[3] = {x[0] + wb, x[1] + wb, x[2] + wb};
-          std::array<std::int32_t, 3> bf, bl;
-          loc.bin_range(blo, bhi, bf, bl);
-          bool whole = true;
-          for (int d = 0; d < 3; ++d) whole = whole && bf[d] == 0 && bl[d] == loc.divisions()[d] - 1;
-          ws.cands.clear();
-          const double r2 = tile.security2();
-          loc.for_each_row_run(bf, bl, [&](std::uint32_t f, std::uint32_t e) {
-            for (std::uint32_t k = f; k < e; ++k) {
-              if (k == slot || lowest[k] >= 0) continue;
-              const auto& q = loc.point(k);
-              const double dx = q[0] - x[0], dy = q[1] - x[1], dz = q[2] - x[2];
-              const double cheb = std::max({std::fabs(dx), std::fabs(dy), std::fabs(dz)});
-              if (cheb <= covered || cheb > w) continue;  // an earlier round's, or a later one's
-              const double d2 = dx * dx + dy * dy + dz * dz;
-              if (d2 <= r2) ws.cands.push_back({d2, loc.id(k), k});
-            }
-          });
-          // Nearest first, a dozen at a time: once a cell has its nearest
-          // neighbours its security radius passes most of the rest unsorted.
-          auto nearer = [](const auto& a, const auto& b2) { return a.d2 != b2.d2 ? a.d2 < b2.d2 : a.id < b2.id; };
-          // The first few clips of a cell go ahead without asking its
-          // radius (a clip that changes nothing is merely a wasted test).
-          auto first = ws.cands.begin(), last = ws.cands.end();
-          while (first != last) {
-            const auto stop = last - first > 12 ? first + 12 : last;
-            if (stop != last) std::nth_element(first, stop - 1, last, nearer);
-            std::sort(first, stop, nearer);
-            bool done = false;
-            for (; first != stop; ++first) {
-              if (tile.state() == kernels::SphereTile::State::empty ||
-                  (++clips > 6 && first->d2 > tile.security2())) {
-                done = true;
-                break;
+    // Progress: the cells are ~60% of a run, the second pass the rest;
+    // chunks of 32 blocks (65,536 cells) between the callbacks.
+    std::function<void(double)> progress1, progress2;
+    if (o.progress) {
+      progress1 = [&](double f) { o.progress(0.6 * f); };
+      progress2 = [&](double f) { o.progress(0.6 + 0.4 * f); };
+    }
+    detail::in_progress_chunks(n_blocks, progress1, [&](std::size_t b0, std::size_t b1) {
+      tbb::parallel_for(b0, b1, [&](std::size_t bk) {
+        Workspace& ws = spaces.local();
+        Block& block = blocks[bk];
+        const std::size_t first = bk * block_slots, last = std::min(n, first + block_slots);
+        for (std::size_t slot = first; slot < last; ++slot) {
+          block.start.push_back(static_cast<std::uint32_t>(block.ring.size()));
+          if (lowest[slot] >= 0) {
+            block.state.push_back(static_cast<std::uint8_t>(kernels::SphereTile::State::empty));
+            continue;
+          }
+          const double* x = loc.point(slot).data();
+          const std::int32_t id = loc.id(slot);
+          auto& tile = ws.tile;
+          tile.reset(id, x, c.data(), r_max);
+          int clips = 0;
+          // Candidates by boxes of growing half-width w: each round offers the
+          // points whose largest coordinate difference from x (computed the
+          // same way every round) lies in (the last w, w], once each (a cell
+          // clipped twice by one plane would tie with itself). The bins of the
+          // box [x - w, x + w], widened by a few ulps for its rounded corners,
+          // hold them all. The search ends once the cell's radius is within w
+          // (less a rounding margin: a point that near has a difference within
+          // w) or the box holds the whole grid.
+          double covered = -1;
+          for (double w = w0;; w *= 2) {
+            if (tile.state() == kernels::SphereTile::State::empty) break;
+            const double wb = w + 4 * std::numeric_limits<double>::epsilon() *
+                                      (w + std::max({std::fabs(x[0]), std::fabs(x[1]), std::fabs(x[2])}));
+            const double blo[3] = {x[0] - wb, x[1] - wb, x[2] - wb}, bhi[3] = {x[0] + wb, x[1] + wb, x[2] + wb};
+            std::array<std::int32_t, 3> bf, bl;
+            loc.bin_range(blo, bhi, bf, bl);
+            bool whole = true;
+            for (int d = 0; d < 3; ++d) whole = whole && bf[d] == 0 && bl[d] == loc.divisions()[d] - 1;
+            ws.cands.clear();
+            const double r2 = tile.security2();
+            loc.for_each_row_run(bf, bl, [&](std::uint32_t f, std::uint32_t e) {
+              for (std::uint32_t k = f; k < e; ++k) {
+                if (k == slot || lowest[k] >= 0) continue;
+                const auto& q = loc.point(k);
+                const double dx = q[0] - x[0], dy = q[1] - x[1], dz = q[2] - x[2];
+                const double cheb = std::max({std::fabs(dx), std::fabs(dy), std::fabs(dz)});
+                if (cheb <= covered || cheb > w) continue;  // an earlier round's, or a later one's
+                const double d2 = dx * dx + dy * dy + dz * dz;
+                if (d2 <= r2) ws.cands.push_back({d2, loc.id(k), k});
               }
-              tile.clip(first->id, loc.point(first->slot).data());
+            });
+            // Nearest first, a dozen at a time: once a cell has its nearest
+            // neighbours its security radius passes most of the rest unsorted.
+            auto nearer = [](const auto& a, const auto& b2) { return a.d2 != b2.d2 ? a.d2 < b2.d2 : a.id < b2.id; };
+            // The first few clips of a cell go ahead without asking its
+            // radius (a clip that changes nothing is merely a wasted test).
+            auto first = ws.cands.begin(), last = ws.cands.end();
+            while (first != last) {
+              const auto stop = last - first > 12 ? first + 12 : last;
+              if (stop != last) std::nth_element(first, stop - 1, last, nearer);
+              std::sort(first, stop, nearer);
+              bool done = false;
+              for (; first != stop; ++first) {
+                if (tile.state() == kernels::SphereTile::State::empty ||
+                    (++clips > 6 && first->d2 > tile.security2())) {
+                  done = true;
+                  break;
+                }
+                tile.clip(first->id, loc.point(first->slot).data());
+              }
+              if (done) break;
+              // Drop what the radius now passes before sorting again.
+              const double r2now = tile.security2();
+              last = std::partition(first, last, [&](const auto& cd) { return cd.d2 <= r2now; });
             }
-            if (done) break;
-            // Drop what the radius now passes before sorting again.
-            const double r2now = tile.security2();
-            last = std::partition(first, last, [&](const auto& cd) { return cd.d2 <= r2now; });
+            covered = w;
+            const double sure = w * (1 - 1e-12);
+            if (tile.security2() <= sure * sure) break;
+            if (whole) {
+              // The last round: what lay beyond w in the box's bins.
+              if (covered == std::numeric_limits<double>::infinity()) break;
+              w = std::numeric_limits<double>::infinity() / 2;
+            }
           }
-          covered = w;
-          const double sure = w * (1 - 1e-12);
-          if (tile.security2() <= sure * sure) break;
-          if (whole) {
-            // The last round: what lay beyond w in the box's bins.
-            if (covered == std::numeric_limits<double>::infinity()) break;
-            w = std::numeric_limits<double>::infinity() / 2;
-          }
+          ws.exact_tests += tile.exact_tests();
+          block.state.push_back(static_cast<std::uint8_t>(tile.state()));
+          // The ring by the neighbours' slots (the passes below read their
+          // points and rings there), rotated to start at the lowest id.
+          const auto ring = tile.edges();
+          const auto ring_pts = tile.edge_points();
+          const std::size_t rot = static_cast<std::size_t>(std::min_element(ring.begin(), ring.end()) - ring.begin());
+          for (std::size_t k = 0; k < ring.size(); ++k)
+            block.ring.push_back(static_cast<std::int32_t>((ring_pts[(rot + k) % ring.size()] - slot0) / 3));
         }
-        ws.exact_tests += tile.exact_tests();
-        block.state.push_back(static_cast<std::uint8_t>(tile.state()));
-        // The ring by the neighbours' slots (the passes below read their
-        // points and rings there), rotated to start at the lowest id.
-        const auto ring = tile.edges();
-        const auto ring_pts = tile.edge_points();
-        const std::size_t rot = static_cast<std::size_t>(std::min_element(ring.begin(), ring.end()) - ring.begin());
-        for (std::size_t k = 0; k < ring.size(); ++k)
-          block.ring.push_back(static_cast<std::int32_t>((ring_pts[(rot + k) % ring.size()] - slot0) / 3));
-      }
-      block.start.push_back(static_cast<std::uint32_t>(block.ring.size()));
-    });
+        block.start.push_back(static_cast<std::uint32_t>(block.ring.size()));
+      });
+    }, 32);
     for (const auto& ws : spaces) out.exact_tests += ws.exact_tests;
 
     // Rings in slot order (the blocks back to back), of slots: the pass
@@ -420,130 +430,132 @@ SphericalVoronoi spherical_voronoi(std::span<const double> pts, const SphericalV
     const double R = out.radius, R2 = R * R;
     constexpr double pi = std::numbers::pi;
     tbb::enumerable_thread_specific<std::vector<double>> unit_space;
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 2048), [&](const tbb::blocked_range<std::size_t>& r) {
-      std::vector<double>& unit = unit_space.local();
-      for (std::size_t s = r.begin(); s != r.end(); ++s) {
-        const std::int32_t p = loc.id(s);
-        const std::size_t i = static_cast<std::size_t>(p);
-        const double* x = loc.point(s).data();
-        const auto rg = ring(s);
-        const std::size_t m = rg.size();
-        unit.resize(3 * m);
-        bool all_known = true;  // every vertex's normal (unit_normal)
-        if (m >= 2) {
-          std::int64_t next_owned = owned[i];
-          for (std::size_t e = 0; e < m; ++e) {
-            const std::int32_t as = rg[(e + m - 1) % m], bs = rg[e], ps = static_cast<std::int32_t>(s);
-            const std::int32_t a = id_at(as), b = id_at(bs);
-            // The facet from its lowest generator, so that every cell
-            // holding it computes the same normal (facet_normal).
-            const std::int32_t lowest = std::min({p, a, b});
-            const std::int32_t f0 = lowest == p ? ps : (lowest == a ? as : bs);
-            const std::int32_t f1 = lowest == p ? as : (lowest == a ? bs : ps);
-            const std::int32_t f2 = lowest == p ? bs : (lowest == a ? ps : as);
-            double* un = &unit[3 * e];
-            all_known = unit_normal(point(f0), point(f1), point(f2), c.data(), un) && all_known;
-            std::int64_t v;
-            if (lowest == p) {
-              v = next_owned++;
-              std::int32_t* t = &out.triangles[3 * static_cast<std::size_t>(v)];
-              t[0] = p, t[1] = a, t[2] = b;
-              double* pos = &out.vertices[3 * static_cast<std::size_t>(v)];
-              for (int d = 0; d < 3; ++d) pos[d] = c[d] + R * un[d];
-            } else {
-              // The owner q = lowest: the facet is (a, b, p) in a's ring, (b, p, a) in b's.
-              const std::int32_t q = lowest;
-              const std::int32_t in = q == a ? bs : ps, outgoing = q == a ? ps : as;  // slots
-              const auto oring = ring(static_cast<std::size_t>(q == a ? as : bs));
-              const std::size_t om = oring.size();
-              v = -1;
-              std::int64_t num = owned[static_cast<std::size_t>(q)];
-              for (std::size_t f = 0; f < om; ++f) {
-                const std::int32_t oa = oring[(f + om - 1) % om], ob = oring[f];
-                if (oa == in && ob == outgoing) {
-                  v = num;
-                  break;
+    detail::in_progress_chunks(n, progress2, [&](std::size_t s0, std::size_t s1) {
+      tbb::parallel_for(tbb::blocked_range<std::size_t>(s0, s1, 2048), [&](const tbb::blocked_range<std::size_t>& r) {
+        std::vector<double>& unit = unit_space.local();
+        for (std::size_t s = r.begin(); s != r.end(); ++s) {
+          const std::int32_t p = loc.id(s);
+          const std::size_t i = static_cast<std::size_t>(p);
+          const double* x = loc.point(s).data();
+          const auto rg = ring(s);
+          const std::size_t m = rg.size();
+          unit.resize(3 * m);
+          bool all_known = true;  // every vertex's normal (unit_normal)
+          if (m >= 2) {
+            std::int64_t next_owned = owned[i];
+            for (std::size_t e = 0; e < m; ++e) {
+              const std::int32_t as = rg[(e + m - 1) % m], bs = rg[e], ps = static_cast<std::int32_t>(s);
+              const std::int32_t a = id_at(as), b = id_at(bs);
+              // The facet from its lowest generator, so that every cell
+              // holding it computes the same normal (facet_normal).
+              const std::int32_t lowest = std::min({p, a, b});
+              const std::int32_t f0 = lowest == p ? ps : (lowest == a ? as : bs);
+              const std::int32_t f1 = lowest == p ? as : (lowest == a ? bs : ps);
+              const std::int32_t f2 = lowest == p ? bs : (lowest == a ? ps : as);
+              double* un = &unit[3 * e];
+              all_known = unit_normal(point(f0), point(f1), point(f2), c.data(), un) && all_known;
+              std::int64_t v;
+              if (lowest == p) {
+                v = next_owned++;
+                std::int32_t* t = &out.triangles[3 * static_cast<std::size_t>(v)];
+                t[0] = p, t[1] = a, t[2] = b;
+                double* pos = &out.vertices[3 * static_cast<std::size_t>(v)];
+                for (int d = 0; d < 3; ++d) pos[d] = c[d] + R * un[d];
+              } else {
+                // The owner q = lowest: the facet is (a, b, p) in a's ring, (b, p, a) in b's.
+                const std::int32_t q = lowest;
+                const std::int32_t in = q == a ? bs : ps, outgoing = q == a ? ps : as;  // slots
+                const auto oring = ring(static_cast<std::size_t>(q == a ? as : bs));
+                const std::size_t om = oring.size();
+                v = -1;
+                std::int64_t num = owned[static_cast<std::size_t>(q)];
+                for (std::size_t f = 0; f < om; ++f) {
+                  const std::int32_t oa = oring[(f + om - 1) % om], ob = oring[f];
+                  if (oa == in && ob == outgoing) {
+                    v = num;
+                    break;
+                  }
+                  num += q < id_at(oa) && q < id_at(ob);
                 }
-                num += q < id_at(oa) && q < id_at(ob);
+                if (v < 0)
+                  throw std::logic_error("spherical voronoi: cell " + std::to_string(p) + "'s vertex with " + std::to_string(a) +
+                                         ", " + std::to_string(b) + " is not in cell " + std::to_string(q));
               }
-              if (v < 0)
-                throw std::logic_error("spherical voronoi: cell " + std::to_string(p) + "'s vertex with " + std::to_string(a) +
-                                       ", " + std::to_string(b) + " is not in cell " + std::to_string(q));
+              out.region_vertices[static_cast<std::size_t>(out.region_offsets[i]) + e] = static_cast<std::int32_t>(v);
             }
-            out.region_vertices[static_cast<std::size_t>(out.region_offsets[i]) + e] = static_cast<std::int32_t>(v);
           }
-        }
-        // Areas and centroids.
-        double dir[3] = {x[0] - c[0], x[1] - c[1], x[2] - c[2]};  // the centroid's direction
-        double omega = 0;
-        if (out.status[i] != SphereCellStatus::cell) {
-          omega = 0;
-        } else if (m == 0) {
-          omega = 4 * pi;
-        } else if (m == 1) {
-          const double* q = point(rg[0]);
-          for (int d = 0; d < 3; ++d) dir[d] = x[d] - q[d];
-          omega = 2 * pi;
-        } else {
-          auto U = [&](std::size_t k) { return &unit[3 * (k % m)]; };
-          // Vector area: edge k runs from vertex k to k+1 on the plane of
-          // rg[k], whose unit normal into the cell is (p - q) / |p - q|.
-          double vec[3] = {0, 0, 0};
-          for (std::size_t k = 0; k < m; ++k) {
-            const double* a = U(k);
-            const double* b = U(k + 1);
-            const double cr[3] = {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
-            const double theta = std::atan2(std::sqrt(cr[0] * cr[0] + cr[1] * cr[1] + cr[2] * cr[2]), a[0] * b[0] + a[1] * b[1] + a[2] * b[2]);
-            const double* q = point(rg[k]);
-            const double nq[3] = {x[0] - q[0], x[1] - q[1], x[2] - q[2]};
-            const double ln = norm3(nq);
-            for (int d = 0; d < 3; ++d) vec[d] += 0.5 * theta * nq[d] / ln;
-          }
-          for (int d = 0; d < 3; ++d) dir[d] = vec[d];
-          // A fan of triangles from p's direction (accurate to rounding on
-          // small cells) where p lies inside its cell, no edge is long and
-          // every vertex is known; else Gauss-Bonnet: 2 pi less the turns
-          // between the edges' planes, which needs no vertex (a lune's edges
-          // are half circles, a flat hull's cells reach from pole to pole, a
-          // facet of collinear points has no normal to compute).
-          const double xc[3] = {x[0] - c[0], x[1] - c[1], x[2] - c[2]};
-          const double pl = norm3(xc);
-          const double apex[3] = {xc[0] / pl, xc[1] / pl, xc[2] / pl};
-          bool fan = m >= 3 && all_known;
-          for (std::size_t k = 0; k < m && fan; ++k) {
-            const double* a = U(k);
-            const double* b = U(k + 1);
-            const double* q = point(rg[k]);
-            fan = a[0] * b[0] + a[1] * b[1] + a[2] * b[2] > -0.5 &&
-                  apex[0] * (x[0] - q[0]) + apex[1] * (x[1] - q[1]) + apex[2] * (x[2] - q[2]) > 0;
-          }
-          if (fan) {
+          // Areas and centroids.
+          double dir[3] = {x[0] - c[0], x[1] - c[1], x[2] - c[2]};  // the centroid's direction
+          double omega = 0;
+          if (out.status[i] != SphereCellStatus::cell) {
+            omega = 0;
+          } else if (m == 0) {
+            omega = 4 * pi;
+          } else if (m == 1) {
+            const double* q = point(rg[0]);
+            for (int d = 0; d < 3; ++d) dir[d] = x[d] - q[d];
+            omega = 2 * pi;
+          } else {
+            auto U = [&](std::size_t k) { return &unit[3 * (k % m)]; };
+            // Vector area: edge k runs from vertex k to k+1 on the plane of
+            // rg[k], whose unit normal into the cell is (p - q) / |p - q|.
+            double vec[3] = {0, 0, 0};
             for (std::size_t k = 0; k < m; ++k) {
               const double* a = U(k);
               const double* b = U(k + 1);
-              const double det = apex[0] * (a[1] * b[2] - a[2] * b[1]) + apex[1] * (a[2] * b[0] - a[0] * b[2]) +
-                                 apex[2] * (a[0] * b[1] - a[1] * b[0]);
-              const double den = 1 + (apex[0] * a[0] + apex[1] * a[1] + apex[2] * a[2]) + (a[0] * b[0] + a[1] * b[1] + a[2] * b[2]) +
-                                 (b[0] * apex[0] + b[1] * apex[1] + b[2] * apex[2]);
-              omega += 2 * std::atan2(det, den);
+              const double cr[3] = {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+              const double theta = std::atan2(std::sqrt(cr[0] * cr[0] + cr[1] * cr[1] + cr[2] * cr[2]), a[0] * b[0] + a[1] * b[1] + a[2] * b[2]);
+              const double* q = point(rg[k]);
+              const double nq[3] = {x[0] - q[0], x[1] - q[1], x[2] - q[2]};
+              const double ln = norm3(nq);
+              for (int d = 0; d < 3; ++d) vec[d] += 0.5 * theta * nq[d] / ln;
             }
-          } else {
-            omega = 2 * pi;
-            for (std::size_t k = 0; k < m; ++k) {
-              const double* q0 = point(rg[k]);
-              const double* q1 = point(rg[(k + 1) % m]);
-              const double n0[3] = {x[0] - q0[0], x[1] - q0[1], x[2] - q0[2]};
-              const double n1[3] = {x[0] - q1[0], x[1] - q1[1], x[2] - q1[2]};
-              const double cr[3] = {n0[1] * n1[2] - n0[2] * n1[1], n0[2] * n1[0] - n0[0] * n1[2], n0[0] * n1[1] - n0[1] * n1[0]};
-              omega -= std::atan2(std::hypot(cr[0], cr[1], cr[2]), n0[0] * n1[0] + n0[1] * n1[1] + n0[2] * n1[2]);
+            for (int d = 0; d < 3; ++d) dir[d] = vec[d];
+            // A fan of triangles from p's direction (accurate to rounding on
+            // small cells) where p lies inside its cell, no edge is long and
+            // every vertex is known; else Gauss-Bonnet: 2 pi less the turns
+            // between the edges' planes, which needs no vertex (a lune's edges
+            // are half circles, a flat hull's cells reach from pole to pole, a
+            // facet of collinear points has no normal to compute).
+            const double xc[3] = {x[0] - c[0], x[1] - c[1], x[2] - c[2]};
+            const double pl = norm3(xc);
+            const double apex[3] = {xc[0] / pl, xc[1] / pl, xc[2] / pl};
+            bool fan = m >= 3 && all_known;
+            for (std::size_t k = 0; k < m && fan; ++k) {
+              const double* a = U(k);
+              const double* b = U(k + 1);
+              const double* q = point(rg[k]);
+              fan = a[0] * b[0] + a[1] * b[1] + a[2] * b[2] > -0.5 &&
+                    apex[0] * (x[0] - q[0]) + apex[1] * (x[1] - q[1]) + apex[2] * (x[2] - q[2]) > 0;
+            }
+            if (fan) {
+              for (std::size_t k = 0; k < m; ++k) {
+                const double* a = U(k);
+                const double* b = U(k + 1);
+                const double det = apex[0] * (a[1] * b[2] - a[2] * b[1]) + apex[1] * (a[2] * b[0] - a[0] * b[2]) +
+                                   apex[2] * (a[0] * b[1] - a[1] * b[0]);
+                const double den = 1 + (apex[0] * a[0] + apex[1] * a[1] + apex[2] * a[2]) + (a[0] * b[0] + a[1] * b[1] + a[2] * b[2]) +
+                                   (b[0] * apex[0] + b[1] * apex[1] + b[2] * apex[2]);
+                omega += 2 * std::atan2(det, den);
+              }
+            } else {
+              omega = 2 * pi;
+              for (std::size_t k = 0; k < m; ++k) {
+                const double* q0 = point(rg[k]);
+                const double* q1 = point(rg[(k + 1) % m]);
+                const double n0[3] = {x[0] - q0[0], x[1] - q0[1], x[2] - q0[2]};
+                const double n1[3] = {x[0] - q1[0], x[1] - q1[1], x[2] - q1[2]};
+                const double cr[3] = {n0[1] * n1[2] - n0[2] * n1[1], n0[2] * n1[0] - n0[0] * n1[2], n0[0] * n1[1] - n0[1] * n1[0]};
+                omega -= std::atan2(std::hypot(cr[0], cr[1], cr[2]), n0[0] * n1[0] + n0[1] * n1[1] + n0[2] * n1[2]);
+              }
             }
           }
+          out.areas[i] = R2 * omega;
+          double ld = norm3(dir);
+          if (!(ld > 0)) dir[0] = x[0] - c[0], dir[1] = x[1] - c[1], dir[2] = x[2] - c[2], ld = norm3(dir);
+          for (int d = 0; d < 3; ++d) out.centroids[3 * i + d] = c[d] + R * dir[d] / ld;
         }
-        out.areas[i] = R2 * omega;
-        double ld = norm3(dir);
-        if (!(ld > 0)) dir[0] = x[0] - c[0], dir[1] = x[1] - c[1], dir[2] = x[2] - c[2], ld = norm3(dir);
-        for (int d = 0; d < 3; ++d) out.centroids[3 * i + d] = c[d] + R * dir[d] / ld;
-      }
+      });
     });
     front::CompensatedSum total;
     for (double a : out.areas) total.add(a);
