@@ -33,6 +33,7 @@
 #include <tbb/parallel_for.h>
 
 #include "compensated_sum.hpp"
+#include "tessera/finite_points.hpp"
 #include "../progress_chunks.hpp"
 #include "tessera/cells.hpp"
 #include "tessera/engine/thread_arena.hpp"
@@ -46,7 +47,7 @@ using Locator = kernels::BinLocator<3>;
 
 std::string num(double x) {
   char buf[64];
-  std::snprintf(buf, sizeof buf, "%.17g", x);
+  std::snprintf(buf, sizeof buf, "%.10g", x);
   return buf;
 }
 
@@ -58,9 +59,17 @@ double norm3(const double* v) {
   return s > 0x1p-960 && s < 0x1p960 ? std::sqrt(s) : std::hypot(v[0], v[1], v[2]);
 }
 
-// The sphere's radius and how far the points stray from it (InputError for
-// what the header names).
-void fit_sphere(std::span<const double> pts, const SphericalVoronoiOptions& o, SphericalVoronoi& out) {
+// What one pass over the points gives: the largest distance from the centre
+// and the points' bounding box.
+struct Extent {
+  double r_max = 0;
+  std::array<double, 3> lo{}, hi{};
+};
+
+// The sphere's radius and how far the points stray from it, in one pass
+// (the deviation is the larger of the nearest's and the farthest's);
+// InputError for what the header names.
+Extent fit_sphere(std::span<const double> pts, const SphericalVoronoiOptions& o, SphericalVoronoi& out) {
   const std::size_t n = pts.size() / 3;
   const auto& c = o.center;
   for (int d = 0; d < 3; ++d)
@@ -68,35 +77,38 @@ void fit_sphere(std::span<const double> pts, const SphericalVoronoiOptions& o, S
   if (!(o.tolerance >= 0)) throw InputError("spherical voronoi: the tolerance must be >= 0, not " + num(o.tolerance));
   if (!(o.radius >= 0) || !std::isfinite(o.radius))
     throw InputError("spherical voronoi: the radius must be positive and finite, not " + num(o.radius));
+  Extent e;
+  e.lo = e.hi = {pts[0], pts[1], pts[2]};
+  double r_min = std::numeric_limits<double>::infinity();
+  std::size_t nearest = 0, farthest = 0;
   front::CompensatedSum sum;
   for (std::size_t i = 0; i < n; ++i) {
+    if (!finite_point(pts, i, 3))
+      throw InputError("spherical voronoi: point " + std::to_string(i) + " has a non-finite coordinate");
     const double* p = &pts[3 * i];
-    for (int d = 0; d < 3; ++d)
-      if (!std::isfinite(p[d]))
-        throw InputError("spherical voronoi: point " + std::to_string(i) + " has a non-finite coordinate");
     const double pc[3] = {p[0] - c[0], p[1] - c[1], p[2] - c[2]};
     const double r = norm3(pc);
     if (!(r > 0)) throw InputError("spherical voronoi: point " + std::to_string(i) + " lies at the centre");
     sum.add(r);
+    if (r < r_min) r_min = r, nearest = i;
+    if (r > e.r_max) e.r_max = r, farthest = i;
+    for (int d = 0; d < 3; ++d) {
+      e.lo[d] = std::min(e.lo[d], p[d]);
+      e.hi[d] = std::max(e.hi[d], p[d]);
+    }
   }
   out.radius = o.radius > 0 ? o.radius : sum.value() / static_cast<double>(n);
   if (!(out.radius > 0) || !std::isfinite(out.radius))
     throw InputError("spherical voronoi: the points' mean distance from the centre is not a usable radius");
-  std::size_t worst = 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    const double* p = &pts[3 * i];
-    const double pc[3] = {p[0] - c[0], p[1] - c[1], p[2] - c[2]};
-    const double dev = std::fabs(norm3(pc) - out.radius) / out.radius;
-    if (dev > out.max_deviation) {
-      out.max_deviation = dev;
-      worst = i;
-    }
-  }
+  const double below = (out.radius - r_min) / out.radius, above = (e.r_max - out.radius) / out.radius;
+  out.max_deviation = std::max({below, above, 0.0});
+  const std::size_t worst = above >= below ? farthest : nearest;
   if (out.max_deviation > o.tolerance)
     throw InputError("spherical voronoi: point " + std::to_string(worst) + " lies " +
                      num(out.max_deviation * out.radius) + " off the sphere of radius " + num(out.radius) +
                      " (relative " + num(out.max_deviation) + ", tolerance " + num(o.tolerance) +
                      "); give the sphere's centre and radius, or a larger tolerance");
+  return e;
 }
 
 // Bins for points on a surface: a volume's default (a few points per bin)
@@ -112,34 +124,6 @@ double surface_bin_points(std::size_t n) {
   return dn / bins;
 }
 
-// The outward normal (y - x) x (z - x) of facet (x, y, z), computed from
-// the corner with the largest angle (opposite the longest edge): the normal
-// is the same from every corner of the cyclic order, but its rounding error
-// relative to its length is ~u / sin(angle at the corner), and a facet of
-// two points 1e-13 apart and a third far away (a pole given once per
-// longitude) has two corners of angle ~1e-16. Returns its length, and in
-// `err` a bound on the error of u (each difference and product rounded).
-double facet_normal(const double* x, const double* y, const double* z, double* u, double& err) {
-  double e[3][3];  // e[0] = y - x, e[1] = z - y, e[2] = x - z
-  for (int d = 0; d < 3; ++d) {
-    e[0][d] = y[d] - x[d];
-    e[1][d] = z[d] - y[d];
-    e[2][d] = x[d] - z[d];
-  }
-  double len2[3];
-  for (int k = 0; k < 3; ++k) len2[k] = e[k][0] * e[k][0] + e[k][1] * e[k][1] + e[k][2] * e[k][2];
-  // The longest edge k is opposite corner k + 2 (edge 1, y-z, is opposite
-  // x); the normal is (edge after the corner) x -(edge before it).
-  const int k = static_cast<int>(std::max_element(len2, len2 + 3) - len2);
-  const double* f = e[(k + 2) % 3];  // leaves the corner
-  const double* g = e[(k + 1) % 3];  // arrives at the corner
-  u[0] = -(f[1] * g[2] - f[2] * g[1]);
-  u[1] = -(f[2] * g[0] - f[0] * g[2]);
-  u[2] = -(f[0] * g[1] - f[1] * g[0]);
-  err = 8 * std::numeric_limits<double>::epsilon() * std::sqrt(len2[(k + 2) % 3] * len2[(k + 1) % 3]);
-  return norm3(u);
-}
-
 // The unit outward normal of facet (x, y, z), given from its lowest id
 // (every cell holding the facet asks the same question and gets the same
 // bits). A facet of (nearly) collinear points, decided by the perturbation,
@@ -148,8 +132,9 @@ double facet_normal(const double* x, const double* y, const double* z, double* u
 // the normal is known to 1e-6 (a cell with one that is not is measured
 // without its vertices: Gauss-Bonnet).
 bool unit_normal(const double* x, const double* y, const double* z, const double* c, double* un) {
-  double u[3], err = 0;
-  double len = facet_normal(x, y, z, u, err);
+  double u[3];
+  const double err = kernels::widest_corner_normal(x, y, z, u);
+  double len = norm3(u);
   const bool known = len > 1e6 * err && std::isfinite(len);
   if (!(len > 0) || !std::isfinite(len)) {
     for (int d = 0; d < 3; ++d) u[d] = x[d] + y[d] + z[d] - 3 * c[d];
@@ -158,6 +143,71 @@ bool unit_normal(const double* x, const double* y, const double* z, const double
   }
   for (int d = 0; d < 3; ++d) un[d] = u[d] / len;
   return known;
+}
+
+// A polygon cell's solid angle, and in `dir` its vector area (the
+// centroid's direction): cell of the point at x, ring `rg` of slots (point()
+// gives their coordinates), vertex k's unit direction at unit + 3k.
+//  * The vector area int x dA = 1/2 sum_edges theta_e n_e (Stokes on the unit
+//    sphere): edge k runs from vertex k to k+1 on the plane of rg[k], whose
+//    unit normal into the cell is (x - q) / |x - q|.
+//  * The solid angle as a fan of Van Oosterom-Strackee triangles from x's
+//    direction (accurate to rounding on small cells) where x lies inside its
+//    cell, no edge is long and every vertex is known (`all_known`); else by
+//    Gauss-Bonnet, 2 pi less the turns between the edges' planes, which needs
+//    no vertex (a lune's edges are half circles, a flat hull's cells reach
+//    from pole to pole, a facet of collinear points has no normal).
+template <class Point>
+double polygon_measure(const double* x, const double* c, std::span<const std::int32_t> rg, const double* unit,
+                       bool all_known, Point&& point, double* dir) {
+  constexpr double pi = std::numbers::pi;
+  const std::size_t m = rg.size();
+  auto U = [&](std::size_t k) { return unit + 3 * (k % m); };
+  auto dot = [](const double* a, const double* b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; };
+  auto cross = [](const double* a, const double* b, double* out) {
+    out[0] = a[1] * b[2] - a[2] * b[1];
+    out[1] = a[2] * b[0] - a[0] * b[2];
+    out[2] = a[0] * b[1] - a[1] * b[0];
+  };
+  for (int d = 0; d < 3; ++d) dir[d] = 0;
+  for (std::size_t k = 0; k < m; ++k) {
+    double cr[3];
+    cross(U(k), U(k + 1), cr);
+    const double theta = std::atan2(std::sqrt(dot(cr, cr)), dot(U(k), U(k + 1)));
+    const double* q = point(rg[k]);
+    const double nq[3] = {x[0] - q[0], x[1] - q[1], x[2] - q[2]};
+    const double ln = norm3(nq);
+    for (int d = 0; d < 3; ++d) dir[d] += 0.5 * theta * nq[d] / ln;
+  }
+  const double xc[3] = {x[0] - c[0], x[1] - c[1], x[2] - c[2]};
+  const double pl = norm3(xc);
+  const double apex[3] = {xc[0] / pl, xc[1] / pl, xc[2] / pl};
+  bool fan = m >= 3 && all_known;
+  for (std::size_t k = 0; k < m && fan; ++k) {
+    const double* q = point(rg[k]);
+    const double nq[3] = {x[0] - q[0], x[1] - q[1], x[2] - q[2]};
+    fan = dot(U(k), U(k + 1)) > -0.5 && dot(apex, nq) > 0;
+  }
+  double omega = 0;
+  if (fan) {
+    for (std::size_t k = 0; k < m; ++k) {
+      double cr[3];
+      cross(U(k), U(k + 1), cr);
+      omega += 2 * std::atan2(dot(apex, cr), 1 + dot(apex, U(k)) + dot(U(k), U(k + 1)) + dot(U(k + 1), apex));
+    }
+    return omega;
+  }
+  omega = 2 * pi;
+  for (std::size_t k = 0; k < m; ++k) {
+    const double* q0 = point(rg[k]);
+    const double* q1 = point(rg[(k + 1) % m]);
+    const double n0[3] = {x[0] - q0[0], x[1] - q0[1], x[2] - q0[2]};
+    const double n1[3] = {x[0] - q1[0], x[1] - q1[1], x[2] - q1[2]};
+    double cr[3];
+    cross(n0, n1, cr);
+    omega -= std::atan2(std::hypot(cr[0], cr[1], cr[2]), dot(n0, n1));
+  }
+  return omega;
 }
 
 struct Workspace {
@@ -211,19 +261,10 @@ SphericalVoronoi spherical_voronoi(std::span<const double> pts, const SphericalV
   SphericalVoronoi out;
   out.center = o.center;
   out.n_points = n;
-  fit_sphere(pts, o, out);
+  const Extent extent = fit_sphere(pts, o, out);
   const auto& c = o.center;
-  double r_max = 0;
-  std::array<double, 3> lo{pts[0], pts[1], pts[2]}, hi = lo;
-  for (std::size_t i = 0; i < n; ++i) {
-    const double* p = &pts[3 * i];
-    const double pc[3] = {p[0] - c[0], p[1] - c[1], p[2] - c[2]};
-    r_max = std::max(r_max, norm3(pc));
-    for (int d = 0; d < 3; ++d) {
-      lo[d] = std::min(lo[d], p[d]);
-      hi[d] = std::max(hi[d], p[d]);
-    }
-  }
+  double r_max = extent.r_max;
+  std::array<double, 3> lo = extent.lo, hi = extent.hi;
   r_max *= 1 + 1e-12;
   // The grid needs a box of some extent along every axis (one point, a ring
   // in a coordinate plane); the padding is nothing beside the sphere.
@@ -447,7 +488,7 @@ SphericalVoronoi spherical_voronoi(std::span<const double> pts, const SphericalV
               const std::int32_t as = rg[(e + m - 1) % m], bs = rg[e], ps = static_cast<std::int32_t>(s);
               const std::int32_t a = id_at(as), b = id_at(bs);
               // The facet from its lowest generator, so that every cell
-              // holding it computes the same normal (facet_normal).
+              // holding it computes the same normal (unit_normal).
               const std::int32_t lowest = std::min({p, a, b});
               const std::int32_t f0 = lowest == p ? ps : (lowest == a ? as : bs);
               const std::int32_t f1 = lowest == p ? as : (lowest == a ? bs : ps);
@@ -496,59 +537,7 @@ SphericalVoronoi spherical_voronoi(std::span<const double> pts, const SphericalV
             for (int d = 0; d < 3; ++d) dir[d] = x[d] - q[d];
             omega = 2 * pi;
           } else {
-            auto U = [&](std::size_t k) { return &unit[3 * (k % m)]; };
-            // Vector area: edge k runs from vertex k to k+1 on the plane of
-            // rg[k], whose unit normal into the cell is (p - q) / |p - q|.
-            double vec[3] = {0, 0, 0};
-            for (std::size_t k = 0; k < m; ++k) {
-              const double* a = U(k);
-              const double* b = U(k + 1);
-              const double cr[3] = {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
-              const double theta = std::atan2(std::sqrt(cr[0] * cr[0] + cr[1] * cr[1] + cr[2] * cr[2]), a[0] * b[0] + a[1] * b[1] + a[2] * b[2]);
-              const double* q = point(rg[k]);
-              const double nq[3] = {x[0] - q[0], x[1] - q[1], x[2] - q[2]};
-              const double ln = norm3(nq);
-              for (int d = 0; d < 3; ++d) vec[d] += 0.5 * theta * nq[d] / ln;
-            }
-            for (int d = 0; d < 3; ++d) dir[d] = vec[d];
-            // A fan of triangles from p's direction (accurate to rounding on
-            // small cells) where p lies inside its cell, no edge is long and
-            // every vertex is known; else Gauss-Bonnet: 2 pi less the turns
-            // between the edges' planes, which needs no vertex (a lune's edges
-            // are half circles, a flat hull's cells reach from pole to pole, a
-            // facet of collinear points has no normal to compute).
-            const double xc[3] = {x[0] - c[0], x[1] - c[1], x[2] - c[2]};
-            const double pl = norm3(xc);
-            const double apex[3] = {xc[0] / pl, xc[1] / pl, xc[2] / pl};
-            bool fan = m >= 3 && all_known;
-            for (std::size_t k = 0; k < m && fan; ++k) {
-              const double* a = U(k);
-              const double* b = U(k + 1);
-              const double* q = point(rg[k]);
-              fan = a[0] * b[0] + a[1] * b[1] + a[2] * b[2] > -0.5 &&
-                    apex[0] * (x[0] - q[0]) + apex[1] * (x[1] - q[1]) + apex[2] * (x[2] - q[2]) > 0;
-            }
-            if (fan) {
-              for (std::size_t k = 0; k < m; ++k) {
-                const double* a = U(k);
-                const double* b = U(k + 1);
-                const double det = apex[0] * (a[1] * b[2] - a[2] * b[1]) + apex[1] * (a[2] * b[0] - a[0] * b[2]) +
-                                   apex[2] * (a[0] * b[1] - a[1] * b[0]);
-                const double den = 1 + (apex[0] * a[0] + apex[1] * a[1] + apex[2] * a[2]) + (a[0] * b[0] + a[1] * b[1] + a[2] * b[2]) +
-                                   (b[0] * apex[0] + b[1] * apex[1] + b[2] * apex[2]);
-                omega += 2 * std::atan2(det, den);
-              }
-            } else {
-              omega = 2 * pi;
-              for (std::size_t k = 0; k < m; ++k) {
-                const double* q0 = point(rg[k]);
-                const double* q1 = point(rg[(k + 1) % m]);
-                const double n0[3] = {x[0] - q0[0], x[1] - q0[1], x[2] - q0[2]};
-                const double n1[3] = {x[0] - q1[0], x[1] - q1[1], x[2] - q1[2]};
-                const double cr[3] = {n0[1] * n1[2] - n0[2] * n1[1], n0[2] * n1[0] - n0[0] * n1[2], n0[0] * n1[1] - n0[1] * n1[0]};
-                omega -= std::atan2(std::hypot(cr[0], cr[1], cr[2]), n0[0] * n1[0] + n0[1] * n1[1] + n0[2] * n1[2]);
-              }
-            }
+            omega = polygon_measure(x, c.data(), rg, unit.data(), all_known, point, dir);
           }
           out.areas[i] = R2 * omega;
           double ld = norm3(dir);

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "io_detail.hpp"
+#include "ordered_chunks.hpp"
 #include "tessera/io/atomic_file.hpp"
 #include "tessera/io/npy.hpp"
 #include "tessera/io/vtk_polydata.hpp"
@@ -89,20 +90,25 @@ void write_spherical_table(const std::string& path, const SphericalVoronoi& sv) 
   }
   write_file_atomic(path, [&](std::ostream& os) {
     os << "id,area,cx,cy,cz,edges,neighbors\n";
-    char buf[cols * 26];
-    for (std::size_t i = 0; i < sv.n_points; ++i) {
-      if (!has_cell(sv, i)) continue;
-      double r[cols];
-      row(i, r);
-      char* p = buf;
-      for (std::size_t k = 0; k < cols; ++k) {
-        // Integers (id, counts) as integers, the measures in their shortest round-trip form.
-        p = (k == 0 || k >= 5) ? std::to_chars(p, buf + sizeof buf, static_cast<std::int64_t>(r[k])).ptr
-                               : std::to_chars(p, buf + sizeof buf, r[k]).ptr;
-        *p++ = k + 1 < cols ? ',' : '\n';
+    // Rows formatted by chunks on the worker threads, written in order (as
+    // the cells' table, tables.cpp).
+    constexpr std::size_t kRowsPerChunk = 8192, kRowBytes = cols * 26;
+    detail::write_ordered_chunks(sv.n_points, kRowsPerChunk, [&](std::size_t i0, std::size_t i1, std::vector<char>& out) {
+      out.resize((i1 - i0) * kRowBytes);
+      char* p = out.data();
+      char* const end = p + out.size();
+      for (std::size_t i = i0; i < i1; ++i) {
+        if (!has_cell(sv, i)) continue;
+        double r[cols];
+        row(i, r);
+        for (std::size_t k = 0; k < cols; ++k) {
+          // Integers (id, counts) as integers, the measures in their shortest round-trip form.
+          p = (k == 0 || k >= 5) ? std::to_chars(p, end, static_cast<std::int64_t>(r[k])).ptr : std::to_chars(p, end, r[k]).ptr;
+          *p++ = k + 1 < cols ? ',' : '\n';
+        }
       }
-      os.write(buf, p - buf);
-    }
+      out.resize(static_cast<std::size_t>(p - out.data()));
+    }, [&](const char* data, std::size_t size) { os.write(data, static_cast<std::streamsize>(size)); });
   });
 }
 

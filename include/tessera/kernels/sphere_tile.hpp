@@ -45,6 +45,33 @@
 
 namespace tessera::kernels {
 
+/// The outward normal (y - x) x (z - x) of facet (x, y, z), computed from
+/// the corner with the largest angle (opposite the longest edge): the normal
+/// is the same vector from every corner of the cyclic order, but its
+/// rounding error relative to its length is ~u / sin(the corner's angle),
+/// and a facet of two points 1e-13 apart and a third far away (a pole given
+/// once per longitude) has two corners of angle ~1e-16. Returns a bound on
+/// the error of each component (the differences and products rounded).
+inline double widest_corner_normal(const double* x, const double* y, const double* z, double* u) {
+  double e[3][3];  // e[0] = y - x, e[1] = z - y, e[2] = x - z
+  for (int d = 0; d < 3; ++d) {
+    e[0][d] = y[d] - x[d];
+    e[1][d] = z[d] - y[d];
+    e[2][d] = x[d] - z[d];
+  }
+  double len2[3];
+  for (int k = 0; k < 3; ++k) len2[k] = e[k][0] * e[k][0] + e[k][1] * e[k][1] + e[k][2] * e[k][2];
+  // The longest edge k is opposite corner k + 2 (edge 1, y-z, is opposite
+  // x); the normal is (edge leaving the corner) x -(edge arriving at it).
+  const int k = static_cast<int>(std::max_element(len2, len2 + 3) - len2);
+  const double* f = e[(k + 2) % 3];
+  const double* g = e[(k + 1) % 3];
+  u[0] = -(f[1] * g[2] - f[2] * g[1]);
+  u[1] = -(f[2] * g[0] - f[0] * g[2]);
+  u[2] = -(f[0] * g[1] - f[1] * g[0]);
+  return 16 * filter::u * std::sqrt(len2[(k + 2) % 3] * len2[(k + 1) % 3]);
+}
+
 class SphereTile {
  public:
   enum class State : std::uint8_t { sphere, hemisphere, polygon, empty };
@@ -169,20 +196,13 @@ class SphereTile {
     bool clipped;
   };
 
+  // Vertex (p, a, b): its normal (a - p) x (b - p) from p's corner, and the
+  // permanent of each component for the filter.
   void make_vertex(Vertex& v, const double* a, const double* b) const {
-    make_normal(v, p_, a, b);
-    v.clipped = false;
-    v.rho2 = -1;  // not yet known (security2 computes it when asked)
-    v.a = a;
-    v.b = b;
-  }
-
-  // (a - o) x (b - o) and its permanent into v.u, v.perm.
-  static void make_normal(Vertex& v, const double* o, const double* a, const double* b) {
     double da[3], db[3];
     for (int d = 0; d < 3; ++d) {
-      da[d] = a[d] - o[d];
-      db[d] = b[d] - o[d];
+      da[d] = a[d] - p_[d];
+      db[d] = b[d] - p_[d];
     }
     v.u[0] = da[1] * db[2] - da[2] * db[1];
     v.u[1] = da[2] * db[0] - da[0] * db[2];
@@ -190,6 +210,10 @@ class SphereTile {
     v.perm[0] = std::fabs(da[1] * db[2]) + std::fabs(da[2] * db[1]);
     v.perm[1] = std::fabs(da[2] * db[0]) + std::fabs(da[0] * db[2]);
     v.perm[2] = std::fabs(da[0] * db[1]) + std::fabs(da[1] * db[0]);
+    v.clipped = false;
+    v.rho2 = -1;  // not yet known (security2 computes it when asked)
+    v.a = a;
+    v.b = b;
   }
 
   // Does s remove vertex k: orientation(p, edge_k, edge_k+1, s) > 0, which
@@ -214,28 +238,15 @@ class SphereTile {
   // nearly collinear points) makes it infinite.
   double vertex_security2(const Vertex& v) const {
     const double* u = v.u;
-    const double* perm = v.perm;
     double len2 = u[0] * u[0] + u[1] * u[1] + u[2] * u[2];
-    double err2 = 64 * filter::u * filter::u * (perm[0] * perm[0] + perm[1] * perm[1] + perm[2] * perm[2]);
-    Vertex best;
+    double err2 = 64 * filter::u * filter::u * (v.perm[0] * v.perm[0] + v.perm[1] * v.perm[1] + v.perm[2] * v.perm[2]);
+    double wide[3];
     if (!(len2 > 1e6 * err2)) {
-      // The corner at p is too thin (two points 1e-13 apart and a third
-      // far off: a pole given once per longitude): the same normal from
-      // the facet's widest corner, opposite its longest edge.
-      const double* q[3] = {p_, v.a, v.b};
-      double e2[3];
-      for (int k = 0; k < 3; ++k) {
-        const double* x = q[k];
-        const double* y = q[(k + 1) % 3];
-        e2[k] = (y[0] - x[0]) * (y[0] - x[0]) + (y[1] - x[1]) * (y[1] - x[1]) + (y[2] - x[2]) * (y[2] - x[2]);
-      }
-      const int k = static_cast<int>(std::max_element(e2, e2 + 3) - e2);  // edge q[k] -> q[k+1]
-      const double* corner = q[(k + 2) % 3];
-      make_normal(best, corner, q[k], q[(k + 1) % 3]);  // cyclic: (corner, q[k], q[k+1])
-      u = best.u;
-      perm = best.perm;
+      // The corner at p is too thin: the same normal from the widest one.
+      const double err = widest_corner_normal(p_, v.a, v.b, wide);
+      u = wide;
       len2 = u[0] * u[0] + u[1] * u[1] + u[2] * u[2];
-      err2 = 64 * filter::u * filter::u * (perm[0] * perm[0] + perm[1] * perm[1] + perm[2] * perm[2]);
+      err2 = err * err;
     }
     if (!(len2 > 1e6 * err2) || !(len2 > 0) || !(len2 < std::numeric_limits<double>::infinity()))
       return std::numeric_limits<double>::infinity();
